@@ -1,0 +1,184 @@
+#pragma once
+
+// RAII over the Cyclone DDS C API. Every failed call throws DdsError naming the call.
+
+#include <dds/dds.h>
+
+#include <chrono>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/transport/errors.hpp"
+#include "fleet/transport/traits.hpp"
+
+namespace fleet::transport {
+
+/// The loopback-only configuration used when CYCLONEDDS_URI is unset: interface lo, multicast
+/// off, unicast discovery with peer 127.0.0.1, room for 200 participants on the host.
+const char* loopbackConfig();
+
+/// Domain id from FLEET_DDS_DOMAIN (0..229), else 0. Tests set it to keep parallel runs apart.
+int domainFromEnvironment();
+
+/// An owned DDS entity handle; deleting it deletes its children.
+class Entity {
+ public:
+  Entity() = default;
+  explicit Entity(dds_entity_t h) : h_(h) {}
+  Entity(const Entity&) = delete;
+  Entity& operator=(const Entity&) = delete;
+  Entity(Entity&& o) noexcept : h_(o.h_) { o.h_ = 0; }
+  Entity& operator=(Entity&& o) noexcept;
+  ~Entity();
+  [[nodiscard]] dds_entity_t handle() const { return h_; }
+
+ private:
+  dds_entity_t h_ = 0;
+};
+
+class Participant {
+ public:
+  /// Joins `domain`; when CYCLONEDDS_URI is unset the domain is first created with loopbackConfig().
+  explicit Participant(int domain = domainFromEnvironment());
+  [[nodiscard]] dds_entity_t handle() const { return e_.handle(); }
+  [[nodiscard]] int domain() const { return domain_; }
+
+ private:
+  int domain_;
+  Entity e_;
+};
+
+namespace detail {
+dds_entity_t createTopic(const Participant& p, const dds_topic_descriptor_t* desc, const std::string& name);
+dds_entity_t createWriter(const Participant& p, dds_entity_t topic, const QosProfile& q);
+dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q);
+std::uint32_t matched(dds_entity_t e, bool publication);
+}  // namespace detail
+
+template <class T>
+class Writer {
+ public:
+  using Tr = Traits<T>;
+  explicit Writer(const Participant& p, std::optional<QosProfile> q = std::nullopt,
+                  const std::string& topic = Tr::kTopic)
+      : topic_(detail::createTopic(p, Tr::descriptor(), topic)),
+        w_(detail::createWriter(p, topic_, q.value_or(Tr::qos()))) {}
+
+  /// Copies `m` into a C sample and writes it. Throws MessageError (bounds) or DdsError.
+  void write(const T& m) {
+    typename Tr::C c{};
+    arena_.clear();
+    Tr::toC(m, c, arena_);
+    check(dds_write(w_, &c), "dds_write");
+  }
+  /// Disposes the instance with m's key (readers see it not-alive).
+  void dispose(const T& m) {
+    typename Tr::C c{};
+    arena_.clear();
+    Tr::toC(m, c, arena_);
+    check(dds_dispose(w_, &c), "dds_dispose");
+  }
+  [[nodiscard]] std::uint32_t matchedReaders() const { return detail::matched(w_, true); }
+  [[nodiscard]] dds_entity_t handle() const { return w_; }
+
+ private:
+  dds_entity_t topic_;
+  dds_entity_t w_;  // children of the participant: deleted with it
+  Arena arena_;
+};
+
+template <class T>
+class Reader {
+ public:
+  using Tr = Traits<T>;
+  explicit Reader(const Participant& p, std::optional<QosProfile> q = std::nullopt,
+                  const std::string& topic = Tr::kTopic)
+      : topic_(detail::createTopic(p, Tr::descriptor(), topic)),
+        r_(detail::createReader(p, topic_, q.value_or(Tr::qos()))) {}
+
+  /// Takes every available sample (removing it from the reader). Loans are returned before return.
+  std::vector<T> take(std::size_t max = 1u << 20) { return collect(max, true); }
+  /// Reads without removing: for keep-last-1 "latest value" topics.
+  std::vector<T> read(std::size_t max = 1u << 20) { return collect(max, false); }
+  /// Calls f for each sample taken; returns how many.
+  std::size_t takeEach(const std::function<void(const T&)>& f, std::size_t max = 1u << 20) {
+    auto v = take(max);
+    for (const auto& m : v) {
+      f(m);
+    }
+    return v.size();
+  }
+  /// Blocks until data is available or the timeout passes; true when data is there.
+  bool waitForData(std::chrono::milliseconds timeout);
+  [[nodiscard]] std::uint32_t matchedWriters() const { return detail::matched(r_, false); }
+  [[nodiscard]] dds_entity_t handle() const { return r_; }
+
+ private:
+  std::vector<T> collect(std::size_t max, bool takeIt) {
+    constexpr std::size_t kBatch = 64;
+    std::vector<T> out;
+    while (out.size() < max) {
+      void* samples[kBatch] = {nullptr};
+      dds_sample_info_t infos[kBatch];
+      const std::size_t want = std::min(kBatch, max - out.size());
+      const int n = takeIt ? dds_take(r_, samples, infos, want, static_cast<std::uint32_t>(want))
+                           : dds_read(r_, samples, infos, want, static_cast<std::uint32_t>(want));
+      check(n, takeIt ? "dds_take" : "dds_read");
+      for (int i = 0; i < n; ++i) {
+        if (infos[i].valid_data) {
+          out.push_back(Tr::fromC(*static_cast<const typename Tr::C*>(samples[i])));
+        }
+      }
+      if (n > 0) {
+        check(dds_return_loan(r_, samples, n), "dds_return_loan");
+      }
+      if (static_cast<std::size_t>(n) < want || !takeIt) {
+        break;
+      }
+    }
+    return out;
+  }
+
+  dds_entity_t topic_;
+  dds_entity_t r_;
+  Entity waitset_;
+};
+
+/// Waits on several readers at once; wake() interrupts a wait from another thread (shutdown).
+class WaitSet {
+ public:
+  explicit WaitSet(const Participant& p);
+  template <class T>
+  void attach(const Reader<T>& r) {
+    attachReader(r.handle());
+  }
+  /// Returns the number of triggered conditions (0 on timeout).
+  int wait(std::chrono::milliseconds timeout);
+  void wake();
+
+ private:
+  void attachReader(dds_entity_t reader);
+  dds_entity_t ws_;
+  dds_entity_t guard_;
+  std::vector<dds_entity_t> conditions_;
+};
+
+template <class T>
+bool Reader<T>::waitForData(std::chrono::milliseconds timeout) {
+  if (waitset_.handle() == 0) {
+    const dds_entity_t ws = check(dds_create_waitset(dds_get_participant(r_)), "dds_create_waitset");
+    waitset_ = Entity(ws);
+    const dds_entity_t rc = check(
+        dds_create_readcondition(r_, DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ANY_INSTANCE_STATE),
+        "dds_create_readcondition");
+    check(dds_waitset_attach(ws, rc, 0), "dds_waitset_attach");
+  }
+  const int n =
+      dds_waitset_wait(waitset_.handle(), nullptr, 0, DDS_MSECS(static_cast<std::int64_t>(timeout.count())));
+  check(n, "dds_waitset_wait");
+  return n > 0;
+}
+
+}  // namespace fleet::transport

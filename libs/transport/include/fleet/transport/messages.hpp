@@ -1,0 +1,240 @@
+#pragma once
+
+// C++ forms of the DDS types in idl/fleet.idl. Services work with these; the transport layer copies
+// them to and from the generated C structs. Field meanings and units: docs/messages.md.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fleet/core/pose2.hpp"
+
+namespace fleet::msg {
+
+enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
+enum class TaskState : std::uint8_t {
+  Queued,
+  Assigned,
+  EnRoute,
+  Loading,
+  Delivering,
+  Unloading,
+  Done,
+  Failed,
+  Cancelled,
+  Requeued,
+  Rejected
+};
+enum class RobotMode : std::uint8_t { Idle, Moving, Waiting, Loading, Charging, Blocked, Fault };
+enum class SourceKind : std::uint8_t { Robot, Human };
+enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
+
+struct Task {
+  std::string task_id;
+  TaskKind kind = TaskKind::Transport;
+  std::string pickup;
+  std::string dropoff;
+  Pose2 goal;
+  bool has_goal = false;
+  double load_s = 0;
+  double unload_s = 0;
+  std::int32_t priority = 0;
+  std::int64_t deadline_ns = 0;
+  std::int64_t created_ns = 0;
+  std::string body;
+  bool cancel = false;
+  bool operator==(const Task&) const = default;
+};
+
+struct TaskEvent {
+  std::string task_id;
+  TaskState state = TaskState::Queued;
+  std::string robot_id;
+  std::string reason;
+  std::int64_t stamp_ns = 0;
+  std::uint32_t seq = 0;
+  bool operator==(const TaskEvent&) const = default;
+};
+
+struct Goal {
+  Pose2 pose;
+  std::string station;
+  GoalAction action = GoalAction::None;
+  double duration_s = 0;
+  bool operator==(const Goal&) const = default;
+};
+
+struct TaskAssignment {
+  std::string robot_id;
+  std::string task_id;
+  std::uint32_t revision = 0;
+  std::vector<Goal> goals;
+  bool paused = false;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TaskAssignment&) const = default;
+};
+
+struct TaskStatus {
+  std::string robot_id;
+  std::string task_id;
+  std::uint32_t revision = 0;
+  TaskState state = TaskState::Queued;
+  float progress = 0;
+  std::string error;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TaskStatus&) const = default;
+};
+
+struct RobotState {
+  std::string robot_id;
+  std::int64_t stamp_ns = 0;
+  Pose2 pose;
+  std::array<double, 9> covariance{};
+  double v = 0;
+  double w = 0;
+  RobotMode mode = RobotMode::Idle;
+  float battery = 1;
+  std::string task_id;
+  float radius = 0;
+  bool operator==(const RobotState&) const = default;
+};
+
+struct Disc {
+  float x = 0;
+  float y = 0;
+  float r = 0;
+  float sigma = 0;
+  bool operator==(const Disc&) const = default;
+};
+
+struct PredictedDiscs {
+  std::string source_id;
+  SourceKind kind = SourceKind::Robot;
+  std::int64_t t0_ns = 0;
+  float dt = 0;
+  std::vector<Disc> discs;
+  bool operator==(const PredictedDiscs&) const = default;
+};
+
+struct LevelRun {
+  std::uint8_t level = 0;
+  std::uint32_t count = 0;
+  bool operator==(const LevelRun&) const = default;
+};
+
+using Ring = std::vector<Vec2>;
+
+struct Region {
+  std::uint8_t level = 0;
+  Ring outer;
+  std::vector<Ring> holes;
+  bool operator==(const Region&) const = default;
+};
+
+struct RiskMap {
+  std::int64_t stamp_ns = 0;
+  double origin_x = 0;
+  double origin_y = 0;
+  double resolution = 0;
+  std::uint32_t width = 0;
+  std::uint32_t height = 0;
+  std::uint8_t levels = 0;
+  float horizon_s = 0;
+  float scene_index = 0;
+  std::uint32_t sources = 0;
+  std::vector<LevelRun> runs;
+  std::vector<Region> regions;
+  bool operator==(const RiskMap&) const = default;
+};
+
+struct LandmarkBearing {
+  std::int32_t id = 0;
+  float bearing = 0;
+  bool operator==(const LandmarkBearing&) const = default;
+};
+
+struct Detection {
+  SourceKind kind = SourceKind::Robot;
+  float x = 0;
+  float y = 0;
+  float r = 0;
+  bool operator==(const Detection&) const = default;
+};
+
+struct SensorFrame {
+  std::string robot_id;
+  std::int64_t stamp_ns = 0;
+  std::uint32_t seq = 0;
+  double ds_left = 0;
+  double ds_right = 0;
+  float angle_min = 0;
+  float angle_increment = 0;
+  float range_max = 0;
+  std::vector<float> ranges;
+  bool compass_valid = false;
+  double compass = 0;
+  std::vector<LandmarkBearing> landmarks;
+  std::vector<Detection> detections;
+  float battery = 1;
+  bool charging = false;
+  bool operator==(const SensorFrame&) const = default;
+};
+
+struct VelocityCommand {
+  std::string robot_id;
+  double v = 0;
+  double w = 0;
+  std::int64_t stamp_ns = 0;
+  std::uint32_t seq = 0;
+  bool operator==(const VelocityCommand&) const = default;
+};
+
+struct Clock {
+  std::int64_t step = 0;
+  std::int64_t sim_time_ns = 0;
+  std::int64_t dt_ns = 0;
+  bool lockstep = false;
+  bool operator==(const Clock&) const = default;
+};
+
+struct StepDone {
+  static constexpr std::int64_t kRegister = -1;
+  static constexpr std::int64_t kLeave = -2;
+  std::string participant_id;
+  std::int64_t step = 0;
+  bool operator==(const StepDone&) const = default;
+};
+
+struct Body {
+  std::string id;
+  SourceKind kind = SourceKind::Robot;
+  Pose2 pose;
+  double v = 0;
+  double radius = 0;
+  bool operator==(const Body&) const = default;
+};
+
+struct Contact {
+  std::string a;
+  std::string b;
+  double depth = 0;
+  bool operator==(const Contact&) const = default;
+};
+
+struct GroundTruth {
+  std::int64_t step = 0;
+  std::int64_t sim_time_ns = 0;
+  std::vector<Body> bodies;
+  std::vector<Contact> contacts;
+  bool operator==(const GroundTruth&) const = default;
+};
+
+const char* toString(TaskState s);
+const char* toString(TaskKind k);
+const char* toString(RobotMode m);
+/// Inverse of toString; false when the name is unknown.
+bool parse(const std::string& name, TaskState& out);
+bool parse(const std::string& name, TaskKind& out);
+
+}  // namespace fleet::msg

@@ -1,0 +1,376 @@
+// Copies between the C++ messages and the idlc-generated C structs. Writing never truncates: a
+// string or sequence over its IDL bound is a MessageError naming the field.
+
+#include <cstring>
+#include <string>
+#include <type_traits>
+
+#include "fleet/transport/dds.hpp"
+
+namespace fleet::transport {
+namespace {
+
+template <std::size_t N>
+void putStr(char (&dst)[N], const std::string& s, const char* field) {
+  if (s.size() > N - 1) {
+    throw MessageError(std::string(field) + ": " + std::to_string(s.size()) + " bytes, at most " +
+                       std::to_string(N - 1) + " allowed");
+  }
+  if (s.find('\0') != std::string::npos) {
+    throw MessageError(std::string(field) + ": contains a NUL byte");
+  }
+  std::memcpy(dst, s.data(), s.size());
+  dst[s.size()] = '\0';
+}
+
+template <std::size_t N>
+std::string getStr(const char (&src)[N]) {
+  return std::string(src, strnlen(src, N));
+}
+
+template <class Seq, class S, class F>
+void putSeq(Seq& seq, const std::vector<S>& v, std::size_t bound, Arena& arena, const char* field, F&& conv) {
+  using E = std::remove_pointer_t<decltype(seq._buffer)>;
+  if (bound != 0 && v.size() > bound) {
+    throw MessageError(std::string(field) + ": " + std::to_string(v.size()) + " elements, at most " +
+                       std::to_string(bound) + " allowed");
+  }
+  E* buf = arena.alloc<E>(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    conv(v[i], buf[i]);
+  }
+  seq._buffer = buf;
+  seq._length = static_cast<std::uint32_t>(v.size());
+  seq._maximum = static_cast<std::uint32_t>(v.size());
+  seq._release = false;
+}
+
+template <class Seq, class F>
+auto getSeq(const Seq& seq, F&& conv) {
+  using R = decltype(conv(*seq._buffer));
+  std::vector<R> out;
+  out.reserve(seq._length);
+  for (std::uint32_t i = 0; i < seq._length; ++i) {
+    out.push_back(conv(seq._buffer[i]));
+  }
+  return out;
+}
+
+fleet_Pose2D putPose(const Pose2& p) {
+  return {p.x, p.y, p.theta};
+}
+Pose2 getPose(const fleet_Pose2D& p) {
+  return {p.x, p.y, p.theta};
+}
+
+template <class E, class C>
+E getEnum(C c, E maxValue) {
+  const auto v = static_cast<int>(c);
+  // A peer with a newer enum may send values we don't know; map them to the last (most generic).
+  return (v < 0 || v > static_cast<int>(maxValue)) ? maxValue : static_cast<E>(v);
+}
+
+}  // namespace
+
+// ---- Task
+void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
+  putStr(out.task_id, in.task_id, "Task.task_id");
+  out.kind = static_cast<fleet_TaskKind>(in.kind);
+  putStr(out.pickup, in.pickup, "Task.pickup");
+  putStr(out.dropoff, in.dropoff, "Task.dropoff");
+  out.goal = putPose(in.goal);
+  out.has_goal = in.has_goal;
+  out.load_s = in.load_s;
+  out.unload_s = in.unload_s;
+  out.priority = in.priority;
+  out.deadline_ns = in.deadline_ns;
+  out.created_ns = in.created_ns;
+  putStr(out.body, in.body, "Task.body");
+  out.cancel = in.cancel;
+}
+msg::Task Traits<msg::Task>::fromC(const C& in) {
+  msg::Task m;
+  m.task_id = getStr(in.task_id);
+  m.kind = getEnum(in.kind, msg::TaskKind::Park);
+  m.pickup = getStr(in.pickup);
+  m.dropoff = getStr(in.dropoff);
+  m.goal = getPose(in.goal);
+  m.has_goal = in.has_goal;
+  m.load_s = in.load_s;
+  m.unload_s = in.unload_s;
+  m.priority = in.priority;
+  m.deadline_ns = in.deadline_ns;
+  m.created_ns = in.created_ns;
+  m.body = getStr(in.body);
+  m.cancel = in.cancel;
+  return m;
+}
+
+// ---- TaskEvent
+void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
+  putStr(out.task_id, in.task_id, "TaskEvent.task_id");
+  out.state = static_cast<fleet_TaskState>(in.state);
+  putStr(out.robot_id, in.robot_id, "TaskEvent.robot_id");
+  putStr(out.reason, in.reason, "TaskEvent.reason");
+  out.stamp_ns = in.stamp_ns;
+  out.seq = in.seq;
+}
+msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
+  return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
+          getStr(in.robot_id), getStr(in.reason),
+          in.stamp_ns,         in.seq};
+}
+
+// ---- TaskAssignment
+void Traits<msg::TaskAssignment>::toC(const msg::TaskAssignment& in, C& out, Arena& arena) {
+  putStr(out.robot_id, in.robot_id, "TaskAssignment.robot_id");
+  putStr(out.task_id, in.task_id, "TaskAssignment.task_id");
+  out.revision = in.revision;
+  putSeq(out.goals, in.goals, 16, arena, "TaskAssignment.goals", [](const msg::Goal& g, fleet_Goal& c) {
+    c.pose = putPose(g.pose);
+    putStr(c.station, g.station, "TaskAssignment.goals[].station");
+    c.action = static_cast<fleet_GoalAction>(g.action);
+    c.duration_s = g.duration_s;
+  });
+  out.paused = in.paused;
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
+  msg::TaskAssignment m;
+  m.robot_id = getStr(in.robot_id);
+  m.task_id = getStr(in.task_id);
+  m.revision = in.revision;
+  m.goals = getSeq(in.goals, [](const fleet_Goal& c) {
+    return msg::Goal{getPose(c.pose), getStr(c.station), getEnum(c.action, msg::GoalAction::Park),
+                     c.duration_s};
+  });
+  m.paused = in.paused;
+  m.stamp_ns = in.stamp_ns;
+  return m;
+}
+
+// ---- TaskStatus
+void Traits<msg::TaskStatus>::toC(const msg::TaskStatus& in, C& out, Arena&) {
+  putStr(out.robot_id, in.robot_id, "TaskStatus.robot_id");
+  putStr(out.task_id, in.task_id, "TaskStatus.task_id");
+  out.revision = in.revision;
+  out.state = static_cast<fleet_TaskState>(in.state);
+  out.progress = in.progress;
+  putStr(out.error, in.error, "TaskStatus.error");
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TaskStatus Traits<msg::TaskStatus>::fromC(const C& in) {
+  return {getStr(in.robot_id), getStr(in.task_id), in.revision, getEnum(in.state, msg::TaskState::Rejected),
+          in.progress,         getStr(in.error),   in.stamp_ns};
+}
+
+// ---- RobotState
+void Traits<msg::RobotState>::toC(const msg::RobotState& in, C& out, Arena&) {
+  putStr(out.robot_id, in.robot_id, "RobotState.robot_id");
+  out.stamp_ns = in.stamp_ns;
+  out.pose = putPose(in.pose);
+  std::memcpy(out.covariance, in.covariance.data(), sizeof(out.covariance));
+  out.v = in.v;
+  out.w = in.w;
+  out.mode = static_cast<fleet_RobotMode>(in.mode);
+  out.battery = in.battery;
+  putStr(out.task_id, in.task_id, "RobotState.task_id");
+  out.radius = in.radius;
+}
+msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
+  msg::RobotState m;
+  m.robot_id = getStr(in.robot_id);
+  m.stamp_ns = in.stamp_ns;
+  m.pose = getPose(in.pose);
+  std::memcpy(m.covariance.data(), in.covariance, sizeof(in.covariance));
+  m.v = in.v;
+  m.w = in.w;
+  m.mode = getEnum(in.mode, msg::RobotMode::Fault);
+  m.battery = in.battery;
+  m.task_id = getStr(in.task_id);
+  m.radius = in.radius;
+  return m;
+}
+
+// ---- PredictedDiscs
+void Traits<msg::PredictedDiscs>::toC(const msg::PredictedDiscs& in, C& out, Arena& arena) {
+  putStr(out.source_id, in.source_id, "PredictedDiscs.source_id");
+  out.kind = static_cast<fleet_SourceKind>(in.kind);
+  out.t0_ns = in.t0_ns;
+  out.dt = in.dt;
+  putSeq(out.discs, in.discs, 64, arena, "PredictedDiscs.discs", [](const msg::Disc& d, fleet_Disc& c) {
+    c = {d.x, d.y, d.r, d.sigma};
+  });
+}
+msg::PredictedDiscs Traits<msg::PredictedDiscs>::fromC(const C& in) {
+  msg::PredictedDiscs m;
+  m.source_id = getStr(in.source_id);
+  m.kind = getEnum(in.kind, msg::SourceKind::Human);
+  m.t0_ns = in.t0_ns;
+  m.dt = in.dt;
+  m.discs = getSeq(in.discs, [](const fleet_Disc& c) { return msg::Disc{c.x, c.y, c.r, c.sigma}; });
+  return m;
+}
+
+// ---- RiskMap
+namespace {
+void putRing(const msg::Ring& ring, fleet_Ring& c, Arena& arena, const char* field) {
+  putSeq(c.points, ring, 0, arena, field, [](const Vec2& p, fleet_Point2D& q) { q = {p.x, p.y}; });
+}
+msg::Ring getRing(const fleet_Ring& c) {
+  return getSeq(c.points, [](const fleet_Point2D& q) { return Vec2{q.x, q.y}; });
+}
+}  // namespace
+
+void Traits<msg::RiskMap>::toC(const msg::RiskMap& in, C& out, Arena& arena) {
+  out.stamp_ns = in.stamp_ns;
+  out.origin_x = in.origin_x;
+  out.origin_y = in.origin_y;
+  out.resolution = in.resolution;
+  out.width = in.width;
+  out.height = in.height;
+  out.levels = in.levels;
+  out.horizon_s = in.horizon_s;
+  out.scene_index = in.scene_index;
+  out.sources = in.sources;
+  putSeq(out.runs, in.runs, 0, arena, "RiskMap.runs", [](const msg::LevelRun& r, fleet_LevelRun& c) {
+    c = {r.level, r.count};
+  });
+  putSeq(out.regions, in.regions, 0, arena, "RiskMap.regions",
+         [&arena](const msg::Region& r, fleet_Region& c) {
+           c.level = r.level;
+           putRing(r.outer, c.outer, arena, "RiskMap.regions[].outer");
+           putSeq(c.holes, r.holes, 0, arena, "RiskMap.regions[].holes",
+                  [&arena](const msg::Ring& h, fleet_Ring& hc) {
+                    putRing(h, hc, arena, "RiskMap.regions[].holes[]");
+                  });
+         });
+}
+msg::RiskMap Traits<msg::RiskMap>::fromC(const C& in) {
+  msg::RiskMap m;
+  m.stamp_ns = in.stamp_ns;
+  m.origin_x = in.origin_x;
+  m.origin_y = in.origin_y;
+  m.resolution = in.resolution;
+  m.width = in.width;
+  m.height = in.height;
+  m.levels = in.levels;
+  m.horizon_s = in.horizon_s;
+  m.scene_index = in.scene_index;
+  m.sources = in.sources;
+  m.runs = getSeq(in.runs, [](const fleet_LevelRun& c) { return msg::LevelRun{c.level, c.count}; });
+  m.regions = getSeq(in.regions, [](const fleet_Region& c) {
+    return msg::Region{c.level, getRing(c.outer),
+                       getSeq(c.holes, [](const fleet_Ring& h) { return getRing(h); })};
+  });
+  return m;
+}
+
+// ---- SensorFrame
+void Traits<msg::SensorFrame>::toC(const msg::SensorFrame& in, C& out, Arena& arena) {
+  putStr(out.robot_id, in.robot_id, "SensorFrame.robot_id");
+  out.stamp_ns = in.stamp_ns;
+  out.seq = in.seq;
+  out.ds_left = in.ds_left;
+  out.ds_right = in.ds_right;
+  out.angle_min = in.angle_min;
+  out.angle_increment = in.angle_increment;
+  out.range_max = in.range_max;
+  putSeq(out.ranges, in.ranges, 1024, arena, "SensorFrame.ranges", [](float r, float& c) { c = r; });
+  out.compass_valid = in.compass_valid;
+  out.compass = in.compass;
+  putSeq(out.landmarks, in.landmarks, 64, arena, "SensorFrame.landmarks",
+         [](const msg::LandmarkBearing& l, fleet_LandmarkBearing& c) {
+           c = {l.id, l.bearing};
+         });
+  putSeq(out.detections, in.detections, 256, arena, "SensorFrame.detections",
+         [](const msg::Detection& d, fleet_Detection& c) {
+           c = {static_cast<fleet_SourceKind>(d.kind), d.x, d.y, d.r};
+         });
+  out.battery = in.battery;
+  out.charging = in.charging;
+}
+msg::SensorFrame Traits<msg::SensorFrame>::fromC(const C& in) {
+  msg::SensorFrame m;
+  m.robot_id = getStr(in.robot_id);
+  m.stamp_ns = in.stamp_ns;
+  m.seq = in.seq;
+  m.ds_left = in.ds_left;
+  m.ds_right = in.ds_right;
+  m.angle_min = in.angle_min;
+  m.angle_increment = in.angle_increment;
+  m.range_max = in.range_max;
+  m.ranges = getSeq(in.ranges, [](float r) { return r; });
+  m.compass_valid = in.compass_valid;
+  m.compass = in.compass;
+  m.landmarks = getSeq(in.landmarks, [](const fleet_LandmarkBearing& c) {
+    return msg::LandmarkBearing{c.id, c.bearing};
+  });
+  m.detections = getSeq(in.detections, [](const fleet_Detection& c) {
+    return msg::Detection{getEnum(c.kind, msg::SourceKind::Human), c.x, c.y, c.r};
+  });
+  m.battery = in.battery;
+  m.charging = in.charging;
+  return m;
+}
+
+// ---- VelocityCommand
+void Traits<msg::VelocityCommand>::toC(const msg::VelocityCommand& in, C& out, Arena&) {
+  putStr(out.robot_id, in.robot_id, "VelocityCommand.robot_id");
+  out.v = in.v;
+  out.w = in.w;
+  out.stamp_ns = in.stamp_ns;
+  out.seq = in.seq;
+}
+msg::VelocityCommand Traits<msg::VelocityCommand>::fromC(const C& in) {
+  return {getStr(in.robot_id), in.v, in.w, in.stamp_ns, in.seq};
+}
+
+// ---- Clock / StepDone
+void Traits<msg::Clock>::toC(const msg::Clock& in, C& out, Arena&) {
+  out = {in.step, in.sim_time_ns, in.dt_ns, in.lockstep};
+}
+msg::Clock Traits<msg::Clock>::fromC(const C& in) {
+  return {in.step, in.sim_time_ns, in.dt_ns, in.lockstep};
+}
+
+void Traits<msg::StepDone>::toC(const msg::StepDone& in, C& out, Arena&) {
+  putStr(out.participant_id, in.participant_id, "StepDone.participant_id");
+  out.step = in.step;
+}
+msg::StepDone Traits<msg::StepDone>::fromC(const C& in) {
+  return {getStr(in.participant_id), in.step};
+}
+
+// ---- GroundTruth
+void Traits<msg::GroundTruth>::toC(const msg::GroundTruth& in, C& out, Arena& arena) {
+  out.step = in.step;
+  out.sim_time_ns = in.sim_time_ns;
+  putSeq(out.bodies, in.bodies, 0, arena, "GroundTruth.bodies", [](const msg::Body& b, fleet_Body& c) {
+    putStr(c.id, b.id, "GroundTruth.bodies[].id");
+    c.kind = static_cast<fleet_SourceKind>(b.kind);
+    c.pose = putPose(b.pose);
+    c.v = b.v;
+    c.radius = b.radius;
+  });
+  putSeq(out.contacts, in.contacts, 0, arena, "GroundTruth.contacts",
+         [](const msg::Contact& k, fleet_Contact& c) {
+           putStr(c.a, k.a, "GroundTruth.contacts[].a");
+           putStr(c.b, k.b, "GroundTruth.contacts[].b");
+           c.depth = k.depth;
+         });
+}
+msg::GroundTruth Traits<msg::GroundTruth>::fromC(const C& in) {
+  msg::GroundTruth m;
+  m.step = in.step;
+  m.sim_time_ns = in.sim_time_ns;
+  m.bodies = getSeq(in.bodies, [](const fleet_Body& c) {
+    return msg::Body{getStr(c.id), getEnum(c.kind, msg::SourceKind::Human), getPose(c.pose), c.v, c.radius};
+  });
+  m.contacts = getSeq(in.contacts, [](const fleet_Contact& c) {
+    return msg::Contact{getStr(c.a), getStr(c.b), c.depth};
+  });
+  return m;
+}
+
+}  // namespace fleet::transport

@@ -1,0 +1,151 @@
+#include "fleet/transport/dds.hpp"
+
+#include <cstdlib>
+#include <map>
+#include <mutex>
+
+namespace fleet::transport {
+
+DdsError::DdsError(const std::string& what, int rc)
+    : std::runtime_error(what + " failed: " + dds_strretcode(rc) + " (" + std::to_string(rc) + ")"),
+      rc_(rc) {}
+
+int check(int rc, const char* what) {
+  if (rc < 0) {
+    throw DdsError(what, rc);
+  }
+  return rc;
+}
+
+const char* loopbackConfig() {
+  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+         "<AllowMulticast>false</AllowMulticast></General>"
+         "<Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
+         "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
+}
+
+int domainFromEnvironment() {
+  const char* s = std::getenv("FLEET_DDS_DOMAIN");
+  if (s == nullptr || *s == '\0') {
+    return 0;
+  }
+  char* end = nullptr;
+  const long v = std::strtol(s, &end, 10);
+  if (*end != '\0' || v < 0 || v > 229) {
+    throw DdsError(std::string("FLEET_DDS_DOMAIN=\"") + s + "\" is not a domain id in 0..229",
+                   DDS_RETCODE_BAD_PARAMETER);
+  }
+  return static_cast<int>(v);
+}
+
+Entity& Entity::operator=(Entity&& o) noexcept {
+  if (this != &o) {
+    if (h_ > 0) {
+      dds_delete(h_);
+    }
+    h_ = o.h_;
+    o.h_ = 0;
+  }
+  return *this;
+}
+
+Entity::~Entity() {
+  if (h_ > 0) {
+    dds_delete(h_);  // may already be gone with its parent; nothing to do then
+  }
+}
+
+namespace {
+// Domains we created with the built-in config stay for the life of the process, so that every
+// participant of the process (one per agent, say) shares them.
+void ensureLoopbackDomain(int domain) {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri != nullptr && *uri != '\0') {
+    return;
+  }
+  static std::mutex m;
+  static std::map<int, dds_entity_t> domains;
+  std::lock_guard lock(m);
+  if (domains.count(domain) != 0) {
+    return;
+  }
+  const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(domain), loopbackConfig());
+  if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) {
+    check(d, "dds_create_domain (built-in loopback config)");
+  }
+  domains[domain] = d;
+}
+}  // namespace
+
+Participant::Participant(int domain) : domain_(domain) {
+  ensureLoopbackDomain(domain);
+  e_ = Entity(check(dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr),
+                    "dds_create_participant"));
+}
+
+namespace detail {
+
+dds_entity_t createTopic(const Participant& p, const dds_topic_descriptor_t* desc, const std::string& name) {
+  return check(dds_create_topic(p.handle(), desc, name.c_str(), nullptr, nullptr),
+               ("dds_create_topic " + name).c_str());
+}
+
+dds_entity_t createWriter(const Participant& p, dds_entity_t topic, const QosProfile& q) {
+  dds_qos_t* qos = q.make();
+  const dds_entity_t w = dds_create_writer(p.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  return check(w, "dds_create_writer");
+}
+
+dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q) {
+  dds_qos_t* qos = q.make();
+  const dds_entity_t r = dds_create_reader(p.handle(), topic, qos, nullptr);
+  dds_delete_qos(qos);
+  return check(r, "dds_create_reader");
+}
+
+std::uint32_t matched(dds_entity_t e, bool publication) {
+  if (publication) {
+    dds_publication_matched_status_t st{};
+    check(dds_get_publication_matched_status(e, &st), "dds_get_publication_matched_status");
+    return st.current_count;
+  }
+  dds_subscription_matched_status_t st{};
+  check(dds_get_subscription_matched_status(e, &st), "dds_get_subscription_matched_status");
+  return st.current_count;
+}
+
+}  // namespace detail
+
+WaitSet::WaitSet(const Participant& p)
+    : ws_(check(dds_create_waitset(p.handle()), "dds_create_waitset")),
+      guard_(check(dds_create_guardcondition(p.handle()), "dds_create_guardcondition")) {
+  check(dds_waitset_attach(ws_, guard_, guard_), "dds_waitset_attach");
+}
+
+void WaitSet::attachReader(dds_entity_t reader) {
+  const dds_entity_t c =
+      check(dds_create_readcondition(reader,
+                                     DDS_NOT_READ_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ANY_INSTANCE_STATE),
+            "dds_create_readcondition");
+  check(dds_waitset_attach(ws_, c, c), "dds_waitset_attach");
+  conditions_.push_back(c);
+}
+
+int WaitSet::wait(std::chrono::milliseconds timeout) {
+  dds_attach_t triggered[16];
+  const int n = dds_waitset_wait(ws_, triggered, 16, DDS_MSECS(static_cast<std::int64_t>(timeout.count())));
+  check(n, "dds_waitset_wait");
+  for (int i = 0; i < std::min(n, 16); ++i) {
+    if (triggered[i] == static_cast<dds_attach_t>(guard_)) {
+      dds_set_guardcondition(guard_, false);
+    }
+  }
+  return n;
+}
+
+void WaitSet::wake() {
+  check(dds_set_guardcondition(guard_, true), "dds_set_guardcondition");
+}
+
+}  // namespace fleet::transport

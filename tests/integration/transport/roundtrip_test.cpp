@@ -1,0 +1,175 @@
+// Two processes over loopback DDS: this test writes samples of every topic type, the echo peer
+// (a separate process) writes them back, and every field must come back equal.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "fleet/transport/dds.hpp"
+#include "test_process.hpp"
+
+using namespace fleet;
+using namespace fleet::transport;
+using namespace std::chrono_literals;
+
+namespace {
+const QosProfile kAll{true, false, 0, 0, 2000};
+const std::string kNonAscii = "Kệ hàng Ω-7 → dock ✓";  // UTF-8, multi-byte
+
+class RoundTrip : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    setenv("FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain()).c_str(), 1);
+    peer_ = new test::ChildProcess(FLEET_BINARY_DIR "/tests/integration/transport/transport_echo_peer",
+                                   {"15"}, {{"FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain())}});
+    participant_ = new Participant();
+  }
+  static void TearDownTestSuite() {
+    delete participant_;
+    delete peer_;
+  }
+
+  template <class T>
+  std::vector<T> roundTrip(const std::vector<T>& samples) {
+    Writer<T> w(*participant_, kAll);
+    Reader<T> r(*participant_, kAll, std::string(Traits<T>::kTopic) + "_echo");
+    const auto deadline = std::chrono::steady_clock::now() + 15s;
+    while ((w.matchedReaders() == 0 || r.matchedWriters() == 0) &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(10ms);
+    }
+    EXPECT_GT(w.matchedReaders(), 0u) << "peer never matched " << Traits<T>::kTopic;
+    for (const auto& s : samples) {
+      w.write(s);
+    }
+    std::vector<T> got;
+    while (got.size() < samples.size() && std::chrono::steady_clock::now() < deadline) {
+      r.waitForData(100ms);
+      for (auto& m : r.take()) {
+        got.push_back(std::move(m));
+      }
+    }
+    return got;
+  }
+
+  template <class T>
+  void expectRoundTrip(const std::vector<T>& samples) {
+    auto got = roundTrip(samples);
+    ASSERT_EQ(got.size(), samples.size()) << Traits<T>::kTopic;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      EXPECT_TRUE(got[i] == samples[i]) << Traits<T>::kTopic << " sample " << i << " differs";
+    }
+  }
+
+  static test::ChildProcess* peer_;
+  static Participant* participant_;
+};
+test::ChildProcess* RoundTrip::peer_ = nullptr;
+Participant* RoundTrip::participant_ = nullptr;
+
+std::string maxId() {
+  return std::string(63, 'z');
+}
+}  // namespace
+
+TEST_F(RoundTrip, Task) {
+  msg::Task a{
+      "t-1", msg::TaskKind::Transport, "P-12", "D-3", {}, false, 5, 7.5, 3, 123456789, 42, R"({"a":1})",
+      false};
+  msg::Task b{maxId(), msg::TaskKind::Park,    "",  "", {1, -2, 3.0}, true, 0, 0, -5, 0,
+              0,       std::string(4096, 'b'), true};
+  msg::Task c = a;
+  c.task_id = "t-2";
+  c.body = kNonAscii;
+  expectRoundTrip<msg::Task>({a, b, c});
+}
+
+TEST_F(RoundTrip, TaskEvent) {
+  expectRoundTrip<msg::TaskEvent>({{"t-1", msg::TaskState::Unloading, "r-7", kNonAscii, 99, 4},
+                                   {"t-2", msg::TaskState::Rejected, "", std::string(255, 'x'), -1, 0}});
+}
+
+TEST_F(RoundTrip, TaskAssignment) {
+  msg::TaskAssignment a{"r-1", "t-1", 3, {}, false, 10};
+  msg::TaskAssignment b{"r-2", "t-2", 4, {}, true, 11};
+  for (int i = 0; i < 16; ++i) {
+    b.goals.push_back({{i * 1.0, -i * 0.5, 0.1 * i},
+                       i % 2 ? "S-" + std::to_string(i) : kNonAscii,
+                       static_cast<msg::GoalAction>(i % 5),
+                       i * 0.25});
+  }
+  expectRoundTrip<msg::TaskAssignment>({a, b});
+}
+
+TEST_F(RoundTrip, TaskStatus) {
+  expectRoundTrip<msg::TaskStatus>({{"r-1", "t-1", 2, msg::TaskState::EnRoute, 0.5f, "", 7},
+                                    {"r-2", "", 0, msg::TaskState::Failed, 1.0f, kNonAscii, 8}});
+}
+
+TEST_F(RoundTrip, RobotState) {
+  msg::RobotState s{"r-1", 5,    {1.5, 2.5, -3.0},         {1, 2, 3, 4, 5, 6, 7, 8, 9},
+                    0.7,   -0.2, msg::RobotMode::Charging, 0.33f,
+                    "t-9", 0.35f};
+  expectRoundTrip<msg::RobotState>({s});
+}
+
+TEST_F(RoundTrip, PredictedDiscs) {
+  msg::PredictedDiscs a{"h-1", msg::SourceKind::Human, 100, 0.1f, {}};
+  msg::PredictedDiscs b{"r-1", msg::SourceKind::Robot, 200, 0.2f, {}};
+  for (int i = 0; i < 64; ++i) {
+    b.discs.push_back({i * 0.1f, -i * 0.2f, 0.4f, 0.01f * static_cast<float>(i)});
+  }
+  expectRoundTrip<msg::PredictedDiscs>({a, b});
+}
+
+TEST_F(RoundTrip, RiskMap) {
+  msg::RiskMap empty{};
+  msg::RiskMap m{1, -5, -6, 0.1, 200, 100, 10, 3.0f, 0.25f, 42, {}, {}};
+  for (int i = 0; i < 5000; ++i) {
+    m.runs.push_back({static_cast<std::uint8_t>(i % 11), static_cast<std::uint32_t>(i + 1)});
+  }
+  m.regions.push_back({3, {{0, 0}, {1, 0}, {1, 1}}, {}});
+  m.regions.push_back(
+      {7, {{0, 0}, {4, 0}, {4, 4}, {0, 4}}, {{{1, 1}, {1, 2}, {2, 2}}, {{3, 3}, {3, 3.5}, {3.5, 3.5}}}});
+  expectRoundTrip<msg::RiskMap>({empty, m});
+}
+
+TEST_F(RoundTrip, SensorFrame) {
+  msg::SensorFrame a{"r-1", 1, 2, 0.01, 0.02, -3.1f, 0.087f, 10.0f, {}, false, 0, {}, {}, 0.9f, false};
+  msg::SensorFrame b = a;
+  b.robot_id = "r-2";
+  for (int i = 0; i < 1024; ++i) {
+    b.ranges.push_back(static_cast<float>(i) * 0.01f);
+  }
+  for (int i = 0; i < 64; ++i) {
+    b.landmarks.push_back({i, 0.01f * static_cast<float>(i)});
+  }
+  for (int i = 0; i < 256; ++i) {
+    b.detections.push_back({i % 2 ? msg::SourceKind::Human : msg::SourceKind::Robot, 1.0f, -1.0f, 0.3f});
+  }
+  b.compass_valid = true;
+  b.compass = 1.25;
+  b.charging = true;
+  expectRoundTrip<msg::SensorFrame>({a, b});
+}
+
+TEST_F(RoundTrip, VelocityCommandClockStepDone) {
+  expectRoundTrip<msg::VelocityCommand>({{"r-1", 0.5, -0.25, 77, 9}});
+  expectRoundTrip<msg::Clock>({{12, 1200000000, 100000000, true}});
+  expectRoundTrip<msg::StepDone>({{"agent-proc-1", 12}, {maxId(), msg::StepDone::kRegister}});
+}
+
+TEST_F(RoundTrip, GroundTruth) {
+  msg::GroundTruth g{5, 500, {}, {}};
+  for (int i = 0; i < 2000; ++i) {
+    g.bodies.push_back({"b" + std::to_string(i),
+                        i % 3 ? msg::SourceKind::Robot : msg::SourceKind::Human,
+                        {i * 0.1, i * 0.2, 0.3},
+                        1.0,
+                        0.3});
+  }
+  g.contacts.push_back({"b1", "#shelf", 0.01});
+  g.contacts.push_back({kNonAscii, "b2", 0.2});
+  expectRoundTrip<msg::GroundTruth>({msg::GroundTruth{}, g});
+}

@@ -1,0 +1,89 @@
+#pragma once
+
+// A child process for multi-process tests: started with fork/exec, killed (SIGKILL) when the
+// object goes out of scope so a failing test never leaves orphans.
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace fleet::test {
+
+class ChildProcess {
+ public:
+  ChildProcess(const std::string& exe, const std::vector<std::string>& args,
+               const std::vector<std::pair<std::string, std::string>>& env = {}) {
+    pid_ = fork();
+    if (pid_ < 0) {
+      throw std::runtime_error("fork failed");
+    }
+    if (pid_ == 0) {
+      for (const auto& [k, v] : env) {
+        setenv(k.c_str(), v.c_str(), 1);
+      }
+      std::vector<char*> argv;
+      argv.push_back(const_cast<char*>(exe.c_str()));
+      for (const auto& a : args) {
+        argv.push_back(const_cast<char*>(a.c_str()));
+      }
+      argv.push_back(nullptr);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+  ~ChildProcess() { kill(SIGKILL); }
+
+  [[nodiscard]] pid_t pid() const { return pid_; }
+
+  void kill(int sig) {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, sig);
+      if (sig == SIGKILL) {
+        (void)wait(std::chrono::seconds(10));
+      }
+    }
+  }
+
+  /// Waits for exit; returns the exit status (128+signal when killed), or -1 on timeout.
+  int wait(std::chrono::milliseconds timeout) {
+    if (exited_) {
+      return status_;
+    }
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (true) {
+      int st = 0;
+      const pid_t r = waitpid(pid_, &st, WNOHANG);
+      if (r == pid_) {
+        exited_ = true;
+        status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+        return status_;
+      }
+      if (std::chrono::steady_clock::now() > end) {
+        return -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  int status_ = -1;
+};
+
+/// A DDS domain id for this test process, so parallel ctest runs don't hear each other.
+inline int uniqueDomain() {
+  return 10 + static_cast<int>(getpid() % 200);
+}
+
+}  // namespace fleet::test

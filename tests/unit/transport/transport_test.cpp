@@ -1,0 +1,144 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "fleet/transport/dds.hpp"
+#include "test_process.hpp"
+
+using namespace fleet;
+using namespace fleet::transport;
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+namespace {
+class Transport : public ::testing::Test {
+ protected:
+  void SetUp() override { setenv("FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain()).c_str(), 1); }
+};
+
+template <class W, class R>
+void waitMatched(const W& w, const R& r) {
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while ((w.matchedReaders() == 0 || r.matchedWriters() == 0) && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(5ms);
+  }
+}
+}  // namespace
+
+TEST_F(Transport, OversizedFieldsAreRefusedWithTheFieldName) {
+  Participant p;
+  Writer<msg::RobotState> w(p);
+  msg::RobotState s;
+  s.robot_id = std::string(64, 'x');
+  try {
+    w.write(s);
+    FAIL() << "expected MessageError";
+  } catch (const MessageError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("RobotState.robot_id: 64 bytes, at most 63 allowed"));
+  }
+  Writer<msg::PredictedDiscs> wd(p);
+  msg::PredictedDiscs d;
+  d.source_id = "s";
+  d.discs.resize(65);
+  EXPECT_THROW(wd.write(d), MessageError);
+  msg::TaskEvent ev;
+  ev.task_id = std::string("a\0b", 3);
+  Writer<msg::TaskEvent> we(p);
+  EXPECT_THROW(we.write(ev), MessageError);
+}
+
+TEST_F(Transport, InProcessPublishSubscribe) {
+  Participant p;
+  Writer<msg::VelocityCommand> w(p, qos::command(true));
+  Reader<msg::VelocityCommand> r(p, qos::command(true));
+  waitMatched(w, r);
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    w.write({"r" + std::to_string(i), 0.1 * i, 0.0, 0, i});
+  }
+  std::vector<msg::VelocityCommand> got;
+  const auto end = std::chrono::steady_clock::now() + 5s;
+  while (got.size() < 3 && std::chrono::steady_clock::now() < end) {
+    r.waitForData(100ms);
+    for (auto& m : r.take()) {
+      got.push_back(m);
+    }
+  }
+  ASSERT_EQ(got.size(), 3u);
+  EXPECT_EQ(got[2].robot_id, "r2");
+  EXPECT_TRUE(r.take().empty());
+}
+
+TEST_F(Transport, TransientLocalReachesLateJoiner) {
+  Participant p;
+  Writer<msg::TaskAssignment> w(p);
+  w.write({"robot-1", "task-1", 1, {}, false, 0});
+  w.write({"robot-1", "task-2", 2, {}, false, 0});  // keep-last 1 per key: only this one survives
+  w.write({"robot-2", "task-3", 1, {}, false, 0});
+  Participant late;
+  Reader<msg::TaskAssignment> r(late);
+  std::vector<msg::TaskAssignment> got;
+  const auto end = std::chrono::steady_clock::now() + 5s;
+  while (got.size() < 2 && std::chrono::steady_clock::now() < end) {
+    r.waitForData(100ms);
+    for (auto& m : r.take()) {
+      got.push_back(m);
+    }
+  }
+  ASSERT_EQ(got.size(), 2u);
+  for (const auto& a : got) {
+    EXPECT_EQ(a.task_id, a.robot_id == "robot-1" ? "task-2" : "task-3");
+  }
+}
+
+TEST_F(Transport, WaitSetWakesOnGuard) {
+  Participant p;
+  WaitSet ws(p);
+  Reader<msg::Clock> r(p);
+  ws.attach(r);
+  std::thread t([&] {
+    std::this_thread::sleep_for(50ms);
+    ws.wake();
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_GT(ws.wait(10s), 0);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 5s);
+  t.join();
+  EXPECT_EQ(ws.wait(10ms), 0);  // the guard was reset
+}
+
+TEST(TransportConfig, QosByNameAndDomainValidation) {
+  QosProfile q;
+  EXPECT_TRUE(qos::byName("robot_state", q));
+  EXPECT_FALSE(q.reliable);
+  EXPECT_EQ(q.livelinessLeaseMs, 1000);
+  EXPECT_TRUE(qos::byName("task_request", q));
+  EXPECT_TRUE(q.reliable && q.transientLocal);
+  EXPECT_FALSE(qos::byName("nope", q));
+  setenv("FLEET_DDS_DOMAIN", "999", 1);
+  EXPECT_THROW((void)domainFromEnvironment(), DdsError);
+  setenv("FLEET_DDS_DOMAIN", "12", 1);
+  EXPECT_EQ(domainFromEnvironment(), 12);
+  EXPECT_THAT(std::string(loopbackConfig()), HasSubstr("<NetworkInterface name=\"lo\"/>"));
+  EXPECT_THAT(std::string(loopbackConfig()), HasSubstr("<AllowMulticast>false</AllowMulticast>"));
+  try {
+    check(DDS_RETCODE_BAD_PARAMETER, "dds_something");
+    FAIL();
+  } catch (const DdsError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("dds_something failed: "));
+    EXPECT_EQ(e.code(), DDS_RETCODE_BAD_PARAMETER);
+  }
+}
+
+TEST(MessageNames, RoundTrip) {
+  for (int i = 0; i <= static_cast<int>(msg::TaskState::Rejected); ++i) {
+    msg::TaskState s{};
+    ASSERT_TRUE(msg::parse(msg::toString(static_cast<msg::TaskState>(i)), s));
+    EXPECT_EQ(static_cast<int>(s), i);
+  }
+  msg::TaskKind k{};
+  EXPECT_TRUE(msg::parse("goto", k));
+  EXPECT_EQ(k, msg::TaskKind::GoTo);
+  EXPECT_FALSE(msg::parse("teleport", k));
+}
