@@ -117,7 +117,7 @@ class Reader {
 
  private:
   std::vector<T> collect(std::size_t max, bool takeIt) {
-    constexpr std::size_t kBatch = 64;
+    constexpr std::size_t kBatch = 256;
     std::vector<T> out;
     while (out.size() < max) {
       void* samples[kBatch] = {nullptr};

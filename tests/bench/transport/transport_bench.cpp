@@ -1,0 +1,219 @@
+// One-way latency (round trip / 2, as ddsperf reports it) and throughput of RobotState (~256 B)
+// between two processes through our transport wrapper. The second process is this executable
+// started with --pong or --sink. tests/bench/transport/run.sh runs ddsperf in the same run.
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "fleet/transport/dds.hpp"
+#include "test_process.hpp"
+
+using namespace fleet;
+using namespace fleet::transport;
+using namespace std::chrono_literals;
+using Clk = std::chrono::steady_clock;
+
+namespace {
+const QosProfile kPingQos{true, false, 1, 0, 1000};
+const QosProfile kStreamQos{true, false, 0, 0, 5000};  // reliable keep-all: nothing may be lost
+
+msg::RobotState sample(std::uint32_t i) {
+  msg::RobotState s;
+  s.robot_id = "robot-" + std::to_string(i % 16);
+  s.pose = {1.0 * i, 2.0, 0.5};
+  s.covariance = {0.01, 0, 0, 0, 0.01, 0, 0, 0, 0.001};
+  s.v = 1.0;
+  s.task_id = "task-0000000001";
+  s.radius = 0.35f;
+  return s;
+}
+
+template <class W, class R>
+void waitMatched(const W& w, const R& r) {
+  const auto end = Clk::now() + 20s;
+  while ((w.matchedReaders() == 0 || r.matchedWriters() == 0) && Clk::now() < end) {
+    std::this_thread::sleep_for(10ms);
+  }
+}
+
+int runPong() {
+  Participant p;
+  Reader<msg::RobotState> in(p, kPingQos, "BenchPing");
+  Writer<msg::RobotState> out(p, kPingQos, "BenchPong");
+  auto last = Clk::now();
+  while (Clk::now() - last < 5s) {
+    if (in.waitForData(100ms)) {
+      for (const auto& m : in.take()) {
+        out.write(m);
+      }
+      last = Clk::now();
+    }
+  }
+  return 0;
+}
+
+int runSink() {
+  Participant p;
+  Reader<msg::RobotState> in(p, kStreamQos, "BenchStream");
+  Reader<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
+  Writer<msg::StepDone> reply(p, kPingQos, "BenchReply");
+  std::int64_t count = 0;
+  auto last = Clk::now();
+  while (Clk::now() - last < 10s) {
+    if (in.waitForData(20ms)) {
+      count += static_cast<std::int64_t>(in.take().size());
+      last = Clk::now();
+    }
+    for (const auto& c : ctl.take()) {
+      // Drain what is still in flight before answering.
+      const auto settle = Clk::now() + 2s;
+      while (count < c.step && Clk::now() < settle) {
+        in.waitForData(20ms);
+        count += static_cast<std::int64_t>(in.take().size());
+      }
+      reply.write({"sink", count});
+      count = 0;
+      last = Clk::now();
+    }
+  }
+  return 0;
+}
+
+std::string self;
+
+void BM_PingPongOneWay(benchmark::State& state) {
+  test::ChildProcess pong(self, {"--pong"});
+  Participant p;
+  Writer<msg::RobotState> out(p, kPingQos, "BenchPing");
+  Reader<msg::RobotState> in(p, kPingQos, "BenchPong");
+  waitMatched(out, in);
+  std::vector<double> oneWayUs;
+  std::uint32_t i = 0;
+  for (int warm = 0; warm < 200; ++warm) {
+    out.write(sample(i++));
+    while (in.take().empty()) {
+      in.waitForData(1000ms);
+    }
+  }
+  for (auto _ : state) {
+    const auto t0 = Clk::now();
+    out.write(sample(i++));
+    std::size_t got = 0;
+    while (got == 0) {
+      in.waitForData(1000ms);
+      got = in.take().size();
+    }
+    oneWayUs.push_back(std::chrono::duration<double, std::micro>(Clk::now() - t0).count() / 2);
+  }
+  std::sort(oneWayUs.begin(), oneWayUs.end());
+  auto pct = [&](double q) {
+    return oneWayUs[static_cast<std::size_t>(q * static_cast<double>(oneWayUs.size() - 1))];
+  };
+  state.counters["p50_us"] = pct(0.5);
+  state.counters["p90_us"] = pct(0.9);
+  state.counters["p99_us"] = pct(0.99);
+  state.counters["max_us"] = oneWayUs.back();
+}
+
+void BM_Throughput(benchmark::State& state) {
+  test::ChildProcess sink(self, {"--sink"});
+  Participant p;
+  Writer<msg::RobotState> out(p, kStreamQos, "BenchStream");
+  Writer<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
+  Reader<msg::StepDone> reply(p, kPingQos, "BenchReply");
+  waitMatched(out, reply);
+  waitMatched(ctl, reply);
+  std::vector<msg::RobotState> samples;
+  for (std::uint32_t i = 0; i < 16; ++i) {
+    samples.push_back(sample(i));
+  }
+  std::int64_t written = 0;
+  std::int64_t received = 0;
+  double seconds = 0;
+  for (auto _ : state) {
+    const std::int64_t n = state.range(0);
+    const auto t0 = Clk::now();
+    for (std::int64_t k = 0; k < n; ++k) {
+      out.write(samples[static_cast<std::size_t>(k % 16)]);
+    }
+    ctl.write({"bench", n});
+    std::int64_t got = -1;
+    while (got < 0) {
+      reply.waitForData(1000ms);
+      for (const auto& r : reply.take()) {
+        got = r.step;
+      }
+    }
+    seconds += std::chrono::duration<double>(Clk::now() - t0).count();
+    written += n;
+    received += got;
+  }
+  state.counters["samples_per_s"] = static_cast<double>(received) / seconds;
+  state.counters["lost"] = static_cast<double>(written - received);
+  state.counters["MB_per_s"] = static_cast<double>(received) * 256.0 / seconds / 1e6;
+}
+
+// Cost of one write through the wrapper vs the same sample written with the raw C API (one local
+// reader matched, so the sample is really serialized and delivered): the wrapper's own overhead.
+void BM_WriteWrapper(benchmark::State& state) {
+  Participant p;
+  Writer<msg::RobotState> w(p, kStreamQos, "BenchLocal");
+  Reader<msg::RobotState> r(p, kStreamQos, "BenchLocal");
+  const auto s = sample(1);
+  std::int64_t n = 0;
+  for (auto _ : state) {
+    w.write(s);
+    if (++n % 256 == 0) {
+      state.PauseTiming();
+      (void)r.take();
+      state.ResumeTiming();
+    }
+  }
+}
+
+void BM_WriteRawC(benchmark::State& state) {
+  Participant p;
+  Writer<msg::RobotState> w(p, kStreamQos, "BenchLocal");
+  Reader<msg::RobotState> r(p, kStreamQos, "BenchLocal");
+  fleet_RobotState c{};
+  Arena arena;
+  Traits<msg::RobotState>::toC(sample(1), c, arena);
+  std::int64_t n = 0;
+  for (auto _ : state) {
+    check(dds_write(w.handle(), &c), "dds_write");
+    if (++n % 256 == 0) {
+      state.PauseTiming();
+      (void)r.take();
+      state.ResumeTiming();
+    }
+  }
+}
+
+BENCHMARK(BM_WriteWrapper)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WriteRawC)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PingPongOneWay)->Iterations(20000)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Throughput)->Arg(200000)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "--pong") == 0) {
+    return runPong();
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--sink") == 0) {
+    return runSink();
+  }
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  self = std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0);
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
