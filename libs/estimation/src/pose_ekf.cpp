@@ -190,8 +190,15 @@ LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
         continue;
       }
       const Eigen::Vector2d innov(obs.r - p.r, angleDiff(obs.psi, p.psi));
+      // Closed-form 2×2 Mahalanobis distance: this loop runs for every (observation, map line) pair.
       const Eigen::Matrix2d S = p.H * P_ * p.H.transpose() + R;
-      const double d2 = innov.dot(S.ldlt().solve(innov));
+      const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      if (!(det > 0.0)) {
+        continue;
+      }
+      const double d2 = (S(1, 1) * innov(0) * innov(0) - 2.0 * S(0, 1) * innov(0) * innov(1) +
+                         S(0, 0) * innov(1) * innov(1)) /
+                        det;
       if (d2 <= best) {
         best = d2;
         best_j = j;
