@@ -1,0 +1,124 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "fleet/core/expected.hpp"
+#include "fleet/risk/grid.hpp"
+#include "fleet/risk/iso_levels.hpp"
+#include "fleet/risk/reference_algorithm.hpp"
+#include "fleet/risk/risk_model.hpp"
+#include "fleet/risk/source.hpp"
+
+namespace fleet::risk {
+
+struct FusionConfig {
+  GridSpec grid{0.0, 0.0, 0.1, 1000, 500};
+  int levels = 10;  // K
+  double dt = 0.1;  // s between fused steps
+  int steps = 30;   // horizon = steps · dt
+  PairPolicy policy;
+  SourceLimits limits;
+  int tileSize = 32;  // cells per side of the unit of incremental recomputation
+};
+
+/// Configuration problems, or nothing. Codes: "bad_grid", "bad_levels", "bad_time_base", "bad_tile".
+Expected<void> validateFusionConfig(const FusionConfig& config);
+
+struct FusionStats {
+  bool fullRecompute = false;
+  std::size_t discs = 0;          // discs present over all steps
+  std::size_t pairsTested = 0;    // candidate pairs from the spatial hash within reach
+  std::size_t pairsPositive = 0;  // pairs with score > 0
+  std::size_t discsPainted = 0;
+  std::size_t cellsVisited = 0;
+  std::size_t tilesRecomputed = 0;
+};
+
+struct FusionResult {
+  TimeBase time;
+  ProbabilityGrid probability;            // p(M) of def. 3.5 per cell
+  LevelGrid levels;                       // def. 3.6
+  std::vector<double> sceneIndexPerStep;  // eq. (3.7) per step over the allowed pairs
+  double sceneIndex = 0.0;                // max over the steps
+  FusionStats stats;
+};
+
+/// The production fusion: sources (robots, humans) with predicted discs → the per-cell maximum over
+/// pairs and steps of the pair score, its iso-levels and the scene index. Equal cell for cell to
+/// referenceProbabilityGrid on the aligned sources. Pairs are found with a per-step uniform spatial
+/// hash sized by the model's reach, each disc is painted once per step with the largest score of its
+/// pairs, only over the cells of its bounding box. When the time base is unchanged since the last
+/// fuse(), only the tiles an upserted or removed source can influence are recomputed.
+class FusionEngine {
+ public:
+  static Expected<FusionEngine> create(FusionConfig config, std::shared_ptr<const RiskModel> model);
+
+  /// Adds or replaces the source with this id after validateSource (now_ns enables the timestamp check).
+  Expected<void> upsert(Source source, std::optional<std::int64_t> now_ns = std::nullopt);
+  /// Removes a source; false when the id is unknown.
+  bool remove(std::string_view id);
+  /// Removes every source whose t0 is older than cutoff_ns; returns how many.
+  std::size_t removeOlderThan(std::int64_t cutoff_ns);
+  [[nodiscard]] std::size_t sourceCount() const { return sources_.size(); }
+  [[nodiscard]] bool contains(std::string_view id) const;
+
+  /// Fuses every source onto the time base starting at t_ref_ns. The reference stays valid until the
+  /// next call.
+  const FusionResult& fuse(std::int64_t t_ref_ns);
+  [[nodiscard]] const FusionResult& result() const { return result_; }
+
+  /// The sources as aligned for the last fuse(), in a fixed order (for the reference and tests).
+  [[nodiscard]] std::vector<AlignedSource> alignedSources() const;
+  [[nodiscard]] const FusionConfig& config() const { return config_; }
+  [[nodiscard]] const RiskModel& model() const { return *model_; }
+
+ private:
+  struct Entry {
+    Source source;
+    AlignedSource aligned;  // on result_.time, valid when alignedFor == result_.time
+    TimeBase alignedFor{};
+    bool hasAligned = false;
+  };
+  struct StepDisc {
+    Disc disc;
+    std::uint32_t source;  // index into the current entry order
+    SourceKind kind;
+    double reach;
+  };
+
+  FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model);
+  void noteChanged(const AlignedSource& aligned);
+  void markDirtyTiles(double maxReach);
+  void recompute(bool full);
+  void paintDisc(const Disc& d, double p);
+  void buildHash(const std::vector<StepDisc>& discs);
+
+  FusionConfig config_;
+  std::shared_ptr<const RiskModel> model_;
+  std::unordered_map<std::string, Entry> sources_;
+  FusionResult result_;
+  bool haveResult_ = false;
+  std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
+  std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
+  int tilesX_ = 0;
+  int tilesY_ = 0;
+  // scratch, kept between calls to avoid reallocation
+  std::vector<std::vector<StepDisc>> stepDiscs_;
+  std::vector<double> discMax_;
+  std::vector<std::uint8_t> active_;
+  std::vector<std::uint32_t> bucketStart_;
+  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> bucketOf_;
+  double bucketMinX_ = 0.0;
+  double bucketMinY_ = 0.0;
+  double bucketSize_ = 1.0;
+  int bucketsX_ = 0;
+  int bucketsY_ = 0;
+};
+
+}  // namespace fleet::risk

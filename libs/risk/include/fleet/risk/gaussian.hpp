@@ -1,0 +1,46 @@
+#pragma once
+
+#include "fleet/core/vec2.hpp"
+#include "fleet/risk/disc.hpp"
+#include "fleet/risk/risk_model.hpp"
+
+namespace fleet::risk {
+
+/// Symmetric 2×2 covariance [[xx, xy], [xy, yy]] (m²).
+struct Cov2 {
+  double xx = 0.0;
+  double xy = 0.0;
+  double yy = 0.0;
+};
+
+/// P(‖x‖ ≤ R) for x ~ N(μ, σ² I) with ‖μ‖ = d: the noncentral χ² (k = 2) CDF at R²/σ² with
+/// λ = d²/σ², i.e. 1 − Q₁(d/σ, R/σ). Exact up to ~1e-15 absolute (Poisson-mixture series summed
+/// downwards so every addition is of positive terms). sigma = 0 gives the indicator d < R.
+double gaussianCollisionProbability(double d, double R, double sigma);
+
+/// P(‖x‖ ≤ R) for x ~ N(mean, cov) (anisotropic): Foster-style polar quadrature around the disc centre,
+/// with the radial integral done in closed form (exp/erf) and the periodic angular integral by the
+/// trapezoid rule. thetaSteps = 0 picks a step count from the shape of the Gaussian. A singular or
+/// non-positive covariance falls back to the isotropic formula with the largest standard deviation.
+double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int thetaSteps = 0);
+
+/// Probability that two discs with independent Gaussian centre errors (isotropic, each disc's sigma)
+/// overlap: relative position ~ N(μa − μb, (σa² + σb²) I), collision iff ‖x‖ ≤ ra + rb.
+/// Values below `floor` are reported as 0 so that culling pairs farther than cullDistance (where the
+/// tail bound exp(−(d−R)²/(2σ²)) < floor) changes nothing.
+class Gaussian final : public RiskModel {
+ public:
+  explicit Gaussian(double floor = 1e-4);
+
+  [[nodiscard]] double pair(const Disc& a, const Disc& b) const override;
+  [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
+  [[nodiscard]] double reach(const Disc& a) const override;
+  [[nodiscard]] std::string_view name() const override { return "gaussian"; }
+  [[nodiscard]] double floor() const { return floor_; }
+
+ private:
+  double floor_;
+  double tailSigmas_;  // sqrt(2 ln(1/floor)), slightly padded
+};
+
+}  // namespace fleet::risk

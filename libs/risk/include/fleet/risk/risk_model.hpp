@@ -1,0 +1,28 @@
+#pragma once
+
+#include <string_view>
+
+#include "fleet/risk/disc.hpp"
+
+namespace fleet::risk {
+
+/// Probability-like score that two discs collide at one time step. Implementations are pure and
+/// thread-compatible (const methods, no hidden state).
+class RiskModel {
+ public:
+  virtual ~RiskModel() = default;
+
+  /// Score in [0, 1], symmetric in its arguments.
+  [[nodiscard]] virtual double pair(const Disc& a, const Disc& b) const = 0;
+
+  /// Centre distance at and beyond which pair(a, b) is exactly 0, so culling beyond it changes nothing.
+  [[nodiscard]] virtual double cullDistance(const Disc& a, const Disc& b) const = 0;
+
+  /// Per-disc reach with reach(a) + reach(b) >= cullDistance(a, b) for every pair, so a spatial hash
+  /// can find all candidate partners of a disc without knowing them first.
+  [[nodiscard]] virtual double reach(const Disc& a) const = 0;
+
+  [[nodiscard]] virtual std::string_view name() const = 0;
+};
+
+}  // namespace fleet::risk

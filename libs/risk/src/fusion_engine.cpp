@@ -1,0 +1,431 @@
+#include "fleet/risk/fusion_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "fleet/risk/overlap_ratio.hpp"
+
+namespace fleet::risk {
+
+Expected<void> validateFusionConfig(const FusionConfig& c) {
+  const GridSpec& g = c.grid;
+  if (!(g.resolution > 0.0) || !std::isfinite(g.resolution) || !std::isfinite(g.originX) ||
+      !std::isfinite(g.originY) || g.width <= 0 || g.height <= 0 ||
+      static_cast<double>(g.width) * static_cast<double>(g.height) > 1e9) {
+    return unexpected("bad_grid", "grid needs a positive finite resolution and 1..1e9 cells");
+  }
+  if (c.levels < 1 || c.levels > kMaxLevels) {
+    return unexpected("bad_levels", "levels K must be in 1.." + std::to_string(kMaxLevels));
+  }
+  if (!(c.dt > 0.0) || !std::isfinite(c.dt) || c.steps < 1 || c.steps > 10000) {
+    return unexpected("bad_time_base", "fusion needs dt > 0 and 1..10000 steps");
+  }
+  if (c.tileSize < 1 || c.tileSize > 4096) {
+    return unexpected("bad_tile", "tile size must be in 1..4096 cells");
+  }
+  return {};
+}
+
+Expected<FusionEngine> FusionEngine::create(FusionConfig config, std::shared_ptr<const RiskModel> model) {
+  if (auto ok = validateFusionConfig(config); !ok) {
+    return unexpected(ok.error());
+  }
+  if (!model) {
+    return unexpected("no_model", "fusion engine needs a risk model");
+  }
+  return FusionEngine(std::move(config), std::move(model));
+}
+
+FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model)
+    : config_(std::move(config)), model_(std::move(model)) {
+  const GridSpec& g = config_.grid;
+  tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
+  tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
+  dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
+  result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
+  result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
+  result_.time = TimeBase{0, config_.dt, config_.steps};
+}
+
+bool FusionEngine::contains(std::string_view id) const {
+  return sources_.find(std::string(id)) != sources_.end();
+}
+
+void FusionEngine::noteChanged(const AlignedSource& aligned) {
+  for (const auto& d : aligned.steps) {
+    if (d.has_value()) {
+      pendingDirty_.push_back(*d);
+    }
+  }
+}
+
+Expected<void> FusionEngine::upsert(Source source, std::optional<std::int64_t> now_ns) {
+  if (auto ok = validateSource(source, config_.limits, now_ns); !ok) {
+    return ok;
+  }
+  auto it = sources_.find(source.id);
+  if (it == sources_.end()) {
+    it = sources_.emplace(source.id, Entry{}).first;
+  } else if (it->second.hasAligned && haveResult_) {
+    noteChanged(it->second.aligned);
+  }
+  Entry& e = it->second;
+  e.source = std::move(source);
+  if (haveResult_) {
+    e.aligned = alignSource(e.source, result_.time);
+    e.alignedFor = result_.time;
+    e.hasAligned = true;
+    noteChanged(e.aligned);
+  } else {
+    e.hasAligned = false;
+  }
+  return {};
+}
+
+bool FusionEngine::remove(std::string_view id) {
+  auto it = sources_.find(std::string(id));
+  if (it == sources_.end()) {
+    return false;
+  }
+  if (it->second.hasAligned && haveResult_) {
+    noteChanged(it->second.aligned);
+  }
+  sources_.erase(it);
+  return true;
+}
+
+std::size_t FusionEngine::removeOlderThan(std::int64_t cutoff_ns) {
+  std::vector<std::string> stale;
+  for (const auto& [id, e] : sources_) {
+    if (e.source.t0_ns < cutoff_ns) {
+      stale.push_back(id);
+    }
+  }
+  for (const auto& id : stale) {
+    remove(id);
+  }
+  return stale.size();
+}
+
+std::vector<AlignedSource> FusionEngine::alignedSources() const {
+  std::vector<const Entry*> entries;
+  for (const auto& [id, e] : sources_) {
+    entries.push_back(&e);
+  }
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry* a, const Entry* b) { return a->source.id < b->source.id; });
+  std::vector<AlignedSource> out;
+  for (const Entry* e : entries) {
+    out.push_back(e->hasAligned && e->alignedFor == result_.time ? e->aligned
+                                                                 : alignSource(e->source, result_.time));
+  }
+  return out;
+}
+
+void FusionEngine::markDirtyTiles(double maxReach) {
+  const GridSpec& g = config_.grid;
+  const double tileM = g.resolution * config_.tileSize;
+  for (const Disc& d : pendingDirty_) {
+    // A changed disc a influences its own cells and those of every partner b within
+    // reach(a) + reach(b), whose disc extends r_b <= reach(b) further.
+    const double m = model_->reach(d) + 2.0 * maxReach + g.resolution;
+    const int tx0 = std::max(0, static_cast<int>(std::floor((d.x - m - g.originX) / tileM)));
+    const int tx1 = std::min(tilesX_ - 1, static_cast<int>(std::floor((d.x + m - g.originX) / tileM)));
+    const int ty0 = std::max(0, static_cast<int>(std::floor((d.y - m - g.originY) / tileM)));
+    const int ty1 = std::min(tilesY_ - 1, static_cast<int>(std::floor((d.y + m - g.originY) / tileM)));
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        dirtyTiles_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tilesX_) +
+                    static_cast<std::size_t>(tx)] = 1;
+      }
+    }
+  }
+  pendingDirty_.clear();
+}
+
+const FusionResult& FusionEngine::fuse(std::int64_t t_ref_ns) {
+  const TimeBase base{t_ref_ns, config_.dt, config_.steps};
+  const bool full = !haveResult_ || !(base == result_.time);
+  result_.time = base;
+  for (auto& [id, e] : sources_) {
+    if (!e.hasAligned || !(e.alignedFor == base)) {
+      e.aligned = alignSource(e.source, base);
+      e.alignedFor = base;
+      e.hasAligned = true;
+    }
+  }
+  recompute(full);
+  haveResult_ = true;
+  return result_;
+}
+
+void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
+  // Uniform buckets of side >= the largest reach sum, over the bounding box of the centres, filled by
+  // counting sort: every partner of a disc lies in its own or one of the 8 neighbouring buckets.
+  double minX = discs[0].disc.x, maxX = minX, minY = discs[0].disc.y, maxY = minY, maxR = 0.0;
+  for (const auto& s : discs) {
+    minX = std::min(minX, s.disc.x);
+    maxX = std::max(maxX, s.disc.x);
+    minY = std::min(minY, s.disc.y);
+    maxY = std::max(maxY, s.disc.y);
+    maxR = std::max(maxR, s.reach);
+  }
+  double size = std::max(2.0 * maxR, 1e-6);
+  const double cap = 4.0 * static_cast<double>(discs.size()) + 64.0;
+  double nx = std::floor((maxX - minX) / size) + 1.0;
+  double ny = std::floor((maxY - minY) / size) + 1.0;
+  if (nx * ny > cap) {
+    size *= std::sqrt(nx * ny / cap) * 1.01;
+    nx = std::floor((maxX - minX) / size) + 1.0;
+    ny = std::floor((maxY - minY) / size) + 1.0;
+  }
+  bucketMinX_ = minX;
+  bucketMinY_ = minY;
+  bucketSize_ = size;
+  bucketsX_ = static_cast<int>(nx);
+  bucketsY_ = static_cast<int>(ny);
+  const std::size_t nb = static_cast<std::size_t>(bucketsX_) * static_cast<std::size_t>(bucketsY_);
+  bucketStart_.assign(nb + 1, 0);
+  bucketOf_.resize(discs.size());
+  for (std::size_t i = 0; i < discs.size(); ++i) {
+    const int bx = std::min(bucketsX_ - 1, static_cast<int>((discs[i].disc.x - minX) / size));
+    const int by = std::min(bucketsY_ - 1, static_cast<int>((discs[i].disc.y - minY) / size));
+    bucketOf_[i] = static_cast<std::uint32_t>(by * bucketsX_ + bx);
+    ++bucketStart_[bucketOf_[i] + 1];
+  }
+  for (std::size_t b = 0; b < nb; ++b) {
+    bucketStart_[b + 1] += bucketStart_[b];
+  }
+  order_.resize(discs.size());
+  std::vector<std::uint32_t> fill(bucketStart_.begin(), bucketStart_.end() - 1);
+  for (std::size_t i = 0; i < discs.size(); ++i) {
+    order_[fill[bucketOf_[i]]++] = static_cast<std::uint32_t>(i);
+  }
+}
+
+void FusionEngine::paintDisc(const Disc& d, double p) {
+  const GridSpec& g = config_.grid;
+  auto& P = result_.probability.p;
+  // Bounding box of the cell centres that can be inside, padded by one cell against rounding; the exact
+  // test cellInsideDisc decides, as in the reference.
+  const int i0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / g.resolution - 0.5)) - 1);
+  const int i1 =
+      std::min(g.width - 1, static_cast<int>(std::ceil((d.x + d.r - g.originX) / g.resolution - 0.5)) + 1);
+  const int j0 = std::max(0, static_cast<int>(std::floor((d.y - d.r - g.originY) / g.resolution - 0.5)) - 1);
+  const int j1 =
+      std::min(g.height - 1, static_cast<int>(std::ceil((d.y + d.r - g.originY) / g.resolution - 0.5)) + 1);
+  if (i0 > i1 || j0 > j1) {
+    return;
+  }
+  const int ts = config_.tileSize;
+  std::size_t visited = 0;
+  for (int j = j0; j <= j1; ++j) {
+    const double cy = g.cellCentreY(j);
+    const std::size_t tileRow = static_cast<std::size_t>(j / ts) * static_cast<std::size_t>(tilesX_);
+    for (int tx = i0 / ts; tx <= i1 / ts; ++tx) {
+      if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
+        continue;
+      }
+      const int a = std::max(i0, tx * ts);
+      const int b = std::min(i1, tx * ts + ts - 1);
+      double* row = P.data() + g.index(0, j);
+      for (int i = a; i <= b; ++i) {
+        if (cellInsideDisc(g.cellCentreX(i), cy, d)) {
+          row[i] = std::max(row[i], p);
+        }
+      }
+      visited += static_cast<std::size_t>(b - a + 1);
+    }
+  }
+  result_.stats.cellsVisited += visited;
+}
+
+void FusionEngine::recompute(bool full) {
+  const GridSpec& g = config_.grid;
+  const int steps = config_.steps;
+  FusionStats stats;
+  stats.fullRecompute = full;
+  result_.stats = stats;
+
+  // Entries in id order so the per-step disc order is deterministic.
+  std::vector<const Entry*> entries;
+  entries.reserve(sources_.size());
+  for (const auto& [id, e] : sources_) {
+    entries.push_back(&e);
+  }
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry* a, const Entry* b) { return a->source.id < b->source.id; });
+
+  stepDiscs_.resize(static_cast<std::size_t>(steps));
+  double maxReach = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    auto& list = stepDiscs_[static_cast<std::size_t>(k)];
+    list.clear();
+    for (std::size_t s = 0; s < entries.size(); ++s) {
+      const auto& slot = entries[s]->aligned.steps[static_cast<std::size_t>(k)];
+      if (slot.has_value()) {
+        const double reach = model_->reach(*slot);
+        maxReach = std::max(maxReach, reach);
+        list.push_back(StepDisc{*slot, static_cast<std::uint32_t>(s), entries[s]->source.kind, reach});
+      }
+    }
+    result_.stats.discs += list.size();
+  }
+  for (const Disc& d : pendingDirty_) {
+    maxReach = std::max(maxReach, model_->reach(d));
+  }
+
+  if (full) {
+    std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
+    pendingDirty_.clear();
+    std::fill(result_.probability.p.begin(), result_.probability.p.end(), 0.0);
+  } else {
+    markDirtyTiles(maxReach);
+    const int ts = config_.tileSize;
+    for (int ty = 0; ty < tilesY_; ++ty) {
+      for (int tx = 0; tx < tilesX_; ++tx) {
+        if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
+          continue;
+        }
+        for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
+          double* row = result_.probability.p.data() + g.index(0, j);
+          std::fill(row + tx * ts, row + std::min(g.width, tx * ts + ts), 0.0);
+        }
+      }
+    }
+  }
+  for (auto t : dirtyTiles_) {
+    result_.stats.tilesRecomputed += t;
+  }
+
+  const double tileM = g.resolution * config_.tileSize;
+  auto touchesDirty = [&](const Disc& d) {
+    const int tx0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / tileM - 1e-9)));
+    const int tx1 =
+        std::min(tilesX_ - 1, static_cast<int>(std::floor((d.x + d.r - g.originX) / tileM + 1e-9)));
+    const int ty0 = std::max(0, static_cast<int>(std::floor((d.y - d.r - g.originY) / tileM - 1e-9)));
+    const int ty1 =
+        std::min(tilesY_ - 1, static_cast<int>(std::floor((d.y + d.r - g.originY) / tileM + 1e-9)));
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] != 0) {
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+
+  result_.sceneIndexPerStep.assign(static_cast<std::size_t>(steps), 0.0);
+  const PairPolicy& policy = config_.policy;
+  for (int k = 0; k < steps; ++k) {
+    const auto& list = stepDiscs_[static_cast<std::size_t>(k)];
+    if (list.empty()) {
+      continue;
+    }
+    discMax_.assign(list.size(), 0.0);
+    active_.resize(list.size());
+    double areaAll = 0.0;
+    double areaHumans = 0.0;
+    std::size_t humans = 0;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      active_[i] = touchesDirty(list[i].disc) ? 1 : 0;
+      const double a = std::numbers::pi * list[i].disc.r * list[i].disc.r;
+      areaAll += a;
+      if (list[i].kind == SourceKind::kHuman) {
+        areaHumans += a;
+        ++humans;
+      }
+    }
+    buildHash(list);
+    double interSum = 0.0;
+    auto visitPair = [&](std::uint32_t i, std::uint32_t j) {
+      const StepDisc& a = list[i];
+      const StepDisc& b = list[j];
+      const double dx = a.disc.x - b.disc.x;
+      const double dy = a.disc.y - b.disc.y;
+      const double reachSum = a.reach + b.reach;
+      if (dx * dx + dy * dy >= reachSum * reachSum || !pairAllowed(a.kind, b.kind, policy)) {
+        return;
+      }
+      ++result_.stats.pairsTested;
+      const double d = centreDistance(a.disc, b.disc);
+      interSum += discIntersectionArea(a.disc.r, b.disc.r, d);
+      if (active_[i] == 0 && active_[j] == 0) {
+        return;
+      }
+      const double p = model_->pair(a.disc, b.disc);
+      if (p > 0.0) {
+        ++result_.stats.pairsPositive;
+        discMax_[i] = std::max(discMax_[i], p);
+        discMax_[j] = std::max(discMax_[j], p);
+      }
+    };
+    for (int by = 0; by < bucketsY_; ++by) {
+      for (int bx = 0; bx < bucketsX_; ++bx) {
+        const std::size_t b = static_cast<std::size_t>(by * bucketsX_ + bx);
+        for (std::uint32_t u = bucketStart_[b]; u < bucketStart_[b + 1]; ++u) {
+          const std::uint32_t i = order_[u];
+          for (std::uint32_t v = u + 1; v < bucketStart_[b + 1]; ++v) {
+            visitPair(i, order_[v]);
+          }
+          // Forward half of the 8-neighbourhood, so every pair of buckets is visited once.
+          constexpr int kNeighbours[4][2] = {{1, -1}, {1, 0}, {1, 1}, {0, 1}};
+          for (const auto& nb : kNeighbours) {
+            const int nx = bx + nb[0];
+            const int ny = by + nb[1];
+            if (nx < 0 || ny < 0 || nx >= bucketsX_ || ny >= bucketsY_) {
+              continue;
+            }
+            const std::size_t c = static_cast<std::size_t>(ny * bucketsX_ + nx);
+            for (std::uint32_t v = bucketStart_[c]; v < bucketStart_[c + 1]; ++v) {
+              visitPair(i, order_[v]);
+            }
+          }
+        }
+      }
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (active_[i] != 0 && discMax_[i] > 0.0) {
+        ++result_.stats.discsPainted;
+        paintDisc(list[i].disc, discMax_[i]);
+      }
+    }
+    // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
+    // = (n − 1)·ΣA over all pairs, minus (h − 1)·ΣA_humans for the human–human pairs when skipped.
+    const double n = static_cast<double>(list.size());
+    double pairAreas = (n - 1.0) * areaAll;
+    if (!policy.humanHuman && humans > 0) {
+      pairAreas -= (static_cast<double>(humans) - 1.0) * areaHumans;
+    }
+    const double den = pairAreas - interSum;
+    result_.sceneIndexPerStep[static_cast<std::size_t>(k)] =
+        den > 0.0 ? std::clamp(interSum / den, 0.0, 1.0) : 0.0;
+  }
+  result_.sceneIndex = 0.0;
+  for (double s : result_.sceneIndexPerStep) {
+    result_.sceneIndex = std::max(result_.sceneIndex, s);
+  }
+
+  // Levels of the recomputed tiles.
+  const int ts = config_.tileSize;
+  for (int ty = 0; ty < tilesY_; ++ty) {
+    for (int tx = 0; tx < tilesX_; ++tx) {
+      if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
+        continue;
+      }
+      for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
+        for (int i = tx * ts; i < std::min(g.width, tx * ts + ts); ++i) {
+          const std::size_t idx = g.index(i, j);
+          result_.levels.level[idx] =
+              static_cast<std::uint8_t>(isoLevel(result_.probability.p[idx], config_.levels));
+        }
+      }
+    }
+  }
+  std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 0);
+}
+
+}  // namespace fleet::risk

@@ -1,0 +1,181 @@
+#include "fleet/risk/regions.hpp"
+
+#include <algorithm>
+#include <cstdint>
+
+namespace fleet::risk {
+namespace {
+
+// Directions of boundary edges: +x, +y, −x, −y. A left turn is (d + 1) % 4.
+constexpr int kDx[4] = {1, 0, -1, 0};
+constexpr int kDy[4] = {0, 1, 0, -1};
+
+struct Edge {
+  std::uint32_t from;  // vertex id j·(W+1) + i
+  std::uint8_t dir;
+  bool used;
+};
+
+}  // namespace
+
+double signedArea(const Ring& ring) {
+  double a = 0.0;
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Vec2& p = ring[k];
+    const Vec2& q = ring[(k + 1) % ring.size()];
+    a += p.cross(q);
+  }
+  return 0.5 * a;
+}
+
+namespace {
+bool ringContains(const Ring& ring, Vec2 pt) {
+  bool in = false;
+  for (std::size_t k = 0, m = ring.size() - 1; k < ring.size(); m = k++) {
+    const Vec2& a = ring[k];
+    const Vec2& b = ring[m];
+    if ((a.y > pt.y) != (b.y > pt.y) && pt.x < (b.x - a.x) * (pt.y - a.y) / (b.y - a.y) + a.x) {
+      in = !in;
+    }
+  }
+  return in;
+}
+}  // namespace
+
+bool regionContains(const Region& region, Vec2 point) {
+  if (region.outer.empty() || !ringContains(region.outer, point)) {
+    return false;
+  }
+  return std::none_of(region.holes.begin(), region.holes.end(),
+                      [&](const Ring& h) { return ringContains(h, point); });
+}
+
+std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
+  const GridSpec& g = grid.spec;
+  const int W = g.width;
+  const int H = g.height;
+  std::vector<Region> regions;
+  if (W <= 0 || H <= 0 || grid.level.size() != g.cellCount()) {
+    return regions;
+  }
+  const std::uint32_t VW = static_cast<std::uint32_t>(W) + 1;
+  std::vector<std::int32_t> label(g.cellCount(), -1);
+  // Outgoing boundary edges per vertex (at most two, at a saddle), reset after each component.
+  std::vector<std::int32_t> out0(static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1), -1);
+  std::vector<std::int32_t> out1(out0.size(), -1);
+  std::vector<std::uint32_t> stack;
+  std::vector<std::uint32_t> members;
+  std::vector<Edge> edges;
+
+  for (std::size_t seed = 0; seed < grid.level.size(); ++seed) {
+    const int lvl = grid.level[seed];
+    if (lvl < minLevel || label[seed] >= 0) {
+      continue;
+    }
+    const auto id = static_cast<std::int32_t>(regions.size());
+    // Flood fill (4-neighbour) of the component.
+    members.clear();
+    stack.assign(1, static_cast<std::uint32_t>(seed));
+    label[seed] = id;
+    while (!stack.empty()) {
+      const std::uint32_t c = stack.back();
+      stack.pop_back();
+      members.push_back(c);
+      const int i = static_cast<int>(c % static_cast<std::uint32_t>(W));
+      const int j = static_cast<int>(c / static_cast<std::uint32_t>(W));
+      const int ni[4] = {i + 1, i - 1, i, i};
+      const int nj[4] = {j, j, j + 1, j - 1};
+      for (int n = 0; n < 4; ++n) {
+        if (ni[n] < 0 || nj[n] < 0 || ni[n] >= W || nj[n] >= H) {
+          continue;
+        }
+        const std::size_t nc = g.index(ni[n], nj[n]);
+        if (label[nc] < 0 && grid.level[nc] == lvl) {
+          label[nc] = id;
+          stack.push_back(static_cast<std::uint32_t>(nc));
+        }
+      }
+    }
+    // Boundary edges with the component on their left.
+    edges.clear();
+    auto inComp = [&](int i, int j) {
+      return i >= 0 && j >= 0 && i < W && j < H && label[g.index(i, j)] == id;
+    };
+    auto vid = [&](int i, int j) {
+      return static_cast<std::uint32_t>(j) * VW + static_cast<std::uint32_t>(i);
+    };
+    auto addEdge = [&](std::uint32_t from, std::uint8_t dir) {
+      const auto e = static_cast<std::int32_t>(edges.size());
+      edges.push_back(Edge{from, dir, false});
+      (out0[from] < 0 ? out0[from] : out1[from]) = e;
+    };
+    for (std::uint32_t c : members) {
+      const int i = static_cast<int>(c % static_cast<std::uint32_t>(W));
+      const int j = static_cast<int>(c / static_cast<std::uint32_t>(W));
+      if (!inComp(i, j - 1))
+        addEdge(vid(i, j), 0);
+      if (!inComp(i + 1, j))
+        addEdge(vid(i + 1, j), 1);
+      if (!inComp(i, j + 1))
+        addEdge(vid(i + 1, j + 1), 2);
+      if (!inComp(i - 1, j))
+        addEdge(vid(i, j + 1), 3);
+    }
+    Region region;
+    region.level = lvl;
+    region.cells = members.size();
+    for (std::size_t start = 0; start < edges.size(); ++start) {
+      if (edges[start].used) {
+        continue;
+      }
+      Ring ring;
+      std::size_t e = start;
+      int prevDir = -1;
+      while (!edges[e].used) {
+        edges[e].used = true;
+        const int dir = edges[e].dir;
+        const std::uint32_t from = edges[e].from;
+        if (dir != prevDir) {  // keep corners only
+          ring.push_back(Vec2{g.originX + static_cast<double>(from % VW) * g.resolution,
+                              g.originY + static_cast<double>(from / VW) * g.resolution});
+        }
+        prevDir = dir;
+        const std::uint32_t to = from + static_cast<std::uint32_t>(kDx[dir]) +
+                                 static_cast<std::uint32_t>(kDy[dir]) * VW;  // unsigned wrap is intended
+        const std::int32_t a = out0[to];
+        const std::int32_t b = out1[to];
+        std::int32_t next = a;
+        if (b >= 0) {
+          // Saddle: turn left, hugging the current cell, so diagonal neighbours stay apart.
+          next = edges[static_cast<std::size_t>(a)].dir == (dir + 1) % 4 ? a : b;
+          if (edges[static_cast<std::size_t>(next)].used) {
+            next = next == a ? b : a;
+          }
+        }
+        if (next < 0) {
+          break;
+        }
+        e = static_cast<std::size_t>(next);
+      }
+      // The start vertex is a corner unless the ring closed going straight through it.
+      if (ring.size() > 1 && edges[start].dir == prevDir) {
+        ring.erase(ring.begin());
+      }
+      if (signedArea(ring) > 0.0) {
+        region.outer = std::move(ring);
+      } else {
+        region.holes.push_back(std::move(ring));
+      }
+    }
+    for (const auto& e : edges) {
+      out0[e.from] = -1;
+      out1[e.from] = -1;
+    }
+    regions.push_back(std::move(region));
+  }
+  std::stable_sort(regions.begin(), regions.end(),
+                   [](const Region& a, const Region& b) { return a.level < b.level; });
+  return regions;
+}
+
+}  // namespace fleet::risk
