@@ -1,0 +1,142 @@
+// risk_map: fuses every source's PredictedDiscs into the collision-probability iso-level map and
+// publishes RiskMap at a fixed rate. See docs/operator-guide.md for the configuration keys.
+
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+
+#include "fleet/core/clock.hpp"
+#include "fleet/core/logging.hpp"
+#include "fleet/service/runtime.hpp"
+#include "fleet/transport/dds.hpp"
+#include "risk_map_node.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+
+namespace {
+
+int run(const riskmap::Settings& settings, const std::string& id) {
+  auto created = riskmap::RiskMapNode::create(settings);
+  if (!created) {
+    spdlog::critical("risk map: {}", created.error().message);
+    return 2;
+  }
+  auto& node = *created;
+  transport::Participant p;
+  transport::Reader<msg::PredictedDiscs> discs(p);
+  transport::Writer<msg::RiskMap> out(p);
+  transport::Reader<msg::Clock> clockIn(p);
+  transport::Writer<msg::StepDone> stepDone(p);
+  transport::WaitSet ws(p);
+  ws.attach(discs);
+  ws.attach(clockIn);
+  service::RateLimitedLog badInput;
+  WallClock wall;
+  const bool simClock = settings.clock == "sim";
+  std::int64_t now = simClock ? 0 : wall.nowNs();
+  bool haveClock = !simClock;
+  const std::int64_t period = secToNs(1.0 / settings.rateHz);
+  std::int64_t nextFuse = now;
+  auto lastRegister = std::chrono::steady_clock::now() - 10s;
+  auto lastStats = std::chrono::steady_clock::now();
+  std::uint64_t published = 0;
+  spdlog::info("risk map: {}x{} cells at {} m, K={}, horizon {} x {} s, model {}, {} Hz, clock {}",
+               settings.fusion.grid.width, settings.fusion.grid.height, settings.fusion.grid.resolution,
+               settings.fusion.levels, settings.fusion.steps, settings.fusion.dt, settings.model,
+               settings.rateHz, settings.clock);
+
+  auto ingest = [&] {
+    for (const auto& m : discs.take()) {
+      if (!haveClock) {
+        continue;
+      }
+      auto ok = node.accept(m, now);
+      if (!ok) {
+        badInput.warn(ok.error().code,
+                      "dropped PredictedDiscs from \"" + m.source_id + "\": " + ok.error().message);
+      }
+    }
+  };
+  auto publish = [&] {
+    out.write(node.fuse(now));
+    ++published;
+  };
+
+  while (!service::stopRequested()) {
+    if (settings.lockstep && !haveClock && std::chrono::steady_clock::now() - lastRegister > 1s) {
+      stepDone.write({id, msg::StepDone::kRegister});
+      lastRegister = std::chrono::steady_clock::now();
+    }
+    const auto wait =
+        simClock
+            ? 100ms
+            : std::chrono::milliseconds(std::max<std::int64_t>(0, (nextFuse - wall.nowNs()) / 1'000'000));
+    ws.wait(wait);
+    if (simClock) {
+      for (const auto& c : clockIn.take()) {
+        now = c.sim_time_ns;
+        if (!haveClock) {
+          nextFuse = now;
+          haveClock = true;
+        }
+        ingest();
+        if (now >= nextFuse) {
+          publish();
+          nextFuse += period * std::max<std::int64_t>(1, (now - nextFuse) / period + 1);
+        }
+        if (settings.lockstep && c.lockstep) {
+          stepDone.write({id, c.step});
+        }
+      }
+      ingest();
+    } else {
+      now = wall.nowNs();
+      ingest();
+      if (now >= nextFuse) {
+        publish();
+        nextFuse = std::max(nextFuse + period, now);
+      }
+    }
+    if (std::chrono::steady_clock::now() - lastStats > 10s) {
+      spdlog::info(
+          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected, {} stale dropped",
+          node.sources(), published, node.accepted(), node.rejected(), node.dropped_stale());
+      lastStats = std::chrono::steady_clock::now();
+    }
+  }
+  if (settings.lockstep) {
+    stepDone.write({id, msg::StepDone::kLeave});
+  }
+  spdlog::info("risk map: stopped after {} maps", published);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"risk_map: collision-probability iso-level map service"};
+  std::string configPath;
+  std::string level = "info";
+  std::string id = "risk_map";
+  app.add_option("-c,--config", configPath, "JSON configuration file");
+  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  app.add_option("--id", id, "participant id in lockstep");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    logging::setup("risk_map", level);
+    Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
+                                    : Config::fromFile(configPath);
+    const auto settings = riskmap::readSettings(cfg);
+    cfg.finish();
+    service::installStopHandlers();
+    return run(settings, id);
+  } catch (const ConfigError& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::critical("risk map: {}", e.what());
+    return 1;
+  }
+}
