@@ -1,0 +1,118 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fleet/core/expected.hpp"
+#include "fleet/fleet/allocator.hpp"
+#include "fleet/fleet/robot_registry.hpp"
+#include "fleet/fleet/station_map.hpp"
+#include "fleet/fleet/task_store.hpp"
+
+namespace fleet {
+
+struct DispatcherConfig {
+  AllocationPolicy policy;
+  std::int32_t maxAttempts = 3;  ///< a task that failed this many assignments is failed for good
+  std::int64_t leaseNs = 1'000'000'000;
+  /// Above this many task×robot pairs a tick uses the greedy allocator instead of the Hungarian one.
+  std::size_t hungarianMaxPairs = 2'000'000;
+};
+
+/// A state change to publish as `TaskEvent`.
+struct TaskEvent {
+  std::string taskId;
+  TaskState state = TaskState::Queued;
+  std::string robotId;
+  std::string reason;
+  std::int64_t stampNs = 0;
+};
+
+/// A task a robot must now execute (publish as `TaskAssignment`, key robot_id).
+struct AssignmentOrder {
+  std::string robotId;
+  Task task;
+  std::int64_t revision = 0;  ///< the task record's revision: newer orders supersede older ones
+};
+
+/// What a call changed; the service publishes it. Everything in it is already committed.
+struct DispatchResult {
+  std::vector<AssignmentOrder> assignments;
+  std::vector<std::string>
+      revoked;  ///< robots whose task was withdrawn (cancelled): publish an empty assignment
+  std::vector<TaskEvent> events;
+  std::vector<Error> errors;  ///< problems that did not stop the call (a store error on one task)
+
+  void append(DispatchResult other);
+};
+
+struct DispatcherCounters {
+  std::int64_t submitted = 0;
+  std::int64_t assigned = 0;
+  std::int64_t done = 0;
+  std::int64_t failed = 0;
+  std::int64_t cancelled = 0;
+  std::int64_t requeued = 0;
+  std::int64_t robotsLost = 0;
+};
+
+/// The fleet manager's logic without DDS: owns the open tasks in memory, the robot registry and
+/// the allocation, and writes every change through the TaskStore before reporting it. Not
+/// thread-safe: the service calls it from one thread (or under one lock).
+class Dispatcher {
+ public:
+  Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg = {});
+
+  /// Rebuilds the open tasks from the store after a restart. Active tasks stay with their robots
+  /// (whose lease starts now) and are returned as assignments to re-publish.
+  Expected<DispatchResult> recover(std::int64_t nowNs);
+
+  /// Validates against the station map and stores durably (one group commit). Per task: the stored
+  /// record, or an error (invalid / unknown_station → 400, conflict → 409, storage → 503).
+  std::vector<Expected<SubmitResult>> submit(const std::vector<Task>& tasks, std::int64_t nowNs,
+                                             DispatchResult* out = nullptr);
+
+  void onRobotState(const RobotObservation& o);
+  /// DDS liveliness lost: the robot's task is requeued at once.
+  DispatchResult onRobotLost(const std::string& robotId, std::int64_t nowNs);
+  /// A robot's report on its task. Intermediate happy-path steps it skipped are filled in; failed
+  /// is turned into requeued while attempts remain. Errors: not_found (unknown or closed task),
+  /// wrong_robot (the robot does not hold it; the service should revoke), illegal_transition.
+  Expected<DispatchResult> onTaskStatus(const std::string& robotId, const std::string& taskId,
+                                        TaskState state, const std::string& reason, std::int64_t nowNs);
+  /// Operator cancel; an active task is withdrawn from its robot.
+  Expected<DispatchResult> cancel(const std::string& taskId, const std::string& reason, std::int64_t nowNs);
+
+  /// Periodic work: expire leases (requeue the lost robots' tasks), send low robots to charge, and
+  /// assign waiting tasks to idle robots.
+  DispatchResult tick(std::int64_t nowNs);
+
+  [[nodiscard]] const RobotRegistry& robots() const { return registry_; }
+  [[nodiscard]] const StationMap& stations() const { return stations_; }
+  [[nodiscard]] const std::map<std::string, TaskRecord, std::less<>>& openTasks() const { return open_; }
+  [[nodiscard]] std::size_t waitingCount() const;
+  [[nodiscard]] std::size_t activeCount() const;
+  [[nodiscard]] const DispatcherCounters& counters() const { return counters_; }
+
+ private:
+  void applied(const TaskRecord& r, DispatchResult& out);
+  void requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason, std::int64_t nowNs,
+                     DispatchResult& out);
+  void chargeLowRobots(std::int64_t nowNs, DispatchResult& out);
+  void allocate(std::int64_t nowNs, DispatchResult& out);
+
+  TaskStore& store_;
+  StationMap stations_;
+  TravelCost travel_;
+  DispatcherConfig cfg_;
+  RobotRegistry registry_;
+  HungarianAllocator hungarian_;
+  GreedyAllocator greedy_;
+  std::map<std::string, TaskRecord, std::less<>> open_;
+  DispatcherCounters counters_;
+};
+
+}  // namespace fleet

@@ -1,0 +1,15 @@
+#pragma once
+
+namespace fleet::errc {
+
+/// `Error::code` values returned by the fleet library, so services can map them to HTTP statuses
+/// (invalid → 400, not_found → 404, conflict → 409, storage → 503).
+inline constexpr const char* kInvalid = "invalid";
+inline constexpr const char* kUnknownStation = "unknown_station";
+inline constexpr const char* kNotFound = "not_found";
+inline constexpr const char* kConflict = "conflict";
+inline constexpr const char* kIllegalTransition = "illegal_transition";
+inline constexpr const char* kStorage = "storage";
+inline constexpr const char* kWrongRobot = "wrong_robot";
+
+}  // namespace fleet::errc

@@ -1,0 +1,90 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fleet/core/expected.hpp"
+#include "fleet/fleet/task.hpp"
+#include "fleet/fleet/task_state.hpp"
+
+namespace fleet {
+
+/// A task with where it stands.
+struct TaskRecord {
+  Task task;
+  TaskState state = TaskState::Queued;
+  std::string robotId;        ///< robot holding the task while active; empty otherwise
+  std::int32_t attempts = 0;  ///< times the task was assigned
+  std::string reason;         ///< reason given with the latest transition
+  std::int64_t updatedNs = 0;
+  std::int64_t revision = 0;  ///< transitions applied; 1 right after submit
+};
+
+/// One row of the append-only transition log. `from` is empty for the submission itself.
+struct TransitionRecord {
+  std::int64_t seq = 0;
+  std::string taskId;
+  std::optional<TaskState> from;
+  TaskState to = TaskState::Queued;
+  std::string robotId;
+  std::string reason;
+  std::int64_t stampNs = 0;
+};
+
+struct SubmitResult {
+  TaskRecord record;
+  bool created = false;  ///< false: the same task was already stored (an idempotent retry)
+};
+
+struct TransitionRequest {
+  std::string taskId;
+  TaskState to = TaskState::Queued;
+  /// Required for `assigned`. For later steps, when given it must match the robot holding the task
+  /// (error "wrong_robot": a report from a robot that no longer holds it); leave empty for
+  /// transitions the manager makes itself (cancel, requeue).
+  std::string robotId;
+  std::string reason;
+  std::int64_t stampNs = 0;
+};
+
+/// Durable tasks: a current-state table and an append-only transition log. Every call that
+/// changes state has committed when it returns. Error codes (fleet/fleet/errors.hpp): conflict
+/// (same id, different body), not_found, illegal_transition, wrong_robot, invalid, storage.
+class TaskStore {
+ public:
+  virtual ~TaskStore() = default;
+
+  /// Stores a new task as queued (created_ns defaults to `stampNs`). The same id with the same
+  /// canonical body returns the stored record with created = false; a different body is a conflict.
+  virtual Expected<SubmitResult> submit(const Task& t, std::int64_t stampNs) = 0;
+  /// Like submit for each task, all in one transaction and one durable commit (group commit).
+  /// Items are independent: a conflict fails that item only. If the commit fails, every item
+  /// fails with "storage" and nothing is stored.
+  virtual std::vector<Expected<SubmitResult>> submitBatch(const std::vector<Task>& tasks,
+                                                          std::int64_t stampNs) = 0;
+
+  /// Applies one legal transition (checkTransition with the task's kind) and logs it.
+  virtual Expected<TaskRecord> transition(const TransitionRequest& r) = 0;
+  Expected<TaskRecord> transition(std::string_view taskId, TaskState to, std::string_view robotId,
+                                  std::string_view reason, std::int64_t stampNs) {
+    return transition(
+        TransitionRequest{std::string(taskId), to, std::string(robotId), std::string(reason), stampNs});
+  }
+  /// Several transitions in one commit; each is checked against the state left by the ones before.
+  virtual std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) = 0;
+
+  virtual Expected<TaskRecord> get(std::string_view id) = 0;
+  /// Tasks in `state` (all when empty) ordered by id, at most `limit`, with ids after `afterId`.
+  virtual Expected<std::vector<TaskRecord>> list(std::optional<TaskState> state, std::size_t limit,
+                                                 std::string_view afterId = {}) = 0;
+  /// Every task not done, failed or cancelled, oldest first: what a restarted manager rebuilds from.
+  virtual Expected<std::vector<TaskRecord>> openTasks() = 0;
+  virtual Expected<std::vector<TransitionRecord>> history(std::string_view id) = 0;
+  virtual Expected<std::map<TaskState, std::int64_t>> countByState() = 0;
+};
+
+}  // namespace fleet

@@ -1,0 +1,351 @@
+#include "fleet/fleet/dispatcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fleet/core/ids.hpp"
+#include "fleet/fleet/errors.hpp"
+
+namespace fleet {
+namespace {
+
+/// Happy path of a task kind, from assigned to done.
+std::vector<TaskState> happyPath(TaskKind kind) {
+  using S = TaskState;
+  if (kind == TaskKind::Transport) {
+    return {S::Assigned, S::EnRoute, S::Loading, S::Delivering, S::Unloading, S::Done};
+  }
+  return {S::Assigned, S::EnRoute, S::Done};
+}
+
+std::string chargeTaskId(const std::string& robot, std::int64_t nowNs) {
+  std::string id = "charge.";
+  id += std::to_string(nowNs);
+  id += '.';
+  if (id.size() + robot.size() <= kMaxIdLength) {
+    id += robot;
+  } else {
+    id += std::to_string(std::hash<std::string>{}(robot));
+  }
+  return id;
+}
+
+}  // namespace
+
+void DispatchResult::append(DispatchResult other) {
+  for (auto& a : other.assignments) {
+    assignments.push_back(std::move(a));
+  }
+  for (auto& r : other.revoked) {
+    revoked.push_back(std::move(r));
+  }
+  for (auto& e : other.events) {
+    events.push_back(std::move(e));
+  }
+  for (auto& e : other.errors) {
+    errors.push_back(std::move(e));
+  }
+}
+
+Dispatcher::Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg)
+    : store_(store),
+      stations_(std::move(stations)),
+      travel_(std::move(travel)),
+      cfg_(cfg),
+      registry_(cfg.leaseNs),
+      hungarian_(cfg.policy),
+      greedy_(cfg.policy) {}
+
+std::size_t Dispatcher::waitingCount() const {
+  return static_cast<std::size_t>(
+      std::count_if(open_.begin(), open_.end(), [](const auto& kv) { return isWaiting(kv.second.state); }));
+}
+
+std::size_t Dispatcher::activeCount() const {
+  return static_cast<std::size_t>(
+      std::count_if(open_.begin(), open_.end(), [](const auto& kv) { return isActive(kv.second.state); }));
+}
+
+void Dispatcher::applied(const TaskRecord& r, DispatchResult& out) {
+  out.events.push_back({r.task.id, r.state, r.robotId, r.reason, r.updatedNs});
+  switch (r.state) {
+    case TaskState::Assigned:
+      ++counters_.assigned;
+      break;
+    case TaskState::Done:
+      ++counters_.done;
+      break;
+    case TaskState::Failed:
+      ++counters_.failed;
+      break;
+    case TaskState::Cancelled:
+      ++counters_.cancelled;
+      break;
+    case TaskState::Requeued:
+      ++counters_.requeued;
+      break;
+    default:
+      break;
+  }
+  if (isTerminal(r.state)) {
+    open_.erase(r.task.id);
+  } else {
+    open_.insert_or_assign(r.task.id, r);
+  }
+}
+
+Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {
+  auto tasks = store_.openTasks();
+  if (!tasks) {
+    return unexpected(tasks.error());
+  }
+  DispatchResult out;
+  open_.clear();
+  for (auto& r : *tasks) {
+    if (isActive(r.state)) {
+      registry_.expect(r.robotId, nowNs);
+      registry_.setTask(r.robotId, r.task.id);
+      out.assignments.push_back({r.robotId, r.task, r.revision});
+    }
+    std::string id = r.task.id;
+    open_.emplace(std::move(id), std::move(r));
+  }
+  return out;
+}
+
+std::vector<Expected<SubmitResult>> Dispatcher::submit(const std::vector<Task>& tasks, std::int64_t nowNs,
+                                                       DispatchResult* out) {
+  std::vector<Expected<SubmitResult>> results;
+  results.reserve(tasks.size());
+  std::vector<Task> valid;
+  std::vector<std::size_t> where;
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    auto errs = validateTask(tasks[i], &stations_);
+    if (!errs.empty()) {
+      const bool station = std::any_of(errs.begin(), errs.end(), [](const FieldError& e) {
+        return e.reason.starts_with("unknown station");
+      });
+      results.emplace_back(unexpected(station ? errc::kUnknownStation : errc::kInvalid,
+                                      makeValidationError(std::move(errs)).message));
+      continue;
+    }
+    results.emplace_back(unexpected(errc::kStorage, "not stored"));
+    valid.push_back(tasks[i]);
+    where.push_back(i);
+  }
+  if (valid.empty()) {
+    return results;
+  }
+  auto stored = store_.submitBatch(valid, nowNs);
+  DispatchResult local;
+  for (std::size_t k = 0; k < stored.size(); ++k) {
+    if (stored[k] && stored[k]->created) {
+      ++counters_.submitted;
+      applied(stored[k]->record, local);
+    }
+    results[where[k]] = std::move(stored[k]);
+  }
+  if (out != nullptr) {
+    out->append(std::move(local));
+  }
+  return results;
+}
+
+void Dispatcher::onRobotState(const RobotObservation& o) {
+  registry_.observe(o);
+}
+
+void Dispatcher::requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason,
+                               std::int64_t nowNs, DispatchResult& out) {
+  const bool giveUp = failedByRobot && r.attempts >= cfg_.maxAttempts;
+  const TaskState to = giveUp ? TaskState::Failed : TaskState::Requeued;
+  const std::string robot = r.robotId;
+  auto res = store_.transition(r.task.id, to, "", reason, nowNs);
+  if (!res) {
+    out.errors.push_back(res.error());
+    return;
+  }
+  registry_.clearTask(robot);
+  applied(*res, out);
+}
+
+DispatchResult Dispatcher::onRobotLost(const std::string& robotId, std::int64_t nowNs) {
+  DispatchResult out;
+  if (!registry_.markLost(robotId)) {
+    return out;
+  }
+  ++counters_.robotsLost;
+  const RobotInfo* info = registry_.find(robotId);
+  if (info != nullptr && !info->taskId.empty()) {
+    auto it = open_.find(info->taskId);
+    if (it != open_.end() && isActive(it->second.state) && it->second.robotId == robotId) {
+      requeueOrFail(it->second, false, "robot " + robotId + " lost", nowNs, out);
+    }
+  }
+  return out;
+}
+
+Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, const std::string& taskId,
+                                                  TaskState state, const std::string& reason,
+                                                  std::int64_t nowNs) {
+  auto it = open_.find(taskId);
+  if (it == open_.end()) {
+    return unexpected(errc::kNotFound, "no open task '" + taskId + "'");
+  }
+  const TaskRecord cur = it->second;
+  if (!isActive(cur.state) || cur.robotId != robotId) {
+    return unexpected(errc::kWrongRobot, "task '" + taskId + "' is not held by robot '" + robotId + "'");
+  }
+  DispatchResult out;
+  if (state == TaskState::Failed) {
+    requeueOrFail(cur, true, reason.empty() ? std::string("failed") : reason, nowNs, out);
+    if (!out.errors.empty()) {
+      return unexpected(out.errors.front());
+    }
+    return out;
+  }
+  if (state == cur.state) {
+    return out;  // a repeated report
+  }
+  const auto path = happyPath(cur.task.kind);
+  const auto from = std::find(path.begin(), path.end(), cur.state);
+  const auto to = std::find(path.begin(), path.end(), state);
+  if (from == path.end() || to == path.end() || to <= from) {
+    return unexpected(errc::kIllegalTransition, "task '" + taskId + "': robot reported " +
+                                                    std::string(toString(state)) + " while it is " +
+                                                    std::string(toString(cur.state)));
+  }
+  std::vector<TransitionRequest> steps;
+  for (auto s = from + 1; s <= to; ++s) {
+    steps.push_back(
+        {taskId, *s, robotId, s == to ? reason : std::string("implied by a later report"), nowNs});
+  }
+  auto results = store_.transitionBatch(steps);
+  for (auto& r : results) {
+    if (!r) {
+      return unexpected(r.error());
+    }
+    applied(*r, out);
+  }
+  if (isTerminal(state)) {
+    registry_.clearTask(robotId);
+  }
+  return out;
+}
+
+Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std::string& reason,
+                                            std::int64_t nowNs) {
+  auto it = open_.find(taskId);
+  if (it == open_.end()) {
+    auto stored = store_.get(taskId);
+    if (!stored) {
+      return unexpected(stored.error());
+    }
+    return unexpected(errc::kIllegalTransition,
+                      "task '" + taskId + "' is already " + std::string(toString(stored->state)));
+  }
+  const std::string robot = it->second.robotId;
+  const bool active = isActive(it->second.state);
+  auto res = store_.transition(taskId, TaskState::Cancelled, "", reason, nowNs);
+  if (!res) {
+    return unexpected(res.error());
+  }
+  DispatchResult out;
+  if (active) {
+    registry_.clearTask(robot);
+    out.revoked.push_back(robot);
+  }
+  applied(*res, out);
+  return out;
+}
+
+void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
+  const auto chargers = stations_.ofKind(StationKind::Charging);
+  for (const auto& r : registry_.idleRobots()) {
+    if (r.battery >= cfg_.policy.batteryThreshold) {
+      continue;
+    }
+    const bool pending = std::any_of(open_.begin(), open_.end(), [&](const auto& kv) {
+      return kv.second.task.robot == r.id && kv.second.task.kind == TaskKind::Charge &&
+             isWaiting(kv.second.state);
+    });
+    if (pending) {
+      continue;
+    }
+    Task t;
+    t.id = chargeTaskId(r.id, nowNs);
+    t.kind = TaskKind::Charge;
+    t.robot = r.id;
+    double best = kInfeasible;
+    for (const Station* s : chargers) {
+      Task cand = t;
+      cand.station = s->name;
+      const double d = travel_(r, cand);
+      if (std::isfinite(d) && d < best) {
+        best = d;
+        t.station = s->name;
+      }
+    }
+    if (t.station.empty()) {
+      out.errors.push_back(
+          Error{errc::kNotFound, "robot " + r.id + " is low but no charging station is reachable"});
+      continue;
+    }
+    auto res = store_.submit(t, nowNs);
+    if (!res) {
+      out.errors.push_back(res.error());
+      continue;
+    }
+    ++counters_.submitted;
+    applied(res->record, out);
+  }
+}
+
+void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
+  std::vector<Task> waiting;
+  for (const auto& [id, r] : open_) {
+    if (isWaiting(r.state)) {
+      waiting.push_back(r.task);
+    }
+  }
+  const auto idle = registry_.idleRobots();
+  if (waiting.empty() || idle.empty()) {
+    return;
+  }
+  const Allocator& alloc = waiting.size() * idle.size() > cfg_.hungarianMaxPairs
+                               ? static_cast<const Allocator&>(greedy_)
+                               : static_cast<const Allocator&>(hungarian_);
+  const auto assignments = alloc.assign(waiting, idle, travel_, nowNs);
+  std::vector<TransitionRequest> reqs;
+  reqs.reserve(assignments.size());
+  for (const auto& a : assignments) {
+    reqs.push_back({waiting[a.task].id, TaskState::Assigned, idle[a.robot].id, "allocated", nowNs});
+  }
+  auto results = store_.transitionBatch(reqs);
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    if (!results[k]) {
+      out.errors.push_back(results[k].error());
+      continue;
+    }
+    registry_.setTask(reqs[k].robotId, reqs[k].taskId);
+    out.assignments.push_back({reqs[k].robotId, results[k]->task, results[k]->revision});
+    applied(*results[k], out);
+  }
+}
+
+DispatchResult Dispatcher::tick(std::int64_t nowNs) {
+  DispatchResult out;
+  for (const auto& lost : registry_.expire(nowNs)) {
+    ++counters_.robotsLost;
+    auto it = open_.find(lost.taskId);
+    if (!lost.taskId.empty() && it != open_.end() && isActive(it->second.state) &&
+        it->second.robotId == lost.id) {
+      requeueOrFail(it->second, false, "robot " + lost.id + " lost", nowNs, out);
+    }
+  }
+  chargeLowRobots(nowNs, out);
+  allocate(nowNs, out);
+  return out;
+}
+
+}  // namespace fleet

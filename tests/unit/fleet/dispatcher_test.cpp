@@ -1,0 +1,225 @@
+#include "fleet/fleet/dispatcher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fleet/fleet/errors.hpp"
+#include "fleet/fleet/sqlite_task_store.hpp"
+#include "temp_dir.hpp"
+
+namespace fleet {
+namespace {
+
+using S = TaskState;
+constexpr std::int64_t kSec = 1'000'000'000;
+
+StationMap stations() {
+  StationMap m;
+  EXPECT_TRUE(m.add({"P-1", {0, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  EXPECT_TRUE(m.add({"D-1", {20, 0, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
+  EXPECT_TRUE(m.add({"C-near", {0, 5, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+  EXPECT_TRUE(m.add({"C-far", {100, 100, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+  EXPECT_TRUE(m.add({"K-1", {50, 0, 0}, static_cast<std::uint8_t>(StationKind::Parking)}));
+  return m;
+}
+
+/// Straight-line seconds at 1 m/s to the first station of the task.
+TravelCost straightLine(const StationMap& m) {
+  return [&m](const RobotInfo& r, const Task& t) {
+    const std::string& first = t.kind == TaskKind::Transport ? t.pickup : t.station;
+    const Station* s = m.find(first);
+    if (s == nullptr) {
+      return 0.0;
+    }
+    return std::hypot(r.pose.x - s->pose.x, r.pose.y - s->pose.y);
+  };
+}
+
+Task transport(std::string id) {
+  Task t;
+  t.id = std::move(id);
+  t.pickup = "P-1";
+  t.dropoff = "D-1";
+  return t;
+}
+
+class DispatcherTest : public ::testing::Test {
+ protected:
+  void SetUp() override { reopen(); }
+  void reopen() {
+    dispatcher.reset();
+    store.reset();
+    auto s = SqliteTaskStore::open({dir.file("tasks.db")});
+    ASSERT_TRUE(s) << s.error().message;
+    store = std::move(s).value();
+    dispatcher = std::make_unique<Dispatcher>(*store, map, straightLine(map), cfg);
+  }
+  void robot(const std::string& id, double x, double battery, std::int64_t t) {
+    dispatcher->onRobotState({id, {x, 0, 0}, battery, t});
+  }
+  S stateOf(const std::string& id) { return store->get(id).value().state; }
+
+  test::TempDir dir;
+  StationMap map = stations();
+  DispatcherConfig cfg;
+  std::unique_ptr<SqliteTaskStore> store;
+  std::unique_ptr<Dispatcher> dispatcher;
+};
+
+TEST_F(DispatcherTest, SubmitValidatesAgainstStations) {
+  Task bad = transport("t2");
+  bad.pickup = "P-404";
+  DispatchResult out;
+  auto rs = dispatcher->submit({transport("t1"), bad, transport("t1")}, 1, &out);
+  ASSERT_EQ(rs.size(), 3u);
+  EXPECT_TRUE(rs[0] && rs[0]->created);
+  ASSERT_FALSE(rs[1]);
+  EXPECT_EQ(rs[1].error().code, errc::kUnknownStation);
+  EXPECT_EQ(rs[1].error().message, "pickup: unknown station 'P-404'");
+  EXPECT_TRUE(rs[2] && !rs[2]->created);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].state, S::Queued);
+  EXPECT_EQ(dispatcher->waitingCount(), 1u);
+}
+
+TEST_F(DispatcherTest, AssignsNearestAndTracksProgress) {
+  robot("far", 40, 0.9, 0);
+  robot("near", 3, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto out = dispatcher->tick(kSec / 10);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "near");
+  EXPECT_EQ(stateOf("t1"), S::Assigned);
+  EXPECT_TRUE(dispatcher->tick(kSec / 5).assignments.empty()) << "never assigned twice";
+
+  EXPECT_EQ(dispatcher->onTaskStatus("far", "t1", S::EnRoute, "", 1).error().code, errc::kWrongRobot);
+  auto r = dispatcher->onTaskStatus("near", "t1", S::Delivering, "", 1);
+  ASSERT_TRUE(r) << r.error().message;
+  ASSERT_EQ(r->events.size(), 3u) << "en_route and loading are filled in";
+  EXPECT_EQ(r->events[0].state, S::EnRoute);
+  EXPECT_EQ(r->events[2].state, S::Delivering);
+  EXPECT_EQ(dispatcher->onTaskStatus("near", "t1", S::Loading, "", 1).error().code, errc::kIllegalTransition);
+  ASSERT_TRUE(dispatcher->onTaskStatus("near", "t1", S::Done, "", 2));
+  EXPECT_EQ(stateOf("t1"), S::Done);
+  EXPECT_TRUE(dispatcher->robots().find("near")->idle());
+  EXPECT_EQ(dispatcher->counters().done, 1);
+  EXPECT_EQ(dispatcher->onTaskStatus("near", "t1", S::Done, "", 3).error().code, errc::kNotFound);
+}
+
+TEST_F(DispatcherTest, LostRobotTaskIsRequeuedAndReassigned) {
+  robot("a", 1, 0.9, 0);
+  robot("b", 30, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto first = dispatcher->tick(kSec / 10);
+  ASSERT_EQ(first.assignments.size(), 1u);
+  ASSERT_EQ(first.assignments[0].robotId, "a");
+  ASSERT_TRUE(dispatcher->onTaskStatus("a", "t1", S::EnRoute, "", kSec / 5));
+  // b keeps publishing, a falls silent; its lease (1 s) expires.
+  robot("b", 30, 0.9, kSec);
+  robot("b", 30, 0.9, 2 * kSec);
+  auto out = dispatcher->tick(2 * kSec);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "b");
+  ASSERT_GE(out.events.size(), 2u);
+  EXPECT_EQ(out.events[0].state, S::Requeued);
+  EXPECT_EQ(out.events[0].reason, "robot a lost");
+  EXPECT_EQ(out.events[1].state, S::Assigned);
+  auto rec = store->get("t1").value();
+  EXPECT_EQ(rec.robotId, "b");
+  EXPECT_EQ(rec.attempts, 2);
+  // The lost robot's late report is refused, and when it returns it is idle.
+  EXPECT_EQ(dispatcher->onTaskStatus("a", "t1", S::Loading, "", 3 * kSec).error().code, errc::kWrongRobot);
+  robot("a", 1, 0.9, 3 * kSec);
+  EXPECT_TRUE(dispatcher->robots().find("a")->idle());
+}
+
+TEST_F(DispatcherTest, LivelinessLossRequeuesAtOnce) {
+  robot("a", 1, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
+  auto out = dispatcher->onRobotLost("a", 2);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(stateOf("t1"), S::Requeued);
+  EXPECT_TRUE(dispatcher->tick(3).assignments.empty()) << "no robot left";
+  EXPECT_EQ(dispatcher->waitingCount(), 1u);
+}
+
+TEST_F(DispatcherTest, FailedTaskRetriesThenFails) {
+  cfg.maxAttempts = 2;
+  reopen();
+  robot("a", 1, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
+  auto f1 = dispatcher->onTaskStatus("a", "t1", S::Failed, "blocked", 2);
+  ASSERT_TRUE(f1);
+  EXPECT_EQ(stateOf("t1"), S::Requeued);
+  ASSERT_EQ(dispatcher->tick(3).assignments.size(), 1u);
+  auto f2 = dispatcher->onTaskStatus("a", "t1", S::Failed, "blocked again", 4);
+  ASSERT_TRUE(f2);
+  EXPECT_EQ(stateOf("t1"), S::Failed);
+  EXPECT_EQ(dispatcher->counters().failed, 1);
+  EXPECT_TRUE(dispatcher->openTasks().empty());
+}
+
+TEST_F(DispatcherTest, LowBatteryRobotGoesToNearestChargerNotToWork) {
+  robot("low", 0, 0.1, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "low");
+  EXPECT_EQ(out.assignments[0].task.kind, TaskKind::Charge);
+  EXPECT_EQ(out.assignments[0].task.station, "C-near");
+  EXPECT_EQ(out.assignments[0].task.robot, "low");
+  EXPECT_EQ(stateOf("t1"), S::Queued) << "no transport for a low robot";
+  // Charged: it reports done, then takes the transport.
+  const std::string chargeId = out.assignments[0].task.id;
+  ASSERT_TRUE(dispatcher->onTaskStatus("low", chargeId, S::Done, "", 2));
+  robot("low", 0, 0.95, 3);
+  auto next = dispatcher->tick(4);
+  ASSERT_EQ(next.assignments.size(), 1u);
+  EXPECT_EQ(next.assignments[0].task.id, "t1");
+  EXPECT_TRUE(dispatcher->tick(5).assignments.empty()) << "no second charge task";
+}
+
+TEST_F(DispatcherTest, CancelWithdrawsActiveTask) {
+  robot("a", 1, 0.9, 0);
+  dispatcher->submit({transport("t1"), transport("t2")}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const std::string held = out.assignments[0].task.id;
+  auto c = dispatcher->cancel(held, "operator", 2);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->revoked, std::vector<std::string>{"a"});
+  EXPECT_EQ(stateOf(held), S::Cancelled);
+  EXPECT_EQ(dispatcher->cancel(held, "again", 3).error().code, errc::kIllegalTransition);
+  EXPECT_EQ(dispatcher->cancel("nope", "", 3).error().code, errc::kNotFound);
+  EXPECT_EQ(dispatcher->tick(4).assignments.size(), 1u) << "the robot is free for the other task";
+}
+
+TEST_F(DispatcherTest, RecoverRebuildsOpenStateAfterRestart) {
+  robot("a", 1, 0.9, 0);
+  dispatcher->submit({transport("t1"), transport("t2"), transport("t3")}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const std::string held = out.assignments[0].task.id;
+  ASSERT_TRUE(dispatcher->onTaskStatus("a", held, S::Loading, "", 2));
+  reopen();  // the manager restarts: new store connection, new dispatcher
+  auto rec = dispatcher->recover(10 * kSec);
+  ASSERT_TRUE(rec) << rec.error().message;
+  ASSERT_EQ(rec->assignments.size(), 1u) << "the active assignment is re-published";
+  EXPECT_EQ(rec->assignments[0].robotId, "a");
+  EXPECT_EQ(rec->assignments[0].task.id, held);
+  EXPECT_EQ(dispatcher->openTasks().size(), 3u);
+  EXPECT_EQ(dispatcher->waitingCount(), 2u);
+  EXPECT_EQ(dispatcher->activeCount(), 1u);
+  // The robot carries on where it was.
+  ASSERT_TRUE(dispatcher->onTaskStatus("a", held, S::Delivering, "", 11 * kSec));
+  // If it never speaks again its lease, started at the restart, expires and the task is requeued.
+  auto later = dispatcher->tick(12 * kSec);
+  EXPECT_EQ(stateOf(held), S::Requeued);
+  EXPECT_TRUE(later.assignments.empty());
+}
+
+}  // namespace
+}  // namespace fleet

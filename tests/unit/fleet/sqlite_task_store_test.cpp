@@ -1,0 +1,222 @@
+#include "fleet/fleet/sqlite_task_store.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "fleet/fleet/errors.hpp"
+#include "temp_dir.hpp"
+
+namespace fleet {
+namespace {
+
+using S = TaskState;
+
+Task transport(std::string id, std::int32_t priority = 0) {
+  Task t;
+  t.id = std::move(id);
+  t.kind = TaskKind::Transport;
+  t.pickup = "P-1";
+  t.dropoff = "D-1";
+  t.priority = priority;
+  return t;
+}
+
+// Not `"t" + std::to_string(i)`: GCC 12 reports a false -Wrestrict on it.
+std::string numbered(std::string prefix, int i) {
+  prefix += std::to_string(i);
+  return prefix;
+}
+
+std::unique_ptr<SqliteTaskStore> openStore(const std::string& path) {
+  auto s = SqliteTaskStore::open({path});
+  EXPECT_TRUE(s) << s.error().message;
+  return std::move(s).value();
+}
+
+TEST(SqliteTaskStore, SubmitIsIdempotentAndDetectsConflicts) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  auto first = store->submit(transport("t1"), 100);
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_TRUE(first->created);
+  EXPECT_EQ(first->record.state, S::Queued);
+  EXPECT_EQ(first->record.task.createdNs, 100) << "created_ns defaults to the submit stamp";
+  EXPECT_EQ(first->record.revision, 1);
+
+  auto again = store->submit(transport("t1"), 200);
+  ASSERT_TRUE(again);
+  EXPECT_FALSE(again->created);
+  EXPECT_EQ(again->record.task.createdNs, 100) << "the retry returns the original record";
+
+  Task withStamp = transport("t1");
+  withStamp.createdNs = 555;
+  auto sameBody = store->submit(withStamp, 300);
+  ASSERT_TRUE(sameBody) << "created_ns is not part of the body";
+  EXPECT_FALSE(sameBody->created);
+
+  auto conflict = store->submit(transport("t1", 7), 300);
+  ASSERT_FALSE(conflict);
+  EXPECT_EQ(conflict.error().code, errc::kConflict);
+
+  Task bad = transport("t 2");
+  auto invalid = store->submit(bad, 300);
+  ASSERT_FALSE(invalid);
+  EXPECT_EQ(invalid.error().code, errc::kInvalid);
+  EXPECT_EQ(store->get("t 2").error().code, errc::kNotFound);
+}
+
+TEST(SqliteTaskStore, TransitionsFollowTheStateMachine) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  ASSERT_TRUE(store->submit(transport("t1"), 1));
+  EXPECT_EQ(store->transition("t1", S::EnRoute, "r1", "", 2).error().code, errc::kIllegalTransition);
+  EXPECT_EQ(store->transition("t1", S::Assigned, "", "", 2).error().code, errc::kInvalid);
+  EXPECT_EQ(store->transition("nope", S::Assigned, "r1", "", 2).error().code, errc::kNotFound);
+
+  auto a = store->transition("t1", S::Assigned, "r1", "allocated", 3);
+  ASSERT_TRUE(a) << a.error().message;
+  EXPECT_EQ(a->robotId, "r1");
+  EXPECT_EQ(a->attempts, 1);
+  EXPECT_EQ(store->transition("t1", S::EnRoute, "r2", "", 4).error().code, errc::kWrongRobot);
+  ASSERT_TRUE(store->transition("t1", S::EnRoute, "r1", "", 4));
+  EXPECT_EQ(store->transition("t1", S::Done, "r1", "", 5).error().code, errc::kIllegalTransition)
+      << "a transport task must load and unload";
+  auto rq = store->transition("t1", S::Requeued, "", "robot lost", 6);
+  ASSERT_TRUE(rq);
+  EXPECT_TRUE(rq->robotId.empty());
+  auto again = store->transition("t1", S::Assigned, "r2", "", 7);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->attempts, 2);
+  for (auto s : {S::EnRoute, S::Loading, S::Delivering, S::Unloading, S::Done}) {
+    ASSERT_TRUE(store->transition("t1", s, "r2", "", 8)) << toString(s);
+  }
+  auto done = store->get("t1");
+  ASSERT_TRUE(done);
+  EXPECT_EQ(done->state, S::Done);
+  EXPECT_EQ(done->revision, 10);
+  EXPECT_EQ(store->transition("t1", S::Cancelled, "", "", 9).error().code, errc::kIllegalTransition);
+
+  auto h = store->history("t1");
+  ASSERT_TRUE(h);
+  ASSERT_EQ(h->size(), 10u);
+  EXPECT_FALSE(h->front().from.has_value());
+  for (std::size_t i = 1; i < h->size(); ++i) {
+    EXPECT_EQ((*h)[i].from, (*h)[i - 1].to);
+    EXPECT_GT((*h)[i].seq, (*h)[i - 1].seq);
+  }
+  EXPECT_EQ((*h)[3].reason, "robot lost");
+  EXPECT_EQ((*h)[3].robotId, "r1") << "the log keeps who held the task";
+}
+
+TEST(SqliteTaskStore, PinnedTaskOnlyForItsRobot) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  Task c;
+  c.id = "charge-r1";
+  c.kind = TaskKind::Charge;
+  c.robot = "r1";
+  ASSERT_TRUE(store->submit(c, 1));
+  EXPECT_EQ(store->transition("charge-r1", S::Assigned, "r2", "", 2).error().code, errc::kWrongRobot);
+  EXPECT_TRUE(store->transition("charge-r1", S::Assigned, "r1", "", 2));
+  EXPECT_TRUE(store->transition("charge-r1", S::EnRoute, "r1", "", 3));
+  EXPECT_TRUE(store->transition("charge-r1", S::Done, "r1", "", 4));
+}
+
+TEST(SqliteTaskStore, BatchesAreIndependentItemsInOneCommit) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  ASSERT_TRUE(store->submit(transport("old"), 1));
+  auto rs = store->submitBatch(
+      {transport("a"), transport("old"), transport("old", 3), transport("a"), transport("b")}, 10);
+  ASSERT_EQ(rs.size(), 5u);
+  EXPECT_TRUE(rs[0] && rs[0]->created);
+  EXPECT_TRUE(rs[1] && !rs[1]->created);
+  ASSERT_FALSE(rs[2]);
+  EXPECT_EQ(rs[2].error().code, errc::kConflict);
+  EXPECT_TRUE(rs[3] && !rs[3]->created) << "a repeat inside the batch is a retry of the first";
+  EXPECT_TRUE(rs[4] && rs[4]->created);
+
+  auto ts = store->transitionBatch({{"a", S::Assigned, "r1", "", 11},
+                                    {"a", S::EnRoute, "r1", "", 12},
+                                    {"b", S::EnRoute, "r1", "", 12},
+                                    {"b", S::Cancelled, "", "operator", 13}});
+  ASSERT_EQ(ts.size(), 4u);
+  EXPECT_TRUE(ts[0]);
+  EXPECT_TRUE(ts[1]) << "checked against the state the previous item left";
+  EXPECT_FALSE(ts[2]);
+  EXPECT_TRUE(ts[3]);
+  auto counts = store->countByState();
+  ASSERT_TRUE(counts);
+  EXPECT_EQ((*counts)[S::Queued], 1);
+  EXPECT_EQ((*counts)[S::EnRoute], 1);
+  EXPECT_EQ((*counts)[S::Cancelled], 1);
+}
+
+TEST(SqliteTaskStore, ListFiltersAndPages) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  std::vector<Task> batch;
+  for (int i = 0; i < 25; ++i) {
+    batch.push_back(transport(numbered("t", 100 + i)));
+  }
+  ASSERT_EQ(store->submitBatch(batch, 1).size(), 25u);
+  for (int i = 0; i < 25; i += 3) {
+    ASSERT_TRUE(store->transition(numbered("t", 100 + i), S::Assigned, "r", "", 2));
+  }
+  auto assigned = store->list(S::Assigned, 100);
+  ASSERT_TRUE(assigned);
+  EXPECT_EQ(assigned->size(), 9u);
+  std::vector<std::string> ids;
+  std::string after;
+  for (;;) {
+    auto page = store->list(std::nullopt, 10, after);
+    ASSERT_TRUE(page);
+    if (page->empty()) {
+      break;
+    }
+    EXPECT_LE(page->size(), 10u);
+    for (const auto& r : *page) {
+      ids.push_back(r.task.id);
+    }
+    after = page->back().task.id;
+  }
+  EXPECT_EQ(ids.size(), 25u);
+  EXPECT_TRUE(std::is_sorted(ids.begin(), ids.end()));
+  EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), 25u);
+}
+
+TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
+  test::TempDir dir;
+  const auto path = dir.file("tasks.db");
+  {
+    auto store = openStore(path);
+    Task late = transport("late");
+    late.deadlineNs = 99;
+    late.loadNs = 5;
+    ASSERT_TRUE(store->submit(transport("a"), 3));
+    ASSERT_TRUE(store->submit(late, 1));
+    ASSERT_TRUE(store->submit(transport("done"), 2));
+    ASSERT_TRUE(store->transition("a", S::Assigned, "r1", "", 4));
+    ASSERT_TRUE(store->transition("done", S::Cancelled, "", "", 4));
+  }
+  auto store = openStore(path);
+  auto open = store->openTasks();
+  ASSERT_TRUE(open);
+  ASSERT_EQ(open->size(), 2u);
+  EXPECT_EQ((*open)[0].task.id, "late") << "oldest first";
+  EXPECT_EQ((*open)[0].task.deadlineNs, 99);
+  EXPECT_EQ((*open)[0].task.loadNs, 5);
+  EXPECT_EQ((*open)[1].state, S::Assigned);
+  EXPECT_EQ((*open)[1].robotId, "r1");
+  EXPECT_EQ((*open)[1].attempts, 1);
+}
+
+TEST(SqliteTaskStore, OpenFailsWithStorageError) {
+  auto s = SqliteTaskStore::open({"/nonexistent-dir/x/tasks.db"});
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code, errc::kStorage);
+}
+
+}  // namespace
+}  // namespace fleet
