@@ -75,11 +75,12 @@ E getEnum(C c, E maxValue) {
 // ---- Task
 void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
   putStr(out.task_id, in.task_id, "Task.task_id");
+  putStr(out.request_id, in.request_id, "Task.request_id");
   out.kind = static_cast<fleet_TaskKind>(in.kind);
   putStr(out.pickup, in.pickup, "Task.pickup");
   putStr(out.dropoff, in.dropoff, "Task.dropoff");
-  out.goal = putPose(in.goal);
-  out.has_goal = in.has_goal;
+  putStr(out.station, in.station, "Task.station");
+  putStr(out.robot, in.robot, "Task.robot");
   out.load_s = in.load_s;
   out.unload_s = in.unload_s;
   out.priority = in.priority;
@@ -91,11 +92,12 @@ void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
 msg::Task Traits<msg::Task>::fromC(const C& in) {
   msg::Task m;
   m.task_id = getStr(in.task_id);
+  m.request_id = getStr(in.request_id);
   m.kind = getEnum(in.kind, msg::TaskKind::Park);
   m.pickup = getStr(in.pickup);
   m.dropoff = getStr(in.dropoff);
-  m.goal = getPose(in.goal);
-  m.has_goal = in.has_goal;
+  m.station = getStr(in.station);
+  m.robot = getStr(in.robot);
   m.load_s = in.load_s;
   m.unload_s = in.unload_s;
   m.priority = in.priority;
@@ -104,6 +106,24 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.body = getStr(in.body);
   m.cancel = in.cancel;
   return m;
+}
+
+// ---- TaskAck
+void Traits<msg::TaskAck>::toC(const msg::TaskAck& in, C& out, Arena&) {
+  putStr(out.request_id, in.request_id, "TaskAck.request_id");
+  putStr(out.task_id, in.task_id, "TaskAck.task_id");
+  out.result = static_cast<fleet_AckResult>(in.result);
+  out.state = static_cast<fleet_TaskState>(in.state);
+  putStr(out.detail, in.detail, "TaskAck.detail");
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TaskAck Traits<msg::TaskAck>::fromC(const C& in) {
+  return {getStr(in.request_id),
+          getStr(in.task_id),
+          getEnum(in.result, msg::AckResult::Unavailable),
+          getEnum(in.state, msg::TaskState::Rejected),
+          getStr(in.detail),
+          in.stamp_ns};
 }
 
 // ---- TaskEvent

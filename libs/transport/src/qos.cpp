@@ -29,6 +29,9 @@ namespace qos {
 QosProfile taskRequest() {
   return {true, true, 1, 0, 1000};
 }
+QosProfile taskAck() {
+  return {true, false, 4, 0, 1000};
+}
 QosProfile taskEvent() {
   return {true, true, 32, 0, 1000};
 }

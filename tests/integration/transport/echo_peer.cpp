@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
     WaitSet ws(p);
     std::vector<std::unique_ptr<Echo>> echoes;
     echoes.push_back(std::make_unique<EchoOf<msg::Task>>(p, ws));
+    echoes.push_back(std::make_unique<EchoOf<msg::TaskAck>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::TaskEvent>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::TaskAssignment>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::TaskStatus>>(p, ws));

@@ -75,14 +75,21 @@ std::string maxId() {
 
 TEST_F(RoundTrip, Task) {
   msg::Task a{
-      "t-1", msg::TaskKind::Transport, "P-12", "D-3", {}, false, 5, 7.5, 3, 123456789, 42, R"({"a":1})",
-      false};
-  msg::Task b{maxId(), msg::TaskKind::Park,    "",  "", {1, -2, 3.0}, true, 0, 0, -5, 0,
-              0,       std::string(4096, 'b'), true};
+      "t-1",        "req-1", msg::TaskKind::Transport, "P-12", "D-3", "", "", 5, 7.5, 3, 123456789, 42,
+      R"({"a":1})", false};
+  msg::Task b{maxId(), maxId(), msg::TaskKind::Park,    "",  "", "PARK-1", "r-9", 0, 0, -5,
+              0,       0,       std::string(4096, 'b'), true};
   msg::Task c = a;
   c.task_id = "t-2";
   c.body = kNonAscii;
   expectRoundTrip<msg::Task>({a, b, c});
+}
+
+TEST_F(RoundTrip, TaskAck) {
+  expectRoundTrip<msg::TaskAck>(
+      {{"req-1", "t-1", msg::AckResult::Stored, msg::TaskState::Queued, "", 5},
+       {"req-2", "t-2", msg::AckResult::Invalid, msg::TaskState::Rejected, std::string(1023, 'd'), 6},
+       {"req-3", "t-3", msg::AckResult::Unavailable, msg::TaskState::Done, kNonAscii, 7}});
 }
 
 TEST_F(RoundTrip, TaskEvent) {

@@ -32,11 +32,12 @@ enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
 
 struct Task {
   std::string task_id;
+  std::string request_id;
   TaskKind kind = TaskKind::Transport;
   std::string pickup;
   std::string dropoff;
-  Pose2 goal;
-  bool has_goal = false;
+  std::string station;
+  std::string robot;
   double load_s = 0;
   double unload_s = 0;
   std::int32_t priority = 0;
@@ -45,6 +46,18 @@ struct Task {
   std::string body;
   bool cancel = false;
   bool operator==(const Task&) const = default;
+};
+
+enum class AckResult : std::uint8_t { Stored, Duplicate, Conflict, Invalid, NotFound, Refused, Unavailable };
+
+struct TaskAck {
+  std::string request_id;
+  std::string task_id;
+  AckResult result = AckResult::Stored;
+  TaskState state = TaskState::Queued;
+  std::string detail;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TaskAck&) const = default;
 };
 
 struct TaskEvent {

@@ -22,6 +22,7 @@ struct QosProfile {
 /// Named profiles, one per topic family of DESIGN.md §3.
 namespace qos {
 QosProfile taskRequest();           // Task: reliable, transient-local, keep-last 1 per key
+QosProfile taskAck();               // TaskAck: reliable, volatile, keep-last 4 per request
 QosProfile taskEvent();             // TaskEvent: reliable, transient-local, keep-last 32 per key
 QosProfile assignment();            // TaskAssignment: reliable, transient-local, keep-last 1
 QosProfile taskStatus();            // TaskStatus: reliable, keep-last 16

@@ -45,6 +45,7 @@ struct Traits;
   };
 
 FLEET_DECLARE_TRAITS(Task, fleet_Task, "Task", qos::taskRequest())
+FLEET_DECLARE_TRAITS(TaskAck, fleet_TaskAck, "TaskAck", qos::taskAck())
 FLEET_DECLARE_TRAITS(TaskEvent, fleet_TaskEvent, "TaskEvent", qos::taskEvent())
 FLEET_DECLARE_TRAITS(TaskAssignment, fleet_TaskAssignment, "TaskAssignment", qos::assignment())
 FLEET_DECLARE_TRAITS(TaskStatus, fleet_TaskStatus, "TaskStatus", qos::taskStatus())
