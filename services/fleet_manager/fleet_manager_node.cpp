@@ -1,0 +1,294 @@
+#include "fleet_manager_node.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include "fleet/core/clock.hpp"
+#include "fleet/fleet/errors.hpp"
+
+namespace fleet::manager {
+namespace {
+
+msg::TaskState toMsg(TaskState s) {
+  return static_cast<msg::TaskState>(static_cast<int>(s));
+}
+
+msg::TaskAck ack(const msg::Task& req, msg::AckResult r, msg::TaskState state, std::string detail,
+                 std::int64_t nowNs) {
+  if (detail.size() > 1023) {
+    detail = detail.substr(0, 1020) + "...";
+  }
+  return {req.request_id, req.task_id, r, state, std::move(detail), nowNs};
+}
+
+std::string fieldsJson(const std::vector<FieldError>& fields) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& f : fields) {
+    a.push_back({{"path", f.path}, {"reason", f.reason}});
+  }
+  return a.dump();
+}
+
+}  // namespace
+
+Settings readSettings(Config& cfg) {
+  Settings s;
+  cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "battery_threshold",
+                         "nominal_speed", "clock", "metrics_file"});
+  s.db = cfg.string("db", s.db);
+  s.stationsFile = cfg.requireString("stations");
+  s.syncFull = cfg.string("sync", "full", {"full", "normal"}) == "full";
+  s.tickS = cfg.number("tick_s", s.tickS, {0.0, 60.0, true});
+  s.leaseS = cfg.number("lease_s", s.leaseS, {0.0, 3600.0, true});
+  s.maxAttempts = static_cast<int>(cfg.integer("max_attempts", s.maxAttempts, {1, 100}));
+  s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
+  s.nominalSpeed = cfg.number("nominal_speed", s.nominalSpeed, {0.0, 20.0, true});
+  s.clock = cfg.string("clock", "wall", {"wall", "sim"});
+  s.metricsFile = cfg.string("metrics_file", "");
+  return s;
+}
+
+Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
+                                                                     std::int64_t nowNs) {
+  SqliteTaskStoreOptions opts;
+  opts.path = s.db;
+  opts.sync = s.syncFull ? SqliteTaskStoreOptions::Sync::Full : SqliteTaskStoreOptions::Sync::Normal;
+  auto store = SqliteTaskStore::open(opts);
+  if (!store) {
+    return unexpected(store.error());
+  }
+  std::unique_ptr<FleetManagerNode> n(new FleetManagerNode());
+  n->settings_ = s;
+  n->store_ = std::move(*store);
+  DispatcherConfig dc;
+  dc.maxAttempts = s.maxAttempts;
+  dc.leaseNs = secToNs(s.leaseS);
+  dc.policy.batteryThreshold = s.batteryThreshold;
+  const double speed = s.nominalSpeed;
+  // Straight-line travel time to the task's first stop; the grid distance field replaces this
+  // when a map is configured.
+  TravelCost travel = [speed, st = &n->dispatcher_](const RobotInfo& r, const Task& t) {
+    const std::string& first = t.kind == TaskKind::Transport ? t.pickup : t.station;
+    const Station* stn = (*st)->stations().find(first);
+    if (stn == nullptr) {
+      return 0.0;
+    }
+    return distance(r.pose, stn->pose) / speed;
+  };
+  n->dispatcher_ = std::make_unique<Dispatcher>(*n->store_, std::move(stations), travel, dc);
+  auto rec = n->dispatcher_->recover(nowNs);
+  if (!rec) {
+    return unexpected(rec.error());
+  }
+  n->publish(std::move(*rec), nowNs, n->recovered_);
+  return n;
+}
+
+msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std::int64_t nowNs) {
+  msg::TaskAssignment a;
+  a.robot_id = o.robotId;
+  a.task_id = o.task.id;
+  auto& rev = revisions_[o.robotId];
+  // Unique across restarts: start from the clock in ms, then count.
+  rev = std::max<std::uint32_t>(rev + 1, static_cast<std::uint32_t>((nowNs / 1'000'000) % 2'000'000'000));
+  a.revision = rev;
+  a.stamp_ns = nowNs;
+  auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
+    const Station* s = dispatcher_->stations().find(name);
+    msg::Goal g;
+    g.station = name;
+    g.pose = s != nullptr ? s->pose : Pose2{};
+    g.action = action;
+    g.duration_s = duration;
+    a.goals.push_back(g);
+  };
+  switch (o.task.kind) {
+    case TaskKind::Transport:
+      goal(o.task.pickup, msg::GoalAction::Load, nsToSec(o.task.loadNs));
+      goal(o.task.dropoff, msg::GoalAction::Unload, nsToSec(o.task.unloadNs));
+      break;
+    case TaskKind::Goto:
+      goal(o.task.station, msg::GoalAction::None, 0);
+      break;
+    case TaskKind::Charge:
+      goal(o.task.station, msg::GoalAction::Charge, 0);
+      break;
+    case TaskKind::Park:
+      goal(o.task.station, msg::GoalAction::Park, 0);
+      break;
+  }
+  return a;
+}
+
+void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out) {
+  for (const auto& e : r.events) {
+    auto& seq = eventSeq_[e.taskId];
+    out.events.push_back({e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq});
+    if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
+      queuedAt_[e.taskId] = e.stampNs;
+    } else if (e.state == TaskState::Assigned) {
+      auto it = queuedAt_.find(e.taskId);
+      if (it != queuedAt_.end()) {
+        metrics_.assignLatencyMs.push_back(static_cast<double>(e.stampNs - it->second) / 1e6);
+        if (metrics_.assignLatencyMs.size() > 10000) {
+          metrics_.assignLatencyMs.erase(metrics_.assignLatencyMs.begin(),
+                                         metrics_.assignLatencyMs.begin() + 5000);
+        }
+        queuedAt_.erase(it);
+      }
+    }
+    if (isTerminal(e.state)) {
+      eventSeq_.erase(e.taskId);
+      queuedAt_.erase(e.taskId);
+    }
+  }
+  for (const auto& o : r.assignments) {
+    out.assignments.push_back(toAssignment(o, nowNs));
+    ++metrics_.assignments;
+  }
+  for (const auto& robot : r.revoked) {
+    msg::TaskAssignment a;
+    a.robot_id = robot;
+    auto& rev = revisions_[robot];
+    rev = std::max<std::uint32_t>(rev + 1, static_cast<std::uint32_t>((nowNs / 1'000'000) % 2'000'000'000));
+    a.revision = rev;
+    a.stamp_ns = nowNs;
+    out.assignments.push_back(a);
+  }
+}
+
+void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::int64_t nowNs, Outbox& out) {
+  std::vector<Task> batch;
+  std::vector<const msg::Task*> batchReq;
+  auto flush = [&] {
+    if (batch.empty()) {
+      return;
+    }
+    DispatchResult r;
+    auto results = dispatcher_->submit(batch, nowNs, &r);
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const auto& req = *batchReq[i];
+      if (results[i]) {
+        const bool created = results[i]->created;
+        ++(created ? metrics_.stored : metrics_.duplicates);
+        out.acks.push_back(ack(req, created ? msg::AckResult::Stored : msg::AckResult::Duplicate,
+                               toMsg(results[i]->record.state), "", nowNs));
+      } else {
+        const auto& code = results[i].error().code;
+        const auto result = code == errc::kConflict  ? msg::AckResult::Conflict
+                            : code == errc::kStorage ? msg::AckResult::Unavailable
+                                                     : msg::AckResult::Invalid;
+        ++metrics_.rejected;
+        out.acks.push_back(ack(req, result, msg::TaskState::Rejected, results[i].error().message, nowNs));
+      }
+    }
+    publish(std::move(r), nowNs, out);
+    batch.clear();
+    batchReq.clear();
+  };
+  for (const auto& req : requests) {
+    ++metrics_.requests;
+    if (req.cancel) {
+      flush();  // a cancel must see the tasks submitted before it
+      auto r = dispatcher_->cancel(req.task_id, "cancelled by request", nowNs);
+      if (r) {
+        out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Cancelled, "", nowNs));
+        publish(std::move(*r), nowNs, out);
+      } else {
+        const bool missing = r.error().code == errc::kNotFound;
+        out.acks.push_back(ack(req, missing ? msg::AckResult::NotFound : msg::AckResult::Refused,
+                               msg::TaskState::Rejected, r.error().message, nowNs));
+      }
+      continue;
+    }
+    nlohmann::json body;
+    try {
+      body = nlohmann::json::parse(req.body);
+    } catch (const nlohmann::json::exception& e) {
+      ++metrics_.rejected;
+      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                             fieldsJson({{"", std::string("body is not valid JSON: ") + e.what()}}), nowNs));
+      continue;
+    }
+    auto parsed = parseTask(body, &dispatcher_->stations());
+    if (!parsed) {
+      ++metrics_.rejected;
+      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                             fieldsJson(parsed.error().fields), nowNs));
+      continue;
+    }
+    if (parsed->id != req.task_id) {
+      ++metrics_.rejected;
+      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                             fieldsJson({{"id", "does not match the request's task_id"}}), nowNs));
+      continue;
+    }
+    if (parsed->createdNs == 0) {
+      parsed->createdNs = req.created_ns != 0 ? req.created_ns : nowNs;
+    }
+    batch.push_back(std::move(*parsed));
+    batchReq.push_back(&req);
+  }
+  flush();
+}
+
+void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out) {
+  if (s.task_id.empty()) {
+    return;
+  }
+  const auto state = static_cast<TaskState>(static_cast<int>(s.state));
+  if (s.state == msg::TaskState::Rejected || state == TaskState::Queued || state == TaskState::Assigned) {
+    return;  // not a robot's report
+  }
+  auto r = dispatcher_->onTaskStatus(s.robot_id, s.task_id, state, s.error, nowNs);
+  if (r) {
+    publish(std::move(*r), nowNs, out);
+    return;
+  }
+  // A robot working on a task it no longer holds (cancelled, or given to another robot while it
+  // was thought lost) is told to drop it, unless it already has a newer task.
+  const auto& code = r.error().code;
+  const RobotInfo* robot = dispatcher_->robots().find(s.robot_id);
+  if ((code == errc::kWrongRobot || code == errc::kNotFound) && (robot == nullptr || robot->taskId.empty())) {
+    DispatchResult revoke;
+    revoke.revoked.push_back(s.robot_id);
+    publish(std::move(revoke), nowNs, out);
+  }
+}
+
+void FleetManagerNode::onRobotState(const msg::RobotState& s) {
+  dispatcher_->onRobotState({s.robot_id, s.pose, static_cast<double>(s.battery), s.stamp_ns});
+}
+
+void FleetManagerNode::onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out) {
+  publish(dispatcher_->onRobotLost(robotId, nowNs), nowNs, out);
+}
+
+void FleetManagerNode::tick(std::int64_t nowNs, Outbox& out) {
+  publish(dispatcher_->tick(nowNs), nowNs, out);
+}
+
+nlohmann::json FleetManagerNode::metricsJson() const {
+  const auto& c = dispatcher_->counters();
+  auto lat = metrics_.assignLatencyMs;
+  std::sort(lat.begin(), lat.end());
+  auto pct = [&](double q) {
+    return lat.empty() ? 0.0 : lat[static_cast<std::size_t>(q * static_cast<double>(lat.size() - 1))];
+  };
+  return {{"queued", dispatcher_->waitingCount()},
+          {"active", dispatcher_->activeCount()},
+          {"submitted", c.submitted},
+          {"done", c.done},
+          {"failed", c.failed},
+          {"cancelled", c.cancelled},
+          {"requeued", c.requeued},
+          {"robots_lost", c.robotsLost},
+          {"robots_online", dispatcher_->robots().onlineCount()},
+          {"requests", metrics_.requests},
+          {"duplicates", metrics_.duplicates},
+          {"rejected", metrics_.rejected},
+          {"assignments", metrics_.assignments},
+          {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.size()}}}};
+}
+
+}  // namespace fleet::manager

@@ -1,0 +1,83 @@
+#pragma once
+
+// The fleet manager without its DDS wiring: turns Task requests, TaskStatus reports and RobotState
+// samples into dispatcher calls, and dispatcher results into the messages to publish.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fleet/core/config.hpp"
+#include "fleet/fleet/dispatcher.hpp"
+#include "fleet/fleet/sqlite_task_store.hpp"
+#include "fleet/transport/messages.hpp"
+
+namespace fleet::manager {
+
+struct Settings {
+  std::string db = "fleet.db";
+  std::string stationsFile;  // JSON: {"stations": [...]} (a scenario file works too)
+  bool syncFull = true;      // SQLite synchronous=FULL (survives power loss) or NORMAL (process crash)
+  double tickS = 0.2;        // periodic assignment
+  double leaseS = 1.0;       // a robot silent this long is lost
+  int maxAttempts = 3;
+  double batteryThreshold = 0.2;
+  double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
+  std::string clock = "wall";
+  std::string metricsFile;  // written every second when set (JSON)
+};
+
+Settings readSettings(Config& cfg);
+
+/// Everything a call produced that must go on the wire, in order.
+struct Outbox {
+  std::vector<msg::TaskAck> acks;
+  std::vector<msg::TaskEvent> events;
+  std::vector<msg::TaskAssignment> assignments;
+};
+
+struct Metrics {
+  std::int64_t requests = 0;
+  std::int64_t stored = 0;
+  std::int64_t duplicates = 0;
+  std::int64_t rejected = 0;
+  std::int64_t assignments = 0;
+  std::vector<double> assignLatencyMs;  // queued → assigned, recent window
+};
+
+class FleetManagerNode {
+ public:
+  static Expected<std::unique_ptr<FleetManagerNode>> create(const Settings& s, StationMap stations,
+                                                            std::int64_t nowNs);
+
+  /// A batch of requests taken from the Task topic: stores new tasks in one group commit, answers
+  /// each with a TaskAck, publishes the resulting events. Cancels are applied in order.
+  void onRequests(const std::vector<msg::Task>& requests, std::int64_t nowNs, Outbox& out);
+  void onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out);
+  void onRobotState(const msg::RobotState& s);
+  void onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out);
+  void tick(std::int64_t nowNs, Outbox& out);
+  /// Assignments to re-publish after a restart (from the store).
+  [[nodiscard]] const Outbox& recovered() const { return recovered_; }
+
+  [[nodiscard]] const Dispatcher& dispatcher() const { return *dispatcher_; }
+  [[nodiscard]] const Metrics& metrics() const { return metrics_; }
+  [[nodiscard]] nlohmann::json metricsJson() const;
+
+ private:
+  FleetManagerNode() = default;
+  void publish(DispatchResult r, std::int64_t nowNs, Outbox& out);
+  msg::TaskAssignment toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
+
+  Settings settings_;
+  std::unique_ptr<SqliteTaskStore> store_;
+  std::unique_ptr<Dispatcher> dispatcher_;
+  std::map<std::string, std::uint32_t> eventSeq_;
+  std::map<std::string, std::uint32_t> revisions_;
+  std::map<std::string, std::int64_t> queuedAt_;
+  Outbox recovered_;
+  Metrics metrics_;
+};
+
+}  // namespace fleet::manager
