@@ -24,6 +24,11 @@ bool positiveFinite(double v) {
   return std::isfinite(v) && v > 0.0;
 }
 
+bool validLineObservation(const LineObservation& o) {
+  return std::isfinite(o.r) && std::isfinite(o.psi) && positiveFinite(o.var_r) && positiveFinite(o.var_psi) &&
+         std::isfinite(o.cov_r_psi) && o.cov_r_psi * o.cov_r_psi < o.var_r * o.var_psi;
+}
+
 }  // namespace
 
 Expected<void> EkfParams::validate() const {
@@ -149,7 +154,7 @@ UpdateStatus PoseEkf::updateBearing(Vec2 landmark, double bearing, double varian
 
 UpdateStatus PoseEkf::updateLine(const MapLine& map_line, const LineObservation& obs) {
   if (!std::isfinite(map_line.rho) || !std::isfinite(map_line.beta) || !std::isfinite(obs.r) ||
-      !std::isfinite(obs.psi) || !positiveFinite(obs.var_r) || !positiveFinite(obs.var_psi)) {
+      !validLineObservation(obs)) {
     ++stats_.line.rejected_non_finite;
     return UpdateStatus::kRejectedNonFinite;
   }
@@ -162,6 +167,7 @@ UpdateStatus PoseEkf::updateLine(const MapLine& map_line, const LineObservation&
   Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
   R(0, 0) = obs.var_r;
   R(1, 1) = obs.var_psi;
+  R(0, 1) = R(1, 0) = obs.cov_r_psi;
   return correct<2>(innov, p.H, R, params_.gate_2dof, stats_.line);
 }
 
@@ -170,8 +176,7 @@ LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
   LineBatchResult result;
   std::vector<bool> used(map.size(), false);
   for (const LineObservation& obs : observations) {
-    if (!std::isfinite(obs.r) || !std::isfinite(obs.psi) || !positiveFinite(obs.var_r) ||
-        !positiveFinite(obs.var_psi)) {
+    if (!validLineObservation(obs)) {
       ++stats_.line.rejected_non_finite;
       ++result.rejected_non_finite;
       continue;
@@ -179,6 +184,7 @@ LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
     Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
     R(0, 0) = obs.var_r;
     R(1, 1) = obs.var_psi;
+    R(0, 1) = R(1, 0) = obs.cov_r_psi;
     double best = params_.gate_2dof;
     std::size_t best_j = map.size();
     for (std::size_t j = 0; j < map.size(); ++j) {

@@ -12,6 +12,7 @@
 
 #include "fleet/control/lyapunov_pose_controller.hpp"
 #include "fleet/control/path_follower.hpp"
+#include "fleet/estimation/line_extraction.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
 #include "square_drive_sim.hpp"
 
@@ -218,5 +219,41 @@ static void BM_EkfPlusControllerCycle(benchmark::State& state) {
   addPercentiles(state, ns);
 }
 BENCHMARK(BM_EkfPlusControllerCycle);
+
+/// Line extraction from one 180° / 0.5° scan (361 beams) of a room corner seen from inside a 4-wall room
+/// (the thesis's MATLAB version took 150–250 ms for 360 points).
+static void BM_LineExtraction(benchmark::State& state) {
+  LaserScan scan;
+  scan.angle_min = -kPi / 2;
+  scan.angle_increment = kPi / 360;
+  const std::vector<MapLine> room = sim::roomMap();
+  const Pose2 pose{0.4, -0.3, 0.5};
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i <= 360; ++i) {
+    const double a = pose.theta + scan.angle_min + i * scan.angle_increment;
+    double best = 100.0;
+    for (const MapLine& w : room) {
+      const double den = std::cos(a) * std::cos(w.beta) + std::sin(a) * std::sin(w.beta);
+      if (std::abs(den) < 1e-9) {
+        continue;
+      }
+      const double t = (w.rho - pose.x * std::cos(w.beta) - pose.y * std::sin(w.beta)) / den;
+      if (t > 0.0 && t < best) {
+        best = t;
+      }
+    }
+    scan.ranges.push_back(best + noise(rng));
+  }
+  std::size_t lines = 0;
+  for (auto _ : state) {
+    const auto out = extractLines(scan);
+    lines = out.size();
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["lines"] = static_cast<double>(lines);
+  state.counters["beams"] = static_cast<double>(scan.ranges.size());
+}
+BENCHMARK(BM_LineExtraction);
 
 BENCHMARK_MAIN();

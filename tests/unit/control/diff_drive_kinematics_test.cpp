@@ -1,12 +1,11 @@
 #include "fleet/control/diff_drive_kinematics.hpp"
 
-#include "fleet/control/diff_drive_base.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "fleet/control/diff_drive_base.hpp"
 #include "fleet/core/angles.hpp"
 
 using namespace fleet;

@@ -57,6 +57,8 @@ struct LineObservation {
   double psi = 0.0;
   double var_r = 1e-4;
   double var_psi = 1e-3;
+  /// Correlation of r and ψ from the fit (not in the thesis's diagonal R, eq. 3.23); |cov|² < var_r·var_psi.
+  double cov_r_psi = 0.0;
 };
 
 struct LineBatchResult {
