@@ -1,0 +1,172 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "fleet_manager_node.hpp"
+
+using namespace fleet;
+using ::testing::HasSubstr;
+
+namespace {
+StationMap stations() {
+  auto m = StationMap::fromJson(nlohmann::json::parse(R"({"stations": [
+    {"name": "P-1", "x": 1, "y": 1, "theta": 0, "kinds": ["pickup"]},
+    {"name": "D-1", "x": 5, "y": 1, "theta": 0, "kinds": ["dropoff"]},
+    {"name": "C-1", "x": 0, "y": 0, "theta": 0, "kinds": ["charging", "parking"]}]})"));
+  EXPECT_TRUE(m);
+  return *m;
+}
+
+int gRequest = 0;
+
+msg::Task request(const std::string& id, const std::string& body, bool cancel = false) {
+  msg::Task t;
+  t.task_id = id;
+  t.request_id = "req-" + std::to_string(++gRequest);
+  t.body = body;
+  t.cancel = cancel;
+  return t;
+}
+
+std::string transport(const std::string& id, const std::string& pickup = "P-1") {
+  return R"({"id": ")" + id + R"(", "kind": "transport", "pickup": ")" + pickup +
+         R"(", "dropoff": "D-1", "load_duration_ns": 2000000000})";
+}
+
+class Node : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("fm_node_" + std::to_string(getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    settings_.db = (dir_ / "fleet.db").string();
+    settings_.stationsFile = "unused";
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::unique_ptr<manager::FleetManagerNode> open(std::int64_t now) {
+    auto n = manager::FleetManagerNode::create(settings_, stations(), now);
+    EXPECT_TRUE(n) << (n ? "" : n.error().message);
+    return std::move(*n);
+  }
+  std::filesystem::path dir_;
+  manager::Settings settings_;
+};
+}  // namespace
+
+TEST_F(Node, RequestsAreAcknowledgedWithTheRightResult) {
+  auto node = open(1'000);
+  manager::Outbox out;
+  const std::vector<msg::Task> reqs = {request("t1", transport("t1")), request("t2", transport("t2", "NOPE")),
+                                       request("t3", "{not json"), request("t1", transport("t1")),
+                                       request("t1", R"({"id": "t1", "kind": "goto", "station": "D-1"})")};
+  node->onRequests(reqs, 2'000, out);
+  ASSERT_EQ(out.acks.size(), 5u);
+  // Acks come in commit order (invalid ones at once, stored ones after the group commit).
+  std::vector<msg::TaskAck> acks;
+  for (const auto& r : reqs) {
+    for (const auto& a : out.acks) {
+      if (a.request_id == r.request_id) {
+        acks.push_back(a);
+      }
+    }
+  }
+  ASSERT_EQ(acks.size(), 5u);
+  EXPECT_EQ(acks[0].result, msg::AckResult::Stored);
+  EXPECT_EQ(acks[0].state, msg::TaskState::Queued);
+  EXPECT_EQ(acks[1].result, msg::AckResult::Invalid);
+  EXPECT_THAT(acks[1].detail, HasSubstr("\"path\":\"pickup\""));
+  EXPECT_THAT(acks[1].detail, HasSubstr("NOPE"));
+  EXPECT_EQ(acks[2].result, msg::AckResult::Invalid);
+  EXPECT_THAT(acks[2].detail, HasSubstr("not valid JSON"));
+  EXPECT_EQ(acks[3].result, msg::AckResult::Duplicate);
+  EXPECT_EQ(acks[4].result, msg::AckResult::Conflict);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].task_id, "t1");
+  EXPECT_EQ(out.events[0].state, msg::TaskState::Queued);
+  EXPECT_EQ(out.events[0].seq, 1u);
+}
+
+TEST_F(Node, TaskGoesFromQueuedToDoneWithStationGoals) {
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRequests({request("t1", transport("t1"))}, 1'000'000, out);
+  node->onRobotState({"r1", 1'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  out = {};
+  node->tick(2'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const auto& a = out.assignments[0];
+  EXPECT_EQ(a.robot_id, "r1");
+  EXPECT_EQ(a.task_id, "t1");
+  ASSERT_EQ(a.goals.size(), 2u);
+  EXPECT_EQ(a.goals[0].station, "P-1");
+  EXPECT_EQ(a.goals[0].action, msg::GoalAction::Load);
+  EXPECT_DOUBLE_EQ(a.goals[0].duration_s, 2.0);
+  EXPECT_DOUBLE_EQ(a.goals[1].pose.x, 5.0);
+  EXPECT_EQ(a.goals[1].action, msg::GoalAction::Unload);
+  out = {};
+  node->onStatus({"r1", "t1", a.revision, msg::TaskState::Done, 1.0f, "", 3'000'000}, 3'000'000, out);
+  ASSERT_FALSE(out.events.empty());
+  EXPECT_EQ(out.events.back().state, msg::TaskState::Done);
+  EXPECT_EQ(node->dispatcher().counters().done, 1);
+  const auto m = node->metricsJson();
+  EXPECT_EQ(m["done"], 1);
+  EXPECT_EQ(m["assign_latency_ms"]["samples"], 1);
+}
+
+TEST_F(Node, LostRobotsTaskIsReassignedAndStaleReportsRevoked) {
+  settings_.leaseS = 1.0;
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRequests({request("t1", transport("t1"))}, 0, out);
+  node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  node->tick(100'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  // r1 falls silent; r2 appears.
+  node->onRobotState({"r2", 1'500'000'000, {4, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  out = {};
+  node->tick(1'600'000'000, out);
+  bool requeued = false;
+  for (const auto& e : out.events) {
+    requeued = requeued || e.state == msg::TaskState::Requeued;
+  }
+  EXPECT_TRUE(requeued);
+  ASSERT_FALSE(out.assignments.empty());
+  EXPECT_EQ(out.assignments.back().robot_id, "r2");
+  // r1 comes back and reports progress on a task it no longer holds: it is told to drop it.
+  node->onRobotState({"r1", 1'700'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Moving, 0.9f, "t1", 0.3f});
+  out = {};
+  node->onStatus({"r1", "t1", 1, msg::TaskState::Loading, 0.5f, "", 1'700'000'000}, 1'700'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robot_id, "r1");
+  EXPECT_TRUE(out.assignments[0].task_id.empty());
+}
+
+TEST_F(Node, RestartRecoversOpenTasksAndAssignments) {
+  {
+    auto node = open(0);
+    manager::Outbox out;
+    node->onRequests({request("t1", transport("t1")), request("t2", transport("t2"))}, 0, out);
+    node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+    node->tick(1, out);
+  }
+  auto node = open(10);
+  EXPECT_EQ(node->dispatcher().openTasks().size(), 2u);
+  ASSERT_EQ(node->recovered().assignments.size(), 1u);
+  EXPECT_EQ(node->recovered().assignments[0].robot_id, "r1");
+}
+
+TEST_F(Node, CancelAnswers) {
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRequests({request("t1", transport("t1")), request("t1", "", true), request("zz", "", true),
+                    request("t1", "", true)},
+                   0, out);
+  ASSERT_EQ(out.acks.size(), 4u);
+  EXPECT_EQ(out.acks[1].result, msg::AckResult::Stored);
+  EXPECT_EQ(out.acks[1].state, msg::TaskState::Cancelled);
+  EXPECT_EQ(out.acks[2].result, msg::AckResult::NotFound);
+  EXPECT_EQ(out.acks[3].result, msg::AckResult::Refused);
+}
