@@ -113,7 +113,7 @@ TEST(TransportConfig, QosByNameAndDomainValidation) {
   EXPECT_TRUE(qos::byName("robot_state", q));
   EXPECT_FALSE(q.reliable);
   EXPECT_EQ(q.livelinessLeaseMs, 1000);
-  EXPECT_TRUE(qos::byName("task_request", q));
+  EXPECT_TRUE(qos::byName("assignment", q));
   EXPECT_TRUE(q.reliable && q.transientLocal);
   EXPECT_FALSE(qos::byName("nope", q));
   setenv("FLEET_DDS_DOMAIN", "999", 1);

@@ -80,6 +80,13 @@ class Writer {
     Tr::toC(m, c, arena_);
     check(dds_dispose(w_, &c), "dds_dispose");
   }
+  /// Tells readers this writer has nothing more for m's key and lets it forget the instance.
+  void unregister(const T& m) {
+    typename Tr::C c{};
+    arena_.clear();
+    Tr::toC(m, c, arena_);
+    check(dds_unregister_instance(w_, &c), "dds_unregister_instance");
+  }
   [[nodiscard]] std::uint32_t matchedReaders() const { return detail::matched(w_, true); }
   [[nodiscard]] dds_entity_t handle() const { return w_; }
 

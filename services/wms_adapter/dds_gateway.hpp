@@ -1,0 +1,42 @@
+#pragma once
+
+#include <atomic>
+#include <thread>
+#include <unordered_map>
+
+#include "fleet/transport/dds.hpp"
+#include "gateway.hpp"
+
+namespace fleet::wms {
+
+/// TaskGateway over DDS: writes Task requests, matches TaskAcks to waiting requests, and feeds the
+/// FleetView from TaskEvent and RobotState on a background thread.
+class DdsGateway final : public TaskGateway {
+ public:
+  DdsGateway(transport::Participant& p, FleetView& view);
+  ~DdsGateway() override;
+  DdsGateway(const DdsGateway&) = delete;
+  DdsGateway& operator=(const DdsGateway&) = delete;
+
+  std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
+                                                  std::chrono::milliseconds timeout) override;
+  [[nodiscard]] bool managerOnline() const override;
+
+ private:
+  void loop();
+
+  FleetView& view_;
+  transport::Writer<msg::Task> tasks_;
+  transport::Reader<msg::TaskAck> acks_;
+  transport::Reader<msg::TaskEvent> events_;
+  transport::Reader<msg::RobotState> robots_;
+  transport::WaitSet ws_;
+  std::mutex writeMutex_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::unordered_map<std::string, std::optional<msg::TaskAck>> pending_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace fleet::wms

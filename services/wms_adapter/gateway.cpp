@@ -1,0 +1,127 @@
+#include "gateway.hpp"
+
+namespace fleet::wms {
+namespace {
+constexpr std::size_t kEventBuffer = 10'000;
+bool terminal(msg::TaskState s) {
+  return s == msg::TaskState::Done || s == msg::TaskState::Failed || s == msg::TaskState::Cancelled;
+}
+}  // namespace
+
+void FleetView::onEvent(const msg::TaskEvent& e) {
+  {
+    std::lock_guard lock(m_);
+    auto [it, inserted] = tasks_.try_emplace(e.task_id);
+    auto& v = it->second;
+    if (inserted) {
+      v.id = e.task_id;
+      insertion_.push_back(e.task_id);
+    }
+    // Events may arrive twice (transient-local history to a late joiner) or out of order across
+    // restarts of the manager: keep the newest by sequence, then by time.
+    if (inserted || e.seq > v.seq || (e.seq == v.seq && e.stamp_ns >= v.updatedNs)) {
+      v.state = e.state;
+      v.robot = e.robot_id;
+      v.reason = e.reason;
+      v.updatedNs = e.stamp_ns;
+      v.seq = e.seq;
+    }
+    events_.push_back(e);
+    ++eventCount_;
+    if (events_.size() > kEventBuffer) {
+      events_.pop_front();
+    }
+    // Bound memory: forget the oldest finished tasks first.
+    while (tasks_.size() > maxTasks_ && !insertion_.empty()) {
+      const std::string old = insertion_.front();
+      insertion_.pop_front();
+      auto o = tasks_.find(old);
+      if (o != tasks_.end() && terminal(o->second.state)) {
+        tasks_.erase(o);
+      } else if (o != tasks_.end()) {
+        insertion_.push_back(old);
+        if (insertion_.size() > 2 * maxTasks_) {
+          break;
+        }
+      }
+    }
+  }
+  cv_.notify_all();
+}
+
+void FleetView::onAccepted(const std::string& id, const std::string& body, msg::TaskState state,
+                           std::int64_t nowNs) {
+  std::lock_guard lock(m_);
+  auto [it, inserted] = tasks_.try_emplace(id);
+  if (inserted) {
+    it->second.id = id;
+    it->second.state = state;
+    it->second.updatedNs = nowNs;
+    insertion_.push_back(id);
+  }
+  it->second.body = body;
+}
+
+void FleetView::onRobot(const msg::RobotState& s) {
+  std::lock_guard lock(m_);
+  robots_[s.robot_id] = s;
+}
+
+std::optional<TaskView> FleetView::task(const std::string& id) const {
+  std::lock_guard lock(m_);
+  auto it = tasks_.find(id);
+  if (it == tasks_.end()) {
+    return std::nullopt;
+  }
+  return it->second;
+}
+
+std::vector<TaskView> FleetView::tasks(std::optional<msg::TaskState> state, std::size_t limit) const {
+  std::lock_guard lock(m_);
+  std::vector<TaskView> out;
+  for (const auto& [id, v] : tasks_) {
+    if (out.size() >= limit) {
+      break;
+    }
+    if (!state || v.state == *state) {
+      out.push_back(v);
+    }
+  }
+  return out;
+}
+
+std::vector<msg::RobotState> FleetView::robots() const {
+  std::lock_guard lock(m_);
+  std::vector<msg::RobotState> out;
+  for (const auto& [id, r] : robots_) {
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::map<std::string, std::int64_t> FleetView::countByState() const {
+  std::lock_guard lock(m_);
+  std::map<std::string, std::int64_t> out;
+  for (const auto& [id, v] : tasks_) {
+    ++out[msg::toString(v.state)];
+  }
+  return out;
+}
+
+std::uint64_t FleetView::eventsAfter(std::uint64_t cursor, std::chrono::milliseconds timeout,
+                                     std::vector<msg::TaskEvent>& out) const {
+  std::unique_lock lock(m_);
+  cv_.wait_for(lock, timeout, [&] { return eventCount_ > cursor; });
+  const std::uint64_t first = eventCount_ - events_.size();
+  for (std::uint64_t i = std::max(cursor, first); i < eventCount_; ++i) {
+    out.push_back(events_[static_cast<std::size_t>(i - first)]);
+  }
+  return eventCount_;
+}
+
+std::uint64_t FleetView::eventCursor() const {
+  std::lock_guard lock(m_);
+  return eventCount_;
+}
+
+}  // namespace fleet::wms

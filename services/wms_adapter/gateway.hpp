@@ -1,0 +1,73 @@
+#pragma once
+
+// What the HTTP API needs from the rest of the fleet, as an interface so the API can be tested
+// without DDS: send task requests and wait for the manager's acknowledgements, and read the task
+// and robot views kept from TaskEvent / RobotState.
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/transport/messages.hpp"
+
+namespace fleet::wms {
+
+/// A task as the API shows it: the latest event plus the task JSON we accepted.
+struct TaskView {
+  std::string id;
+  msg::TaskState state = msg::TaskState::Queued;
+  std::string robot;
+  std::string reason;
+  std::int64_t updatedNs = 0;
+  std::uint32_t seq = 0;
+  std::string body;  // the task JSON, when this adapter submitted it
+};
+
+class TaskGateway {
+ public:
+  virtual ~TaskGateway() = default;
+  /// Sends the requests and waits for one ack each. A missing ack (timeout, manager unreachable)
+  /// is nothing in its slot.
+  virtual std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
+                                                          std::chrono::milliseconds timeout) = 0;
+  /// Whether a fleet manager is matched on the Task topic.
+  [[nodiscard]] virtual bool managerOnline() const = 0;
+};
+
+/// Task and robot views and the event stream, fed from DDS (or by tests). Thread-safe.
+class FleetView {
+ public:
+  explicit FleetView(std::size_t maxTasks = 200'000) : maxTasks_(maxTasks) {}
+  void onEvent(const msg::TaskEvent& e);
+  void onAccepted(const std::string& id, const std::string& body, msg::TaskState state, std::int64_t nowNs);
+  void onRobot(const msg::RobotState& s);
+
+  [[nodiscard]] std::optional<TaskView> task(const std::string& id) const;
+  [[nodiscard]] std::vector<TaskView> tasks(std::optional<msg::TaskState> state, std::size_t limit) const;
+  [[nodiscard]] std::vector<msg::RobotState> robots() const;
+  [[nodiscard]] std::map<std::string, std::int64_t> countByState() const;
+
+  /// Events after `cursor` (a running count), waiting up to `timeout` for one to arrive. Returns the
+  /// new cursor. Events older than the buffer are skipped.
+  std::uint64_t eventsAfter(std::uint64_t cursor, std::chrono::milliseconds timeout,
+                            std::vector<msg::TaskEvent>& out) const;
+  [[nodiscard]] std::uint64_t eventCursor() const;
+
+ private:
+  mutable std::mutex m_;
+  mutable std::condition_variable cv_;
+  std::size_t maxTasks_;
+  std::map<std::string, TaskView> tasks_;
+  std::deque<std::string> insertion_;
+  std::map<std::string, msg::RobotState> robots_;
+  std::deque<msg::TaskEvent> events_;
+  std::uint64_t eventCount_ = 0;
+};
+
+}  // namespace fleet::wms

@@ -1,0 +1,212 @@
+// The HTTP API against a fake gateway (no DDS): every documented status code and error body.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "http_api.hpp"
+
+using namespace fleet;
+using namespace fleet::wms;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+namespace {
+
+/// A manager in memory: stores tasks by id, answers duplicates and conflicts like the real one.
+class FakeGateway : public TaskGateway {
+ public:
+  std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
+                                                  std::chrono::milliseconds) override {
+    std::vector<std::optional<msg::TaskAck>> out;
+    for (const auto& r : requests) {
+      if (silent) {
+        out.emplace_back();
+        continue;
+      }
+      msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
+      if (r.cancel) {
+        auto it = bodies.find(r.task_id);
+        a.result = it == bodies.end() ? msg::AckResult::NotFound : msg::AckResult::Stored;
+        a.state = msg::TaskState::Cancelled;
+      } else if (auto it = bodies.find(r.task_id); it != bodies.end()) {
+        a.result = it->second == r.body ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
+      } else {
+        bodies[r.task_id] = r.body;
+      }
+      out.emplace_back(a);
+    }
+    return out;
+  }
+  [[nodiscard]] bool managerOnline() const override { return online; }
+  std::map<std::string, std::string> bodies;
+  bool online = true;
+  bool silent = false;
+};
+
+StationMap stations() {
+  return *StationMap::fromJson(json::parse(R"({"stations": [
+    {"name": "P-1", "x": 1, "y": 1, "kinds": ["pickup"]},
+    {"name": "D-1", "x": 5, "y": 1, "kinds": ["dropoff"]}]})"));
+}
+
+class Api : public ::testing::Test {
+ protected:
+  void start(ApiSettings s = {}) {
+    s.port = 0;
+    s.ackTimeoutMs = 200;
+    api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
+    ASSERT_TRUE(api_->bind());
+    thread_ = std::thread([this] { api_->serve(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
+  }
+  void TearDown() override {
+    if (api_) {
+      api_->stop();
+      thread_.join();
+    }
+  }
+  httplib::Result post(const std::string& body, const httplib::Headers& h = {}) {
+    return client_->Post("/v1/tasks", h, body, "application/json");
+  }
+  StationMap stations_ = stations();
+  FakeGateway gateway_;
+  FleetView view_;
+  WallClock clock_;
+  std::unique_ptr<HttpApi> api_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+const std::string kTask = R"({"id": "t-1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})";
+}  // namespace
+
+TEST_F(Api, CreateThenIdempotentRepeatThenConflict) {
+  start();
+  auto r = post(kTask);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 201);
+  EXPECT_EQ(json::parse(r->body)["state"], "queued");
+  r = post(kTask);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_EQ(json::parse(r->body)["result"], "duplicate");
+  r = post(R"({"id": "t-1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1", "priority": 5})");
+  EXPECT_EQ(r->status, 409);
+  EXPECT_EQ(json::parse(r->body)["error"], "conflict");
+  r = client_->Get("/v1/tasks/t-1");
+  ASSERT_EQ(r->status, 200);
+  EXPECT_EQ(json::parse(r->body)["task"]["pickup"], "P-1");
+}
+
+TEST_F(Api, ValidationErrorsNameTheField) {
+  start();
+  auto r =
+      post(R"({"id": "t-2", "kind": "transport", "pickup": "P-404", "dropoff": "D-1", "priority": 99999})");
+  ASSERT_EQ(r->status, 400);
+  const auto body = json::parse(r->body);
+  EXPECT_EQ(body["error"], "invalid");
+  std::string paths;
+  for (const auto& f : body["fields"]) {
+    paths += f["path"].get<std::string>() + ";";
+  }
+  EXPECT_THAT(paths, HasSubstr("priority;"));
+  r = post(R"({"id": "t-2", "kind": "transport", "pickup": "P-404", "dropoff": "D-1"})");
+  ASSERT_EQ(r->status, 400);
+  EXPECT_EQ(json::parse(r->body)["fields"][0]["path"], "pickup");
+  EXPECT_THAT(r->body, HasSubstr("P-404"));
+  r = post("{\"id\": ");
+  EXPECT_EQ(r->status, 400);
+  EXPECT_EQ(json::parse(r->body)["error"], "invalid_json");
+  r = post(R"([{"id": "a", "kind": "goto", "station": "D-1"}, {"id": "b", "kind": "fly"}])");
+  ASSERT_EQ(r->status, 400);
+  EXPECT_THAT(r->body, HasSubstr("[1].kind"));
+  EXPECT_TRUE(gateway_.bodies.empty()) << "an invalid batch stores nothing";
+}
+
+TEST_F(Api, BatchReportsEachItem) {
+  start();
+  ASSERT_EQ(post(kTask)->status, 201);
+  auto r = post(R"({"tasks": [{"id": "t-1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"},
+                              {"id": "t-9", "kind": "goto", "station": "D-1"}]})");
+  ASSERT_EQ(r->status, 200);
+  const auto res = json::parse(r->body)["results"];
+  EXPECT_EQ(res[0]["status"], 200);
+  EXPECT_EQ(res[1]["status"], 201);
+}
+
+TEST_F(Api, NotFoundTooLargeUnknownStateAndCancel) {
+  ApiSettings s;
+  s.maxBodyBytes = 2048;
+  s.maxBatch = 2;
+  start(s);
+  EXPECT_EQ(client_->Get("/v1/tasks/nope")->status, 404);
+  EXPECT_EQ(client_->Delete("/v1/tasks/nope")->status, 404);
+  EXPECT_EQ(post(std::string(4096, ' ') + kTask)->status, 413);
+  auto r =
+      post(R"([{"id": "a", "kind": "goto", "station": "D-1"}, {"id": "b", "kind": "goto", "station": "D-1"},
+                    {"id": "c", "kind": "goto", "station": "D-1"}])");
+  EXPECT_EQ(r->status, 413);
+  r = client_->Get("/v1/tasks?state=flying");
+  EXPECT_EQ(r->status, 400);
+  EXPECT_THAT(r->body, HasSubstr("unknown task state"));
+  ASSERT_EQ(post(kTask)->status, 201);
+  EXPECT_EQ(client_->Delete("/v1/tasks/t-1")->status, 200);
+}
+
+TEST_F(Api, ManagerUnreachableGives503AndNothingIsClaimed) {
+  start();
+  gateway_.online = false;
+  auto r = post(kTask);
+  EXPECT_EQ(r->status, 503);
+  EXPECT_EQ(r->get_header_value("Retry-After"), "2");
+  EXPECT_EQ(client_->Get("/v1/health")->status, 503);
+  gateway_.online = true;
+  gateway_.silent = true;  // matched but never answers
+  r = post(kTask);
+  EXPECT_EQ(r->status, 503);
+  EXPECT_EQ(client_->Get("/v1/tasks/t-1")->status, 404) << "an unacknowledged task is not shown as accepted";
+}
+
+TEST_F(Api, BearerTokenIsRequiredWhenConfigured) {
+  ApiSettings s;
+  s.token = "s3cret";
+  start(s);
+  EXPECT_EQ(client_->Get("/v1/health")->status, 401);
+  EXPECT_EQ(post(kTask)->status, 401);
+  EXPECT_EQ(post(kTask, {{"Authorization", "Bearer wrong"}})->status, 401);
+  EXPECT_TRUE(gateway_.bodies.empty());
+  EXPECT_EQ(post(kTask, {{"Authorization", "Bearer s3cret"}})->status, 201);
+  EXPECT_EQ(client_->Get("/v1/health", {{"Authorization", "Bearer s3cret"}})->status, 200);
+}
+
+TEST_F(Api, NoTokenMeansOpenAndListensOnLoopback) {
+  start();
+  EXPECT_EQ(client_->Get("/v1/health")->status, 200);
+  auto cfg = Config::fromText("{}", "t");
+  unsetenv("FLEET_WMS_TOKEN");
+  const auto s = readApiSettings(cfg);
+  EXPECT_EQ(s.host, "127.0.0.1");
+  EXPECT_TRUE(s.token.empty());
+}
+
+TEST_F(Api, EventsStreamAndMetrics) {
+  start();
+  std::string received;
+  std::thread reader([&] {
+    httplib::Client c("127.0.0.1", api_->port());
+    c.set_read_timeout(5, 0);
+    c.Get("/v1/events", [&](const char* data, std::size_t n) {
+      received.append(data, n);
+      return received.find("\"state\":\"done\"") == std::string::npos;
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  view_.onEvent({"t-5", msg::TaskState::Assigned, "r1", "", 1, 1});
+  view_.onEvent({"t-5", msg::TaskState::Done, "r1", "", 2, 2});
+  reader.join();
+  EXPECT_THAT(received, HasSubstr("event: task"));
+  EXPECT_THAT(received, HasSubstr("\"state\":\"assigned\""));
+  auto m = json::parse(client_->Get("/v1/metrics")->body);
+  EXPECT_EQ(m["tasks_by_state"]["done"], 1);
+}
