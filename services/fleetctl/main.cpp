@@ -1,0 +1,212 @@
+// fleetctl: the operator's command line. Talks to the WMS adapter's HTTP API.
+//   fleetctl submit tasks.csv        submit tasks from a JSON or CSV file
+//   fleetctl tasks [--state S]       list tasks          fleetctl task ID     one task
+//   fleetctl cancel ID               cancel a task       fleetctl robots      list robots
+//   fleetctl follow [--count N]      print task events as they happen
+//   fleetctl health | metrics
+
+#include <httplib.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
+#include "task_file.hpp"
+
+using nlohmann::json;
+
+namespace {
+
+struct Target {
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  std::string token;
+};
+
+Target parseUrl(const std::string& url) {
+  Target t;
+  std::string rest = url;
+  if (rest.rfind("http://", 0) == 0) {
+    rest = rest.substr(7);
+  }
+  const auto colon = rest.find(':');
+  t.host = rest.substr(0, colon);
+  if (colon != std::string::npos) {
+    t.port = std::atoi(rest.substr(colon + 1).c_str());
+  }
+  return t;
+}
+
+httplib::Headers headers(const Target& t) {
+  if (t.token.empty()) {
+    return {};
+  }
+  return {{"Authorization", "Bearer " + t.token}};
+}
+
+int fail(const std::string& msg) {
+  std::fprintf(stderr, "fleetctl: %s\n", msg.c_str());
+  return 1;
+}
+
+int show(const httplib::Result& r) {
+  if (!r) {
+    return fail("cannot reach the WMS adapter (" + httplib::to_string(r.error()) + ")");
+  }
+  auto j = json::parse(r->body, nullptr, false);
+  std::cout << (j.is_discarded() ? r->body : j.dump(2)) << "\n";
+  return r->status < 300 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"fleetctl: operate the warehouse fleet through the WMS adapter"};
+  app.require_subcommand(1);
+  std::string url = "http://127.0.0.1:8080";
+  std::string tokenFile;
+  app.add_option("--url", url, "WMS adapter address")->envname("FLEET_WMS_URL");
+  app.add_option("--token-file", tokenFile, "file holding the bearer token (else FLEET_WMS_TOKEN)");
+
+  auto* submit = app.add_subcommand("submit", "submit tasks from a JSON or CSV file");
+  std::string file;
+  int batch = 500;
+  submit->add_option("file", file, "tasks.json or tasks.csv")->required();
+  submit->add_option("--batch", batch, "tasks per request")->check(CLI::Range(1, 1000));
+  auto* tasks = app.add_subcommand("tasks", "list tasks");
+  std::string state;
+  int limit = 100;
+  tasks->add_option("--state", state, "queued, assigned, en_route, ..., done, failed, cancelled");
+  tasks->add_option("--limit", limit)->check(CLI::Range(1, 100000));
+  auto* task = app.add_subcommand("task", "show one task");
+  std::string id;
+  task->add_option("id", id)->required();
+  auto* cancel = app.add_subcommand("cancel", "cancel a task");
+  cancel->add_option("id", id)->required();
+  auto* robots = app.add_subcommand("robots", "list robots");
+  auto* follow = app.add_subcommand("follow", "print task events as they happen");
+  int count = 0;
+  int seconds = 0;
+  follow->add_option("--count", count, "stop after this many events (0 = never)");
+  follow->add_option("--seconds", seconds, "stop after this long (0 = never)");
+  auto* health = app.add_subcommand("health", "is the adapter up and does it see the manager");
+  auto* metrics = app.add_subcommand("metrics", "the adapter's counters");
+  CLI11_PARSE(app, argc, argv);
+
+  Target t = parseUrl(url);
+  if (!tokenFile.empty()) {
+    std::ifstream in(tokenFile);
+    if (!in || !std::getline(in, t.token)) {
+      return fail("cannot read a token from " + tokenFile);
+    }
+  } else if (const char* env = std::getenv("FLEET_WMS_TOKEN")) {
+    t.token = env;
+  }
+  httplib::Client c(t.host, t.port);
+  c.set_read_timeout(30, 0);
+  const auto h = headers(t);
+
+  if (*submit) {
+    auto all = fleet::ctl::loadTaskFile(file);
+    if (!all) {
+      return fail(all.error().message);
+    }
+    int ok = 0;
+    int bad = 0;
+    for (std::size_t i = 0; i < all->size(); i += static_cast<std::size_t>(batch)) {
+      json part = json::array();
+      for (std::size_t k = i; k < std::min(all->size(), i + static_cast<std::size_t>(batch)); ++k) {
+        part.push_back((*all)[k]);
+      }
+      auto r = c.Post("/v1/tasks", h, part.dump(), "application/json");
+      if (!r) {
+        return fail("cannot reach the WMS adapter at " + url + " (" + httplib::to_string(r.error()) + ")");
+      }
+      auto body = json::parse(r->body, nullptr, false);
+      if (body.is_object() && body.contains("results")) {
+        for (const auto& item : body["results"]) {
+          const int s = item.value("status", 0);
+          if (s == 200 || s == 201) {
+            ++ok;
+          } else {
+            ++bad;
+            std::cerr << "fleetctl: " << item.dump() << "\n";
+          }
+        }
+      } else {
+        bad += static_cast<int>(part.size());
+        std::cerr << "fleetctl: HTTP " << r->status << ": " << r->body << "\n";
+      }
+    }
+    std::printf("submitted %d tasks, %d refused\n", ok, bad);
+    return bad == 0 ? 0 : 1;
+  }
+  if (*tasks) {
+    std::string path = "/v1/tasks?limit=" + std::to_string(limit);
+    if (!state.empty()) {
+      path += "&state=" + state;
+    }
+    auto r = c.Get(path, h);
+    if (!r || r->status != 200) {
+      return show(r);
+    }
+    auto body = json::parse(r->body);
+    std::printf("%-24s %-11s %-12s %s\n", "ID", "STATE", "ROBOT", "REASON");
+    for (const auto& x : body["tasks"]) {
+      std::printf("%-24s %-11s %-12s %s\n", x.value("id", "").c_str(), x.value("state", "").c_str(),
+                  x.value("robot", "").c_str(), x.value("reason", "").c_str());
+    }
+    return 0;
+  }
+  if (*task) {
+    return show(c.Get("/v1/tasks/" + id, h));
+  }
+  if (*cancel) {
+    return show(c.Delete("/v1/tasks/" + id, h));
+  }
+  if (*robots) {
+    auto r = c.Get("/v1/robots", h);
+    if (!r || r->status != 200) {
+      return show(r);
+    }
+    std::printf("%-12s %8s %8s %7s %-9s %7s %s\n", "ID", "X", "Y", "THETA", "MODE", "BATTERY", "TASK");
+    for (const auto& x : json::parse(r->body)["robots"]) {
+      std::printf("%-12s %8.2f %8.2f %7.2f %-9s %6.0f%% %s\n", x.value("id", "").c_str(),
+                  x["pose"].value("x", 0.0), x["pose"].value("y", 0.0), x["pose"].value("theta", 0.0),
+                  x.value("mode", "").c_str(), 100.0 * x.value("battery", 0.0), x.value("task", "").c_str());
+    }
+    return 0;
+  }
+  if (*follow) {
+    int seen = 0;
+    const auto start = std::chrono::steady_clock::now();
+    std::string buf;
+    auto r = c.Get("/v1/events", h, [&](const char* data, std::size_t n) {
+      buf.append(data, n);
+      std::size_t pos = 0;
+      while ((pos = buf.find("\n\n")) != std::string::npos) {
+        const std::string frame = buf.substr(0, pos);
+        buf.erase(0, pos + 2);
+        const auto d = frame.find("data: ");
+        if (d != std::string::npos) {
+          std::cout << frame.substr(d + 6) << std::endl;
+          ++seen;
+        }
+      }
+      const bool timeUp =
+          seconds > 0 && std::chrono::steady_clock::now() - start > std::chrono::seconds(seconds);
+      return !(count > 0 && seen >= count) && !timeUp;
+    });
+    (void)r;
+    return 0;
+  }
+  if (*health) {
+    return show(c.Get("/v1/health", h));
+  }
+  if (*metrics) {
+    return show(c.Get("/v1/metrics", h));
+  }
+  return 0;
+}

@@ -1,0 +1,21 @@
+#pragma once
+
+// Task files an operator submits: JSON (one task, an array, or {"tasks": [...]}) or CSV with a
+// header row naming the columns (id,kind,pickup,dropoff,station,robot,priority,load_s,unload_s,
+// deadline_ns). Errors name the file, the line and the column.
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "fleet/core/expected.hpp"
+
+namespace fleet::ctl {
+
+/// Parses CSV text into the JSON array the HTTP API takes. Field types are checked here; the
+/// semantics (stations, kinds) are the server's job.
+Expected<nlohmann::json> csvToTasks(const std::string& text, const std::string& origin);
+
+/// Reads a .json or .csv file into a JSON array of task objects.
+Expected<nlohmann::json> loadTaskFile(const std::string& path);
+
+}  // namespace fleet::ctl
