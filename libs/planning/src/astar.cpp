@@ -1,0 +1,111 @@
+#include "fleet/planning/astar.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <queue>
+
+namespace fleet::planning {
+
+namespace {
+
+double heuristic(Cell a, Cell b, Connectivity conn) {
+  const double dx = std::abs(a.x - b.x);
+  const double dy = std::abs(a.y - b.y);
+  if (conn == Connectivity::Four) {
+    return dx + dy;
+  }
+  return std::max(dx, dy) + (std::numbers::sqrt2 - 1.0) * std::min(dx, dy);
+}
+
+}  // namespace
+
+Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Connectivity conn) {
+  if (grid.blocked(start) || grid.blocked(goal)) {
+    return unexpected("unreachable", "start or goal cell is blocked or outside the map");
+  }
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  // Scratch buffers are reused across calls on the same thread: queries are many and small.
+  thread_local std::vector<double> g;
+  thread_local std::vector<std::uint32_t> parent;
+  thread_local std::vector<std::uint32_t> stamp;
+  thread_local std::uint32_t epoch = 0;
+  if (g.size() != grid.size()) {
+    g.assign(grid.size(), inf);
+    parent.assign(grid.size(), 0);
+    stamp.assign(grid.size(), 0);
+    epoch = 0;
+  }
+  if (++epoch == 0) {
+    std::fill(stamp.begin(), stamp.end(), 0);
+    epoch = 1;
+  }
+  auto gOf = [&](std::size_t i) { return stamp[i] == epoch ? g[i] : inf; };
+  struct Item {
+    double f;
+    double g;
+    std::uint32_t idx;
+    bool operator>(const Item& o) const { return f > o.f || (f == o.f && g < o.g); }
+  };
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  const auto si = static_cast<std::uint32_t>(grid.index(start));
+  const auto gi = static_cast<std::uint32_t>(grid.index(goal));
+  g[si] = 0.0;
+  stamp[si] = epoch;
+  parent[si] = si;
+  open.push({heuristic(start, goal, conn), 0.0, si});
+  GridPath out;
+  const auto& offs = neighbourOffsets(conn);
+  while (!open.empty()) {
+    const Item it = open.top();
+    open.pop();
+    if (it.g > gOf(it.idx)) {
+      continue;
+    }
+    ++out.expanded;
+    if (it.idx == gi) {
+      out.cost = it.g;
+      for (std::uint32_t k = gi;; k = parent[k]) {
+        out.cells.push_back(grid.cellOf(k));
+        if (k == si) {
+          break;
+        }
+      }
+      std::reverse(out.cells.begin(), out.cells.end());
+      return out;
+    }
+    const Cell c = grid.cellOf(it.idx);
+    for (const Cell& o : offs) {
+      if (!moveAllowed(grid, c, o)) {
+        continue;
+      }
+      const Cell n{c.x + o.x, c.y + o.y};
+      const auto ni = static_cast<std::uint32_t>(grid.index(n));
+      const double ng = it.g + moveCost(o);
+      if (ng < gOf(ni)) {
+        g[ni] = ng;
+        stamp[ni] = epoch;
+        parent[ni] = it.idx;
+        open.push({ng + heuristic(n, goal, conn), ng, ni});
+      }
+    }
+  }
+  return unexpected("unreachable", "no path between (" + std::to_string(start.x) + ", " +
+                                       std::to_string(start.y) + ") and (" + std::to_string(goal.x) + ", " +
+                                       std::to_string(goal.y) + ")");
+}
+
+Expected<Path> AStarPlanner::plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) {
+  const auto q = resolveQuery(grid, from, to);
+  if (!q) {
+    return unexpected(q.error());
+  }
+  const auto gp = astar(grid, q->start, q->goal, conn_);
+  if (!gp) {
+    return unexpected(gp.error());
+  }
+  return cellsToPath(grid, gp->cells, from, to);
+}
+
+}  // namespace fleet::planning
