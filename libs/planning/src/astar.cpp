@@ -42,21 +42,29 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
     epoch = 1;
   }
   auto gOf = [&](std::size_t i) { return stamp[i] == epoch ? g[i] : inf; };
+  // f is quantised to 1e-9 cells so that paths of equal length compare equal despite rounding;
+  // among them the deeper node (larger g) goes first, which cuts expansions in open areas.
   struct Item {
-    double f;
+    std::int64_t fq;
     double g;
     std::uint32_t idx;
-    bool operator>(const Item& o) const { return f > o.f || (f == o.f && g < o.g); }
+    bool operator>(const Item& o) const { return fq > o.fq || (fq == o.fq && g < o.g); }
   };
+  auto quant = [](double f) { return static_cast<std::int64_t>(std::llround(f * 1e9)); };
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
   const auto si = static_cast<std::uint32_t>(grid.index(start));
   const auto gi = static_cast<std::uint32_t>(grid.index(goal));
   g[si] = 0.0;
   stamp[si] = epoch;
   parent[si] = si;
-  open.push({heuristic(start, goal, conn), 0.0, si});
+  open.push({quant(heuristic(start, goal, conn)), 0.0, si});
   GridPath out;
   const auto& offs = neighbourOffsets(conn);
+  const bool eight = conn == Connectivity::Eight;
+  const int w = grid.width();
+  const int h = grid.height();
+  const auto W = static_cast<std::ptrdiff_t>(w);
+  const std::uint8_t* occ = grid.cells().data();
   while (!open.empty()) {
     const Item it = open.top();
     open.pop();
@@ -75,19 +83,35 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
       std::reverse(out.cells.begin(), out.cells.end());
       return out;
     }
-    const Cell c = grid.cellOf(it.idx);
-    for (const Cell& o : offs) {
-      if (!moveAllowed(grid, c, o)) {
+    // Neighbour moves on the raw cell array, in neighbourOffsets order; diagonals need both
+    // orthogonal cells free (no corner cutting).
+    const int x = static_cast<int>(it.idx % static_cast<std::uint32_t>(w));
+    const int y = static_cast<int>(it.idx / static_cast<std::uint32_t>(w));
+    const auto i = static_cast<std::ptrdiff_t>(it.idx);
+    const bool e = x + 1 < w && occ[i + 1] == 0;
+    const bool s = y > 0 && occ[i - W] == 0;
+    const bool wst = x > 0 && occ[i - 1] == 0;
+    const bool n = y + 1 < h && occ[i + W] == 0;
+    const bool ok[8] = {e,
+                        s,
+                        wst,
+                        n,
+                        eight && e && s && occ[i - W + 1] == 0,
+                        eight && wst && s && occ[i - W - 1] == 0,
+                        eight && wst && n && occ[i + W - 1] == 0,
+                        eight && e && n && occ[i + W + 1] == 0};
+    for (int k = 0; k < (eight ? 8 : 4); ++k) {
+      if (!ok[k]) {
         continue;
       }
-      const Cell n{c.x + o.x, c.y + o.y};
-      const auto ni = static_cast<std::uint32_t>(grid.index(n));
-      const double ng = it.g + moveCost(o);
+      const Cell o = offs[static_cast<std::size_t>(k)];
+      const auto ni = static_cast<std::uint32_t>(i + o.x + o.y * W);
+      const double ng = it.g + (k < 4 ? 1.0 : std::numbers::sqrt2);
       if (ng < gOf(ni)) {
         g[ni] = ng;
         stamp[ni] = epoch;
         parent[ni] = it.idx;
-        open.push({ng + heuristic(n, goal, conn), ng, ni});
+        open.push({quant(ng + heuristic({x + o.x, y + o.y}, goal, conn)), ng, ni});
       }
     }
   }
