@@ -1,5 +1,6 @@
 #include "fleet/planning/wavefront.hpp"
 
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -88,24 +89,26 @@ DistanceField computeDistanceField(const OccupancyGrid& grid, Cell goal, Connect
   const int h = grid.height();
   const std::uint8_t* occ = grid.cells().data();
   const auto W = static_cast<std::ptrdiff_t>(w);
-  std::vector<std::vector<std::uint32_t>> buckets(1);
+  // Moves cost at most sqrt(2) < 2, so while bucket b is settled only buckets b+1 and b+2 receive
+  // cells: a ring of three reusable buckets suffices.
+  std::array<std::vector<std::uint32_t>, 3> ring;
+  for (auto& r : ring) {
+    r.reserve(1024);
+  }
   std::vector<std::uint8_t> done(grid.size(), 0);
-  buckets[0].push_back(static_cast<std::uint32_t>(grid.index(goal)));
+  ring[0].push_back(static_cast<std::uint32_t>(grid.index(goal)));
   double* cost = f.cost.data();
   auto relax = [&](std::size_t ni, double nd) {
     if (nd < cost[ni]) {
       cost[ni] = nd;
-      const auto b = static_cast<std::size_t>(nd);
-      if (b >= buckets.size()) {
-        buckets.resize(b + 1);
-      }
-      buckets[b].push_back(static_cast<std::uint32_t>(ni));
+      ring[static_cast<std::size_t>(nd) % 3].push_back(static_cast<std::uint32_t>(ni));
     }
   };
   constexpr double diag = std::numbers::sqrt2;
-  for (std::size_t b = 0; b < buckets.size(); ++b) {
-    for (std::size_t k = 0; k < buckets[b].size(); ++k) {
-      const std::size_t idx = buckets[b][k];
+  for (std::size_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
+    auto& bucket = ring[b % 3];
+    for (std::size_t k = 0; k < bucket.size(); ++k) {
+      const std::size_t idx = bucket[k];
       if (done[idx] != 0 || static_cast<std::size_t>(cost[idx]) != b) {
         continue;  // already settled, or improved into an earlier bucket
       }
@@ -143,6 +146,7 @@ DistanceField computeDistanceField(const OccupancyGrid& grid, Cell goal, Connect
         relax(static_cast<std::size_t>(i + W + 1), d + diag);
       }
     }
+    bucket.clear();
   }
   return f;
 }
