@@ -21,7 +21,92 @@ double heuristic(Cell a, Cell b, Connectivity conn) {
 
 }  // namespace
 
-Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Connectivity conn) {
+LandmarkHeuristic LandmarkHeuristic::build(const OccupancyGrid& grid, Connectivity conn, int count) {
+  LandmarkHeuristic lh;
+  lh.conn_ = conn;
+  // Landmarks go into the largest connected region (4-connected regions: without corner cutting a
+  // diagonal move needs both orthogonal cells free, so both move sets have the same regions).
+  std::size_t seed = grid.size();
+  {
+    std::vector<std::uint8_t> seen(grid.size(), 0);
+    std::vector<std::size_t> queue;
+    std::size_t bestSize = 0;
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+      if (grid.cells()[i] != 0 || seen[i] != 0) {
+        continue;
+      }
+      queue.assign(1, i);
+      seen[i] = 1;
+      for (std::size_t head = 0; head < queue.size(); ++head) {
+        const Cell c = grid.cellOf(queue[head]);
+        for (const Cell& o : neighbourOffsets(Connectivity::Four)) {
+          const Cell n{c.x + o.x, c.y + o.y};
+          if (grid.freeCell(n) && seen[grid.index(n)] == 0) {
+            seen[grid.index(n)] = 1;
+            queue.push_back(grid.index(n));
+          }
+        }
+      }
+      if (queue.size() > bestSize) {
+        bestSize = queue.size();
+        seed = i;
+      }
+    }
+  }
+  if (seed == grid.size() || count <= 0) {
+    return lh;
+  }
+  std::vector<DistanceField> fields;
+  // Farthest-first: each new landmark maximises its distance to the nearest landmark chosen so far
+  // (the first one: to an arbitrary free cell).
+  std::vector<double> minDist = computeDistanceField(grid, grid.cellOf(seed), conn).cost;
+  for (int l = 0; l < count; ++l) {
+    std::size_t best = grid.size();
+    double bestD = -1.0;
+    for (std::size_t i = 0; i < minDist.size(); ++i) {
+      if (std::isfinite(minDist[i]) && minDist[i] > bestD) {
+        bestD = minDist[i];
+        best = i;
+      }
+    }
+    if (best == grid.size() || bestD <= 0.0) {
+      break;
+    }
+    lh.landmarks_.push_back(grid.cellOf(best));
+    fields.push_back(computeDistanceField(grid, grid.cellOf(best), conn));
+    for (std::size_t i = 0; i < minDist.size(); ++i) {
+      minDist[i] = std::min(minDist[i], fields.back().cost[i]);
+    }
+  }
+  lh.count_ = static_cast<int>(fields.size());
+  lh.dist_.resize(grid.size() * fields.size());
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    for (std::size_t l = 0; l < fields.size(); ++l) {
+      lh.dist_[i * fields.size() + l] = fields[l].cost[i];
+    }
+  }
+  return lh;
+}
+
+double LandmarkHeuristic::bound(std::size_t cell, std::size_t goal) const {
+  const auto k = static_cast<std::size_t>(count_);
+  const double* a = dist_.data() + cell * k;
+  const double* b = dist_.data() + goal * k;
+  double h = 0.0;
+  for (std::size_t l = 0; l < k; ++l) {
+    // Cells of another component than the landmark hold +inf: that landmark says nothing.
+    if (std::isfinite(a[l]) && std::isfinite(b[l])) {
+      h = std::max(h, std::abs(a[l] - b[l]));
+    }
+  }
+  return h;
+}
+
+Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Connectivity conn,
+                         const LandmarkHeuristic* landmarks) {
+  if (landmarks != nullptr && (landmarks->connectivity() != conn || landmarks->count() == 0)) {
+    landmarks = nullptr;  // built for another move set: its bounds would not be admissible
+  }
   if (grid.blocked(start) || grid.blocked(goal)) {
     return unexpected("unreachable", "start or goal cell is blocked or outside the map");
   }
@@ -57,7 +142,12 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   g[si] = 0.0;
   stamp[si] = epoch;
   parent[si] = si;
-  open.push({quant(heuristic(start, goal, conn)), 0.0, si});
+  const std::size_t goalIdx = grid.index(goal);
+  auto hOf = [&](Cell c, std::size_t idx) {
+    const double oct = heuristic(c, goal, conn);
+    return landmarks != nullptr ? std::max(oct, landmarks->bound(idx, goalIdx)) : oct;
+  };
+  open.push({quant(hOf(start, si)), 0.0, si});
   GridPath out;
   const auto& offs = neighbourOffsets(conn);
   const bool eight = conn == Connectivity::Eight;
@@ -111,7 +201,7 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
         g[ni] = ng;
         stamp[ni] = epoch;
         parent[ni] = it.idx;
-        open.push({quant(ng + heuristic({x + o.x, y + o.y}, goal, conn)), ng, ni});
+        open.push({quant(ng + hOf({x + o.x, y + o.y}, ni)), ng, ni});
       }
     }
   }

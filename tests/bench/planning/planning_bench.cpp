@@ -51,6 +51,9 @@ BENCHMARK(BM_WavefrontDistanceField)->Arg(4)->Arg(8)->Unit(benchmark::kMilliseco
 // 1000 random start/goal pairs per iteration, each timed: median and 90th percentile as counters.
 void BM_AStarRandomQueries(benchmark::State& state) {
   const auto& g = warehouse();
+  // Arg 0: octile heuristic only; Arg k > 0: max(octile, ALT with k landmarks).
+  const int k = static_cast<int>(state.range(0));
+  const LandmarkHeuristic lh = LandmarkHeuristic::build(g, Connectivity::Eight, k);
   const auto cells = freeCells(g);
   std::mt19937 rng(2);
   std::uniform_int_distribution<std::size_t> pick(0, cells.size() - 1);
@@ -66,7 +69,7 @@ void BM_AStarRandomQueries(benchmark::State& state) {
       const Cell a = cells[pick(rng)], b = cells[pick(rng)];
       const double c0 = cpuNow();
       const auto t0 = std::chrono::steady_clock::now();
-      const auto r = astar(g, a, b, Connectivity::Eight);
+      const auto r = astar(g, a, b, Connectivity::Eight, k > 0 ? &lh : nullptr);
       us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
       cpuUs.push_back(cpuNow() - c0);
       expanded += r ? r->expanded : 0;
@@ -80,7 +83,7 @@ void BM_AStarRandomQueries(benchmark::State& state) {
   state.counters["max_us"] = us.back();
   state.counters["mean_expanded"] = expanded / static_cast<double>(us.size());
 }
-BENCHMARK(BM_AStarRandomQueries)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_AStarRandomQueries)->Arg(0)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 // A fleet asking travel costs from 200 robots to 50 stations, repeatedly: fields are cached.
 void BM_DistanceFieldCacheTravelCosts(benchmark::State& state) {

@@ -68,6 +68,38 @@ TEST(AStar, MatchesDistanceFieldOnRandomGrids) {
   }
 }
 
+TEST(AStar, LandmarkHeuristicKeepsCostsAndExpandsLess) {
+  std::mt19937 rng(31);
+  for (Connectivity conn : {Connectivity::Four, Connectivity::Eight}) {
+    const OccupancyGrid g = randomGrid(rng, 80, 50, 0.3);  // several components
+    const LandmarkHeuristic lh = LandmarkHeuristic::build(g, conn, 6);
+    EXPECT_EQ(lh.count(), 6);
+    long plain = 0, alt = 0;
+    for (int q = 0; q < 200; ++q) {
+      const Cell s = randomFree(rng, g), t = randomFree(rng, g);
+      const auto a = astar(g, s, t, conn);
+      const auto b = astar(g, s, t, conn, &lh);
+      ASSERT_EQ(a.has_value(), b.has_value());
+      if (a) {
+        EXPECT_NEAR(a->cost, b->cost, 1e-9);
+        plain += a->expanded;
+        alt += b->expanded;
+      }
+    }
+    EXPECT_LT(alt, plain) << (conn == Connectivity::Four ? "four" : "eight");
+  }
+  // Landmarks built for the other move set are ignored, not misused.
+  const OccupancyGrid g = randomGrid(rng, 30, 30, 0.2);
+  const LandmarkHeuristic four = LandmarkHeuristic::build(g, Connectivity::Four, 4);
+  const Cell s = randomFree(rng, g), t = randomFree(rng, g);
+  const auto a = astar(g, s, t, Connectivity::Eight);
+  const auto b = astar(g, s, t, Connectivity::Eight, &four);
+  ASSERT_EQ(a.has_value(), b.has_value());
+  if (a) {
+    EXPECT_NEAR(a->cost, b->cost, 1e-9);
+  }
+}
+
 TEST(GlobalPlanner, WavefrontAndAStarGiveEqualLengthsOnTheWarehouse) {
   WarehouseParams wp;
   wp.resolution = 0.5;
