@@ -115,28 +115,35 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   thread_local std::vector<double> g;
   thread_local std::vector<std::uint32_t> parent;
   thread_local std::vector<std::uint32_t> stamp;
+  thread_local std::vector<std::uint32_t> closed;
   thread_local std::uint32_t epoch = 0;
   if (g.size() != grid.size()) {
     g.assign(grid.size(), inf);
     parent.assign(grid.size(), 0);
     stamp.assign(grid.size(), 0);
+    closed.assign(grid.size(), 0);
     epoch = 0;
   }
   if (++epoch == 0) {
     std::fill(stamp.begin(), stamp.end(), 0);
+    std::fill(closed.begin(), closed.end(), 0);
     epoch = 1;
   }
   auto gOf = [&](std::size_t i) { return stamp[i] == epoch ? g[i] : inf; };
   // f is quantised to 1e-9 cells so that paths of equal length compare equal despite rounding;
   // among them the deeper node (larger g) goes first, which cuts expansions in open areas.
+  // With a consistent heuristic the first time a cell leaves the queue its g is optimal, so later
+  // copies are skipped by the closed mark; g in the item only breaks ties (16-byte items).
   struct Item {
     std::int64_t fq;
-    double g;
+    float g;
     std::uint32_t idx;
     bool operator>(const Item& o) const { return fq > o.fq || (fq == o.fq && g < o.g); }
   };
   auto quant = [](double f) { return static_cast<std::int64_t>(std::llround(f * 1e9)); };
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  std::vector<Item> heapStore;
+  heapStore.reserve(4096);
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open(std::greater<>{}, std::move(heapStore));
   const auto si = static_cast<std::uint32_t>(grid.index(start));
   const auto gi = static_cast<std::uint32_t>(grid.index(goal));
   g[si] = 0.0;
@@ -147,7 +154,7 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
     const double oct = heuristic(c, goal, conn);
     return landmarks != nullptr ? std::max(oct, landmarks->bound(idx, goalIdx)) : oct;
   };
-  open.push({quant(hOf(start, si)), 0.0, si});
+  open.push({quant(hOf(start, si)), 0.0F, si});
   GridPath out;
   const auto& offs = neighbourOffsets(conn);
   const bool eight = conn == Connectivity::Eight;
@@ -158,12 +165,14 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   while (!open.empty()) {
     const Item it = open.top();
     open.pop();
-    if (it.g > gOf(it.idx)) {
+    if (closed[it.idx] == epoch) {
       continue;
     }
+    closed[it.idx] = epoch;
+    const double gCur = g[it.idx];
     ++out.expanded;
     if (it.idx == gi) {
-      out.cost = it.g;
+      out.cost = gCur;
       for (std::uint32_t k = gi;; k = parent[k]) {
         out.cells.push_back(grid.cellOf(k));
         if (k == si) {
@@ -196,12 +205,12 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
       }
       const Cell o = offs[static_cast<std::size_t>(k)];
       const auto ni = static_cast<std::uint32_t>(i + o.x + o.y * W);
-      const double ng = it.g + (k < 4 ? 1.0 : std::numbers::sqrt2);
+      const double ng = gCur + (k < 4 ? 1.0 : std::numbers::sqrt2);
       if (ng < gOf(ni)) {
         g[ni] = ng;
         stamp[ni] = epoch;
         parent[ni] = it.idx;
-        open.push({quant(ng + hOf({x + o.x, y + o.y}, ni)), ng, ni});
+        open.push({quant(ng + hOf({x + o.x, y + o.y}, ni)), static_cast<float>(ng), ni});
       }
     }
   }
