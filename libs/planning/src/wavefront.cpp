@@ -1,5 +1,6 @@
 #include "fleet/planning/wavefront.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <deque>
@@ -56,97 +57,100 @@ DistanceField computeDistanceField(const OccupancyGrid& grid, Cell goal, Connect
   if (grid.blocked(goal)) {
     return f;
   }
-  const auto& offs = neighbourOffsets(conn);
-  // The seed's pseudocode never sets d(B) = 0, re-queues B and does not exclude obstacles in
-  // check(); all three are fixed here.
-  f.cost[grid.index(goal)] = 0.0;
-  if (conn == Connectivity::Four) {
-    std::vector<std::size_t> queue;
-    queue.reserve(grid.size());
-    queue.push_back(grid.index(goal));
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::size_t idx = queue[head];
-      const Cell c = grid.cellOf(idx);
-      const double next = f.cost[idx] + 1.0;
-      for (const Cell& o : offs) {
-        const Cell n{c.x + o.x, c.y + o.y};
-        if (grid.blocked(n)) {
-          continue;
-        }
-        const std::size_t ni = grid.index(n);
-        if (f.cost[ni] == kInf) {
-          f.cost[ni] = next;
-          queue.push_back(ni);
-        }
-      }
-    }
-    return f;
-  }
-  // Dijkstra with a bucket queue of width 1 (Dinitz): every move costs at least 1, so relaxing a
-  // cell of bucket b only reaches buckets > b and the cells inside one bucket can be settled in any
-  // order. Same result as a binary heap, without its log factor.
+  // Work on a copy padded with one blocked cell all around: the inner loops then need neither
+  // bounds checks nor index divisions.
   const int w = grid.width();
   const int h = grid.height();
-  const std::uint8_t* occ = grid.cells().data();
-  const auto W = static_cast<std::ptrdiff_t>(w);
-  // Moves cost at most sqrt(2) < 2, so while bucket b is settled only buckets b+1 and b+2 receive
-  // cells: a ring of three reusable buckets suffices.
-  std::array<std::vector<std::uint32_t>, 3> ring;
-  for (auto& r : ring) {
-    r.reserve(1024);
+  const auto P = static_cast<std::ptrdiff_t>(w) + 2;
+  const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
+  std::vector<std::uint8_t> occ(padded, 1);
+  for (int y = 0; y < h; ++y) {
+    std::copy_n(grid.cells().begin() + static_cast<std::ptrdiff_t>(y) * w, w, occ.begin() + (y + 1) * P + 1);
   }
-  std::vector<std::uint8_t> done(grid.size(), 0);
-  ring[0].push_back(static_cast<std::uint32_t>(grid.index(goal)));
-  double* cost = f.cost.data();
-  auto relax = [&](std::size_t ni, double nd) {
-    if (nd < cost[ni]) {
-      cost[ni] = nd;
-      ring[static_cast<std::size_t>(nd) % 3].push_back(static_cast<std::uint32_t>(ni));
-    }
-  };
-  constexpr double diag = std::numbers::sqrt2;
-  for (std::size_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
-    auto& bucket = ring[b % 3];
-    for (std::size_t k = 0; k < bucket.size(); ++k) {
-      const std::size_t idx = bucket[k];
-      if (done[idx] != 0 || static_cast<std::size_t>(cost[idx]) != b) {
-        continue;  // already settled, or improved into an earlier bucket
-      }
-      done[idx] = 1;
-      const double d = cost[idx];
-      const int x = static_cast<int>(idx % static_cast<std::size_t>(w));
-      const int y = static_cast<int>(idx / static_cast<std::size_t>(w));
-      const auto i = static_cast<std::ptrdiff_t>(idx);
-      const bool e = x + 1 < w && occ[i + 1] == 0;
-      const bool wst = x > 0 && occ[i - 1] == 0;
-      const bool n = y + 1 < h && occ[i + W] == 0;
-      const bool s = y > 0 && occ[i - W] == 0;
-      if (e) {
-        relax(static_cast<std::size_t>(i + 1), d + 1.0);
-      }
-      if (s) {
-        relax(static_cast<std::size_t>(i - W), d + 1.0);
-      }
-      if (wst) {
-        relax(static_cast<std::size_t>(i - 1), d + 1.0);
-      }
-      if (n) {
-        relax(static_cast<std::size_t>(i + W), d + 1.0);
-      }
-      if (e && s && occ[i - W + 1] == 0) {
-        relax(static_cast<std::size_t>(i - W + 1), d + diag);
-      }
-      if (wst && s && occ[i - W - 1] == 0) {
-        relax(static_cast<std::size_t>(i - W - 1), d + diag);
-      }
-      if (wst && n && occ[i + W - 1] == 0) {
-        relax(static_cast<std::size_t>(i + W - 1), d + diag);
-      }
-      if (e && n && occ[i + W + 1] == 0) {
-        relax(static_cast<std::size_t>(i + W + 1), d + diag);
+  std::vector<double> cost(padded, kInf);
+  const auto start = static_cast<std::uint32_t>((goal.y + 1) * P + goal.x + 1);
+  // The seed's pseudocode never sets d(B) = 0, re-queues B and does not exclude obstacles in
+  // check(); all three are fixed here.
+  cost[start] = 0.0;
+  if (conn == Connectivity::Four) {
+    std::vector<std::uint32_t> queue;
+    queue.reserve(grid.size());
+    queue.push_back(start);
+    const std::ptrdiff_t steps[4] = {1, -P, -1, P};
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const auto i = static_cast<std::ptrdiff_t>(queue[head]);
+      const double next = cost[static_cast<std::size_t>(i)] + 1.0;
+      for (const std::ptrdiff_t st : steps) {
+        const auto ni = static_cast<std::size_t>(i + st);
+        if (occ[ni] == 0 && cost[ni] == kInf) {
+          cost[ni] = next;
+          queue.push_back(static_cast<std::uint32_t>(ni));
+        }
       }
     }
-    bucket.clear();
+  } else {
+    // Dijkstra with a bucket queue of width 1 (Dinitz): every move costs at least 1, so relaxing a
+    // cell of bucket b only reaches buckets > b and cells inside one bucket can be settled in any
+    // order. Moves cost at most sqrt(2) < 2, so only buckets b+1 and b+2 receive cells while b is
+    // settled: a ring of three reusable buckets suffices.
+    std::array<std::vector<std::uint32_t>, 3> ring;
+    for (auto& r : ring) {
+      r.reserve(1024);
+    }
+    std::vector<std::uint8_t> done(padded, 0);
+    ring[0].push_back(start);
+    auto relax = [&](std::ptrdiff_t ni, double nd) {
+      const auto u = static_cast<std::size_t>(ni);
+      if (nd < cost[u]) {
+        cost[u] = nd;
+        ring[static_cast<std::size_t>(nd) % 3].push_back(static_cast<std::uint32_t>(u));
+      }
+    };
+    constexpr double diag = std::numbers::sqrt2;
+    for (std::size_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
+      auto& bucket = ring[b % 3];
+      for (std::size_t k = 0; k < bucket.size(); ++k) {
+        const std::size_t idx = bucket[k];
+        if (done[idx] != 0 || static_cast<std::size_t>(cost[idx]) != b) {
+          continue;  // already settled, or improved into an earlier bucket
+        }
+        done[idx] = 1;
+        const double d = cost[idx];
+        const auto i = static_cast<std::ptrdiff_t>(idx);
+        const bool e = occ[static_cast<std::size_t>(i + 1)] == 0;
+        const bool s = occ[static_cast<std::size_t>(i - P)] == 0;
+        const bool wst = occ[static_cast<std::size_t>(i - 1)] == 0;
+        const bool n = occ[static_cast<std::size_t>(i + P)] == 0;
+        if (e) {
+          relax(i + 1, d + 1.0);
+        }
+        if (s) {
+          relax(i - P, d + 1.0);
+        }
+        if (wst) {
+          relax(i - 1, d + 1.0);
+        }
+        if (n) {
+          relax(i + P, d + 1.0);
+        }
+        if (e && s && occ[static_cast<std::size_t>(i - P + 1)] == 0) {
+          relax(i - P + 1, d + diag);
+        }
+        if (wst && s && occ[static_cast<std::size_t>(i - P - 1)] == 0) {
+          relax(i - P - 1, d + diag);
+        }
+        if (wst && n && occ[static_cast<std::size_t>(i + P - 1)] == 0) {
+          relax(i + P - 1, d + diag);
+        }
+        if (e && n && occ[static_cast<std::size_t>(i + P + 1)] == 0) {
+          relax(i + P + 1, d + diag);
+        }
+      }
+      bucket.clear();
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    std::copy_n(cost.begin() + (y + 1) * P + 1, w, f.cost.begin() + static_cast<std::ptrdiff_t>(y) * w);
   }
   return f;
 }
