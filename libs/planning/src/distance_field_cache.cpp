@@ -1,6 +1,7 @@
 #include "fleet/planning/distance_field_cache.hpp"
 
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <utility>
 
@@ -45,7 +46,18 @@ std::shared_ptr<const DistanceField> DistanceFieldCache::field(Cell goal) {
   if (mustCompute) {
     // Computed outside the lock: other goals are served meanwhile, and requests for this goal wait
     // on the future instead of computing it again.
-    promise.set_value(std::make_shared<const DistanceField>(computeDistanceField(*grid_, goal, conn_)));
+    try {
+      promise.set_value(std::make_shared<const DistanceField>(computeDistanceField(*grid_, goal, conn_)));
+    } catch (...) {
+      // Waiters must not block forever; drop the entry so a later request retries.
+      promise.set_exception(std::current_exception());
+      std::lock_guard lock(mu_);
+      const auto it = entries_.find(key);
+      if (it != entries_.end()) {
+        lru_.erase(it->second.lru);
+        entries_.erase(it);
+      }
+    }
   }
   return future.get();
 }
