@@ -24,6 +24,8 @@ double heuristic(Cell a, Cell b, Connectivity conn) {
 LandmarkHeuristic LandmarkHeuristic::build(const OccupancyGrid& grid, Connectivity conn, int count) {
   LandmarkHeuristic lh;
   lh.conn_ = conn;
+  lh.width_ = grid.width();
+  lh.height_ = grid.height();
   // Landmarks go into the largest connected region (4-connected regions: without corner cutting a
   // diagonal move needs both orthogonal cells free, so both move sets have the same regions).
   std::size_t seed = grid.size();
@@ -104,7 +106,8 @@ double LandmarkHeuristic::bound(std::size_t cell, std::size_t goal) const {
 
 Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Connectivity conn,
                          const LandmarkHeuristic* landmarks) {
-  if (landmarks != nullptr && (landmarks->connectivity() != conn || landmarks->count() == 0)) {
+  if (landmarks != nullptr &&
+      (landmarks->connectivity() != conn || landmarks->count() == 0 || !landmarks->matches(grid))) {
     landmarks = nullptr;  // built for another move set: its bounds would not be admissible
   }
   if (grid.blocked(start) || grid.blocked(goal)) {
@@ -224,7 +227,7 @@ Expected<Path> AStarPlanner::plan(const OccupancyGrid& grid, Pose2 from, Pose2 t
   if (!q) {
     return unexpected(q.error());
   }
-  const auto gp = astar(grid, q->start, q->goal, conn_);
+  const auto gp = astar(grid, q->start, q->goal, conn_, landmarks_.get());
   if (!gp) {
     return unexpected(gp.error());
   }

@@ -107,7 +107,9 @@ TEST(GlobalPlanner, WavefrontAndAStarGiveEqualLengthsOnTheWarehouse) {
   std::mt19937 rng(4);
   WavefrontPlanner wf;
   AStarPlanner as;
-  std::vector<GlobalPlanner*> planners{&wf, &as};
+  AStarPlanner alt(Connectivity::Eight, std::make_shared<const LandmarkHeuristic>(
+                                            LandmarkHeuristic::build(g, Connectivity::Eight, 4)));
+  std::vector<GlobalPlanner*> planners{&wf, &as, &alt};
   for (int q = 0; q < 10; ++q) {
     const Vec2 a = g.cellCenter(randomFree(rng, g)), b = g.cellCenter(randomFree(rng, g));
     std::vector<double> lengths;
@@ -122,6 +124,7 @@ TEST(GlobalPlanner, WavefrontAndAStarGiveEqualLengthsOnTheWarehouse) {
       }
     }
     EXPECT_NEAR(lengths[0], lengths[1], 1e-9);
+    EXPECT_NEAR(lengths[0], lengths[2], 1e-9);
     EXPECT_GE(lengths[0], distance(a, b) - 1e-9);
   }
 }

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <memory>
+#include <utility>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
@@ -26,8 +28,14 @@ class LandmarkHeuristic {
   [[nodiscard]] int count() const { return count_; }
   [[nodiscard]] Connectivity connectivity() const { return conn_; }
   [[nodiscard]] const std::vector<Cell>& landmarks() const { return landmarks_; }
+  /// Built for a grid of this shape (a cheap guard against using it on another map).
+  [[nodiscard]] bool matches(const OccupancyGrid& grid) const {
+    return grid.width() == width_ && grid.height() == height_;
+  }
 
  private:
+  int width_ = 0;
+  int height_ = 0;
   int count_ = 0;
   Connectivity conn_ = Connectivity::Eight;
   std::vector<Cell> landmarks_;
@@ -44,12 +52,15 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal,
 
 class AStarPlanner final : public GlobalPlanner {
  public:
-  explicit AStarPlanner(Connectivity conn = Connectivity::Eight) : conn_(conn) {}
+  explicit AStarPlanner(Connectivity conn = Connectivity::Eight,
+                        std::shared_ptr<const LandmarkHeuristic> landmarks = nullptr)
+      : conn_(conn), landmarks_(std::move(landmarks)) {}
   [[nodiscard]] Expected<Path> plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) override;
   [[nodiscard]] const char* name() const override { return "astar"; }
 
  private:
   Connectivity conn_;
+  std::shared_ptr<const LandmarkHeuristic> landmarks_;  ///< used only on a grid of matching shape
 };
 
 }  // namespace fleet::planning
