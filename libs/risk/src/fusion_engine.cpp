@@ -208,35 +208,55 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
 void FusionEngine::paintDisc(const Disc& d, double p) {
   const GridSpec& g = config_.grid;
   auto& P = result_.probability.p;
-  // Bounding box of the cell centres that can be inside, padded by one cell against rounding; the exact
-  // test cellInsideDisc decides, as in the reference.
-  const int i0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / g.resolution - 0.5)) - 1);
-  const int i1 =
-      std::min(g.width - 1, static_cast<int>(std::ceil((d.x + d.r - g.originX) / g.resolution - 0.5)) + 1);
-  const int j0 = std::max(0, static_cast<int>(std::floor((d.y - d.r - g.originY) / g.resolution - 0.5)) - 1);
-  const int j1 =
-      std::min(g.height - 1, static_cast<int>(std::ceil((d.y + d.r - g.originY) / g.resolution - 0.5)) + 1);
-  if (i0 > i1 || j0 > j1) {
-    return;
-  }
+  const double fy = (d.y - g.originY) / g.resolution - 0.5;  // row coordinate of the centre
+  const double fr = d.r / g.resolution;
+  const int j0 = std::max(0, static_cast<int>(std::floor(fy - fr)) - 1);
+  const int j1 = std::min(g.height - 1, static_cast<int>(std::ceil(fy + fr)) + 1);
+  const double fx = (d.x - g.originX) / g.resolution - 0.5;
   const int ts = config_.tileSize;
   std::size_t visited = 0;
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
+    const double dy = cy - d.y;
+    const double rem = d.r * d.r - dy * dy;
+    if (rem < -1e-9 * d.r * d.r) {
+      continue;
+    }
+    // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
+    // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
+    const double half = std::sqrt(std::max(rem, 0.0)) / g.resolution;
+    int a = std::max(0, static_cast<int>(std::ceil(fx - half)));
+    int b = std::min(g.width - 1, static_cast<int>(std::floor(fx + half)));
+    while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
+      --a;
+    while (a <= b && !cellInsideDisc(g.cellCentreX(a), cy, d))
+      ++a;
+    while (b < g.width - 1 && cellInsideDisc(g.cellCentreX(b + 1), cy, d))
+      ++b;
+    while (b >= a && !cellInsideDisc(g.cellCentreX(b), cy, d))
+      --b;
+    if (a > b) {
+      continue;
+    }
+    double* row = P.data() + g.index(0, j);
+    if (allDirty_) {
+      for (int i = a; i <= b; ++i) {
+        row[i] = std::max(row[i], p);
+      }
+      visited += static_cast<std::size_t>(b - a + 1);
+      continue;
+    }
     const std::size_t tileRow = static_cast<std::size_t>(j / ts) * static_cast<std::size_t>(tilesX_);
-    for (int tx = i0 / ts; tx <= i1 / ts; ++tx) {
+    for (int tx = a / ts; tx <= b / ts; ++tx) {
       if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
         continue;
       }
-      const int a = std::max(i0, tx * ts);
-      const int b = std::min(i1, tx * ts + ts - 1);
-      double* row = P.data() + g.index(0, j);
-      for (int i = a; i <= b; ++i) {
-        if (cellInsideDisc(g.cellCentreX(i), cy, d)) {
-          row[i] = std::max(row[i], p);
-        }
+      const int lo = std::max(a, tx * ts);
+      const int hi = std::min(b, tx * ts + ts - 1);
+      for (int i = lo; i <= hi; ++i) {
+        row[i] = std::max(row[i], p);
       }
-      visited += static_cast<std::size_t>(b - a + 1);
+      visited += static_cast<std::size_t>(hi - lo + 1);
     }
   }
   result_.stats.cellsVisited += visited;
@@ -277,6 +297,7 @@ void FusionEngine::recompute(bool full) {
     maxReach = std::max(maxReach, model_->reach(d));
   }
 
+  allDirty_ = full;
   if (full) {
     std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
     pendingDirty_.clear();
@@ -302,6 +323,9 @@ void FusionEngine::recompute(bool full) {
 
   const double tileM = g.resolution * config_.tileSize;
   auto touchesDirty = [&](const Disc& d) {
+    if (full) {
+      return true;
+    }
     const int tx0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / tileM - 1e-9)));
     const int tx1 =
         std::min(tilesX_ - 1, static_cast<int>(std::floor((d.x + d.r - g.originX) / tileM + 1e-9)));

@@ -71,6 +71,8 @@ class FusionEngine {
   /// next call.
   const FusionResult& fuse(std::int64_t t_ref_ns);
   [[nodiscard]] const FusionResult& result() const { return result_; }
+  /// Makes the next fuse() recompute everything (e.g. after the caller changed its mind about the map).
+  void invalidate() { haveResult_ = false; }
 
   /// The sources as aligned for the last fuse(), in a fixed order (for the reference and tests).
   [[nodiscard]] std::vector<AlignedSource> alignedSources() const;
@@ -105,6 +107,7 @@ class FusionEngine {
   bool haveResult_ = false;
   std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
   std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
+  bool allDirty_ = false;
   int tilesX_ = 0;
   int tilesY_ = 0;
   // scratch, kept between calls to avoid reallocation
