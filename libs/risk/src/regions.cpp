@@ -51,6 +51,11 @@ bool regionContains(const Region& region, Vec2 point) {
 }
 
 std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
+  RegionExtractor extractor;
+  return extractor.extract(grid, minLevel);
+}
+
+std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel) {
   const GridSpec& g = grid.spec;
   const int W = g.width;
   const int H = g.height;
@@ -59,10 +64,16 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
     return regions;
   }
   const std::uint32_t VW = static_cast<std::uint32_t>(W) + 1;
-  std::vector<std::int32_t> label(g.cellCount(), -1);
+  label_.assign(g.cellCount(), -1);
   // Outgoing boundary edges per vertex (at most two, at a saddle), reset after each component.
-  std::vector<std::int32_t> out0(static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1), -1);
-  std::vector<std::int32_t> out1(out0.size(), -1);
+  const std::size_t vertices = static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1);
+  if (out0_.size() != vertices) {
+    out0_.assign(vertices, -1);
+    out1_.assign(vertices, -1);
+  }
+  auto& label = label_;
+  auto& out0 = out0_;
+  auto& out1 = out1_;
   std::vector<std::uint32_t> stack;
   std::vector<std::uint32_t> members;
   std::vector<Edge> edges;
@@ -173,9 +184,19 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
     }
     regions.push_back(std::move(region));
   }
-  std::stable_sort(regions.begin(), regions.end(),
-                   [](const Region& a, const Region& b) { return a.level < b.level; });
-  return regions;
+  // Order by level, stable in first-cell order (a counting pass instead of sorting heavy objects).
+  std::vector<std::size_t> start(static_cast<std::size_t>(kMaxLevels) + 2, 0);
+  for (const auto& r : regions) {
+    ++start[static_cast<std::size_t>(r.level) + 1];
+  }
+  for (std::size_t l = 1; l < start.size(); ++l) {
+    start[l] += start[l - 1];
+  }
+  std::vector<Region> ordered(regions.size());
+  for (auto& r : regions) {
+    ordered[start[static_cast<std::size_t>(r.level)]++] = std::move(r);
+  }
+  return ordered;
 }
 
 }  // namespace fleet::risk

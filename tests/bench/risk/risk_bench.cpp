@@ -166,10 +166,11 @@ void BM_FuseWarehouse(benchmark::State& state) {
   const auto scene = warehouse(n, steps, 100.0, 50.0, 7);
   auto engine = loaded(warehouseConfig(100.0, 50.0, 0.1, steps), scene, static_cast<int>(state.range(2)));
   std::size_t regions = 0, runs = 0, painted = 0, pairs = 0;
+  RegionExtractor extractor;
   for (auto _ : state) {
     engine.invalidate();
     const auto& r = engine.fuse(0);
-    const auto reg = extractRegions(r.levels);
+    const auto reg = extractor.extract(r.levels);
     const auto rle = encodeRle(r.levels.level);
     regions = reg.size();
     runs = rle.size();

@@ -110,7 +110,13 @@ class FusionEngine {
   bool allDirty_ = false;
   int tilesX_ = 0;
   int tilesY_ = 0;
+  struct Paint {
+    Disc disc;
+    double p;
+    std::uint32_t key;
+  };
   // scratch, kept between calls to avoid reallocation
+  std::vector<Paint> paints_;
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
   std::vector<std::uint8_t> active_;
