@@ -45,6 +45,41 @@ double lowerGammaInt(int s, double x, double lgs, double logX) {
   return std::clamp(lead * sum, 0.0, 1.0);
 }
 
+// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre recurrence), computed once.
+struct GaussLegendre {
+  static constexpr int kN = 8;
+  double x[kN];
+  double w[kN];
+  GaussLegendre() : x{}, w{} {
+    for (int i = 0; i < kN; ++i) {
+      double z = std::cos(kPi * (i + 0.75) / (kN + 0.5));
+      double dp = 1.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0;
+        double p1 = z;
+        for (int k = 2; k <= kN; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        dp = kN * (z * p1 - p0) / (z * z - 1.0);
+        const double dz = p1 / dp;
+        z -= dz;
+        if (std::abs(dz) < 1e-16) {
+          break;
+        }
+      }
+      x[i] = z;
+      w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+  }
+};
+
+const GaussLegendre& gaussLegendre() {
+  static const GaussLegendre gl;
+  return gl;
+}
+
 // erf(hi) − erf(lo) for lo <= hi without cancellation in the tails.
 double erfDiff(double lo, double hi) {
   if (lo >= 0.0) {
@@ -118,7 +153,7 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
   return std::clamp(sum, 0.0, 1.0);
 }
 
-double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int thetaSteps) {
+double gaussianCollisionProbabilityPolar(Vec2 mean, const Cov2& cov, double R, int thetaSteps) {
   if (!(R > 0.0)) {
     return 0.0;
   }
@@ -184,6 +219,108 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int th
   }
   const double p = sum * dth / (2.0 * kPi * std::sqrt(det));
   return std::clamp(p, 0.0, 1.0);
+}
+
+double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R) {
+  if (!(R > 0.0)) {
+    return 0.0;
+  }
+  const double tr = cov.xx + cov.yy;
+  const double disc =
+      std::sqrt(std::max(0.0, 0.25 * (cov.xx - cov.yy) * (cov.xx - cov.yy) + cov.xy * cov.xy));
+  const double lmax = 0.5 * tr + disc;
+  const double lmin = 0.5 * tr - disc;
+  if (!(cov.xx > 0.0) || !(lmin > 1e-12 * std::max(lmax, 1e-300))) {
+    return gaussianCollisionProbability(mean.norm(), R, std::sqrt(std::max(lmax, 0.0)));
+  }
+  const double dist = mean.norm();
+  const double smax = std::sqrt(lmax);
+  if (dist - R > 9.0 * smax) {
+    return 0.0;  // Rayleigh tail bound with the largest sigma: below exp(−40.5)
+  }
+  if (R - dist > 9.0 * smax) {
+    return 1.0;
+  }
+  // cov = L Lᵀ, L lower triangular; x = mean + L z. ‖x‖² ≤ R² along z = ρ v is A ρ² + 2 B ρ + C ≤ 0 with
+  // A = vᵀ M v (M = LᵀL), B = bᵀ v (b = Lᵀ mean), C = ‖mean‖² − R².
+  const double l11 = std::sqrt(cov.xx);
+  const double l21 = cov.xy / l11;
+  const double l22 = std::sqrt(std::max(cov.yy - l21 * l21, 1e-300));
+  const double m11 = l11 * l11 + l21 * l21;
+  const double m12 = l21 * l22;
+  const double m22 = l22 * l22;
+  const double b1 = l11 * mean.x + l21 * mean.y;
+  const double b2 = l22 * mean.y;
+  const double C = (dist - R) * (dist + R);
+  // Angular detail scales with how far (in whitened units) the ellipse reaches and how curved it is.
+  const double smin = std::sqrt(lmin);
+  const double scale = 1.0 + (dist + R) / smin;
+  const double elong = smax / smin;
+  auto rayAB = [&](double c, double s, double& A, double& B) {
+    A = m11 * c * c + 2.0 * m12 * c * s + m22 * s * s;
+    B = b1 * c + b2 * s;
+  };
+  if (C < 0.0) {
+    // Mean inside the disc: every ray leaves the ellipse once, at ρ+; integrand 1 − e^{−ρ+²/2}, smooth
+    // and periodic, so the trapezoid rule converges geometrically (faster the rounder the ellipse).
+    const int n =
+        static_cast<int>(std::clamp(std::ceil(8.0 * (scale + 2.0 * elong) / 8.0) * 8.0, 32.0, 8192.0));
+    const double dth = 2.0 * kPi / n;
+    const double cr = std::cos(dth);
+    const double sr = std::sin(dth);
+    double c = std::cos(0.5 * dth);
+    double s = std::sin(0.5 * dth);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double A = 0.0, B = 0.0;
+      rayAB(c, s, A, B);
+      const double sq = std::sqrt(B * B - A * C);
+      const double rho = B >= 0.0 ? -C / (B + sq) : (sq - B) / A;
+      sum += -std::expm1(-0.5 * rho * rho);
+      const double nc = c * cr - s * sr;  // next direction by rotation (n <= 8192: drift ~1e-12)
+      s = c * sr + s * cr;
+      c = nc;
+    }
+    return std::clamp(sum / n, 0.0, 1.0);
+  }
+  // Mean outside: rays hit the ellipse for vᵀ(b bᵀ − C M)v ≥ 0 with bᵀv < 0, an arc |θ − θm| ≤ h.
+  // vᵀQv = α0 + α1 cos 2θ + α2 sin 2θ.
+  const double q11 = b1 * b1 - C * m11;
+  const double q12 = b1 * b2 - C * m12;
+  const double q22 = b2 * b2 - C * m22;
+  const double a0 = 0.5 * (q11 + q22);
+  const double a1 = 0.5 * (q11 - q22);
+  const double a2 = q12;
+  const double rq = std::hypot(a1, a2);
+  if (!(rq > 0.0) || a0 + rq <= 0.0) {
+    return 0.0;
+  }
+  const double phi = std::atan2(a2, a1);
+  const double h = 0.5 * std::acos(std::clamp(-a0 / rq, -1.0, 1.0));
+  double thm = 0.5 * phi;
+  if (b1 * std::cos(thm) + b2 * std::sin(thm) > 0.0) {
+    thm += kPi;
+  }
+  const auto& gl = gaussLegendre();
+  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong)), 2.0, 1024.0));
+  const double du = kPi / panels;
+  double sum = 0.0;
+  for (int p = 0; p < panels; ++p) {
+    const double uc = -0.5 * kPi + (p + 0.5) * du;
+    for (int k = 0; k < GaussLegendre::kN; ++k) {
+      const double u = uc + 0.5 * du * gl.x[k];
+      const double th = thm + h * std::sin(u);
+      double A = 0.0, B = 0.0;
+      rayAB(std::cos(th), std::sin(th), A, B);
+      const double sq = std::sqrt(std::max(B * B - A * C, 0.0));
+      const double rhoPlus = (sq - B) / A;
+      const double rhoMinus = C / (sq - B);
+      // e^{−ρ−²/2} − e^{−ρ+²/2} without cancellation near the tangent rays (ρ+ − ρ− = 2 sq / A).
+      const double f = std::exp(-0.5 * rhoMinus * rhoMinus) * -std::expm1(-(sq / A) * (rhoPlus + rhoMinus));
+      sum += 0.5 * du * gl.w[k] * std::cos(u) * f;
+    }
+  }
+  return std::clamp(sum * h / (2.0 * kPi), 0.0, 1.0);
 }
 
 Gaussian::Gaussian(double floor)
