@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -26,7 +27,7 @@ struct Region {
 /// cell edges (marching squares on the level-indicator, with saddles resolved for 4-connectivity).
 std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel = 1);
 
-/// extractRegions with its working buffers (labels, vertex tables: ~14 bytes per cell) kept between
+/// extractRegions with its working buffers (labels, vertex tables: ~12 bytes per cell) kept between
 /// calls, for callers that extract every cycle.
 class RegionExtractor {
  public:
@@ -34,8 +35,7 @@ class RegionExtractor {
 
  private:
   std::vector<std::int32_t> label_;
-  std::vector<std::int32_t> out0_;
-  std::vector<std::int32_t> out1_;
+  std::vector<std::array<std::int32_t, 2>> out_;
 };
 
 /// Signed area of a ring (positive when counter-clockwise).
