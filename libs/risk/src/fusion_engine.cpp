@@ -280,17 +280,23 @@ void FusionEngine::recompute(bool full) {
 
   stepDiscs_.resize(static_cast<std::size_t>(steps));
   double maxReach = 0.0;
-  for (int k = 0; k < steps; ++k) {
-    auto& list = stepDiscs_[static_cast<std::size_t>(k)];
+  for (auto& list : stepDiscs_) {
     list.clear();
-    for (std::size_t s = 0; s < entries.size(); ++s) {
-      const auto& slot = entries[s]->aligned.steps[static_cast<std::size_t>(k)];
+  }
+  // Source-major: each source's discs are contiguous, the per-step lists are appended to in order.
+  for (std::size_t s = 0; s < entries.size(); ++s) {
+    const auto& aligned = entries[s]->aligned.steps;
+    for (int k = 0; k < steps; ++k) {
+      const auto& slot = aligned[static_cast<std::size_t>(k)];
       if (slot.has_value()) {
         const double reach = model_->reach(*slot);
         maxReach = std::max(maxReach, reach);
-        list.push_back(StepDisc{*slot, static_cast<std::uint32_t>(s), entries[s]->source.kind, reach});
+        stepDiscs_[static_cast<std::size_t>(k)].push_back(
+            StepDisc{*slot, static_cast<std::uint32_t>(s), entries[s]->source.kind, reach});
       }
     }
+  }
+  for (const auto& list : stepDiscs_) {
     result_.stats.discs += list.size();
   }
   for (const Disc& d : pendingDirty_) {
@@ -448,7 +454,26 @@ void FusionEngine::recompute(bool full) {
     result_.sceneIndex = std::max(result_.sceneIndex, s);
   }
 
-  // Levels of the recomputed tiles.
+  // Levels of the recomputed tiles: isoLevel with the boundaries l/K from a table (no divisions).
+  const int K = config_.levels;
+  const double Kd = static_cast<double>(K);
+  std::vector<double> bound(static_cast<std::size_t>(K) + 1);
+  for (int l = 0; l <= K; ++l) {
+    bound[static_cast<std::size_t>(l)] = levelUpperBound(l, K);
+  }
+  auto levelOf = [&](double p) -> std::uint8_t {
+    if (p >= 1.0) {
+      return static_cast<std::uint8_t>(K);
+    }
+    int l = std::clamp(static_cast<int>(std::ceil(p * Kd)), 1, K);
+    while (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) {
+      --l;
+    }
+    while (l < K && p > bound[static_cast<std::size_t>(l)]) {
+      ++l;
+    }
+    return static_cast<std::uint8_t>(l);
+  };
   const int ts = config_.tileSize;
   for (int ty = 0; ty < tilesY_; ++ty) {
     for (int tx = 0; tx < tilesX_; ++tx) {
@@ -458,8 +483,8 @@ void FusionEngine::recompute(bool full) {
       for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
         for (int i = tx * ts; i < std::min(g.width, tx * ts + ts); ++i) {
           const std::size_t idx = g.index(i, j);
-          result_.levels.level[idx] =
-              static_cast<std::uint8_t>(isoLevel(result_.probability.p[idx], config_.levels));
+          const double p = result_.probability.p[idx];
+          result_.levels.level[idx] = p > 0.0 ? levelOf(p) : 0;
         }
       }
     }
