@@ -22,8 +22,8 @@ Expected<void> validateFusionConfig(const FusionConfig& c) {
   if (!(c.dt > 0.0) || !std::isfinite(c.dt) || c.steps < 1 || c.steps > 10000) {
     return unexpected("bad_time_base", "fusion needs dt > 0 and 1..10000 steps");
   }
-  if (c.tileSize < 1 || c.tileSize > 4096) {
-    return unexpected("bad_tile", "tile size must be in 1..4096 cells");
+  if (c.tileSize < 1 || c.tileSize > 4096 || (c.tileSize & (c.tileSize - 1)) != 0) {
+    return unexpected("bad_tile", "tile size must be a power of two in 1..4096 cells");
   }
   return {};
 }
@@ -41,9 +41,13 @@ Expected<FusionEngine> FusionEngine::create(FusionConfig config, std::shared_ptr
 FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model)
     : config_(std::move(config)), model_(std::move(model)) {
   const GridSpec& g = config_.grid;
+  while ((1 << tileShift_) < config_.tileSize) {
+    ++tileShift_;  // tile index = cell index >> tileShift_ (integer division is slow on the paint path)
+  }
   tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
   tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
   dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
+  paintedTiles_.assign(dirtyTiles_.size(), 0);
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -208,11 +212,12 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
 void FusionEngine::paintDisc(const Disc& d, double p) {
   const GridSpec& g = config_.grid;
   auto& P = result_.probability.p;
-  const double fy = (d.y - g.originY) / g.resolution - 0.5;  // row coordinate of the centre
-  const double fr = d.r / g.resolution;
+  const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
+  const double fy = (d.y - g.originY) * invRes - 0.5;  // row coordinate of the centre
+  const double fr = d.r * invRes;
   const int j0 = std::max(0, static_cast<int>(std::floor(fy - fr)) - 1);
   const int j1 = std::min(g.height - 1, static_cast<int>(std::ceil(fy + fr)) + 1);
-  const double fx = (d.x - g.originX) / g.resolution - 0.5;
+  const double fx = (d.x - g.originX) * invRes - 0.5;
   const int ts = config_.tileSize;
   std::size_t visited = 0;
   for (int j = j0; j <= j1; ++j) {
@@ -224,7 +229,7 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
     }
     // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
     // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
-    const double half = std::sqrt(std::max(rem, 0.0)) / g.resolution;
+    const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
     int a = std::max(0, static_cast<int>(std::ceil(fx - half)));
     int b = std::min(g.width - 1, static_cast<int>(std::floor(fx + half)));
     while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
@@ -239,18 +244,22 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
       continue;
     }
     double* row = P.data() + g.index(0, j);
+    const std::size_t tileRow = static_cast<std::size_t>(j >> tileShift_) * static_cast<std::size_t>(tilesX_);
     if (allDirty_) {
       for (int i = a; i <= b; ++i) {
         row[i] = std::max(row[i], p);
       }
+      for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
+        paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
+      }
       visited += static_cast<std::size_t>(b - a + 1);
       continue;
     }
-    const std::size_t tileRow = static_cast<std::size_t>(j / ts) * static_cast<std::size_t>(tilesX_);
-    for (int tx = a / ts; tx <= b / ts; ++tx) {
+    for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
       if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
         continue;
       }
+      paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
       const int lo = std::max(a, tx * ts);
       const int hi = std::min(b, tx * ts + ts - 1);
       for (int i = lo; i <= hi; ++i) {
@@ -461,17 +470,13 @@ void FusionEngine::recompute(bool full) {
   for (int l = 0; l <= K; ++l) {
     bound[static_cast<std::size_t>(l)] = levelUpperBound(l, K);
   }
+  // ceil(p·K) is off by at most one from the level; one comparison on each side settles it (the table
+  // has a sentinel so both lookups stay in range).
+  bound.push_back(2.0);
   auto levelOf = [&](double p) -> std::uint8_t {
-    if (p >= 1.0) {
-      return static_cast<std::uint8_t>(K);
-    }
     int l = std::clamp(static_cast<int>(std::ceil(p * Kd)), 1, K);
-    while (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) {
-      --l;
-    }
-    while (l < K && p > bound[static_cast<std::size_t>(l)]) {
-      ++l;
-    }
+    l -= (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) ? 1 : 0;
+    l += (l < K && p > bound[static_cast<std::size_t>(l)]) ? 1 : 0;
     return static_cast<std::uint8_t>(l);
   };
   const int ts = config_.tileSize;
@@ -480,16 +485,25 @@ void FusionEngine::recompute(bool full) {
       if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
         continue;
       }
+      const bool painted = paintedTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] != 0;
+      const int i0 = tx * ts;
+      const int i1 = std::min(g.width, tx * ts + ts);
       for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
-        for (int i = tx * ts; i < std::min(g.width, tx * ts + ts); ++i) {
-          const std::size_t idx = g.index(i, j);
-          const double p = result_.probability.p[idx];
-          result_.levels.level[idx] = p > 0.0 ? levelOf(p) : 0;
+        const double* prow = result_.probability.p.data() + g.index(0, j);
+        std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
+        if (!painted) {  // nothing was painted here since the tile was cleared: all level 0
+          std::fill(lrow + i0, lrow + i1, std::uint8_t{0});
+          continue;
+        }
+        for (int i = i0; i < i1; ++i) {
+          const double p = prow[i];
+          lrow[i] = p > 0.0 ? levelOf(p) : 0;
         }
       }
     }
   }
   std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 0);
+  std::fill(paintedTiles_.begin(), paintedTiles_.end(), 0);
 }
 
 }  // namespace fleet::risk

@@ -23,7 +23,7 @@ struct FusionConfig {
   int steps = 30;   // horizon = steps · dt
   PairPolicy policy;
   SourceLimits limits;
-  int tileSize = 32;  // cells per side of the unit of incremental recomputation
+  int tileSize = 32;  // cells per side of the unit of incremental recomputation (a power of two)
 };
 
 /// Configuration problems, or nothing. Codes: "bad_grid", "bad_levels", "bad_time_base", "bad_tile".
@@ -108,6 +108,8 @@ class FusionEngine {
   std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
   std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
   bool allDirty_ = false;
+  std::vector<std::uint8_t> paintedTiles_;  // tiles painted since they were last cleared
+  int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
   struct Paint {
