@@ -54,6 +54,10 @@ struct FusionResult {
 /// hash sized by the model's reach, each disc is painted once per step with the largest score of its
 /// pairs, only over the cells of its bounding box. When the time base is unchanged since the last
 /// fuse(), only the tiles an upserted or removed source can influence are recomputed.
+/// Not thread-safe: one thread owns an engine (the service's fusion loop).
+///
+/// Typical cycle: upsert()/remove() as samples arrive, then fuse(now) → result().levels, encodeRle(
+/// result().levels.level) and RegionExtractor::extract(result().levels) for the wire.
 class FusionEngine {
  public:
   static Expected<FusionEngine> create(FusionConfig config, std::shared_ptr<const RiskModel> model);
