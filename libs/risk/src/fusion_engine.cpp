@@ -22,8 +22,8 @@ Expected<void> validateFusionConfig(const FusionConfig& c) {
   if (!(c.dt > 0.0) || !std::isfinite(c.dt) || c.steps < 1 || c.steps > 10000) {
     return unexpected("bad_time_base", "fusion needs dt > 0 and 1..10000 steps");
   }
-  if (c.tileSize < 1 || c.tileSize > 4096) {
-    return unexpected("bad_tile", "tile size must be in 1..4096 cells");
+  if (c.tileSize < 1 || c.tileSize > 4096 || (c.tileSize & (c.tileSize - 1)) != 0) {
+    return unexpected("bad_tile", "tile size must be a power of two in 1..4096 cells");
   }
   return {};
 }
@@ -41,9 +41,13 @@ Expected<FusionEngine> FusionEngine::create(FusionConfig config, std::shared_ptr
 FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model)
     : config_(std::move(config)), model_(std::move(model)) {
   const GridSpec& g = config_.grid;
+  while ((1 << tileShift_) < config_.tileSize) {
+    ++tileShift_;  // tile index = cell index >> tileShift_ (integer division is slow on the paint path)
+  }
   tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
   tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
   dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
+  paintedTiles_.assign(dirtyTiles_.size(), 0);
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -208,35 +212,60 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
 void FusionEngine::paintDisc(const Disc& d, double p) {
   const GridSpec& g = config_.grid;
   auto& P = result_.probability.p;
-  // Bounding box of the cell centres that can be inside, padded by one cell against rounding; the exact
-  // test cellInsideDisc decides, as in the reference.
-  const int i0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / g.resolution - 0.5)) - 1);
-  const int i1 =
-      std::min(g.width - 1, static_cast<int>(std::ceil((d.x + d.r - g.originX) / g.resolution - 0.5)) + 1);
-  const int j0 = std::max(0, static_cast<int>(std::floor((d.y - d.r - g.originY) / g.resolution - 0.5)) - 1);
-  const int j1 =
-      std::min(g.height - 1, static_cast<int>(std::ceil((d.y + d.r - g.originY) / g.resolution - 0.5)) + 1);
-  if (i0 > i1 || j0 > j1) {
-    return;
-  }
+  const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
+  const double fy = (d.y - g.originY) * invRes - 0.5;  // row coordinate of the centre
+  const double fr = d.r * invRes;
+  const int j0 = std::max(0, static_cast<int>(std::floor(fy - fr)) - 1);
+  const int j1 = std::min(g.height - 1, static_cast<int>(std::ceil(fy + fr)) + 1);
+  const double fx = (d.x - g.originX) * invRes - 0.5;
   const int ts = config_.tileSize;
   std::size_t visited = 0;
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
-    const std::size_t tileRow = static_cast<std::size_t>(j / ts) * static_cast<std::size_t>(tilesX_);
-    for (int tx = i0 / ts; tx <= i1 / ts; ++tx) {
+    const double dy = cy - d.y;
+    const double rem = d.r * d.r - dy * dy;
+    if (rem < -1e-9 * d.r * d.r) {
+      continue;
+    }
+    // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
+    // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
+    const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
+    int a = std::max(0, static_cast<int>(std::ceil(fx - half)));
+    int b = std::min(g.width - 1, static_cast<int>(std::floor(fx + half)));
+    while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
+      --a;
+    while (a <= b && !cellInsideDisc(g.cellCentreX(a), cy, d))
+      ++a;
+    while (b < g.width - 1 && cellInsideDisc(g.cellCentreX(b + 1), cy, d))
+      ++b;
+    while (b >= a && !cellInsideDisc(g.cellCentreX(b), cy, d))
+      --b;
+    if (a > b) {
+      continue;
+    }
+    double* row = P.data() + g.index(0, j);
+    const std::size_t tileRow = static_cast<std::size_t>(j >> tileShift_) * static_cast<std::size_t>(tilesX_);
+    if (allDirty_) {
+      for (int i = a; i <= b; ++i) {
+        row[i] = std::max(row[i], p);
+      }
+      for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
+        paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
+      }
+      visited += static_cast<std::size_t>(b - a + 1);
+      continue;
+    }
+    for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
       if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
         continue;
       }
-      const int a = std::max(i0, tx * ts);
-      const int b = std::min(i1, tx * ts + ts - 1);
-      double* row = P.data() + g.index(0, j);
-      for (int i = a; i <= b; ++i) {
-        if (cellInsideDisc(g.cellCentreX(i), cy, d)) {
-          row[i] = std::max(row[i], p);
-        }
+      paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
+      const int lo = std::max(a, tx * ts);
+      const int hi = std::min(b, tx * ts + ts - 1);
+      for (int i = lo; i <= hi; ++i) {
+        row[i] = std::max(row[i], p);
       }
-      visited += static_cast<std::size_t>(b - a + 1);
+      visited += static_cast<std::size_t>(hi - lo + 1);
     }
   }
   result_.stats.cellsVisited += visited;
@@ -260,23 +289,30 @@ void FusionEngine::recompute(bool full) {
 
   stepDiscs_.resize(static_cast<std::size_t>(steps));
   double maxReach = 0.0;
-  for (int k = 0; k < steps; ++k) {
-    auto& list = stepDiscs_[static_cast<std::size_t>(k)];
+  for (auto& list : stepDiscs_) {
     list.clear();
-    for (std::size_t s = 0; s < entries.size(); ++s) {
-      const auto& slot = entries[s]->aligned.steps[static_cast<std::size_t>(k)];
+  }
+  // Source-major: each source's discs are contiguous, the per-step lists are appended to in order.
+  for (std::size_t s = 0; s < entries.size(); ++s) {
+    const auto& aligned = entries[s]->aligned.steps;
+    for (int k = 0; k < steps; ++k) {
+      const auto& slot = aligned[static_cast<std::size_t>(k)];
       if (slot.has_value()) {
         const double reach = model_->reach(*slot);
         maxReach = std::max(maxReach, reach);
-        list.push_back(StepDisc{*slot, static_cast<std::uint32_t>(s), entries[s]->source.kind, reach});
+        stepDiscs_[static_cast<std::size_t>(k)].push_back(
+            StepDisc{*slot, static_cast<std::uint32_t>(s), entries[s]->source.kind, reach});
       }
     }
+  }
+  for (const auto& list : stepDiscs_) {
     result_.stats.discs += list.size();
   }
   for (const Disc& d : pendingDirty_) {
     maxReach = std::max(maxReach, model_->reach(d));
   }
 
+  allDirty_ = full;
   if (full) {
     std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
     pendingDirty_.clear();
@@ -302,6 +338,9 @@ void FusionEngine::recompute(bool full) {
 
   const double tileM = g.resolution * config_.tileSize;
   auto touchesDirty = [&](const Disc& d) {
+    if (full) {
+      return true;
+    }
     const int tx0 = std::max(0, static_cast<int>(std::floor((d.x - d.r - g.originX) / tileM - 1e-9)));
     const int tx1 =
         std::min(tilesX_ - 1, static_cast<int>(std::floor((d.x + d.r - g.originX) / tileM + 1e-9)));
@@ -319,6 +358,7 @@ void FusionEngine::recompute(bool full) {
   };
 
   result_.sceneIndexPerStep.assign(static_cast<std::size_t>(steps), 0.0);
+  paints_.clear();
   const PairPolicy& policy = config_.policy;
   for (int k = 0; k < steps; ++k) {
     const auto& list = stepDiscs_[static_cast<std::size_t>(k)];
@@ -389,8 +429,7 @@ void FusionEngine::recompute(bool full) {
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {
-        ++result_.stats.discsPainted;
-        paintDisc(list[i].disc, discMax_[i]);
+        paints_.push_back(Paint{list[i].disc, discMax_[i], 0});
       }
     }
     // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
@@ -404,28 +443,67 @@ void FusionEngine::recompute(bool full) {
     result_.sceneIndexPerStep[static_cast<std::size_t>(k)] =
         den > 0.0 ? std::clamp(interSum / den, 0.0, 1.0) : 0.0;
   }
+  // Paint in tile order rather than step order: discs of nearby places and different steps then reuse
+  // the same cache lines of the grid (the grid is megabytes; the discs are scattered).
+  {
+    const double inv = 1.0 / (g.resolution * config_.tileSize);
+    for (auto& pt : paints_) {
+      const auto tx = static_cast<std::uint32_t>(std::clamp((pt.disc.x - g.originX) * inv, 0.0, 65535.0));
+      const auto ty = static_cast<std::uint32_t>(std::clamp((pt.disc.y - g.originY) * inv, 0.0, 65535.0));
+      pt.key = (ty << 16) | tx;
+    }
+    std::sort(paints_.begin(), paints_.end(), [](const Paint& a, const Paint& b) { return a.key < b.key; });
+    for (const auto& pt : paints_) {
+      paintDisc(pt.disc, pt.p);
+    }
+    result_.stats.discsPainted = paints_.size();
+  }
   result_.sceneIndex = 0.0;
   for (double s : result_.sceneIndexPerStep) {
     result_.sceneIndex = std::max(result_.sceneIndex, s);
   }
 
-  // Levels of the recomputed tiles.
+  // Levels of the recomputed tiles: isoLevel with the boundaries l/K from a table (no divisions).
+  const int K = config_.levels;
+  const double Kd = static_cast<double>(K);
+  std::vector<double> bound(static_cast<std::size_t>(K) + 1);
+  for (int l = 0; l <= K; ++l) {
+    bound[static_cast<std::size_t>(l)] = levelUpperBound(l, K);
+  }
+  // ceil(p·K) is off by at most one from the level; one comparison on each side settles it (the table
+  // has a sentinel so both lookups stay in range).
+  bound.push_back(2.0);
+  auto levelOf = [&](double p) -> std::uint8_t {
+    int l = std::clamp(static_cast<int>(std::ceil(p * Kd)), 1, K);
+    l -= (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) ? 1 : 0;
+    l += (l < K && p > bound[static_cast<std::size_t>(l)]) ? 1 : 0;
+    return static_cast<std::uint8_t>(l);
+  };
   const int ts = config_.tileSize;
   for (int ty = 0; ty < tilesY_; ++ty) {
     for (int tx = 0; tx < tilesX_; ++tx) {
       if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
         continue;
       }
+      const bool painted = paintedTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] != 0;
+      const int i0 = tx * ts;
+      const int i1 = std::min(g.width, tx * ts + ts);
       for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
-        for (int i = tx * ts; i < std::min(g.width, tx * ts + ts); ++i) {
-          const std::size_t idx = g.index(i, j);
-          result_.levels.level[idx] =
-              static_cast<std::uint8_t>(isoLevel(result_.probability.p[idx], config_.levels));
+        const double* prow = result_.probability.p.data() + g.index(0, j);
+        std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
+        if (!painted) {  // nothing was painted here since the tile was cleared: all level 0
+          std::fill(lrow + i0, lrow + i1, std::uint8_t{0});
+          continue;
+        }
+        for (int i = i0; i < i1; ++i) {
+          const double p = prow[i];
+          lrow[i] = p > 0.0 ? levelOf(p) : 0;
         }
       }
     }
   }
   std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 0);
+  std::fill(paintedTiles_.begin(), paintedTiles_.end(), 0);
 }
 
 }  // namespace fleet::risk

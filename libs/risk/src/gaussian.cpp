@@ -9,24 +9,30 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// Regularized lower incomplete gamma P(s, x) for integer s >= 1 (= P(Poisson(x) >= s)).
-double lowerGammaInt(int s, double x) {
+// Regularized lower incomplete gamma P(s, x) for integer s >= 1 (= P(Poisson(x) >= s)), given
+// lgs = lgamma(s) and logX = log(x), which the caller has at hand.
+double lowerGammaInt(int s, double x, double lgs, double logX) {
   if (x <= 0.0) {
     return 0.0;
   }
   const double sd = static_cast<double>(s);
   if (sd <= x) {
-    // Q(s, x) = e^{-x} Σ_{j<s} x^j / j!: a finite sum of positive terms.
-    double term = std::exp(-x);
-    double q = term;
-    for (int j = 1; j < s; ++j) {
-      term *= x / static_cast<double>(j);
+    // Q(s, x) = Σ_{j<s} Pois(j; x), summed from j = s − 1 downwards: below the mode x the terms shrink
+    // at least geometrically, so the sum stops after O(sqrt(x)) terms.
+    double term = std::exp(-x + (sd - 1.0) * logX - lgs);
+    double q = 0.0;
+    const double invX = 1.0 / x;
+    for (int j = s - 1; j >= 0; --j) {
       q += term;
+      if (term < 1e-18 * q) {
+        break;
+      }
+      term *= static_cast<double>(j) * invX;
     }
     return std::clamp(1.0 - q, 0.0, 1.0);
   }
   // P(s, x) = e^{-x} x^s / s! · Σ_n x^n / ((s+1)…(s+n)); converges geometrically since s > x.
-  const double lead = std::exp(-x + sd * std::log(x) - std::lgamma(sd + 1.0));
+  const double lead = std::exp(-x + sd * logX - lgs - std::log(sd));
   double term = 1.0;
   double sum = 1.0;
   for (int n = 1; n < 100000; ++n) {
@@ -37,6 +43,41 @@ double lowerGammaInt(int s, double x) {
     }
   }
   return std::clamp(lead * sum, 0.0, 1.0);
+}
+
+// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre recurrence), computed once.
+struct GaussLegendre {
+  static constexpr int kN = 8;
+  double x[kN];
+  double w[kN];
+  GaussLegendre() : x{}, w{} {
+    for (int i = 0; i < kN; ++i) {
+      double z = std::cos(kPi * (i + 0.75) / (kN + 0.5));
+      double dp = 1.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0;
+        double p1 = z;
+        for (int k = 2; k <= kN; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
+          p0 = p1;
+          p1 = p2;
+        }
+        dp = kN * (z * p1 - p0) / (z * z - 1.0);
+        const double dz = p1 / dp;
+        z -= dz;
+        if (std::abs(dz) < 1e-16) {
+          break;
+        }
+      }
+      x[i] = z;
+      w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+  }
+};
+
+const GaussLegendre& gaussLegendre() {
+  static const GaussLegendre gl;
+  return gl;
 }
 
 // erf(hi) − erf(lo) for lo <= hi without cancellation in the tails.
@@ -60,6 +101,14 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
   if (!(sigma > 0.0)) {
     return d < R ? 1.0 : 0.0;
   }
+  // Outside 9 sigma of the rim the answer is 0 or 1 to within exp(−40.5) < 3e-18 (Rayleigh tail bound
+  // on ‖x − μ‖), which also keeps the series below short.
+  if (d - R > 9.0 * sigma) {
+    return 0.0;
+  }
+  if (R - d > 9.0 * sigma) {
+    return 1.0;
+  }
   const double s2 = 2.0 * sigma * sigma;
   const double a = d * d / s2;  // half the noncentrality λ/2
   const double b = R * R / s2;  // half the χ² argument x/2
@@ -73,15 +122,19 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
   const bool fullUpperTail = ka <= kb;
   const int kHi = static_cast<int>(std::ceil(std::min(ka, kb)));
   const double kHiD = static_cast<double>(kHi);
-  const double logPa0 = -a + kHiD * std::log(a) - std::lgamma(kHiD + 1.0);
+  const double lgk = std::lgamma(kHiD + 1.0);
+  const double logB = std::log(b);
+  const double logPa0 = -a + kHiD * std::log(a) - lgk;
   // Poisson(a) weights are carried relative to Pois(kHi; a): with a in the thousands, exp(logPa0) has a
   // relative error of ~1e-12 from lgamma, which normalising by the summed weights removes.
   const double stopWeight = 1e-20 * std::exp(-logPa0);
-  double g = lowerGammaInt(kHi + 1, b);                                     // P(k + 1, b)
-  double pb = std::exp(-b + kHiD * std::log(b) - std::lgamma(kHiD + 1.0));  // Pois(k; b)
-  double w = 1.0;                                                           // Pois(k; a) / Pois(kHi; a)
+  double g = lowerGammaInt(kHi + 1, b, lgk, logB);  // P(k + 1, b)
+  double pb = std::exp(-b + kHiD * logB - lgk);     // Pois(k; b)
+  double w = 1.0;                                   // Pois(k; a) / Pois(kHi; a)
   double sum = 0.0;
   double weights = 0.0;
+  const double invA = 1.0 / a;
+  const double invB = 1.0 / b;
   for (int k = kHi; k >= 0; --k) {
     sum += w * g;
     weights += w;
@@ -90,8 +143,8 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
       break;  // below the Poisson mode every further term is smaller still
     }
     g += pb;  // P(k, b) = P(k + 1, b) + Pois(k; b)
-    w *= kd / a;
-    pb *= kd / b;
+    w *= kd * invA;
+    pb *= kd * invB;
   }
   if (fullUpperTail && weights > 0.0) {  // the loop covered all but 1e-20 of the Poisson(a) mass
     return std::clamp(sum / weights, 0.0, 1.0);
@@ -100,7 +153,7 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
   return std::clamp(sum, 0.0, 1.0);
 }
 
-double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int thetaSteps) {
+double gaussianCollisionProbabilityPolar(Vec2 mean, const Cov2& cov, double R, int thetaSteps) {
   if (!(R > 0.0)) {
     return 0.0;
   }
@@ -118,34 +171,156 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int th
   const double wxy = -cov.xy / det;
   const double wyy = cov.xx / det;
   const double gamma = mean.x * (wxx * mean.x + wxy * mean.y) + mean.y * (wxy * mean.x + wyy * mean.y);
+  const double smin = std::sqrt(lmin);
+  const double dist = mean.norm();
+  // Far outside the disc the whole integral is below exp(−40.5) (tail bound with the largest sigma).
+  if (dist - R > 9.0 * std::sqrt(lmax)) {
+    return 0.0;
+  }
   int n = thetaSteps;
   if (n <= 0) {
-    // The angular integrand is peaked with a width of about sigma_min / R radians; 8 points per
-    // width make the trapezoid rule (exponentially convergent on periodic integrands) exact to ~1e-12.
-    const double perWidth = 8.0 * 2.0 * kPi * R / std::sqrt(lmin);
-    n = static_cast<int>(std::clamp(std::ceil(perWidth / 8.0) * 8.0, 64.0, 8192.0));
+    // Seen from the disc centre the Gaussian spans an angle of about sigma_min / max(|μ|, sigma_min);
+    // the trapezoid rule on a periodic peak of that width is accurate to ~1e-12 with 8 points per width.
+    const double width = smin / std::max(dist, smin);
+    n = static_cast<int>(std::clamp(std::ceil(8.0 * 2.0 * kPi / width / 4.0) * 4.0, 32.0, 4096.0));
   }
   const double eg = std::exp(-0.5 * gamma);
   double sum = 0.0;
   const double dth = 2.0 * kPi / static_cast<double>(n);
+  // Unit vectors by rotation (re-seeded every 64 steps against drift) instead of cos/sin per point.
+  const double cr = std::cos(dth);
+  const double sr = std::sin(dth);
+  double ux = std::cos(0.5 * dth);
+  double uy = std::sin(0.5 * dth);
   for (int i = 0; i < n; ++i) {
-    const double th = (static_cast<double>(i) + 0.5) * dth;
-    const double ux = std::cos(th);
-    const double uy = std::sin(th);
+    if ((i & 63) == 0 && i > 0) {
+      const double th = (static_cast<double>(i) + 0.5) * dth;
+      ux = std::cos(th);
+      uy = std::sin(th);
+    }
     // Along the ray r·u the exponent is −½(α r² − 2 β r + γ).
     const double alpha = ux * (wxx * ux + wxy * uy) + uy * (wxy * ux + wyy * uy);
     const double beta = ux * (wxx * mean.x + wxy * mean.y) + uy * (wxy * mean.x + wyy * mean.y);
     const double m = beta / alpha;
-    const double qR = alpha * R * R - 2.0 * beta * R + gamma;
-    // ∫0^R r e^{−q/2} dr = (e^{−γ/2} − e^{−q(R)/2})/α + m √(π/(2α)) e^{−(γ − β²/α)/2} [erf]…
-    const double part1 = (eg - std::exp(-0.5 * qR)) / alpha;
-    const double s = std::sqrt(0.5 * alpha);
-    const double part2 = m * std::sqrt(kPi / (2.0 * alpha)) * std::exp(-0.5 * (gamma - beta * m)) *
-                         erfDiff(-m * s, (R - m) * s);
-    sum += part1 + part2;
+    const double rc = std::clamp(m, 0.0, R);
+    const double qMin = alpha * rc * rc - 2.0 * beta * rc + gamma;
+    if (qMin < 92.0) {  // rays whose density stays below exp(−46) everywhere on [0, R] add nothing
+      const double qR = alpha * R * R - 2.0 * beta * R + gamma;
+      // ∫0^R r e^{−q/2} dr = (e^{−γ/2} − e^{−q(R)/2})/α + m √(π/(2α)) e^{−(γ − β m)/2} [erf(..) − erf(..)]
+      const double part1 = (eg - std::exp(-0.5 * qR)) / alpha;
+      const double sq = std::sqrt(0.5 * alpha);
+      const double part2 = m * std::sqrt(kPi / (2.0 * alpha)) * std::exp(-0.5 * (gamma - beta * m)) *
+                           erfDiff(-m * sq, (R - m) * sq);
+      sum += part1 + part2;
+    }
+    const double nx = ux * cr - uy * sr;
+    uy = ux * sr + uy * cr;
+    ux = nx;
   }
   const double p = sum * dth / (2.0 * kPi * std::sqrt(det));
   return std::clamp(p, 0.0, 1.0);
+}
+
+double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R) {
+  if (!(R > 0.0)) {
+    return 0.0;
+  }
+  const double tr = cov.xx + cov.yy;
+  const double disc =
+      std::sqrt(std::max(0.0, 0.25 * (cov.xx - cov.yy) * (cov.xx - cov.yy) + cov.xy * cov.xy));
+  const double lmax = 0.5 * tr + disc;
+  const double lmin = 0.5 * tr - disc;
+  if (!(cov.xx > 0.0) || !(lmin > 1e-12 * std::max(lmax, 1e-300))) {
+    return gaussianCollisionProbability(mean.norm(), R, std::sqrt(std::max(lmax, 0.0)));
+  }
+  const double dist = mean.norm();
+  const double smax = std::sqrt(lmax);
+  if (dist - R > 9.0 * smax) {
+    return 0.0;  // Rayleigh tail bound with the largest sigma: below exp(−40.5)
+  }
+  if (R - dist > 9.0 * smax) {
+    return 1.0;
+  }
+  // cov = L Lᵀ, L lower triangular; x = mean + L z. ‖x‖² ≤ R² along z = ρ v is A ρ² + 2 B ρ + C ≤ 0 with
+  // A = vᵀ M v (M = LᵀL), B = bᵀ v (b = Lᵀ mean), C = ‖mean‖² − R².
+  const double l11 = std::sqrt(cov.xx);
+  const double l21 = cov.xy / l11;
+  const double l22 = std::sqrt(std::max(cov.yy - l21 * l21, 1e-300));
+  const double m11 = l11 * l11 + l21 * l21;
+  const double m12 = l21 * l22;
+  const double m22 = l22 * l22;
+  const double b1 = l11 * mean.x + l21 * mean.y;
+  const double b2 = l22 * mean.y;
+  const double C = (dist - R) * (dist + R);
+  // Angular detail scales with how far (in whitened units) the ellipse reaches and how curved it is.
+  const double smin = std::sqrt(lmin);
+  const double scale = 1.0 + (dist + R) / smin;
+  const double elong = smax / smin;
+  auto rayAB = [&](double c, double s, double& A, double& B) {
+    A = m11 * c * c + 2.0 * m12 * c * s + m22 * s * s;
+    B = b1 * c + b2 * s;
+  };
+  if (C < 0.0) {
+    // Mean inside the disc: every ray leaves the ellipse once, at ρ+; integrand 1 − e^{−ρ+²/2}, smooth
+    // and periodic, so the trapezoid rule converges geometrically (faster the rounder the ellipse).
+    const int n =
+        static_cast<int>(std::clamp(std::ceil(8.0 * (scale + 2.0 * elong) / 8.0) * 8.0, 32.0, 8192.0));
+    const double dth = 2.0 * kPi / n;
+    const double cr = std::cos(dth);
+    const double sr = std::sin(dth);
+    double c = std::cos(0.5 * dth);
+    double s = std::sin(0.5 * dth);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double A = 0.0, B = 0.0;
+      rayAB(c, s, A, B);
+      const double sq = std::sqrt(B * B - A * C);
+      const double rho = B >= 0.0 ? -C / (B + sq) : (sq - B) / A;
+      sum += -std::expm1(-0.5 * rho * rho);
+      const double nc = c * cr - s * sr;  // next direction by rotation (n <= 8192: drift ~1e-12)
+      s = c * sr + s * cr;
+      c = nc;
+    }
+    return std::clamp(sum / n, 0.0, 1.0);
+  }
+  // Mean outside: rays hit the ellipse for vᵀ(b bᵀ − C M)v ≥ 0 with bᵀv < 0, an arc |θ − θm| ≤ h.
+  // vᵀQv = α0 + α1 cos 2θ + α2 sin 2θ.
+  const double q11 = b1 * b1 - C * m11;
+  const double q12 = b1 * b2 - C * m12;
+  const double q22 = b2 * b2 - C * m22;
+  const double a0 = 0.5 * (q11 + q22);
+  const double a1 = 0.5 * (q11 - q22);
+  const double a2 = q12;
+  const double rq = std::hypot(a1, a2);
+  if (!(rq > 0.0) || a0 + rq <= 0.0) {
+    return 0.0;
+  }
+  const double phi = std::atan2(a2, a1);
+  const double h = 0.5 * std::acos(std::clamp(-a0 / rq, -1.0, 1.0));
+  double thm = 0.5 * phi;
+  if (b1 * std::cos(thm) + b2 * std::sin(thm) > 0.0) {
+    thm += kPi;
+  }
+  const auto& gl = gaussLegendre();
+  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong)), 2.0, 1024.0));
+  const double du = kPi / panels;
+  double sum = 0.0;
+  for (int p = 0; p < panels; ++p) {
+    const double uc = -0.5 * kPi + (p + 0.5) * du;
+    for (int k = 0; k < GaussLegendre::kN; ++k) {
+      const double u = uc + 0.5 * du * gl.x[k];
+      const double th = thm + h * std::sin(u);
+      double A = 0.0, B = 0.0;
+      rayAB(std::cos(th), std::sin(th), A, B);
+      const double sq = std::sqrt(std::max(B * B - A * C, 0.0));
+      const double rhoPlus = (sq - B) / A;
+      const double rhoMinus = C / (sq - B);
+      // e^{−ρ−²/2} − e^{−ρ+²/2} without cancellation near the tangent rays (ρ+ − ρ− = 2 sq / A).
+      const double f = std::exp(-0.5 * rhoMinus * rhoMinus) * -std::expm1(-(sq / A) * (rhoPlus + rhoMinus));
+      sum += 0.5 * du * gl.w[k] * std::cos(u) * f;
+    }
+  }
+  return std::clamp(sum * h / (2.0 * kPi), 0.0, 1.0);
 }
 
 Gaussian::Gaussian(double floor)

@@ -51,6 +51,11 @@ bool regionContains(const Region& region, Vec2 point) {
 }
 
 std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
+  RegionExtractor extractor;
+  return extractor.extract(grid, minLevel);
+}
+
+std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel) {
   const GridSpec& g = grid.spec;
   const int W = g.width;
   const int H = g.height;
@@ -59,12 +64,15 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
     return regions;
   }
   const std::uint32_t VW = static_cast<std::uint32_t>(W) + 1;
-  std::vector<std::int32_t> label(g.cellCount(), -1);
+  label_.assign(g.cellCount(), -1);
   // Outgoing boundary edges per vertex (at most two, at a saddle), reset after each component.
-  std::vector<std::int32_t> out0(static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1), -1);
-  std::vector<std::int32_t> out1(out0.size(), -1);
+  const std::size_t vertices = static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1);
+  if (out_.size() != vertices) {
+    out_.assign(vertices, {-1, -1});  // both slots of a vertex share a cache line
+  }
+  auto& label = label_;
+  auto& out = out_;
   std::vector<std::uint32_t> stack;
-  std::vector<std::uint32_t> members;
   std::vector<Edge> edges;
 
   for (std::size_t seed = 0; seed < grid.level.size(); ++seed) {
@@ -73,57 +81,45 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
       continue;
     }
     const auto id = static_cast<std::int32_t>(regions.size());
-    // Flood fill (4-neighbour) of the component.
-    members.clear();
-    stack.assign(1, static_cast<std::uint32_t>(seed));
-    label[seed] = id;
-    while (!stack.empty()) {
-      const std::uint32_t c = stack.back();
-      stack.pop_back();
-      members.push_back(c);
-      const int i = static_cast<int>(c % static_cast<std::uint32_t>(W));
-      const int j = static_cast<int>(c / static_cast<std::uint32_t>(W));
-      const int ni[4] = {i + 1, i - 1, i, i};
-      const int nj[4] = {j, j, j + 1, j - 1};
-      for (int n = 0; n < 4; ++n) {
-        if (ni[n] < 0 || nj[n] < 0 || ni[n] >= W || nj[n] >= H) {
-          continue;
-        }
-        const std::size_t nc = g.index(ni[n], nj[n]);
-        if (label[nc] < 0 && grid.level[nc] == lvl) {
-          label[nc] = id;
-          stack.push_back(static_cast<std::uint32_t>(nc));
-        }
-      }
-    }
-    // Boundary edges with the component on their left.
+    // Flood fill (4-neighbour) of the component, emitting its boundary edges on the way: a 4-neighbour
+    // of the same level is in the same component, anything else (other level, off the grid) is across
+    // the boundary. Edges keep the component on their left.
     edges.clear();
-    auto inComp = [&](int i, int j) {
-      return i >= 0 && j >= 0 && i < W && j < H && label[g.index(i, j)] == id;
-    };
     auto vid = [&](int i, int j) {
       return static_cast<std::uint32_t>(j) * VW + static_cast<std::uint32_t>(i);
     };
     auto addEdge = [&](std::uint32_t from, std::uint8_t dir) {
       const auto e = static_cast<std::int32_t>(edges.size());
       edges.push_back(Edge{from, dir, false});
-      (out0[from] < 0 ? out0[from] : out1[from]) = e;
+      (out[from][0] < 0 ? out[from][0] : out[from][1]) = e;
     };
-    for (std::uint32_t c : members) {
+    std::size_t cells = 0;
+    stack.assign(1, static_cast<std::uint32_t>(seed));
+    label[seed] = id;
+    while (!stack.empty()) {
+      const std::uint32_t c = stack.back();
+      stack.pop_back();
+      ++cells;
       const int i = static_cast<int>(c % static_cast<std::uint32_t>(W));
       const int j = static_cast<int>(c / static_cast<std::uint32_t>(W));
-      if (!inComp(i, j - 1))
-        addEdge(vid(i, j), 0);
-      if (!inComp(i + 1, j))
-        addEdge(vid(i + 1, j), 1);
-      if (!inComp(i, j + 1))
-        addEdge(vid(i + 1, j + 1), 2);
-      if (!inComp(i - 1, j))
-        addEdge(vid(i, j + 1), 3);
+      // Neighbours: below (edge +x at the bottom), right (+y), above (−x), left (−y).
+      const int ni[4] = {i, i + 1, i, i - 1};
+      const int nj[4] = {j - 1, j, j + 1, j};
+      const std::uint32_t from[4] = {vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)};
+      for (int n = 0; n < 4; ++n) {
+        const bool inGrid = ni[n] >= 0 && nj[n] >= 0 && ni[n] < W && nj[n] < H;
+        const std::size_t nc = inGrid ? g.index(ni[n], nj[n]) : 0;
+        if (!inGrid || grid.level[nc] != lvl) {
+          addEdge(from[n], static_cast<std::uint8_t>(n));
+        } else if (label[nc] < 0) {
+          label[nc] = id;
+          stack.push_back(static_cast<std::uint32_t>(nc));
+        }
+      }
     }
     Region region;
     region.level = lvl;
-    region.cells = members.size();
+    region.cells = cells;
     for (std::size_t start = 0; start < edges.size(); ++start) {
       if (edges[start].used) {
         continue;
@@ -142,8 +138,8 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
         prevDir = dir;
         const std::uint32_t to = from + static_cast<std::uint32_t>(kDx[dir]) +
                                  static_cast<std::uint32_t>(kDy[dir]) * VW;  // unsigned wrap is intended
-        const std::int32_t a = out0[to];
-        const std::int32_t b = out1[to];
+        const std::int32_t a = out[to][0];
+        const std::int32_t b = out[to][1];
         std::int32_t next = a;
         if (b >= 0) {
           // Saddle: turn left, hugging the current cell, so diagonal neighbours stay apart.
@@ -168,14 +164,23 @@ std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel) {
       }
     }
     for (const auto& e : edges) {
-      out0[e.from] = -1;
-      out1[e.from] = -1;
+      out[e.from] = {-1, -1};
     }
     regions.push_back(std::move(region));
   }
-  std::stable_sort(regions.begin(), regions.end(),
-                   [](const Region& a, const Region& b) { return a.level < b.level; });
-  return regions;
+  // Order by level, stable in first-cell order (a counting pass instead of sorting heavy objects).
+  std::vector<std::size_t> start(static_cast<std::size_t>(kMaxLevels) + 2, 0);
+  for (const auto& r : regions) {
+    ++start[static_cast<std::size_t>(r.level) + 1];
+  }
+  for (std::size_t l = 1; l < start.size(); ++l) {
+    start[l] += start[l - 1];
+  }
+  std::vector<Region> ordered(regions.size());
+  for (auto& r : regions) {
+    ordered[start[static_cast<std::size_t>(r.level)]++] = std::move(r);
+  }
+  return ordered;
 }
 
 }  // namespace fleet::risk

@@ -209,6 +209,11 @@ TEST(FusionEngine, ConfigValidation) {
   c.dt = 0;
   EXPECT_EQ(FusionEngine::create(c, std::make_shared<OverlapRatio>()).error().code, "bad_time_base");
   EXPECT_EQ(FusionEngine::create(FusionConfig{}, nullptr).error().code, "no_model");
+  c = FusionConfig{};
+  c.tileSize = 24;  // tiles are indexed by shifts
+  EXPECT_EQ(FusionEngine::create(c, std::make_shared<OverlapRatio>()).error().code, "bad_tile");
+  c.tileSize = 64;
+  EXPECT_TRUE(FusionEngine::create(c, std::make_shared<OverlapRatio>()).has_value());
 }
 
 }  // namespace

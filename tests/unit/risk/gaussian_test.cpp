@@ -96,6 +96,9 @@ TEST(GaussianAnisotropic, ReducesToIsotropic) {
       const double iso = gaussianCollisionProbability(d, 1.0, s);
       const double q = gaussianCollisionProbability(Vec2{d * 0.6, d * 0.8}, Cov2{s * s, 0.0, s * s}, 1.0);
       EXPECT_NEAR(q, iso, 1e-10 + 1e-8 * iso) << d << " " << s;
+      const double qp =
+          gaussianCollisionProbabilityPolar(Vec2{d * 0.6, d * 0.8}, Cov2{s * s, 0.0, s * s}, 1.0);
+      EXPECT_NEAR(qp, iso, 1e-10 + 1e-8 * iso) << d << " " << s;
     }
   }
 }
@@ -123,8 +126,25 @@ TEST(GaussianAnisotropic, MonteCarloMillionSamples) {
     const Cov2 r{cs * cs * a - 2 * cs * sn * b + sn * sn * e, cs * sn * (a - e) + (cs * cs - sn * sn) * b,
                  sn * sn * a + 2 * cs * sn * b + cs * cs * e};
     EXPECT_NEAR(gaussianCollisionProbability(m2, r, c.R), q, 1e-10);
-    // More angular steps change nothing visible: the default is converged.
-    EXPECT_NEAR(gaussianCollisionProbability(c.mean, c.cov, c.R, 16384), q, 1e-10);
+    // The polar (Foster-style) quadrature with many steps agrees: two independent methods.
+    EXPECT_NEAR(gaussianCollisionProbabilityPolar(c.mean, c.cov, c.R, 16384), q, 1e-10);
+    EXPECT_NEAR(gaussianCollisionProbabilityPolar(c.mean, c.cov, c.R), q, 1e-10);
+  }
+}
+
+TEST(GaussianAnisotropic, WhitenedAndPolarQuadratureAgreeOnRandomCases) {
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> ud(0.0, 2.5), ua(0.0, 6.283185307179586), us(0.02, 0.6),
+      ue(0.05, 1.0), ur(0.3, 1.5);
+  for (int t = 0; t < 400; ++t) {
+    const double d = ud(rng), th = ua(rng), R = ur(rng);
+    const double l1 = us(rng) * us(rng) + 1e-4, l2 = l1 * ue(rng), rot = ua(rng);
+    const double c = std::cos(rot), s = std::sin(rot);
+    const Cov2 cov{c * c * l1 + s * s * l2, c * s * (l1 - l2), s * s * l1 + c * c * l2};
+    const Vec2 mean{d * std::cos(th), d * std::sin(th)};
+    const double fast = gaussianCollisionProbability(mean, cov, R);
+    const double polar = gaussianCollisionProbabilityPolar(mean, cov, R, 16384);
+    ASSERT_NEAR(fast, polar, 1e-9) << "d=" << d << " R=" << R << " l1=" << l1 << " l2=" << l2;
   }
 }
 

@@ -4,6 +4,9 @@
 
 #include "fleet/risk/gaussian.hpp"
 #include "fleet/risk/overlap_ratio.hpp"
+#include "fleet/risk/thesis_cases.hpp"
+
+#include <algorithm>
 
 namespace fleet::risk {
 namespace {
@@ -69,7 +72,7 @@ TEST(ReferenceAlgorithm, GaussianScoresDiscsThatDoNotTouch) {
                                        track(SourceKind::kRobot, {{1.0, 0, 0.4, 0.2}})};
   EXPECT_EQ(referenceProbabilityGrid(spec, src, OverlapRatio{}).p[spec.index(20, 20)], 0.0);
   const auto g = referenceProbabilityGrid(spec, src, Gaussian{1e-4});
-  EXPECT_NEAR(g.p[spec.index(20, 20)], gaussianCollisionProbability(1.0, 0.8, std::sqrt(0.08)), 1e-15);
+  EXPECT_NEAR(g.p[spec.index(20, 20)], gaussianCollisionProbability(1.0, 0.8, std::sqrt(0.08)), 1e-13);
 }
 
 TEST(ReferenceAlgorithm, Spheres3D) {
@@ -80,6 +83,27 @@ TEST(ReferenceAlgorithm, Spheres3D) {
   EXPECT_DOUBLE_EQ(g[spec.index(8, 8, 15)],
                    sphereOverlapRatio(1, 1, 1));  // z = 1.75 only in sphere 2 at step 0
   EXPECT_EQ(g[spec.index(0, 0, 0)], 0.0);
+}
+
+}  // namespace
+}  // namespace fleet::risk
+
+namespace fleet::risk {
+namespace {
+
+TEST(ThesisCases, MaximaAreTheAnalyticValuesOfTheDocumentedTrajectories) {
+  const auto cases = thesisCases();
+  ASSERT_EQ(cases.size(), 7u);
+  auto maxOf = [](const ThesisCase& c) {
+    const auto g = referenceProbabilityGrid(c.grid, c.sources, OverlapRatio{}, PairPolicy{true});
+    return *std::max_element(g.p.begin(), g.p.end());
+  };
+  EXPECT_DOUBLE_EQ(maxOf(cases[0]), 0.36);                           // r 30 inside r 50 at t = 40
+  EXPECT_DOUBLE_EQ(maxOf(cases[1]), 1.0);                            // identical discs meet at t = 25
+  EXPECT_NEAR(maxOf(cases[2]), 50.0 * 50.0 / (60.0 * 60.0), 1e-12);  // containment on the arc
+  EXPECT_NEAR(maxOf(cases[4]), 4.0 / 9.0, 1e-12);                    // r 20 inside r 30
+  EXPECT_EQ(cases[0].grid.width, 81);                                // N + 1 points
+  EXPECT_NEAR(cases[0].grid.cellCentreX(80), 400.0, 1e-9);           // x_N = xmax
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ struct FusionConfig {
   int steps = 30;   // horizon = steps · dt
   PairPolicy policy;
   SourceLimits limits;
-  int tileSize = 32;  // cells per side of the unit of incremental recomputation
+  int tileSize = 32;  // cells per side of the unit of incremental recomputation (a power of two)
 };
 
 /// Configuration problems, or nothing. Codes: "bad_grid", "bad_levels", "bad_time_base", "bad_tile".
@@ -54,6 +54,10 @@ struct FusionResult {
 /// hash sized by the model's reach, each disc is painted once per step with the largest score of its
 /// pairs, only over the cells of its bounding box. When the time base is unchanged since the last
 /// fuse(), only the tiles an upserted or removed source can influence are recomputed.
+/// Not thread-safe: one thread owns an engine (the service's fusion loop).
+///
+/// Typical cycle: upsert()/remove() as samples arrive, then fuse(now) → result().levels, encodeRle(
+/// result().levels.level) and RegionExtractor::extract(result().levels) for the wire.
 class FusionEngine {
  public:
   static Expected<FusionEngine> create(FusionConfig config, std::shared_ptr<const RiskModel> model);
@@ -71,6 +75,8 @@ class FusionEngine {
   /// next call.
   const FusionResult& fuse(std::int64_t t_ref_ns);
   [[nodiscard]] const FusionResult& result() const { return result_; }
+  /// Makes the next fuse() recompute everything (e.g. after the caller changed its mind about the map).
+  void invalidate() { haveResult_ = false; }
 
   /// The sources as aligned for the last fuse(), in a fixed order (for the reference and tests).
   [[nodiscard]] std::vector<AlignedSource> alignedSources() const;
@@ -105,9 +111,18 @@ class FusionEngine {
   bool haveResult_ = false;
   std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
   std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
+  bool allDirty_ = false;
+  std::vector<std::uint8_t> paintedTiles_;  // tiles painted since they were last cleared
+  int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
+  struct Paint {
+    Disc disc;
+    double p;
+    std::uint32_t key;
+  };
   // scratch, kept between calls to avoid reallocation
+  std::vector<Paint> paints_;
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
   std::vector<std::uint8_t> active_;

@@ -18,11 +18,19 @@ struct Cov2 {
 /// downwards so every addition is of positive terms). sigma = 0 gives the indicator d < R.
 double gaussianCollisionProbability(double d, double R, double sigma);
 
-/// P(‖x‖ ≤ R) for x ~ N(mean, cov) (anisotropic): Foster-style polar quadrature around the disc centre,
-/// with the radial integral done in closed form (exp/erf) and the periodic angular integral by the
-/// trapezoid rule. thetaSteps = 0 picks a step count from the shape of the Gaussian. A singular or
-/// non-positive covariance falls back to the isotropic formula with the largest standard deviation.
-double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, int thetaSteps = 0);
+/// P(‖x‖ ≤ R) for x ~ N(mean, cov) (anisotropic), fast path: in whitened coordinates z = L⁻¹(x − mean)
+/// (cov = L Lᵀ) the density is the standard normal and each ray from the mean crosses the transformed
+/// disc (an ellipse) in one interval [ρ1, ρ2], whose radial integral is e^{−ρ1²/2} − e^{−ρ2²/2}. The
+/// angle is integrated by the periodic trapezoid rule when the mean is inside the disc, and over the arc
+/// of rays that hit the ellipse (substituted θ = θm + h·sin u, which removes the square-root ends) by
+/// composite Gauss–Legendre otherwise. A singular covariance falls back to the isotropic formula with
+/// the largest standard deviation.
+double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R);
+
+/// The same probability by Foster-style polar quadrature centred on the disc (the radial integral of
+/// each ray in closed form with exp/erf, trapezoid over the angle; thetaSteps = 0 picks a step count
+/// from the angular width of the Gaussian). Slower; kept as the independent cross-check.
+double gaussianCollisionProbabilityPolar(Vec2 mean, const Cov2& cov, double R, int thetaSteps = 0);
 
 /// Probability that two discs with independent Gaussian centre errors (isotropic, each disc's sigma)
 /// overlap: relative position ~ N(μa − μb, (σa² + σb²) I), collision iff ‖x‖ ≤ ra + rb.

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "fleet/core/vec2.hpp"
@@ -24,6 +26,17 @@ struct Region {
 /// ordered by level then by the row-major index of the region's first cell. Boundary tracing on the
 /// cell edges (marching squares on the level-indicator, with saddles resolved for 4-connectivity).
 std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel = 1);
+
+/// extractRegions with its working buffers (labels, vertex tables: ~12 bytes per cell) kept between
+/// calls, for callers that extract every cycle.
+class RegionExtractor {
+ public:
+  std::vector<Region> extract(const LevelGrid& grid, int minLevel = 1);
+
+ private:
+  std::vector<std::int32_t> label_;
+  std::vector<std::array<std::int32_t, 2>> out_;
+};
 
 /// Signed area of a ring (positive when counter-clockwise).
 double signedArea(const Ring& ring);

@@ -1,0 +1,292 @@
+// risk_bench: pair models, warehouse-scale fusion (+ levels, regions, RLE), engine vs the thesis grid
+// loop in the same run, and growth with sources / horizon / grid size. Figures: docs/benchmarks.md.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <ctime>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "fleet/risk/fusion_engine.hpp"
+#include "fleet/risk/gaussian.hpp"
+#include "fleet/risk/overlap_ratio.hpp"
+#include "fleet/risk/reference_algorithm.hpp"
+#include "fleet/risk/regions.hpp"
+#include "fleet/risk/rle.hpp"
+
+namespace {
+
+using namespace fleet::risk;
+
+// ---------------------------------------------------------------- pair models
+struct PairSet {
+  std::vector<Disc> a, b;
+};
+
+PairSet makePairs(double sigmaMax) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> ur(0.3, 0.6), ud(0.0, 1.6), ua(0.0, 6.283), us(0.03, sigmaMax);
+  PairSet s;
+  for (int i = 0; i < 1024; ++i) {
+    const double d = ud(rng), th = ua(rng);
+    s.a.push_back({0, 0, ur(rng), us(rng)});
+    s.b.push_back({d * std::cos(th), d * std::sin(th), ur(rng), us(rng)});
+  }
+  return s;
+}
+
+void BM_PairOverlapRatio(benchmark::State& state) {
+  const auto s = makePairs(0.3);
+  const OverlapRatio m;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(m.pair(s.a[i & 1023], s.b[i & 1023]));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairOverlapRatio);
+
+void BM_PairGaussianIsotropic(benchmark::State& state) {
+  const auto s = makePairs(0.3);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Disc& a = s.a[i & 1023];
+    const Disc& b = s.b[i & 1023];
+    benchmark::DoNotOptimize(gaussianCollisionProbability(centreDistance(a, b), a.r + b.r,
+                                                          std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma)));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianIsotropic);
+
+void BM_PairGaussianAnisotropic(benchmark::State& state) {
+  const auto s = makePairs(0.3);
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> ue(0.2, 1.0), ua(0.0, 3.1416);
+  std::vector<Cov2> covs;
+  for (int i = 0; i < 1024; ++i) {
+    const double s2 = s.a[static_cast<std::size_t>(i)].sigma * s.a[static_cast<std::size_t>(i)].sigma +
+                      s.b[static_cast<std::size_t>(i)].sigma * s.b[static_cast<std::size_t>(i)].sigma;
+    const double l1 = s2, l2 = s2 * ue(rng), th = ua(rng), c = std::cos(th), sn = std::sin(th);
+    covs.push_back({c * c * l1 + sn * sn * l2, c * sn * (l1 - l2), sn * sn * l1 + c * c * l2});
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t k = i & 1023;
+    const fleet::Vec2 mean{s.b[k].x - s.a[k].x, s.b[k].y - s.a[k].y};
+    benchmark::DoNotOptimize(gaussianCollisionProbability(mean, covs[k], s.a[k].r + s.b[k].r));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianAnisotropic);
+
+// ---------------------------------------------------------------- warehouse scenes
+// Robots (80 %) drive along aisles (horizontal every 3 m, vertical every 5 m) at 0.5–1.5 m/s, humans
+// (20 %) walk in random directions at 0.5–1.4 m/s; radius 0.3–0.6 m (humans 0.3–0.4 m); sigma grows
+// with the prediction step (robots 0.05 + 0.01 k m, humans 0.1 + 0.03 k m).
+std::vector<Source> warehouse(int sources, int steps, double w, double h, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::vector<Source> out;
+  for (int s = 0; s < sources; ++s) {
+    Source src;
+    src.id = "s";
+    src.id += std::to_string(s);
+    src.dt = 0.1;
+    const bool human = u01(rng) < 0.2;
+    src.kind = human ? SourceKind::kHuman : SourceKind::kRobot;
+    double x, y, vx, vy, r;
+    const double speed = human ? 0.5 + 0.9 * u01(rng) : 0.5 + u01(rng);
+    const double sign = u01(rng) < 0.5 ? -1.0 : 1.0;
+    if (human) {
+      x = w * u01(rng);
+      y = h * u01(rng);
+      const double th = 6.283185 * u01(rng);
+      vx = speed * std::cos(th);
+      vy = speed * std::sin(th);
+      r = 0.3 + 0.1 * u01(rng);
+    } else if (u01(rng) < 0.5) {
+      const int aisles = std::max(1, static_cast<int>(h / 3.0));
+      y = 1.5 + 3.0 * std::floor(u01(rng) * aisles);
+      x = w * u01(rng);
+      vx = sign * speed;
+      vy = 0;
+      r = 0.3 + 0.3 * u01(rng);
+    } else {
+      const int aisles = std::max(1, static_cast<int>(w / 5.0));
+      x = 2.5 + 5.0 * std::floor(u01(rng) * aisles);
+      y = h * u01(rng);
+      vx = 0;
+      vy = sign * speed;
+      r = 0.3 + 0.3 * u01(rng);
+    }
+    for (int k = 0; k < steps; ++k) {
+      const double t = 0.1 * k;
+      src.discs.push_back({x + vx * t, y + vy * t, r, human ? 0.1 + 0.03 * k : 0.05 + 0.01 * k});
+    }
+    out.push_back(std::move(src));
+  }
+  return out;
+}
+
+FusionConfig warehouseConfig(double w, double h, double res, int steps) {
+  FusionConfig c;
+  c.grid =
+      GridSpec{0.0, 0.0, res, static_cast<int>(std::lround(w / res)), static_cast<int>(std::lround(h / res))};
+  c.levels = 10;
+  c.dt = 0.1;
+  c.steps = steps;
+  return c;
+}
+
+std::shared_ptr<const RiskModel> modelOf(int which) {
+  if (which == 0) {
+    return std::make_shared<OverlapRatio>();
+  }
+  return std::make_shared<Gaussian>(1e-4);
+}
+
+FusionEngine loaded(const FusionConfig& cfg, const std::vector<Source>& scene, int model) {
+  auto engine = FusionEngine::create(cfg, modelOf(model));
+  for (const auto& s : scene) {
+    (void)engine->upsert(s);
+  }
+  return std::move(engine.value());
+}
+
+// Full fusion + levels + regions + RLE of the 100 m × 50 m warehouse at 0.1 m, K = 10.
+// Args: sources, steps, model (0 overlap ratio, 1 Gaussian).
+void BM_FuseWarehouse(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int steps = static_cast<int>(state.range(1));
+  const auto scene = warehouse(n, steps, 100.0, 50.0, 7);
+  auto engine = loaded(warehouseConfig(100.0, 50.0, 0.1, steps), scene, static_cast<int>(state.range(2)));
+  std::size_t regions = 0, runs = 0, painted = 0, pairs = 0;
+  RegionExtractor extractor;
+  for (auto _ : state) {
+    engine.invalidate();
+    const auto& r = engine.fuse(0);
+    const auto reg = extractor.extract(r.levels);
+    const auto rle = encodeRle(r.levels.level);
+    regions = reg.size();
+    runs = rle.size();
+    painted = r.stats.discsPainted;
+    pairs = r.stats.pairsPositive;
+    benchmark::DoNotOptimize(reg.data());
+  }
+  state.counters["regions"] = static_cast<double>(regions);
+  state.counters["rle_runs"] = static_cast<double>(runs);
+  state.counters["discs_painted"] = static_cast<double>(painted);
+  state.counters["pairs_positive"] = static_cast<double>(pairs);
+}
+BENCHMARK(BM_FuseWarehouse)
+    ->ArgNames({"sources", "steps", "gauss"})
+    ->Args({1000, 30, 0})
+    ->Args({1000, 30, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(9)
+    ->ReportAggregatesOnly(true);
+
+// Fusion alone (no regions), for the breakdown.
+void BM_FuseOnlyWarehouse(benchmark::State& state) {
+  const auto scene = warehouse(1000, 30, 100.0, 50.0, 7);
+  auto engine = loaded(warehouseConfig(100.0, 50.0, 0.1, 30), scene, static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    engine.invalidate();
+    benchmark::DoNotOptimize(engine.fuse(0).sceneIndex);
+  }
+}
+BENCHMARK(BM_FuseOnlyWarehouse)->ArgNames({"gauss"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Incremental: 10 of 1000 sources change between fusions on the same time base.
+void BM_FuseIncremental10of1000(benchmark::State& state) {
+  const auto scene = warehouse(1000, 30, 100.0, 50.0, 7);
+  const auto moved = warehouse(1000, 30, 100.0, 50.0, 8);
+  auto engine = loaded(warehouseConfig(100.0, 50.0, 0.1, 30), scene, static_cast<int>(state.range(0)));
+  engine.fuse(0);
+  std::size_t k = 0, tiles = 0;
+  for (auto _ : state) {
+    for (int c = 0; c < 10; ++c, ++k) {
+      Source s = moved[k % 1000];
+      s.id = scene[(k * 37) % 1000].id;
+      (void)engine.upsert(std::move(s));
+    }
+    tiles = engine.fuse(0).stats.tilesRecomputed;
+  }
+  state.counters["tiles_recomputed"] = static_cast<double>(tiles);
+}
+BENCHMARK(BM_FuseIncremental10of1000)->ArgNames({"gauss"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// Thread CPU time in ms: on a shared machine wall time mostly measures the other processes.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+// Engine vs the thesis grid loop on 50 sources × 30 steps, 20 m × 20 m at 0.1 m, timed in the same
+// run; counters: engine_ms, reference_ms (medians of thread CPU time over the iterations), the ratio.
+void BM_EngineVsReference(benchmark::State& state) {
+  const int model = static_cast<int>(state.range(0));
+  const auto scene = warehouse(50, 30, 20.0, 20.0, 11);
+  const auto cfg = warehouseConfig(20.0, 20.0, 0.1, 30);
+  auto engine = loaded(cfg, scene, model);
+  engine.fuse(0);
+  const auto aligned = engine.alignedSources();
+  const auto m = modelOf(model);
+  std::vector<double> te, tr;
+  bool equal = true;
+  for (auto _ : state) {
+    const double t0 = threadCpuMs();
+    engine.invalidate();
+    const auto& r = engine.fuse(0);
+    const double t1 = threadCpuMs();
+    const auto ref = referenceProbabilityGrid(cfg.grid, aligned, *m, cfg.policy);
+    const double t2 = threadCpuMs();
+    equal = equal && ref.p == r.probability.p;
+    te.push_back(t1 - t0);
+    tr.push_back(t2 - t1);
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  state.counters["engine_ms"] = median(te);
+  state.counters["reference_ms"] = median(tr);
+  state.counters["ratio"] = median(tr) / median(te);
+  state.counters["equal"] = equal ? 1.0 : 0.0;
+}
+BENCHMARK(BM_EngineVsReference)
+    ->ArgNames({"gauss"})
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+// Growth: full fusion (no regions) with sources, horizon and resolution varied one at a time around
+// (500 sources, 30 steps, 0.1 m) on the 100 m × 50 m floor. Args: sources, steps, resolution in mm.
+void BM_Growth(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const int steps = static_cast<int>(state.range(1));
+  const double res = static_cast<double>(state.range(2)) / 1000.0;
+  const auto scene = warehouse(n, steps, 100.0, 50.0, 7);
+  auto engine = loaded(warehouseConfig(100.0, 50.0, res, steps), scene, static_cast<int>(state.range(3)));
+  for (auto _ : state) {
+    engine.invalidate();
+    benchmark::DoNotOptimize(engine.fuse(0).sceneIndex);
+  }
+}
+BENCHMARK(BM_Growth)
+    ->ArgNames({"sources", "steps", "res_mm", "gauss"})
+    ->ArgsProduct({{250, 500, 1000, 2000}, {30}, {100}, {0, 1}})
+    ->ArgsProduct({{500}, {10, 60}, {100}, {0, 1}})
+    ->ArgsProduct({{500}, {30}, {200, 50}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
