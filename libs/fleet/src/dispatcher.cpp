@@ -47,7 +47,7 @@ void DispatchResult::append(DispatchResult other) {
   }
 }
 
-Dispatcher::Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg)
+Dispatcher::Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg)
     : store_(store),
       stations_(std::move(stations)),
       travel_(std::move(travel)),
@@ -280,7 +280,7 @@ void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
     for (const Station* s : chargers) {
       Task cand = t;
       cand.station = s->name;
-      const double d = travel_(r, cand);
+      const double d = travel_(cand)(r);
       if (std::isfinite(d) && d < best) {
         best = d;
         t.station = s->name;

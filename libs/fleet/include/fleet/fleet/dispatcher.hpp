@@ -64,7 +64,9 @@ struct DispatcherCounters {
 /// thread-safe: the service calls it from one thread (or under one lock).
 class Dispatcher {
  public:
-  Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg = {});
+  Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg = {});
+  Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg = {})
+      : Dispatcher(store, std::move(stations), perPair(std::move(travel)), cfg) {}
 
   /// Rebuilds the open tasks from the store after a restart. Active tasks stay with their robots
   /// (whose lease starts now) and are returned as assignments to re-publish.
@@ -106,7 +108,7 @@ class Dispatcher {
 
   TaskStore& store_;
   StationMap stations_;
-  TravelCost travel_;
+  TravelModel travel_;
   DispatcherConfig cfg_;
   RobotRegistry registry_;
   HungarianAllocator hungarian_;
