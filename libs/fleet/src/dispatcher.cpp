@@ -312,7 +312,9 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   if (waiting.empty() || idle.empty()) {
     return;
   }
-  const Allocator& alloc = waiting.size() * idle.size() > cfg_.hungarianMaxPairs
+  const auto small = static_cast<double>(std::min(waiting.size(), idle.size()));
+  const auto big = static_cast<double>(std::max(waiting.size(), idle.size()));
+  const Allocator& alloc = small * small * big > cfg_.hungarianMaxWork
                                ? static_cast<const Allocator&>(greedy_)
                                : static_cast<const Allocator&>(hungarian_);
   const auto assignments = alloc.assign(waiting, idle, travel_, nowNs);

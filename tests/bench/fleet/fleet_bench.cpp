@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <random>
+#include <thread>
 
 #include "fleet/fleet/allocator.hpp"
 #include "fleet/fleet/dispatcher.hpp"
@@ -248,8 +249,75 @@ void BM_Submit(benchmark::State& state) {
 BENCHMARK(BM_Submit)
     ->ArgNames({"batch", "full"})
     ->ArgsProduct({{1, 10, 100, 1000}, {1, 0}})
+    ->UseRealTime()  // fsync-bound: the rate must be per wall-clock second
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
+
+/// Offered load: tasks arrive at `rate` per second (as DDS samples would); the intake loop takes
+/// everything that has arrived and stores it in one commit, so batches grow with the commit time.
+/// Reports achieved throughput, arrival → durable latency, and the mean batch.
+void BM_IntakeAtRate(benchmark::State& state) {
+  const double rate = static_cast<double>(state.range(0));
+  const bool full = state.range(1) != 0;
+  const std::string dir = benchDir();
+  std::filesystem::create_directories(dir);
+  auto store = SqliteTaskStore::open(
+      {dir + "/tasks.db", full ? SqliteTaskStoreOptions::Sync::Full : SqliteTaskStoreOptions::Sync::Normal});
+  if (!store) {
+    state.SkipWithError(store.error().message.c_str());
+    return;
+  }
+  std::mt19937 rng(3);
+  const Site site(rng);
+  const auto pool = site.tasks(rng, 200'000, "a");
+  using Clock = std::chrono::steady_clock;
+  std::vector<double> latencyMs;
+  std::size_t taken = 0;
+  std::size_t commits = 0;
+  double seconds = 0.0;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    const std::size_t base = taken;
+    // Two seconds of offered load per iteration.
+    while (true) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      if (elapsed >= 2.0 || taken >= pool.size()) {
+        seconds += elapsed;
+        break;
+      }
+      const auto due = base + static_cast<std::size_t>(elapsed * rate);
+      if (due <= taken) {
+        std::this_thread::sleep_for(std::chrono::microseconds(100));  // idle like a blocked reader
+        continue;
+      }
+      const std::vector<Task> batch(pool.begin() + static_cast<std::ptrdiff_t>(taken),
+                                    pool.begin() + static_cast<std::ptrdiff_t>(std::min(due, pool.size())));
+      auto rs = (*store)->submitBatch(batch, 1);
+      const double done = std::chrono::duration<double>(Clock::now() - start).count();
+      for (std::size_t i = taken; i < taken + batch.size(); ++i) {
+        const double arrived = static_cast<double>(i - base) / rate;
+        latencyMs.push_back((done - arrived) * 1e3);
+      }
+      taken += batch.size();
+      ++commits;
+    }
+  }
+  state.counters["offered_per_s"] = rate;
+  state.counters["stored_per_s"] = static_cast<double>(taken) / seconds;
+  state.counters["latency_p99_ms"] = quantile(latencyMs, 0.99);
+  state.counters["latency_p50_ms"] = quantile(latencyMs, 0.50);
+  state.counters["mean_batch"] =
+      static_cast<double>(taken) / static_cast<double>(std::max<std::size_t>(commits, 1));
+  state.SetLabel(full ? "synchronous=FULL" : "synchronous=NORMAL");
+  store->reset();
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_IntakeAtRate)
+    ->ArgNames({"rate", "full"})
+    ->ArgsProduct({{2000, 5000}, {1, 0}})
+    ->Iterations(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 /// One dispatcher tick over 100 new tasks and 1,000 idle robots: allocation plus the durable commit
 /// of the 100 assignments — the manager's assignment latency.
