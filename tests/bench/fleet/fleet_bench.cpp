@@ -314,7 +314,7 @@ void BM_IntakeAtRate(benchmark::State& state) {
 }
 BENCHMARK(BM_IntakeAtRate)
     ->ArgNames({"rate", "full"})
-    ->ArgsProduct({{2000, 5000}, {1, 0}})
+    ->ArgsProduct({{2000, 5000, 20000}, {1, 0}})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
