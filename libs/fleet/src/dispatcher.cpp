@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <tuple>
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
@@ -311,6 +313,16 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   const auto idle = registry_.idleRobots();
   if (waiting.empty() || idle.empty()) {
     return;
+  }
+  if (waiting.size() > cfg_.maxCandidates) {
+    auto key = [](const Task& t) {
+      return std::tuple(t.robot.empty(), -t.priority, t.deadlineNs > 0 ? t.deadlineNs : INT64_MAX,
+                        t.createdNs);
+    };
+    const auto keep = static_cast<std::ptrdiff_t>(cfg_.maxCandidates);
+    std::partial_sort(waiting.begin(), waiting.begin() + keep, waiting.end(),
+                      [&](const Task& a, const Task& b) { return key(a) < key(b); });
+    waiting.resize(cfg_.maxCandidates);
   }
   const auto small = static_cast<double>(std::min(waiting.size(), idle.size()));
   const auto big = static_cast<double>(std::max(waiting.size(), idle.size()));

@@ -21,6 +21,9 @@ struct DispatcherConfig {
   /// The Hungarian method costs about k²·K steps for k = min(tasks, robots), K = max; above this
   /// many a tick uses the greedy allocator (200 tasks × 1,000 robots = 4e7 takes ~15 ms).
   double hungarianMaxWork = 4e7;
+  /// With a long backlog only this many waiting tasks enter one allocation: pinned tasks first
+  /// (a robot's own charge task), then by priority, deadline and age. Bounds a tick's cost.
+  std::size_t maxCandidates = 1000;
 };
 
 /// A state change to publish as `TaskEvent`.
