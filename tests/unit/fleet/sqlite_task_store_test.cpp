@@ -212,6 +212,30 @@ TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
   EXPECT_EQ((*open)[1].attempts, 1);
 }
 
+TEST(SqliteTaskStore, JsonViewsOfRecordsAndLog) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  ASSERT_TRUE(store->submit(transport("t1", 2), 100));
+  auto rec = store->transition("t1", S::Assigned, "r1", "allocated", 200);
+  ASSERT_TRUE(rec);
+  const auto j = toJson(*rec);
+  EXPECT_EQ(j.at("state"), "assigned");
+  EXPECT_EQ(j.at("robot"), "r1");
+  EXPECT_EQ(j.at("attempts"), 1);
+  EXPECT_EQ(j.at("revision"), 2);
+  EXPECT_EQ(j.at("task").at("created_ns"), 100);
+  EXPECT_EQ(j.at("task").at("priority"), 2);
+  // The task part parses back to the same task.
+  auto back = parseTask(j.at("task"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, rec->task);
+  auto h = store->history("t1");
+  ASSERT_TRUE(h);
+  EXPECT_TRUE(toJson(h->front()).at("from").is_null());
+  EXPECT_EQ(toJson(h->back()).at("from"), "queued");
+  EXPECT_EQ(toJson(h->back()).at("to"), "assigned");
+}
+
 TEST(SqliteTaskStore, OpenFailsWithStorageError) {
   auto s = SqliteTaskStore::open({"/nonexistent-dir/x/tasks.db"});
   ASSERT_FALSE(s);
