@@ -27,8 +27,14 @@ double pairCost(const Task& t, double travelS, const AllocationPolicy& p, std::i
   return travelS + p.latenessWeight * std::max(0.0, finish - nsToSec(t.deadlineNs));
 }
 
+TravelModel perPair(TravelCost f) {
+  return [f = std::move(f)](const Task& t) -> RobotTravel {
+    return [&f, &t](const RobotInfo& r) { return f(r, t); };
+  };
+}
+
 CostMatrix effectiveCosts(std::span<const Task> tasks, std::span<const RobotInfo> robots,
-                          const TravelCost& travel, const AllocationPolicy& p, std::int64_t nowNs,
+                          const TravelModel& travel, const AllocationPolicy& p, std::int64_t nowNs,
                           CostMatrix* travelOut) {
   CostMatrix c(tasks.size(), robots.size(), kInfeasible);
   if (travelOut != nullptr) {
@@ -40,11 +46,12 @@ CostMatrix effectiveCosts(std::span<const Task> tasks, std::span<const RobotInfo
     const double handling = nsToSec(t.loadNs + t.unloadNs);
     const double deadline = t.deadlineNs > 0 ? nsToSec(t.deadlineNs) : kInfeasible;
     double minTravel = kInfeasible;
+    const RobotTravel fromRobot = travel(t);
     for (std::size_t j = 0; j < robots.size(); ++j) {
       if (!eligible(robots[j], t, p)) {
         continue;
       }
-      const double d = travel(robots[j], t);
+      const double d = fromRobot(robots[j]);
       if (!std::isfinite(d)) {
         continue;
       }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <tuple>
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
@@ -47,7 +49,7 @@ void DispatchResult::append(DispatchResult other) {
   }
 }
 
-Dispatcher::Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg)
+Dispatcher::Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg)
     : store_(store),
       stations_(std::move(stations)),
       travel_(std::move(travel)),
@@ -280,7 +282,7 @@ void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
     for (const Station* s : chargers) {
       Task cand = t;
       cand.station = s->name;
-      const double d = travel_(r, cand);
+      const double d = travel_(cand)(r);
       if (std::isfinite(d) && d < best) {
         best = d;
         t.station = s->name;
@@ -312,7 +314,19 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   if (waiting.empty() || idle.empty()) {
     return;
   }
-  const Allocator& alloc = waiting.size() * idle.size() > cfg_.hungarianMaxPairs
+  if (waiting.size() > cfg_.maxCandidates) {
+    auto key = [](const Task& t) {
+      return std::tuple(t.robot.empty(), -t.priority, t.deadlineNs > 0 ? t.deadlineNs : INT64_MAX,
+                        t.createdNs);
+    };
+    const auto keep = static_cast<std::ptrdiff_t>(cfg_.maxCandidates);
+    std::partial_sort(waiting.begin(), waiting.begin() + keep, waiting.end(),
+                      [&](const Task& a, const Task& b) { return key(a) < key(b); });
+    waiting.resize(cfg_.maxCandidates);
+  }
+  const auto small = static_cast<double>(std::min(waiting.size(), idle.size()));
+  const auto big = static_cast<double>(std::max(waiting.size(), idle.size()));
+  const Allocator& alloc = small * small * big > cfg_.hungarianMaxWork
                                ? static_cast<const Allocator&>(greedy_)
                                : static_cast<const Allocator&>(hungarian_);
   const auto assignments = alloc.assign(waiting, idle, travel_, nowNs);

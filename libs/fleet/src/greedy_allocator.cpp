@@ -8,7 +8,7 @@
 namespace fleet {
 
 std::vector<Assignment> GreedyAllocator::assign(std::span<const Task> tasks,
-                                                std::span<const RobotInfo> robots, const TravelCost& travel,
+                                                std::span<const RobotInfo> robots, const TravelModel& travel,
                                                 std::int64_t nowNs) const {
   std::vector<std::size_t> order(tasks.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -32,6 +32,7 @@ std::vector<Assignment> GreedyAllocator::assign(std::span<const Task> tasks,
       break;
     }
     const Task& t = tasks[i];
+    const RobotTravel fromRobot = travel(t);
     double best = kInfeasible;
     double bestTravel = 0.0;
     std::size_t bestJ = 0;
@@ -39,7 +40,7 @@ std::vector<Assignment> GreedyAllocator::assign(std::span<const Task> tasks,
       if (taken[j] != 0 || !eligible(robots[j], t, p_)) {
         continue;
       }
-      const double d = travel(robots[j], t);
+      const double d = fromRobot(robots[j]);
       if (!std::isfinite(d)) {
         continue;
       }

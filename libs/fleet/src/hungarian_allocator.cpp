@@ -112,7 +112,7 @@ std::vector<int> solveHungarian(const CostMatrix& c) {
 
 std::vector<Assignment> HungarianAllocator::assign(std::span<const Task> tasks,
                                                    std::span<const RobotInfo> robots,
-                                                   const TravelCost& travel, std::int64_t nowNs) const {
+                                                   const TravelModel& travel, std::int64_t nowNs) const {
   CostMatrix travelS;
   const CostMatrix c = effectiveCosts(tasks, robots, travel, p_, nowNs, &travelS);
   const auto rowToCol = solveHungarian(c);

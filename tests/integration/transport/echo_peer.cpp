@@ -13,7 +13,9 @@ using namespace fleet;
 using namespace fleet::transport;
 
 namespace {
-const QosProfile kAll{true, false, 0, 0, 2000};  // reliable keep-all: nothing may be dropped
+// Reliable keep-all transient-local: nothing may be dropped, not even a sample written before the
+// other side has discovered the writer (discovery is not symmetric in time).
+const QosProfile kAll{true, true, 0, 0, 2000};
 
 struct Echo {
   virtual ~Echo() = default;

@@ -14,7 +14,9 @@ using namespace fleet::transport;
 using namespace std::chrono_literals;
 
 namespace {
-const QosProfile kAll{true, false, 0, 0, 2000};
+// Reliable keep-all transient-local: nothing may be dropped, not even a sample written before the
+// other side has discovered the writer (discovery is not symmetric in time).
+const QosProfile kAll{true, true, 0, 0, 2000};
 const std::string kNonAscii = "Kệ hàng Ω-7 → dock ✓";  // UTF-8, multi-byte
 
 class RoundTrip : public ::testing::Test {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "fleet/fleet/errors.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
@@ -180,6 +181,27 @@ TEST_F(DispatcherTest, LowBatteryRobotGoesToNearestChargerNotToWork) {
   ASSERT_EQ(next.assignments.size(), 1u);
   EXPECT_EQ(next.assignments[0].task.id, "t1");
   EXPECT_TRUE(dispatcher->tick(5).assignments.empty()) << "no second charge task";
+}
+
+TEST_F(DispatcherTest, BacklogCapKeepsTheMostUrgentTasks) {
+  cfg.maxCandidates = 2;
+  reopen();
+  robot("a", 1, 0.9, 0);
+  robot("b", 2, 0.9, 0);
+  robot("c", 3, 0.9, 0);
+  Task urgent = transport("urgent");
+  urgent.priority = 5;
+  Task soon = transport("soon");
+  soon.deadlineNs = 100 * kSec;
+  dispatcher->submit({transport("t1"), transport("t2"), urgent, soon}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 2u) << "only two candidates enter one allocation";
+  std::set<std::string> ids;
+  for (const auto& a : out.assignments) {
+    ids.insert(a.task.id);
+  }
+  EXPECT_EQ(ids, (std::set<std::string>{"urgent", "soon"}));
+  EXPECT_EQ(dispatcher->tick(2).assignments.size(), 1u) << "the rest follow on later ticks";
 }
 
 TEST_F(DispatcherTest, CancelWithdrawsActiveTask) {

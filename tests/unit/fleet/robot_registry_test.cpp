@@ -64,3 +64,23 @@ TEST(RobotRegistry, ExpectStartsTheLeaseAtRestart) {
 
 }  // namespace
 }  // namespace fleet
+
+namespace fleet {
+namespace {
+
+TEST(RobotRegistry, JsonView) {
+  RobotRegistry reg(kSec);
+  reg.observe({"r1", {1.5, -2.0, 0.25}, 0.75, 42});
+  reg.setTask("r1", "t9");
+  const auto j = toJson(*reg.find("r1"));
+  EXPECT_EQ(j.at("id"), "r1");
+  EXPECT_DOUBLE_EQ(j.at("x").get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(j.at("theta").get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(j.at("battery").get<double>(), 0.75);
+  EXPECT_EQ(j.at("last_seen_ns"), 42);
+  EXPECT_EQ(j.at("lost"), false);
+  EXPECT_EQ(j.at("task"), "t9");
+}
+
+}  // namespace
+}  // namespace fleet

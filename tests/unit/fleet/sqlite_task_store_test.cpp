@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <thread>
 
 #include "fleet/fleet/errors.hpp"
 #include "temp_dir.hpp"
@@ -210,6 +211,56 @@ TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
   EXPECT_EQ((*open)[1].state, S::Assigned);
   EXPECT_EQ((*open)[1].robotId, "r1");
   EXPECT_EQ((*open)[1].attempts, 1);
+}
+
+TEST(SqliteTaskStore, JsonViewsOfRecordsAndLog) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  ASSERT_TRUE(store->submit(transport("t1", 2), 100));
+  auto rec = store->transition("t1", S::Assigned, "r1", "allocated", 200);
+  ASSERT_TRUE(rec);
+  const auto j = toJson(*rec);
+  EXPECT_EQ(j.at("state"), "assigned");
+  EXPECT_EQ(j.at("robot"), "r1");
+  EXPECT_EQ(j.at("attempts"), 1);
+  EXPECT_EQ(j.at("revision"), 2);
+  EXPECT_EQ(j.at("task").at("created_ns"), 100);
+  EXPECT_EQ(j.at("task").at("priority"), 2);
+  // The task part parses back to the same task.
+  auto back = parseTask(j.at("task"));
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, rec->task);
+  auto h = store->history("t1");
+  ASSERT_TRUE(h);
+  EXPECT_TRUE(toJson(h->front()).at("from").is_null());
+  EXPECT_EQ(toJson(h->back()).at("from"), "queued");
+  EXPECT_EQ(toJson(h->back()).at("to"), "assigned");
+}
+
+TEST(SqliteTaskStore, ConcurrentWritersShareOneStore) {
+  test::TempDir dir;
+  auto store = openStore(dir.file("tasks.db"));
+  std::vector<std::thread> threads;
+  for (int w = 0; w < 4; ++w) {
+    threads.emplace_back([&store, w] {
+      for (int i = 0; i < 40; ++i) {
+        // Every writer also submits task "shared-i": exactly one of them creates it.
+        ASSERT_TRUE(store->submit(transport(numbered(numbered("w", w) + '-', i)), 1));
+        ASSERT_TRUE(store->submit(transport(numbered("shared-", i)), 1));
+      }
+    });
+  }
+  for (auto& t : threads) {
+    t.join();
+  }
+  auto all = store->list(std::nullopt, 10'000);
+  ASSERT_TRUE(all);
+  EXPECT_EQ(all->size(), 4u * 40u + 40u);
+  for (int i = 0; i < 40; ++i) {
+    auto h = store->history(numbered("shared-", i));
+    ASSERT_TRUE(h);
+    EXPECT_EQ(h->size(), 1u) << "one submission logged, however many retries";
+  }
 }
 
 TEST(SqliteTaskStore, OpenFailsWithStorageError) {

@@ -18,8 +18,12 @@ struct DispatcherConfig {
   AllocationPolicy policy;
   std::int32_t maxAttempts = 3;  ///< a task that failed this many assignments is failed for good
   std::int64_t leaseNs = 1'000'000'000;
-  /// Above this many task×robot pairs a tick uses the greedy allocator instead of the Hungarian one.
-  std::size_t hungarianMaxPairs = 2'000'000;
+  /// The Hungarian method costs about k²·K steps for k = min(tasks, robots), K = max; above this
+  /// many a tick uses the greedy allocator (200 tasks × 1,000 robots = 4e7 takes ~15 ms).
+  double hungarianMaxWork = 4e7;
+  /// With a long backlog only this many waiting tasks enter one allocation: pinned tasks first
+  /// (a robot's own charge task), then by priority, deadline and age. Bounds a tick's cost.
+  std::size_t maxCandidates = 1000;
 };
 
 /// A state change to publish as `TaskEvent`.
@@ -64,7 +68,9 @@ struct DispatcherCounters {
 /// thread-safe: the service calls it from one thread (or under one lock).
 class Dispatcher {
  public:
-  Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg = {});
+  Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg = {});
+  Dispatcher(TaskStore& store, StationMap stations, TravelCost travel, DispatcherConfig cfg = {})
+      : Dispatcher(store, std::move(stations), perPair(std::move(travel)), cfg) {}
 
   /// Rebuilds the open tasks from the store after a restart. Active tasks stay with their robots
   /// (whose lease starts now) and are returned as assignments to re-publish.
@@ -106,7 +112,7 @@ class Dispatcher {
 
   TaskStore& store_;
   StationMap stations_;
-  TravelCost travel_;
+  TravelModel travel_;
   DispatcherConfig cfg_;
   RobotRegistry registry_;
   HungarianAllocator hungarian_;

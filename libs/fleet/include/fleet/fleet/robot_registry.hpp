@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,9 @@ struct RobotInfo {
 
   [[nodiscard]] bool idle() const { return !lost && taskId.empty(); }
 };
+
+/// `{"id", "x", "y", "theta", "battery", "last_seen_ns", "lost", "task"}` for `GET /v1/robots`.
+nlohmann::json toJson(const RobotInfo& r);
 
 /// One `RobotState` sample, reduced to what allocation needs.
 struct RobotObservation {

@@ -35,6 +35,12 @@ struct TransitionRecord {
   std::int64_t stampNs = 0;
 };
 
+/// `{"task": {…toJson(task)…, "created_ns": …}, "state": "en_route", "robot": "r1", "attempts": 1,
+/// "reason": "…", "updated_ns": …, "revision": 3}` — the body of `GET /v1/tasks/{id}`.
+nlohmann::json toJson(const TaskRecord& r);
+/// `{"seq": …, "task_id": …, "from": "queued" | null, "to": …, "robot": …, "reason": …, "stamp_ns": …}`
+nlohmann::json toJson(const TransitionRecord& t);
+
 struct SubmitResult {
   TaskRecord record;
   bool created = false;  ///< false: the same task was already stored (an idempotent retry)
