@@ -5,6 +5,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/fleet/errors.hpp"
+#include "fleet/planning/map_io.hpp"
 
 namespace fleet::manager {
 namespace {
@@ -34,7 +35,13 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "battery_threshold",
-                         "nominal_speed", "clock", "metrics_file"});
+                         "nominal_speed", "clock", "metrics_file", "map"});
+  auto map = cfg.child("map");
+  map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
+  s.mapFile = map.string("file", "");
+  s.mapResolution = map.number("resolution", 1.0, {0.0, 100.0, true});
+  s.mapOriginX = map.number("origin_x", 0.0, {-1e6, 1e6});
+  s.mapOriginY = map.number("origin_y", 0.0, {-1e6, 1e6});
   s.db = cfg.string("db", s.db);
   s.stationsFile = cfg.requireString("stations");
   s.syncFull = cfg.string("sync", "full", {"full", "normal"}) == "full";
@@ -46,6 +53,42 @@ Settings readSettings(Config& cfg) {
   s.clock = cfg.string("clock", "wall", {"wall", "sim"});
   s.metricsFile = cfg.string("metrics_file", "");
   return s;
+}
+
+TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning::DistanceFieldCache> cache,
+                            double speed) {
+  // Stations are copied in: the model outlives the caller's map.
+  return [stations, cache, speed](const Task& t) -> RobotTravel {
+    std::vector<Vec2> stops;
+    for (const auto* name : {&t.pickup, &t.dropoff, &t.station}) {
+      if (const Station* s = name->empty() ? nullptr : stations.find(*name)) {
+        stops.push_back(s->pose.position());
+      }
+    }
+    if (stops.empty()) {
+      return [](const RobotInfo&) { return 0.0; };  // a charge/park task the dispatcher resolves
+    }
+    double rest = 0.0;  // the legs between stops do not depend on the robot
+    for (std::size_t i = 1; i < stops.size(); ++i) {
+      rest += cache ? cache->travelDistance(stops[i - 1], stops[i]) : distance(stops[i - 1], stops[i]);
+    }
+    if (!cache) {
+      return [first = stops[0], rest, speed](const RobotInfo& r) {
+        return (distance(r.pose.position(), first) + rest) / speed;
+      };
+    }
+    const auto goal = cache->grid().cellAt(stops[0]);
+    if (!goal) {
+      return [](const RobotInfo&) { return kInfeasible; };
+    }
+    auto field = cache->field(*goal);
+    const double res = cache->grid().resolution();
+    return [field, cache, rest, speed, res](const RobotInfo& r) {
+      const auto c = cache->grid().cellAt(r.pose.position());
+      const double cells = c ? field->at(*c) : kInfeasible;
+      return (cells * res + rest) / speed;
+    };
+  };
 }
 
 Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
@@ -64,18 +107,17 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   dc.maxAttempts = s.maxAttempts;
   dc.leaseNs = secToNs(s.leaseS);
   dc.policy.batteryThreshold = s.batteryThreshold;
-  const double speed = s.nominalSpeed;
-  // Straight-line travel time to the task's first stop; the grid distance field replaces this
-  // when a map is configured.
-  TravelCost travel = [speed, st = &n->dispatcher_](const RobotInfo& r, const Task& t) {
-    const std::string& first = t.kind == TaskKind::Transport ? t.pickup : t.station;
-    const Station* stn = (*st)->stations().find(first);
-    if (stn == nullptr) {
-      return 0.0;
+  std::shared_ptr<planning::DistanceFieldCache> cache;
+  if (!s.mapFile.empty()) {
+    auto grid = planning::loadMovingAiMap(s.mapFile, s.mapResolution, {s.mapOriginX, s.mapOriginY});
+    if (!grid) {
+      return unexpected(grid.error());
     }
-    return distance(r.pose, stn->pose) / speed;
-  };
-  n->dispatcher_ = std::make_unique<Dispatcher>(*n->store_, std::move(stations), travel, dc);
+    cache = std::make_shared<planning::DistanceFieldCache>(
+        std::make_shared<const planning::OccupancyGrid>(std::move(*grid)));
+  }
+  auto travel = makeTravelModel(stations, cache, s.nominalSpeed);
+  n->dispatcher_ = std::make_unique<Dispatcher>(*n->store_, std::move(stations), std::move(travel), dc);
   auto rec = n->dispatcher_->recover(nowNs);
   if (!rec) {
     return unexpected(rec.error());

@@ -11,6 +11,7 @@
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
+#include "fleet/planning/distance_field_cache.hpp"
 #include "fleet/transport/messages.hpp"
 
 namespace fleet::manager {
@@ -26,7 +27,17 @@ struct Settings {
   double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
   std::string clock = "wall";
   std::string metricsFile;  // written every second when set (JSON)
+  // Optional map: travel costs from grid distance fields instead of straight lines.
+  std::string mapFile;  // MovingAI .map
+  double mapResolution = 1.0;
+  double mapOriginX = 0.0;
+  double mapOriginY = 0.0;
 };
+
+/// Seconds a robot needs for a task: to its first stop and on through the task's stops, along grid
+/// distance fields when `cache` is given, else in straight lines.
+TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning::DistanceFieldCache> cache,
+                            double speed);
 
 Settings readSettings(Config& cfg);
 

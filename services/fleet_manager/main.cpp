@@ -119,13 +119,17 @@ int run(const manager::Settings& settings) {
       node.onRobotState(s);
     }
     auto reqs = tasks.take();
+    bool changed = !reqs.empty();
     if (!reqs.empty()) {
       node.onRequests(reqs, now, out);
     }
     for (const auto& s : statuses.take()) {
       node.onStatus(s, now, out);
+      changed = true;
     }
-    if (now >= nextTick) {
+    // Event-driven assignment: new tasks or freed robots are matched at once rather than at the
+    // next periodic tick (which still expires leases and handles charging).
+    if (now >= nextTick || changed) {
       node.tick(now, out);
       nextTick = now + tickNs;
     }

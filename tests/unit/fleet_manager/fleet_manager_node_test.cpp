@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
+#include "fleet/planning/map_io.hpp"
 #include "fleet_manager_node.hpp"
 
 using namespace fleet;
@@ -169,4 +171,38 @@ TEST_F(Node, CancelAnswers) {
   EXPECT_EQ(out.acks[1].state, msg::TaskState::Cancelled);
   EXPECT_EQ(out.acks[2].result, msg::AckResult::NotFound);
   EXPECT_EQ(out.acks[3].result, msg::AckResult::Refused);
+}
+
+TEST(TravelModel, GridDistanceGoesAroundWallsStraightLineDoesNot) {
+  // 10×5 cells of 1 m; a wall at x = 5 open only in the top row (y = 4 in the map frame).
+  const std::string path = (std::filesystem::temp_directory_path() / "fm_travel.map").string();
+  {
+    std::ofstream out(path);
+    out << "type octile\nheight 5\nwidth 10\nmap\n";
+    out << "..........\n";
+    for (int r = 0; r < 4; ++r) {
+      out << ".....@....\n";
+    }
+  }
+  auto grid = planning::loadMovingAiMap(path, 1.0);
+  ASSERT_TRUE(grid) << grid.error().message;
+  auto cache =
+      std::make_shared<planning::DistanceFieldCache>(std::make_shared<const planning::OccupancyGrid>(*grid));
+  StationMap st;
+  ASSERT_TRUE(st.add({"P", {7.5, 0.5, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  ASSERT_TRUE(st.add({"D", {7.5, 3.5, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
+  Task t;
+  t.id = "t";
+  t.pickup = "P";
+  t.dropoff = "D";
+  RobotInfo r;
+  r.pose = {2.5, 0.5, 0};
+  const double straight = manager::makeTravelModel(st, nullptr, 1.0)(t)(r);
+  const double grid_s = manager::makeTravelModel(st, cache, 1.0)(t)(r);
+  EXPECT_NEAR(straight, 5.0 + 3.0, 1e-9);
+  EXPECT_GT(grid_s, straight + 4.0) << "the wall forces a detour through the top row";
+  EXPECT_NEAR(grid_s,
+              cache->travelDistance({2.5, 0.5}, {7.5, 0.5}) + cache->travelDistance({7.5, 0.5}, {7.5, 3.5}),
+              1e-9);
+  std::filesystem::remove(path);
 }
