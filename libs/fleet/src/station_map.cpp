@@ -72,7 +72,21 @@ Expected<StationMap> StationMap::fromJson(const nlohmann::json& doc) {
   }
   StationMap map;
   for (std::size_t i = 0; i < list->size(); ++i) {
-    const auto& e = (*list)[i];
+    // The simulator's scenario files write a station as {"name", "kind", "pose": [x, y, theta]};
+    // accept that form too, so one scenario file can configure the whole fleet.
+    nlohmann::json e = (*list)[i];
+    if (e.is_object() && e.contains("pose") && e["pose"].is_array() && !e.contains("x") && !e.contains("y")) {
+      const auto& pose = e["pose"];
+      if (pose.size() >= 1)
+        e["x"] = pose[0];
+      if (pose.size() >= 2)
+        e["y"] = pose[1];
+      if (pose.size() >= 3)
+        e["theta"] = pose[2];
+    }
+    if (e.is_object() && e.contains("kind") && !e.contains("kinds")) {
+      e["kinds"] = nlohmann::json::array({e["kind"]});
+    }
     const std::string p = base + "[" + std::to_string(i) + "]";
     if (!e.is_object()) {
       problems.push_back(p + ": expected an object");

@@ -173,5 +173,22 @@ TEST(Task, BatchPathsNameTheElement) {
   EXPECT_EQ(bad.error().fields.at(0).path, "[0].pickup");
 }
 
+TEST(StationMapTest, AcceptsTheSimulatorScenarioForm) {
+  auto m = StationMap::fromJson(nlohmann::json::parse(R"({"name": "x", "map": {}, "stations": [
+    {"name": "PARK-1", "kind": "parking", "pose": [4.0, 1.25, 1.5708]},
+    {"name": "P-1", "kinds": ["pickup", "dropoff"], "x": 1, "y": 2}]})"));
+  ASSERT_TRUE(m) << m.error().message;
+  const Station* park = m->find("PARK-1");
+  ASSERT_NE(park, nullptr);
+  EXPECT_DOUBLE_EQ(park->pose.x, 4.0);
+  EXPECT_DOUBLE_EQ(park->pose.theta, 1.5708);
+  EXPECT_TRUE(park->has(StationKind::Parking));
+  auto bad = StationMap::fromJson(
+      nlohmann::json::parse(R"({"stations": [{"name": "Q", "kind": "dock", "pose": [1]}]})"));
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("unknown kind"), std::string::npos);
+  EXPECT_NE(bad.error().message.find("stations[0].y"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fleet
