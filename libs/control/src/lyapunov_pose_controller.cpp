@@ -1,0 +1,98 @@
+#include "fleet/control/lyapunov_pose_controller.hpp"
+
+#include <cmath>
+
+namespace fleet::control {
+
+PolarError polarError(const Pose2& pose, const Pose2& goal) {
+  const double dx = goal.x - pose.x;
+  const double dy = goal.y - pose.y;
+  const double bearing = std::atan2(dy, dx);
+  return {std::hypot(dx, dy), wrapAngle(bearing - pose.theta), wrapAngle(bearing - goal.theta)};
+}
+
+double lyapunovGlobal(const PolarError& e, double h) {
+  return 0.5 * e.rho * e.rho + 0.5 * (e.alpha * e.alpha + h * e.phi * e.phi);
+}
+
+Twist globalLaw(const PolarError& e, const LyapunovGains& g) {
+  const double ca = std::cos(e.alpha);
+  // sin α/α → 1; the series keeps the law smooth through α = 0.
+  const double sinc = std::abs(e.alpha) < 1e-6 ? 1.0 - e.alpha * e.alpha / 6.0 : std::sin(e.alpha) / e.alpha;
+  return {g.k_v * e.rho * ca, g.k_alpha * e.alpha + g.k_v * ca * sinc * (e.alpha + g.h * e.phi)};
+}
+
+Expected<void> LyapunovParams::validate() const {
+  const bool positive = gains.k_v > 0.0 && gains.k_alpha > 0.0 && gains.k_theta > 0.0 && gains.h > 0.0;
+  if (!positive || !std::isfinite(gains.k_v) || !std::isfinite(gains.k_alpha) ||
+      !std::isfinite(gains.k_theta) || !std::isfinite(gains.h)) {
+    return fleet::unexpected("invalid_gains", "k_v, k_alpha, k_theta and h must be finite and > 0");
+  }
+  if (!(eps_rho >= 0.0) || !(eps_theta >= 0.0) || !std::isfinite(eps_rho) || !std::isfinite(eps_theta)) {
+    return fleet::unexpected("invalid_region", "eps_rho and eps_theta must be finite and >= 0");
+  }
+  if (!(local_exit_factor >= 1.0) || !std::isfinite(local_exit_factor)) {
+    return fleet::unexpected("invalid_region", "local_exit_factor must be finite and >= 1");
+  }
+  if (!(reverse_hysteresis >= 0.0) || reverse_hysteresis >= 0.5 * kPi) {
+    return fleet::unexpected("invalid_hysteresis", "reverse_hysteresis must be in [0, pi/2)");
+  }
+  return {};
+}
+
+LyapunovPoseController::LyapunovPoseController(LyapunovParams params) : params_(params) {}
+
+Expected<PoseControlOutput> LyapunovPoseController::step(const Pose2& estimate, const Pose2& goal) {
+  if (!estimate.isFinite() || !goal.isFinite()) {
+    return fleet::unexpected("non_finite_pose", "pose estimate or goal is NaN/inf");
+  }
+  PoseControlOutput out;
+  out.error = polarError(estimate, goal);
+  const LyapunovGains& g = params_.gains;
+  const double theta_e = angleDiff(estimate.theta, goal.theta);
+
+  if (in_local_ && !(goal == local_goal_)) {
+    in_local_ = false;
+  }
+  const double grow = in_local_ ? params_.local_exit_factor : 1.0;
+  in_local_ = params_.law == PoseLaw::kTwoRegion && out.error.rho < grow * params_.eps_rho &&
+              std::abs(theta_e) < grow * params_.eps_theta;
+  if (in_local_) {
+    local_goal_ = goal;
+    // Ω_L: φ and α are meaningless this close (they follow the feedback noise), so only the heading error
+    // is driven to zero; ρ·cos α is the signed projection of the goal offset on the heading, so the
+    // same v law also backs up when the goal is behind.
+    out.region = ControlRegion::kLocal;
+    out.cmd = {g.k_v * out.error.rho * std::cos(out.error.alpha), -g.k_theta * theta_e};
+    out.lyapunov = 0.5 * out.error.rho * out.error.rho + 0.5 * theta_e * theta_e;
+    return out;
+  }
+
+  if (!have_direction_ || !(goal == direction_goal_)) {
+    reverse_ = params_.allow_reverse && std::abs(out.error.alpha) > 0.5 * kPi;
+    have_direction_ = true;
+    direction_goal_ = goal;
+  } else if (params_.allow_reverse) {
+    const double a = std::abs(out.error.alpha);
+    if (!reverse_ && a > 0.5 * kPi + params_.reverse_hysteresis) {
+      reverse_ = true;
+    } else if (reverse_ && a < 0.5 * kPi - params_.reverse_hysteresis) {
+      reverse_ = false;
+    }
+  }
+
+  PolarError e = out.error;
+  if (reverse_) {
+    // A robot driving backwards is a forward robot with heading θ + π that must reach θ_goal + π, so
+    // α and φ both shift by π and the law's v changes sign.
+    e.alpha = wrapAngle(e.alpha + kPi);
+    e.phi = wrapAngle(e.phi + kPi);
+  }
+  const Twist t = globalLaw(e, g);
+  out.cmd = reverse_ ? Twist{-t.v, t.omega} : t;
+  out.reverse = reverse_;
+  out.lyapunov = lyapunovGlobal(e, g.h);
+  return out;
+}
+
+}  // namespace fleet::control
