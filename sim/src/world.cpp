@@ -284,11 +284,21 @@ void World::stepRobots() {
     const double before = discGridPenetration(sc_.map, r.pose.position(), spec.radius);
     const double after = discGridPenetration(sc_.map, next.position(), spec.radius);
     if (after > 0.0 && after > before + 1e-12) {
-      // The shelf stops the robot: it stays where it was, wheels stalled; the bump is a contact.
+      // The shelf stops the robot where it touches (bisection on the fraction of the step), wheels
+      // stalled; the attempted overlap is the contact depth.
       bumpDepth_[i] = after;
       ++r.bumps;
+      double lo = 0.0;
+      double hi = 1.0;
+      for (int it = 0; it < 30; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        const Pose2 q = control::DiffDriveKinematics::integrateExact(r.pose, executed, dt * mid);
+        (discGridPenetration(sc_.map, q.position(), spec.radius) > before ? hi : lo) = mid;
+      }
+      r.pose = control::DiffDriveKinematics::integrateExact(r.pose, executed, dt * lo);
+      vl *= lo;
+      vr *= lo;
       r.twist = {};
-      vl = vr = 0.0;
     } else {
       r.pose = next;
       r.twist = t;
