@@ -29,7 +29,7 @@ bool nearestBlocked(const GridMap& map, Vec2 p, double reach, double& dist, Vec2
         continue;
       }
       const Vec2 q = closestOnCell(map, cx, cy, p);
-      const double d = distance(p, q);
+      const double d = std::sqrt((p - q).squaredNorm());
       if (d < best || (!found && d <= best)) {
         best = d;
         bestPoint = q;

@@ -11,7 +11,7 @@ Vec2 drivingForce(Vec2 desiredVelocity, Vec2 velocity, double tau) {
 
 Vec2 bodyRepulsion(double A, double B, double lambda, Vec2 pi, double ri, Vec2 heading, Vec2 pj, double rj) {
   const Vec2 diff = pi - pj;
-  const double d = diff.norm();
+  const double d = std::sqrt(diff.squaredNorm());  // hypot's overflow guard is not needed here
   const Vec2 n = d > 0.0 ? diff / d : Vec2{1.0, 0.0};
   const double cosPhi = -n.dot(heading);  // heading · (direction from i to j)
   const double w = heading.squaredNorm() > 0.0 ? lambda + (1.0 - lambda) * 0.5 * (1.0 + cosPhi) : 1.0;

@@ -24,13 +24,30 @@ std::uint64_t splitmix(std::uint64_t& x) {
 double uniform01(std::mt19937_64& g) {
   return static_cast<double>(g() >> 11) * 0x1.0p-53;
 }
-double normal(std::mt19937_64& g, double sigma) {
+double normal(GaussianStream& g, double sigma) {
   if (sigma <= 0.0) {
     return 0.0;
   }
-  const double u1 = std::max(uniform01(g), 1e-300);
-  const double u2 = uniform01(g);
-  return sigma * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+  if (g.hasSpare) {
+    g.hasSpare = false;
+    return sigma * g.spare;
+  }
+  // Box-Muller: both outputs are used, the second one cached for the next draw.
+  const double u1 = std::max(uniform01(g.engine), 1e-300);
+  const double u2 = uniform01(g.engine);
+  const double rho = std::sqrt(-2.0 * std::log(u1));
+  g.spare = rho * std::sin(2.0 * kPi * u2);
+  g.hasSpare = true;
+  return sigma * rho * std::cos(2.0 * kPi * u2);
+}
+double uniform01(GaussianStream& g) {
+  return uniform01(g.engine);
+}
+
+// std::hypot (behind Vec2::norm) guards against overflow we cannot have at warehouse scale, at
+// several times the cost of a square root; this is the hot path of scans and contacts.
+double len(Vec2 v) {
+  return std::sqrt(v.squaredNorm());
 }
 
 std::uint64_t pairKey(int a, int b) {
@@ -49,9 +66,9 @@ World::World(Scenario scenario)
             {sc_.map.origin.x + sc_.map.widthM() + 1.0, sc_.map.origin.y + sc_.map.heightM() + 1.0},
             std::max(2.0, sc_.social.cutoff)) {
   std::uint64_t s = sc_.seed;
-  motionRng_.seed(splitmix(s));
-  humanRng_.seed(splitmix(s));
-  sensorRng_.seed(splitmix(s));
+  motionRng_.engine.seed(splitmix(s));
+  humanRng_.engine.seed(splitmix(s));
+  sensorRng_.engine.seed(splitmix(s));
   robots_.resize(sc_.robots.size());
   for (std::size_t i = 0; i < robots_.size(); ++i) {
     robots_[i].pose = sc_.robots[i].start;
@@ -206,9 +223,9 @@ void World::pickGoal(std::size_t hi) {
     return;
   }
   const auto n = randomGoals_.size();
-  int next = randomGoals_[static_cast<std::size_t>(humanRng_() % n)];
+  int next = randomGoals_[static_cast<std::size_t>(humanRng_.engine() % n)];
   if (next == h.field && n > 1) {
-    next = randomGoals_[(static_cast<std::size_t>(humanRng_() % (n - 1)) + 1 +
+    next = randomGoals_[(static_cast<std::size_t>(humanRng_.engine() % (n - 1)) + 1 +
                          static_cast<std::size_t>(std::find(randomGoals_.begin(), randomGoals_.end(), next) -
                                                   randomGoals_.begin())) %
                         n];
@@ -441,7 +458,7 @@ void World::updateContacts() {
       if (ju < nr && ju <= i) {
         return;  // each robot pair once
       }
-      const double gap = distance(p, positions_[ju]) - ri - radii_[ju];
+      const double gap = len(p - positions_[ju]) - ri - radii_[ju];
       if (gap >= sc_.nearMiss) {
         return;
       }
@@ -502,6 +519,11 @@ void World::scanInto(std::size_t ri, std::vector<float>& out) const {
   const double amin = full ? -kPi : -0.5 * s.fov;
   const geometry::GridView view = sc_.map.view();
   std::vector<double> best(static_cast<std::size_t>(n));
+  std::vector<Vec2> dirs(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double a = pose.theta + amin + k * inc;
+    dirs[static_cast<std::size_t>(k)] = {std::cos(a), std::sin(a)};
+  }
   for (int k = 0; k < n; ++k) {
     const auto hit = geometry::raycastGrid(view, pose.position(), pose.theta + amin + k * inc, s.rangeMax);
     best[static_cast<std::size_t>(k)] = hit.hit ? hit.range : s.rangeMax;
@@ -514,7 +536,7 @@ void World::scanInto(std::size_t ri, std::vector<float>& out) const {
       return;
     }
     const Vec2 d = positions_[ju] - o;
-    const double dist = d.norm();
+    const double dist = len(d);
     const double rj = radii_[ju];
     if (dist <= rj || dist - rj >= s.rangeMax) {
       return;
@@ -530,8 +552,7 @@ void World::scanInto(std::size_t ri, std::vector<float>& out) const {
       } else if (k < 0 || k >= n) {
         continue;
       }
-      const double a = pose.theta + amin + k * inc;
-      const Vec2 u{std::cos(a), std::sin(a)};
+      const Vec2 u = dirs[static_cast<std::size_t>(k)];
       const double proj = d.dot(u);
       const double perp2 = dist * dist - proj * proj;
       if (proj <= 0.0 || perp2 > rj * rj) {
@@ -604,7 +625,7 @@ SensorReading World::sensorFrame(std::size_t i, bool withScan) {
     std::vector<int> seen;
     hash_.forEachNear(o, s.detectionRange, [&](int j) {
       if (static_cast<std::size_t>(j) != i &&
-          distance(o, positions_[static_cast<std::size_t>(j)]) <= s.detectionRange) {
+          len(o - positions_[static_cast<std::size_t>(j)]) <= s.detectionRange) {
         seen.push_back(j);
       }
     });

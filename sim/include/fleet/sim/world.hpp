@@ -103,6 +103,13 @@ struct PredictedDisc {
   double sigma = 0;
 };
 
+/// A random stream with a cached second Box-Muller normal.
+struct GaussianStream {
+  std::mt19937_64 engine;
+  bool hasSpare = false;
+  double spare = 0.0;
+};
+
 enum class CommandOutcome { Accepted, Clamped, Ignored };
 
 /// The simulated warehouse. Everything random comes from generators seeded by the scenario seed and
@@ -161,9 +168,9 @@ class World {
   std::unordered_map<std::string, int> robotIds_;
   std::vector<FlowField> fields_;
   std::vector<int> randomGoals_;  // fields humans pick from when they have no route
-  std::mt19937_64 motionRng_;
-  std::mt19937_64 humanRng_;
-  std::mt19937_64 sensorRng_;
+  GaussianStream motionRng_;
+  GaussianStream humanRng_;
+  GaussianStream sensorRng_;
   std::int64_t step_ = 0;
   std::vector<int> sensorEvery_;  // per robot, steps between frames
   std::vector<Vec2> positions_;   // robots then humans, for the hash
