@@ -57,6 +57,9 @@ std::uint64_t pairKey(int a, int b) {
 constexpr double kChargeReach = 0.5;  // m from a charging station's pose
 constexpr double kStillSpeed = 0.02;  // m/s under which a robot is idle
 constexpr double kArrive = 0.6;       // m: a human reached its goal
+// Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
+// a run whose bodies never come that close reports null.
+constexpr double kSeparationReach = 2.0;
 
 }  // namespace
 
@@ -451,7 +454,8 @@ void World::updateContacts() {
   for (std::size_t i = 0; i < nr; ++i) {
     const Vec2 p = positions_[i];
     const double ri = radii_[i];
-    const double reach = ri + maxRadius_ + sc_.nearMiss;
+    const double sepReach = std::max(sc_.nearMiss, kSeparationReach);
+    const double reach = ri + maxRadius_ + sepReach;
     std::vector<std::pair<int, double>> hits;
     hash_.forEachNear(p, reach, [&](int j) {
       const auto ju = static_cast<std::size_t>(j);
@@ -459,10 +463,9 @@ void World::updateContacts() {
         return;  // each robot pair once
       }
       const double gap = len(p - positions_[ju]) - ri - radii_[ju];
-      if (gap >= sc_.nearMiss) {
-        return;
+      if (gap < sepReach) {
+        hits.emplace_back(j, gap);
       }
-      hits.emplace_back(j, gap);
     });
     std::sort(hits.begin(), hits.end());
     for (const auto& [j, gap] : hits) {
@@ -476,7 +479,7 @@ void World::updateContacts() {
         if (!touching_.count(key)) {
           ++(human ? metrics_.robotHumanContacts : metrics_.robotRobotContacts);
         }
-      } else {
+      } else if (gap < sc_.nearMiss) {
         near.insert(key);
         if (!near_.count(key) && !touching_.count(key)) {
           ++(human ? metrics_.nearMissRobotHuman : metrics_.nearMissRobotRobot);
@@ -485,7 +488,7 @@ void World::updateContacts() {
     }
     double wd = 0.0;
     Vec2 away;
-    if (nearestBlocked(sc_.map, p, ri + sc_.nearMiss, wd, away)) {
+    if (nearestBlocked(sc_.map, p, ri + sepReach, wd, away)) {
       metrics_.minSepRobotShelf = std::min(metrics_.minSepRobotShelf, wd - ri);
     }
     const double depth = std::max(bumpDepth_[i], discGridPenetration(sc_.map, p, ri));

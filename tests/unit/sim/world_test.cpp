@@ -195,3 +195,13 @@ TEST(Lockstep, BarrierWaitsForEveryRegisteredParticipant) {
   EXPECT_TRUE(b.complete(1));
   EXPECT_EQ(b.registered(), 1U);
 }
+
+TEST(World, MinimumSeparationIsTheExactSurfaceGap) {
+  auto j = test::room(40, 10);
+  j["robots"] = {{{"id", "a"}, {"start", {5.0, 2.5, 0.0}}}, {{"id", "b"}, {"start", {6.0, 2.5, 0.0}}}};
+  World w(test::parse(j));
+  w.advance();
+  EXPECT_NEAR(w.metrics().minSepRobotRobot, 1.0 - 0.6, 1e-12);
+  EXPECT_EQ(w.metrics().nearMissRobotRobot, 0U);  // 0.4 m is above the 0.3 m threshold
+  EXPECT_NEAR(w.metrics().minSepRobotShelf, 2.5 - 0.5 - 0.3, 1e-12);  // floor wall face at y = 0.5
+}
