@@ -36,10 +36,14 @@ class ConvexChain {
  public:
   ConvexChain(Vec2 p, Vec2 q, const std::vector<Segment2>& segs)
       : p_(p), q_(q), segs_(segs), n_(segs.size()) {
-    scale_ = (q - p).norm();
+    // Problem scale: the skeleton length plus the segment lengths (grows linearly with n).
+    scale_ = 0.0;
+    Vec2 prev = p;
     for (const auto& s : segs) {
-      scale_ += (s.b - s.a).norm() + (s.a - p).norm();
+      scale_ += (s.b - s.a).norm() + (s.a - prev).norm();
+      prev = s.a;
     }
+    scale_ += (q - prev).norm();
     scale_ = std::max(scale_, 1e-300);
   }
 

@@ -20,6 +20,14 @@ class Mms {
   Mms(Vec2 p, Vec2 q, const std::vector<Segment2>& segs, const MmsOptions& opt)
       : p_(p), q_(q), segs_(segs), opt_(opt), n_(static_cast<int>(segs.size())) {
     buildCuts(std::max(1, opt.subsequence));
+    if (!opt.cuts.empty()) {
+      cuts_.clear();
+      for (int k : opt.cuts) {
+        if (k >= 0 && k < n_ && (cuts_.empty() || k > cuts_.back())) {
+          cuts_.push_back(k);
+        }
+      }
+    }
     t_.assign(segs.size(), 0.0);  // shooting points start at the bundle vertices (skeleton side)
   }
 
@@ -49,7 +57,7 @@ class Mms {
         const int last = tp[i].lastDone;
         std::vector<Segment2> sub(segs_.begin() + first, segs_.begin() + last + 1);
         std::vector<double> warm(t_.begin() + first, t_.begin() + last + 1);
-        const SegmentPath sp = shortestPathConvex(tp[i - 1].at, tp[i].at, sub, warm, {});
+        const SegmentPath sp = shortestPathConvex(tp[i - 1].at, tp[i].at, sub, warm, inner_);
         next[static_cast<std::size_t>(cut)] = sp.params[static_cast<std::size_t>(cut - first)];
       }
       if (flag) {
@@ -57,6 +65,8 @@ class Mms {
         break;
       }
       ++iter;
+      // Once the first sub-paths are solved, warm starts are close: skip the coarse smoothing stages.
+      inner_.muStart = 1e-6;
       t_ = next;
       solveSubPaths();
       const double newLen = length();
@@ -126,7 +136,7 @@ class Mms {
       }
       std::vector<Segment2> sub(segs_.begin() + a + 1, segs_.begin() + b);
       std::vector<double> warm(t_.begin() + a + 1, t_.begin() + b);
-      const SegmentPath sp = shortestPathConvex(at(a), at(b), sub, warm, {});
+      const SegmentPath sp = shortestPathConvex(at(a), at(b), sub, warm, inner_);
       std::copy(sp.params.begin(), sp.params.end(), t_.begin() + a + 1);
     }
   }
@@ -187,6 +197,7 @@ class Mms {
   int n_;
   std::vector<int> cuts_;
   int sub_ = 1;
+  ConvexOptions inner_{};
   std::vector<double> t_;
 };
 

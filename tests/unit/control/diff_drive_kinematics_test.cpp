@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "fleet/control/diff_drive_base.hpp"
 #include "fleet/core/angles.hpp"
 
 using namespace fleet;
@@ -109,4 +110,39 @@ TEST(DiffDriveKinematics, ExactArcClosesCircle) {
   const Pose2 s = DiffDriveKinematics::integrateExact(Pose2{0, 0, 0.3}, Twist{2.0, 0.0}, 0.5);
   EXPECT_NEAR(s.x, std::cos(0.3), 1e-12);
   EXPECT_NEAR(s.y, std::sin(0.3), 1e-12);
+}
+
+TEST(DiffDriveBase, LimitsCommandsAndReportsWheelIncrements) {
+  const VelocityLimits limits;  // 0.45 m/s, 0.5 m/s²
+  auto base = DiffDriveBase::create(0.6, limits, Pose2{});
+  ASSERT_TRUE(base.has_value());
+  EXPECT_FALSE(DiffDriveBase::create(0.6, limits, Pose2{std::nan(""), 0, 0}).has_value());
+  EXPECT_FALSE(DiffDriveBase::create(-1.0, limits, Pose2{}).has_value());
+  // Full-speed request: ramps at 0.05 m/s per 0.1 s step, then holds 0.45 m/s.
+  double travelled = 0.0;
+  Pose2 odo{};
+  for (int k = 0; k < 30; ++k) {
+    const auto r = base->step(Twist{2.0, 0.0}, 0.1);
+    travelled += 0.5 * (r.ds_left + r.ds_right);
+    odo = base->kinematics().applyOdometry(odo, r.ds_left, r.ds_right);
+  }
+  EXPECT_NEAR(base->twist().v, 0.45, 1e-12);
+  EXPECT_NEAR(base->pose().x, travelled, 1e-12);
+  // 9 ramp steps (0.05 … 0.45) then 21 at 0.45.
+  EXPECT_NEAR(travelled, 0.1 * (0.05 * 45.0 + 0.45 * 21.0), 1e-9);
+  // Turning: the encoders' odometry agrees with the exact pose to the midpoint rule's accuracy.
+  for (int k = 0; k < 50; ++k) {
+    const auto r = base->step(Twist{0.3, 0.8}, 0.1);
+    odo = base->kinematics().applyOdometry(odo, r.ds_left, r.ds_right);
+  }
+  EXPECT_LT(distance(odo, base->pose()), 1e-3);
+  EXPECT_NEAR(angleDiff(odo.theta, base->pose().theta), 0.0, 1e-9);
+  // A NaN request brings the base to a controlled stop and is flagged.
+  int rejected = 0;
+  for (int k = 0; k < 20; ++k) {
+    rejected += base->step(Twist{std::nan(""), 0.0}, 0.1).applied.rejected ? 1 : 0;
+  }
+  EXPECT_EQ(rejected, 20);
+  EXPECT_EQ(base->twist(), (Twist{0.0, 0.0}));
+  EXPECT_TRUE(base->pose().isFinite());
 }

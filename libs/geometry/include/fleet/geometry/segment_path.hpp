@@ -51,8 +51,11 @@ SegmentPath shortestPathConvex(Vec2 p, Vec2 q, const std::vector<Segment2>& segs
 /// shared bundle vertex), neighbouring sub-sequences are merged (c doubles) and the iteration goes on.
 struct MmsOptions {
   int subsequence = 5;
+  /// Explicit cutting segments (increasing indices), e.g. the last segment of each bundle; when
+  /// empty, every `subsequence`-th segment is one.
+  std::vector<int> cuts{};
   double angleTol = 1e-11;
-  double lengthTol = 1e-15;
+  double lengthTol = 1e-13;
   int maxIterations = 20000;
 };
 SegmentPath shortestPathMms(Vec2 p, Vec2 q, const std::vector<Segment2>& segs, const MmsOptions& opt = {});

@@ -1,0 +1,231 @@
+#include "fleet/estimation/pose_ekf.hpp"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "fleet/core/angles.hpp"
+
+namespace fleet::estimation {
+
+namespace {
+
+bool isPositiveDefinite(const Eigen::Matrix3d& P) {
+  if (!P.allFinite() || !P.isApprox(P.transpose(), 1e-9)) {
+    return false;
+  }
+  return Eigen::LLT<Eigen::Matrix3d>(P).info() == Eigen::Success;
+}
+
+bool positiveFinite(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
+
+bool validLineObservation(const LineObservation& o) {
+  return std::isfinite(o.r) && std::isfinite(o.psi) && positiveFinite(o.var_r) && positiveFinite(o.var_psi) &&
+         std::isfinite(o.cov_r_psi) && o.cov_r_psi * o.cov_r_psi < o.var_r * o.var_psi;
+}
+
+}  // namespace
+
+Expected<void> EkfParams::validate() const {
+  if (!positiveFinite(wheel_base) || !std::isfinite(delta) || delta < 0.0) {
+    return fleet::unexpected("invalid_ekf_params", "wheel_base must be > 0 and delta >= 0");
+  }
+  if (!positiveFinite(compass_variance) || !positiveFinite(bearing_variance) ||
+      !std::isfinite(compass_offset)) {
+    return fleet::unexpected("invalid_ekf_params", "sensor variances must be finite and > 0");
+  }
+  if (!positiveFinite(gate_1dof) || !positiveFinite(gate_2dof) || !std::isfinite(min_line_distance) ||
+      min_line_distance < 0.0) {
+    return fleet::unexpected("invalid_ekf_params", "gates must be > 0 and min_line_distance >= 0");
+  }
+  return {};
+}
+
+PoseEkf::PoseEkf(const EkfParams& params, const Pose2& initial, const Eigen::Matrix3d& P0)
+    : params_(params), x_(initial.x, initial.y, wrapAngle(initial.theta)), P_(P0) {}
+
+Expected<PoseEkf> PoseEkf::create(const EkfParams& params, const Pose2& initial, const Eigen::Matrix3d& P0) {
+  if (auto ok = params.validate(); !ok) {
+    return fleet::unexpected(ok.error());
+  }
+  if (!initial.isFinite()) {
+    return fleet::unexpected("non_finite_pose", "initial pose is NaN/inf");
+  }
+  if (!isPositiveDefinite(P0)) {
+    return fleet::unexpected("invalid_covariance", "P0 must be finite, symmetric and positive-definite");
+  }
+  return PoseEkf(params, initial, P0);
+}
+
+Expected<void> PoseEkf::reset(const Pose2& pose, const Eigen::Matrix3d& P0) {
+  if (!pose.isFinite()) {
+    return fleet::unexpected("non_finite_pose", "pose is NaN/inf");
+  }
+  if (!isPositiveDefinite(P0)) {
+    return fleet::unexpected("invalid_covariance", "P0 must be finite, symmetric and positive-definite");
+  }
+  x_ = Eigen::Vector3d(pose.x, pose.y, wrapAngle(pose.theta));
+  P_ = P0;
+  return {};
+}
+
+UpdateStatus PoseEkf::predict(double ds_left, double ds_right) {
+  if (!std::isfinite(ds_left) || !std::isfinite(ds_right)) {
+    ++stats_.odometry.rejected_non_finite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
+  const OdometryModel m = odometryModel(pose(), ds_left, ds_right, params_.wheel_base);
+  const Eigen::Matrix2d Q = odometryNoise(ds_left, ds_right, params_.delta);
+  x_ << m.pose.x, m.pose.y, m.pose.theta;
+  P_ = m.A * P_ * m.A.transpose() + m.W * Q * m.W.transpose();
+  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: transpose aliases P_
+  ++stats_.odometry.accepted;
+  return UpdateStatus::kAccepted;
+}
+
+template <int M>
+UpdateStatus PoseEkf::correct(const Eigen::Matrix<double, M, 1>& innovation,
+                              const Eigen::Matrix<double, M, 3>& H, const Eigen::Matrix<double, M, M>& R,
+                              double gate, SensorStats& stats) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  const MatM S = H * P_ * H.transpose() + R;
+  const Eigen::LLT<MatM> llt(S);
+  if (llt.info() != Eigen::Success) {
+    ++stats.rejected_geometry;
+    return UpdateStatus::kRejectedGeometry;
+  }
+  const double d2 = innovation.dot(llt.solve(innovation));
+  if (!(d2 <= gate)) {
+    ++stats.rejected_gate;
+    return UpdateStatus::kRejectedGate;
+  }
+  // K = P Hᵀ S⁻¹, solved through the Cholesky factor rather than an explicit inverse.
+  const Eigen::Matrix<double, 3, M> K = llt.solve(H * P_).transpose();
+  const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * H;
+  // Joseph form stays positive semi-definite under rounding, unlike (I − KH)P.
+  P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
+  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: transpose aliases P_
+  x_ += K * innovation;
+  x_(2) = wrapAngle(x_(2));
+  ++stats.accepted;
+  return UpdateStatus::kAccepted;
+}
+
+UpdateStatus PoseEkf::updateCompass(double reading) {
+  return updateCompass(reading, params_.compass_variance);
+}
+
+UpdateStatus PoseEkf::updateCompass(double reading, double variance) {
+  if (!std::isfinite(reading) || !positiveFinite(variance)) {
+    ++stats_.compass.rejected_non_finite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
+  Eigen::Matrix<double, 1, 1> innov;
+  innov(0) = angleDiff(reading - params_.compass_offset, x_(2));
+  const Eigen::Matrix<double, 1, 3> H(0.0, 0.0, 1.0);
+  const Eigen::Matrix<double, 1, 1> R = Eigen::Matrix<double, 1, 1>::Constant(variance);
+  return correct<1>(innov, H, R, params_.gate_1dof, stats_.compass);
+}
+
+UpdateStatus PoseEkf::updateBearing(Vec2 landmark, double bearing) {
+  return updateBearing(landmark, bearing, params_.bearing_variance);
+}
+
+UpdateStatus PoseEkf::updateBearing(Vec2 landmark, double bearing, double variance) {
+  if (!landmark.isFinite() || !std::isfinite(bearing) || !positiveFinite(variance)) {
+    ++stats_.bearing.rejected_non_finite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
+  const BearingPrediction b = predictBearing(pose(), landmark);
+  if (b.range < 1e-6) {
+    ++stats_.bearing.rejected_geometry;
+    return UpdateStatus::kRejectedGeometry;
+  }
+  Eigen::Matrix<double, 1, 1> innov;
+  innov(0) = angleDiff(bearing, b.gamma);
+  const Eigen::Matrix<double, 1, 1> R = Eigen::Matrix<double, 1, 1>::Constant(variance);
+  return correct<1>(innov, Eigen::Matrix<double, 1, 3>(b.H), R, params_.gate_1dof, stats_.bearing);
+}
+
+UpdateStatus PoseEkf::updateLine(const MapLine& map_line, const LineObservation& obs) {
+  if (!std::isfinite(map_line.rho) || !std::isfinite(map_line.beta) || !std::isfinite(obs.r) ||
+      !validLineObservation(obs)) {
+    ++stats_.line.rejected_non_finite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
+  const LinePrediction p = predictLine(pose(), map_line);
+  if (p.r < params_.min_line_distance) {
+    ++stats_.line.rejected_geometry;
+    return UpdateStatus::kRejectedGeometry;
+  }
+  const Eigen::Vector2d innov(obs.r - p.r, angleDiff(obs.psi, p.psi));
+  Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
+  R(0, 0) = obs.var_r;
+  R(1, 1) = obs.var_psi;
+  R(0, 1) = R(1, 0) = obs.cov_r_psi;
+  return correct<2>(innov, p.H, R, params_.gate_2dof, stats_.line);
+}
+
+LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
+                                     std::span<const LineObservation> observations) {
+  LineBatchResult result;
+  std::vector<bool> used(map.size(), false);
+  for (const LineObservation& obs : observations) {
+    if (!validLineObservation(obs)) {
+      ++stats_.line.rejected_non_finite;
+      ++result.rejected_non_finite;
+      continue;
+    }
+    Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
+    R(0, 0) = obs.var_r;
+    R(1, 1) = obs.var_psi;
+    R(0, 1) = R(1, 0) = obs.cov_r_psi;
+    double best = params_.gate_2dof;
+    std::size_t best_j = map.size();
+    for (std::size_t j = 0; j < map.size(); ++j) {
+      if (used[j]) {
+        continue;
+      }
+      const LinePrediction p = predictLine(pose(), map[j]);
+      if (p.r < params_.min_line_distance) {
+        continue;
+      }
+      const Eigen::Vector2d innov(obs.r - p.r, angleDiff(obs.psi, p.psi));
+      // Closed-form 2×2 Mahalanobis distance: this loop runs for every (observation, map line) pair.
+      const Eigen::Matrix2d S = p.H * P_ * p.H.transpose() + R;
+      const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      if (!(det > 0.0)) {
+        continue;
+      }
+      const double d2 = (S(1, 1) * innov(0) * innov(0) - 2.0 * S(0, 1) * innov(0) * innov(1) +
+                         S(0, 0) * innov(1) * innov(1)) /
+                        det;
+      if (d2 <= best) {
+        best = d2;
+        best_j = j;
+      }
+    }
+    if (best_j == map.size()) {
+      ++stats_.lines_unmatched;
+      ++result.unmatched;
+      continue;
+    }
+    used[best_j] = true;
+    if (updateLine(map[best_j], obs) == UpdateStatus::kAccepted) {
+      ++result.accepted;
+    }
+  }
+  return result;
+}
+
+double normalizedEstimationErrorSquared(const Pose2& truth, const Pose2& estimate, const Eigen::Matrix3d& P) {
+  const Eigen::Vector3d e(estimate.x - truth.x, estimate.y - truth.y, angleDiff(estimate.theta, truth.theta));
+  return e.dot(P.ldlt().solve(e));
+}
+
+}  // namespace fleet::estimation

@@ -1,0 +1,187 @@
+#include <gtest/gtest.h>
+
+#include <random>
+#include <thread>
+
+#include "fleet/planning/astar.hpp"
+#include "fleet/planning/distance_field_cache.hpp"
+#include "fleet/planning/wavefront.hpp"
+
+using namespace fleet;
+using namespace fleet::planning;
+
+namespace {
+
+OccupancyGrid randomGrid(std::mt19937& rng, int w, int h, double p) {
+  std::bernoulli_distribution occ(p);
+  OccupancyGrid g(w, h, 0.5, {-3.0, 4.0});
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      g.setBlocked({x, y}, occ(rng));
+    }
+  }
+  return g;
+}
+
+Cell randomFree(std::mt19937& rng, const OccupancyGrid& g) {
+  std::uniform_int_distribution<int> ux(0, g.width() - 1), uy(0, g.height() - 1);
+  while (true) {
+    const Cell c{ux(rng), uy(rng)};
+    if (!g.blocked(c)) {
+      return c;
+    }
+  }
+}
+
+}  // namespace
+
+TEST(AStar, MatchesDistanceFieldOnRandomGrids) {
+  std::mt19937 rng(12);
+  for (Connectivity conn : {Connectivity::Four, Connectivity::Eight}) {
+    int reached = 0, unreachable = 0;
+    for (int trial = 0; trial < 30; ++trial) {
+      const OccupancyGrid g = randomGrid(rng, 40, 30, 0.3);
+      const Cell goal = randomFree(rng, g);
+      const DistanceField f = computeDistanceField(g, goal, conn);
+      for (int q = 0; q < 10; ++q) {
+        const Cell s = randomFree(rng, g);
+        const auto r = astar(g, s, goal, conn);
+        ASSERT_EQ(r.has_value(), f.reachable(s));
+        if (!r) {
+          ++unreachable;
+          EXPECT_EQ(r.error().code, "unreachable");
+          continue;
+        }
+        ++reached;
+        EXPECT_NEAR(r->cost, f.at(s), 1e-9);
+        double sum = 0.0;
+        for (std::size_t k = 1; k < r->cells.size(); ++k) {
+          const Cell o{r->cells[k].x - r->cells[k - 1].x, r->cells[k].y - r->cells[k - 1].y};
+          ASSERT_TRUE(moveAllowed(g, r->cells[k - 1], o));
+          sum += moveCost(o);
+        }
+        EXPECT_NEAR(sum, r->cost, 1e-9);
+      }
+    }
+    EXPECT_GT(reached, 100);
+    EXPECT_GT(unreachable, 0);
+  }
+}
+
+TEST(AStar, LandmarkHeuristicKeepsCostsAndExpandsLess) {
+  std::mt19937 rng(31);
+  for (Connectivity conn : {Connectivity::Four, Connectivity::Eight}) {
+    const OccupancyGrid g = randomGrid(rng, 80, 50, 0.3);  // several components
+    const LandmarkHeuristic lh = LandmarkHeuristic::build(g, conn, 6);
+    EXPECT_EQ(lh.count(), 6);
+    long plain = 0, alt = 0;
+    for (int q = 0; q < 200; ++q) {
+      const Cell s = randomFree(rng, g), t = randomFree(rng, g);
+      const auto a = astar(g, s, t, conn);
+      const auto b = astar(g, s, t, conn, &lh);
+      ASSERT_EQ(a.has_value(), b.has_value());
+      if (a) {
+        EXPECT_NEAR(a->cost, b->cost, 1e-9);
+        plain += a->expanded;
+        alt += b->expanded;
+      }
+    }
+    EXPECT_LT(alt, plain) << (conn == Connectivity::Four ? "four" : "eight");
+  }
+  // Landmarks built for the other move set are ignored, not misused.
+  const OccupancyGrid g = randomGrid(rng, 30, 30, 0.2);
+  const LandmarkHeuristic four = LandmarkHeuristic::build(g, Connectivity::Four, 4);
+  const Cell s = randomFree(rng, g), t = randomFree(rng, g);
+  const auto a = astar(g, s, t, Connectivity::Eight);
+  const auto b = astar(g, s, t, Connectivity::Eight, &four);
+  ASSERT_EQ(a.has_value(), b.has_value());
+  if (a) {
+    EXPECT_NEAR(a->cost, b->cost, 1e-9);
+  }
+}
+
+TEST(GlobalPlanner, WavefrontAndAStarGiveEqualLengthsOnTheWarehouse) {
+  WarehouseParams wp;
+  wp.resolution = 0.5;
+  const OccupancyGrid g = makeWarehouseGrid(wp);
+  std::mt19937 rng(4);
+  WavefrontPlanner wf;
+  AStarPlanner as;
+  AStarPlanner alt(Connectivity::Eight, std::make_shared<const LandmarkHeuristic>(
+                                            LandmarkHeuristic::build(g, Connectivity::Eight, 4)));
+  std::vector<GlobalPlanner*> planners{&wf, &as, &alt};
+  for (int q = 0; q < 10; ++q) {
+    const Vec2 a = g.cellCenter(randomFree(rng, g)), b = g.cellCenter(randomFree(rng, g));
+    std::vector<double> lengths;
+    for (GlobalPlanner* p : planners) {
+      const auto path = p->plan(g, {a.x, a.y, 0.3}, {b.x, b.y, -1.0});
+      ASSERT_TRUE(path.has_value()) << p->name();
+      EXPECT_DOUBLE_EQ(path->poses.front().theta, 0.3);
+      EXPECT_DOUBLE_EQ(path->poses.back().theta, -1.0);
+      lengths.push_back(path->length());
+      for (const Pose2& pose : path->poses) {
+        EXPECT_FALSE(g.blocked(*g.cellAt(pose.position())));
+      }
+    }
+    EXPECT_NEAR(lengths[0], lengths[1], 1e-9);
+    EXPECT_NEAR(lengths[0], lengths[2], 1e-9);
+    EXPECT_GE(lengths[0], distance(a, b) - 1e-9);
+  }
+}
+
+TEST(DistanceFieldCache, CachedCostsMatchAStarAndAreComputedOncePerGoal) {
+  std::mt19937 rng(6);
+  auto grid = std::make_shared<const OccupancyGrid>(randomGrid(rng, 60, 40, 0.2));
+  DistanceFieldCache cache(grid, Connectivity::Eight, 8);
+  std::vector<Cell> goals;
+  for (int k = 0; k < 4; ++k) {
+    goals.push_back(randomFree(rng, *grid));
+  }
+  std::vector<Cell> starts;
+  for (int k = 0; k < 50; ++k) {
+    starts.push_back(randomFree(rng, *grid));
+  }
+  std::vector<std::thread> threads;
+  std::vector<std::vector<double>> results(4);
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (int rep = 0; rep < 3; ++rep) {
+        for (const Cell& goal : goals) {
+          for (const Cell& s : starts) {
+            results[static_cast<std::size_t>(t)].push_back(cache.travelCost(s, goal));
+          }
+        }
+      }
+    });
+  }
+  for (auto& th : threads) {
+    th.join();
+  }
+  EXPECT_EQ(cache.computations(), goals.size());
+  for (int t = 1; t < 4; ++t) {
+    EXPECT_EQ(results[static_cast<std::size_t>(t)], results[0]);
+  }
+  std::size_t k = 0;
+  for (const Cell& goal : goals) {
+    for (const Cell& s : starts) {
+      const auto r = astar(*grid, s, goal);
+      const double c = results[0][k++];
+      if (r) {
+        EXPECT_NEAR(c, r->cost, 1e-9);
+      } else {
+        EXPECT_TRUE(std::isinf(c));
+      }
+    }
+  }
+  // Metres: resolution 0.5.
+  const Vec2 a = grid->cellCenter(starts[0]), b = grid->cellCenter(goals[0]);
+  EXPECT_NEAR(cache.travelDistance(a, b), 0.5 * cache.travelCost(starts[0], goals[0]), 1e-12);
+  EXPECT_TRUE(std::isinf(cache.travelDistance({-100, -100}, b)));
+  // LRU: more goals than the capacity forces recomputation of the evicted ones.
+  for (int j = 0; j < 10; ++j) {
+    cache.field(randomFree(rng, *grid));
+  }
+  const std::size_t before = cache.computations();
+  cache.field(goals[0]);
+  EXPECT_EQ(cache.computations(), before + 1);
+}
