@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 namespace fleet::sim {
 
@@ -69,99 +68,13 @@ double discGridPenetration(const GridMap& map, Vec2 centre, double radius) {
   return d <= 0.0 ? radius : std::max(0.0, radius - d);
 }
 
-Expected<GridMap> parseMovingAiMap(const std::string& text, const std::string& source, double resolution) {
-  std::istringstream in(text);
-  std::string line;
-  int width = -1;
-  int height = -1;
-  int lineNo = 0;
-  bool inMap = false;
-  std::vector<std::string> rows;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    if (!line.empty() && line.back() == '\r') {
-      line.pop_back();
-    }
-    if (!inMap) {
-      std::istringstream ls(line);
-      std::string key;
-      ls >> key;
-      if (key == "height") {
-        ls >> height;
-      } else if (key == "width") {
-        ls >> width;
-      } else if (key == "map") {
-        inMap = true;
-      } else if (key != "type" && !key.empty()) {
-        return unexpected("map_format", source + ":" + std::to_string(lineNo) + ": unexpected header key '" +
-                                            key + "' (expected type, height, width, map)");
-      }
-      continue;
-    }
-    if (line.empty()) {
-      continue;
-    }
-    if (static_cast<int>(line.size()) != width) {
-      return unexpected("map_format", source + ":" + std::to_string(lineNo) + ": row has " +
-                                          std::to_string(line.size()) + " cells, expected width " +
-                                          std::to_string(width));
-    }
-    rows.push_back(line);
-  }
-  if (width <= 0 || height <= 0) {
-    return unexpected("map_format", source + ": header must give positive 'width' and 'height'");
-  }
-  if (static_cast<int>(rows.size()) != height) {
-    return unexpected("map_format", source + ": " + std::to_string(rows.size()) +
-                                        " map rows, expected height " + std::to_string(height));
-  }
+GridMap fromOccupancyGrid(const planning::OccupancyGrid& g) {
   GridMap m;
-  m.width = width;
-  m.height = height;
-  m.resolution = resolution;
-  m.cells.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0);
-  for (int r = 0; r < height; ++r) {
-    const int cy = height - 1 - r;
-    for (int cx = 0; cx < width; ++cx) {
-      const char c = rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(cx)];
-      m.cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(width) + static_cast<std::size_t>(cx)] =
-          (c == '.' || c == 'G') ? 0 : 1;
-    }
-  }
-  return m;
-}
-
-GridMap makeWarehouseMap(const WarehouseLayout& p) {
-  GridMap m;
-  m.width = p.width;
-  m.height = p.height;
-  m.resolution = p.resolution;
-  m.cells.assign(static_cast<std::size_t>(p.width) * static_cast<std::size_t>(p.height), 0);
-  auto set = [&](int cx, int cy) {
-    m.cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(p.width) + static_cast<std::size_t>(cx)] =
-        1;
-  };
-  for (int cx = 0; cx < p.width; ++cx) {
-    set(cx, 0);
-    set(cx, p.height - 1);
-  }
-  for (int cy = 0; cy < p.height; ++cy) {
-    set(0, cy);
-    set(p.width - 1, cy);
-  }
-  const int x0 = 1 + p.margin;
-  const int y0 = 1 + p.margin;
-  const int x1 = p.width - 1 - p.margin;
-  const int y1 = p.height - 1 - p.margin;
-  for (int by = y0; by + p.shelfHeight <= y1; by += p.shelfHeight + p.aisleY) {
-    for (int bx = x0; bx + p.shelfWidth <= x1; bx += p.shelfWidth + p.aisleX) {
-      for (int cy = by; cy < by + p.shelfHeight; ++cy) {
-        for (int cx = bx; cx < bx + p.shelfWidth; ++cx) {
-          set(cx, cy);
-        }
-      }
-    }
-  }
+  m.width = g.width();
+  m.height = g.height();
+  m.resolution = g.resolution();
+  m.origin = g.origin();
+  m.cells = g.cells();
   return m;
 }
 

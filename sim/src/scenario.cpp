@@ -9,6 +9,7 @@
 
 #include "fleet/core/angles.hpp"
 #include "fleet/core/ids.hpp"
+#include "fleet/planning/map_io.hpp"
 
 namespace fleet::sim {
 
@@ -137,51 +138,48 @@ std::vector<std::string> with(std::vector<std::string> a, const std::vector<std:
 }
 
 GridMap readMap(Config c, const std::string& baseDir) {
-  c.rejectUnknownKeys({"file", "warehouse", "rows", "resolution", "origin"});
+  c.rejectUnknownKeys({"file", "image", "warehouse", "rows", "resolution", "origin"});
   const double res = c.number("resolution", 0.5, {0.0, 100.0, true});
   Vec2 origin;
   readPoint(c, "origin", origin, false);
-  GridMap m;
-  const int sources = (c.has("file") ? 1 : 0) + (c.has("warehouse") ? 1 : 0) + (c.has("rows") ? 1 : 0);
+  const int sources = (c.has("file") ? 1 : 0) + (c.has("image") ? 1 : 0) + (c.has("warehouse") ? 1 : 0) +
+                      (c.has("rows") ? 1 : 0);
   if (sources != 1) {
-    c.problem("", "expected exactly one of 'file' (MovingAI .map), 'warehouse' (generated) or 'rows'");
-    return m;
+    c.problem("",
+              "expected exactly one of 'file' (MovingAI .map), 'image' (side file of a PGM map), "
+              "'warehouse' (generated) or 'rows'");
+    return {};
   }
+  auto resolve = [&](const std::string& f) {
+    std::filesystem::path p(f);
+    return (p.is_relative() ? std::filesystem::path(baseDir) / p : p).string();
+  };
+  Expected<planning::OccupancyGrid> grid = planning::OccupancyGrid{};
+  std::string key;
   if (c.has("file")) {
-    const std::string file = c.string("file", "");
-    std::filesystem::path p(file);
-    if (p.is_relative()) {
-      p = std::filesystem::path(baseDir) / p;
-    }
-    std::ifstream in(p);
-    if (!in) {
-      c.problem("file", "cannot read map file '" + p.string() + "'");
-      return m;
-    }
-    std::stringstream ss;
-    ss << in.rdbuf();
-    auto parsed = parseMovingAiMap(ss.str(), p.string(), res);
-    if (!parsed) {
-      c.problem("file", parsed.error().message);
-      return m;
-    }
-    m = std::move(*parsed);
+    key = "file";
+    grid = planning::loadMovingAiMap(resolve(c.string("file", "")), res, origin);
+  } else if (c.has("image")) {
+    key = "image";  // resolution and origin come from the side file
+    grid = planning::loadImageMap(resolve(c.string("image", "")));
   } else if (c.has("warehouse")) {
+    key = "warehouse";
     Config w = c.child("warehouse");
     w.rejectUnknownKeys({"width", "height", "margin", "shelf_width", "shelf_height", "aisle_x", "aisle_y"});
-    WarehouseLayout l;
+    planning::WarehouseParams l;
     l.resolution = res;
-    l.width = static_cast<int>(w.integer("width", l.width, {3, 10000}));
-    l.height = static_cast<int>(w.integer("height", l.height, {3, 10000}));
-    l.margin = static_cast<int>(w.integer("margin", l.margin, {0, 10000}));
-    l.shelfWidth = static_cast<int>(w.integer("shelf_width", l.shelfWidth, {1, 10000}));
-    l.shelfHeight = static_cast<int>(w.integer("shelf_height", l.shelfHeight, {1, 10000}));
-    l.aisleX = static_cast<int>(w.integer("aisle_x", l.aisleX, {1, 10000}));
-    l.aisleY = static_cast<int>(w.integer("aisle_y", l.aisleY, {1, 10000}));
-    m = makeWarehouseMap(l);
+    l.origin = origin;
+    l.width = static_cast<int>(w.integer("width", 60, {3, 10000}));
+    l.height = static_cast<int>(w.integer("height", 40, {3, 10000}));
+    l.margin = static_cast<int>(w.integer("margin", 4, {1, 10000}));
+    l.shelfWidth = static_cast<int>(w.integer("shelf_width", 8, {1, 10000}));
+    l.shelfHeight = static_cast<int>(w.integer("shelf_height", 2, {1, 10000}));
+    l.aisleX = static_cast<int>(w.integer("aisle_x", 3, {1, 10000}));
+    l.aisleY = static_cast<int>(w.integer("aisle_y", 3, {1, 10000}));
+    grid = planning::makeWarehouseGrid(l);
   } else {
+    key = "rows";
     const nlohmann::json* rows = c.find("rows");
-    std::string text;
     bool ok = rows->is_array() && !rows->empty();
     std::size_t w = 0;
     if (ok) {
@@ -193,21 +191,20 @@ GridMap readMap(Config c, const std::string& baseDir) {
     if (!ok || w == 0) {
       c.problem("rows",
                 "expected a non-empty array of equally long strings ('.' free, '@' blocked; first = top)");
-      return m;
+      return {};
     }
-    text = "type octile\nheight " + std::to_string(rows->size()) + "\nwidth " + std::to_string(w) + "\nmap\n";
+    std::string text =
+        "type octile\nheight " + std::to_string(rows->size()) + "\nwidth " + std::to_string(w) + "\nmap\n";
     for (const auto& r : *rows) {
       text += r.get<std::string>() + "\n";
     }
-    auto parsed = parseMovingAiMap(text, c.keyPath("rows"), res);
-    if (!parsed) {
-      c.problem("rows", parsed.error().message);
-      return m;
-    }
-    m = std::move(*parsed);
+    grid = planning::parseMovingAiMap(text, c.keyPath("rows"), res, origin);
   }
-  m.origin = origin;
-  return m;
+  if (!grid) {
+    c.problem(key, grid.error().message);
+    return {};
+  }
+  return fromOccupancyGrid(*grid);
 }
 
 // 4-connected free-cell components; label 0 = blocked.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 #include "fleet/sim/scenario.hpp"
 #include "sim_fixtures.hpp"
@@ -116,21 +117,32 @@ TEST(Scenario, FleetPlacementFillsFreeSpotsOnly) {
   EXPECT_THROW(test::parse(j), ConfigError);
 }
 
-TEST(GridMap, MovingAiRowsAreFlippedAndErrorsNamed) {
-  auto m = parseMovingAiMap("type octile\nheight 2\nwidth 3\nmap\n@..\n..@\n", "t.map", 1.0);
-  ASSERT_TRUE(m);
-  EXPECT_TRUE(m->blocked(0, 1));  // first file row is the top
-  EXPECT_TRUE(m->blocked(2, 0));
-  EXPECT_FALSE(m->blocked(0, 0));
-  auto bad = parseMovingAiMap("type octile\nheight 2\nwidth 3\nmap\n@..\n..\n", "t.map", 1.0);
-  ASSERT_FALSE(bad);
-  EXPECT_NE(bad.error().message.find("t.map:6"), std::string::npos);
+TEST(Scenario, LoadsMovingAiFileRelativeToScenarioAndNamesItsErrors) {
+  const auto dir = std::filesystem::temp_directory_path() / ("sim_map_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "m.map") << "type octile\nheight 3\nwidth 4\nmap\n@@@@\n@..@\n@@@@\n";
+  std::ofstream(dir / "bad.map") << "type octile\nheight 3\nwidth 4\nmap\n@@@@\n@..\n@@@@\n";
+  nlohmann::json j = {{"map", {{"file", "m.map"}, {"resolution", 1.0}}}, {"robots", nlohmann::json::array()}};
+  const Scenario s = parseScenario(j, (dir / "s.json").string(), dir.string());
+  EXPECT_EQ(s.map.width, 4);
+  EXPECT_FALSE(s.map.blocked(1, 1));
+  EXPECT_TRUE(s.map.blocked(0, 1));
+  j["map"]["file"] = "bad.map";
+  try {
+    parseScenario(j, "s.json", dir.string());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(anyContains(e.problems(), "map.file"));
+    EXPECT_TRUE(anyContains(e.problems(), "bad.map"));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(GridMap, DiscPenetrationIsExactAgainstCellBoxes) {
-  auto m =
-      parseMovingAiMap("type octile\nheight 5\nwidth 5\nmap\n.....\n.....\n..@..\n.....\n.....\n", "t", 1.0);
-  ASSERT_TRUE(m);
+  planning::OccupancyGrid g(5, 5, 1.0);
+  g.setBlocked({2, 2});
+  const GridMap map = fromOccupancyGrid(g);
+  const GridMap* m = &map;
   // Blocked cell spans [2,3]x[2,3]. A disc at (1.5, 2.5) of radius 0.6 overlaps the left face by 0.1.
   EXPECT_NEAR(discGridPenetration(*m, {1.5, 2.5}, 0.6), 0.1, 1e-12);
   // Corner: distance from (1.5, 1.5) to (2, 2) is sqrt(0.5).

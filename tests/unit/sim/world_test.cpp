@@ -202,6 +202,6 @@ TEST(World, MinimumSeparationIsTheExactSurfaceGap) {
   World w(test::parse(j));
   w.advance();
   EXPECT_NEAR(w.metrics().minSepRobotRobot, 1.0 - 0.6, 1e-12);
-  EXPECT_EQ(w.metrics().nearMissRobotRobot, 0U);  // 0.4 m is above the 0.3 m threshold
+  EXPECT_EQ(w.metrics().nearMissRobotRobot, 0U);                      // 0.4 m is above the 0.3 m threshold
   EXPECT_NEAR(w.metrics().minSepRobotShelf, 2.5 - 0.5 - 0.3, 1e-12);  // floor wall face at y = 0.5
 }

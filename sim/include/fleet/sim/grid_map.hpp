@@ -2,12 +2,11 @@
 
 #include <cmath>
 #include <cstdint>
-#include <string>
 #include <vector>
 
-#include "fleet/core/expected.hpp"
 #include "fleet/core/vec2.hpp"
 #include "fleet/geometry/grid_raycast.hpp"
+#include "fleet/planning/occupancy_grid.hpp"
 
 namespace fleet::sim {
 
@@ -48,20 +47,8 @@ double discGridPenetration(const GridMap& map, Vec2 centre, double radius);
 /// `p`; returns false when nothing is within reach.
 bool nearestBlocked(const GridMap& map, Vec2 p, double reach, double& dist, Vec2& awayDir);
 
-/// MovingAI `.map` text (row 0 of the file is the top). `.` and `G` are free, everything else blocked.
-Expected<GridMap> parseMovingAiMap(const std::string& text, const std::string& source, double resolution);
-
-/// Procedural warehouse: border wall, free margin band, array of shelf blocks separated by aisles.
-struct WarehouseLayout {
-  int width = 60;
-  int height = 40;
-  int margin = 4;
-  int shelfWidth = 8;
-  int shelfHeight = 2;
-  int aisleX = 3;
-  int aisleY = 3;
-  double resolution = 0.5;
-};
-GridMap makeWarehouseMap(const WarehouseLayout& p);
+/// The simulator's copy of a planning grid (loaded by libs/planning: MovingAI, image + side file,
+/// generated warehouse).
+GridMap fromOccupancyGrid(const planning::OccupancyGrid& g);
 
 }  // namespace fleet::sim
