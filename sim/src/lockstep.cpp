@@ -6,7 +6,7 @@ namespace fleet::sim {
 
 bool LockstepBarrier::onStepDone(const std::string& participant, std::int64_t step) {
   if (step == kRegister) {
-    acked_.try_emplace(participant, -1);
+    acked_.try_emplace(participant, current_);
     return true;
   }
   if (step == kLeave) {

@@ -168,6 +168,7 @@ class Simulator {
     const auto start = std::chrono::steady_clock::now();
     const auto dt = std::chrono::nanoseconds(secToNs(w_.scenario().dt));
     for (std::int64_t k = 0;; ++k) {
+      barrier_.begin(k);
       publish();
       if (k >= total || gStop) {
         break;

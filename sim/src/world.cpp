@@ -488,7 +488,9 @@ void World::updateContacts() {
     }
     double wd = 0.0;
     Vec2 away;
-    if (nearestBlocked(sc_.map, p, ri + sepReach, wd, away)) {
+    // Shelves are everywhere in a warehouse: their clearance is tracked only up to 0.5 m (or the
+    // near-miss distance) to keep the cell scan small.
+    if (nearestBlocked(sc_.map, p, ri + std::max(sc_.nearMiss, 0.5), wd, away)) {
       metrics_.minSepRobotShelf = std::min(metrics_.minSepRobotShelf, wd - ri);
     }
     const double depth = std::max(bumpDepth_[i], discGridPenetration(sc_.map, p, ri));
@@ -633,12 +635,15 @@ SensorReading World::sensorFrame(std::size_t i, bool withScan) {
       }
     });
     std::sort(seen.begin(), seen.end());
+    const double c = std::cos(r.pose.theta);
+    const double sn = std::sin(r.pose.theta);
     for (int j : seen) {
       if (f.detections.size() >= 256) {
         break;
       }
       const auto ju = static_cast<std::size_t>(j);
-      const Vec2 local = r.pose.inverse().transform(positions_[ju]);
+      const Vec2 d = positions_[ju] - o;
+      const Vec2 local{c * d.x + sn * d.y, -sn * d.x + c * d.y};  // into the robot frame
       f.detections.push_back(
           {ju >= robots_.size(), static_cast<float>(local.x + normal(sensorRng_, s.rangeSigma)),
            static_cast<float>(local.y + normal(sensorRng_, s.rangeSigma)), static_cast<float>(radii_[ju])});

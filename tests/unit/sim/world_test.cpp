@@ -194,14 +194,21 @@ TEST(Lockstep, BarrierWaitsForEveryRegisteredParticipant) {
   b.onStepDone("b", 0);  // stale ack does not go backwards
   EXPECT_TRUE(b.complete(1));
   EXPECT_EQ(b.registered(), 1U);
+  // Joining while step 5 is out: not waited for at step 5 (it may have missed Clock(5)), but at 6.
+  b.onStepDone("b", 5);
+  b.begin(5);
+  b.onStepDone("late", LockstepBarrier::kRegister);
+  EXPECT_TRUE(b.complete(5));
+  EXPECT_FALSE(b.complete(6));
+  EXPECT_EQ(b.missing(6), (std::vector<std::string>{"b", "late"}));
 }
 
 TEST(World, MinimumSeparationIsTheExactSurfaceGap) {
   auto j = test::room(40, 10);
-  j["robots"] = {{{"id", "a"}, {"start", {5.0, 2.5, 0.0}}}, {{"id", "b"}, {"start", {6.0, 2.5, 0.0}}}};
+  j["robots"] = {{{"id", "a"}, {"start", {5.0, 1.2, 0.0}}}, {{"id", "b"}, {"start", {6.0, 1.2, 0.0}}}};
   World w(test::parse(j));
   w.advance();
   EXPECT_NEAR(w.metrics().minSepRobotRobot, 1.0 - 0.6, 1e-12);
   EXPECT_EQ(w.metrics().nearMissRobotRobot, 0U);                      // 0.4 m is above the 0.3 m threshold
-  EXPECT_NEAR(w.metrics().minSepRobotShelf, 2.5 - 0.5 - 0.3, 1e-12);  // floor wall face at y = 0.5
+  EXPECT_NEAR(w.metrics().minSepRobotShelf, 1.2 - 0.5 - 0.3, 1e-12);  // floor wall face at y = 0.5
 }

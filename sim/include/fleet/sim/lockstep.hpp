@@ -14,6 +14,9 @@ class LockstepBarrier {
   static constexpr std::int64_t kRegister = -1;
   static constexpr std::int64_t kLeave = -2;
 
+  /// Step k is about to be published. Participants registering from now on are waited for from step
+  /// k + 1 on: they may have missed Clock(k).
+  void begin(std::int64_t step) { current_ = step; }
   /// Applies one StepDone; returns false for ids never registered acknowledging a step (ignored).
   bool onStepDone(const std::string& participant, std::int64_t step);
   /// Everyone registered has acknowledged `step` (or a later one).
@@ -24,6 +27,7 @@ class LockstepBarrier {
 
  private:
   std::map<std::string, std::int64_t> acked_;  // last acknowledged step, -1 = none yet
+  std::int64_t current_ = -1;
 };
 
 }  // namespace fleet::sim

@@ -68,7 +68,8 @@ struct Metrics {
   std::uint64_t contactSteps = 0;        // steps with at least one contact
   std::uint64_t nearMissRobotRobot = 0;  // pair came closer than nearMiss without touching (events)
   std::uint64_t nearMissRobotHuman = 0;
-  // Smallest surface gap seen (m, < 0: overlap) among pairs closer than max(near_miss, 2 m); inf if none.
+  // Smallest surface gap seen (m, < 0: overlap) among pairs closer than max(near_miss, 2 m) (shelves:
+  // max(near_miss, 0.5 m)); inf if none.
   double minSepRobotRobot = std::numeric_limits<double>::infinity();
   double minSepRobotHuman = std::numeric_limits<double>::infinity();
   double minSepRobotShelf = std::numeric_limits<double>::infinity();
