@@ -176,7 +176,12 @@ class Simulator {
       if (lockstep_) {
         awaitStep(k);
       } else {
-        std::this_thread::sleep_until(start + dt * (k + 1));
+        const auto due = start + dt * (k + 1);
+        if (std::chrono::steady_clock::now() > due && ++w_.counters().wallOverruns % 100 == 1) {
+          spdlog::warn("wall clock: step {} overran dt; the simulation is behind real time ({} overruns)", k,
+                       w_.counters().wallOverruns);
+        }
+        std::this_thread::sleep_until(due);
         pollStepDone();
       }
       applyCommands();

@@ -104,6 +104,7 @@ nlohmann::json summary(const World& w) {
                    {"unknown_robot", c.unknownRobot},
                    {"timeouts", c.timeouts}};
   j["lockstep_step_timeouts"] = c.stepTimeouts;
+  j["wall_overruns"] = c.wallOverruns;
   nlohmann::json per = nlohmann::json::object();
   for (std::size_t i = 0; i < w.robots().size(); ++i) {
     const auto& r = w.robots()[i];

@@ -59,6 +59,7 @@ struct Counters {
   std::uint64_t unknownRobot = 0;     // commands for robots not in the scenario (ignored)
   std::uint64_t timeouts = 0;         // robots stopped by the command timeout (rising edges)
   std::uint64_t stepTimeouts = 0;     // lockstep steps that advanced without every StepDone
+  std::uint64_t wallOverruns = 0;     // wall-clock steps that took longer than dt (the run fell behind)
 };
 
 struct Metrics {
