@@ -146,7 +146,8 @@ class Simulator {
         clockW_(p_),
         cmdR_(p_, transport::qos::command(lockstep)),
         doneR_(p_),
-        stateR_(p_) {}
+        stateR_(p_),
+        riskR_(p_) {}
 
   int run() {
     if (!o_.replay.empty()) {
@@ -290,7 +291,23 @@ class Simulator {
     }
     truthW_.write(gt);
     if (replay_) {
-      (void)replay_->write(sim::replayStep(w_));
+      auto line = sim::replayStep(w_);
+      // The newest risk map (if the risk service runs) goes into the step it arrived at, for the viewer.
+      auto maps = riskR_.take();
+      if (!maps.empty()) {
+        const auto& m = maps.back();
+        nlohmann::json runs = nlohmann::json::array();
+        for (const auto& r : m.runs) {
+          runs.push_back({r.level, r.count});
+        }
+        line["risk"] = {{"origin", {m.origin_x, m.origin_y}},
+                        {"resolution", m.resolution},
+                        {"width", m.width},
+                        {"height", m.height},
+                        {"levels", m.levels},
+                        {"runs", runs}};
+      }
+      (void)replay_->write(line);
     }
     clockW_.write({w_.step(), lockstep_ ? w_.timeNs() : st, secToNs(w_.scenario().dt), lockstep_});
   }
@@ -338,6 +355,7 @@ class Simulator {
   transport::Reader<msg::VelocityCommand> cmdR_;
   transport::Reader<msg::StepDone> doneR_;
   transport::Reader<msg::RobotState> stateR_;
+  transport::Reader<msg::RiskMap> riskR_;
   sim::LockstepBarrier barrier_;
   std::optional<sim::ReplayWriter> replay_;
   int ignoredLogged_ = 0;

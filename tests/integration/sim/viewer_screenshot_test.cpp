@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/transport/dds.hpp"
 #include "test_process.hpp"
 
 namespace {
@@ -140,13 +141,27 @@ TEST(SimViewer, HeadlessChromiumRendersMapRobotsAndHumans) {
   const std::string html = (dir / "viewer.html").string();
   const std::string png = (dir / "shot.png").string();
   {
+    // A risk map as the risk service would publish it (transient-local: the simulator gets it on
+    // discovery): level 2 of 3 over the lower half of the 30 m x 15 m aisle map, 0.5 m cells.
+    const std::string dom = std::to_string(fleet::test::uniqueDomain());
+    setenv("FLEET_DDS_DOMAIN", dom.c_str(), 1);
+    fleet::transport::Participant p;
+    fleet::transport::Writer<fleet::msg::RiskMap> risk(p);
+    fleet::msg::RiskMap m;
+    m.resolution = 0.5;
+    m.width = 60;
+    m.height = 30;
+    m.levels = 3;
+    m.runs = {{2, 60 * 15}, {0, 60 * 15}};
+    risk.write(m);
     fleet::test::ChildProcess sim(
         FLEET_BINARY_DIR "/sim/src/fleet-sim",
-        {"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/aisle_crossing.json", "--clock", "lockstep",
-         "--duration", "3", "--replay", (dir / "r.jsonl.gz").string(), "--html", html, "--log-level", "warn"},
-        {{"FLEET_DDS_DOMAIN", std::to_string(fleet::test::uniqueDomain())}});
+        {"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/aisle_crossing.json", "--clock", "wall", "--duration",
+         "3", "--replay", (dir / "r.jsonl.gz").string(), "--html", html, "--log-level", "warn"},
+        {{"FLEET_DDS_DOMAIN", dom}});
     ASSERT_EQ(sim.wait(std::chrono::seconds(60)), 0);
   }
+  EXPECT_NE(slurp(html).find("\"risk\":{"), std::string::npos) << "risk map not recorded in the replay";
   const std::string profile = (dir / "profile").string();
   const std::string cmd = std::string("timeout 90 ") + chromium +
                           " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
@@ -165,5 +180,7 @@ TEST(SimViewer, HeadlessChromiumRendersMapRobotsAndHumans) {
   EXPECT_GT(walls, 100000U) << "map not drawn";
   EXPECT_GT(robots, 4 * 100U) << "4 robots not drawn";
   EXPECT_GT(humans, 3 * 50U) << "3 humans not drawn";
+  // Level 2 of 3 shaded over white: alpha 0.367 of (150, 0, 190) -> about (216, 161, 231).
+  EXPECT_GT(countColour(img, 216, 161, 231, 6), 20000U) << "risk iso-levels not drawn";
   std::filesystem::remove_all(dir);
 }
