@@ -118,6 +118,12 @@ AgentRun runLockstep(const std::string& scenario, double duration, const std::st
         cmd.write({robots[i], v, 0.3 * std::sin(0.2 * static_cast<double>(c.step) + static_cast<double>(i)),
                    c.sim_time_ns, static_cast<std::uint32_t>(c.step)});
       }
+      if (c.step == 5 && robots.size() > 2) {
+        // Bad input over the wire: NaN is ignored, an over-limit speed clamped, both counted.
+        cmd.write({robots[1], std::nan(""), 0.0, c.sim_time_ns, 5});
+        cmd.write({robots[2], 50.0, 0.0, c.sim_time_ns, 5});
+        cmd.write({"no-such-robot", 0.1, 0.0, c.sim_time_ns, 5});
+      }
       done.write({"agent", c.step});
     }
   }
@@ -144,6 +150,9 @@ TEST(SimLockstep, AgentDrivesRobotStepByStep) {
   EXPECT_EQ(s["lockstep_step_timeouts"], 0);
   EXPECT_EQ(s["steps"], 30);
   EXPECT_EQ(s["commands"]["timeouts"], 0);  // a command every step: never timed out
+  EXPECT_EQ(s["commands"]["nan_ignored"], 1);
+  EXPECT_EQ(s["commands"]["clamped"], 1);
+  EXPECT_EQ(s["commands"]["unknown_robot"], 1);
 }
 
 TEST(SimLockstep, SameSeedGivesByteIdenticalReplays) {
