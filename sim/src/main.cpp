@@ -1,0 +1,414 @@
+// fleet-sim: the headless warehouse simulator on DDS. See docs/simulator.md for the protocol.
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "fleet/core/clock.hpp"
+#include "fleet/core/config.hpp"
+#include "fleet/core/logging.hpp"
+#include "fleet/sim/lockstep.hpp"
+#include "fleet/sim/replay.hpp"
+#include "fleet/sim/world.hpp"
+#include "fleet/transport/dds.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::atomic<bool> gStop{false};
+void onSignal(int) {
+  gStop = true;
+}
+
+struct Options {
+  std::string scenario;
+  std::optional<std::string> clock;
+  std::optional<std::uint64_t> seed;
+  std::optional<double> duration;
+  int participants = 0;
+  int startTimeoutMs = 10000;
+  int stepTimeoutMs = 1000;
+  std::string replay;
+  std::string summary;
+  std::string html;
+  std::string logLevel = "info";
+  bool noScan = false;
+  bool validateOnly = false;
+  std::string makeViewerFrom;  // convert an existing replay to HTML and exit
+};
+
+const char* kUsage =
+    "usage: fleet-sim --scenario FILE [--clock wall|lockstep] [--seed N] [--duration S]\n"
+    "                 [--participants N] [--start-timeout-ms MS] [--step-timeout-ms MS]\n"
+    "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
+    "                 [--validate] [--log-level LEVEL]\n"
+    "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
+
+bool parseArgs(int argc, char** argv, Options& o) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        throw std::invalid_argument(a + " needs a value");
+      }
+      return argv[++i];
+    };
+    if (a == "--scenario") {
+      o.scenario = next();
+    } else if (a == "--clock") {
+      o.clock = next();
+      if (*o.clock != "wall" && *o.clock != "lockstep") {
+        throw std::invalid_argument("--clock must be wall or lockstep");
+      }
+    } else if (a == "--seed") {
+      o.seed = std::stoull(next());
+    } else if (a == "--duration") {
+      o.duration = std::stod(next());
+    } else if (a == "--participants") {
+      o.participants = std::stoi(next());
+    } else if (a == "--start-timeout-ms") {
+      o.startTimeoutMs = std::stoi(next());
+    } else if (a == "--step-timeout-ms") {
+      o.stepTimeoutMs = std::stoi(next());
+    } else if (a == "--replay") {
+      o.replay = next();
+    } else if (a == "--summary") {
+      o.summary = next();
+    } else if (a == "--html") {
+      o.html = next();
+    } else if (a == "--log-level") {
+      o.logLevel = next();
+    } else if (a == "--no-scan") {
+      o.noScan = true;
+    } else if (a == "--validate") {
+      o.validateOnly = true;
+    } else if (a == "--viewer") {
+      o.makeViewerFrom = next();
+    } else if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else {
+      throw std::invalid_argument("unknown option " + a);
+    }
+  }
+  return !o.scenario.empty() || !o.makeViewerFrom.empty();
+}
+
+bool writeText(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  return static_cast<bool>(out);
+}
+
+msg::SensorFrame toMsg(const sim::World& w, const sim::SensorReading& r, std::int64_t stamp) {
+  msg::SensorFrame f;
+  f.robot_id = w.scenario().robots[r.robot].id;
+  f.stamp_ns = stamp;
+  f.seq = r.seq;
+  f.ds_left = r.dsLeft;
+  f.ds_right = r.dsRight;
+  f.angle_min = r.angleMin;
+  f.angle_increment = r.angleIncrement;
+  f.range_max = r.rangeMax;
+  f.ranges = r.ranges;
+  f.compass_valid = r.compassValid;
+  f.compass = r.compass;
+  for (const auto& [id, b] : r.landmarks) {
+    f.landmarks.push_back({id, b});
+  }
+  for (const auto& d : r.detections) {
+    f.detections.push_back({d.human ? msg::SourceKind::Human : msg::SourceKind::Robot, d.x, d.y, d.r});
+  }
+  f.battery = r.battery;
+  f.charging = r.charging;
+  return f;
+}
+
+class Simulator {
+ public:
+  Simulator(sim::World& w, const Options& o, bool lockstep)
+      : w_(w),
+        o_(o),
+        lockstep_(lockstep),
+        sensorW_(p_, transport::qos::sensor(lockstep)),
+        truthW_(p_),
+        discsW_(p_),
+        clockW_(p_),
+        cmdR_(p_, transport::qos::command(lockstep)),
+        doneR_(p_),
+        stateR_(p_),
+        riskR_(p_) {}
+
+  int run() {
+    if (!o_.replay.empty()) {
+      auto r = sim::ReplayWriter::open(o_.replay);
+      if (!r) {
+        spdlog::error("{}", r.error().message);
+        return 1;
+      }
+      replay_.emplace(std::move(*r));
+      (void)replay_->write(sim::replayHeader(w_));
+    }
+    const auto total = static_cast<std::int64_t>(std::llround(w_.scenario().durationS / w_.scenario().dt));
+    spdlog::info("scenario '{}': {} robots, {} humans, {} steps of {} s, clock {}, seed {}",
+                 w_.scenario().name, w_.robots().size(), w_.humans().size(), total, w_.scenario().dt,
+                 lockstep_ ? "lockstep" : "wall", w_.scenario().seed);
+    if (lockstep_) {
+      waitForParticipants();
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const auto dt = std::chrono::nanoseconds(secToNs(w_.scenario().dt));
+    for (std::int64_t k = 0;; ++k) {
+      barrier_.begin(k);
+      publish();
+      if (k >= total || gStop) {
+        break;
+      }
+      if (lockstep_) {
+        awaitStep(k);
+      } else {
+        const auto due = start + dt * (k + 1);
+        if (std::chrono::steady_clock::now() > due && ++w_.counters().wallOverruns % 100 == 1) {
+          spdlog::warn("wall clock: step {} overran dt; the simulation is behind real time ({} overruns)", k,
+                       w_.counters().wallOverruns);
+        }
+        std::this_thread::sleep_until(due);
+        pollStepDone();
+      }
+      applyCommands();
+      w_.advance();
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return finish(wall);
+  }
+
+ private:
+  std::int64_t stamp() const { return lockstep_ ? w_.timeNs() : wall_.nowNs(); }
+
+  void waitForParticipants() {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(o_.startTimeoutMs);
+    while (static_cast<int>(barrier_.registered()) < o_.participants && !gStop) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        spdlog::warn("lockstep: only {} of {} participants registered after {} ms; starting anyway",
+                     barrier_.registered(), o_.participants, o_.startTimeoutMs);
+        break;
+      }
+      doneR_.waitForData(50ms);
+      pollStepDone();
+    }
+    spdlog::info("lockstep: {} participant(s) registered", barrier_.registered());
+  }
+
+  void pollStepDone() {
+    for (const auto& d : doneR_.take()) {
+      if (!barrier_.onStepDone(d.participant_id, d.step)) {
+        spdlog::debug("StepDone({}) from unregistered '{}' ignored", d.step, d.participant_id);
+      } else if (d.step < 0) {
+        spdlog::info("lockstep: '{}' {}", d.participant_id, d.step == -1 ? "registered" : "left");
+      }
+    }
+  }
+
+  void awaitStep(std::int64_t k) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(o_.stepTimeoutMs);
+    pollStepDone();
+    while (!barrier_.complete(k) && !gStop) {
+      if (std::chrono::steady_clock::now() > deadline) {
+        ++w_.counters().stepTimeouts;
+        const auto missing = barrier_.missing(k);
+        std::string who;
+        for (const auto& m : missing) {
+          who += (who.empty() ? "" : ", ") + m;
+        }
+        if (w_.counters().stepTimeouts <= 10 || w_.counters().stepTimeouts % 100 == 0) {
+          spdlog::warn("lockstep: step {} timed out after {} ms waiting for {} (timeouts so far: {})", k,
+                       o_.stepTimeoutMs, who, w_.counters().stepTimeouts);
+        }
+        return;
+      }
+      doneR_.waitForData(5ms);
+      pollStepDone();
+    }
+  }
+
+  void applyCommands() {
+    for (const auto& c : cmdR_.take()) {
+      if (w_.command(c.robot_id, c.v, c.w) == sim::CommandOutcome::Ignored) {
+        if (++ignoredLogged_ <= 10) {
+          spdlog::warn("ignored VelocityCommand for '{}' (v={}, w={}): {}", c.robot_id, c.v, c.w,
+                       w_.robotIndex(c.robot_id) < 0 ? "unknown robot" : "not finite");
+        }
+      }
+    }
+    for (const auto& s : stateR_.take()) {
+      const int i = w_.robotIndex(s.robot_id);
+      if (i >= 0) {
+        w_.setLabel(static_cast<std::size_t>(i), msg::toString(s.mode), s.task_id);
+      }
+    }
+  }
+
+  void publish() {
+    const std::int64_t st = stamp();
+    for (const auto& r : w_.sensorFrames(!o_.noScan)) {
+      sensorW_.write(toMsg(w_, r, st));
+    }
+    msg::GroundTruth gt;
+    gt.step = w_.step();
+    gt.sim_time_ns = w_.timeNs();
+    for (std::size_t i = 0; i < w_.robots().size(); ++i) {
+      const auto& r = w_.robots()[i];
+      gt.bodies.push_back({w_.scenario().robots[i].id, msg::SourceKind::Robot, r.pose, r.twist.v,
+                           w_.scenario().robots[i].radius});
+    }
+    for (std::size_t i = 0; i < w_.humans().size(); ++i) {
+      const auto& h = w_.humans()[i];
+      gt.bodies.push_back(
+          {h.id, msg::SourceKind::Human, Pose2{h.p.x, h.p.y, std::atan2(h.v.y, h.v.x)}, h.v.norm(), h.r});
+      msg::PredictedDiscs pd;
+      pd.source_id = h.id;
+      pd.kind = msg::SourceKind::Human;
+      pd.t0_ns = st;
+      pd.dt = static_cast<float>(w_.scenario().predictionDt);
+      for (const auto& d : w_.predictHuman(i)) {
+        pd.discs.push_back({static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.r),
+                            static_cast<float>(d.sigma)});
+      }
+      discsW_.write(pd);
+    }
+    for (const auto& c : w_.contacts()) {
+      gt.contacts.push_back({w_.bodyId(c.a), w_.bodyId(c.b), c.depth});
+    }
+    truthW_.write(gt);
+    if (replay_) {
+      auto line = sim::replayStep(w_);
+      // The newest risk map (if the risk service runs) goes into the step it arrived at, for the viewer.
+      auto maps = riskR_.take();
+      if (!maps.empty()) {
+        const auto& m = maps.back();
+        nlohmann::json runs = nlohmann::json::array();
+        for (const auto& r : m.runs) {
+          runs.push_back({r.level, r.count});
+        }
+        line["risk"] = {{"origin", {m.origin_x, m.origin_y}},
+                        {"resolution", m.resolution},
+                        {"width", m.width},
+                        {"height", m.height},
+                        {"levels", m.levels},
+                        {"runs", runs}};
+      }
+      (void)replay_->write(line);
+    }
+    clockW_.write({w_.step(), lockstep_ ? w_.timeNs() : st, secToNs(w_.scenario().dt), lockstep_});
+  }
+
+  int finish(double wallS) {
+    const auto s = sim::summary(w_);
+    if (replay_) {
+      if (auto r = replay_->close(); !r) {
+        spdlog::error("{}", r.error().message);
+        return 1;
+      }
+    }
+    if (!o_.summary.empty() && !writeText(o_.summary, s.dump(2) + "\n")) {
+      spdlog::error("cannot write summary '{}'", o_.summary);
+      return 1;
+    }
+    if (!o_.html.empty()) {
+      auto lines = sim::readReplayLines(o_.replay);
+      if (o_.replay.empty() || !lines) {
+        spdlog::error("--html needs --replay (the page embeds the replay)");
+        return 1;
+      }
+      if (!writeText(o_.html, sim::viewerHtml(*lines))) {
+        spdlog::error("cannot write '{}'", o_.html);
+        return 1;
+      }
+    }
+    spdlog::info(
+        "done: {} steps ({} s simulated) in {:.2f} s wall; contacts rr={} rh={} rs={}; step timeouts {}",
+        w_.step(), w_.time(), wallS, w_.metrics().robotRobotContacts, w_.metrics().robotHumanContacts,
+        w_.metrics().robotShelfContacts, w_.counters().stepTimeouts);
+    std::cout << s.dump() << std::endl;
+    return 0;
+  }
+
+  sim::World& w_;
+  const Options& o_;
+  bool lockstep_;
+  WallClock wall_;
+  transport::Participant p_;
+  transport::Writer<msg::SensorFrame> sensorW_;
+  transport::Writer<msg::GroundTruth> truthW_;
+  transport::Writer<msg::PredictedDiscs> discsW_;
+  transport::Writer<msg::Clock> clockW_;
+  transport::Reader<msg::VelocityCommand> cmdR_;
+  transport::Reader<msg::StepDone> doneR_;
+  transport::Reader<msg::RobotState> stateR_;
+  transport::Reader<msg::RiskMap> riskR_;
+  sim::LockstepBarrier barrier_;
+  std::optional<sim::ReplayWriter> replay_;
+  int ignoredLogged_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  try {
+    if (!parseArgs(argc, argv, o)) {
+      std::cerr << kUsage;
+      return 2;
+    }
+    logging::setup("fleet-sim", o.logLevel);
+  } catch (const std::exception& e) {
+    std::cerr << "fleet-sim: " << e.what() << "\n" << kUsage;
+    return 2;
+  }
+  if (!o.makeViewerFrom.empty()) {
+    auto lines = sim::readReplayLines(o.makeViewerFrom);
+    if (!lines || o.html.empty()) {
+      std::cerr << "fleet-sim: " << (lines ? "--viewer needs --html OUT" : lines.error().message) << "\n";
+      return 1;
+    }
+    return writeText(o.html, sim::viewerHtml(*lines)) ? 0 : 1;
+  }
+  std::optional<sim::Scenario> sc;
+  try {
+    sc = sim::loadScenario(o.scenario);
+  } catch (const ConfigError& e) {
+    std::cerr << "fleet-sim: scenario refused, " << e.what() << "\n";
+    return 2;
+  }
+  if (o.validateOnly) {
+    std::cout << "scenario '" << sc->name << "' is valid: " << sc->robots.size() << " robots\n";
+    return 0;
+  }
+  if (o.seed) {
+    sc->seed = *o.seed;
+  }
+  if (o.duration) {
+    sc->durationS = *o.duration;
+  }
+  const bool lockstep = o.clock.value_or(sc->clock) == "lockstep";
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  try {
+    sim::World world(std::move(*sc));
+    Simulator s(world, o, lockstep);
+    return s.run();
+  } catch (const std::exception& e) {
+    spdlog::critical("fleet-sim failed: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,182 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "fleet/sim/flow_field.hpp"
+#include "fleet/sim/social_force.hpp"
+#include "fleet/sim/spatial_hash.hpp"
+#include "fleet/sim/world.hpp"
+#include "sim_fixtures.hpp"
+
+using namespace fleet;
+using namespace fleet::sim;
+
+TEST(SocialForce, DrivingForceRelaxesWithinTau) {
+  const Vec2 f = drivingForce({1.3, 0.0}, {0.3, 0.0}, 0.5);
+  EXPECT_DOUBLE_EQ(f.x, 2.0);
+  EXPECT_DOUBLE_EQ(f.y, 0.0);
+}
+
+TEST(SocialForce, RepulsionIsSymmetricWithoutAnisotropyAndDecaysExponentially) {
+  const Vec2 a{0.0, 0.0};
+  const Vec2 b{0.8, 0.3};
+  const Vec2 fab = bodyRepulsion(2.1, 0.3, 1.0, a, 0.25, {1.0, 0.0}, b, 0.25);
+  const Vec2 fba = bodyRepulsion(2.1, 0.3, 1.0, b, 0.25, {1.0, 0.0}, a, 0.25);
+  EXPECT_NEAR(fab.x, -fba.x, 1e-12);
+  EXPECT_NEAR(fab.y, -fba.y, 1e-12);
+  EXPECT_LT(fab.dot(b - a), 0.0);  // pushes away
+  // Magnitude A exp((ri + rj - d)/B).
+  const double d = distance(a, b);
+  EXPECT_NEAR(fab.norm(), 2.1 * std::exp((0.5 - d) / 0.3), 1e-12);
+  // Monotone decreasing in distance.
+  double prev = 1e300;
+  for (double x = 0.3; x < 4.0; x += 0.1) {
+    const double m = bodyRepulsion(2.1, 0.3, 1.0, a, 0.25, {}, {x, 0.0}, 0.25).norm();
+    EXPECT_LT(m, prev);
+    prev = m;
+  }
+}
+
+TEST(SocialForce, AnisotropyWeighsWhatIsAheadMore) {
+  const Vec2 heading{1.0, 0.0};
+  const double ahead = bodyRepulsion(2.1, 0.3, 0.35, {0, 0}, 0.25, heading, {1.0, 0.0}, 0.25).norm();
+  const double behind = bodyRepulsion(2.1, 0.3, 0.35, {0, 0}, 0.25, heading, {-1.0, 0.0}, 0.25).norm();
+  EXPECT_NEAR(behind / ahead, 0.35, 1e-12);
+  const Vec2 w = wallRepulsion(5.0, 0.2, 0.25, 0.5, {0.0, 1.0});
+  EXPECT_NEAR(w.y, 5.0 * std::exp(-0.25 / 0.2), 1e-12);
+}
+
+TEST(SpatialHash, FindsEveryPointWithinRadiusLikeBruteForce) {
+  std::mt19937_64 g(3);
+  std::uniform_real_distribution<double> u(-5.0, 25.0);  // some outside the hashed rectangle
+  std::vector<Vec2> pts(500);
+  for (auto& p : pts) {
+    p = {u(g), u(g)};
+  }
+  SpatialHash h({0, 0}, {20, 20}, 2.0);
+  h.build(pts);
+  for (int q = 0; q < 50; ++q) {
+    const Vec2 c{u(g), u(g)};
+    std::vector<int> found;
+    h.forEachNear(c, 3.0, [&](int i) {
+      if (distance(pts[static_cast<std::size_t>(i)], c) <= 3.0) {
+        found.push_back(i);
+      }
+    });
+    std::sort(found.begin(), found.end());
+    std::vector<int> brute;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (distance(pts[i], c) <= 3.0) {
+        brute.push_back(static_cast<int>(i));
+      }
+    }
+    EXPECT_EQ(found, brute);
+  }
+}
+
+TEST(FlowField, FollowingDirectionsReachesGoalAroundAWall) {
+  auto j = test::room(20, 20, 1.0);
+  auto& rows = j["map"]["rows"];
+  for (int r = 1; r < 15; ++r) {  // wall at column 10 with a gap near the bottom rows
+    std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+    s[10] = '@';
+    rows[static_cast<std::size_t>(r)] = s;
+  }
+  const Scenario sc = test::parse(j);
+  const FlowField f(sc.map, {15.5, 10.5});
+  Vec2 p{4.5, 10.5};
+  EXPECT_GT(f.cellsToGoal(sc.map, p), 11);  // must detour through the gap
+  for (int k = 0; k < 400 && distance(p, f.goal()) > 0.2; ++k) {
+    p += f.direction(sc.map, p) * 0.1;
+    ASSERT_FALSE(sc.map.blocked(sc.map.cellX(p.x), sc.map.cellY(p.y))) << p.x << "," << p.y;
+  }
+  EXPECT_LT(distance(p, f.goal()), 0.2);
+}
+
+TEST(Humans, WalkRouteAroundShelvesNeverInsideWalls) {
+  auto j = test::room(40, 20);
+  auto& rows = j["map"]["rows"];
+  for (int r = 1; r < 14; ++r) {
+    std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+    s[20] = '@';
+    s[21] = '@';
+    rows[static_cast<std::size_t>(r)] = s;
+  }
+  // The wall between start and goal is open only below y = 3 m.
+  j["humans"] = {{"list", {{{"id", "h"}, {"start", {3.0, 5.0}}, {"route", {{16.0, 5.0}}}}}},
+                 {"stop_probability", 0.0}};
+  const Scenario sc = test::parse(j);
+  World w(sc);
+  double maxSpeed = 0.0;
+  bool reached = false;
+  for (int k = 0; k < 400; ++k) {
+    w.advance();
+    const auto& h = w.humans()[0];
+    EXPECT_FALSE(w.scenario().map.blocked(w.scenario().map.cellX(h.p.x), w.scenario().map.cellY(h.p.y)));
+    maxSpeed = std::max(maxSpeed, h.v.norm());
+    reached = reached || distance(h.p, {16.0, 5.0}) < 0.7;
+  }
+  EXPECT_TRUE(reached);
+  EXPECT_LE(maxSpeed, 1.3 * 1.3 + 1e-9);
+  EXPECT_GT(maxSpeed, 1.0);
+}
+
+TEST(Humans, CrowdKeepsApartAndAvoidsParkedRobots) {
+  auto j = test::room(40, 40);
+  j["robots"] = {{{"id", "r1"}, {"start", {10.0, 10.0}}}, {{"id", "r2"}, {"start", {5.0, 15.0}}}};
+  j["points_of_interest"] = {{3.0, 3.0}, {17.0, 17.0}, {3.0, 17.0}, {17.0, 3.0}, {10.0, 10.5}};
+  j["humans"] = {{"count", 30}, {"stop_probability", 0.0}, {"speed_sd", 0.1}};
+  World w(test::parse(j));
+  ASSERT_EQ(w.humans().size(), 30U);
+  double minHH = 1e9;
+  for (int k = 0; k < 600; ++k) {
+    w.advance();
+    const auto& hs = w.humans();
+    for (std::size_t a = 0; a < hs.size(); ++a) {
+      for (std::size_t b = a + 1; b < hs.size(); ++b) {
+        minHH = std::min(minHH, distance(hs[a].p, hs[b].p) - hs[a].r - hs[b].r);
+      }
+    }
+  }
+  EXPECT_GT(minHH, -0.25);  // people may brush, never walk through each other
+  // A goal next to a parked robot: repulsion keeps people off it.
+  EXPECT_GT(w.metrics().minSepRobotHuman, -0.15);
+  double moved = 0.0;
+  for (const auto& h : w.humans()) {
+    moved += h.v.norm();
+  }
+  EXPECT_GT(moved / 30.0, 0.3);  // the crowd is still walking, not jammed
+}
+
+TEST(Humans, PredictionIsConstantVelocityWithGrowingSigma) {
+  auto j = test::room(40, 20);
+  j["humans"] = {{"list", {{{"id", "h"}, {"start", {3.0, 5.0}}, {"route", {{16.0, 5.0}}}}}}};
+  World w(test::parse(j));
+  for (int k = 0; k < 20; ++k) {
+    w.advance();
+  }
+  const auto d = w.predictHuman(0);
+  ASSERT_EQ(d.size(), 7U);  // 3 s at 0.5 s, t = 0 included
+  const auto& h = w.humans()[0];
+  for (std::size_t k = 0; k < d.size(); ++k) {
+    const double t = 0.5 * static_cast<double>(k);
+    EXPECT_NEAR(d[k].x, h.p.x + h.v.x * t, 1e-12);
+    EXPECT_NEAR(d[k].y, h.p.y + h.v.y * t, 1e-12);
+    EXPECT_NEAR(d[k].sigma, 0.05 + 0.3 * t, 1e-12);
+  }
+}
+
+TEST(Humans, GroupsShareGoals) {
+  auto j = test::room(40, 40);
+  j["points_of_interest"] = {{3.0, 3.0}, {17.0, 17.0}, {3.0, 17.0}};
+  j["humans"] = {{"count", 6}, {"group_size", 3}};
+  World w(test::parse(j));
+  for (int k = 0; k < 100; ++k) {
+    w.advance();
+    const auto& hs = w.humans();
+    for (const auto& h : hs) {
+      EXPECT_EQ(h.field, hs[static_cast<std::size_t>(h.leader)].field);
+    }
+  }
+}
