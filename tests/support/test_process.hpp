@@ -4,6 +4,7 @@
 // object goes out of scope so a failing test never leaves orphans.
 
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,6 +27,8 @@ class ChildProcess {
       throw std::runtime_error("fork failed");
     }
     if (pid_ == 0) {
+      // Die with the parent, even when it is killed or crashes before its destructors run.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
       for (const auto& [k, v] : env) {
         setenv(k.c_str(), v.c_str(), 1);
       }

@@ -6,7 +6,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <memory>
 #include <thread>
@@ -21,6 +23,13 @@ using namespace std::chrono_literals;
 using Clk = std::chrono::steady_clock;
 
 namespace {
+// Children end on SIGTERM by leaving the loop, so their DDS participant is deleted and announced;
+// a SIGKILLed reader would stay matched (and block reliable writers) until its lease expires.
+std::atomic<bool> gStop{false};
+extern "C" void onTerm(int) {
+  gStop = true;
+}
+
 const QosProfile kPingQos{true, false, 1, 0, 1000};
 const QosProfile kStreamQos{true, false, 0, 0, 5000};  // reliable keep-all: nothing may be lost
 
@@ -48,7 +57,7 @@ int runPong() {
   Reader<msg::RobotState> in(p, kPingQos, "BenchPing");
   Writer<msg::RobotState> out(p, kPingQos, "BenchPong");
   auto last = Clk::now();
-  while (Clk::now() - last < 5s) {
+  while (!gStop && Clk::now() - last < 5s) {
     if (in.waitForData(100ms)) {
       for (const auto& m : in.take()) {
         out.write(m);
@@ -59,16 +68,30 @@ int runPong() {
   return 0;
 }
 
-int runSink() {
+// raw = count with dds_take loans and no conversion (to see what the wrapper's copy costs).
+int runSink(bool raw) {
   Participant p;
   Reader<msg::RobotState> in(p, kStreamQos, "BenchStream");
   Reader<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
   Writer<msg::StepDone> reply(p, kPingQos, "BenchReply");
   std::int64_t count = 0;
   auto last = Clk::now();
-  while (Clk::now() - last < 10s) {
+  while (!gStop && Clk::now() - last < 10s) {
     if (in.waitForData(20ms)) {
-      count += static_cast<std::int64_t>(in.take().size());
+      if (raw) {
+        dds_sample_info_t infos[256];
+        while (true) {
+          void* samples[256] = {nullptr};  // null first entry: ask for a loan every time
+          const int n = dds_take(in.handle(), samples, infos, 256, 256);
+          if (n <= 0) {
+            break;
+          }
+          count += n;
+          dds_return_loan(in.handle(), samples, n);
+        }
+      } else {
+        count += static_cast<std::int64_t>(in.take().size());
+      }
       last = Clk::now();
     }
     for (const auto& c : ctl.take()) {
@@ -112,6 +135,8 @@ void BM_PingPongOneWay(benchmark::State& state) {
     }
     oneWayUs.push_back(std::chrono::duration<double, std::micro>(Clk::now() - t0).count() / 2);
   }
+  pong.kill(SIGTERM);
+  (void)pong.wait(10s);
   std::sort(oneWayUs.begin(), oneWayUs.end());
   auto pct = [&](double q) {
     return oneWayUs[static_cast<std::size_t>(q * static_cast<double>(oneWayUs.size() - 1))];
@@ -123,7 +148,7 @@ void BM_PingPongOneWay(benchmark::State& state) {
 }
 
 void BM_Throughput(benchmark::State& state) {
-  test::ChildProcess sink(self, {"--sink"});
+  test::ChildProcess sink(self, {state.range(1) != 0 ? "--sink-raw" : "--sink"});
   Participant p;
   Writer<msg::RobotState> out(p, kStreamQos, "BenchStream");
   Writer<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
@@ -155,6 +180,8 @@ void BM_Throughput(benchmark::State& state) {
     written += n;
     received += got;
   }
+  sink.kill(SIGTERM);
+  (void)sink.wait(10s);
   state.counters["samples_per_s"] = static_cast<double>(received) / seconds;
   state.counters["lost"] = static_cast<double>(written - received);
   state.counters["MB_per_s"] = static_cast<double>(received) * 256.0 / seconds / 1e6;
@@ -199,15 +226,24 @@ void BM_WriteRawC(benchmark::State& state) {
 BENCHMARK(BM_WriteWrapper)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WriteRawC)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_PingPongOneWay)->Iterations(20000)->Unit(benchmark::kMicrosecond)->UseRealTime();
-BENCHMARK(BM_Throughput)->Arg(200000)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Throughput)
+    ->Args({200000, 0})
+    ->Args({200000, 1})
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::signal(SIGTERM, onTerm);
   if (argc > 1 && std::strcmp(argv[1], "--pong") == 0) {
     return runPong();
   }
   if (argc > 1 && std::strcmp(argv[1], "--sink") == 0) {
-    return runSink();
+    return runSink(false);
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--sink-raw") == 0) {
+    return runSink(true);
   }
   char buf[4096];
   const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
