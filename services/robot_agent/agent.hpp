@@ -1,0 +1,108 @@
+#pragma once
+
+// One robot's stack without DDS: EKF localization (odometry, compass, landmark bearings), a global
+// A* path on the inflated map, a path follower with the Lyapunov pose controller, a stop-and-yield
+// safety rule on what the sensors see, and task execution (goals with dwell times).
+//
+// This first agent has no local avoidance planner yet (libs/avoidance is being built): it keeps to
+// its path and stops for what is ahead; standoffs between two robots are broken by the robot with
+// the larger id backing off and replanning.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/control/path_follower.hpp"
+#include "fleet/estimation/pose_ekf.hpp"
+#include "fleet/planning/occupancy_grid.hpp"
+#include "fleet/transport/messages.hpp"
+
+namespace fleet::agent {
+
+struct AgentParams {
+  std::string id;
+  Pose2 start;
+  double radius = 0.3;
+  double wheelBase = 0.4;
+  double vMax = 0.8;             // m/s cruise
+  double wMax = 1.5;             // rad/s
+  double stopGap = 0.35;         // m of free space kept ahead at standstill
+  double headway = 1.0;          // s: the stop distance grows with speed
+  double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
+  double blockedFailS = 60.0;    // a task that cannot progress this long fails
+  double predictionHorizonS = 3.0;
+  double predictionDt = 0.5;
+  std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+};
+
+struct AgentOutput {
+  msg::VelocityCommand command;
+  msg::RobotState state;
+  msg::PredictedDiscs discs;
+  std::optional<msg::TaskStatus> status;  // on every task state change
+};
+
+class Agent {
+ public:
+  /// `grid` is the map inflated by the robot radius (where the centre may go); `raw` the map itself.
+  Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> grid,
+        std::shared_ptr<const planning::OccupancyGrid> raw);
+
+  void onFrame(const msg::SensorFrame& f);
+  /// Other robots' states: used to know who is blocking (the larger id yields).
+  void onOtherRobot(const msg::RobotState& s);
+  /// A new revision replaces the current order (an empty task id cancels).
+  void onAssignment(const msg::TaskAssignment& a);
+  AgentOutput step(std::int64_t nowNs, double dt);
+
+  [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
+  [[nodiscard]] const std::string& id() const { return p_.id; }
+  [[nodiscard]] bool busy() const { return !task_.empty(); }
+  [[nodiscard]] std::uint64_t framesRejected() const { return rejected_; }
+
+ private:
+  enum class Phase { Idle, Driving, Dwelling, BackingOff };
+  /// Plans to the current goal; with `avoid`, the cells around that point count as blocked (a
+  /// detour around whatever stands in the way).
+  void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
+  void finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs);
+  msg::TaskState taskStateFor(std::size_t goalIndex, bool dwelling) const;
+  /// Largest forward speed that keeps the stop gap to everything seen ahead, and whether a robot
+  /// (not a human) is what blocks.
+  double clearSpeed(double v, bool& blockedByRobot, std::string& blocker) const;
+  /// Nothing within a short distance behind (backing off must not hit what it cannot see coming).
+  [[nodiscard]] bool rearClear() const;
+
+  AgentParams p_;
+  std::shared_ptr<const planning::OccupancyGrid> grid_;
+  std::shared_ptr<const planning::OccupancyGrid> raw_;
+  estimation::PoseEkf ekf_;
+  control::PathFollower follower_;
+  msg::SensorFrame frame_;
+  bool haveFrame_ = false;
+  std::uint64_t rejected_ = 0;
+
+  std::string task_;
+  std::uint32_t revision_ = 0;
+  std::vector<msg::Goal> goals_;
+  std::size_t goal_ = 0;
+  Phase phase_ = Phase::Idle;
+  std::int64_t phaseStartNs_ = 0;
+  std::int64_t blockedSinceNs_ = -1;
+  std::int64_t lastProgressNs_ = 0;
+  std::optional<msg::TaskStatus> pendingStatus_;
+  msg::TaskState reported_ = msg::TaskState::Queued;
+  std::vector<std::pair<std::string, Vec2>> others_;
+  mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
+  bool detoured_ = false;                   // already tried a detour for the current standoff
+  double v_ = 0.0;
+  double w_ = 0.0;
+  double battery_ = 1.0;
+};
+
+/// The planning grid from a scenario's occupancy cells, inflated by `radius`.
+std::shared_ptr<const planning::OccupancyGrid> inflate(const planning::OccupancyGrid& raw, double radius);
+
+}  // namespace fleet::agent

@@ -1,0 +1,183 @@
+// robot_agent: runs the stack of one or many robots (one DDS participant per process), in wall-clock
+// or lockstep mode against the simulator or real robot drivers speaking the same topics.
+
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "agent.hpp"
+#include "fleet/core/clock.hpp"
+#include "fleet/core/logging.hpp"
+#include "fleet/service/runtime.hpp"
+#include "fleet/sim/scenario.hpp"
+#include "fleet/transport/dds.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
+  auto g = std::make_shared<planning::OccupancyGrid>(m.width, m.height, m.resolution, m.origin);
+  for (int y = 0; y < m.height; ++y) {
+    for (int x = 0; x < m.width; ++x) {
+      if (m.blocked(x, y)) {
+        g->setBlocked({x, y});
+      }
+    }
+  }
+  return g;
+}
+
+int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep,
+        const std::string& id) {
+  auto raw = gridOf(scn.map);
+  std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
+  std::vector<std::unique_ptr<agent::Agent>> agents;
+  std::map<std::string, agent::Agent*> byId;
+  for (const auto& r : scn.robots) {
+    if (!only.empty() && std::find(only.begin(), only.end(), r.id) == only.end()) {
+      continue;
+    }
+    auto& grid = inflatedByRadius[r.radius];
+    if (!grid) {
+      // Plan with a margin beyond the footprint so paths keep to the middle of aisles.
+      grid = agent::inflate(*raw, r.radius + 0.2);
+    }
+    agent::AgentParams p;
+    p.id = r.id;
+    p.start = r.start;
+    p.radius = r.radius;
+    p.wheelBase = r.wheelBase;
+    p.vMax = std::min(0.8, r.limits.v_max);
+    p.wMax = r.limits.omega_max;
+    for (const auto& l : scn.landmarks) {
+      p.landmarks.emplace_back(l.id, l.position);
+    }
+    agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
+    byId[r.id] = agents.back().get();
+  }
+  if (agents.empty()) {
+    spdlog::critical("robot agent: none of the requested robots is in the scenario");
+    return 2;
+  }
+  transport::Participant part;
+  transport::Reader<msg::SensorFrame> frames(part, transport::qos::sensor(lockstep));
+  transport::Reader<msg::TaskAssignment> assignments(part);
+  transport::Reader<msg::Clock> clockIn(part);
+  transport::Reader<msg::RobotState> others(part);
+  transport::Writer<msg::VelocityCommand> commands(part, transport::qos::command(lockstep));
+  transport::Writer<msg::RobotState> states(part);
+  transport::Writer<msg::PredictedDiscs> discs(part);
+  transport::Writer<msg::TaskStatus> statuses(part);
+  transport::Writer<msg::StepDone> stepDone(part);
+  transport::WaitSet ws(part);
+  ws.attach(clockIn);
+  ws.attach(frames);
+  spdlog::info("robot agent {}: {} robots, {} mode", id, agents.size(), lockstep ? "lockstep" : "wall");
+
+  bool haveClock = false;
+  auto lastRegister = std::chrono::steady_clock::now() - 1s;
+  std::int64_t simNow = 0;
+  double dt = scn.dt;
+  std::uint64_t steps = 0;
+  auto cycle = [&](std::int64_t now) {
+    for (const auto& f : frames.take()) {
+      if (auto it = byId.find(f.robot_id); it != byId.end()) {
+        it->second->onFrame(f);
+      }
+    }
+    for (const auto& s : others.take()) {
+      for (auto& a : agents) {
+        a->onOtherRobot(s);
+      }
+    }
+    for (const auto& a : assignments.take()) {
+      if (auto it = byId.find(a.robot_id); it != byId.end()) {
+        it->second->onAssignment(a);
+      }
+    }
+    for (auto& a : agents) {
+      auto out = a->step(now, dt);
+      out.command.seq = static_cast<std::uint32_t>(steps);
+      commands.write(out.command);
+      states.write(out.state);
+      discs.write(out.discs);
+      if (out.status) {
+        statuses.write(*out.status);
+        spdlog::debug("{}: task {} {}", a->id(), out.status->task_id, msg::toString(out.status->state));
+      }
+    }
+    ++steps;
+  };
+
+  auto wallNext = std::chrono::steady_clock::now();
+  while (!service::stopRequested()) {
+    if (lockstep) {
+      if (!haveClock && std::chrono::steady_clock::now() - lastRegister > 100ms) {
+        stepDone.write({id, msg::StepDone::kRegister});
+        lastRegister = std::chrono::steady_clock::now();
+      }
+      ws.wait(100ms);
+      for (const auto& c : clockIn.take()) {
+        haveClock = true;
+        simNow = c.sim_time_ns;
+        dt = nsToSec(c.dt_ns);
+        cycle(simNow);
+        stepDone.write({id, c.step});
+      }
+    } else {
+      std::this_thread::sleep_until(wallNext);
+      wallNext += std::chrono::milliseconds(static_cast<int>(dt * 1000));
+      for (const auto& c : clockIn.take()) {
+        simNow = c.sim_time_ns;
+      }
+      cycle(WallClock{}.nowNs());
+    }
+  }
+  if (lockstep) {
+    stepDone.write({id, msg::StepDone::kLeave});
+  }
+  spdlog::info("robot agent {}: stopped after {} cycles", id, steps);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"robot_agent: the local stack of one or many robots"};
+  std::string scenario;
+  std::string robots;
+  std::string clock = "wall";
+  std::string id = "agents";
+  std::string level = "info";
+  app.add_option("--scenario", scenario, "scenario JSON (map, robots, landmarks)")->required();
+  app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
+  app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
+  app.add_option("--id", id, "participant id in lockstep");
+  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    logging::setup("robot_agent", level);
+    const auto scn = sim::loadScenario(scenario);
+    std::vector<std::string> only;
+    std::stringstream ss(robots);
+    for (std::string r; std::getline(ss, r, ',');) {
+      if (!r.empty()) {
+        only.push_back(r);
+      }
+    }
+    service::installStopHandlers();
+    return run(scn, only, clock == "lockstep", id);
+  } catch (const ConfigError& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::critical("robot agent: {}", e.what());
+    return 1;
+  }
+}
