@@ -20,6 +20,9 @@ class FakeGateway : public TaskGateway {
   std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
                                                   std::chrono::milliseconds) override {
     std::vector<std::optional<msg::TaskAck>> out;
+    if (delay.count() > 0) {
+      std::this_thread::sleep_for(delay);
+    }
     for (const auto& r : requests) {
       if (silent) {
         out.emplace_back();
@@ -43,6 +46,7 @@ class FakeGateway : public TaskGateway {
   std::map<std::string, std::string> bodies;
   bool online = true;
   bool silent = false;
+  std::chrono::milliseconds delay{0};  // a slow manager
 };
 
 StationMap stations() {
@@ -166,6 +170,25 @@ TEST_F(Api, ManagerUnreachableGives503AndNothingIsClaimed) {
   r = post(kTask);
   EXPECT_EQ(r->status, 503);
   EXPECT_EQ(client_->Get("/v1/tasks/t-1")->status, 404) << "an unacknowledged task is not shown as accepted";
+}
+
+TEST_F(Api, TooManyRequestsInFlightGet429) {
+  ApiSettings s;
+  s.maxInFlight = 1;
+  start(s);
+  gateway_.delay = std::chrono::milliseconds(500);
+  int slowStatus = 0;
+  std::thread slow([&] {
+    httplib::Client c("127.0.0.1", api_->port());
+    slowStatus = c.Post("/v1/tasks", kTask, "application/json")->status;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  auto r = post(R"({"id": "t-2", "kind": "goto", "station": "D-1"})");
+  EXPECT_EQ(r->status, 429);
+  EXPECT_EQ(r->get_header_value("Retry-After"), "1");
+  slow.join();
+  EXPECT_EQ(slowStatus, 201);
+  EXPECT_EQ(gateway_.bodies.count("t-2"), 0u) << "a refused request stores nothing";
 }
 
 TEST_F(Api, BearerTokenIsRequiredWhenConfigured) {
