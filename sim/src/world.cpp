@@ -57,6 +57,8 @@ std::uint64_t pairKey(int a, int b) {
 constexpr double kChargeReach = 0.5;  // m from a charging station's pose
 constexpr double kStillSpeed = 0.02;  // m/s under which a robot is idle
 constexpr double kArrive = 0.6;       // m: a human reached its goal
+constexpr double kProgressM = 0.5;    // m: moving less than this in kGiveUpS is being stuck
+constexpr double kGiveUpS = 5.0;      // s of being stuck before choosing another goal
 // Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
 // a run whose bodies never come that close reports null.
 constexpr double kSeparationReach = 2.0;
@@ -361,6 +363,17 @@ void World::stepHumans() {
       const HumanBody& l = humans_[static_cast<std::size_t>(h.leader)];
       h.field = l.field;
       h.stopUntil = l.stopUntil;
+      continue;
+    }
+    // People who cannot get past (a robot waiting in a narrow aisle, a crowd) do not push forever:
+    // after kGiveUpS without kProgressM of progress they turn to another goal.
+    if (h.progressAt < 0 || now < h.stopUntil || distance(h.p, h.progressRef) > kProgressM) {
+      h.progressRef = h.p;
+      h.progressAt = now;
+    } else if (h.field >= 0 && now - h.progressAt > kGiveUpS) {
+      h.progressRef = h.p;
+      h.progressAt = now;
+      pickGoal(i);
       continue;
     }
     if (h.field >= 0 && now >= h.stopUntil &&

@@ -180,3 +180,37 @@ TEST(Humans, GroupsShareGoals) {
     }
   }
 }
+
+TEST(Humans, SomeoneBlockedInAnAisleTurnsToAnotherGoal) {
+  // A 1 m wide corridor with a parked robot in the middle; the person's goal is behind the robot.
+  auto j = test::room(40, 20);
+  auto& rows = j["map"]["rows"];
+  for (int r = 1; r < 19; ++r) {
+    if (r == 9 || r == 10) {
+      continue;  // the corridor: rows 9-10 (y 4.5..5.5 m from the bottom of the 20-row map)
+    }
+    std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+    for (int c = 8; c < 32; ++c) {
+      s[static_cast<std::size_t>(c)] = '@';
+    }
+    rows[static_cast<std::size_t>(r)] = s;
+  }
+  j["robots"] = {{{"id", "r1"}, {"start", {10.0, 5.0}}}};
+  j["points_of_interest"] = {{17.0, 5.0}, {2.0, 2.0}, {2.0, 8.0}};
+  j["humans"] = {{"list", {{{"id", "h"}, {"start", {13.0, 5.0}}, {"route", {{6.0, 5.0}, {17.0, 5.0}}}}}},
+                 {"stop_probability", 0.0}};
+  const Scenario sc = test::parse(j);
+  World w(sc);
+  double minX = 1e9;
+  double maxXLater = -1e9;
+  for (int k = 0; k < 300; ++k) {  // 30 s
+    w.advance();
+    const auto& h = w.humans()[0];
+    minX = std::min(minX, h.p.x);
+    if (k > 150) {
+      maxXLater = std::max(maxXLater, h.p.x);
+    }
+  }
+  EXPECT_GT(minX, 10.0) << "nobody walks through the robot";
+  EXPECT_GT(maxXLater, 14.0) << "after giving up the person walks away from the robot instead of pushing";
+}

@@ -44,6 +44,8 @@ struct HumanBody {
   std::size_t routeIdx = 0;
   double stopUntil = 0.0;  // sim s
   int leader = -1;         // group leader's index (self when leading or alone)
+  Vec2 progressRef;        // where the human was when it last made progress
+  double progressAt = -1;  // sim s of that moment; -1 before the first step
 };
 
 /// A contact between two bodies this step. Indices: robots 0..R-1, humans R..R+H-1, b = -1 is the map.
