@@ -12,7 +12,105 @@ namespace fleet::planning {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Exact octile Dijkstra with two FIFO queues, one per move cost (1 and sqrt 2). Cells leave the
+// queues in non-decreasing cost, so every key pushed with cost d + c is >= the keys already in the
+// queue for c: each queue stays sorted and the smaller of the two heads is the global minimum. An
+// entry is stale when its key exceeds the cell's current cost (it was improved later); costs only
+// ever decrease by strict improvement, so the live entry of a cell is unique and no "done" array is
+// needed. Blocked cells (and a one-cell border) hold -1 in the padded cost array: a relaxation
+// "nd < cost" then never succeeds on them and the same array answers "is this cell free?".
+// Relaxations are branch-free (conditional store plus conditional tail advance); the queues are
+// sized for the worst case (every cell improved through each of its four in-moves of that kind).
+void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<double>& out) {
+  const int w = grid.width();
+  const int h = grid.height();
+  const auto P = static_cast<std::ptrdiff_t>(w) + 2;
+  const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
+  struct Entry {
+    double key;
+    std::uint32_t idx;
+  };
+  thread_local std::vector<double> cost;
+  thread_local std::vector<Entry> q1;
+  thread_local std::vector<Entry> q2;
+  cost.resize(padded);
+  // Only the border needs setting here: the fill below writes every interior cell.
+  std::fill_n(cost.begin(), P, -1.0);
+  std::fill_n(cost.end() - P, P, -1.0);
+  for (int y = 1; y <= h; ++y) {
+    cost[static_cast<std::size_t>(y * P)] = -1.0;
+    cost[static_cast<std::size_t>(y * P + P - 1)] = -1.0;
+  }
+  if (q1.size() < 4 * padded + 2) {
+    q1.resize(4 * padded + 2);
+    q2.resize(4 * padded + 2);
+  }
+  const std::uint8_t* occ = grid.cells().data();
+  for (int y = 0; y < h; ++y) {
+    double* row = cost.data() + (y + 1) * P + 1;
+    const std::uint8_t* orow = occ + static_cast<std::ptrdiff_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      row[x] = orow[x] == 0 ? kInf : -1.0;
+    }
+  }
+  double* c = cost.data();
+  Entry* a = q1.data();
+  Entry* b = q2.data();
+  // Each queue ends in a sentinel with key +inf, so choosing the head needs no emptiness tests.
+  std::size_t ha = 0, ta = 0, hb = 0, tb = 0;
+  c[start] = 0.0;
+  a[ta++] = {0.0, start};
+  a[ta] = {kInf, 0};
+  b[tb] = {kInf, 0};
+  constexpr double diag = std::numbers::sqrt2;
+  for (;;) {
+    const double ka = a[ha].key;
+    const double kb = b[hb].key;
+    if (ka == kInf && kb == kInf) {
+      break;
+    }
+    const bool fromA = ka <= kb;
+    const Entry e = fromA ? a[ha] : b[hb];
+    ha += fromA ? 1U : 0U;
+    hb += fromA ? 0U : 1U;
+    const auto i = static_cast<std::ptrdiff_t>(e.idx);
+    const double d = e.key;
+    if (d > c[i]) {
+      continue;  // stale
+    }
+    const double ce = c[i + 1], cs = c[i - P], cw = c[i - 1], cn = c[i + P];
+    const double cse = c[i - P + 1], csw = c[i - P - 1], cnw = c[i + P - 1], cne = c[i + P + 1];
+    const double n1 = d + 1.0;
+    const double n2 = d + diag;
+    auto relax = [](double* cell, Entry* q, std::size_t& t, double cj, double nd, std::ptrdiff_t j, bool ok) {
+      const bool imp = ok && nd < cj;
+      *cell = imp ? nd : cj;
+      q[t] = {nd, static_cast<std::uint32_t>(j)};
+      t += imp ? 1U : 0U;
+    };
+    relax(c + i + 1, a, ta, ce, n1, i + 1, true);
+    relax(c + i - P, a, ta, cs, n1, i - P, true);
+    relax(c + i - 1, a, ta, cw, n1, i - 1, true);
+    relax(c + i + P, a, ta, cn, n1, i + P, true);
+    const bool fe = ce >= 0.0, fs = cs >= 0.0, fw = cw >= 0.0, fn = cn >= 0.0;
+    relax(c + i - P + 1, b, tb, cse, n2, i - P + 1, fe && fs);
+    relax(c + i - P - 1, b, tb, csw, n2, i - P - 1, fw && fs);
+    relax(c + i + P - 1, b, tb, cnw, n2, i + P - 1, fw && fn);
+    relax(c + i + P + 1, b, tb, cne, n2, i + P + 1, fe && fn);
+    a[ta] = {kInf, 0};
+    b[tb] = {kInf, 0};
+  }
+  for (int y = 0; y < h; ++y) {
+    const double* row = c + (y + 1) * P + 1;
+    double* dst = out.data() + static_cast<std::ptrdiff_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      dst[x] = row[x] < 0.0 ? kInf : row[x];
+    }
+  }
 }
+
+}  // namespace
 
 const std::vector<Cell>& neighbourOffsets(Connectivity conn) {
   static const std::vector<Cell> four{{1, 0}, {0, -1}, {-1, 0}, {0, 1}};
@@ -53,100 +151,44 @@ DistanceField computeDistanceField(const OccupancyGrid& grid, Cell goal, Connect
   f.height = grid.height();
   f.goal = goal;
   f.conn = conn;
-  f.cost.assign(grid.size(), kInf);
   if (grid.blocked(goal)) {
+    f.cost.assign(grid.size(), kInf);
     return f;
   }
-  // Work on a copy padded with one blocked cell all around: the inner loops then need neither
-  // bounds checks nor index divisions.
   const int w = grid.width();
   const int h = grid.height();
   const auto P = static_cast<std::ptrdiff_t>(w) + 2;
   const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
+  const auto start = static_cast<std::uint32_t>((goal.y + 1) * P + goal.x + 1);
+  if (conn == Connectivity::Eight) {
+    f.cost.resize(grid.size());  // every cell is written by octileField
+    octileField(grid, start, f.cost);
+    return f;
+  }
+  // Work on a copy padded with one blocked cell all around: the inner loops then need neither
+  // bounds checks nor index divisions.
   std::vector<std::uint8_t> occ(padded, 1);
   for (int y = 0; y < h; ++y) {
     std::copy_n(grid.cells().begin() + static_cast<std::ptrdiff_t>(y) * w, w, occ.begin() + (y + 1) * P + 1);
   }
   std::vector<double> cost(padded, kInf);
-  const auto start = static_cast<std::uint32_t>((goal.y + 1) * P + goal.x + 1);
+  f.cost.resize(grid.size());
   // The seed's pseudocode never sets d(B) = 0, re-queues B and does not exclude obstacles in
   // check(); all three are fixed here.
   cost[start] = 0.0;
-  if (conn == Connectivity::Four) {
-    std::vector<std::uint32_t> queue;
-    queue.reserve(grid.size());
-    queue.push_back(start);
-    const std::ptrdiff_t steps[4] = {1, -P, -1, P};
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const auto i = static_cast<std::ptrdiff_t>(queue[head]);
-      const double next = cost[static_cast<std::size_t>(i)] + 1.0;
-      for (const std::ptrdiff_t st : steps) {
-        const auto ni = static_cast<std::size_t>(i + st);
-        if (occ[ni] == 0 && cost[ni] == kInf) {
-          cost[ni] = next;
-          queue.push_back(static_cast<std::uint32_t>(ni));
-        }
+  std::vector<std::uint32_t> queue;
+  queue.reserve(grid.size());
+  queue.push_back(start);
+  const std::ptrdiff_t steps[4] = {1, -P, -1, P};
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const auto i = static_cast<std::ptrdiff_t>(queue[head]);
+    const double next = cost[static_cast<std::size_t>(i)] + 1.0;
+    for (const std::ptrdiff_t st : steps) {
+      const auto ni = static_cast<std::size_t>(i + st);
+      if (occ[ni] == 0 && cost[ni] == kInf) {
+        cost[ni] = next;
+        queue.push_back(static_cast<std::uint32_t>(ni));
       }
-    }
-  } else {
-    // Dijkstra with a bucket queue of width 1 (Dinitz): every move costs at least 1, so relaxing a
-    // cell of bucket b only reaches buckets > b and cells inside one bucket can be settled in any
-    // order. Moves cost at most sqrt(2) < 2, so only buckets b+1 and b+2 receive cells while b is
-    // settled: a ring of three reusable buckets suffices.
-    std::array<std::vector<std::uint32_t>, 3> ring;
-    for (auto& r : ring) {
-      r.reserve(1024);
-    }
-    std::vector<std::uint8_t> done(padded, 0);
-    ring[0].push_back(start);
-    auto relax = [&](std::ptrdiff_t ni, double nd) {
-      const auto u = static_cast<std::size_t>(ni);
-      if (nd < cost[u]) {
-        cost[u] = nd;
-        ring[static_cast<std::size_t>(nd) % 3].push_back(static_cast<std::uint32_t>(u));
-      }
-    };
-    constexpr double diag = std::numbers::sqrt2;
-    for (std::size_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
-      auto& bucket = ring[b % 3];
-      for (std::size_t k = 0; k < bucket.size(); ++k) {
-        const std::size_t idx = bucket[k];
-        if (done[idx] != 0 || static_cast<std::size_t>(cost[idx]) != b) {
-          continue;  // already settled, or improved into an earlier bucket
-        }
-        done[idx] = 1;
-        const double d = cost[idx];
-        const auto i = static_cast<std::ptrdiff_t>(idx);
-        const bool e = occ[static_cast<std::size_t>(i + 1)] == 0;
-        const bool s = occ[static_cast<std::size_t>(i - P)] == 0;
-        const bool wst = occ[static_cast<std::size_t>(i - 1)] == 0;
-        const bool n = occ[static_cast<std::size_t>(i + P)] == 0;
-        if (e) {
-          relax(i + 1, d + 1.0);
-        }
-        if (s) {
-          relax(i - P, d + 1.0);
-        }
-        if (wst) {
-          relax(i - 1, d + 1.0);
-        }
-        if (n) {
-          relax(i + P, d + 1.0);
-        }
-        if (e && s && occ[static_cast<std::size_t>(i - P + 1)] == 0) {
-          relax(i - P + 1, d + diag);
-        }
-        if (wst && s && occ[static_cast<std::size_t>(i - P - 1)] == 0) {
-          relax(i - P - 1, d + diag);
-        }
-        if (wst && n && occ[static_cast<std::size_t>(i + P - 1)] == 0) {
-          relax(i + P - 1, d + diag);
-        }
-        if (e && n && occ[static_cast<std::size_t>(i + P + 1)] == 0) {
-          relax(i + P + 1, d + diag);
-        }
-      }
-      bucket.clear();
     }
   }
   for (int y = 0; y < h; ++y) {
