@@ -4,22 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <queue>
 
 namespace fleet::planning {
-
-namespace {
-
-double heuristic(Cell a, Cell b, Connectivity conn) {
-  const double dx = std::abs(a.x - b.x);
-  const double dy = std::abs(a.y - b.y);
-  if (conn == Connectivity::Four) {
-    return dx + dy;
-  }
-  return std::max(dx, dy) + (std::numbers::sqrt2 - 1.0) * std::min(dx, dy);
-}
-
-}  // namespace
 
 LandmarkHeuristic LandmarkHeuristic::build(const OccupancyGrid& grid, Connectivity conn, int count) {
   LandmarkHeuristic lh;
@@ -113,80 +99,109 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   if (grid.blocked(start) || grid.blocked(goal)) {
     return unexpected("unreachable", "start or goal cell is blocked or outside the map");
   }
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  // Scratch buffers are reused across calls on the same thread: queries are many and small.
-  thread_local std::vector<double> g;
-  thread_local std::vector<std::uint32_t> parent;
-  thread_local std::vector<std::uint32_t> stamp;
-  thread_local std::vector<std::uint32_t> closed;
+  // Costs are a + b*sqrt(2) cells. They are kept in 32.32 fixed point (one cell = 2^32, a diagonal
+  // = round(sqrt(2) * 2^32)), so sums are exact and order-independent: equal-length paths get
+  // exactly equal keys without rounding tolerances. Distinct lengths below ~2,000 cells differ by
+  // > 1e-4 cell while the fixed-point error is < 2,000 * 2^-33, so the order is that of the true
+  // values. The octile heuristic in the same units stays exactly consistent (each move changes it
+  // by at most its own cost).
+  constexpr std::int64_t kOne = std::int64_t{1} << 32;
+  const auto kDiag = static_cast<std::int64_t>(std::numbers::sqrt2 * static_cast<double>(kOne) + 0.5);
+  // One 16-byte record per cell (g, parent, epoch stamp) so a relaxation touches one cache line.
+  // stamp == 2*epoch: reached in this query; 2*epoch + 1: closed. Scratch is reused across calls on
+  // the same thread: queries are many and small.
+  struct Node {
+    std::int64_t g;
+    std::uint32_t parent;
+    std::uint32_t stamp;
+  };
+  thread_local std::vector<Node> nodes;
   thread_local std::uint32_t epoch = 0;
-  if (g.size() != grid.size()) {
-    g.assign(grid.size(), inf);
-    parent.assign(grid.size(), 0);
-    stamp.assign(grid.size(), 0);
-    closed.assign(grid.size(), 0);
+  if (nodes.size() != grid.size()) {
+    nodes.assign(grid.size(), Node{0, 0, 0});
     epoch = 0;
   }
-  if (++epoch == 0) {
-    std::fill(stamp.begin(), stamp.end(), 0);
-    std::fill(closed.begin(), closed.end(), 0);
+  if (++epoch >= (std::uint32_t{1} << 31)) {
+    std::fill(nodes.begin(), nodes.end(), Node{0, 0, 0});
     epoch = 1;
   }
-  auto gOf = [&](std::size_t i) { return stamp[i] == epoch ? g[i] : inf; };
-  // f is quantised to 1e-9 cells so that paths of equal length compare equal despite rounding;
-  // among them the deeper node (larger g) goes first, which cuts expansions in open areas.
-  // With a consistent heuristic the first time a cell leaves the queue its g is optimal, so later
-  // copies are skipped by the closed mark; g in the item only breaks ties (16-byte items).
+  const std::uint32_t seen = 2 * epoch;
+  const std::uint32_t closedMark = 2 * epoch + 1;
+  // Ties on f prefer the deeper node (larger g), which cuts expansions in open areas. With a
+  // consistent heuristic the first time a cell leaves the queue its g is optimal, so later copies
+  // are skipped by the closed mark.
   struct Item {
-    std::int64_t fq;
-    float g;
-    std::uint32_t idx;
-    bool operator>(const Item& o) const { return fq > o.fq || (fq == o.fq && g < o.g); }
+    std::int64_t f;
+    std::int64_t g;
+    bool operator<(const Item& o) const { return f > o.f || (f == o.f && g < o.g); }
   };
-  auto quant = [](double f) { return static_cast<std::int64_t>(std::llround(f * 1e9)); };
-  std::vector<Item> heapStore;
-  heapStore.reserve(4096);
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> open(std::greater<>{}, std::move(heapStore));
+  struct HeapItem {
+    Item key;
+    std::uint32_t idx;
+  };
+  auto worse = [](const HeapItem& x, const HeapItem& y) { return x.key < y.key; };
+  thread_local std::vector<HeapItem> heap;
+  heap.clear();
   const auto si = static_cast<std::uint32_t>(grid.index(start));
   const auto gi = static_cast<std::uint32_t>(grid.index(goal));
-  g[si] = 0.0;
-  stamp[si] = epoch;
-  parent[si] = si;
+  nodes[si] = {0, si, seen};
   const std::size_t goalIdx = grid.index(goal);
-  auto hOf = [&](Cell c, std::size_t idx) {
-    const double oct = heuristic(c, goal, conn);
-    return landmarks != nullptr ? std::max(oct, landmarks->bound(idx, goalIdx)) : oct;
-  };
-  open.push({quant(hOf(start, si)), 0.0F, si});
-  GridPath out;
-  const auto& offs = neighbourOffsets(conn);
   const bool eight = conn == Connectivity::Eight;
+  auto hOf = [&](int x, int y, std::size_t idx) {
+    const std::int64_t dx = std::abs(x - goal.x);
+    const std::int64_t dy = std::abs(y - goal.y);
+    std::int64_t hv =
+        eight ? (std::max(dx, dy) - std::min(dx, dy)) * kOne + std::min(dx, dy) * kDiag : (dx + dy) * kOne;
+    if (landmarks != nullptr) {
+      // Truncation keeps the landmark bound admissible.
+      hv =
+          std::max(hv, static_cast<std::int64_t>(landmarks->bound(idx, goalIdx) * static_cast<double>(kOne)));
+    }
+    return hv;
+  };
+  // The landmark bound comes from floating-point fields, so it differs from the fixed-point sums by
+  // a fraction of 2^-32 per diagonal: f is compared at 2^-16 cell (the low 16 bits rounded away), far
+  // below the 1e-4-cell gap between distinct lengths but above that noise, so equal-length paths
+  // still tie and the larger-g rule applies.
+  auto quant = [](std::int64_t f) { return (f + (std::int64_t{1} << 15)) >> 16; };
+  heap.push_back({{quant(hOf(start.x, start.y, si)), 0}, si});
+  GridPath out;
   const int w = grid.width();
   const int h = grid.height();
   const auto W = static_cast<std::ptrdiff_t>(w);
   const std::uint8_t* occ = grid.cells().data();
-  while (!open.empty()) {
-    const Item it = open.top();
-    open.pop();
-    if (closed[it.idx] == epoch) {
+  // Moves in neighbourOffsets order: E, S, W, N, SE, SW, NW, NE.
+  const int mdx[8] = {1, 0, -1, 0, 1, -1, -1, 1};
+  const int mdy[8] = {0, -1, 0, 1, -1, -1, 1, 1};
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), worse);
+    const HeapItem it = heap.back();
+    heap.pop_back();
+    Node& cur = nodes[it.idx];
+    if (cur.stamp == closedMark) {
       continue;
     }
-    closed[it.idx] = epoch;
-    const double gCur = g[it.idx];
+    cur.stamp = closedMark;
+    const std::int64_t gCur = cur.g;
     ++out.expanded;
     if (it.idx == gi) {
-      out.cost = gCur;
-      for (std::uint32_t k = gi;; k = parent[k]) {
-        out.cells.push_back(grid.cellOf(k));
+      int straight = 0, diagonal = 0;
+      for (std::uint32_t k = gi;; k = nodes[k].parent) {
+        const Cell c = grid.cellOf(k);
+        if (!out.cells.empty()) {
+          const Cell& nx = out.cells.back();
+          (nx.x != c.x && nx.y != c.y ? diagonal : straight) += 1;
+        }
+        out.cells.push_back(c);
         if (k == si) {
           break;
         }
       }
       std::reverse(out.cells.begin(), out.cells.end());
+      out.cost = static_cast<double>(straight) + static_cast<double>(diagonal) * std::numbers::sqrt2;
       return out;
     }
-    // Neighbour moves on the raw cell array, in neighbourOffsets order; diagonals need both
-    // orthogonal cells free (no corner cutting).
+    // Diagonals need both orthogonal cells free (no corner cutting).
     const int x = static_cast<int>(it.idx % static_cast<std::uint32_t>(w));
     const int y = static_cast<int>(it.idx / static_cast<std::uint32_t>(w));
     const auto i = static_cast<std::ptrdiff_t>(it.idx);
@@ -206,14 +221,17 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
       if (!ok[k]) {
         continue;
       }
-      const Cell o = offs[static_cast<std::size_t>(k)];
-      const auto ni = static_cast<std::uint32_t>(i + o.x + o.y * W);
-      const double ng = gCur + (k < 4 ? 1.0 : std::numbers::sqrt2);
-      if (ng < gOf(ni)) {
-        g[ni] = ng;
-        stamp[ni] = epoch;
-        parent[ni] = it.idx;
-        open.push({quant(ng + hOf({x + o.x, y + o.y}, ni)), static_cast<float>(ng), ni});
+      const auto ni = static_cast<std::uint32_t>(i + mdx[k] + mdy[k] * W);
+      const std::int64_t ng = gCur + (k < 4 ? kOne : kDiag);
+      Node& nb = nodes[ni];
+      const bool known = nb.stamp == seen || nb.stamp == closedMark;
+      if (!known || ng < nb.g) {
+        if (nb.stamp == closedMark) {
+          continue;  // consistent heuristic: a closed cell already has its optimal g
+        }
+        nb = {ng, it.idx, seen};
+        heap.push_back({{quant(ng + hOf(x + mdx[k], y + mdy[k], ni)), ng}, ni});
+        std::push_heap(heap.begin(), heap.end(), worse);
       }
     }
   }
