@@ -99,52 +99,67 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   if (grid.blocked(start) || grid.blocked(goal)) {
     return unexpected("unreachable", "start or goal cell is blocked or outside the map");
   }
-  // Costs are a + b*sqrt(2) cells. They are kept in 32.32 fixed point (one cell = 2^32, a diagonal
-  // = round(sqrt(2) * 2^32)), so sums are exact and order-independent: equal-length paths get
-  // exactly equal keys without rounding tolerances. Distinct lengths below ~2,000 cells differ by
-  // > 1e-4 cell while the fixed-point error is < 2,000 * 2^-33, so the order is that of the true
-  // values. The octile heuristic in the same units stays exactly consistent (each move changes it
-  // by at most its own cost).
-  constexpr std::int64_t kOne = std::int64_t{1} << 32;
+  // Costs are a + b*sqrt(2) cells. They are kept in fixed point with `frac` fractional bits (one
+  // cell = 2^frac, a diagonal = round(sqrt(2) * 2^frac)), so sums are exact and order-independent:
+  // equal-length paths get exactly equal keys without rounding tolerances. The octile heuristic in
+  // the same units stays exactly consistent (each move changes it by at most its own cost). frac
+  // is 32 unless the grid is so large that a path through every cell (< 1.5 * cells) would not fit
+  // in the 52 bits of g kept per cell; the fixed-point error (< diagonals * 2^-(frac+1)) is far
+  // below the gap between distinct lengths of realistic paths (~1e-4 cell for 2,000 diagonals).
+  int cellBits = 0;
+  while ((std::uint64_t{3} * grid.size()) >> cellBits != 0) {
+    ++cellBits;
+  }
+  const int frac = std::min(32, 51 - cellBits);
+  const std::int64_t kOne = std::int64_t{1} << frac;
   const auto kDiag = static_cast<std::int64_t>(std::numbers::sqrt2 * static_cast<double>(kOne) + 0.5);
-  // One 16-byte record per cell (g, parent, epoch stamp) so a relaxation touches one cache line.
-  // stamp == 2*epoch: reached in this query; 2*epoch + 1: closed. Scratch is reused across calls on
-  // the same thread: queries are many and small.
-  struct Node {
-    std::int64_t g;
-    std::uint32_t parent;
-    std::uint32_t stamp;
-  };
-  thread_local std::vector<Node> nodes;
+  // One 8-byte word per cell: a 12-bit query stamp above a 52-bit g.
+  // stamp == 2*epoch: reached in this query; 2*epoch + 1: closed. No parent is stored: with exact
+  // costs the path is recovered by stepping back to a neighbour whose g plus the move cost equals
+  // the current g. Scratch is reused across calls on the same thread: queries are many and small.
+  constexpr int kStampShift = 52;
+  constexpr std::uint64_t kGMask = (std::uint64_t{1} << kStampShift) - 1;
+  thread_local std::vector<std::uint64_t> nodes;
   thread_local std::uint32_t epoch = 0;
   if (nodes.size() != grid.size()) {
-    nodes.assign(grid.size(), Node{0, 0, 0});
+    nodes.assign(grid.size(), 0);
     epoch = 0;
   }
-  if (++epoch >= (std::uint32_t{1} << 31)) {
-    std::fill(nodes.begin(), nodes.end(), Node{0, 0, 0});
+  if (++epoch >= (std::uint32_t{1} << 11)) {
+    std::fill(nodes.begin(), nodes.end(), 0);
     epoch = 1;
   }
-  const std::uint32_t seen = 2 * epoch;
-  const std::uint32_t closedMark = 2 * epoch + 1;
-  // Ties on f prefer the deeper node (larger g), which cuts expansions in open areas. With a
-  // consistent heuristic the first time a cell leaves the queue its g is optimal, so later copies
-  // are skipped by the closed mark.
-  struct Item {
-    std::int64_t f;
-    std::int64_t g;
-    bool operator<(const Item& o) const { return f > o.f || (f == o.f && g < o.g); }
+  const std::uint64_t seen = std::uint64_t{2} * epoch;
+  const std::uint64_t closedMark = seen + 1;
+  auto stampOf = [&](std::size_t k) { return nodes[k] >> kStampShift; };
+  auto gOf = [&](std::size_t k) { return static_cast<std::int64_t>(nodes[k] & kGMask); };
+  auto setNode = [&](std::size_t k, std::int64_t g, std::uint64_t st) {
+    nodes[k] = (st << kStampShift) | static_cast<std::uint64_t>(g);
   };
+  // Heap key (one 64-bit compare): f rounded to 2^-16 cell in the high 40 bits, then the
+  // complement of g in 2^-8 cell (24 bits, saturating beyond 65,536 cells) so that ties on f go to
+  // the deeper node, which cuts expansions in open areas. With a consistent heuristic the first
+  // time a cell leaves the queue its g is optimal; later copies are skipped by the closed mark. The
+  // landmark bound comes from floating-point fields and differs from the fixed-point sums by a
+  // fraction of 2^-frac per move: rounding f to 2^-16 keeps equal-length paths tied while distinct
+  // lengths stay > 1e-4 cell apart.
   struct HeapItem {
-    Item key;
+    std::uint64_t key;
     std::uint32_t idx;
   };
-  auto worse = [](const HeapItem& x, const HeapItem& y) { return x.key < y.key; };
+  auto worse = [](const HeapItem& x, const HeapItem& y) { return x.key > y.key; };
+  const int fShift = frac - 16;
+  const int gShift = frac - 8;
+  auto item = [&](std::int64_t f, std::int64_t g, std::uint32_t idx) {
+    const auto fq = static_cast<std::uint64_t>((f + (std::int64_t{1} << (fShift - 1))) >> fShift);
+    const auto gq = std::min<std::uint64_t>(static_cast<std::uint64_t>(g >> gShift), 0xFFFFFF);
+    return HeapItem{(fq << 24) | (0xFFFFFF - gq), idx};
+  };
   thread_local std::vector<HeapItem> heap;
   heap.clear();
   const auto si = static_cast<std::uint32_t>(grid.index(start));
   const auto gi = static_cast<std::uint32_t>(grid.index(goal));
-  nodes[si] = {0, si, seen};
+  setNode(si, 0, seen);
   const std::size_t goalIdx = grid.index(goal);
   const bool eight = conn == Connectivity::Eight;
   auto hOf = [&](int x, int y, std::size_t idx) {
@@ -159,12 +174,7 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
     }
     return hv;
   };
-  // The landmark bound comes from floating-point fields, so it differs from the fixed-point sums by
-  // a fraction of 2^-32 per diagonal: f is compared at 2^-16 cell (the low 16 bits rounded away), far
-  // below the 1e-4-cell gap between distinct lengths but above that noise, so equal-length paths
-  // still tie and the larger-g rule applies.
-  auto quant = [](std::int64_t f) { return (f + (std::int64_t{1} << 15)) >> 16; };
-  heap.push_back({{quant(hOf(start.x, start.y, si)), 0}, si});
+  heap.push_back(item(hOf(start.x, start.y, si), 0, si));
   GridPath out;
   const int w = grid.width();
   const int h = grid.height();
@@ -173,66 +183,84 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   // Moves in neighbourOffsets order: E, S, W, N, SE, SW, NW, NE.
   const int mdx[8] = {1, 0, -1, 0, 1, -1, -1, 1};
   const int mdy[8] = {0, -1, 0, 1, -1, -1, 1, 1};
+  auto allowedMoves = [&](std::ptrdiff_t i, int x, int y, bool* ok) {
+    // Diagonals need both orthogonal cells free (no corner cutting).
+    const bool e = x + 1 < w && occ[i + 1] == 0;
+    const bool s = y > 0 && occ[i - W] == 0;
+    const bool wst = x > 0 && occ[i - 1] == 0;
+    const bool n = y + 1 < h && occ[i + W] == 0;
+    ok[0] = e;
+    ok[1] = s;
+    ok[2] = wst;
+    ok[3] = n;
+    ok[4] = eight && e && s && occ[i - W + 1] == 0;
+    ok[5] = eight && wst && s && occ[i - W - 1] == 0;
+    ok[6] = eight && wst && n && occ[i + W - 1] == 0;
+    ok[7] = eight && e && n && occ[i + W + 1] == 0;
+  };
+  const int moves = eight ? 8 : 4;
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), worse);
-    const HeapItem it = heap.back();
+    const std::uint32_t idx = heap.back().idx;
     heap.pop_back();
-    Node& cur = nodes[it.idx];
-    if (cur.stamp == closedMark) {
+    if (stampOf(idx) == closedMark) {
       continue;
     }
-    cur.stamp = closedMark;
-    const std::int64_t gCur = cur.g;
+    const std::int64_t gCur = gOf(idx);
+    setNode(idx, gCur, closedMark);
     ++out.expanded;
-    if (it.idx == gi) {
+    const int x = static_cast<int>(idx % static_cast<std::uint32_t>(w));
+    const int y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
+    const auto i = static_cast<std::ptrdiff_t>(idx);
+    bool ok[8];
+    if (idx == gi) {
+      // Walk back along exact predecessors (moves are symmetric, so the allowed moves out of a
+      // cell are the allowed moves into it). Closed cells' g are optimal; a reached cell's g is
+      // the cost of a real path through a closed parent, so the walk always continues.
       int straight = 0, diagonal = 0;
-      for (std::uint32_t k = gi;; k = nodes[k].parent) {
-        const Cell c = grid.cellOf(k);
-        if (!out.cells.empty()) {
-          const Cell& nx = out.cells.back();
-          (nx.x != c.x && nx.y != c.y ? diagonal : straight) += 1;
+      Cell c{x, y};
+      std::size_t k = idx;
+      out.cells.push_back(c);
+      while (k != si) {
+        allowedMoves(static_cast<std::ptrdiff_t>(k), c.x, c.y, ok);
+        const std::int64_t gk = gOf(k);
+        bool stepped = false;
+        for (int m = 0; m < moves && !stepped; ++m) {
+          if (!ok[m]) {
+            continue;
+          }
+          const auto pk = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + mdx[m] + mdy[m] * W);
+          const std::uint64_t st = stampOf(pk);
+          if ((st == seen || st == closedMark) && gOf(pk) + (m < 4 ? kOne : kDiag) == gk) {
+            k = pk;
+            c = {c.x + mdx[m], c.y + mdy[m]};
+            (m < 4 ? straight : diagonal) += 1;
+            stepped = true;
+          }
         }
         out.cells.push_back(c);
-        if (k == si) {
-          break;
+        if (!stepped) {
+          return unexpected("internal", "A* path reconstruction failed");
         }
       }
       std::reverse(out.cells.begin(), out.cells.end());
       out.cost = static_cast<double>(straight) + static_cast<double>(diagonal) * std::numbers::sqrt2;
       return out;
     }
-    // Diagonals need both orthogonal cells free (no corner cutting).
-    const int x = static_cast<int>(it.idx % static_cast<std::uint32_t>(w));
-    const int y = static_cast<int>(it.idx / static_cast<std::uint32_t>(w));
-    const auto i = static_cast<std::ptrdiff_t>(it.idx);
-    const bool e = x + 1 < w && occ[i + 1] == 0;
-    const bool s = y > 0 && occ[i - W] == 0;
-    const bool wst = x > 0 && occ[i - 1] == 0;
-    const bool n = y + 1 < h && occ[i + W] == 0;
-    const bool ok[8] = {e,
-                        s,
-                        wst,
-                        n,
-                        eight && e && s && occ[i - W + 1] == 0,
-                        eight && wst && s && occ[i - W - 1] == 0,
-                        eight && wst && n && occ[i + W - 1] == 0,
-                        eight && e && n && occ[i + W + 1] == 0};
-    for (int k = 0; k < (eight ? 8 : 4); ++k) {
+    allowedMoves(i, x, y, ok);
+    for (int k = 0; k < moves; ++k) {
       if (!ok[k]) {
         continue;
       }
       const auto ni = static_cast<std::uint32_t>(i + mdx[k] + mdy[k] * W);
       const std::int64_t ng = gCur + (k < 4 ? kOne : kDiag);
-      Node& nb = nodes[ni];
-      const bool known = nb.stamp == seen || nb.stamp == closedMark;
-      if (!known || ng < nb.g) {
-        if (nb.stamp == closedMark) {
-          continue;  // consistent heuristic: a closed cell already has its optimal g
-        }
-        nb = {ng, it.idx, seen};
-        heap.push_back({{quant(ng + hOf(x + mdx[k], y + mdy[k], ni)), ng}, ni});
-        std::push_heap(heap.begin(), heap.end(), worse);
+      const std::uint64_t st = stampOf(ni);
+      if (st == closedMark || (st == seen && gOf(ni) <= ng)) {
+        continue;  // closed: optimal already (consistent heuristic); or no improvement
       }
+      setNode(ni, ng, seen);
+      heap.push_back(item(ng + hOf(x + mdx[k], y + mdy[k], ni), ng, ni));
+      std::push_heap(heap.begin(), heap.end(), worse);
     }
   }
   return unexpected("unreachable", "no path between (" + std::to_string(start.x) + ", " +
