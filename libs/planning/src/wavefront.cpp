@@ -15,32 +15,36 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Exact octile Dijkstra with two FIFO queues, one per move cost (1 and sqrt 2). Cells leave the
 // queues in non-decreasing cost, so every key pushed with cost d + c is >= the keys already in the
-// queue for c: each queue stays sorted and the smaller of the two heads is the global minimum. An
-// entry is stale when its key exceeds the cell's current cost (it was improved later); costs only
-// ever decrease by strict improvement, so the live entry of a cell is unique and no "done" array is
-// needed. Blocked cells (and a one-cell border) hold -1 in the padded cost array: a relaxation
-// "nd < cost" then never succeeds on them and the same array answers "is this cell free?".
-// Relaxations are branch-free (conditional store plus conditional tail advance); the queues are
-// sized for the worst case (every cell improved through each of its four in-moves of that kind).
+// queue for c: each queue stays sorted and the smaller of the two heads is the global minimum.
+// A cell reached by a straight move from the current minimum d is final at once (a cheaper
+// diagonal arrival would need a parent below d - 0.41, already expanded), so straight-queue
+// entries are never stale and their key is simply the cell's cost. A diagonal entry is stale only
+// when a straight move later improved the cell; reading its key from the cell's cost then yields
+// that final value, which is never below the straight queue's head, so taking it first (on a tie)
+// is harmless and the cell's second entry is skipped. Queues therefore hold 4-byte cell indices.
+// One padded cost array carries all state: +inf unreached, >= 0 tentative, sign bit set once
+// expanded (-d, exact; -0 for the goal), -inf blocked (and the one-cell border), so relaxations
+// "nd < cost" fail on expanded and blocked cells without further tests and are branch-free
+// (conditional store plus conditional tail advance). The extra slot at the end holds +inf and is
+// the queues' end sentinel. Queues are sized for the worst case (four arrivals of each kind).
 void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<double>& out) {
   const int w = grid.width();
   const int h = grid.height();
   const auto P = static_cast<std::ptrdiff_t>(w) + 2;
   const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
-  struct Entry {
-    double key;
-    std::uint32_t idx;
-  };
+  constexpr double kBlocked = -std::numeric_limits<double>::infinity();
   thread_local std::vector<double> cost;
-  thread_local std::vector<Entry> q1;
-  thread_local std::vector<Entry> q2;
-  cost.resize(padded);
+  thread_local std::vector<std::uint32_t> q1;
+  thread_local std::vector<std::uint32_t> q2;
+  cost.resize(padded + 1);
+  cost[padded] = kInf;
+  const auto sentinel = static_cast<std::uint32_t>(padded);
   // Only the border needs setting here: the fill below writes every interior cell.
-  std::fill_n(cost.begin(), P, -1.0);
-  std::fill_n(cost.end() - P, P, -1.0);
+  std::fill_n(cost.begin(), P, kBlocked);
+  std::fill_n(cost.begin() + static_cast<std::ptrdiff_t>(padded) - P, P, kBlocked);
   for (int y = 1; y <= h; ++y) {
-    cost[static_cast<std::size_t>(y * P)] = -1.0;
-    cost[static_cast<std::size_t>(y * P + P - 1)] = -1.0;
+    cost[static_cast<std::size_t>(y * P)] = kBlocked;
+    cost[static_cast<std::size_t>(y * P + P - 1)] = kBlocked;
   }
   if (q1.size() < 4 * padded + 2) {
     q1.resize(4 * padded + 2);
@@ -51,61 +55,68 @@ void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<dou
     double* row = cost.data() + (y + 1) * P + 1;
     const std::uint8_t* orow = occ + static_cast<std::ptrdiff_t>(y) * w;
     for (int x = 0; x < w; ++x) {
-      row[x] = orow[x] == 0 ? kInf : -1.0;
+      row[x] = orow[x] == 0 ? kInf : kBlocked;
     }
   }
   double* c = cost.data();
-  Entry* a = q1.data();
-  Entry* b = q2.data();
-  // Each queue ends in a sentinel with key +inf, so choosing the head needs no emptiness tests.
+  std::uint32_t* a = q1.data();
+  std::uint32_t* b = q2.data();
   std::size_t ha = 0, ta = 0, hb = 0, tb = 0;
   c[start] = 0.0;
-  a[ta++] = {0.0, start};
-  a[ta] = {kInf, 0};
-  b[tb] = {kInf, 0};
+  a[ta++] = start;
+  a[ta] = sentinel;
+  b[tb] = sentinel;
   constexpr double diag = std::numbers::sqrt2;
   for (;;) {
-    const double ka = a[ha].key;
-    const double kb = b[hb].key;
+    const double ka = c[a[ha]];
+    const double kb = c[b[hb]];
     if (ka == kInf && kb == kInf) {
       break;
     }
-    const bool fromA = ka <= kb;
-    const Entry e = fromA ? a[ha] : b[hb];
-    ha += fromA ? 1U : 0U;
-    hb += fromA ? 0U : 1U;
-    const auto i = static_cast<std::ptrdiff_t>(e.idx);
-    const double d = e.key;
-    if (d > c[i]) {
-      continue;  // stale
+    // A branch, not a select: the queue heads then do not wait for this comparison.
+    std::uint32_t idx;
+    double d;
+    if (ka <= kb) {
+      idx = a[ha++];
+      d = ka;
+    } else {
+      idx = b[hb++];
+      d = kb;
     }
+    if (std::signbit(d)) {
+      continue;  // already expanded
+    }
+    const auto i = static_cast<std::ptrdiff_t>(idx);
+    c[i] = -d;
     const double ce = c[i + 1], cs = c[i - P], cw = c[i - 1], cn = c[i + P];
     const double cse = c[i - P + 1], csw = c[i - P - 1], cnw = c[i + P - 1], cne = c[i + P + 1];
     const double n1 = d + 1.0;
     const double n2 = d + diag;
-    auto relax = [](double* cell, Entry* q, std::size_t& t, double cj, double nd, std::ptrdiff_t j, bool ok) {
-      const bool imp = ok && nd < cj;
-      *cell = imp ? nd : cj;
-      q[t] = {nd, static_cast<std::uint32_t>(j)};
-      t += imp ? 1U : 0U;
+    // min() and an integer tail increment compile to minsd/setcc: no data-dependent branches.
+    auto relax = [](double* cell, std::uint32_t* q, std::size_t& t, double cj, double nd, std::ptrdiff_t j) {
+      *cell = std::min(nd, cj);
+      q[t] = static_cast<std::uint32_t>(j);
+      t += static_cast<std::size_t>(nd < cj);
     };
-    relax(c + i + 1, a, ta, ce, n1, i + 1, true);
-    relax(c + i - P, a, ta, cs, n1, i - P, true);
-    relax(c + i - 1, a, ta, cw, n1, i - 1, true);
-    relax(c + i + P, a, ta, cn, n1, i + P, true);
-    const bool fe = ce >= 0.0, fs = cs >= 0.0, fw = cw >= 0.0, fn = cn >= 0.0;
-    relax(c + i - P + 1, b, tb, cse, n2, i - P + 1, fe && fs);
-    relax(c + i - P - 1, b, tb, csw, n2, i - P - 1, fw && fs);
-    relax(c + i + P - 1, b, tb, cnw, n2, i + P - 1, fw && fn);
-    relax(c + i + P + 1, b, tb, cne, n2, i + P + 1, fe && fn);
-    a[ta] = {kInf, 0};
-    b[tb] = {kInf, 0};
+    relax(c + i + 1, a, ta, ce, n1, i + 1);
+    relax(c + i - P, a, ta, cs, n1, i - P);
+    relax(c + i - 1, a, ta, cw, n1, i - 1);
+    relax(c + i + P, a, ta, cn, n1, i + P);
+    // A diagonal needs both orthogonal cells beside it free; otherwise offer +inf, never an improvement.
+    const bool fe = ce != kBlocked, fs = cs != kBlocked, fw = cw != kBlocked, fn = cn != kBlocked;
+    relax(c + i - P + 1, b, tb, cse, (fe && fs) ? n2 : kInf, i - P + 1);
+    relax(c + i - P - 1, b, tb, csw, (fw && fs) ? n2 : kInf, i - P - 1);
+    relax(c + i + P - 1, b, tb, cnw, (fw && fn) ? n2 : kInf, i + P - 1);
+    relax(c + i + P + 1, b, tb, cne, (fe && fn) ? n2 : kInf, i + P + 1);
+    a[ta] = sentinel;
+    b[tb] = sentinel;
   }
   for (int y = 0; y < h; ++y) {
     const double* row = c + (y + 1) * P + 1;
     double* dst = out.data() + static_cast<std::ptrdiff_t>(y) * w;
     for (int x = 0; x < w; ++x) {
-      dst[x] = row[x] < 0.0 ? kInf : row[x];
+      const double v = row[x];
+      dst[x] = v == kBlocked ? kInf : std::abs(v);  // unreached cells keep +inf
     }
   }
 }
