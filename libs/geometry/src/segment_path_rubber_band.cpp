@@ -1,8 +1,8 @@
 // Independent cross-check for the shortest path through ordered segments: a "rubber band" pulled
 // tight one touch point at a time. It shares no code with the convex (smoothed Newton) solver or
 // MMS: each point is moved to the exact minimiser of its two adjacent path pieces (a reflection
-// construction), with over-relaxation, and coincident neighbours are moved together by an exact
-// nested one-dimensional search.
+// construction), optionally over-relaxed, and runs of coincident points are moved together by
+// exact nested one-dimensional searches.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -27,14 +27,19 @@ class RubberBand {
       scale_ += dist(s.a, s.b) + dist(s.a, p);
     }
     scale_ = std::max(scale_, 1e-300);
-    // Start in the middle of every segment: neither the skeleton (MMS's start) nor anything the
-    // other solvers compute.
+    // Start in the middle of every segment (unless told otherwise): neither the skeleton (MMS's
+    // start) nor anything the other solvers compute.
     t_.assign(segs.size(), 0.5);
+    if (opt.start.size() == segs.size()) {
+      for (std::size_t k = 0; k < segs.size(); ++k) {
+        t_[k] = std::clamp(opt.start[k], 0.0, 1.0);
+      }
+    }
     x_.resize(segs.size() + 2);
     x_[0] = p;
     x_[segs.size() + 1] = q;
     for (int k = 0; k < n_; ++k) {
-      x_[static_cast<std::size_t>(k) + 1] = pointOn(k, 0.5);
+      x_[static_cast<std::size_t>(k) + 1] = pointOn(k, t_[static_cast<std::size_t>(k)]);
     }
   }
 
@@ -59,8 +64,14 @@ class RubberBand {
       // Single-point moves are exhausted. Where two touch points coincide (segments crossing or
       // sharing an end) the length is not differentiable and only a joint move may shorten it.
       bool improved = false;
+      // Runs of coincident points (up to kMaxRun at a time; bundles put several segments' touch
+      // points on one shared vertex) are moved jointly.
       for (int k = 0; k + 1 < n_; ++k) {
-        if (dist(x(k), x(k + 1)) <= tol && relaxPair(k) > tol) {
+        int r = 1;
+        while (k + r < n_ && r < kMaxRun && dist(x(k), x(k + r)) <= tol) {
+          ++r;
+        }
+        if (r >= 2 && relaxRun(k, r) > tol) {
           improved = true;
           ++out.merges;
         }
@@ -138,44 +149,63 @@ class RubberBand {
     return dist(before, x(k));
   }
 
-  // Exact joint move of points k and k+1: the length as a function of t_k with t_{k+1} minimised
-  // exactly is convex (partial minimisation of a jointly convex function), so a golden-section
-  // search on t_k with the inner reflection minimiser finds the joint optimum. Kept only when it
-  // shortens the path. Returns how far the pair moved.
-  double relaxPair(int k) {
-    const Vec2 prev = x(k - 1), next = x(k + 2);
-    auto inner = [&](double tk, double* tk1) {
-      const Vec2 xk = pointOn(k, tk);
-      *tk1 = exactMin(k + 1, xk, next, t_[static_cast<std::size_t>(k) + 1]);
-      const Vec2 xk1 = pointOn(k + 1, *tk1);
-      return dist(prev, xk) + dist(xk, xk1) + dist(xk1, next);
+  // Exact joint move of the r consecutive points k .. k+r-1. The length as a function of t_k with
+  // the later points minimised exactly is convex (partial minimisation of a jointly convex
+  // function), so nested golden-section searches, with the reflection minimiser for the last
+  // point, find the joint optimum. Kept only when it shortens the path. Returns how far the points
+  // moved.
+  static constexpr int kMaxRun = 3;
+
+  // min over the points j .. last of |from - x_j| + ... + |x_last - next|; writes the minimisers.
+  double nested(int j, int last, Vec2 from, Vec2 next, double* t) const {
+    if (j == last) {
+      t[0] = exactMin(j, from, next, t_[static_cast<std::size_t>(j)]);
+      const Vec2 xj = pointOn(j, t[0]);
+      return dist(from, xj) + dist(xj, next);
+    }
+    auto value = [&](double tj, double* rest) {
+      const Vec2 xj = pointOn(j, tj);
+      return dist(from, xj) + nested(j + 1, last, xj, next, rest);
     };
-    double lo = 0.0, hi = 1.0, tmp = 0.0;
+    double scratch[kMaxRun];
+    double lo = 0.0, hi = 1.0;
     constexpr double g = 0.6180339887498949;
     double c = hi - g * (hi - lo), d = lo + g * (hi - lo);
-    double fc = inner(c, &tmp), fd = inner(d, &tmp);
-    for (int it = 0; it < 90 && hi - lo > 1e-16; ++it) {
+    double fc = value(c, scratch), fd = value(d, scratch);
+    for (int it = 0; it < 80 && hi - lo > 1e-15; ++it) {
       if (fc <= fd) {
         hi = d, d = c, fd = fc;
         c = hi - g * (hi - lo);
-        fc = inner(c, &tmp);
+        fc = value(c, scratch);
       } else {
         lo = c, c = d, fc = fd;
         d = lo + g * (hi - lo);
-        fd = inner(d, &tmp);
+        fd = value(d, scratch);
       }
     }
-    const double tk = 0.5 * (lo + hi);
-    double tk1 = 0.0;
-    const double fNew = inner(tk, &tk1);
-    const double fOld = dist(prev, x(k)) + dist(x(k), x(k + 1)) + dist(x(k + 1), next);
+    t[0] = 0.5 * (lo + hi);
+    return value(t[0], t + 1);
+  }
+
+  double relaxRun(int k, int r) {
+    const int last = k + r - 1;
+    const Vec2 prev = x(k - 1), next = x(last + 1);
+    double t[kMaxRun];
+    const double fNew = nested(k, last, prev, next, t);
+    double fOld = dist(prev, x(k)) + dist(x(last), next);
+    for (int j = k; j < last; ++j) {
+      fOld += dist(x(j), x(j + 1));
+    }
     if (!(fNew < fOld)) {
       return 0.0;
     }
-    const Vec2 b0 = x(k), b1 = x(k + 1);
-    set(k, tk);
-    set(k + 1, tk1);
-    return std::max(dist(b0, x(k)), dist(b1, x(k + 1)));
+    double moved = 0.0;
+    for (int j = 0; j < r; ++j) {
+      const Vec2 before = x(k + j);
+      set(k + j, t[j]);
+      moved = std::max(moved, dist(before, x(k + j)));
+    }
+    return moved;
   }
 
   Vec2 p_, q_;

@@ -204,3 +204,25 @@ TEST(SegmentPath, RubberBandLeavesCrossingsWhenJointMoveShortens) {
     EXPECT_NEAR(rb.length, mms.length, 1e-9 * mms.length) << trial;
   }
 }
+
+// Started at the bundle vertices (t = 0, the skeleton), plain coordinate descent is stuck on T6:
+// all three touch points sit on the shared vertex and no single point can leave it. The joint
+// move of the coincident run must take it to 2 + 2*sqrt(2). Every worked case is also solved from
+// the skeleton start and from the far ends (t = 1).
+TEST(SegmentPath, RubberBandFromSkeletonAndFarEndsStarts) {
+  int idx = 0;
+  for (const auto& c : seedCases()) {
+    for (double t0 : {0.0, 1.0}) {
+      RubberBandOptions opt;
+      opt.start.assign(c.segs.size(), t0);
+      const auto rb = shortestPathRubberBand(c.p, c.q, c.segs, opt);
+      EXPECT_TRUE(rb.converged);
+      EXPECT_NEAR(rb.length, c.expected, 1e-9 * c.expected) << "case T" << idx + 1 << " start t=" << t0;
+    }
+    ++idx;
+  }
+  const auto& t6 = seedCases()[5];
+  RubberBandOptions opt;
+  opt.start.assign(t6.segs.size(), 0.0);
+  EXPECT_GE(shortestPathRubberBand(t6.p, t6.q, t6.segs, opt).merges, 1);
+}
