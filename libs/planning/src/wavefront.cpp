@@ -26,7 +26,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // expanded (-d, exact; -0 for the goal), -inf blocked (and the one-cell border), so relaxations
 // "nd < cost" fail on expanded and blocked cells without further tests and are branch-free
 // (conditional store plus conditional tail advance). The extra slot at the end holds +inf and is
-// the queues' end sentinel. Queues are sized for the worst case (four arrivals of each kind).
+// the queues' end sentinel. Each cell enters each queue at most once (a straight arrival is
+// final; a second diagonal arrival would need a parent cheaper than the first one's, but parents
+// are expanded in non-decreasing cost), so padded + 2 slots hold every entry, the sentinel and the
+// speculative write past the tail.
 void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<double>& out) {
   const int w = grid.width();
   const int h = grid.height();
@@ -46,9 +49,9 @@ void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<dou
     cost[static_cast<std::size_t>(y * P)] = kBlocked;
     cost[static_cast<std::size_t>(y * P + P - 1)] = kBlocked;
   }
-  if (q1.size() < 4 * padded + 2) {
-    q1.resize(4 * padded + 2);
-    q2.resize(4 * padded + 2);
+  if (q1.size() < padded + 2) {
+    q1.resize(padded + 2);
+    q2.resize(padded + 2);
   }
   const std::uint8_t* occ = grid.cells().data();
   for (int y = 0; y < h; ++y) {
