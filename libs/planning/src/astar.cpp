@@ -4,22 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <queue>
 
 namespace fleet::planning {
-
-namespace {
-
-double heuristic(Cell a, Cell b, Connectivity conn) {
-  const double dx = std::abs(a.x - b.x);
-  const double dy = std::abs(a.y - b.y);
-  if (conn == Connectivity::Four) {
-    return dx + dy;
-  }
-  return std::max(dx, dy) + (std::numbers::sqrt2 - 1.0) * std::min(dx, dy);
-}
-
-}  // namespace
 
 LandmarkHeuristic LandmarkHeuristic::build(const OccupancyGrid& grid, Connectivity conn, int count) {
   LandmarkHeuristic lh;
@@ -113,108 +99,168 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
   if (grid.blocked(start) || grid.blocked(goal)) {
     return unexpected("unreachable", "start or goal cell is blocked or outside the map");
   }
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  // Scratch buffers are reused across calls on the same thread: queries are many and small.
-  thread_local std::vector<double> g;
-  thread_local std::vector<std::uint32_t> parent;
-  thread_local std::vector<std::uint32_t> stamp;
-  thread_local std::vector<std::uint32_t> closed;
+  // Costs are a + b*sqrt(2) cells. They are kept in fixed point with `frac` fractional bits (one
+  // cell = 2^frac, a diagonal = round(sqrt(2) * 2^frac)), so sums are exact and order-independent:
+  // equal-length paths get exactly equal keys without rounding tolerances. The octile heuristic in
+  // the same units stays exactly consistent (each move changes it by at most its own cost). frac
+  // is 32 unless the grid is so large that a path through every cell (< 1.5 * cells) would not fit
+  // in the 52 bits of g kept per cell; the fixed-point error (< diagonals * 2^-(frac+1)) is far
+  // below the gap between distinct lengths of realistic paths (~1e-4 cell for 2,000 diagonals).
+  int cellBits = 0;
+  while ((std::uint64_t{3} * grid.size()) >> cellBits != 0) {
+    ++cellBits;
+  }
+  const int frac = std::min(32, 51 - cellBits);
+  const std::int64_t kOne = std::int64_t{1} << frac;
+  const auto kDiag = static_cast<std::int64_t>(std::numbers::sqrt2 * static_cast<double>(kOne) + 0.5);
+  // One 8-byte word per cell: a 12-bit query stamp above a 52-bit g.
+  // stamp == 2*epoch: reached in this query; 2*epoch + 1: closed. No parent is stored: with exact
+  // costs the path is recovered by stepping back to a neighbour whose g plus the move cost equals
+  // the current g. Scratch is reused across calls on the same thread: queries are many and small.
+  constexpr int kStampShift = 52;
+  constexpr std::uint64_t kGMask = (std::uint64_t{1} << kStampShift) - 1;
+  thread_local std::vector<std::uint64_t> nodes;
   thread_local std::uint32_t epoch = 0;
-  if (g.size() != grid.size()) {
-    g.assign(grid.size(), inf);
-    parent.assign(grid.size(), 0);
-    stamp.assign(grid.size(), 0);
-    closed.assign(grid.size(), 0);
+  if (nodes.size() != grid.size()) {
+    nodes.assign(grid.size(), 0);
     epoch = 0;
   }
-  if (++epoch == 0) {
-    std::fill(stamp.begin(), stamp.end(), 0);
-    std::fill(closed.begin(), closed.end(), 0);
+  if (++epoch >= (std::uint32_t{1} << 11)) {
+    std::fill(nodes.begin(), nodes.end(), 0);
     epoch = 1;
   }
-  auto gOf = [&](std::size_t i) { return stamp[i] == epoch ? g[i] : inf; };
-  // f is quantised to 1e-9 cells so that paths of equal length compare equal despite rounding;
-  // among them the deeper node (larger g) goes first, which cuts expansions in open areas.
-  // With a consistent heuristic the first time a cell leaves the queue its g is optimal, so later
-  // copies are skipped by the closed mark; g in the item only breaks ties (16-byte items).
-  struct Item {
-    std::int64_t fq;
-    float g;
-    std::uint32_t idx;
-    bool operator>(const Item& o) const { return fq > o.fq || (fq == o.fq && g < o.g); }
+  const std::uint64_t seen = std::uint64_t{2} * epoch;
+  const std::uint64_t closedMark = seen + 1;
+  auto stampOf = [&](std::size_t k) { return nodes[k] >> kStampShift; };
+  auto gOf = [&](std::size_t k) { return static_cast<std::int64_t>(nodes[k] & kGMask); };
+  auto setNode = [&](std::size_t k, std::int64_t g, std::uint64_t st) {
+    nodes[k] = (st << kStampShift) | static_cast<std::uint64_t>(g);
   };
-  auto quant = [](double f) { return static_cast<std::int64_t>(std::llround(f * 1e9)); };
-  std::vector<Item> heapStore;
-  heapStore.reserve(4096);
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> open(std::greater<>{}, std::move(heapStore));
+  // Heap key (one 64-bit compare): f rounded to 2^-16 cell in the high 40 bits, then the
+  // complement of g in 2^-8 cell (24 bits, saturating beyond 65,536 cells) so that ties on f go to
+  // the deeper node, which cuts expansions in open areas. With a consistent heuristic the first
+  // time a cell leaves the queue its g is optimal; later copies are skipped by the closed mark. The
+  // landmark bound comes from floating-point fields and differs from the fixed-point sums by a
+  // fraction of 2^-frac per move: rounding f to 2^-16 keeps equal-length paths tied while distinct
+  // lengths stay > 1e-4 cell apart.
+  struct HeapItem {
+    std::uint64_t key;
+    std::uint32_t idx;
+  };
+  auto worse = [](const HeapItem& x, const HeapItem& y) { return x.key > y.key; };
+  const int fShift = frac - 16;
+  const int gShift = frac - 8;
+  auto item = [&](std::int64_t f, std::int64_t g, std::uint32_t idx) {
+    const auto fq = static_cast<std::uint64_t>((f + (std::int64_t{1} << (fShift - 1))) >> fShift);
+    const auto gq = std::min<std::uint64_t>(static_cast<std::uint64_t>(g >> gShift), 0xFFFFFF);
+    return HeapItem{(fq << 24) | (0xFFFFFF - gq), idx};
+  };
+  thread_local std::vector<HeapItem> heap;
+  heap.clear();
   const auto si = static_cast<std::uint32_t>(grid.index(start));
   const auto gi = static_cast<std::uint32_t>(grid.index(goal));
-  g[si] = 0.0;
-  stamp[si] = epoch;
-  parent[si] = si;
+  setNode(si, 0, seen);
   const std::size_t goalIdx = grid.index(goal);
-  auto hOf = [&](Cell c, std::size_t idx) {
-    const double oct = heuristic(c, goal, conn);
-    return landmarks != nullptr ? std::max(oct, landmarks->bound(idx, goalIdx)) : oct;
-  };
-  open.push({quant(hOf(start, si)), 0.0F, si});
-  GridPath out;
-  const auto& offs = neighbourOffsets(conn);
   const bool eight = conn == Connectivity::Eight;
+  auto hOf = [&](int x, int y, std::size_t idx) {
+    const std::int64_t dx = std::abs(x - goal.x);
+    const std::int64_t dy = std::abs(y - goal.y);
+    std::int64_t hv =
+        eight ? (std::max(dx, dy) - std::min(dx, dy)) * kOne + std::min(dx, dy) * kDiag : (dx + dy) * kOne;
+    if (landmarks != nullptr) {
+      // Truncation keeps the landmark bound admissible.
+      hv =
+          std::max(hv, static_cast<std::int64_t>(landmarks->bound(idx, goalIdx) * static_cast<double>(kOne)));
+    }
+    return hv;
+  };
+  heap.push_back(item(hOf(start.x, start.y, si), 0, si));
+  GridPath out;
   const int w = grid.width();
   const int h = grid.height();
   const auto W = static_cast<std::ptrdiff_t>(w);
   const std::uint8_t* occ = grid.cells().data();
-  while (!open.empty()) {
-    const Item it = open.top();
-    open.pop();
-    if (closed[it.idx] == epoch) {
-      continue;
-    }
-    closed[it.idx] = epoch;
-    const double gCur = g[it.idx];
-    ++out.expanded;
-    if (it.idx == gi) {
-      out.cost = gCur;
-      for (std::uint32_t k = gi;; k = parent[k]) {
-        out.cells.push_back(grid.cellOf(k));
-        if (k == si) {
-          break;
-        }
-      }
-      std::reverse(out.cells.begin(), out.cells.end());
-      return out;
-    }
-    // Neighbour moves on the raw cell array, in neighbourOffsets order; diagonals need both
-    // orthogonal cells free (no corner cutting).
-    const int x = static_cast<int>(it.idx % static_cast<std::uint32_t>(w));
-    const int y = static_cast<int>(it.idx / static_cast<std::uint32_t>(w));
-    const auto i = static_cast<std::ptrdiff_t>(it.idx);
+  // Moves in neighbourOffsets order: E, S, W, N, SE, SW, NW, NE.
+  const int mdx[8] = {1, 0, -1, 0, 1, -1, -1, 1};
+  const int mdy[8] = {0, -1, 0, 1, -1, -1, 1, 1};
+  auto allowedMoves = [&](std::ptrdiff_t i, int x, int y, bool* ok) {
+    // Diagonals need both orthogonal cells free (no corner cutting).
     const bool e = x + 1 < w && occ[i + 1] == 0;
     const bool s = y > 0 && occ[i - W] == 0;
     const bool wst = x > 0 && occ[i - 1] == 0;
     const bool n = y + 1 < h && occ[i + W] == 0;
-    const bool ok[8] = {e,
-                        s,
-                        wst,
-                        n,
-                        eight && e && s && occ[i - W + 1] == 0,
-                        eight && wst && s && occ[i - W - 1] == 0,
-                        eight && wst && n && occ[i + W - 1] == 0,
-                        eight && e && n && occ[i + W + 1] == 0};
-    for (int k = 0; k < (eight ? 8 : 4); ++k) {
+    ok[0] = e;
+    ok[1] = s;
+    ok[2] = wst;
+    ok[3] = n;
+    ok[4] = eight && e && s && occ[i - W + 1] == 0;
+    ok[5] = eight && wst && s && occ[i - W - 1] == 0;
+    ok[6] = eight && wst && n && occ[i + W - 1] == 0;
+    ok[7] = eight && e && n && occ[i + W + 1] == 0;
+  };
+  const int moves = eight ? 8 : 4;
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), worse);
+    const std::uint32_t idx = heap.back().idx;
+    heap.pop_back();
+    if (stampOf(idx) == closedMark) {
+      continue;
+    }
+    const std::int64_t gCur = gOf(idx);
+    setNode(idx, gCur, closedMark);
+    ++out.expanded;
+    const int x = static_cast<int>(idx % static_cast<std::uint32_t>(w));
+    const int y = static_cast<int>(idx / static_cast<std::uint32_t>(w));
+    const auto i = static_cast<std::ptrdiff_t>(idx);
+    bool ok[8];
+    if (idx == gi) {
+      // Walk back along exact predecessors (moves are symmetric, so the allowed moves out of a
+      // cell are the allowed moves into it). Closed cells' g are optimal; a reached cell's g is
+      // the cost of a real path through a closed parent, so the walk always continues.
+      int straight = 0, diagonal = 0;
+      Cell c{x, y};
+      std::size_t k = idx;
+      out.cells.push_back(c);
+      while (k != si) {
+        allowedMoves(static_cast<std::ptrdiff_t>(k), c.x, c.y, ok);
+        const std::int64_t gk = gOf(k);
+        bool stepped = false;
+        for (int m = 0; m < moves && !stepped; ++m) {
+          if (!ok[m]) {
+            continue;
+          }
+          const auto pk = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(k) + mdx[m] + mdy[m] * W);
+          const std::uint64_t st = stampOf(pk);
+          if ((st == seen || st == closedMark) && gOf(pk) + (m < 4 ? kOne : kDiag) == gk) {
+            k = pk;
+            c = {c.x + mdx[m], c.y + mdy[m]};
+            (m < 4 ? straight : diagonal) += 1;
+            stepped = true;
+          }
+        }
+        out.cells.push_back(c);
+        if (!stepped) {
+          return unexpected("internal", "A* path reconstruction failed");
+        }
+      }
+      std::reverse(out.cells.begin(), out.cells.end());
+      out.cost = static_cast<double>(straight) + static_cast<double>(diagonal) * std::numbers::sqrt2;
+      return out;
+    }
+    allowedMoves(i, x, y, ok);
+    for (int k = 0; k < moves; ++k) {
       if (!ok[k]) {
         continue;
       }
-      const Cell o = offs[static_cast<std::size_t>(k)];
-      const auto ni = static_cast<std::uint32_t>(i + o.x + o.y * W);
-      const double ng = gCur + (k < 4 ? 1.0 : std::numbers::sqrt2);
-      if (ng < gOf(ni)) {
-        g[ni] = ng;
-        stamp[ni] = epoch;
-        parent[ni] = it.idx;
-        open.push({quant(ng + hOf({x + o.x, y + o.y}, ni)), static_cast<float>(ng), ni});
+      const auto ni = static_cast<std::uint32_t>(i + mdx[k] + mdy[k] * W);
+      const std::int64_t ng = gCur + (k < 4 ? kOne : kDiag);
+      const std::uint64_t st = stampOf(ni);
+      if (st == closedMark || (st == seen && gOf(ni) <= ng)) {
+        continue;  // closed: optimal already (consistent heuristic); or no improvement
       }
+      setNode(ni, ng, seen);
+      heap.push_back(item(ng + hOf(x + mdx[k], y + mdy[k], ni), ng, ni));
+      std::push_heap(heap.begin(), heap.end(), worse);
     }
   }
   return unexpected("unreachable", "no path between (" + std::to_string(start.x) + ", " +

@@ -12,7 +12,119 @@ namespace fleet::planning {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Exact octile Dijkstra with two FIFO queues, one per move cost (1 and sqrt 2). Cells leave the
+// queues in non-decreasing cost, so every key pushed with cost d + c is >= the keys already in the
+// queue for c: each queue stays sorted and the smaller of the two heads is the global minimum.
+// A cell reached by a straight move from the current minimum d is final at once (a cheaper
+// diagonal arrival would need a parent below d - 0.41, already expanded), so straight-queue
+// entries are never stale and their key is simply the cell's cost. A diagonal entry is stale only
+// when a straight move later improved the cell; reading its key from the cell's cost then yields
+// that final value, which is never below the straight queue's head, so taking it first (on a tie)
+// is harmless and the cell's second entry is skipped. Queues therefore hold 4-byte cell indices.
+// One padded cost array carries all state: +inf unreached, >= 0 tentative, sign bit set once
+// expanded (-d, exact; -0 for the goal), -inf blocked (and the one-cell border), so relaxations
+// "nd < cost" fail on expanded and blocked cells without further tests and are branch-free
+// (conditional store plus conditional tail advance). The extra slot at the end holds +inf and is
+// the queues' end sentinel. Each cell enters each queue at most once (a straight arrival is
+// final; a second diagonal arrival would need a parent cheaper than the first one's, but parents
+// are expanded in non-decreasing cost), so padded + 2 slots hold every entry, the sentinel and the
+// speculative write past the tail.
+void octileField(const OccupancyGrid& grid, std::uint32_t start, std::vector<double>& out) {
+  const int w = grid.width();
+  const int h = grid.height();
+  const auto P = static_cast<std::ptrdiff_t>(w) + 2;
+  const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
+  constexpr double kBlocked = -std::numeric_limits<double>::infinity();
+  thread_local std::vector<double> cost;
+  thread_local std::vector<std::uint32_t> q1;
+  thread_local std::vector<std::uint32_t> q2;
+  cost.resize(padded + 1);
+  cost[padded] = kInf;
+  const auto sentinel = static_cast<std::uint32_t>(padded);
+  // Only the border needs setting here: the fill below writes every interior cell.
+  std::fill_n(cost.begin(), P, kBlocked);
+  std::fill_n(cost.begin() + static_cast<std::ptrdiff_t>(padded) - P, P, kBlocked);
+  for (int y = 1; y <= h; ++y) {
+    cost[static_cast<std::size_t>(y * P)] = kBlocked;
+    cost[static_cast<std::size_t>(y * P + P - 1)] = kBlocked;
+  }
+  if (q1.size() < padded + 2) {
+    q1.resize(padded + 2);
+    q2.resize(padded + 2);
+  }
+  const std::uint8_t* occ = grid.cells().data();
+  for (int y = 0; y < h; ++y) {
+    double* row = cost.data() + (y + 1) * P + 1;
+    const std::uint8_t* orow = occ + static_cast<std::ptrdiff_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      row[x] = orow[x] == 0 ? kInf : kBlocked;
+    }
+  }
+  double* c = cost.data();
+  std::uint32_t* a = q1.data();
+  std::uint32_t* b = q2.data();
+  std::size_t ha = 0, ta = 0, hb = 0, tb = 0;
+  c[start] = 0.0;
+  a[ta++] = start;
+  a[ta] = sentinel;
+  b[tb] = sentinel;
+  constexpr double diag = std::numbers::sqrt2;
+  for (;;) {
+    const double ka = c[a[ha]];
+    const double kb = c[b[hb]];
+    if (ka == kInf && kb == kInf) {
+      break;
+    }
+    // A branch, not a select: the queue heads then do not wait for this comparison.
+    std::uint32_t idx;
+    double d;
+    if (ka <= kb) {
+      idx = a[ha++];
+      d = ka;
+    } else {
+      idx = b[hb++];
+      d = kb;
+    }
+    if (std::signbit(d)) {
+      continue;  // already expanded
+    }
+    const auto i = static_cast<std::ptrdiff_t>(idx);
+    c[i] = -d;
+    const double ce = c[i + 1], cs = c[i - P], cw = c[i - 1], cn = c[i + P];
+    const double cse = c[i - P + 1], csw = c[i - P - 1], cnw = c[i + P - 1], cne = c[i + P + 1];
+    const double n1 = d + 1.0;
+    const double n2 = d + diag;
+    // min() and an integer tail increment compile to minsd/setcc: no data-dependent branches.
+    auto relax = [](double* cell, std::uint32_t* q, std::size_t& t, double cj, double nd, std::ptrdiff_t j) {
+      *cell = std::min(nd, cj);
+      q[t] = static_cast<std::uint32_t>(j);
+      t += static_cast<std::size_t>(nd < cj);
+    };
+    relax(c + i + 1, a, ta, ce, n1, i + 1);
+    relax(c + i - P, a, ta, cs, n1, i - P);
+    relax(c + i - 1, a, ta, cw, n1, i - 1);
+    relax(c + i + P, a, ta, cn, n1, i + P);
+    // A diagonal needs both orthogonal cells beside it free; otherwise offer +inf, never an improvement.
+    const bool fe = ce != kBlocked, fs = cs != kBlocked, fw = cw != kBlocked, fn = cn != kBlocked;
+    relax(c + i - P + 1, b, tb, cse, (fe && fs) ? n2 : kInf, i - P + 1);
+    relax(c + i - P - 1, b, tb, csw, (fw && fs) ? n2 : kInf, i - P - 1);
+    relax(c + i + P - 1, b, tb, cnw, (fw && fn) ? n2 : kInf, i + P - 1);
+    relax(c + i + P + 1, b, tb, cne, (fe && fn) ? n2 : kInf, i + P + 1);
+    a[ta] = sentinel;
+    b[tb] = sentinel;
+  }
+  for (int y = 0; y < h; ++y) {
+    const double* row = c + (y + 1) * P + 1;
+    double* dst = out.data() + static_cast<std::ptrdiff_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      const double v = row[x];
+      dst[x] = v == kBlocked ? kInf : std::abs(v);  // unreached cells keep +inf
+    }
+  }
 }
+
+}  // namespace
 
 const std::vector<Cell>& neighbourOffsets(Connectivity conn) {
   static const std::vector<Cell> four{{1, 0}, {0, -1}, {-1, 0}, {0, 1}};
@@ -53,100 +165,44 @@ DistanceField computeDistanceField(const OccupancyGrid& grid, Cell goal, Connect
   f.height = grid.height();
   f.goal = goal;
   f.conn = conn;
-  f.cost.assign(grid.size(), kInf);
   if (grid.blocked(goal)) {
+    f.cost.assign(grid.size(), kInf);
     return f;
   }
-  // Work on a copy padded with one blocked cell all around: the inner loops then need neither
-  // bounds checks nor index divisions.
   const int w = grid.width();
   const int h = grid.height();
   const auto P = static_cast<std::ptrdiff_t>(w) + 2;
   const auto padded = static_cast<std::size_t>(P) * static_cast<std::size_t>(h + 2);
+  const auto start = static_cast<std::uint32_t>((goal.y + 1) * P + goal.x + 1);
+  if (conn == Connectivity::Eight) {
+    f.cost.resize(grid.size());  // every cell is written by octileField
+    octileField(grid, start, f.cost);
+    return f;
+  }
+  // Work on a copy padded with one blocked cell all around: the inner loops then need neither
+  // bounds checks nor index divisions.
   std::vector<std::uint8_t> occ(padded, 1);
   for (int y = 0; y < h; ++y) {
     std::copy_n(grid.cells().begin() + static_cast<std::ptrdiff_t>(y) * w, w, occ.begin() + (y + 1) * P + 1);
   }
   std::vector<double> cost(padded, kInf);
-  const auto start = static_cast<std::uint32_t>((goal.y + 1) * P + goal.x + 1);
+  f.cost.resize(grid.size());
   // The seed's pseudocode never sets d(B) = 0, re-queues B and does not exclude obstacles in
   // check(); all three are fixed here.
   cost[start] = 0.0;
-  if (conn == Connectivity::Four) {
-    std::vector<std::uint32_t> queue;
-    queue.reserve(grid.size());
-    queue.push_back(start);
-    const std::ptrdiff_t steps[4] = {1, -P, -1, P};
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const auto i = static_cast<std::ptrdiff_t>(queue[head]);
-      const double next = cost[static_cast<std::size_t>(i)] + 1.0;
-      for (const std::ptrdiff_t st : steps) {
-        const auto ni = static_cast<std::size_t>(i + st);
-        if (occ[ni] == 0 && cost[ni] == kInf) {
-          cost[ni] = next;
-          queue.push_back(static_cast<std::uint32_t>(ni));
-        }
+  std::vector<std::uint32_t> queue;
+  queue.reserve(grid.size());
+  queue.push_back(start);
+  const std::ptrdiff_t steps[4] = {1, -P, -1, P};
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const auto i = static_cast<std::ptrdiff_t>(queue[head]);
+    const double next = cost[static_cast<std::size_t>(i)] + 1.0;
+    for (const std::ptrdiff_t st : steps) {
+      const auto ni = static_cast<std::size_t>(i + st);
+      if (occ[ni] == 0 && cost[ni] == kInf) {
+        cost[ni] = next;
+        queue.push_back(static_cast<std::uint32_t>(ni));
       }
-    }
-  } else {
-    // Dijkstra with a bucket queue of width 1 (Dinitz): every move costs at least 1, so relaxing a
-    // cell of bucket b only reaches buckets > b and cells inside one bucket can be settled in any
-    // order. Moves cost at most sqrt(2) < 2, so only buckets b+1 and b+2 receive cells while b is
-    // settled: a ring of three reusable buckets suffices.
-    std::array<std::vector<std::uint32_t>, 3> ring;
-    for (auto& r : ring) {
-      r.reserve(1024);
-    }
-    std::vector<std::uint8_t> done(padded, 0);
-    ring[0].push_back(start);
-    auto relax = [&](std::ptrdiff_t ni, double nd) {
-      const auto u = static_cast<std::size_t>(ni);
-      if (nd < cost[u]) {
-        cost[u] = nd;
-        ring[static_cast<std::size_t>(nd) % 3].push_back(static_cast<std::uint32_t>(u));
-      }
-    };
-    constexpr double diag = std::numbers::sqrt2;
-    for (std::size_t b = 0; !(ring[0].empty() && ring[1].empty() && ring[2].empty()); ++b) {
-      auto& bucket = ring[b % 3];
-      for (std::size_t k = 0; k < bucket.size(); ++k) {
-        const std::size_t idx = bucket[k];
-        if (done[idx] != 0 || static_cast<std::size_t>(cost[idx]) != b) {
-          continue;  // already settled, or improved into an earlier bucket
-        }
-        done[idx] = 1;
-        const double d = cost[idx];
-        const auto i = static_cast<std::ptrdiff_t>(idx);
-        const bool e = occ[static_cast<std::size_t>(i + 1)] == 0;
-        const bool s = occ[static_cast<std::size_t>(i - P)] == 0;
-        const bool wst = occ[static_cast<std::size_t>(i - 1)] == 0;
-        const bool n = occ[static_cast<std::size_t>(i + P)] == 0;
-        if (e) {
-          relax(i + 1, d + 1.0);
-        }
-        if (s) {
-          relax(i - P, d + 1.0);
-        }
-        if (wst) {
-          relax(i - 1, d + 1.0);
-        }
-        if (n) {
-          relax(i + P, d + 1.0);
-        }
-        if (e && s && occ[static_cast<std::size_t>(i - P + 1)] == 0) {
-          relax(i - P + 1, d + diag);
-        }
-        if (wst && s && occ[static_cast<std::size_t>(i - P - 1)] == 0) {
-          relax(i - P - 1, d + diag);
-        }
-        if (wst && n && occ[static_cast<std::size_t>(i + P - 1)] == 0) {
-          relax(i + P - 1, d + diag);
-        }
-        if (e && n && occ[static_cast<std::size_t>(i + P + 1)] == 0) {
-          relax(i + P + 1, d + diag);
-        }
-      }
-      bucket.clear();
     }
   }
   for (int y = 0; y < h; ++y) {

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <random>
 
 #include "fleet/geometry/bvh.hpp"
@@ -188,6 +189,51 @@ void BM_SegmentPath_Convex(benchmark::State& state) {
   state.counters["newton_steps"] = r.iterations;
 }
 BENCHMARK(BM_SegmentPath_Convex)
+    ->Arg(10)
+    ->Arg(30)
+    ->Arg(100)
+    ->Arg(300)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond);
+
+// MMS and the independent rubber-band solver on the same sequence in one loop, thread CPU time of
+// each side: counters mms_ms, rubber_band_ms, their ratio, MMS iterations, rubber-band sweeps and
+// joint pair moves, and the relative length difference.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
+void BM_SegmentPath_MmsVsRubberBand(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const auto segs = randomSegments(n, 11);
+  const Vec2 p{0, 0}, q{2.0 * (n + 1), 0.5};
+  SegmentPath m, r;
+  double tm = 0, tr = 0;
+  for (auto _ : state) {
+    const double c0 = threadCpuMs();
+    m = shortestPathMms(p, q, segs);
+    const double c1 = threadCpuMs();
+    r = shortestPathRubberBand(p, q, segs);
+    const double c2 = threadCpuMs();
+    tm += c1 - c0;
+    tr += c2 - c1;
+    benchmark::DoNotOptimize(m.length + r.length);
+  }
+  const auto it = static_cast<double>(state.iterations());
+  state.counters["mms_ms"] = tm / it;
+  state.counters["rubber_band_ms"] = tr / it;
+  state.counters["mms_over_rb"] = tm / tr;
+  state.counters["mms_iterations"] = m.iterations;
+  state.counters["rb_sweeps"] = r.iterations;
+  state.counters["rb_pair_moves"] = r.merges;
+  state.counters["rel_diff"] = std::abs(m.length - r.length) / r.length;
+  if (!m.converged || !r.converged) {
+    state.SkipWithError("a solver did not converge");
+  }
+}
+BENCHMARK(BM_SegmentPath_MmsVsRubberBand)
     ->Arg(10)
     ->Arg(30)
     ->Arg(100)

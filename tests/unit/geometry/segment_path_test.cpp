@@ -139,3 +139,90 @@ TEST(SegmentPath, InvariantUnderRigidMotion) {
   const double l1 = shortestPathMms(tf(p), tf(q), moved).length;
   EXPECT_NEAR(l0, l1, 1e-9 * l0);
 }
+
+// The rubber band shares no code with MMS or the convex solver (it starts from the segment
+// midpoints and uses exact reflection moves), so agreement is a genuine cross-check.
+TEST(SegmentPath, RubberBandMatchesSeedWorkedCasesAndMms) {
+  int idx = 0;
+  for (const auto& c : seedCases()) {
+    const auto rb = shortestPathRubberBand(c.p, c.q, c.segs);
+    const auto mms = shortestPathMms(c.p, c.q, c.segs);
+    EXPECT_TRUE(rb.converged) << "case T" << idx + 1;
+    EXPECT_NEAR(rb.length, c.expected, 1e-9 * c.expected)
+        << "case T" << idx + 1 << " sweeps=" << rb.iterations;
+    EXPECT_NEAR(mms.length, rb.length, 1e-9 * rb.length) << "case T" << idx + 1;
+    for (std::size_t k = 0; k < c.segs.size(); ++k) {
+      EXPECT_TRUE(onSegment(rb.points[k + 1], c.segs[k]));
+    }
+    ++idx;
+  }
+}
+
+TEST(SegmentPath, MmsAgreesWithRubberBandOnRandomSequences) {
+  std::mt19937 rng(33);
+  int maxMmsIter = 0, maxSweeps = 0;
+  for (int n : {3, 8, 20, 50, 120}) {
+    for (int trial = 0; trial < 8; ++trial) {
+      const auto segs = randomSegments(rng, n);
+      const Vec2 p{0, 0}, q{2.0 * (n + 1), 0.3};
+      const auto mms = shortestPathMms(p, q, segs);
+      const auto rb = shortestPathRubberBand(p, q, segs);
+      ASSERT_TRUE(mms.converged) << n;
+      ASSERT_TRUE(rb.converged) << n;
+      EXPECT_NEAR(mms.length, rb.length, 1e-9 * rb.length)
+          << "n=" << n << " trial=" << trial << " mms iterations=" << mms.iterations
+          << " sweeps=" << rb.iterations;
+      EXPECT_LE(rb.length, skeletonLength(p, q, segs) * (1 + 1e-12));
+      for (std::size_t k = 0; k < segs.size(); ++k) {
+        EXPECT_TRUE(onSegment(rb.points[k + 1], segs[k]));
+      }
+      maxMmsIter = std::max(maxMmsIter, mms.iterations);
+      maxSweeps = std::max(maxSweeps, rb.iterations);
+    }
+  }
+  RecordProperty("max_mms_iterations", maxMmsIter);
+  RecordProperty("max_rubber_band_sweeps", maxSweeps);
+}
+
+// Segments that cross each other in an X: at the crossing two consecutive touch points coincide,
+// single-point moves cannot shorten the path, and the joint move must. Known answer by dense search
+// over both parameters (as above) and MMS.
+TEST(SegmentPath, RubberBandLeavesCrossingsWhenJointMoveShortens) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 30; ++trial) {
+    const Vec2 c{3 + u(rng), u(rng)};
+    const double a1 = 1.2 + 0.3 * u(rng), a2 = -1.2 + 0.3 * u(rng);
+    const Vec2 d1{std::cos(a1), std::sin(a1)}, d2{std::cos(a2), std::sin(a2)};
+    const std::vector<Segment2> segs{{c - d1 * 2.0, c + d1 * 2.0}, {c + d2 * 2.0, c - d2 * 2.0}};
+    const Vec2 p{0, 2 * u(rng)}, q{6, 2 * u(rng)};
+    const auto rb = shortestPathRubberBand(p, q, segs);
+    const auto mms = shortestPathMms(p, q, segs, {.subsequence = 1});
+    const auto cvx = shortestPathConvex(p, q, segs);
+    EXPECT_TRUE(rb.converged);
+    EXPECT_NEAR(rb.length, cvx.length, 1e-9 * cvx.length) << trial;
+    EXPECT_NEAR(rb.length, mms.length, 1e-9 * mms.length) << trial;
+  }
+}
+
+// Started at the bundle vertices (t = 0, the skeleton), plain coordinate descent is stuck on T6:
+// all three touch points sit on the shared vertex and no single point can leave it. The joint
+// move of the coincident run must take it to 2 + 2*sqrt(2). Every worked case is also solved from
+// the skeleton start and from the far ends (t = 1).
+TEST(SegmentPath, RubberBandFromSkeletonAndFarEndsStarts) {
+  int idx = 0;
+  for (const auto& c : seedCases()) {
+    for (double t0 : {0.0, 1.0}) {
+      RubberBandOptions opt;
+      opt.start.assign(c.segs.size(), t0);
+      const auto rb = shortestPathRubberBand(c.p, c.q, c.segs, opt);
+      EXPECT_TRUE(rb.converged);
+      EXPECT_NEAR(rb.length, c.expected, 1e-9 * c.expected) << "case T" << idx + 1 << " start t=" << t0;
+    }
+    ++idx;
+  }
+  const auto& t6 = seedCases()[5];
+  RubberBandOptions opt;
+  opt.start.assign(t6.segs.size(), 0.0);
+  EXPECT_GE(shortestPathRubberBand(t6.p, t6.q, t6.segs, opt).merges, 1);
+}

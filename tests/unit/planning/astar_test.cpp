@@ -185,3 +185,33 @@ TEST(DistanceFieldCache, CachedCostsMatchAStarAndAreComputedOncePerGoal) {
   cache.field(goals[0]);
   EXPECT_EQ(cache.computations(), before + 1);
 }
+
+// Grids above ~175k cells use fewer fractional bits for the fixed-point costs (so a path through
+// every cell still fits); costs must stay exact there too, and the per-thread scratch must follow
+// the grid size when queries alternate between maps.
+TEST(AStar, ExactOnLargeGridsAndAcrossGridSizes) {
+  std::mt19937 rng(31);
+  const OccupancyGrid big = randomGrid(rng, 600, 400, 0.2);
+  const OccupancyGrid small = randomGrid(rng, 30, 20, 0.2);
+  for (int round = 0; round < 3; ++round) {
+    const Cell goal = randomFree(rng, big);
+    const DistanceField f = computeDistanceField(big, goal, Connectivity::Eight);
+    for (int q = 0; q < 4; ++q) {
+      const Cell s = randomFree(rng, big);
+      const auto r = astar(big, s, goal);
+      ASSERT_EQ(r.has_value(), f.reachable(s));
+      if (r) {
+        EXPECT_NEAR(r->cost, f.at(s), 1e-9);
+        EXPECT_EQ(r->cells.front(), s);
+        EXPECT_EQ(r->cells.back(), goal);
+      }
+    }
+    const Cell sg = randomFree(rng, small), ss = randomFree(rng, small);
+    const DistanceField fs = computeDistanceField(small, sg, Connectivity::Eight);
+    const auto rs = astar(small, ss, sg);
+    ASSERT_EQ(rs.has_value(), fs.reachable(ss));
+    if (rs) {
+      EXPECT_NEAR(rs->cost, fs.at(ss), 1e-9);
+    }
+  }
+}

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <set>
 
+#include "fleet/planning/astar.hpp"
 #include "fleet/planning/map_io.hpp"
 #include "fleet/planning/wavefront.hpp"
 #include "seed_map.hpp"
@@ -157,6 +159,55 @@ TEST(Wavefront, EightConnectedFieldIsConsistent) {
         }
       }
       EXPECT_NEAR(best, f.at(c), 1e-9);
+    }
+  }
+}
+
+// The octile field reuses per-thread scratch sized for the last grid: alternate grid sizes, and
+// check the warehouse field (the benchmark's map) for Bellman optimality and against A*.
+TEST(Wavefront, OctileFieldExactOnWarehouseAndAcrossGridSizes) {
+  const OccupancyGrid big = makeWarehouseGrid();
+  OccupancyGrid small(7, 5);
+  small.setBlocked({3, 1}, true);
+  small.setBlocked({3, 2}, true);
+  small.setBlocked({3, 3}, true);
+  std::mt19937 rng(44);
+  std::uniform_int_distribution<int> px(0, big.width() - 1), py(0, big.height() - 1);
+  for (int round = 0; round < 3; ++round) {
+    const DistanceField fs = computeDistanceField(small, {0, 2}, Connectivity::Eight);
+    EXPECT_NEAR(fs.at({6, 2}), 2.0 + 4.0 * std::sqrt(2.0), 1e-12);  // around the wall x = 3
+    EXPECT_FALSE(fs.reachable({3, 2}));
+    Cell goal{px(rng), py(rng)};
+    while (big.blocked(goal)) {
+      goal = {px(rng), py(rng)};
+    }
+    const DistanceField f = computeDistanceField(big, goal, Connectivity::Eight);
+    int checked = 0;
+    for (int y = 0; y < big.height(); ++y) {
+      for (int x = 0; x < big.width(); ++x) {
+        const Cell c{x, y};
+        if (!f.reachable(c) || c == goal) {
+          continue;
+        }
+        double best = 1e300;
+        for (const Cell& o : neighbourOffsets(Connectivity::Eight)) {
+          if (moveAllowed(big, c, o)) {
+            best = std::min(best, f.at({x + o.x, y + o.y}) + moveCost(o));
+          }
+        }
+        ASSERT_NEAR(best, f.at(c), 1e-9) << x << "," << y;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 38000);
+    for (int q = 0; q < 20; ++q) {
+      Cell s{px(rng), py(rng)};
+      if (big.blocked(s)) {
+        continue;
+      }
+      const auto r = astar(big, s, goal);
+      ASSERT_TRUE(r.has_value());
+      EXPECT_NEAR(r->cost, f.at(s), 1e-9);
     }
   }
 }
