@@ -2,13 +2,25 @@
 
 #include <string>
 
+#include "fleet/avoidance/bug.hpp"
 #include "fleet/avoidance/dynamic_window.hpp"
+#include "fleet/avoidance/potential_field.hpp"
+#include "fleet/avoidance/risk_stepping.hpp"
 
 namespace fleet::avoidance {
 
 Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
+  using Ptr = std::unique_ptr<LocalPlanner>;
   if (name == "dwa")
-    return std::unique_ptr<LocalPlanner>(std::make_unique<DynamicWindowPlanner>());
+    return Ptr(std::make_unique<DynamicWindowPlanner>());
+  if (name == "potential_field")
+    return Ptr(std::make_unique<PotentialFieldPlanner>());
+  if (name == "bug1")
+    return Ptr(std::make_unique<BugPlanner>(BugVariant::kBug1));
+  if (name == "bug2")
+    return Ptr(std::make_unique<BugPlanner>(BugVariant::kBug2));
+  if (name == "risk_stepping")
+    return Ptr(std::make_unique<RiskSteppingPlanner>());
   return fleet::unexpected("unknown_planner", "no local planner named '" + std::string(name) + "'");
 }
 
