@@ -4,6 +4,7 @@
 
 #include "fleet/avoidance/bug.hpp"
 #include "fleet/avoidance/dynamic_window.hpp"
+#include "fleet/avoidance/elastic_strips.hpp"
 #include "fleet/avoidance/potential_field.hpp"
 #include "fleet/avoidance/risk_stepping.hpp"
 
@@ -21,6 +22,10 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<BugPlanner>(BugVariant::kBug2));
   if (name == "risk_stepping")
     return Ptr(std::make_unique<RiskSteppingPlanner>());
+  if (name == "elastic_strips")
+    return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kOriginal));
+  if (name == "elastic_strips_bvh")
+    return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kBvhTwoSided));
   return fleet::unexpected("unknown_planner", "no local planner named '" + std::string(name) + "'");
 }
 

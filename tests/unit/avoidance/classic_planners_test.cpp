@@ -187,7 +187,8 @@ TEST(RiskStepping, CandidatesThroughObstaclesAreUnreachable) {
 }
 
 TEST(Factory, BuildsEveryPlannerByName) {
-  for (const char* n : {"dwa", "potential_field", "bug1", "bug2", "risk_stepping"}) {
+  for (const char* n :
+       {"dwa", "potential_field", "bug1", "bug2", "risk_stepping", "elastic_strips", "elastic_strips_bvh"}) {
     auto p = makePlanner(n);
     ASSERT_TRUE(p.has_value()) << n;
     EXPECT_EQ((*p)->name(), n);
