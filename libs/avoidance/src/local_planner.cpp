@@ -7,6 +7,7 @@
 #include "fleet/avoidance/elastic_strips.hpp"
 #include "fleet/avoidance/potential_field.hpp"
 #include "fleet/avoidance/risk_stepping.hpp"
+#include "fleet/avoidance/velocity_obstacle.hpp"
 
 namespace fleet::avoidance {
 
@@ -26,6 +27,13 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kOriginal));
   if (name == "elastic_strips_bvh")
     return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kBvhTwoSided));
+  if (name == "vo")
+    return Ptr(std::make_unique<VelocityObstaclePlanner>());
+  if (name == "rvo") {
+    VelocityObstacleParams p;
+    p.reciprocal = true;
+    return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
+  }
   return fleet::unexpected("unknown_planner", "no local planner named '" + std::string(name) + "'");
 }
 
