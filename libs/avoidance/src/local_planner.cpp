@@ -34,6 +34,11 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     p.reciprocal = true;
     return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
   }
+  if (name == "vo_keep_right") {
+    VelocityObstacleParams p;
+    p.right_bias = 1.0;
+    return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
+  }
   return fleet::unexpected("unknown_planner", "no local planner named '" + std::string(name) + "'");
 }
 

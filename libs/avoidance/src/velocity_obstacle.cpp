@@ -45,6 +45,12 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
   const Vec2 v_cur = pose.heading() * view.robot.twist.v;
   const double r = view.robot.radius + params_.margin;
 
+  // Is anything on a collision course with the preferred velocity?
+  bool conflict = false;
+  for (const MovingDisc& d : view.discs) {
+    if (discTimeToCollision(d.position - p, v_pref - d.velocity, r + d.radius) < params_.horizon)
+      conflict = true;
+  }
   Vec2 best_v;
   double best_cost = std::numeric_limits<double>::infinity();
   auto evaluate = [&](Vec2 cand) {
@@ -59,7 +65,10 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
     for (const Vec2& q : view.scan)
       ttc = std::min(ttc, discTimeToCollision(q - p, cand, r));
     const double pen = ttc < params_.horizon ? params_.w_ttc / std::max(ttc, 1e-3) : 0.0;
-    const double cost = pen + std::sqrt((cand - v_pref).squaredNorm());
+    double cost = pen + std::sqrt((cand - v_pref).squaredNorm());
+    if (params_.right_bias > 0.0 && conflict) {
+      cost += params_.right_bias * std::max(0.0, v_pref.normalized().cross(cand));
+    }
     if (cost < best_cost) {
       best_cost = cost;
       best_v = cand;

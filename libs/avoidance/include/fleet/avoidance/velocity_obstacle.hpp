@@ -16,6 +16,10 @@ struct VelocityObstacleParams {
   double horizon = 5.0;     ///< collisions later than this are ignored [s]
   double margin = 0.05;     ///< added to every combined radius [m]
   double k_omega = 2.5;
+  /// Cost per m/s of velocity to the left of the preferred one while a conflict is in view: a
+  /// shared keep-right convention turns head-on symmetric encounters (circle swap) into a
+  /// roundabout instead of a standoff. 0 = the plain baseline.
+  double right_bias = 0.0;
 
   [[nodiscard]] Expected<void> validate() const;
 };
@@ -27,7 +31,9 @@ class VelocityObstaclePlanner final : public LocalPlanner {
  public:
   explicit VelocityObstaclePlanner(VelocityObstacleParams params = {}) : params_(params) {}
   Command plan(const LocalView& view) override;
-  [[nodiscard]] std::string_view name() const override { return params_.reciprocal ? "rvo" : "vo"; }
+  [[nodiscard]] std::string_view name() const override {
+    return params_.reciprocal ? "rvo" : (params_.right_bias > 0.0 ? "vo_keep_right" : "vo");
+  }
 
  private:
   VelocityObstacleParams params_;
