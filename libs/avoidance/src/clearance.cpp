@@ -58,9 +58,19 @@ struct Arc {
     end = c + Vec2{r0.x * cs - r0.y * sn, r0.x * sn + r0.y * cs};
   }
 
-  [[nodiscard]] double lowerBound(Vec2 p) const {
-    const double da = fastDistance(a, p) - reach;
-    return straight ? da : std::max(da, std::abs(fastDistance(c, p) - R));
+  // True when p cannot be closer than `best` to the arc (squared tests only: no sqrt per point).
+  [[nodiscard]] bool cannotBeat(Vec2 p, double best) const {
+    const double ra = reach + best;
+    if ((a - p).squaredNorm() >= ra * ra)
+      return true;
+    if (straight)
+      return false;
+    const double dc2 = (c - p).squaredNorm();
+    const double hi = R + best;
+    if (dc2 >= hi * hi)
+      return true;
+    const double lo = R - best;
+    return lo > 0.0 && dc2 <= lo * lo;
   }
 
   [[nodiscard]] double distanceTo(Vec2 p) const {
@@ -91,7 +101,7 @@ double arcClearance(const Pose2& start, Twist t, double duration, std::span<cons
   const Arc arc(start, t, duration);
   double best = cap + radius;
   for (const Vec2& p : scan) {
-    if (arc.lowerBound(p) >= best)
+    if (arc.cannotBeat(p, best))
       continue;
     best = std::min(best, arc.distanceTo(p));
   }

@@ -93,6 +93,20 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
   const double w_heading = escape ? 0.0 : params_.w_heading;
   const double w_progress = escape ? 0.0 : params_.w_progress;
 
+  // Position on the sample's arc at time t (exact integration, without integrateExact's angle
+  // wrapping, which the rollouts do not need).
+  const Vec2 p0 = pose.position();
+  const double th0 = pose.theta;
+  const double c0 = std::cos(th0);
+  const double s0 = std::sin(th0);
+  auto along = [&](Twist tw, double t) {
+    if (std::abs(tw.omega) < 1e-9)
+      return p0 + Vec2{c0, s0} * (tw.v * t);
+    const double R = tw.v / tw.omega;
+    const double th = th0 + tw.omega * t;
+    return p0 + Vec2{R * (std::sin(th) - s0), -R * (std::cos(th) - c0)};
+  };
+
   const int nv = params_.v_samples;
   const int nw = params_.omega_samples;
   samples_.reserve(static_cast<std::size_t>(nv * nw));
@@ -110,7 +124,7 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       double clr = arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap);
       for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
         const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
-        const Vec2 p = DiffDriveKinematics::integrateExact(pose, s.twist, t).position();
+        const Vec2 p = along(s.twist, t);
         for (const MovingDisc& d : view.discs) {
           clr = std::min(clr, fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
         }
@@ -123,7 +137,8 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearance_length, near_,
                                       view.robot.radius, params_.clearance_cap);
       const double clr_term = std::min(clr, ext);
-      const Pose2 end = DiffDriveKinematics::integrateExact(pose, s.twist, T);
+      const Vec2 end_p = along(s.twist, T);
+      const Pose2 end{end_p.x, end_p.y, pose.theta + w * T};
       const double goal_bearing = std::atan2(carrot.y - end.y, carrot.x - end.x);
       s.heading = fastDistance(end.position(), carrot) < 1e-6
                       ? 1.0
@@ -137,8 +152,7 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       if (view.risk) {
         for (int k = 1; k <= params_.risk_samples; ++k) {
           const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
-          s.risk =
-              std::max(s.risk, view.risk(DiffDriveKinematics::integrateExact(pose, s.twist, t).position()));
+          s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
         }
       }
       s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
