@@ -245,6 +245,10 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
     res.mean_time_to_goal = t_sum / res.reached;
     res.mean_path_length = l_sum / res.reached;
   }
+  for (std::size_t i = 0; i < n; ++i) {
+    res.mean_remaining += fastDistance(pose[i].position(), sc.robots[i].goal) / static_cast<double>(n);
+    res.mean_travelled += length[i] / static_cast<double>(n);
+  }
   res.agent_steps = static_cast<std::int64_t>(compute_us.size());
   if (!compute_us.empty()) {
     double s = 0.0;

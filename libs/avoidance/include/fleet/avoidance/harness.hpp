@@ -53,6 +53,8 @@ struct ScenarioResult {
   double mean_time_to_goal = 0.0;   ///< over the robots that arrived [s]
   double makespan = 0.0;            ///< time the last robot arrived (or the run ended) [s]
   double mean_path_length = 0.0;    ///< over the robots that arrived [m]
+  double mean_remaining = 0.0;      ///< mean distance to goal at the end over all robots [m]
+  double mean_travelled = 0.0;      ///< mean path length over all robots [m]
   std::int64_t agent_steps = 0;     ///< planner calls
   double compute_mean_us = 0.0;     ///< per planner call (safety layer included)
   double compute_p99_us = 0.0;
