@@ -1,0 +1,79 @@
+#pragma once
+
+#include <vector>
+
+#include "fleet/avoidance/local_planner.hpp"
+
+namespace fleet::avoidance {
+
+/// Objective G = w_heading·heading + w_clearance·clearance + w_velocity·velocity
+///             + w_progress·progress − w_risk·risk, each term normalised to [0, 1].
+struct DwaParams {
+  int v_samples = 20;                   ///< Nav2 DWB vx_samples
+  int omega_samples = 20;               ///< Nav2 DWB vtheta_samples
+  double sim_time = 1.7;                ///< rollout horizon [s] (Nav2 DWB sim_time)
+  double w_heading = 0.8;               ///< end-pose heading towards the carrot (Fox et al.'s "heading")
+  double w_clearance = 0.3;             ///< surface clearance along the rollout, saturated at clearance_cap
+  double w_velocity = 0.3;              ///< forward speed / v_max
+  double w_progress = 1.0;              ///< decrease of the distance to the carrot over the rollout
+  double w_risk = 1.0;                  ///< max collision probability along the rollout (RiskLookup)
+  double clearance_cap = 1.0;           ///< [m]
+  double clearance_length = 2.0;        ///< arc length of the clearance term's extended arc [m]
+  double curvature_speed_floor = 0.25;  ///< curvature of a slow sample = ω / max(|v|, floor·v_max)
+  double min_clearance = 0.10;          ///< rollouts closer than this to anything are inadmissible [m]
+  double lookahead = 1.5;               ///< carrot distance along the path [m]
+  int risk_samples = 4;                 ///< risk lookups per rollout (evenly spaced, end included)
+  int disc_samples = 8;                 ///< time samples for the moving-disc check per rollout
+  bool allow_reverse = false;
+  /// Local-minimum escape: after stuck_cycles cycles without getting closer to the carrot by
+  /// stuck_progress, drop the heading and progress terms for escape_cycles cycles, so the robot
+  /// follows the most open arc (clearance + speed) around what blocks it.
+  int stuck_cycles = 15;
+  double stuck_progress = 0.05;  ///< [m]
+  int escape_cycles = 25;
+
+  [[nodiscard]] Expected<void> validate() const;
+};
+
+/// Score of one sampled velocity; exposed for tests and the benchmark.
+struct DwaSample {
+  Twist twist;
+  double heading = 0.0;
+  double clearance = 0.0;
+  double velocity = 0.0;
+  double progress = 0.0;
+  double risk = 0.0;
+  double score = 0.0;
+  bool admissible = false;
+};
+
+/// Pick the carrot: the point `lookahead` along the path from the path point nearest the robot.
+Vec2 carrotOnPath(std::span<const Vec2> path, Vec2 robot, double lookahead);
+
+class DynamicWindowPlanner final : public LocalPlanner {
+ public:
+  explicit DynamicWindowPlanner(DwaParams params = {}) : params_(params) {}
+  Command plan(const LocalView& view) override;
+  [[nodiscard]] std::string_view name() const override { return "dwa"; }
+
+  /// All samples of the last plan() (admissible or not).
+  [[nodiscard]] const std::vector<DwaSample>& lastSamples() const { return samples_; }
+  [[nodiscard]] const DwaParams& params() const { return params_; }
+  [[nodiscard]] bool escaping() const { return escape_left_ > 0; }
+  void reset() override {
+    no_progress_ = 0;
+    escape_left_ = 0;
+    best_carrot_distance_ = 0.0;
+  }
+
+ private:
+  DwaParams params_;
+  std::vector<DwaSample> samples_;
+  std::vector<Vec2> near_;
+  double best_carrot_distance_ = 0.0;
+  int no_progress_ = 0;
+  int escape_left_ = 0;
+  Vec2 last_goal_;
+};
+
+}  // namespace fleet::avoidance

@@ -1,0 +1,75 @@
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "fleet/avoidance/local_planner.hpp"
+
+namespace fleet::avoidance {
+
+/// Internal (contraction) force of seed 000 eq. 2.16 on control point P^j between P^{j−1} and
+/// P^{j+1}: k_c·( d⁻/(d⁻ + d⁺)·(P^{j+1} − P^{j−1}) − (P^j − P^{j−1}) ).
+Vec2 elasticInternalForce(Vec2 prev, Vec2 cur, Vec2 next, double k_c);
+
+/// External force of eq. 2.21: K_r·(threshold − d_obs,min)·(P_m − P_o)/|P_m − P_o| when
+/// d_obs,min < threshold, else 0. The original uses threshold d_o = d_safe + d_r; the thesis's
+/// two-sided variant (2.27) uses d_safe.
+Vec2 elasticExternalForce(Vec2 robot, Vec2 obstacle, double d_obs_min, double threshold, double k_r);
+
+/// The thesis's obstacle-box scan (§2.3.1): nearest reading below d_safe in the first half of the
+/// scan (left) and in the second half (right); both start at d_safe.
+struct LeftRightMinimum {
+  double min_left = 0.0;
+  double min_right = 0.0;
+  int left_index = -1;
+  int right_index = -1;
+  bool found = false;  ///< false when no reading is below d_safe (the thesis's FALSE)
+};
+LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double d_safe);
+
+enum class ElasticVariant { kOriginal, kBvhTwoSided };
+
+/// Parameters in metres; defaults = Table 2.3 case 1 (K_c 0.8, K_r 0.6, d_safe 1000 mm, d_r 350 mm).
+struct ElasticStripsParams {
+  double k_c = 0.8;
+  double k_r = 0.6;
+  double d_safe = 1.0;
+  double spacing = 0.3;  ///< control-point spacing of the strip [m]
+  double k_omega = 2.0;
+  int beams = 72;  ///< the two-sided variant bins the scan into this many bearings
+
+  [[nodiscard]] Expected<void> validate() const;
+};
+
+/// Elastic Strips turned into a (v, ω) planner: each cycle the strip is rebuilt from the robot
+/// along the path, the next control point is displaced by F = F_int + F_ext (eq. 2.24: new
+/// point = planned point + F), and the robot steers to the displaced point (heading
+/// atan2(Δy, Δx), the fix of eq. 2.26 noted in docs/algorithms.md).
+class ElasticStripsPlanner final : public LocalPlanner {
+ public:
+  explicit ElasticStripsPlanner(ElasticVariant variant, ElasticStripsParams params = {})
+      : variant_(variant), params_(params) {}
+  Command plan(const LocalView& view) override;
+  [[nodiscard]] std::string_view name() const override {
+    return variant_ == ElasticVariant::kOriginal ? "elastic_strips" : "elastic_strips_bvh";
+  }
+  void reset() override { have_prev_ = false; }
+
+  /// The displaced next control point of the last plan() and the force applied to it.
+  [[nodiscard]] Vec2 lastTarget() const { return target_; }
+  [[nodiscard]] Vec2 lastForce() const { return force_; }
+
+ private:
+  [[nodiscard]] Vec2 externalForce(const LocalView& view, Vec2 at) const;
+
+  ElasticVariant variant_;
+  ElasticStripsParams params_;
+  bool have_prev_ = false;
+  Vec2 prev_;
+  Vec2 target_;
+  Vec2 force_;
+  std::vector<double> ranges_;
+  std::vector<Vec2> hits_;
+};
+
+}  // namespace fleet::avoidance

@@ -1,0 +1,173 @@
+#include "fleet/avoidance/dynamic_window.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fleet/avoidance/clearance.hpp"
+#include "fleet/control/diff_drive_kinematics.hpp"
+#include "fleet/core/angles.hpp"
+
+namespace fleet::avoidance {
+
+using control::DiffDriveKinematics;
+
+Expected<void> DwaParams::validate() const {
+  if (v_samples < 1 || omega_samples < 1 || !(sim_time > 0.0) || !(clearance_cap > 0.0) ||
+      !(lookahead > 0.0) || risk_samples < 1 || disc_samples < 1 || w_heading < 0.0 || w_clearance < 0.0 ||
+      w_velocity < 0.0 || w_progress < 0.0 || w_risk < 0.0) {
+    return fleet::unexpected("invalid_dwa_params", "sample counts >= 1, times/distances > 0, weights >= 0");
+  }
+  return {};
+}
+
+Vec2 carrotOnPath(std::span<const Vec2> path, Vec2 robot, double lookahead) {
+  if (path.empty())
+    return robot;
+  if (path.size() == 1)
+    return path.front();
+  std::size_t best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  double best_s = 0.0;
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Vec2 ab = path[i + 1] - path[i];
+    const double l2 = ab.squaredNorm();
+    const double s = l2 > 0.0 ? std::clamp((robot - path[i]).dot(ab) / l2, 0.0, 1.0) : 0.0;
+    const double d = fastDistance(path[i] + ab * s, robot);
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+      best_s = s;
+    }
+  }
+  double remaining = lookahead;
+  Vec2 from = path[best] + (path[best + 1] - path[best]) * best_s;
+  for (std::size_t i = best + 1; i < path.size(); ++i) {
+    const double seg = fastDistance(from, path[i]);
+    if (seg >= remaining)
+      return from + (path[i] - from).normalized() * remaining;
+    remaining -= seg;
+    from = path[i];
+  }
+  return path.back();
+}
+
+Command DynamicWindowPlanner::plan(const LocalView& view) {
+  const Pose2& pose = view.robot.pose;
+  const Vec2 goal = view.goal();
+  samples_.clear();
+  if (fastDistance(pose.position(), goal) <= view.goal_tolerance)
+    return {{}, PlanStatus::kGoalReached, false};
+
+  const auto& lim = view.limits;
+  const double T = params_.sim_time;
+  const Twist cur = view.robot.twist;
+  // Dynamic window: velocities reachable within one cycle, intersected with the speed bounds.
+  const double v_lo = std::max(params_.allow_reverse ? lim.v_min : 0.0, cur.v - lim.accel_max * view.dt);
+  const double v_hi = std::min(lim.v_max, cur.v + lim.accel_max * view.dt);
+  const double w_lo = std::max(-lim.omega_max, cur.omega - lim.alpha_max * view.dt);
+  const double w_hi = std::min(lim.omega_max, cur.omega + lim.alpha_max * view.dt);
+
+  const Vec2 carrot = carrotOnPath(view.path, pose.position(), params_.lookahead);
+  const double carrot_d0 = fastDistance(pose.position(), carrot);
+  const double reach = std::max(std::max(lim.v_max, -lim.v_min) * T, params_.clearance_length) +
+                       view.robot.radius + params_.clearance_cap;
+  nearbyPoints(view.scan, pose.position(), reach, near_);
+
+  // Progress bookkeeping for the local-minimum escape (towards the goal, which does not move
+  // with the robot the way the carrot does).
+  const double goal_d = fastDistance(pose.position(), goal);
+  if (!(goal == last_goal_) || no_progress_ == 0) {
+    best_carrot_distance_ = goal_d;
+    last_goal_ = goal;
+    no_progress_ = 1;
+  } else if (goal_d < best_carrot_distance_ - params_.stuck_progress) {
+    best_carrot_distance_ = goal_d;
+    no_progress_ = 1;
+  } else if (++no_progress_ > params_.stuck_cycles && escape_left_ == 0) {
+    escape_left_ = params_.escape_cycles;
+  }
+  const bool escape = escape_left_ > 0;
+  if (escape && --escape_left_ == 0)
+    no_progress_ = 0;
+  const double w_heading = escape ? 0.0 : params_.w_heading;
+  const double w_progress = escape ? 0.0 : params_.w_progress;
+
+  // Position on the sample's arc at time t (exact integration, without integrateExact's angle
+  // wrapping, which the rollouts do not need).
+  const Vec2 p0 = pose.position();
+  const double th0 = pose.theta;
+  const double c0 = std::cos(th0);
+  const double s0 = std::sin(th0);
+  auto along = [&](Twist tw, double t) {
+    if (std::abs(tw.omega) < 1e-9)
+      return p0 + Vec2{c0, s0} * (tw.v * t);
+    const double R = tw.v / tw.omega;
+    const double th = th0 + tw.omega * t;
+    return p0 + Vec2{R * (std::sin(th) - s0), -R * (std::cos(th) - c0)};
+  };
+
+  const int nv = params_.v_samples;
+  const int nw = params_.omega_samples;
+  samples_.reserve(static_cast<std::size_t>(nv * nw));
+  const double vmax_abs = std::max(lim.v_max, 1e-9);
+  DwaSample best;
+  best.score = -std::numeric_limits<double>::infinity();
+  for (int a = 0; a < nv; ++a) {
+    const double v =
+        nv == 1 ? v_hi : v_lo + (v_hi - v_lo) * static_cast<double>(a) / static_cast<double>(nv - 1);
+    for (int b = 0; b < nw; ++b) {
+      const double w = nw == 1 ? 0.5 * (w_lo + w_hi)
+                               : w_lo + (w_hi - w_lo) * static_cast<double>(b) / static_cast<double>(nw - 1);
+      DwaSample s;
+      s.twist = {v, w};
+      double clr = arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap);
+      for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
+        const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
+        const Vec2 p = along(s.twist, t);
+        for (const MovingDisc& d : view.discs) {
+          clr = std::min(clr, fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
+        }
+      }
+      s.admissible = clr >= params_.min_clearance;
+      // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
+      // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
+      // arcs bending away score better long before the straight one becomes inadmissible.
+      const double v_eval = std::max(std::abs(v), params_.curvature_speed_floor * vmax_abs);
+      const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearance_length, near_,
+                                      view.robot.radius, params_.clearance_cap);
+      const double clr_term = std::min(clr, ext);
+      const Vec2 end_p = along(s.twist, T);
+      const Pose2 end{end_p.x, end_p.y, pose.theta + w * T};
+      const double goal_bearing = std::atan2(carrot.y - end.y, carrot.x - end.x);
+      s.heading = fastDistance(end.position(), carrot) < 1e-6
+                      ? 1.0
+                      : 1.0 - std::abs(angleDiff(goal_bearing, end.theta)) / kPi;
+      s.clearance = std::clamp(clr_term, 0.0, params_.clearance_cap) / params_.clearance_cap;
+      s.velocity = std::max(v, 0.0) / vmax_abs;
+      s.progress =
+          carrot_d0 > 1e-9
+              ? std::clamp((carrot_d0 - fastDistance(end.position(), carrot)) / (vmax_abs * T), -1.0, 1.0)
+              : 0.0;
+      if (view.risk) {
+        for (int k = 1; k <= params_.risk_samples; ++k) {
+          const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
+          s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
+        }
+      }
+      s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
+                w_progress * s.progress - params_.w_risk * s.risk;
+      if (s.admissible && s.score > best.score)
+        best = s;
+      samples_.push_back(s);
+    }
+  }
+  if (!best.admissible) {
+    // Nothing admissible: brake as hard as the window allows and turn towards the carrot.
+    const double turn = angleDiff(std::atan2(carrot.y - pose.y, carrot.x - pose.x), pose.theta);
+    return {{std::max(v_lo, 0.0), std::clamp(turn, w_lo, w_hi)}, PlanStatus::kBlocked, false};
+  }
+  return {best.twist, PlanStatus::kMoving, false};
+}
+
+}  // namespace fleet::avoidance

@@ -1,0 +1,200 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fleet/avoidance/bug.hpp"
+#include "fleet/avoidance/potential_field.hpp"
+#include "fleet/avoidance/risk_stepping.hpp"
+#include "fleet/avoidance/safety_layer.hpp"
+#include "test_support.hpp"
+
+namespace fleet::avoidance {
+namespace {
+
+// Seed 002 worked values.
+TEST(PotentialField, AttractiveForceWorkedExample) {
+  const Vec2 f = attractiveForce({0, 0}, {3, 4}, 1.0);
+  EXPECT_DOUBLE_EQ(f.x, 3.0);
+  EXPECT_DOUBLE_EQ(f.y, 4.0);
+  EXPECT_EQ(attractiveForce({3, 4}, {3, 4}, 1.0), (Vec2{0, 0}));
+}
+
+TEST(PotentialField, KhatibRepulsionWorkedExample) {
+  // k_rep = 1, ρ0 = 1, obstacle at the origin, q = (0.5, 0): Khatib's form gives (4, 0); the
+  // seed's printed (3.8) would give (1, 0).
+  const Vec2 f = repulsiveForce({0.5, 0}, {0, 0}, 0.5, 1.0, 1.0);
+  EXPECT_NEAR(f.x, 4.0, 1e-12);
+  EXPECT_NEAR(f.y, 0.0, 1e-12);
+  EXPECT_EQ(repulsiveForce({1.0, 0}, {0, 0}, 1.0, 1.0, 1.0), (Vec2{0, 0}));
+  EXPECT_EQ(repulsiveForce({1.5, 0}, {0, 0}, 1.5, 1.0, 1.0), (Vec2{0, 0}));
+}
+
+TEST(PotentialField, RepulsionIsMonotoneAndPointsAway) {
+  double prev = 0.0;
+  for (double rho = 1.0; rho > 0.05; rho -= 0.05) {
+    const Vec2 q{0.6 * rho, 0.8 * rho};
+    const Vec2 f = repulsiveForce(q, {0, 0}, rho, 1.0, 1.0);
+    EXPECT_GE(std::sqrt(f.squaredNorm()), prev);
+    prev = std::sqrt(f.squaredNorm());
+    EXPECT_GE(f.dot(q), 0.0);
+    EXPECT_NEAR(f.cross(q), 0.0, 1e-9);
+  }
+}
+
+TEST(PotentialField, TotalForceSumsEveryReading) {
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.radius = 0.0;
+  const std::vector<Vec2> path{{0, 0}};
+  v.path = path;  // goal at the robot: no attraction
+  const std::vector<Vec2> one{{0.5, 0}};
+  const std::vector<Vec2> two{{0.5, 0}, {0.5, 0}};
+  PotentialFieldParams p;
+  p.k_rep = 1.0;
+  v.scan = one;
+  const Vec2 f1 = totalForce(v, p);
+  v.scan = two;
+  const Vec2 f2 = totalForce(v, p);
+  EXPECT_NEAR(f2.x, 2.0 * f1.x, 1e-12);
+  EXPECT_NEAR(f1.x, -4.0, 1e-12);
+}
+
+TEST(PotentialField, ReachesGoalPastAnOffsetObstacleWithinLimits) {
+  const auto scan = test::ring({2.5, 0.6}, 0.4);
+  PotentialFieldPlanner pf;
+  LocalView probe;
+  const auto r = test::drive(pf, {0, 0, 0}, {{5.0, 0.0}}, scan, 800);
+  EXPECT_TRUE(r.reached);
+  EXPECT_GT(r.min_clearance, 0.0);
+}
+
+std::vector<Vec2> uTrap() {
+  // U open towards the start (−x), its base across the line to the goal.
+  auto pts = test::wall({3.0, -1.2}, {3.0, 1.2});
+  const auto top = test::wall({1.5, 1.2}, {3.0, 1.2});
+  const auto bottom = test::wall({1.5, -1.2}, {3.0, -1.2});
+  pts.insert(pts.end(), top.begin(), top.end());
+  pts.insert(pts.end(), bottom.begin(), bottom.end());
+  return pts;
+}
+
+TEST(PotentialField, UShapeTrapIsDetectedAndReported) {
+  PotentialFieldParams p;
+  p.escape_with_bug2 = false;
+  PotentialFieldPlanner pf(p);
+  const auto scan = uTrap();
+  const auto r = test::drive(pf, {0, 0, 0}, {{6.0, 0.0}}, scan, 600);
+  EXPECT_FALSE(r.reached);
+  EXPECT_GT(pf.stuckDetections(), 0);
+  EXPECT_LT(r.trace.back().x, 3.0);  // trapped inside the U
+}
+
+TEST(PotentialField, Bug2EscapeLeavesTheTrapAndReachesTheGoal) {
+  PotentialFieldPlanner pf;
+  const auto scan = uTrap();
+  const auto r = test::drive(pf, {0, 0, 0}, {{6.0, 0.0}}, scan, 3000);
+  EXPECT_TRUE(r.reached);
+  EXPECT_GT(pf.stuckDetections(), 0);
+  EXPECT_GT(r.min_clearance, 0.0);
+}
+
+TEST(Bug, BothReachGoalPastABoxAndBug2IsShorter) {
+  // Square obstacle on the start–goal line.
+  std::vector<Vec2> box = test::wall({2.0, -0.8}, {2.0, 0.8});
+  for (const auto& seg : {test::wall({2.0, 0.8}, {3.6, 0.8}), test::wall({3.6, 0.8}, {3.6, -0.8}),
+                          test::wall({3.6, -0.8}, {2.0, -0.8})}) {
+    box.insert(box.end(), seg.begin(), seg.end());
+  }
+  BugPlanner b1(BugVariant::kBug1), b2(BugVariant::kBug2);
+  const auto r1 = test::drive(b1, {0, 0, 0}, {{6.0, 0.0}}, box, 4000);
+  const auto r2 = test::drive(b2, {0, 0, 0}, {{6.0, 0.0}}, box, 4000);
+  EXPECT_TRUE(r1.reached);
+  EXPECT_TRUE(r2.reached);
+  EXPECT_EQ(b1.hits(), 1);
+  EXPECT_EQ(b2.hits(), 1);
+  EXPECT_GT(r1.min_clearance, 0.0);
+  EXPECT_GT(r2.min_clearance, 0.0);
+  EXPECT_LT(r2.path_length, r1.path_length);
+  // Bug1 went all the way round: at least the box perimeter plus the detour to L.
+  EXPECT_GT(r1.path_length, 2.0 * (1.6 + 1.6) + 6.0);
+}
+
+TEST(Bug, EnclosedGoalIsReportedUnreachable) {
+  const auto scan = test::ring({5.0, 0.0}, 1.0, 128);
+  for (const auto variant : {BugVariant::kBug1, BugVariant::kBug2}) {
+    BugPlanner b(variant);
+    LocalView v;
+    v.robot.pose = {0, 0, 0};
+    v.robot.radius = 0.3;
+    const std::vector<Vec2> path{{5.0, 0.0}};
+    v.path = path;
+    v.scan = scan;
+    PlanStatus last = PlanStatus::kMoving;
+    for (int k = 0; k < 6000 && last == PlanStatus::kMoving; ++k) {
+      const Command c = b.plan(v);
+      last = c.status;
+      const auto lt = control::applyLimits(v.limits, c.twist, v.robot.twist, v.dt);
+      v.robot.pose = control::DiffDriveKinematics::integrateExact(v.robot.pose, lt.twist, v.dt);
+      v.robot.twist = lt.twist;
+    }
+    EXPECT_EQ(last, PlanStatus::kUnreachable) << static_cast<int>(variant);
+  }
+}
+
+TEST(RiskStepping, PicksTheLowestRiskReachableCandidate) {
+  // Risk is high everywhere except a band at y < −0.2: the chosen point must be in that band,
+  // though the goal lies straight ahead.
+  risk::ProbabilityGrid grid;
+  grid.spec = {-5.0, -5.0, 0.1, 100, 100};
+  grid.p.assign(grid.spec.cellCount(), 0.0);
+  for (int j = 0; j < 100; ++j) {
+    for (int i = 0; i < 100; ++i) {
+      grid.p[grid.spec.index(i, j)] =
+          grid.spec.cellCentreY(j) > -0.2 && grid.spec.cellCentreX(i) > 0.2 ? 0.8 : 0.0;
+    }
+  }
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  const std::vector<Vec2> path{{4.0, 0.0}};
+  v.path = path;
+  v.risk = riskLookup(grid);
+  RiskSteppingPlanner rs;
+  const auto c = rs.choose(v);
+  ASSERT_TRUE(c.found);
+  EXPECT_LT(c.point.y, -0.2);
+  EXPECT_DOUBLE_EQ(c.safety, 1.0);
+  // Without risk it heads straight for the goal.
+  v.risk = {};
+  const auto straight = rs.choose(v);
+  EXPECT_NEAR(straight.point.y, 0.0, 1e-9);
+}
+
+TEST(RiskStepping, CandidatesThroughObstaclesAreUnreachable) {
+  const auto scan = test::wall({0.5, -0.1}, {0.5, 0.1});
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.radius = 0.2;
+  const std::vector<Vec2> path{{4.0, 0.0}};
+  v.path = path;
+  v.scan = scan;
+  RiskSteppingPlanner rs;
+  const auto c = rs.choose(v);
+  ASSERT_TRUE(c.found);
+  EXPECT_GT(std::abs(c.point.y), 0.2);
+  const auto r = test::drive(rs, {0, 0, 0}, {{4.0, 0.0}}, scan, 400, {}, 0.2);
+  EXPECT_TRUE(r.reached);
+  EXPECT_GT(r.min_clearance, 0.0);
+}
+
+TEST(Factory, BuildsEveryPlannerByName) {
+  for (const char* n :
+       {"dwa", "potential_field", "bug1", "bug2", "risk_stepping", "elastic_strips", "elastic_strips_bvh"}) {
+    auto p = makePlanner(n);
+    ASSERT_TRUE(p.has_value()) << n;
+    EXPECT_EQ((*p)->name(), n);
+  }
+  EXPECT_FALSE(makePlanner("teleport").has_value());
+}
+
+}  // namespace
+}  // namespace fleet::avoidance

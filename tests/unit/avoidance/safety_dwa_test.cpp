@@ -1,0 +1,182 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "fleet/avoidance/clearance.hpp"
+#include "fleet/avoidance/dynamic_window.hpp"
+#include "fleet/avoidance/safety_layer.hpp"
+#include "fleet/core/angles.hpp"
+#include "test_support.hpp"
+
+namespace fleet::avoidance {
+namespace {
+
+using control::DiffDriveKinematics;
+
+TEST(ArcClearance, AnalyticDistanceMatchesDenseSampling) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    const Pose2 start{u(rng), u(rng), u(rng)};
+    const Twist t{0.5 * u(rng), trial % 5 == 0 ? 0.0 : u(rng)};
+    const Vec2 p{u(rng), u(rng)};
+    const double T = 1.7;
+    double brute = 1e9;
+    for (int k = 0; k <= 20000; ++k) {
+      const double s = T * static_cast<double>(k) / 20000.0;
+      brute = std::min(brute, distance(DiffDriveKinematics::integrateExact(start, t, s).position(), p));
+    }
+    EXPECT_NEAR(arcPointDistance(start, t, T, p), brute, 2e-4) << trial;
+  }
+}
+
+// A planner that always asks for full speed straight ahead, whatever is there.
+class Reckless final : public LocalPlanner {
+ public:
+  Command plan(const LocalView& v) override { return {{v.limits.v_max, 0.0}, PlanStatus::kMoving, false}; }
+  [[nodiscard]] std::string_view name() const override { return "reckless"; }
+};
+
+TEST(SafetyLayer, OverrulesAPlannerDrivingIntoAWall) {
+  const auto scan = test::wall({2.0, -1.0}, {2.0, 1.0});
+  // Without the layer the reckless planner hits the wall.
+  Reckless raw;
+  const auto bad = test::drive(raw, {0, 0, 0}, {{5.0, 0.0}}, scan, 100);
+  EXPECT_LT(bad.min_clearance, 0.0);
+  SafePlanner safe(std::make_unique<Reckless>());
+  const auto good = test::drive(safe, {0, 0, 0}, {{5.0, 0.0}}, scan, 200);
+  EXPECT_GT(good.overruled, 0);
+  EXPECT_GE(good.min_clearance, 0.0);
+  EXPECT_GT(good.trace.back().x, 1.0);  // it still drove up to the wall, then stopped
+  EXPECT_EQ(safe.lastSafety().twist.v, 0.0);
+}
+
+TEST(SafetyLayer, StopsForADiscCrossingItsPath) {
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.twist = {0.45, 0.0};
+  std::vector<MovingDisc> discs{{{1.0, -1.0}, {0.0, 1.0}, 0.3}};  // will cross at x = 1 in ~1 s
+  v.discs = discs;
+  const SafetyLayer layer;
+  const auto r = layer.filter(v, {0.45, 0.0});
+  EXPECT_TRUE(r.overruled);
+  EXPECT_LT(r.twist.v, 0.45);
+  EXPECT_LT(r.time_to_collision, 2.0);
+  // Far away and moving away: untouched.
+  discs[0] = {{5.0, 5.0}, {0.0, 1.0}, 0.3};
+  const auto ok = layer.filter(v, {0.45, 0.0});
+  EXPECT_FALSE(ok.overruled);
+  EXPECT_EQ(ok.twist.v, 0.45);
+}
+
+TEST(SafetyLayer, AllowsBackingAwayFromSomethingTooClose) {
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.radius = 0.3;
+  const std::vector<Vec2> scan{{0.32, 0.0}};  // 2 cm from the surface: inside the stop zone
+  v.scan = scan;
+  const SafetyLayer layer;
+  EXPECT_EQ(layer.filter(v, {0.2, 0.0}).twist.v, 0.0);
+  EXPECT_EQ(layer.filter(v, {-0.2, 0.0}).twist.v, -0.2);
+  EXPECT_FALSE(layer.filter(v, {-0.2, 0.0}).overruled);
+}
+
+TEST(SafetyLayer, RejectsNonFiniteRequests) {
+  LocalView v;
+  const SafetyLayer layer;
+  const auto r = layer.filter(v, {std::nan(""), 0.0});
+  EXPECT_TRUE(r.blocked);
+  EXPECT_EQ(r.twist, Twist{});
+}
+
+TEST(SafetyLayer, SlowDownZoneCapsSpeedNearObstacles) {
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.twist = {0.45, 0.0};
+  v.robot.radius = 0.3;
+  const auto scan = test::wall({0.0, 0.5}, {3.0, 0.5});  // wall alongside, 0.2 m from the surface
+  v.scan = scan;
+  const SafetyLayer layer;
+  const auto r = layer.filter(v, {0.45, 0.0});
+  EXPECT_TRUE(r.slowed);
+  EXPECT_NEAR(r.twist.v, 0.5 * 0.45, 1e-12);
+}
+
+TEST(Dwa, SamplesStayInsideTheDynamicWindow) {
+  DynamicWindowPlanner dwa;
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.twist = {0.2, 0.1};
+  const std::vector<Vec2> path{{5.0, 0.0}};
+  v.path = path;
+  (void)dwa.plan(v);
+  ASSERT_EQ(dwa.lastSamples().size(), 400u);
+  for (const auto& s : dwa.lastSamples()) {
+    EXPECT_LE(std::abs(s.twist.v - 0.2), v.limits.accel_max * v.dt + 1e-12);
+    EXPECT_LE(std::abs(s.twist.omega - 0.1), v.limits.alpha_max * v.dt + 1e-12);
+    EXPECT_GE(s.twist.v, 0.0);
+  }
+}
+
+TEST(Dwa, ReachesGoalAroundAnObstacleWithoutTouchingIt) {
+  const auto scan = test::ring({2.5, 0.05}, 0.5);
+  SafePlanner p(std::make_unique<DynamicWindowPlanner>());
+  const auto r = test::drive(p, {0, 0, 0}, {{5.0, 0.0}}, scan, 600);
+  EXPECT_TRUE(r.reached);
+  EXPECT_GT(r.min_clearance, 0.0);
+}
+
+TEST(Dwa, RiskTermSteersToTheLowRiskSide) {
+  // Mirror-symmetric scene (obstacle on the line to the goal); the risk lookup marks one half-plane
+  // as risky, so the chosen turn must go to the other side, and flip when the risk is mirrored.
+  const auto scan = test::ring({2.5, 0.0}, 0.5);
+  const std::vector<Vec2> path{{5.0, 0.0}};
+  for (const double side : {1.0, -1.0}) {
+    DynamicWindowPlanner dwa;
+    LocalView v;
+    v.robot.pose = {0.8, 0.0, 0.0};
+    v.robot.twist = {0.3, 0.0};
+    v.path = path;
+    v.scan = scan;
+    v.risk = [side](Vec2 p) { return side * p.y > 1e-9 ? 0.9 : 0.0; };
+    const Command c = dwa.plan(v);
+    ASSERT_EQ(c.status, PlanStatus::kMoving);
+    EXPECT_LT(side * c.twist.omega, 0.0) << side;
+    // Without risk the scene is symmetric up to sampling; the risk weight is what decides.
+    v.risk = [](Vec2) { return 0.0; };
+    DwaParams no_risk;
+    no_risk.w_risk = 0.0;
+    v.risk = [side](Vec2 p) { return side * p.y > 1e-9 ? 0.9 : 0.0; };
+    DynamicWindowPlanner blind(no_risk);
+    const Command cb = blind.plan(v);
+    double max_risk_chosen = 0.0;
+    for (const auto& s : blind.lastSamples()) {
+      if (s.twist == cb.twist)
+        max_risk_chosen = s.risk;
+    }
+    double risk_aware_chosen = 1.0;
+    for (const auto& s : dwa.lastSamples()) {
+      if (s.twist == c.twist)
+        risk_aware_chosen = s.risk;
+    }
+    EXPECT_LE(risk_aware_chosen, max_risk_chosen);
+    EXPECT_EQ(risk_aware_chosen, 0.0);
+  }
+}
+
+TEST(Dwa, WeightsChangeTheChoice) {
+  // With clearance weighted heavily the robot keeps farther from a wall it drives along.
+  const auto scan = test::wall({0.0, 0.6}, {6.0, 0.6});
+  DwaParams greedy;
+  greedy.w_clearance = 0.0;
+  DwaParams careful;
+  careful.w_clearance = 3.0;
+  DynamicWindowPlanner a(greedy), b(careful);
+  const auto ra = test::drive(a, {0, 0, 0}, {{6.0, 0.3}}, scan, 400);
+  const auto rb = test::drive(b, {0, 0, 0}, {{6.0, 0.3}}, scan, 400);
+  EXPECT_GT(rb.min_clearance, ra.min_clearance);
+}
+
+}  // namespace
+}  // namespace fleet::avoidance
