@@ -47,7 +47,6 @@ FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel>
   tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
   tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
   dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
-  paintedTiles_.assign(dirtyTiles_.size(), 0);
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -209,9 +208,10 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
   }
 }
 
-void FusionEngine::paintDisc(const Disc& d, double p) {
+void FusionEngine::paintDisc(const Disc& d, double p, std::uint8_t level) {
   const GridSpec& g = config_.grid;
   auto& P = result_.probability.p;
+  auto& L = result_.levels.level;
   const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
   const double fy = (d.y - g.originY) * invRes - 0.5;  // row coordinate of the centre
   const double fr = d.r * invRes;
@@ -244,13 +244,14 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
       continue;
     }
     double* row = P.data() + g.index(0, j);
+    std::uint8_t* lrow = L.data() + g.index(0, j);
     const std::size_t tileRow = static_cast<std::size_t>(j >> tileShift_) * static_cast<std::size_t>(tilesX_);
     if (allDirty_) {
       for (int i = a; i <= b; ++i) {
         row[i] = std::max(row[i], p);
       }
-      for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
-        paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
+      for (int i = a; i <= b; ++i) {
+        lrow[i] = std::max(lrow[i], level);
       }
       visited += static_cast<std::size_t>(b - a + 1);
       continue;
@@ -259,11 +260,13 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
       if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
         continue;
       }
-      paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
       const int lo = std::max(a, tx * ts);
       const int hi = std::min(b, tx * ts + ts - 1);
       for (int i = lo; i <= hi; ++i) {
         row[i] = std::max(row[i], p);
+      }
+      for (int i = lo; i <= hi; ++i) {
+        lrow[i] = std::max(lrow[i], level);
       }
       visited += static_cast<std::size_t>(hi - lo + 1);
     }
@@ -317,6 +320,7 @@ void FusionEngine::recompute(bool full) {
     std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
     pendingDirty_.clear();
     std::fill(result_.probability.p.begin(), result_.probability.p.end(), 0.0);
+    std::fill(result_.levels.level.begin(), result_.levels.level.end(), std::uint8_t{0});
   } else {
     markDirtyTiles(maxReach);
     const int ts = config_.tileSize;
@@ -328,6 +332,8 @@ void FusionEngine::recompute(bool full) {
         for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
           double* row = result_.probability.p.data() + g.index(0, j);
           std::fill(row + tx * ts, row + std::min(g.width, tx * ts + ts), 0.0);
+          std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
+          std::fill(lrow + tx * ts, lrow + std::min(g.width, tx * ts + ts), std::uint8_t{0});
         }
       }
     }
@@ -429,7 +435,7 @@ void FusionEngine::recompute(bool full) {
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {
-        paints_.push_back(Paint{list[i].disc, discMax_[i], 0});
+        paints_.push_back(Paint{list[i].disc, discMax_[i], 0, 0});
       }
     }
     // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
@@ -453,8 +459,11 @@ void FusionEngine::recompute(bool full) {
       pt.key = (ty << 16) | tx;
     }
     std::sort(paints_.begin(), paints_.end(), [](const Paint& a, const Paint& b) { return a.key < b.key; });
+    // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
+    // level with max gives the classified grid without a pass over the cells.
+    const int K = config_.levels;
     for (const auto& pt : paints_) {
-      paintDisc(pt.disc, pt.p);
+      paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }
     result_.stats.discsPainted = paints_.size();
   }
@@ -463,47 +472,7 @@ void FusionEngine::recompute(bool full) {
     result_.sceneIndex = std::max(result_.sceneIndex, s);
   }
 
-  // Levels of the recomputed tiles: isoLevel with the boundaries l/K from a table (no divisions).
-  const int K = config_.levels;
-  const double Kd = static_cast<double>(K);
-  std::vector<double> bound(static_cast<std::size_t>(K) + 1);
-  for (int l = 0; l <= K; ++l) {
-    bound[static_cast<std::size_t>(l)] = levelUpperBound(l, K);
-  }
-  // ceil(p·K) is off by at most one from the level; one comparison on each side settles it (the table
-  // has a sentinel so both lookups stay in range).
-  bound.push_back(2.0);
-  auto levelOf = [&](double p) -> std::uint8_t {
-    int l = std::clamp(static_cast<int>(std::ceil(p * Kd)), 1, K);
-    l -= (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) ? 1 : 0;
-    l += (l < K && p > bound[static_cast<std::size_t>(l)]) ? 1 : 0;
-    return static_cast<std::uint8_t>(l);
-  };
-  const int ts = config_.tileSize;
-  for (int ty = 0; ty < tilesY_; ++ty) {
-    for (int tx = 0; tx < tilesX_; ++tx) {
-      if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
-        continue;
-      }
-      const bool painted = paintedTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] != 0;
-      const int i0 = tx * ts;
-      const int i1 = std::min(g.width, tx * ts + ts);
-      for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
-        const double* prow = result_.probability.p.data() + g.index(0, j);
-        std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
-        if (!painted) {  // nothing was painted here since the tile was cleared: all level 0
-          std::fill(lrow + i0, lrow + i1, std::uint8_t{0});
-          continue;
-        }
-        for (int i = i0; i < i1; ++i) {
-          const double p = prow[i];
-          lrow[i] = p > 0.0 ? levelOf(p) : 0;
-        }
-      }
-    }
-  }
   std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 0);
-  std::fill(paintedTiles_.begin(), paintedTiles_.end(), 0);
 }
 
 }  // namespace fleet::risk

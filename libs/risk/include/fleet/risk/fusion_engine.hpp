@@ -101,7 +101,7 @@ class FusionEngine {
   void noteChanged(const AlignedSource& aligned);
   void markDirtyTiles(double maxReach);
   void recompute(bool full);
-  void paintDisc(const Disc& d, double p);
+  void paintDisc(const Disc& d, double p, std::uint8_t level);
   void buildHash(const std::vector<StepDisc>& discs);
 
   FusionConfig config_;
@@ -112,7 +112,6 @@ class FusionEngine {
   std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
   std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
   bool allDirty_ = false;
-  std::vector<std::uint8_t> paintedTiles_;  // tiles painted since they were last cleared
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
@@ -120,6 +119,7 @@ class FusionEngine {
     Disc disc;
     double p;
     std::uint32_t key;
+    std::uint8_t level;
   };
   // scratch, kept between calls to avoid reallocation
   std::vector<Paint> paints_;
