@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 
 namespace fleet::risk {
 namespace {
@@ -9,6 +10,7 @@ namespace {
 // Directions of boundary edges: +x, +y, −x, −y. A left turn is (d + 1) % 4.
 constexpr int kDx[4] = {1, 0, -1, 0};
 constexpr int kDy[4] = {0, 1, 0, -1};
+constexpr std::int32_t kOffGrid = std::numeric_limits<std::int32_t>::min();  // neither an id nor a level key
 
 }  // namespace
 
@@ -58,7 +60,11 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
     return regions;
   }
   const std::uint8_t* level = grid.level.data();
-  label_.assign(g.cellCount(), -1);
+  // label_ holds the region id of a labelled cell and −1 − level of one not yet labelled, so the flood
+  // fill settles "same level, not yet visited" with one load.
+  label_.resize(g.cellCount());
+  std::transform(grid.level.begin(), grid.level.end(), label_.begin(),
+                 [](std::uint8_t l) { return -1 - static_cast<std::int32_t>(l); });
   // Sides of each cell already traced (bit n = side n), cleared per component from its edge list.
   if (traced_.size() != g.cellCount()) {
     traced_.assign(g.cellCount(), 0);
@@ -76,6 +82,7 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
       continue;
     }
     const auto id = static_cast<std::int32_t>(regions.size());
+    const std::int32_t unvisitedKey = -1 - lvl;
     // Flood fill (4-neighbour) of the component, listing its boundary edges on the way: a 4-neighbour
     // of the same level is in the same component, anything else (other level, off the grid) is across
     // the boundary. Edge n of a cell is its side with the cell on the left when walked in direction n
@@ -99,11 +106,12 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
       const std::ptrdiff_t across[4] = {-step[1], step[0], step[1], -step[0]};
       for (int n = 0; n < 4; ++n) {
         const std::size_t nc = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c.cell) + across[n]);
-        if (!inGrid[n] || level[nc] != lvl) {
-          edges.push_back(SideRef{c.cell, static_cast<std::uint32_t>(n)});
-        } else if (label[nc] < 0) {
+        const std::int32_t l = inGrid[n] ? label[nc] : kOffGrid;
+        if (l == unvisitedKey) {
           label[nc] = id;
           stack.push_back(CellRef{static_cast<std::uint32_t>(nc), ni[n], nj[n]});
+        } else if (l != id) {  // another level or off the grid (4-neighbours of a level connect)
+          edges.push_back(SideRef{c.cell, static_cast<std::uint32_t>(n)});
         }
       }
     }
@@ -118,7 +126,8 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
       if ((traced[startEdge.cell] >> startEdge.side) & 1U) {
         continue;
       }
-      Ring ring;
+      Ring& ring = ring_;
+      ring.clear();
       int ci = static_cast<int>(startEdge.cell % static_cast<std::uint32_t>(W));
       int cj = static_cast<int>(startEdge.cell / static_cast<std::uint32_t>(W));
       int side = static_cast<int>(startEdge.side);
@@ -167,13 +176,13 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
         }
       }
       // The start vertex is a corner unless the ring closed going straight through it.
-      if (ring.size() > 1 && static_cast<int>(startEdge.side) == prevDir) {
-        ring.erase(ring.begin());
-      }
-      if (signedArea(ring) > 0.0) {
-        region.outer = std::move(ring);
+      const auto first =
+          ring.begin() + ((ring.size() > 1 && static_cast<int>(startEdge.side) == prevDir) ? 1 : 0);
+      Ring exact(first, ring.end());  // one allocation of the final size
+      if (signedArea(exact) > 0.0) {
+        region.outer = std::move(exact);
       } else {
-        region.holes.push_back(std::move(ring));
+        region.holes.push_back(std::move(exact));
       }
     }
     for (const SideRef& e : edges) {

@@ -44,6 +44,7 @@ class RegionExtractor {
   std::vector<std::uint8_t> traced_;
   std::vector<CellRef> stack_;
   std::vector<SideRef> edges_;
+  Ring ring_;
 };
 
 /// Signed area of a ring (positive when counter-clockwise).
