@@ -202,14 +202,17 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
     bucketStart_[b + 1] += bucketStart_[b];
   }
   order_.resize(discs.size());
-  std::vector<std::uint32_t> fill(bucketStart_.begin(), bucketStart_.end() - 1);
+  auto& fill = bucketFill_;
+  fill.assign(bucketStart_.begin(), bucketStart_.end() - 1);
   for (std::size_t i = 0; i < discs.size(); ++i) {
     order_[fill[bucketOf_[i]]++] = static_cast<std::uint32_t>(i);
   }
 }
 
-void FusionEngine::paintDisc(const Disc& d, double p, std::uint8_t level) {
-  const GridSpec& g = config_.grid;
+void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
+  // Local copies: the grid writes below could otherwise alias them and force reloads.
+  const Disc d = disc;
+  const GridSpec g = config_.grid;
   auto& P = result_.probability.p;
   auto& L = result_.levels.level;
   const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
@@ -220,6 +223,9 @@ void FusionEngine::paintDisc(const Disc& d, double p, std::uint8_t level) {
   const double fx = (d.x - g.originX) * invRes - 0.5;
   const int ts = config_.tileSize;
   std::size_t visited = 0;
+  // First the cell interval of every row (independent rows, so their square roots overlap in the
+  // pipeline), then the writes.
+  rowSpans_.clear();
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
     const double dy = cy - d.y;
@@ -230,8 +236,10 @@ void FusionEngine::paintDisc(const Disc& d, double p, std::uint8_t level) {
     // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
     // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
     const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
-    int a = std::max(0, static_cast<int>(std::ceil(fx - half)));
-    int b = std::min(g.width - 1, static_cast<int>(std::floor(fx + half)));
+    // Truncation instead of ceil/floor (no SSE4.1 rounding in the baseline ISA): the estimates are at
+    // most one cell too wide, which the outward-only corrections below undo.
+    int a = std::max(0, static_cast<int>(std::max(fx - half, -1.0) + 1.0) - 1);
+    int b = std::min(g.width - 1, static_cast<int>(std::max(fx + half, -1.0)));
     while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
       --a;
     while (a <= b && !cellInsideDisc(g.cellCentreX(a), cy, d))
@@ -240,9 +248,14 @@ void FusionEngine::paintDisc(const Disc& d, double p, std::uint8_t level) {
       ++b;
     while (b >= a && !cellInsideDisc(g.cellCentreX(b), cy, d))
       --b;
-    if (a > b) {
-      continue;
+    if (a <= b) {
+      rowSpans_.push_back(RowSpan{j, a, b});
     }
+  }
+  for (const RowSpan& span : rowSpans_) {
+    const int j = span.j;
+    const int a = span.a;
+    const int b = span.b;
     double* row = P.data() + g.index(0, j);
     std::uint8_t* lrow = L.data() + g.index(0, j);
     const std::size_t tileRow = static_cast<std::size_t>(j >> tileShift_) * static_cast<std::size_t>(tilesX_);
@@ -398,11 +411,12 @@ void FusionEngine::recompute(bool full) {
       }
       ++result_.stats.pairsTested;
       const double d = centreDistance(a.disc, b.disc);
-      interSum += discIntersectionArea(a.disc.r, b.disc.r, d);
+      const double inter = discIntersectionArea(a.disc.r, b.disc.r, d);
+      interSum += inter;
       if (active_[i] == 0 && active_[j] == 0) {
         return;
       }
-      const double p = model_->pair(a.disc, b.disc);
+      const double p = model_->pairWithIntersection(a.disc, b.disc, d, inter);
       if (p > 0.0) {
         ++result_.stats.pairsPositive;
         discMax_[i] = std::max(discMax_[i], p);

@@ -121,8 +121,13 @@ class FusionEngine {
     std::uint32_t key;
     std::uint8_t level;
   };
+  struct RowSpan {
+    int j, a, b;  // row j, cells a..b inside the disc
+  };
   // scratch, kept between calls to avoid reallocation
   std::vector<Paint> paints_;
+  std::vector<RowSpan> rowSpans_;
+  std::vector<std::uint32_t> bucketFill_;
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
   std::vector<std::uint8_t> active_;
