@@ -47,6 +47,10 @@ FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel>
   tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
   tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
   dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
+  cellX_.resize(static_cast<std::size_t>(g.width));
+  for (int i = 0; i < g.width; ++i) {
+    cellX_[static_cast<std::size_t>(i)] = g.cellCentreX(i);  // the same doubles, looked up on the paint path
+  }
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -226,6 +230,7 @@ void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
   // First the cell interval of every row (independent rows, so their square roots overlap in the
   // pipeline), then the writes.
   rowSpans_.clear();
+  const double* cx = cellX_.data();
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
     const double dy = cy - d.y;
@@ -240,13 +245,13 @@ void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
     // most one cell too wide, which the outward-only corrections below undo.
     int a = std::max(0, static_cast<int>(std::max(fx - half, -1.0) + 1.0) - 1);
     int b = std::min(g.width - 1, static_cast<int>(std::max(fx + half, -1.0)));
-    while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
+    while (a > 0 && cellInsideDisc(cx[a - 1], cy, d))
       --a;
-    while (a <= b && !cellInsideDisc(g.cellCentreX(a), cy, d))
+    while (a <= b && !cellInsideDisc(cx[a], cy, d))
       ++a;
-    while (b < g.width - 1 && cellInsideDisc(g.cellCentreX(b + 1), cy, d))
+    while (b < g.width - 1 && cellInsideDisc(cx[b + 1], cy, d))
       ++b;
-    while (b >= a && !cellInsideDisc(g.cellCentreX(b), cy, d))
+    while (b >= a && !cellInsideDisc(cx[b], cy, d))
       --b;
     if (a <= b) {
       rowSpans_.push_back(RowSpan{j, a, b});

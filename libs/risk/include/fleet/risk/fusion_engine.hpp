@@ -128,6 +128,7 @@ class FusionEngine {
   std::vector<Paint> paints_;
   std::vector<RowSpan> rowSpans_;
   std::vector<std::uint32_t> bucketFill_;
+  std::vector<double> cellX_;  // cell-centre x of every column
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
   std::vector<std::uint8_t> active_;
