@@ -118,8 +118,6 @@ class FusionEngine {
   struct Paint {
     Disc disc;
     double p;
-    std::uint32_t key;
-    std::uint8_t level;
   };
   struct RowSpan {
     int j, a, b;  // row j, cells a..b inside the disc
@@ -128,6 +126,7 @@ class FusionEngine {
   std::vector<Paint> paints_;
   std::vector<RowSpan> rowSpans_;
   std::vector<std::uint32_t> bucketFill_;
+  std::vector<std::uint64_t> paintOrder_;
   std::vector<double> cellX_;  // cell-centre x of every column
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
