@@ -339,7 +339,9 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R) {
     thm += kPi;
   }
   const auto& gl = gaussLegendre();
-  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong)), 2.0, 1024.0));
+  // 8-point panels per unit of h·(scale + 2·elong) / 1.5: two thirds of the first sizing, which moved
+  // no result by more than 2e-11 on 3 400 random cases (halving it moved some by 9e-10).
+  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong) / 1.5), 2.0, 1024.0));
   const double du = kPi / panels;
   double sum = 0.0;
   for (int p = 0; p < panels; ++p) {
