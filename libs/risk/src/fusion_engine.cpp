@@ -231,6 +231,10 @@ void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
   // pipeline), then the writes.
   rowSpans_.clear();
   const double* cx = cellX_.data();
+  // The estimate's error bound below holds for coordinates under 1e6 cells and radii under 100 cells
+  // (the rounding of r² − dy² then moves the ends by < 1e-8 cells when half > 1e-3); else always test.
+  const bool spansByEstimate =
+      fr < 100.0 && (std::abs(d.x) + std::abs(g.originX) + g.width * g.resolution) * invRes < 1e6;
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
     const double dy = cy - d.y;
@@ -241,18 +245,44 @@ void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
     // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
     // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
     const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
-    // Truncation instead of ceil/floor (no SSE4.1 rounding in the baseline ISA): the estimates are at
-    // most one cell too wide, which the outward-only corrections below undo.
-    int a = std::max(0, static_cast<int>(std::max(fx - half, -1.0) + 1.0) - 1);
-    int b = std::min(g.width - 1, static_cast<int>(std::max(fx + half, -1.0)));
-    while (a > 0 && cellInsideDisc(cx[a - 1], cy, d))
-      --a;
-    while (a <= b && !cellInsideDisc(cx[a], cy, d))
-      ++a;
-    while (b < g.width - 1 && cellInsideDisc(cx[b + 1], cy, d))
-      ++b;
-    while (b >= a && !cellInsideDisc(cx[b], cy, d))
-      --b;
+    // Cell i's centre is at column coordinate i, so the row's cells are those in [lo, hi]. When both
+    // ends are more than 1e-6 cells from a cell centre (and the row is not a near-tangent sliver), the
+    // floating-point error of either computation (~1e-12 cells) cannot change which cells are inside,
+    // and the interval stands as computed; otherwise the exact test the reference uses settles it.
+    const double lo = fx - half;
+    const double hi = fx + half;
+    bool clear = spansByEstimate && half > 1e-3;
+    int a = 0;
+    int b = g.width - 1;
+    if (lo > static_cast<double>(g.width)) {
+      a = g.width;
+    } else if (lo >= -1.0) {
+      const int f = static_cast<int>(lo + 1.0) - 1;  // floor (lo + 1 >= 0), without SSE4.1 rounding
+      const double frac = lo - static_cast<double>(f);
+      clear = clear && frac > 1e-6 && frac < 1.0 - 1e-6;
+      a = f + 1;
+    }
+    if (hi < -1.0) {
+      b = -1;
+    } else if (hi <= static_cast<double>(g.width)) {
+      const int f = static_cast<int>(hi + 1.0) - 1;
+      const double frac = hi - static_cast<double>(f);
+      clear = clear && frac > 1e-6 && frac < 1.0 - 1e-6;
+      b = std::min(f, g.width - 1);
+    }
+    if (!clear) {
+      // Estimates at most one cell off; the corrections walk to the exact ends.
+      a = std::clamp(a, 0, g.width);
+      b = std::clamp(b, -1, g.width - 1);
+      while (a > 0 && cellInsideDisc(cx[a - 1], cy, d))
+        --a;
+      while (a <= b && !cellInsideDisc(cx[a], cy, d))
+        ++a;
+      while (b < g.width - 1 && cellInsideDisc(cx[b + 1], cy, d))
+        ++b;
+      while (b >= a && !cellInsideDisc(cx[b], cy, d))
+        --b;
+    }
     if (a <= b) {
       rowSpans_.push_back(RowSpan{j, a, b});
     }
