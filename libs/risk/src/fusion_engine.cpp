@@ -514,8 +514,13 @@ void FusionEngine::recompute(bool full) {
     // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
     // level with max gives the classified grid without a pass over the cells.
     const int K = config_.levels;
+    // Gathered into tile order first: the gather's independent loads overlap, whereas a load behind
+    // each long paint call would wait for its cache miss alone.
+    sortedPaints_.clear();
     for (const std::uint64_t word : paintOrder_) {
-      const Paint& pt = paints_[static_cast<std::size_t>(word & 0xffffffffU)];
+      sortedPaints_.push_back(paints_[static_cast<std::size_t>(word & 0xffffffffU)]);
+    }
+    for (const Paint& pt : sortedPaints_) {
       paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }
     result_.stats.discsPainted = paints_.size();

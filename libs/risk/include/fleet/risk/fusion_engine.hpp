@@ -127,6 +127,7 @@ class FusionEngine {
   std::vector<RowSpan> rowSpans_;
   std::vector<std::uint32_t> bucketFill_;
   std::vector<std::uint64_t> paintOrder_;
+  std::vector<Paint> sortedPaints_;
   std::vector<double> cellX_;  // cell-centre x of every column
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
