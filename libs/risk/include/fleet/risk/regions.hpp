@@ -45,6 +45,7 @@ class RegionExtractor {
   std::vector<CellRef> stack_;
   std::vector<SideRef> edges_;
   Ring ring_;
+  std::vector<Region> regions_;  // in discovery order, before ordering by level
 };
 
 /// Signed area of a ring (positive when counter-clockwise).
