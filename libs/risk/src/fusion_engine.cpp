@@ -502,24 +502,31 @@ void FusionEngine::recompute(bool full) {
   // the same cache lines of the grid (the grid is megabytes; the discs are scattered).
   {
     const double inv = 1.0 / (g.resolution * config_.tileSize);
-    // Sorted as 64-bit (tile key, index) words: cheaper to move than the paint records.
-    paintOrder_.clear();
+    // Counting sort by tile (stable; discs off the grid go to the nearest edge tile), gathered into
+    // tile order before painting: the gather's independent loads overlap, whereas a load behind each
+    // long paint call would wait for its cache miss alone.
+    const std::size_t tiles = static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_);
+    paintTile_.resize(paints_.size());
+    tileStart_.assign(tiles + 1, 0);
     for (std::size_t n = 0; n < paints_.size(); ++n) {
       const Paint& pt = paints_[n];
-      const auto tx = static_cast<std::uint64_t>(std::clamp((pt.disc.x - g.originX) * inv, 0.0, 65535.0));
-      const auto ty = static_cast<std::uint64_t>(std::clamp((pt.disc.y - g.originY) * inv, 0.0, 65535.0));
-      paintOrder_.push_back((((ty << 16) | tx) << 32) | n);
+      const auto tx = static_cast<std::size_t>(
+          std::clamp((pt.disc.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
+      const auto ty = static_cast<std::size_t>(
+          std::clamp((pt.disc.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
+      paintTile_[n] = static_cast<std::uint32_t>(ty * static_cast<std::size_t>(tilesX_) + tx);
+      ++tileStart_[paintTile_[n] + 1];
     }
-    std::sort(paintOrder_.begin(), paintOrder_.end());
+    for (std::size_t t = 0; t < tiles; ++t) {
+      tileStart_[t + 1] += tileStart_[t];
+    }
+    sortedPaints_.resize(paints_.size());
+    for (std::size_t n = 0; n < paints_.size(); ++n) {
+      sortedPaints_[tileStart_[paintTile_[n]]++] = paints_[n];
+    }
     // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
     // level with max gives the classified grid without a pass over the cells.
     const int K = config_.levels;
-    // Gathered into tile order first: the gather's independent loads overlap, whereas a load behind
-    // each long paint call would wait for its cache miss alone.
-    sortedPaints_.clear();
-    for (const std::uint64_t word : paintOrder_) {
-      sortedPaints_.push_back(paints_[static_cast<std::size_t>(word & 0xffffffffU)]);
-    }
     for (const Paint& pt : sortedPaints_) {
       paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }

@@ -126,7 +126,8 @@ class FusionEngine {
   std::vector<Paint> paints_;
   std::vector<RowSpan> rowSpans_;
   std::vector<std::uint32_t> bucketFill_;
-  std::vector<std::uint64_t> paintOrder_;
+  std::vector<std::uint32_t> paintTile_;
+  std::vector<std::uint32_t> tileStart_;
   std::vector<Paint> sortedPaints_;
   std::vector<double> cellX_;  // cell-centre x of every column
   std::vector<std::vector<StepDisc>> stepDiscs_;
