@@ -47,7 +47,10 @@ FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel>
   tilesX_ = (g.width + config_.tileSize - 1) / config_.tileSize;
   tilesY_ = (g.height + config_.tileSize - 1) / config_.tileSize;
   dirtyTiles_.assign(static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_), 0);
-  paintedTiles_.assign(dirtyTiles_.size(), 0);
+  cellX_.resize(static_cast<std::size_t>(g.width));
+  for (int i = 0; i < g.width; ++i) {
+    cellX_[static_cast<std::size_t>(i)] = g.cellCentreX(i);  // the same doubles, looked up on the paint path
+  }
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -203,15 +206,19 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
     bucketStart_[b + 1] += bucketStart_[b];
   }
   order_.resize(discs.size());
-  std::vector<std::uint32_t> fill(bucketStart_.begin(), bucketStart_.end() - 1);
+  auto& fill = bucketFill_;
+  fill.assign(bucketStart_.begin(), bucketStart_.end() - 1);
   for (std::size_t i = 0; i < discs.size(); ++i) {
     order_[fill[bucketOf_[i]]++] = static_cast<std::uint32_t>(i);
   }
 }
 
-void FusionEngine::paintDisc(const Disc& d, double p) {
-  const GridSpec& g = config_.grid;
+void FusionEngine::paintDisc(const Disc& disc, double p, std::uint8_t level) {
+  // Local copies: the grid writes below could otherwise alias them and force reloads.
+  const Disc d = disc;
+  const GridSpec g = config_.grid;
   auto& P = result_.probability.p;
+  auto& L = result_.levels.level;
   const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
   const double fy = (d.y - g.originY) * invRes - 0.5;  // row coordinate of the centre
   const double fr = d.r * invRes;
@@ -220,6 +227,14 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
   const double fx = (d.x - g.originX) * invRes - 0.5;
   const int ts = config_.tileSize;
   std::size_t visited = 0;
+  // First the cell interval of every row (independent rows, so their square roots overlap in the
+  // pipeline), then the writes.
+  rowSpans_.clear();
+  const double* cx = cellX_.data();
+  // The estimate's error bound below holds for coordinates under 1e6 cells and radii under 100 cells
+  // (the rounding of r² − dy² then moves the ends by < 1e-8 cells when half > 1e-3); else always test.
+  const bool spansByEstimate =
+      fr < 100.0 && (std::abs(d.x) + std::abs(g.originX) + g.width * g.resolution) * invRes < 1e6;
   for (int j = j0; j <= j1; ++j) {
     const double cy = g.cellCentreY(j);
     const double dy = cy - d.y;
@@ -230,27 +245,61 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
     // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
     // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
     const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
-    int a = std::max(0, static_cast<int>(std::ceil(fx - half)));
-    int b = std::min(g.width - 1, static_cast<int>(std::floor(fx + half)));
-    while (a > 0 && cellInsideDisc(g.cellCentreX(a - 1), cy, d))
-      --a;
-    while (a <= b && !cellInsideDisc(g.cellCentreX(a), cy, d))
-      ++a;
-    while (b < g.width - 1 && cellInsideDisc(g.cellCentreX(b + 1), cy, d))
-      ++b;
-    while (b >= a && !cellInsideDisc(g.cellCentreX(b), cy, d))
-      --b;
-    if (a > b) {
-      continue;
+    // Cell i's centre is at column coordinate i, so the row's cells are those in [lo, hi]. When both
+    // ends are more than 1e-6 cells from a cell centre (and the row is not a near-tangent sliver), the
+    // floating-point error of either computation (~1e-12 cells) cannot change which cells are inside,
+    // and the interval stands as computed; otherwise the exact test the reference uses settles it.
+    const double lo = fx - half;
+    const double hi = fx + half;
+    bool clear = spansByEstimate && half > 1e-3;
+    int a = 0;
+    int b = g.width - 1;
+    if (lo > static_cast<double>(g.width)) {
+      a = g.width;
+    } else if (lo >= -1.0) {
+      const int f = static_cast<int>(lo + 1.0) - 1;  // floor (lo + 1 >= 0), without SSE4.1 rounding
+      const double frac = lo - static_cast<double>(f);
+      clear = clear && frac > 1e-6 && frac < 1.0 - 1e-6;
+      a = f + 1;
     }
+    if (hi < -1.0) {
+      b = -1;
+    } else if (hi <= static_cast<double>(g.width)) {
+      const int f = static_cast<int>(hi + 1.0) - 1;
+      const double frac = hi - static_cast<double>(f);
+      clear = clear && frac > 1e-6 && frac < 1.0 - 1e-6;
+      b = std::min(f, g.width - 1);
+    }
+    if (!clear) {
+      // Estimates at most one cell off; the corrections walk to the exact ends.
+      a = std::clamp(a, 0, g.width);
+      b = std::clamp(b, -1, g.width - 1);
+      while (a > 0 && cellInsideDisc(cx[a - 1], cy, d))
+        --a;
+      while (a <= b && !cellInsideDisc(cx[a], cy, d))
+        ++a;
+      while (b < g.width - 1 && cellInsideDisc(cx[b + 1], cy, d))
+        ++b;
+      while (b >= a && !cellInsideDisc(cx[b], cy, d))
+        --b;
+    }
+    if (a <= b) {
+      rowSpans_.push_back(RowSpan{j, a, b});
+    }
+  }
+  for (const RowSpan& span : rowSpans_) {
+    const int j = span.j;
+    const int a = span.a;
+    const int b = span.b;
     double* row = P.data() + g.index(0, j);
+    std::uint8_t* lrow = L.data() + g.index(0, j);
     const std::size_t tileRow = static_cast<std::size_t>(j >> tileShift_) * static_cast<std::size_t>(tilesX_);
     if (allDirty_) {
       for (int i = a; i <= b; ++i) {
         row[i] = std::max(row[i], p);
       }
-      for (int tx = a >> tileShift_; tx <= (b >> tileShift_); ++tx) {
-        paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
+      for (int i = a; i <= b; ++i) {
+        lrow[i] = std::max(lrow[i], level);
       }
       visited += static_cast<std::size_t>(b - a + 1);
       continue;
@@ -259,11 +308,13 @@ void FusionEngine::paintDisc(const Disc& d, double p) {
       if (dirtyTiles_[tileRow + static_cast<std::size_t>(tx)] == 0) {
         continue;
       }
-      paintedTiles_[tileRow + static_cast<std::size_t>(tx)] = 1;
       const int lo = std::max(a, tx * ts);
       const int hi = std::min(b, tx * ts + ts - 1);
       for (int i = lo; i <= hi; ++i) {
         row[i] = std::max(row[i], p);
+      }
+      for (int i = lo; i <= hi; ++i) {
+        lrow[i] = std::max(lrow[i], level);
       }
       visited += static_cast<std::size_t>(hi - lo + 1);
     }
@@ -317,6 +368,7 @@ void FusionEngine::recompute(bool full) {
     std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
     pendingDirty_.clear();
     std::fill(result_.probability.p.begin(), result_.probability.p.end(), 0.0);
+    std::fill(result_.levels.level.begin(), result_.levels.level.end(), std::uint8_t{0});
   } else {
     markDirtyTiles(maxReach);
     const int ts = config_.tileSize;
@@ -328,6 +380,8 @@ void FusionEngine::recompute(bool full) {
         for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
           double* row = result_.probability.p.data() + g.index(0, j);
           std::fill(row + tx * ts, row + std::min(g.width, tx * ts + ts), 0.0);
+          std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
+          std::fill(lrow + tx * ts, lrow + std::min(g.width, tx * ts + ts), std::uint8_t{0});
         }
       }
     }
@@ -392,11 +446,12 @@ void FusionEngine::recompute(bool full) {
       }
       ++result_.stats.pairsTested;
       const double d = centreDistance(a.disc, b.disc);
-      interSum += discIntersectionArea(a.disc.r, b.disc.r, d);
+      const double inter = discIntersectionArea(a.disc.r, b.disc.r, d);
+      interSum += inter;
       if (active_[i] == 0 && active_[j] == 0) {
         return;
       }
-      const double p = model_->pair(a.disc, b.disc);
+      const double p = model_->pairWithIntersection(a.disc, b.disc, d, inter);
       if (p > 0.0) {
         ++result_.stats.pairsPositive;
         discMax_[i] = std::max(discMax_[i], p);
@@ -429,7 +484,7 @@ void FusionEngine::recompute(bool full) {
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {
-        paints_.push_back(Paint{list[i].disc, discMax_[i], 0});
+        paints_.push_back(Paint{list[i].disc, discMax_[i]});
       }
     }
     // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
@@ -447,14 +502,33 @@ void FusionEngine::recompute(bool full) {
   // the same cache lines of the grid (the grid is megabytes; the discs are scattered).
   {
     const double inv = 1.0 / (g.resolution * config_.tileSize);
-    for (auto& pt : paints_) {
-      const auto tx = static_cast<std::uint32_t>(std::clamp((pt.disc.x - g.originX) * inv, 0.0, 65535.0));
-      const auto ty = static_cast<std::uint32_t>(std::clamp((pt.disc.y - g.originY) * inv, 0.0, 65535.0));
-      pt.key = (ty << 16) | tx;
+    // Counting sort by tile (stable; discs off the grid go to the nearest edge tile), gathered into
+    // tile order before painting: the gather's independent loads overlap, whereas a load behind each
+    // long paint call would wait for its cache miss alone.
+    const std::size_t tiles = static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_);
+    paintTile_.resize(paints_.size());
+    tileStart_.assign(tiles + 1, 0);
+    for (std::size_t n = 0; n < paints_.size(); ++n) {
+      const Paint& pt = paints_[n];
+      const auto tx = static_cast<std::size_t>(
+          std::clamp((pt.disc.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
+      const auto ty = static_cast<std::size_t>(
+          std::clamp((pt.disc.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
+      paintTile_[n] = static_cast<std::uint32_t>(ty * static_cast<std::size_t>(tilesX_) + tx);
+      ++tileStart_[paintTile_[n] + 1];
     }
-    std::sort(paints_.begin(), paints_.end(), [](const Paint& a, const Paint& b) { return a.key < b.key; });
-    for (const auto& pt : paints_) {
-      paintDisc(pt.disc, pt.p);
+    for (std::size_t t = 0; t < tiles; ++t) {
+      tileStart_[t + 1] += tileStart_[t];
+    }
+    sortedPaints_.resize(paints_.size());
+    for (std::size_t n = 0; n < paints_.size(); ++n) {
+      sortedPaints_[tileStart_[paintTile_[n]]++] = paints_[n];
+    }
+    // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
+    // level with max gives the classified grid without a pass over the cells.
+    const int K = config_.levels;
+    for (const Paint& pt : sortedPaints_) {
+      paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }
     result_.stats.discsPainted = paints_.size();
   }
@@ -463,47 +537,7 @@ void FusionEngine::recompute(bool full) {
     result_.sceneIndex = std::max(result_.sceneIndex, s);
   }
 
-  // Levels of the recomputed tiles: isoLevel with the boundaries l/K from a table (no divisions).
-  const int K = config_.levels;
-  const double Kd = static_cast<double>(K);
-  std::vector<double> bound(static_cast<std::size_t>(K) + 1);
-  for (int l = 0; l <= K; ++l) {
-    bound[static_cast<std::size_t>(l)] = levelUpperBound(l, K);
-  }
-  // ceil(p·K) is off by at most one from the level; one comparison on each side settles it (the table
-  // has a sentinel so both lookups stay in range).
-  bound.push_back(2.0);
-  auto levelOf = [&](double p) -> std::uint8_t {
-    int l = std::clamp(static_cast<int>(std::ceil(p * Kd)), 1, K);
-    l -= (l > 1 && p <= bound[static_cast<std::size_t>(l - 1)]) ? 1 : 0;
-    l += (l < K && p > bound[static_cast<std::size_t>(l)]) ? 1 : 0;
-    return static_cast<std::uint8_t>(l);
-  };
-  const int ts = config_.tileSize;
-  for (int ty = 0; ty < tilesY_; ++ty) {
-    for (int tx = 0; tx < tilesX_; ++tx) {
-      if (dirtyTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] == 0) {
-        continue;
-      }
-      const bool painted = paintedTiles_[static_cast<std::size_t>(ty * tilesX_ + tx)] != 0;
-      const int i0 = tx * ts;
-      const int i1 = std::min(g.width, tx * ts + ts);
-      for (int j = ty * ts; j < std::min(g.height, ty * ts + ts); ++j) {
-        const double* prow = result_.probability.p.data() + g.index(0, j);
-        std::uint8_t* lrow = result_.levels.level.data() + g.index(0, j);
-        if (!painted) {  // nothing was painted here since the tile was cleared: all level 0
-          std::fill(lrow + i0, lrow + i1, std::uint8_t{0});
-          continue;
-        }
-        for (int i = i0; i < i1; ++i) {
-          const double p = prow[i];
-          lrow[i] = p > 0.0 ? levelOf(p) : 0;
-        }
-      }
-    }
-  }
   std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 0);
-  std::fill(paintedTiles_.begin(), paintedTiles_.end(), 0);
 }
 
 }  // namespace fleet::risk

@@ -1,6 +1,7 @@
 #include "fleet/risk/gaussian.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -8,6 +9,8 @@ namespace fleet::risk {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// Up to this b = R²/(2σ²) the isotropic series is summed upwards from j = 0 (at most ~270 terms).
+constexpr double kUpwardMaxB = 150.0;
 
 // Regularized lower incomplete gamma P(s, x) for integer s >= 1 (= P(Poisson(x) >= s)), given
 // lgs = lgamma(s) and logX = log(x), which the caller has at hand.
@@ -43,6 +46,35 @@ double lowerGammaInt(int s, double x, double lgs, double logX) {
     }
   }
   return std::clamp(lead * sum, 0.0, 1.0);
+}
+
+// 1/j for the Poisson recurrences (a table lookup instead of a division per term).
+constexpr int kInvTable = 512;
+constexpr std::array<double, kInvTable> kInv = [] {
+  std::array<double, kInvTable> t{};
+  for (int j = 1; j < kInvTable; ++j) {
+    t[static_cast<std::size_t>(j)] = 1.0 / static_cast<double>(j);
+  }
+  return t;
+}();
+
+// Σ_{k≥0} Pois(k; a) P(k + 1, b) rearranged as Σ_{j≥1} Pois(j; b) · P(Poisson(a) ≤ j − 1): both Poisson
+// weights by upward recurrence from e^{−a}, e^{−b} (normal doubles for a, b < 700) and the Poisson(a) CDF
+// by upward summation, so every operation adds or multiplies positive terms (no lgamma, no cancellation).
+// Beyond jMax the remaining Poisson(b) mass, an upper bound on what is left out, is below 1e-17.
+double marcumSeriesUpward(double a, double b, int jMax) {
+  double pb = std::exp(-b);  // Pois(j; b)
+  double w = std::exp(-a);   // Pois(j; a)
+  double cdf = 0.0;          // P(Poisson(a) ≤ j − 1)
+  double sum = 0.0;
+  for (int j = 1; j <= jMax; ++j) {
+    cdf += w;
+    const double inv = kInv[static_cast<std::size_t>(j)];
+    pb *= b * inv;
+    w *= a * inv;
+    sum += pb * cdf;
+  }
+  return std::clamp(sum, 0.0, 1.0);
 }
 
 // Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre recurrence), computed once.
@@ -114,6 +146,11 @@ double gaussianCollisionProbability(double d, double R, double sigma) {
   const double b = R * R / s2;  // half the χ² argument x/2
   if (a == 0.0) {
     return -std::expm1(-b);
+  }
+  // Small and moderate arguments (the usual case: a few sigma between the centres): the upward series
+  // over j ≤ b + 9 sqrt(b) + 10 costs a few multiplications per term and two exp.
+  if (b <= kUpwardMaxB && a < 600.0) {
+    return marcumSeriesUpward(a, b, static_cast<int>(std::ceil(b + 9.0 * std::sqrt(b) + 10.0)));
   }
   // P = Σ_k Pois(k; a) · P(k + 1, b). Terms above kHi are below 1e-20 because either the Poisson(a)
   // tail or P(k + 1, b) is; summing downwards keeps every recurrence an addition of positive terms.
@@ -302,7 +339,9 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R) {
     thm += kPi;
   }
   const auto& gl = gaussLegendre();
-  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong)), 2.0, 1024.0));
+  // 8-point panels per unit of h·(scale + 2·elong) / 1.5: two thirds of the first sizing, which moved
+  // no result by more than 2e-11 on 3 400 random cases (halving it moved some by 9e-10).
+  const int panels = static_cast<int>(std::clamp(std::ceil(h * (scale + 2.0 * elong) / 1.5), 2.0, 1024.0));
   const double du = kPi / panels;
   double sum = 0.0;
   for (int p = 0; p < panels; ++p) {

@@ -39,7 +39,10 @@ double discIntersectionArea(double r1, double r2, double d) {
   return std::clamp(area, 0.0, kPi * rmin * rmin);
 }
 
-double discOverlapRatio(double r1, double r2, double d) {
+namespace {
+// The overlap ratio given inter = discIntersectionArea(r1, r2, d), shared by both entry points so that
+// they agree bit for bit.
+double overlapRatioFromArea(double r1, double r2, double d, double inter) {
   if (r1 < r2) {
     std::swap(r1, r2);  // one argument order, so the result is bitwise symmetric
   }
@@ -50,9 +53,17 @@ double discOverlapRatio(double r1, double r2, double d) {
     const double q = std::min(r1, r2) / std::max(r1, r2);
     return q * q;
   }
-  const double inter = discIntersectionArea(r1, r2, d);
   const double uni = kPi * (r1 * r1 + r2 * r2) - inter;
   return std::clamp(inter / uni, 0.0, 1.0);
+}
+
+}  // namespace
+
+double discOverlapRatio(double r1, double r2, double d) {
+  if (!(r1 > 0.0) || !(r2 > 0.0) || d >= r1 + r2) {
+    return 0.0;
+  }
+  return overlapRatioFromArea(r1, r2, d, discIntersectionArea(r1, r2, d));
 }
 
 double sphereIntersectionVolume(double r1, double r2, double d) {
@@ -121,6 +132,11 @@ double sceneOverlapRatio(std::span<const Sphere> spheres) {
 
 double OverlapRatio::pair(const Disc& a, const Disc& b) const {
   return discOverlapRatio(a.r, b.r, centreDistance(a, b));
+}
+
+double OverlapRatio::pairWithIntersection(const Disc& a, const Disc& b, double d,
+                                          double intersectionArea) const {
+  return overlapRatioFromArea(a.r, b.r, d, intersectionArea);
 }
 
 double OverlapRatio::cullDistance(const Disc& a, const Disc& b) const {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 namespace fleet::risk {
 namespace {
@@ -9,12 +11,7 @@ namespace {
 // Directions of boundary edges: +x, +y, −x, −y. A left turn is (d + 1) % 4.
 constexpr int kDx[4] = {1, 0, -1, 0};
 constexpr int kDy[4] = {0, 1, 0, -1};
-
-struct Edge {
-  std::uint32_t from;  // vertex id j·(W+1) + i
-  std::uint8_t dir;
-  bool used;
-};
+constexpr std::int32_t kOffGrid = std::numeric_limits<std::int32_t>::min();  // neither an id nor a level key
 
 }  // namespace
 
@@ -59,112 +56,154 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
   const GridSpec& g = grid.spec;
   const int W = g.width;
   const int H = g.height;
-  std::vector<Region> regions;
+  auto& regions = regions_;
+  regions.clear();
   if (W <= 0 || H <= 0 || grid.level.size() != g.cellCount()) {
-    return regions;
+    return {};
   }
-  const std::uint32_t VW = static_cast<std::uint32_t>(W) + 1;
-  label_.assign(g.cellCount(), -1);
-  // Outgoing boundary edges per vertex (at most two, at a saddle), reset after each component.
-  const std::size_t vertices = static_cast<std::size_t>(VW) * static_cast<std::size_t>(H + 1);
-  if (out_.size() != vertices) {
-    out_.assign(vertices, {-1, -1});  // both slots of a vertex share a cache line
+  const std::uint8_t* level = grid.level.data();
+  // label_ holds the region id of a labelled cell and −1 − level of one not yet labelled, so the flood
+  // fill settles "same level, not yet visited" with one load.
+  label_.resize(g.cellCount());
+  std::transform(grid.level.begin(), grid.level.end(), label_.begin(),
+                 [](std::uint8_t l) { return -1 - static_cast<std::int32_t>(l); });
+  // Sides of each cell already traced (bit n = side n), cleared per component from its edge list.
+  if (traced_.size() != g.cellCount()) {
+    traced_.assign(g.cellCount(), 0);
   }
   auto& label = label_;
-  auto& out = out_;
-  std::vector<std::uint32_t> stack;
-  std::vector<Edge> edges;
+  auto& traced = traced_;
+  auto& stack = stack_;
+  auto& edges = edges_;
+  // Cell steps along the side directions +x, +y, −x, −y.
+  const std::ptrdiff_t step[4] = {1, static_cast<std::ptrdiff_t>(W), -1, -static_cast<std::ptrdiff_t>(W)};
 
-  for (std::size_t seed = 0; seed < grid.level.size(); ++seed) {
-    const int lvl = grid.level[seed];
+  const std::size_t cellCount = grid.level.size();
+  for (std::size_t seed = 0; seed < cellCount; ++seed) {
+    if (minLevel >= 1) {
+      // Skip level-0 cells (most of a risk map) eight at a time.
+      while (seed + 8 <= cellCount) {
+        std::uint64_t word = 0;
+        std::memcpy(&word, level + seed, sizeof word);
+        if (word != 0) {
+          break;
+        }
+        seed += 8;
+      }
+      if (seed >= cellCount) {
+        break;
+      }
+    }
+    const int lvl = level[seed];
     if (lvl < minLevel || label[seed] >= 0) {
       continue;
     }
     const auto id = static_cast<std::int32_t>(regions.size());
-    // Flood fill (4-neighbour) of the component, emitting its boundary edges on the way: a 4-neighbour
+    const std::int32_t unvisitedKey = -1 - lvl;
+    // Flood fill (4-neighbour) of the component, listing its boundary edges on the way: a 4-neighbour
     // of the same level is in the same component, anything else (other level, off the grid) is across
-    // the boundary. Edges keep the component on their left.
+    // the boundary. Edge n of a cell is its side with the cell on the left when walked in direction n
+    // (bottom +x, right +y, top −x, left −y).
     edges.clear();
-    auto vid = [&](int i, int j) {
-      return static_cast<std::uint32_t>(j) * VW + static_cast<std::uint32_t>(i);
-    };
-    auto addEdge = [&](std::uint32_t from, std::uint8_t dir) {
-      const auto e = static_cast<std::int32_t>(edges.size());
-      edges.push_back(Edge{from, dir, false});
-      (out[from][0] < 0 ? out[from][0] : out[from][1]) = e;
-    };
     std::size_t cells = 0;
-    stack.assign(1, static_cast<std::uint32_t>(seed));
+    const auto seedI = static_cast<std::uint32_t>(seed % static_cast<std::size_t>(W));
+    const auto seedJ = static_cast<std::uint32_t>(seed / static_cast<std::size_t>(W));
+    stack.assign(1, CellRef{static_cast<std::uint32_t>(seed), seedI, seedJ});
     label[seed] = id;
     while (!stack.empty()) {
-      const std::uint32_t c = stack.back();
+      const CellRef c = stack.back();
       stack.pop_back();
       ++cells;
-      const int i = static_cast<int>(c % static_cast<std::uint32_t>(W));
-      const int j = static_cast<int>(c / static_cast<std::uint32_t>(W));
-      // Neighbours: below (edge +x at the bottom), right (+y), above (−x), left (−y).
-      const int ni[4] = {i, i + 1, i, i - 1};
-      const int nj[4] = {j - 1, j, j + 1, j};
-      const std::uint32_t from[4] = {vid(i, j), vid(i + 1, j), vid(i + 1, j + 1), vid(i, j + 1)};
+      const int i = static_cast<int>(c.i);
+      const int j = static_cast<int>(c.j);
+      const bool inGrid[4] = {j > 0, i + 1 < W, j + 1 < H, i > 0};
+      const std::uint32_t ni[4] = {c.i, c.i + 1, c.i, c.i - 1};
+      const std::uint32_t nj[4] = {c.j - 1, c.j, c.j + 1, c.j};
+      // Neighbours across the sides: below, right, above, left.
+      const std::ptrdiff_t across[4] = {-step[1], step[0], step[1], -step[0]};
       for (int n = 0; n < 4; ++n) {
-        const bool inGrid = ni[n] >= 0 && nj[n] >= 0 && ni[n] < W && nj[n] < H;
-        const std::size_t nc = inGrid ? g.index(ni[n], nj[n]) : 0;
-        if (!inGrid || grid.level[nc] != lvl) {
-          addEdge(from[n], static_cast<std::uint8_t>(n));
-        } else if (label[nc] < 0) {
+        const std::size_t nc = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(c.cell) + across[n]);
+        const std::int32_t l = inGrid[n] ? label[nc] : kOffGrid;
+        if (l == unvisitedKey) {
           label[nc] = id;
-          stack.push_back(static_cast<std::uint32_t>(nc));
+          stack.push_back(CellRef{static_cast<std::uint32_t>(nc), ni[n], nj[n]});
+        } else if (l != id) {  // another level or off the grid (4-neighbours of a level connect)
+          edges.push_back(SideRef{c.cell, static_cast<std::uint32_t>(n)});
         }
       }
     }
+    // Is cell (i, j) on the grid and of this component's level?
+    auto sameLevel = [&](int i, int j) {
+      return i >= 0 && j >= 0 && i < W && j < H && level[g.index(i, j)] == lvl;
+    };
     Region region;
     region.level = lvl;
     region.cells = cells;
-    for (std::size_t start = 0; start < edges.size(); ++start) {
-      if (edges[start].used) {
+    for (const SideRef& startEdge : edges) {
+      if ((traced[startEdge.cell] >> startEdge.side) & 1U) {
         continue;
       }
-      Ring ring;
-      std::size_t e = start;
+      Ring& ring = ring_;
+      ring.clear();
+      int ci = static_cast<int>(startEdge.cell % static_cast<std::uint32_t>(W));
+      int cj = static_cast<int>(startEdge.cell / static_cast<std::uint32_t>(W));
+      int side = static_cast<int>(startEdge.side);
       int prevDir = -1;
-      while (!edges[e].used) {
-        edges[e].used = true;
-        const int dir = edges[e].dir;
-        const std::uint32_t from = edges[e].from;
-        if (dir != prevDir) {  // keep corners only
-          ring.push_back(Vec2{g.originX + static_cast<double>(from % VW) * g.resolution,
-                              g.originY + static_cast<double>(from / VW) * g.resolution});
-        }
-        prevDir = dir;
-        const std::uint32_t to = from + static_cast<std::uint32_t>(kDx[dir]) +
-                                 static_cast<std::uint32_t>(kDy[dir]) * VW;  // unsigned wrap is intended
-        const std::int32_t a = out[to][0];
-        const std::int32_t b = out[to][1];
-        std::int32_t next = a;
-        if (b >= 0) {
-          // Saddle: turn left, hugging the current cell, so diagonal neighbours stay apart.
-          next = edges[static_cast<std::size_t>(a)].dir == (dir + 1) % 4 ? a : b;
-          if (edges[static_cast<std::size_t>(next)].used) {
-            next = next == a ? b : a;
-          }
-        }
-        if (next < 0) {
+      while (true) {
+        std::uint8_t& bits = traced[g.index(ci, cj)];
+        if ((bits >> side) & 1U) {
           break;
         }
-        e = static_cast<std::size_t>(next);
+        bits = static_cast<std::uint8_t>(bits | (1U << side));
+        const int dir = side;
+        if (dir != prevDir) {  // keep corners only
+          // Start vertex of side n: corners (0,0), (1,0), (1,1), (0,1) of the cell.
+          const int vi = ci + ((dir == 1 || dir == 2) ? 1 : 0);
+          const int vj = cj + ((dir == 2 || dir == 3) ? 1 : 0);
+          ring.push_back(Vec2{g.originX + static_cast<double>(vi) * g.resolution,
+                              g.originY + static_cast<double>(vj) * g.resolution});
+        }
+        prevDir = dir;
+        // At the end vertex the cell ahead (L, across the next side of this cell) and the one diagonally
+        // ahead-right (R) decide the next boundary edge; the cell behind-right is outside by definition.
+        const int rdir = (dir + 3) % 4;
+        const int li = ci + kDx[dir];
+        const int lj = cj + kDy[dir];
+        const int ri = li + kDx[rdir];
+        const int rj = lj + kDy[rdir];
+        if (!sameLevel(li, lj)) {
+          // Turn left, hugging the current cell: at a saddle this keeps diagonal neighbours apart. Should
+          // that edge be traced already, the vertex's other outgoing edge (along R, if R is in this
+          // component) is taken, as a vertex table of the component's edges would.
+          const int left = (dir + 1) % 4;
+          if (((bits >> left) & 1U) != 0 && sameLevel(ri, rj) && label[g.index(ri, rj)] == id) {
+            ci = ri;
+            cj = rj;
+            side = rdir;
+          } else {
+            side = left;
+          }
+        } else if (sameLevel(ri, rj)) {
+          ci = ri;  // turn right around the vertex, onto R
+          cj = rj;
+          side = rdir;
+        } else {
+          ci = li;  // straight on along L
+          cj = lj;
+        }
       }
       // The start vertex is a corner unless the ring closed going straight through it.
-      if (ring.size() > 1 && edges[start].dir == prevDir) {
-        ring.erase(ring.begin());
-      }
-      if (signedArea(ring) > 0.0) {
-        region.outer = std::move(ring);
+      const auto first =
+          ring.begin() + ((ring.size() > 1 && static_cast<int>(startEdge.side) == prevDir) ? 1 : 0);
+      Ring exact(first, ring.end());  // one allocation of the final size
+      if (signedArea(exact) > 0.0) {
+        region.outer = std::move(exact);
       } else {
-        region.holes.push_back(std::move(ring));
+        region.holes.push_back(std::move(exact));
       }
     }
-    for (const auto& e : edges) {
-      out[e.from] = {-1, -1};
+    for (const SideRef& e : edges) {
+      traced[e.cell] = 0;
     }
     regions.push_back(std::move(region));
   }
@@ -180,6 +219,7 @@ std::vector<Region> RegionExtractor::extract(const LevelGrid& grid, int minLevel
   for (auto& r : regions) {
     ordered[start[static_cast<std::size_t>(r.level)]++] = std::move(r);
   }
+  regions.clear();  // keeps its capacity: no fresh (page-faulting) allocation next time
   return ordered;
 }
 

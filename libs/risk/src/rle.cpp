@@ -1,5 +1,6 @@
 #include "fleet/risk/rle.hpp"
 
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -7,13 +8,31 @@ namespace fleet::risk {
 
 std::vector<LevelRun> encodeRle(std::span<const std::uint8_t> levels) {
   std::vector<LevelRun> runs;
-  for (std::uint8_t v : levels) {
-    if (!runs.empty() && runs.back().level == v &&
-        runs.back().length < std::numeric_limits<std::uint32_t>::max()) {
-      ++runs.back().length;
-    } else {
-      runs.push_back(LevelRun{v, 1});
+  constexpr std::size_t kMaxRun = std::numeric_limits<std::uint32_t>::max();
+  const std::size_t n = levels.size();
+  std::size_t i = 0;
+  while (i < n) {
+    const std::uint8_t v = levels[i];
+    std::size_t j = i + 1;
+    // Long runs (most of a risk map is level 0) are extended eight bytes at a time.
+    const std::uint64_t pattern = 0x0101010101010101ULL * v;
+    while (j + 8 <= n) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, levels.data() + j, sizeof word);
+      if (word != pattern) {
+        break;
+      }
+      j += 8;
     }
+    while (j < n && levels[j] == v) {
+      ++j;
+    }
+    std::size_t length = j - i;
+    for (; length > kMaxRun; length -= kMaxRun) {
+      runs.push_back(LevelRun{v, static_cast<std::uint32_t>(kMaxRun)});
+    }
+    runs.push_back(LevelRun{v, static_cast<std::uint32_t>(length)});
+    i = j;
   }
   return runs;
 }

@@ -105,6 +105,34 @@ TEST_P(FusionEquality, RandomScenesMatchReferenceCellForCell) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, FusionEquality, ::testing::Range(0, 8));
 
+// Discs centred on cell centres and corners with radii of whole and half cells (and 3-4-5 distances),
+// so cell centres lie on or within rounding of the rims: the painter's interval estimate must defer to
+// the exact test there.
+TEST(FusionEngine, LatticeAlignedDiscsMatchReferenceCellForCell) {
+  auto cfg = smallConfig(6.0, 6.0, 3);
+  cfg.policy.humanHuman = true;
+  auto engine = FusionEngine::create(cfg, std::make_shared<OverlapRatio>());
+  ASSERT_TRUE(engine.has_value());
+  const double radii[] = {0.3, 0.5, 0.25, 0.35, 1.0};
+  int n = 0;
+  for (int k = 0; k < 10; ++k) {
+    const double r = radii[k % 5];
+    const double cx = 0.55 + 0.5 * k + (k % 2 == 0 ? 0.0 : 0.05);  // cell centre or cell corner
+    for (int m = 0; m < 4; ++m) {
+      Source s;
+      s.id = idOf("l", n++);
+      s.kind = SourceKind::kRobot;
+      s.dt = 0.1;
+      const double cy = 0.55 + 1.4 * m + (m % 2 == 0 ? 0.0 : 0.05);
+      for (int step = 0; step < 3; ++step) {
+        s.discs.push_back({cx, cy + 0.1 * step, r, 0.0});
+      }
+      ASSERT_TRUE(engine->upsert(s));
+    }
+  }
+  expectEqualsReference(*engine, engine->fuse(0));
+}
+
 TEST(FusionEngine, IncrementalUpdateTouchesOnlyNearbyTiles) {
   auto cfg = smallConfig(20.0, 20.0, 5);
   auto engine = FusionEngine::create(cfg, std::make_shared<OverlapRatio>());

@@ -82,6 +82,18 @@ TEST(GaussianIsotropic, SpecialCasesBoundsAndMonotonicity) {
   EXPECT_NEAR(gaussianCollisionProbability(100.0, 99.0, 1.0), 0.15744234516055491, 1e-10);  // scipy ncx2
 }
 
+// The isotropic series is summed upwards from j = 0 for b = R²/(2σ²) <= 150 and downwards from the
+// truncation point (with lgamma) above: two independent summations, which must meet at the switch.
+TEST(GaussianIsotropic, UpwardAndDownwardSeriesAgreeAtTheSwitch) {
+  const double sigma = 0.1;
+  const double rSwitch = std::sqrt(2.0 * 150.0) * sigma;
+  for (double d = 0.0; d < rSwitch + 1.0; d += 0.01) {
+    const double below = gaussianCollisionProbability(d, rSwitch * (1.0 - 1e-13), sigma);
+    const double above = gaussianCollisionProbability(d, rSwitch * (1.0 + 1e-13), sigma);
+    ASSERT_NEAR(below, above, 2e-12 + 1e-10 * above) << "d=" << d;
+  }
+}
+
 TEST(GaussianIsotropic, MonteCarloMillionSamples) {
   for (auto [d, R, s] :
        std::vector<std::array<double, 3>>{{1.0, 0.6, 0.3}, {0.4, 0.8, 0.5}, {1.5, 0.9, 0.2}}) {

@@ -38,6 +38,32 @@ TEST(Rle, RoundTripAndMaximalRuns) {
   EXPECT_TRUE(encodeRle(std::vector<std::uint8_t>{}).empty());
 }
 
+// The encoder extends runs eight bytes at a time; compare with a cell-by-cell encoder on random rows
+// of short and long runs (lengths not multiples of eight, runs ending at the array's end).
+TEST(Rle, WordwiseEncoderMatchesCellByCell) {
+  std::mt19937_64 rng(3);
+  for (int t = 0; t < 3000; ++t) {
+    std::vector<std::uint8_t> v(rng() % 200);
+    const std::uint64_t change = t % 3 == 0 ? 2 : (t % 3 == 1 ? 10 : 40);
+    std::uint8_t cur = 0;
+    for (auto& x : v) {
+      if (rng() % change == 0) {
+        cur = static_cast<std::uint8_t>(rng() % 4);
+      }
+      x = cur;
+    }
+    std::vector<LevelRun> naive;
+    for (std::uint8_t x : v) {
+      if (!naive.empty() && naive.back().level == x) {
+        ++naive.back().length;
+      } else {
+        naive.push_back(LevelRun{x, 1});
+      }
+    }
+    ASSERT_EQ(encodeRle(v), naive) << "case " << t;
+  }
+}
+
 TEST(Rle, DecodeRejectsMalformedRuns) {
   const std::vector<LevelRun> ok{{0, 5}, {2, 5}};
   EXPECT_TRUE(decodeRle(ok, 10, 2).has_value());

@@ -101,7 +101,7 @@ class FusionEngine {
   void noteChanged(const AlignedSource& aligned);
   void markDirtyTiles(double maxReach);
   void recompute(bool full);
-  void paintDisc(const Disc& d, double p);
+  void paintDisc(const Disc& d, double p, std::uint8_t level);
   void buildHash(const std::vector<StepDisc>& discs);
 
   FusionConfig config_;
@@ -112,17 +112,24 @@ class FusionEngine {
   std::vector<Disc> pendingDirty_;        // old and new discs of sources changed since the last fuse
   std::vector<std::uint8_t> dirtyTiles_;  // tiles to recompute
   bool allDirty_ = false;
-  std::vector<std::uint8_t> paintedTiles_;  // tiles painted since they were last cleared
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
   struct Paint {
     Disc disc;
     double p;
-    std::uint32_t key;
+  };
+  struct RowSpan {
+    int j, a, b;  // row j, cells a..b inside the disc
   };
   // scratch, kept between calls to avoid reallocation
   std::vector<Paint> paints_;
+  std::vector<RowSpan> rowSpans_;
+  std::vector<std::uint32_t> bucketFill_;
+  std::vector<std::uint32_t> paintTile_;
+  std::vector<std::uint32_t> tileStart_;
+  std::vector<Paint> sortedPaints_;
+  std::vector<double> cellX_;  // cell-centre x of every column
   std::vector<std::vector<StepDisc>> stepDiscs_;
   std::vector<double> discMax_;
   std::vector<std::uint8_t> active_;

@@ -14,8 +14,10 @@ struct Cov2 {
 };
 
 /// P(‖x‖ ≤ R) for x ~ N(μ, σ² I) with ‖μ‖ = d: the noncentral χ² (k = 2) CDF at R²/σ² with
-/// λ = d²/σ², i.e. 1 − Q₁(d/σ, R/σ). Exact up to ~1e-15 absolute (Poisson-mixture series summed
-/// downwards so every addition is of positive terms). sigma = 0 gives the indicator d < R.
+/// λ = d²/σ², i.e. 1 − Q₁(d/σ, R/σ), as a Poisson-mixture series in which every addition is of
+/// positive terms: for b = R²/(2σ²) <= 150 summed upwards from e^{−a}, e^{−b} (a few multiplications
+/// per term; ~1e-14 absolute, checked against 60-digit sums), above that downwards from the truncation
+/// point with lgamma (~1e-12 absolute at a, b in the thousands). sigma = 0 gives the indicator d < R.
 double gaussianCollisionProbability(double d, double R, double sigma);
 
 /// P(‖x‖ ≤ R) for x ~ N(mean, cov) (anisotropic), fast path: in whitened coordinates z = L⁻¹(x − mean)

@@ -33,6 +33,8 @@ class OverlapRatio final : public RiskModel {
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double reach(const Disc& a) const override;
   [[nodiscard]] std::string_view name() const override { return "overlap_ratio"; }
+  [[nodiscard]] double pairWithIntersection(const Disc& a, const Disc& b, double d,
+                                            double intersectionArea) const override;
 };
 
 }  // namespace fleet::risk

@@ -27,15 +27,25 @@ struct Region {
 /// cell edges (marching squares on the level-indicator, with saddles resolved for 4-connectivity).
 std::vector<Region> extractRegions(const LevelGrid& grid, int minLevel = 1);
 
-/// extractRegions with its working buffers (labels, vertex tables: ~12 bytes per cell) kept between
+/// extractRegions with its working buffers (labels and traced sides: 5 bytes per cell) kept between
 /// calls, for callers that extract every cycle.
 class RegionExtractor {
  public:
   std::vector<Region> extract(const LevelGrid& grid, int minLevel = 1);
 
  private:
+  struct CellRef {
+    std::uint32_t cell, i, j;
+  };
+  struct SideRef {
+    std::uint32_t cell, side;
+  };
   std::vector<std::int32_t> label_;
-  std::vector<std::array<std::int32_t, 2>> out_;
+  std::vector<std::uint8_t> traced_;
+  std::vector<CellRef> stack_;
+  std::vector<SideRef> edges_;
+  Ring ring_;
+  std::vector<Region> regions_;  // in discovery order, before ordering by level
 };
 
 /// Signed area of a ring (positive when counter-clockwise).

@@ -23,6 +23,12 @@ class RiskModel {
   [[nodiscard]] virtual double reach(const Disc& a) const = 0;
 
   [[nodiscard]] virtual std::string_view name() const = 0;
+  /// pair(a, b) for a caller that already has the centre distance d and the area of intersection of the
+  /// two discs (the fusion engine needs it for the scene index); must equal pair(a, b) exactly.
+  [[nodiscard]] virtual double pairWithIntersection(const Disc& a, const Disc& b, double /*d*/,
+                                                    double /*intersectionArea*/) const {
+    return pair(a, b);
+  }
 };
 
 }  // namespace fleet::risk
