@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/planning/astar.hpp"
+
+#include <stdexcept>
 
 namespace fleet::agent {
 namespace {
@@ -40,7 +43,57 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       grid_(std::move(grid)),
       raw_(std::move(raw)),
       ekf_(makeEkf(p_)),
-      follower_(followerParams()) {}
+      follower_(followerParams()) {
+  if (p_.localPlanner != "follow") {
+    auto inner = avoidance::makePlanner(p_.localPlanner);
+    if (!inner) {
+      throw std::invalid_argument("local planner: " + inner.error().message);
+    }
+    planner_ = std::make_unique<avoidance::SafePlanner>(std::move(*inner));
+  }
+}
+
+control::Twist Agent::planLocal(bool& reached, bool& blocked) {
+  const Pose2 pose = ekf_.pose();
+  // Drop the path points already passed: keep from the one nearest to the robot.
+  std::size_t nearest = 0;
+  for (std::size_t i = 0; i < path_.size() && i < 40; ++i) {
+    if (distance(path_[i], pose.position()) < distance(path_[nearest], pose.position())) {
+      nearest = i;
+    }
+  }
+  path_.erase(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(nearest));
+  std::vector<Vec2> scan;
+  std::vector<avoidance::MovingDisc> discs;
+  if (haveFrame_) {
+    for (std::size_t i = 0; i < frame_.ranges.size(); ++i) {
+      const double range = static_cast<double>(frame_.ranges[i]);
+      if (range < static_cast<double>(frame_.range_max) && range < 3.0) {
+        const double a = static_cast<double>(frame_.angle_min) +
+                         static_cast<double>(i) * static_cast<double>(frame_.angle_increment);
+        scan.push_back(pose.transform({range * std::cos(a), range * std::sin(a)}));
+      }
+    }
+    for (const auto& d : frame_.detections) {
+      discs.push_back({pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
+                       {},
+                       static_cast<double>(d.r)});
+    }
+  }
+  avoidance::LocalView view;
+  view.robot = {pose, {v_, w_}, p_.radius};
+  view.path = path_;
+  view.scan = scan;
+  view.discs = discs;
+  view.limits = p_.limits;
+  view.dt = 0.1;
+  view.goal_tolerance = 0.15;
+  const auto cmd = planner_->plan(view);
+  reached = cmd.status == avoidance::PlanStatus::kGoalReached || distance(pose, goals_[goal_].pose) < 0.15;
+  blocked = cmd.status == avoidance::PlanStatus::kBlocked ||
+            (cmd.overruled && std::abs(cmd.twist.v) < 0.05 && std::abs(cmd.twist.omega) < 0.05);
+  return cmd.twist;
+}
 
 void Agent::onFrame(const msg::SensorFrame& f) {
   if (ekf_.predict(f.ds_left, f.ds_right) != estimation::UpdateStatus::kAccepted) {
@@ -150,6 +203,13 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
                    (path ? std::string("follower refused the path") : path.error().message),
                nowNs);
     return;
+  }
+  path_.clear();
+  for (const auto& q : path->poses) {
+    path_.push_back(q.position());
+  }
+  if (planner_) {
+    planner_->reset();
   }
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
@@ -266,7 +326,50 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   if (!task_.empty() && phase_ == Phase::Idle) {
     startGoal(nowNs);
   }
-  if (phase_ == Phase::Driving) {
+  if (phase_ == Phase::Driving && planner_) {
+    bool reached = false;
+    bool blocked = false;
+    const auto tw = planLocal(reached, blocked);
+    if (reached) {
+      phase_ = Phase::Dwelling;
+      phaseStartNs_ = nowNs;
+      const auto st = taskStateFor(goal_, true);
+      if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
+        reported_ = st;
+        pendingStatus_ = msg::TaskStatus{
+            p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
+            "",    nowNs};
+      }
+    } else {
+      v = tw.v;
+      w = tw.omega;
+      mode = blocked ? msg::RobotMode::Waiting : msg::RobotMode::Moving;
+      if (blocked) {
+        bool byRobot = false;
+        std::string blocker;
+        (void)clearSpeed(0.5, byRobot, blocker);  // who is in the way
+        if (blockedSinceNs_ < 0) {
+          blockedSinceNs_ = nowNs;
+        }
+        const double blockedS = nsToSec(nowNs - blockedSinceNs_);
+        const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
+        if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
+          phase_ = Phase::BackingOff;
+          phaseStartNs_ = nowNs;
+        } else if (blockedS > 2.0 * p_.blockedBackoffS && !detoured_ && blockPoint_) {
+          startGoal(nowNs, blockPoint_);
+          detoured_ = true;
+        } else if (blockedS > p_.blockedFailS) {
+          finishTask(msg::TaskState::Failed,
+                     "blocked for " + std::to_string(static_cast<int>(p_.blockedFailS)) + " s", nowNs);
+          v = 0;
+          w = 0;
+        }
+      } else {
+        blockedSinceNs_ = -1;
+      }
+    }
+  } else if (phase_ == Phase::Driving) {
     auto r = follower_.step(ekf_.pose());
     if (!r) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/avoidance/local_planner.hpp"
 #include "fleet/control/path_follower.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
@@ -35,6 +36,10 @@ struct AgentParams {
   double predictionHorizonS = 3.0;
   double predictionDt = 0.5;
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+  /// "follow": the path follower with the stop rule; any libs/avoidance planner name ("dwa", "vo",
+  /// ...): that planner on the path ahead, always behind the safety layer.
+  std::string localPlanner = "follow";
+  control::VelocityLimits limits{0.8, -0.3, 1.5, 1.0, 3.0};
 };
 
 struct AgentOutput {
@@ -80,6 +85,10 @@ class Agent {
   std::shared_ptr<const planning::OccupancyGrid> raw_;
   estimation::PoseEkf ekf_;
   control::PathFollower follower_;
+  std::unique_ptr<avoidance::LocalPlanner> planner_;  // null: "follow"
+  std::vector<Vec2> path_;                            // remaining path (world frame)
+  /// One cycle of the configured avoidance planner; returns the twist and whether it is blocked.
+  control::Twist planLocal(bool& reached, bool& blocked);
   msg::SensorFrame frame_;
   bool haveFrame_ = false;
   std::uint64_t rejected_ = 0;

@@ -33,8 +33,8 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
   return g;
 }
 
-int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep,
-        const std::string& id) {
+int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep, const std::string& id,
+        const std::string& localPlanner) {
   auto raw = gridOf(scn.map);
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::vector<std::unique_ptr<agent::Agent>> agents;
@@ -55,6 +55,9 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
     p.wheelBase = r.wheelBase;
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
+    p.localPlanner = localPlanner;
+    p.limits = r.limits;
+    p.limits.v_max = p.vMax;
     for (const auto& l : scn.landmarks) {
       p.landmarks.emplace_back(l.id, l.position);
     }
@@ -155,6 +158,10 @@ int main(int argc, char** argv) {
   std::string clock = "wall";
   std::string id = "agents";
   std::string level = "info";
+  std::string localPlanner = "follow";
+  app.add_option(
+      "--local-planner", localPlanner,
+      "follow (path follower + stop rule) or a libs/avoidance planner: dwa, vo, potential_field, ...");
   app.add_option("--scenario", scenario, "scenario JSON (map, robots, landmarks)")->required();
   app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
@@ -172,7 +179,7 @@ int main(int argc, char** argv) {
       }
     }
     service::installStopHandlers();
-    return run(scn, only, clock == "lockstep", id);
+    return run(scn, only, clock == "lockstep", id, localPlanner);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;
