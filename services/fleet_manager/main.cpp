@@ -111,12 +111,20 @@ int run(const manager::Settings& settings) {
       sim.set(c.sim_time_ns);
     }
     const std::int64_t now = clock.nowNs();
-    for (const auto& s : states.take()) {
+    std::vector<msg::RobotState> gone;
+    for (const auto& s : states.takeWithLifecycle(gone)) {
       if (!isValidId(s.robot_id) || !s.pose.isFinite() || !std::isfinite(s.battery)) {
         badInput.warn("robot_state", "dropped RobotState with an invalid id, pose or battery");
         continue;
       }
       node.onRobotState(s);
+    }
+    // DDS liveliness: a robot whose RobotState writer is gone (agent process ended, lease lost) is
+    // lost now, without waiting for the state lease.
+    for (const auto& g : gone) {
+      if (isValidId(g.robot_id)) {
+        node.onRobotLost(g.robot_id, now, out);
+      }
     }
     auto reqs = tasks.take();
     bool changed = !reqs.empty();

@@ -221,3 +221,47 @@ TEST_F(FleetE2E, KillNineUnderLoadLosesNothingAcknowledged) {
   }
   EXPECT_EQ(missing, 0) << "of " << acknowledged.size() << " acknowledged tasks";
 }
+
+TEST_F(FleetE2E, RobotWhoseAgentEndsIsLostAtOnceByLiveliness) {
+  // A long state lease, so only DDS liveliness can explain a quick re-queue.
+  manager_->kill(SIGKILL);
+  std::ofstream(dir_ / "manager.json") << json{
+      {"db", (dir_ / "fleet.db").string()},
+      {"stations", (dir_ / "stations.json").string()},
+      {"tick_s", 0.05},
+      {"lease_s", 30.0},
+      {"sync", "normal"}}.dump();
+  startManager();
+  waitHealthy();
+  auto agentProcess = std::make_unique<transport::Participant>();  // plays one agent process
+  FakeRobots doomed(*agentProcess, 1);
+  transport::Participant observer;
+  transport::Reader<msg::TaskEvent> events(observer);
+  auto r =
+      http_->Post("/v1/tasks", R"({"id": "job-live", "kind": "goto", "station": "D-1"})", "application/json");
+  ASSERT_EQ(r->status, 201);
+  // The robot takes the task but never finishes it.
+  const auto end = Clk::now() + 20s;
+  while (Clk::now() < end && doomed.received.empty()) {
+    doomed.publishStates();
+    for (auto& a : doomed.orders.take()) {
+      if (!a.task_id.empty()) {
+        doomed.received.push_back(a);
+      }
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_FALSE(doomed.received.empty());
+  (void)events.take();
+  const auto t0 = Clk::now();
+  agentProcess.reset();  // the agent process ends: its writers disappear
+  bool requeued = false;
+  while (!requeued && Clk::now() - t0 < 10s) {
+    events.waitForData(100ms);
+    for (const auto& e : events.take()) {
+      requeued = requeued || (e.task_id == "job-live" && e.state == msg::TaskState::Requeued);
+    }
+  }
+  EXPECT_TRUE(requeued);
+  EXPECT_LT(Clk::now() - t0, 5s) << "re-queued by liveliness, well before the 30 s state lease";
+}

@@ -117,6 +117,34 @@ class Reader {
     }
     return v.size();
   }
+  /// Takes everything, like take(), and also reports instances whose writers are all gone or that
+  /// were disposed (liveliness lost, process ended): `gone` gets the key fields of each such
+  /// instance (other fields empty).
+  std::vector<T> takeWithLifecycle(std::vector<T>& gone) {
+    constexpr std::size_t kBatch = 256;
+    std::vector<T> out;
+    while (true) {
+      void* samples[kBatch] = {nullptr};
+      dds_sample_info_t infos[kBatch];
+      const int n = dds_take(r_, samples, infos, kBatch, kBatch);
+      check(n, "dds_take");
+      for (int i = 0; i < n; ++i) {
+        const auto& c = *static_cast<const typename Tr::C*>(samples[i]);
+        if (infos[i].valid_data) {
+          out.push_back(Tr::fromC(c));
+        } else if (infos[i].instance_state != DDS_IST_ALIVE) {
+          gone.push_back(Tr::fromC(c));
+        }
+      }
+      if (n > 0) {
+        check(dds_return_loan(r_, samples, n), "dds_return_loan");
+      }
+      if (static_cast<std::size_t>(n) < kBatch) {
+        break;
+      }
+    }
+    return out;
+  }
   /// Blocks until data is available or the timeout passes; true when data is there.
   bool waitForData(std::chrono::milliseconds timeout);
   [[nodiscard]] std::uint32_t matchedWriters() const { return detail::matched(r_, false); }
