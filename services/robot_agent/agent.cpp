@@ -318,6 +318,42 @@ bool Agent::rearClear() const {
   return true;
 }
 
+void Agent::enterDwell(std::int64_t nowNs) {
+  phase_ = Phase::Dwelling;
+  phaseStartNs_ = nowNs;
+  const auto st = taskStateFor(goal_, true);
+  if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
+    reported_ = st;
+    pendingStatus_ = msg::TaskStatus{
+        p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
+        "",    nowNs};
+  }
+}
+
+void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w) {
+  if (blockedSinceNs_ < 0) {
+    blockedSinceNs_ = nowNs;
+  }
+  const double blockedS = nsToSec(nowNs - blockedSinceNs_);
+  // A person who does not step aside, or two robots face to face (the larger id yields): back off
+  // if nothing is behind, then try another way around, rather than wait forever.
+  const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
+  if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
+    phase_ = Phase::BackingOff;
+    phaseStartNs_ = nowNs;
+  } else if (blockedS > 2.0 * p_.blockedBackoffS && !detoured_ && blockPoint_) {
+    startGoal(nowNs, blockPoint_);
+    detoured_ = true;
+  } else if (blockedS > p_.blockedFailS) {
+    finishTask(msg::TaskState::Failed,
+               "blocked by " + (blocker.empty() ? std::string("an obstacle") : blocker) + " for " +
+                   std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
+               nowNs);
+    v = 0;
+    w = 0;
+  }
+}
+
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   AgentOutput out;
   double v = 0.0;
@@ -331,15 +367,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     bool blocked = false;
     const auto tw = planLocal(reached, blocked);
     if (reached) {
-      phase_ = Phase::Dwelling;
-      phaseStartNs_ = nowNs;
-      const auto st = taskStateFor(goal_, true);
-      if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
-        reported_ = st;
-        pendingStatus_ = msg::TaskStatus{
-            p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
-            "",    nowNs};
-      }
+      enterDwell(nowNs);
     } else {
       v = tw.v;
       w = tw.omega;
@@ -348,23 +376,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
         bool byRobot = false;
         std::string blocker;
         (void)clearSpeed(0.5, byRobot, blocker);  // who is in the way
-        if (blockedSinceNs_ < 0) {
-          blockedSinceNs_ = nowNs;
-        }
-        const double blockedS = nsToSec(nowNs - blockedSinceNs_);
-        const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
-        if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
-          phase_ = Phase::BackingOff;
-          phaseStartNs_ = nowNs;
-        } else if (blockedS > 2.0 * p_.blockedBackoffS && !detoured_ && blockPoint_) {
-          startGoal(nowNs, blockPoint_);
-          detoured_ = true;
-        } else if (blockedS > p_.blockedFailS) {
-          finishTask(msg::TaskState::Failed,
-                     "blocked for " + std::to_string(static_cast<int>(p_.blockedFailS)) + " s", nowNs);
-          v = 0;
-          w = 0;
-        }
+        onStandoff(nowNs, byRobot, blocker, v, w);
       } else {
         blockedSinceNs_ = -1;
       }
@@ -374,15 +386,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     if (!r) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
     } else if (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15)) {
-      phase_ = Phase::Dwelling;
-      phaseStartNs_ = nowNs;
-      const auto st = taskStateFor(goal_, true);
-      if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
-        reported_ = st;
-        pendingStatus_ = msg::TaskStatus{
-            p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
-            "",    nowNs};
-      }
+      enterDwell(nowNs);
     } else {
       v = std::clamp(r->cmd.v, -0.3, p_.vMax);
       w = std::clamp(r->cmd.omega, -p_.wMax, p_.wMax);
@@ -408,28 +412,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
       }
       if (wanted > 0.1 && allowed < 0.05) {
         mode = msg::RobotMode::Waiting;
-        if (blockedSinceNs_ < 0) {
-          blockedSinceNs_ = nowNs;
-        }
-        const double blockedS = nsToSec(nowNs - blockedSinceNs_);
-        // Two robots face to face: the larger id yields by backing off and replanning.
-        // A person who does not step aside, or two robots face to face (the larger id yields):
-        // back off and replan rather than wait forever.
-        const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
-        if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
-          phase_ = Phase::BackingOff;
-          phaseStartNs_ = nowNs;
-        } else if (blockedS > 2.0 * p_.blockedBackoffS && !detoured_ && blockPoint_) {
-          startGoal(nowNs, blockPoint_);  // try another aisle around what blocks
-          detoured_ = true;
-        } else if (blockedS > p_.blockedFailS) {
-          finishTask(
-              msg::TaskState::Failed,
-              "blocked by " + blocker + " for " + std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
-              nowNs);
-          v = 0;
-          w = 0;
-        }
+        onStandoff(nowNs, byRobot, blocker, v, w);
       } else {
         blockedSinceNs_ = -1;
       }

@@ -73,6 +73,10 @@ class Agent {
   /// detour around whatever stands in the way).
   void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
   void finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs);
+  /// At a goal: dwell there for its duration, reporting loading/unloading.
+  void enterDwell(std::int64_t nowNs);
+  /// Something keeps the robot from moving: after a while back off, then detour, then fail.
+  void onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w);
   msg::TaskState taskStateFor(std::size_t goalIndex, bool dwelling) const;
   /// Largest forward speed that keeps the stop gap to everything seen ahead, and whether a robot
   /// (not a human) is what blocks.

@@ -3,7 +3,9 @@
 // A child process for multi-process tests: started with fork/exec, killed (SIGKILL) when the
 // object goes out of scope so a failing test never leaves orphans.
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -84,9 +86,26 @@ class ChildProcess {
   int status_ = -1;
 };
 
-/// A DDS domain id for this test process, so parallel ctest runs don't hear each other.
+/// A DDS domain id that no other test process on this machine holds, so parallel ctest runs (and
+/// two checkouts testing at once) never hear each other: the first of 10..209, starting from one
+/// derived from the pid, whose lock file this process can lock. The lock is held until exit.
 inline int uniqueDomain() {
-  return 10 + static_cast<int>(getpid() % 200);
+  static const int domain = [] {
+    const int start = static_cast<int>(getpid() % 200);
+    for (int k = 0; k < 200; ++k) {
+      const int d = 10 + (start + k) % 200;
+      const std::string path = "/tmp/fleet-test-dds-domain-" + std::to_string(d) + ".lock";
+      const int fd = open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+      if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0) {
+        return d;  // fd stays open: the lock lives as long as the process
+      }
+      if (fd >= 0) {
+        close(fd);
+      }
+    }
+    return 10 + start;
+  }();
+  return domain;
 }
 
 }  // namespace fleet::test
