@@ -126,14 +126,18 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   return n;
 }
 
+std::uint32_t FleetManagerNode::nextRevision(const std::string& robot, std::int64_t nowNs) {
+  // Unique across restarts of the manager: start from the clock in ms, then count.
+  auto& rev = revisions_[robot];
+  rev = std::max<std::uint32_t>(rev + 1, static_cast<std::uint32_t>((nowNs / 1'000'000) % 2'000'000'000));
+  return rev;
+}
+
 msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std::int64_t nowNs) {
   msg::TaskAssignment a;
   a.robot_id = o.robotId;
   a.task_id = o.task.id;
-  auto& rev = revisions_[o.robotId];
-  // Unique across restarts: start from the clock in ms, then count.
-  rev = std::max<std::uint32_t>(rev + 1, static_cast<std::uint32_t>((nowNs / 1'000'000) % 2'000'000'000));
-  a.revision = rev;
+  a.revision = nextRevision(o.robotId, nowNs);
   a.stamp_ns = nowNs;
   auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
     const Station* s = dispatcher_->stations().find(name);
@@ -191,9 +195,7 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
   for (const auto& robot : r.revoked) {
     msg::TaskAssignment a;
     a.robot_id = robot;
-    auto& rev = revisions_[robot];
-    rev = std::max<std::uint32_t>(rev + 1, static_cast<std::uint32_t>((nowNs / 1'000'000) % 2'000'000'000));
-    a.revision = rev;
+    a.revision = nextRevision(robot, nowNs);
     a.stamp_ns = nowNs;
     out.assignments.push_back(a);
   }

@@ -80,6 +80,7 @@ class FleetManagerNode {
   FleetManagerNode() = default;
   void publish(DispatchResult r, std::int64_t nowNs, Outbox& out);
   msg::TaskAssignment toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
+  std::uint32_t nextRevision(const std::string& robot, std::int64_t nowNs);
 
   Settings settings_;
   std::unique_ptr<SqliteTaskStore> store_;

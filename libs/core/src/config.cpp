@@ -17,22 +17,6 @@ std::string joinProblems(const std::vector<std::string>& problems) {
   return out;
 }
 
-std::string typeName(const nlohmann::json& j) {
-  if (j.is_null())
-    return "null";
-  if (j.is_boolean())
-    return "a boolean";
-  if (j.is_number_integer() || j.is_number_unsigned())
-    return "an integer";
-  if (j.is_number())
-    return "a number";
-  if (j.is_string())
-    return "a string";
-  if (j.is_array())
-    return "an array";
-  return "an object";
-}
-
 std::string shortDump(const nlohmann::json& j) {
   std::string s = j.dump();
   if (s.size() > 40) {
@@ -65,6 +49,22 @@ std::string describeRange(const Range& r, bool integral) {
 
 }  // namespace
 
+std::string jsonTypeName(const nlohmann::json& j) {
+  if (j.is_null())
+    return "null";
+  if (j.is_boolean())
+    return "a boolean";
+  if (j.is_number_integer() || j.is_number_unsigned())
+    return "an integer";
+  if (j.is_number())
+    return "a number";
+  if (j.is_string())
+    return "a string";
+  if (j.is_array())
+    return "an array";
+  return "an object";
+}
+
 ConfigError::ConfigError(std::vector<std::string> problems)
     : std::runtime_error(joinProblems(problems)), problems_(std::move(problems)) {}
 
@@ -82,7 +82,7 @@ Config Config::fromJson(nlohmann::json doc, std::string origin) {
   const nlohmann::json* node = root.get();
   Config c(root, node, std::move(origin), "", problems);
   if (!node->is_object()) {
-    c.problem("", "expected a JSON object at the top level, got " + typeName(*node));
+    c.problem("", "expected a JSON object at the top level, got " + jsonTypeName(*node));
   }
   return c;
 }
@@ -163,7 +163,7 @@ std::optional<double> Config::readNumber(std::string_view path, Range r, bool in
     return std::nullopt;
   }
   if (!j->is_number() || (integral && !(j->is_number_integer() || j->is_number_unsigned()))) {
-    problem(path, "expected " + expected + ", got " + typeName(*j) + " " + shortDump(*j));
+    problem(path, "expected " + expected + ", got " + jsonTypeName(*j) + " " + shortDump(*j));
     return std::nullopt;
   }
   const double v = j->get<double>();
@@ -196,7 +196,7 @@ bool Config::boolean(std::string_view path, bool fallback) {
     return fallback;
   }
   if (!j->is_boolean()) {
-    problem(path, "expected a boolean (true/false), got " + typeName(*j) + " " + shortDump(*j));
+    problem(path, "expected a boolean (true/false), got " + jsonTypeName(*j) + " " + shortDump(*j));
     return fallback;
   }
   return j->get<bool>();
@@ -219,7 +219,7 @@ std::optional<std::string> Config::readString(std::string_view path, const std::
     return std::nullopt;
   }
   if (!j->is_string()) {
-    problem(path, "expected " + expected + ", got " + typeName(*j) + " " + shortDump(*j));
+    problem(path, "expected " + expected + ", got " + jsonTypeName(*j) + " " + shortDump(*j));
     return std::nullopt;
   }
   std::string v = j->get<std::string>();
@@ -254,7 +254,7 @@ Config Config::child(std::string_view path, bool required) {
     return Config(root_, &kEmpty, origin_, keyPath(path), problems_);
   }
   if (!j->is_object()) {
-    problem(path, "expected an object, got " + typeName(*j));
+    problem(path, "expected an object, got " + jsonTypeName(*j));
     return Config(root_, &kEmpty, origin_, keyPath(path), problems_);
   }
   return Config(root_, j, origin_, keyPath(path), problems_);
@@ -270,7 +270,7 @@ std::vector<Config> Config::array(std::string_view path, bool required) {
     return out;
   }
   if (!j->is_array()) {
-    problem(path, "expected an array, got " + typeName(*j));
+    problem(path, "expected an array, got " + jsonTypeName(*j));
     return out;
   }
   out.reserve(j->size());
@@ -278,7 +278,7 @@ std::vector<Config> Config::array(std::string_view path, bool required) {
     const std::string p = keyPath(path) + "[" + std::to_string(i) + "]";
     out.push_back(Config(root_, &(*j)[i], origin_, p, problems_));
     if (!(*j)[i].is_object()) {
-      out.back().problem("", "expected an object, got " + typeName((*j)[i]));
+      out.back().problem("", "expected an object, got " + jsonTypeName((*j)[i]));
     }
   }
   return out;

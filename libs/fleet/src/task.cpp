@@ -1,5 +1,7 @@
 #include "fleet/fleet/task.hpp"
 
+#include "fleet/core/config.hpp"
+
 #include <limits>
 #include <set>
 
@@ -15,22 +17,6 @@ std::string join(std::string_view prefix, std::string_view field) {
     return std::string(field);
   }
   return std::string(prefix) + "." + std::string(field);
-}
-
-std::string typeName(const nlohmann::json& j) {
-  if (j.is_null())
-    return "null";
-  if (j.is_boolean())
-    return "a boolean";
-  if (j.is_number_integer() || j.is_number_unsigned())
-    return "an integer";
-  if (j.is_number())
-    return "a number";
-  if (j.is_string())
-    return "a string";
-  if (j.is_array())
-    return "an array";
-  return "an object";
 }
 
 void checkStation(const std::string& name, std::string_view path, StationKind need,
@@ -141,7 +127,7 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
                                           std::string_view prefix) {
   std::vector<FieldError> errs;
   if (!j.is_object()) {
-    errs.push_back({std::string(prefix), "expected a task object, got " + typeName(j)});
+    errs.push_back({std::string(prefix), "expected a task object, got " + jsonTypeName(j)});
     return unexpected(makeValidationError(std::move(errs)));
   }
   static const std::set<std::string, std::less<>> kKnown = {
@@ -165,7 +151,7 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
       return;
     }
     if (!it->is_string()) {
-      errs.push_back({join(prefix, key), "expected a string, got " + typeName(*it)});
+      errs.push_back({join(prefix, key), "expected a string, got " + jsonTypeName(*it)});
       typesOk = false;
       return;
     }
@@ -192,7 +178,7 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
     } else if (it->is_number_integer()) {
       dst = it->get<std::int64_t>();
     } else {
-      errs.push_back({join(prefix, key), "expected an integer, got " + typeName(*it)});
+      errs.push_back({join(prefix, key), "expected an integer, got " + jsonTypeName(*it)});
       typesOk = false;
       return;
     }
@@ -253,7 +239,7 @@ Expected<std::vector<Task>, ValidationError> parseTasks(const nlohmann::json& bo
     list = &body.at("tasks");
     base = "tasks";
     if (!list->is_array()) {
-      errs.push_back({"tasks", "expected an array, got " + typeName(*list)});
+      errs.push_back({"tasks", "expected an array, got " + jsonTypeName(*list)});
       return unexpected(makeValidationError(std::move(errs)));
     }
   } else {

@@ -91,7 +91,7 @@ TEST_F(Node, RequestsAreAcknowledgedWithTheRightResult) {
   EXPECT_EQ(out.events[0].seq, 1u);
 }
 
-TEST_F(Node, TaskGoesFromQueuedToDoneWithStationGoals) {
+TEST_F(Node, TransportTaskIsAssignedWithStationGoalsAndFinishes) {
   auto node = open(0);
   manager::Outbox out;
   node->onRequests({request("t1", transport("t1"))}, 1'000'000, out);

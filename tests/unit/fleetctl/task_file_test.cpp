@@ -1,6 +1,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "task_file.hpp"
 
 using namespace fleet::ctl;
@@ -34,5 +37,24 @@ TEST(TaskFile, CsvErrorsNameLineAndColumn) {
 }
 
 TEST(TaskFile, JsonShapes) {
+  const auto dir = std::filesystem::temp_directory_path();
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream((dir / name).string()) << text;
+    return (dir / name).string();
+  };
+  const auto one = loadTaskFile(write("tf_one.json", R"({"id": "a", "kind": "goto"})"));
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->size(), 1u);
+  const auto arr = loadTaskFile(write("tf_arr.json", R"([{"id": "a"}, {"id": "b"}])"));
+  ASSERT_TRUE(arr);
+  EXPECT_EQ(arr->size(), 2u);
+  const auto wrapped =
+      loadTaskFile(write("tf_wrap.json", R"({"tasks": [{"id": "a"}, {"id": "b"}, {"id": "c"}]})"));
+  ASSERT_TRUE(wrapped);
+  EXPECT_EQ(wrapped->size(), 3u);
+  const auto bad = loadTaskFile(write("tf_bad.json", "[1, 2"));
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message, HasSubstr("not valid JSON"));
+  EXPECT_FALSE(loadTaskFile(write("tf_num.json", "42")));
   EXPECT_FALSE(loadTaskFile("/nonexistent.json"));
 }

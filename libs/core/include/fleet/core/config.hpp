@@ -22,6 +22,9 @@ class ConfigError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
+/// "a string", "an integer", "an object"...: how error messages name a JSON value's type.
+std::string jsonTypeName(const nlohmann::json& j);
+
 struct Range {
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
