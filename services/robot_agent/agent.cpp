@@ -171,7 +171,10 @@ msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
-  planning::AStarPlanner astar;
+  planning::AStarPlanner plainAstar;
+  planning::LanePlanner lanePlanner(p_.lanes);
+  planning::GlobalPlanner& astar = p_.lanes ? static_cast<planning::GlobalPlanner&>(lanePlanner)
+                                            : static_cast<planning::GlobalPlanner&>(plainAstar);
   Expected<planning::Path> path = unexpected("no_path", "not planned");
   if (avoid) {
     planning::OccupancyGrid detour = *grid_;

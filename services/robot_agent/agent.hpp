@@ -17,6 +17,7 @@
 #include "fleet/avoidance/local_planner.hpp"
 #include "fleet/control/path_follower.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
+#include "fleet/planning/lane_map.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "fleet/transport/messages.hpp"
 
@@ -40,6 +41,8 @@ struct AgentParams {
   /// ...): that planner on the path ahead, always behind the safety layer.
   std::string localPlanner = "follow";
   control::VelocityLimits limits{0.8, -0.3, 1.5, 1.0, 3.0};
+  /// One-way aisles of the map (shared by every agent of a process); null: plain A*.
+  std::shared_ptr<const planning::LaneMap> lanes;
 };
 
 struct AgentOutput {

@@ -34,9 +34,14 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
 }
 
 int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep, const std::string& id,
-        const std::string& localPlanner) {
+        const std::string& localPlanner, bool useLanes) {
   auto raw = gridOf(scn.map);
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
+  std::shared_ptr<const planning::LaneMap> lanes;
+  if (useLanes) {
+    lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
+    spdlog::info("robot agent: {} one-way aisle cells", lanes->oneWayCells());
+  }
   std::vector<std::unique_ptr<agent::Agent>> agents;
   std::map<std::string, agent::Agent*> byId;
   for (const auto& r : scn.robots) {
@@ -56,6 +61,7 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
     p.localPlanner = localPlanner;
+    p.lanes = lanes;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
     for (const auto& l : scn.landmarks) {
@@ -159,6 +165,8 @@ int main(int argc, char** argv) {
   std::string id = "agents";
   std::string level = "info";
   std::string localPlanner = "follow";
+  bool noLanes = false;
+  app.add_flag("--no-lanes", noLanes, "plan with plain A* instead of one-way narrow aisles");
   app.add_option(
       "--local-planner", localPlanner,
       "follow (path follower + stop rule) or a libs/avoidance planner: dwa, vo, potential_field, ...");
@@ -179,7 +187,7 @@ int main(int argc, char** argv) {
       }
     }
     service::installStopHandlers();
-    return run(scn, only, clock == "lockstep", id, localPlanner);
+    return run(scn, only, clock == "lockstep", id, localPlanner, !noLanes);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

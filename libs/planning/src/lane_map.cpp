@@ -85,6 +85,23 @@ LaneMap LaneMap::derive(const OccupancyGrid& raw, const LaneParams& p) {
       m.dir_[i] = {d, 0};
     }
   }
+  // Wider corridors (the bands along the walls) get two lanes, keep right: heading +x the right
+  // hand is -y, so the lower half runs +x and the upper half -x; heading +y the right hand is +x.
+  // Robots meeting in a band pass side by side instead of nose to nose.
+  const int twoLane = static_cast<int>(std::floor(p.max_two_lane_width / raw.resolution() + 1e-9));
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (hrun[i] == 0 || m.dir_[i] != LaneDir{}) {
+      continue;
+    }
+    const Cell c = raw.cellOf(i);
+    if (hrun[i] >= narrow && hrun[i] <= twoLane && vrun[i] >= p.min_aspect * hrun[i]) {
+      const bool rightHalf = 2 * (c.x - hstart[i]) >= hrun[i];
+      m.dir_[i] = {0, static_cast<std::int8_t>(rightHalf ? 1 : -1)};
+    } else if (vrun[i] >= narrow && vrun[i] <= twoLane && hrun[i] >= p.min_aspect * vrun[i]) {
+      const bool upperHalf = 2 * (c.y - vstart[i]) >= vrun[i];
+      m.dir_[i] = {static_cast<std::int8_t>(upperHalf ? -1 : 1), 0};
+    }
+  }
   return m;
 }
 

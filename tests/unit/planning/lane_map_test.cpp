@@ -56,18 +56,24 @@ TEST(LaneMap, NarrowAislesAreOneWayAndAlternate) {
   EXPECT_EQ(v1.dx, 0);
   EXPECT_NE(v1.dy, 0);
   EXPECT_EQ(v2.dy, -v1.dy);
-  // Intersections and the wide bands along the walls are two-way.
+  // Intersections are free in every direction.
   EXPECT_EQ(lanes.at({14, 8}), LaneDir{});
-  EXPECT_EQ(lanes.at({2, 20}), LaneDir{});
-  EXPECT_EQ(lanes.at({30, 37}), LaneDir{});
-  EXPECT_EQ(lanes.at({52, 20}), LaneDir{});
+  // The bands along the walls have two lanes, keep right: the left band (x = 1..4) runs down on
+  // its left half and up on its right half; the top band (y = 32..38) runs +x low and -x high; the
+  // right band (x = 46..58) likewise down on the left, up on the right.
+  EXPECT_EQ(lanes.at({2, 20}), (LaneDir{0, -1}));
+  EXPECT_EQ(lanes.at({3, 20}), (LaneDir{0, 1}));
+  EXPECT_EQ(lanes.at({30, 33}), (LaneDir{1, 0}));
+  EXPECT_EQ(lanes.at({30, 37}), (LaneDir{-1, 0}));
+  EXPECT_EQ(lanes.at({48, 20}), (LaneDir{0, -1}));
+  EXPECT_EQ(lanes.at({56, 20}), (LaneDir{0, 1}));
   // Shelves have no lane.
   EXPECT_EQ(lanes.at({6, 5}), LaneDir{});
   EXPECT_GT(lanes.oneWayCells(), 100U);
 }
 
 TEST(LaneMap, OpenMapHasNoLanes) {
-  OccupancyGrid open(40, 40, 0.5);
+  OccupancyGrid open(40, 40, 0.1);
   EXPECT_EQ(LaneMap::derive(open).oneWayCells(), 0U);
 }
 

@@ -2,7 +2,8 @@
 
 // Traffic lanes for a warehouse map: narrow aisles become one-way, adjacent aisles in alternating
 // directions, so two robots never meet head-on in an aisle too narrow to pass (the common rule of
-// industrial AGV layouts). Wide areas (bands along the walls, intersections) stay two-way.
+// industrial AGV layouts). Wider corridors (bands along the walls) get two lanes, keep right;
+// intersections and open areas stay free in every direction.
 
 #include <cstdint>
 #include <memory>
@@ -18,7 +19,9 @@ struct LaneParams {
   /// A corridor narrower than this [m] is a narrow aisle (one-way). The default lets two robots of
   /// 0.3 m radius pass each other with margin in anything at least 2 m wide.
   double max_aisle_width = 2.0;
-  /// ... provided the aisle runs at least this many times its width along its length.
+  /// Corridors from max_aisle_width up to this width [m] get two lanes (keep right).
+  double max_two_lane_width = 8.0;
+  /// ... provided the aisle or corridor runs at least this many times its width along its length.
   double min_aspect = 2.0;
   /// A move against a lane costs this many times its length: a legal detour is taken unless it is
   /// more than this much longer (dead ends, a goal just behind the robot).
