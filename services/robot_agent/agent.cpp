@@ -344,7 +344,11 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
     phase_ = Phase::BackingOff;
     phaseStartNs_ = nowNs;
-  } else if (blockedS > 2.0 * p_.blockedBackoffS && !detoured_ && blockPoint_) {
+  } else if (blockedS > 2.0 * p_.blockedBackoffS && blockPoint_ &&
+             (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 2.0 * p_.blockedBackoffS)) {
+    // Try a way around what stands in the way, again every while: in a queue of robots nobody
+    // can back off, and the one ahead may have moved aside since the last attempt.
+    lastDetourNs_ = nowNs;
     startGoal(nowNs, blockPoint_);
     detoured_ = true;
   } else if (blockedS > p_.blockedFailS) {

@@ -113,6 +113,7 @@ class Agent {
   std::vector<std::pair<std::string, Vec2>> others_;
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
   bool detoured_ = false;                   // already tried a detour for the current standoff
+  std::int64_t lastDetourNs_ = -1;          // when the last detour was tried
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
