@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
@@ -108,9 +109,9 @@ DbContents readDb(const fs::path& path) {
     return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
   };
   sqlite3_stmt* s = nullptr;
-  if (sqlite3_prepare_v2(db, "SELECT id, state, created_ns FROM tasks", -1, &s, nullptr) == SQLITE_OK) {
+  if (sqlite3_prepare_v2(db, "SELECT id, state FROM tasks", -1, &s, nullptr) == SQLITE_OK) {
     while (sqlite3_step(s) == SQLITE_ROW) {
-      out.tasks.push_back({text(s, 0), text(s, 1), sqlite3_column_int64(s, 2)});
+      out.tasks.push_back({text(s, 0), text(s, 1)});
     }
   } else {
     out.error = sqlite3_errmsg(db);
@@ -148,7 +149,10 @@ struct Run {
   std::vector<std::string> pickups, dropoffs;
   std::mt19937_64 rng;
   double simS = 0;
-  std::unique_ptr<httplib::Client> http;
+  std::unique_ptr<httplib::Client> http;      // progress and sim time (main thread)
+  std::unique_ptr<httplib::Client> postHttp;  // task submission (poster thread)
+  std::mutex mu;                              // pending, ledger, counters
+  std::atomic<bool> stopPosting{false};
   ProcessSpec managerSpec;
 
   explicit Run(const LoadtestOptions& opt) : o(opt), rng(opt.seed) {}
@@ -164,6 +168,7 @@ struct Run {
     const double rate =
         o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(scenario["robots"].size());
     const int due = static_cast<int>(std::floor(simS * rate / 60.0)) + 1;
+    std::lock_guard<std::mutex> lock(mu);
     while (generated < due && (o.maxTasks <= 0 || generated < o.maxTasks)) {
       ++generated;
       char id[32];
@@ -182,16 +187,21 @@ struct Run {
   /// Posts what is pending; acknowledged ids go to the ledger, refused ones are dropped (counted),
   /// unavailable ones stay pending and are re-sent (ids are idempotency keys).
   void submitPending() {
-    if (pending.empty()) {
+    std::vector<json> todo;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      todo.swap(pending);
+    }
+    if (todo.empty()) {
       return;
     }
     std::vector<json> keep;
-    for (std::size_t i = 0; i < pending.size(); i += 100) {
+    for (std::size_t i = 0; i < todo.size(); i += 100) {
       json batch = json::array();
-      for (std::size_t k = i; k < std::min(pending.size(), i + 100); ++k) {
-        batch.push_back(pending[k]);
+      for (std::size_t k = i; k < std::min(todo.size(), i + 100); ++k) {
+        batch.push_back(todo[k]);
       }
-      auto r = http->Post("/v1/tasks", batch.dump(), "application/json");
+      auto r = postHttp->Post("/v1/tasks", batch.dump(), "application/json");
       if (!r) {
         ++postErrors;
         for (auto& t : batch) {
@@ -212,6 +222,7 @@ struct Run {
         const int st = item.value("status", 0);
         answered.insert(id);
         if (st == 200 || st == 201) {
+          std::lock_guard<std::mutex> lock(mu);
           ledger.acknowledged(id);
         } else if (st >= 400 && st < 500 && st != 429) {
           ++refused;
@@ -230,7 +241,17 @@ struct Run {
         }
       }
     }
-    pending = std::move(keep);
+    std::lock_guard<std::mutex> lock(mu);
+    pending.insert(pending.begin(), keep.begin(), keep.end());
+  }
+
+  /// Posting runs on its own thread: a POST waits up to the adapter's acknowledgement timeout
+  /// while the manager is down, and faults and progress must not wait for it.
+  void postLoop() {
+    while (!stopPosting) {
+      submitPending();
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
   }
 
   void pollSimTime() {
@@ -505,6 +526,9 @@ int Run::run() {
   http = std::make_unique<httplib::Client>("127.0.0.1", port);
   http->set_connection_timeout(2, 0);
   http->set_read_timeout(10, 0);
+  postHttp = std::make_unique<httplib::Client>("127.0.0.1", port);
+  postHttp->set_connection_timeout(2, 0);
+  postHttp->set_read_timeout(10, 0);
   const auto t0 = Clock::now();
   auto wall = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   bool healthy = false;
@@ -555,6 +579,7 @@ int Run::run() {
   double lastProgress = -1e9;
   json progress = json::array();
   const auto simStart = Clock::now();
+  std::thread poster([this] { postLoop(); });
   while (true) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
     if (gSignal != 0) {
@@ -587,15 +612,19 @@ int Run::run() {
     }
     pollSimTime();
     applyFaults();
-    generateDue();
-    submitPending();
+    if (simS > 0) {  // tasks arrive on the simulated clock, once it runs
+      generateDue();
+    }
     if (wall() - lastProgress >= o.progressEveryS) {
       lastProgress = wall();
       say(progressLine(wall()));
+      std::lock_guard<std::mutex> lock(mu);
       progress.push_back({{"wall_s", wall()}, {"sim_s", simS}, {"acknowledged", ledger.count()}});
     }
   }
   const double wallS = std::chrono::duration<double>(Clock::now() - simStart).count();
+  stopPosting = true;
+  poster.join();
   // Faults still in progress end now, so the manager's final state is on disk and nothing is stopped.
   for (std::size_t i = 0; i < faults.size(); ++i) {
     if (faultStarted[i] && !faultEnded[i]) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 namespace fleet::ctl {
 
@@ -62,7 +63,11 @@ Accounting TaskLedger::reconcile(const std::vector<TaskRow>& tasks,
     }
   }
   std::map<std::string, int> terminal;
+  std::map<std::string, std::int64_t> created;  // first transition: stored (simulated clock)
   std::map<std::string, std::int64_t> firstAssigned;
+  std::set<std::string> unstamped;
+  std::int64_t latest = 0;
+  constexpr std::int64_t kClockSlackNs = 1000000000;
   std::vector<double> assign;
   std::vector<double> e2e;
   for (const auto& tr : transitions) {
@@ -73,7 +78,20 @@ Accounting TaskLedger::reconcile(const std::vector<TaskRow>& tasks,
     if (row == known.end()) {
       continue;
     }
-    const double sinceCreated = static_cast<double>(tr.stampNs - row->second->createdNs) / 1e9;
+    // A restarted manager stamps what it stores before its first simulator Clock message with 0:
+    // a first stamp well behind the log's latest one means "no clock yet", and such a task gives
+    // no latency samples.
+    const bool first = !created.count(tr.taskId);
+    const std::int64_t c0 = created.try_emplace(tr.taskId, tr.stampNs).first->second;
+    if (first && tr.stampNs + kClockSlackNs < latest) {
+      unstamped.insert(tr.taskId);
+      ++a.unstamped;
+    }
+    latest = std::max(latest, tr.stampNs);
+    if (unstamped.count(tr.taskId)) {
+      continue;
+    }
+    const double sinceCreated = static_cast<double>(tr.stampNs - c0) / 1e9;
     if (tr.toState == "assigned" && !firstAssigned.count(tr.taskId)) {
       firstAssigned[tr.taskId] = tr.stampNs;
       assign.push_back(sinceCreated);
@@ -100,6 +118,7 @@ nlohmann::json toJson(const Accounting& a) {
           {"cancelled", a.cancelled},
           {"still_tracked", a.active},
           {"known_not_acknowledged", a.unacknowledgedKnown},
+          {"unstamped", a.unstamped},
           {"lost", a.lost.size()},
           {"lost_ids", a.lost},
           {"duplicated", a.duplicated.size()},

@@ -5,8 +5,9 @@
 // acknowledged task must end done/failed/cancelled exactly once or still be tracked:
 //   lost       = acknowledged, but the manager does not know the id at the end
 //   duplicated = a task that reached a terminal state more than once
-// Latencies come from the database (simulated time): assignment = stored -> first "assigned",
-// end to end = stored -> "done".
+// Latencies come from the transitions (stamped with the simulated clock; the task's created_ns is
+// the WMS's wall clock, so it is not used): assignment = first transition (stored) -> first
+// "assigned", end to end = first transition -> "done".
 
 #include <cstdint>
 #include <optional>
@@ -21,7 +22,6 @@ namespace fleet::ctl {
 struct TaskRow {
   std::string id;
   std::string state;
-  std::int64_t createdNs = 0;
 };
 
 struct TransitionRow {
@@ -42,6 +42,7 @@ struct Accounting {
   std::size_t acknowledged = 0;
   std::size_t done = 0, failed = 0, cancelled = 0, active = 0;
   std::size_t unacknowledgedKnown = 0;  // in the database but never acknowledged (a 503 after storing)
+  std::size_t unstamped = 0;            // stored by a manager without a clock yet: no latency samples
   std::vector<std::string> lost;
   std::vector<std::string> duplicated;
   Percentiles assignS;  // simulated seconds

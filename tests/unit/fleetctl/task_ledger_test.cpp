@@ -16,7 +16,7 @@ TEST(TaskLedger, EveryAcknowledgedTaskAccountedFor) {
   }
   l.acknowledged("a");  // a re-sent task acknowledged twice (200 duplicate) counts once
   const std::vector<TaskRow> rows = {
-      {"a", "done", 0}, {"b", "failed", 0}, {"c", "cancelled", 0}, {"d", "en_route", 0}, {"x", "queued", 0}};
+      {"a", "done"}, {"b", "failed"}, {"c", "cancelled"}, {"d", "en_route"}, {"x", "queued"}};
   const auto a = l.reconcile(rows, {});
   EXPECT_EQ(a.acknowledged, 5u);
   EXPECT_EQ(a.done, 1u);
@@ -33,10 +33,10 @@ TEST(TaskLedger, TerminalTwiceIsDuplicated) {
   TaskLedger l;
   l.acknowledged("a");
   l.acknowledged("b");
-  const std::vector<TaskRow> rows = {{"a", "done", 0}, {"b", "done", 0}};
+  const std::vector<TaskRow> rows = {{"a", "done"}, {"b", "done"}};
   const std::vector<TransitionRow> tr = {
-      {"a", "queued", 0},        {"a", "assigned", 1 * kS}, {"a", "done", 5 * kS}, {"b", "queued", 0},
-      {"b", "assigned", 2 * kS}, {"b", "done", 6 * kS},     {"b", "done", 7 * kS}, {"b", "failed", 8 * kS}};
+      {"a", "queued", 0},    {"b", "queued", 0},    {"a", "assigned", 1 * kS}, {"b", "assigned", 2 * kS},
+      {"a", "done", 5 * kS}, {"b", "done", 6 * kS}, {"b", "done", 7 * kS},     {"b", "failed", 8 * kS}};
   const auto a = l.reconcile(rows, tr);
   ASSERT_EQ(a.duplicated.size(), 1u);  // reported once however many extra terminal transitions
   EXPECT_EQ(a.duplicated[0], "b");
@@ -48,11 +48,12 @@ TEST(TaskLedger, LatenciesFromCreationInSimulatedTime) {
   TaskLedger l;
   l.acknowledged("a");
   l.acknowledged("b");
-  const std::vector<TaskRow> rows = {{"a", "done", 10 * kS}, {"b", "queued", 20 * kS}};
-  const std::vector<TransitionRow> tr = {{"a", "queued", 10 * kS},   {"a", "assigned", 12 * kS},
-                                         {"a", "queued", 15 * kS},   {"a", "assigned", 16 * kS},
-                                         {"a", "done", 40 * kS},     {"b", "queued", 20 * kS},
-                                         {"b", "assigned", 23 * kS}, {"b", "queued", 25 * kS}};
+  const std::vector<TaskRow> rows = {{"a", "done"}, {"b", "queued"}};
+  // Stamps on the simulated clock; the first transition of a task is its creation.
+  const std::vector<TransitionRow> tr = {{"a", "queued", 10 * kS}, {"a", "assigned", 12 * kS},
+                                         {"a", "queued", 15 * kS}, {"a", "assigned", 16 * kS},
+                                         {"b", "queued", 20 * kS}, {"b", "assigned", 23 * kS},
+                                         {"b", "queued", 25 * kS}, {"a", "done", 40 * kS}};
   const auto a = l.reconcile(rows, tr);
   EXPECT_EQ(a.assignS.count, 2u);  // first assignment per task only
   EXPECT_DOUBLE_EQ(a.assignS.max, 3.0);
@@ -65,6 +66,30 @@ TEST(TaskLedger, LatenciesFromCreationInSimulatedTime) {
 }
 
 // Randomised: the counts always partition the acknowledged set; lost are exactly the ids removed.
+// A task stored by a restarted manager before its first Clock message is stamped 0 although the
+// log is at 20 s: it must not count as a 20 s assignment latency.
+TEST(TaskLedger, UnstampedTasksGiveNoLatency) {
+  TaskLedger l;
+  l.acknowledged("a");
+  l.acknowledged("b");
+  const std::vector<TaskRow> rows = {{"a", "done"}, {"b", "en_route"}};
+  const std::vector<TransitionRow> tr = {{"a", "queued", 0},         {"a", "assigned", 1 * kS},
+                                         {"b", "queued", 0},         {"a", "done", 20 * kS},
+                                         {"b", "assigned", 20 * kS}, {"b", "en_route", 21 * kS}};
+  // "b" is stored at seq 3 with stamp 0 while the log was at 1 s: within the slack, a real 0.
+  const auto a = l.reconcile(rows, tr);
+  EXPECT_EQ(a.unstamped, 0u);
+  EXPECT_EQ(a.assignS.count, 2u);
+  TaskLedger l2;
+  l2.acknowledged("c");
+  const std::vector<TransitionRow> late = {
+      {"a", "queued", 0}, {"a", "assigned", 20 * kS}, {"c", "queued", 0}, {"c", "assigned", 21 * kS}};
+  const auto b = l2.reconcile({{"a", "done"}, {"c", "en_route"}}, late);
+  EXPECT_EQ(b.unstamped, 1u);
+  EXPECT_EQ(b.assignS.count, 1u);  // only "a"; "c" has no trustworthy creation time
+  EXPECT_DOUBLE_EQ(b.assignS.max, 20.0);
+}
+
 TEST(TaskLedger, RandomisedPartition) {
   std::mt19937 rng(11);
   const char* states[] = {"queued", "assigned", "en_route", "done", "failed", "cancelled"};
@@ -80,7 +105,7 @@ TEST(TaskLedger, RandomisedPartition) {
         ++removed;
         continue;
       }
-      rows.push_back({id, states[rng() % 6], 0});
+      rows.push_back({id, states[rng() % 6]});
     }
     const auto a = l.reconcile(rows, {});
     EXPECT_EQ(a.lost.size(), removed);
