@@ -166,7 +166,10 @@ def main(run):
                 assign_lat.append((stamp - created[task]) / 1e9)
     sim_s = sim.get("sim_time_s", 0) or 1
     done = len(done_at)
-    cumulative = [(0.0, 0)] + [(t, i + 1) for i, t in enumerate(sorted(done_at))] + [(sim_s, done)]
+    cumulative = [(0.0, 0)]
+    for i, t in enumerate(sorted(done_at)):  # a step up at each completion
+        cumulative += [(t, i), (t, i + 1)]
+    cumulative.append((sim_s, done))
     summary = {
         "scenario": sim.get("scenario"),
         "sim_time_s": sim_s,
