@@ -5,6 +5,7 @@ metrics. Usage: scripts/report.py RUN_DIR"""
 import gzip
 import html
 import json
+import math
 import os
 import sqlite3
 import sys
@@ -105,8 +106,8 @@ def svg_hist(values, bins=12, w=520, h=220, xlabel=""):
 def pct(values, q):
     if not values:
         return None
-    v = sorted(values)
-    return v[min(len(v) - 1, int(q * (len(v) - 1)))]
+    v = sorted(values)  # nearest rank, as fleetctl's task ledger
+    return v[min(len(v), max(1, math.ceil(q * len(v)))) - 1]
 
 
 def loadtest_html(lt):
