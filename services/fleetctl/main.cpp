@@ -4,6 +4,7 @@
 //   fleetctl cancel ID               cancel a task       fleetctl robots      list robots
 //   fleetctl follow [--count N]      print task events as they happen
 //   fleetctl health | metrics
+//   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet
 
 #include <httplib.h>
 
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "loadtest.hpp"
 #include "task_file.hpp"
 
 using nlohmann::json;
@@ -93,7 +95,53 @@ int main(int argc, char** argv) {
   follow->add_option("--seconds", seconds, "stop after this long (0 = never)");
   auto* health = app.add_subcommand("health", "is the adapter up and does it see the manager");
   auto* metrics = app.add_subcommand("metrics", "the adapter's counters");
+  auto* loadtest =
+      app.add_subcommand("loadtest", "start a whole fleet here, feed it tasks, inject faults, report");
+  fleet::ctl::LoadtestOptions lt;
+  lt.templ = FLEETCTL_SOURCE_DIR "/sim/scenarios/small_warehouse.json";
+  lt.reportScript = FLEETCTL_SOURCE_DIR "/scripts/report.py";
+  lt.binDir = FLEETCTL_BINARY_DIR;
+  lt.out = "reports/loadtest";
+  loadtest->add_option("--scenario", lt.scenario, "run this scenario file as is (else one is generated)");
+  loadtest->add_option("--template", lt.templ, "template of generated scenarios")->capture_default_str();
+  loadtest->add_option("--robots", lt.robots, "robots of the generated scenario")
+      ->check(CLI::Range(1, 2000))
+      ->capture_default_str();
+  loadtest->add_option("--humans", lt.humans, "humans of the generated scenario")
+      ->check(CLI::Range(0, 5000))
+      ->capture_default_str();
+  loadtest->add_option("--rate", lt.ratePerMin, "tasks per simulated minute (0 = 0.75 per robot)")
+      ->check(CLI::Range(0.0, 100000.0));
+  loadtest->add_option("--tasks", lt.maxTasks, "at most this many tasks (0 = no cap)")
+      ->check(CLI::Range(0, 1000000));
+  loadtest->add_option("--duration", lt.durationS, "simulated seconds")
+      ->check(CLI::Range(1.0, 86400.0))
+      ->capture_default_str();
+  loadtest->add_option("--wall-limit", lt.wallLimitS, "stop after this many wall seconds whatever happens")
+      ->check(CLI::Range(5.0, 86400.0))
+      ->capture_default_str();
+  loadtest->add_option("--agents", lt.agents, "robot agent processes")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  loadtest->add_option(
+      "--fault", lt.faults,
+      "kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, drop-dds=F (T simulated s, D wall s)");
+  loadtest->add_option("--out", lt.out, "run folder (report, logs, database)")->capture_default_str();
+  loadtest->add_option("--bin", lt.binDir, "build tree with the services")->capture_default_str();
+  loadtest->add_option("--report-script", lt.reportScript, "scripts/report.py ('' = no HTML report)");
+  loadtest->add_option("--port", lt.port, "WMS adapter port (0 = a free one)");
+  loadtest->add_option("--domain", lt.domain, "DDS domain (default FLEET_DDS_DOMAIN or a random one)")
+      ->check(CLI::Range(0, 229));
+  loadtest->add_option("--seed", lt.seed, "scenario and task seed")->capture_default_str();
+  loadtest->add_option("--local-planner", lt.localPlanner, "robot agents' local planner")
+      ->capture_default_str();
+  loadtest->add_option("--step-timeout-ms", lt.stepTimeoutMs, "lockstep step timeout of the simulator")
+      ->check(CLI::Range(10, 60000))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  if (*loadtest) {
+    return fleet::ctl::runLoadtest(lt);
+  }
 
   Target t = parseUrl(url);
   if (!tokenFile.empty()) {

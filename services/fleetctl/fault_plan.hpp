@@ -1,0 +1,36 @@
+#pragma once
+
+// Faults a load test injects, parsed from `--fault` options. Times are simulated seconds since the
+// start of the run; down times are wall seconds (a process is down for real time, not sim time).
+//   kill-agent@T[+D][:K]   SIGKILL agent process K (default 0) at T, restart it D s later (default 2)
+//   kill-manager@T[+D]     SIGKILL the fleet manager at T, restart it D s later (default 1)
+//   stall:ROBOT@T+D        SIGSTOP the agent process of ROBOT (it runs alone) at T, SIGCONT D s later
+//   drop-dds=F             every process drops the fraction F (0..0.5) of its outgoing DDS packets
+
+#include <string>
+#include <vector>
+
+#include "fleet/core/expected.hpp"
+
+namespace fleet::ctl {
+
+struct Fault {
+  enum class Kind { KillAgent, KillManager, StallRobot, DropDds };
+  Kind kind = Kind::KillAgent;
+  double atS = 0.0;     // simulated seconds
+  double downS = 0.0;   // wall seconds
+  int agent = 0;        // kill-agent: which agent process
+  std::string robot;    // stall: which robot
+  double fraction = 0;  // drop-dds
+};
+
+/// Parses every spec; the error lists each bad one with what was expected.
+Expected<std::vector<Fault>> parseFaults(const std::vector<std::string>& specs);
+
+/// The one-line form of a fault for logs and reports (parses back to the same fault).
+std::string describe(const Fault& f);
+
+/// The DDS drop fraction of the plan (0 when none); at most one drop-dds is allowed.
+double dropFraction(const std::vector<Fault>& faults);
+
+}  // namespace fleet::ctl

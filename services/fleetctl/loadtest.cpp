@@ -1,0 +1,729 @@
+#include "loadtest.hpp"
+
+#include <arpa/inet.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sqlite3.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "fault_plan.hpp"
+#include "scenario_gen.hpp"
+#include "supervisor.hpp"
+#include "task_ledger.hpp"
+
+namespace fleet::ctl {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<int> gSignal{0};
+extern "C" void onSignal(int sig) {
+  gSignal = sig;
+}
+
+void say(const std::string& s) {
+  std::cout << "loadtest: " << s << std::endl;
+}
+
+int freePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  socklen_t len = sizeof a;
+  int port = 0;
+  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
+      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
+    port = ntohs(a.sin_port);
+  }
+  close(fd);
+  return port;
+}
+
+bool writeFile(const fs::path& p, const std::string& text) {
+  std::ofstream out(p);
+  out << text;
+  return static_cast<bool>(out);
+}
+
+std::optional<json> readJson(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) {
+    return std::nullopt;
+  }
+  auto j = json::parse(in, nullptr, false);
+  if (j.is_discarded()) {
+    return std::nullopt;
+  }
+  return j;
+}
+
+/// The loopback Cyclone configuration of deploy/cyclonedds-local.xml, plus Cyclone's own packet
+/// dropper (Internal/Test/XmitLossiness, per mille of outgoing packets) for the drop-dds fault.
+std::string cycloneConfig(double drop) {
+  std::ostringstream x;
+  x << "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain id=\"any\"><General><Interfaces>"
+       "<NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast></General>"
+       "<Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
+       "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery>"
+       "<Internal><Test><XmitLossiness>"
+    << static_cast<int>(std::lround(drop * 1000.0))
+    << "</XmitLossiness></Test></Internal></Domain></CycloneDDS>\n";
+  return x.str();
+}
+
+struct DbContents {
+  std::vector<TaskRow> tasks;
+  std::vector<TransitionRow> transitions;
+  std::string error;
+};
+
+DbContents readDb(const fs::path& path) {
+  DbContents out;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    out.error = "cannot open " + path.string() + ": " + (db ? sqlite3_errmsg(db) : "out of memory");
+    sqlite3_close(db);
+    return out;
+  }
+  auto text = [](sqlite3_stmt* s, int c) {
+    const auto* p = sqlite3_column_text(s, c);
+    return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+  };
+  sqlite3_stmt* s = nullptr;
+  if (sqlite3_prepare_v2(db, "SELECT id, state FROM tasks", -1, &s, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(s) == SQLITE_ROW) {
+      out.tasks.push_back({text(s, 0), text(s, 1)});
+    }
+  } else {
+    out.error = sqlite3_errmsg(db);
+  }
+  sqlite3_finalize(s);
+  if (sqlite3_prepare_v2(db, "SELECT task_id, to_state, stamp_ns FROM transitions ORDER BY seq", -1, &s,
+                         nullptr) == SQLITE_OK) {
+    while (sqlite3_step(s) == SQLITE_ROW) {
+      out.transitions.push_back({text(s, 0), text(s, 1), sqlite3_column_int64(s, 2)});
+    }
+  } else {
+    out.error = sqlite3_errmsg(db);
+  }
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return out;
+}
+
+struct Run {
+  const LoadtestOptions& o;
+  Supervisor sup;
+  fs::path out;
+  json scenario;
+  std::vector<std::string> agentNames;
+  std::map<std::string, std::string> agentOfRobot;
+  std::vector<Fault> faults;
+  std::vector<bool> faultStarted, faultEnded;
+  std::vector<Clock::time_point> faultEndAt;
+  json faultLog = json::array();
+  TaskLedger ledger;
+  std::vector<json> pending;  // generated, not acknowledged yet
+  int generated = 0;
+  int refused = 0;
+  int postErrors = 0;
+  std::vector<std::string> pickups, dropoffs;
+  std::mt19937_64 rng;
+  double simS = 0;
+  std::unique_ptr<httplib::Client> http;      // progress and sim time (main thread)
+  std::unique_ptr<httplib::Client> postHttp;  // task submission (poster thread)
+  std::mutex mu;                              // pending, ledger, counters
+  std::atomic<bool> stopPosting{false};
+  ProcessSpec managerSpec;
+
+  explicit Run(const LoadtestOptions& opt) : o(opt), rng(opt.seed) {}
+
+  std::string bin(const std::string& rel) const { return (fs::path(o.binDir) / rel).string(); }
+
+  void logFault(const std::string& what) {
+    faultLog.push_back({{"sim_s", simS}, {"event", what}});
+    say("fault: " + what);
+  }
+
+  void generateDue() {
+    const double rate =
+        o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(scenario["robots"].size());
+    const int due = static_cast<int>(std::floor(simS * rate / 60.0)) + 1;
+    std::lock_guard<std::mutex> lock(mu);
+    while (generated < due && (o.maxTasks <= 0 || generated < o.maxTasks)) {
+      ++generated;
+      char id[32];
+      std::snprintf(id, sizeof id, "lt-%05d", generated);
+      std::uniform_int_distribution<std::size_t> p(0, pickups.size() - 1);
+      std::uniform_int_distribution<std::size_t> d(0, dropoffs.size() - 1);
+      pending.push_back({{"id", id},
+                         {"kind", "transport"},
+                         {"pickup", pickups[p(rng)]},
+                         {"dropoff", dropoffs[d(rng)]},
+                         {"load_duration_ns", 2000000000LL},
+                         {"unload_duration_ns", 2000000000LL}});
+    }
+  }
+
+  /// Posts what is pending; acknowledged ids go to the ledger, refused ones are dropped (counted),
+  /// unavailable ones stay pending and are re-sent (ids are idempotency keys).
+  void submitPending() {
+    std::vector<json> todo;
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      todo.swap(pending);
+    }
+    if (todo.empty()) {
+      return;
+    }
+    std::vector<json> keep;
+    for (std::size_t i = 0; i < todo.size(); i += 100) {
+      json batch = json::array();
+      for (std::size_t k = i; k < std::min(todo.size(), i + 100); ++k) {
+        batch.push_back(todo[k]);
+      }
+      auto r = postHttp->Post("/v1/tasks", batch.dump(), "application/json");
+      if (!r) {
+        ++postErrors;
+        for (auto& t : batch) {
+          keep.push_back(t);
+        }
+        continue;
+      }
+      auto body = json::parse(r->body, nullptr, false);
+      json results = json::array();
+      if (body.is_object() && body.contains("results")) {
+        results = body["results"];
+      } else if (body.is_object() && body.contains("id")) {
+        results.push_back(body);
+      }
+      std::set<std::string> answered;
+      for (const auto& item : results) {
+        const std::string id = item.value("id", "");
+        const int st = item.value("status", 0);
+        answered.insert(id);
+        if (st == 200 || st == 201) {
+          std::lock_guard<std::mutex> lock(mu);
+          ledger.acknowledged(id);
+        } else if (st >= 400 && st < 500 && st != 429) {
+          ++refused;
+          say("task " + id + " refused: " + item.dump());
+        } else {
+          for (auto& t : batch) {
+            if (t["id"] == id) {
+              keep.push_back(t);
+            }
+          }
+        }
+      }
+      for (auto& t : batch) {
+        if (!answered.count(t["id"].get<std::string>())) {
+          keep.push_back(t);
+        }
+      }
+    }
+    std::lock_guard<std::mutex> lock(mu);
+    pending.insert(pending.begin(), keep.begin(), keep.end());
+  }
+
+  /// Posting runs on its own thread: a POST waits up to the adapter's acknowledgement timeout
+  /// while the manager is down, and faults and progress must not wait for it.
+  void postLoop() {
+    while (!stopPosting) {
+      submitPending();
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+  }
+
+  void pollSimTime() {
+    auto r = http->Get("/v1/robots");
+    if (!r || r->status != 200) {
+      return;
+    }
+    auto body = json::parse(r->body, nullptr, false);
+    if (!body.is_object()) {
+      return;
+    }
+    for (const auto& x : body.value("robots", json::array())) {
+      simS = std::max(simS, static_cast<double>(x.value("stamp_ns", std::int64_t{0})) / 1e9);
+    }
+  }
+
+  std::string agentFor(const Fault& f) const {
+    if (f.kind == Fault::Kind::StallRobot) {
+      auto it = agentOfRobot.find(f.robot);
+      return it == agentOfRobot.end() ? "" : it->second;
+    }
+    return "agent-" + std::to_string(f.agent);
+  }
+
+  void applyFaults() {
+    const auto now = Clock::now();
+    for (std::size_t i = 0; i < faults.size(); ++i) {
+      const Fault& f = faults[i];
+      if (f.kind == Fault::Kind::DropDds) {
+        continue;
+      }
+      const std::string who = f.kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(f);
+      if (!faultStarted[i] && simS >= f.atS) {
+        faultStarted[i] = true;
+        faultEndAt[i] =
+            now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(f.downS));
+        if (f.kind == Fault::Kind::StallRobot) {
+          sup.signal(who, SIGSTOP);
+          logFault("SIGSTOP " + who + " (robot " + f.robot + ")");
+        } else {
+          sup.killHard(who);
+          logFault("SIGKILL " + who);
+        }
+      } else if (faultStarted[i] && !faultEnded[i] && now >= faultEndAt[i]) {
+        faultEnded[i] = true;
+        if (f.kind == Fault::Kind::StallRobot) {
+          sup.signal(who, SIGCONT);
+          logFault("SIGCONT " + who);
+        } else {
+          sup.restart(who);
+          logFault("restarted " + who);
+        }
+      }
+    }
+  }
+
+  std::string progressLine(double wallS) {
+    std::string states;
+    if (auto r = http->Get("/v1/metrics"); r && r->status == 200) {
+      auto m = json::parse(r->body, nullptr, false);
+      if (m.is_object() && m.contains("tasks_by_state")) {
+        for (const auto& [k, v] : m["tasks_by_state"].items()) {
+          states += " " + k + "=" + v.dump();
+        }
+      }
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%5.0f s wall | %6.1f s sim (%.2fx) | acknowledged %zu pending %zu |",
+                  wallS, simS, wallS > 0 ? simS / wallS : 0.0, ledger.count(), pending.size());
+    return buf + states;
+  }
+
+  int run();
+};
+
+int Run::run() {
+  out = o.out;
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) {
+    say("cannot create " + out.string() + ": " + ec.message());
+    return 1;
+  }
+  auto parsed = parseFaults(o.faults);
+  if (!parsed) {
+    std::cerr << "fleetctl loadtest: " << parsed.error().message << "\n";
+    return 2;
+  }
+  faults = *parsed;
+  faultStarted.assign(faults.size(), false);
+  faultEnded.assign(faults.size(), false);
+  faultEndAt.assign(faults.size(), Clock::now());
+
+  // The scenario: a file as is, or one generated for the fleet size.
+  fs::path scenarioPath = out / "scenario.json";
+  if (!o.scenario.empty()) {
+    auto s = readJson(o.scenario);
+    if (!s) {
+      std::cerr << "fleetctl loadtest: " << o.scenario << ": cannot read a JSON scenario\n";
+      return 2;
+    }
+    scenario = *s;
+    scenario["duration_s"] = o.durationS;
+  } else {
+    auto t = readJson(o.templ);
+    if (!t) {
+      std::cerr << "fleetctl loadtest: " << o.templ << ": cannot read the scenario template\n";
+      return 2;
+    }
+    auto g = generateScenario(*t, {o.robots, o.humans, o.durationS, o.seed});
+    if (!g) {
+      std::cerr << "fleetctl loadtest: " << g.error().message << "\n";
+      return 2;
+    }
+    scenario = *g;
+  }
+  // A relative map file stays relative to the original scenario's folder.
+  if (!o.scenario.empty() && scenario["map"].contains("file")) {
+    scenario["map"]["file"] =
+        (fs::absolute(o.scenario).parent_path() / scenario["map"]["file"].get<std::string>()).string();
+  }
+  writeFile(scenarioPath, scenario.dump(1));
+  for (const auto& s : scenario.value("stations", json::array())) {
+    if (s.value("kind", "") == "pickup") {
+      pickups.push_back(s["name"]);
+    } else if (s.value("kind", "") == "dropoff") {
+      dropoffs.push_back(s["name"]);
+    }
+  }
+  if (pickups.empty() || dropoffs.empty()) {
+    std::cerr << "fleetctl loadtest: the scenario has no pickup or no dropoff station\n";
+    return 2;
+  }
+  std::vector<std::string> robots;
+  for (const auto& r : scenario.value("robots", json::array())) {
+    robots.push_back(r.value("id", ""));
+  }
+  for (const auto& f : faults) {
+    if (f.kind == Fault::Kind::StallRobot &&
+        std::find(robots.begin(), robots.end(), f.robot) == robots.end()) {
+      std::cerr << "fleetctl loadtest: --fault stall:" << f.robot << ": the scenario has no robot '"
+                << f.robot << "'\n";
+      return 2;
+    }
+    if (f.kind == Fault::Kind::KillAgent && f.agent >= o.agents) {
+      std::cerr << "fleetctl loadtest: --fault " << describe(f) << ": there are only " << o.agents
+                << " agent process(es) (--agents)\n";
+      return 2;
+    }
+  }
+
+  // Processes: configuration files, DDS settings, then start in dependency order.
+  const int port = o.port > 0 ? o.port : freePort();
+  int domain = o.domain;
+  if (domain < 0) {
+    const char* env = std::getenv("FLEET_DDS_DOMAIN");
+    domain = env ? std::atoi(env) : 100 + static_cast<int>(std::random_device{}() % 100);
+  }
+  std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", std::to_string(domain)}};
+  const double drop = dropFraction(faults);
+  if (drop > 0) {
+    writeFile(out / "cyclonedds.xml", cycloneConfig(drop));
+    env.emplace_back("CYCLONEDDS_URI", "file://" + fs::absolute(out / "cyclonedds.xml").string());
+  }
+  auto [wM, hM] = mapExtent(scenario);
+  if (wM <= 0) {
+    wM = 100;
+    hM = 50;
+  }
+  // 0.1 m cells up to ~1.2 M cells, coarser beyond (the fusion cost grows with the cell count).
+  const double res = wM * hM / 0.01 <= 1.2e6 ? 0.1 : (wM * hM / 0.04 <= 1.2e6 ? 0.2 : 0.25);
+  const fs::path db = out / "fleet.db";
+  fs::remove(db, ec);
+  fs::remove(out / "fleet.db-wal", ec);
+  fs::remove(out / "fleet.db-shm", ec);
+  writeFile(out / "manager.json", json{{"stations", fs::absolute(scenarioPath).string()},
+                                       {"db", fs::absolute(db).string()},
+                                       {"clock", "sim"},
+                                       {"lease_s", 3.0},
+                                       {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
+                                      .dump(1));
+  writeFile(out / "risk_map.json", json{{"grid",
+                                         {{"width", static_cast<int>(wM / res)},
+                                          {"height", static_cast<int>(hM / res)},
+                                          {"resolution", res}}},
+                                        {"clock", "sim"},
+                                        {"lockstep", true},
+                                        {"rate_hz", 2}}
+                                       .dump(1));
+  const std::string scn = fs::absolute(scenarioPath).string();
+  auto log = [&](const std::string& name) { return fs::absolute(out / (name + ".log")).string(); };
+  managerSpec = {"fleet_manager",
+                 bin("services/fleet_manager/fleet_manager"),
+                 {"--config", fs::absolute(out / "manager.json").string(), "--log-level", "warn"},
+                 env,
+                 log("fleet_manager")};
+  std::vector<ProcessSpec> specs = {
+      managerSpec,
+      {"wms_adapter",
+       bin("services/wms_adapter/wms_adapter"),
+       {"--stations", scn, "--port", std::to_string(port), "--log-level", "warn"},
+       env,
+       log("wms_adapter")},
+      {"risk_map",
+       bin("services/risk_map/risk_map"),
+       {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "warn"},
+       env,
+       log("risk_map")}};
+  // Robots: a process of their own for each stalled robot, the rest round robin over --agents.
+  std::set<std::string> alone;
+  for (const auto& f : faults) {
+    if (f.kind == Fault::Kind::StallRobot) {
+      alone.insert(f.robot);
+    }
+  }
+  std::vector<std::vector<std::string>> groups(static_cast<std::size_t>(o.agents));
+  std::size_t next = 0;
+  for (const auto& r : robots) {
+    if (alone.count(r)) {
+      agentOfRobot[r] = "agent-" + r;
+      continue;
+    }
+    groups[next % groups.size()].push_back(r);
+    agentOfRobot[r] = "agent-" + std::to_string(next % groups.size());
+    ++next;
+  }
+  auto agentSpec = [&](const std::string& name, const std::vector<std::string>& ids) {
+    std::string list;
+    for (const auto& r : ids) {
+      list += (list.empty() ? "" : ",") + r;
+    }
+    return ProcessSpec{name,
+                       bin("services/robot_agent/robot_agent"),
+                       {"--scenario", scn, "--clock", "lockstep", "--id", name, "--robots", list,
+                        "--local-planner", o.localPlanner, "--log-level", "warn"},
+                       env,
+                       log(name)};
+  };
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (!groups[g].empty()) {
+      specs.push_back(agentSpec("agent-" + std::to_string(g), groups[g]));
+      agentNames.push_back(specs.back().name);
+    }
+  }
+  for (const auto& r : alone) {
+    specs.push_back(agentSpec("agent-" + r, {r}));
+    agentNames.push_back(specs.back().name);
+  }
+
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGHUP, &sa, nullptr);
+
+  say("scenario " + scenario.value("name", std::string("?")) + ": " + std::to_string(robots.size()) +
+      " robots, " + std::to_string(scenario.value("humans", json::object()).value("count", 0)) + " humans, " +
+      std::to_string(static_cast<int>(o.durationS)) + " s simulated (wall limit " +
+      std::to_string(static_cast<int>(o.wallLimitS)) + " s), " + std::to_string(agentNames.size()) +
+      " agent process(es), DDS domain " + std::to_string(domain) +
+      ", WMS API http://127.0.0.1:" + std::to_string(port) + ", run folder " + out.string());
+  for (const auto& f : faults) {
+    say("fault planned: " + describe(f));
+  }
+  for (const auto& s : specs) {
+    if (!sup.start(s)) {
+      say("cannot start " + s.name);
+      return 1;
+    }
+  }
+  http = std::make_unique<httplib::Client>("127.0.0.1", port);
+  http->set_connection_timeout(2, 0);
+  http->set_read_timeout(10, 0);
+  postHttp = std::make_unique<httplib::Client>("127.0.0.1", port);
+  postHttp->set_connection_timeout(2, 0);
+  postHttp->set_read_timeout(10, 0);
+  const auto t0 = Clock::now();
+  auto wall = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  bool healthy = false;
+  while (wall() < 30 && gSignal == 0) {
+    if (auto r = http->Get("/v1/health"); r && r->status == 200) {
+      healthy = true;
+      break;
+    }
+    if (auto gone = sup.reapUnexpected(); !gone.empty()) {
+      say(gone[0].first + " exited with status " + std::to_string(gone[0].second) + " at start; see " +
+          log(gone[0].first));
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  if (!healthy) {
+    say(gSignal ? "interrupted" : "the WMS adapter did not report a healthy fleet manager within 30 s");
+    return gSignal ? 130 : 1;
+  }
+  const int participants = 1 + static_cast<int>(agentNames.size());
+  sup.start({"fleet-sim",
+             bin("sim/src/fleet-sim"),
+             {"--scenario",
+              scn,
+              "--clock",
+              "lockstep",
+              "--participants",
+              std::to_string(participants),
+              "--duration",
+              std::to_string(o.durationS),
+              "--start-timeout-ms",
+              "60000",
+              "--step-timeout-ms",
+              std::to_string(o.stepTimeoutMs),
+              "--replay",
+              fs::absolute(out / "replay.jsonl.gz").string(),
+              "--summary",
+              fs::absolute(out / "sim_summary.json").string(),
+              "--html",
+              fs::absolute(out / "viewer.html").string(),
+              "--log-level",
+              "warn"},
+             env,
+             log("fleet-sim")});
+
+  int code = 0;
+  bool wallLimited = false;
+  double lastProgress = -1e9;
+  json progress = json::array();
+  const auto simStart = Clock::now();
+  std::thread poster([this] { postLoop(); });
+  while (true) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    if (gSignal != 0) {
+      say("interrupted; stopping the fleet");
+      code = 130;
+      break;
+    }
+    bool simEnded = false;
+    for (const auto& [name, status] : sup.reapUnexpected()) {
+      if (name == "fleet-sim") {
+        simEnded = true;
+        if (status != 0) {
+          say("the simulator exited with status " + std::to_string(status) + "; see " + log(name));
+          code = 1;
+        }
+      } else {
+        say(name + " exited unexpectedly with status " + std::to_string(status) + "; see " + log(name));
+        code = 1;
+      }
+    }
+    if (simEnded || code != 0) {
+      break;
+    }
+    if (wall() > o.wallLimitS) {
+      say("wall-time limit reached; stopping the simulator");
+      wallLimited = true;
+      sup.signal("fleet-sim", SIGINT);
+      sup.waitExit("fleet-sim", 20.0);
+      break;
+    }
+    pollSimTime();
+    applyFaults();
+    if (simS > 0) {  // tasks arrive on the simulated clock, once it runs
+      generateDue();
+    }
+    if (wall() - lastProgress >= o.progressEveryS) {
+      lastProgress = wall();
+      say(progressLine(wall()));
+      std::lock_guard<std::mutex> lock(mu);
+      progress.push_back({{"wall_s", wall()}, {"sim_s", simS}, {"acknowledged", ledger.count()}});
+    }
+  }
+  const double wallS = std::chrono::duration<double>(Clock::now() - simStart).count();
+  stopPosting = true;
+  poster.join();
+  // Faults still in progress end now, so the manager's final state is on disk and nothing is stopped.
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    if (faultStarted[i] && !faultEnded[i]) {
+      const std::string who =
+          faults[i].kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(faults[i]);
+      if (faults[i].kind == Fault::Kind::StallRobot) {
+        sup.signal(who, SIGCONT);
+      } else if (faults[i].kind == Fault::Kind::KillManager) {
+        sup.restart(who);
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+      }
+      faultEnded[i] = true;
+    }
+  }
+  if (code == 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // last events and metrics file
+    if (auto m = readJson(out / "manager_metrics.json")) {
+      writeFile(out / "manager_metrics_final.json", m->dump(1));
+    }
+  }
+  sup.stopAll(5.0);
+  say("fleet stopped");
+
+  // Reconcile the acknowledged tasks with the manager's database.
+  const auto contents = readDb(db);
+  const Accounting acc = ledger.reconcile(contents.tasks, contents.transitions);
+  json summary = readJson(out / "sim_summary.json").value_or(json::object());
+  const double simTime = summary.value("sim_time_s", simS);
+  json report = {
+      {"scenario", scenario.value("name", std::string())},
+      {"robots", robots.size()},
+      {"humans", scenario.value("humans", json::object()).value("count", 0)},
+      {"agent_processes", agentNames.size()},
+      {"duration_s", o.durationS},
+      {"sim_time_s", simTime},
+      {"wall_time_s", wallS},
+      {"real_time_factor", wallS > 0 ? simTime / wallS : 0.0},
+      {"wall_limited", wallLimited},
+      {"interrupted", code == 130},
+      {"rate_per_min", o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(robots.size())},
+      {"tasks",
+       {{"generated", generated},
+        {"refused", refused},
+        {"never_acknowledged", pending.size()},
+        {"post_errors", postErrors}}},
+      {"accounting", toJson(acc)},
+      {"throughput",
+       {{"done_per_sim_hour", simTime > 0 ? static_cast<double>(acc.done) * 3600.0 / simTime : 0.0},
+        {"done_per_wall_hour", wallS > 0 ? static_cast<double>(acc.done) * 3600.0 / wallS : 0.0}}},
+      {"safety",
+       {{"contacts", summary.value("contacts", json::object())},
+        {"min_separation_m", summary.value("min_separation_m", json::object())},
+        {"near_misses", summary.value("near_misses", json::object())},
+        {"lockstep_step_timeouts", summary.value("lockstep_step_timeouts", json())}}},
+      {"faults", faultLog},
+      {"fault_plan", json::array()},
+      {"progress", progress},
+      {"db_error", contents.error}};
+  for (const auto& f : faults) {
+    report["fault_plan"].push_back(describe(f));
+  }
+  writeFile(out / "loadtest.json", report.dump(2));
+  char line[256];
+  std::snprintf(
+      line, sizeof line,
+      "%zu acknowledged: %zu done, %zu failed, %zu cancelled, %zu still tracked; LOST %zu, DUPLICATED %zu",
+      acc.acknowledged, acc.done, acc.failed, acc.cancelled, acc.active, acc.lost.size(),
+      acc.duplicated.size());
+  say(line);
+  std::snprintf(
+      line, sizeof line,
+      "%.0f s simulated in %.0f s wall (%.2fx); end-to-end p50 %.1f s p99 %.1f s; assignment p99 %.2f s",
+      simTime, wallS, wallS > 0 ? simTime / wallS : 0.0, acc.endToEndS.p50, acc.endToEndS.p99,
+      acc.assignS.p99);
+  say(line);
+  if (!contents.error.empty()) {
+    say("task database: " + contents.error);
+    code = code == 0 ? 1 : code;
+  }
+  if (!o.reportScript.empty() && fs::exists(out / "sim_summary.json")) {
+    const std::string cmd =
+        "python3 '" + o.reportScript + "' '" + fs::absolute(out).string() + "' >/dev/null";
+    if (std::system(cmd.c_str()) == 0) {
+      say("report: " + (fs::absolute(out) / "index.html").string());
+    } else {
+      say("the report script failed: " + cmd);
+    }
+  }
+  if (code == 0 && (!acc.lost.empty() || !acc.duplicated.empty())) {
+    code = 3;
+  }
+  return code;
+}
+
+}  // namespace
+
+int runLoadtest(const LoadtestOptions& o) {
+  Run r(o);
+  return r.run();
+}
+
+}  // namespace fleet::ctl

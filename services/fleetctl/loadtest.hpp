@@ -1,0 +1,39 @@
+#pragma once
+
+// `fleetctl loadtest`: starts the whole fleet on this machine under a Supervisor, feeds tasks over
+// the WMS adapter's HTTP API at a given arrival rate (in simulated time), injects faults, prints
+// progress, stops everything, reconciles acknowledged tasks with the manager's database and writes
+// loadtest.json (plus the HTML report through scripts/report.py).
+
+#include <string>
+#include <vector>
+
+namespace fleet::ctl {
+
+struct LoadtestOptions {
+  std::string scenario;  // a scenario file to run as is; empty: generate one
+  std::string templ;     // template for generated scenarios
+  int robots = 20;       // generated scenarios
+  int humans = 8;
+  double ratePerMin = 0;    // tasks per simulated minute; 0: 0.75 per robot
+  int maxTasks = 0;         // 0: no cap besides the duration
+  double durationS = 180;   // simulated seconds
+  double wallLimitS = 600;  // the run is stopped after this much wall time whatever happens
+  int agents = 1;           // robot agent processes (besides one per stalled robot)
+  std::vector<std::string> faults;
+  std::string out;           // run folder
+  std::string binDir;        // build tree holding the services
+  std::string reportScript;  // scripts/report.py; empty: no HTML report
+  int port = 0;              // 0: a free port
+  int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
+  std::uint64_t seed = 7;
+  std::string localPlanner = "dwa";
+  int stepTimeoutMs = 300;
+  double progressEveryS = 2.0;
+};
+
+/// Runs the load test; returns the process exit code (0 ok, 3 lost or duplicated tasks, 1 error,
+/// 130 interrupted).
+int runLoadtest(const LoadtestOptions& o);
+
+}  // namespace fleet::ctl

@@ -1,0 +1,129 @@
+#include "scenario_gen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace fleet::ctl {
+namespace {
+
+constexpr double kRes = 0.5;            // m per cell, as in the template
+constexpr double kAreaPerRobot = 30.0;  // m², the small warehouse's floor per robot
+constexpr double kParkDx = 1.2;         // m between parked robots
+constexpr double kRowDy = 1.6;          // m between parking rows (1 m lane for 0.3 m robots)
+constexpr double kStationGap = 2.5;     // m between pickups / drop-offs / chargers
+
+nlohmann::json station(const std::string& name, const char* kind, double x, double y, double theta) {
+  return {{"name", name}, {"kind", kind}, {"pose", {x, y, theta}}};
+}
+
+}  // namespace
+
+Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const ScenarioSize& size) {
+  if (size.robots < 1 || size.robots > 2000) {
+    return unexpected("invalid", "--robots: expected 1..2000, got " + std::to_string(size.robots));
+  }
+  if (size.humans < 0 || size.humans > 5000) {
+    return unexpected("invalid", "--humans: expected 0..5000, got " + std::to_string(size.humans));
+  }
+  if (!templ.is_object()) {
+    return unexpected("invalid", "the scenario template is not a JSON object");
+  }
+  const double n = size.robots;
+  // Floor area from the fleet size, 3:2 aspect; at least the small warehouse (30 m x 20 m).
+  const double area = std::max(600.0, kAreaPerRobot * n);
+  double widthM = std::max(30.0, std::round(std::sqrt(area * 1.5)));
+  // Parking: rows along the bottom margin; the margin grows with the number of rows.
+  const int perRow = static_cast<int>(std::floor((widthM - 4.0) / kParkDx)) + 1;
+  const int rows = (size.robots + perRow - 1) / perRow;
+  const double marginM = std::max(2.5, std::ceil((1.25 + (rows - 1) * kRowDy + 1.0) / kRes) * kRes);
+  double heightM = std::max(20.0, std::round(area / widthM) + 2.0 * (marginM - 2.5));
+  const int wCells = static_cast<int>(widthM / kRes);
+  const int hCells = static_cast<int>(heightM / kRes);
+  widthM = wCells * kRes;
+  heightM = hCells * kRes;
+
+  nlohmann::json s = templ;
+  s["name"] = "loadtest-" + std::to_string(size.robots) + "r-" + std::to_string(size.humans) + "h";
+  s["seed"] = size.seed;
+  s["duration_s"] = size.durationS;
+  s["map"] = {{"warehouse",
+               {{"width", wCells},
+                {"height", hCells},
+                {"margin", static_cast<int>(marginM / kRes)},
+                {"shelf_width", 8},
+                {"shelf_height", 2},
+                {"aisle_x", 3},
+                {"aisle_y", 3}}},
+              {"resolution", kRes}};
+
+  nlohmann::json stations = nlohmann::json::array();
+  int k = 0;
+  for (int r = 0; r < rows; ++r) {
+    for (int i = 0; i < perRow && k < size.robots; ++i) {
+      ++k;
+      stations.push_back(
+          station("PARK-" + std::to_string(k), "parking", 2.0 + i * kParkDx, 1.25 + r * kRowDy, 1.5708));
+    }
+  }
+  // Chargers, pickups, drop-offs: about one per ten, four and five robots, as room allows.
+  const double sideY0 = marginM + 1.0;
+  const double sideY1 = heightM - marginM - 1.0;
+  const int sideRoom = std::max(1, static_cast<int>((sideY1 - sideY0) / kStationGap) + 1);
+  const int topRoom = std::max(1, static_cast<int>((widthM - 6.0) / kStationGap) + 1);
+  const int chargers = std::clamp(size.robots / 10, 3, sideRoom);
+  const int pickups = std::clamp(size.robots / 4, 5, topRoom);
+  const int dropoffs = std::clamp(size.robots / 5, 4, sideRoom);
+  auto spread = [](double lo, double hi, int count, int i) {
+    return count == 1 ? (lo + hi) / 2 : lo + (hi - lo) * i / (count - 1);
+  };
+  for (int i = 0; i < chargers; ++i) {
+    stations.push_back(station("CHG-" + std::to_string(i + 1), "charging", 1.5,
+                               spread(sideY0, sideY1, chargers, i), 3.1416));
+  }
+  for (int i = 0; i < pickups; ++i) {
+    stations.push_back(station("P-" + std::to_string(i + 1), "pickup", spread(3.5, widthM - 3.5, pickups, i),
+                               heightM - 1.5, 1.5708));
+  }
+  for (int i = 0; i < dropoffs; ++i) {
+    stations.push_back(station("D-" + std::to_string(i + 1), "dropoff", widthM - 1.5,
+                               spread(sideY0, sideY1, dropoffs, i), 0.0));
+  }
+  s["stations"] = stations;
+
+  nlohmann::json robots = nlohmann::json::array();
+  for (int i = 1; i <= size.robots; ++i) {
+    robots.push_back({{"id", "r" + std::to_string(i)}, {"start_station", "PARK-" + std::to_string(i)}});
+  }
+  s["robots"] = robots;
+
+  // Landmarks on the walls every ~10 m, for the robots' localisation.
+  nlohmann::json landmarks = nlohmann::json::array();
+  int id = 1;
+  for (double y = 5.0; y < heightM - 2.0; y += 10.0) {
+    landmarks.push_back({{"id", id++}, {"position", {0.25, y}}});
+    landmarks.push_back({{"id", id++}, {"position", {widthM - 0.25, y}}});
+  }
+  for (double x = 5.0; x < widthM - 2.0; x += 10.0) {
+    landmarks.push_back({{"id", id++}, {"position", {x, heightM - 0.25}}});
+  }
+  s["landmarks"] = landmarks;
+
+  nlohmann::json humans = templ.contains("humans") ? templ["humans"] : nlohmann::json::object();
+  humans["count"] = size.humans;
+  // People walk in the top margin (pickups) and the middle of the shelf area.
+  humans["spawn_areas"] = {{2.0, heightM - marginM + 0.5, widthM - 2.0, heightM - 1.0}};
+  s["humans"] = humans;
+  return s;
+}
+
+std::pair<double, double> mapExtent(const nlohmann::json& scenario) {
+  const auto& m = scenario.value("map", nlohmann::json::object());
+  if (!m.contains("warehouse")) {
+    return {0.0, 0.0};
+  }
+  const double r = m.value("resolution", 1.0);
+  return {m["warehouse"].value("width", 0) * r, m["warehouse"].value("height", 0) * r};
+}
+
+}  // namespace fleet::ctl

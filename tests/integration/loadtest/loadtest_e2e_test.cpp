@@ -1,0 +1,129 @@
+// `fleetctl loadtest` end to end: a small generated fleet, the fleet manager killed with SIGKILL
+// and restarted, an agent process killed and restarted; every acknowledged task must be accounted
+// for (0 lost, 0 duplicated) and no process of the run may outlive it, also after Ctrl-C.
+
+#include <dirent.h>
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "../../support/test_process.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kFleetctl = std::string(FLEET_BINARY_DIR) + "/services/fleetctl/fleetctl";
+
+/// Processes whose command line mentions `needle` (every process of a run names its folder).
+int processesMentioning(const std::string& needle) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename();
+    if (name.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    std::string cmd;
+    if (FILE* f = std::fopen((e.path() / "cmdline").c_str(), "r")) {
+      char buf[4096];
+      std::size_t got = 0;
+      while ((got = std::fread(buf, 1, sizeof buf, f)) > 0) {
+        cmd.append(buf, got);
+      }
+      std::fclose(f);
+    }
+    std::string st;
+    std::ifstream stat(e.path() / "stat");
+    std::getline(stat, st);
+    const auto close = st.rfind(')');
+    const bool zombie = close != std::string::npos && close + 2 < st.size() && st[close + 2] == 'Z';
+    if (!zombie && cmd.find(needle) != std::string::npos && name != std::to_string(getpid())) {
+      ++n;
+    }
+  }
+  return n;
+}
+
+std::vector<std::string> baseArgs(const fs::path& out, int robots, double duration) {
+  return {"loadtest",
+          "--robots",
+          std::to_string(robots),
+          "--humans",
+          "4",
+          "--duration",
+          std::to_string(duration),
+          "--agents",
+          "2",
+          "--rate",
+          "24",
+          "--out",
+          out.string(),
+          "--domain",
+          std::to_string(fleet::test::uniqueDomain()),
+          "--report-script",
+          "",
+          "--wall-limit",
+          "150"};
+}
+
+TEST(LoadtestE2E, ManagerAndAgentKilledNoTaskLostOrDuplicated) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-e2e-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto args = baseArgs(out, 8, 60);
+  for (const char* f : {"kill-manager@15+1", "kill-agent@30+1:1"}) {
+    args.push_back("--fault");
+    args.push_back(f);
+  }
+  fleet::test::ChildProcess run(kFleetctl, args);
+  const int status = run.wait(std::chrono::seconds(200));
+  ASSERT_EQ(status, 0) << "see " << out;
+  std::ifstream in(out / "loadtest.json");
+  ASSERT_TRUE(in) << out;
+  const json r = json::parse(in);
+  const auto& a = r["accounting"];
+  EXPECT_EQ(r["db_error"], "");
+  EXPECT_GE(r["sim_time_s"].get<double>(), 59.0);
+  EXPECT_GE(a["acknowledged"].get<int>(), 10) << a.dump();
+  EXPECT_EQ(a["lost"], 0) << a.dump();
+  EXPECT_EQ(a["duplicated"], 0) << a.dump();
+  // Every acknowledged task is in a final state exactly once or still tracked.
+  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
+                a["still_tracked"].get<int>(),
+            a["acknowledged"].get<int>());
+  std::vector<std::string> events;
+  for (const auto& e : r["faults"]) {
+    events.push_back(e["event"]);
+  }
+  const std::vector<std::string> expected = {"SIGKILL fleet_manager", "restarted fleet_manager",
+                                             "SIGKILL agent-1", "restarted agent-1"};
+  EXPECT_EQ(events, expected);
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+}
+
+TEST(LoadtestE2E, InterruptStopsEveryProcess) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-int-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  fleet::test::ChildProcess run(kFleetctl, baseArgs(out, 4, 3600));
+  // Wait until the whole fleet runs (the simulator has written its log), then Ctrl-C.
+  for (int i = 0; i < 300 && processesMentioning(out.string() + "/sim_summary.json") == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_GT(processesMentioning(out.string()), 4);  // manager, adapter, risk map, agents, simulator
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  run.kill(SIGINT);
+  EXPECT_EQ(run.wait(std::chrono::seconds(60)), 130);
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+  std::ifstream in(out / "loadtest.json");
+  ASSERT_TRUE(in);
+  const json r = json::parse(in);
+  EXPECT_TRUE(r["interrupted"].get<bool>());
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+}
+
+}  // namespace

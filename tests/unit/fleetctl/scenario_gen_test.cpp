@@ -1,0 +1,89 @@
+#include "scenario_gen.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <set>
+
+#include "fleet/sim/scenario.hpp"
+
+namespace fleet::ctl {
+namespace {
+
+nlohmann::json smallTemplate() {
+  std::ifstream in(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.json");
+  return nlohmann::json::parse(in);
+}
+
+class GeneratedScenario : public ::testing::TestWithParam<int> {};
+
+// The simulator's own loader accepts it: no robot or station in a shelf, no overlapping robots,
+// every station and robot reachable from the first robot.
+TEST_P(GeneratedScenario, LoadsInTheSimulatorAndFitsTheFleet) {
+  const int n = GetParam();
+  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
+  ASSERT_TRUE(doc) << doc.error().message;
+  sim::Scenario s;
+  try {
+    s = sim::parseScenario(*doc, "generated", ".");
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+  ASSERT_EQ(static_cast<int>(s.robots.size()), n);
+  EXPECT_EQ((*doc)["humans"]["count"], n / 2);
+  std::set<std::string> ids;
+  int parking = 0, pickups = 0, dropoffs = 0, chargers = 0;
+  for (const auto& st : (*doc)["stations"]) {
+    const std::string k = st["kind"];
+    parking += k == "parking";
+    pickups += k == "pickup";
+    dropoffs += k == "dropoff";
+    chargers += k == "charging";
+  }
+  EXPECT_EQ(parking, n);  // a parking spot per robot
+  EXPECT_GE(pickups, 5);
+  EXPECT_GE(dropoffs, 4);
+  EXPECT_GE(chargers, 3);
+  for (const auto& r : (*doc)["robots"]) {
+    EXPECT_TRUE(ids.insert(r["start_station"].get<std::string>()).second);  // distinct start spots
+  }
+  // About 30 m² of floor per robot (never smaller than the template's 30 m x 20 m).
+  const auto [w, h] = mapExtent(*doc);
+  EXPECT_GE(w * h, std::max(600.0, 25.0 * n));
+  EXPECT_LE(w * h, std::max(1200.0, 60.0 * n));
+}
+
+INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 100, 500));
+
+TEST(ScenarioGen, BiggerFleetsGetBiggerWarehouses) {
+  double last = 0;
+  for (int n : {20, 100, 500, 1000}) {
+    auto doc = generateScenario(smallTemplate(), {n, 0, 60, 1});
+    ASSERT_TRUE(doc);
+    const auto [w, h] = mapExtent(*doc);
+    EXPECT_GT(w * h, last);
+    last = w * h;
+  }
+}
+
+TEST(ScenarioGen, KeepsTheTemplateRobotModel) {
+  const auto t = smallTemplate();
+  auto doc = generateScenario(t, {50, 10, 90, 1});
+  ASSERT_TRUE(doc);
+  EXPECT_EQ((*doc)["robot_defaults"], t["robot_defaults"]);
+  EXPECT_EQ((*doc)["prediction"], t["prediction"]);
+  EXPECT_EQ((*doc)["duration_s"], 90.0);
+}
+
+TEST(ScenarioGen, RefusesBadSizes) {
+  auto a = generateScenario(smallTemplate(), {0, 0, 60, 1});
+  ASSERT_FALSE(a);
+  EXPECT_NE(a.error().message.find("--robots"), std::string::npos);
+  auto b = generateScenario(smallTemplate(), {10, -1, 60, 1});
+  ASSERT_FALSE(b);
+  EXPECT_NE(b.error().message.find("--humans"), std::string::npos);
+  EXPECT_FALSE(generateScenario(nlohmann::json::array(), {10, 0, 60, 1}));
+}
+
+}  // namespace
+}  // namespace fleet::ctl
