@@ -632,8 +632,10 @@ int Run::run() {
           faults[i].kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(faults[i]);
       if (faults[i].kind == Fault::Kind::StallRobot) {
         sup.signal(who, SIGCONT);
+        logFault("SIGCONT " + who + " (end of run)");
       } else if (faults[i].kind == Fault::Kind::KillManager) {
         sup.restart(who);
+        logFault("restarted " + who + " (end of run)");
         std::this_thread::sleep_for(std::chrono::seconds(1));
       }
       faultEnded[i] = true;

@@ -96,13 +96,16 @@ TEST(LoadtestE2E, ManagerAndAgentKilledNoTaskLostOrDuplicated) {
   EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
                 a["still_tracked"].get<int>(),
             a["acknowledged"].get<int>());
-  std::vector<std::string> events;
+  // Each fault happened and ended; the order depends on how fast the simulation runs (the down
+  // times are wall seconds), and a restart may fall after the end of the run.
+  std::string events;
   for (const auto& e : r["faults"]) {
-    events.push_back(e["event"]);
+    events += e["event"].get<std::string>() + "\n";
   }
-  const std::vector<std::string> expected = {"SIGKILL fleet_manager", "restarted fleet_manager",
-                                             "SIGKILL agent-1", "restarted agent-1"};
-  EXPECT_EQ(events, expected);
+  for (const char* e : {"SIGKILL fleet_manager\n", "SIGKILL agent-1\n", "restarted agent-1"}) {
+    EXPECT_NE(events.find(e), std::string::npos) << e << " missing in\n" << events;
+  }
+  EXPECT_NE(events.find("restarted fleet_manager"), std::string::npos) << events;
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
 
