@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# CI smoke test of the service containers: builds the images from the host build, starts the
+# small-fleet pod (simulator, risk map, fleet manager, WMS adapter, robot agent) with
+# `podman play kube --network none`, posts a transport task over HTTP from inside the pod and
+# asserts that every container started and stays healthy and that the task reached `done` (which
+# needs DDS traffic between all five services). Exit 77 (ctest skip) only when podman cannot run
+# containers on this machine at all. Usage: containers_smoke.sh SOURCE_DIR BUILD_DIR
+set -uo pipefail
+SRC=$1
+export BUILD_DIR=$2
+cd "$SRC"
+t0=$SECONDS
+fail() { echo "FAIL: $*"; exit 1; }
+
+command -v podman >/dev/null || fail "podman is not installed (scripts/setup installs it)"
+if ! out=$(podman info 2>&1); then
+  echo "SKIP: podman cannot run here: $(tail -n 3 <<<"$out")"
+  exit 77
+fi
+scripts/containers build || fail "building the images failed"
+if ! out=$(podman run --rm --network none localhost/bookworm-min true 2>&1); then
+  echo "SKIP: podman cannot start a container here: $(tail -n 3 <<<"$out")"
+  exit 77
+fi
+echo "images built after $((SECONDS - t0)) s"
+
+export POD=fleet-smoke-$$
+dir=$(mktemp -d /tmp/fleet-smoke.XXXXXX)
+cleanup() {
+  if [[ ${ok:-0} != 1 ]]; then
+    for c in fleet-manager wms-adapter risk-map robot-agent fleet-sim; do
+      echo "--- log of $POD-$c"
+      podman logs --tail 30 "$POD-$c" 2>&1
+    done
+  fi
+  podman pod rm -f -t 1 "$POD" >/dev/null 2>&1
+  rm -rf "$dir"
+}
+trap cleanup EXIT
+scripts/containers up "$dir" sim/scenarios/one_robot.json 150 1 || fail "podman play kube failed"
+
+ctl() { podman run --rm --pod "$POD" -v "$dir/config:/etc/fleet:ro" localhost/fleet-fleetctl \
+  --url http://127.0.0.1:8080 "$@"; }
+services=(fleet-manager wms-adapter risk-map robot-agent fleet-sim)
+for c in "${services[@]}"; do
+  [[ $(podman inspect --format '{{.State.Status}}' "$POD-$c") == running ]] || fail "$POD-$c did not start"
+done
+for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
+ctl submit /etc/fleet/tasks.csv | tee "$dir/submit.txt"
+grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the task"
+touch "$dir/data/start"  # the simulator starts now (deploy/fleet-pod.yaml)
+
+state=""
+deadline=$((SECONDS + 150))
+while ((SECONDS < deadline)); do
+  state=$(ctl task job-000 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
+  [[ $state == done || $state == failed ]] && break
+  sleep 1
+done
+echo "task job-000: $state after $((SECONDS - t0)) s"
+[[ $state == done ]] || fail "the task did not reach done (last state '$state')"
+
+for c in fleet-manager wms-adapter risk-map robot-agent; do
+  [[ $(podman inspect --format '{{.State.Status}}' "$POD-$c") == running ]] || fail "$POD-$c is no longer running"
+  # A probe is a podman exec: on a loaded machine one may time out, so up to three tries.
+  h=1
+  for _ in 1 2 3; do podman healthcheck run "$POD-$c" >/dev/null && { h=0; break; }; sleep 1; done
+  ((h == 0)) || fail "$POD-$c is unhealthy"
+  echo "$POD-$c running and healthy"
+done
+sim=$(podman inspect --format '{{.State.Status}} {{.State.ExitCode}}' "$POD-fleet-sim")
+[[ $sim == "running 0" || $sim == "exited 0" ]] || fail "the simulator ended badly ($sim)"
+ok=1
+echo "PASS: containers smoke test in $((SECONDS - t0)) s"
