@@ -32,11 +32,6 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<VelocityObstaclePlanner>());
   if (name == "orca")
     return Ptr(std::make_unique<OrcaPlanner>());
-  if (name == "rvo") {
-    VelocityObstacleParams p;
-    p.reciprocal = true;
-    return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
-  }
   if (name == "vo_keep_right") {
     VelocityObstacleParams p;
     p.right_bias = 1.0;
