@@ -115,6 +115,7 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
   const std::size_t count = static_cast<std::size_t>(nv) * static_cast<std::size_t>(nw);
   samples_.assign(count, DwaSample{});
   upper_.resize(count);
+  disc_clr_.resize(count);
   order_.resize(count);
   for (int a = 0; a < nv; ++a) {
     const double v =
@@ -137,8 +138,27 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
           carrot_d0 > 1e-9
               ? std::clamp((carrot_d0 - fastDistance(end.position(), carrot)) / (vmax_abs * T), -1.0, 1.0)
               : 0.0;
-      upper_[idx] = w_heading * s.heading + params_.w_clearance * 1.0 + params_.w_velocity * s.velocity +
-                    w_progress * s.progress;
+      // Discs and risk are cheap next to the scan arcs: compute them here so the bound is tight.
+      double clr_discs = std::numeric_limits<double>::infinity();
+      for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
+        const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
+        const Vec2 p = along(s.twist, t);
+        for (const MovingDisc& d : view.discs) {
+          clr_discs = std::min(clr_discs,
+                               fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
+        }
+      }
+      disc_clr_[idx] = clr_discs;
+      if (view.risk) {
+        for (int k = 1; k <= params_.risk_samples; ++k) {
+          const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
+          s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
+        }
+      }
+      // The clearance term can only be lower than the disc clearance alone.
+      const double clr_bound = std::clamp(clr_discs, 0.0, params_.clearance_cap) / params_.clearance_cap;
+      upper_[idx] = w_heading * s.heading + params_.w_clearance * clr_bound +
+                    params_.w_velocity * s.velocity + w_progress * s.progress - params_.w_risk * s.risk;
       order_[idx] = idx;
     }
   }
@@ -159,14 +179,13 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
     const double v = s.twist.v;
     const double w = s.twist.omega;
     s.evaluated = true;
-    double clr = arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap);
-    for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
-      const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
-      const Vec2 p = along(s.twist, t);
-      for (const MovingDisc& d : view.discs) {
-        clr = std::min(clr, fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
-      }
+    if (params_.prune && disc_clr_[idx] < params_.min_clearance) {
+      // Inadmissible whatever the scan says: it can never be chosen.
+      s.evaluated = false;
+      continue;
     }
+    const double clr = std::min(
+        arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap), disc_clr_[idx]);
     s.admissible = clr >= params_.min_clearance;
     // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
     // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
@@ -176,12 +195,6 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
                                     view.robot.radius, params_.clearance_cap);
     const double clr_term = std::min(clr, ext);
     s.clearance = std::clamp(clr_term, 0.0, params_.clearance_cap) / params_.clearance_cap;
-    if (view.risk) {
-      for (int k = 1; k <= params_.risk_samples; ++k) {
-        const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
-        s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
-      }
-    }
     s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
               w_progress * s.progress - params_.w_risk * s.risk;
     if (s.admissible && (s.score > best_score || (s.score == best_score && idx < best_idx))) {

@@ -77,6 +77,7 @@ class DynamicWindowPlanner final : public LocalPlanner {
   std::vector<DwaSample> samples_;
   std::vector<Vec2> near_;
   std::vector<double> upper_;
+  std::vector<double> disc_clr_;
   std::vector<std::size_t> order_;
   double best_carrot_distance_ = 0.0;
   int no_progress_ = 0;
