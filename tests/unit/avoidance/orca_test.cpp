@@ -120,6 +120,19 @@ TEST(Orca, CircleSwapSmallGroupsReachTheirGoalsWithoutContact) {
   }
 }
 
+// The target is 100/100 at goal; ORCA does not reach it yet (see docs/benchmarks.md). This
+// pins what it does: no contact at all among 100 robots and more than half home in 150 s, where the
+// sampling VO brings none.
+TEST(Orca, HundredRobotSwapHasNoContactAndBeatsTheStandoff) {
+  Scenario sc = circleSwap(100, 20.0);
+  sc.max_steps = 1500;
+  const auto r = runScenario(sc, "orca");
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->collisions, 0);
+  EXPECT_GT(r->min_separation, 0.0);
+  EXPECT_GE(r->reached, 50);
+}
+
 TEST(Orca, RegisteredAndValidated) {
   auto p = makePlanner("orca");
   ASSERT_TRUE(p.has_value());
