@@ -109,59 +109,102 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
 
   const int nv = params_.v_samples;
   const int nw = params_.omega_samples;
-  samples_.reserve(static_cast<std::size_t>(nv * nw));
   const double vmax_abs = std::max(lim.v_max, 1e-9);
-  DwaSample best;
-  best.score = -std::numeric_limits<double>::infinity();
+  // Pass 1 (cheap): heading, velocity and progress of every sample, and the best score it could
+  // still reach (clearance term at its cap, no risk).
+  const std::size_t count = static_cast<std::size_t>(nv) * static_cast<std::size_t>(nw);
+  samples_.assign(count, DwaSample{});
+  upper_.resize(count);
+  disc_clr_.resize(count);
+  order_.resize(count);
   for (int a = 0; a < nv; ++a) {
     const double v =
         nv == 1 ? v_hi : v_lo + (v_hi - v_lo) * static_cast<double>(a) / static_cast<double>(nv - 1);
     for (int b = 0; b < nw; ++b) {
       const double w = nw == 1 ? 0.5 * (w_lo + w_hi)
                                : w_lo + (w_hi - w_lo) * static_cast<double>(b) / static_cast<double>(nw - 1);
-      DwaSample s;
+      const std::size_t idx =
+          static_cast<std::size_t>(a) * static_cast<std::size_t>(nw) + static_cast<std::size_t>(b);
+      DwaSample& s = samples_[idx];
       s.twist = {v, w};
-      double clr = arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap);
-      for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
-        const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
-        const Vec2 p = along(s.twist, t);
-        for (const MovingDisc& d : view.discs) {
-          clr = std::min(clr, fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
-        }
-      }
-      s.admissible = clr >= params_.min_clearance;
-      // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
-      // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
-      // arcs bending away score better long before the straight one becomes inadmissible.
-      const double v_eval = std::max(std::abs(v), params_.curvature_speed_floor * vmax_abs);
-      const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearance_length, near_,
-                                      view.robot.radius, params_.clearance_cap);
-      const double clr_term = std::min(clr, ext);
       const Vec2 end_p = along(s.twist, T);
       const Pose2 end{end_p.x, end_p.y, pose.theta + w * T};
       const double goal_bearing = std::atan2(carrot.y - end.y, carrot.x - end.x);
       s.heading = fastDistance(end.position(), carrot) < 1e-6
                       ? 1.0
                       : 1.0 - std::abs(angleDiff(goal_bearing, end.theta)) / kPi;
-      s.clearance = std::clamp(clr_term, 0.0, params_.clearance_cap) / params_.clearance_cap;
       s.velocity = std::max(v, 0.0) / vmax_abs;
       s.progress =
           carrot_d0 > 1e-9
               ? std::clamp((carrot_d0 - fastDistance(end.position(), carrot)) / (vmax_abs * T), -1.0, 1.0)
               : 0.0;
+      // Discs and risk are cheap next to the scan arcs: compute them here so the bound is tight.
+      double clr_discs = std::numeric_limits<double>::infinity();
+      for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
+        const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
+        const Vec2 p = along(s.twist, t);
+        for (const MovingDisc& d : view.discs) {
+          clr_discs = std::min(clr_discs,
+                               fastDistance(p, d.position + d.velocity * t) - view.robot.radius - d.radius);
+        }
+      }
+      disc_clr_[idx] = clr_discs;
       if (view.risk) {
         for (int k = 1; k <= params_.risk_samples; ++k) {
           const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
           s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
         }
       }
-      s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
-                w_progress * s.progress - params_.w_risk * s.risk;
-      if (s.admissible && s.score > best.score)
-        best = s;
-      samples_.push_back(s);
+      // The clearance term can only be lower than the disc clearance alone.
+      const double clr_bound = std::clamp(clr_discs, 0.0, params_.clearance_cap) / params_.clearance_cap;
+      upper_[idx] = w_heading * s.heading + params_.w_clearance * clr_bound +
+                    params_.w_velocity * s.velocity + w_progress * s.progress - params_.w_risk * s.risk;
+      order_[idx] = idx;
     }
   }
+  // Pass 2 (expensive: clearance against the scan and discs, risk) in decreasing order of the
+  // bound, stopping once no remaining sample can beat the best. Ties keep the sample that comes
+  // first in (v, ω) order, as the exhaustive loop does, so the choice is the same.
+  if (params_.prune) {
+    std::sort(order_.begin(), order_.end(), [&](std::size_t x, std::size_t y) {
+      return upper_[x] != upper_[y] ? upper_[x] > upper_[y] : x < y;
+    });
+  }
+  std::size_t best_idx = count;
+  double best_score = -std::numeric_limits<double>::infinity();
+  for (const std::size_t idx : order_) {
+    if (params_.prune && best_idx < count && upper_[idx] < best_score)
+      break;
+    DwaSample& s = samples_[idx];
+    const double v = s.twist.v;
+    const double w = s.twist.omega;
+    s.evaluated = true;
+    if (params_.prune && disc_clr_[idx] < params_.min_clearance) {
+      // Inadmissible whatever the scan says: it can never be chosen.
+      s.evaluated = false;
+      continue;
+    }
+    const double clr = std::min(
+        arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap), disc_clr_[idx]);
+    s.admissible = clr >= params_.min_clearance;
+    // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
+    // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
+    // arcs bending away score better long before the straight one becomes inadmissible.
+    const double v_eval = std::max(std::abs(v), params_.curvature_speed_floor * vmax_abs);
+    const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearance_length, near_,
+                                    view.robot.radius, params_.clearance_cap);
+    const double clr_term = std::min(clr, ext);
+    s.clearance = std::clamp(clr_term, 0.0, params_.clearance_cap) / params_.clearance_cap;
+    s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
+              w_progress * s.progress - params_.w_risk * s.risk;
+    if (s.admissible && (s.score > best_score || (s.score == best_score && idx < best_idx))) {
+      best_score = s.score;
+      best_idx = idx;
+    }
+  }
+  DwaSample best;
+  if (best_idx < count)
+    best = samples_[best_idx];
   if (!best.admissible) {
     // Nothing admissible: brake as hard as the window allows and turn towards the carrot.
     const double turn = angleDiff(std::atan2(carrot.y - pose.y, carrot.x - pose.x), pose.theta);

@@ -5,6 +5,7 @@
 #include "fleet/avoidance/bug.hpp"
 #include "fleet/avoidance/dynamic_window.hpp"
 #include "fleet/avoidance/elastic_strips.hpp"
+#include "fleet/avoidance/orca.hpp"
 #include "fleet/avoidance/potential_field.hpp"
 #include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/velocity_obstacle.hpp"
@@ -29,11 +30,8 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kBvhTwoSided));
   if (name == "vo")
     return Ptr(std::make_unique<VelocityObstaclePlanner>());
-  if (name == "rvo") {
-    VelocityObstacleParams p;
-    p.reciprocal = true;
-    return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
-  }
+  if (name == "orca")
+    return Ptr(std::make_unique<OrcaPlanner>());
   if (name == "vo_keep_right") {
     VelocityObstacleParams p;
     p.right_bias = 1.0;

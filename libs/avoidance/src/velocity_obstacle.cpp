@@ -42,7 +42,6 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
   const Vec2 carrot = carrotOnPath(view.path, p, 1.5);
   // Slow down on the last stretch so the goal tolerance is not overshot.
   const Vec2 v_pref = (carrot - p).normalized() * std::min(vmax, dg / 1.0);
-  const Vec2 v_cur = pose.heading() * view.robot.twist.v;
   const double r = view.robot.radius + params_.margin;
 
   // Is anything on a collision course with the preferred velocity?
@@ -54,13 +53,9 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
   Vec2 best_v;
   double best_cost = std::numeric_limits<double>::infinity();
   auto evaluate = [&](Vec2 cand) {
-    const Vec2 test = params_.reciprocal ? cand * 2.0 - v_cur : cand;
     double ttc = std::numeric_limits<double>::infinity();
     for (const MovingDisc& d : view.discs) {
-      // Reciprocal only towards agents that move (humans and parked robots do not share the work).
-      const bool recip = params_.reciprocal && d.velocity.squaredNorm() > 1e-6;
-      ttc = std::min(ttc,
-                     discTimeToCollision(d.position - p, (recip ? test : cand) - d.velocity, r + d.radius));
+      ttc = std::min(ttc, discTimeToCollision(d.position - p, cand - d.velocity, r + d.radius));
     }
     for (const Vec2& q : view.scan)
       ttc = std::min(ttc, discTimeToCollision(q - p, cand, r));

@@ -157,6 +157,7 @@ BENCHMARK_CAPTURE(BM_CircleSwap, vo_keep_right, "vo_keep_right")
     ->Arg(100)
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
+BENCHMARK_CAPTURE(BM_CircleSwap, orca, "orca")->Arg(8)->Arg(100)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK_CAPTURE(BM_CircleSwap, dwa, "dwa")->Arg(8)->Arg(100)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace

@@ -180,3 +180,50 @@ TEST(Dwa, WeightsChangeTheChoice) {
 
 }  // namespace
 }  // namespace fleet::avoidance
+
+namespace fleet::avoidance {
+namespace {
+
+// The pruned search must pick exactly the command the exhaustive one picks.
+TEST(Dwa, PrunedSearchChoosesTheSameCommandAsTheExhaustiveOne) {
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  DwaParams full;
+  full.prune = false;
+  DwaParams fast;
+  fast.prune = true;
+  int evaluated_fewer = 0;
+  for (int k = 0; k < 150; ++k) {
+    std::vector<Vec2> scan;
+    const int pts = static_cast<int>(rng() % 360);
+    for (int i = 0; i < pts; ++i)
+      scan.push_back({3.0 * u(rng), 3.0 * u(rng)});
+    std::vector<MovingDisc> discs;
+    for (int i = 0; i < static_cast<int>(rng() % 6); ++i)
+      discs.push_back({{4.0 * u(rng), 4.0 * u(rng)}, {0.5 * u(rng), 0.5 * u(rng)}, 0.3});
+    const std::vector<Vec2> path{{5.0 * u(rng), 5.0 * u(rng)}};
+    LocalView v;
+    v.robot = {{0.0, 0.0, 3.0 * u(rng)}, {0.2 + 0.2 * u(rng), 0.5 * u(rng)}, 0.3};
+    v.path = path;
+    v.scan = scan;
+    v.discs = discs;
+    if (k % 2 == 0) {
+      const double cx = u(rng), cy = u(rng);
+      v.risk = [cx, cy](Vec2 p) { return std::exp(-((p.x - cx) * (p.x - cx) + (p.y - cy) * (p.y - cy))); };
+    }
+    DynamicWindowPlanner a(full), b(fast);
+    const Command ca = a.plan(v);
+    const Command cb = b.plan(v);
+    EXPECT_EQ(ca.twist, cb.twist) << k;
+    EXPECT_EQ(ca.status, cb.status) << k;
+    int n_eval = 0;
+    for (const auto& s : b.lastSamples())
+      n_eval += s.evaluated ? 1 : 0;
+    if (n_eval < static_cast<int>(a.lastSamples().size()))
+      ++evaluated_fewer;
+  }
+  EXPECT_GT(evaluated_fewer, 0);  // the pruning actually prunes
+}
+
+}  // namespace
+}  // namespace fleet::avoidance

@@ -31,6 +31,9 @@ struct DwaParams {
   int stuck_cycles = 15;
   double stuck_progress = 0.05;  ///< [m]
   int escape_cycles = 25;
+  /// Evaluate samples in decreasing order of their score bound and stop once none can beat the
+  /// best (same choice as the exhaustive loop, which `prune = false` runs: the cross-check).
+  bool prune = true;
 
   [[nodiscard]] Expected<void> validate() const;
 };
@@ -45,6 +48,9 @@ struct DwaSample {
   double risk = 0.0;
   double score = 0.0;
   bool admissible = false;
+  /// False when pruning skipped the expensive terms (clearance, risk, score and admissible are
+  /// then not computed): its bound showed it could not beat the chosen sample.
+  bool evaluated = false;
 };
 
 /// Pick the carrot: the point `lookahead` along the path from the path point nearest the robot.
@@ -70,6 +76,9 @@ class DynamicWindowPlanner final : public LocalPlanner {
   DwaParams params_;
   std::vector<DwaSample> samples_;
   std::vector<Vec2> near_;
+  std::vector<double> upper_;
+  std::vector<double> disc_clr_;
+  std::vector<std::size_t> order_;
   double best_carrot_distance_ = 0.0;
   int no_progress_ = 0;
   int escape_left_ = 0;

@@ -71,7 +71,8 @@ class LocalPlanner {
 };
 
 /// The planner named in config: "dwa", "potential_field", "bug1", "bug2", "risk_stepping",
-/// "elastic_strips", "elastic_strips_bvh", "vo", "rvo".
+/// "elastic_strips", "elastic_strips_bvh", "vo", "vo_keep_right", "orca"
+/// (the former sampling "rvo" never resolved a swap and was removed: "orca" is the reciprocal one).
 Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name);
 
 }  // namespace fleet::avoidance

@@ -9,12 +9,11 @@ namespace fleet::avoidance {
 double discTimeToCollision(Vec2 rel, Vec2 vel, double R);
 
 struct VelocityObstacleParams {
-  bool reciprocal = false;  ///< RVO: test 2·v − v_current against the others (each takes half)
-  int headings = 24;        ///< candidate directions over the full circle (plus the preferred one)
-  int speeds = 5;           ///< candidate speeds in (0, v_max] (plus standing still)
-  double w_ttc = 1.0;       ///< penalty = w_ttc / ttc + |v − v_pref| (van den Berg et al. 2008)
-  double horizon = 5.0;     ///< collisions later than this are ignored [s]
-  double margin = 0.05;     ///< added to every combined radius [m]
+  int headings = 24;     ///< candidate directions over the full circle (plus the preferred one)
+  int speeds = 5;        ///< candidate speeds in (0, v_max] (plus standing still)
+  double w_ttc = 1.0;    ///< penalty = w_ttc / ttc + |v − v_pref| (van den Berg et al. 2008)
+  double horizon = 5.0;  ///< collisions later than this are ignored [s]
+  double margin = 0.05;  ///< added to every combined radius [m]
   double k_omega = 2.5;
   /// Cost per m/s of velocity to the left of the preferred one while a conflict is in view: a
   /// shared keep-right convention turns head-on symmetric encounters (circle swap) into a
@@ -32,7 +31,7 @@ class VelocityObstaclePlanner final : public LocalPlanner {
   explicit VelocityObstaclePlanner(VelocityObstacleParams params = {}) : params_(params) {}
   Command plan(const LocalView& view) override;
   [[nodiscard]] std::string_view name() const override {
-    return params_.reciprocal ? "rvo" : (params_.right_bias > 0.0 ? "vo_keep_right" : "vo");
+    return params_.right_bias > 0.0 ? "vo_keep_right" : "vo";
   }
 
  private:
