@@ -63,7 +63,7 @@ TEST(FleetScenario, OneRobotDeliversATransportTaskWithoutContact) {
 
   test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
                          {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",
-                          "120", "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
+                          "200", "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
                          env);
   std::vector<msg::TaskState> seen;
   while (std::chrono::steady_clock::now() < deadline + 200s &&
