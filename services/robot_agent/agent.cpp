@@ -115,6 +115,7 @@ void Agent::onFrame(const msg::SensorFrame& f) {
   }
   frame_ = f;
   haveFrame_ = true;
+  frameSinceStep_ = true;
 }
 
 void Agent::onOtherRobot(const msg::RobotState& s) {
@@ -354,7 +355,54 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   }
 }
 
+bool Agent::sensorStreamLost(std::int64_t nowNs) {
+  if (frameSinceStep_ || lastFrameNs_ < 0) {
+    // The first step starts the count: a robot that never gets a frame is reported too.
+    lastFrameNs_ = nowNs;
+  }
+  const bool fresh = frameSinceStep_;
+  frameSinceStep_ = false;
+  const bool lost = !fresh && nsToSec(nowNs - lastFrameNs_) > p_.sensorTimeoutS;
+  if (lost == sensorLost_) {
+    return lost;
+  }
+  sensorLost_ = lost;
+  std::string reason;
+  if (lost) {
+    lostSinceNs_ = nowNs;
+    reason = "sensor stream lost: no SensorFrame for " + std::to_string(nsToSec(nowNs - lastFrameNs_)) + " s";
+  } else {
+    // The outage is not time spent blocked or without progress.
+    const std::int64_t outage = nowNs - lostSinceNs_;
+    if (blockedSinceNs_ >= 0) {
+      blockedSinceNs_ += outage;
+    }
+    lastProgressNs_ += outage;
+    if (planner_) {
+      planner_->reset();
+    }
+  }
+  if (!task_.empty()) {
+    const float progress =
+        goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
+    pendingStatus_ = msg::TaskStatus{p_.id, task_, revision_, reported_, progress, reason, nowNs};
+  }
+  return lost;
+}
+
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
+  if (!sensorStreamLost(nowNs)) {
+    return drive(nowNs, dt);
+  }
+  // Blind: hold still and say why; the task is kept and resumes when frames come back.
+  AgentOutput out;
+  v_ = 0.0;
+  w_ = 0.0;
+  report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
+  return out;
+}
+
+AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   AgentOutput out;
   double v = 0.0;
   double w = 0.0;
@@ -437,7 +485,12 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   }
   v_ = v;
   w_ = w;
+  (void)dt;
+  report(out, nowNs, v, w, mode);
+  return out;
+}
 
+void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
   const Pose2 pose = ekf_.pose();
   out.command = {p_.id, v, w, nowNs, 0};
   out.state.robot_id = p_.id;
@@ -471,10 +524,8 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     q = {q.x + v * std::cos(q.theta) * p_.predictionDt, q.y + v * std::sin(q.theta) * p_.predictionDt,
          wrapAngle(q.theta + w * p_.predictionDt)};
   }
-  (void)dt;
   out.status = std::move(pendingStatus_);
   pendingStatus_.reset();
-  return out;
 }
 
 }  // namespace fleet::agent
