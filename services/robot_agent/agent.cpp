@@ -6,6 +6,7 @@
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/planning/astar.hpp"
+#include "risk_astar.hpp"
 
 #include <stdexcept>
 
@@ -88,6 +89,9 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
   view.limits = p_.limits;
   view.dt = 0.1;
   view.goal_tolerance = 0.15;
+  if (risk_) {
+    view.risk = [r = risk_](Vec2 q) { return r->at(q); };
+  }
   const auto cmd = planner_->plan(view);
   reached = cmd.status == avoidance::PlanStatus::kGoalReached || distance(pose, goals_[goal_].pose) < 0.15;
   blocked = cmd.status == avoidance::PlanStatus::kBlocked ||
@@ -192,6 +196,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     if (!path) {
       return;  // no way around: keep the current path and wait
     }
+  } else if (risk_) {
+    RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
+    path = riskAware.plan(*grid_, ekf_.pose(), g.pose);
   } else {
     path = astar.plan(*grid_, ekf_.pose(), g.pose);
   }

@@ -19,6 +19,7 @@
 #include "fleet/estimation/pose_ekf.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "fleet/transport/messages.hpp"
+#include "risk_field.hpp"
 
 namespace fleet::agent {
 
@@ -35,6 +36,8 @@ struct AgentParams {
   double blockedFailS = 60.0;    // a task that cannot progress this long fails
   /// No SensorFrame for this long (of the agent's clock): stop, report RM_FAULT, resume on frames.
   double sensorTimeoutS = 0.5;
+  /// A* cell cost = step length × (1 + riskWeightGlobal · p): paths at most (1 + w)× the shortest.
+  double riskWeightGlobal = 1.0;
   double predictionHorizonS = 3.0;
   double predictionDt = 0.5;
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
@@ -62,6 +65,9 @@ class Agent {
   void onOtherRobot(const msg::RobotState& s);
   /// A new revision replaces the current order (an empty task id cancels).
   void onAssignment(const msg::TaskAssignment& a);
+  /// The latest risk map (shared by every agent of the process): the local planner's risk term and
+  /// the global planner's cell cost. Null: no risk information.
+  void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
   AgentOutput step(std::int64_t nowNs, double dt);
   /// True while the sensor stream is considered lost (as of the last step).
   [[nodiscard]] bool sensorLost() const { return sensorLost_; }
@@ -109,6 +115,7 @@ class Agent {
   bool frameSinceStep_ = false;
   std::int64_t lastFrameNs_ = -1;  // step time at which the latest frame was seen
   bool sensorLost_ = false;
+  std::shared_ptr<const RiskField> risk_;
   std::int64_t lostSinceNs_ = 0;
   std::uint64_t rejected_ = 0;
 

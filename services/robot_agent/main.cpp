@@ -15,6 +15,8 @@
 #include "fleet/service/runtime.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "fleet/transport/dds.hpp"
+#include "risk_field.hpp"
+#include "worker_pool.hpp"
 
 using namespace fleet;
 using namespace std::chrono_literals;
@@ -33,8 +35,21 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
   return g;
 }
 
-int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep, const std::string& id,
-        const std::string& localPlanner) {
+struct Options {
+  std::vector<std::string> only;
+  bool lockstep = false;
+  std::string id = "agents";
+  std::string localPlanner = "dwa";
+  unsigned threads = 0;  // 0: hardware concurrency
+  double sensorTimeoutS = 0.5;
+  double riskWeightGlobal = 1.0;
+  bool useRisk = true;
+};
+
+int run(const sim::Scenario& scn, const Options& opt) {
+  const auto& only = opt.only;
+  const bool lockstep = opt.lockstep;
+  const std::string& id = opt.id;
   auto raw = gridOf(scn.map);
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::vector<std::unique_ptr<agent::Agent>> agents;
@@ -55,7 +70,9 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
     p.wheelBase = r.wheelBase;
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
-    p.localPlanner = localPlanner;
+    p.localPlanner = opt.localPlanner;
+    p.sensorTimeoutS = opt.sensorTimeoutS;
+    p.riskWeightGlobal = opt.riskWeightGlobal;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
     for (const auto& l : scn.landmarks) {
@@ -73,6 +90,7 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
   transport::Reader<msg::TaskAssignment> assignments(part);
   transport::Reader<msg::Clock> clockIn(part);
   transport::Reader<msg::RobotState> others(part);
+  transport::Reader<msg::RiskMap> riskMaps(part);
   transport::Writer<msg::VelocityCommand> commands(part, transport::qos::command(lockstep));
   transport::Writer<msg::RobotState> states(part);
   transport::Writer<msg::PredictedDiscs> discs(part);
@@ -81,7 +99,14 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
-  spdlog::info("robot agent {}: {} robots, {} mode", id, agents.size(), lockstep ? "lockstep" : "wall");
+  const unsigned threads =
+      std::max(1u, std::min(opt.threads == 0 ? std::thread::hardware_concurrency() : opt.threads,
+                            static_cast<unsigned>(agents.size())));
+  agent::WorkerPool pool(threads);
+  std::vector<agent::AgentOutput> outs(agents.size());
+  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}", id, agents.size(),
+               lockstep ? "lockstep" : "wall", pool.threads(), opt.localPlanner, opt.useRisk ? "on" : "off");
+  std::uint64_t badRiskMaps = 0;
 
   bool haveClock = false;
   auto lastRegister = std::chrono::steady_clock::now() - 1s;
@@ -104,8 +129,24 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
         it->second->onAssignment(a);
       }
     }
-    for (auto& a : agents) {
-      auto out = a->step(now, dt);
+    if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
+      // Only the newest map matters; it is decoded once and shared read-only by every agent.
+      if (auto field = agent::RiskField::fromMessage(maps.back())) {
+        for (auto& a : agents) {
+          a->onRiskMap(*field);
+        }
+      } else if (badRiskMaps++ % 100 == 0) {
+        spdlog::warn("robot agent {}: RiskMap ignored ({} so far): {}", id, badRiskMaps,
+                     field.error().message);
+      }
+    }
+    // Agents step in parallel (each touches only its own state and const shared maps); outputs
+    // are written afterwards in robot order, so the DDS traffic of a lockstep run does not depend
+    // on thread timing.
+    pool.forEach(agents.size(), [&](std::size_t i) { outs[i] = agents[i]->step(now, dt); });
+    for (std::size_t i = 0; i < agents.size(); ++i) {
+      auto& a = agents[i];
+      auto& out = outs[i];
       out.command.seq = static_cast<std::uint32_t>(steps);
       commands.write(out.command);
       states.write(out.state);
@@ -158,10 +199,20 @@ int main(int argc, char** argv) {
   std::string clock = "wall";
   std::string id = "agents";
   std::string level = "info";
-  std::string localPlanner = "follow";
-  app.add_option(
-      "--local-planner", localPlanner,
-      "follow (path follower + stop rule) or a libs/avoidance planner: dwa, vo, potential_field, ...");
+  Options opt;
+  bool noRisk = false;
+  app.add_option("--local-planner", opt.localPlanner,
+                 "dwa (default, with the risk map's term) or follow (path follower + stop rule) or another "
+                 "libs/avoidance planner: vo, potential_field, ...");
+  app.add_option("--threads", opt.threads, "worker threads stepping the agents (0: hardware concurrency)")
+      ->check(CLI::Range(0u, 256u));
+  app.add_option("--sensor-timeout", opt.sensorTimeoutS,
+                 "s without a SensorFrame (agent clock) before a robot stops and reports RM_FAULT")
+      ->check(CLI::Range(0.05, 60.0));
+  app.add_option("--risk-weight", opt.riskWeightGlobal,
+                 "global planner: cell cost = length x (1 + w p); paths stay within (1 + w) x the shortest")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_flag("--no-risk", noRisk, "ignore RiskMap (planners without the risk term)");
   app.add_option("--scenario", scenario, "scenario JSON (map, robots, landmarks)")->required();
   app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
@@ -171,15 +222,17 @@ int main(int argc, char** argv) {
   try {
     logging::setup("robot_agent", level);
     const auto scn = sim::loadScenario(scenario);
-    std::vector<std::string> only;
     std::stringstream ss(robots);
     for (std::string r; std::getline(ss, r, ',');) {
       if (!r.empty()) {
-        only.push_back(r);
+        opt.only.push_back(r);
       }
     }
+    opt.lockstep = clock == "lockstep";
+    opt.id = id;
+    opt.useRisk = !noRisk;
     service::installStopHandlers();
-    return run(scn, only, clock == "lockstep", id, localPlanner);
+    return run(scn, opt);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;
