@@ -39,7 +39,7 @@ struct Options {
   std::vector<std::string> only;
   bool lockstep = false;
   std::string id = "agents";
-  std::string localPlanner = "dwa";
+  std::string localPlanner = "follow";
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
   double riskWeightGlobal = 1.0;
@@ -160,6 +160,10 @@ int run(const sim::Scenario& scn, const Options& opt) {
   };
 
   auto wallNext = std::chrono::steady_clock::now();
+  // Wall mode: the achieved control rate against the configured one, logged every 10 s.
+  auto rateSince = wallNext;
+  std::uint64_t rateCycles = 0;
+  std::uint64_t overruns = 0;
   while (!service::stopRequested()) {
     if (lockstep) {
       if (!haveClock && std::chrono::steady_clock::now() - lastRegister > 100ms) {
@@ -176,7 +180,19 @@ int run(const sim::Scenario& scn, const Options& opt) {
       }
     } else {
       std::this_thread::sleep_until(wallNext);
-      wallNext += std::chrono::milliseconds(static_cast<int>(dt * 1000));
+      const auto period = std::chrono::microseconds(static_cast<std::int64_t>(dt * 1e6));
+      wallNext += period;
+      if (const auto t = std::chrono::steady_clock::now(); t > wallNext) {
+        ++overruns;  // a cycle took longer than the period: do not burst to catch up
+        wallNext = t;
+      }
+      if (++rateCycles; std::chrono::steady_clock::now() - rateSince >= 10s) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - rateSince).count();
+        spdlog::info("robot agent {}: {:.2f} cycles/s (configured {:.1f} Hz), {} overruns so far", id,
+                     static_cast<double>(rateCycles) / s, 1.0 / dt, overruns);
+        rateSince = std::chrono::steady_clock::now();
+        rateCycles = 0;
+      }
       for (const auto& c : clockIn.take()) {
         simNow = c.sim_time_ns;
       }
@@ -202,8 +218,8 @@ int main(int argc, char** argv) {
   Options opt;
   bool noRisk = false;
   app.add_option("--local-planner", opt.localPlanner,
-                 "dwa (default, with the risk map's term) or follow (path follower + stop rule) or another "
-                 "libs/avoidance planner: vo, potential_field, ...");
+                 "follow (default: path follower + stop rule) or a libs/avoidance planner behind the safety "
+                 "layer: dwa (uses the risk map's term), vo, potential_field, ...");
   app.add_option("--threads", opt.threads, "worker threads stepping the agents (0: hardware concurrency)")
       ->check(CLI::Range(0u, 256u));
   app.add_option("--sensor-timeout", opt.sensorTimeoutS,
