@@ -122,6 +122,7 @@ void BM_AgentCycle(benchmark::State& state, const std::string& scenario, const s
   frame.compass_valid = true;
   frame.battery = 0.9f;
   int done = 0;
+  int failed = 0;
   for (auto _ : state) {
     for (std::size_t i = 0; i < f.agents.size(); ++i) {
       const auto& c = f.last[i];
@@ -145,6 +146,9 @@ void BM_AgentCycle(benchmark::State& state, const std::string& scenario, const s
       if (outs[i].status && outs[i].status->state == msg::TaskState::Done) {
         ++done;
       }
+      if (outs[i].status && outs[i].status->state == msg::TaskState::Failed) {
+        ++failed;
+      }
       if (!f.agents[i]->busy()) {
         f.agents[i]->onAssignment(f.order(i));
       }
@@ -161,6 +165,7 @@ void BM_AgentCycle(benchmark::State& state, const std::string& scenario, const s
   // Cycles per second the pool could sustain at the p99 cycle (the service runs at 1/dt = 10 Hz).
   state.counters["rate_at_p99_hz"] = 1.0 / std::max(1e-9, percentile(cycles, 0.99));
   state.counters["tasks_done"] = done;
+  state.counters["tasks_failed"] = failed;
 }
 
 }  // namespace
