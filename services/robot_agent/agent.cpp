@@ -6,6 +6,7 @@
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/planning/astar.hpp"
+#include "risk_astar.hpp"
 
 #include <stdexcept>
 
@@ -88,6 +89,9 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
   view.limits = p_.limits;
   view.dt = 0.1;
   view.goal_tolerance = 0.15;
+  if (risk_) {
+    view.risk = [r = risk_](Vec2 q) { return r->at(q); };
+  }
   const auto cmd = planner_->plan(view);
   reached = cmd.status == avoidance::PlanStatus::kGoalReached || distance(pose, goals_[goal_].pose) < 0.15;
   blocked = cmd.status == avoidance::PlanStatus::kBlocked ||
@@ -115,6 +119,7 @@ void Agent::onFrame(const msg::SensorFrame& f) {
   }
   frame_ = f;
   haveFrame_ = true;
+  frameSinceStep_ = true;
 }
 
 void Agent::onOtherRobot(const msg::RobotState& s) {
@@ -172,7 +177,14 @@ msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
   planning::AStarPlanner plainAstar;
-  planning::LanePlanner lanePlanner(p_.lanes);
+  // Lanes and risk together: the risk map's probability scales each cell's cost as in risk_astar.
+  planning::CellCostFactor riskFactor;
+  if (risk_) {
+    riskFactor = [r = risk_, w = p_.riskWeightGlobal, gr = grid_](planning::Cell c) {
+      return 1.0 + w * r->at(gr->cellCenter(c));
+    };
+  }
+  planning::LanePlanner lanePlanner(p_.lanes, riskFactor);
   planning::GlobalPlanner& astar = p_.lanes ? static_cast<planning::GlobalPlanner&>(lanePlanner)
                                             : static_cast<planning::GlobalPlanner&>(plainAstar);
   Expected<planning::Path> path = unexpected("no_path", "not planned");
@@ -194,6 +206,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     if (!path) {
       return;  // no way around: keep the current path and wait
     }
+  } else if (risk_ && !p_.lanes) {
+    RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
+    path = riskAware.plan(*grid_, ekf_.pose(), g.pose);
   } else {
     path = astar.plan(*grid_, ekf_.pose(), g.pose);
   }
@@ -361,7 +376,54 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   }
 }
 
+bool Agent::sensorStreamLost(std::int64_t nowNs) {
+  if (frameSinceStep_ || lastFrameNs_ < 0) {
+    // The first step starts the count: a robot that never gets a frame is reported too.
+    lastFrameNs_ = nowNs;
+  }
+  const bool fresh = frameSinceStep_;
+  frameSinceStep_ = false;
+  const bool lost = !fresh && nsToSec(nowNs - lastFrameNs_) > p_.sensorTimeoutS;
+  if (lost == sensorLost_) {
+    return lost;
+  }
+  sensorLost_ = lost;
+  std::string reason;
+  if (lost) {
+    lostSinceNs_ = nowNs;
+    reason = "sensor stream lost: no SensorFrame for " + std::to_string(nsToSec(nowNs - lastFrameNs_)) + " s";
+  } else {
+    // The outage is not time spent blocked or without progress.
+    const std::int64_t outage = nowNs - lostSinceNs_;
+    if (blockedSinceNs_ >= 0) {
+      blockedSinceNs_ += outage;
+    }
+    lastProgressNs_ += outage;
+    if (planner_) {
+      planner_->reset();
+    }
+  }
+  if (!task_.empty()) {
+    const float progress =
+        goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
+    pendingStatus_ = msg::TaskStatus{p_.id, task_, revision_, reported_, progress, reason, nowNs};
+  }
+  return lost;
+}
+
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
+  if (!sensorStreamLost(nowNs)) {
+    return drive(nowNs, dt);
+  }
+  // Blind: hold still and say why; the task is kept and resumes when frames come back.
+  AgentOutput out;
+  v_ = 0.0;
+  w_ = 0.0;
+  report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
+  return out;
+}
+
+AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   AgentOutput out;
   double v = 0.0;
   double w = 0.0;
@@ -444,7 +506,12 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   }
   v_ = v;
   w_ = w;
+  (void)dt;
+  report(out, nowNs, v, w, mode);
+  return out;
+}
 
+void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
   const Pose2 pose = ekf_.pose();
   out.command = {p_.id, v, w, nowNs, 0};
   out.state.robot_id = p_.id;
@@ -478,10 +545,8 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     q = {q.x + v * std::cos(q.theta) * p_.predictionDt, q.y + v * std::sin(q.theta) * p_.predictionDt,
          wrapAngle(q.theta + w * p_.predictionDt)};
   }
-  (void)dt;
   out.status = std::move(pendingStatus_);
   pendingStatus_.reset();
-  return out;
 }
 
 }  // namespace fleet::agent

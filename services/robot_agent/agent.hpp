@@ -20,6 +20,7 @@
 #include "fleet/planning/lane_map.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "fleet/transport/messages.hpp"
+#include "risk_field.hpp"
 
 namespace fleet::agent {
 
@@ -34,6 +35,10 @@ struct AgentParams {
   double headway = 1.0;          // s: the stop distance grows with speed
   double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
   double blockedFailS = 60.0;    // a task that cannot progress this long fails
+  /// No SensorFrame for this long (of the agent's clock): stop, report RM_FAULT, resume on frames.
+  double sensorTimeoutS = 0.5;
+  /// A* cell cost = step length × (1 + riskWeightGlobal · p): paths at most (1 + w)× the shortest.
+  double riskWeightGlobal = 1.0;
   double predictionHorizonS = 3.0;
   double predictionDt = 0.5;
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
@@ -63,7 +68,12 @@ class Agent {
   void onOtherRobot(const msg::RobotState& s);
   /// A new revision replaces the current order (an empty task id cancels).
   void onAssignment(const msg::TaskAssignment& a);
+  /// The latest risk map (shared by every agent of the process): the local planner's risk term and
+  /// the global planner's cell cost. Null: no risk information.
+  void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
   AgentOutput step(std::int64_t nowNs, double dt);
+  /// True while the sensor stream is considered lost (as of the last step).
+  [[nodiscard]] bool sensorLost() const { return sensorLost_; }
 
   [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
@@ -72,6 +82,13 @@ class Agent {
 
  private:
   enum class Phase { Idle, Driving, Dwelling, BackingOff };
+  /// The task stack for one cycle (the body of step() while sensors are live).
+  AgentOutput drive(std::int64_t nowNs, double dt);
+  /// Tracks frame arrival against the step clock; on loss and on recovery queues a TaskStatus with
+  /// the reason and shifts the task's timers so the outage does not count as being blocked.
+  bool sensorStreamLost(std::int64_t nowNs);
+  /// Command, state and predicted discs for the chosen twist and mode.
+  void report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode);
   /// Plans to the current goal; with `avoid`, the cells around that point count as blocked (a
   /// detour around whatever stands in the way).
   void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
@@ -98,6 +115,11 @@ class Agent {
   control::Twist planLocal(bool& reached, bool& blocked);
   msg::SensorFrame frame_;
   bool haveFrame_ = false;
+  bool frameSinceStep_ = false;
+  std::int64_t lastFrameNs_ = -1;  // step time at which the latest frame was seen
+  bool sensorLost_ = false;
+  std::shared_ptr<const RiskField> risk_;
+  std::int64_t lostSinceNs_ = 0;
   std::uint64_t rejected_ = 0;
 
   std::string task_;

@@ -15,6 +15,8 @@
 #include "fleet/service/runtime.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "fleet/transport/dds.hpp"
+#include "risk_field.hpp"
+#include "worker_pool.hpp"
 
 using namespace fleet;
 using namespace std::chrono_literals;
@@ -33,12 +35,26 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
   return g;
 }
 
-int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool lockstep, const std::string& id,
-        const std::string& localPlanner, bool useLanes) {
+struct Options {
+  std::vector<std::string> only;
+  bool lockstep = false;
+  std::string id = "agents";
+  std::string localPlanner = "follow";
+  unsigned threads = 0;  // 0: hardware concurrency
+  double sensorTimeoutS = 0.5;
+  double riskWeightGlobal = 1.0;
+  bool useRisk = true;
+  bool useLanes = true;
+};
+
+int run(const sim::Scenario& scn, const Options& opt) {
+  const auto& only = opt.only;
+  const bool lockstep = opt.lockstep;
+  const std::string& id = opt.id;
   auto raw = gridOf(scn.map);
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::shared_ptr<const planning::LaneMap> lanes;
-  if (useLanes) {
+  if (opt.useLanes) {
     lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
     spdlog::info("robot agent: {} one-way aisle cells", lanes->oneWayCells());
   }
@@ -60,7 +76,9 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
     p.wheelBase = r.wheelBase;
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
-    p.localPlanner = localPlanner;
+    p.localPlanner = opt.localPlanner;
+    p.sensorTimeoutS = opt.sensorTimeoutS;
+    p.riskWeightGlobal = opt.riskWeightGlobal;
     p.lanes = lanes;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
@@ -79,6 +97,7 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
   transport::Reader<msg::TaskAssignment> assignments(part);
   transport::Reader<msg::Clock> clockIn(part);
   transport::Reader<msg::RobotState> others(part);
+  transport::Reader<msg::RiskMap> riskMaps(part);
   transport::Writer<msg::VelocityCommand> commands(part, transport::qos::command(lockstep));
   transport::Writer<msg::RobotState> states(part);
   transport::Writer<msg::PredictedDiscs> discs(part);
@@ -87,7 +106,14 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
-  spdlog::info("robot agent {}: {} robots, {} mode", id, agents.size(), lockstep ? "lockstep" : "wall");
+  const unsigned threads =
+      std::max(1u, std::min(opt.threads == 0 ? std::thread::hardware_concurrency() : opt.threads,
+                            static_cast<unsigned>(agents.size())));
+  agent::WorkerPool pool(threads);
+  std::vector<agent::AgentOutput> outs(agents.size());
+  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}", id, agents.size(),
+               lockstep ? "lockstep" : "wall", pool.threads(), opt.localPlanner, opt.useRisk ? "on" : "off");
+  std::uint64_t badRiskMaps = 0;
 
   bool haveClock = false;
   auto lastRegister = std::chrono::steady_clock::now() - 1s;
@@ -110,8 +136,24 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
         it->second->onAssignment(a);
       }
     }
-    for (auto& a : agents) {
-      auto out = a->step(now, dt);
+    if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
+      // Only the newest map matters; it is decoded once and shared read-only by every agent.
+      if (auto field = agent::RiskField::fromMessage(maps.back())) {
+        for (auto& a : agents) {
+          a->onRiskMap(*field);
+        }
+      } else if (badRiskMaps++ % 100 == 0) {
+        spdlog::warn("robot agent {}: RiskMap ignored ({} so far): {}", id, badRiskMaps,
+                     field.error().message);
+      }
+    }
+    // Agents step in parallel (each touches only its own state and const shared maps); outputs
+    // are written afterwards in robot order, so the DDS traffic of a lockstep run does not depend
+    // on thread timing.
+    pool.forEach(agents.size(), [&](std::size_t i) { outs[i] = agents[i]->step(now, dt); });
+    for (std::size_t i = 0; i < agents.size(); ++i) {
+      auto& a = agents[i];
+      auto& out = outs[i];
       out.command.seq = static_cast<std::uint32_t>(steps);
       commands.write(out.command);
       states.write(out.state);
@@ -125,6 +167,10 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
   };
 
   auto wallNext = std::chrono::steady_clock::now();
+  // Wall mode: the achieved control rate against the configured one, logged every 10 s.
+  auto rateSince = wallNext;
+  std::uint64_t rateCycles = 0;
+  std::uint64_t overruns = 0;
   while (!service::stopRequested()) {
     if (lockstep) {
       if (!haveClock && std::chrono::steady_clock::now() - lastRegister > 100ms) {
@@ -141,7 +187,19 @@ int run(const sim::Scenario& scn, const std::vector<std::string>& only, bool loc
       }
     } else {
       std::this_thread::sleep_until(wallNext);
-      wallNext += std::chrono::milliseconds(static_cast<int>(dt * 1000));
+      const auto period = std::chrono::microseconds(static_cast<std::int64_t>(dt * 1e6));
+      wallNext += period;
+      if (const auto t = std::chrono::steady_clock::now(); t > wallNext) {
+        ++overruns;  // a cycle took longer than the period: do not burst to catch up
+        wallNext = t;
+      }
+      if (++rateCycles; std::chrono::steady_clock::now() - rateSince >= 10s) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - rateSince).count();
+        spdlog::info("robot agent {}: {:.2f} cycles/s (configured {:.1f} Hz), {} overruns so far", id,
+                     static_cast<double>(rateCycles) / s, 1.0 / dt, overruns);
+        rateSince = std::chrono::steady_clock::now();
+        rateCycles = 0;
+      }
       for (const auto& c : clockIn.take()) {
         simNow = c.sim_time_ns;
       }
@@ -164,12 +222,23 @@ int main(int argc, char** argv) {
   std::string clock = "wall";
   std::string id = "agents";
   std::string level = "info";
-  std::string localPlanner = "follow";
+  Options opt;
+  bool noRisk = false;
+  app.add_option("--local-planner", opt.localPlanner,
+                 "follow (default: path follower + stop rule) or a libs/avoidance planner behind the safety "
+                 "layer: dwa (uses the risk map's term), vo, potential_field, ...");
+  app.add_option("--threads", opt.threads, "worker threads stepping the agents (0: hardware concurrency)")
+      ->check(CLI::Range(0u, 256u));
+  app.add_option("--sensor-timeout", opt.sensorTimeoutS,
+                 "s without a SensorFrame (agent clock) before a robot stops and reports RM_FAULT")
+      ->check(CLI::Range(0.05, 60.0));
+  app.add_option("--risk-weight", opt.riskWeightGlobal,
+                 "global planner: cell cost = length x (1 + w p); paths stay within (1 + w) x the shortest")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_flag("--no-risk", noRisk, "ignore RiskMap (planners without the risk term)");
   bool noLanes = false;
-  app.add_flag("--no-lanes", noLanes, "plan with plain A* instead of one-way narrow aisles");
-  app.add_option(
-      "--local-planner", localPlanner,
-      "follow (path follower + stop rule) or a libs/avoidance planner: dwa, vo, potential_field, ...");
+  app.add_flag("--no-lanes", noLanes,
+               "plan with plain A* instead of the lane map (one-way narrow aisles, keep-right bands)");
   app.add_option("--scenario", scenario, "scenario JSON (map, robots, landmarks)")->required();
   app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
@@ -179,15 +248,18 @@ int main(int argc, char** argv) {
   try {
     logging::setup("robot_agent", level);
     const auto scn = sim::loadScenario(scenario);
-    std::vector<std::string> only;
     std::stringstream ss(robots);
     for (std::string r; std::getline(ss, r, ',');) {
       if (!r.empty()) {
-        only.push_back(r);
+        opt.only.push_back(r);
       }
     }
+    opt.lockstep = clock == "lockstep";
+    opt.id = id;
+    opt.useRisk = !noRisk;
     service::installStopHandlers();
-    return run(scn, only, clock == "lockstep", id, localPlanner, !noLanes);
+    opt.useLanes = !noLanes;
+    return run(scn, opt);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

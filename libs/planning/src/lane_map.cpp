@@ -180,7 +180,8 @@ Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& 
         continue;  // no corner cutting
       }
       const double len = m < 4 ? 1.0 : std::numbers::sqrt2;
-      const double ng = g[idx] + len * (lanes.againstLane(c, n) ? lanes.wrongWayFactor() : 1.0);
+      const double extra = factor ? std::max(1.0, factor(n)) : 1.0;
+      const double ng = g[idx] + len * extra * (lanes.againstLane(c, n) ? lanes.wrongWayFactor() : 1.0);
       const std::size_t ni = grid.index(n);
       if (ng < g[ni]) {
         g[ni] = ng;
@@ -202,7 +203,7 @@ Expected<Path> LanePlanner::plan(const OccupancyGrid& grid, Pose2 from, Pose2 to
   if (!lanes_) {
     return unexpected("no_lanes", "lane planner has no lane map");
   }
-  const auto cells = laneAstar(grid, *lanes_, q->start, q->goal);
+  const auto cells = laneAstar(grid, *lanes_, q->start, q->goal, factor_);
   if (!cells) {
     return unexpected(cells.error());
   }

@@ -140,3 +140,79 @@ TEST(Agent, CancelStopsAndIgnoresRepeatedOrders) {
   a.onAssignment(other);
   EXPECT_FALSE(a.busy()) << "another robot's order is not ours";
 }
+
+// A robot whose SensorFrame stream stops holds still, reports RM_FAULT and a TaskStatus naming the
+// reason, keeps its task, and drives on to finish it when frames come back.
+TEST(Agent, SensorStreamLossStopsReportsAndResumes) {
+  auto grid = emptyGrid();
+  auto p = params();
+  p.sensorTimeoutS = 0.5;
+  agent::Agent a(p, grid, grid);
+  World world;
+  a.onAssignment(transport());
+  double v = 0;
+  double w = 0;
+  std::int64_t now = 0;
+  const std::int64_t tick = 100'000'000;
+  for (int k = 0; k < 20; ++k, now += tick) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(now, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+  }
+  ASSERT_GT(v, 0.1) << "moving before the loss";
+  // Frames stop: within the timeout the robot goes on; past it, zero command and a fault.
+  std::vector<agent::AgentOutput> blind;
+  for (int k = 0; k < 30; ++k, now += tick) {
+    blind.push_back(a.step(now, 0.1));
+  }
+  EXPECT_NE(blind[3].state.mode, msg::RobotMode::Fault) << "0.4 s without frames is within 0.5 s";
+  int faultAt = -1;
+  int statuses = 0;
+  for (int k = 0; k < static_cast<int>(blind.size()); ++k) {
+    if (blind[static_cast<std::size_t>(k)].state.mode == msg::RobotMode::Fault && faultAt < 0) {
+      faultAt = k;
+    }
+    if (const auto& s = blind[static_cast<std::size_t>(k)].status) {
+      ++statuses;
+      EXPECT_EQ(s->task_id, "t1");
+      EXPECT_NE(s->error.find("sensor stream lost"), std::string::npos) << s->error;
+      EXPECT_EQ(s->state, msg::TaskState::EnRoute) << "the task is kept, not failed";
+    }
+  }
+  EXPECT_EQ(faultAt, 5) << "the first step more than 0.5 s after the last frame";
+  EXPECT_EQ(statuses, 1) << "one report when the stream is lost";
+  for (std::size_t k = static_cast<std::size_t>(faultAt); k < blind.size(); ++k) {
+    EXPECT_EQ(blind[k].command.v, 0.0);
+    EXPECT_EQ(blind[k].command.w, 0.0);
+    EXPECT_EQ(blind[k].state.mode, msg::RobotMode::Fault);
+    EXPECT_EQ(blind[k].state.v, 0.0);
+  }
+  EXPECT_TRUE(a.sensorLost());
+  EXPECT_TRUE(a.busy());
+  // The robot really stood still from the fault on (the world executes the last command once).
+  v = 0;
+  w = 0;
+  // Frames come back: the fault clears at once, a status without error says so, and the task ends.
+  std::vector<msg::TaskState> after;
+  bool clearedReported = false;
+  for (int k = 0; k < 1500 && (after.empty() || after.back() != msg::TaskState::Done); ++k, now += tick) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(now, 0.1);
+    if (k == 0) {
+      EXPECT_NE(out.state.mode, msg::RobotMode::Fault);
+      ASSERT_TRUE(out.status.has_value());
+      EXPECT_TRUE(out.status->error.empty());
+      clearedReported = true;
+    }
+    v = out.command.v;
+    w = out.command.w;
+    if (out.status && k > 0) {
+      after.push_back(out.status->state);
+    }
+  }
+  EXPECT_TRUE(clearedReported);
+  ASSERT_FALSE(after.empty());
+  EXPECT_EQ(after.back(), msg::TaskState::Done);
+  EXPECT_FALSE(a.sensorLost());
+}

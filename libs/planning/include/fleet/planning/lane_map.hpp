@@ -6,6 +6,7 @@
 // intersections and open areas stay free in every direction.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -61,19 +62,26 @@ class LaneMap {
   std::vector<LaneDir> dir_;
 };
 
+/// Extra cost factor for entering a cell (e.g. 1 + w * collision probability); values below 1 count
+/// as 1 so the heuristic stays admissible.
+using CellCostFactor = std::function<double(Cell)>;
+
 /// A* over the 8-connected grid (no corner cutting) where a move against a lane costs
-/// `wrongWayFactor` times its length. The octile heuristic stays admissible (costs only grow).
-/// Errors: those of resolveQuery, "unreachable".
-Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& lanes, Cell start, Cell goal);
+/// `wrongWayFactor` times its length, times `factor` of the entered cell if given. The octile
+/// heuristic stays admissible (costs only grow). Errors: those of resolveQuery, "unreachable".
+Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& lanes, Cell start, Cell goal,
+                                      const CellCostFactor& factor = {});
 
 class LanePlanner final : public GlobalPlanner {
  public:
-  explicit LanePlanner(std::shared_ptr<const LaneMap> lanes) : lanes_(std::move(lanes)) {}
+  explicit LanePlanner(std::shared_ptr<const LaneMap> lanes, CellCostFactor factor = {})
+      : lanes_(std::move(lanes)), factor_(std::move(factor)) {}
   [[nodiscard]] Expected<Path> plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) override;
   [[nodiscard]] const char* name() const override { return "lanes"; }
 
  private:
   std::shared_ptr<const LaneMap> lanes_;
+  CellCostFactor factor_;
 };
 
 }  // namespace fleet::planning

@@ -1,0 +1,107 @@
+// End to end in the simulator on the wall clock (no lockstep: the simulator, the fleet manager and the
+// robot agent each run in real time on their own timers): the manager assigns a transport task, the
+// agent drives the simulated robot to the pickup and the drop-off, and the task is done with no
+// contact. The lockstep counterpart is tests/scenario/fleet/fleet_scenario_test.cpp.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "fleet/transport/dds.hpp"
+#include "test_process.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+using nlohmann::json;
+
+TEST(WallClockScenario, OneRobotDeliversATransportTaskInRealTime) {
+  const std::string domain = std::to_string(test::uniqueDomain());
+  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
+  const auto dir = std::filesystem::temp_directory_path() / ("agent_wall_scn_" + domain);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
+  std::ofstream(dir / "manager.json") << json{
+      {"db", (dir / "fleet.db").string()},
+      {"stations", scenario},
+      {"clock", "wall"},
+      {"lease_s", 3.0},
+      {"sync", "normal"}}.dump();
+  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain}};
+  test::ChildProcess manager(FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
+                             {"--config", (dir / "manager.json").string(), "--log-level", "warn"}, env);
+  test::ChildProcess agent(
+      FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
+      {"--scenario", scenario, "--clock", "wall", "--threads", "2", "--log-level", "warn"}, env);
+
+  // Submit the task over DDS, as the WMS adapter does, and wait for the durable acknowledgement.
+  transport::Participant p;
+  transport::Writer<msg::Task> tasks(p);
+  transport::Reader<msg::TaskAck> acks(p);
+  transport::Reader<msg::TaskEvent> events(p);
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (tasks.matchedReaders() == 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  msg::Task t;
+  t.task_id = "job-1";
+  t.request_id = "req-1";
+  t.body = R"({"id": "job-1", "kind": "transport", "pickup": "P-2", "dropoff": "D-1",
+               "load_duration_ns": 2000000000, "unload_duration_ns": 2000000000})";
+  tasks.write(t);
+  std::optional<msg::TaskAck> ack;
+  while (!ack && std::chrono::steady_clock::now() < deadline) {
+    acks.waitForData(100ms);
+    for (const auto& a : acks.take()) {
+      ack = a;
+    }
+  }
+  ASSERT_TRUE(ack);
+  ASSERT_EQ(ack->result, msg::AckResult::Stored) << ack->detail;
+
+  test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
+                         {"--scenario", scenario, "--clock", "wall", "--duration", "280", "--summary",
+                          (dir / "summary.json").string(), "--log-level", "warn"},
+                         env);
+  const auto simStart = std::chrono::steady_clock::now();
+  std::vector<msg::TaskState> seen;
+  while (std::chrono::steady_clock::now() < deadline + 330s &&
+         (seen.empty() || seen.back() != msg::TaskState::Done)) {
+    events.waitForData(100ms);
+    for (const auto& e : events.take()) {
+      if (e.task_id == "job-1" && (seen.empty() || seen.back() != e.state)) {
+        seen.push_back(e.state);
+      }
+    }
+    if (sim.wait(1ms) >= 0) {
+      for (const auto& e : events.take()) {
+        if (e.task_id == "job-1" && (seen.empty() || seen.back() != e.state)) {
+          seen.push_back(e.state);
+        }
+      }
+      break;
+    }
+  }
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back(), msg::TaskState::Done);
+  const std::vector<msg::TaskState> happy = {
+      msg::TaskState::Queued,     msg::TaskState::Assigned,  msg::TaskState::EnRoute, msg::TaskState::Loading,
+      msg::TaskState::Delivering, msg::TaskState::Unloading, msg::TaskState::Done};
+  EXPECT_EQ(seen, happy);
+  std::cout << "task done after "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - simStart).count()
+            << " s of wall time\n";
+  sim.kill(SIGINT);  // the simulator stops at once and still writes its summary
+  ASSERT_EQ(sim.wait(60s), 0) << "the simulator did not finish";
+  const json summary = json::parse(std::ifstream(dir / "summary.json"));
+  EXPECT_EQ(summary["contacts"]["robot_shelf"], 0);
+  EXPECT_EQ(summary["contacts"]["robot_robot"], 0);
+  EXPECT_GT(summary["per_robot"]["r1"]["distance_m"].get<double>(), 10.0);
+  std::filesystem::remove_all(dir);
+}
