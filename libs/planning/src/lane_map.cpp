@@ -130,8 +130,8 @@ std::size_t LaneMap::oneWayCells() const {
       std::count_if(dir_.begin(), dir_.end(), [](LaneDir d) { return d.dx != 0 || d.dy != 0; }));
 }
 
-Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& lanes, Cell start,
-                                      Cell goal) {
+Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& lanes, Cell start, Cell goal,
+                                      const CellCostFactor& factor) {
   if (!lanes.matches(grid)) {
     return unexpected("lane_map_mismatch", "lane map was derived from a map of another size");
   }
