@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <numbers>
 #include <random>
 
@@ -195,4 +196,28 @@ TEST(LaneAstar, MismatchedMapIsAnError) {
   const auto r = laneAstar(other, lanes, {1, 1}, {5, 5});
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, "lane_map_mismatch");
+}
+
+TEST(LaneAstar, CellCostFactorSteersAroundCostlyCells) {
+  // A costly band across the direct route between the left and right bands: with the factor the
+  // route goes through another aisle, without it straight through; factors below 1 change nothing.
+  const auto raw = smallWarehouse();
+  const auto grid = raw.inflated(0.5);
+  const auto lanes = LaneMap::derive(raw);
+  const Cell from{3, 18};
+  const Cell to{50, 18};
+  const auto plain = laneAstar(grid, lanes, from, to);
+  ASSERT_TRUE(plain);
+  auto crosses = [](const std::vector<Cell>& cells, int y0, int y1) {
+    return std::any_of(cells.begin(), cells.end(),
+                       [&](Cell c) { return c.x == 30 && c.y >= y0 && c.y <= y1; });
+  };
+  ASSERT_TRUE(crosses(*plain, 15, 21));
+  const auto costly = laneAstar(grid, lanes, from, to,
+                                [](Cell c) { return c.x == 30 && c.y >= 15 && c.y <= 21 ? 50.0 : 1.0; });
+  ASSERT_TRUE(costly);
+  EXPECT_FALSE(crosses(*costly, 15, 21));
+  const auto cheap = laneAstar(grid, lanes, from, to, [](Cell) { return 0.1; });
+  ASSERT_TRUE(cheap);
+  EXPECT_EQ(cheap->size(), plain->size());
 }
