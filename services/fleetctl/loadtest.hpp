@@ -27,7 +27,7 @@ struct LoadtestOptions {
   int port = 0;              // 0: a free port
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
-  std::string localPlanner = "dwa";
+  std::string localPlanner = "follow";
   int stepTimeoutMs = 300;
   double progressEveryS = 2.0;
 };
