@@ -258,7 +258,7 @@ double gaussianCollisionProbabilityPolar(Vec2 mean, const Cov2& cov, double R, i
   return std::clamp(p, 0.0, 1.0);
 }
 
-double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R) {
+double gaussianCollisionProbabilityWhitened(Vec2 mean, const Cov2& cov, double R) {
   if (!(R > 0.0)) {
     return 0.0;
   }

@@ -62,22 +62,37 @@ void BM_PairGaussianIsotropic(benchmark::State& state) {
 }
 BENCHMARK(BM_PairGaussianIsotropic);
 
-void BM_PairGaussianAnisotropic(benchmark::State& state) {
+// Relative positions and covariances for the anisotropic model: the isotropic pair set with the summed
+// variance as the major eigenvalue, the minor one `minRatio`…1 times that (log-uniform below 0.2,
+// uniform 0.2–1 as in the recorded figures), random orientation.
+struct AnisoSet {
+  std::vector<fleet::Vec2> mean;
+  std::vector<Cov2> cov;
+  std::vector<double> R;
+};
+
+AnisoSet anisotropicPairs(double minRatio) {
   const auto s = makePairs(0.3);
   std::mt19937_64 rng(2);
-  std::uniform_real_distribution<double> ue(0.2, 1.0), ua(0.0, 3.1416);
-  std::vector<Cov2> covs;
-  for (int i = 0; i < 1024; ++i) {
-    const double s2 = s.a[static_cast<std::size_t>(i)].sigma * s.a[static_cast<std::size_t>(i)].sigma +
-                      s.b[static_cast<std::size_t>(i)].sigma * s.b[static_cast<std::size_t>(i)].sigma;
-    const double l1 = s2, l2 = s2 * ue(rng), th = ua(rng), c = std::cos(th), sn = std::sin(th);
-    covs.push_back({c * c * l1 + sn * sn * l2, c * sn * (l1 - l2), sn * sn * l1 + c * c * l2});
+  std::uniform_real_distribution<double> ue(0.2, 1.0), ua(0.0, 3.1416), ul(std::log(minRatio), 0.0);
+  AnisoSet out;
+  for (std::size_t i = 0; i < 1024; ++i) {
+    const double s2 = s.a[i].sigma * s.a[i].sigma + s.b[i].sigma * s.b[i].sigma;
+    const double ratio = minRatio >= 0.2 ? ue(rng) : std::exp(ul(rng));
+    const double l1 = s2, l2 = s2 * ratio, th = ua(rng), c = std::cos(th), sn = std::sin(th);
+    out.cov.push_back({c * c * l1 + sn * sn * l2, c * sn * (l1 - l2), sn * sn * l1 + c * c * l2});
+    out.mean.push_back({s.b[i].x - s.a[i].x, s.b[i].y - s.a[i].y});
+    out.R.push_back(s.a[i].r + s.b[i].r);
   }
+  return out;
+}
+
+void BM_PairGaussianAnisotropic(benchmark::State& state) {
+  const auto p = anisotropicPairs(0.2);
   std::size_t i = 0;
   for (auto _ : state) {
     const std::size_t k = i & 1023;
-    const fleet::Vec2 mean{s.b[k].x - s.a[k].x, s.b[k].y - s.a[k].y};
-    benchmark::DoNotOptimize(gaussianCollisionProbability(mean, covs[k], s.a[k].r + s.b[k].r));
+    benchmark::DoNotOptimize(gaussianCollisionProbability(p.mean[k], p.cov[k], p.R[k]));
     ++i;
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
@@ -227,6 +242,48 @@ double threadCpuMs() {
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
+
+// The anisotropic model (eigen-axis trapezoid) against the previous implementation (whitened rays,
+// kept as the reference) on the same 1024 pairs in the same run. Arg: 1/minimum eigenvalue ratio
+// (5: ratios 0.2–1 as above; 10000: 1e-4–1). Counters: ns per pair (medians of thread CPU time over
+// the iterations, each a pass over all pairs), the ratio, and the largest |difference|.
+void BM_PairAnisotropicVsReference(benchmark::State& state) {
+  const auto p = anisotropicPairs(1.0 / static_cast<double>(state.range(0)));
+  std::vector<double> tf, tr;
+  double maxDiff = 0.0;
+  std::vector<double> fast(1024), ref(1024);
+  for (auto _ : state) {
+    const double t0 = threadCpuMs();
+    for (std::size_t k = 0; k < 1024; ++k) {
+      fast[k] = gaussianCollisionProbability(p.mean[k], p.cov[k], p.R[k]);
+    }
+    benchmark::DoNotOptimize(fast.data());
+    const double t1 = threadCpuMs();
+    for (std::size_t k = 0; k < 1024; ++k) {
+      ref[k] = gaussianCollisionProbabilityWhitened(p.mean[k], p.cov[k], p.R[k]);
+    }
+    benchmark::DoNotOptimize(ref.data());
+    const double t2 = threadCpuMs();
+    tf.push_back(t1 - t0);
+    tr.push_back(t2 - t1);
+    for (std::size_t k = 0; k < 1024; ++k) {
+      maxDiff = std::max(maxDiff, std::abs(fast[k] - ref[k]));
+    }
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  state.counters["fast_ns"] = median(tf) * 1e6 / 1024.0;
+  state.counters["reference_ns"] = median(tr) * 1e6 / 1024.0;
+  state.counters["ratio"] = median(tr) / median(tf);
+  state.counters["max_abs_diff"] = maxDiff;
+}
+BENCHMARK(BM_PairAnisotropicVsReference)
+    ->ArgNames({"inv_ratio"})
+    ->Arg(5)
+    ->Arg(10000)
+    ->Unit(benchmark::kMillisecond);
 
 // Engine vs the thesis grid loop on 50 sources × 30 steps, 20 m × 20 m at 0.1 m, timed in the same
 // run; counters: engine_ms, reference_ms (medians of thread CPU time over the iterations), the ratio.

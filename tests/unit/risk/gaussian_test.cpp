@@ -144,6 +144,7 @@ TEST(GaussianAnisotropic, MonteCarloMillionSamples) {
   }
 }
 
+// The previous production path (whitened rays) against the Foster-style polar quadrature.
 TEST(GaussianAnisotropic, WhitenedAndPolarQuadratureAgreeOnRandomCases) {
   std::mt19937_64 rng(77);
   std::uniform_real_distribution<double> ud(0.0, 2.5), ua(0.0, 6.283185307179586), us(0.02, 0.6),
@@ -154,9 +155,127 @@ TEST(GaussianAnisotropic, WhitenedAndPolarQuadratureAgreeOnRandomCases) {
     const double c = std::cos(rot), s = std::sin(rot);
     const Cov2 cov{c * c * l1 + s * s * l2, c * s * (l1 - l2), s * s * l1 + c * c * l2};
     const Vec2 mean{d * std::cos(th), d * std::sin(th)};
-    const double fast = gaussianCollisionProbability(mean, cov, R);
+    const double whitened = gaussianCollisionProbabilityWhitened(mean, cov, R);
     const double polar = gaussianCollisionProbabilityPolar(mean, cov, R, 16384);
-    ASSERT_NEAR(fast, polar, 1e-9) << "d=" << d << " R=" << R << " l1=" << l1 << " l2=" << l2;
+    ASSERT_NEAR(whitened, polar, 1e-9) << "d=" << d << " R=" << R << " l1=" << l1 << " l2=" << l2;
+  }
+}
+
+// A random covariance with eigenvalues l1 >= l2 = l1·ratio at a random orientation.
+Cov2 rotatedCov(double l1, double l2, double rot) {
+  const double c = std::cos(rot), s = std::sin(rot);
+  return {c * c * l1 + s * s * l2, c * s * (l1 - l2), s * s * l1 + c * c * l2};
+}
+
+// Polar quadrature with enough angle steps for the narrowest Gaussian seen from the disc centre.
+double finePolar(Vec2 mean, const Cov2& cov, double R, double smin) {
+  int steps = 16384;
+  while (steps < 16.0 * 3.15 * (mean.norm() + R) / smin && steps < (1 << 21)) {
+    steps *= 2;
+  }
+  return gaussianCollisionProbabilityPolar(mean, cov, R, steps);
+}
+
+// The production path (eigen-axis trapezoid) against both earlier methods on the same random cases.
+TEST(GaussianAnisotropic, TrapezoidMatchesPolarAndWhitenedOnRandomCases) {
+  std::mt19937_64 rng(77);
+  std::uniform_real_distribution<double> ud(0.0, 2.5), ua(0.0, 6.283185307179586), us(0.02, 0.6),
+      ue(0.05, 1.0), ur(0.3, 1.5);
+  for (int t = 0; t < 400; ++t) {
+    const double d = ud(rng), th = ua(rng), R = ur(rng);
+    const double l1 = us(rng) * us(rng) + 1e-4, l2 = l1 * ue(rng);
+    const Cov2 cov = rotatedCov(l1, l2, ua(rng));
+    const Vec2 mean{d * std::cos(th), d * std::sin(th)};
+    const double fast = gaussianCollisionProbability(mean, cov, R);
+    ASSERT_NEAR(fast, gaussianCollisionProbabilityPolar(mean, cov, R, 16384), 1e-10)
+        << "d=" << d << " R=" << R << " l1=" << l1 << " l2=" << l2;
+    ASSERT_NEAR(fast, gaussianCollisionProbabilityWhitened(mean, cov, R), 1e-9);
+  }
+}
+
+// Sigma ratios 1e-1 … 1e-3 and sigmas from 0.01 R to 2 R, against the polar quadrature with enough
+// angle steps for the narrow axis. (At these ratios the polar quadrature itself carries ~1e-10 near
+// P = 1, and the whitened reference up to ~1e-6 with the mean near the rim: see algorithms.md.)
+TEST(GaussianAnisotropic, ExtremeAnisotropyMatchesFinePolar) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> ud(0.0, 2.5), ua(0.0, 6.283185307179586), us(0.01, 1.2),
+      ul(std::log(1e-6), std::log(1e-2)), ur(0.3, 1.5);
+  int nonTrivial = 0;
+  for (int t = 0; t < 40; ++t) {
+    const double d = ud(rng), th = ua(rng), R = ur(rng);
+    const double l1 = us(rng) * us(rng) * R * R, l2 = l1 * std::exp(ul(rng));
+    const Cov2 cov = rotatedCov(l1, l2, ua(rng));
+    const Vec2 mean{d * std::cos(th), d * std::sin(th)};
+    const double fast = gaussianCollisionProbability(mean, cov, R);
+    ASSERT_NEAR(fast, finePolar(mean, cov, R, std::sqrt(l2)), 3e-10)
+        << "d=" << d << " R=" << R << " l1=" << l1 << " l2=" << l2;
+    nonTrivial += (fast > 1e-6 && fast < 1.0 - 1e-6) ? 1 : 0;
+  }
+  EXPECT_GT(nonTrivial, 15);
+}
+
+// As the minor variance goes to 0 the probability tends to the singular covariance's closed form
+// P(|m2 + s2 z| ≤ √(R² − m1²)) (mass on the line x1 = m1), linearly in λmin away from the rim and like
+// √s1 where the line is tangent to the circle.
+TEST(GaussianAnisotropic, NearDegenerateCovarianceTendsToTheLineLimit) {
+  const double R = 1.0, s2 = 0.4, rot = 0.3;
+  for (const double m1 : {0.0, 0.5, 0.9, -0.97}) {
+    for (const double m2 : {0.0, 0.3, 1.1}) {
+      const Vec2 mean{std::cos(rot) * m2 - std::sin(rot) * m1, std::sin(rot) * m2 + std::cos(rot) * m1};
+      const double w = std::sqrt(R * R - m1 * m1);
+      const double line =
+          0.5 * (std::erf((w - m2) / (s2 * std::sqrt(2.0))) + std::erf((w + m2) / (s2 * std::sqrt(2.0))));
+      // (The rotated covariance's determinant rounds to ±1e-18, not 0: then the trapezoid runs, whose
+      // aliasing error at the chosen step is ~2e-12 relative.)
+      EXPECT_NEAR(gaussianCollisionProbability(mean, rotatedCov(s2 * s2, 0.0, rot), R), line, 5e-12);
+      EXPECT_NEAR(gaussianCollisionProbability(Vec2{m1, m2}, Cov2{0.0, 0.0, s2 * s2}, R), line, 1e-15);
+      double prevErr = 1.0;
+      for (const double s1 : {1e-2, 1e-4, 1e-6, 1e-9}) {
+        const double p = gaussianCollisionProbability(mean, rotatedCov(s2 * s2, s1 * s1, rot), R);
+        const double err = std::abs(p - line);
+        EXPECT_LE(err, 1.0 * s1 * s1 / ((1.0 - std::abs(m1)) * (1.0 - std::abs(m1))) + 5e-12)
+            << m1 << " " << m2 << " " << s1;
+        EXPECT_LE(err, prevErr + 5e-12);
+        prevErr = err;
+      }
+    }
+  }
+  // Line tangent to the circle (m1 = R): the singular limit is 0, approached like √(s1 R).
+  const double pTangentCoarse = gaussianCollisionProbability(Vec2{0.0, 1.0}, Cov2{s2 * s2, 0.0, 1e-8}, R);
+  const double pTangentFine = gaussianCollisionProbability(Vec2{0.0, 1.0}, Cov2{s2 * s2, 0.0, 1e-16}, R);
+  EXPECT_GT(pTangentCoarse, 0.0);
+  EXPECT_NEAR(pTangentFine / pTangentCoarse, 1e-2, 2e-3);  // s1 down 1e4 → P down ~1e2
+  // And a near-degenerate case against a million-sample Monte Carlo.
+  const Vec2 mean{0.2, 0.95};
+  const Cov2 cov = rotatedCov(0.16, 1e-10, 0.4);
+  const auto mc = monteCarlo(mean, cov, R, 1'000'000, 9);
+  EXPECT_NEAR(gaussianCollisionProbability(mean, cov, R), mc.p, 5.0 * mc.se);
+}
+
+TEST(GaussianAnisotropic, SymmetriesBoundsMonotoneInRadiusAndFloor) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> ud(0.0, 2.0), ua(0.0, 6.283185307179586), us(0.02, 0.8),
+      ul(std::log(1e-4), 0.0), ur(0.2, 1.2);
+  for (int t = 0; t < 300; ++t) {
+    const double d = ud(rng), th = ua(rng), R = ur(rng);
+    const double l1 = us(rng) * us(rng), l2 = l1 * std::exp(ul(rng)), rot = ua(rng);
+    const Cov2 cov = rotatedCov(l1, l2, rot);
+    const Vec2 mean{d * std::cos(th), d * std::sin(th)};
+    const double p = gaussianCollisionProbability(mean, cov, R);
+    ASSERT_GE(p, 0.0);
+    ASSERT_LE(p, 1.0);
+    // Point reflection, mirror image and rotation of the whole configuration leave P unchanged.
+    EXPECT_NEAR(gaussianCollisionProbability(Vec2{-mean.x, -mean.y}, cov, R), p, 1e-12);
+    EXPECT_NEAR(gaussianCollisionProbability(Vec2{mean.x, -mean.y}, Cov2{cov.xx, -cov.xy, cov.yy}, R), p,
+                1e-12);
+    const Vec2 rotated{std::cos(1.1) * mean.x - std::sin(1.1) * mean.y,
+                       std::sin(1.1) * mean.x + std::cos(1.1) * mean.y};
+    EXPECT_NEAR(gaussianCollisionProbability(rotated, rotatedCov(l1, l2, rot + 1.1), R), p, 1e-11);
+    // A larger disc contains the smaller one.
+    ASSERT_GE(gaussianCollisionProbability(mean, cov, R * 1.05), p - 1e-12);
+    // The floor early-out only ever drops probabilities below the floor.
+    const double floored = gaussianCollisionProbability(mean, cov, R, 1e-4);
+    ASSERT_TRUE(floored == p || (floored == 0.0 && p < 1e-4)) << p << " " << floored;
   }
 }
 
