@@ -187,19 +187,19 @@ struct Run {
   /// Posts what is pending; acknowledged ids go to the ledger, refused ones are dropped (counted),
   /// unavailable ones stay pending and are re-sent (ids are idempotency keys).
   void submitPending() {
-    std::vector<json> todo;
+    std::vector<json> toPost;
     {
       std::lock_guard<std::mutex> lock(mu);
-      todo.swap(pending);
+      toPost.swap(pending);
     }
-    if (todo.empty()) {
+    if (toPost.empty()) {
       return;
     }
     std::vector<json> keep;
-    for (std::size_t i = 0; i < todo.size(); i += 100) {
+    for (std::size_t i = 0; i < toPost.size(); i += 100) {
       json batch = json::array();
-      for (std::size_t k = i; k < std::min(todo.size(), i + 100); ++k) {
-        batch.push_back(todo[k]);
+      for (std::size_t k = i; k < std::min(toPost.size(), i + 100); ++k) {
+        batch.push_back(toPost[k]);
       }
       auto r = postHttp->Post("/v1/tasks", batch.dump(), "application/json");
       if (!r) {
