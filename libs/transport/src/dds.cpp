@@ -17,11 +17,15 @@ int check(int rc, const char* what) {
   return rc;
 }
 
-const char* loopbackConfig() {
-  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-         "<AllowMulticast>false</AllowMulticast></General>"
-         "<Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
-         "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
+std::string loopbackConfig(bool writeBatch) {
+  return std::string(
+             "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface "
+             "name=\"lo\"/></Interfaces>"
+             "<AllowMulticast>false</AllowMulticast></General>"
+             "<Discovery><Peers><Peer "
+             "address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
+             "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery>") +
+         (writeBatch ? "<Internal><WriteBatch>true</WriteBatch></Internal>" : "") + "</Domain></CycloneDDS>";
 }
 
 int domainFromEnvironment() {
@@ -58,27 +62,36 @@ Entity::~Entity() {
 namespace {
 // Domains we created with the built-in config stay for the life of the process, so that every
 // participant of the process (one per agent, say) shares them.
-void ensureLoopbackDomain(int domain) {
+// With CYCLONEDDS_URI set the operator's file decides everything, write batching included
+// (Writer::write() still flushes, so it is correct either way).
+void ensureLoopbackDomain(int domain, bool writeBatch) {
   const char* uri = std::getenv("CYCLONEDDS_URI");
   if (uri != nullptr && *uri != '\0') {
     return;
   }
   static std::mutex m;
-  static std::map<int, dds_entity_t> domains;
+  static std::map<int, bool> domains;  // domain -> created with write batching
   std::lock_guard lock(m);
-  if (domains.count(domain) != 0) {
+  if (const auto it = domains.find(domain); it != domains.end()) {
+    if (it->second != writeBatch) {
+      throw DdsError("Participant on domain " + std::to_string(domain) +
+                         " with writeBatching=" + (writeBatch ? "true" : "false") +
+                         ": this process already joined the domain with the other setting",
+                     DDS_RETCODE_PRECONDITION_NOT_MET);
+    }
     return;
   }
-  const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(domain), loopbackConfig());
+  const dds_entity_t d =
+      dds_create_domain(static_cast<dds_domainid_t>(domain), loopbackConfig(writeBatch).c_str());
   if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) {
     check(d, "dds_create_domain (built-in loopback config)");
   }
-  domains[domain] = d;
+  domains[domain] = writeBatch;
 }
 }  // namespace
 
-Participant::Participant(int domain) : domain_(domain) {
-  ensureLoopbackDomain(domain);
+Participant::Participant(int domain, ParticipantOptions options) : domain_(domain), options_(options) {
+  ensureLoopbackDomain(domain, options.writeBatching);
   e_ = Entity(check(dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr),
                     "dds_create_participant"));
 }

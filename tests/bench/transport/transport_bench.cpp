@@ -68,6 +68,32 @@ int runPong() {
   return 0;
 }
 
+// The same echo with the C API only (loaned sample written straight back): what Cyclone costs for
+// this type without the wrapper, to split the gap to ddsperf into "type" and "wrapper".
+int runPongRaw() {
+  Participant p;
+  Reader<msg::RobotState> in(p, kPingQos, "BenchPing");
+  Writer<msg::RobotState> out(p, kPingQos, "BenchPong");
+  auto last = Clk::now();
+  while (!gStop && Clk::now() - last < 5s) {
+    if (in.waitForData(100ms)) {
+      void* samples[16] = {nullptr};
+      dds_sample_info_t infos[16];
+      const int n = dds_take(in.handle(), samples, infos, 16, 16);
+      for (int i = 0; i < n; ++i) {
+        if (infos[i].valid_data) {
+          check(dds_write(out.handle(), samples[i]), "dds_write");
+        }
+      }
+      if (n > 0) {
+        dds_return_loan(in.handle(), samples, n);
+      }
+      last = Clk::now();
+    }
+  }
+  return 0;
+}
+
 // raw = count with dds_take loans and no conversion (to see what the wrapper's copy costs).
 int runSink(bool raw) {
   Participant p;
@@ -111,28 +137,52 @@ int runSink(bool raw) {
 
 std::string self;
 
+// Arg 0: through the wrapper on both sides; 1: the C API on both sides (same type, same QoS).
 void BM_PingPongOneWay(benchmark::State& state) {
-  test::ChildProcess pong(self, {"--pong"});
+  const bool raw = state.range(0) != 0;
+  test::ChildProcess pong(self, {raw ? "--pong-raw" : "--pong"});
   Participant p;
   Writer<msg::RobotState> out(p, kPingQos, "BenchPing");
   Reader<msg::RobotState> in(p, kPingQos, "BenchPong");
   waitMatched(out, in);
+  fleet_RobotState c{};
+  Arena arena;
+  const auto rawSample = sample(1);
+  Traits<msg::RobotState>::toC(rawSample, c, arena);
+  std::vector<msg::RobotState> pings;
+  for (std::uint32_t k = 0; k < 16; ++k) {
+    pings.push_back(sample(k));
+  }
+  auto exchange = [&](std::uint32_t k) {
+    if (!raw) {
+      out.write(pings[k % 16]);
+      std::size_t got = 0;
+      while (got == 0) {
+        in.waitForData(1000ms);
+        got = in.take().size();
+      }
+      return;
+    }
+    check(dds_write(out.handle(), &c), "dds_write");
+    while (true) {
+      in.waitForData(1000ms);
+      void* samples[4] = {nullptr};
+      dds_sample_info_t infos[4];
+      const int n = dds_take(in.handle(), samples, infos, 4, 4);
+      if (n > 0) {
+        dds_return_loan(in.handle(), samples, n);
+        return;
+      }
+    }
+  };
   std::vector<double> oneWayUs;
   std::uint32_t i = 0;
   for (int warm = 0; warm < 200; ++warm) {
-    out.write(sample(i++));
-    while (in.take().empty()) {
-      in.waitForData(1000ms);
-    }
+    exchange(i++);
   }
   for (auto _ : state) {
     const auto t0 = Clk::now();
-    out.write(sample(i++));
-    std::size_t got = 0;
-    while (got == 0) {
-      in.waitForData(1000ms);
-      got = in.take().size();
-    }
+    exchange(i++);
     oneWayUs.push_back(std::chrono::duration<double, std::micro>(Clk::now() - t0).count() / 2);
   }
   pong.kill(SIGTERM);
@@ -147,9 +197,14 @@ void BM_PingPongOneWay(benchmark::State& state) {
   state.counters["max_us"] = oneWayUs.back();
 }
 
+// Args: samples per burst, raw sink (no conversion), write batching (queue() the burst, one flush()).
 void BM_Throughput(benchmark::State& state) {
-  test::ChildProcess sink(self, {state.range(1) != 0 ? "--sink-raw" : "--sink"});
-  Participant p;
+  const bool batching = state.range(2) != 0;
+  // Write batching is a per-process domain setting: the batched runs use a domain of their own.
+  const int domain = domainFromEnvironment() + (batching ? 1 : 0);
+  test::ChildProcess sink(self, {state.range(1) != 0 ? "--sink-raw" : "--sink"},
+                          {{"FLEET_DDS_DOMAIN", std::to_string(domain)}});
+  Participant p(domain, ParticipantOptions{.writeBatching = batching});
   Writer<msg::RobotState> out(p, kStreamQos, "BenchStream");
   Writer<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
   Reader<msg::StepDone> reply(p, kPingQos, "BenchReply");
@@ -166,8 +221,9 @@ void BM_Throughput(benchmark::State& state) {
     const std::int64_t n = state.range(0);
     const auto t0 = Clk::now();
     for (std::int64_t k = 0; k < n; ++k) {
-      out.write(samples[static_cast<std::size_t>(k % 16)]);
+      out.queue(samples[static_cast<std::size_t>(k % 16)]);
     }
+    out.flush();
     ctl.write({"bench", n});
     std::int64_t got = -1;
     while (got < 0) {
@@ -225,10 +281,12 @@ void BM_WriteRawC(benchmark::State& state) {
 
 BENCHMARK(BM_WriteWrapper)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WriteRawC)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_PingPongOneWay)->Iterations(20000)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_PingPongOneWay)->Arg(0)->Arg(1)->Iterations(20000)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_Throughput)
-    ->Args({200000, 0})
-    ->Args({200000, 1})
+    ->Args({200000, 0, 0})
+    ->Args({200000, 1, 0})
+    ->Args({200000, 0, 1})
+    ->Args({200000, 1, 1})
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
@@ -238,6 +296,9 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, onTerm);
   if (argc > 1 && std::strcmp(argv[1], "--pong") == 0) {
     return runPong();
+  }
+  if (argc > 1 && std::strcmp(argv[1], "--pong-raw") == 0) {
+    return runPongRaw();
   }
   if (argc > 1 && std::strcmp(argv[1], "--sink") == 0) {
     return runSink(false);

@@ -17,7 +17,8 @@ namespace fleet::transport {
 
 /// The loopback-only configuration used when CYCLONEDDS_URI is unset: interface lo, multicast
 /// off, unicast discovery with peer 127.0.0.1, room for 200 participants on the host.
-const char* loopbackConfig();
+/// `writeBatch` adds Cyclone's Internal/WriteBatch (see ParticipantOptions).
+std::string loopbackConfig(bool writeBatch = false);
 
 /// Domain id from FLEET_DDS_DOMAIN (0..229), else 0. Tests set it to keep parallel runs apart.
 int domainFromEnvironment();
@@ -38,15 +39,29 @@ class Entity {
   dds_entity_t h_ = 0;
 };
 
+struct ParticipantOptions {
+  /// Writers pack samples into shared datagrams and send them when a datagram is full or on
+  /// Writer::flush() (Writer::write() flushes by itself; Writer::queue() does not). For processes
+  /// that publish bursts of small samples: one datagram per ~50 RobotStates instead of one each.
+  /// It is a property of the process's domain (Cyclone's Internal/WriteBatch), so every
+  /// participant of the process on that domain must ask for the same setting.
+  bool writeBatching = false;
+};
+
 class Participant {
  public:
   /// Joins `domain`; when CYCLONEDDS_URI is unset the domain is first created with loopbackConfig().
-  explicit Participant(int domain = domainFromEnvironment());
+  /// Throws DdsError (PRECONDITION_NOT_MET) when the process already joined `domain` with a
+  /// different writeBatching setting.
+  explicit Participant(int domain = domainFromEnvironment(), ParticipantOptions options = {});
+  explicit Participant(ParticipantOptions options) : Participant(domainFromEnvironment(), options) {}
   [[nodiscard]] dds_entity_t handle() const { return e_.handle(); }
   [[nodiscard]] int domain() const { return domain_; }
+  [[nodiscard]] bool writeBatching() const { return options_.writeBatching; }
 
  private:
   int domain_;
+  ParticipantOptions options_;
   Entity e_;
 };
 
@@ -64,15 +79,27 @@ class Writer {
   explicit Writer(const Participant& p, std::optional<QosProfile> q = std::nullopt,
                   const std::string& topic = Tr::kTopic)
       : topic_(detail::createTopic(p, Tr::descriptor(), topic)),
-        w_(detail::createWriter(p, topic_, q.value_or(Tr::qos()))) {}
+        w_(detail::createWriter(p, topic_, q.value_or(Tr::qos()))),
+        batching_(p.writeBatching()) {}
 
-  /// Copies `m` into a C sample and writes it. Throws MessageError (bounds) or DdsError.
+  /// Copies `m` into a C sample and writes it; it is on its way when this returns (also on a
+  /// write-batching participant). Throws MessageError (bounds) or DdsError.
   void write(const T& m) {
+    queue(m);
+    if (batching_) {
+      flush();
+    }
+  }
+  /// Like write(), but on a write-batching participant the sample may wait in the writer's
+  /// datagram until it is full or flush() is called: write a burst with queue(), then flush().
+  void queue(const T& m) {
     typename Tr::C c{};
     arena_.clear();
     Tr::toC(m, c, arena_);
     check(dds_write(w_, &c), "dds_write");
   }
+  /// Sends what queue() left in the writer's datagram (nothing to do without write batching).
+  void flush() { dds_write_flush(w_); }
   /// Disposes the instance with m's key (readers see it not-alive).
   void dispose(const T& m) {
     typename Tr::C c{};
@@ -93,6 +120,7 @@ class Writer {
  private:
   dds_entity_t topic_;
   dds_entity_t w_;  // children of the participant: deleted with it
+  bool batching_;
   Arena arena_;
 };
 
@@ -153,11 +181,15 @@ class Reader {
  private:
   std::vector<T> collect(std::size_t max, bool takeIt) {
     constexpr std::size_t kBatch = 256;
+    // Most calls find one or a few samples: a small first request keeps Cyclone's per-call loan
+    // handling small; a full first batch means a backlog, then take it in large batches.
+    std::size_t batch = 8;
     std::vector<T> out;
     while (out.size() < max) {
       void* samples[kBatch] = {nullptr};
       dds_sample_info_t infos[kBatch];
-      const std::size_t want = std::min(kBatch, max - out.size());
+      const std::size_t want = std::min(batch, max - out.size());
+      batch = kBatch;
       const int n = takeIt ? dds_take(r_, samples, infos, want, static_cast<std::uint32_t>(want))
                            : dds_read(r_, samples, infos, want, static_cast<std::uint32_t>(want));
       check(n, takeIt ? "dds_take" : "dds_read");
