@@ -563,6 +563,8 @@ int Run::run() {
               "60000",
               "--step-timeout-ms",
               std::to_string(o.stepTimeoutMs),
+              "--max-speed",
+              std::to_string(o.maxSpeed),
               "--replay",
               fs::absolute(out / "replay.jsonl.gz").string(),
               "--summary",

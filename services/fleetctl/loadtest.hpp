@@ -29,6 +29,10 @@ struct LoadtestOptions {
   std::uint64_t seed = 7;
   std::string localPlanner = "follow";
   int stepTimeoutMs = 300;
+  /// Cap on simulated seconds per wall second (0: none). The fleet manager, WMS adapter and load
+  /// generator run on the wall clock; uncapped, a fast machine compresses their latencies into
+  /// long simulated ones.
+  double maxSpeed = 4.0;
   double progressEveryS = 2.0;
 };
 

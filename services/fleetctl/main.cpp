@@ -135,6 +135,10 @@ int main(int argc, char** argv) {
   loadtest->add_option("--seed", lt.seed, "scenario and task seed")->capture_default_str();
   loadtest->add_option("--local-planner", lt.localPlanner, "robot agents' local planner")
       ->capture_default_str();
+  loadtest
+      ->add_option("--max-speed", lt.maxSpeed,
+                   "at most this many simulated s per wall s (0 = as fast as the fleet steps)")
+      ->check(CLI::Range(0.0, 1000.0));
   loadtest->add_option("--step-timeout-ms", lt.stepTimeoutMs, "lockstep step timeout of the simulator")
       ->check(CLI::Range(10, 60000))
       ->capture_default_str();

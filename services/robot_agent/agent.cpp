@@ -24,9 +24,11 @@ estimation::PoseEkf makeEkf(const AgentParams& p) {
   return std::move(*e);  // parameters are constants above: cannot fail
 }
 
+constexpr double kLookahead = 0.5;
+
 control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
-  fp.lookahead = 0.5;
+  fp.lookahead = kLookahead;
   fp.goal_tolerance_xy = 0.15;
   fp.goal_tolerance_theta = 0.25;
   return fp;
@@ -99,6 +101,43 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
   return cmd.twist;
 }
 
+bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
+  const Pose2 pose = ekf_.pose();
+  std::vector<avoidance::MovingDisc> discs;
+  for (const auto& o : others_) {
+    if (distance(o.pos, pose.position()) < 3.0) {
+      discs.push_back({o.pos, o.velocity, p_.radius});
+    }
+  }
+  if (discs.empty()) {
+    return true;
+  }
+  avoidance::LocalView view;
+  view.robot = {pose, {v_, w_}, p_.radius};
+  view.discs = discs;
+  view.limits = p_.limits;
+  view.dt = 0.1;
+  const auto r = safety_.filter(view, {v, w});
+  if (!r.blocked && !(r.overruled && std::abs(r.twist.v) < 0.05 && std::abs(v) > 0.1)) {
+    v = r.twist.v;
+    w = r.twist.omega;
+    return true;
+  }
+  // Name the robot in the way: the nearest one ahead.
+  double best = 1e9;
+  for (const auto& o : others_) {
+    const Vec2 rel = o.pos - pose.position();
+    const double ahead = rel.x * std::cos(pose.theta) + rel.y * std::sin(pose.theta);
+    if (ahead > 0.0 && rel.norm() < best) {
+      best = rel.norm();
+      blocker = o.id;
+    }
+  }
+  v = r.twist.v;
+  w = r.twist.omega;
+  return false;
+}
+
 void Agent::onFrame(const msg::SensorFrame& f) {
   if (ekf_.predict(f.ds_left, f.ds_right) != estimation::UpdateStatus::kAccepted) {
     ++rejected_;
@@ -126,13 +165,17 @@ void Agent::onOtherRobot(const msg::RobotState& s) {
   if (s.robot_id == p_.id || !s.pose.isFinite()) {
     return;
   }
-  for (auto& [id, pos] : others_) {
-    if (id == s.robot_id) {
-      pos = s.pose.position();
+  for (auto& o : others_) {
+    if (o.id == s.robot_id) {
+      o.pos = s.pose.position();
+      o.mode = s.mode;
+      o.hasTask = !s.task_id.empty();
+      o.velocity = Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v;
       return;
     }
   }
-  others_.emplace_back(s.robot_id, s.pose.position());
+  others_.push_back({s.robot_id, s.pose.position(), s.mode, !s.task_id.empty(),
+                     Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v});
 }
 
 void Agent::onAssignment(const msg::TaskAssignment& a) {
@@ -140,6 +183,8 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
     return;  // not ours, or the same order again (transient-local re-delivery)
   }
   revision_ = a.revision;
+  homing_ = false;  // an order (or a cancel) replaces the trip home
+  idleSinceNs_ = -1;
   if (a.task_id.empty()) {
     task_.clear();
     goals_.clear();
@@ -174,6 +219,38 @@ msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
   return msg::TaskState::EnRoute;
 }
 
+bool Agent::standing(const Other& o) {
+  return o.mode == msg::RobotMode::Loading || o.mode == msg::RobotMode::Charging ||
+         o.mode == msg::RobotMode::Fault || (o.mode == msg::RobotMode::Idle && !o.hasTask);
+}
+
+planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
+  planning::OccupancyGrid g = *grid_;
+  const double res = g.resolution();
+  const double keep = 2.0 * p_.radius;  // centre-to-centre distance at contact
+  const Vec2 self = ekf_.pose().position();
+  for (const auto& o : others_) {
+    // Never wall in the robot itself or its goal: a robot parked on my goal is a wait, not a detour.
+    if (!standing(o) || distance(o.pos, self) < keep + res || distance(o.pos, goal) < keep + res) {
+      continue;
+    }
+    const auto c = g.cellAt(o.pos);
+    if (!c) {
+      continue;
+    }
+    const int reach = static_cast<int>(std::ceil(keep / res));
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const planning::Cell q{c->x + dx, c->y + dy};
+        if (g.inside(q) && distance(g.cellCenter(q), o.pos) < keep) {
+          g.setBlocked(q);
+        }
+      }
+    }
+  }
+  return g;
+}
+
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
   planning::AStarPlanner plainAstar;
@@ -188,8 +265,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   planning::GlobalPlanner& astar = p_.lanes ? static_cast<planning::GlobalPlanner&>(lanePlanner)
                                             : static_cast<planning::GlobalPlanner&>(plainAstar);
   Expected<planning::Path> path = unexpected("no_path", "not planned");
+  const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
   if (avoid) {
-    planning::OccupancyGrid detour = *grid_;
+    planning::OccupancyGrid detour = around;
     const double res = detour.resolution();
     const int reach = static_cast<int>(std::ceil(0.9 / res));
     if (const auto c = detour.cellAt(*avoid)) {
@@ -208,9 +286,12 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     }
   } else if (risk_ && !p_.lanes) {
     RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
-    path = riskAware.plan(*grid_, ekf_.pose(), g.pose);
+    path = riskAware.plan(around, ekf_.pose(), g.pose);
   } else {
-    path = astar.plan(*grid_, ekf_.pose(), g.pose);
+    path = astar.plan(around, ekf_.pose(), g.pose);
+  }
+  if (!path) {
+    path = astar.plan(*grid_, ekf_.pose(), g.pose);  // boxed in by standing robots: wait them out
   }
   if (!path) {
     path = astar.plan(*raw_, ekf_.pose(), g.pose);  // a start or goal hugging a shelf
@@ -244,9 +325,18 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
 }
 
 void Agent::finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs) {
-  pendingStatus_ = msg::TaskStatus{
-      p_.id, task_, revision_, final, final == msg::TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255),
-      nowNs};
+  if (homing_) {
+    // The trip home is no order of the manager's: nothing to report; retry later if it failed.
+    homing_ = false;
+    if (final != msg::TaskState::Done) {
+      homeRetryNs_ = nowNs + secToNs(30.0);
+    }
+  } else {
+    pendingStatus_ = msg::TaskStatus{
+        p_.id, task_, revision_, final, final == msg::TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255),
+        nowNs};
+  }
+  idleSinceNs_ = nowNs;
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;
@@ -258,8 +348,11 @@ double Agent::clearSpeed(double v, bool& blockedByRobot, std::string& blocker) c
     return v;
   }
   double allowed = v;
-  auto limit = [&](double gap) {
-    allowed = std::min(allowed, std::max(0.0, (gap - p_.stopGap) / p_.headway));
+  // Docking at a station next to a shelf or wall: the last few decimetres are driven slowly, so
+  // static points may come closer than the cruising stop gap (else the robot stalls short of it).
+  const double staticGap = docking_ ? 0.08 : p_.stopGap;
+  auto limit = [&](double gap, double keep) {
+    allowed = std::min(allowed, std::max(0.0, (gap - keep) / p_.headway));
   };
   for (const auto& d : frame_.detections) {
     const double x = static_cast<double>(d.x);
@@ -270,7 +363,7 @@ double Agent::clearSpeed(double v, bool& blockedByRobot, std::string& blocker) c
     }
     const double gap = std::hypot(x, y) - p_.radius - r;
     const double before = allowed;
-    limit(gap);
+    limit(gap, p_.stopGap);
     if (allowed < before) {
       blockPoint_ = ekf_.pose().transform({x, y});
     }
@@ -281,10 +374,10 @@ double Agent::clearSpeed(double v, bool& blockedByRobot, std::string& blocker) c
         // Name the robot: the known robot nearest to where the detection is.
         const Vec2 at = ekf_.pose().transform({x, y});
         double best = 1.0;
-        for (const auto& [id, pos] : others_) {
-          if (distance(pos, at) < best) {
-            best = distance(pos, at);
-            blocker = id;
+        for (const auto& o : others_) {
+          if (distance(o.pos, at) < best) {
+            best = distance(o.pos, at);
+            blocker = o.id;
           }
         }
       }
@@ -301,7 +394,7 @@ double Agent::clearSpeed(double v, bool& blockedByRobot, std::string& blocker) c
     const double ahead = range * std::cos(a);
     if (ahead > 0.0 && std::abs(range * std::sin(a)) < p_.radius + 0.05) {
       const double before = allowed;
-      limit(ahead - p_.radius);
+      limit(ahead - p_.radius, staticGap);
       if (allowed < before) {
         blockPoint_ = ekf_.pose().transform({ahead, range * std::sin(a)});
       }
@@ -353,12 +446,24 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     blockedSinceNs_ = nowNs;
   }
   const double blockedS = nsToSec(nowNs - blockedSinceNs_);
+  // Behind a robot that will stand there for a while (loading, charging, parked, faulted): plan
+  // around it now instead of queueing (the plan blocks the cells of every standing robot).
+  if (byRobot && blockedS > 1.0 && (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 3.0)) {
+    for (const auto& o : others_) {
+      if (o.id == blocker && standing(o)) {
+        lastDetourNs_ = nowNs;
+        startGoal(nowNs);
+        return;
+      }
+    }
+  }
   // A person who does not step aside, or two robots face to face (the larger id yields): back off
   // if nothing is behind, then try another way around, rather than wait forever.
   const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
   if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
     phase_ = Phase::BackingOff;
     phaseStartNs_ = nowNs;
+    backoffFrom_ = blockPoint_;
   } else if (blockedS > 2.0 * p_.blockedBackoffS && blockPoint_ &&
              (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 2.0 * p_.blockedBackoffS)) {
     // Try a way around what stands in the way, again every while: in a queue of robots nobody
@@ -428,9 +533,10 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   double v = 0.0;
   double w = 0.0;
   msg::RobotMode mode = msg::RobotMode::Idle;
-  if (!task_.empty() && phase_ == Phase::Idle) {
+  if ((!task_.empty() || homing_) && phase_ == Phase::Idle) {
     startGoal(nowNs);
   }
+  maybeReturnHome(nowNs);
   if (phase_ == Phase::Driving && planner_) {
     bool reached = false;
     bool blocked = false;
@@ -457,8 +563,25 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     } else if (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15)) {
       enterDwell(nowNs);
     } else {
-      v = std::clamp(r->cmd.v, -0.3, p_.vMax);
-      w = std::clamp(r->cmd.omega, -p_.wMax, p_.wMax);
+      v = r->cmd.v;
+      w = r->cmd.omega;
+      docking_ = r->final_approach;
+      if (!r->final_approach) {
+        // The far-field law gives v = k_v·ρ·cos α with ρ ≈ the lookahead: scale v so the robot
+        // tracks its path at cruise speed. ω keeps the law's gains (scaling it too made the robot
+        // weave in the aisles: the loop gain grows with it while the actuation lags a cycle).
+        v *= p_.vMax / (kLookahead * control::LyapunovGains{}.k_v);
+      }
+      // Clamp keeping the curvature: a turn limited by ω_max is driven slower, not wider.
+      if (std::abs(w) > p_.wMax) {
+        v *= p_.wMax / std::abs(w);
+        w = std::copysign(p_.wMax, w);
+      }
+      if (v > p_.vMax || v < -0.3) {
+        const double c = std::clamp(v, -0.3, p_.vMax) / v;
+        v *= c;
+        w *= c;
+      }
       // Far off the carrot's bearing: turn in place first, so the robot does not sweep an arc
       // through its neighbours (robots park side by side) or into shelf ends.
       const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
@@ -479,7 +602,13 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         }
         v = allowed;
       }
-      if (wanted > 0.1 && allowed < 0.05) {
+      std::string crossing;
+      const bool crossOk = crossTrafficSafe(v, w, crossing);
+      if (!crossOk && allowed >= 0.05) {
+        byRobot = true;
+        blocker = crossing.empty() ? std::string("robot") : crossing;
+      }
+      if (wanted > 0.1 && (allowed < 0.05 || !crossOk)) {
         mode = msg::RobotMode::Waiting;
         onStandoff(nowNs, byRobot, blocker, v, w);
       } else {
@@ -501,7 +630,16 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     mode = msg::RobotMode::Waiting;
     v = rearClear() ? -0.2 : 0.0;
     if (nsToSec(nowNs - phaseStartNs_) > 1.5) {
-      startGoal(nowNs);  // replan from where it stands
+      // Replan from where it stands around what blocked it (the same path would lead straight
+      // back into the standoff); with no way around, the plain plan.
+      phase_ = Phase::Idle;
+      if (backoffFrom_) {
+        startGoal(nowNs, backoffFrom_);
+      }
+      if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
+        startGoal(nowNs);
+      }
+      backoffFrom_.reset();
     }
   }
   v_ = v;
@@ -509,6 +647,23 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   (void)dt;
   report(out, nowNs, v, w, mode);
   return out;
+}
+
+void Agent::maybeReturnHome(std::int64_t nowNs) {
+  if (!task_.empty() || homing_ || phase_ != Phase::Idle || p_.returnHomeS < 0.0) {
+    return;
+  }
+  if (idleSinceNs_ < 0) {
+    idleSinceNs_ = nowNs;
+  }
+  if (nsToSec(nowNs - idleSinceNs_) < p_.returnHomeS || nowNs < homeRetryNs_ ||
+      distance(ekf_.pose().position(), p_.start.position()) < 0.3) {
+    return;
+  }
+  homing_ = true;
+  goals_ = {msg::Goal{p_.start, "home", msg::GoalAction::Park, 0.0}};
+  goal_ = 0;
+  startGoal(nowNs);
 }
 
 void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
@@ -544,6 +699,9 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
                                static_cast<float>(p_.radius), static_cast<float>(sigma0 + 0.1 * t)});
     q = {q.x + v * std::cos(q.theta) * p_.predictionDt, q.y + v * std::sin(q.theta) * p_.predictionDt,
          wrapAngle(q.theta + w * p_.predictionDt)};
+  }
+  if (pendingStatus_ && (homing_ || pendingStatus_->task_id.empty())) {
+    pendingStatus_.reset();  // the trip home is not a task
   }
   out.status = std::move(pendingStatus_);
   pendingStatus_.reset();

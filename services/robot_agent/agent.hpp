@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fleet/avoidance/local_planner.hpp"
+#include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
 #include "fleet/planning/lane_map.hpp"
@@ -35,6 +36,10 @@ struct AgentParams {
   double headway = 1.0;          // s: the stop distance grows with speed
   double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
   double blockedFailS = 60.0;    // a task that cannot progress this long fails
+  /// Idle this long [s] away from its start pose (its parking place): drive back there, so a
+  /// finished robot does not stay on a drop-off station or in a lane. A new order preempts the
+  /// trip. Negative: stay where the last task ended.
+  double returnHomeS = 5.0;
   /// No SensorFrame for this long (of the agent's clock): stop, report RM_FAULT, resume on frames.
   double sensorTimeoutS = 0.5;
   /// A* cell cost = step length × (1 + riskWeightGlobal · p): paths at most (1 + w)× the shortest.
@@ -78,6 +83,8 @@ class Agent {
   [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
   [[nodiscard]] bool busy() const { return !task_.empty(); }
+  /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
+  [[nodiscard]] bool homing() const { return homing_; }
   [[nodiscard]] std::uint64_t framesRejected() const { return rejected_; }
 
  private:
@@ -89,6 +96,8 @@ class Agent {
   bool sensorStreamLost(std::int64_t nowNs);
   /// Command, state and predicted discs for the chosen twist and mode.
   void report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode);
+  /// Idle and away from home for returnHomeS: start the trip home (an internal order, never reported).
+  void maybeReturnHome(std::int64_t nowNs);
   /// Plans to the current goal; with `avoid`, the cells around that point count as blocked (a
   /// detour around whatever stands in the way).
   void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
@@ -132,13 +141,34 @@ class Agent {
   std::int64_t lastProgressNs_ = 0;
   std::optional<msg::TaskStatus> pendingStatus_;
   msg::TaskState reported_ = msg::TaskState::Queued;
-  std::vector<std::pair<std::string, Vec2>> others_;
+  struct Other {
+    std::string id;
+    Vec2 pos;
+    msg::RobotMode mode = msg::RobotMode::Idle;
+    bool hasTask = false;
+    Vec2 velocity;
+  };
+  /// The follower's command through the safety layer, against the scan and the other robots
+  /// extrapolated at their reported velocities (crossings at intersections, which the stop rule's
+  /// straight-ahead corridor sees too late). Returns false when it had to stop the robot.
+  bool crossTrafficSafe(double& v, double& w, std::string& blocker) const;
+  avoidance::SafetyLayer safety_;
+  std::vector<Other> others_;
+  /// The planning grid with the robots that stand still for a while (parked, loading, charging,
+  /// faulted) blocked, so a path goes around them instead of into a queue behind them.
+  [[nodiscard]] planning::OccupancyGrid gridAroundStandingRobots(Vec2 goal) const;
+  static bool standing(const Other& o);
+  std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
   bool detoured_ = false;                   // already tried a detour for the current standoff
   std::int64_t lastDetourNs_ = -1;          // when the last detour was tried
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
+  bool homing_ = false;
+  bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
+  std::int64_t idleSinceNs_ = -1;
+  std::int64_t homeRetryNs_ = -1;  // after a failed trip home, not before this time
 };
 
 /// The planning grid from a scenario's occupancy cells, inflated by `radius`.

@@ -43,6 +43,7 @@ struct Options {
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
   double riskWeightGlobal = 1.0;
+  double returnHomeS = 5.0;
   bool useRisk = true;
   bool useLanes = true;
 };
@@ -78,6 +79,7 @@ int run(const sim::Scenario& scn, const Options& opt) {
     p.wMax = r.limits.omega_max;
     p.localPlanner = opt.localPlanner;
     p.sensorTimeoutS = opt.sensorTimeoutS;
+    p.returnHomeS = opt.returnHomeS;
     p.riskWeightGlobal = opt.riskWeightGlobal;
     p.lanes = lanes;
     p.limits = r.limits;
@@ -235,6 +237,9 @@ int main(int argc, char** argv) {
   app.add_option("--risk-weight", opt.riskWeightGlobal,
                  "global planner: cell cost = length x (1 + w p); paths stay within (1 + w) x the shortest")
       ->check(CLI::Range(0.0, 10.0));
+  app.add_option("--return-home", opt.returnHomeS,
+                 "s idle before a robot drives back to its start (parking) pose; negative: stay put")
+      ->check(CLI::Range(-1.0, 3600.0));
   app.add_flag("--no-risk", noRisk, "ignore RiskMap (planners without the risk term)");
   bool noLanes = false;
   app.add_flag("--no-lanes", noLanes,

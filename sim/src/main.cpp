@@ -38,6 +38,7 @@ struct Options {
   int participants = 0;
   int startTimeoutMs = 10000;
   int stepTimeoutMs = 1000;
+  double maxSpeed = 0.0;  // lockstep: at most this many simulated seconds per wall second (0: no cap)
   std::string replay;
   std::string summary;
   std::string html;
@@ -50,6 +51,7 @@ struct Options {
 const char* kUsage =
     "usage: fleet-sim --scenario FILE [--clock wall|lockstep] [--seed N] [--duration S]\n"
     "                 [--participants N] [--start-timeout-ms MS] [--step-timeout-ms MS]\n"
+    "                 [--max-speed F]\n"
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
     "                 [--validate] [--log-level LEVEL]\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
@@ -80,6 +82,11 @@ bool parseArgs(int argc, char** argv, Options& o) {
       o.startTimeoutMs = std::stoi(next());
     } else if (a == "--step-timeout-ms") {
       o.stepTimeoutMs = std::stoi(next());
+    } else if (a == "--max-speed") {
+      o.maxSpeed = std::stod(next());
+      if (!(o.maxSpeed >= 0.0)) {
+        throw std::invalid_argument("--max-speed must be >= 0 (simulated s per wall s; 0 = no cap)");
+      }
     } else if (a == "--replay") {
       o.replay = next();
     } else if (a == "--summary") {
@@ -176,6 +183,12 @@ class Simulator {
       }
       if (lockstep_) {
         awaitStep(k);
+        if (o_.maxSpeed > 0.0) {
+          // Services on the wall clock (fleet manager, WMS adapter, the load generator) see time
+          // pass maxSpeed times slower than the robots do: a cap keeps their latencies meaningful.
+          std::this_thread::sleep_until(
+              start + std::chrono::duration_cast<std::chrono::nanoseconds>(dt * (k + 1) / o_.maxSpeed));
+        }
       } else {
         const auto due = start + dt * (k + 1);
         if (std::chrono::steady_clock::now() > due && ++w_.counters().wallOverruns % 100 == 1) {
