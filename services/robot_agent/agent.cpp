@@ -6,6 +6,7 @@
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/planning/astar.hpp"
+#include "fleet/planning/return_path.hpp"
 #include "risk_astar.hpp"
 
 #include <stdexcept>
@@ -25,6 +26,8 @@ estimation::PoseEkf makeEkf(const AgentParams& p) {
 }
 
 constexpr double kLookahead = 0.5;
+constexpr double kTrailStep = 0.25;        // m between trail points
+constexpr std::size_t kTrailPoints = 120;  // 30 m of trail
 
 control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
@@ -227,7 +230,8 @@ bool Agent::standing(const Other& o) {
 planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
   planning::OccupancyGrid g = *grid_;
   const double res = g.resolution();
-  const double keep = 2.0 * p_.radius;  // centre-to-centre distance at contact
+  // Centre-to-centre distance at contact plus room for the safety layer's slow-down zone.
+  const double keep = 2.0 * p_.radius + 0.2;
   const Vec2 self = ekf_.pose().position();
   for (const auto& o : others_) {
     // Never wall in the robot itself or its goal: a robot parked on my goal is a wait, not a detour.
@@ -429,6 +433,126 @@ bool Agent::rearClear() const {
   return true;
 }
 
+void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const {
+  v = r.cmd.v;
+  w = r.cmd.omega;
+  if (!r.final_approach) {
+    // The far-field law gives v = k_v·ρ·cos α with ρ ≈ the lookahead: scale v so the robot
+    // tracks its path at cruise speed. ω keeps the law's gains (scaling it too made the robot
+    // weave in the aisles: the loop gain grows with it while the actuation lags a cycle).
+    v *= p_.vMax / (kLookahead * control::LyapunovGains{}.k_v);
+  }
+  // Clamp keeping the curvature: a turn limited by ω_max is driven slower, not wider.
+  if (std::abs(w) > p_.wMax) {
+    v *= p_.wMax / std::abs(w);
+    w = std::copysign(p_.wMax, w);
+  }
+  if (v > p_.vMax || v < -0.3) {
+    const double c = std::clamp(v, -0.3, p_.vMax) / v;
+    v *= c;
+    w *= c;
+  }
+  // Far off the carrot's bearing: turn in place first, so the robot does not sweep an arc
+  // through its neighbours (robots park side by side) or into shelf ends.
+  const Vec2 toCarrot = r.target.position() - ekf_.pose().position();
+  const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
+  if (!r.final_approach && toCarrot.norm() > 0.05 && std::abs(bearing) > 0.7) {
+    v = 0.0;
+    w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
+  }
+}
+
+bool Agent::heldUp(double& v, double& w, bool& byRobot, std::string& blocker) const {
+  const double allowed = clearSpeed(v, byRobot, blocker);
+  if (allowed < v - 1e-9) {
+    // Keep the curvature while slowing, so the robot stays on its path.
+    if (std::abs(v) > 1e-9) {
+      w *= allowed / v;
+    }
+    v = allowed;
+  }
+  std::string crossing;
+  const bool crossOk = crossTrafficSafe(v, w, crossing);
+  if (!crossOk && allowed >= 0.05) {
+    byRobot = true;
+    blocker = crossing.empty() ? std::string("robot") : crossing;
+  }
+  return allowed < 0.05 || !crossOk;
+}
+
+double Agent::freeWidth(Vec2 p, Vec2 dir) const {
+  const double n = dir.norm();
+  if (n < 1e-9) {
+    return 0.0;
+  }
+  const Vec2 side{-dir.y / n, dir.x / n};
+  double width = 0.0;
+  for (const double sign : {1.0, -1.0}) {
+    double s = 0.0;
+    while (s < 3.0) {
+      const auto c = raw_->cellAt(p + side * (sign * (s + 0.05)));
+      if (!c || raw_->blocked(*c)) {
+        break;
+      }
+      s += 0.05;
+    }
+    width += s;
+  }
+  return width;
+}
+
+bool Agent::narrow(Vec2 p, Vec2 dir) const {
+  // Two robots side by side with 0.1 m between them and to each wall.
+  return freeWidth(p, dir) < 4.0 * p_.radius + 0.3;
+}
+
+bool Agent::startReturn(std::int64_t nowNs) {
+  const Vec2 here = ekf_.pose().position();
+  const Vec2 heading{std::cos(ekf_.pose().theta), std::sin(ekf_.pose().theta)};
+  if (trail_.size() < 2 || !narrow(here, heading)) {
+    return false;
+  }
+  // Walk the trail back to the first point wide enough for the other robot to pass, at least a
+  // body length away (the trail's newest point may be where the robot stands).
+  std::vector<Vec2> skeleton{here};
+  double travelled = 0.0;
+  bool found = false;
+  for (std::size_t i = trail_.size(); i-- > 0;) {
+    const Vec2 q = trail_[i];
+    if (distance(q, skeleton.back()) < 0.05) {
+      continue;
+    }
+    travelled += distance(q, skeleton.back());
+    const Vec2 dir = q - skeleton.back();
+    skeleton.push_back(q);
+    if (travelled > 2.0 * p_.radius + 0.5 && !narrow(q, dir)) {
+      found = true;
+      break;
+    }
+  }
+  if (!found) {
+    return false;
+  }
+  // The trail was driven, so it is free of what the map does not show; seed 001's return path
+  // shortens it around the inside of each turn (falling back to the trail itself).
+  std::vector<Vec2> points = skeleton;
+  if (auto rp = planning::planReturnPath(*grid_, skeleton)) {
+    points = rp->points;
+  }
+  const Vec2 last = points.back() - points[points.size() - 2];
+  if (!follower_.setPath(points, std::atan2(last.y, last.x))) {
+    return false;
+  }
+  path_ = points;
+  phase_ = Phase::Returning;
+  phaseStartNs_ = nowNs;
+  blockedSinceNs_ = -1;
+  backoffFrom_ = blockPoint_;
+  trail_.clear();  // the way back is driven now; what it leaves behind starts a new trail
+  ++conduct_.returns;
+  return true;
+}
+
 void Agent::enterDwell(std::int64_t nowNs) {
   phase_ = Phase::Dwelling;
   phaseStartNs_ = nowNs;
@@ -446,12 +570,25 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     blockedSinceNs_ = nowNs;
   }
   const double blockedS = nsToSec(nowNs - blockedSinceNs_);
+  if (blockedS > 1.0 && countedStandoffNs_ != blockedSinceNs_) {
+    countedStandoffNs_ = blockedSinceNs_;
+    ++conduct_.standoffs;
+    for (const auto& o : others_) {
+      // Waiting on a robot that waits too: a cycle of the wait-for graph (or a chain into one).
+      // The id rule below breaks any cycle: some robot in it has a larger id than the one it
+      // waits on, and that one yields.
+      if (byRobot && o.id == blocker && o.mode == msg::RobotMode::Waiting) {
+        ++conduct_.mutualBlocks;
+      }
+    }
+  }
   // Behind a robot that will stand there for a while (loading, charging, parked, faulted): plan
   // around it now instead of queueing (the plan blocks the cells of every standing robot).
   if (byRobot && blockedS > 1.0 && (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 3.0)) {
     for (const auto& o : others_) {
       if (o.id == blocker && standing(o)) {
         lastDetourNs_ = nowNs;
+        ++conduct_.detours;
         startGoal(nowNs);
         return;
       }
@@ -460,15 +597,20 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   // A person who does not step aside, or two robots face to face (the larger id yields): back off
   // if nothing is behind, then try another way around, rather than wait forever.
   const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
-  if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
+  if (blockedS > p_.blockedBackoffS && yields && startReturn(nowNs)) {
+    v = 0.0;
+    w = 0.0;
+  } else if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
     phase_ = Phase::BackingOff;
     phaseStartNs_ = nowNs;
     backoffFrom_ = blockPoint_;
+    ++conduct_.backoffs;
   } else if (blockedS > 2.0 * p_.blockedBackoffS && blockPoint_ &&
              (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 2.0 * p_.blockedBackoffS)) {
     // Try a way around what stands in the way, again every while: in a queue of robots nobody
     // can back off, and the one ahead may have moved aside since the last attempt.
     lastDetourNs_ = nowNs;
+    ++conduct_.detours;
     startGoal(nowNs, blockPoint_);
     detoured_ = true;
   } else if (blockedS > p_.blockedFailS) {
@@ -563,57 +705,52 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     } else if (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15)) {
       enterDwell(nowNs);
     } else {
-      v = r->cmd.v;
-      w = r->cmd.omega;
       docking_ = r->final_approach;
-      if (!r->final_approach) {
-        // The far-field law gives v = k_v·ρ·cos α with ρ ≈ the lookahead: scale v so the robot
-        // tracks its path at cruise speed. ω keeps the law's gains (scaling it too made the robot
-        // weave in the aisles: the loop gain grows with it while the actuation lags a cycle).
-        v *= p_.vMax / (kLookahead * control::LyapunovGains{}.k_v);
-      }
-      // Clamp keeping the curvature: a turn limited by ω_max is driven slower, not wider.
-      if (std::abs(w) > p_.wMax) {
-        v *= p_.wMax / std::abs(w);
-        w = std::copysign(p_.wMax, w);
-      }
-      if (v > p_.vMax || v < -0.3) {
-        const double c = std::clamp(v, -0.3, p_.vMax) / v;
-        v *= c;
-        w *= c;
-      }
-      // Far off the carrot's bearing: turn in place first, so the robot does not sweep an arc
-      // through its neighbours (robots park side by side) or into shelf ends.
-      const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
-      const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
-      if (!r->final_approach && toCarrot.norm() > 0.05 && std::abs(bearing) > 0.7) {
-        v = 0.0;
-        w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
-      }
+      followerTwist(*r, v, w);
       mode = msg::RobotMode::Moving;
       bool byRobot = false;
       std::string blocker;
       const double wanted = v;
-      const double allowed = clearSpeed(v, byRobot, blocker);
-      if (allowed < v - 1e-9) {
-        // Keep the curvature while slowing, so the robot stays on its path.
-        if (std::abs(v) > 1e-9) {
-          w *= allowed / v;
-        }
-        v = allowed;
-      }
-      std::string crossing;
-      const bool crossOk = crossTrafficSafe(v, w, crossing);
-      if (!crossOk && allowed >= 0.05) {
-        byRobot = true;
-        blocker = crossing.empty() ? std::string("robot") : crossing;
-      }
-      if (wanted > 0.1 && (allowed < 0.05 || !crossOk)) {
+      if (heldUp(v, w, byRobot, blocker) && wanted > 0.1) {
         mode = msg::RobotMode::Waiting;
         onStandoff(nowNs, byRobot, blocker, v, w);
       } else {
         blockedSinceNs_ = -1;
       }
+    }
+  } else if (phase_ == Phase::Returning) {
+    mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
+    auto r = follower_.step(ekf_.pose());
+    const bool arrived =
+        !r || r->goal_reached ||
+        (r->final_approach && path_.size() > 0 && distance(ekf_.pose().position(), path_.back()) < 0.25);
+    bool byRobot = false;
+    std::string blocker;
+    if (!arrived) {
+      docking_ = false;
+      followerTwist(*r, v, w);
+      const double wanted = v;
+      if (heldUp(v, w, byRobot, blocker) && wanted > 0.1) {
+        if (blockedSinceNs_ < 0) {
+          blockedSinceNs_ = nowNs;
+        }
+      } else {
+        blockedSinceNs_ = -1;
+      }
+    }
+    // At the wide place (or stuck on the way back for a while): replan around what blocked it.
+    if (arrived || (blockedSinceNs_ >= 0 && nsToSec(nowNs - blockedSinceNs_) > p_.blockedBackoffS)) {
+      v = 0.0;
+      w = 0.0;
+      phase_ = Phase::Idle;
+      if (backoffFrom_) {
+        ++conduct_.detours;
+        startGoal(nowNs, backoffFrom_);
+      }
+      if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
+        startGoal(nowNs);
+      }
+      backoffFrom_.reset();
     }
   } else if (phase_ == Phase::Dwelling) {
     mode =
@@ -640,6 +777,15 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         startGoal(nowNs);
       }
       backoffFrom_.reset();
+    }
+  }
+  if (phase_ == Phase::Driving) {
+    const Vec2 here = ekf_.pose().position();
+    if (trail_.empty() || distance(trail_.back(), here) > kTrailStep) {
+      trail_.push_back(here);
+      if (trail_.size() > kTrailPoints) {
+        trail_.erase(trail_.begin());
+      }
     }
   }
   v_ = v;

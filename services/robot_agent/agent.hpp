@@ -4,9 +4,9 @@
 // A* path on the inflated map, a path follower with the Lyapunov pose controller, a stop-and-yield
 // safety rule on what the sensors see, and task execution (goals with dwell times).
 //
-// This first agent has no local avoidance planner yet (libs/avoidance is being built): it keeps to
-// its path and stops for what is ahead; standoffs between two robots are broken by the robot with
-// the larger id backing off and replanning.
+// Standoffs between robots are broken by the robot with the larger id backing off and replanning;
+// in a passage too narrow for two, it backs out along the way it came (seed 001's return path over
+// its own trail) to the last place wide enough, and replans from there (docs/algorithms.md).
 
 #include <cstdint>
 #include <memory>
@@ -87,8 +87,18 @@ class Agent {
   [[nodiscard]] bool homing() const { return homing_; }
   [[nodiscard]] std::uint64_t framesRejected() const { return rejected_; }
 
+  /// What the robot did about being blocked (cumulative), for tests and the service's counters.
+  struct Conduct {
+    std::uint64_t standoffs = 0;     ///< times it stopped for something in its way (> 1 s)
+    std::uint64_t mutualBlocks = 0;  ///< ... for a robot that was itself waiting (a wait cycle)
+    std::uint64_t backoffs = 0;      ///< it yielded by backing off a little
+    std::uint64_t returns = 0;       ///< it yielded by backing out of a narrow passage (return path)
+    std::uint64_t detours = 0;       ///< plans around what blocked it
+  };
+  [[nodiscard]] const Conduct& conduct() const { return conduct_; }
+
  private:
-  enum class Phase { Idle, Driving, Dwelling, BackingOff };
+  enum class Phase { Idle, Driving, Dwelling, BackingOff, Returning };
   /// The task stack for one cycle (the body of step() while sensors are live).
   AgentOutput drive(std::int64_t nowNs, double dt);
   /// Tracks frame arrival against the step clock; on loss and on recovery queues a TaskStatus with
@@ -112,6 +122,17 @@ class Agent {
   double clearSpeed(double v, bool& blockedByRobot, std::string& blocker) const;
   /// Nothing within a short distance behind (backing off must not hit what it cannot see coming).
   [[nodiscard]] bool rearClear() const;
+  /// Free width of the map across direction `dir` at `p` [m] (up to 2 x 3 m).
+  [[nodiscard]] double freeWidth(Vec2 p, Vec2 dir) const;
+  /// Too narrow for another robot to pass this one.
+  [[nodiscard]] bool narrow(Vec2 p, Vec2 dir) const;
+  /// Yielding inside a narrow passage: plan the way back along the trail to the last point wide
+  /// enough (seed 001's return path) and start following it. False when there is no such point.
+  bool startReturn(std::int64_t nowNs);
+  /// The follower's command, scaled to cruise and limited (shared by driving and returning).
+  void followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const;
+  /// Stop rule and cross-traffic check on (v, w); true when the robot is held up.
+  bool heldUp(double& v, double& w, bool& byRobot, std::string& blocker) const;
 
   AgentParams p_;
   std::shared_ptr<const planning::OccupancyGrid> grid_;
@@ -138,6 +159,7 @@ class Agent {
   Phase phase_ = Phase::Idle;
   std::int64_t phaseStartNs_ = 0;
   std::int64_t blockedSinceNs_ = -1;
+  std::int64_t countedStandoffNs_ = -1;  // the standoff already counted in conduct_
   std::int64_t lastProgressNs_ = 0;
   std::optional<msg::TaskStatus> pendingStatus_;
   msg::TaskState reported_ = msg::TaskState::Queued;
@@ -169,6 +191,8 @@ class Agent {
   bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
   std::int64_t idleSinceNs_ = -1;
   std::int64_t homeRetryNs_ = -1;  // after a failed trip home, not before this time
+  std::vector<Vec2> trail_;        // where the robot drove, a point every kTrailStep (newest last)
+  Conduct conduct_;
 };
 
 /// The planning grid from a scenario's occupancy cells, inflated by `radius`.

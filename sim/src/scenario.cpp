@@ -457,7 +457,7 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
   if (c.has("social_force")) {
     Config f = c.child("social_force");
     f.rejectUnknownKeys({"tau", "human_a", "human_b", "wall_a", "wall_b", "robot_a", "robot_b", "lambda",
-                         "cutoff", "max_speed_factor"});
+                         "cutoff", "max_speed_factor", "robot_keep"});
     auto& p = s.social;
     p.tau = f.number("tau", p.tau, {0.0, 10.0, true});
     p.humanA = f.number("human_a", p.humanA, {0.0, 1000.0});
@@ -469,6 +469,7 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
     p.lambda = f.number("lambda", p.lambda, {0.0, 1.0});
     p.cutoff = f.number("cutoff", p.cutoff, {0.0, 100.0, true});
     p.maxSpeedFactor = f.number("max_speed_factor", p.maxSpeedFactor, {1.0, 10.0});
+    p.robotKeep = f.number("robot_keep", p.robotKeep, {-1.0, 1.0});
   }
   if (c.has("prediction")) {
     Config f = c.child("prediction");

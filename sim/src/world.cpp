@@ -426,9 +426,27 @@ void World::stepHumans() {
   for (std::size_t i = 0; i < humans_.size(); ++i) {
     HumanBody& h = humans_[i];
     const double before = discGridPenetration(sc_.map, h.p, h.r);
+    // How far inside the keep distance of the nearest robot (step-start poses) a position is. The
+    // social force is soft: alone it lets a person press into a robot standing in an aisle,
+    // which no one does with a machine in view.
+    auto crowding = [&](Vec2 p) {
+      double worst = 0.0;
+      if (sf.robotKeep < 0.0) {
+        return worst;
+      }
+      hash_.forEachNear(p, h.r + maxRadius_ + sf.robotKeep, [&](int j) {
+        const auto ju = static_cast<std::size_t>(j);
+        if (ju < nr) {
+          worst = std::max(worst, sf.robotKeep - (len(p - positions_[ju]) - h.r - radii_[ju]));
+        }
+      });
+      return worst;
+    };
+    const double crowdedBefore = crowding(h.p);
     auto ok = [&](Vec2 p) {
       const double a = discGridPenetration(sc_.map, p, h.r);
-      return a <= 0.0 || a <= before;
+      const double c = crowding(p);
+      return (a <= 0.0 || a <= before) && (c <= 0.0 || c <= crowdedBefore);
     };
     if (ok(newP[i])) {
       h.p = newP[i];

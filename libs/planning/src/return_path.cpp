@@ -7,7 +7,7 @@
 
 #include "fleet/core/angles.hpp"
 #include "fleet/geometry/grid_raycast.hpp"
-#include "fleet/planning/ompl_planner.hpp"
+#include "fleet/planning/segment_free.hpp"
 
 namespace fleet::planning {
 

@@ -2,6 +2,7 @@
 
 #include "fleet/planning/astar.hpp"
 #include "fleet/planning/ompl_planner.hpp"
+#include "fleet/planning/segment_free.hpp"
 
 using namespace fleet;
 using namespace fleet::planning;

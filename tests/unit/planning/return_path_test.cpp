@@ -5,6 +5,7 @@
 #include "fleet/geometry/segment_path.hpp"
 #include "fleet/planning/ompl_planner.hpp"
 #include "fleet/planning/return_path.hpp"
+#include "fleet/planning/segment_free.hpp"
 
 using namespace fleet;
 using namespace fleet::planning;

@@ -216,3 +216,183 @@ TEST(Agent, SensorStreamLossStopsReportsAndResumes) {
   EXPECT_EQ(after.back(), msg::TaskState::Done);
   EXPECT_FALSE(a.sensorLost());
 }
+
+namespace {
+// Steps the agent in the test world until `until` holds or `steps` run out; returns the statuses.
+template <class Until>
+std::vector<msg::TaskStatus> run(agent::Agent& a, World& world, int& k, int steps, Until until,
+                                 double* minDistTo = nullptr, Vec2 to = {}) {
+  std::vector<msg::TaskStatus> statuses;
+  double v = 0;
+  double w = 0;
+  for (int i = 0; i < steps && !until(); ++i, ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    if (out.status) {
+      statuses.push_back(*out.status);
+    }
+    if (minDistTo != nullptr) {
+      *minDistTo = std::min(*minDistTo, distance(world.truth.position(), to));
+    }
+  }
+  return statuses;
+}
+
+msg::RobotState parked(const std::string& id, Vec2 at) {
+  msg::RobotState s;
+  s.robot_id = id;
+  s.pose = {at.x, at.y, 0.0};
+  s.mode = msg::RobotMode::Idle;
+  return s;
+}
+}  // namespace
+
+TEST(Agent, ReturnsHomeWhenIdleWithoutReportingTheTrip) {
+  auto grid = emptyGrid();
+  auto p = params();
+  p.returnHomeS = 2.0;
+  agent::Agent a(p, grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  auto statuses = run(a, world, k, 1500, [&] { return !a.busy() && k > 10; });
+  ASSERT_FALSE(statuses.empty());
+  ASSERT_EQ(statuses.back().state, msg::TaskState::Done);
+  ASSERT_GT(distance(world.truth.position(), p.start.position()), 3.0);
+  // Idle at the drop-off: after 2 s it drives home, reporting nothing (no order of the manager's).
+  const auto during = run(a, world, k, 1500, [&] {
+    return distance(world.truth.position(), p.start.position()) < 0.2 && !a.homing();
+  });
+  EXPECT_TRUE(during.empty());
+  EXPECT_LT(distance(world.truth.position(), p.start.position()), 0.2);
+  EXPECT_FALSE(a.busy());
+  EXPECT_FALSE(a.homing());
+}
+
+TEST(Agent, NewOrderPreemptsTheTripHome) {
+  auto grid = emptyGrid();
+  auto p = params();
+  p.returnHomeS = 0.5;
+  agent::Agent a(p, grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  (void)run(a, world, k, 1500, [&] { return !a.busy() && k > 10; });
+  (void)run(a, world, k, 20, [] { return false; });
+  ASSERT_TRUE(a.homing());
+  auto order = transport();
+  order.task_id = "t2";
+  order.revision = 8;
+  a.onAssignment(order);
+  EXPECT_FALSE(a.homing());
+  const auto statuses = run(a, world, k, 1500, [&] { return !a.busy(); });
+  ASSERT_FALSE(statuses.empty());
+  EXPECT_EQ(statuses.front().task_id, "t2");
+  EXPECT_EQ(statuses.front().state, msg::TaskState::EnRoute);
+  EXPECT_EQ(statuses.back().state, msg::TaskState::Done);
+}
+
+TEST(Agent, PlansAroundARobotParkedOnItsWay) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  // Parked (idle, no task) right on the straight line to the pickup at (5, 1). The test world has
+  // no sensor model of it: only the plan can keep the robot away.
+  a.onOtherRobot(parked("r2", {3.0, 1.0}));
+  a.onAssignment(transport());
+  int k = 0;
+  double minDist = 1e9;
+  const auto statuses = run(a, world, k, 1500, [&] { return !a.busy() && k > 10; }, &minDist, {3.0, 1.0});
+  ASSERT_FALSE(statuses.empty());
+  EXPECT_EQ(statuses.back().state, msg::TaskState::Done);
+  EXPECT_GE(minDist, 2 * params().radius) << "drove through the parked robot";
+}
+
+TEST(Agent, StopsForARobotCrossingFromTheSide) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  (void)run(a, world, k, 25, [] { return false; });
+  ASSERT_GT(world.truth.x, 1.3);
+  // Another robot 1 m ahead and 1 m to the right, driving across the path at 0.8 m/s: on
+  // collision course, but outside the straight corridor ahead that the stop rule watches.
+  msg::RobotState other;
+  other.robot_id = "r2";
+  other.pose = {world.truth.x + 0.9, world.truth.y - 0.9, M_PI / 2};
+  other.v = 0.8;
+  other.mode = msg::RobotMode::Moving;
+  other.task_id = "t9";
+  a.onOtherRobot(other);
+  a.onFrame(world.frame(0.8, 0.0, 0.1));
+  const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+  EXPECT_LT(out.command.v, 0.5) << "did not slow for the crossing robot";
+}
+
+TEST(Agent, BacksOutOfANarrowPassageAlongItsTrailAndTakesTheOtherWay) {
+  // 10 m x 10 m: two rooms joined by a 1.25 m passage (one robot wide) and, further round, by a
+  // 2 m corridor. A robot with a smaller id stands in the passage facing this one, waiting on it.
+  auto raw = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 10; x < 30; ++x) {
+      const double cy = raw->cellCenter({x, y}).y;
+      const bool passage = cy > 4.25 && cy < 5.5;
+      const bool corridor = cy > 8.0;
+      if (!passage && !corridor) {
+        raw->setBlocked({x, y});
+      }
+    }
+  }
+  auto grid = agent::inflate(*raw, 0.3);
+  auto p = params();
+  p.id = "r2";
+  p.start = {1.0, 4.875, 0.0};
+  agent::Agent a(p, grid, raw);
+  World world;
+  world.truth = p.start;
+  msg::TaskAssignment order;
+  order.robot_id = "r2";
+  order.task_id = "t1";
+  order.revision = 1;
+  order.goals.push_back({{9.0, 4.875, 0.0}, "D-1", msg::GoalAction::Unload, 0.5});
+  a.onAssignment(order);
+  const Vec2 blocker{5.5, 4.875};
+  msg::RobotState other;
+  other.robot_id = "r1";
+  other.pose = {blocker.x, blocker.y, M_PI};
+  other.mode = msg::RobotMode::Waiting;
+  other.task_id = "t9";
+  double v = 0;
+  double w = 0;
+  double minDist = 1e9;
+  bool done = false;
+  double maxX = 0.0;
+  for (int k = 0; k < 2000 && !done; ++k) {
+    // The blocker as the robot's sensors see it, in the robot's frame.
+    const Vec2 rel = blocker - world.truth.position();
+    const double c = std::cos(world.truth.theta);
+    const double s = std::sin(world.truth.theta);
+    world.detections = {{msg::SourceKind::Robot, static_cast<float>(c * rel.x + s * rel.y),
+                         static_cast<float>(-s * rel.x + c * rel.y), 0.3f}};
+    a.onOtherRobot(other);
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    done = out.status && out.status->state == msg::TaskState::Done;
+    minDist = std::min(minDist, distance(world.truth.position(), blocker));
+    if (world.truth.y < 6.0 && world.truth.x < 7.5) {  // in the passage
+      maxX = std::max(maxX, world.truth.x);
+    }
+    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed) << out.status->error;
+  }
+  EXPECT_TRUE(done);
+  EXPECT_GE(a.conduct().returns, 1u) << "backed out along its trail";
+  EXPECT_GE(a.conduct().mutualBlocks, 1u) << "the blocker waits on it: a wait cycle";
+  EXPECT_GE(minDist, 0.6 + 0.2) << "kept clear of the robot it yielded to";
+  EXPECT_LT(maxX, blocker.x) << "never went past the blocker in the passage";
+  EXPECT_LT(distance(world.truth, Pose2{9.0, 4.875, 0.0}), 0.3);
+}

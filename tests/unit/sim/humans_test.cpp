@@ -214,3 +214,26 @@ TEST(Humans, SomeoneBlockedInAnAisleTurnsToAnotherGoal) {
   EXPECT_GT(minX, 10.0) << "nobody walks through the robot";
   EXPECT_GT(maxXLater, 14.0) << "after giving up the person walks away from the robot instead of pushing";
 }
+
+TEST(Humans, NeverWalkIntoAStandingRobotUnlessTheKeepDistanceIsOff) {
+  // Everyone walks to a point of interest just behind a parked robot, pushed on by the people
+  // behind them: the social force alone lets them press into the robot; the keep distance does not.
+  auto closest = [](double keep) {
+    auto j = test::room(40, 40);
+    j["robots"] = {{{"id", "r1"}, {"start", {10.0, 10.0}}}};
+    j["points_of_interest"] = {{3.0, 10.0}, {10.5, 10.0}};
+    j["humans"] = {{"count", 12}, {"stop_probability", 0.0}, {"speed_sd", 0.1}};
+    j["social_force"] = {{"robot_keep", keep}};
+    World w(test::parse(j));
+    for (int k = 0; k < 900; ++k) {
+      w.advance();
+    }
+    return std::pair{w.metrics().minSepRobotHuman, w.metrics().robotHumanContacts};
+  };
+  const auto [sepOn, contactsOn] = closest(0.05);
+  EXPECT_EQ(contactsOn, 0U);
+  EXPECT_GE(sepOn, 0.0);
+  const auto [sepOff, contactsOff] = closest(-1.0);
+  EXPECT_GT(contactsOff, 0U) << "the scene must press people into the robot for this test to mean anything";
+  EXPECT_LT(sepOff, 0.0);
+}

@@ -100,6 +100,9 @@ struct SocialForceParams {
   double lambda = 0.35;  // anisotropy: weight of what is behind
   double cutoff = 3.0;   // m, interactions further than this are ignored
   double maxSpeedFactor = 1.3;
+  /// m: a person's step never ends closer than this to a robot's body (cut like a step into a
+  /// wall: slide or stand). Negative: off (people may walk into robots, pure social force).
+  double robotKeep = 0.05;
 };
 
 struct Scenario {

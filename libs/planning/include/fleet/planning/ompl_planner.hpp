@@ -47,7 +47,4 @@ class OmplPlanner final : public GlobalPlanner {
   OmplStats stats_;
 };
 
-/// Straight segment a->b crosses only free cells of `grid` (and stays inside the map).
-bool segmentFree(const OccupancyGrid& grid, Vec2 a, Vec2 b);
-
 }  // namespace fleet::planning
