@@ -34,8 +34,8 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 
 Settings readSettings(Config& cfg) {
   Settings s;
-  cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "battery_threshold",
-                         "nominal_speed", "clock", "metrics_file", "map"});
+  cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
+                         "battery_threshold", "nominal_speed", "clock", "metrics_file", "map"});
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -48,6 +48,7 @@ Settings readSettings(Config& cfg) {
   s.tickS = cfg.number("tick_s", s.tickS, {0.0, 60.0, true});
   s.leaseS = cfg.number("lease_s", s.leaseS, {0.0, 3600.0, true});
   s.maxAttempts = static_cast<int>(cfg.integer("max_attempts", s.maxAttempts, {1, 100}));
+  s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
   s.nominalSpeed = cfg.number("nominal_speed", s.nominalSpeed, {0.0, 20.0, true});
   s.clock = cfg.string("clock", "wall", {"wall", "sim"});
@@ -105,6 +106,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   n->store_ = std::move(*store);
   DispatcherConfig dc;
   dc.maxAttempts = s.maxAttempts;
+  dc.stationCapacity = static_cast<std::size_t>(s.stationCapacity);
   dc.leaseNs = secToNs(s.leaseS);
   dc.policy.batteryThreshold = s.batteryThreshold;
   std::shared_ptr<planning::DistanceFieldCache> cache;

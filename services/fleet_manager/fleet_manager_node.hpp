@@ -23,6 +23,8 @@ struct Settings {
   double tickS = 0.2;        // periodic assignment
   double leaseS = 1.0;       // a robot silent this long is lost
   int maxAttempts = 3;
+  /// Active tasks per station at most (0: no limit); see DispatcherConfig::stationCapacity.
+  int stationCapacity = 2;
   double batteryThreshold = 0.2;
   double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
   std::string clock = "wall";

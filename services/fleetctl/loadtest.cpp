@@ -308,6 +308,22 @@ struct Run {
     }
   }
 
+  /// Tasks the manager holds in a final state (done, failed, cancelled), from the adapter's metrics.
+  std::size_t finishedTasks() {
+    std::size_t n = 0;
+    if (auto r = http->Get("/v1/metrics"); r && r->status == 200) {
+      auto m = json::parse(r->body, nullptr, false);
+      if (m.is_object() && m.contains("tasks_by_state") && m["tasks_by_state"].is_object()) {
+        for (const char* k : {"done", "failed", "cancelled"}) {
+          if (m["tasks_by_state"].contains(k) && m["tasks_by_state"][k].is_number_unsigned()) {
+            n += m["tasks_by_state"][k].get<std::size_t>();
+          }
+        }
+      }
+    }
+    return n;
+  }
+
   std::string progressLine(double wallS) {
     std::string states;
     if (auto r = http->Get("/v1/metrics"); r && r->status == 200) {
@@ -431,6 +447,7 @@ int Run::run() {
                                        {"db", fs::absolute(db).string()},
                                        {"clock", "sim"},
                                        {"lease_s", 3.0},
+                                       {"station_capacity", o.stationCapacity},
                                        {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
                                       .dump(1));
   writeFile(out / "risk_map.json", json{{"grid",
@@ -483,12 +500,24 @@ int Run::run() {
     for (const auto& r : ids) {
       list += (list.empty() ? "" : ",") + r;
     }
-    return ProcessSpec{name,
-                       bin("services/robot_agent/robot_agent"),
-                       {"--scenario", scn, "--clock", "lockstep", "--id", name, "--robots", list,
-                        "--local-planner", o.localPlanner, "--log-level", "warn"},
-                       env,
-                       log(name)};
+    std::vector<std::string> args = {"--scenario",
+                                     scn,
+                                     "--clock",
+                                     "lockstep",
+                                     "--id",
+                                     name,
+                                     "--robots",
+                                     list,
+                                     "--local-planner",
+                                     o.localPlanner,
+                                     "--return-home",
+                                     std::to_string(o.returnHomeS),
+                                     "--log-level",
+                                     "warn"};
+    if (o.lanes) {
+      args.emplace_back("--lanes");
+    }
+    return ProcessSpec{name, bin("services/robot_agent/robot_agent"), args, env, log(name)};
   };
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (!groups[g].empty()) {
@@ -578,6 +607,8 @@ int Run::run() {
 
   int code = 0;
   bool wallLimited = false;
+  bool finishedEarly = false;
+  double lastDoneCheck = -1e9;
   double lastProgress = -1e9;
   json progress = json::array();
   const auto simStart = Clock::now();
@@ -604,6 +635,19 @@ int Run::run() {
     }
     if (simEnded || code != 0) {
       break;
+    }
+    if (o.untilDone && o.maxTasks > 0 && generated >= o.maxTasks && wall() - lastDoneCheck >= 1.0 && [this] {
+          std::lock_guard<std::mutex> lock(mu);
+          return pending.empty();
+        }()) {
+      lastDoneCheck = wall();
+      if (finishedTasks() >= static_cast<std::size_t>(o.maxTasks)) {
+        say("every task finished at " + std::to_string(static_cast<int>(simS)) + " s simulated; stopping");
+        finishedEarly = true;
+        sup.signal("fleet-sim", SIGINT);
+        sup.waitExit("fleet-sim", 20.0);
+        break;
+      }
     }
     if (wall() > o.wallLimitS) {
       say("wall-time limit reached; stopping the simulator");
@@ -667,6 +711,7 @@ int Run::run() {
       {"wall_time_s", wallS},
       {"real_time_factor", wallS > 0 ? simTime / wallS : 0.0},
       {"wall_limited", wallLimited},
+      {"finished_early", finishedEarly},
       {"interrupted", code == 130},
       {"rate_per_min", o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(robots.size())},
       {"tasks",

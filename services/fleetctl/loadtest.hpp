@@ -17,6 +17,7 @@ struct LoadtestOptions {
   int humans = 8;
   double ratePerMin = 0;    // tasks per simulated minute; 0: 0.75 per robot
   int maxTasks = 0;         // 0: no cap besides the duration
+  bool untilDone = false;   // with maxTasks: stop once every one of them is done/failed/cancelled
   double durationS = 180;   // simulated seconds
   double wallLimitS = 600;  // the run is stopped after this much wall time whatever happens
   int agents = 1;           // robot agent processes (besides one per stalled robot)
@@ -28,6 +29,9 @@ struct LoadtestOptions {
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
   std::string localPlanner = "follow";
+  bool lanes = false;        // robot agents plan on the one-way lanes (their --lanes)
+  int stationCapacity = 2;   // the fleet manager's station_capacity (0: no limit)
+  double returnHomeS = 5.0;  // robot agents' --return-home (negative: stay where a task ends)
   int stepTimeoutMs = 300;
   /// Cap on simulated seconds per wall second (0: none). The fleet manager, WMS adapter and load
   /// generator run on the wall clock; uncapped, a fast machine compresses their latencies into

@@ -114,6 +114,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 100000.0));
   loadtest->add_option("--tasks", lt.maxTasks, "at most this many tasks (0 = no cap)")
       ->check(CLI::Range(0, 1000000));
+  loadtest->add_flag("--until-done", lt.untilDone,
+                     "with --tasks: stop as soon as every task is done, failed or cancelled");
+  loadtest->add_flag("--lanes", lt.lanes, "robot agents plan on one-way lanes (default: plain A*)");
+  loadtest->add_option("--station-capacity", lt.stationCapacity, "active tasks per station (0 = no limit)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  loadtest
+      ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")
+      ->capture_default_str();
   loadtest->add_option("--duration", lt.durationS, "simulated seconds")
       ->check(CLI::Range(1.0, 86400.0))
       ->capture_default_str();

@@ -26,6 +26,7 @@ estimation::PoseEkf makeEkf(const AgentParams& p) {
 }
 
 constexpr double kLookahead = 0.5;
+constexpr double kQueueDistance = 2.0;     // m from a station where a robot waits while it is taken
 constexpr double kTrailStep = 0.25;        // m between trail points
 constexpr std::size_t kTrailPoints = 120;  // 30 m of trail
 
@@ -107,9 +108,21 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
 bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
   const Pose2 pose = ekf_.pose();
   std::vector<avoidance::MovingDisc> discs;
+  // Only what is ahead or beside: whoever comes from behind keeps the distance (its own stop rule
+  // does); counting it here froze whole queues, each robot held by the one closing in behind it.
+  const Vec2 heading{std::cos(pose.theta), std::sin(pose.theta)};
+  auto relevant = [&](Vec2 at) {
+    const Vec2 rel = at - pose.position();
+    return rel.norm() < 3.0 && rel.dot(heading) > -p_.radius;
+  };
   for (const auto& o : others_) {
-    if (distance(o.pos, pose.position()) < 3.0) {
+    if (relevant(o.pos)) {
       discs.push_back({o.pos, o.velocity, p_.radius});
+    }
+  }
+  for (const auto& h : people_) {
+    if (relevant(h.pos)) {
+      discs.push_back({h.pos, h.velocity, h.radius});
     }
   }
   if (discs.empty()) {
@@ -136,6 +149,12 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
       blocker = o.id;
     }
   }
+  for (const auto& h : people_) {
+    if (distance(h.pos, pose.position()) < best) {
+      best = distance(h.pos, pose.position());
+      blocker = "human";
+    }
+  }
   v = r.twist.v;
   w = r.twist.omega;
   return false;
@@ -159,6 +178,32 @@ void Agent::onFrame(const msg::SensorFrame& f) {
   if (std::isfinite(f.battery)) {
     battery_ = static_cast<double>(f.battery);
   }
+  // Track people from frame to frame (nearest previous detection within 0.5 m) for a velocity.
+  std::vector<Person> seen;
+  const double dtFrame =
+      peopleStampNs_ >= 0 && f.stamp_ns > peopleStampNs_ ? nsToSec(f.stamp_ns - peopleStampNs_) : 0.0;
+  for (const auto& d : f.detections) {
+    if (d.kind != msg::SourceKind::Human || !std::isfinite(d.x) || !std::isfinite(d.y)) {
+      continue;
+    }
+    Person p{ekf_.pose().transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
+             {},
+             static_cast<double>(d.r)};
+    const Person* prev = nullptr;
+    for (const auto& q : people_) {
+      if (distance(q.pos, p.pos) < 0.5 &&
+          (prev == nullptr || distance(q.pos, p.pos) < distance(prev->pos, p.pos))) {
+        prev = &q;
+      }
+    }
+    if (prev != nullptr && dtFrame > 0.0 && dtFrame < 1.0) {
+      // Smoothed: detections jitter by a few centimetres per frame.
+      p.velocity = prev->velocity * 0.5 + ((p.pos - prev->pos) / dtFrame) * 0.5;
+    }
+    seen.push_back(p);
+  }
+  people_ = std::move(seen);
+  peopleStampNs_ = f.stamp_ns;
   frame_ = f;
   haveFrame_ = true;
   frameSinceStep_ = true;
@@ -200,6 +245,8 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
   task_ = a.task_id;
   goals_ = a.goals;
   goal_ = 0;
+  holdSinceNs_ = -1;
+  movedNs_ = -1;  // the progress watch starts with this order
   reported_ = msg::TaskState::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
 }
@@ -234,8 +281,9 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
   const double keep = 2.0 * p_.radius + 0.2;
   const Vec2 self = ekf_.pose().position();
   for (const auto& o : others_) {
-    // Never wall in the robot itself or its goal: a robot parked on my goal is a wait, not a detour.
-    if (!standing(o) || distance(o.pos, self) < keep + res || distance(o.pos, goal) < keep + res) {
+    // Never wall in the goal: a robot parked on my goal is a wait, not a detour. (The robot's own
+    // surroundings are opened again below.)
+    if (!standing(o) || distance(o.pos, goal) < keep + res) {
       continue;
     }
     const auto c = g.cellAt(o.pos);
@@ -248,6 +296,36 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
         const planning::Cell q{c->x + dx, c->y + dy};
         if (g.inside(q) && distance(g.cellCenter(q), o.pos) < keep) {
           g.setBlocked(q);
+        }
+      }
+    }
+  }
+  // A robot parked closer to a wall than the planning margin starts in a blocked cell; open the
+  // cells around it that are free on the map and not next to a standing robot, so the plan leads
+  // out of the parking place instead of falling back to the raw map (which ignores the neighbours).
+  if (const auto c = g.cellAt(self); c && g.blocked(*c)) {
+    const double open = p_.radius + 0.35;
+    const int reach = static_cast<int>(std::ceil(open / res));
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const planning::Cell q{c->x + dx, c->y + dy};
+        if (!g.inside(q) || distance(g.cellCenter(q), self) > open) {
+          continue;
+        }
+        const auto rc = raw_->cellAt(g.cellCenter(q));
+        // Only where the robot's body fits on the map (clear of walls by its radius).
+        bool fits = rc.has_value();
+        for (int k = 0; fits && k < 8; ++k) {
+          const double a = k * M_PI / 4.0;
+          const auto e = raw_->cellAt(g.cellCenter(q) + Vec2{std::cos(a), std::sin(a)} * p_.radius);
+          fits = e && !raw_->blocked(*e);
+        }
+        bool nearStanding = false;
+        for (const auto& o : others_) {
+          nearStanding = nearStanding || (standing(o) && distance(o.pos, g.cellCenter(q)) < keep);
+        }
+        if (fits && !raw_->blocked(*rc) && !nearStanding) {
+          g.setBlocked(q, false);
         }
       }
     }
@@ -271,6 +349,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   Expected<planning::Path> path = unexpected("no_path", "not planned");
   const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
   if (avoid) {
+    const Vec2 self = ekf_.pose().position();
     planning::OccupancyGrid detour = around;
     const double res = detour.resolution();
     const int reach = static_cast<int>(std::ceil(0.9 / res));
@@ -278,7 +357,11 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
       for (int dy = -reach; dy <= reach; ++dy) {
         for (int dx = -reach; dx <= reach; ++dx) {
           const planning::Cell q{c->x + dx, c->y + dy};
-          if (detour.inside(q) && distance(detour.cellCenter(q), *avoid) <= 0.9) {
+          // Close to the obstacle the robot stands inside that disc itself: keep free the cells
+          // next to it on the side away from the obstacle, so the detour can start by leaving.
+          const Vec2 off = detour.inside(q) ? detour.cellCenter(q) - self : Vec2{};
+          const bool leaving = off.norm() < p_.radius + 0.15 && off.dot(*avoid - self) <= 0.0;
+          if (detour.inside(q) && distance(detour.cellCenter(q), *avoid) <= 0.9 && !leaving) {
             detour.setBlocked(q);
           }
         }
@@ -341,6 +424,8 @@ void Agent::finishTask(msg::TaskState final, const std::string& reason, std::int
         nowNs};
   }
   idleSinceNs_ = nowNs;
+  holdSinceNs_ = -1;
+  movedNs_ = nowNs;
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;
@@ -474,7 +559,7 @@ bool Agent::heldUp(double& v, double& w, bool& byRobot, std::string& blocker) co
   std::string crossing;
   const bool crossOk = crossTrafficSafe(v, w, crossing);
   if (!crossOk && allowed >= 0.05) {
-    byRobot = true;
+    byRobot = crossing != "human";
     blocker = crossing.empty() ? std::string("robot") : crossing;
   }
   return allowed < 0.05 || !crossOk;
@@ -594,9 +679,19 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
       }
     }
   }
-  // A person who does not step aside, or two robots face to face (the larger id yields): back off
-  // if nothing is behind, then try another way around, rather than wait forever.
-  const bool yields = byRobot ? (blocker != "robot" && p_.id > blocker) : true;
+  // A person who does not step aside, or two robots face to face: the one of lower priority backs
+  // off if nothing is behind, then tries another way around, rather than wait forever. Priority:
+  // a robot on an order before one driving home, then the smaller id. It is a total order, so in
+  // every wait cycle some robot waits on one of higher priority and yields.
+  bool yields = !byRobot;
+  if (byRobot && blocker != "robot") {
+    yields = p_.id > blocker;
+    for (const auto& o : others_) {
+      if (o.id == blocker && homing_ != !o.hasTask) {
+        yields = homing_;  // exactly one of the two drives home: that one yields
+      }
+    }
+  }
   if (blockedS > p_.blockedBackoffS && yields && startReturn(nowNs)) {
     v = 0.0;
     w = 0.0;
@@ -646,6 +741,7 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
       blockedSinceNs_ += outage;
     }
     lastProgressNs_ += outage;
+    movedNs_ += outage;
     if (planner_) {
       planner_->reset();
     }
@@ -704,14 +800,36 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
     } else if (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15)) {
       enterDwell(nowNs);
+    } else if (const Other* occupant = stationOccupant(); occupant != nullptr) {
+      // Queue for the station a little way off instead of pushing into the robot on it.
+      mode = msg::RobotMode::Waiting;
+      if (holdSinceNs_ < 0) {
+        holdSinceNs_ = nowNs;
+      } else if (nsToSec(nowNs - holdSinceNs_) > p_.blockedFailS) {
+        finishTask(msg::TaskState::Failed,
+                   goals_[goal_].station + " occupied by " + occupant->id + " for " +
+                       std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
+                   nowNs);
+      }
+      movedNs_ = nowNs;  // waiting in the queue is not being stuck
     } else {
+      holdSinceNs_ = -1;
       docking_ = r->final_approach;
       followerTwist(*r, v, w);
       mode = msg::RobotMode::Moving;
       bool byRobot = false;
       std::string blocker;
       const double wanted = v;
-      if (heldUp(v, w, byRobot, blocker) && wanted > 0.1) {
+      const bool held = heldUp(v, w, byRobot, blocker) && wanted > 0.1;
+      const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
+      const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
+      if (held && !byRobot && blocker.empty() && !r->final_approach && std::abs(bearing) > 0.25) {
+        // A wall or shelf ahead while the path bends away (a diagonal A* step into a band): turn
+        // toward the carrot on the spot, which no static obstacle can stop, instead of waiting.
+        v = 0.0;
+        w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
+        blockedSinceNs_ = -1;
+      } else if (held) {
         mode = msg::RobotMode::Waiting;
         onStandoff(nowNs, byRobot, blocker, v, w);
       } else {
@@ -779,6 +897,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       backoffFrom_.reset();
     }
   }
+  watchProgress(nowNs);
   if (phase_ == Phase::Driving) {
     const Vec2 here = ekf_.pose().position();
     if (trail_.empty() || distance(trail_.back(), here) > kTrailStep) {
@@ -795,6 +914,43 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   return out;
 }
 
+void Agent::watchProgress(std::int64_t nowNs) {
+  const Vec2 here = ekf_.pose().position();
+  const bool travelling =
+      phase_ == Phase::Driving || phase_ == Phase::Returning || phase_ == Phase::BackingOff;
+  if (!travelling || movedNs_ < 0 || distance(here, movedFrom_) > 0.1) {
+    movedFrom_ = here;
+    movedNs_ = nowNs;
+    return;
+  }
+  const double stillS = nsToSec(nowNs - movedNs_);
+  // A last resort behind the standoff rules (whose timer restarts whenever the robot inches on):
+  // three times their limit, so a robot in a long queue is not failed for queueing.
+  if (stillS > 3.0 * p_.blockedFailS && (!task_.empty() || homing_)) {
+    finishTask(msg::TaskState::Failed,
+               "no progress for " + std::to_string(static_cast<int>(3.0 * p_.blockedFailS)) + " s", nowNs);
+  } else if (phase_ == Phase::Returning && stillS > 2.0 * p_.blockedBackoffS) {
+    phase_ = Phase::Idle;  // the way back is held up too: plan afresh from here
+    backoffFrom_.reset();
+    startGoal(nowNs);
+  }
+}
+
+const Agent::Other* Agent::stationOccupant() const {
+  const auto& g = goals_[goal_];
+  const Vec2 here = ekf_.pose().position();
+  const double toGoal = distance(here, g.pose.position());
+  if (homing_ || toGoal > kQueueDistance || toGoal < kQueueDistance - 0.5) {
+    return nullptr;  // far off, or already past the queue place: go on
+  }
+  for (const auto& o : others_) {
+    if (distance(o.pos, g.pose.position()) < 2.0 * p_.radius + 0.1) {
+      return &o;
+    }
+  }
+  return nullptr;
+}
+
 void Agent::maybeReturnHome(std::int64_t nowNs) {
   if (!task_.empty() || homing_ || phase_ != Phase::Idle || p_.returnHomeS < 0.0) {
     return;
@@ -802,8 +958,13 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
   if (idleSinceNs_ < 0) {
     idleSinceNs_ = nowNs;
   }
-  if (nsToSec(nowNs - idleSinceNs_) < p_.returnHomeS || nowNs < homeRetryNs_ ||
-      distance(ekf_.pose().position(), p_.start.position()) < 0.3) {
+  // Someone waiting close by may be queueing for the station this robot stands on: leave at once.
+  const bool wanted = std::any_of(others_.begin(), others_.end(), [&](const Other& o) {
+    return o.mode == msg::RobotMode::Waiting &&
+           distance(o.pos, ekf_.pose().position()) < kQueueDistance + 0.5;
+  });
+  if (nsToSec(nowNs - idleSinceNs_) < (wanted ? std::min(1.0, p_.returnHomeS) : p_.returnHomeS) ||
+      nowNs < homeRetryNs_ || distance(ekf_.pose().position(), p_.start.position()) < 0.3) {
     return;
   }
   homing_ = true;

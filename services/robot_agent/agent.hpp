@@ -175,6 +175,15 @@ class Agent {
   /// straight-ahead corridor sees too late). Returns false when it had to stop the robot.
   bool crossTrafficSafe(double& v, double& w, std::string& blocker) const;
   avoidance::SafetyLayer safety_;
+  /// People seen in the latest frame (map frame) with a velocity from the frame before: a person
+  /// walking across the robot's way is outside the corridor the stop rule watches until too late.
+  struct Person {
+    Vec2 pos;
+    Vec2 velocity;
+    double radius = 0.25;
+  };
+  std::vector<Person> people_;
+  std::int64_t peopleStampNs_ = -1;
   std::vector<Other> others_;
   /// The planning grid with the robots that stand still for a while (parked, loading, charging,
   /// faulted) blocked, so a path goes around them instead of into a queue behind them.
@@ -191,7 +200,15 @@ class Agent {
   bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
   std::int64_t idleSinceNs_ = -1;
   std::int64_t homeRetryNs_ = -1;  // after a failed trip home, not before this time
-  std::vector<Vec2> trail_;        // where the robot drove, a point every kTrailStep (newest last)
+  /// On the way to a station that another robot stands on, this far off: that robot (else null).
+  [[nodiscard]] const Other* stationOccupant() const;
+  std::int64_t holdSinceNs_ = -1;  // queueing for an occupied station since
+  Vec2 movedFrom_;                 // where the robot last moved 0.1 m from
+  std::int64_t movedNs_ = 0;       // ... and when
+  /// A task whose robot has not moved for 3 x blockedFailS fails (whatever held it: a planner that
+  /// outputs nothing, a return that cannot finish); a return that has not moved for a while ends.
+  void watchProgress(std::int64_t nowNs);
+  std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
   Conduct conduct_;
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <tuple>
+#include <unordered_map>
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
@@ -303,6 +304,50 @@ void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
   }
 }
 
+namespace {
+// The stations a task occupies while it is active.
+std::vector<const std::string*> stationsOf(const Task& t) {
+  std::vector<const std::string*> s;
+  for (const std::string* n : {&t.pickup, &t.dropoff, &t.station}) {
+    if (!n->empty()) {
+      s.push_back(n);
+    }
+  }
+  return s;
+}
+}  // namespace
+
+void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
+  std::unordered_map<std::string, std::size_t> load;
+  for (const auto& [id, r] : open_) {
+    if (isActive(r.state)) {
+      for (const std::string* s : stationsOf(r.task)) {
+        ++load[*s];
+      }
+    }
+  }
+  // Oldest first (pinned and urgent before that), so a busy station's queue is served in order.
+  std::stable_sort(waiting.begin(), waiting.end(), [](const Task& a, const Task& b) {
+    return std::tuple(a.robot.empty(), -a.priority, a.createdNs) <
+           std::tuple(b.robot.empty(), -b.priority, b.createdNs);
+  });
+  std::vector<Task> admitted;
+  for (auto& t : waiting) {
+    const auto stations = stationsOf(t);
+    // A robot's own charge task is never held back: its battery does not wait for the queue.
+    const bool full = t.robot.empty() &&
+                      std::any_of(stations.begin(), stations.end(),
+                                  [&](const std::string* s) { return load[*s] >= cfg_.stationCapacity; });
+    if (!full) {
+      for (const std::string* s : stations) {
+        ++load[*s];
+      }
+      admitted.push_back(std::move(t));
+    }
+  }
+  waiting = std::move(admitted);
+}
+
 void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   std::vector<Task> waiting;
   for (const auto& [id, r] : open_) {
@@ -313,6 +358,12 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   const auto idle = registry_.idleRobots();
   if (waiting.empty() || idle.empty()) {
     return;
+  }
+  if (cfg_.stationCapacity > 0) {
+    admitByStationCapacity(waiting);
+    if (waiting.empty()) {
+      return;
+    }
   }
   if (waiting.size() > cfg_.maxCandidates) {
     auto key = [](const Task& t) {

@@ -204,6 +204,45 @@ TEST_F(DispatcherTest, BacklogCapKeepsTheMostUrgentTasks) {
   EXPECT_EQ(dispatcher->tick(2).assignments.size(), 1u) << "the rest follow on later ticks";
 }
 
+TEST_F(DispatcherTest, StationCapacityHoldsTasksBackOldestFirst) {
+  cfg.stationCapacity = 2;
+  reopen();
+  for (int i = 0; i < 5; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  // Four tasks to D-1 (two of them submitted first) and one charge trip elsewhere.
+  dispatcher->submit({transport("t1"), transport("t2")}, 0);
+  dispatcher->submit({transport("t3"), transport("t4")}, 1);
+  Task park;
+  park.id = "park";
+  park.kind = TaskKind::Park;
+  park.station = "K-1";
+  dispatcher->submit({park}, 2);
+  auto out = dispatcher->tick(3);
+  std::set<std::string> ids;
+  for (const auto& a : out.assignments) {
+    ids.insert(a.task.id);
+  }
+  EXPECT_EQ(ids, (std::set<std::string>{"t1", "t2", "park"})) << "two robots per station, oldest first";
+  EXPECT_TRUE(dispatcher->tick(4).assignments.empty()) << "the station is still full";
+  const std::string holder =
+      out.assignments[0].task.id == "park" ? out.assignments[1].robotId : out.assignments[0].robotId;
+  const std::string done =
+      out.assignments[0].task.id == "park" ? out.assignments[1].task.id : out.assignments[0].task.id;
+  ASSERT_TRUE(dispatcher->onTaskStatus(holder, done, S::Done, "", 5));
+  const auto next = dispatcher->tick(6);
+  ASSERT_EQ(next.assignments.size(), 1u) << "a place freed: one more task goes";
+  EXPECT_EQ(next.assignments[0].task.id, "t3");
+}
+
+TEST_F(DispatcherTest, WithoutStationCapacityEveryRobotIsSent) {
+  for (int i = 0; i < 4; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  dispatcher->submit({transport("t1"), transport("t2"), transport("t3"), transport("t4")}, 0);
+  EXPECT_EQ(dispatcher->tick(1).assignments.size(), 4u);
+}
+
 TEST_F(DispatcherTest, CancelWithdrawsActiveTask) {
   robot("a", 1, 0.9, 0);
   dispatcher->submit({transport("t1"), transport("t2")}, 0);

@@ -396,3 +396,41 @@ TEST(Agent, BacksOutOfANarrowPassageAlongItsTrailAndTakesTheOtherWay) {
   EXPECT_LT(maxX, blocker.x) << "never went past the blocker in the passage";
   EXPECT_LT(distance(world.truth, Pose2{9.0, 4.875, 0.0}), 0.3);
 }
+
+TEST(Agent, SlowsForAPersonWalkingAcrossItsWay) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  (void)run(a, world, k, 25, [] { return false; });
+  ASSERT_GT(world.truth.x, 1.3);
+  // A person 1 m ahead and 1 m to the right walking across at 1.2 m/s, seen in two frames 0.1 s
+  // apart: outside the straight corridor the stop rule watches, on collision course all the same.
+  auto step = [&](double side, std::int64_t stampNs) {
+    world.detections = {{msg::SourceKind::Human, 1.0f, static_cast<float>(side), 0.25f}};
+    auto f = world.frame(0.8, 0.0, 0.1);
+    f.stamp_ns = stampNs;
+    a.onFrame(f);
+    return a.step(stampNs, 0.1);
+  };
+  (void)step(-1.12, static_cast<std::int64_t>(k) * 100'000'000);
+  const auto out = step(-1.0, static_cast<std::int64_t>(k + 1) * 100'000'000);
+  EXPECT_LT(out.command.v, 0.5) << "did not slow for the person crossing";
+  // The same person standing still there is no reason to slow down.
+  agent::Agent b(params(), grid, grid);
+  World still;
+  b.onAssignment(transport());
+  int j = 0;
+  (void)run(b, still, j, 25, [] { return false; });
+  still.detections = {{msg::SourceKind::Human, 1.0f, -1.0f, 0.25f}};
+  for (int i = 0; i < 2; ++i) {
+    auto f = still.frame(0.8, 0.0, 0.1);
+    f.stamp_ns = static_cast<std::int64_t>(j + i) * 100'000'000;
+    b.onFrame(f);
+    const auto o = b.step(f.stamp_ns, 0.1);
+    if (i == 1) {
+      EXPECT_GT(o.command.v, 0.5);
+    }
+  }
+}

@@ -24,6 +24,10 @@ struct DispatcherConfig {
   /// With a long backlog only this many waiting tasks enter one allocation: pinned tasks first
   /// (a robot's own charge task), then by priority, deadline and age. Bounds a tick's cost.
   std::size_t maxCandidates = 1000;
+  /// At most this many active tasks use one station (pickup, drop-off or target) at a time; a
+  /// task whose station is full waits in the queue (oldest first) instead of sending another robot
+  /// to crowd the station. 0: no limit.
+  std::size_t stationCapacity = 0;
 };
 
 /// A state change to publish as `TaskEvent`.
@@ -109,6 +113,8 @@ class Dispatcher {
                      DispatchResult& out);
   void chargeLowRobots(std::int64_t nowNs, DispatchResult& out);
   void allocate(std::int64_t nowNs, DispatchResult& out);
+  /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig).
+  void admitByStationCapacity(std::vector<Task>& waiting) const;
 
   TaskStore& store_;
   StationMap stations_;

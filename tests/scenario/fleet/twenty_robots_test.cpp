@@ -1,0 +1,100 @@
+// The whole fleet in lockstep on the small warehouse: 20 robots, 8 people, 100 transport tasks
+// posted through the WMS adapter by `fleetctl loadtest`. Safety is absolute (no contact of any
+// kind); the fleet must not deadlock (tasks keep being delivered) and nothing acknowledged may be
+// lost or duplicated. How many of the 100 are done in the time given is the throughput figure
+// (docs/benchmarks.md); the floor here only catches a collapse.
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "test_process.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+/// Simulated seconds at which tasks reached `done`, from the manager's database.
+std::vector<double> doneTimes(const fs::path& db) {
+  std::vector<double> t;
+  sqlite3* h = nullptr;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    sqlite3_close(h);
+    return t;
+  }
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(h, "SELECT stamp_ns FROM transitions WHERE to_state = 'done' ORDER BY stamp_ns", -1,
+                         &st, nullptr) == SQLITE_OK) {
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      t.push_back(static_cast<double>(sqlite3_column_int64(st, 0)) * 1e-9);
+    }
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(h);
+  return t;
+}
+
+}  // namespace
+
+TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
+  const fs::path out = fs::temp_directory_path() / ("fleet_twenty_" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const double durationS = 1800.0;
+  fleet::test::ChildProcess run(FLEET_BINARY_DIR "/services/fleetctl/fleetctl",
+                                {"loadtest",
+                                 "--scenario",
+                                 FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse.json",
+                                 "--tasks",
+                                 "100",
+                                 "--rate",
+                                 "12",
+                                 "--until-done",
+                                 "--duration",
+                                 std::to_string(durationS),
+                                 "--max-speed",
+                                 "10",
+                                 "--wall-limit",
+                                 "400",
+                                 "--domain",
+                                 std::to_string(fleet::test::uniqueDomain()),
+                                 "--report-script",
+                                 "",
+                                 "--out",
+                                 out.string()});
+  ASSERT_EQ(run.wait(std::chrono::seconds(480)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  const auto& a = r["accounting"];
+  EXPECT_EQ(r["wall_limited"], false) << "the machine could not keep up; see " << out;
+  EXPECT_EQ(a["acknowledged"], 100);
+  EXPECT_EQ(a["lost"], 0) << a.dump();
+  EXPECT_EQ(a["duplicated"], 0) << a.dump();
+  const auto& s = r["safety"];
+  EXPECT_EQ(s["contacts"]["robot_robot"], 0) << s.dump();
+  EXPECT_EQ(s["contacts"]["robot_human"], 0) << s.dump();
+  EXPECT_EQ(s["contacts"]["robot_shelf"], 0) << s.dump();
+  EXPECT_EQ(s["lockstep_step_timeouts"], 0) << s.dump();
+
+  // No deadlock: from the first delivery to the end of the run, no 300 s without one.
+  auto done = doneTimes(out / "fleet.db");
+  ASSERT_FALSE(done.empty());
+  const double end = r["sim_time_s"].get<double>();
+  done.push_back(end);
+  double longestGap = 0.0;
+  for (std::size_t k = 1; k < done.size(); ++k) {
+    longestGap = std::max(longestGap, done[k] - done[k - 1]);
+  }
+  EXPECT_LT(longestGap, 300.0) << "the fleet stopped delivering for " << longestGap << " s";
+  EXPECT_GE(a["done"].get<int>(), 50) << a.dump();
+  std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
+            << " s wall), failed " << a["failed"] << ", min separation robot-robot "
+            << s["min_separation_m"]["robot_robot"] << " m, robot-human "
+            << s["min_separation_m"]["robot_human"] << " m\n";
+  fs::remove_all(out);
+}
