@@ -35,7 +35,8 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
-                         "battery_threshold", "nominal_speed", "clock", "metrics_file", "map"});
+                         "robot_fail_limit", "robot_hold_s", "battery_threshold", "nominal_speed", "clock",
+                         "metrics_file", "map"});
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -48,6 +49,8 @@ Settings readSettings(Config& cfg) {
   s.tickS = cfg.number("tick_s", s.tickS, {0.0, 60.0, true});
   s.leaseS = cfg.number("lease_s", s.leaseS, {0.0, 3600.0, true});
   s.maxAttempts = static_cast<int>(cfg.integer("max_attempts", s.maxAttempts, {1, 100}));
+  s.robotFailLimit = static_cast<int>(cfg.integer("robot_fail_limit", s.robotFailLimit, {0, 1000}));
+  s.robotHoldS = cfg.number("robot_hold_s", s.robotHoldS, {0.0, 86400.0});
   s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
   s.nominalSpeed = cfg.number("nominal_speed", s.nominalSpeed, {0.0, 20.0, true});
@@ -107,6 +110,8 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   DispatcherConfig dc;
   dc.maxAttempts = s.maxAttempts;
   dc.stationCapacity = static_cast<std::size_t>(s.stationCapacity);
+  dc.robotFailLimit = s.robotFailLimit;
+  dc.robotHoldNs = secToNs(s.robotHoldS);
   dc.leaseNs = secToNs(s.leaseS);
   dc.policy.batteryThreshold = s.batteryThreshold;
   std::shared_ptr<planning::DistanceFieldCache> cache;

@@ -25,6 +25,8 @@ struct Settings {
   int maxAttempts = 3;
   /// Active tasks per station at most (0: no limit); see DispatcherConfig::stationCapacity.
   int stationCapacity = 2;
+  int robotFailLimit = 3;    ///< failures in a row before a robot is held back (0: never)
+  double robotHoldS = 60.0;  ///< ... for this long
   double batteryThreshold = 0.2;
   double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
   std::string clock = "wall";

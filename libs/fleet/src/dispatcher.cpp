@@ -201,6 +201,12 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   }
   DispatchResult out;
   if (state == TaskState::Failed) {
+    auto& streak = failStreak_[robotId];
+    if (cfg_.robotFailLimit > 0 && ++streak.count >= cfg_.robotFailLimit) {
+      streak.count = 0;
+      streak.holdUntilNs = nowNs + cfg_.robotHoldNs;
+      ++counters_.robotsHeld;
+    }
     requeueOrFail(cur, true, reason.empty() ? std::string("failed") : reason, nowNs, out);
     if (!out.errors.empty()) {
       return unexpected(out.errors.front());
@@ -232,6 +238,9 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   }
   if (isTerminal(state)) {
     registry_.clearTask(robotId);
+  }
+  if (state == TaskState::Done) {
+    failStreak_[robotId].count = 0;
   }
   return out;
 }
@@ -355,7 +364,11 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
       waiting.push_back(r.task);
     }
   }
-  const auto idle = registry_.idleRobots();
+  auto idle = registry_.idleRobots();
+  std::erase_if(idle, [&](const RobotInfo& r) {
+    const auto it = failStreak_.find(r.id);
+    return it != failStreak_.end() && it->second.holdUntilNs > nowNs;
+  });
   if (waiting.empty() || idle.empty()) {
     return;
   }

@@ -235,6 +235,43 @@ TEST_F(DispatcherTest, StationCapacityHoldsTasksBackOldestFirst) {
   EXPECT_EQ(next.assignments[0].task.id, "t3");
 }
 
+TEST_F(DispatcherTest, ARobotThatFailsEveryTaskIsHeldBackForAWhile) {
+  robot("broken", 1, 0.9, 0);
+  robot("far", 30, 0.9, 0);
+  for (int i = 0; i < 20; ++i) {
+    dispatcher->submit({transport("t" + std::to_string(i))}, 0);
+  }
+  auto taskOf = [&](const char* id) { return dispatcher->robots().find(id)->taskId; };
+  // The nearer robot fails each task it gets at once, three times in a row; the other delivers.
+  auto alive = [&](std::int64_t t) {  // states keep both robots within their lease
+    robot("broken", 1, 0.9, t);
+    robot("far", 30, 0.9, t);
+  };
+  for (int k = 0; k < 3; ++k) {
+    alive(kSec * (k + 1));
+    (void)dispatcher->tick(kSec * (k + 1));
+    const std::string mine = taskOf("broken");
+    ASSERT_FALSE(mine.empty()) << "round " << k;
+    ASSERT_TRUE(
+        dispatcher->onTaskStatus("broken", mine, S::Failed, "no path: start cell blocked", kSec * (k + 1)));
+    if (const std::string other = taskOf("far"); !other.empty()) {
+      ASSERT_TRUE(dispatcher->onTaskStatus("far", other, S::Done, "", kSec * (k + 1)));
+    }
+  }
+  EXPECT_EQ(dispatcher->counters().robotsHeld, 1);
+  for (int k = 4; k < 30; ++k) {
+    alive(kSec * k);
+    (void)dispatcher->tick(kSec * k);
+    EXPECT_TRUE(taskOf("broken").empty()) << "held back after three failures in a row (t = " << k << " s)";
+    if (const std::string other = taskOf("far"); !other.empty() && k % 5 == 0) {
+      ASSERT_TRUE(dispatcher->onTaskStatus("far", other, S::Done, "", kSec * k));
+    }
+  }
+  alive(70 * kSec);
+  (void)dispatcher->tick(70 * kSec);
+  EXPECT_FALSE(taskOf("broken").empty()) << "after the hold it gets work again";
+}
+
 TEST_F(DispatcherTest, WithoutStationCapacityEveryRobotIsSent) {
   for (int i = 0; i < 4; ++i) {
     robot("r" + std::to_string(i), i, 0.9, 0);

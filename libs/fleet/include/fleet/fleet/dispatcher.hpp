@@ -28,6 +28,11 @@ struct DispatcherConfig {
   /// task whose station is full waits in the queue (oldest first) instead of sending another robot
   /// to crowd the station. 0: no limit.
   std::size_t stationCapacity = 0;
+  /// A robot that fails this many tasks in a row gets no task for robotHoldNs: an agent that fails
+  /// every order at once (a pose estimate inside a shelf after a restart) would otherwise burn
+  /// through the queue, each task failing its attempts on it. 0: never held.
+  std::int32_t robotFailLimit = 3;
+  std::int64_t robotHoldNs = 60'000'000'000;
 };
 
 /// A state change to publish as `TaskEvent`.
@@ -65,6 +70,7 @@ struct DispatcherCounters {
   std::int64_t cancelled = 0;
   std::int64_t requeued = 0;
   std::int64_t robotsLost = 0;
+  std::int64_t robotsHeld = 0;  ///< times a robot was held back after robotFailLimit failures in a row
 };
 
 /// The fleet manager's logic without DDS: owns the open tasks in memory, the robot registry and
@@ -125,6 +131,11 @@ class Dispatcher {
   GreedyAllocator greedy_;
   std::map<std::string, TaskRecord, std::less<>> open_;
   DispatcherCounters counters_;
+  struct FailStreak {
+    std::int32_t count = 0;
+    std::int64_t holdUntilNs = 0;
+  };
+  std::map<std::string, FailStreak, std::less<>> failStreak_;  // by robot id
 };
 
 }  // namespace fleet
