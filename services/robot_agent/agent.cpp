@@ -421,9 +421,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   }
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
-  lastProgressNs_ = nowNs;
   blockedSinceNs_ = -1;
-  detoured_ = avoid.has_value();
   const auto st = taskStateFor(goal_, false);
   if (st != reported_) {
     reported_ = st;
@@ -729,7 +727,6 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     lastDetourNs_ = nowNs;
     ++conduct_.detours;
     startGoal(nowNs, blockPoint_);
-    detoured_ = true;
   } else if (blockedS > p_.blockedFailS) {
     finishTask(msg::TaskState::Failed,
                "blocked by " + (blocker.empty() ? std::string("an obstacle") : blocker) + " for " +
@@ -762,7 +759,6 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
     if (blockedSinceNs_ >= 0) {
       blockedSinceNs_ += outage;
     }
-    lastProgressNs_ += outage;
     movedNs_ += outage;
     if (planner_) {
       planner_->reset();

@@ -160,7 +160,6 @@ class Agent {
   std::int64_t phaseStartNs_ = 0;
   std::int64_t blockedSinceNs_ = -1;
   std::int64_t countedStandoffNs_ = -1;  // the standoff already counted in conduct_
-  std::int64_t lastProgressNs_ = 0;
   std::optional<msg::TaskStatus> pendingStatus_;
   msg::TaskState reported_ = msg::TaskState::Queued;
   struct Other {
@@ -191,7 +190,6 @@ class Agent {
   static bool standing(const Other& o);
   std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
-  bool detoured_ = false;                   // already tried a detour for the current standoff
   std::int64_t lastDetourNs_ = -1;          // when the last detour was tried
   double v_ = 0.0;
   double w_ = 0.0;
