@@ -68,13 +68,35 @@ TEST_F(WriteBatching, QueuedBurstArrivesWholeAfterFlush) {
     std::this_thread::sleep_for(10ms);
   }
   ASSERT_GT(w.matchedReaders(), 0u);
+  // One round trip first. Our reader seeing the peer's echo writer does not mean that writer has
+  // seen our reader yet; until it has, transient-local keeps only the last sample per instance for
+  // us (on a loaded CI machine 7 of 1,003 arrived, one per robot id).
+  msg::RobotState warm = state(0);
+  warm.robot_id = "warm-up";
+  bool echoed = false;
+  while (!echoed && std::chrono::steady_clock::now() < deadline) {
+    w.write(warm);
+    r.waitForData(200ms);
+    for (const auto& m : r.take()) {
+      echoed = echoed || m.robot_id == "warm-up";
+    }
+  }
+  ASSERT_TRUE(echoed) << "the peer never echoed";
   // 1,003 samples: many full datagrams plus a partial last one that only flush() sends.
   constexpr std::uint32_t kN = 1003;
   for (std::uint32_t i = 0; i < kN; ++i) {
     w.queue(state(i));
   }
   w.flush();
-  auto got = collect(r, kN, deadline);
+  std::vector<msg::RobotState> got;
+  while (got.size() < kN && std::chrono::steady_clock::now() < deadline) {
+    r.waitForData(100ms);
+    for (auto& m : r.take()) {
+      if (m.robot_id != "warm-up") {  // repeats of the round trip may still come in
+        got.push_back(std::move(m));
+      }
+    }
+  }
   ASSERT_EQ(got.size(), kN);
   // A take() returns samples grouped by instance (robot id), so compare in write order by stamp.
   std::sort(got.begin(), got.end(), [](const auto& a, const auto& b) { return a.stamp_ns < b.stamp_ns; });
