@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "fleet/avoidance/safety_layer.hpp"
+#include "fleet/core/angles.hpp"
 #include "fleet/core/clock.hpp"
+#include "fleet/geometry/grid_raycast.hpp"
 #include "fleet/planning/astar.hpp"
 #include "fleet/planning/return_path.hpp"
 #include "risk_astar.hpp"
@@ -70,17 +72,9 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
     }
   }
   path_.erase(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(nearest));
-  std::vector<Vec2> scan;
+  const std::vector<Vec2> scan = scanPoints(3.0);
   std::vector<avoidance::MovingDisc> discs;
   if (haveFrame_) {
-    for (std::size_t i = 0; i < frame_.ranges.size(); ++i) {
-      const double range = static_cast<double>(frame_.ranges[i]);
-      if (range < static_cast<double>(frame_.range_max) && range < 3.0) {
-        const double a = static_cast<double>(frame_.angle_min) +
-                         static_cast<double>(i) * static_cast<double>(frame_.angle_increment);
-        scan.push_back(pose.transform({range * std::cos(a), range * std::sin(a)}));
-      }
-    }
     for (const auto& d : frame_.detections) {
       discs.push_back({pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
                        {},
@@ -103,6 +97,23 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
   blocked = cmd.status == avoidance::PlanStatus::kBlocked ||
             (cmd.overruled && std::abs(cmd.twist.v) < 0.05 && std::abs(cmd.twist.omega) < 0.05);
   return cmd.twist;
+}
+
+std::vector<Vec2> Agent::scanPoints(double maxRange) const {
+  std::vector<Vec2> pts;
+  if (!haveFrame_) {
+    return pts;
+  }
+  const Pose2 pose = ekf_.pose();
+  for (std::size_t i = 0; i < frame_.ranges.size(); ++i) {
+    const double range = static_cast<double>(frame_.ranges[i]);
+    if (range < static_cast<double>(frame_.range_max) && range < maxRange) {
+      const double a = static_cast<double>(frame_.angle_min) +
+                       static_cast<double>(i) * static_cast<double>(frame_.angle_increment);
+      pts.push_back(pose.transform({range * std::cos(a), range * std::sin(a)}));
+    }
+  }
+  return pts;
 }
 
 bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
@@ -139,19 +150,11 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
     w = r.twist.omega;
     // Then the scan: a shelf corner beside the straight corridor of the stop rule is still in the
     // way of a curving robot (one brushed a corner in a 100-robot run). A stop for it is static.
-    std::vector<Vec2> scan;
-    for (std::size_t i = 0; haveFrame_ && i < frame_.ranges.size(); ++i) {
-      const double range = static_cast<double>(frame_.ranges[i]);
-      if (range < static_cast<double>(frame_.range_max) && range < 1.5) {
-        const double a = static_cast<double>(frame_.angle_min) +
-                         static_cast<double>(i) * static_cast<double>(frame_.angle_increment);
-        scan.push_back(pose.transform({range * std::cos(a), range * std::sin(a)}));
-      }
-    }
+    std::vector<Vec2> scan = scanPoints(1.5);
     if (scan.empty() || docking_) {
       return true;  // (docking: the stop rule's docking gap governs the last decimetres)
     }
-    view.scan = scan;
+    view.scan = std::move(scan);
     const auto s = safety_.filter(view, {v, w});
     v = s.twist.v;
     w = s.twist.omega;
@@ -590,20 +593,10 @@ double Agent::freeWidth(Vec2 p, Vec2 dir) const {
   if (n < 1e-9) {
     return 0.0;
   }
-  const Vec2 side{-dir.y / n, dir.x / n};
-  double width = 0.0;
-  for (const double sign : {1.0, -1.0}) {
-    double s = 0.0;
-    while (s < 3.0) {
-      const auto c = raw_->cellAt(p + side * (sign * (s + 0.05)));
-      if (!c || raw_->blocked(*c)) {
-        break;
-      }
-      s += 0.05;
-    }
-    width += s;
-  }
-  return width;
+  const double across = std::atan2(dir.x, -dir.y);  // the left normal of dir
+  const auto view = raw_->view();
+  return geometry::raycastGrid(view, p, across, 3.0).range +
+         geometry::raycastGrid(view, p, across + kPi, 3.0).range;
 }
 
 bool Agent::narrow(Vec2 p, Vec2 dir) const {
@@ -680,8 +673,7 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     ++conduct_.standoffs;
     for (const auto& o : others_) {
       // Waiting on a robot that waits too: a cycle of the wait-for graph (or a chain into one).
-      // The id rule below breaks any cycle: some robot in it has a larger id than the one it
-      // waits on, and that one yields.
+      // The priority rule below breaks any cycle.
       if (byRobot && o.id == blocker && o.mode == msg::RobotMode::Waiting) {
         ++conduct_.mutualBlocks;
       }
@@ -878,15 +870,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     if (arrived || (blockedSinceNs_ >= 0 && nsToSec(nowNs - blockedSinceNs_) > p_.blockedBackoffS)) {
       v = 0.0;
       w = 0.0;
-      phase_ = Phase::Idle;
-      if (backoffFrom_) {
-        ++conduct_.detours;
-        startGoal(nowNs, backoffFrom_);
-      }
-      if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
-        startGoal(nowNs);
-      }
-      backoffFrom_.reset();
+      endYield(nowNs);
     }
   } else if (phase_ == Phase::Dwelling) {
     mode =
@@ -903,16 +887,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     mode = msg::RobotMode::Waiting;
     v = rearClear() ? -0.2 : 0.0;
     if (nsToSec(nowNs - phaseStartNs_) > 1.5) {
-      // Replan from where it stands around what blocked it (the same path would lead straight
-      // back into the standoff); with no way around, the plain plan.
-      phase_ = Phase::Idle;
-      if (backoffFrom_) {
-        startGoal(nowNs, backoffFrom_);
-      }
-      if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
-        startGoal(nowNs);
-      }
-      backoffFrom_.reset();
+      endYield(nowNs);
     }
   }
   watchProgress(nowNs);
@@ -932,6 +907,20 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   return out;
 }
 
+void Agent::endYield(std::int64_t nowNs) {
+  // Replan from where it stands around what blocked it (the same path would lead straight back
+  // into the standoff); with no way around, the plain plan.
+  phase_ = Phase::Idle;
+  if (backoffFrom_) {
+    ++conduct_.detours;
+    startGoal(nowNs, backoffFrom_);
+  }
+  if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
+    startGoal(nowNs);
+  }
+  backoffFrom_.reset();
+}
+
 void Agent::watchProgress(std::int64_t nowNs) {
   const Vec2 here = ekf_.pose().position();
   const bool travelling =
@@ -948,9 +937,7 @@ void Agent::watchProgress(std::int64_t nowNs) {
     finishTask(msg::TaskState::Failed,
                "no progress for " + std::to_string(static_cast<int>(3.0 * p_.blockedFailS)) + " s", nowNs);
   } else if (phase_ == Phase::Returning && stillS > 2.0 * p_.blockedBackoffS) {
-    phase_ = Phase::Idle;  // the way back is held up too: plan afresh from here
-    backoffFrom_.reset();
-    startGoal(nowNs);
+    endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
   }
 }
 

@@ -122,6 +122,10 @@ class Agent {
   double clearSpeed(double v, bool& blockedByRobot, std::string& blocker) const;
   /// Nothing within a short distance behind (backing off must not hit what it cannot see coming).
   [[nodiscard]] bool rearClear() const;
+  /// Scan points closer than maxRange, in the map frame (none before the first frame).
+  [[nodiscard]] std::vector<Vec2> scanPoints(double maxRange) const;
+  /// After backing off or backing out: re-plan around what blocked the robot, else plainly.
+  void endYield(std::int64_t nowNs);
   /// Free width of the map across direction `dir` at `p` [m] (up to 2 x 3 m).
   [[nodiscard]] double freeWidth(Vec2 p, Vec2 dir) const;
   /// Too narrow for another robot to pass this one.
