@@ -337,25 +337,39 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
         if (!g.inside(q) || distance(g.cellCenter(q), self) > open) {
           continue;
         }
-        const auto rc = raw_->cellAt(g.cellCenter(q));
-        // Only where the robot's body fits on the map (clear of walls by its radius).
-        bool fits = rc.has_value();
-        for (int k = 0; fits && k < 8; ++k) {
-          const double a = k * M_PI / 4.0;
-          const auto e = raw_->cellAt(g.cellCenter(q) + Vec2{std::cos(a), std::sin(a)} * p_.radius);
-          fits = e && !raw_->blocked(*e);
-        }
         bool nearStanding = false;
         for (const auto& o : others_) {
           nearStanding = nearStanding || (standing(o) && distance(o.pos, g.cellCenter(q)) < keep);
         }
-        if (fits && !raw_->blocked(*rc) && !nearStanding) {
+        if (bodyFits(g.cellCenter(q)) && !nearStanding) {
           g.setBlocked(q, false);
         }
       }
     }
   }
+  openGoal(g, goal);
   return g;
+}
+
+bool Agent::bodyFits(Vec2 p) const {
+  const auto c = raw_->cellAt(p);
+  bool fits = c && !raw_->blocked(*c);
+  for (int k = 0; fits && k < 8; ++k) {
+    const double a = k * kPi / 4.0;
+    const auto e = raw_->cellAt(p + Vec2{std::cos(a), std::sin(a)} * p_.radius);
+    fits = e && !raw_->blocked(*e);
+  }
+  return fits;
+}
+
+void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
+  // A station closer to a wall than the planning margin (parking places along a wall) lies in a
+  // blocked cell. Planning to it then fell back to the raw map, whose paths hug walls and shelf
+  // corners that the stop rule will not let the robot pass: open just the goal's cell, so the path
+  // keeps its margin up to the last cell and then steps onto the station.
+  if (const auto c = g.cellAt(goal); c && g.blocked(*c) && bodyFits(goal)) {
+    g.setBlocked(*c, false);
+  }
 }
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
@@ -403,7 +417,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     path = astar.plan(around, ekf_.pose(), g.pose);
   }
   if (!path) {
-    path = astar.plan(*grid_, ekf_.pose(), g.pose);  // boxed in by standing robots: wait them out
+    planning::OccupancyGrid plain = *grid_;  // boxed in by standing robots: wait them out
+    openGoal(plain, g.pose.position());
+    path = astar.plan(plain, ekf_.pose(), g.pose);
   }
   if (!path) {
     path = astar.plan(*raw_, ekf_.pose(), g.pose);  // a start or goal hugging a shelf
@@ -425,6 +441,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
   blockedSinceNs_ = -1;
+  straightDock_ = false;
   const auto st = taskStateFor(goal_, false);
   if (st != reported_) {
     reported_ = st;
@@ -573,8 +590,9 @@ void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, doubl
 bool Agent::heldUp(double& v, double& w, bool& byRobot, std::string& blocker) const {
   const double allowed = clearSpeed(v, byRobot, blocker);
   if (allowed < v - 1e-9) {
-    // Keep the curvature while slowing, so the robot stays on its path.
-    if (std::abs(v) > 1e-9) {
+    // Keep the curvature while slowing, so the robot stays on its path. Not while docking: there
+    // the turn toward the station is what frees the robot from the wall that limits its speed.
+    if (std::abs(v) > 1e-9 && !docking_) {
       w *= allowed / v;
     }
     v = allowed;
@@ -826,6 +844,13 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       holdSinceNs_ = -1;
       docking_ = r->final_approach;
       followerTwist(*r, v, w);
+      if (docking_ && straightDock_) {
+        // Face the station, then drive straight onto it (see below).
+        const Vec2 to = r->target.position() - ekf_.pose().position();
+        const double b = angleDiff(std::atan2(to.y, to.x), ekf_.pose().theta);
+        w = std::clamp(2.0 * b, -p_.wMax, p_.wMax);
+        v = std::abs(b) > 0.25 ? 0.0 : std::min(0.3, to.norm());
+      }
       mode = msg::RobotMode::Moving;
       bool byRobot = false;
       std::string blocker;
@@ -833,12 +858,16 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       const bool held = heldUp(v, w, byRobot, blocker) && wanted > 0.1;
       const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
       const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
-      if (held && !byRobot && blocker.empty() && !r->final_approach && std::abs(bearing) > 0.25) {
+      if (held && !byRobot && blocker.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
         // A wall or shelf ahead while the path bends away (a diagonal A* step into a band): turn
         // toward the carrot on the spot, which no static obstacle can stop, instead of waiting.
+        // Docking too: the pose law's curve onto a station beside a wall runs through the wall, and
+        // the law keeps asking for it (it left robots facing the wall 0.2 m off their parking
+        // place); from then on the robot faces the station and drives straight onto it.
         v = 0.0;
         w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
         blockedSinceNs_ = -1;
+        straightDock_ = r->final_approach;
       } else if (held) {
         mode = msg::RobotMode::Waiting;
         onStandoff(nowNs, byRobot, blocker, v, w);

@@ -192,6 +192,10 @@ class Agent {
   /// faulted) blocked, so a path goes around them instead of into a queue behind them.
   [[nodiscard]] planning::OccupancyGrid gridAroundStandingRobots(Vec2 goal) const;
   static bool standing(const Other& o);
+  /// The robot's disc at `p` is clear of the raw map's obstacles.
+  [[nodiscard]] bool bodyFits(Vec2 p) const;
+  /// Unblocks the goal's cell of `g` when the robot fits on the goal itself.
+  void openGoal(planning::OccupancyGrid& g, Vec2 goal) const;
   std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
   std::int64_t lastDetourNs_ = -1;          // when the last detour was tried
@@ -200,6 +204,8 @@ class Agent {
   double battery_ = 1.0;
   bool homing_ = false;
   bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
+  /// The pose law's curve onto this goal was blocked by a wall: turn to face it and drive straight.
+  bool straightDock_ = false;
   std::int64_t idleSinceNs_ = -1;
   std::int64_t homeRetryNs_ = -1;  // after a failed trip home, not before this time
   /// On the way to a station that another robot stands on, this far off: that robot (else null).

@@ -1,8 +1,9 @@
 // The whole fleet in lockstep on the small warehouse: 20 robots, 8 people, 100 transport tasks
 // posted through the WMS adapter by `fleetctl loadtest`. Safety is absolute (no contact of any
-// kind); the fleet must not deadlock (tasks keep being delivered) and nothing acknowledged may be
-// lost or duplicated. How many of the 100 are done in the time given is the throughput figure
-// (docs/benchmarks.md); the floor here only catches a collapse.
+// kind); the fleet must not deadlock (tasks keep being delivered), every task must be done, and
+// nothing acknowledged may be lost or duplicated. The run stops when the last task is done (about
+// 1650-1750 s simulated, 170 s wall); the time and tasks per hour are the figures of
+// docs/benchmarks.md.
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -46,7 +47,7 @@ std::vector<double> doneTimes(const fs::path& db) {
 TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
   const fs::path out = fs::temp_directory_path() / ("fleet_twenty_" + std::to_string(getpid()));
   fs::remove_all(out);
-  const double durationS = 1800.0;
+  const double durationS = 2400.0;
   fleet::test::ChildProcess run(FLEET_BINARY_DIR "/services/fleetctl/fleetctl",
                                 {"loadtest",
                                  "--scenario",
@@ -91,7 +92,7 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
     longestGap = std::max(longestGap, done[k] - done[k - 1]);
   }
   EXPECT_LT(longestGap, 300.0) << "the fleet stopped delivering for " << longestGap << " s";
-  EXPECT_GE(a["done"].get<int>(), 50) << a.dump();
+  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump();
   std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "
             << s["min_separation_m"]["robot_robot"] << " m, robot-human "

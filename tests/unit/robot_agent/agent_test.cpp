@@ -7,6 +7,7 @@
 
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
+#include "fleet/geometry/grid_raycast.hpp"
 
 using namespace fleet;
 
@@ -395,6 +396,61 @@ TEST(Agent, BacksOutOfANarrowPassageAlongItsTrailAndTakesTheOtherWay) {
   EXPECT_GE(minDist, 0.6 + 0.2) << "kept clear of the robot it yielded to";
   EXPECT_LT(maxX, blocker.x) << "never went past the blocker in the passage";
   EXPECT_LT(distance(world.truth, Pose2{9.0, 4.875, 0.0}), 0.3);
+}
+
+TEST(Agent, ReachesAStationInsideThePlanningMarginWithoutHuggingTheWall) {
+  // 10 m x 5 m at the warehouse's 0.5 m cells: a wall along the bottom and a shelf above a 2 m
+  // corridor (as the parking band). The station at y = 0.9 is 0.4 m from the wall, so its cell is
+  // blocked on the planning grid (map inflated by radius + 0.2). Planning there fell back to the
+  // raw map, whose shortest path runs along the wall 0.25 m off it, where the stop rule (which sees
+  // the wall ahead in its corridor) never lets the robot drive.
+  auto raw = std::make_shared<planning::OccupancyGrid>(20, 10, 0.5, Vec2{0, 0});
+  for (int x = 0; x < 20; ++x) {
+    raw->setBlocked({x, 0});
+    for (int y = 5; y < 10 && x >= 6 && x < 16; ++y) {
+      raw->setBlocked({x, y});
+    }
+  }
+  auto grid = agent::inflate(*raw, 0.5);
+  ASSERT_TRUE(grid->blocked(*grid->cellAt({1.5, 0.9})));
+  auto p = params();
+  p.start = {9.0, 1.5, M_PI};
+  agent::Agent a(p, grid, raw);
+  World world;
+  world.truth = p.start;
+  msg::TaskAssignment order;
+  order.robot_id = "r1";
+  order.task_id = "t1";
+  order.revision = 1;
+  order.goals.push_back({{1.5, 0.9, M_PI / 2}, "PARK-1", msg::GoalAction::Unload, 0.5});
+  a.onAssignment(order);
+  double v = 0;
+  double w = 0;
+  bool done = false;
+  double minWall = 1e9;
+  const auto view = raw->view();
+  for (int k = 0; k < 600 && !done; ++k) {
+    auto f = world.frame(v, w, 0.1);
+    f.angle_min = static_cast<float>(-M_PI);
+    f.angle_increment = static_cast<float>(2.0 * M_PI / 72.0);
+    for (int i = 0; i < 72; ++i) {
+      const double ang = world.truth.theta - M_PI + i * 2.0 * M_PI / 72.0;
+      f.ranges.push_back(
+          static_cast<float>(geometry::raycastGrid(view, world.truth.position(), ang, 8.0).range));
+    }
+    a.onFrame(f);
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    done = out.status && out.status->state == msg::TaskState::Done;
+    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed) << out.status->error;
+    if (world.truth.x > 3.5) {  // along the corridor, before the final approach
+      minWall = std::min(minWall, world.truth.y - 0.5);
+    }
+  }
+  EXPECT_TRUE(done) << "stalled at " << world.truth.x << ", " << world.truth.y;
+  EXPECT_GT(minWall, 0.5) << "drove along the wall";
+  EXPECT_LT(distance(world.truth.position(), Vec2{1.5, 0.9}), 0.2);
 }
 
 TEST(Agent, SlowsForAPersonWalkingAcrossItsWay) {
