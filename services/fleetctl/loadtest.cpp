@@ -149,6 +149,7 @@ struct Run {
   std::vector<std::string> pickups, dropoffs;
   std::mt19937_64 rng;
   double simS = 0;
+  double firstStampS = 0;                     // wall clock: the first robot stamp seen
   std::unique_ptr<httplib::Client> http;      // progress and sim time (main thread)
   std::unique_ptr<httplib::Client> postHttp;  // task submission (poster thread)
   std::mutex mu;                              // pending, ledger, counters
@@ -264,7 +265,16 @@ struct Run {
       return;
     }
     for (const auto& x : body.value("robots", json::array())) {
-      simS = std::max(simS, static_cast<double>(x.value("stamp_ns", std::int64_t{0})) / 1e9);
+      const double stampS = static_cast<double>(x.value("stamp_ns", std::int64_t{0})) / 1e9;
+      if (o.wallClock) {
+        // Stamps are wall-clock epoch times: the simulated time is the time since the first one.
+        if (stampS > 0 && firstStampS == 0) {
+          firstStampS = stampS;
+        }
+        simS = std::max(simS, stampS - firstStampS);
+      } else {
+        simS = std::max(simS, stampS);
+      }
     }
   }
 
@@ -455,7 +465,7 @@ int Run::run() {
                                           {"height", static_cast<int>(hM / res)},
                                           {"resolution", res}}},
                                         {"clock", "sim"},
-                                        {"lockstep", true},
+                                        {"lockstep", !o.wallClock},
                                         {"rate_hz", 2}}
                                        .dump(1));
   const std::string scn = fs::absolute(scenarioPath).string();
@@ -496,6 +506,7 @@ int Run::run() {
     ++next;
   }
   auto agentSpec = [&](const std::string& name, const std::vector<std::string>& ids) {
+    fs::remove(out / (name + "_metrics.json"), ec);  // not a previous run's
     std::string list;
     for (const auto& r : ids) {
       list += (list.empty() ? "" : ",") + r;
@@ -503,7 +514,9 @@ int Run::run() {
     std::vector<std::string> args = {"--scenario",
                                      scn,
                                      "--clock",
-                                     "lockstep",
+                                     o.wallClock ? "wall" : "lockstep",
+                                     "--metrics",
+                                     fs::absolute(out / (name + "_metrics.json")).string(),
                                      "--id",
                                      name,
                                      "--robots",
@@ -578,32 +591,24 @@ int Run::run() {
     return gSignal ? 130 : 1;
   }
   const int participants = 1 + static_cast<int>(agentNames.size());
-  sup.start({"fleet-sim",
-             bin("sim/src/fleet-sim"),
-             {"--scenario",
-              scn,
-              "--clock",
-              "lockstep",
-              "--participants",
-              std::to_string(participants),
-              "--duration",
-              std::to_string(o.durationS),
-              "--start-timeout-ms",
-              "60000",
-              "--step-timeout-ms",
-              std::to_string(o.stepTimeoutMs),
-              "--max-speed",
-              std::to_string(o.maxSpeed),
-              "--replay",
-              fs::absolute(out / "replay.jsonl.gz").string(),
-              "--summary",
-              fs::absolute(out / "sim_summary.json").string(),
-              "--html",
-              fs::absolute(out / "viewer.html").string(),
-              "--log-level",
-              "warn"},
-             env,
-             log("fleet-sim")});
+  std::vector<std::string> simArgs = {"--scenario",  scn,
+                                      "--duration",  std::to_string(o.durationS),
+                                      "--replay",    fs::absolute(out / "replay.jsonl.gz").string(),
+                                      "--summary",   fs::absolute(out / "sim_summary.json").string(),
+                                      "--html",      fs::absolute(out / "viewer.html").string(),
+                                      "--log-level", "warn",
+                                      "--clock"};
+  if (o.wallClock) {
+    simArgs.emplace_back("wall");
+  } else {
+    for (const std::string& a :
+         {std::string("lockstep"), std::string("--participants"), std::to_string(participants),
+          std::string("--start-timeout-ms"), std::string("60000"), std::string("--step-timeout-ms"),
+          std::to_string(o.stepTimeoutMs), std::string("--max-speed"), std::to_string(o.maxSpeed)}) {
+      simArgs.push_back(a);
+    }
+  }
+  sup.start({"fleet-sim", bin("sim/src/fleet-sim"), simArgs, env, log("fleet-sim")});
 
   int code = 0;
   bool wallLimited = false;
@@ -701,6 +706,13 @@ int Run::run() {
   const Accounting acc = ledger.reconcile(contents.tasks, contents.transitions);
   json summary = readJson(out / "sim_summary.json").value_or(json::object());
   const double simTime = summary.value("sim_time_s", simS);
+  // The robot agents' achieved control rate and cycle times (each process writes its own file).
+  json agentMetrics = json::array();
+  for (const auto& name : agentNames) {
+    if (auto m = readJson(out / (name + "_metrics.json"))) {
+      agentMetrics.push_back(*m);
+    }
+  }
   json report = {
       {"scenario", scenario.value("name", std::string())},
       {"robots", robots.size()},
@@ -728,6 +740,8 @@ int Run::run() {
         {"min_separation_m", summary.value("min_separation_m", json::object())},
         {"near_misses", summary.value("near_misses", json::object())},
         {"lockstep_step_timeouts", summary.value("lockstep_step_timeouts", json())}}},
+      {"clock", o.wallClock ? "wall" : "lockstep"},
+      {"agents", agentMetrics},
       {"faults", faultLog},
       {"fault_plan", json::array()},
       {"progress", progress},
@@ -749,6 +763,16 @@ int Run::run() {
       simTime, wallS, wallS > 0 ? simTime / wallS : 0.0, acc.endToEndS.p50, acc.endToEndS.p99,
       acc.assignS.p99);
   say(line);
+  for (const auto& m : agentMetrics) {
+    std::snprintf(line, sizeof line,
+                  "%s (%s): %d robots, %.2f cycles/s (configured %.1f Hz), %d overruns, cycle p50 %.2f ms "
+                  "p99 %.2f ms max %.1f ms",
+                  m.value("id", std::string("?")).c_str(), m.value("clock", std::string("?")).c_str(),
+                  m.value("robots", 0), m.value("achieved_hz", 0.0), m.value("configured_hz", 0.0),
+                  m.value("overruns", 0), m["cycle_ms"].value("p50", 0.0), m["cycle_ms"].value("p99", 0.0),
+                  m["cycle_ms"].value("max", 0.0));
+    say(line);
+  }
   if (!contents.error.empty()) {
     say("task database: " + contents.error);
     code = code == 0 ? 1 : code;

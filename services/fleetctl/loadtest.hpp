@@ -33,6 +33,9 @@ struct LoadtestOptions {
   int stationCapacity = 2;   // the fleet manager's station_capacity (0: no limit)
   double returnHomeS = 5.0;  // robot agents' --return-home (negative: stay where a task ends)
   int stepTimeoutMs = 300;
+  /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents
+  /// at their configured rate (their achieved rate is reported), and nothing waits for anyone.
+  bool wallClock = false;
   /// Cap on simulated seconds per wall second (0: none). The fleet manager, WMS adapter and load
   /// generator run on the wall clock; uncapped, a fast machine compresses their latencies into
   /// long simulated ones.

@@ -151,6 +151,9 @@ int main(int argc, char** argv) {
   loadtest->add_option("--step-timeout-ms", lt.stepTimeoutMs, "lockstep step timeout of the simulator")
       ->check(CLI::Range(10, 60000))
       ->capture_default_str();
+  loadtest->add_flag("--wall-clock", lt.wallClock,
+                     "run every service on the wall clock at 1x, as in production (default: lockstep); "
+                     "reports the robot agents' achieved control rate");
   CLI11_PARSE(app, argc, argv);
   if (*loadtest) {
     return fleet::ctl::runLoadtest(lt);

@@ -130,3 +130,32 @@ TEST(LoadtestE2E, InterruptStopsEveryProcess) {
 }
 
 }  // namespace
+
+TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
+  // As in production: nothing waits for anyone; the agents tick at their own 10 Hz.
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-wall-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto args = baseArgs(out, 4, 30);
+  args.push_back("--wall-clock");
+  fleet::test::ChildProcess run(kFleetctl, args);
+  ASSERT_EQ(run.wait(std::chrono::seconds(120)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  EXPECT_EQ(r["clock"], "wall");
+  EXPECT_NEAR(r["sim_time_s"].get<double>(), 30.0, 3.0);
+  EXPECT_GE(r["accounting"]["acknowledged"].get<int>(), 5);
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+  EXPECT_EQ(r["safety"]["contacts"]["robot_robot"], 0);
+  ASSERT_EQ(r["agents"].size(), 2u) << r["agents"].dump();
+  int robots = 0;
+  for (const auto& m : r["agents"]) {
+    EXPECT_EQ(m["clock"], "wall");
+    EXPECT_DOUBLE_EQ(m["configured_hz"].get<double>(), 10.0);
+    // About 30 s of 10 Hz cycles; the rate itself is the benchmark's figure, not a test threshold.
+    EXPECT_GT(m["cycles"].get<int>(), 100) << m.dump();
+    EXPECT_GT(m["achieved_hz"].get<double>(), 0.0);
+    EXPECT_GE(m["cycle_ms"]["p99"].get<double>(), m["cycle_ms"]["p50"].get<double>());
+    robots += m["robots"].get<int>();
+  }
+  EXPECT_EQ(robots, 4);
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+}
