@@ -146,6 +146,7 @@ msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std
   a.task_id = o.task.id;
   a.revision = nextRevision(o.robotId, nowNs);
   a.stamp_ns = nowNs;
+  a.paused = o.paused;
   auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
     const Station* s = dispatcher_->stations().find(name);
     msg::Goal g;
@@ -244,6 +245,23 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       auto r = dispatcher_->cancel(req.task_id, "cancelled by request", nowNs);
       if (r) {
         out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Cancelled, "", nowNs));
+        publish(std::move(*r), nowNs, out);
+      } else {
+        const bool missing = r.error().code == errc::kNotFound;
+        out.acks.push_back(ack(req, missing ? msg::AckResult::NotFound : msg::AckResult::Refused,
+                               msg::TaskState::Rejected, r.error().message, nowNs));
+      }
+      continue;
+    }
+    if (req.control != msg::TaskControl::None) {
+      flush();  // a pause must see the tasks submitted before it
+      const bool pause = req.control == msg::TaskControl::Pause;
+      auto r = dispatcher_->setPaused(req.task_id, pause, nowNs);
+      if (r) {
+        const auto it = dispatcher_->openTasks().find(req.task_id);
+        const auto state =
+            it != dispatcher_->openTasks().end() ? toMsg(it->second.state) : msg::TaskState::Queued;
+        out.acks.push_back(ack(req, msg::AckResult::Stored, state, pause ? "paused" : "resumed", nowNs));
         publish(std::move(*r), nowNs, out);
       } else {
         const bool missing = r.error().code == errc::kNotFound;

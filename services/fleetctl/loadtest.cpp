@@ -523,6 +523,8 @@ int Run::run() {
                                      list,
                                      "--local-planner",
                                      o.localPlanner,
+                                     "--global-planner",
+                                     o.globalPlanner,
                                      "--return-home",
                                      std::to_string(o.returnHomeS),
                                      "--log-level",

@@ -29,9 +29,10 @@ struct LoadtestOptions {
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
   std::string localPlanner = "follow";
-  bool lanes = false;        // robot agents plan on the one-way lanes (their --lanes)
-  int stationCapacity = 2;   // the fleet manager's station_capacity (0: no limit)
-  double returnHomeS = 5.0;  // robot agents' --return-home (negative: stay where a task ends)
+  std::string globalPlanner = "astar";  // robot agents' --global-planner
+  bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
+  int stationCapacity = 2;              // the fleet manager's station_capacity (0: no limit)
+  double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)
   int stepTimeoutMs = 300;
   /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents
   /// at their configured rate (their achieved rate is reported), and nothing waits for anyone.

@@ -2,6 +2,7 @@
 //   fleetctl submit tasks.csv        submit tasks from a JSON or CSV file
 //   fleetctl tasks [--state S]       list tasks          fleetctl task ID     one task
 //   fleetctl cancel ID               cancel a task       fleetctl robots      list robots
+//   fleetctl pause ID | resume ID    hold a task (its robot stands still) / let it go on
 //   fleetctl follow [--count N]      print task events as they happen
 //   fleetctl health | metrics
 //   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet
@@ -87,6 +88,11 @@ int main(int argc, char** argv) {
   task->add_option("id", id)->required();
   auto* cancel = app.add_subcommand("cancel", "cancel a task");
   cancel->add_option("id", id)->required();
+  auto* pause = app.add_subcommand(
+      "pause", "hold a task: its robot stands still with it, a waiting task is not dispatched");
+  pause->add_option("id", id)->required();
+  auto* resume = app.add_subcommand("resume", "let a paused task go on");
+  resume->add_option("id", id)->required();
   auto* robots = app.add_subcommand("robots", "list robots");
   auto* follow = app.add_subcommand("follow", "print task events as they happen");
   int count = 0;
@@ -143,6 +149,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 229));
   loadtest->add_option("--seed", lt.seed, "scenario and task seed")->capture_default_str();
   loadtest->add_option("--local-planner", lt.localPlanner, "robot agents' local planner")
+      ->capture_default_str();
+  loadtest->add_option("--global-planner", lt.globalPlanner, "robot agents' global planner")
+      ->check(CLI::IsMember({"astar", "wavefront", "ompl"}))
       ->capture_default_str();
   loadtest
       ->add_option("--max-speed", lt.maxSpeed,
@@ -229,6 +238,9 @@ int main(int argc, char** argv) {
   }
   if (*cancel) {
     return show(c.Delete("/v1/tasks/" + id, h));
+  }
+  if (*pause || *resume) {
+    return show(c.Post("/v1/tasks/" + id + (*pause ? "/pause" : "/resume"), h, "", "application/json"));
   }
   if (*robots) {
     auto r = c.Get("/v1/robots", h);

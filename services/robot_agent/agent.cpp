@@ -8,7 +8,9 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/geometry/grid_raycast.hpp"
 #include "fleet/planning/astar.hpp"
+#include "fleet/planning/ompl_planner.hpp"
 #include "fleet/planning/return_path.hpp"
+#include "fleet/planning/wavefront.hpp"
 #include "risk_astar.hpp"
 
 #include <stdexcept>
@@ -53,6 +55,9 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       raw_(std::move(raw)),
       ekf_(makeEkf(p_)),
       follower_(followerParams()) {
+  if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
+    throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
+  }
   if (p_.localPlanner != "follow") {
     auto inner = avoidance::makePlanner(p_.localPlanner);
     if (!inner) {
@@ -265,8 +270,10 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
     return;
   }
   if (a.task_id == task_ && a.goals == goals_) {
-    return;  // re-published after a manager restart: keep going
+    paused_ = a.paused;  // a pause / resume, or re-published after a manager restart
+    return;
   }
+  paused_ = a.paused;
   task_ = a.task_id;
   goals_ = a.goals;
   goal_ = 0;
@@ -374,7 +381,6 @@ void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
-  planning::AStarPlanner plainAstar;
   // Lanes and risk together: the risk map's probability scales each cell's cost as in risk_astar.
   planning::CellCostFactor riskFactor;
   if (risk_) {
@@ -382,9 +388,23 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
       return 1.0 + w * r->at(gr->cellCenter(c));
     };
   }
-  planning::LanePlanner lanePlanner(p_.lanes, riskFactor);
-  planning::GlobalPlanner& astar = p_.lanes ? static_cast<planning::GlobalPlanner&>(lanePlanner)
-                                            : static_cast<planning::GlobalPlanner&>(plainAstar);
+  std::unique_ptr<planning::GlobalPlanner> chosen;
+  if (p_.lanes) {
+    chosen = std::make_unique<planning::LanePlanner>(p_.lanes, riskFactor);
+  } else if (p_.globalPlanner == "wavefront") {
+    chosen = std::make_unique<planning::WavefrontPlanner>();
+  } else if (p_.globalPlanner == "ompl") {
+    planning::OmplOptions oo;
+    // Planned inside the agent's cycle: a short budget, and stop at the first path within 20 % of
+    // the straight line (the grid is inflated already, so the robot is a point here).
+    oo.timeBudget = 0.05;
+    oo.simplifyTime = 0.02;
+    oo.costThreshold = 1.2 * distance(ekf_.pose(), g.pose);
+    chosen = std::make_unique<planning::OmplPlanner>(oo);
+  } else {
+    chosen = std::make_unique<planning::AStarPlanner>();
+  }
+  planning::GlobalPlanner& astar = *chosen;
   Expected<planning::Path> path = unexpected("no_path", "not planned");
   const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
   if (avoid) {
@@ -410,7 +430,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     if (!path) {
       return;  // no way around: keep the current path and wait
     }
-  } else if (risk_ && !p_.lanes) {
+  } else if (risk_ && !p_.lanes && p_.globalPlanner == "astar") {
     RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
     path = riskAware.plan(around, ekf_.pose(), g.pose);
   } else {
@@ -796,6 +816,28 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
 
 AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   AgentOutput out;
+  if (paused_ && !task_.empty()) {
+    // Held by the operator: stand still with the task; the hold is no time blocked or dwelling.
+    if (pausedSinceNs_ < 0) {
+      pausedSinceNs_ = nowNs;
+    }
+    v_ = 0.0;
+    w_ = 0.0;
+    report(out, nowNs, 0.0, 0.0, msg::RobotMode::Waiting);
+    return out;
+  }
+  if (pausedSinceNs_ >= 0) {
+    const std::int64_t held = nowNs - pausedSinceNs_;
+    pausedSinceNs_ = -1;
+    for (std::int64_t* t : {&blockedSinceNs_, &movedNs_, &phaseStartNs_, &holdSinceNs_}) {
+      if (*t >= 0) {
+        *t += held;
+      }
+    }
+    if (planner_) {
+      planner_->reset();
+    }
+  }
   double v = 0.0;
   double w = 0.0;
   msg::RobotMode mode = msg::RobotMode::Idle;

@@ -51,7 +51,12 @@ struct AgentParams {
   /// ...): that planner on the path ahead, always behind the safety layer.
   std::string localPlanner = "follow";
   control::VelocityLimits limits{0.8, -0.3, 1.5, 1.0, 3.0};
-  /// One-way aisles of the map (shared by every agent of a process); null: plain A*.
+  /// Global planner on the inflated grid: "astar" (with the risk map as cell cost when one is
+  /// received), "wavefront" (distance field from the goal, then descent) or "ompl" (Informed RRT*,
+  /// 50 ms budget inside the agent's cycle). Replanning around blockers uses the same planner.
+  std::string globalPlanner = "astar";
+  /// One-way aisles of the map (shared by every agent of a process); null: plain A*. Set, it
+  /// replaces the global planner.
   std::shared_ptr<const planning::LaneMap> lanes;
 };
 
@@ -83,6 +88,8 @@ class Agent {
   [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
   [[nodiscard]] bool busy() const { return !task_.empty(); }
+  /// The current order is paused by the operator: the robot stands still with it.
+  [[nodiscard]] bool paused() const { return paused_ && !task_.empty(); }
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
   [[nodiscard]] bool homing() const { return homing_; }
   [[nodiscard]] std::uint64_t framesRejected() const { return rejected_; }
@@ -158,6 +165,8 @@ class Agent {
 
   std::string task_;
   std::uint32_t revision_ = 0;
+  bool paused_ = false;              // the order says hold (TaskAssignment.paused)
+  std::int64_t pausedSinceNs_ = -1;  // holding since (its length is added to the task's timers)
   std::vector<msg::Goal> goals_;
   std::size_t goal_ = 0;
   Phase phase_ = Phase::Idle;

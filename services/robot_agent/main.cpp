@@ -46,6 +46,7 @@ struct Options {
   bool lockstep = false;
   std::string id = "agents";
   std::string localPlanner = "follow";
+  std::string globalPlanner = "astar";
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
   double riskWeightGlobal = 1.0;
@@ -108,6 +109,7 @@ int run(const sim::Scenario& scn, const Options& opt) {
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
     p.localPlanner = opt.localPlanner;
+    p.globalPlanner = opt.globalPlanner;
     p.sensorTimeoutS = opt.sensorTimeoutS;
     p.returnHomeS = opt.returnHomeS;
     p.riskWeightGlobal = opt.riskWeightGlobal;
@@ -284,6 +286,10 @@ int main(int argc, char** argv) {
   std::string level = "info";
   Options opt;
   bool noRisk = false;
+  app.add_option(
+         "--global-planner", opt.globalPlanner,
+         "astar (default; the risk map as cell cost), wavefront, or ompl (Informed RRT*, 50 ms per plan)")
+      ->check(CLI::IsMember({"astar", "wavefront", "ompl"}));
   app.add_option("--local-planner", opt.localPlanner,
                  "follow (default: path follower + stop rule) or a libs/avoidance planner behind the safety "
                  "layer: dwa (uses the risk map's term), vo, potential_field, ...");

@@ -186,6 +186,10 @@ void HttpApi::routes() {
                [this](const httplib::Request& req, httplib::Response& res) { postTasks(req, res); });
   server_.Delete(R"(/v1/tasks/([^/]+))",
                  [this](const httplib::Request& req, httplib::Response& res) { deleteTask(req, res); });
+  server_.Post(R"(/v1/tasks/([^/]+)/pause)",
+               [this](const httplib::Request& req, httplib::Response& res) { controlTask(req, res, true); });
+  server_.Post(R"(/v1/tasks/([^/]+)/resume)",
+               [this](const httplib::Request& req, httplib::Response& res) { controlTask(req, res, false); });
   server_.Get(R"(/v1/tasks/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
     const std::string id = req.matches[1];
     auto v = view_.task(id);
@@ -394,6 +398,42 @@ void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
     reply(res, 503, error("unavailable", "the fleet manager did not acknowledge the cancel in time"));
   } else if (a->result == msg::AckResult::Stored) {
     reply(res, 200, {{"id", id}, {"state", "cancelled"}});
+  } else if (a->result == msg::AckResult::NotFound) {
+    reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
+  } else {
+    reply(res, 409, error("conflict", a->detail));
+  }
+}
+
+void HttpApi::controlTask(const httplib::Request& req, httplib::Response& res, bool pause) {
+  const std::string id = req.matches[1];
+  const char* verb = pause ? "paused" : "resumed";
+  if (!isValidId(id)) {
+    reply(res, 400,
+          {{"error", "invalid"},
+           {"fields", json::array({{{"path", "id"}, {"reason", "not a valid task id"}}})}});
+    return;
+  }
+  if (!gateway_.managerOnline()) {
+    res.set_header("Retry-After", "2");
+    reply(res, 503,
+          error("unavailable", std::string("the fleet manager is unreachable; nothing was ") + verb));
+    return;
+  }
+  msg::Task m;
+  m.task_id = id;
+  m.request_id = nextRequestId();
+  m.control = pause ? msg::TaskControl::Pause : msg::TaskControl::Resume;
+  const auto acks = gateway_.submit({m}, std::chrono::milliseconds(settings_.ackTimeoutMs));
+  const auto& a = acks[0];
+  if (!a) {
+    res.set_header("Retry-After", "2");
+    reply(res, 503,
+          error("unavailable",
+                "the fleet manager did not acknowledge in time; retry (pause and resume "
+                "are idempotent)"));
+  } else if (a->result == msg::AckResult::Stored) {
+    reply(res, 200, {{"id", id}, {"paused", pause}, {"state", msg::toString(a->state)}});
   } else if (a->result == msg::AckResult::NotFound) {
     reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
   } else {

@@ -54,6 +54,8 @@ class HttpApi {
   void routes();
   void postTasks(const httplib::Request& req, httplib::Response& res);
   void deleteTask(const httplib::Request& req, httplib::Response& res);
+  /// POST /v1/tasks/{id}/pause and /resume.
+  void controlTask(const httplib::Request& req, httplib::Response& res, bool pause);
   std::string nextRequestId();
 
   ApiSettings settings_;

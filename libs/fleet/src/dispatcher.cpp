@@ -108,7 +108,7 @@ Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {
     if (isActive(r.state)) {
       registry_.expect(r.robotId, nowNs);
       registry_.setTask(r.robotId, r.task.id);
-      out.assignments.push_back({r.robotId, r.task, r.revision});
+      out.assignments.push_back({r.robotId, r.task, r.revision, r.paused});
     }
     std::string id = r.task.id;
     open_.emplace(std::move(id), std::move(r));
@@ -271,6 +271,34 @@ Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std
   return out;
 }
 
+Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool paused, std::int64_t nowNs) {
+  auto it = open_.find(taskId);
+  if (it == open_.end()) {
+    auto stored = store_.get(taskId);
+    if (!stored) {
+      return unexpected(stored.error());
+    }
+    return unexpected(errc::kIllegalTransition,
+                      "task '" + taskId + "' is already " + std::string(toString(stored->state)));
+  }
+  auto res = store_.setPaused(taskId, paused, nowNs);
+  if (!res) {
+    return unexpected(res.error());
+  }
+  DispatchResult out;
+  const bool changed = it->second.paused != paused;
+  it->second.paused = res->paused;
+  if (isActive(it->second.state)) {
+    // Re-sent even when unchanged: the operator may be repeating a pause the robot never got.
+    out.assignments.push_back({it->second.robotId, it->second.task, it->second.revision, paused});
+  }
+  if (changed) {
+    out.events.push_back({taskId, it->second.state, it->second.robotId,
+                          paused ? "paused by request" : "resumed by request", nowNs});
+  }
+  return out;
+}
+
 void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
   const auto chargers = stations_.ofKind(StationKind::Charging);
   for (const auto& r : registry_.idleRobots()) {
@@ -360,7 +388,7 @@ void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
 void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   std::vector<Task> waiting;
   for (const auto& [id, r] : open_) {
-    if (isWaiting(r.state)) {
+    if (isWaiting(r.state) && !r.paused) {
       waiting.push_back(r.task);
     }
   }

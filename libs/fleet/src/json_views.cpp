@@ -10,7 +10,7 @@ nlohmann::json toJson(const TaskRecord& r) {
   return {{"task", std::move(task)}, {"state", std::string(toString(r.state))},
           {"robot", r.robotId},      {"attempts", r.attempts},
           {"reason", r.reason},      {"updated_ns", r.updatedNs},
-          {"revision", r.revision}};
+          {"revision", r.revision},  {"paused", r.paused}};
 }
 
 nlohmann::json toJson(const TransitionRecord& t) {

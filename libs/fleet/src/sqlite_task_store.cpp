@@ -70,7 +70,8 @@ CREATE TABLE IF NOT EXISTS tasks(
   reason TEXT NOT NULL DEFAULT '',
   created_ns INTEGER NOT NULL,
   updated_ns INTEGER NOT NULL,
-  revision INTEGER NOT NULL
+  revision INTEGER NOT NULL,
+  paused INTEGER NOT NULL DEFAULT 0
 ) WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS tasks_by_state ON tasks(state, id);
 CREATE TABLE IF NOT EXISTS transitions(
@@ -83,17 +84,19 @@ CREATE TABLE IF NOT EXISTS transitions(
   stamp_ns INTEGER NOT NULL
 );
 CREATE INDEX IF NOT EXISTS transitions_by_task ON transitions(task_id, seq);
-PRAGMA user_version = 1;
 )sql";
 
+/// Schema version 2 added tasks.paused; a version-1 database gets the column on open.
+constexpr int kSchemaVersion = 2;
+
 constexpr const char* kRecordColumns =
-    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision";
+    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused";
 
 }  // namespace
 
 struct SqliteTaskStore::Impl {
   sqlite3* db = nullptr;
-  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open;
+  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open, pause;
 
   ~Impl() {
     // close_v2 defers the close until the statements (members, destroyed after this body) are
@@ -142,6 +145,7 @@ struct SqliteTaskStore::Impl {
     r.task.createdNs = s.integer(6);
     r.updatedNs = s.integer(7);
     r.revision = s.integer(8);
+    r.paused = s.integer(9) != 0;
     return r;
   }
 
@@ -216,6 +220,31 @@ struct SqliteTaskStore::Impl {
   }
 
   /// Inside a transaction.
+  /// Brings an older database to kSchemaVersion (a fresh one only gets its version stamped).
+  Expected<void> migrate() {
+    Stmt v;
+    if (!v.prepare(db, "PRAGMA user_version")) {
+      return storageError(db, "read the schema version");
+    }
+    const int version = v.step() == SQLITE_ROW ? static_cast<int>(v.integer(0)) : 0;
+    v.reset();
+    if (version >= kSchemaVersion) {
+      return {};
+    }
+    Stmt cols;
+    if (!cols.prepare(db, "SELECT COUNT(*) FROM pragma_table_info('tasks') WHERE name = 'paused'")) {
+      return storageError(db, "read the tasks table's columns");
+    }
+    const bool hasPaused = cols.step() == SQLITE_ROW && cols.integer(0) > 0;
+    cols.reset();
+    if (!hasPaused) {
+      if (auto ok = exec("ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0"); !ok) {
+        return ok;
+      }
+    }
+    return exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+  }
+
   Expected<TaskRecord> transitionOne(const TransitionRequest& q) {
     auto cur = load(q.taskId);
     if (!cur) {
@@ -321,8 +350,11 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
   if (auto ok = impl->exec(kSchema); !ok) {
     return unexpected(ok.error());
   }
+  if (auto ok = impl->migrate(); !ok) {
+    return unexpected(ok.error());
+  }
   const std::string sel = std::string("SELECT ") + kRecordColumns + " FROM tasks";
-  const std::array<std::pair<Stmt*, std::string>, 10> stmts = {{
+  const std::array<std::pair<Stmt*, std::string>, 11> stmts = {{
       {&impl->begin, "BEGIN IMMEDIATE"},
       {&impl->commit, "COMMIT"},
       {&impl->rollback, "ROLLBACK"},
@@ -342,6 +374,7 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
        "?1 "
        "ORDER BY seq"},
       {&impl->counts, "SELECT state, COUNT(*) FROM tasks GROUP BY state"},
+      {&impl->pause, "UPDATE tasks SET paused = ?1, updated_ns = ?2 WHERE id = ?3"},
       {&impl->open, sel + " WHERE state NOT IN ('done', 'failed', 'cancelled') ORDER BY created_ns, id"},
   }};
   for (const auto& [stmt, sql] : stmts) {
@@ -397,6 +430,30 @@ std::vector<Expected<TaskRecord>> SqliteTaskStore::transitionBatch(const std::ve
     }
   }
   return out;
+}
+
+Expected<TaskRecord> SqliteTaskStore::setPaused(std::string_view id, bool paused, std::int64_t stampNs) {
+  std::lock_guard lock(mu_);
+  auto cur = impl_->load(id);
+  if (!cur) {
+    return cur;
+  }
+  if (isTerminal(cur->state)) {
+    return unexpected(errc::kIllegalTransition,
+                      "task '" + std::string(id) + "' is already " + std::string(toString(cur->state)));
+  }
+  if (cur->paused == paused) {
+    return cur;  // idempotent: nothing to write
+  }
+  impl_->pause.bind(1, static_cast<std::int64_t>(paused ? 1 : 0));
+  impl_->pause.bind(2, stampNs);
+  impl_->pause.bind(3, id);
+  if (auto ok = impl_->stepDone(impl_->pause, "pause task"); !ok) {
+    return unexpected(ok.error());
+  }
+  cur->paused = paused;
+  cur->updatedNs = stampNs;
+  return cur;
 }
 
 Expected<TaskRecord> SqliteTaskStore::get(std::string_view id) {

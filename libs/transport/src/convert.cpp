@@ -88,6 +88,7 @@ void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
   out.created_ns = in.created_ns;
   putStr(out.body, in.body, "Task.body");
   out.cancel = in.cancel;
+  out.control = static_cast<fleet_TaskControl>(in.control);
 }
 msg::Task Traits<msg::Task>::fromC(const C& in) {
   msg::Task m;
@@ -105,6 +106,7 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.created_ns = in.created_ns;
   m.body = getStr(in.body);
   m.cancel = in.cancel;
+  m.control = getEnum(in.control, msg::TaskControl::Resume);
   return m;
 }
 

@@ -265,3 +265,58 @@ TEST_F(FleetE2E, RobotWhoseAgentEndsIsLostAtOnceByLiveliness) {
   EXPECT_TRUE(requeued);
   EXPECT_LT(Clk::now() - t0, 5s) << "re-queued by liveliness, well before the 30 s state lease";
 }
+
+TEST_F(FleetE2E, PauseOverHttpHoldsTheRobotAndSurvivesAManagerKill) {
+  transport::Participant p;
+  FakeRobots robots(p, 1);
+  ASSERT_EQ(
+      http_
+          ->Post("/v1/tasks", R"({"id": "job-p", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})",
+                 "application/json")
+          ->status,
+      201);
+  // Orders the robot gets, without finishing them (it is driving).
+  std::vector<msg::TaskAssignment> got;
+  auto waitFor = [&](auto pred, std::chrono::seconds limit) {
+    const auto end = Clk::now() + limit;
+    while (Clk::now() < end) {
+      robots.publishStates();
+      for (auto& a : robots.orders.take()) {
+        got.push_back(a);
+        if (!a.task_id.empty()) {
+          robots.current[a.robot_id] = a;
+        }
+        if (pred(a)) {
+          return true;
+        }
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    return false;
+  };
+  ASSERT_TRUE(waitFor([](const msg::TaskAssignment& a) { return a.task_id == "job-p" && !a.paused; }, 10s));
+  auto r = http_->Post("/v1/tasks/job-p/pause", "", "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["paused"], true);
+  ASSERT_TRUE(waitFor([](const msg::TaskAssignment& a) { return a.task_id == "job-p" && a.paused; }, 10s));
+  // The hold is durable: a restarted manager re-sends the order still paused.
+  got.clear();
+  manager_->kill(SIGKILL);
+  manager_->wait(5s);
+  startManager();
+  ASSERT_TRUE(waitFor([](const msg::TaskAssignment& a) { return a.task_id == "job-p"; }, 15s));
+  EXPECT_TRUE(got.back().paused) << "the restarted manager lost the pause";
+  waitHealthy();
+  r = http_->Post("/v1/tasks/job-p/resume", "", "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  ASSERT_TRUE(waitFor([](const msg::TaskAssignment& a) { return a.task_id == "job-p" && !a.paused; }, 10s));
+  robots.work();  // drives on and delivers
+  const auto end = Clk::now() + 10s;
+  while (Clk::now() < end && getTask("job-p").value("state", "") != "done") {
+    robots.publishStates();
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(getTask("job-p").value("state", ""), "done");
+}

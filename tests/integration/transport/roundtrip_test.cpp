@@ -84,7 +84,12 @@ TEST_F(RoundTrip, Task) {
   msg::Task c = a;
   c.task_id = "t-2";
   c.body = kNonAscii;
-  expectRoundTrip<msg::Task>({a, b, c});
+  c.control = msg::TaskControl::Resume;
+  msg::Task d = a;
+  d.task_id = "t-3";
+  d.body.clear();
+  d.control = msg::TaskControl::Pause;
+  expectRoundTrip<msg::Task>({a, b, c, d});
 }
 
 TEST_F(RoundTrip, TaskAck) {

@@ -295,6 +295,34 @@ TEST_F(DispatcherTest, CancelWithdrawsActiveTask) {
   EXPECT_EQ(dispatcher->tick(4).assignments.size(), 1u) << "the robot is free for the other task";
 }
 
+TEST_F(DispatcherTest, PausedTaskIsNotDispatchedAndAnActiveOneIsHeldDurably) {
+  robot("a", 1, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto p = dispatcher->setPaused("t1", true, 1);
+  ASSERT_TRUE(p) << p.error().message;
+  EXPECT_TRUE(p->assignments.empty()) << "a waiting task has no robot to tell";
+  EXPECT_TRUE(dispatcher->tick(2).assignments.empty()) << "a paused task is not dispatched";
+  ASSERT_TRUE(dispatcher->setPaused("t1", false, 3));
+  auto out = dispatcher->tick(4);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_FALSE(out.assignments[0].paused);
+  // Active: the order is re-sent with `paused`, and the hold survives a manager restart.
+  p = dispatcher->setPaused("t1", true, 5);
+  ASSERT_TRUE(p);
+  ASSERT_EQ(p->assignments.size(), 1u);
+  EXPECT_EQ(p->assignments[0].robotId, "a");
+  EXPECT_TRUE(p->assignments[0].paused);
+  EXPECT_EQ(stateOf("t1"), S::Assigned) << "pausing is no transition";
+  reopen();
+  auto rec = dispatcher->recover(6);
+  ASSERT_TRUE(rec);
+  ASSERT_EQ(rec->assignments.size(), 1u);
+  EXPECT_TRUE(rec->assignments[0].paused);
+  ASSERT_TRUE(dispatcher->onTaskStatus("a", "t1", S::Done, "", 7));
+  EXPECT_EQ(dispatcher->setPaused("t1", false, 8).error().code, errc::kIllegalTransition);
+  EXPECT_EQ(dispatcher->setPaused("nope", true, 8).error().code, errc::kNotFound);
+}
+
 TEST_F(DispatcherTest, RecoverRebuildsOpenStateAfterRestart) {
   robot("a", 1, 0.9, 0);
   dispatcher->submit({transport("t1"), transport("t2"), transport("t3")}, 0);

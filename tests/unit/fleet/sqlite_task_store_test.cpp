@@ -1,6 +1,7 @@
 #include "fleet/fleet/sqlite_task_store.hpp"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <set>
 #include <thread>
@@ -33,6 +34,57 @@ std::unique_ptr<SqliteTaskStore> openStore(const std::string& path) {
   auto s = SqliteTaskStore::open({path});
   EXPECT_TRUE(s) << s.error().message;
   return std::move(s).value();
+}
+
+TEST(SqliteTaskStore, PausedFlagIsDurableAndRefusedOnFinishedTasks) {
+  test::TempDir dir;
+  {
+    auto store = openStore(dir.file("tasks.db"));
+    ASSERT_TRUE(store->submit(transport("t1"), 1));
+    ASSERT_TRUE(store->transition("t1", S::Assigned, "r1", "", 2));
+    auto p = store->setPaused("t1", true, 3);
+    ASSERT_TRUE(p) << p.error().message;
+    EXPECT_TRUE(p->paused);
+    EXPECT_EQ(p->state, S::Assigned);
+    EXPECT_EQ(p->revision, 2) << "not a transition";
+    EXPECT_EQ(store->history("t1")->size(), 2u);
+    // A transition keeps the flag.
+    EXPECT_TRUE(store->transition("t1", S::EnRoute, "r1", "", 4)->paused);
+    EXPECT_EQ(store->setPaused("nope", true, 5).error().code, errc::kNotFound);
+  }
+  auto store = openStore(dir.file("tasks.db"));
+  EXPECT_TRUE(store->get("t1")->paused);
+  EXPECT_TRUE(store->openTasks()->front().paused);
+  ASSERT_TRUE(store->setPaused("t1", false, 6));
+  EXPECT_FALSE(store->get("t1")->paused);
+  ASSERT_TRUE(store->transition("t1", S::Cancelled, "", "", 7));
+  EXPECT_EQ(store->setPaused("t1", true, 8).error().code, errc::kIllegalTransition);
+}
+
+TEST(SqliteTaskStore, OpensAVersionOneDatabaseAddingThePausedColumn) {
+  // The schema before `paused` (user_version 1), with one task in it.
+  test::TempDir dir;
+  const std::string path = dir.file("v1.db");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  const char* v1 = R"sql(
+CREATE TABLE tasks(id TEXT PRIMARY KEY, kind TEXT NOT NULL, body TEXT NOT NULL, state TEXT NOT NULL,
+  robot TEXT NOT NULL DEFAULT '', attempts INTEGER NOT NULL DEFAULT 0, reason TEXT NOT NULL DEFAULT '',
+  created_ns INTEGER NOT NULL, updated_ns INTEGER NOT NULL, revision INTEGER NOT NULL) WITHOUT ROWID;
+CREATE TABLE transitions(seq INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, from_state TEXT,
+  to_state TEXT NOT NULL, robot TEXT NOT NULL DEFAULT '', reason TEXT NOT NULL DEFAULT '', stamp_ns INTEGER NOT NULL);
+INSERT INTO tasks VALUES('old', 'goto', '{"id":"old","kind":"goto","station":"D-1"}', 'queued', '', 0, '', 5, 5, 1);
+PRAGMA user_version = 1;
+)sql";
+  ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  sqlite3_close(db);
+  auto store = openStore(path);
+  auto old = store->get("old");
+  ASSERT_TRUE(old) << old.error().message;
+  EXPECT_FALSE(old->paused);
+  ASSERT_TRUE(store->setPaused("old", true, 6));
+  store.reset();
+  EXPECT_TRUE(openStore(path)->get("old")->paused) << "migrated once, then used as version 2";
 }
 
 TEST(SqliteTaskStore, SubmitIsIdempotentAndDetectsConflicts) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "agent.hpp"
@@ -91,6 +92,57 @@ TEST(Agent, DeliversATransportTaskReportingEveryState) {
   EXPECT_LT(distance(world.truth, Pose2{5.0, 6.0, 0}), 0.3);
   EXPECT_LT(distance(a.pose(), world.truth), 0.05) << "odometry + compass keep the estimate close";
   EXPECT_FALSE(a.busy());
+}
+
+class GlobalPlannerChoice : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GlobalPlannerChoice, DeliversAroundAWallWithoutEnteringIt) {
+  // A wall from y = 0 to y = 4.5 at x = 3 stands between the start (1, 1) and the pickup (5, 1):
+  // only a plan around its top end gets there (the test world has no scan, so the stop rule
+  // cannot save a path through it).
+  auto raw = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int y = 0; y < 18; ++y) {
+    raw->setBlocked({12, y});
+  }
+  auto grid = agent::inflate(*raw, 0.5);
+  auto p = params();
+  p.globalPlanner = GetParam();
+  agent::Agent a(p, grid, raw);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  bool done = false;
+  double minWall = 1e9;
+  double v = 0;
+  double w = 0;
+  for (; k < 3000 && !done; ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    done = out.status && out.status->state == msg::TaskState::Done;
+    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed) << out.status->error;
+    // Distance from the robot's centre to the wall's rectangle [3, 3.25] x [0, 4.5].
+    const double dx = std::max({3.0 - world.truth.x, 0.0, world.truth.x - 3.25});
+    const double dy = std::max(0.0, world.truth.y - 4.5);
+    minWall = std::min(minWall, std::hypot(dx, dy));
+  }
+  EXPECT_TRUE(done) << GetParam();
+  EXPECT_GT(minWall, 0.3) << GetParam() << ": the robot's body touched the wall";
+  EXPECT_LT(distance(world.truth, Pose2{5.0, 6.0, 0}), 0.3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Agent, GlobalPlannerChoice, ::testing::Values("astar", "wavefront", "ompl"));
+
+TEST(Agent, UnknownGlobalPlannerIsRefusedByName) {
+  auto p = params();
+  p.globalPlanner = "dijkstra";
+  try {
+    agent::Agent a(p, emptyGrid(), emptyGrid());
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("dijkstra"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Agent, StopsForSomethingAheadAndReportsWaiting) {
@@ -249,6 +301,42 @@ msg::RobotState parked(const std::string& id, Vec2 at) {
   return s;
 }
 }  // namespace
+
+TEST(Agent, PausedOrderHoldsStillLongerThanTheFailTimeoutAndResumes) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  (void)run(a, world, k, 20, [] { return false; });
+  ASSERT_GT(world.truth.x, 1.2) << "under way";
+  auto hold = transport();
+  hold.revision = 8;
+  hold.paused = true;
+  a.onAssignment(hold);
+  EXPECT_TRUE(a.paused());
+  // Twice the 60 s fail timeout: no status (no failure), standing still, reporting `waiting`.
+  const Pose2 at = world.truth;
+  double v = 0;
+  double w = 0;
+  for (int i = 0; i < 1200; ++i, ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    ASSERT_FALSE(out.status) << "reported " << msg::toString(out.status->state) << " while paused";
+    EXPECT_EQ(out.state.mode, msg::RobotMode::Waiting);
+  }
+  EXPECT_LT(distance(world.truth, at), 0.05) << "moved while paused";
+  EXPECT_TRUE(a.busy());
+  auto go = transport();
+  go.revision = 9;
+  a.onAssignment(go);
+  EXPECT_FALSE(a.paused());
+  const auto statuses = run(a, world, k, 1500, [&] { return !a.busy(); });
+  ASSERT_FALSE(statuses.empty());
+  EXPECT_EQ(statuses.back().state, msg::TaskState::Done);
+}
 
 TEST(Agent, ReturnsHomeWhenIdleWithoutReportingTheTrip) {
   auto grid = emptyGrid();

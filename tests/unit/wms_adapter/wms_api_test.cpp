@@ -29,10 +29,11 @@ class FakeGateway : public TaskGateway {
         continue;
       }
       msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
-      if (r.cancel) {
+      if (r.cancel || r.control != msg::TaskControl::None) {
         auto it = bodies.find(r.task_id);
         a.result = it == bodies.end() ? msg::AckResult::NotFound : msg::AckResult::Stored;
-        a.state = msg::TaskState::Cancelled;
+        a.state = r.cancel ? msg::TaskState::Cancelled : msg::TaskState::EnRoute;
+        controls.push_back(r.control);
       } else if (auto it = bodies.find(r.task_id); it != bodies.end()) {
         a.result = it->second == r.body ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
       } else {
@@ -44,6 +45,7 @@ class FakeGateway : public TaskGateway {
   }
   [[nodiscard]] bool managerOnline() const override { return online; }
   std::map<std::string, std::string> bodies;
+  std::vector<msg::TaskControl> controls;
   bool online = true;
   bool silent = false;
   std::chrono::milliseconds delay{0};  // a slow manager
@@ -232,4 +234,23 @@ TEST_F(Api, EventsStreamAndMetrics) {
   EXPECT_THAT(received, HasSubstr("\"state\":\"assigned\""));
   auto m = json::parse(client_->Get("/v1/metrics")->body);
   EXPECT_EQ(m["tasks_by_state"]["done"], 1);
+}
+
+TEST_F(Api, PauseAndResumeReachTheManagerAndAnswerWithTheState) {
+  start();
+  ASSERT_EQ(post(kTask)->status, 201);
+  auto r = client_->Post("/v1/tasks/t-1/pause", "", "application/json");
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body), json::parse(R"({"id": "t-1", "paused": true, "state": "en_route"})"));
+  r = client_->Post("/v1/tasks/t-1/resume", "", "application/json");
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["paused"], false);
+  EXPECT_EQ(gateway_.controls,
+            (std::vector<msg::TaskControl>{msg::TaskControl::Pause, msg::TaskControl::Resume}));
+  EXPECT_EQ(client_->Post("/v1/tasks/nope/pause", "", "application/json")->status, 404);
+  EXPECT_EQ(client_->Post("/v1/tasks/a%20b/pause", "", "application/json")->status, 400);
+  gateway_.online = false;
+  r = client_->Post("/v1/tasks/t-1/pause", "", "application/json");
+  EXPECT_EQ(r->status, 503);
+  EXPECT_THAT(r->body, HasSubstr("nothing was paused"));
 }

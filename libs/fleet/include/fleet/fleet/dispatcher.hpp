@@ -49,6 +49,7 @@ struct AssignmentOrder {
   std::string robotId;
   Task task;
   std::int64_t revision = 0;  ///< the task record's revision: newer orders supersede older ones
+  bool paused = false;        ///< the robot holds where it is with the task until resumed
 };
 
 /// What a call changed; the service publishes it. Everything in it is already committed.
@@ -101,6 +102,10 @@ class Dispatcher {
                                         TaskState state, const std::string& reason, std::int64_t nowNs);
   /// Operator cancel; an active task is withdrawn from its robot.
   Expected<DispatchResult> cancel(const std::string& taskId, const std::string& reason, std::int64_t nowNs);
+  /// Operator pause / resume (durable): a paused waiting task is not dispatched; an active one is
+  /// re-sent to its robot with `paused` set, and the robot stands still with it until resumed.
+  /// Errors as cancel (not_found, illegal_transition for a finished task).
+  Expected<DispatchResult> setPaused(const std::string& taskId, bool paused, std::int64_t nowNs);
 
   /// Periodic work: expire leases (requeue the lost robots' tasks), send low robots to charge, and
   /// assign waiting tasks to idle robots.

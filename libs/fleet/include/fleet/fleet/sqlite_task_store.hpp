@@ -32,6 +32,7 @@ class SqliteTaskStore final : public TaskStore {
   using TaskStore::transition;
   Expected<TaskRecord> transition(const TransitionRequest& r) override;
   std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) override;
+  Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) override;
   Expected<TaskRecord> get(std::string_view id) override;
   Expected<std::vector<TaskRecord>> list(std::optional<TaskState> state, std::size_t limit,
                                          std::string_view afterId = {}) override;

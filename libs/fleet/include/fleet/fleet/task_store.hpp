@@ -22,6 +22,9 @@ struct TaskRecord {
   std::string reason;         ///< reason given with the latest transition
   std::int64_t updatedNs = 0;
   std::int64_t revision = 0;  ///< transitions applied; 1 right after submit
+  /// Held by an operator: a waiting task is not dispatched, an active one's robot stands still
+  /// with it. Not a state: the task keeps its state and transitions while paused.
+  bool paused = false;
 };
 
 /// One row of the append-only transition log. `from` is empty for the submission itself.
@@ -82,6 +85,10 @@ class TaskStore {
   }
   /// Several transitions in one commit; each is checked against the state left by the ones before.
   virtual std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) = 0;
+
+  /// Sets the task's `paused` flag durably (not a transition: the log is unchanged). Errors:
+  /// not_found; illegal_transition for a task already done, failed or cancelled.
+  virtual Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) = 0;
 
   virtual Expected<TaskRecord> get(std::string_view id) = 0;
   /// Tasks in `state` (all when empty) ordered by id, at most `limit`, with ids after `afterId`.

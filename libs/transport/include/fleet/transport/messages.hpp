@@ -13,6 +13,7 @@
 namespace fleet::msg {
 
 enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
+enum class TaskControl : std::uint8_t { None, Pause, Resume };
 enum class TaskState : std::uint8_t {
   Queued,
   Assigned,
@@ -45,6 +46,7 @@ struct Task {
   std::int64_t created_ns = 0;
   std::string body;
   bool cancel = false;
+  TaskControl control = TaskControl::None;
   bool operator==(const Task&) const = default;
 };
 
