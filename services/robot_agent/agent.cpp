@@ -126,7 +126,9 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
   std::vector<avoidance::MovingDisc> discs;
   // Only what is ahead or beside: whoever comes from behind keeps the distance (its own stop rule
   // does); counting it here froze whole queues, each robot held by the one closing in behind it.
-  const Vec2 heading{std::cos(pose.theta), std::sin(pose.theta)};
+  // (Driving backwards, "ahead" is behind: a robot reversing onto its parking place backed into
+  // a person standing behind it, whom this check ignored.)
+  const Vec2 heading = Vec2{std::cos(pose.theta), std::sin(pose.theta)} * (v < 0.0 ? -1.0 : 1.0);
   auto relevant = [&](Vec2 at) {
     const Vec2 rel = at - pose.position();
     return rel.norm() < 3.0 && rel.dot(heading) > -p_.radius;
@@ -314,19 +316,22 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
   const Vec2 self = ekf_.pose().position();
   for (const auto& o : others_) {
     // Never wall in the goal: a robot parked on my goal is a wait, not a detour. (The robot's own
-    // surroundings are opened again below.)
-    if (!standing(o) || distance(o.pos, goal) < keep + res) {
+    // surroundings are opened again below.) Its neighbours (parking places 1 m apart) keep only
+    // their bodies' disc, so the way in comes from in front of the place and not over them.
+    const double toGoal = distance(o.pos, goal);
+    if (!standing(o) || toGoal < 2.0 * p_.radius + 0.1) {
       continue;
     }
+    const double around = toGoal < keep + res ? 2.0 * p_.radius + 0.05 : keep;
     const auto c = g.cellAt(o.pos);
     if (!c) {
       continue;
     }
-    const int reach = static_cast<int>(std::ceil(keep / res));
+    const int reach = static_cast<int>(std::ceil(around / res));
     for (int dy = -reach; dy <= reach; ++dy) {
       for (int dx = -reach; dx <= reach; ++dx) {
         const planning::Cell q{c->x + dx, c->y + dy};
-        if (g.inside(q) && distance(g.cellCenter(q), o.pos) < keep) {
+        if (g.inside(q) && distance(g.cellCenter(q), o.pos) < around) {
           g.setBlocked(q);
         }
       }
@@ -462,6 +467,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   phaseStartNs_ = nowNs;
   blockedSinceNs_ = -1;
   straightDock_ = false;
+  makingRoom_ = false;
   const auto st = taskStateFor(goal_, false);
   if (st != reported_) {
     reported_ = st;
@@ -617,6 +623,9 @@ bool Agent::heldUp(double& v, double& w, bool& byRobot, std::string& blocker) co
     }
     v = allowed;
   }
+  if (v < 0.0 && !rearClear()) {
+    v = 0.0;  // the stop rule for reversing (the pose law backs onto a station it faces away from)
+  }
   std::string crossing;
   const bool crossOk = crossTrafficSafe(v, w, crossing);
   if (!crossOk && allowed >= 0.05) {
@@ -724,7 +733,12 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
       if (o.id == blocker && standing(o)) {
         lastDetourNs_ = nowNs;
         ++conduct_.detours;
+        // The clock keeps running: when the new plan leads into the same hold, the rules below
+        // (back off, detour around the point, fail) must still get their turn. Restarting it here
+        // kept a robot re-planning the same path every 3 s for minutes.
+        const std::int64_t since = blockedSinceNs_;
         startGoal(nowNs);
+        blockedSinceNs_ = since;
         return;
       }
     }
@@ -881,9 +895,19 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
                        std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
                    nowNs);
       }
+      // The robot on the station wants out (it reports waiting or moving: held up, most likely by
+      // this queue, which stands where its way out begins). Back away up to 1 m more, so it can
+      // pass; a queue robot and the occupant waiting on each other failed both tasks after 60 s.
+      const bool wantsOut =
+          occupant->mode == msg::RobotMode::Waiting || occupant->mode == msg::RobotMode::Moving;
+      if (wantsOut && distance(ekf_.pose(), goals_[goal_].pose) < kQueueDistance + 1.0 && rearClear()) {
+        v = -0.2;
+        makingRoom_ = true;
+      }
       movedNs_ = nowNs;  // waiting in the queue is not being stuck
     } else {
       holdSinceNs_ = -1;
+      makingRoom_ = false;
       docking_ = r->final_approach;
       followerTwist(*r, v, w);
       if (docking_ && straightDock_) {
@@ -1016,7 +1040,8 @@ const Agent::Other* Agent::stationOccupant() const {
   const auto& g = goals_[goal_];
   const Vec2 here = ekf_.pose().position();
   const double toGoal = distance(here, g.pose.position());
-  if (homing_ || toGoal > kQueueDistance || toGoal < kQueueDistance - 0.5) {
+  const double reach = makingRoom_ ? kQueueDistance + 1.3 : kQueueDistance;  // (hysteresis)
+  if (homing_ || toGoal > reach || toGoal < kQueueDistance - 0.5) {
     return nullptr;  // far off, or already past the queue place: go on
   }
   for (const auto& o : others_) {

@@ -220,6 +220,7 @@ class Agent {
   /// On the way to a station that another robot stands on, this far off: that robot (else null).
   [[nodiscard]] const Other* stationOccupant() const;
   std::int64_t holdSinceNs_ = -1;  // queueing for an occupied station since
+  bool makingRoom_ = false;        // queueing further back: the occupant wants out
   Vec2 movedFrom_;                 // where the robot last moved 0.1 m from
   std::int64_t movedNs_ = 0;       // ... and when
   /// A task whose robot has not moved for 3 x blockedFailS fails (whatever held it: a planner that

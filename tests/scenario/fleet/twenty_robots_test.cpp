@@ -22,6 +22,32 @@ using nlohmann::json;
 
 namespace {
 
+/// Every transition to `requeued` or `failed` with its robot and reason, for the log.
+std::string failures(const fs::path& db) {
+  std::string out;
+  sqlite3* h = nullptr;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(
+            h,
+            "SELECT stamp_ns, task_id, to_state, robot, reason FROM transitions WHERE to_state "
+            "IN ('requeued', 'failed') ORDER BY seq",
+            -1, &st, nullptr) == SQLITE_OK) {
+      while (sqlite3_step(st) == SQLITE_ROW) {
+        for (int c = 0; c < 5; ++c) {
+          const auto* t = sqlite3_column_text(st, c);
+          out += (c == 0 ? std::to_string(sqlite3_column_int64(st, 0) / 1'000'000'000) + " s"
+                         : std::string(t != nullptr ? reinterpret_cast<const char*>(t) : "")) +
+                 (c < 4 ? " | " : "\n");
+        }
+      }
+    }
+    sqlite3_finalize(st);
+  }
+  sqlite3_close(h);
+  return out;
+}
+
 /// Simulated seconds at which tasks reached `done`, from the manager's database.
 std::vector<double> doneTimes(const fs::path& db) {
   std::vector<double> t;
@@ -92,7 +118,9 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
     longestGap = std::max(longestGap, done[k] - done[k - 1]);
   }
   EXPECT_LT(longestGap, 300.0) << "the fleet stopped delivering for " << longestGap << " s";
-  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump();
+  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump() << "\nrequeued and failed:\n"
+                                       << failures(out / "fleet.db");
+  std::cout << "requeued and failed:\n" << failures(out / "fleet.db");
   std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "
             << s["min_separation_m"]["robot_robot"] << " m, robot-human "

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
@@ -338,6 +339,46 @@ TEST(Agent, PausedOrderHoldsStillLongerThanTheFailTimeoutAndResumes) {
   EXPECT_EQ(statuses.back().state, msg::TaskState::Done);
 }
 
+TEST(Agent, QueueForAStationBacksAwayWhenTheRobotOnItWantsOut) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  a.onAssignment(transport());  // pickup P-1 at (5, 1)
+  msg::RobotState onStation = parked("r2", {5.0, 1.0});
+  onStation.mode = msg::RobotMode::Loading;
+  onStation.task_id = "t9";
+  int k = 0;
+  double closest = 1e9;
+  auto stepWith = [&](int n) {
+    double v = 0;
+    double w = 0;
+    for (int i = 0; i < n; ++i, ++k) {
+      a.onOtherRobot(onStation);
+      a.onFrame(world.frame(v, w, 0.1));
+      const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+      v = out.command.v;
+      w = out.command.w;
+      closest = std::min(closest, distance(world.truth.position(), Vec2{5.0, 1.0}));
+    }
+  };
+  stepWith(150);
+  const double queued = distance(world.truth.position(), Vec2{5.0, 1.0});
+  EXPECT_GE(queued, 1.4);
+  EXPECT_LE(queued, 2.1) << "queues 1.5-2 m off the occupied station";
+  // Loading done, it wants out (held up: waiting). The queue makes room: about 1 m further back.
+  onStation.mode = msg::RobotMode::Waiting;
+  stepWith(150);
+  const double room = distance(world.truth.position(), Vec2{5.0, 1.0});
+  EXPECT_GT(room, queued + 0.6) << "did not make room";
+  EXPECT_LE(room, 3.4) << "backed away too far";
+  // Gone: the station is free and the robot drives on to it.
+  onStation.pose = {9.0, 9.0, 0.0};
+  onStation.mode = msg::RobotMode::Moving;
+  closest = 1e9;
+  stepWith(150);
+  EXPECT_LT(closest, 0.2) << "did not go on to the station once it was free";
+}
+
 TEST(Agent, ReturnsHomeWhenIdleWithoutReportingTheTrip) {
   auto grid = emptyGrid();
   auto p = params();
@@ -539,6 +580,144 @@ TEST(Agent, ReachesAStationInsideThePlanningMarginWithoutHuggingTheWall) {
   EXPECT_TRUE(done) << "stalled at " << world.truth.x << ", " << world.truth.y;
   EXPECT_GT(minWall, 0.5) << "drove along the wall";
   EXPECT_LT(distance(world.truth.position(), Vec2{1.5, 0.9}), 0.2);
+}
+
+TEST(Agent, PassesRobotsParkedBesideItsWayInsteadOfWaitingOnThem) {
+  // The parking band of the warehouse: a wall along the bottom, robots parked every metre at
+  // y = 0.9, a shelf above a 2 m corridor. A robot driving home stopped 0.8 m above the row,
+  // facing down-left across its path west: its first arc toward the path swept within a body of
+  // a parked robot, the safety layer held it, the standoff rule re-planned around the "standing
+  // blocker" every 3 s (the same path) and restarted its clock each time, so it stood there for
+  // three minutes until the progress watch failed the trip.
+  auto raw = std::make_shared<planning::OccupancyGrid>(40, 10, 0.5, Vec2{0, 0});
+  for (int x = 0; x < 40; ++x) {
+    raw->setBlocked({x, 0});
+    for (int y = 5; y < 10 && x >= 6 && x < 36; ++y) {
+      raw->setBlocked({x, y});
+    }
+  }
+  auto grid = agent::inflate(*raw, 0.5);
+  auto p = params();
+  p.id = "r7";
+  p.start = {17.43, 1.68, -2.78};
+  agent::Agent a(p, grid, raw);
+  World world;
+  world.truth = p.start;
+  msg::TaskAssignment order;
+  order.robot_id = "r7";
+  order.task_id = "t1";
+  order.revision = 1;
+  order.goals.push_back({{9.0, 0.9, M_PI / 2}, "PARK-7", msg::GoalAction::Park, 0.0});
+  a.onAssignment(order);
+  std::vector<msg::RobotState> parkedRow;
+  for (int x = 10; x <= 19; ++x) {
+    parkedRow.push_back(parked("p" + std::to_string(x), {static_cast<double>(x), 0.9}));
+  }
+  double v = 0;
+  double w = 0;
+  bool done = false;
+  double closest = 1e9;
+  for (int k = 0; k < 900 && !done; ++k) {
+    for (const auto& s : parkedRow) {
+      a.onOtherRobot(s);
+      closest = std::min(closest, distance(world.truth.position(), s.pose.position()));
+    }
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    done = out.status && out.status->state == msg::TaskState::Done;
+    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed) << out.status->error;
+  }
+  EXPECT_TRUE(done) << "stood at " << world.truth.x << ", " << world.truth.y;
+  EXPECT_GE(closest, 0.6) << "touched a parked robot";
+}
+
+TEST(Agent, ARobotParkedInAPassageFailsTheTaskAfterTheBlockedTimeout) {
+  // A 1 m passage (one robot wide) with a robot parked in it and no other way: re-planning around
+  // the parked robot finds nothing, and the task must fail after blockedFailS (60 s) with the
+  // blocker named — not stand for three minutes because each re-plan restarted the clock.
+  auto raw = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 8; x < 32; ++x) {
+      const double cy = raw->cellCenter({x, y}).y;
+      if (cy < 4.5 || cy > 5.5) {
+        raw->setBlocked({x, y});
+      }
+    }
+  }
+  auto grid = agent::inflate(*raw, 0.3);
+  auto p = params();
+  p.start = {1.0, 5.0, 0.0};
+  agent::Agent a(p, grid, raw);
+  World world;
+  world.truth = p.start;
+  msg::TaskAssignment order;
+  order.robot_id = "r1";
+  order.task_id = "t1";
+  order.revision = 1;
+  order.goals.push_back({{9.5, 5.0, 0.0}, "D-1", msg::GoalAction::Unload, 0.5});
+  a.onAssignment(order);
+  const Vec2 blocker{5.0, 5.0};
+  double v = 0;
+  double w = 0;
+  std::optional<msg::TaskStatus> failed;
+  int k = 0;
+  for (; k < 1200 && !failed; ++k) {
+    const Vec2 rel = blocker - world.truth.position();
+    const double c = std::cos(world.truth.theta);
+    const double s = std::sin(world.truth.theta);
+    world.detections = {{msg::SourceKind::Robot, static_cast<float>(c * rel.x + s * rel.y),
+                         static_cast<float>(-s * rel.x + c * rel.y), 0.3f}};
+    a.onOtherRobot(parked("r9", blocker));
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    if (out.status && out.status->state == msg::TaskState::Failed) {
+      failed = out.status;
+    }
+  }
+  ASSERT_TRUE(failed) << "still waiting after " << k / 10 << " s";
+  EXPECT_NE(failed->error.find("blocked by r9"), std::string::npos) << failed->error;
+  EXPECT_LT(k, 900) << "failed only after " << k / 10 << " s";
+}
+
+TEST(Agent, BackingOntoAStationStopsForAPersonBehind) {
+  // The goal lies 0.4 m behind the robot, facing the robot's heading: the pose law backs onto it.
+  // A person stands behind, on the way: reversing is held by the rear check.
+  auto grid = emptyGrid();
+  auto p = params();
+  p.start = {5.0, 2.3, M_PI / 2};
+  agent::Agent a(p, grid, grid);
+  World world;
+  world.truth = p.start;
+  msg::TaskAssignment order;
+  order.robot_id = "r1";
+  order.task_id = "t1";
+  order.revision = 1;
+  order.goals.push_back({{5.0, 1.9, M_PI / 2}, "PARK-1", msg::GoalAction::Park, 0.0});
+  a.onAssignment(order);
+  const Vec2 person{5.0, 1.5};
+  double v = 0;
+  double w = 0;
+  double closest = 1e9;
+  bool reversed = false;
+  for (int k = 0; k < 100; ++k) {
+    const Vec2 rel = person - world.truth.position();
+    const double c = std::cos(world.truth.theta);
+    const double s = std::sin(world.truth.theta);
+    world.detections = {{msg::SourceKind::Human, static_cast<float>(c * rel.x + s * rel.y),
+                         static_cast<float>(-s * rel.x + c * rel.y), 0.25f}};
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    reversed = reversed || v < -0.01;
+    closest = std::min(closest, distance(world.truth.position(), person) - 0.3 - 0.25);
+  }
+  EXPECT_TRUE(reversed) << "the scene did not make the robot back up";
+  EXPECT_GT(closest, 0.15) << "backed into the person";
 }
 
 TEST(Agent, SlowsForAPersonWalkingAcrossItsWay) {
