@@ -774,6 +774,16 @@ int Run::run() {
                   m.value("overruns", 0), m["cycle_ms"].value("p50", 0.0), m["cycle_ms"].value("p99", 0.0),
                   m["cycle_ms"].value("max", 0.0));
     say(line);
+    if (m.contains("conduct")) {
+      const auto& c = m["conduct"];
+      std::snprintf(line, sizeof line,
+                    "%s conduct: %d standoffs (%d on a robot itself waiting: wait cycles), %d back-offs, %d "
+                    "returns along the trail, %d detours",
+                    m.value("id", std::string("?")).c_str(), c.value("standoffs", 0),
+                    c.value("wait_cycles", 0), c.value("backoffs", 0), c.value("returns", 0),
+                    c.value("detours", 0));
+      say(line);
+    }
   }
   if (!contents.error.empty()) {
     say("task database: " + contents.error);

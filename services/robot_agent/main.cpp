@@ -217,8 +217,21 @@ int run(const sim::Scenario& scn, const Options& opt) {
     }
     const auto from = lockstep && firstCycle ? *firstCycle : started;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count();
-    const auto m =
-        cycleMetrics(id, lockstep, agents.size(), pool.threads(), dt, steps, elapsed, overruns, cycleMs);
+    auto m = cycleMetrics(id, lockstep, agents.size(), pool.threads(), dt, steps, elapsed, overruns, cycleMs);
+    // How the robots of this process dealt with each other (docs/algorithms.md, fleet conduct).
+    agent::Agent::Conduct c;
+    for (const auto& a : agents) {
+      c.standoffs += a->conduct().standoffs;
+      c.mutualBlocks += a->conduct().mutualBlocks;
+      c.backoffs += a->conduct().backoffs;
+      c.returns += a->conduct().returns;
+      c.detours += a->conduct().detours;
+    }
+    m["conduct"] = {{"standoffs", c.standoffs},
+                    {"wait_cycles", c.mutualBlocks},
+                    {"backoffs", c.backoffs},
+                    {"returns", c.returns},
+                    {"detours", c.detours}};
     std::ofstream f(opt.metricsFile + ".tmp");
     f << m.dump(1) << "\n";
     f.close();
