@@ -91,6 +91,7 @@ void Dispatcher::applied(const TaskRecord& r, DispatchResult& out) {
       break;
   }
   if (isTerminal(r.state)) {
+    failedBy_.erase(r.task.id);
     open_.erase(r.task.id);
   } else {
     open_.insert_or_assign(r.task.id, r);
@@ -201,6 +202,7 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   }
   DispatchResult out;
   if (state == TaskState::Failed) {
+    failedBy_[taskId] = robotId;
     auto& streak = failStreak_[robotId];
     if (cfg_.robotFailLimit > 0 && ++streak.count >= cfg_.robotFailLimit) {
       streak.count = 0;
@@ -421,7 +423,20 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   const Allocator& alloc = small * small * big > cfg_.hungarianMaxWork
                                ? static_cast<const Allocator&>(greedy_)
                                : static_cast<const Allocator&>(hungarian_);
-  const auto assignments = alloc.assign(waiting, idle, travel_, nowNs);
+  TravelModel travel = travel_;
+  if (!failedBy_.empty() && idle.size() > 1) {
+    // A retry goes to another robot: whatever held the last one (boxed in, a bad pose estimate)
+    // is likely to hold it again. With a single idle robot it may take the task back.
+    travel = [this](const Task& t) -> RobotTravel {
+      RobotTravel base = travel_(t);
+      const auto it = failedBy_.find(t.id);
+      if (it == failedBy_.end()) {
+        return base;
+      }
+      return [base, who = it->second](const RobotInfo& r) { return r.id == who ? kInfeasible : base(r); };
+    };
+  }
+  const auto assignments = alloc.assign(waiting, idle, travel, nowNs);
   std::vector<TransitionRequest> reqs;
   reqs.reserve(assignments.size());
   for (const auto& a : assignments) {

@@ -323,6 +323,28 @@ TEST_F(DispatcherTest, PausedTaskIsNotDispatchedAndAnActiveOneIsHeldDurably) {
   EXPECT_EQ(dispatcher->setPaused("nope", true, 8).error().code, errc::kNotFound);
 }
 
+TEST_F(DispatcherTest, AFailedTaskIsRetriedByAnotherRobotWhenOneIsIdle) {
+  robot("a", 1, 0.9, 0);
+  robot("b", 9, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  ASSERT_EQ(out.assignments[0].robotId, "a") << "the nearer robot first";
+  ASSERT_TRUE(dispatcher->onTaskStatus("a", "t1", S::Failed, "blocked by r5 for 60 s", 2));
+  out = dispatcher->tick(3);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "b") << "the retry went back to the robot that failed it";
+  // Alone, the robot that failed it may take it again.
+  ASSERT_TRUE(dispatcher->onTaskStatus("b", "t1", S::Failed, "", 4));
+  robot("b", 9, 0.05, 5);  // b is low now and goes to charge: a is the only candidate
+  out = dispatcher->tick(6);
+  bool aGotIt = false;
+  for (const auto& o : out.assignments) {
+    aGotIt = aGotIt || (o.robotId == "a" && o.task.id == "t1");
+  }
+  EXPECT_TRUE(aGotIt);
+}
+
 TEST_F(DispatcherTest, RecoverRebuildsOpenStateAfterRestart) {
   robot("a", 1, 0.9, 0);
   dispatcher->submit({transport("t1"), transport("t2"), transport("t3")}, 0);

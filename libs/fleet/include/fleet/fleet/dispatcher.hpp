@@ -141,6 +141,9 @@ class Dispatcher {
     std::int64_t holdUntilNs = 0;
   };
   std::map<std::string, FailStreak, std::less<>> failStreak_;  // by robot id
+  /// Task id -> the robot that failed it last: the retry goes to another idle robot if there is
+  /// one (a robot boxed in at its parking place failed the same task three times in a row).
+  std::map<std::string, std::string, std::less<>> failedBy_;
 };
 
 }  // namespace fleet
