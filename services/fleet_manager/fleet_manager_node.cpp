@@ -22,6 +22,12 @@ msg::TaskAck ack(const msg::Task& req, msg::AckResult r, msg::TaskState state, s
   return {req.request_id, req.task_id, r, state, std::move(detail), nowNs};
 }
 
+/// An operator request (cancel, pause, resume) on an unknown or finished task.
+msg::TaskAck refused(const msg::Task& req, const Error& e, std::int64_t nowNs) {
+  return ack(req, e.code == errc::kNotFound ? msg::AckResult::NotFound : msg::AckResult::Refused,
+             msg::TaskState::Rejected, e.message, nowNs);
+}
+
 std::string fieldsJson(const std::vector<FieldError>& fields) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& f : fields) {
@@ -247,9 +253,7 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
         out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Cancelled, "", nowNs));
         publish(std::move(*r), nowNs, out);
       } else {
-        const bool missing = r.error().code == errc::kNotFound;
-        out.acks.push_back(ack(req, missing ? msg::AckResult::NotFound : msg::AckResult::Refused,
-                               msg::TaskState::Rejected, r.error().message, nowNs));
+        out.acks.push_back(refused(req, r.error(), nowNs));
       }
       continue;
     }
@@ -264,9 +268,7 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
         out.acks.push_back(ack(req, msg::AckResult::Stored, state, pause ? "paused" : "resumed", nowNs));
         publish(std::move(*r), nowNs, out);
       } else {
-        const bool missing = r.error().code == errc::kNotFound;
-        out.acks.push_back(ack(req, missing ? msg::AckResult::NotFound : msg::AckResult::Refused,
-                               msg::TaskState::Rejected, r.error().message, nowNs));
+        out.acks.push_back(refused(req, r.error(), nowNs));
       }
       continue;
     }

@@ -375,17 +375,25 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
   reply(res, status, {{"results", results}});
 }
 
-void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
-  const std::string id = req.matches[1];
+bool HttpApi::admitTaskRequest(const std::string& id, const char* verb, httplib::Response& res) {
   if (!isValidId(id)) {
     reply(res, 400,
           {{"error", "invalid"},
            {"fields", json::array({{{"path", "id"}, {"reason", "not a valid task id"}}})}});
-    return;
+    return false;
   }
   if (!gateway_.managerOnline()) {
     res.set_header("Retry-After", "2");
-    reply(res, 503, error("unavailable", "the fleet manager is unreachable; nothing was cancelled"));
+    reply(res, 503,
+          error("unavailable", std::string("the fleet manager is unreachable; nothing was ") + verb));
+    return false;
+  }
+  return true;
+}
+
+void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
+  const std::string id = req.matches[1];
+  if (!admitTaskRequest(id, "cancelled", res)) {
     return;
   }
   msg::Task m;
@@ -407,17 +415,7 @@ void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
 
 void HttpApi::controlTask(const httplib::Request& req, httplib::Response& res, bool pause) {
   const std::string id = req.matches[1];
-  const char* verb = pause ? "paused" : "resumed";
-  if (!isValidId(id)) {
-    reply(res, 400,
-          {{"error", "invalid"},
-           {"fields", json::array({{{"path", "id"}, {"reason", "not a valid task id"}}})}});
-    return;
-  }
-  if (!gateway_.managerOnline()) {
-    res.set_header("Retry-After", "2");
-    reply(res, 503,
-          error("unavailable", std::string("the fleet manager is unreachable; nothing was ") + verb));
+  if (!admitTaskRequest(id, pause ? "paused" : "resumed", res)) {
     return;
   }
   msg::Task m;

@@ -54,6 +54,9 @@ class HttpApi {
   void routes();
   void postTasks(const httplib::Request& req, httplib::Response& res);
   void deleteTask(const httplib::Request& req, httplib::Response& res);
+  /// A request on task `id` (cancel, pause, resume): a valid id and a reachable manager, else the
+  /// 400 / 503 reply is written ("nothing was <verb>") and false returned.
+  bool admitTaskRequest(const std::string& id, const char* verb, httplib::Response& res);
   /// POST /v1/tasks/{id}/pause and /resume.
   void controlTask(const httplib::Request& req, httplib::Response& res, bool pause);
   std::string nextRequestId();

@@ -247,17 +247,27 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   return out;
 }
 
+Expected<std::map<std::string, TaskRecord, std::less<>>::iterator> Dispatcher::findOpen(
+    const std::string& taskId) {
+  auto it = open_.find(taskId);
+  if (it != open_.end()) {
+    return it;
+  }
+  auto stored = store_.get(taskId);
+  if (!stored) {
+    return unexpected(stored.error());  // not_found
+  }
+  return unexpected(errc::kIllegalTransition,
+                    "task '" + taskId + "' is already " + std::string(toString(stored->state)));
+}
+
 Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std::string& reason,
                                             std::int64_t nowNs) {
-  auto it = open_.find(taskId);
-  if (it == open_.end()) {
-    auto stored = store_.get(taskId);
-    if (!stored) {
-      return unexpected(stored.error());
-    }
-    return unexpected(errc::kIllegalTransition,
-                      "task '" + taskId + "' is already " + std::string(toString(stored->state)));
+  auto found = findOpen(taskId);
+  if (!found) {
+    return unexpected(found.error());
   }
+  const auto it = *found;
   const std::string robot = it->second.robotId;
   const bool active = isActive(it->second.state);
   auto res = store_.transition(taskId, TaskState::Cancelled, "", reason, nowNs);
@@ -274,15 +284,11 @@ Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std
 }
 
 Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool paused, std::int64_t nowNs) {
-  auto it = open_.find(taskId);
-  if (it == open_.end()) {
-    auto stored = store_.get(taskId);
-    if (!stored) {
-      return unexpected(stored.error());
-    }
-    return unexpected(errc::kIllegalTransition,
-                      "task '" + taskId + "' is already " + std::string(toString(stored->state)));
+  auto found = findOpen(taskId);
+  if (!found) {
+    return unexpected(found.error());
   }
+  const auto it = *found;
   auto res = store_.setPaused(taskId, paused, nowNs);
   if (!res) {
     return unexpected(res.error());

@@ -120,6 +120,8 @@ class Dispatcher {
 
  private:
   void applied(const TaskRecord& r, DispatchResult& out);
+  /// The open task, or not_found / illegal_transition ("already done") for an operator request.
+  Expected<std::map<std::string, TaskRecord, std::less<>>::iterator> findOpen(const std::string& taskId);
   void requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason, std::int64_t nowNs,
                      DispatchResult& out);
   void chargeLowRobots(std::int64_t nowNs, DispatchResult& out);
