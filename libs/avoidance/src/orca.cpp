@@ -228,9 +228,12 @@ Command OrcaPlanner::plan(const LocalView& view) {
   // Perfectly symmetric encounters (circle swap) are a fixed point of ORCA: every robot's optimum
   // is to slow down straight ahead. A shared convention breaks the symmetry: while the preferred
   // velocity is not permitted, prefer passing on the right (rotate it clockwise).
+  // Only towards moving discs: a robot standing still (arrived, parked) takes no part in the
+  // convention, and biasing against it kept the last robots of the 100-robot swap circling outside
+  // the ring of arrived robots instead of entering their goal's gap.
   Vec2 opt = v_pref;
   for (std::size_t i = hard; i < planes_.size(); ++i) {
-    if (violation(planes_[i], v_pref) > 0.0) {
+    if (view.discs[i - hard].velocity.squaredNorm() > 0.05 * 0.05 && violation(planes_[i], v_pref) > 0.0) {
       const double c = std::cos(params_.right_bias);
       const double s = std::sin(params_.right_bias);
       opt = Vec2{c * v_pref.x + s * v_pref.y, -s * v_pref.x + c * v_pref.y};

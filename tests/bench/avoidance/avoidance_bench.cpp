@@ -130,7 +130,7 @@ void BM_CircleSwap(benchmark::State& state, const char* planner) {
   ScenarioResult mine{};
   for (auto _ : state) {
     Scenario sc = circleSwap(n, R);
-    sc.max_steps = 1500;  // 150 s simulated: twice the straight-line time across the circle at n = 100
+    sc.max_steps = 3000;  // 300 s simulated: the straight-line crossing takes 40 s at n = 100
     auto m = runScenario(sc, planner);
     auto b = runScenario(sc, "vo");
     if (!m || !b) {
