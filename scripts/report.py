@@ -123,6 +123,20 @@ def loadtest_html(lt):
     faults = "".join(f"<tr><td>{e.get('sim_s', 0):.1f}</td><td>{html.escape(e.get('event', ''))}</td></tr>"
                      for e in lt.get("faults", []))
     progress = [(p["wall_s"], p["sim_s"]) for p in lt.get("progress", [])]
+    # The robot agent processes: the control rate they achieved and how their robots dealt with
+    # each other (agent-K_metrics.json, collected by fleetctl loadtest).
+    agent_rows = "".join(
+        f"<tr><td>{html.escape(str(m.get('id', '?')))}</td><td>{m.get('robots', 0)}</td>"
+        f"<td>{m.get('achieved_hz', 0):.2f} / {m.get('configured_hz', 0):.0f}</td><td>{m.get('overruns', 0)}</td>"
+        f"<td>{m.get('cycle_ms', {}).get('p50', 0):.2f} / {m.get('cycle_ms', {}).get('p99', 0):.2f}</td>"
+        f"<td>{m.get('conduct', {}).get('standoffs', 0)} / {m.get('conduct', {}).get('wait_cycles', 0)} / "
+        f"{m.get('conduct', {}).get('backoffs', 0)} / {m.get('conduct', {}).get('returns', 0)} / "
+        f"{m.get('conduct', {}).get('detours', 0)}</td></tr>"
+        for m in lt.get("agents", []))
+    agents = (f"<h3>Robot agents ({html.escape(str(lt.get('clock', 'lockstep')))} clock)</h3><table>"
+              "<tr><td>process</td><td>robots</td><td>cycles/s (achieved / configured)</td><td>overruns</td>"
+              "<td>cycle ms p50 / p99</td><td>standoffs / wait cycles / back-offs / returns / detours</td></tr>"
+              f"{agent_rows}</table>") if agent_rows else ""
     return f"""<h2>Load test</h2>{verdict}
 <p>{lt.get('robots')} robots in {lt.get('agent_processes')} agent process(es), {lt.get('humans')} humans,
 {lt.get('sim_time_s', 0):.0f} s simulated in {lt.get('wall_time_s', 0):.0f} s wall
@@ -133,7 +147,8 @@ Arrival rate {lt.get('rate_per_min', 0):g} tasks per simulated minute. Fault pla
 <div><h3>Latency (s, simulated)</h3><table><tr><td></td><td>p50</td><td>p90</td><td>p99</td><td>max</td><td>n</td></tr>
 {''.join(f"<tr><td>{n}</td>" + ''.join(f"<td>{a.get(k, {}).get(q, 0):.2f}</td>" for q in ('p50', 'p90', 'p99', 'max')) + f"<td>{a.get(k, {}).get('count', 0)}</td></tr>" for n, k in (('assignment', 'assignment_latency_s'), ('end to end', 'end_to_end_latency_s')))}</table>
 <h3>Faults injected</h3><table><tr><td>sim s</td><td>event</td></tr>{faults}</table></div>
-<div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)')}</div></div>"""
+<div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)')}</div></div>
+{agents}"""
 
 
 def main(run):

@@ -5,6 +5,7 @@
 #include <dirent.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -137,6 +138,10 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
   fs::remove_all(out);
   auto args = baseArgs(out, 4, 30);
   args.push_back("--wall-clock");
+  // With the HTML report this time (what scripts/demo writes), agents' table included.
+  const auto report = std::find(args.begin(), args.end(), "--report-script");
+  ASSERT_NE(report, args.end());
+  *(report + 1) = FLEET_SOURCE_DIR "/scripts/report.py";
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(120)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
@@ -157,5 +162,13 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
     robots += m["robots"].get<int>();
   }
   EXPECT_EQ(robots, 4);
+  std::ifstream page(out / "index.html");
+  ASSERT_TRUE(page) << "no report in " << out;
+  std::string html;
+  for (std::string line; std::getline(page, line);) {
+    html += line + "\n";
+  }
+  EXPECT_NE(html.find("Robot agents (wall clock)"), std::string::npos);
+  EXPECT_NE(html.find("0 lost, 0 duplicated"), std::string::npos);
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
