@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Writes the fleet run report (index.html + summary.json) from what a demo or load-test run left
 in its folder: the simulator's summary and replay viewer, the fleet manager's task database and
-metrics. Usage: scripts/report.py RUN_DIR"""
+metrics. index.html is one self-contained file: the replay viewer travels inside it (gzip +
+base64, unpacked by the browser), so it can be copied or mailed on its own; viewer.html stays
+next to it for opening the viewer by itself. Usage: scripts/report.py RUN_DIR"""
+import base64
 import gzip
 import html
 import json
@@ -11,96 +14,132 @@ import sqlite3
 import sys
 
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"]
+MARKS = (("p50", 0.5, "#1f77b4"), ("p90", 0.9, "#ff7f0e"), ("p99", 0.99, "#d62728"))
 
 
-def svg_lines(series, w=520, h=220, xlabel="", ylabel=""):
-    """Several named lines [(name, [(x, y)...])] on shared axes, with a legend."""
+def no_data(why, w=520, h=220):
+    """A placeholder the size of a plot, saying why there is nothing to draw."""
+    return (f'<div class="nodata" style="width:{w-2}px;height:{h-2}px">(no data: {html.escape(why)})</div>')
+
+
+def nice_ticks(lo, hi, n=5, integer=False):
+    """About n round tick values covering [lo, hi]."""
+    span = hi - lo
+    if span <= 0:
+        return [lo]
+    raw = span / n
+    step = 10 ** math.floor(math.log10(raw))
+    for m in (1, 2, 2.5, 5, 10):
+        if raw <= step * m:
+            step *= m
+            break
+    if integer:
+        step = max(1, round(step))
+    first = math.ceil(lo / step - 1e-9) * step
+    return [round(first + i * step, 10) for i in range(int((hi - first) / step + 1e-9) + 1)]
+
+
+def fmt(v):
+    return f"{v:.3g}" if abs(v) < 1000 else f"{v:.0f}"
+
+
+def svg_frame(w, h, x0, x1, y1, xlabel, ylabel, right=20, top=20, integer_y=False):
+    """Axes with ticks, grid lines and labels for a plot of [x0, x1] × [0, y1]; returns the
+    scales and the SVG of the frame. The plot area is x in [55, w-right], y in [top, h-40]."""
+    left, bottom = 55, h - 40
+    sx = lambda x: left + (x - x0) / ((x1 - x0) or 1) * (w - right - left)
+    sy = lambda y: bottom - y / (y1 or 1) * (bottom - top)
+    parts = []
+    for t in nice_ticks(0, y1, 4, integer_y):
+        parts.append(f'<line x1="{left}" y1="{sy(t):.1f}" x2="{w-right}" y2="{sy(t):.1f}" stroke="#e4e4e4"/>'
+                     f'<text x="{left-4}" y="{sy(t)+4:.1f}" text-anchor="end">{fmt(t)}</text>')
+    for t in nice_ticks(x0, x1, 6):
+        parts.append(f'<line x1="{sx(t):.1f}" y1="{bottom}" x2="{sx(t):.1f}" y2="{bottom+4}" stroke="#444"/>'
+                     f'<text x="{sx(t):.1f}" y="{bottom+15}" text-anchor="middle">{fmt(t)}</text>')
+    parts.append(f'<line x1="{left}" y1="{bottom}" x2="{w-right}" y2="{bottom}" stroke="#444"/>'
+                 f'<line x1="{left}" y1="{top}" x2="{left}" y2="{bottom}" stroke="#444"/>'
+                 f'<text x="{(left + w - right)/2}" y="{h-6}" text-anchor="middle">{html.escape(xlabel)}</text>'
+                 f'<text x="13" y="{(top + bottom)/2}" transform="rotate(-90 13 {(top + bottom)/2})" '
+                 f'text-anchor="middle">{html.escape(ylabel)}</text>')
+    return sx, sy, "".join(parts)
+
+
+def svg_open(w, h):
+    return f'<svg width="{w}" height="{h}" xmlns="http://www.w3.org/2000/svg" font-size="11" font-family="sans-serif">'
+
+
+def svg_lines(series, w=520, h=240, xlabel="", ylabel="", why="nothing recorded", legend_title=""):
+    """Several named lines [(name, [(x, y)...])] on shared axes, with a legend right of the plot."""
     series = [(n, pts) for n, pts in series if pts]
     if not series:
-        return "<p>(no data)</p>"
+        return no_data(why, w, h)
     xs = [x for _, pts in series for x, _ in pts]
     x0, x1 = min(xs), max(xs)
     y1 = max(y for _, pts in series for _, y in pts) or 1
-    sx = lambda x: 50 + (x - x0) / ((x1 - x0) or 1) * (w - 150)
-    sy = lambda y: h - 35 - y / y1 * (h - 55)
+    sx, sy, frame = svg_frame(w, h, x0, x1, y1, xlabel, ylabel, right=95)
     paths, legend = [], []
+    if legend_title:
+        legend.append(f'<text x="{w-85}" y="24" font-weight="bold">{html.escape(legend_title)}</text>')
     for i, (name, pts) in enumerate(series):
         c = COLORS[i % len(COLORS)]
         d = " ".join(f"{'M' if k == 0 else 'L'}{sx(x):.1f},{sy(y):.1f}" for k, (x, y) in enumerate(pts))
         paths.append(f'<path d="{d}" fill="none" stroke="{c}" stroke-width="1.5"/>')
-        legend.append(f'<text x="{w-92}" y="{24+i*13}" fill="{c}">{html.escape(name)}</text>')
-    return (f'<svg width="{w}" height="{h}" xmlns="http://www.w3.org/2000/svg" font-size="11">'
-            f'<line x1="50" y1="{h-35}" x2="{w-100}" y2="{h-35}" stroke="#444"/>'
-            f'<line x1="50" y1="20" x2="50" y2="{h-35}" stroke="#444"/>{"".join(paths)}{"".join(legend)}'
-            f'<text x="{(w-100)/2}" y="{h-8}" text-anchor="middle">{html.escape(xlabel)}</text>'
-            f'<text x="12" y="{h/2}" transform="rotate(-90 12 {h/2})" text-anchor="middle">{html.escape(ylabel)}</text>'
-            f'<text x="46" y="24" text-anchor="end">{y1:.3g}</text><text x="46" y="{h-35}" text-anchor="end">0</text>'
-            f'<text x="50" y="{h-22}">{x0:g}</text><text x="{w-100}" y="{h-22}" text-anchor="end">{x1:g}</text></svg>')
+        y = 24 + (i + (1 if legend_title else 0)) * 14
+        legend.append(f'<line x1="{w-85}" y1="{y-4}" x2="{w-71}" y2="{y-4}" stroke="{c}" stroke-width="2"/>'
+                      f'<text x="{w-67}" y="{y}">{html.escape(name)}</text>')
+    return f'{svg_open(w, h)}{frame}{"".join(paths)}{"".join(legend)}</svg>'
 
 
-def risk_levels_over_time(run):
-    """Area (m²) of the risk map at or above each iso-level, per recorded map in the replay."""
-    path = os.path.join(run, "replay.jsonl.gz")
-    if not os.path.exists(path):
-        return []
-    levels = {}
-    with gzip.open(path, "rt") as f:
-        for line in f:
-            if '"risk"' not in line:
-                continue
-            d = json.loads(line)
-            r = d.get("risk")
-            if not r or "runs" not in r:
-                continue
-            cell = r.get("resolution", 0.1) ** 2
-            counts = [0] * (r.get("levels", 10) + 1)
-            for level, n in r["runs"]:
-                if 0 <= level < len(counts):
-                    counts[level] += n
-            for l in range(1, len(counts)):
-                levels.setdefault(l, []).append((d.get("t", 0.0), sum(counts[l:]) * cell))
-    k = max(levels) if levels else 0
-    return [(f"p >= {l / k:.1f}", pts) for l, pts in sorted(levels.items()) if l in (1, 2, 3, 5, 7, 9, k)]
-
-
-def svg_line(points, w=520, h=220, xlabel="", ylabel=""):
+def svg_line(points, w=520, h=240, xlabel="", ylabel="", why="nothing recorded", diagonal=None):
+    """One line; diagonal=(label) also draws y = x, dashed, for reference."""
     if not points:
-        return "<p>(no data)</p>"
+        return no_data(why, w, h)
     xs = [p[0] for p in points]
-    ys = [p[1] for p in points]
-    x0, x1 = min(xs), max(xs) or 1
-    y1 = max(ys) or 1
-    sx = lambda x: 50 + (x - x0) / ((x1 - x0) or 1) * (w - 70)
-    sy = lambda y: h - 35 - y / y1 * (h - 55)
+    x0, x1 = min(xs), max(xs)
+    y1 = max(p[1] for p in points) or 1
+    sx, sy, frame = svg_frame(w, h, x0, x1, y1, xlabel, ylabel)
     path = " ".join(f"{'M' if i == 0 else 'L'}{sx(x):.1f},{sy(y):.1f}" for i, (x, y) in enumerate(points))
-    return (f'<svg width="{w}" height="{h}" xmlns="http://www.w3.org/2000/svg" font-size="11">'
-            f'<line x1="50" y1="{h-35}" x2="{w-20}" y2="{h-35}" stroke="#444"/>'
-            f'<line x1="50" y1="20" x2="50" y2="{h-35}" stroke="#444"/>'
-            f'<path d="{path}" fill="none" stroke="#1f77b4" stroke-width="2"/>'
-            f'<text x="{w/2}" y="{h-8}" text-anchor="middle">{html.escape(xlabel)}</text>'
-            f'<text x="12" y="{h/2}" transform="rotate(-90 12 {h/2})" text-anchor="middle">{html.escape(ylabel)}</text>'
-            f'<text x="46" y="24" text-anchor="end">{y1:g}</text><text x="46" y="{h-35}" text-anchor="end">0</text>'
-            f'<text x="50" y="{h-22}">{x0:g}</text><text x="{w-20}" y="{h-22}" text-anchor="end">{x1:g}</text></svg>')
+    ref = ""
+    if diagonal:
+        e = min(x1, y1)
+        ref = (f'<path d="M{sx(max(x0, 0)):.1f},{sy(max(x0, 0)):.1f} L{sx(e):.1f},{sy(e):.1f}" stroke="#999" '
+               f'stroke-dasharray="4 3" fill="none"/><text x="{sx(e)-4:.1f}" y="{sy(e)+14:.1f}" '
+               f'text-anchor="end" fill="#777">{html.escape(diagonal)}</text>')
+    return (f'{svg_open(w, h)}{frame}{ref}<path d="{path}" fill="none" stroke="#1f77b4" stroke-width="2"/></svg>')
 
 
-def svg_hist(values, bins=12, w=520, h=220, xlabel=""):
+def svg_hist(values, bins=20, w=520, h=240, xlabel="", ylabel="tasks", why="no samples", color="#2ca02c"):
+    """A histogram of values from 0 (times), with dashed p50 / p90 / p99 markers and their values
+    above the plot."""
     if not values:
-        return "<p>(no data)</p>"
-    lo, hi = min(values), max(values)
-    width = (hi - lo) / bins or 1
+        return no_data(why, w, h)
+    lo, hi = 0.0, max(values)
+    nt = nice_ticks(0, hi, 6)
+    if len(nt) < 2:  # all zero
+        hi = 1.0
+    elif nt[-1] < hi:  # bins on round edges: up to the first tick at or above the maximum
+        hi = nt[-1] + (nt[1] - nt[0])
+    width = (hi - lo) / bins
     counts = [0] * bins
     for v in values:
         counts[min(bins - 1, int((v - lo) / width))] += 1
     top = max(counts)
-    bw = (w - 70) / bins
+    sx, sy, frame = svg_frame(w, h, lo, hi, top, xlabel, ylabel, top=30, integer_y=True)
     bars = "".join(
-        f'<rect x="{50 + i*bw:.1f}" y="{h-35-(c/top)*(h-55):.1f}" width="{bw-2:.1f}" height="{(c/top)*(h-55):.1f}" fill="#2ca02c"/>'
-        for i, c in enumerate(counts))
-    return (f'<svg width="{w}" height="{h}" xmlns="http://www.w3.org/2000/svg" font-size="11">{bars}'
-            f'<line x1="50" y1="{h-35}" x2="{w-20}" y2="{h-35}" stroke="#444"/>'
-            f'<text x="{w/2}" y="{h-8}" text-anchor="middle">{html.escape(xlabel)}</text>'
-            f'<text x="50" y="{h-22}">{lo:.0f}</text><text x="{w-20}" y="{h-22}" text-anchor="end">{hi:.0f}</text>'
-            f'<text x="46" y="24" text-anchor="end">{top}</text></svg>')
+        f'<rect x="{sx(lo + i*width)+0.5:.1f}" y="{sy(c):.1f}" width="{max(sx(lo + width) - sx(lo) - 1, 0.5):.1f}" '
+        f'height="{sy(0) - sy(c):.1f}" fill="{color}" fill-opacity="0.75"><title>{fmt(lo + i*width)}–'
+        f'{fmt(lo + (i+1)*width)}: {c}</title></rect>'
+        for i, c in enumerate(counts) if c)
+    marks, x = [], 55
+    for name, q, c in MARKS:
+        v = pct(values, q)
+        marks.append(f'<line x1="{sx(v):.1f}" y1="30" x2="{sx(v):.1f}" y2="{h-40}" stroke="{c}" stroke-dasharray="4 3"/>')
+        label = f"{name} {v:.4g}"
+        marks.append(f'<line x1="{x}" y1="11" x2="{x+14}" y2="11" stroke="{c}" stroke-dasharray="4 3"/>'
+                     f'<text x="{x+18}" y="15" fill="{c}">{html.escape(label)}</text>')
+        x += 30 + 6.5 * len(label)
+    marks.append(f'<text x="{w-20}" y="15" text-anchor="end" fill="#555">n = {len(values)}</text>')
+    return f'{svg_open(w, h)}{frame}{bars}{"".join(marks)}</svg>'
 
 
 def pct(values, q):
@@ -110,6 +149,91 @@ def pct(values, q):
     return v[min(len(v), max(1, math.ceil(q * len(v)))) - 1]
 
 
+def percentiles(values):
+    return {"p50": pct(values, 0.5), "p90": pct(values, 0.9), "p99": pct(values, 0.99),
+            "max": pct(values, 1.0), "count": len(values)}
+
+
+def replay_header(run):
+    path = os.path.join(run, "replay.jsonl.gz")
+    if not os.path.exists(path):
+        return {}
+    with gzip.open(path, "rt") as f:
+        for line in f:
+            d = json.loads(line)
+            return d if d.get("type") == "header" else {}
+    return {}
+
+
+def risk_levels_over_time(run):
+    """Area (m²) of the risk map at or above each iso-level, per recorded map in the replay. Level l
+    of K holds collision probabilities in ((l-1)/K, l/K], so "at or above l" is p > (l-1)/K."""
+    path = os.path.join(run, "replay.jsonl.gz")
+    if not os.path.exists(path):
+        return []
+    levels = {}
+    K = 0
+    with gzip.open(path, "rt") as f:
+        for line in f:
+            if '"risk"' not in line:
+                continue
+            d = json.loads(line)
+            r = d.get("risk")
+            if not r or "runs" not in r:
+                continue
+            cell = r.get("resolution", 0.1) ** 2
+            K = r.get("levels", 10)
+            counts = [0] * (K + 1)
+            for level, n in r["runs"]:
+                if 0 <= level < len(counts):
+                    counts[level] += n
+            for l in range(1, len(counts)):
+                levels.setdefault(l, []).append((d.get("t", 0.0), sum(counts[l:]) * cell))
+    shown = {1, 2, 3, 5, 7, 9, K} if K == 10 else set(sorted(levels)[::max(1, K // 6)]) | {K}
+    return [(f"p > {(l - 1) / K:.2g}", pts) for l, pts in sorted(levels.items()) if l in shown]
+
+
+def embedded_viewer(run):
+    """The replay viewer as an iframe whose document travels inside this page (gzip + base64):
+    a few lines of script unpack it into srcdoc, so the page needs no other file."""
+    path = os.path.join(run, "viewer.html")
+    if not os.path.exists(path):
+        return no_data("the run left no viewer.html", 600, 80)
+    raw = open(path, "rb").read()
+    packed = base64.b64encode(gzip.compress(raw, 9, mtime=0)).decode("ascii")
+    return f"""<iframe id="viewer" title="replay viewer"></iframe>
+<p id="viewer-note" class="note"></p>
+<script id="viewer-gz" type="application/octet-stream">{packed}</script>
+<script>
+(async () => {{
+  const note = document.getElementById("viewer-note");
+  try {{
+    const b = atob(document.getElementById("viewer-gz").textContent.trim());
+    const bytes = Uint8Array.from(b, c => c.charCodeAt(0));
+    if (!window.DecompressionStream) throw new Error("this browser has no DecompressionStream");
+    const text = await new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"))).text();
+    document.getElementById("viewer").srcdoc = text;
+  }} catch (e) {{
+    note.textContent = "The embedded viewer could not be unpacked (" + e.message + "); open viewer.html from the run folder instead.";
+  }}
+}})();
+</script>
+<noscript><p>The embedded replay viewer needs JavaScript.</p></noscript>"""
+
+
+def num(v, spec=".2f"):
+    return "—" if v is None else format(v, spec)
+
+
+def latency_table(blocks):
+    """[(name, what, {p50, p90, p99, max, count})] as one table, seconds of simulated time."""
+    head = "<tr><th></th><th>from → to</th><th>p50</th><th>p90</th><th>p99</th><th>max</th><th>n</th></tr>"
+    body = "".join(f"<tr><td>{html.escape(n)}</td><td>{html.escape(what)}</td>"
+                   + "".join(f'<td class="r">{num(p.get(q))}</td>' for q in ("p50", "p90", "p99", "max"))
+                   + f'<td class="r">{p.get("count", 0)}</td></tr>' for n, what, p in blocks)
+    return f"<table>{head}{body}</table>"
+
+
 def loadtest_html(lt):
     if not lt:
         return ""
@@ -117,37 +241,42 @@ def loadtest_html(lt):
     bad = (a.get("lost", 0) or 0) + (a.get("duplicated", 0) or 0)
     verdict = (f'<p style="font-size:1.3em;color:{"#b00" if bad else "#070"}"><b>{a.get("lost")} lost, '
                f'{a.get("duplicated")} duplicated</b> of {a.get("acknowledged")} acknowledged tasks</p>')
-    rows = lambda d: "".join(f"<tr><td>{html.escape(str(k))}</td><td>{html.escape(json.dumps(v))}</td></tr>" for k, v in d.items())
+    cell = lambda v: f"{v:.1f}" if isinstance(v, float) else html.escape(json.dumps(v))
+    rows = lambda d: "".join(f"<tr><td>{html.escape(str(k).replace('_', ' '))}</td><td class=\"r\">{cell(v)}</td></tr>"
+                             for k, v in d.items())
     acc = {k: a.get(k) for k in ("acknowledged", "done", "failed", "cancelled", "still_tracked", "lost",
                                  "duplicated", "known_not_acknowledged", "unstamped")}
-    faults = "".join(f"<tr><td>{e.get('sim_s', 0):.1f}</td><td>{html.escape(e.get('event', ''))}</td></tr>"
+    faults = "".join(f"<tr><td class=\"r\">{e.get('sim_s', 0):.1f}</td><td>{html.escape(e.get('event', ''))}</td></tr>"
                      for e in lt.get("faults", []))
+    faults = (f"<table><tr><th>simulated s</th><th>event</th></tr>{faults}</table>" if faults
+              else "<p>none</p>")
     progress = [(p["wall_s"], p["sim_s"]) for p in lt.get("progress", [])]
     # The robot agent processes: the control rate they achieved and how their robots dealt with
     # each other (agent-K_metrics.json, collected by fleetctl loadtest).
     agent_rows = "".join(
-        f"<tr><td>{html.escape(str(m.get('id', '?')))}</td><td>{m.get('robots', 0)}</td>"
-        f"<td>{m.get('achieved_hz', 0):.2f} / {m.get('configured_hz', 0):.0f}</td><td>{m.get('overruns', 0)}</td>"
-        f"<td>{m.get('cycle_ms', {}).get('p50', 0):.2f} / {m.get('cycle_ms', {}).get('p99', 0):.2f}</td>"
-        f"<td>{m.get('conduct', {}).get('standoffs', 0)} / {m.get('conduct', {}).get('wait_cycles', 0)} / "
+        f"<tr><td>{html.escape(str(m.get('id', '?')))}</td><td class=\"r\">{m.get('robots', 0)}</td>"
+        f"<td class=\"r\">{m.get('achieved_hz', 0):.2f} / {m.get('configured_hz', 0):.0f}</td><td class=\"r\">{m.get('overruns', 0)}</td>"
+        f"<td class=\"r\">{m.get('cycle_ms', {}).get('p50', 0):.2f} / {m.get('cycle_ms', {}).get('p99', 0):.2f}</td>"
+        f"<td class=\"r\">{m.get('conduct', {}).get('standoffs', 0)} / {m.get('conduct', {}).get('wait_cycles', 0)} / "
         f"{m.get('conduct', {}).get('backoffs', 0)} / {m.get('conduct', {}).get('returns', 0)} / "
         f"{m.get('conduct', {}).get('detours', 0)}</td></tr>"
         for m in lt.get("agents", []))
     agents = (f"<h3>Robot agents ({html.escape(str(lt.get('clock', 'lockstep')))} clock)</h3><table>"
-              "<tr><td>process</td><td>robots</td><td>cycles/s (achieved / configured)</td><td>overruns</td>"
-              "<td>cycle ms p50 / p99</td><td>standoffs / wait cycles / back-offs / returns / detours</td></tr>"
+              "<tr><th>process</th><th>robots</th><th>cycles/s (achieved / configured)</th><th>overruns</th>"
+              "<th>cycle ms p50 / p99</th><th>standoffs / wait cycles / back-offs / returns / detours</th></tr>"
               f"{agent_rows}</table>") if agent_rows else ""
-    return f"""<h2>Load test</h2>{verdict}
+    lat = latency_table([("assignment", "submitted → first assigned", a.get("assignment_latency_s", {})),
+                         ("end to end", "submitted → done", a.get("end_to_end_latency_s", {}))])
+    return f"""<h2 id="loadtest">Load test</h2>{verdict}
 <p>{lt.get('robots')} robots in {lt.get('agent_processes')} agent process(es), {lt.get('humans')} humans,
 {lt.get('sim_time_s', 0):.0f} s simulated in {lt.get('wall_time_s', 0):.0f} s wall
 (<b>{lt.get('real_time_factor', 0):.2f}×</b> real time){' — stopped by the wall-time limit' if lt.get('wall_limited') else ''}.
 Arrival rate {lt.get('rate_per_min', 0):g} tasks per simulated minute. Fault plan: {html.escape(', '.join(lt.get('fault_plan', [])) or 'none')}.</p>
-<div class="grid"><div><h3>Acknowledged tasks</h3><table>{rows(acc)}</table>
+<div class="grid"><div><h3>Acknowledged tasks (fleetctl's ledger)</h3><table>{rows(acc)}</table>
 <h3>Throughput</h3><table>{rows(lt.get('throughput', {}))}</table></div>
-<div><h3>Latency (s, simulated)</h3><table><tr><td></td><td>p50</td><td>p90</td><td>p99</td><td>max</td><td>n</td></tr>
-{''.join(f"<tr><td>{n}</td>" + ''.join(f"<td>{a.get(k, {}).get(q, 0):.2f}</td>" for q in ('p50', 'p90', 'p99', 'max')) + f"<td>{a.get(k, {}).get('count', 0)}</td></tr>" for n, k in (('assignment', 'assignment_latency_s'), ('end to end', 'end_to_end_latency_s')))}</table>
-<h3>Faults injected</h3><table><tr><td>sim s</td><td>event</td></tr>{faults}</table></div>
-<div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)')}</div></div>
+<div><h3>Latency of acknowledged tasks (s, simulated)</h3>{lat}
+<h3>Faults injected</h3>{faults}</div>
+<div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)', why='no progress samples', diagonal='1× real time')}</div></div>
 {agents}"""
 
 
@@ -158,12 +287,14 @@ def main(run):
     db = sqlite3.connect(os.path.join(run, "fleet.db"))
     states = dict(db.execute("select state, count(*) from tasks group by state").fetchall())
     created = {}
-    assigned = set()
+    first_assigned = {}
+    finished = set()
     unstamped = set()
     latest = 0
     done_at = []
-    durations = []
-    assign_lat = []
+    durations = []  # submitted → done: end to end
+    executions = []  # first assigned → done
+    assign_lat = []  # submitted → first assigned
     for task, to, stamp in db.execute("select task_id, to_state, stamp_ns from transitions order by seq"):
         if task not in created:
             created[task] = stamp
@@ -172,12 +303,15 @@ def main(run):
             if stamp + 1e9 < latest:
                 unstamped.add(task)
         latest = max(latest, stamp)
-        if to == "done":
+        if to == "done" and task not in finished:  # a task's first "done" only, as the ledger
+            finished.add(task)
             done_at.append(stamp / 1e9)
             if task not in unstamped:
                 durations.append((stamp - created[task]) / 1e9)
-        if to == "assigned" and task not in assigned:
-            assigned.add(task)
+                if task in first_assigned:
+                    executions.append((stamp - first_assigned[task]) / 1e9)
+        if to == "assigned" and task not in first_assigned:
+            first_assigned[task] = stamp
             if task not in unstamped:
                 assign_lat.append((stamp - created[task]) / 1e9)
     sim_s = sim.get("sim_time_s", 0) or 1
@@ -186,6 +320,12 @@ def main(run):
     for i, t in enumerate(sorted(done_at)):  # a step up at each completion
         cumulative += [(t, i), (t, i + 1)]
     cumulative.append((sim_s, done))
+    header = replay_header(run)
+    near_m = header.get("near_miss_m")
+    scenario_path = os.path.join(run, "scenario.json")
+    if near_m is None and os.path.exists(scenario_path):
+        near_m = json.load(open(scenario_path)).get("near_miss_m")
+    end_to_end = percentiles(durations)
     summary = {
         "scenario": sim.get("scenario"),
         "sim_time_s": sim_s,
@@ -193,13 +333,15 @@ def main(run):
         "humans": sim.get("humans"),
         "tasks": {"submitted": sum(states.values()), "by_state": states, "done": done,
                   "per_hour": done * 3600.0 / sim_s,
-                  "time_s": {"p50": pct(durations, 0.5), "p90": pct(durations, 0.9), "max": pct(durations, 1.0)}},
-        "assignment_latency_s": {"p50": pct(assign_lat, 0.5), "p90": pct(assign_lat, 0.9),
-                                 "p99": pct(assign_lat, 0.99), "max": pct(assign_lat, 1.0)},
+                  # Task time is end to end (submitted → done), as end_to_end_latency_s below.
+                  "time_s": end_to_end,
+                  "execution_time_s": percentiles(executions)},
+        "assignment_latency_s": percentiles(assign_lat),
+        "end_to_end_latency_s": end_to_end,
         "manager_assignment_latency_ms": manager.get("assign_latency_ms"),
         "requeued": manager.get("requeued"),
         "safety": {"contacts": sim.get("contacts"), "min_separation_m": sim.get("min_separation_m"),
-                   "near_misses": sim.get("near_misses")},
+                   "near_misses": sim.get("near_misses"), "near_miss_m": near_m},
         "lockstep_step_timeouts": sim.get("lockstep_step_timeouts"),
     }
     lt_path = os.path.join(run, "loadtest.json")
@@ -210,30 +352,63 @@ def main(run):
                                                      "wall_limited", "interrupted")}
     json.dump(summary, open(os.path.join(run, "summary.json"), "w"), indent=2)
     risk = risk_levels_over_time(run)
+    viewer = embedded_viewer(run)
 
-    rows = lambda d: "".join(f"<tr><td>{html.escape(str(k))}</td><td>{html.escape(json.dumps(v))}</td></tr>" for k, v in d.items())
-    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>Fleet run {html.escape(os.path.basename(run))}</title>
-<style>body{{font-family:sans-serif;margin:20px;color:#222}} table{{border-collapse:collapse}} td{{border:1px solid #ccc;padding:3px 8px}}
-.grid{{display:flex;gap:24px;flex-wrap:wrap}} iframe{{border:1px solid #aaa;width:100%;height:820px}}</style></head><body>
+    state_rows = "".join(f'<tr><td>{html.escape(str(k))}</td><td class="r">{v}</td></tr>' for k, v in sorted(states.items())) \
+        or '<tr><td colspan="2">(no tasks)</td></tr>'
+    contacts = sim.get("contacts", {}) or {}
+    near = sim.get("near_misses", {}) or {}
+    sep = sim.get("min_separation_m", {}) or {}
+    gap = lambda v: "—" if v is None else f"{v:.3f}"
+    bad = lambda v: ' class="r bad"' if v else ' class="r"'
+    safety_rows = "".join(
+        f"<tr><td>{label}</td><td{bad(contacts.get(k))}>{contacts.get(k, '—')}</td>"
+        f"<td class=\"r\">{near[k] if k in near else 'not counted'}</td><td class=\"r\">{gap(sep.get(k))}</td></tr>"
+        for label, k in (("robot – robot", "robot_robot"), ("robot – human", "robot_human"), ("robot – shelf", "robot_shelf")))
+    near_txt = f"closer than {near_m:g} m" if near_m is not None else "close"
+    timeouts = sim.get("lockstep_step_timeouts")
+    times = latency_table([("assignment latency", "submitted → first assigned", summary["assignment_latency_s"]),
+                           ("execution time", "first assigned → done", summary["tasks"]["execution_time_s"]),
+                           ("task time (end to end)", "submitted → done", end_to_end)])
+    page = f"""<!doctype html><html><head><meta charset="utf-8"><title>Fleet run {html.escape(os.path.basename(os.path.abspath(run)))}</title>
+<style>body{{font-family:sans-serif;margin:20px;color:#222;max-width:1400px}} table{{border-collapse:collapse;margin-bottom:8px}}
+td,th{{border:1px solid #ccc;padding:3px 8px;font-size:14px}} th{{background:#f2f2f2;font-weight:600}} td.r{{text-align:right;font-variant-numeric:tabular-nums}}
+td.bad{{color:#b00;font-weight:bold}} h2{{border-bottom:1px solid #ddd;padding-bottom:3px;margin-top:28px}} h3{{margin:14px 0 4px;font-size:15px}}
+.grid{{display:flex;gap:28px;flex-wrap:wrap;align-items:flex-start}} .note{{color:#555;font-size:13px;max-width:520px}}
+.nodata{{display:flex;align-items:center;justify-content:center;border:1px dashed #bbb;color:#777;font-size:13px}}
+iframe{{border:1px solid #aaa;width:100%;max-width:1200px;height:790px}} nav a{{margin-right:12px}}</style></head><body>
 <h1>Fleet run: {html.escape(str(summary['scenario']))}</h1>
 <p>{summary['robots']} robots, {summary['humans']} humans, {sim_s:.0f} s of simulated time.
-<b>{done}</b> of {summary['tasks']['submitted']} tasks done ({summary['tasks']['per_hour']:.0f} per hour).</p>
+<b>{done}</b> of {summary['tasks']['submitted']} tasks done ({summary['tasks']['per_hour']:.0f} per simulated hour);
+<b class="{'bad' if sum(v or 0 for k, v in contacts.items() if k != 'steps_with_contact') else ''}">{contacts.get('robot_robot', '—')} robot–robot and {contacts.get('robot_human', '—')} robot–human contacts</b>.</p>
+<nav><a href="#throughput">Throughput &amp; latency</a><a href="#safety">Safety</a><a href="#risk">Risk map</a>{'<a href="#loadtest">Load test</a>' if lt else ''}<a href="#replay">Replay</a><a href="#raw">Raw summary</a></nav>
+<h2 id="throughput">Throughput and latency</h2>
+<p class="note" style="max-width:900px">All times are seconds of simulated time, from the fleet manager's task database (every task it stored).
+Percentiles are nearest-rank; a task restarted before the manager had a clock gives no samples.</p>
 <div class="grid">
-<div><h2>Tasks</h2><table>{rows(states)}</table>
-<h3>Task time (s)</h3><table>{rows(summary['tasks']['time_s'])}</table>
-<h3>Assignment latency (s of simulated time, stored → first assigned)</h3><table>{rows(summary['assignment_latency_s'])}</table></div>
-<div><h2>Safety</h2><table>{rows(sim.get('contacts', {}))}</table><h3>Minimum separations (m)</h3><table>{rows(sim.get('min_separation_m', {}))}</table>
-<h3>Near misses</h3><table>{rows(sim.get('near_misses', {}))}</table></div>
-<div><h2>Tasks done over time</h2>{svg_line(cumulative, xlabel='simulated time (s)', ylabel='tasks done')}
-<h2>Task time distribution (end to end)</h2>{svg_hist(durations, xlabel='seconds from submission to done')}
-<h2>Assignment latency distribution</h2>{svg_hist(assign_lat, xlabel='seconds from submission to first assignment')}</div>
-<div><h2>Risk map iso-levels over time</h2>{svg_lines(risk, xlabel='simulated time (s)', ylabel='area at or above the level (m²)')}</div>
+<div><h3>Tasks by state</h3><table><tr><th>state</th><th>tasks</th></tr>{state_rows}</table></div>
+<div><h3>Task times and latencies (s)</h3>{times}</div>
 </div>
+<div class="grid">
+<div><h3>Tasks done over time</h3>{svg_line(cumulative if done else [], xlabel='simulated time (s)', ylabel='tasks done (cumulative)', why='no task reached done')}</div>
+<div><h3>Execution time distribution (first assigned → done)</h3>{svg_hist(executions, xlabel='execution time (s)', why='no task reached done', color='#9467bd')}</div>
+<div><h3>Assignment latency distribution (submitted → first assigned)</h3>{svg_hist(assign_lat, xlabel='assignment latency (s)', why='no task was assigned', color='#1f77b4')}</div>
+<div><h3>End-to-end latency distribution (task time: submitted → done)</h3>{svg_hist(durations, xlabel='end-to-end latency (s)', why='no task reached done', color='#2ca02c')}</div>
+</div>
+<h2 id="safety">Safety</h2>
+<div class="grid"><div><table><tr><th>bodies</th><th>contacts</th><th>near misses ({html.escape(near_txt)})</th><th>minimum surface gap (m)</th></tr>{safety_rows}</table>
+<p class="note">Contacts and near misses count episodes (a pair coming into touch or into near-miss range once, however
+long it stays). A negative gap is an overlap; a gap of "—": no such pair ever came within 2 m (separations are tracked only closer than that).
+{contacts.get('steps_with_contact', 0)} simulation steps had a contact{f"; {timeouts} lockstep step timeouts" if timeouts else ""}.</p></div></div>
+<h2 id="risk">Risk map iso-levels over time</h2>
+<div class="grid"><div>{svg_lines(risk, w=640, h=260, xlabel='simulated time (s)', ylabel='area (m²)', legend_title='collision p', why='no risk map in the replay (was the risk map service running?)')}</div>
+<p class="note">Area of the warehouse floor whose collision probability exceeds each iso-level's lower bound, for each risk map
+the simulator recorded. Level l of K holds p in ((l−1)/K, l/K].</p></div>
 {loadtest_html(lt)}
-<h2>Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded.
-<a href="viewer.html">Open the viewer on its own</a>.</p>
-<iframe src="viewer.html"></iframe>
-<h2>Raw summary</h2><pre>{html.escape(json.dumps(summary, indent=2))}</pre>
+<h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded.
+The viewer is embedded in this page; <a href="viewer.html">open it on its own</a> (viewer.html, next to this page in the run folder).</p>
+{viewer}
+<h2 id="raw">Raw summary</h2><details><summary>summary.json</summary><pre>{html.escape(json.dumps(summary, indent=2))}</pre></details>
 </body></html>"""
     open(os.path.join(run, "index.html"), "w").write(page)
     print(json.dumps(summary, indent=2))
