@@ -59,11 +59,13 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
     throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
   }
   if (p_.localPlanner != "follow") {
-    auto inner = avoidance::makePlanner(p_.localPlanner);
+    auto inner = p_.localPlanner == "dwa" ? Expected<std::unique_ptr<avoidance::LocalPlanner>>(
+                                                std::make_unique<avoidance::DynamicWindowPlanner>(p_.dwa))
+                                          : avoidance::makePlanner(p_.localPlanner);
     if (!inner) {
       throw std::invalid_argument("local planner: " + inner.error().message);
     }
-    planner_ = std::make_unique<avoidance::SafePlanner>(std::move(*inner));
+    planner_ = std::make_unique<avoidance::SafePlanner>(std::move(*inner), p_.safety);
   }
 }
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/avoidance/dynamic_window.hpp"
 #include "fleet/avoidance/local_planner.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
@@ -50,6 +51,8 @@ struct AgentParams {
   /// "follow": the path follower with the stop rule; any libs/avoidance planner name ("dwa", "vo",
   /// ...): that planner on the path ahead, always behind the safety layer.
   std::string localPlanner = "follow";
+  avoidance::DwaParams dwa;        ///< when localPlanner is "dwa" (weights etc. from --config)
+  avoidance::SafetyParams safety;  ///< the safety layer behind every libs/avoidance planner
   control::VelocityLimits limits{0.8, -0.3, 1.5, 1.0, 3.0};
   /// Global planner on the inflated grid: "astar" (with the risk map as cell cost when one is
   /// received), "wavefront" (distance field from the goal, then descent) or "ompl" (Informed RRT*,

@@ -15,7 +15,9 @@
 #include <thread>
 
 #include "agent.hpp"
+#include "fleet/avoidance/planner_config.hpp"
 #include "fleet/core/clock.hpp"
+#include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/sim/scenario.hpp"
@@ -47,6 +49,8 @@ struct Options {
   std::string id = "agents";
   std::string localPlanner = "follow";
   std::string globalPlanner = "astar";
+  avoidance::DwaParams dwa;
+  avoidance::SafetyParams safety;
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
   double riskWeightGlobal = 1.0;
@@ -109,6 +113,8 @@ int run(const sim::Scenario& scn, const Options& opt) {
     p.vMax = std::min(0.8, r.limits.v_max);
     p.wMax = r.limits.omega_max;
     p.localPlanner = opt.localPlanner;
+    p.dwa = opt.dwa;
+    p.safety = opt.safety;
     p.globalPlanner = opt.globalPlanner;
     p.sensorTimeoutS = opt.sensorTimeoutS;
     p.returnHomeS = opt.returnHomeS;
@@ -288,6 +294,31 @@ int run(const sim::Scenario& scn, const Options& opt) {
   return 0;
 }
 
+/// The --config file: planner choice and parameters (docs/operator-guide.md, robot agent). Command
+/// line options given explicitly win over the file. Every problem is reported at once.
+void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, bool globalFromCli) {
+  Config cfg = Config::fromFile(path);
+  const std::string local = cfg.string("local_planner", opt.localPlanner);
+  const std::string global = cfg.string("global_planner", opt.globalPlanner, {"astar", "wavefront", "ompl"});
+  Config dwa = cfg.child("dwa");
+  Config safety = cfg.child("safety");
+  opt.dwa = avoidance::dwaParams(dwa);
+  opt.safety = avoidance::safetyParams(safety);
+  cfg.rejectUnknownKeys({"local_planner", "global_planner", "dwa", "safety"});
+  if (!localFromCli) {
+    opt.localPlanner = local;
+  }
+  if (!globalFromCli) {
+    opt.globalPlanner = global;
+  }
+  if (opt.localPlanner != "follow") {
+    if (auto p = avoidance::makePlanner(opt.localPlanner); !p) {
+      cfg.problem("local_planner", p.error().message + " (or \"follow\")");
+    }
+  }
+  cfg.finish();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -332,9 +363,16 @@ int main(int argc, char** argv) {
   app.add_option("--metrics", opt.metricsFile,
                  "write cycle metrics (achieved rate, overruns, cycle time p50/p99) to this JSON file every "
                  "10 s in wall mode and at exit");
+  std::string configFile;
+  app.add_option("-c,--config", configFile,
+                 "JSON file: local_planner, global_planner, dwa {weights, samples, horizon...}, safety "
+                 "{zones} (docs/operator-guide.md); options given on the command line win");
   CLI11_PARSE(app, argc, argv);
   try {
     logging::setup("robot_agent", level);
+    if (!configFile.empty()) {
+      applyConfigFile(configFile, opt, app.count("--local-planner") > 0, app.count("--global-planner") > 0);
+    }
     const auto scn = sim::loadScenario(scenario);
     std::stringstream ss(robots);
     for (std::string r; std::getline(ss, r, ',');) {

@@ -17,7 +17,15 @@ double distanceToLine(Vec2 a, Vec2 b, Vec2 p) {
   return n > 0.0 ? std::abs(ab.cross(p - a)) / n : fastDistance(a, p);
 }
 
-// Nearest obstacle point (scan or disc surface) and its distance from the robot centre.
+// Bug is an algorithm for a static world: a boundary it follows must stay put. Moving discs (people
+// walking by, robots driving) are left to the safety layer, which holds the robot until they pass;
+// a disc standing still (a parked robot) is a boundary like a shelf.
+constexpr double kStandingSpeed = 0.05;  // m/s
+bool standing(const MovingDisc& d) {
+  return d.velocity.squaredNorm() <= kStandingSpeed * kStandingSpeed;
+}
+
+// Nearest static obstacle point (scan or standing disc surface) and its distance from the robot centre.
 std::pair<Vec2, double> nearestObstacle(const LocalView& view) {
   const Vec2 p = view.robot.pose.position();
   Vec2 best_pt = p;
@@ -30,6 +38,8 @@ std::pair<Vec2, double> nearestObstacle(const LocalView& view) {
     }
   }
   for (const MovingDisc& d : view.discs) {
+    if (!standing(d))
+      continue;
     const double dc = fastDistance(p, d.position) - d.radius;
     if (dc < best) {
       best = dc;
@@ -80,7 +90,7 @@ bool BugPlanner::blockedTowards(const LocalView& view, Vec2 direction) const {
       return true;
   }
   for (const MovingDisc& d : view.discs) {
-    if (inCorridor(d.position, d.radius))
+    if (standing(d) && inCorridor(d.position, d.radius))
       return true;
   }
   return false;

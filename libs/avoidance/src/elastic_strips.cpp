@@ -141,9 +141,9 @@ Command ElasticStripsPlanner::plan(const LocalView& view) {
   prev_ = p;
   have_prev_ = true;
   const Vec2 f_int = elasticInternalForce(prev, p, next, params_.k_c);
-  // No external force on the strip's end point (the goal).
-  const bool end_point =
-      fastDistance(next, view.goal()) < 1e-9 && fastDistance(p, next) < params_.spacing * 0.5;
+  // No external force on the strip's end point: the goal is the strip's fixed end (a wall just
+  // behind a goal would otherwise push the last point back and the robot would stop short of it).
+  const bool end_point = fastDistance(next, view.goal()) < 1e-9;
   const Vec2 f_ext = end_point ? Vec2{} : externalForce(view, next);
   force_ = f_int + f_ext;
   target_ = next + force_;

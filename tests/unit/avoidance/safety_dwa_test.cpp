@@ -5,6 +5,7 @@
 
 #include "fleet/avoidance/clearance.hpp"
 #include "fleet/avoidance/dynamic_window.hpp"
+#include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/angles.hpp"
 #include "test_support.hpp"
@@ -162,6 +163,40 @@ TEST(Dwa, RiskTermSteersToTheLowRiskSide) {
     }
     EXPECT_LE(risk_aware_chosen, max_risk_chosen);
     EXPECT_EQ(risk_aware_chosen, 0.0);
+  }
+}
+
+TEST(Dwa, RiskThroughTheRiskMapQueryApiSteersToTheLowRiskSide) {
+  // The same mirrored scene as above, with the risk read the way the agent reads the risk map:
+  // riskLookup over a ProbabilityGrid (cells of the map, bilinear lookup), one half-plane at 0.9.
+  const auto scan = test::ring({2.5, 0.0}, 0.5);
+  const std::vector<Vec2> path{{5.0, 0.0}};
+  for (const double side : {1.0, -1.0}) {
+    risk::ProbabilityGrid grid;
+    grid.spec = {-2.0, -4.0, 0.1, 100, 80};
+    grid.p.assign(grid.spec.cellCount(), 0.0);
+    for (int j = 0; j < grid.spec.height; ++j) {
+      for (int i = 0; i < grid.spec.width; ++i) {
+        grid.p[grid.spec.index(i, j)] = side * grid.spec.cellCentreY(j) > 0.0 ? 0.9 : 0.0;
+      }
+    }
+    LocalView v;
+    v.robot.pose = {0.8, 0.0, 0.0};
+    v.robot.twist = {0.3, 0.0};
+    v.path = path;
+    v.scan = scan;
+    v.risk = riskLookup(grid);
+    ASSERT_GT(v.riskAt({2.0, side * 0.5}), 0.5);
+    ASSERT_EQ(v.riskAt({2.0, -side * 0.5}), 0.0);
+    DynamicWindowPlanner dwa;
+    const Command c = dwa.plan(v);
+    ASSERT_EQ(c.status, PlanStatus::kMoving);
+    EXPECT_LT(side * c.twist.omega, 0.0) << side;
+    for (const auto& smp : dwa.lastSamples()) {
+      if (smp.twist == c.twist) {
+        EXPECT_EQ(smp.risk, 0.0) << side;
+      }
+    }
   }
 }
 

@@ -37,6 +37,10 @@ struct Scenario {
   double sensing_range = 4.0;  ///< scan points and discs farther than this are not in the view
   double goal_tolerance = 0.15;
   std::uint32_t seed = 1;
+  /// Give each robot an A* path on the grid inflated by its radius + path_margin (as the robot
+  /// agent does) instead of only its goal. Planners that navigate by the goal alone (Bug) ignore it.
+  bool global_path = false;
+  double path_margin = 0.2;
 };
 
 struct ScenarioResult {
@@ -49,14 +53,15 @@ struct ScenarioResult {
   int static_collisions = 0;  ///< robot–shelf/wall
   int human_collisions = 0;   ///< robot–human (humans do not avoid: a stopped robot can be walked into)
   int human_hits_while_moving = 0;  ///< robot–human contacts that began while the robot was moving
-  double min_separation = 0.0;      ///< smallest surface gap robot–anything over the run [m]
-  double mean_time_to_goal = 0.0;   ///< over the robots that arrived [s]
-  double makespan = 0.0;            ///< time the last robot arrived (or the run ended) [s]
-  double mean_path_length = 0.0;    ///< over the robots that arrived [m]
-  double mean_remaining = 0.0;      ///< mean distance to goal at the end over all robots [m]
-  double mean_travelled = 0.0;      ///< mean path length over all robots [m]
-  std::int64_t agent_steps = 0;     ///< planner calls
-  double compute_mean_us = 0.0;     ///< per planner call (safety layer included)
+  int human_hits_by_robot = 0;     ///< ... while the robot drove towards the person at > 0.05 m/s (its fault)
+  double min_separation = 0.0;     ///< smallest surface gap robot–anything over the run [m]
+  double mean_time_to_goal = 0.0;  ///< over the robots that arrived [s]
+  double makespan = 0.0;           ///< time the last robot arrived (or the run ended) [s]
+  double mean_path_length = 0.0;   ///< over the robots that arrived [m]
+  double mean_remaining = 0.0;     ///< mean distance to goal at the end over all robots [m]
+  double mean_travelled = 0.0;     ///< mean path length over all robots [m]
+  std::int64_t agent_steps = 0;    ///< planner calls
+  double compute_mean_us = 0.0;    ///< per planner call (safety layer included)
   double compute_p99_us = 0.0;
   int overruled = 0;  ///< safety-layer interventions
 
@@ -74,5 +79,14 @@ Scenario circleSwap(int n, double circle_radius, double robot_radius = 0.4);
 /// A 20 m warehouse aisle between two shelf rows with a cross aisle in the middle; robots drive
 /// along the aisle both ways while humans cross it (straight, back and forth) and one walks at random.
 Scenario aisleCrossing(int robots_each_way = 2, int crossing_humans = 2, std::uint32_t seed = 1);
+
+/// One robot, 16 m to go past three boxes (the first square across the straight line, the other
+/// two offset to alternating sides) inside a walled hall: the static case every local planner is
+/// built for, with no moving discs.
+Scenario obstacleCourse();
+
+/// One robot driving the length of aisleCrossing's aisle while people cross it and one walks at
+/// random: the moving-obstacle case for a single robot (the multi-robot cases are comparisons).
+Scenario aisleCrossingAlone(int crossing_humans = 2, std::uint32_t seed = 1);
 
 }  // namespace fleet::avoidance

@@ -1,0 +1,73 @@
+// robot_agent --config as an operator meets it: a good file starts the agents, a bad one stops the
+// process at once (exit 2) with every problem named by file and key path.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "test_process.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct AgentRun {
+  int code = -1;
+  std::string output;
+};
+
+/// Runs robot_agent with a config file until it exits (bad config) or `seconds` pass (`timeout`
+/// ends a good one, which would otherwise run until stopped).
+AgentRun agentWith(const std::string& configText, int seconds) {
+  const fs::path cfg = fs::temp_directory_path() / ("agent_cfg_" + std::to_string(getpid()) + ".json");
+  std::ofstream(cfg) << configText;
+  const std::string cmd = "FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) +
+                          " timeout --preserve-status -s INT " + std::to_string(seconds) +
+                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent " +
+                          "--scenario " FLEET_SOURCE_DIR
+                          "/sim/scenarios/one_robot.json --clock wall --config " +
+                          cfg.string() + " 2>&1";
+  AgentRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 512> buf{};
+  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
+    r.output += buf.data();
+  }
+  const int status = p != nullptr ? pclose(p) : -1;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  fs::remove(cfg);
+  return r;
+}
+
+}  // namespace
+
+TEST(RobotAgentConfig, BadFileStopsAtStartNamingEveryProblem) {
+  const AgentRun r = agentWith(
+      R"({"local_planner": "dwa", "dwa": {"w_risk": -2, "samples": 5}, "safety": {"stop_margin": "far"},
+          "colour": "red"})",
+      20);
+  EXPECT_EQ(r.code, 2) << r.output;
+  for (const char* what :
+       {"dwa.w_risk", "dwa.samples: unknown key", "safety.stop_margin", "colour: unknown key"}) {
+    EXPECT_NE(r.output.find(what), std::string::npos) << what << " not in:\n" << r.output;
+  }
+  EXPECT_NE(r.output.find("agent_cfg_"), std::string::npos) << "the file is not named:\n" << r.output;
+}
+
+TEST(RobotAgentConfig, UnknownPlannerInTheFileIsNamed) {
+  const AgentRun r = agentWith(R"({"local_planner": "teleport"})", 20);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("local_planner: no local planner named 'teleport'"), std::string::npos) << r.output;
+}
+
+TEST(RobotAgentConfig, GoodFileRunsTheConfiguredPlanner) {
+  // Runs until `timeout` interrupts it (SIGINT: a clean stop, exit 0).
+  const AgentRun r = agentWith(R"({"local_planner": "dwa", "dwa": {"w_risk": 2.0, "v_samples": 14}})", 3);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("dwa"), std::string::npos) << r.output;
+}
