@@ -2,7 +2,8 @@
 // update, DWA with the risk term over a 360-point scan and 6 discs, and the safety layer — with its
 // per-cycle p50/p99 as counters; (2) the circle swap (N robots of radius 0.4 m to their
 // antipodes) run in the same process with the stack's planner and with the VO baseline, reporting
-// success, overlaps and compute per agent-step side by side (ratio counter).
+// success, overlaps and compute per agent-step side by side (ratio counter); (3) every planner on
+// every harness scenario (BM_Harness: the comparison table).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <ctime>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "fleet/avoidance/dynamic_window.hpp"
@@ -159,6 +161,54 @@ BENCHMARK_CAPTURE(BM_CircleSwap, vo_keep_right, "vo_keep_right")
     ->Iterations(1);
 BENCHMARK_CAPTURE(BM_CircleSwap, orca, "orca")->Arg(8)->Arg(100)->Unit(benchmark::kSecond)->Iterations(1);
 BENCHMARK_CAPTURE(BM_CircleSwap, dwa, "dwa")->Arg(8)->Arg(100)->Unit(benchmark::kSecond)->Iterations(1);
+
+// The harness comparison table of docs/benchmarks.md: every planner (behind the safety layer) on
+// every harness scenario, one deterministic run each; only the µs depend on the machine.
+const char* const kPlanners[] = {
+    "dwa", "potential_field", "bug1", "bug2", "risk_stepping", "elastic_strips", "elastic_strips_bvh",
+    "vo",  "vo_keep_right",   "orca"};
+
+Scenario harnessScenario(int which) {
+  switch (which) {
+    case 0:
+      return obstacleCourse();
+    case 1:
+      return aisleCrossingAlone();
+    case 2:
+      return circleSwap(8, 4.0);
+    default:
+      return aisleCrossing(2, 2, 3);
+  }
+}
+
+void BM_Harness(benchmark::State& state) {
+  const char* planner = kPlanners[state.range(0)];
+  const Scenario sc = harnessScenario(static_cast<int>(state.range(1)));
+  ScenarioResult r{};
+  for (auto _ : state) {
+    auto res = runScenario(sc, planner);
+    if (!res) {
+      state.SkipWithError(res.error().message.c_str());
+      return;
+    }
+    r = *res;
+  }
+  state.SetLabel(std::string(planner) + " " + sc.name);
+  state.counters["reached"] = r.reached;
+  state.counters["robots"] = r.robots;
+  state.counters["static_contacts"] = r.static_collisions;
+  state.counters["robot_contacts"] = r.robot_collisions;
+  state.counters["human_contacts"] = r.human_collisions;
+  state.counters["driven_into_human"] = r.human_hits_by_robot;
+  state.counters["min_gap_m"] = r.min_separation;
+  state.counters["mean_time_s"] = r.mean_time_to_goal;
+  state.counters["mean_path_m"] = r.mean_path_length;
+  state.counters["us_per_call"] = r.compute_mean_us;
+}
+BENCHMARK(BM_Harness)
+    ->ArgsProduct({benchmark::CreateDenseRange(0, 9, 1), {0, 1, 2, 3}})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
 
 }  // namespace
 BENCHMARK_MAIN();

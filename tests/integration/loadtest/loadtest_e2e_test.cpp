@@ -110,6 +110,44 @@ TEST(LoadtestE2E, ManagerAndAgentKilledNoTaskLostOrDuplicated) {
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
 
+TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
+  // The other two faults: 5 % of every process's outgoing DDS packets dropped (Cyclone's
+  // XmitLossiness) for the whole run, and robot r3's agent process frozen (SIGSTOP) for 5 s.
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-stall-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto args = baseArgs(out, 8, 60);
+  for (const char* f : {"drop-dds=0.05", "stall:r3@20+5"}) {
+    args.push_back("--fault");
+    args.push_back(f);
+  }
+  fleet::test::ChildProcess run(kFleetctl, args);
+  ASSERT_EQ(run.wait(std::chrono::seconds(200)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  const auto& a = r["accounting"];
+  EXPECT_GE(r["sim_time_s"].get<double>(), 59.0);
+  EXPECT_GE(a["acknowledged"].get<int>(), 10) << a.dump();
+  EXPECT_EQ(a["lost"], 0) << a.dump();
+  EXPECT_EQ(a["duplicated"], 0) << a.dump();
+  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
+                a["still_tracked"].get<int>(),
+            a["acknowledged"].get<int>());
+  // Every process ran with the lossy transmit path.
+  std::ifstream cfg(out / "cyclonedds.xml");
+  std::string xml;
+  for (std::string line; std::getline(cfg, line);) {
+    xml += line;
+  }
+  EXPECT_NE(xml.find("<XmitLossiness>50</XmitLossiness>"), std::string::npos) << xml;
+  std::string events;
+  for (const auto& e : r["faults"]) {
+    events += e["event"].get<std::string>() + "\n";
+  }
+  EXPECT_NE(events.find("SIGSTOP"), std::string::npos) << events;
+  EXPECT_NE(events.find("(robot r3)"), std::string::npos) << events;
+  EXPECT_NE(events.find("SIGCONT"), std::string::npos) << events;
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+}
+
 TEST(LoadtestE2E, InterruptStopsEveryProcess) {
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-int-" + std::to_string(getpid()));
   fs::remove_all(out);
