@@ -757,3 +757,62 @@ TEST(Agent, SlowsForAPersonWalkingAcrossItsWay) {
     }
   }
 }
+
+TEST(Agent, AGoalInsideAWalledOffRoomFailsTheTaskNamingIt) {
+  // The pickup P-1 at (7, 7) lies inside a closed room (walls one cell thick around
+  // [6, 8] x [6, 8], no door): no plan reaches it on the inflated map, on the plain map nor on the
+  // raw map. The task must fail at once with the station named, and the robot must not drive off.
+  auto raw = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int i = 23; i <= 33; ++i) {
+    raw->setBlocked({i, 23});
+    raw->setBlocked({i, 33});
+    raw->setBlocked({23, i});
+    raw->setBlocked({33, i});
+  }
+  ASSERT_FALSE(raw->blocked(*raw->cellAt({7.0, 7.0}))) << "the goal itself is free, only walled off";
+  auto grid = agent::inflate(*raw, 0.3);
+  agent::Agent a(params(), grid, raw);
+  World world;
+  msg::TaskAssignment order = transport();
+  order.goals.front().pose = {7.0, 7.0, 0.0};
+  a.onAssignment(order);
+  ASSERT_TRUE(a.busy());
+  std::optional<msg::TaskStatus> failed;
+  std::vector<msg::TaskStatus> statuses;
+  agent::AgentOutput last;
+  double v = 0;
+  double w = 0;
+  int k = 0;
+  for (; k < 50 && !failed; ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    last = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = last.command.v;
+    w = last.command.w;
+    if (last.status) {
+      statuses.push_back(*last.status);
+      if (last.status->state == msg::TaskState::Failed) {
+        failed = last.status;
+      }
+    }
+  }
+  ASSERT_TRUE(failed) << "still busy after " << k << " steps at " << world.truth.x << ", " << world.truth.y;
+  EXPECT_EQ(k, 1) << "failed on the first step, when the goal is planned";
+  EXPECT_EQ(statuses.size(), 1u) << "no en-route report before the failure";
+  EXPECT_EQ(failed->task_id, "t1");
+  EXPECT_EQ(failed->revision, 7u);
+  EXPECT_NE(failed->error.find("no path to P-1"), std::string::npos) << failed->error;
+  EXPECT_FALSE(a.busy());
+  EXPECT_EQ(last.command.v, 0.0);
+  EXPECT_EQ(last.command.w, 0.0);
+  // Afterwards it stays put: no further reports, no motion.
+  for (int i = 0; i < 30; ++i, ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    EXPECT_FALSE(out.status) << msg::toString(out.status->state);
+    EXPECT_EQ(out.command.v, 0.0);
+    EXPECT_EQ(out.command.w, 0.0);
+  }
+  EXPECT_LT(distance(world.truth, params().start), 1e-6) << "drove off";
+}
