@@ -153,37 +153,51 @@ void BM_PingPongOneWay(benchmark::State& state) {
   for (std::uint32_t k = 0; k < 16; ++k) {
     pings.push_back(sample(k));
   }
+  // False when no echo came back within 5 s (the pong process died or lost the match): the bench
+  // reports an error and ends instead of waiting for ever.
   auto exchange = [&](std::uint32_t k) {
+    const auto giveUp = Clk::now() + 5s;
     if (!raw) {
       out.write(pings[k % 16]);
-      std::size_t got = 0;
-      while (got == 0) {
-        in.waitForData(1000ms);
-        got = in.take().size();
+      while (Clk::now() < giveUp) {
+        in.waitForData(100ms);
+        if (!in.take().empty()) {
+          return true;
+        }
       }
-      return;
+      return false;
     }
     check(dds_write(out.handle(), &c), "dds_write");
-    while (true) {
-      in.waitForData(1000ms);
+    while (Clk::now() < giveUp) {
+      in.waitForData(100ms);
       void* samples[4] = {nullptr};
       dds_sample_info_t infos[4];
       const int n = dds_take(in.handle(), samples, infos, 4, 4);
       if (n > 0) {
         dds_return_loan(in.handle(), samples, n);
-        return;
+        return true;
       }
     }
+    return false;
   };
   std::vector<double> oneWayUs;
   std::uint32_t i = 0;
   for (int warm = 0; warm < 200; ++warm) {
-    exchange(i++);
+    if (!exchange(i++)) {
+      state.SkipWithError("no echo from the pong process within 5 s (warm-up)");
+      return;
+    }
   }
   for (auto _ : state) {
     const auto t0 = Clk::now();
-    exchange(i++);
+    if (!exchange(i++)) {
+      state.SkipWithError("no echo from the pong process within 5 s");
+      break;
+    }
     oneWayUs.push_back(std::chrono::duration<double, std::micro>(Clk::now() - t0).count() / 2);
+  }
+  if (oneWayUs.empty()) {
+    return;
   }
   pong.kill(SIGTERM);
   (void)pong.wait(10s);
@@ -226,11 +240,16 @@ void BM_Throughput(benchmark::State& state) {
     out.flush();
     ctl.write({"bench", n});
     std::int64_t got = -1;
-    while (got < 0) {
-      reply.waitForData(1000ms);
+    const auto giveUp = Clk::now() + 30s;
+    while (got < 0 && Clk::now() < giveUp) {
+      reply.waitForData(100ms);
       for (const auto& r : reply.take()) {
         got = r.step;
       }
+    }
+    if (got < 0) {
+      state.SkipWithError("no count from the sink process within 30 s");
+      break;
     }
     seconds += std::chrono::duration<double>(Clk::now() - t0).count();
     written += n;
@@ -238,6 +257,9 @@ void BM_Throughput(benchmark::State& state) {
   }
   sink.kill(SIGTERM);
   (void)sink.wait(10s);
+  if (seconds <= 0.0) {
+    return;
+  }
   state.counters["samples_per_s"] = static_cast<double>(received) / seconds;
   state.counters["lost"] = static_cast<double>(written - received);
   state.counters["MB_per_s"] = static_cast<double>(received) * 256.0 / seconds / 1e6;
