@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "fleet/avoidance/clearance.hpp"
@@ -45,6 +46,37 @@ LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double d_safe)
   }
   out.found = out.left_index >= 0 || out.right_index >= 0;
   return out;
+}
+
+geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double d_safe) {
+  // Axes: along L→R and across it; the box holds the four corners L, R, L + d·h, R + d·h (a
+  // rectangle when h is square to L→R, else the rectangle around that parallelogram).
+  Vec2 u = right - left;
+  const double len = std::sqrt(u.squaredNorm());
+  u = len > 1e-9 ? u * (1.0 / len) : heading.perp();
+  const Vec2 w = u.perp();
+  const Vec2 corners[4] = {left, right, left + heading * d_safe, right + heading * d_safe};
+  double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_w = lo_u, hi_w = -lo_u;
+  for (const Vec2& c : corners) {
+    lo_u = std::min(lo_u, c.dot(u));
+    hi_u = std::max(hi_u, c.dot(u));
+    lo_w = std::min(lo_w, c.dot(w));
+    hi_w = std::max(hi_w, c.dot(w));
+  }
+  geometry::Obb2 box;
+  box.center = u * (0.5 * (lo_u + hi_u)) + w * (0.5 * (lo_w + hi_w));
+  box.angle = std::atan2(u.y, u.x);
+  box.half = {0.5 * (hi_u - lo_u), 0.5 * (hi_w - lo_w)};
+  return box;
+}
+
+geometry::Obb2 robotBox(Vec2 robot, Vec2 next, Vec2 heading, double radius) {
+  const double ahead = std::max(0.0, (next - robot).dot(heading));
+  geometry::Obb2 box;
+  box.center = robot + heading * (0.5 * ahead);
+  box.angle = std::atan2(heading.y, heading.x);
+  box.half = {0.5 * ahead + radius, radius};
+  return box;
 }
 
 Expected<void> ElasticStripsParams::validate() const {
@@ -95,6 +127,7 @@ Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) const {
   const int beams = params_.beams;
   std::vector<double> ranges(static_cast<std::size_t>(beams), std::numeric_limits<double>::infinity());
   std::vector<Vec2> pts(static_cast<std::size_t>(beams));
+  std::vector<std::uint8_t> moving(static_cast<std::size_t>(beams), 0);  // the reading is a disc
   for (const int idx : bvh.overlappingDisc(at, params_.d_safe + r)) {
     const auto& pr = prims[static_cast<std::size_t>(idx)];
     const Vec2 rel = pr.center - at;
@@ -106,21 +139,42 @@ Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) const {
     if (dist < ranges[static_cast<std::size_t>(b)]) {
       ranges[static_cast<std::size_t>(b)] = dist;
       pts[static_cast<std::size_t>(b)] = pr.center;
+      moving[static_cast<std::size_t>(b)] = static_cast<std::size_t>(idx) >= view.scan.size() ? 1 : 0;
     }
   }
   const LeftRightMinimum m = leftRightMinimum(ranges, params_.d_safe);
-  if (!m.found)
+  if (!m.found) {
+    contact_ = Contact::kNone;
     return {};
-  Vec2 f;
-  if (m.left_index >= 0) {
-    f += elasticExternalForce(at, pts[static_cast<std::size_t>(m.left_index)], m.min_left, params_.d_safe,
-                              params_.k_r);
   }
-  if (m.right_index >= 0) {
-    f += elasticExternalForce(at, pts[static_cast<std::size_t>(m.right_index)], m.min_right, params_.d_safe,
-                              params_.k_r);
+  if (m.left_index < 0 || m.right_index < 0) {
+    // One collision point: no boxes, the original Elastic Strips (thesis §2.3.1): the nearest
+    // reading, threshold d_o = d_safe + d_r on the centre distance.
+    contact_ = Contact::kOnePoint;
+    const Vec2 q = pts[static_cast<std::size_t>(m.left_index >= 0 ? m.left_index : m.right_index)];
+    return elasticExternalForce(at, q, fastDistance(at, q), params_.d_safe + r, params_.k_r);
   }
-  return f;
+  // Two collision points: OBB-O from them, OBB-R from the robot's size and direction of motion; the
+  // two forces act only when the boxes meet (the obstacles lie in this step's way).
+  const Vec2 L = pts[static_cast<std::size_t>(m.left_index)];
+  const Vec2 R = pts[static_cast<std::size_t>(m.right_index)];
+  const Vec2 h{std::cos(theta), std::sin(theta)};
+  const Vec2 robot = view.robot.pose.position();
+  if (!geometry::overlaps(robotBox(robot, at, h, r), obstacleBox(L, R, h, params_.d_safe))) {
+    contact_ = Contact::kBoxesApart;
+    return {};
+  }
+  contact_ = Contact::kBoxesMeet;
+  const Vec2 f_left = elasticExternalForce(at, L, m.min_left, params_.d_safe, params_.k_r);
+  const Vec2 f_right = elasticExternalForce(at, R, m.min_right, params_.d_safe, params_.k_r);
+  const bool discs = moving[static_cast<std::size_t>(m.left_index)] != 0 ||
+                     moving[static_cast<std::size_t>(m.right_index)] != 0;
+  if (discs || fastDistance(L, R) >= 2.0 * r)
+    return f_left + f_right;  // a gap the robot fits through, or robots/people: both push (2.28)
+  // Static readings too close together to pass between: one obstacle to go around. Their symmetric
+  // pushes would cancel sideways and hold the robot in front of it (the seed's open question 6), so
+  // only the nearer reading pushes, towards the side where the obstacle recedes; a tie passes right.
+  return m.min_left <= m.min_right ? f_left : f_right;
 }
 
 Command ElasticStripsPlanner::plan(const LocalView& view) {

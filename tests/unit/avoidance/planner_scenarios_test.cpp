@@ -33,12 +33,12 @@ TEST(PlannerScenarios, EveryPlannerDrivesPastStaticBoxesWithoutContact) {
     print(*r);
     EXPECT_EQ(r->reached, 1) << name;
     EXPECT_EQ(r->collisions, 0) << name;
-    // Past three boxes a detour is needed, but not a wander: at most twice the straight 15 m, except
+    // Past three boxes a detour is needed, but not a wander: at most twice the straight 16 m, except
     // for Bug1, which tours every obstacle it meets once and a half by design. Its bound (Lumelsky)
     // is D + 1.5·Σ perimeters, the perimeters followed at r + follow_gap = 0.65 m from the boxes
     // (1 × 2 m and twice 1.2 × 2.4 m): 2(w + h) + 2π·0.65 each.
     const double followed = (6.0 + 7.2 + 7.2) + 3.0 * 2.0 * 3.14159265 * 0.65;
-    EXPECT_LT(r->mean_path_length, std::string(name) == "bug1" ? 15.0 + 1.5 * followed : 30.0) << name;
+    EXPECT_LT(r->mean_path_length, std::string(name) == "bug1" ? 16.0 + 1.5 * followed : 32.0) << name;
   }
 }
 

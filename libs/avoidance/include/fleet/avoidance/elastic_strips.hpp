@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "fleet/avoidance/local_planner.hpp"
+#include "fleet/geometry/obb.hpp"
 
 namespace fleet::avoidance {
 
@@ -26,6 +27,12 @@ struct LeftRightMinimum {
   bool found = false;  ///< false when no reading is below d_safe (the thesis's FALSE)
 };
 LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double d_safe);
+
+/// The thesis's boxes (§2.3.1, Figs. 2.22-2.23): OBB-O spans the nearest left reading L, the nearest
+/// right reading R, and both moved d_safe along the direction of motion `heading` (unit); OBB-R is
+/// the robot's footprint swept over the step: width 2r, from r behind `robot` to r past `next`.
+geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double d_safe);
+geometry::Obb2 robotBox(Vec2 robot, Vec2 next, Vec2 heading, double radius);
 
 enum class ElasticVariant { kOriginal, kBvhTwoSided };
 
@@ -58,6 +65,14 @@ class ElasticStripsPlanner final : public LocalPlanner {
   /// The displaced next control point of the last plan() and the force applied to it.
   [[nodiscard]] Vec2 lastTarget() const { return target_; }
   [[nodiscard]] Vec2 lastForce() const { return force_; }
+  /// Two-sided variant, last plan(): how the external force was decided.
+  enum class Contact {
+    kNone,        ///< no reading within d_safe: no external force
+    kOnePoint,    ///< one side only: the original's single-reading force (the thesis's rule)
+    kBoxesApart,  ///< readings on both sides, but OBB-R does not meet OBB-O: no external force
+    kBoxesMeet,   ///< readings on both sides and the boxes overlap: the two forces (2.27, 2.28)
+  };
+  [[nodiscard]] Contact lastContact() const { return contact_; }
 
  private:
   [[nodiscard]] Vec2 externalForce(const LocalView& view, Vec2 at) const;
@@ -68,6 +83,7 @@ class ElasticStripsPlanner final : public LocalPlanner {
   Vec2 prev_;
   Vec2 target_;
   Vec2 force_;
+  mutable Contact contact_ = Contact::kNone;
   std::vector<double> ranges_;
   std::vector<Vec2> hits_;
 };
