@@ -1,6 +1,7 @@
 #include "fleet_manager_node.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 
 #include "fleet/core/clock.hpp"
@@ -41,8 +42,8 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
-                         "robot_fail_limit", "robot_hold_s", "battery_threshold", "nominal_speed", "clock",
-                         "metrics_file", "map"});
+                         "robot_fail_limit", "robot_hold_s", "battery_threshold", "charge_until",
+                         "charge_max_s", "nominal_speed", "clock", "metrics_file", "map"});
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -59,6 +60,15 @@ Settings readSettings(Config& cfg) {
   s.robotHoldS = cfg.number("robot_hold_s", s.robotHoldS, {0.0, 86400.0});
   s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
+  s.chargeUntil = cfg.number("charge_until", s.chargeUntil, {0.0, 1.0});
+  if (s.chargeUntil <= s.batteryThreshold) {
+    // Released below (or at) the threshold, a robot would be sent back to charge at once.
+    char what[96];
+    std::snprintf(what, sizeof what, "must be greater than battery_threshold (%g), got %g",
+                  s.batteryThreshold, s.chargeUntil);
+    cfg.problem("charge_until", what);
+  }
+  s.chargeMaxS = cfg.number("charge_max_s", s.chargeMaxS, {0.0, 86400.0, true});
   s.nominalSpeed = cfg.number("nominal_speed", s.nominalSpeed, {0.0, 20.0, true});
   s.clock = cfg.string("clock", "wall", {"wall", "sim"});
   s.metricsFile = cfg.string("metrics_file", "");
@@ -120,6 +130,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   dc.robotHoldNs = secToNs(s.robotHoldS);
   dc.leaseNs = secToNs(s.leaseS);
   dc.policy.batteryThreshold = s.batteryThreshold;
+  dc.chargeUntil = s.chargeUntil;
   std::shared_ptr<planning::DistanceFieldCache> cache;
   if (!s.mapFile.empty()) {
     auto grid = planning::loadMovingAiMap(s.mapFile, s.mapResolution, {s.mapOriginX, s.mapOriginY});
@@ -171,7 +182,8 @@ msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std
       goal(o.task.station, msg::GoalAction::None, 0);
       break;
     case TaskKind::Charge:
-      goal(o.task.station, msg::GoalAction::Charge, 0);
+      // Dwell until the manager ends the task (battery at charge_until), at most charge_max_s.
+      goal(o.task.station, msg::GoalAction::Charge, settings_.chargeMaxS);
       break;
     case TaskKind::Park:
       goal(o.task.station, msg::GoalAction::Park, 0);

@@ -28,6 +28,12 @@ struct Settings {
   int robotFailLimit = 3;    ///< failures in a row before a robot is held back (0: never)
   double robotHoldS = 60.0;  ///< ... for this long
   double batteryThreshold = 0.2;
+  /// A charge task ends (done, by the manager) when the robot at the charger reports this battery;
+  /// must exceed batteryThreshold.
+  double chargeUntil = 0.9;
+  /// The robot dwells at the charger at most this long (the charge goal's duration) and then
+  /// reports the task done itself: a charger that does not charge cannot hold a robot for ever.
+  double chargeMaxS = 1800.0;
   double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
   std::string clock = "wall";
   std::string metricsFile;  // written every second when set (JSON)

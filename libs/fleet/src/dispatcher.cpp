@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <tuple>
 #include <unordered_map>
 
@@ -20,6 +21,9 @@ std::vector<TaskState> happyPath(TaskKind kind) {
   }
   return {S::Assigned, S::EnRoute, S::Done};
 }
+
+// RobotState carries the battery as a float: 0.9f reads 0.8999999762 as a double.
+constexpr double kBatteryEps = 1e-6;
 
 std::string chargeTaskId(const std::string& robot, std::int64_t nowNs) {
   std::string id = "charge.";
@@ -307,6 +311,49 @@ Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool p
   return out;
 }
 
+void Dispatcher::completeCharged(std::int64_t nowNs, DispatchResult& out) {
+  std::vector<TransitionRequest> steps;
+  std::map<std::string, std::string, std::less<>> robotOf;  // task id -> robot
+  for (const auto& [id, r] : open_) {
+    if (r.task.kind != TaskKind::Charge || !isActive(r.state) || r.paused) {
+      continue;
+    }
+    const RobotInfo* info = registry_.find(r.robotId);
+    const Station* st = stations_.find(r.task.station);
+    if (info == nullptr || info->lost || info->taskId != id || st == nullptr ||
+        info->battery + kBatteryEps < cfg_.chargeUntil ||
+        distance(info->pose.position(), st->pose.position()) > cfg_.chargeReach) {
+      continue;
+    }
+    // Steps the robot did not report (a lost status sample) are filled in, as in onTaskStatus.
+    const auto path = happyPath(r.task.kind);
+    for (auto s = std::find(path.begin(), path.end(), r.state) + 1; s < path.end(); ++s) {
+      char why[64];
+      std::snprintf(why, sizeof why, "charged to %.2f", info->battery);
+      steps.push_back(
+          {id, *s, r.robotId, *s == TaskState::Done ? std::string(why) : "implied by the charge", nowNs});
+    }
+    robotOf.emplace(id, r.robotId);
+  }
+  if (steps.empty()) {
+    return;
+  }
+  auto results = store_.transitionBatch(steps);
+  for (auto& res : results) {
+    if (!res) {
+      out.errors.push_back(res.error());
+      continue;
+    }
+    if (res->state == TaskState::Done) {
+      const std::string& robot = robotOf.at(res->task.id);
+      ++counters_.charged;
+      registry_.clearTask(robot);
+      out.revoked.push_back(robot);  // stop dwelling at the charger
+    }
+    applied(*res, out);
+  }
+}
+
 void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
   const auto chargers = stations_.ofKind(StationKind::Charging);
   for (const auto& r : registry_.idleRobots()) {
@@ -470,8 +517,15 @@ DispatchResult Dispatcher::tick(std::int64_t nowNs) {
       requeueOrFail(it->second, false, "robot " + lost.id + " lost", nowNs, out);
     }
   }
+  completeCharged(nowNs, out);
   chargeLowRobots(nowNs, out);
   allocate(nowNs, out);
+  // A released robot that got a new task in the same tick must not have it withdrawn by the empty
+  // assignment published after it: the new order replaces the charge order anyway.
+  std::erase_if(out.revoked, [&](const std::string& robot) {
+    return std::any_of(out.assignments.begin(), out.assignments.end(),
+                       [&](const AssignmentOrder& a) { return a.robotId == robot; });
+  });
   return out;
 }
 

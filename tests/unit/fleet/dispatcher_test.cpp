@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -58,6 +59,14 @@ class DispatcherTest : public ::testing::Test {
   }
   void robot(const std::string& id, double x, double battery, std::int64_t t) {
     dispatcher->onRobotState({id, {x, 0, 0}, battery, t});
+  }
+  void robotAt(const std::string& id, double x, double y, double battery, std::int64_t t) {
+    dispatcher->onRobotState({id, {x, y, 0}, battery, t});
+  }
+  std::size_t chargeTasksIn(const DispatchResult& r) {
+    return static_cast<std::size_t>(
+        std::count_if(r.assignments.begin(), r.assignments.end(),
+                      [](const auto& a) { return a.task.kind == TaskKind::Charge; }));
   }
   S stateOf(const std::string& id) { return store->get(id).value().state; }
 
@@ -181,6 +190,84 @@ TEST_F(DispatcherTest, LowBatteryRobotGoesToNearestChargerNotToWork) {
   ASSERT_EQ(next.assignments.size(), 1u);
   EXPECT_EQ(next.assignments[0].task.id, "t1");
   EXPECT_TRUE(dispatcher->tick(5).assignments.empty()) << "no second charge task";
+}
+
+// The robot stays on its charge task (no transport for it, no second charge task) until it
+// stands at the charger with battery >= chargeUntil; then the dispatcher ends the task and the
+// waiting transport goes to it in the same tick (not withdrawn again by the release).
+TEST_F(DispatcherTest, ChargeTaskEndsWhenTheRobotAtTheChargerReachesTheTarget) {
+  robotAt("low", 0, 0, 0.1, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const std::string chargeId = out.assignments[0].task.id;
+  ASSERT_EQ(out.assignments[0].task.station, "C-near");  // at (0, 5)
+  ASSERT_TRUE(dispatcher->onTaskStatus("low", chargeId, S::EnRoute, "", 2));
+  dispatcher->submit({transport("t1")}, 3);
+  // Driving there, then charging: a tick every 0.2 s for 60 s, the battery climbing to 0.89.
+  std::int64_t now = 4;
+  for (int i = 0; i < 300; ++i, now += kSec / 5) {
+    const bool there = i >= 20;
+    robotAt("low", 0, there ? 4.9 : 0.25 * i, there ? 0.1 + 0.79 * (i - 20) / 279.0 : 0.1, now);
+    out = dispatcher->tick(now);
+    ASSERT_TRUE(out.assignments.empty()) << "tick " << i << ": " << out.assignments[0].task.id;
+    ASSERT_TRUE(out.revoked.empty());
+  }
+  EXPECT_EQ(stateOf(chargeId), S::EnRoute);
+  EXPECT_EQ(stateOf("t1"), S::Queued) << "a charging robot is not dispatched";
+  EXPECT_EQ(dispatcher->counters().submitted, 2) << "one charge task, no thrash";
+  // Charged, but somewhere else (the sample of a robot pushed off the charger): not done.
+  robotAt("low", 3, 5, 0.95, now + 1);
+  EXPECT_TRUE(dispatcher->tick(now + 1).events.empty());
+  robotAt("low", 0.1, 5, 0.9, now + 2);
+  out = dispatcher->tick(now + 3);
+  EXPECT_EQ(stateOf(chargeId), S::Done);
+  EXPECT_EQ(store->get(chargeId)->reason, "charged to 0.90");
+  EXPECT_EQ(dispatcher->counters().charged, 1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "t1");
+  EXPECT_EQ(out.assignments[0].robotId, "low");
+  EXPECT_TRUE(out.revoked.empty()) << "the new order replaces the charge order; no empty one after it";
+}
+
+TEST_F(DispatcherTest, ChargedRobotWithNothingToDoIsReleasedOnce) {
+  robotAt("low", 0, 5, 0.15, 0);  // already at C-near
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const std::string chargeId = out.assignments[0].task.id;
+  // No report from the robot at all (lost status samples): the steps are filled in.
+  robotAt("low", 0, 5, 0.93, 2);
+  out = dispatcher->tick(3);
+  EXPECT_EQ(stateOf(chargeId), S::Done);
+  ASSERT_EQ(out.events.size(), 2u);
+  EXPECT_EQ(out.events[0].state, S::EnRoute);
+  EXPECT_EQ(out.events[1].state, S::Done);
+  EXPECT_EQ(out.revoked, std::vector<std::string>{"low"}) << "told to stop dwelling";
+  EXPECT_TRUE(dispatcher->robots().find("low")->idle());
+  // Its late report on the finished task is refused; no new charge task follows.
+  EXPECT_FALSE(dispatcher->onTaskStatus("low", chargeId, S::EnRoute, "", 4));
+  for (std::int64_t t = 5; t < 10; ++t) {
+    robotAt("low", 0, 5, 0.93, t);
+    out = dispatcher->tick(t);
+    EXPECT_TRUE(out.assignments.empty() && out.revoked.empty() && out.events.empty());
+  }
+}
+
+TEST_F(DispatcherTest, RobotThatRunsLowMidTaskFinishesItThenCharges) {
+  robot("r", 0, 0.25, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  ASSERT_EQ(out.assignments[0].task.id, "t1");
+  ASSERT_TRUE(dispatcher->onTaskStatus("r", "t1", S::Delivering, "", 2));
+  for (std::int64_t t = 3; t < 20; ++t) {
+    robot("r", 10, 0.15, t);  // below the threshold while delivering
+    EXPECT_EQ(chargeTasksIn(dispatcher->tick(t)), 0u) << "the task comes first";
+  }
+  ASSERT_TRUE(dispatcher->onTaskStatus("r", "t1", S::Done, "", 20));
+  out = dispatcher->tick(21);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.kind, TaskKind::Charge);
+  EXPECT_EQ(out.assignments[0].robotId, "r");
 }
 
 TEST_F(DispatcherTest, BacklogCapKeepsTheMostUrgentTasks) {

@@ -206,3 +206,65 @@ TEST(TravelModel, GridDistanceGoesAroundWallsStraightLineDoesNot) {
               1e-9);
   std::filesystem::remove(path);
 }
+
+TEST(Settings, ChargeUntilMustExceedTheBatteryThreshold) {
+  auto defaults = Config::fromText(R"({"stations": "s.json"})", "manager.json");
+  const auto s = manager::readSettings(defaults);
+  defaults.finish();
+  EXPECT_DOUBLE_EQ(s.chargeUntil, 0.9);
+  EXPECT_DOUBLE_EQ(s.chargeMaxS, 1800.0);
+  auto set =
+      Config::fromText(R"({"stations": "s.json", "charge_until": 0.8, "charge_max_s": 600})", "m.json");
+  EXPECT_DOUBLE_EQ(manager::readSettings(set).chargeUntil, 0.8);
+  set.finish();
+  for (const char* bad :
+       {R"({"stations": "s.json", "battery_threshold": 0.5, "charge_until": 0.5})",
+        R"({"stations": "s.json", "charge_until": 1.5})", R"({"stations": "s.json", "charge_max_s": 0})"}) {
+    auto c = Config::fromText(bad, "m.json");
+    manager::readSettings(c);
+    EXPECT_THROW(c.finish(), ConfigError) << bad;
+  }
+  try {
+    auto c = Config::fromText(R"({"stations": "s.json", "battery_threshold": 0.5, "charge_until": 0.4})",
+                              "m.json");
+    manager::readSettings(c);
+    c.finish();
+    ADD_FAILURE() << "accepted charge_until below battery_threshold";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("charge_until: must be greater than battery_threshold (0.5), got 0.4"));
+  }
+}
+
+// The charge goal asks the robot to dwell (charge_max_s at most); the manager ends the task when
+// the robot's RobotState at the charger shows charge_until, and tells the robot with an empty order.
+TEST_F(Node, ChargeTaskDwellsUntilTheManagerSeesTheTargetBattery) {
+  settings_.chargeMaxS = 900.0;
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRobotState({"r1", 1'000, {3, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.1f, "", 0.3f});
+  node->tick(2'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const auto a = out.assignments[0];
+  ASSERT_EQ(a.goals.size(), 1u);
+  EXPECT_EQ(a.goals[0].station, "C-1");
+  EXPECT_EQ(a.goals[0].action, msg::GoalAction::Charge);
+  EXPECT_DOUBLE_EQ(a.goals[0].duration_s, 900.0);
+  out = {};
+  node->onStatus({"r1", a.task_id, a.revision, msg::TaskState::EnRoute, 0.0f, "", 3'000}, 3'000, out);
+  std::int64_t now = 4'000;
+  for (float b = 0.1f; b < 0.895f; b += 0.01f, now += 200'000'000) {
+    node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, b, a.task_id, 0.3f});
+    node->tick(now, out);
+  }
+  EXPECT_TRUE(out.assignments.empty()) << "charging: no new order, no second charge task";
+  node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, 0.9f, a.task_id, 0.3f});
+  node->tick(now, out);
+  ASSERT_FALSE(out.events.empty());
+  EXPECT_EQ(out.events.back().task_id, a.task_id);
+  EXPECT_EQ(out.events.back().state, msg::TaskState::Done);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robot_id, "r1");
+  EXPECT_TRUE(out.assignments[0].task_id.empty()) << "released from the charger";
+  EXPECT_GT(out.assignments[0].revision, a.revision);
+  EXPECT_EQ(node->dispatcher().counters().submitted, 1);
+}

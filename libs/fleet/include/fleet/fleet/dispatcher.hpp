@@ -33,6 +33,12 @@ struct DispatcherConfig {
   /// through the queue, each task failing its attempts on it. 0: never held.
   std::int32_t robotFailLimit = 3;
   std::int64_t robotHoldNs = 60'000'000'000;
+  /// A charge task is done when its robot stands within chargeReach (m) of the charging station
+  /// with a battery of at least chargeUntil: the dispatcher completes it and releases the robot
+  /// (the robot itself dwells at the charger until then). Must exceed policy.batteryThreshold, or a
+  /// robot released below the threshold would be sent straight back.
+  double chargeUntil = 0.9;
+  double chargeReach = 0.5;
 };
 
 /// A state change to publish as `TaskEvent`.
@@ -55,8 +61,9 @@ struct AssignmentOrder {
 /// What a call changed; the service publishes it. Everything in it is already committed.
 struct DispatchResult {
   std::vector<AssignmentOrder> assignments;
-  std::vector<std::string>
-      revoked;  ///< robots whose task was withdrawn (cancelled): publish an empty assignment
+  /// Robots whose task was withdrawn (cancelled) or completed by the dispatcher (charged): publish
+  /// an empty assignment. A robot never appears both here and in `assignments` of one result.
+  std::vector<std::string> revoked;
   std::vector<TaskEvent> events;
   std::vector<Error> errors;  ///< problems that did not stop the call (a store error on one task)
 
@@ -72,6 +79,7 @@ struct DispatcherCounters {
   std::int64_t requeued = 0;
   std::int64_t robotsLost = 0;
   std::int64_t robotsHeld = 0;  ///< times a robot was held back after robotFailLimit failures in a row
+  std::int64_t charged = 0;     ///< charge tasks the dispatcher completed (battery reached chargeUntil)
 };
 
 /// The fleet manager's logic without DDS: owns the open tasks in memory, the robot registry and
@@ -107,8 +115,9 @@ class Dispatcher {
   /// Errors as cancel (not_found, illegal_transition for a finished task).
   Expected<DispatchResult> setPaused(const std::string& taskId, bool paused, std::int64_t nowNs);
 
-  /// Periodic work: expire leases (requeue the lost robots' tasks), send low robots to charge, and
-  /// assign waiting tasks to idle robots.
+  /// Periodic work: expire leases (requeue the lost robots' tasks), complete the charge tasks whose
+  /// robot is charged (releasing it), send low robots to charge, and assign waiting tasks to idle
+  /// robots.
   DispatchResult tick(std::int64_t nowNs);
 
   [[nodiscard]] const RobotRegistry& robots() const { return registry_; }
@@ -124,6 +133,8 @@ class Dispatcher {
   Expected<std::map<std::string, TaskRecord, std::less<>>::iterator> findOpen(const std::string& taskId);
   void requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason, std::int64_t nowNs,
                      DispatchResult& out);
+  /// Charge tasks whose robot is at the station with battery >= chargeUntil → done, robot revoked.
+  void completeCharged(std::int64_t nowNs, DispatchResult& out);
   void chargeLowRobots(std::int64_t nowNs, DispatchResult& out);
   void allocate(std::int64_t nowNs, DispatchResult& out);
   /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig).
