@@ -22,7 +22,9 @@
 #include <thread>
 
 #include "fault_plan.hpp"
+#include "fleet/core/config.hpp"
 #include "scenario_gen.hpp"
+#include "scenario_tasks.hpp"
 #include "supervisor.hpp"
 #include "task_ledger.hpp"
 
@@ -142,8 +144,12 @@ struct Run {
   std::vector<Clock::time_point> faultEndAt;
   json faultLog = json::array();
   TaskLedger ledger;
-  std::vector<json> pending;  // generated, not acknowledged yet
-  int generated = 0;
+  std::vector<json> pending;            // generated or due from the list, not acknowledged yet
+  int generated = 0;                    // tasks handed to the poster (generated or from the list)
+  bool fromList = false;                // posting the scenario's task list instead of generating
+  std::vector<ScenarioTask> listTasks;  // the scenario's task list, by at_s (stable)
+  std::size_t listNext = 0;             // first task of listTasks not posted yet
+  int untilDoneTarget = 0;              // --until-done: stop once this many tasks are finished
   int refused = 0;
   int postErrors = 0;
   std::vector<std::string> pickups, dropoffs;
@@ -165,7 +171,31 @@ struct Run {
     say("fault: " + what);
   }
 
+  /// Tasks per simulated minute: the option, 0.75 per robot, or the task list's average rate.
+  double ratePerMin() const {
+    if (fromList) {
+      return o.durationS > 0 ? static_cast<double>(untilDoneTarget) * 60.0 / o.durationS : 0.0;
+    }
+    return o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(scenario["robots"].size());
+  }
+
+  /// The scenario's tasks whose at_s the simulated clock has reached go to the poster (those at or
+  /// after the end never: whether the clock is seen there before the simulator stops is a race).
+  void listDue() {
+    std::lock_guard<std::mutex> lock(mu);
+    while (listNext < listTasks.size() && listTasks[listNext].atS <= simS &&
+           listTasks[listNext].atS < o.durationS) {
+      pending.push_back(toTaskRequest(listTasks[listNext]));
+      ++listNext;
+      ++generated;
+    }
+  }
+
   void generateDue() {
+    if (fromList) {
+      listDue();
+      return;
+    }
     const double rate =
         o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(scenario["robots"].size());
     const int due = static_cast<int>(std::floor(simS * rate / 60.0)) + 1;
@@ -381,6 +411,18 @@ int Run::run() {
     }
     scenario = *s;
     scenario["duration_s"] = o.durationS;
+    // Its task list, checked here so that every problem is reported before anything starts.
+    try {
+      if (auto list = parseScenarioTasks(scenario, o.scenario)) {
+        listTasks = std::move(*list);
+        fromList = !o.generateTasks;
+      }
+    } catch (const ConfigError& e) {
+      std::cerr << "fleetctl loadtest: " << e.what() << "\n";
+      return 2;
+    }
+    std::stable_sort(listTasks.begin(), listTasks.end(),
+                     [](const ScenarioTask& a, const ScenarioTask& b) { return a.atS < b.atS; });
   } else {
     auto t = readJson(o.templ);
     if (!t) {
@@ -558,6 +600,25 @@ int Run::run() {
       std::to_string(static_cast<int>(o.wallLimitS)) + " s), " + std::to_string(agentNames.size()) +
       " agent process(es), DDS domain " + std::to_string(domain) +
       ", WMS API http://127.0.0.1:" + std::to_string(port) + ", run folder " + out.string());
+  if (fromList) {
+    untilDoneTarget = static_cast<int>(std::count_if(
+        listTasks.begin(), listTasks.end(), [&](const ScenarioTask& t) { return t.atS < o.durationS; }));
+    std::string note;
+    if (untilDoneTarget < static_cast<int>(listTasks.size())) {
+      note = " (" + std::to_string(listTasks.size() - static_cast<std::size_t>(untilDoneTarget)) +
+             " at or after the end (" + std::to_string(static_cast<int>(o.durationS)) + " s) are not posted)";
+    }
+    say("tasks: " + std::to_string(listTasks.size()) + " from the scenario's task list" + note);
+  } else {
+    untilDoneTarget = o.maxTasks;
+    char rate[64];
+    std::snprintf(rate, sizeof rate, "%g", ratePerMin());
+    say(std::string("tasks: generated at ") + rate + " per minute" +
+        (o.maxTasks > 0 ? ", at most " + std::to_string(o.maxTasks) : std::string()) +
+        (scenario.contains("tasks") ? " (the scenario's task list of " + std::to_string(listTasks.size()) +
+                                          " is not used: --rate, --tasks or --generate-tasks)"
+                                    : std::string()));
+  }
   for (const auto& f : faults) {
     say("fault planned: " + describe(f));
   }
@@ -643,12 +704,13 @@ int Run::run() {
     if (simEnded || code != 0) {
       break;
     }
-    if (o.untilDone && o.maxTasks > 0 && generated >= o.maxTasks && wall() - lastDoneCheck >= 1.0 && [this] {
+    if (o.untilDone && untilDoneTarget > 0 && generated >= untilDoneTarget && wall() - lastDoneCheck >= 1.0 &&
+        [this] {
           std::lock_guard<std::mutex> lock(mu);
           return pending.empty();
         }()) {
       lastDoneCheck = wall();
-      if (finishedTasks() >= static_cast<std::size_t>(o.maxTasks)) {
+      if (finishedTasks() >= static_cast<std::size_t>(untilDoneTarget)) {
         say("every task finished at " + std::to_string(static_cast<int>(simS)) + " s simulated; stopping");
         finishedEarly = true;
         sup.signal("fleet-sim", SIGINT);
@@ -727,9 +789,10 @@ int Run::run() {
       {"wall_limited", wallLimited},
       {"finished_early", finishedEarly},
       {"interrupted", code == 130},
-      {"rate_per_min", o.ratePerMin > 0 ? o.ratePerMin : 0.75 * static_cast<double>(robots.size())},
+      {"rate_per_min", ratePerMin()},
       {"tasks",
-       {{"generated", generated},
+       {{"source", fromList ? "scenario" : "generated"},
+        {"generated", generated},
         {"refused", refused},
         {"never_acknowledged", pending.size()},
         {"post_errors", postErrors}}},

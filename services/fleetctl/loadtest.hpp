@@ -1,7 +1,8 @@
 #pragma once
 
 // `fleetctl loadtest`: starts the whole fleet on this machine under a Supervisor, feeds tasks over
-// the WMS adapter's HTTP API at a given arrival rate (in simulated time), injects faults, prints
+// the WMS adapter's HTTP API (the scenario's task list, each at its simulated time, or generated at
+// a given arrival rate in simulated time), injects faults, prints
 // progress, stops everything, reconciles acknowledged tasks with the manager's database and writes
 // loadtest.json (plus the HTML report through scripts/report.py).
 
@@ -15,9 +16,12 @@ struct LoadtestOptions {
   std::string templ;     // template for generated scenarios
   int robots = 20;       // generated scenarios
   int humans = 8;
-  double ratePerMin = 0;    // tasks per simulated minute; 0: 0.75 per robot
-  int maxTasks = 0;         // 0: no cap besides the duration
-  bool untilDone = false;   // with maxTasks: stop once every one of them is done/failed/cancelled
+  double ratePerMin = 0;   // tasks per simulated minute; 0: 0.75 per robot
+  int maxTasks = 0;        // 0: no cap besides the duration
+  bool untilDone = false;  // with maxTasks or a task list: stop once every task is done/failed/cancelled
+  /// Generate tasks at ratePerMin even if the scenario has a `tasks` list (set by --generate-tasks
+  /// and whenever --rate or --tasks is given); else the list, when there is one, is posted as is.
+  bool generateTasks = false;
   double durationS = 180;   // simulated seconds
   double wallLimitS = 600;  // the run is stopped after this much wall time whatever happens
   int agents = 1;           // robot agent processes (besides one per stalled robot)

@@ -116,12 +116,18 @@ int main(int argc, char** argv) {
   loadtest->add_option("--humans", lt.humans, "humans of the generated scenario")
       ->check(CLI::Range(0, 5000))
       ->capture_default_str();
-  loadtest->add_option("--rate", lt.ratePerMin, "tasks per simulated minute (0 = 0.75 per robot)")
-      ->check(CLI::Range(0.0, 100000.0));
-  loadtest->add_option("--tasks", lt.maxTasks, "at most this many tasks (0 = no cap)")
-      ->check(CLI::Range(0, 1000000));
+  // Tasks: the scenario's `tasks` list when it has one, unless --rate, --tasks or --generate-tasks.
+  auto* rateOpt = loadtest
+                      ->add_option("--rate", lt.ratePerMin,
+                                   "generate this many tasks per simulated minute (0 = 0.75 per robot)")
+                      ->check(CLI::Range(0.0, 100000.0));
+  auto* tasksOpt =
+      loadtest->add_option("--tasks", lt.maxTasks, "generate at most this many tasks (0 = no cap)")
+          ->check(CLI::Range(0, 1000000));
+  loadtest->add_flag("--generate-tasks", lt.generateTasks,
+                     "generate tasks even if the scenario has a task list (implied by --rate and --tasks)");
   loadtest->add_flag("--until-done", lt.untilDone,
-                     "with --tasks: stop as soon as every task is done, failed or cancelled");
+                     "with --tasks or a task list: stop as soon as every task is done, failed or cancelled");
   loadtest->add_flag("--lanes", lt.lanes, "robot agents plan on one-way lanes (default: plain A*)");
   loadtest->add_option("--station-capacity", lt.stationCapacity, "active tasks per station (0 = no limit)")
       ->check(CLI::Range(0, 1000))
@@ -165,6 +171,7 @@ int main(int argc, char** argv) {
                      "reports the robot agents' achieved control rate");
   CLI11_PARSE(app, argc, argv);
   if (*loadtest) {
+    lt.generateTasks = lt.generateTasks || rateOpt->count() > 0 || tasksOpt->count() > 0;
     return fleet::ctl::runLoadtest(lt);
   }
 

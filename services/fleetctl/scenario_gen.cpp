@@ -44,6 +44,7 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   heightM = hCells * kRes;
 
   nlohmann::json s = templ;
+  s.erase("tasks");  // the template's task list names the template's stations
   s["name"] = "loadtest-" + std::to_string(size.robots) + "r-" + std::to_string(size.humans) + "h";
   s["seed"] = size.seed;
   s["duration_s"] = size.durationS;

@@ -243,9 +243,10 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
   Config c = Config::fromJson(doc, origin);
   Scenario s;
   s.origin = origin;
+  // "tasks" is `fleetctl loadtest`'s task list (checked there); the simulator ignores it.
   c.rejectUnknownKeys({"name", "seed", "duration_s", "dt", "clock", "near_miss_m", "map", "stations",
                        "points_of_interest", "landmarks", "robot_defaults", "robots", "robot_fleet", "humans",
-                       "social_force", "prediction"});
+                       "social_force", "prediction", "tasks"});
   s.name = c.string("name", "scenario");
   s.seed = static_cast<std::uint64_t>(c.integer("seed", 1, {0.0, 9.0e15}));
   s.durationS = c.number("duration_s", s.durationS, {0.0, 1e7, true});

@@ -1,16 +1,20 @@
 // `fleetctl loadtest` end to end: a small generated fleet, the fleet manager killed with SIGKILL
 // and restarted, an agent process killed and restarted; every acknowledged task must be accounted
-// for (0 lost, 0 duplicated) and no process of the run may outlive it, also after Ctrl-C.
+// for (0 lost, 0 duplicated) and no process of the run may outlive it, also after Ctrl-C. A
+// scenario with a `tasks` list gets exactly those tasks, each at its simulated time.
 
 #include <dirent.h>
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "../../support/test_process.hpp"
@@ -146,6 +150,92 @@ TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
   EXPECT_NE(events.find("(robot r3)"), std::string::npos) << events;
   EXPECT_NE(events.find("SIGCONT"), std::string::npos) << events;
   EXPECT_EQ(processesMentioning(out.string()), 0);
+}
+
+/// Task id -> simulated seconds of its first transition (stored), from the manager's database.
+std::map<std::string, double> storedTasks(const fs::path& db) {
+  std::map<std::string, double> out;
+  sqlite3* h = nullptr;
+  if (sqlite3_open_v2(db.c_str(), &h, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    sqlite3_close(h);
+    return out;
+  }
+  sqlite3_stmt* st = nullptr;
+  if (sqlite3_prepare_v2(h, "SELECT task_id, MIN(stamp_ns) FROM transitions GROUP BY task_id", -1, &st,
+                         nullptr) == SQLITE_OK) {
+    while (sqlite3_step(st) == SQLITE_ROW) {
+      out[reinterpret_cast<const char*>(sqlite3_column_text(st, 0))] =
+          static_cast<double>(sqlite3_column_int64(st, 1)) * 1e-9;
+    }
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(h);
+  return out;
+}
+
+/// sim/scenarios/one_robot.json with `tasks` as its task list, written to `dir`.
+fs::path oneRobotWithTasks(const fs::path& dir, const json& tasks) {
+  json s = json::parse(std::ifstream(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json"));
+  s["tasks"] = tasks;
+  fs::create_directories(dir);
+  std::ofstream(dir / "one_robot_tasks.json") << s.dump(1);
+  return dir / "one_robot_tasks.json";
+}
+
+TEST(LoadtestE2E, ScenarioTaskListIsPostedExactlyEachAtItsTime) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-list-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const fs::path scenario = oneRobotWithTasks(out.string() + "-in", json::parse(R"([
+    {"at_s": 0, "pickup": "P-1", "dropoff": "D-1", "id": "list-a"},
+    {"at_s": 6, "pickup": "P-2", "dropoff": "D-2", "priority": 5},
+    {"at_s": 3, "pickup": "P-3", "dropoff": "D-1", "id": "list-c"},
+    {"at_s": 500, "pickup": "P-1", "dropoff": "D-2", "id": "after-the-end"}])"));
+  // No --rate, no --tasks: the list is the source.
+  fleet::test::ChildProcess run(
+      kFleetctl,
+      {"loadtest", "--scenario", scenario.string(), "--duration", "15", "--out", out.string(), "--domain",
+       std::to_string(fleet::test::uniqueDomain()), "--report-script", "", "--wall-limit", "60"});
+  ASSERT_EQ(run.wait(std::chrono::seconds(120)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  EXPECT_EQ(r["tasks"]["source"], "scenario");
+  EXPECT_EQ(r["tasks"]["generated"], 3);
+  EXPECT_EQ(r["tasks"]["refused"], 0);
+  EXPECT_EQ(r["accounting"]["acknowledged"], 3) << r["accounting"].dump();
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+  EXPECT_EQ(r["accounting"]["duplicated"], 0);
+  // Exactly those ids (the second one's generated after its place in the list), each stored once
+  // the simulated clock had reached its at_s (the manager stamps with the simulated clock).
+  const auto stored = storedTasks(out / "fleet.db");
+  ASSERT_EQ(stored.size(), 3u);
+  ASSERT_EQ(stored.count("list-a"), 1u);
+  ASSERT_EQ(stored.count("task-002"), 1u);
+  ASSERT_EQ(stored.count("list-c"), 1u);
+  EXPECT_GE(stored.at("task-002"), 6.0);
+  EXPECT_GE(stored.at("list-c"), 3.0);
+  EXPECT_LT(stored.at("list-a"), 3.0);
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+}
+
+TEST(LoadtestE2E, BadScenarioTaskListIsRefusedBeforeAnythingStarts) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("loadtest-badlist-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const fs::path scenario = oneRobotWithTasks(dir, json::parse(R"([
+    {"at_s": 0, "pickup": "P-9", "dropoff": "D-1"},
+    {"at_s": -2, "pickup": "D-1", "dropoff": "D-1"}])"));
+  const fs::path err = dir / "stderr.txt";
+  fleet::test::ChildProcess run(
+      "/bin/sh", {"-c", "'" + kFleetctl + "' loadtest --scenario '" + scenario.string() + "' --out '" +
+                            (dir / "run").string() + "' 2>'" + err.string() + "'"});
+  ASSERT_EQ(run.wait(std::chrono::seconds(30)), 2);
+  std::stringstream text;
+  text << std::ifstream(err).rdbuf();
+  const std::string where = scenario.string() + ": ";
+  for (const std::string& p :
+       {where + "tasks[0].pickup: unknown station 'P-9'", where + "tasks[1].at_s: expected",
+        where + "tasks[1].pickup: station 'D-1' is a dropoff station"}) {
+    EXPECT_NE(text.str().find(p), std::string::npos) << p << " missing in\n" << text.str();
+  }
+  EXPECT_FALSE(fs::exists(dir / "run" / "fleet.db"));
 }
 
 TEST(LoadtestE2E, InterruptStopsEveryProcess) {

@@ -1,0 +1,152 @@
+#include "scenario_tasks.hpp"
+
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "fleet/core/config.hpp"
+
+namespace fleet::ctl {
+namespace {
+
+/// Task ids the HTTP API accepts: ^[A-Za-z0-9_.:-]{1,63}$.
+bool validId(const std::string& id) {
+  if (id.empty() || id.size() > 63) {
+    return false;
+  }
+  for (const char c : id) {
+    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+                    c == '.' || c == ':' || c == '-';
+    if (!ok) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// "P-1, P-2, P-3" (at most 8 names).
+std::string nameList(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size() && i < 8; ++i) {
+    out += (i == 0 ? "" : ", ") + names[i];
+  }
+  if (names.size() > 8) {
+    out += ", ... (" + std::to_string(names.size()) + " in all)";
+  }
+  return out.empty() ? "none" : out;
+}
+
+}  // namespace
+
+std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json& scenario,
+                                                            const std::string& origin) {
+  if (!scenario.is_object() || !scenario.contains("tasks")) {
+    return std::nullopt;
+  }
+  // Station names and kinds; the stations themselves are the simulator's to check.
+  std::map<std::string, std::string> kindOf;
+  std::map<std::string, std::vector<std::string>> byKind;
+  if (scenario.contains("stations") && scenario["stations"].is_array()) {
+    for (const auto& s : scenario["stations"]) {
+      if (s.is_object() && s.contains("name") && s["name"].is_string() && s.contains("kind") &&
+          s["kind"].is_string()) {
+        const std::string name = s["name"];
+        if (kindOf.emplace(name, s["kind"].get<std::string>()).second) {
+          byKind[s["kind"].get<std::string>()].push_back(name);
+        }
+      }
+    }
+  }
+
+  Config c = Config::fromJson(scenario, origin);
+  std::vector<ScenarioTask> tasks;
+  std::vector<bool> hasId;
+  std::map<std::string, std::string> idAt;  // explicit id -> its key path
+  for (auto& e : c.array("tasks")) {
+    if (!e.json().is_object()) {
+      tasks.emplace_back();
+      hasId.push_back(false);
+      continue;  // already a problem
+    }
+    e.rejectUnknownKeys({"at_s", "pickup", "dropoff", "id", "priority"});
+    ScenarioTask t;
+    t.atS = e.requireNumber("at_s", {0.0, std::numeric_limits<double>::infinity()});
+    for (const auto& [key, wanted] : {std::pair<std::string, std::string>{"pickup", "pickup"},
+                                      std::pair<std::string, std::string>{"dropoff", "dropoff"}}) {
+      const nlohmann::json* j = e.find(key);
+      std::string name = e.requireString(key);
+      if (j == nullptr || !j->is_string()) {
+        continue;
+      }
+      auto it = kindOf.find(name);
+      if (it == kindOf.end()) {
+        e.problem(key, "unknown station '" + name + "' (" + wanted +
+                           " stations: " + nameList(byKind[wanted]) + ")");
+      } else if (it->second != wanted) {
+        e.problem(key, "station '" + name + "' is a " + it->second + " station; expected a " + wanted +
+                           " station (" + nameList(byKind[wanted]) + ")");
+      }
+      (key == "pickup" ? t.pickup : t.dropoff) = name;
+    }
+    if (const nlohmann::json* j = e.find("id"); j != nullptr) {
+      const std::string id = e.requireString("id");
+      if (j->is_string()) {
+        if (!validId(id)) {
+          e.problem("id", "expected 1 to 63 characters of A-Z a-z 0-9 _ . : - (as the HTTP API), got \"" +
+                              id + "\"");
+        } else if (auto [it, fresh] = idAt.emplace(id, e.keyPath("")); !fresh) {
+          e.problem("id", "duplicate id '" + id + "' (also " + it->second + ")");
+        }
+        t.id = id;
+      }
+    }
+    hasId.push_back(e.find("id") != nullptr);
+    if (e.find("priority") != nullptr) {
+      const nlohmann::json* j = e.find("priority");
+      const std::int64_t p = e.integer(
+          "priority", 0, {static_cast<double>(kMinTaskPriority), static_cast<double>(kMaxTaskPriority)});
+      if ((j->is_number_integer() || j->is_number_unsigned()) && p >= kMinTaskPriority &&
+          p <= kMaxTaskPriority) {
+        t.priority = p;
+      }
+    }
+    tasks.push_back(t);
+  }
+  c.finish();  // throws ConfigError listing every problem
+
+  // Ids for entries without one: task-NNN after the entry's place in the list, never an id given.
+  std::set<std::string> used;
+  for (const auto& [id, at] : idAt) {
+    used.insert(id);
+  }
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (hasId[i]) {
+      continue;
+    }
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "task-%03zu", i + 1);
+    std::string id = buf;
+    for (int k = 2; used.count(id); ++k) {
+      id = std::string(buf) + "-" + std::to_string(k);
+    }
+    used.insert(id);
+    tasks[i].id = id;
+  }
+  return tasks;
+}
+
+nlohmann::json toTaskRequest(const ScenarioTask& t) {
+  nlohmann::json j = {{"id", t.id},
+                      {"kind", "transport"},
+                      {"pickup", t.pickup},
+                      {"dropoff", t.dropoff},
+                      {"load_duration_ns", 2000000000LL},
+                      {"unload_duration_ns", 2000000000LL}};
+  if (t.priority) {
+    j["priority"] = *t.priority;
+  }
+  return j;
+}
+
+}  // namespace fleet::ctl

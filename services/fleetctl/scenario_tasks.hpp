@@ -1,0 +1,38 @@
+#pragma once
+
+// The optional `tasks` list of a scenario file: transport tasks `fleetctl loadtest` posts through
+// the WMS adapter's HTTP API, each when the simulated clock reaches its `at_s`.
+//
+//   "tasks": [{"at_s": 0, "pickup": "P-1", "dropoff": "D-2"},
+//             {"at_s": 4.5, "pickup": "P-3", "dropoff": "D-1", "id": "order-17", "priority": 5}]
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fleet::ctl {
+
+struct ScenarioTask {
+  std::string id;       // as given, else generated ("task-001" after its place in the list)
+  double atS = 0;       // simulated seconds after the start at which it is posted
+  std::string pickup;   // a station of kind pickup
+  std::string dropoff;  // a station of kind dropoff
+  std::optional<std::int64_t> priority;
+};
+
+/// Priorities the HTTP API accepts (docs/openapi.yaml, libs/fleet Task).
+inline constexpr std::int64_t kMinTaskPriority = -1000;
+inline constexpr std::int64_t kMaxTaskPriority = 1000;
+
+/// Reads and checks the scenario document's `tasks` list against its `stations`. No `tasks` key:
+/// std::nullopt. Throws ConfigError listing every problem, each with `origin` and the key path
+/// (`small_warehouse.json: tasks[3].pickup: unknown station 'P-9'`). The result is in list order.
+std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json& scenario,
+                                                            const std::string& origin);
+
+/// The task as the HTTP API takes it (transport, 2 s load and unload, as generated tasks).
+nlohmann::json toTaskRequest(const ScenarioTask& t);
+
+}  // namespace fleet::ctl
