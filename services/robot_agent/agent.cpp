@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fleet/avoidance/rotation_shim.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/angles.hpp"
 #include "fleet/core/clock.hpp"
@@ -64,6 +65,11 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
                                           : avoidance::makePlanner(p_.localPlanner);
     if (!inner) {
       throw std::invalid_argument("local planner: " + inner.error().message);
+    }
+    // DWA turns in place towards the path first (Nav2's rotation shim): its acceleration window
+    // alone cannot make the bend from a band into an aisle.
+    if (p_.localPlanner == "dwa") {
+      *inner = std::make_unique<avoidance::RotationShim>(std::move(*inner));
     }
     planner_ = std::make_unique<avoidance::SafePlanner>(std::move(*inner), p_.safety);
   }

@@ -170,6 +170,15 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       return upper_[x] != upper_[y] ? upper_[x] > upper_[y] : x < y;
     });
   }
+  // Admissible: a rollout keeping min_clearance; once the robot is already closer than that (a
+  // shelf corner cut, a person who stepped close), one that brings it no closer than it is now —
+  // otherwise every sample, turning away included, is inadmissible and the robot can never leave
+  // (the safety layer's rule: approaching is forbidden, moving away is allowed).
+  double clr_now = arcClearance(pose, Twist{}, 0.0, near_, view.robot.radius, params_.clearance_cap);
+  for (const MovingDisc& d : view.discs) {
+    clr_now = std::min(clr_now, fastDistance(p0, d.position) - view.robot.radius - d.radius);
+  }
+  const double admissible_clr = std::min(params_.min_clearance, clr_now - 1e-3);
   std::size_t best_idx = count;
   double best_score = -std::numeric_limits<double>::infinity();
   for (const std::size_t idx : order_) {
@@ -179,14 +188,14 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
     const double v = s.twist.v;
     const double w = s.twist.omega;
     s.evaluated = true;
-    if (params_.prune && disc_clr_[idx] < params_.min_clearance) {
+    if (params_.prune && disc_clr_[idx] < admissible_clr) {
       // Inadmissible whatever the scan says: it can never be chosen.
       s.evaluated = false;
       continue;
     }
     const double clr = std::min(
         arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap), disc_clr_[idx]);
-    s.admissible = clr >= params_.min_clearance;
+    s.admissible = clr >= admissible_clr;
     // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
     // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
     // arcs bending away score better long before the straight one becomes inadmissible.
