@@ -762,6 +762,9 @@ int Run::run() {
       writeFile(out / "manager_metrics_final.json", m->dump(1));
     }
   }
+  // The manager first: agents that exit while it runs lose their DDS liveliness, and it would
+  // (rightly) requeue every active task as "robot lost" after the run had ended.
+  sup.stop("fleet_manager", 5.0);
   sup.stopAll(5.0);
   say("fleet stopped");
 
