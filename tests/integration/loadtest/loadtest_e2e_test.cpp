@@ -77,36 +77,52 @@ std::vector<std::string> baseArgs(const fs::path& out, int robots, double durati
           "150"};
 }
 
-TEST(LoadtestE2E, ManagerAndAgentKilledNoTaskLostOrDuplicated) {
-  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-e2e-" + std::to_string(getpid()));
+/// An 8-robot, 60 s load test with `faults`; its loadtest.json (empty when the run failed).
+json runWithFaults(const fs::path& out, std::initializer_list<const char*> faults) {
   fs::remove_all(out);
   auto args = baseArgs(out, 8, 60);
-  for (const char* f : {"kill-manager@15+1", "kill-agent@30+1:1"}) {
+  for (const char* f : faults) {
     args.push_back("--fault");
     args.push_back(f);
   }
   fleet::test::ChildProcess run(kFleetctl, args);
-  const int status = run.wait(std::chrono::seconds(200));
-  ASSERT_EQ(status, 0) << "see " << out;
+  if (run.wait(std::chrono::seconds(200)) != 0) {
+    return json();
+  }
   std::ifstream in(out / "loadtest.json");
-  ASSERT_TRUE(in) << out;
-  const json r = json::parse(in);
-  const auto& a = r["accounting"];
-  EXPECT_EQ(r["db_error"], "");
-  EXPECT_GE(r["sim_time_s"].get<double>(), 59.0);
-  EXPECT_GE(a["acknowledged"].get<int>(), 10) << a.dump();
-  EXPECT_EQ(a["lost"], 0) << a.dump();
-  EXPECT_EQ(a["duplicated"], 0) << a.dump();
-  // Every acknowledged task is in a final state exactly once or still tracked.
-  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
-                a["still_tracked"].get<int>(),
-            a["acknowledged"].get<int>());
-  // Each fault happened and ended; the order depends on how fast the simulation runs (the down
-  // times are wall seconds), and a restart may fall after the end of the run.
+  return in ? json::parse(in) : json();
+}
+
+/// The fault log of a run as one line per event.
+std::string faultEvents(const json& r) {
   std::string events;
   for (const auto& e : r["faults"]) {
     events += e["event"].get<std::string>() + "\n";
   }
+  return events;
+}
+
+/// Every acknowledged task accounted for: none lost or duplicated, each final once or still tracked.
+void expectEveryTaskAccountedFor(const json& r) {
+  const auto& a = r["accounting"];
+  EXPECT_GE(r["sim_time_s"].get<double>(), 59.0);
+  EXPECT_GE(a["acknowledged"].get<int>(), 10) << a.dump();
+  EXPECT_EQ(a["lost"], 0) << a.dump();
+  EXPECT_EQ(a["duplicated"], 0) << a.dump();
+  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
+                a["still_tracked"].get<int>(),
+            a["acknowledged"].get<int>());
+}
+
+TEST(LoadtestE2E, ManagerAndAgentKilledNoTaskLostOrDuplicated) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-e2e-" + std::to_string(getpid()));
+  const json r = runWithFaults(out, {"kill-manager@15+1", "kill-agent@30+1:1"});
+  ASSERT_FALSE(r.is_null()) << "see " << out;
+  EXPECT_EQ(r["db_error"], "");
+  expectEveryTaskAccountedFor(r);
+  // Each fault happened and ended; the order depends on how fast the simulation runs (the down
+  // times are wall seconds), and a restart may fall after the end of the run.
+  const std::string events = faultEvents(r);
   for (const char* e : {"SIGKILL fleet_manager\n", "SIGKILL agent-1\n", "restarted agent-1"}) {
     EXPECT_NE(events.find(e), std::string::npos) << e << " missing in\n" << events;
   }
@@ -118,23 +134,9 @@ TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
   // The other two faults: 5 % of every process's outgoing DDS packets dropped (Cyclone's
   // XmitLossiness) for the whole run, and robot r3's agent process frozen (SIGSTOP) for 5 s.
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-stall-" + std::to_string(getpid()));
-  fs::remove_all(out);
-  auto args = baseArgs(out, 8, 60);
-  for (const char* f : {"drop-dds=0.05", "stall:r3@20+5"}) {
-    args.push_back("--fault");
-    args.push_back(f);
-  }
-  fleet::test::ChildProcess run(kFleetctl, args);
-  ASSERT_EQ(run.wait(std::chrono::seconds(200)), 0) << "see " << out;
-  const json r = json::parse(std::ifstream(out / "loadtest.json"));
-  const auto& a = r["accounting"];
-  EXPECT_GE(r["sim_time_s"].get<double>(), 59.0);
-  EXPECT_GE(a["acknowledged"].get<int>(), 10) << a.dump();
-  EXPECT_EQ(a["lost"], 0) << a.dump();
-  EXPECT_EQ(a["duplicated"], 0) << a.dump();
-  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>() + a["cancelled"].get<int>() +
-                a["still_tracked"].get<int>(),
-            a["acknowledged"].get<int>());
+  const json r = runWithFaults(out, {"drop-dds=0.05", "stall:r3@20+5"});
+  ASSERT_FALSE(r.is_null()) << "see " << out;
+  expectEveryTaskAccountedFor(r);
   // Every process ran with the lossy transmit path.
   std::ifstream cfg(out / "cyclonedds.xml");
   std::string xml;
@@ -142,10 +144,7 @@ TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
     xml += line;
   }
   EXPECT_NE(xml.find("<XmitLossiness>50</XmitLossiness>"), std::string::npos) << xml;
-  std::string events;
-  for (const auto& e : r["faults"]) {
-    events += e["event"].get<std::string>() + "\n";
-  }
+  const std::string events = faultEvents(r);
   EXPECT_NE(events.find("SIGSTOP"), std::string::npos) << events;
   EXPECT_NE(events.find("(robot r3)"), std::string::npos) << events;
   EXPECT_NE(events.find("SIGCONT"), std::string::npos) << events;

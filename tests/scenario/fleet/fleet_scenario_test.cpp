@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "fleet/transport/dds.hpp"
+#include "fleet_stack.hpp"
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -23,43 +24,19 @@ TEST(FleetScenario, OneRobotDeliversATransportTaskWithoutContact) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
-  std::ofstream(dir / "manager.json") << json{
-      {"db", (dir / "fleet.db").string()},
-      {"stations", scenario},
-      {"clock", "sim"},
-      {"lease_s", 3.0},
-      {"sync", "normal"}}.dump();
-  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain}};
-  test::ChildProcess manager(FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
-                             {"--config", (dir / "manager.json").string(), "--log-level", "warn"}, env);
-  test::ChildProcess agent(
-      FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
-      {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--log-level", "warn"}, env);
+  const test::ManagerAndAgent fleet(dir, scenario, domain, {"--clock", "lockstep", "--id", "agents"});
+  const auto& env = fleet.env;
 
-  // Submit the task over DDS, as the WMS adapter does, and wait for the durable acknowledgement.
   transport::Participant p;
   transport::Writer<msg::Task> tasks(p);
   transport::Reader<msg::TaskAck> acks(p);
   transport::Reader<msg::TaskEvent> events(p);
   const auto deadline = std::chrono::steady_clock::now() + 30s;
-  while (tasks.matchedReaders() == 0 && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(20ms);
-  }
-  msg::Task t;
-  t.task_id = "job-1";
-  t.request_id = "req-1";
-  t.body = R"({"id": "job-1", "kind": "transport", "pickup": "P-2", "dropoff": "D-1",
-               "load_duration_ns": 2000000000, "unload_duration_ns": 2000000000})";
-  tasks.write(t);
-  std::optional<msg::TaskAck> ack;
-  while (!ack && std::chrono::steady_clock::now() < deadline) {
-    acks.waitForData(100ms);
-    for (const auto& a : acks.take()) {
-      ack = a;
-    }
-  }
-  ASSERT_TRUE(ack);
-  ASSERT_EQ(ack->result, msg::AckResult::Stored) << ack->detail;
+  const msg::Task t = test::transportTask("job-1", "P-2", "D-1");
+  const auto ack = test::submitUntilAcknowledged(tasks, acks, t, deadline);
+  ASSERT_TRUE(ack) << "no acknowledgement from the fleet manager";
+  ASSERT_TRUE(ack->result == msg::AckResult::Stored || ack->result == msg::AckResult::Duplicate)
+      << ack->detail;
 
   test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
                          {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",

@@ -1,0 +1,96 @@
+// The lockstep fleet of the scenario tests: the fleet manager's config and a task submitted over DDS
+// as the WMS adapter does it. Header-only; the tests that include it link fleet::transport.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "fleet/transport/dds.hpp"
+#include "test_process.hpp"
+
+namespace fleet::test {
+
+/// dir/manager.json: the database in `dir`, the stations of `scenario`, the simulated clock, a 3 s
+/// lease, plus `extra` keys (e.g. battery settings). Returns its path.
+inline std::filesystem::path writeManagerConfig(const std::filesystem::path& dir, const std::string& scenario,
+                                                const nlohmann::json& extra = nlohmann::json::object()) {
+  nlohmann::json cfg{{"db", (dir / "fleet.db").string()},
+                     {"stations", scenario},
+                     {"clock", "sim"},
+                     {"lease_s", 3.0},
+                     {"sync", "normal"}};
+  cfg.update(extra);
+  std::ofstream(dir / "manager.json") << cfg.dump();
+  return dir / "manager.json";
+}
+
+/// fleet_manager (config from writeManagerConfig with `managerExtra`) and robot_agent (`agentArgs`
+/// after --scenario) as processes on `domain`; both die with the test. `env` is for the simulator.
+struct ManagerAndAgent {
+  ManagerAndAgent(const std::filesystem::path& dir, const std::string& scenario, const std::string& domain,
+                  std::vector<std::string> agentArgs,
+                  const nlohmann::json& managerExtra = nlohmann::json::object())
+      : env{{"FLEET_DDS_DOMAIN", domain}},
+        manager(FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
+                {"--config", writeManagerConfig(dir, scenario, managerExtra).string(), "--log-level", "warn"},
+                env),
+        agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
+              withScenario(scenario, std::move(agentArgs)), env) {}
+
+  std::vector<std::pair<std::string, std::string>> env;
+  ChildProcess manager;
+  ChildProcess agent;
+
+ private:
+  static std::vector<std::string> withScenario(const std::string& scenario, std::vector<std::string> args) {
+    args.insert(args.begin(), {"--scenario", scenario, "--log-level", "warn"});
+    return args;
+  }
+};
+
+/// The transport task `id` (request "req-" + id), 2 s to load and 2 s to unload.
+inline msg::Task transportTask(const std::string& id, const std::string& pickup, const std::string& dropoff) {
+  msg::Task t;
+  t.task_id = id;
+  t.request_id = "req-" + id;
+  t.body = nlohmann::json{{"id", id},
+                          {"kind", "transport"},
+                          {"pickup", pickup},
+                          {"dropoff", dropoff},
+                          {"load_duration_ns", 2'000'000'000},
+                          {"unload_duration_ns", 2'000'000'000}}
+               .dump();
+  return t;
+}
+
+/// Submits `task` and waits for the manager's durable acknowledgement until `deadline`. Task is
+/// volatile: a request written before the manager's reader has matched this writer is lost, so it is
+/// repeated every 2 s (the same request: answered `duplicate` if the first one was stored after all).
+inline std::optional<msg::TaskAck> submitUntilAcknowledged(transport::Writer<msg::Task>& tasks,
+                                                           transport::Reader<msg::TaskAck>& acks,
+                                                           const msg::Task& task,
+                                                           std::chrono::steady_clock::time_point deadline) {
+  using namespace std::chrono_literals;
+  while (tasks.matchedReaders() == 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(20ms);
+  }
+  for (int i = 0; std::chrono::steady_clock::now() < deadline; ++i) {
+    if (i % 20 == 0) {
+      tasks.write(task);
+    }
+    acks.waitForData(100ms);
+    for (const auto& a : acks.take()) {
+      if (a.request_id == task.request_id) {
+        return a;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace fleet::test
