@@ -201,6 +201,18 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
 }
 
 void Agent::onFrame(const msg::SensorFrame& f) {
+  // Frames carry odometry increments: whatever the robot moved while none arrived is missing from
+  // the estimate. After a gap longer than the sensor timeout (the robot kept its last command that
+  // long, then braked) widen the covariance by that much, so the landmark bearings, which the
+  // Mahalanobis gate would otherwise reject as outliers, can pull the estimate back.
+  if (haveFrame_ && nsToSec(f.stamp_ns - frame_.stamp_ns) > p_.sensorTimeoutS) {
+    const double t = std::min(nsToSec(f.stamp_ns - frame_.stamp_ns), p_.sensorTimeoutS);
+    const double d = p_.vMax * t + p_.vMax * p_.vMax / (2.0 * p_.limits.accel_max);
+    const double a = p_.wMax * t + p_.wMax * p_.wMax / (2.0 * p_.limits.alpha_max);
+    Eigen::Matrix3d widened = ekf_.covariance();
+    widened += Eigen::Vector3d(d * d, d * d, a * a).asDiagonal();
+    (void)ekf_.reset(ekf_.pose(), widened);
+  }
   if (ekf_.predict(f.ds_left, f.ds_right) != estimation::UpdateStatus::kAccepted) {
     ++rejected_;
   }

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -11,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
@@ -30,8 +32,43 @@ void onSignal(int) {
   gStop = true;
 }
 
+/// A robot whose SensorFrames are not published during [fromS, toS) of simulated time (the robot
+/// itself is still simulated and still obeys its commands): a sensor or driver outage to test with.
+struct SensorOutage {
+  std::string robot;
+  double fromS = 0.0;
+  double toS = 0.0;
+};
+
+/// ROBOT@T+D, T and D in simulated seconds.
+SensorOutage parseOutage(const std::string& text) {
+  const auto at = text.find('@');
+  const auto plus = text.find('+', at == std::string::npos ? 0 : at);
+  SensorOutage o;
+  std::size_t usedT = 0;
+  std::size_t usedD = 0;
+  try {
+    if (at == 0 || at == std::string::npos || plus == std::string::npos) {
+      throw std::invalid_argument("shape");
+    }
+    o.robot = text.substr(0, at);
+    const std::string t = text.substr(at + 1, plus - at - 1);
+    const std::string d = text.substr(plus + 1);
+    o.fromS = std::stod(t, &usedT);
+    o.toS = o.fromS + std::stod(d, &usedD);
+    if (usedT != t.size() || usedD != d.size() || !(o.fromS >= 0.0) || !(o.toS > o.fromS)) {
+      throw std::invalid_argument("values");
+    }
+  } catch (const std::exception&) {
+    throw std::invalid_argument(
+        "--sensor-outage: expected ROBOT@T+D (T >= 0 and D > 0 simulated seconds), got '" + text + "'");
+  }
+  return o;
+}
+
 struct Options {
   std::string scenario;
+  std::vector<SensorOutage> outages;
   std::optional<std::string> clock;
   std::optional<std::uint64_t> seed;
   std::optional<double> duration;
@@ -51,7 +88,7 @@ struct Options {
 const char* kUsage =
     "usage: fleet-sim --scenario FILE [--clock wall|lockstep] [--seed N] [--duration S]\n"
     "                 [--participants N] [--start-timeout-ms MS] [--step-timeout-ms MS]\n"
-    "                 [--max-speed F]\n"
+    "                 [--max-speed F] [--sensor-outage ROBOT@T+D ...]\n"
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
     "                 [--validate] [--log-level LEVEL]\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
@@ -87,6 +124,8 @@ bool parseArgs(int argc, char** argv, Options& o) {
       if (!(o.maxSpeed >= 0.0)) {
         throw std::invalid_argument("--max-speed must be >= 0 (simulated s per wall s; 0 = no cap)");
       }
+    } else if (a == "--sensor-outage") {
+      o.outages.push_back(parseOutage(next()));
     } else if (a == "--replay") {
       o.replay = next();
     } else if (a == "--summary") {
@@ -273,8 +312,14 @@ class Simulator {
 
   void publish() {
     const std::int64_t st = stamp();
+    const double now = static_cast<double>(w_.timeNs()) * 1e-9;
     for (const auto& r : w_.sensorFrames(!o_.noScan)) {
-      sensorW_.write(toMsg(w_, r, st));
+      const bool silent = std::any_of(o_.outages.begin(), o_.outages.end(), [&](const SensorOutage& o) {
+        return w_.robotIndex(o.robot) == static_cast<int>(r.robot) && now >= o.fromS && now < o.toS;
+      });
+      if (!silent) {
+        sensorW_.write(toMsg(w_, r, st));
+      }
     }
     msg::GroundTruth gt;
     gt.step = w_.step();
@@ -412,6 +457,13 @@ int main(int argc, char** argv) {
   }
   if (o.duration) {
     sc->durationS = *o.duration;
+  }
+  for (const auto& out : o.outages) {
+    if (std::none_of(sc->robots.begin(), sc->robots.end(),
+                     [&](const auto& r) { return r.id == out.robot; })) {
+      std::cerr << "fleet-sim: --sensor-outage: the scenario has no robot '" << out.robot << "'\n";
+      return 2;
+    }
   }
   const bool lockstep = o.clock.value_or(sc->clock) == "lockstep";
   std::signal(SIGINT, onSignal);
