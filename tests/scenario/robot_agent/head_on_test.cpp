@@ -47,7 +47,8 @@ TEST(AgentLockstep, HeadOnInAPassageOneRobotWideResolves) {
   while (orders.matchedReaders() == 0 && std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(20ms);
   }
-  std::this_thread::sleep_for(1s);  // the agent holds both orders before the first step
+  // The agent holds both orders before the first step (a fixed wait is not enough under load).
+  ASSERT_TRUE(orders.waitForAcks(30s)) << "the agent did not acknowledge its orders";
   test::ChildProcess sim(
       FLEET_BINARY_DIR "/sim/src/fleet-sim",
       {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration", "120", "--summary",

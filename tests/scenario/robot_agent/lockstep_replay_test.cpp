@@ -60,12 +60,13 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
                              {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--threads",
                               "2", "--local-planner", "dwa", "--no-lanes", "--log-level", "warn"},
                              env);
-    // The agent must hold the orders before the first step, or the two runs start differently.
+    // The agent must hold the orders before the first step, or the two runs start differently (a
+    // fixed wait after the match was not enough under CI load: r4's order came 4 steps late once).
     const auto until = std::chrono::steady_clock::now() + 30s;
     while (orders.matchedReaders() == 0 && std::chrono::steady_clock::now() < until) {
       std::this_thread::sleep_for(20ms);
     }
-    std::this_thread::sleep_for(1s);
+    EXPECT_TRUE(orders.waitForAcks(30s)) << "the agent did not acknowledge its orders";
     test::ChildProcess sim(
         FLEET_BINARY_DIR "/sim/src/fleet-sim",
         {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration", "20", "--replay",

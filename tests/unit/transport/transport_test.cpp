@@ -92,6 +92,21 @@ TEST_F(Transport, TransientLocalReachesLateJoiner) {
   }
 }
 
+TEST_F(Transport, AcknowledgedMeansTheLateJoinerAlreadyHoldsTheData) {
+  Participant p;
+  Writer<msg::TaskAssignment> w(p);
+  w.write({"robot-1", "task-1", 1, {}, false, 0});
+  w.write({"robot-2", "task-2", 1, {}, false, 0});
+  Participant late;
+  Reader<msg::TaskAssignment> r(late);
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (w.matchedReaders() == 0 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_TRUE(w.waitForAcks(10s));
+  EXPECT_EQ(r.take().size(), 2u);  // no waiting for data: acknowledged means delivered
+}
+
 TEST_F(Transport, WaitSetWakesOnGuard) {
   Participant p;
   WaitSet ws(p);

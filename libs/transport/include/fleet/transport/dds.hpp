@@ -115,6 +115,11 @@ class Writer {
     check(dds_unregister_instance(w_, &c), "dds_unregister_instance");
   }
   [[nodiscard]] std::uint32_t matchedReaders() const { return detail::matched(w_, true); }
+  /// True once every matched reliable reader has acknowledged everything this writer holds (for
+  /// transient-local data: the late joiner has it), false when `timeout` passes first.
+  [[nodiscard]] bool waitForAcks(std::chrono::nanoseconds timeout) const {
+    return dds_wait_for_acks(w_, static_cast<dds_duration_t>(timeout.count())) == DDS_RETCODE_OK;
+  }
   [[nodiscard]] dds_entity_t handle() const { return w_; }
 
  private:
