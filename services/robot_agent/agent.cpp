@@ -301,6 +301,7 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
   goal_ = 0;
   holdSinceNs_ = -1;
   movedNs_ = -1;  // the progress watch starts with this order
+  closerNs_ = -1;
   reported_ = msg::TaskState::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
 }
@@ -824,6 +825,9 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
       blockedSinceNs_ += outage;
     }
     movedNs_ += outage;
+    if (closerNs_ >= 0) {
+      closerNs_ += outage;
+    }
     if (planner_) {
       planner_->reset();
     }
@@ -925,6 +929,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         makingRoom_ = true;
       }
       movedNs_ = nowNs;  // waiting in the queue is not being stuck
+      closerNs_ = nowNs;
     } else {
       holdSinceNs_ = -1;
       makingRoom_ = false;
@@ -992,6 +997,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         goals_[goal_].action == msg::GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
     if (nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].duration_s) {
       ++goal_;
+      closerNs_ = -1;
       if (goal_ >= goals_.size()) {
         finishTask(msg::TaskState::Done, "", nowNs);
       } else {
@@ -1040,18 +1046,29 @@ void Agent::watchProgress(std::int64_t nowNs) {
   const Vec2 here = ekf_.pose().position();
   const bool travelling =
       phase_ == Phase::Driving || phase_ == Phase::Returning || phase_ == Phase::BackingOff;
+  // Progress is getting closer to the goal, not moving: two robots yielding to each other by turns,
+  // or a robot backing out and trying again at an aisle mouth, move for ever and get nowhere (a
+  // 20-robot run once held two tasks en route for 600 s that way, each move resetting a "moved
+  // 0.1 m" watch).
+  if (goal_ < goals_.size()) {
+    const double toGoal = distance(here, goals_[goal_].pose.position());
+    if (!travelling || closerNs_ < 0 || toGoal < bestToGoal_ - 0.25) {
+      bestToGoal_ = toGoal;
+      closerNs_ = nowNs;
+    }
+  }
   if (!travelling || movedNs_ < 0 || distance(here, movedFrom_) > 0.1) {
     movedFrom_ = here;
     movedNs_ = nowNs;
-    return;
   }
-  const double stillS = nsToSec(nowNs - movedNs_);
   // A last resort behind the standoff rules (whose timer restarts whenever the robot inches on):
   // three times their limit, so a robot in a long queue is not failed for queueing.
-  if (stillS > 3.0 * p_.blockedFailS && (!task_.empty() || homing_)) {
+  const int limitS = static_cast<int>(3.0 * p_.blockedFailS);
+  if (closerNs_ >= 0 && nsToSec(nowNs - closerNs_) > 3.0 * p_.blockedFailS && (!task_.empty() || homing_)) {
     finishTask(msg::TaskState::Failed,
-               "no progress for " + std::to_string(static_cast<int>(3.0 * p_.blockedFailS)) + " s", nowNs);
-  } else if (phase_ == Phase::Returning && stillS > 2.0 * p_.blockedBackoffS) {
+               "no progress towards " + goals_[goal_].station + " for " + std::to_string(limitS) + " s",
+               nowNs);
+  } else if (phase_ == Phase::Returning && nsToSec(nowNs - movedNs_) > 2.0 * p_.blockedBackoffS) {
     endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
   }
 }
@@ -1091,6 +1108,7 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
   homing_ = true;
   goals_ = {msg::Goal{p_.start, "home", msg::GoalAction::Park, 0.0}};
   goal_ = 0;
+  closerNs_ = -1;
   startGoal(nowNs);
 }
 

@@ -226,6 +226,8 @@ class Agent {
   bool makingRoom_ = false;        // queueing further back: the occupant wants out
   Vec2 movedFrom_;                 // where the robot last moved 0.1 m from
   std::int64_t movedNs_ = 0;       // ... and when
+  double bestToGoal_ = 0.0;        // the closest it has come to the current goal [m]
+  std::int64_t closerNs_ = -1;     // ... when that last improved by 0.25 m (-1: new goal)
   /// A task whose robot has not moved for 3 x blockedFailS fails (whatever held it: a planner that
   /// outputs nothing, a return that cannot finish); a return that has not moved for a while ends.
   void watchProgress(std::int64_t nowNs);

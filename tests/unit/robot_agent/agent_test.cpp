@@ -852,3 +852,27 @@ TEST(Agent, AfterASensorGapLandmarksPullTheEstimateToWhereTheRobotRolledUnseen) 
   }
   EXPECT_LT(distance(out.state.pose, world.truth), 0.05);
 }
+
+TEST(Agent, MovingBackAndForthWithoutGettingCloserFailsTheTaskNamingTheGoal) {
+  // A livelock as one robot lives it: whatever it commands, it is moved 0.3 m forth and back (two
+  // robots yielding to each other by turns; a robot backing out and trying again). Moving is not
+  // progress: after 3 x blockedFailS without getting 0.25 m closer to its goal the task fails.
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  a.onAssignment(transport());
+  std::optional<msg::TaskStatus> failed;
+  int k = 0;
+  for (; k < 2500 && !failed; ++k) {
+    const double v = (k / 10) % 2 == 0 ? 0.3 : -0.3;  // 1 s forth, 1 s back
+    a.onFrame(world.frame(v, 0.0, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    if (out.status && out.status->state == msg::TaskState::Failed) {
+      failed = out.status;
+    }
+  }
+  ASSERT_TRUE(failed) << "still going after " << k / 10 << " s";
+  EXPECT_EQ(failed->error, "no progress towards P-1 for 180 s");
+  EXPECT_GE(k, 1800);  // not before the limit
+  EXPECT_LT(k, 1900);
+}
