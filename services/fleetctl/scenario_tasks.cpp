@@ -6,24 +6,10 @@
 #include <set>
 
 #include "fleet/core/config.hpp"
+#include "fleet/core/ids.hpp"
 
 namespace fleet::ctl {
 namespace {
-
-/// Task ids the HTTP API accepts: ^[A-Za-z0-9_.:-]{1,63}$.
-bool validId(const std::string& id) {
-  if (id.empty() || id.size() > 63) {
-    return false;
-  }
-  for (const char c : id) {
-    const bool ok = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-                    c == '.' || c == ':' || c == '-';
-    if (!ok) {
-      return false;
-    }
-  }
-  return true;
-}
 
 /// "P-1, P-2, P-3" (at most 8 names).
 std::string nameList(const std::vector<std::string>& names) {
@@ -92,7 +78,7 @@ std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json
     if (const nlohmann::json* j = e.find("id"); j != nullptr) {
       const std::string id = e.requireString("id");
       if (j->is_string()) {
-        if (!validId(id)) {
+        if (!isValidId(id)) {
           e.problem("id", "expected 1 to 63 characters of A-Z a-z 0-9 _ . : - (as the HTTP API), got \"" +
                               id + "\"");
         } else if (auto [it, fresh] = idAt.emplace(id, e.keyPath("")); !fresh) {
