@@ -15,6 +15,21 @@
 
 namespace fleet::test {
 
+/// A fresh DDS domain (set for this process as well, so the test's own participants join it) and an
+/// empty temporary folder named after it.
+struct ScenarioRun {
+  std::string domain;
+  std::filesystem::path dir;
+};
+inline ScenarioRun freshRun(const std::string& prefix) {
+  ScenarioRun r{std::to_string(uniqueDomain()), {}};
+  setenv("FLEET_DDS_DOMAIN", r.domain.c_str(), 1);
+  r.dir = std::filesystem::temp_directory_path() / (prefix + r.domain);
+  std::filesystem::remove_all(r.dir);
+  std::filesystem::create_directories(r.dir);
+  return r;
+}
+
 /// dir/manager.json: the database in `dir`, the stations of `scenario`, the simulated clock, a 3 s
 /// lease, plus `extra` keys (e.g. battery settings). Returns its path.
 inline std::filesystem::path writeManagerConfig(const std::filesystem::path& dir, const std::string& scenario,
@@ -92,5 +107,18 @@ inline std::optional<msg::TaskAck> submitUntilAcknowledged(transport::Writer<msg
   }
   return std::nullopt;
 }
+
+/// The WMS adapter's side of the Task topic, on the test's participant (further readers of the test
+/// go on `participant`).
+struct TaskClient {
+  transport::Participant participant;
+  transport::Writer<msg::Task> tasks{participant};
+  transport::Reader<msg::TaskAck> acks{participant};
+
+  /// submitUntilAcknowledged with a deadline `wait` from now.
+  std::optional<msg::TaskAck> submit(const msg::Task& task, std::chrono::seconds wait) {
+    return submitUntilAcknowledged(tasks, acks, task, std::chrono::steady_clock::now() + wait);
+  }
+};
 
 }  // namespace fleet::test

@@ -88,7 +88,7 @@ Expected<void> ElasticStripsParams::validate() const {
   return {};
 }
 
-Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) const {
+Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) {
   const double r = view.robot.radius;
   if (variant_ == ElasticVariant::kOriginal) {
     // Single nearest reading, threshold d_o = d_safe + d_r on the centre distance (eq. 2.20).
@@ -198,6 +198,7 @@ Command ElasticStripsPlanner::plan(const LocalView& view) {
   // No external force on the strip's end point: the goal is the strip's fixed end (a wall just
   // behind a goal would otherwise push the last point back and the robot would stop short of it).
   const bool end_point = fastDistance(next, view.goal()) < 1e-9;
+  contact_ = Contact::kNone;  // stays so for the original variant and at the strip's end
   const Vec2 f_ext = end_point ? Vec2{} : externalForce(view, next);
   force_ = f_int + f_ext;
   target_ = next + force_;

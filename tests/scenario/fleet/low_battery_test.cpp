@@ -54,23 +54,18 @@ void collect(transport::Reader<msg::TaskEvent>& events, std::map<std::string, Se
 
 TEST(FleetCharging, LowRobotFinishesItsTaskThenChargesToTheTargetWithoutContact) {
   const auto wallStart = std::chrono::steady_clock::now();
-  const std::string domain = std::to_string(test::uniqueDomain());
-  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  const auto dir = std::filesystem::temp_directory_path() / ("fleet_charge_" + domain);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto run = test::freshRun("fleet_charge_");
+  const auto& dir = run.dir;
   const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/low_battery.json";
-  const test::ManagerAndAgent fleet(dir, scenario, domain, {"--clock", "lockstep", "--id", "agents"},
+  const test::ManagerAndAgent fleet(dir, scenario, run.domain, {"--clock", "lockstep", "--id", "agents"},
                                     {{"battery_threshold", kThreshold}, {"charge_until", kTarget}});
   const auto& env = fleet.env;
 
-  transport::Participant p;
-  transport::Writer<msg::Task> tasks(p);
-  transport::Reader<msg::TaskAck> acks(p);
-  transport::Reader<msg::TaskEvent> events(p);
+  test::TaskClient client;
+  transport::Reader<msg::TaskEvent> events(client.participant);
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   const msg::Task t = test::transportTask("job-1", "P-2", "D-1");
-  const auto ack = test::submitUntilAcknowledged(tasks, acks, t, deadline);
+  const auto ack = client.submit(t, 30s);
   ASSERT_TRUE(ack) << "no acknowledgement from the fleet manager";
   ASSERT_TRUE(ack->result == msg::AckResult::Stored || ack->result == msg::AckResult::Duplicate)
       << ack->detail;

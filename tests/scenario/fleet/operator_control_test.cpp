@@ -39,21 +39,14 @@ msg::Task operatorRequest(const std::string& id, const std::string& request, boo
 }  // namespace
 
 TEST(FleetScenario, PauseHoldsTheRobotResumeDrivesOnCancelEndsTheTask) {
-  const std::string domain = std::to_string(test::uniqueDomain());
-  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  const auto dir = std::filesystem::temp_directory_path() / ("fleet_control_" + domain);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto run = test::freshRun("fleet_control_");
+  const auto& dir = run.dir;
   const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
-  const test::ManagerAndAgent fleet(dir, scenario, domain, {"--clock", "lockstep", "--id", "agents"});
+  const test::ManagerAndAgent fleet(dir, scenario, run.domain, {"--clock", "lockstep", "--id", "agents"});
 
-  transport::Participant p;
-  transport::Writer<msg::Task> tasks(p);
-  transport::Reader<msg::TaskAck> acks(p);
-  transport::Reader<msg::TaskEvent> events(p);
-  auto deadline = std::chrono::steady_clock::now() + 30s;
-  const auto stored =
-      test::submitUntilAcknowledged(tasks, acks, test::transportTask("job-1", "P-2", "D-1"), deadline);
+  test::TaskClient client;
+  transport::Reader<msg::TaskEvent> events(client.participant);
+  const auto stored = client.submit(test::transportTask("job-1", "P-2", "D-1"), 30s);
   ASSERT_TRUE(stored) << "no acknowledgement from the fleet manager";
 
   const auto replayPath = (dir / "replay.jsonl.gz").string();
@@ -77,19 +70,16 @@ TEST(FleetScenario, PauseHoldsTheRobotResumeDrivesOnCancelEndsTheTask) {
   };
   ASSERT_TRUE(watchFor(msg::TaskState::EnRoute, 30s));
   std::this_thread::sleep_for(1500ms);  // ~7 s simulated: driving to the pickup
-  deadline = std::chrono::steady_clock::now() + 10s;
-  const auto paused = test::submitUntilAcknowledged(
-      tasks, acks, operatorRequest("job-1", "req-pause", false, msg::TaskControl::Pause), deadline);
+  const auto paused =
+      client.submit(operatorRequest("job-1", "req-pause", false, msg::TaskControl::Pause), 10s);
   ASSERT_TRUE(paused && paused->result == msg::AckResult::Stored) << (paused ? paused->detail : "no ack");
   std::this_thread::sleep_for(3s);  // ~15 s simulated held
-  deadline = std::chrono::steady_clock::now() + 10s;
-  const auto resumed = test::submitUntilAcknowledged(
-      tasks, acks, operatorRequest("job-1", "req-resume", false, msg::TaskControl::Resume), deadline);
+  const auto resumed =
+      client.submit(operatorRequest("job-1", "req-resume", false, msg::TaskControl::Resume), 10s);
   ASSERT_TRUE(resumed && resumed->result == msg::AckResult::Stored) << (resumed ? resumed->detail : "no ack");
   std::this_thread::sleep_for(2s);  // ~10 s simulated driving again
-  deadline = std::chrono::steady_clock::now() + 10s;
-  const auto cancelled = test::submitUntilAcknowledged(
-      tasks, acks, operatorRequest("job-1", "req-cancel", true, msg::TaskControl::None), deadline);
+  const auto cancelled =
+      client.submit(operatorRequest("job-1", "req-cancel", true, msg::TaskControl::None), 10s);
   ASSERT_TRUE(cancelled && cancelled->result == msg::AckResult::Stored)
       << (cancelled ? cancelled->detail : "no ack");
   EXPECT_TRUE(watchFor(msg::TaskState::Cancelled, 10s));

@@ -32,21 +32,15 @@ TEST(AgentLockstep, ARobotWhoseSensorStreamStopsStopsReportsItAndResumes) {
   constexpr double kFrom = 4.0;
   constexpr double kTo = 10.0;
   constexpr double kSensorTimeout = 0.5;  // robot_agent's default --sensor-timeout
-  const std::string domain = std::to_string(test::uniqueDomain());
-  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  const auto dir = std::filesystem::temp_directory_path() / ("agent_sensor_loss_" + domain);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto run = test::freshRun("agent_sensor_loss_");
+  const auto& dir = run.dir;
   const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
-  const test::ManagerAndAgent fleet(dir, scenario, domain, {"--clock", "lockstep", "--id", "agents"});
+  const test::ManagerAndAgent fleet(dir, scenario, run.domain, {"--clock", "lockstep", "--id", "agents"});
 
-  transport::Participant p;
-  transport::Writer<msg::Task> tasks(p);
-  transport::Reader<msg::TaskAck> acks(p);
-  transport::Reader<msg::TaskStatus> statuses(p);
+  test::TaskClient client;
+  transport::Reader<msg::TaskStatus> statuses(client.participant);
   const auto deadline = std::chrono::steady_clock::now() + 30s;
-  const auto ack =
-      test::submitUntilAcknowledged(tasks, acks, test::transportTask("job-1", "P-2", "D-1"), deadline);
+  const auto ack = client.submit(test::transportTask("job-1", "P-2", "D-1"), 30s);
   ASSERT_TRUE(ack) << "no acknowledgement from the fleet manager";
 
   const auto replayPath = (dir / "replay.jsonl.gz").string();

@@ -22,23 +22,18 @@ using namespace std::chrono_literals;
 using nlohmann::json;
 
 TEST(WallClockScenario, OneRobotDeliversATransportTaskInRealTime) {
-  const std::string domain = std::to_string(test::uniqueDomain());
-  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  const auto dir = std::filesystem::temp_directory_path() / ("agent_wall_scn_" + domain);
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto run = test::freshRun("agent_wall_scn_");
+  const auto& dir = run.dir;
   const std::string scenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
-  const test::ManagerAndAgent fleet(dir, scenario, domain, {"--clock", "wall", "--threads", "2"},
+  const test::ManagerAndAgent fleet(dir, scenario, run.domain, {"--clock", "wall", "--threads", "2"},
                                     {{"clock", "wall"}});
   const auto& env = fleet.env;
 
-  transport::Participant p;
-  transport::Writer<msg::Task> tasks(p);
-  transport::Reader<msg::TaskAck> acks(p);
-  transport::Reader<msg::TaskEvent> events(p);
+  test::TaskClient client;
+  transport::Reader<msg::TaskEvent> events(client.participant);
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   const msg::Task t = test::transportTask("job-1", "P-2", "D-1");
-  const auto ack = test::submitUntilAcknowledged(tasks, acks, t, deadline);
+  const auto ack = client.submit(t, 30s);
   ASSERT_TRUE(ack) << "no acknowledgement from the fleet manager";
   ASSERT_TRUE(ack->result == msg::AckResult::Stored || ack->result == msg::AckResult::Duplicate)
       << ack->detail;

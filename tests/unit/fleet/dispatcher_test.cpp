@@ -229,7 +229,7 @@ TEST_F(DispatcherTest, ChargeTaskEndsWhenTheRobotAtTheChargerReachesTheTarget) {
   EXPECT_TRUE(out.revoked.empty()) << "the new order replaces the charge order; no empty one after it";
 }
 
-TEST_F(DispatcherTest, ChargedRobotWithNothingToDoIsReleasedOnce) {
+TEST_F(DispatcherTest, ChargedRobotWithNoWorkIsReleasedOnce) {
   robotAt("low", 0, 5, 0.15, 0);  // already at C-near
   auto out = dispatcher->tick(1);
   ASSERT_EQ(out.assignments.size(), 1u);

@@ -75,7 +75,7 @@ class ElasticStripsPlanner final : public LocalPlanner {
   [[nodiscard]] Contact lastContact() const { return contact_; }
 
  private:
-  [[nodiscard]] Vec2 externalForce(const LocalView& view, Vec2 at) const;
+  [[nodiscard]] Vec2 externalForce(const LocalView& view, Vec2 at);
 
   ElasticVariant variant_;
   ElasticStripsParams params_;
@@ -83,7 +83,7 @@ class ElasticStripsPlanner final : public LocalPlanner {
   Vec2 prev_;
   Vec2 target_;
   Vec2 force_;
-  mutable Contact contact_ = Contact::kNone;
+  Contact contact_ = Contact::kNone;
   std::vector<double> ranges_;
   std::vector<Vec2> hits_;
 };
