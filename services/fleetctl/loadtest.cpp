@@ -574,6 +574,10 @@ int Run::run() {
     if (o.lanes) {
       args.emplace_back("--lanes");
     }
+    if (!o.agentConfig.empty()) {
+      args.emplace_back("--config");
+      args.push_back(fs::absolute(o.agentConfig).string());
+    }
     return ProcessSpec{name, bin("services/robot_agent/robot_agent"), args, env, log(name)};
   };
   for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -844,10 +848,10 @@ int Run::run() {
       const auto& c = m["conduct"];
       std::snprintf(line, sizeof line,
                     "%s conduct: %d standoffs (%d on a robot itself waiting: wait cycles), %d back-offs, %d "
-                    "returns along the trail, %d detours",
+                    "returns along the trail, %d detours, %d local-planner recoveries",
                     m.value("id", std::string("?")).c_str(), c.value("standoffs", 0),
                     c.value("wait_cycles", 0), c.value("backoffs", 0), c.value("returns", 0),
-                    c.value("detours", 0));
+                    c.value("detours", 0), c.value("planner_recoveries", 0));
       say(line);
     }
   }

@@ -32,8 +32,9 @@ struct LoadtestOptions {
   int port = 0;              // 0: a free port
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
-  std::string localPlanner = "follow";
+  std::string localPlanner = "dwa";
   std::string globalPlanner = "astar";  // robot agents' --global-planner
+  std::string agentConfig;              // robot agents' --config (a JSON file; empty: none)
   bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
   int stationCapacity = 2;              // the fleet manager's station_capacity (0: no limit)
   double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)

@@ -156,6 +156,11 @@ int main(int argc, char** argv) {
   loadtest->add_option("--seed", lt.seed, "scenario and task seed")->capture_default_str();
   loadtest->add_option("--local-planner", lt.localPlanner, "robot agents' local planner")
       ->capture_default_str();
+  loadtest
+      ->add_option(
+          "--agent-config", lt.agentConfig,
+          "robot agents' --config: JSON with local_planner, dwa {...}, safety {...} (see robot_agent --help)")
+      ->check(CLI::ExistingFile);
   loadtest->add_option("--global-planner", lt.globalPlanner, "robot agents' global planner")
       ->check(CLI::IsMember({"astar", "wavefront", "ompl"}))
       ->capture_default_str();

@@ -33,6 +33,7 @@ estimation::PoseEkf makeEkf(const AgentParams& p) {
 constexpr double kLookahead = 0.5;
 constexpr double kQueueDistance = 2.0;     // m from a station where a robot waits while it is taken
 constexpr double kTrailStep = 0.25;        // m between trail points
+constexpr double kUndockDistance = 1.0;    // m the follower drives off a station before the planner
 constexpr std::size_t kTrailPoints = 120;  // 30 m of trail
 
 control::PathFollowerParams followerParams() {
@@ -44,6 +45,12 @@ control::PathFollowerParams followerParams() {
 }
 
 }  // namespace
+
+avoidance::DwaParams agentDwaDefaults() {
+  avoidance::DwaParams p;
+  p.lookahead = 0.8;
+  return p;
+}
 
 std::shared_ptr<const planning::OccupancyGrid> inflate(const planning::OccupancyGrid& raw, double radius) {
   return std::make_shared<const planning::OccupancyGrid>(raw.inflated(radius));
@@ -75,7 +82,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
   }
 }
 
-control::Twist Agent::planLocal(bool& reached, bool& blocked) {
+control::Twist Agent::planLocal(bool& blocked) {
   const Pose2 pose = ekf_.pose();
   // Drop the path points already passed: keep from the one nearest to the robot.
   std::size_t nearest = 0;
@@ -85,8 +92,23 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
     }
   }
   path_.erase(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(nearest));
-  const std::vector<Vec2> scan = scanPoints(3.0);
+  std::vector<Vec2> scan = scanPoints(3.0);
+  // The map's walls and shelves near the robot as well (a local costmap's static layer): 72 rays
+  // are 26 cm apart at 3 m, and a shelf corner between two of them was not there for the planner.
+  const std::vector<Vec2> walls = mapPoints(2.0);
+  scan.insert(scan.end(), walls.begin(), walls.end());
   std::vector<avoidance::MovingDisc> discs;
+  // Robots as they report themselves (with their velocity) and people as tracked from frame to
+  // frame, as well as whatever is detected: a robot known only from its RobotState (out of the
+  // sensor's view, or a driver without detections) must still be kept clear of.
+  for (const auto& o : others_) {
+    if (distance(o.pos, pose.position()) < 3.0) {
+      discs.push_back({o.pos, o.velocity, p_.radius});
+    }
+  }
+  for (const auto& h : people_) {
+    discs.push_back({h.pos, h.velocity, h.radius});
+  }
   if (haveFrame_) {
     for (const auto& d : frame_.detections) {
       discs.push_back({pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
@@ -106,10 +128,45 @@ control::Twist Agent::planLocal(bool& reached, bool& blocked) {
     view.risk = [r = risk_](Vec2 q) { return r->at(q); };
   }
   const auto cmd = planner_->plan(view);
-  reached = cmd.status == avoidance::PlanStatus::kGoalReached || distance(pose, goals_[goal_].pose) < 0.15;
   blocked = cmd.status == avoidance::PlanStatus::kBlocked ||
             (cmd.overruled && std::abs(cmd.twist.v) < 0.05 && std::abs(cmd.twist.omega) < 0.05);
   return cmd.twist;
+}
+
+std::vector<Vec2> Agent::mapPoints(double range) const {
+  std::vector<Vec2> pts;
+  const double res = raw_->resolution();
+  const Vec2 here = ekf_.pose().position();
+  const int reach = static_cast<int>(std::ceil(range / res));
+  const Vec2 rel = (here - raw_->origin()) * (1.0 / res);
+  const int cx = static_cast<int>(std::floor(rel.x));
+  const int cy = static_cast<int>(std::floor(rel.y));
+  // Points every ~0.1 m along each face a blocked cell shares with a free one.
+  const int perEdge = std::max(1, static_cast<int>(std::ceil(res / 0.1)));
+  for (int y = cy - reach; y <= cy + reach; ++y) {
+    for (int x = cx - reach; x <= cx + reach; ++x) {
+      const planning::Cell c{x, y};
+      if (!raw_->inside(c) || !raw_->blocked(c)) {
+        continue;
+      }
+      const Vec2 lo = raw_->origin() + Vec2{x * res, y * res};
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        if (raw_->blocked({x + dx, y + dy})) {
+          continue;
+        }
+        // The shared face: from a to b.
+        const Vec2 a = lo + Vec2{dx > 0 ? res : 0.0, dy > 0 ? res : 0.0};
+        const Vec2 b = a + (dx != 0 ? Vec2{0.0, res} : Vec2{res, 0.0});
+        for (int k = 0; k <= perEdge; ++k) {
+          const Vec2 q = a + (b - a) * (static_cast<double>(k) / perEdge);
+          if (distance(q, here) < range) {
+            pts.push_back(q);
+          }
+        }
+      }
+    }
+  }
+  return pts;
 }
 
 std::vector<Vec2> Agent::scanPoints(double maxRange) const {
@@ -165,7 +222,10 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
     w = r.twist.omega;
     // Then the scan: a shelf corner beside the straight corridor of the stop rule is still in the
     // way of a curving robot (one brushed a corner in a 100-robot run). A stop for it is static.
+    // (The map's obstacle faces too: a shelf corner between two rays is there all the same.)
     std::vector<Vec2> scan = scanPoints(1.5);
+    const std::vector<Vec2> walls = mapPoints(1.0);
+    scan.insert(scan.end(), walls.begin(), walls.end());
     if (scan.empty() || docking_) {
       return true;  // (docking: the stop rule's docking gap governs the last decimetres)
     }
@@ -201,11 +261,27 @@ bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
 }
 
 void Agent::onFrame(const msg::SensorFrame& f) {
-  // Frames carry odometry increments: whatever the robot moved while none arrived is missing from
-  // the estimate. After a gap longer than the sensor timeout (the robot kept its last command that
-  // long, then braked) widen the covariance by that much, so the landmark bearings, which the
-  // Mahalanobis gate would otherwise reject as outliers, can pull the estimate back.
-  if (haveFrame_ && nsToSec(f.stamp_ns - frame_.stamp_ns) > p_.sensorTimeoutS) {
+  // With the wheel totals the motion since the last frame received is exact, however many were
+  // lost in between. Without them (ds_* are increments since the previous frame sent), whatever
+  // the robot moved while none arrived is missing from the estimate: after a gap longer than the
+  // sensor timeout (the robot kept its last command that long, then braked) widen the covariance
+  // by that much, so the landmark bearings, which the Mahalanobis gate would otherwise reject as
+  // outliers, can pull the estimate back.
+  double dsLeft = f.ds_left;
+  double dsRight = f.ds_right;
+  const bool totals =
+      f.wheel_totals_valid && std::isfinite(f.wheel_left_total) && std::isfinite(f.wheel_right_total);
+  if (totals && haveTotals_) {
+    dsLeft = f.wheel_left_total - wheelLeft_;
+    dsRight = f.wheel_right_total - wheelRight_;
+  }
+  if (totals) {
+    wheelLeft_ = f.wheel_left_total;
+    wheelRight_ = f.wheel_right_total;
+  }
+  const bool motionKnown = totals && haveTotals_;
+  haveTotals_ = totals;
+  if (!motionKnown && haveFrame_ && nsToSec(f.stamp_ns - frame_.stamp_ns) > p_.sensorTimeoutS) {
     const double t = std::min(nsToSec(f.stamp_ns - frame_.stamp_ns), p_.sensorTimeoutS);
     const double d = p_.vMax * t + p_.vMax * p_.vMax / (2.0 * p_.limits.accel_max);
     const double a = p_.wMax * t + p_.wMax * p_.wMax / (2.0 * p_.limits.alpha_max);
@@ -213,7 +289,7 @@ void Agent::onFrame(const msg::SensorFrame& f) {
     widened += Eigen::Vector3d(d * d, d * d, a * a).asDiagonal();
     (void)ekf_.reset(ekf_.pose(), widened);
   }
-  if (ekf_.predict(f.ds_left, f.ds_right) != estimation::UpdateStatus::kAccepted) {
+  if (ekf_.predict(dsLeft, dsRight) != estimation::UpdateStatus::kAccepted) {
     ++rejected_;
   }
   if (f.compass_valid && ekf_.updateCompass(f.compass) != estimation::UpdateStatus::kAccepted) {
@@ -407,6 +483,8 @@ void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
+  // Leaving a station or parking place (not re-planning on the way): see undockFrom_.
+  const bool fromStandstill = phase_ == Phase::Idle || phase_ == Phase::Dwelling;
   // Lanes and risk together: the risk map's probability scales each cell's cost as in risk_astar.
   planning::CellCostFactor riskFactor;
   if (risk_) {
@@ -483,6 +561,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   }
   if (planner_) {
     planner_->reset();
+  }
+  if (fromStandstill) {
+    undockFrom_ = ekf_.pose().position();
   }
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
@@ -883,26 +964,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     startGoal(nowNs);
   }
   maybeReturnHome(nowNs);
-  if (phase_ == Phase::Driving && planner_) {
-    bool reached = false;
-    bool blocked = false;
-    const auto tw = planLocal(reached, blocked);
-    if (reached) {
-      enterDwell(nowNs);
-    } else {
-      v = tw.v;
-      w = tw.omega;
-      mode = blocked ? msg::RobotMode::Waiting : msg::RobotMode::Moving;
-      if (blocked) {
-        bool byRobot = false;
-        std::string blocker;
-        (void)clearSpeed(0.5, byRobot, blocker);  // who is in the way
-        onStandoff(nowNs, byRobot, blocker, v, w);
-      } else {
-        blockedSinceNs_ = -1;
-      }
-    }
-  } else if (phase_ == Phase::Driving) {
+  if (phase_ == Phase::Driving) {
     auto r = follower_.step(ekf_.pose());
     if (!r) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
@@ -934,9 +996,26 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       holdSinceNs_ = -1;
       makingRoom_ = false;
       docking_ = r->final_approach;
-      followerTwist(*r, v, w);
-      if (docking_ && straightDock_) {
-        // Face the station, then drive straight onto it (see below).
+      // The configured planner drives the path; the follower's pose law docks (a sampling
+      // planner stops near the goal, not on it with the goal's heading). Either command then goes
+      // through the same stop rule and standoff handling below, so yielding, backing off and
+      // detours work the same whichever planner drives.
+      bool localBlocked = false;
+      if (undockFrom_ && distance(ekf_.pose().position(), *undockFrom_) > kUndockDistance) {
+        undockFrom_.reset();
+      }
+      const bool planning = planner_ && !docking_ && !undockFrom_ && nowNs >= followUntilNs_;
+      if (planning) {
+        const auto tw = planLocal(localBlocked);
+        v = tw.v;
+        w = tw.omega;
+      } else {
+        followerTwist(*r, v, w);
+      }
+      if (docking_ && (straightDock_ || planner_)) {
+        // Face the station, then drive straight onto it (see below). Always after a sampling
+        // planner: it reaches the final approach off the path's last leg, from where the pose
+        // law's curve onto the station's heading swept into the robots parked beside it.
         const Vec2 to = r->target.position() - ekf_.pose().position();
         const double b = angleDiff(std::atan2(to.y, to.x), ekf_.pose().theta);
         w = std::clamp(2.0 * b, -p_.wMax, p_.wMax);
@@ -946,7 +1025,15 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       bool byRobot = false;
       std::string blocker;
       const double wanted = v;
-      const bool held = heldUp(v, w, byRobot, blocker) && wanted > 0.1;
+      // A sampling planner accelerates from standstill within its dynamic window (a·dt = 0.1 m/s
+      // per cycle), so any forward wish of it counts; the follower always asks for cruise.
+      bool held = heldUp(v, w, byRobot, blocker) && wanted > (planning ? 0.02 : 0.1);
+      if (localBlocked && !held) {
+        // The planner found no admissible move: name what is in the way (probing a speed it
+        // would like) so the standoff rules know whom to yield to.
+        held = true;
+        (void)clearSpeed(0.5, byRobot, blocker);
+      }
       const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
       const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
       if (held && !byRobot && blocker.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
@@ -965,6 +1052,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       } else {
         blockedSinceNs_ = -1;
       }
+      watchPlanner(nowNs, planning && !held);
     }
   } else if (phase_ == Phase::Returning) {
     mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
@@ -1026,6 +1114,28 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   (void)dt;
   report(out, nowNs, v, w, mode);
   return out;
+}
+
+void Agent::watchPlanner(std::int64_t nowNs, bool planning) {
+  // A sampling planner can sit in a local minimum that nothing else notices: the robot turns in
+  // place at an aisle corner, never held by the stop rule, never blocked (a 1.25 m passage turning
+  // into a corridor did that for minutes). After kStallS on one spot the follower, which tracks the
+  // path itself, drives for kRecoverS (Nav2 would run a recovery behaviour here).
+  constexpr double kStallS = 6.0;
+  constexpr double kRecoverS = 8.0;
+  const Vec2 here = ekf_.pose().position();
+  if (!planning) {
+    stallNs_ = -1;
+    return;
+  }
+  if (stallNs_ < 0 || distance(here, stallFrom_) > 0.1) {
+    stallFrom_ = here;
+    stallNs_ = nowNs;
+  } else if (nsToSec(nowNs - stallNs_) > kStallS) {
+    followUntilNs_ = nowNs + static_cast<std::int64_t>(kRecoverS * 1e9);
+    stallNs_ = -1;
+    ++conduct_.plannerRecoveries;
+  }
 }
 
 void Agent::endYield(std::int64_t nowNs) {

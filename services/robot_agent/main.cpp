@@ -47,9 +47,9 @@ struct Options {
   std::vector<std::string> only;
   bool lockstep = false;
   std::string id = "agents";
-  std::string localPlanner = "follow";
+  std::string localPlanner = "dwa";
   std::string globalPlanner = "astar";
-  avoidance::DwaParams dwa;
+  avoidance::DwaParams dwa = agent::agentDwaDefaults();
   avoidance::SafetyParams safety;
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
@@ -170,6 +170,9 @@ int run(const sim::Scenario& scn, const Options& opt) {
       }
     }
     for (const auto& s : others.take()) {
+      if (byId.count(s.robot_id) != 0) {
+        continue;  // hosted here: handed over in-process after the step (below)
+      }
       for (auto& a : agents) {
         a->onOtherRobot(s);
       }
@@ -206,6 +209,16 @@ int run(const sim::Scenario& scn, const Options& opt) {
         spdlog::debug("{}: task {} {}", a->id(), out.status->task_id, msg::toString(out.status->state));
       }
     }
+    // Robots of this process learn each other's state directly, exactly one cycle later. Over DDS
+    // a sample came one or two cycles late depending on timing, and what the local planner makes
+    // of a neighbour's position and velocity made lockstep replays differ between runs.
+    pool.forEach(agents.size(), [&](std::size_t j) {
+      for (std::size_t i = 0; i < agents.size(); ++i) {
+        if (i != j) {
+          agents[j]->onOtherRobot(outs[i].state);
+        }
+      }
+    });
     ++steps;
     if (cycleMs.size() < (1u << 22)) {  // 4 M cycles: 5 days at 10 Hz, 32 MB
       cycleMs.push_back(
@@ -232,12 +245,11 @@ int run(const sim::Scenario& scn, const Options& opt) {
       c.backoffs += a->conduct().backoffs;
       c.returns += a->conduct().returns;
       c.detours += a->conduct().detours;
+      c.plannerRecoveries += a->conduct().plannerRecoveries;
     }
-    m["conduct"] = {{"standoffs", c.standoffs},
-                    {"wait_cycles", c.mutualBlocks},
-                    {"backoffs", c.backoffs},
-                    {"returns", c.returns},
-                    {"detours", c.detours}};
+    m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
+                    {"backoffs", c.backoffs},   {"returns", c.returns},
+                    {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};
     std::ofstream f(opt.metricsFile + ".tmp");
     f << m.dump(1) << "\n";
     f.close();
@@ -302,7 +314,7 @@ void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, b
   const std::string global = cfg.string("global_planner", opt.globalPlanner, {"astar", "wavefront", "ompl"});
   Config dwa = cfg.child("dwa");
   Config safety = cfg.child("safety");
-  opt.dwa = avoidance::dwaParams(dwa);
+  opt.dwa = avoidance::dwaParams(dwa, opt.dwa);
   opt.safety = avoidance::safetyParams(safety);
   cfg.rejectUnknownKeys({"local_planner", "global_planner", "dwa", "safety"});
   if (!localFromCli) {
@@ -335,8 +347,8 @@ int main(int argc, char** argv) {
          "astar (default; the risk map as cell cost), wavefront, or ompl (Informed RRT*, 50 ms per plan)")
       ->check(CLI::IsMember({"astar", "wavefront", "ompl"}));
   app.add_option("--local-planner", opt.localPlanner,
-                 "follow (default: path follower + stop rule) or a libs/avoidance planner behind the safety "
-                 "layer: dwa (uses the risk map's term), vo, potential_field, ...");
+                 "dwa (default; with the risk map's term), vo, potential_field, ... (a libs/avoidance "
+                 "planner behind the safety layer) or follow (the Lyapunov path follower)");
   app.add_option("--threads", opt.threads, "worker threads stepping the agents (0: hardware concurrency)")
       ->check(CLI::Range(0u, 256u));
   app.add_option("--sensor-timeout", opt.sensorTimeoutS,

@@ -163,6 +163,9 @@ msg::SensorFrame toMsg(const sim::World& w, const sim::SensorReading& r, std::in
   f.seq = r.seq;
   f.ds_left = r.dsLeft;
   f.ds_right = r.dsRight;
+  f.wheel_totals_valid = true;
+  f.wheel_left_total = r.wheelLeftTotal;
+  f.wheel_right_total = r.wheelRightTotal;
   f.angle_min = r.angleMin;
   f.angle_increment = r.angleIncrement;
   f.range_max = r.rangeMax;

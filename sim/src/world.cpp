@@ -327,8 +327,12 @@ void World::stepRobots() {
     }
     const double dsl = vl * dt;
     const double dsr = vr * dt;
-    r.odomLeft += dsl * (1.0 + normal(motionRng_, spec.noise.odomSigma));
-    r.odomRight += dsr * (1.0 + normal(motionRng_, spec.noise.odomSigma));
+    const double measuredLeft = dsl * (1.0 + normal(motionRng_, spec.noise.odomSigma));
+    const double measuredRight = dsr * (1.0 + normal(motionRng_, spec.noise.odomSigma));
+    r.odomLeft += measuredLeft;
+    r.odomRight += measuredRight;
+    r.odomLeftTotal += measuredLeft;
+    r.odomRightTotal += measuredRight;
     const double moved = std::abs(0.5 * (dsl + dsr));
     r.distance += moved;
     if (std::abs(r.twist.v) < kStillSpeed && std::abs(r.twist.omega) < kStillSpeed) {
@@ -619,6 +623,8 @@ SensorReading World::sensorFrame(std::size_t i, bool withScan) {
   f.seq = r.frameSeq++;
   f.dsLeft = r.odomLeft;
   f.dsRight = r.odomRight;
+  f.wheelLeftTotal = r.odomLeftTotal;
+  f.wheelRightTotal = r.odomRightTotal;
   r.odomLeft = r.odomRight = 0.0;
   const bool full = s.fov >= 2.0 * kPi - 1e-9;
   f.angleMin = static_cast<float>(full ? -kPi : -0.5 * s.fov);

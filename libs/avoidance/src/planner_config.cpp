@@ -10,8 +10,8 @@ const Range kNonNegative{0.0};
 const Range kPositive{0.0, std::numeric_limits<double>::infinity(), true};
 }  // namespace
 
-DwaParams dwaParams(Config& cfg) {
-  DwaParams p;
+DwaParams dwaParams(Config& cfg, const DwaParams& defaults) {
+  DwaParams p = defaults;
   const auto count = [&](const char* key, int fallback) {
     return static_cast<int>(cfg.integer(key, fallback, {1.0, 200.0}));
   };

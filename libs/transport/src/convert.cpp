@@ -311,6 +311,9 @@ void Traits<msg::SensorFrame>::toC(const msg::SensorFrame& in, C& out, Arena& ar
          });
   out.battery = in.battery;
   out.charging = in.charging;
+  out.wheel_totals_valid = in.wheel_totals_valid;
+  out.wheel_left_total = in.wheel_left_total;
+  out.wheel_right_total = in.wheel_right_total;
 }
 msg::SensorFrame Traits<msg::SensorFrame>::fromC(const C& in) {
   msg::SensorFrame m;
@@ -333,6 +336,9 @@ msg::SensorFrame Traits<msg::SensorFrame>::fromC(const C& in) {
   });
   m.battery = in.battery;
   m.charging = in.charging;
+  m.wheel_totals_valid = in.wheel_totals_valid;
+  m.wheel_left_total = in.wheel_left_total;
+  m.wheel_right_total = in.wheel_right_total;
   return m;
 }
 

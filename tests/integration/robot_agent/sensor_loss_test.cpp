@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <chrono>
 #include <thread>
 
@@ -90,8 +92,13 @@ TEST(RobotAgentSensorLoss, StopsReportsFaultAndResumes) {
   // Live: frames flow, the order arrives, the robot wants to move.
   ASSERT_TRUE(until(true, 20s, [&] { return seen.state.has_value(); })) << "no RobotState from the agent";
   assignments.write(order);
+  // Moving means any command: this driver never moves the robot, so a planner that turns towards
+  // its path first (the default DWA's rotation shim) keeps turning.
+  const auto moving = [&] {
+    return seen.command && (seen.command->v > 0.05 || std::abs(seen.command->w) > 0.05);
+  };
   ASSERT_TRUE(until(true, 20s, [&] {
-    return seen.command && seen.command->v > 0.05 && seen.state && seen.state->mode != msg::RobotMode::Fault;
+    return moving() && seen.state && seen.state->mode != msg::RobotMode::Fault;
   })) << "the robot never drove while frames flowed";
   seen.statuses.clear();
 
@@ -118,6 +125,6 @@ TEST(RobotAgentSensorLoss, StopsReportsFaultAndResumes) {
 
   // Frames come back: the fault clears and the robot drives on.
   ASSERT_TRUE(until(true, 10s, [&] {
-    return seen.state && seen.state->mode != msg::RobotMode::Fault && seen.command && seen.command->v > 0.05;
+    return seen.state && seen.state->mode != msg::RobotMode::Fault && moving();
   })) << "the robot did not resume";
 }

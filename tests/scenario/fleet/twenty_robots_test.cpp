@@ -1,8 +1,9 @@
 // The whole fleet in lockstep on the small warehouse: 20 robots, 8 people, 100 transport tasks
 // posted through the WMS adapter by `fleetctl loadtest`. Safety is absolute (no contact of any
-// kind); the fleet must not deadlock (tasks keep being delivered and every task ends), nearly all
-// must be done, and nothing acknowledged may be lost or duplicated. The run stops when the last task is done
-// (about 1650-1750 s simulated, 170 s wall); the time and tasks per hour are the figures of
+// kind); the fleet must not deadlock (tasks keep being delivered and every task ends), all 100 must
+// be done, and nothing acknowledged may be lost or duplicated. The robots drive with the agent's
+// default local planner (DWA with the risk term). The run stops when the last task is done (about
+// 1700-2000 s simulated, 180-220 s wall); the time and tasks per hour are the figures of
 // docs/benchmarks.md.
 
 #include <gtest/gtest.h>
@@ -88,14 +89,14 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
                                  "--max-speed",
                                  "10",
                                  "--wall-limit",
-                                 "400",
+                                 "450",
                                  "--domain",
                                  std::to_string(fleet::test::uniqueDomain()),
                                  "--report-script",
                                  "",
                                  "--out",
                                  out.string()});
-  ASSERT_EQ(run.wait(std::chrono::seconds(480)), 0) << "see " << out;
+  ASSERT_EQ(run.wait(std::chrono::seconds(500)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
   const auto& a = r["accounting"];
   EXPECT_EQ(r["wall_limited"], false) << "the machine could not keep up; see " << out;
@@ -118,11 +119,12 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
     longestGap = std::max(longestGap, done[k] - done[k - 1]);
   }
   EXPECT_LT(longestGap, 300.0) << "the fleet stopped delivering for " << longestGap << " s";
-  // Every task finished: none left queued or active (a deadlock leaves some). Nearly all done: in
-  // about one run in five one task fails after its three attempts, each "blocked by <robot> for
-  // 60 s" at a parking place (docs/benchmarks.md); the reasons are printed below.
+  // Every task finished: none left queued or active (a deadlock leaves some), and every one done.
+  // A task whose robot gets stuck is retried on another robot (up to three attempts); the retries
+  // and their reasons are printed below.
   EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>(), 100) << a.dump();
-  EXPECT_GE(a["done"].get<int>(), 98) << a.dump() << "\nrequeued and failed:\n" << failures(out / "fleet.db");
+  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump() << "\nrequeued and failed:\n"
+                                       << failures(out / "fleet.db");
   std::cout << "requeued and failed:\n" << failures(out / "fleet.db");
   std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "

@@ -21,6 +21,9 @@ struct World {
   double wheelBase = 0.4;
   std::uint32_t seq = 0;
   std::vector<msg::Detection> detections;
+  bool wheelTotals = false;  // send SensorFrame.wheel_*_total too
+  double leftTotal = 0.0;
+  double rightTotal = 0.0;
 
   msg::SensorFrame frame(double v, double w, double dt) {
     const Pose2 before = truth;
@@ -32,6 +35,11 @@ struct World {
     // Wheel travel for the executed twist (exact arc).
     f.ds_left = (v - w * wheelBase / 2) * dt;
     f.ds_right = (v + w * wheelBase / 2) * dt;
+    leftTotal += f.ds_left;
+    rightTotal += f.ds_right;
+    f.wheel_totals_valid = wheelTotals;
+    f.wheel_left_total = leftTotal;
+    f.wheel_right_total = rightTotal;
     f.compass_valid = true;
     f.compass = truth.theta;
     f.range_max = 8.0f;
@@ -101,7 +109,9 @@ class GlobalPlannerChoice : public ::testing::TestWithParam<const char*> {};
 TEST_P(GlobalPlannerChoice, DeliversAroundAWallWithoutEnteringIt) {
   // A wall from y = 0 to y = 4.5 at x = 3 stands between the start (1, 1) and the pickup (5, 1):
   // only a plan around its top end gets there (the test world has no scan, so the stop rule
-  // cannot save a path through it).
+  // cannot save a path through it). The follower drives, so the path is what is tested: with the
+  // DWA, OMPL's paths, which cut the wall's corner at the margin, left the robot at the corner in
+  // about 4 runs of 10, every move onward closing in on it (docs/algorithms.md, fifth round).
   auto raw = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
   for (int y = 0; y < 18; ++y) {
     raw->setBlocked({12, y});
@@ -109,6 +119,7 @@ TEST_P(GlobalPlannerChoice, DeliversAroundAWallWithoutEnteringIt) {
   auto grid = agent::inflate(*raw, 0.5);
   auto p = params();
   p.globalPlanner = GetParam();
+  p.localPlanner = "follow";
   agent::Agent a(p, grid, raw);
   World world;
   a.onAssignment(transport());
@@ -123,7 +134,8 @@ TEST_P(GlobalPlannerChoice, DeliversAroundAWallWithoutEnteringIt) {
     v = out.command.v;
     w = out.command.w;
     done = out.status && out.status->state == msg::TaskState::Done;
-    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed) << out.status->error;
+    ASSERT_FALSE(out.status && out.status->state == msg::TaskState::Failed)
+        << GetParam() << ": " << out.status->error << " at " << world.truth.x << ", " << world.truth.y;
     // Distance from the robot's centre to the wall's rectangle [3, 3.25] x [0, 4.5].
     const double dx = std::max({3.0 - world.truth.x, 0.0, world.truth.x - 3.25});
     const double dy = std::max(0.0, world.truth.y - 4.5);
@@ -522,6 +534,9 @@ TEST(Agent, BacksOutOfANarrowPassageAlongItsTrailAndTakesTheOtherWay) {
   }
   EXPECT_TRUE(done);
   EXPECT_GE(a.conduct().returns, 1u) << "backed out along its trail";
+  // Where the passage meets the corridor the DWA (the default planner) turns in place for good, a
+  // local minimum nothing else notices; the follower takes over for a while and the robot gets on.
+  EXPECT_GE(a.conduct().plannerRecoveries, 1u) << "the local planner never handed over";
   EXPECT_GE(a.conduct().mutualBlocks, 1u) << "the blocker waits on it: a wait cycle";
   EXPECT_GE(minDist, 0.6 + 0.2) << "kept clear of the robot it yielded to";
   EXPECT_LT(maxX, blocker.x) << "never went past the blocker in the passage";
@@ -741,22 +756,27 @@ TEST(Agent, SlowsForAPersonWalkingAcrossItsWay) {
   (void)step(-1.12, static_cast<std::int64_t>(k) * 100'000'000);
   const auto out = step(-1.0, static_cast<std::int64_t>(k + 1) * 100'000'000);
   EXPECT_LT(out.command.v, 0.5) << "did not slow for the person crossing";
-  // The same person standing still there is no reason to slow down.
-  agent::Agent b(params(), grid, grid);
-  World still;
-  b.onAssignment(transport());
-  int j = 0;
-  (void)run(b, still, j, 25, [] { return false; });
-  still.detections = {{msg::SourceKind::Human, 1.0f, -1.0f, 0.25f}};
-  for (int i = 0; i < 2; ++i) {
-    auto f = still.frame(0.8, 0.0, 0.1);
-    f.stamp_ns = static_cast<std::int64_t>(j + i) * 100'000'000;
-    b.onFrame(f);
-    const auto o = b.step(f.stamp_ns, 0.1);
-    if (i == 1) {
-      EXPECT_GT(o.command.v, 0.5);
+  // The same person standing still there is no reason to slow down: the robot drives as it does
+  // with nobody in view.
+  auto drive = [&](const std::vector<msg::Detection>& seen) {
+    agent::Agent b(params(), grid, grid);
+    World still;
+    b.onAssignment(transport());
+    int j = 0;
+    (void)run(b, still, j, 25, [] { return false; });
+    still.detections = seen;
+    double v = 0.0;
+    for (int i = 0; i < 2; ++i) {
+      auto f = still.frame(0.8, 0.0, 0.1);
+      f.stamp_ns = static_cast<std::int64_t>(j + i) * 100'000'000;
+      b.onFrame(f);
+      v = b.step(f.stamp_ns, 0.1).command.v;
     }
-  }
+    return v;
+  };
+  const double alone = drive({});
+  EXPECT_GT(alone, 0.3);
+  EXPECT_NEAR(drive({{msg::SourceKind::Human, 1.0f, -1.0f, 0.25f}}), alone, 0.05);
 }
 
 TEST(Agent, AGoalInsideAWalledOffRoomFailsTheTaskNamingIt) {
@@ -851,6 +871,55 @@ TEST(Agent, AfterASensorGapLandmarksPullTheEstimateToWhereTheRobotRolledUnseen) 
     feed();
   }
   EXPECT_LT(distance(out.state.pose, world.truth), 0.05);
+}
+
+TEST(Agent, WithWheelTotalsTheMotionDuringASensorGapIsKeptWithoutAnyLandmark) {
+  // The same blind roll, but the driver sends its wheel totals: the motion between the last frame
+  // before the gap and the first after it is known, so the estimate is right at once, without a
+  // single landmark (most of a warehouse's aisles have none in view).
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  world.wheelTotals = true;
+  std::int64_t now = 0;
+  agent::AgentOutput out;
+  auto feed = [&](double v) {
+    msg::SensorFrame f = world.frame(v, 0.0, 0.1);
+    f.stamp_ns = now;
+    a.onFrame(f);
+    out = a.step(now, 0.1);
+    now += 100'000'000;
+  };
+  for (int k = 0; k < 10; ++k) {
+    feed(0.0);
+  }
+  for (int k = 0; k < 30; ++k) {
+    (void)world.frame(0.7 / 3.0, 0.0, 0.1);  // 3 s of frames that never arrive: it rolls 0.7 m
+    now += 100'000'000;
+  }
+  feed(0.0);
+  EXPECT_NEAR(out.state.pose.x, world.truth.x, 0.01);
+  EXPECT_NEAR(world.truth.x, params().start.x + 0.7, 1e-9);
+  // A driver without totals: the same gap loses the roll (what the test above widens P for).
+  agent::Agent b(params(), grid, grid);
+  World old;
+  now = 0;
+  for (int k = 0; k < 10; ++k) {
+    msg::SensorFrame f = old.frame(0.0, 0.0, 0.1);
+    f.stamp_ns = now;
+    b.onFrame(f);
+    out = b.step(now, 0.1);
+    now += 100'000'000;
+  }
+  for (int k = 0; k < 30; ++k) {
+    (void)old.frame(0.7 / 3.0, 0.0, 0.1);
+    now += 100'000'000;
+  }
+  msg::SensorFrame f = old.frame(0.0, 0.0, 0.1);
+  f.stamp_ns = now;
+  b.onFrame(f);
+  out = b.step(now, 0.1);
+  EXPECT_NEAR(out.state.pose.x, params().start.x, 0.01) << "without totals the increments are all it has";
 }
 
 TEST(Agent, MovingBackAndForthWithoutGettingCloserFailsTheTaskNamingTheGoal) {

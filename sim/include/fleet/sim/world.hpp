@@ -25,6 +25,8 @@ struct RobotBody {
   bool charging = false;
   double odomLeft = 0.0;  // measured wheel distances since the last sensor frame, m
   double odomRight = 0.0;
+  double odomLeftTotal = 0.0;  // measured wheel distances since the start, m (what wheel encoders count)
+  double odomRightTotal = 0.0;
   double distance = 0.0;  // true path length, m
   double idleS = 0.0;     // time standing still, s
   std::uint32_t frameSeq = 0;
@@ -83,6 +85,8 @@ struct SensorReading {
   std::uint32_t seq = 0;
   double dsLeft = 0.0;
   double dsRight = 0.0;
+  double wheelLeftTotal = 0.0;
+  double wheelRightTotal = 0.0;
   float angleMin = 0.0F;
   float angleIncrement = 0.0F;
   float rangeMax = 0.0F;

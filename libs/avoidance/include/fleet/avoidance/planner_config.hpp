@@ -7,9 +7,9 @@
 namespace fleet::avoidance {
 
 /// DWA parameters from a config object whose keys are DwaParams' field names (weights, samples,
-/// horizon, ...). Missing keys keep the defaults; wrong types, out-of-range values and unknown
+/// horizon, ...). Missing keys keep `defaults`; wrong types, out-of-range values and unknown
 /// keys are recorded as problems in `cfg` (the caller calls cfg.finish()).
-DwaParams dwaParams(Config& cfg);
+DwaParams dwaParams(Config& cfg, const DwaParams& defaults = {});
 
 /// Safety-layer zones from a config object whose keys are SafetyParams' field names.
 SafetyParams safetyParams(Config& cfg);

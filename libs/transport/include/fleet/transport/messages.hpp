@@ -193,6 +193,9 @@ struct SensorFrame {
   std::vector<Detection> detections;
   float battery = 1;
   bool charging = false;
+  bool wheel_totals_valid = false;  ///< wheel_*_total are set (older drivers leave them out)
+  double wheel_left_total = 0;      ///< [m] since the driver started
+  double wheel_right_total = 0;
   bool operator==(const SensorFrame&) const = default;
 };
 
