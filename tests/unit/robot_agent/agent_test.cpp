@@ -876,50 +876,37 @@ TEST(Agent, AfterASensorGapLandmarksPullTheEstimateToWhereTheRobotRolledUnseen) 
 TEST(Agent, WithWheelTotalsTheMotionDuringASensorGapIsKeptWithoutAnyLandmark) {
   // The same blind roll, but the driver sends its wheel totals: the motion between the last frame
   // before the gap and the first after it is known, so the estimate is right at once, without a
-  // single landmark (most of a warehouse's aisles have none in view).
-  auto grid = emptyGrid();
-  agent::Agent a(params(), grid, grid);
-  World world;
-  world.wheelTotals = true;
-  std::int64_t now = 0;
-  agent::AgentOutput out;
-  auto feed = [&](double v) {
-    msg::SensorFrame f = world.frame(v, 0.0, 0.1);
-    f.stamp_ns = now;
-    a.onFrame(f);
-    out = a.step(now, 0.1);
-    now += 100'000'000;
+  // single landmark (most of a warehouse's aisles have none in view). Without totals the same gap
+  // loses the roll (what the test above widens P for). Returns {estimated x, true x}.
+  auto blindRoll = [](bool totals) {
+    auto grid = emptyGrid();
+    agent::Agent a(params(), grid, grid);
+    World world;
+    world.wheelTotals = totals;
+    std::int64_t now = 0;
+    agent::AgentOutput out;
+    auto feed = [&] {
+      msg::SensorFrame f = world.frame(0.0, 0.0, 0.1);
+      f.stamp_ns = now;
+      a.onFrame(f);
+      out = a.step(now, 0.1);
+      now += 100'000'000;
+    };
+    for (int k = 0; k < 10; ++k) {
+      feed();
+    }
+    for (int k = 0; k < 30; ++k) {
+      (void)world.frame(0.7 / 3.0, 0.0, 0.1);  // 3 s of frames that never arrive: it rolls 0.7 m
+      now += 100'000'000;
+    }
+    feed();
+    return std::pair{out.state.pose.x, world.truth.x};
   };
-  for (int k = 0; k < 10; ++k) {
-    feed(0.0);
-  }
-  for (int k = 0; k < 30; ++k) {
-    (void)world.frame(0.7 / 3.0, 0.0, 0.1);  // 3 s of frames that never arrive: it rolls 0.7 m
-    now += 100'000'000;
-  }
-  feed(0.0);
-  EXPECT_NEAR(out.state.pose.x, world.truth.x, 0.01);
-  EXPECT_NEAR(world.truth.x, params().start.x + 0.7, 1e-9);
-  // A driver without totals: the same gap loses the roll (what the test above widens P for).
-  agent::Agent b(params(), grid, grid);
-  World old;
-  now = 0;
-  for (int k = 0; k < 10; ++k) {
-    msg::SensorFrame f = old.frame(0.0, 0.0, 0.1);
-    f.stamp_ns = now;
-    b.onFrame(f);
-    out = b.step(now, 0.1);
-    now += 100'000'000;
-  }
-  for (int k = 0; k < 30; ++k) {
-    (void)old.frame(0.7 / 3.0, 0.0, 0.1);
-    now += 100'000'000;
-  }
-  msg::SensorFrame f = old.frame(0.0, 0.0, 0.1);
-  f.stamp_ns = now;
-  b.onFrame(f);
-  out = b.step(now, 0.1);
-  EXPECT_NEAR(out.state.pose.x, params().start.x, 0.01) << "without totals the increments are all it has";
+  const auto [withTotals, truth] = blindRoll(true);
+  EXPECT_NEAR(truth, params().start.x + 0.7, 1e-9);
+  EXPECT_NEAR(withTotals, truth, 0.01);
+  EXPECT_NEAR(blindRoll(false).first, params().start.x, 0.01)
+      << "without totals the increments are all it has";
 }
 
 TEST(Agent, MovingBackAndForthWithoutGettingCloserFailsTheTaskNamingTheGoal) {
