@@ -34,6 +34,8 @@ constexpr double kLookahead = 0.5;
 constexpr double kQueueDistance = 2.0;     // m from a station where a robot waits while it is taken
 constexpr double kTrailStep = 0.25;        // m between trail points
 constexpr double kUndockDistance = 1.0;    // m the follower drives off a station before the planner
+constexpr double kAxisDistance = 1.0;      // m in front of a station: where its straight approach starts
+constexpr double kStandingWaitS = 5.0;     // s a robot waits before others plan around it (standing)
 constexpr std::size_t kTrailPoints = 120;  // 30 m of trail
 
 control::PathFollowerParams followerParams() {
@@ -62,7 +64,8 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       grid_(std::move(grid)),
       raw_(std::move(raw)),
       ekf_(makeEkf(p_)),
-      follower_(followerParams()) {
+      follower_(followerParams()),
+      standsAt_(p_.start) {
   if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
     throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
   }
@@ -341,17 +344,23 @@ void Agent::onOtherRobot(const msg::RobotState& s) {
   if (s.robot_id == p_.id || !s.pose.isFinite()) {
     return;
   }
-  for (auto& o : others_) {
-    if (o.id == s.robot_id) {
-      o.pos = s.pose.position();
-      o.mode = s.mode;
-      o.hasTask = !s.task_id.empty();
-      o.velocity = Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v;
-      return;
-    }
+  auto it = std::find_if(others_.begin(), others_.end(), [&](const Other& o) { return o.id == s.robot_id; });
+  if (it == others_.end()) {
+    others_.push_back({s.robot_id, {}, msg::RobotMode::Idle, false, {}, 0.0, -1, 0});
+    it = std::prev(others_.end());
   }
-  others_.push_back({s.robot_id, s.pose.position(), s.mode, !s.task_id.empty(),
-                     Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v});
+  Other& o = *it;
+  if (s.mode != msg::RobotMode::Waiting) {
+    o.waitingSinceNs = -1;
+  } else if (o.waitingSinceNs < 0 || o.mode != msg::RobotMode::Waiting) {
+    o.waitingSinceNs = s.stamp_ns;
+  }
+  o.pos = s.pose.position();
+  o.theta = s.pose.theta;
+  o.mode = s.mode;
+  o.hasTask = !s.task_id.empty();
+  o.velocity = Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v;
+  o.stampNs = s.stamp_ns;
 }
 
 void Agent::onAssignment(const msg::TaskAssignment& a) {
@@ -401,8 +410,23 @@ msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
 }
 
 bool Agent::standing(const Other& o) {
+  // A robot that has waited kStandingWaitS on end (queueing for a station, held by a person who
+  // does not step aside) will most likely stand a while longer too: plan around it rather than
+  // queue behind it. Two chains in 20-robot runs ended that way: robots queueing behind a robot
+  // that waited on a person in an aisle, and a robot leaving a drop-off station through the queue
+  // in front of it, each failing its task after 60 s.
+  const bool waitedLong = o.mode == msg::RobotMode::Waiting && o.waitingSinceNs >= 0 &&
+                          nsToSec(o.stampNs - o.waitingSinceNs) > kStandingWaitS;
   return o.mode == msg::RobotMode::Loading || o.mode == msg::RobotMode::Charging ||
-         o.mode == msg::RobotMode::Fault || (o.mode == msg::RobotMode::Idle && !o.hasTask);
+         o.mode == msg::RobotMode::Fault || (o.mode == msg::RobotMode::Idle && !o.hasTask) || waitedLong;
+}
+
+bool Agent::behind(const Other& o) const {
+  const Vec2 u{std::cos(o.theta), std::sin(o.theta)};
+  const Vec2 rel = ekf_.pose().position() - o.pos;
+  const double along = rel.dot(u);
+  const double lateral = std::abs(rel.x * u.y - rel.y * u.x);
+  return along < 0.0 && -along < 2.0 * p_.radius + 0.35 && lateral < 2.0 * p_.radius + 0.05;
 }
 
 planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
@@ -455,6 +479,11 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
         }
       }
     }
+    // The robot's own cell, whatever its centre fits: the robot stands there. A parking place at
+    // y = 0.9 lies in a cell whose centre is 0.25 m from the wall, so its body never "fits" there,
+    // the plan from it failed, and every trip from home fell back to the raw map, whose paths run
+    // 0.25 m from shelf faces (the local planner then crawled past each shelf corner).
+    g.setBlocked(*c, false);
   }
   openGoal(g, goal);
   return g;
@@ -479,6 +508,37 @@ void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
   if (const auto c = g.cellAt(goal); c && g.blocked(*c) && bodyFits(goal)) {
     g.setBlocked(*c, false);
   }
+}
+
+std::optional<Vec2> Agent::axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const {
+  const Vec2 at = station.position();
+  const Vec2 u{std::cos(station.theta), std::sin(station.theta)};
+  const Vec2 a = at + u * kAxisDistance;
+  if (const auto c = g.cellAt(a); !c || g.blocked(*c)) {
+    return std::nullopt;  // a pickup 0.75 m from its shelf: approached along the row instead
+  }
+  for (double s = 0.1; s < kAxisDistance; s += 0.1) {
+    if (!bodyFits(at + u * s)) {
+      return std::nullopt;
+    }
+  }
+  for (const auto& o : others_) {
+    // Standing on the leg (not on the station itself: that is a queue, see stationOccupant).
+    const double along = std::clamp((o.pos - at).dot(u), 0.0, kAxisDistance);
+    if (standing(o) && distance(o.pos, at) > 2.0 * p_.radius + 0.1 &&
+        distance(o.pos, at + u * along) < 2.0 * p_.radius) {
+      return std::nullopt;
+    }
+  }
+  return a;
+}
+
+bool Agent::onAxis(Vec2 p, const Pose2& station) const {
+  const Vec2 u{std::cos(station.theta), std::sin(station.theta)};
+  const Vec2 rel = p - station.position();
+  const double along = rel.dot(u);
+  const double lateral = std::abs(rel.x * u.y - rel.y * u.x);
+  return along > -0.1 && along < kAxisDistance + 0.3 && lateral < 0.2;
 }
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
@@ -509,44 +569,89 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     chosen = std::make_unique<planning::AStarPlanner>();
   }
   planning::GlobalPlanner& astar = *chosen;
-  Expected<planning::Path> path = unexpected("no_path", "not planned");
   const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
-  if (avoid) {
-    const Vec2 self = ekf_.pose().position();
-    planning::OccupancyGrid detour = around;
-    const double res = detour.resolution();
-    const int reach = static_cast<int>(std::ceil(0.9 / res));
-    if (const auto c = detour.cellAt(*avoid)) {
-      for (int dy = -reach; dy <= reach; ++dy) {
-        for (int dx = -reach; dx <= reach; ++dx) {
-          const planning::Cell q{c->x + dx, c->y + dy};
-          // Close to the obstacle the robot stands inside that disc itself: keep free the cells
-          // next to it on the side away from the obstacle, so the detour can start by leaving.
-          const Vec2 off = detour.inside(q) ? detour.cellCenter(q) - self : Vec2{};
-          const bool leaving = off.norm() < p_.radius + 0.15 && off.dot(*avoid - self) <= 0.0;
-          if (detour.inside(q) && distance(detour.cellCenter(q), *avoid) <= 0.9 && !leaving) {
-            detour.setBlocked(q);
+  // Stations are left and entered straight along their axis, through a point kAxisDistance in
+  // front of them (a dock's pre-dock pose, VDA 5050's approach pose). A path straight from a
+  // parking place to an aisle, or from an aisle onto a parking place, runs diagonally past the
+  // robots parked next to it: two neighbours leaving together each blocked the other's way out
+  // (both tasks failed after 60 s, three times over), and a robot coming home beside a parked
+  // neighbour stood there for good.
+  const Pose2 here = ekf_.pose();
+  Pose2 from = here;
+  Pose2 to = g.pose;
+  std::vector<Pose2> head;
+  std::vector<Pose2> tail;
+  // (Leaving for somewhere a couple of metres off, a station just behind, say, goes there
+  // directly; coming in, the axis counts wherever the robot replans from.)
+  const bool shortMove = distance(here.position(), g.pose.position()) < 2.0 * kAxisDistance;
+  if (!shortMove && standsAt_ && distance(here.position(), standsAt_->position()) < 0.3) {
+    if (const auto e = axisPoint(*standsAt_, around)) {
+      from = {e->x, e->y, standsAt_->theta};
+      head = {here};
+    }
+  }
+  if (!onAxis(here.position(), g.pose)) {
+    if (const auto a = axisPoint(g.pose, around)) {
+      const double in = wrapAngle(g.pose.theta + kPi);
+      to = {a->x, a->y, in};
+      tail = {Pose2{g.pose.x, g.pose.y, in}};
+    }
+  }
+  auto plan = [&](const Pose2& start, const Pose2& end) -> Expected<planning::Path> {
+    if (avoid) {
+      const Vec2 self = here.position();
+      planning::OccupancyGrid detour = around;
+      const double res = detour.resolution();
+      const int reach = static_cast<int>(std::ceil(0.9 / res));
+      if (const auto c = detour.cellAt(*avoid)) {
+        for (int dy = -reach; dy <= reach; ++dy) {
+          for (int dx = -reach; dx <= reach; ++dx) {
+            const planning::Cell q{c->x + dx, c->y + dy};
+            // Close to the obstacle the robot stands inside that disc itself: keep free the cells
+            // next to it on the side away from the obstacle, so the detour can start by leaving.
+            const Vec2 off = detour.inside(q) ? detour.cellCenter(q) - self : Vec2{};
+            const bool leaving = off.norm() < p_.radius + 0.15 && off.dot(*avoid - self) <= 0.0;
+            if (detour.inside(q) && distance(detour.cellCenter(q), *avoid) <= 0.9 && !leaving) {
+              detour.setBlocked(q);
+            }
           }
         }
       }
+      if (const auto c = detour.cellAt(start.position())) {
+        // The robot's own cell (the disc covers it when it stands close): a plan must start.
+        detour.setBlocked(*c, false);
+      }
+      return astar.plan(detour, start, end);  // no way around: the caller keeps its path
     }
-    path = astar.plan(detour, ekf_.pose(), g.pose);
+    Expected<planning::Path> path = unexpected("no_path", "not planned");
+    if (risk_ && !p_.lanes && p_.globalPlanner == "astar") {
+      RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
+      path = riskAware.plan(around, start, end);
+    } else {
+      path = astar.plan(around, start, end);
+    }
     if (!path) {
-      return;  // no way around: keep the current path and wait
+      planning::OccupancyGrid plain = *grid_;  // boxed in by standing robots: wait them out
+      openGoal(plain, end.position());
+      path = astar.plan(plain, start, end);
     }
-  } else if (risk_ && !p_.lanes && p_.globalPlanner == "astar") {
-    RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
-    path = riskAware.plan(around, ekf_.pose(), g.pose);
-  } else {
-    path = astar.plan(around, ekf_.pose(), g.pose);
+    if (!path) {
+      path = astar.plan(*raw_, start, end);  // a start or goal hugging a shelf
+    }
+    return path;
+  };
+  Expected<planning::Path> path = plan(from, to);
+  approach_.reset();
+  if (path) {
+    path->poses.insert(path->poses.begin(), head.begin(), head.end());
+    if (!tail.empty()) {
+      approach_ = tail.back();  // driven once the robot is at the axis point (see drive)
+    }
+  } else if (!head.empty() || !tail.empty()) {
+    path = plan(here, g.pose);  // the axis leads nowhere from here: plainly
   }
-  if (!path) {
-    planning::OccupancyGrid plain = *grid_;  // boxed in by standing robots: wait them out
-    openGoal(plain, g.pose.position());
-    path = astar.plan(plain, ekf_.pose(), g.pose);
-  }
-  if (!path) {
-    path = astar.plan(*raw_, ekf_.pose(), g.pose);  // a start or goal hugging a shelf
+  if (!path && avoid) {
+    return;  // no way around: keep the current path and wait
   }
   if (!path || !follower_.setPath(path->poses)) {
     finishTask(msg::TaskState::Failed,
@@ -802,6 +907,7 @@ bool Agent::startReturn(std::int64_t nowNs) {
 
 void Agent::enterDwell(std::int64_t nowNs) {
   phase_ = Phase::Dwelling;
+  standsAt_ = goals_[goal_].pose;
   phaseStartNs_ = nowNs;
   const auto st = taskStateFor(goal_, true);
   if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
@@ -855,6 +961,12 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     for (const auto& o : others_) {
       if (o.id == blocker && homing_ != !o.hasTask) {
         yields = homing_;  // exactly one of the two drives home: that one yields
+      }
+      if (o.id == blocker && o.mode == msg::RobotMode::Waiting && behind(o)) {
+        // Right at the back of a robot that waits: it may be yielding itself (to a person, to a
+        // robot of higher priority) and need the room this one takes. Make it, whatever the
+        // priority; the one ahead faces away, so it does not wait on this one (no cycle).
+        yields = true;
       }
     }
   }
@@ -966,9 +1078,22 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   maybeReturnHome(nowNs);
   if (phase_ == Phase::Driving) {
     auto r = follower_.step(ekf_.pose());
+    if (r && approach_ && r->final_approach && !path_.empty() &&
+        distance(ekf_.pose().position(), path_.back()) < 0.25) {
+      // At the station's axis point: the last leg, straight in. Followed as one path, the local
+      // planner cut the corner onto the axis and came in diagonally past the neighbours again.
+      path_ = {ekf_.pose().position(), approach_->position()};
+      (void)follower_.setPath(path_, approach_->theta);
+      approach_.reset();
+      if (planner_) {
+        planner_->reset();
+      }
+      r = follower_.step(ekf_.pose());
+    }
     if (!r) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
-    } else if (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15)) {
+    } else if (!approach_ &&
+               (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15))) {
       enterDwell(nowNs);
     } else if (const Other* occupant = stationOccupant(); occupant != nullptr) {
       // Queue for the station a little way off instead of pushing into the robot on it.
@@ -995,7 +1120,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     } else {
       holdSinceNs_ = -1;
       makingRoom_ = false;
-      docking_ = r->final_approach;
+      docking_ = r->final_approach && !approach_;
       // The configured planner drives the path; the follower's pose law docks (a sampling
       // planner stops near the goal, not on it with the goal's heading). Either command then goes
       // through the same stop rule and standoff handling below, so yielding, backing off and
@@ -1028,6 +1153,16 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       // A sampling planner accelerates from standstill within its dynamic window (a·dt = 0.1 m/s
       // per cycle), so any forward wish of it counts; the follower always asks for cruise.
       bool held = heldUp(v, w, byRobot, blocker) && wanted > (planning ? 0.02 : 0.1);
+      if (!held && planning && std::abs(wanted) < 0.02 && std::abs(w) < 0.1) {
+        // The planner stops the robot in front of something (every rollout ends in the stop
+        // gap): as blocked as when the stop rule holds it. Counted only while the stop rule held
+        // it, a homing robot facing one on an order in the wide top band alternated a second
+        // "held" with seconds of the planner's standstill, its blocked clock restarted each time,
+        // it never yielded, and the other's task failed after 60 s.
+        bool anyRobot = false;
+        std::string what;
+        localBlocked = clearSpeed(0.5, anyRobot, what) < 0.5;
+      }
       if (localBlocked && !held) {
         // The planner found no admissible move: name what is in the way (probing a speed it
         // would like) so the standoff rules know whom to yield to.

@@ -199,7 +199,12 @@ class Agent {
     msg::RobotMode mode = msg::RobotMode::Idle;
     bool hasTask = false;
     Vec2 velocity;
+    double theta = 0.0;
+    std::int64_t waitingSinceNs = -1;  // stamp of its first state of the current wait (-1: not waiting)
+    std::int64_t stampNs = 0;          // stamp of its latest state
   };
+  /// This robot stands right at the back of `o` (in the corridor `o` would back into).
+  [[nodiscard]] bool behind(const Other& o) const;
   /// The follower's command through the safety layer, against the scan and the other robots
   /// extrapolated at their reported velocities (crossings at intersections, which the stop rule's
   /// straight-ahead corridor sees too late). Returns false when it had to stop the robot.
@@ -223,6 +228,15 @@ class Agent {
   [[nodiscard]] bool bodyFits(Vec2 p) const;
   /// Unblocks the goal's cell of `g` when the robot fits on the goal itself.
   void openGoal(planning::OccupancyGrid& g, Vec2 goal) const;
+  /// The point kAxisDistance in front of `station` (along its heading) when it is free on `g` and
+  /// the straight leg to it is clear of walls and standing robots; the way in and out.
+  [[nodiscard]] std::optional<Vec2> axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const;
+  /// `p` lies on the station's straight leg already (no approach point needed).
+  [[nodiscard]] bool onAxis(Vec2 p, const Pose2& station) const;
+  std::optional<Pose2> standsAt_;  // the station (or parking place) the robot last stopped on
+  /// The goal's pose (facing in), still to be driven to straight from its axis point once the
+  /// path there is done; empty when the path leads onto the goal itself.
+  std::optional<Pose2> approach_;
   std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
   std::int64_t lastDetourNs_ = -1;          // when the last detour was tried

@@ -119,13 +119,12 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
     longestGap = std::max(longestGap, done[k] - done[k - 1]);
   }
   EXPECT_LT(longestGap, 300.0) << "the fleet stopped delivering for " << longestGap << " s";
-  // Every task finished: none left queued or active (a deadlock leaves some). Nearly all done: a
-  // task whose robot gets stuck is retried on another robot (up to three attempts), but two
-  // neighbours leaving or entering the parking band can hold each other ("blocked by r5" / "by r4")
-  // through all three: 9 of 10 DWA runs on 2026-11-25 finished 100, the clean-clone CI run 98
-  // (issue #7 stays open on it). The retries and their reasons are printed below.
-  EXPECT_EQ(a["done"].get<int>() + a["failed"].get<int>(), 100) << a.dump();
-  EXPECT_GE(a["done"].get<int>(), 98) << a.dump() << "\nrequeued and failed:\n" << failures(out / "fleet.db");
+  // Every task finished (a deadlock leaves some queued or active) and done: a task whose robot gets
+  // stuck is retried on another robot (up to three attempts). Until 2026-11-25 two neighbours in the
+  // parking band could hold each other through all three (about 1 run in 10 ended 98 or 99); the
+  // station axis and the rules for chains of waits (docs/algorithms.md, sixth round) ended that.
+  // The retries and their reasons are printed below.
+  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump() << "\nrequeued and failed:\n" << failures(out / "fleet.db");
   std::cout << "requeued and failed:\n" << failures(out / "fleet.db");
   std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "
