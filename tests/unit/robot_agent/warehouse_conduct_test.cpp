@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
@@ -203,10 +204,23 @@ TEST_P(ParkingBandPair, NeighboursLeaveDoTheTaskAndParkAgain) {
   expectDelivered(drive(robots, {{"r4", station(to4), 0.0}, {"r5", station(to5), lag}}, 3000), 2, robots);
 }
 
+// e.g. "r4_P1_r5_CHG1_at_once", "r4_P1_r5_D1_1500ms_later"
+std::string pairName(const ::testing::TestParamInfo<ParkingBandPair::ParamType>& info) {
+  auto bare = [](std::string n) {
+    std::erase(n, '-');
+    return n;
+  };
+  const double lag = std::get<2>(info.param);
+  return "r4_" + bare(std::get<0>(info.param)) + "_r5_" + bare(std::get<1>(info.param)) +
+         (lag > 0.0 ? "_" + std::to_string(static_cast<int>(lag * 1000)) + "ms_later"
+                    : std::string("_at_once"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Destinations, ParkingBandPair,
                          ::testing::Combine(::testing::Values("P-1", "P-3", "D-1", "CHG-1"),
                                             ::testing::Values("P-1", "P-3", "D-1", "CHG-1"),
-                                            ::testing::Values(0.0, 1.5)));
+                                            ::testing::Values(0.0, 1.5)),
+                         pairName);
 
 TEST(ParkingBand, ThreeNeighboursLeaveTogetherAndComeBack) {
   // The middle one goes west, its neighbours east and west: every way out crosses another's.
@@ -227,9 +241,14 @@ TEST_P(ParkingBandCrossing, ARobotComingHomeAndItsNeighbourLeavingPass) {
   expectDelivered(drive(robots, {{"r5", errand, 0.0}, {"r4", station("P-3"), GetParam()}}, 2500), 2, robots);
 }
 
-INSTANTIATE_TEST_SUITE_P(Timings, ParkingBandCrossing, ::testing::Values(18.0, 22.0, 26.0, 30.0));
+std::string leavingName(const ::testing::TestParamInfo<double>& info) {
+  return "leaves_at_" + std::to_string(static_cast<int>(info.param)) + "s";
+}
 
-TEST(AisleQueue, TheRobotBehindMakesRoomForOneThatYieldsToAPerson) {
+INSTANTIATE_TEST_SUITE_P(Timings, ParkingBandCrossing, ::testing::Values(18.0, 22.0, 26.0, 30.0),
+                         leavingName);
+
+TEST(AisleQueue, TheRobotBehindGoesRoundOneThatWaitsOnAPerson) {
   // Up the aisle above PARK-5 (from a 20-robot run, where the one behind failed its task): a
   // person stands at the mouth of the shelf rows and does not step aside; one robot waits on the
   // person, a second queues right behind it and has priority (the smaller id). The one behind must
