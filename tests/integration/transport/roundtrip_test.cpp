@@ -24,7 +24,7 @@ class RoundTrip : public ::testing::Test {
   static void SetUpTestSuite() {
     setenv("FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain()).c_str(), 1);
     peer_ = new test::ChildProcess(FLEET_BINARY_DIR "/tests/integration/transport/transport_echo_peer",
-                                   {"15"}, {{"FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain())}});
+                                   {"60"}, {{"FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain())}});
     participant_ = new Participant();
   }
   static void TearDownTestSuite() {
@@ -36,15 +36,19 @@ class RoundTrip : public ::testing::Test {
   std::vector<T> roundTrip(const std::vector<T>& samples) {
     Writer<T> w(*participant_, kAll);
     Reader<T> r(*participant_, kAll, std::string(Traits<T>::kTopic) + "_echo");
-    const auto deadline = std::chrono::steady_clock::now() + 15s;
+    // Generous limits, taken separately for discovery and for the echo: under a full parallel
+    // test run on 2 cores one echo of a 40 kB RiskMap missed a shared 15 s (CI, 2026-11-25).
+    // A passing run takes well under a second either way.
+    const auto matchDeadline = std::chrono::steady_clock::now() + 30s;
     while ((w.matchedReaders() == 0 || r.matchedWriters() == 0) &&
-           std::chrono::steady_clock::now() < deadline) {
+           std::chrono::steady_clock::now() < matchDeadline) {
       std::this_thread::sleep_for(10ms);
     }
     EXPECT_GT(w.matchedReaders(), 0u) << "peer never matched " << Traits<T>::kTopic;
     for (const auto& s : samples) {
       w.write(s);
     }
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
     std::vector<T> got;
     while (got.size() < samples.size() && std::chrono::steady_clock::now() < deadline) {
       r.waitForData(100ms);

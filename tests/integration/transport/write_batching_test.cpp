@@ -23,7 +23,7 @@ class WriteBatching : public ::testing::Test {
   static void SetUpTestSuite() {
     setenv("FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain()).c_str(), 1);
     peer_ = new test::ChildProcess(FLEET_BINARY_DIR "/tests/integration/transport/transport_echo_peer",
-                                   {"15"}, {{"FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain())}});
+                                   {"60"}, {{"FLEET_DDS_DOMAIN", std::to_string(test::uniqueDomain())}});
     participant_ = new Participant(ParticipantOptions{.writeBatching = true});
   }
   static void TearDownTestSuite() {
