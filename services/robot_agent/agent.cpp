@@ -160,6 +160,12 @@ std::vector<Vec2> Agent::mapPoints(double range) const {
         // The shared face: from a to b.
         const Vec2 a = lo + Vec2{dx > 0 ? res : 0.0, dy > 0 ? res : 0.0};
         const Vec2 b = a + (dx != 0 ? Vec2{0.0, res} : Vec2{res, 0.0});
+        if ((here - a).dot(Vec2{static_cast<double>(dx), static_cast<double>(dy)}) <= 0.0) {
+          // Turned away from the robot: the far side of its own obstacle, which the robot can
+          // only reach through a face turned towards it. (Half the points: the local planner's
+          // cost grows with them.)
+          continue;
+        }
         for (int k = 0; k <= perEdge; ++k) {
           const Vec2 q = a + (b - a) * (static_cast<double>(k) / perEdge);
           if (distance(q, here) < range) {
@@ -581,10 +587,14 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   Pose2 to = g.pose;
   std::vector<Pose2> head;
   std::vector<Pose2> tail;
-  // (Leaving for somewhere a couple of metres off, a station just behind, say, goes there
-  // directly; coming in, the axis counts wherever the robot replans from.)
+  // (Leaving for somewhere a couple of metres off, a station just behind, say, or for a goal
+  // behind the station's front, goes there directly: the axis would be a U-turn. Coming in, the
+  // axis counts wherever the robot replans from.)
   const bool shortMove = distance(here.position(), g.pose.position()) < 2.0 * kAxisDistance;
-  if (!shortMove && standsAt_ && distance(here.position(), standsAt_->position()) < 0.3) {
+  const bool ahead =
+      standsAt_ && (g.pose.position() - standsAt_->position())
+                           .dot(Vec2{std::cos(standsAt_->theta), std::sin(standsAt_->theta)}) > 0.0;
+  if (!shortMove && ahead && distance(here.position(), standsAt_->position()) < 0.3) {
     if (const auto e = axisPoint(*standsAt_, around)) {
       from = {e->x, e->y, standsAt_->theta};
       head = {here};

@@ -3,7 +3,9 @@
 // per-cycle p50/p99 as counters; (2) the circle swap (N robots of radius 0.4 m to their
 // antipodes) run in the same process with the stack's planner and with the VO baseline, reporting
 // success, overlaps and compute per agent-step side by side (ratio counter); (3) every planner on
-// every harness scenario (BM_Harness: the comparison table).
+// every harness scenario (BM_Harness: the comparison table); (4) the arc clearance of a DWA rollout
+// against 300 obstacle points, the library's sector test by cross products against the atan2 one it
+// replaced (BM_ArcClearance/0 and /1, same run: compare them as a ratio).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -14,10 +16,12 @@
 #include <string>
 #include <vector>
 
+#include "fleet/avoidance/clearance.hpp"
 #include "fleet/avoidance/dynamic_window.hpp"
 #include "fleet/avoidance/harness.hpp"
 #include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
+#include "fleet/core/angles.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
 
 namespace {
@@ -209,6 +213,74 @@ BENCHMARK(BM_Harness)
     ->ArgsProduct({benchmark::CreateDenseRange(0, 9, 1), {0, 1, 2, 3}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
+
+// The arc clearance as it was before 2026-11-25: whether a point lies within the swept sector by
+// the atan2 of its angle from the start (kept here as the reference of the benchmark).
+double arcClearanceAtan2(const Pose2& start, Twist t, double duration, std::span<const Vec2> pts,
+                         double radius, double cap) {
+  double best = cap + radius;
+  const Vec2 a = start.position();
+  const Vec2 h = start.heading();
+  if (std::abs(t.omega) < 1e-6) {
+    const Vec2 end = a + h * (t.v * duration);
+    for (const Vec2& p : pts) {
+      const Vec2 ab = end - a;
+      const double l2 = ab.squaredNorm();
+      const double s = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+      best = std::min(best, fastDistance(a + ab * s, p));
+    }
+    return std::min(best - radius, cap);
+  }
+  const double Rs = t.v / t.omega;
+  const Vec2 c = a + h.perp() * Rs;
+  const double R = std::abs(Rs);
+  const Vec2 r0 = a - c;
+  const double sweep = std::abs(t.omega) * duration;
+  const double sgn = t.omega > 0.0 ? 1.0 : -1.0;
+  const double ang = t.omega * duration;
+  const Vec2 end =
+      c + Vec2{r0.x * std::cos(ang) - r0.y * std::sin(ang), r0.x * std::sin(ang) + r0.y * std::cos(ang)};
+  for (const Vec2& p : pts) {
+    const Vec2 rp = p - c;
+    const double dist_c = std::sqrt(rp.squaredNorm());
+    const double far = std::abs(dist_c - R);
+    if (far >= best)
+      continue;  // (the library skips such points the same way, by squared distances)
+    double delta = sgn * std::atan2(r0.cross(rp), r0.dot(rp));
+    if (delta < 0.0)
+      delta += 2.0 * kPi;
+    const double d =
+        sweep >= 2.0 * kPi || delta <= sweep ? far : std::min(fastDistance(a, p), fastDistance(end, p));
+    best = std::min(best, d);
+  }
+  return std::min(best - radius, cap);
+}
+
+// One DWA window's rollouts (20 x 20 twists over 1.7 s) against 300 points around the robot, the
+// shape of the agent's view in an aisle (map faces within 2 m plus a scan).
+void BM_ArcClearance(benchmark::State& state) {
+  const bool reference = state.range(0) == 1;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::vector<Vec2> pts(300);
+  for (auto& p : pts) {
+    p = {u(rng), u(rng)};
+  }
+  const Pose2 start{0.0, 0.0, 0.3};
+  double sum = 0.0;
+  for (auto _ : state) {
+    for (int a = 0; a < 20; ++a) {
+      for (int b = 0; b < 20; ++b) {
+        const Twist t{0.05 * a, -1.5 + 0.15 * b + 1e-3};
+        sum += reference ? arcClearanceAtan2(start, t, 1.7, pts, 0.3, 1.0)
+                         : arcClearance(start, t, 1.7, pts, 0.3, 1.0);
+      }
+    }
+  }
+  benchmark::DoNotOptimize(sum);
+  state.SetLabel(reference ? "atan2 sector test (before)" : "cross-product sector test (library)");
+}
+BENCHMARK(BM_ArcClearance)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 BENCHMARK_MAIN();

@@ -32,6 +32,32 @@ TEST(ArcClearance, AnalyticDistanceMatchesDenseSampling) {
   }
 }
 
+TEST(ArcClearance, SweepsPastAHalfAndAFullTurnMatchDenseSampling) {
+  // The sector test by cross products has three cases (up to half a turn, more, a full turn or
+  // more); points on the circle itself and near both ends of the arc are the ones it can get wrong.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<double> turn(0.2, 2.0 * kPi + 1.0);
+  for (int trial = 0; trial < 400; ++trial) {
+    const Pose2 start{u(rng), u(rng), kPi * u(rng)};
+    const double T = 1.0;
+    const double w = (trial % 2 ? 1.0 : -1.0) * turn(rng);
+    const Twist t{(trial % 3 == 0 ? -0.4 : 0.6) * (1.0 + u(rng) * 0.5), w};
+    // On or near the arc's circle, at any angle.
+    const double R = std::abs(t.v / t.omega);
+    const Vec2 c = start.position() + start.heading().perp() * (t.v / t.omega);
+    const double phi = kPi * u(rng);
+    const double rr = R * (1.0 + 0.3 * u(rng) * (trial % 4 == 0 ? 0.0 : 1.0));
+    const Vec2 p = c + Vec2{std::cos(phi), std::sin(phi)} * rr;
+    double brute = 1e9;
+    for (int k = 0; k <= 20000; ++k) {
+      const double s = T * static_cast<double>(k) / 20000.0;
+      brute = std::min(brute, distance(DiffDriveKinematics::integrateExact(start, t, s).position(), p));
+    }
+    EXPECT_NEAR(arcPointDistance(start, t, T, p), brute, 2e-4) << trial << " sweep " << std::abs(w * T);
+  }
+}
+
 // A planner that always asks for full speed straight ahead, whatever is there.
 class Reckless final : public LocalPlanner {
  public:

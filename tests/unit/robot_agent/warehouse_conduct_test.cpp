@@ -273,3 +273,4 @@ TEST(StationQueue, ARobotLeavesADropOffThroughTheQueueInFrontOfIt) {
   const msg::Goal p5{{25.5, 16.75, -kUp}, "P-5", msg::GoalAction::Load, 2.0};
   expectDelivered(drive(robots, {{"r1", p5, 0.0}, {"r2", station("D-1"), 0.0}, {"r4", d4, 0.0}}, 2000), 3);
 }
+
