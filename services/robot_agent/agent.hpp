@@ -4,9 +4,11 @@
 // A* path on the inflated map, a path follower with the Lyapunov pose controller, a stop-and-yield
 // safety rule on what the sensors see, and task execution (goals with dwell times).
 //
-// Standoffs between robots are broken by the robot with the larger id backing off and replanning;
-// in a passage too narrow for two, it backs out along the way it came (seed 001's return path over
-// its own trail) to the last place wide enough, and replans from there (docs/algorithms.md).
+// Standoffs between robots are broken by the robot with the larger id backing off and replanning
+// (a robot driving home yields to one on an order; one right at the back of a waiting robot makes
+// room whatever the ids); in a passage too narrow for two, it backs out along the way it came (seed
+// 001's return path over its own trail) to the last place wide enough, and replans from there.
+// Stations are entered and left straight along their axis (docs/algorithms.md, sixth round).
 
 #include <cstdint>
 #include <memory>
