@@ -946,10 +946,13 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   }
   // Behind a robot that will stand there for a while (loading, charging, parked, faulted): plan
   // around it now instead of queueing (the plan blocks the cells of every standing robot).
-  if (byRobot && blockedS > 1.0 && (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 3.0)) {
+  if (byRobot && blockedS > 1.0 &&
+      (lastStandingDetourNs_ < 0 || nsToSec(nowNs - lastStandingDetourNs_) > 3.0)) {
     for (const auto& o : others_) {
       if (o.id == blocker && standing(o)) {
-        lastDetourNs_ = nowNs;
+        // (A timer of its own: sharing the one of the detour around the blocking point below,
+        // this re-plan every 3 s, the same path each time, kept that one from ever running.)
+        lastStandingDetourNs_ = nowNs;
         ++conduct_.detours;
         // The clock keeps running: when the new plan leads into the same hold, the rules below
         // (back off, detour around the point, fail) must still get their turn. Restarting it here

@@ -241,7 +241,8 @@ class Agent {
   std::optional<Pose2> approach_;
   std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
   mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
-  std::int64_t lastDetourNs_ = -1;          // when the last detour was tried
+  std::int64_t lastDetourNs_ = -1;          // when the last detour around the blocking point was tried
+  std::int64_t lastStandingDetourNs_ = -1;  // ... around a standing robot (re-planned with it blocked)
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;

@@ -274,3 +274,17 @@ TEST(StationQueue, ARobotLeavesADropOffThroughTheQueueInFrontOfIt) {
   expectDelivered(drive(robots, {{"r1", p5, 0.0}, {"r2", station("D-1"), 0.0}, {"r4", d4, 0.0}}, 2000), 3);
 }
 
+TEST(ParkingBand, AnOrderWhilePassingAboveAParkedNeighbourIsNotHeldByIt) {
+  // From a 20-robot run: r7, on its way home along the band, gets an order for P-2 right above
+  // its parked neighbour r6. Its path passes r6 with room to spare, but turning towards it, the
+  // local planner faced r6 and stopped. The re-plan around a standing robot (every 3 s, the same
+  // path each time) shared its timer with the detour around the blocking point (every 8 s), which
+  // therefore never ran: the task failed after 60 s. Ordered at several moments of the pass.
+  const std::vector<Robot> robots{{"r6", {8.0, 0.9, kUp}}, {"r7", {9.0, 0.9, kUp}}};
+  const msg::Goal errand{{7.25, 4.5, kUp}, "X", msg::GoalAction::Park, 0.0};
+  const msg::Goal p2{{9.0, 16.75, -kUp}, "P-2", msg::GoalAction::Load, 2.0};
+  for (const double at : {30.0, 30.5, 31.0, 31.5, 32.0}) {
+    SCOPED_TRACE("ordered at " + std::to_string(at) + " s");
+    expectDelivered(drive(robots, {{"r7", errand, 0.0}, {"r7", p2, at}}, 1500), 2);
+  }
+}
