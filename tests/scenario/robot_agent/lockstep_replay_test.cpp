@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -56,6 +57,14 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
     orders.write(a);
   }
   auto runOnce = [&](const std::string& tag) {
+    // The previous run's agent must be gone from discovery first: its reader, still matched,
+    // had acknowledged the orders already, so waitForAcks returned at once while the new agent
+    // had not got them yet, and the second replay diverged (a clean-clone CI run, 2026-11-25).
+    const auto gone = std::chrono::steady_clock::now() + 30s;
+    while (orders.matchedReaders() > 0 && std::chrono::steady_clock::now() < gone) {
+      std::this_thread::sleep_for(20ms);
+    }
+    EXPECT_EQ(orders.matchedReaders(), 0u) << "the previous run's agent is still matched";
     test::ChildProcess agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
                              {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--threads",
                               "2", "--local-planner", "dwa", "--no-lanes", "--log-level", "warn"},
@@ -73,7 +82,10 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
          (dir / (tag + ".jsonl.gz")).string(), "--summary", (dir / (tag + ".json")).string(),
          "--step-timeout-ms", "10000", "--log-level", "warn"},
         env);
-    return sim.wait(120s);
+    const int rc = sim.wait(120s);
+    agent.kill(SIGTERM);  // a clean exit unregisters its reader at once (SIGKILL: a lease later)
+    (void)agent.wait(20s);
+    return rc;
   };
   ASSERT_EQ(runOnce("a"), 0);
   ASSERT_EQ(runOnce("b"), 0);
