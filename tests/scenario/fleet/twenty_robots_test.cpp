@@ -124,7 +124,8 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
   // parking band could hold each other through all three (about 1 run in 10 ended 98 or 99); the
   // station axis and the rules for chains of waits (docs/algorithms.md, sixth round) ended that.
   // The retries and their reasons are printed below.
-  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump() << "\nrequeued and failed:\n" << failures(out / "fleet.db");
+  EXPECT_EQ(a["done"].get<int>(), 100) << a.dump() << "\nrequeued and failed:\n"
+                                       << failures(out / "fleet.db");
   std::cout << "requeued and failed:\n" << failures(out / "fleet.db");
   std::cout << "done " << a["done"] << " of 100 in " << end << " s simulated (" << r["wall_time_s"]
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "
