@@ -427,11 +427,22 @@ bool Agent::standing(const Other& o) {
          o.mode == msg::RobotMode::Fault || (o.mode == msg::RobotMode::Idle && !o.hasTask) || waitedLong;
 }
 
+namespace {
+// Where `p` lies against the axis through `origin` along its heading: how far along it (negative:
+// behind) and how far beside it.
+struct AxisOffset {
+  double along = 0.0;
+  double lateral = 0.0;
+};
+AxisOffset axisOffset(const Pose2& origin, Vec2 p) {
+  const Vec2 u = origin.heading();
+  const Vec2 rel = p - origin.position();
+  return {rel.dot(u), std::abs(rel.x * u.y - rel.y * u.x)};
+}
+}  // namespace
+
 bool Agent::behind(const Other& o) const {
-  const Vec2 u{std::cos(o.theta), std::sin(o.theta)};
-  const Vec2 rel = ekf_.pose().position() - o.pos;
-  const double along = rel.dot(u);
-  const double lateral = std::abs(rel.x * u.y - rel.y * u.x);
+  const auto [along, lateral] = axisOffset({o.pos.x, o.pos.y, o.theta}, ekf_.pose().position());
   return along < 0.0 && -along < 2.0 * p_.radius + 0.35 && lateral < 2.0 * p_.radius + 0.05;
 }
 
@@ -518,7 +529,7 @@ void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
 
 std::optional<Vec2> Agent::axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const {
   const Vec2 at = station.position();
-  const Vec2 u{std::cos(station.theta), std::sin(station.theta)};
+  const Vec2 u = station.heading();
   const Vec2 a = at + u * kAxisDistance;
   if (const auto c = g.cellAt(a); !c || g.blocked(*c)) {
     return std::nullopt;  // a pickup 0.75 m from its shelf: approached along the row instead
@@ -540,10 +551,7 @@ std::optional<Vec2> Agent::axisPoint(const Pose2& station, const planning::Occup
 }
 
 bool Agent::onAxis(Vec2 p, const Pose2& station) const {
-  const Vec2 u{std::cos(station.theta), std::sin(station.theta)};
-  const Vec2 rel = p - station.position();
-  const double along = rel.dot(u);
-  const double lateral = std::abs(rel.x * u.y - rel.y * u.x);
+  const auto [along, lateral] = axisOffset(station, p);
   return along > -0.1 && along < kAxisDistance + 0.3 && lateral < 0.2;
 }
 
@@ -591,12 +599,10 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   // behind the station's front, goes there directly: the axis would be a U-turn. Coming in, the
   // axis counts wherever the robot replans from.)
   const bool shortMove = distance(here.position(), g.pose.position()) < 2.0 * kAxisDistance;
-  const bool ahead =
-      standsAt_ && (g.pose.position() - standsAt_->position())
-                           .dot(Vec2{std::cos(standsAt_->theta), std::sin(standsAt_->theta)}) > 0.0;
-  if (!shortMove && ahead && distance(here.position(), standsAt_->position()) < 0.3) {
-    if (const auto e = axisPoint(*standsAt_, around)) {
-      from = {e->x, e->y, standsAt_->theta};
+  const bool ahead = axisOffset(standsAt_, g.pose.position()).along > 0.0;
+  if (!shortMove && ahead && distance(here.position(), standsAt_.position()) < 0.3) {
+    if (const auto e = axisPoint(standsAt_, around)) {
+      from = {e->x, e->y, standsAt_.theta};
       head = {here};
     }
   }

@@ -235,7 +235,7 @@ class Agent {
   [[nodiscard]] std::optional<Vec2> axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const;
   /// `p` lies on the station's straight leg already (no approach point needed).
   [[nodiscard]] bool onAxis(Vec2 p, const Pose2& station) const;
-  std::optional<Pose2> standsAt_;  // the station (or parking place) the robot last stopped on
+  Pose2 standsAt_;  // the station (or parking place) the robot last stopped on
   /// The goal's pose (facing in), still to be driven to straight from its axis point once the
   /// path there is done; empty when the path leads onto the goal itself.
   std::optional<Pose2> approach_;
