@@ -43,7 +43,8 @@ Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
                          "robot_fail_limit", "robot_hold_s", "battery_threshold", "charge_until",
-                         "charge_max_s", "nominal_speed", "clock", "metrics_file", "map"});
+                         "charge_max_s", "nominal_speed", "clock", "metrics_file", "map", "travel_cost"});
+  s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight"});
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -111,8 +112,9 @@ TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning
   };
 }
 
-Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
-                                                                     std::int64_t nowNs) {
+Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
+    const Settings& s, StationMap stations, std::int64_t nowNs,
+    std::shared_ptr<const planning::OccupancyGrid> siteMap) {
   SqliteTaskStoreOptions opts;
   opts.path = s.db;
   opts.sync = s.syncFull ? SqliteTaskStoreOptions::Sync::Full : SqliteTaskStoreOptions::Sync::Normal;
@@ -132,13 +134,17 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   dc.policy.batteryThreshold = s.batteryThreshold;
   dc.chargeUntil = s.chargeUntil;
   std::shared_ptr<planning::DistanceFieldCache> cache;
-  if (!s.mapFile.empty()) {
+  if (s.travelCost == "straight") {
+    // straight lines: no cache
+  } else if (!s.mapFile.empty()) {
     auto grid = planning::loadMovingAiMap(s.mapFile, s.mapResolution, {s.mapOriginX, s.mapOriginY});
     if (!grid) {
       return unexpected(grid.error());
     }
     cache = std::make_shared<planning::DistanceFieldCache>(
         std::make_shared<const planning::OccupancyGrid>(std::move(*grid)));
+  } else if (siteMap) {
+    cache = std::make_shared<planning::DistanceFieldCache>(std::move(siteMap));
   }
   auto travel = makeTravelModel(stations, cache, s.nominalSpeed);
   n->dispatcher_ = std::make_unique<Dispatcher>(*n->store_, std::move(stations), std::move(travel), dc);

@@ -37,6 +37,9 @@ struct Settings {
   double nominalSpeed = 1.0;  // m/s, turns distance into travel time for allocation
   std::string clock = "wall";
   std::string metricsFile;  // written every second when set (JSON)
+  /// "path": travel costs along grid distance fields on the site's map (or `mapFile`);
+  /// "straight": straight lines, as before sites (kept to measure one against the other).
+  std::string travelCost = "path";
   // Optional map: travel costs from grid distance fields instead of straight lines.
   std::string mapFile;  // MovingAI .map
   double mapResolution = 1.0;
@@ -69,8 +72,11 @@ struct Metrics {
 
 class FleetManagerNode {
  public:
-  static Expected<std::unique_ptr<FleetManagerNode>> create(const Settings& s, StationMap stations,
-                                                            std::int64_t nowNs);
+  /// `siteMap`: the site's drivable map, for travel costs along paths (a "map" file in the
+  /// settings wins; neither: straight lines).
+  static Expected<std::unique_ptr<FleetManagerNode>> create(
+      const Settings& s, StationMap stations, std::int64_t nowNs,
+      std::shared_ptr<const planning::OccupancyGrid> siteMap = nullptr);
 
   /// A batch of requests taken from the Task topic: stores new tasks in one group commit, answers
   /// each with a TaskAck, publishes the resulting events. Cancels are applied in order.

@@ -12,6 +12,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
 
@@ -19,24 +20,6 @@ using namespace fleet;
 using namespace std::chrono_literals;
 
 namespace {
-
-Expected<StationMap> loadStations(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    return unexpected("invalid", path + ": cannot open stations file");
-  }
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    return unexpected("invalid", path + ": not valid JSON: " + e.what());
-  }
-  auto m = StationMap::fromJson(doc);
-  if (!m) {
-    return unexpected("invalid", path + ": " + m.error().message);
-  }
-  return m;
-}
 
 void writeMetrics(const std::string& path, const nlohmann::json& j) {
   const std::string tmp = path + ".tmp";
@@ -48,7 +31,7 @@ void writeMetrics(const std::string& path, const nlohmann::json& j) {
 }
 
 int run(const manager::Settings& settings) {
-  auto stations = loadStations(settings.stationsFile);
+  auto stations = service::loadStationMap(settings.stationsFile);
   if (!stations) {
     spdlog::critical("{}", stations.error().message);
     return 2;
@@ -58,7 +41,12 @@ int run(const manager::Settings& settings) {
   const bool simClock = settings.clock == "sim";
   const Clock& clock = simClock ? static_cast<const Clock&>(sim) : wall;
 
-  auto created = manager::FleetManagerNode::create(settings, std::move(*stations), clock.nowNs());
+  // Travel costs follow paths on the site's map when the stations come from a site.
+  std::shared_ptr<const planning::OccupancyGrid> siteMap;
+  if (auto site = service::loadSiteFile(settings.stationsFile)) {
+    siteMap = std::make_shared<const planning::OccupancyGrid>(site->drivable());
+  }
+  auto created = manager::FleetManagerNode::create(settings, std::move(*stations), clock.nowNs(), siteMap);
   if (!created) {
     spdlog::critical("fleet manager: cannot open task store {}: {}", settings.db, created.error().message);
     return 2;
@@ -168,7 +156,8 @@ int main(int argc, char** argv) {
   std::string stations;
   app.add_option("-c,--config", configPath, "JSON configuration file");
   app.add_option("--db", db, "SQLite task database (overrides the config)");
-  app.add_option("--stations", stations, "stations JSON file (overrides the config)");
+  app.add_option("--stations", stations,
+                 "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
   CLI11_PARSE(app, argc, argv);
   try {

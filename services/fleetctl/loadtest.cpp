@@ -23,6 +23,7 @@
 
 #include "fault_plan.hpp"
 #include "fleet/core/config.hpp"
+#include "fleet/service/site_stations.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
 #include "supervisor.hpp"
@@ -413,6 +414,7 @@ int Run::run() {
     scenario["duration_s"] = o.durationS;
     // Its task list, checked here so that every problem is reported before anything starts.
     try {
+      scenario = resolveScenarioSite(std::move(scenario), o.scenario);
       if (auto list = parseScenarioTasks(scenario, o.scenario)) {
         listTasks = std::move(*list);
         fromList = !o.generateTasks;
@@ -429,20 +431,39 @@ int Run::run() {
       std::cerr << "fleetctl loadtest: " << o.templ << ": cannot read the scenario template\n";
       return 2;
     }
+    // A generated scenario carries its own map and stations; the template gives the rest, and its
+    // site the robot description.
+    if (t->contains("site")) {
+      try {
+        *t = inlineSiteRobot(*t, o.templ);
+      } catch (const ConfigError& e) {
+        std::cerr << "fleetctl loadtest: " << e.what() << "\n";
+        return 2;
+      }
+    }
     auto g = generateScenario(*t, {o.robots, o.humans, o.durationS, o.seed});
     if (!g) {
       std::cerr << "fleetctl loadtest: " << g.error().message << "\n";
       return 2;
     }
-    scenario = *g;
+    // Its map and stations become the run's site, so every service reads a site as in production.
+    auto [site, rest] = splitSite(*g);
+    writeFile(out / "site.json", site.dump(1));
+    rest["site"] = fs::absolute(out / "site.json").string();
+    scenario = resolveScenarioSite(rest, (out / "scenario.json").string());
   }
   // A relative map file stays relative to the original scenario's folder.
-  if (!o.scenario.empty() && scenario["map"].contains("file")) {
+  if (!o.scenario.empty() && scenario.contains("map") && scenario["map"].is_object() &&
+      scenario["map"].contains("file")) {
     scenario["map"]["file"] =
         (fs::absolute(o.scenario).parent_path() / scenario["map"]["file"].get<std::string>()).string();
   }
-  writeFile(scenarioPath, scenario.dump(1));
-  for (const auto& s : scenario.value("stations", json::array())) {
+  {
+    json forRun = scenario;
+    forRun.erase("site_stations");  // fleetctl's own copy of the site's stations
+    writeFile(scenarioPath, forRun.dump(1));
+  }
+  for (const auto& s : scenarioStations(scenario)) {
     if (s.value("kind", "") == "pickup") {
       pickups.push_back(s["name"]);
     } else if (s.value("kind", "") == "dropoff") {
@@ -485,6 +506,15 @@ int Run::run() {
     env.emplace_back("CYCLONEDDS_URI", "file://" + fs::absolute(out / "cyclonedds.xml").string());
   }
   auto [wM, hM] = mapExtent(scenario);
+  if (scenario.contains("site")) {
+    auto site = service::loadSiteFile(scenario["site"].get<std::string>());
+    if (!site) {
+      std::cerr << "fleetctl loadtest: " << site.error().message << "\n";
+      return 2;
+    }
+    wM = site->map.width() * site->map.resolution();
+    hM = site->map.height() * site->map.resolution();
+  }
   if (wM <= 0) {
     wM = 100;
     hM = 50;
@@ -500,6 +530,7 @@ int Run::run() {
                                        {"clock", "sim"},
                                        {"lease_s", 3.0},
                                        {"station_capacity", o.stationCapacity},
+                                       {"travel_cost", o.travelCost},
                                        {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
                                       .dump(1));
   writeFile(out / "risk_map.json", json{{"grid",

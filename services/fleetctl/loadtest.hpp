@@ -37,6 +37,7 @@ struct LoadtestOptions {
   std::string agentConfig;              // robot agents' --config (a JSON file; empty: none)
   bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
   int stationCapacity = 2;              // the fleet manager's station_capacity (0: no limit)
+  std::string travelCost = "path";      // the fleet manager's travel_cost (path | straight)
   double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)
   int stepTimeoutMs = 300;
   /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents

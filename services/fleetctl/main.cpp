@@ -16,6 +16,7 @@
 #include <iostream>
 
 #include "loadtest.hpp"
+#include "site_check.hpp"
 #include "task_file.hpp"
 
 using nlohmann::json;
@@ -133,6 +134,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   loadtest
+      ->add_option("--travel-cost", lt.travelCost,
+                   "fleet manager's travel costs: along paths or straight lines")
+      ->check(CLI::IsMember({"path", "straight"}))
+      ->capture_default_str();
+  loadtest
       ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")
       ->capture_default_str();
   loadtest->add_option("--duration", lt.durationS, "simulated seconds")
@@ -174,7 +180,26 @@ int main(int argc, char** argv) {
   loadtest->add_flag("--wall-clock", lt.wallClock,
                      "run every service on the wall clock at 1x, as in production (default: lockstep); "
                      "reports the robot agents' achieved control rate");
+  auto* site = app.add_subcommand("site", "site files");
+  auto* siteCheck = site->add_subcommand("check", "validate a site or map file and print what it holds");
+  std::string siteFile;
+  double siteRadius = 0.0;
+  double mapResolution = 1.0;
+  bool siteJson = false;
+  siteCheck
+      ->add_option("file", siteFile, "site.json, a scenario naming a site, MovingAI .map or ROS map .yaml")
+      ->required();
+  siteCheck->add_option("--radius", siteRadius, "robot radius in m (default: the site's robot)")
+      ->check(CLI::Range(0.0, 10.0));
+  siteCheck->add_option("--resolution", mapResolution, "m per cell of a MovingAI .map")
+      ->check(CLI::Range(1e-3, 100.0))
+      ->capture_default_str();
+  siteCheck->add_flag("--json", siteJson, "print the report as JSON");
+  site->require_subcommand(1);
   CLI11_PARSE(app, argc, argv);
+  if (*siteCheck) {
+    return fleet::ctl::siteCheck(siteFile, siteRadius, mapResolution, siteJson);
+  }
   if (*loadtest) {
     lt.generateTasks = lt.generateTasks || rateOpt->count() > 0 || tasksOpt->count() > 0;
     return fleet::ctl::runLoadtest(lt);

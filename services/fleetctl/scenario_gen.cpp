@@ -45,6 +45,8 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
 
   nlohmann::json s = templ;
   s.erase("tasks");  // the template's task list names the template's stations
+  // The generated map and stations replace the template's site (inlineSiteRobot() keeps its robot).
+  s.erase("site");
   s["name"] = "loadtest-" + std::to_string(size.robots) + "r-" + std::to_string(size.humans) + "h";
   s["seed"] = size.seed;
   s["duration_s"] = size.durationS;

@@ -1,6 +1,8 @@
 #include "scenario_tasks.hpp"
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -25,6 +27,82 @@ std::string nameList(const std::vector<std::string>& names) {
 
 }  // namespace
 
+nlohmann::json resolveScenarioSite(nlohmann::json scenario, const std::string& origin) {
+  if (!scenario.is_object() || !scenario.contains("site") || !scenario["site"].is_string()) {
+    return scenario;
+  }
+  std::filesystem::path p(scenario["site"].get<std::string>());
+  if (p.is_relative()) {
+    p = std::filesystem::absolute(std::filesystem::path(origin).parent_path() / p).lexically_normal();
+  }
+  scenario["site"] = p.string();
+  std::ifstream in(p);
+  auto site = nlohmann::json::parse(in, nullptr, false);
+  if (!in || site.is_discarded() || !site.is_object()) {
+    throw ConfigError({origin + ": site: cannot read the site file " + p.string()});
+  }
+  scenario["site_stations"] = site.value("stations", nlohmann::json::array());
+  return scenario;
+}
+
+nlohmann::json inlineSiteRobot(nlohmann::json scenario, const std::string& origin) {
+  scenario = resolveScenarioSite(std::move(scenario), origin);
+  if (!scenario.contains("site")) {
+    return scenario;
+  }
+  std::ifstream in(scenario["site"].get<std::string>());
+  const auto site = nlohmann::json::parse(in, nullptr, false);
+  auto& defaults = scenario["robot_defaults"];
+  if (!defaults.is_object()) {
+    defaults = nlohmann::json::object();
+  }
+  const auto robot = site.value("robot", nlohmann::json::object());
+  for (const auto& [k, v] : robot.items()) {
+    if (!defaults.contains(k)) {
+      defaults[k] = v;
+    } else if (v.is_object() && defaults[k].is_object()) {
+      for (const auto& [kk, vv] : v.items()) {
+        if (!defaults[k].contains(kk)) {
+          defaults[k][kk] = vv;
+        }
+      }
+    }
+  }
+  scenario.erase("site");
+  scenario.erase("site_stations");
+  return scenario;
+}
+
+std::pair<nlohmann::json, nlohmann::json> splitSite(nlohmann::json scenario) {
+  nlohmann::json site = {{"format", "fleet-site/1"}, {"name", scenario.value("name", "generated")}};
+  for (const char* k : {"map", "stations", "landmarks"}) {
+    if (scenario.contains(k)) {
+      site[k] = scenario[k];
+      scenario.erase(k);
+    }
+  }
+  if (scenario.contains("robot_defaults") && scenario["robot_defaults"].is_object()) {
+    auto& d = scenario["robot_defaults"];
+    for (const char* k : {"radius", "wheel_base", "limits"}) {
+      if (d.contains(k)) {
+        site["robot"][k] = d[k];
+        d.erase(k);
+      }
+    }
+  }
+  return {site, scenario};
+}
+
+const nlohmann::json& scenarioStations(const nlohmann::json& scenario) {
+  static const nlohmann::json none = nlohmann::json::array();
+  for (const char* k : {"site_stations", "stations"}) {
+    if (scenario.is_object() && scenario.contains(k) && scenario[k].is_array()) {
+      return scenario[k];
+    }
+  }
+  return none;
+}
+
 std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json& scenario,
                                                             const std::string& origin) {
   if (!scenario.is_object() || !scenario.contains("tasks")) {
@@ -33,8 +111,11 @@ std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json
   // Station names and kinds; the stations themselves are the simulator's to check.
   std::map<std::string, std::string> kindOf;
   std::map<std::string, std::vector<std::string>> byKind;
-  if (scenario.contains("stations") && scenario["stations"].is_array()) {
-    for (const auto& s : scenario["stations"]) {
+  {
+    const auto withSite = scenario.contains("site") && !scenario.contains("site_stations")
+                              ? resolveScenarioSite(scenario, origin)
+                              : scenario;
+    for (const auto& s : scenarioStations(withSite)) {
       if (s.is_object() && s.contains("name") && s["name"].is_string() && s.contains("kind") &&
           s["kind"].is_string()) {
         const std::string name = s["name"];

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fleet::ctl {
@@ -26,8 +27,26 @@ struct ScenarioTask {
 inline constexpr std::int64_t kMinTaskPriority = -1000;
 inline constexpr std::int64_t kMaxTaskPriority = 1000;
 
-/// Reads and checks the scenario document's `tasks` list against its `stations`. No `tasks` key:
-/// std::nullopt. Throws ConfigError listing every problem, each with `origin` and the key path
+/// The scenario with its site inlined for fleetctl's own reading: a relative "site" path made
+/// absolute against `origin`'s folder (the run's copy of the scenario lives elsewhere), and the
+/// site's stations copied under "site_stations". A scenario without "site" is returned as it is.
+/// Throws ConfigError when the site file cannot be read.
+nlohmann::json resolveScenarioSite(nlohmann::json scenario, const std::string& origin);
+
+/// A scenario template for generateScenario(): "site" dropped, the site's robot description
+/// (radius, wheel base, limits, sensors) merged under "robot_defaults" where the template does
+/// not set it. Throws ConfigError when the site file cannot be read.
+nlohmann::json inlineSiteRobot(nlohmann::json scenario, const std::string& origin);
+
+/// A scenario that carries its map, stations and landmarks inline split into a site.json document
+/// (with the robot description from "robot_defaults") and the rest of the scenario.
+std::pair<nlohmann::json, nlohmann::json> splitSite(nlohmann::json scenario);
+
+/// The scenario's stations: the site's (after resolveScenarioSite) or its inline "stations".
+const nlohmann::json& scenarioStations(const nlohmann::json& scenario);
+
+/// Reads and checks the scenario document's `tasks` list against its stations (scenarioStations). No `tasks`
+/// key: std::nullopt. Throws ConfigError listing every problem, each with `origin` and the key path
 /// (`small_warehouse.json: tasks[3].pickup: unknown station 'P-9'`). The result is in list order.
 std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json& scenario,
                                                             const std::string& origin);

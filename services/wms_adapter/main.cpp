@@ -10,6 +10,7 @@
 #include "dds_gateway.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/site_stations.hpp"
 #include "http_api.hpp"
 
 using namespace fleet;
@@ -21,7 +22,8 @@ int main(int argc, char** argv) {
   std::string stationsPath;
   int port = -1;
   app.add_option("-c,--config", configPath, "JSON configuration file");
-  app.add_option("--stations", stationsPath, "stations JSON file (overrides the config)");
+  app.add_option("--stations", stationsPath,
+                 "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   app.add_option("--port", port, "HTTP port (overrides the config; 0 = any free port)");
   app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
   CLI11_PARSE(app, argc, argv);
@@ -38,13 +40,9 @@ int main(int argc, char** argv) {
       stationsPath = cfg.requireString("stations");
     }
     cfg.finish();
-    std::ifstream in(stationsPath);
-    if (!in) {
-      throw ConfigError({stationsPath + ": cannot open stations file"});
-    }
-    auto stations = StationMap::fromJson(nlohmann::json::parse(in, nullptr, false));
+    auto stations = service::loadStationMap(stationsPath);
     if (!stations) {
-      throw ConfigError({stationsPath + ": " + stations.error().message});
+      throw ConfigError({stations.error().message});
     }
     service::installStopHandlers();
     transport::Participant participant;

@@ -10,22 +10,9 @@
 #include "fleet/core/angles.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/planning/map_io.hpp"
+#include "fleet/site/site_loader.hpp"
 
 namespace fleet::sim {
-
-const char* toString(StationKind k) {
-  switch (k) {
-    case StationKind::Pickup:
-      return "pickup";
-    case StationKind::Dropoff:
-      return "dropoff";
-    case StationKind::Charging:
-      return "charging";
-    case StationKind::Parking:
-      return "parking";
-  }
-  return "?";
-}
 
 namespace {
 
@@ -35,34 +22,7 @@ std::string fmt(double v) {
   return os.str();
 }
 
-// [x, y] or [x, y, theta]; records a problem and returns false when it is not that.
-bool readPoint(Config& c, const std::string& key, Vec2& out, bool required, double* theta = nullptr) {
-  const nlohmann::json* j = c.find(key);
-  if (j == nullptr) {
-    if (required) {
-      c.problem(key, theta ? "missing; expected [x, y, theta]" : "missing; expected [x, y]");
-    }
-    return false;
-  }
-  const std::size_t want = theta ? 3 : 2;
-  const bool shapeOk = j->is_array() && (j->size() == want || (theta && j->size() == 2));
-  bool numbers = shapeOk;
-  if (shapeOk) {
-    for (const auto& e : *j) {
-      numbers = numbers && e.is_number() && std::isfinite(e.get<double>());
-    }
-  }
-  if (!numbers) {
-    c.problem(key, std::string(theta ? "expected [x, y] or [x, y, theta] in m/rad" : "expected [x, y] in m") +
-                       ", got " + j->dump());
-    return false;
-  }
-  out = {(*j)[0].get<double>(), (*j)[1].get<double>()};
-  if (theta) {
-    *theta = j->size() == 3 ? wrapAngle((*j)[2].get<double>()) : 0.0;
-  }
-  return true;
-}
+using site::readPoint;
 
 bool readArea(Config& c, const std::string& key, const nlohmann::json& j, Area& out) {
   bool ok = j.is_array() && j.size() == 4;
@@ -103,12 +63,7 @@ void readRobotParams(Config& c, RobotSpec& r) {
   r.commandTimeout = c.number("command_timeout_s", r.commandTimeout, {0.0, 3600.0, true});
   if (c.has("limits")) {
     Config l = c.child("limits");
-    l.rejectUnknownKeys({"v_max", "v_min", "w_max", "accel_max", "alpha_max"});
-    r.limits.v_max = l.number("v_max", r.limits.v_max, {0.0, 20.0});
-    r.limits.v_min = l.number("v_min", r.limits.v_min, {-20.0, 0.0});
-    r.limits.omega_max = l.number("w_max", r.limits.omega_max, {0.0, 20.0});
-    r.limits.accel_max = l.number("accel_max", r.limits.accel_max, {0.0, 100.0, true});
-    r.limits.alpha_max = l.number("alpha_max", r.limits.alpha_max, {0.0, 100.0, true});
+    site::readLimits(l, r.limits);
   }
   if (c.has("sensors")) {
     readSensors(c.child("sensors"), r.sensors);
@@ -135,76 +90,6 @@ const std::vector<std::string> kRobotParamKeys = {
 std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
   return a;
-}
-
-GridMap readMap(Config c, const std::string& baseDir) {
-  c.rejectUnknownKeys({"file", "image", "warehouse", "rows", "resolution", "origin"});
-  const double res = c.number("resolution", 0.5, {0.0, 100.0, true});
-  Vec2 origin;
-  readPoint(c, "origin", origin, false);
-  const int sources = (c.has("file") ? 1 : 0) + (c.has("image") ? 1 : 0) + (c.has("warehouse") ? 1 : 0) +
-                      (c.has("rows") ? 1 : 0);
-  if (sources != 1) {
-    c.problem("",
-              "expected exactly one of 'file' (MovingAI .map), 'image' (side file of a PGM map), "
-              "'warehouse' (generated) or 'rows'");
-    return {};
-  }
-  auto resolve = [&](const std::string& f) {
-    std::filesystem::path p(f);
-    return (p.is_relative() ? std::filesystem::path(baseDir) / p : p).string();
-  };
-  Expected<planning::OccupancyGrid> grid = planning::OccupancyGrid{};
-  std::string key;
-  if (c.has("file")) {
-    key = "file";
-    grid = planning::loadMovingAiMap(resolve(c.string("file", "")), res, origin);
-  } else if (c.has("image")) {
-    key = "image";  // resolution and origin come from the side file
-    grid = planning::loadImageMap(resolve(c.string("image", "")));
-  } else if (c.has("warehouse")) {
-    key = "warehouse";
-    Config w = c.child("warehouse");
-    w.rejectUnknownKeys({"width", "height", "margin", "shelf_width", "shelf_height", "aisle_x", "aisle_y"});
-    planning::WarehouseParams l;
-    l.resolution = res;
-    l.origin = origin;
-    l.width = static_cast<int>(w.integer("width", 60, {3, 10000}));
-    l.height = static_cast<int>(w.integer("height", 40, {3, 10000}));
-    l.margin = static_cast<int>(w.integer("margin", 4, {1, 10000}));
-    l.shelfWidth = static_cast<int>(w.integer("shelf_width", 8, {1, 10000}));
-    l.shelfHeight = static_cast<int>(w.integer("shelf_height", 2, {1, 10000}));
-    l.aisleX = static_cast<int>(w.integer("aisle_x", 3, {1, 10000}));
-    l.aisleY = static_cast<int>(w.integer("aisle_y", 3, {1, 10000}));
-    grid = planning::makeWarehouseGrid(l);
-  } else {
-    key = "rows";
-    const nlohmann::json* rows = c.find("rows");
-    bool ok = rows->is_array() && !rows->empty();
-    std::size_t w = 0;
-    if (ok) {
-      w = (*rows)[0].is_string() ? (*rows)[0].get<std::string>().size() : 0;
-      for (const auto& r : *rows) {
-        ok = ok && r.is_string() && r.get<std::string>().size() == w;
-      }
-    }
-    if (!ok || w == 0) {
-      c.problem("rows",
-                "expected a non-empty array of equally long strings ('.' free, '@' blocked; first = top)");
-      return {};
-    }
-    std::string text =
-        "type octile\nheight " + std::to_string(rows->size()) + "\nwidth " + std::to_string(w) + "\nmap\n";
-    for (const auto& r : *rows) {
-      text += r.get<std::string>() + "\n";
-    }
-    grid = planning::parseMovingAiMap(text, c.keyPath("rows"), res, origin);
-  }
-  if (!grid) {
-    c.problem(key, grid.error().message);
-    return {};
-  }
-  return fromOccupancyGrid(*grid);
 }
 
 // 4-connected free-cell components; label 0 = blocked.
@@ -244,7 +129,7 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
   Scenario s;
   s.origin = origin;
   // "tasks" is `fleetctl loadtest`'s task list (checked there); the simulator ignores it.
-  c.rejectUnknownKeys({"name", "seed", "duration_s", "dt", "clock", "near_miss_m", "map", "stations",
+  c.rejectUnknownKeys({"name", "seed", "duration_s", "dt", "clock", "near_miss_m", "site", "map", "stations",
                        "points_of_interest", "landmarks", "robot_defaults", "robots", "robot_fleet", "humans",
                        "social_force", "prediction", "tasks"});
   s.name = c.string("name", "scenario");
@@ -253,19 +138,57 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
   s.dt = c.number("dt", s.dt, {0.0, 10.0, true});
   s.clock = c.string("clock", s.clock, {"wall", "lockstep"});
   s.nearMiss = c.number("near_miss_m", s.nearMiss, {0.0, 100.0});
-  s.map = readMap(c.child("map", true), baseDir);
+  RobotSpec defaults;
+  std::map<std::string, std::size_t> stationIndex;
+  if (c.has("site")) {
+    for (const char* k : {"map", "stations", "landmarks"}) {
+      if (c.has(k)) {
+        c.problem(k, "comes from the site file named by 'site'; remove it here");
+      }
+    }
+    const std::filesystem::path sp(c.string("site", ""));
+    const auto path = sp.is_relative() ? std::filesystem::path(baseDir) / sp : sp;
+    try {
+      auto st = std::make_shared<site::Site>(site::loadSite(path.string()));
+      s.sitePath = std::filesystem::absolute(path).lexically_normal().string();
+      s.map = fromOccupancyGrid(st->map);
+      for (const auto& x : st->stations) {
+        stationIndex[x.name] = s.stations.size();
+        s.stations.push_back({x.name, x.kind, x.pose});
+      }
+      for (const auto& l : st->landmarks) {
+        s.landmarks.push_back({l.id, l.position});
+      }
+      defaults.radius = st->robot.radius;
+      defaults.wheelBase = st->robot.wheelBase;
+      defaults.limits = st->robot.limits;
+      const auto& d = st->robot.sensors;
+      defaults.sensors.rays = d.rays;
+      defaults.sensors.fov = d.fov;
+      defaults.sensors.rangeMax = d.rangeMax;
+      defaults.sensors.rateHz = d.rateHz;
+      defaults.sensors.compass = d.compass;
+      defaults.sensors.landmarks = d.landmarks;
+      defaults.sensors.landmarkRange = d.landmarkRange;
+      defaults.sensors.detectionRange = d.detectionRange;
+      s.site = std::move(st);
+    } catch (const ConfigError& e) {
+      for (const auto& p : e.problems()) {
+        c.problem("site", p);
+      }
+    }
+  } else {
+    s.map = fromOccupancyGrid(site::readMapSection(c.child("map", true), baseDir));
+  }
   const bool haveMap = s.map.width > 0;
 
-  std::map<std::string, std::size_t> stationIndex;
   for (auto& st : c.array("stations")) {
     st.rejectUnknownKeys({"name", "kind", "pose"});
     Station x;
     x.name = st.requireString("name");
-    const std::string kind = st.requireString("kind", {"pickup", "dropoff", "charging", "parking"});
-    x.kind = kind == "dropoff"    ? StationKind::Dropoff
-             : kind == "charging" ? StationKind::Charging
-             : kind == "parking"  ? StationKind::Parking
-                                  : StationKind::Pickup;
+    x.kind =
+        site::stationKindFromString(st.requireString("kind", {"pickup", "dropoff", "charging", "parking"}))
+            .value_or(StationKind::Pickup);
     Vec2 p;
     double th = 0;
     if (readPoint(st, "pose", p, true, &th)) {
@@ -320,7 +243,6 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
     s.landmarks.push_back(l);
   }
 
-  RobotSpec defaults;
   if (c.has("robot_defaults")) {
     Config d = c.child("robot_defaults");
     d.rejectUnknownKeys(kRobotParamKeys);
@@ -534,6 +456,28 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
     }
   }
   c.finish();
+  if (!s.site) {
+    auto st = std::make_shared<site::Site>();
+    st->name = s.name;
+    st->origin = origin;
+    st->map = planning::OccupancyGrid(s.map.width, s.map.height, s.map.resolution, s.map.origin);
+    for (std::size_t i = 0; i < s.map.cells.size(); ++i) {
+      if (s.map.cells[i] != 0) {
+        st->map.setBlocked(st->map.cellOf(i));
+      }
+    }
+    for (const auto& x : s.stations) {
+      st->stations.push_back({x.name, x.kind, x.pose, std::nullopt, false, {}});
+    }
+    for (const auto& l : s.landmarks) {
+      st->landmarks.push_back({l.id, l.position});
+    }
+    st->robot.radius = defaults.radius;
+    st->robot.wheelBase = defaults.wheelBase;
+    st->robot.limits = defaults.limits;
+    site::completeSite(*st);
+    s.site = std::move(st);
+  }
   return s;
 }
 

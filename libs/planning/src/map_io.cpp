@@ -97,9 +97,8 @@ Expected<OccupancyGrid> parseMovingAiMap(std::string_view text, const std::strin
                          "unknown header key '" + key + "' (expected type, height, width, map)");
     }
   }
-  if (!sawType) {
-    return formatError(source, 1, "missing 'type' header line");
-  }
+  // Some published maps omit 'type' (it is always octile); the page's own loader does not need it.
+  (void)sawType;
   if (height < 0 || width < 0) {
     return formatError(source, 0, "missing 'height' or 'width' header line");
   }
@@ -134,12 +133,12 @@ Expected<OccupancyGrid> parseMovingAiMap(std::string_view text, const std::strin
       switch (ch) {
         case '.':
         case 'G':
+        case 'S':  // swamp: "passable from regular terrain"
           break;
         case '@':
         case 'O':
         case 'T':
-        case 'S':
-        case 'W':
+        case 'W':  // water: "not passable from terrain", so never entered by a robot on the floor
           blocked = true;
           break;
         default:

@@ -180,6 +180,8 @@ std::map<std::string, double> storedTasks(const fs::path& db) {
 fs::path oneRobotWithTasks(const fs::path& dir, const json& tasks) {
   json s = json::parse(std::ifstream(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json"));
   s["tasks"] = tasks;
+  // The copy lives elsewhere: its site is named by absolute path.
+  s["site"] = FLEET_SOURCE_DIR "/sim/scenarios/" + s["site"].get<std::string>();
   fs::create_directories(dir);
   std::ofstream(dir / "one_robot_tasks.json") << s.dump(1);
   return dir / "one_robot_tasks.json";

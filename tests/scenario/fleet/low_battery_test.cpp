@@ -115,7 +115,9 @@ TEST(FleetCharging, LowRobotFinishesItsTaskThenChargesToTheTargetWithoutContact)
   const json header = json::parse(lines->front());
   std::vector<std::array<double, 2>> chargers;
   const json scenarioJson = json::parse(std::ifstream(scenario));
-  for (const auto& st : scenarioJson["stations"]) {
+  const json siteJson = json::parse(
+      std::ifstream(std::filesystem::path(scenario).parent_path() / scenarioJson["site"].get<std::string>()));
+  for (const auto& st : siteJson["stations"]) {
     if (st["kind"] == "charging") {
       chargers.push_back({st["pose"][0].get<double>(), st["pose"][1].get<double>()});
     }

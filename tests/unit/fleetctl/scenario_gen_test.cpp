@@ -6,13 +6,15 @@
 #include <set>
 
 #include "fleet/sim/scenario.hpp"
+#include "scenario_tasks.hpp"
 
 namespace fleet::ctl {
 namespace {
 
 nlohmann::json smallTemplate() {
-  std::ifstream in(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.json");
-  return nlohmann::json::parse(in);
+  const std::string path = std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.json";
+  std::ifstream in(path);
+  return inlineSiteRobot(nlohmann::json::parse(in), path);
 }
 
 class GeneratedScenario : public ::testing::TestWithParam<int> {};

@@ -33,6 +33,17 @@ TEST(MovingAi, ParsesAndFlipsRowsToYUp) {
   EXPECT_DOUBLE_EQ(g->origin().y, 2.0);
 }
 
+TEST(MovingAi, TypeLineIsOptionalAndTerrainFollowsTheMovingAiPage) {
+  // Some published maps start at 'height'. Swamp is passable from terrain; water is not.
+  const auto g = parseMovingAiMap("height 1\nwidth 5\nmap\n.GSWT\n", "no-type.map");
+  ASSERT_TRUE(g.has_value()) << g.error().message;
+  EXPECT_FALSE(g->blocked({0, 0}));
+  EXPECT_FALSE(g->blocked({1, 0}));
+  EXPECT_FALSE(g->blocked({2, 0}));
+  EXPECT_TRUE(g->blocked({3, 0}));
+  EXPECT_TRUE(g->blocked({4, 0}));
+}
+
 TEST(MovingAi, RoundTripThroughAFile) {
   const auto g = parseMovingAiMap(seed004MovingAi(), "seed004");
   ASSERT_TRUE(g.has_value());
@@ -57,7 +68,6 @@ TEST(MovingAi, MalformedMapsGiveClearErrors) {
        "truncated map: header says height 3 but only 2 rows"},
       {"type octile\nheight 1\nwidth 3\nmap\n...\n...\n", "bad.map:6: extra rows"},
       {"type octile\nheight -4\nwidth 3\nmap\n", "bad.map:2: height must be a positive integer"},
-      {"height 1\nwidth 3\nmap\n...\n", "missing 'type'"},
       {"type octile\nwidth 3\nmap\n...\n", "missing 'height' or 'width'"},
       {"type octile\nheight 1\nwidth 3\n", "missing 'map' line"},
       {"type octile\ncolour 3\n", "bad.map:2: unknown header key 'colour'"},

@@ -151,3 +151,75 @@ TEST(GridMap, DiscPenetrationIsExactAgainstCellBoxes) {
   // Out of the map counts as blocked.
   EXPECT_NEAR(discGridPenetration(*m, {0.2, 0.9}, 0.3), 0.1, 1e-12);
 }
+
+// A scenario that names its site loads exactly as the same scenario with the site's parts inline
+// (how every scenario looked before sites): same map, stations, landmarks and robots.
+TEST(Scenario, NamingASiteIsTheSameAsCarryingItInline) {
+  const std::filesystem::path dir = std::filesystem::path(FLEET_SOURCE_DIR) / "sim/scenarios";
+  for (const char* f :
+       {"small_warehouse.json", "one_robot.json", "large_warehouse.json", "circle_swap.json"}) {
+    SCOPED_TRACE(f);
+    const auto named = nlohmann::json::parse(std::ifstream(dir / f));
+    const auto site = nlohmann::json::parse(std::ifstream(dir / named["site"].get<std::string>()));
+    auto inlined = named;
+    inlined.erase("site");
+    for (const char* k : {"map", "stations", "landmarks"}) {
+      if (site.contains(k)) {
+        inlined[k] = site[k];
+      }
+    }
+    for (const auto& [k, v] : site["robot"].items()) {
+      if (v.is_object() && inlined["robot_defaults"].contains(k)) {
+        inlined["robot_defaults"][k].update(v);
+      } else {
+        inlined["robot_defaults"][k] = v;
+      }
+    }
+    const Scenario a = parseScenario(named, (dir / f).string(), dir.string());
+    const Scenario b = parseScenario(inlined, (dir / f).string(), dir.string());
+    EXPECT_EQ(a.map.cells, b.map.cells);
+    EXPECT_EQ(a.map.width, b.map.width);
+    EXPECT_DOUBLE_EQ(a.map.resolution, b.map.resolution);
+    ASSERT_EQ(a.stations.size(), b.stations.size());
+    for (std::size_t i = 0; i < a.stations.size(); ++i) {
+      EXPECT_EQ(a.stations[i].name, b.stations[i].name);
+      EXPECT_EQ(a.stations[i].kind, b.stations[i].kind);
+      EXPECT_EQ(a.stations[i].pose, b.stations[i].pose);
+    }
+    ASSERT_EQ(a.landmarks.size(), b.landmarks.size());
+    ASSERT_EQ(a.robots.size(), b.robots.size());
+    for (std::size_t i = 0; i < a.robots.size(); ++i) {
+      EXPECT_EQ(a.robots[i].start, b.robots[i].start);
+      EXPECT_DOUBLE_EQ(a.robots[i].radius, b.robots[i].radius);
+      EXPECT_DOUBLE_EQ(a.robots[i].limits.v_max, b.robots[i].limits.v_max);
+      EXPECT_EQ(a.robots[i].sensors.rays, b.robots[i].sensors.rays);
+      EXPECT_DOUBLE_EQ(a.robots[i].sensors.rangeSigma, b.robots[i].sensors.rangeSigma);
+    }
+    ASSERT_TRUE(a.site);
+    EXPECT_FALSE(a.sitePath.empty());
+    EXPECT_EQ(a.site->stations.size(), a.stations.size());
+    ASSERT_TRUE(b.site);  // an inline scenario gets a site made of its parts
+    EXPECT_EQ(b.site->map.cells(), a.site->map.cells());
+  }
+}
+
+TEST(Scenario, ASiteAndInlinePartsTogetherAreRefusedAndSiteProblemsAreNamed) {
+  const std::filesystem::path dir = std::filesystem::path(FLEET_SOURCE_DIR) / "sim/scenarios";
+  auto j = nlohmann::json::parse(std::ifstream(dir / "one_robot.json"));
+  j["stations"] = nlohmann::json::array();
+  try {
+    parseScenario(j, "s.json", dir.string());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(anyContains(e.problems(), "s.json: stations: comes from the site file"));
+  }
+  j.erase("stations");
+  j["site"] = "no_such.site.json";
+  try {
+    parseScenario(j, "s.json", dir.string());
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_TRUE(anyContains(e.problems(), "s.json: site: ")) << ::testing::PrintToString(e.problems());
+    EXPECT_TRUE(anyContains(e.problems(), "no_such.site.json"));
+  }
+}

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -8,11 +9,11 @@
 #include "fleet/core/config.hpp"
 #include "fleet/core/pose2.hpp"
 #include "fleet/sim/grid_map.hpp"
+#include "fleet/site/site.hpp"
 
 namespace fleet::sim {
 
-enum class StationKind { Pickup, Dropoff, Charging, Parking };
-const char* toString(StationKind k);
+using site::StationKind;  // one set of station kinds; site::toString names them
 
 struct Station {
   std::string name;
@@ -108,6 +109,11 @@ struct SocialForceParams {
 struct Scenario {
   std::string name;
   std::string origin;  // file it came from
+  /// The site the scenario runs on: the file named by "site", or one made from the scenario's own
+  /// map, stations and landmarks (older scenarios carry them inline). `map`, `stations` and
+  /// `landmarks` below are the simulator's copies of it.
+  std::shared_ptr<const site::Site> site;
+  std::string sitePath;  // absolute path of the site file; empty for an inline site
   GridMap map;
   std::vector<Station> stations;
   std::vector<Vec2> pointsOfInterest;  // human goals besides the stations

@@ -8,11 +8,12 @@
 
 namespace fleet::planning {
 
-/// MovingAI `.map` text: header `type octile`, `height H`, `width W`, `map`, then H rows of W
-/// characters. `.` and `G` are free; `@`, `O`, `T`, `S`, `W` are blocked (swamp and water are not
-/// traversable for a wheeled robot). Row 0 of the file is the TOP of the map, so file (x, row)
-/// becomes cell (x, H - 1 - row). Errors name `source`, the line and what was expected
-/// (code "map_format").
+/// MovingAI `.map` text: header `type octile` (optional: some published maps omit it), `height H`,
+/// `width W`, `map`, then H rows of W characters. As the MovingAI page says: `.`, `G` and `S`
+/// (swamp, passable from regular terrain) are free; `@`, `O`, `T` are blocked, and so is `W`
+/// (water: traversable, but not from terrain, so a robot on the floor never enters it). Row 0 of the file is
+/// the TOP of the map, so file (x, row) becomes cell (x, H - 1 - row). Errors name `source`, the line and
+/// what was expected (code "map_format").
 Expected<OccupancyGrid> parseMovingAiMap(std::string_view text, const std::string& source = "<text>",
                                          double resolution = 1.0, Vec2 origin = {});
 Expected<OccupancyGrid> loadMovingAiMap(const std::string& path, double resolution = 1.0, Vec2 origin = {});

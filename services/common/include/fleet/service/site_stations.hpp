@@ -1,0 +1,26 @@
+#pragma once
+
+#include <string>
+
+#include "fleet/core/expected.hpp"
+#include "fleet/fleet/station_map.hpp"
+#include "fleet/site/site.hpp"
+
+namespace fleet::service {
+
+/// The site a service runs on, from a site.json (or a bare .map / ROS .yaml), or from a simulator
+/// scenario that names one with "site". Errors (code "invalid") list every problem of the file,
+/// one per line, each with the file and key path.
+/// `checkGeometry` and `mapResolution` as for site::loadSiteOrMap.
+Expected<site::Site> loadSiteFile(const std::string& path, bool checkGeometry = true,
+                                  double mapResolution = 1.0);
+
+/// The stations the fleet manager and the WMS adapter check tasks against: those of the site
+/// named above, or, for older setups, of a stations file ({"stations": [...]}) or a scenario
+/// that carries its stations inline.
+Expected<StationMap> loadStationMap(const std::string& path);
+
+/// A site's stations as the fleet library holds them (one kind each).
+StationMap stationMapOf(const site::Site& s);
+
+}  // namespace fleet::service

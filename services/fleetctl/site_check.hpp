@@ -1,0 +1,12 @@
+#pragma once
+
+#include <string>
+
+namespace fleet::ctl {
+
+/// `fleetctl site check FILE`: loads a site (or a scenario naming one, a MovingAI .map, a ROS map
+/// .yaml), prints what it holds and where a robot of `radius` (the site's when <= 0) can go.
+/// Exit code: 0 fine, 2 any problem (each named by file and key path).
+int siteCheck(const std::string& file, double radius, double mapResolution, bool asJson);
+
+}  // namespace fleet::ctl
