@@ -268,3 +268,16 @@ TEST_F(Node, ChargeTaskDwellsUntilTheManagerSeesTheTargetBattery) {
   EXPECT_GT(out.assignments[0].revision, a.revision);
   EXPECT_EQ(node->dispatcher().counters().submitted, 1);
 }
+
+TEST(Settings, TravelCostIsPathByDefaultAndStraightOnRequest) {
+  auto defaults = Config::fromText(R"({"stations": "s.json"})", "manager.json");
+  EXPECT_EQ(manager::readSettings(defaults).travelCost, "path");
+  auto straight = Config::fromText(R"({"stations": "s.json", "travel_cost": "straight"})", "manager.json");
+  EXPECT_EQ(manager::readSettings(straight).travelCost, "straight");
+  auto bad =
+      Config::fromText(R"({"stations": "s.json", "travel_cost": "as the crow flies"})", "manager.json");
+  manager::readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.problems()[0].find("manager.json: travel_cost: expected one of"), std::string::npos)
+      << bad.problems()[0];
+}
