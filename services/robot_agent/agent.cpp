@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "axis_offset.hpp"
 #include "fleet/avoidance/rotation_shim.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/angles.hpp"
@@ -12,6 +13,7 @@
 #include "fleet/planning/ompl_planner.hpp"
 #include "fleet/planning/return_path.hpp"
 #include "fleet/planning/wavefront.hpp"
+#include "map_faces.hpp"
 #include "risk_astar.hpp"
 
 #include <stdexcept>
@@ -19,15 +21,43 @@
 namespace fleet::agent {
 namespace {
 
-estimation::PoseEkf makeEkf(const AgentParams& p) {
-  estimation::EkfParams ep;
-  ep.wheel_base = p.wheelBase;
-  ep.compass_variance = 0.02 * 0.02;
-  ep.bearing_variance = 0.01 * 0.01;
-  Eigen::Matrix3d p0 = Eigen::Matrix3d::Zero();
-  p0.diagonal() << 0.01, 0.01, 0.001;
-  auto e = estimation::PoseEkf::create(ep, p.start, p0);
-  return std::move(*e);  // parameters are constants above: cannot fail
+LocalizerParams localizerParams(const AgentParams& p) {
+  LocalizerParams lp;
+  lp.start = p.start;
+  lp.wheelBase = p.wheelBase;
+  lp.sensorTimeoutS = p.sensorTimeoutS;
+  lp.vMax = p.vMax;
+  lp.wMax = p.wMax;
+  lp.accelMax = p.limits.accel_max;
+  lp.alphaMax = p.limits.alpha_max;
+  lp.landmarks = p.landmarks;
+  return lp;
+}
+
+SensorReading readingOf(const msg::SensorFrame& f) {
+  SensorReading r;
+  r.stampNs = f.stamp_ns;
+  r.dsLeft = f.ds_left;
+  r.dsRight = f.ds_right;
+  r.wheelTotalsValid = f.wheel_totals_valid;
+  r.wheelLeftTotal = f.wheel_left_total;
+  r.wheelRightTotal = f.wheel_right_total;
+  r.compassValid = f.compass_valid;
+  r.compass = f.compass;
+  r.bearings.reserve(f.landmarks.size());
+  for (const auto& lb : f.landmarks) {
+    r.bearings.emplace_back(lb.id, lb.bearing);
+  }
+  r.angleMin = f.angle_min;
+  r.angleIncrement = f.angle_increment;
+  r.rangeMax = f.range_max;
+  r.ranges = f.ranges;
+  r.sightings.reserve(f.detections.size());
+  for (const auto& d : f.detections) {
+    r.sightings.push_back(
+        {d.kind == msg::SourceKind::Human ? SeenKind::kHuman : SeenKind::kRobot, d.x, d.y, d.r});
+  }
+  return r;
 }
 
 constexpr double kLookahead = 0.5;
@@ -35,8 +65,27 @@ constexpr double kQueueDistance = 2.0;     // m from a station where a robot wai
 constexpr double kTrailStep = 0.25;        // m between trail points
 constexpr double kUndockDistance = 1.0;    // m the follower drives off a station before the planner
 constexpr double kAxisDistance = 1.0;      // m in front of a station: where its straight approach starts
-constexpr double kStandingWaitS = 5.0;     // s a robot waits before others plan around it (standing)
 constexpr std::size_t kTrailPoints = 120;  // 30 m of trail
+
+OtherRobot::Mode modeOf(msg::RobotMode m) {
+  switch (m) {
+    case msg::RobotMode::Idle:
+      return OtherRobot::Mode::kIdle;
+    case msg::RobotMode::Moving:
+      return OtherRobot::Mode::kMoving;
+    case msg::RobotMode::Waiting:
+      return OtherRobot::Mode::kWaiting;
+    case msg::RobotMode::Loading:
+      return OtherRobot::Mode::kLoading;
+    case msg::RobotMode::Charging:
+      return OtherRobot::Mode::kCharging;
+    case msg::RobotMode::Fault:
+      return OtherRobot::Mode::kFault;
+    case msg::RobotMode::Blocked:
+      break;
+  }
+  return OtherRobot::Mode::kBlocked;  // (and a value off the enum: none of the modes the rules look at)
+}
 
 control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
@@ -63,9 +112,12 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
     : p_(std::move(params)),
       grid_(std::move(grid)),
       raw_(std::move(raw)),
-      ekf_(makeEkf(p_)),
+      localizer_(localizerParams(p_)),
       follower_(followerParams()),
-      standsAt_(p_.start) {
+      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits}),
+      standsAt_(p_.start),
+      progress_(ProgressLimits{p_.blockedFailS, p_.blockedBackoffS}),
+      arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}) {
   if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
     throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
   }
@@ -86,7 +138,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
 }
 
 control::Twist Agent::planLocal(bool& blocked) {
-  const Pose2 pose = ekf_.pose();
+  const Pose2 pose = localizer_.pose();
   // Drop the path points already passed: keep from the one nearest to the robot.
   std::size_t nearest = 0;
   for (std::size_t i = 0; i < path_.size() && i < 40; ++i) {
@@ -95,10 +147,11 @@ control::Twist Agent::planLocal(bool& blocked) {
     }
   }
   path_.erase(path_.begin(), path_.begin() + static_cast<std::ptrdiff_t>(nearest));
-  std::vector<Vec2> scan = scanPoints(3.0);
+  const Perception& seen = localizer_.perception();
+  std::vector<Vec2> scan = seen.scanPoints(3.0);
   // The map's walls and shelves near the robot as well (a local costmap's static layer): 72 rays
   // are 26 cm apart at 3 m, and a shelf corner between two of them was not there for the planner.
-  const std::vector<Vec2> walls = mapPoints(2.0);
+  const std::vector<Vec2> walls = mapFaces(*raw_, pose.position(), 2.0);
   scan.insert(scan.end(), walls.begin(), walls.end());
   std::vector<avoidance::MovingDisc> discs;
   // Robots as they report themselves (with their velocity) and people as tracked from frame to
@@ -109,15 +162,11 @@ control::Twist Agent::planLocal(bool& blocked) {
       discs.push_back({o.pos, o.velocity, p_.radius});
     }
   }
-  for (const auto& h : people_) {
+  for (const auto& h : seen.people) {
     discs.push_back({h.pos, h.velocity, h.radius});
   }
-  if (haveFrame_) {
-    for (const auto& d : frame_.detections) {
-      discs.push_back({pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
-                       {},
-                       static_cast<double>(d.r)});
-    }
+  for (const auto& d : seen.detections) {
+    discs.push_back({d.map, {}, d.radius});
   }
   avoidance::LocalView view;
   view.robot = {pose, {v_, w_}, p_.radius};
@@ -136,214 +185,31 @@ control::Twist Agent::planLocal(bool& blocked) {
   return cmd.twist;
 }
 
-std::vector<Vec2> Agent::mapPoints(double range) const {
-  std::vector<Vec2> pts;
-  const double res = raw_->resolution();
-  const Vec2 here = ekf_.pose().position();
-  const int reach = static_cast<int>(std::ceil(range / res));
-  const Vec2 rel = (here - raw_->origin()) * (1.0 / res);
-  const int cx = static_cast<int>(std::floor(rel.x));
-  const int cy = static_cast<int>(std::floor(rel.y));
-  // Points every ~0.1 m along each face a blocked cell shares with a free one.
-  const int perEdge = std::max(1, static_cast<int>(std::ceil(res / 0.1)));
-  for (int y = cy - reach; y <= cy + reach; ++y) {
-    for (int x = cx - reach; x <= cx + reach; ++x) {
-      const planning::Cell c{x, y};
-      if (!raw_->inside(c) || !raw_->blocked(c)) {
-        continue;
-      }
-      const Vec2 lo = raw_->origin() + Vec2{x * res, y * res};
-      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-        if (raw_->blocked({x + dx, y + dy})) {
-          continue;
-        }
-        // The shared face: from a to b.
-        const Vec2 a = lo + Vec2{dx > 0 ? res : 0.0, dy > 0 ? res : 0.0};
-        const Vec2 b = a + (dx != 0 ? Vec2{0.0, res} : Vec2{res, 0.0});
-        if ((here - a).dot(Vec2{static_cast<double>(dx), static_cast<double>(dy)}) <= 0.0) {
-          // Turned away from the robot: the far side of its own obstacle, which the robot can
-          // only reach through a face turned towards it. (Half the points: the local planner's
-          // cost grows with them.)
-          continue;
-        }
-        for (int k = 0; k <= perEdge; ++k) {
-          const Vec2 q = a + (b - a) * (static_cast<double>(k) / perEdge);
-          if (distance(q, here) < range) {
-            pts.push_back(q);
-          }
-        }
-      }
-    }
-  }
-  return pts;
+GateView Agent::gateView() const {
+  return {localizer_.perception(), others_, *raw_, {v_, w_}, docking_};
 }
 
-std::vector<Vec2> Agent::scanPoints(double maxRange) const {
-  std::vector<Vec2> pts;
-  if (!haveFrame_) {
-    return pts;
-  }
-  const Pose2 pose = ekf_.pose();
-  for (std::size_t i = 0; i < frame_.ranges.size(); ++i) {
-    const double range = static_cast<double>(frame_.ranges[i]);
-    if (range < static_cast<double>(frame_.range_max) && range < maxRange) {
-      const double a = static_cast<double>(frame_.angle_min) +
-                       static_cast<double>(i) * static_cast<double>(frame_.angle_increment);
-      pts.push_back(pose.transform({range * std::cos(a), range * std::sin(a)}));
-    }
-  }
-  return pts;
+double Agent::clearSpeed(double v, Blocker& blocker) {
+  const auto c = gate_.clearSpeed(gateView(), v, blocker);
+  blockPoint_ = c.blockPoint;
+  return c.speed;
 }
 
-bool Agent::crossTrafficSafe(double& v, double& w, std::string& blocker) const {
-  const Pose2 pose = ekf_.pose();
-  std::vector<avoidance::MovingDisc> discs;
-  // Only what is ahead or beside: whoever comes from behind keeps the distance (its own stop rule
-  // does); counting it here froze whole queues, each robot held by the one closing in behind it.
-  // (Driving backwards, "ahead" is behind: a robot reversing onto its parking place backed into
-  // a person standing behind it, whom this check ignored.)
-  const Vec2 heading = Vec2{std::cos(pose.theta), std::sin(pose.theta)} * (v < 0.0 ? -1.0 : 1.0);
-  auto relevant = [&](Vec2 at) {
-    const Vec2 rel = at - pose.position();
-    return rel.norm() < 3.0 && rel.dot(heading) > -p_.radius;
-  };
-  for (const auto& o : others_) {
-    if (relevant(o.pos)) {
-      discs.push_back({o.pos, o.velocity, p_.radius});
-    }
-  }
-  for (const auto& h : people_) {
-    if (relevant(h.pos)) {
-      discs.push_back({h.pos, h.velocity, h.radius});
-    }
-  }
-  avoidance::LocalView view;
-  view.robot = {pose, {v_, w_}, p_.radius};
-  view.discs = discs;
-  view.limits = p_.limits;
-  view.dt = 0.1;
-  auto passes = [&](const avoidance::SafetyResult& r) {
-    return !r.blocked && !(r.overruled && std::abs(r.twist.v) < 0.05 && std::abs(v) > 0.1);
-  };
-  const auto r = discs.empty() ? avoidance::SafetyResult{{v, w}} : safety_.filter(view, {v, w});
-  if (passes(r)) {
-    v = r.twist.v;
-    w = r.twist.omega;
-    // Then the scan: a shelf corner beside the straight corridor of the stop rule is still in the
-    // way of a curving robot (one brushed a corner in a 100-robot run). A stop for it is static.
-    // (The map's obstacle faces too: a shelf corner between two rays is there all the same.)
-    std::vector<Vec2> scan = scanPoints(1.5);
-    const std::vector<Vec2> walls = mapPoints(1.0);
-    scan.insert(scan.end(), walls.begin(), walls.end());
-    if (scan.empty() || docking_) {
-      return true;  // (docking: the stop rule's docking gap governs the last decimetres)
-    }
-    view.scan = std::move(scan);
-    const auto s = safety_.filter(view, {v, w});
-    v = s.twist.v;
-    w = s.twist.omega;
-    if (passes(s)) {
-      return true;
-    }
-    blocker.clear();
-    return false;
-  }
-  // Name the robot in the way: the nearest one ahead.
-  double best = 1e9;
-  for (const auto& o : others_) {
-    const Vec2 rel = o.pos - pose.position();
-    const double ahead = rel.x * std::cos(pose.theta) + rel.y * std::sin(pose.theta);
-    if (ahead > 0.0 && rel.norm() < best) {
-      best = rel.norm();
-      blocker = o.id;
-    }
-  }
-  for (const auto& h : people_) {
-    if (distance(h.pos, pose.position()) < best) {
-      best = distance(h.pos, pose.position());
-      blocker = "human";
-    }
-  }
-  v = r.twist.v;
-  w = r.twist.omega;
-  return false;
+bool Agent::heldUp(double& v, double& w, Blocker& blocker) {
+  const auto h = gate_.heldUp(gateView(), v, w, blocker);
+  blockPoint_ = h.blockPoint;
+  return h.held;
+}
+
+bool Agent::rearClear() const {
+  return gate_.rearClear(gateView());
 }
 
 void Agent::onFrame(const msg::SensorFrame& f) {
-  // With the wheel totals the motion since the last frame received is exact, however many were
-  // lost in between. Without them (ds_* are increments since the previous frame sent), whatever
-  // the robot moved while none arrived is missing from the estimate: after a gap longer than the
-  // sensor timeout (the robot kept its last command that long, then braked) widen the covariance
-  // by that much, so the landmark bearings, which the Mahalanobis gate would otherwise reject as
-  // outliers, can pull the estimate back.
-  double dsLeft = f.ds_left;
-  double dsRight = f.ds_right;
-  const bool totals =
-      f.wheel_totals_valid && std::isfinite(f.wheel_left_total) && std::isfinite(f.wheel_right_total);
-  if (totals && haveTotals_) {
-    dsLeft = f.wheel_left_total - wheelLeft_;
-    dsRight = f.wheel_right_total - wheelRight_;
-  }
-  if (totals) {
-    wheelLeft_ = f.wheel_left_total;
-    wheelRight_ = f.wheel_right_total;
-  }
-  const bool motionKnown = totals && haveTotals_;
-  haveTotals_ = totals;
-  if (!motionKnown && haveFrame_ && nsToSec(f.stamp_ns - frame_.stamp_ns) > p_.sensorTimeoutS) {
-    const double t = std::min(nsToSec(f.stamp_ns - frame_.stamp_ns), p_.sensorTimeoutS);
-    const double d = p_.vMax * t + p_.vMax * p_.vMax / (2.0 * p_.limits.accel_max);
-    const double a = p_.wMax * t + p_.wMax * p_.wMax / (2.0 * p_.limits.alpha_max);
-    Eigen::Matrix3d widened = ekf_.covariance();
-    widened += Eigen::Vector3d(d * d, d * d, a * a).asDiagonal();
-    (void)ekf_.reset(ekf_.pose(), widened);
-  }
-  if (ekf_.predict(dsLeft, dsRight) != estimation::UpdateStatus::kAccepted) {
-    ++rejected_;
-  }
-  if (f.compass_valid && ekf_.updateCompass(f.compass) != estimation::UpdateStatus::kAccepted) {
-    ++rejected_;
-  }
-  for (const auto& lb : f.landmarks) {
-    for (const auto& [id, pos] : p_.landmarks) {
-      if (id == lb.id &&
-          ekf_.updateBearing(pos, static_cast<double>(lb.bearing)) != estimation::UpdateStatus::kAccepted) {
-        ++rejected_;
-      }
-    }
-  }
+  localizer_.onReading(readingOf(f));
   if (std::isfinite(f.battery)) {
     battery_ = static_cast<double>(f.battery);
   }
-  // Track people from frame to frame (nearest previous detection within 0.5 m) for a velocity.
-  std::vector<Person> seen;
-  const double dtFrame =
-      peopleStampNs_ >= 0 && f.stamp_ns > peopleStampNs_ ? nsToSec(f.stamp_ns - peopleStampNs_) : 0.0;
-  for (const auto& d : f.detections) {
-    if (d.kind != msg::SourceKind::Human || !std::isfinite(d.x) || !std::isfinite(d.y)) {
-      continue;
-    }
-    Person p{ekf_.pose().transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
-             {},
-             static_cast<double>(d.r)};
-    const Person* prev = nullptr;
-    for (const auto& q : people_) {
-      if (distance(q.pos, p.pos) < 0.5 &&
-          (prev == nullptr || distance(q.pos, p.pos) < distance(prev->pos, p.pos))) {
-        prev = &q;
-      }
-    }
-    if (prev != nullptr && dtFrame > 0.0 && dtFrame < 1.0) {
-      // Smoothed: detections jitter by a few centimetres per frame.
-      p.velocity = prev->velocity * 0.5 + ((p.pos - prev->pos) / dtFrame) * 0.5;
-    }
-    seen.push_back(p);
-  }
-  people_ = std::move(seen);
-  peopleStampNs_ = f.stamp_ns;
-  frame_ = f;
-  haveFrame_ = true;
-  frameSinceStep_ = true;
 }
 
 void Agent::onOtherRobot(const msg::RobotState& s) {
@@ -352,18 +218,18 @@ void Agent::onOtherRobot(const msg::RobotState& s) {
   }
   auto it = std::find_if(others_.begin(), others_.end(), [&](const Other& o) { return o.id == s.robot_id; });
   if (it == others_.end()) {
-    others_.push_back({s.robot_id, {}, msg::RobotMode::Idle, false, {}, 0.0, -1, 0});
+    others_.push_back({s.robot_id, {}, Other::Mode::kIdle, false, {}, 0.0, -1, 0});
     it = std::prev(others_.end());
   }
   Other& o = *it;
   if (s.mode != msg::RobotMode::Waiting) {
     o.waitingSinceNs = -1;
-  } else if (o.waitingSinceNs < 0 || o.mode != msg::RobotMode::Waiting) {
+  } else if (o.waitingSinceNs < 0 || o.mode != Other::Mode::kWaiting) {
     o.waitingSinceNs = s.stamp_ns;
   }
   o.pos = s.pose.position();
   o.theta = s.pose.theta;
-  o.mode = s.mode;
+  o.mode = modeOf(s.mode);
   o.hasTask = !s.task_id.empty();
   o.velocity = Vec2{std::cos(s.pose.theta), std::sin(s.pose.theta)} * s.v;
   o.stampNs = s.stamp_ns;
@@ -391,8 +257,7 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
   goals_ = a.goals;
   goal_ = 0;
   holdSinceNs_ = -1;
-  movedNs_ = -1;  // the progress watch starts with this order
-  closerNs_ = -1;
+  progress_.newOrder();
   reported_ = msg::TaskState::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
 }
@@ -415,43 +280,12 @@ msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
   return msg::TaskState::EnRoute;
 }
 
-bool Agent::standing(const Other& o) {
-  // A robot that has waited kStandingWaitS on end (queueing for a station, held by a person who
-  // does not step aside) will most likely stand a while longer too: plan around it rather than
-  // queue behind it. Two chains in 20-robot runs ended that way: robots queueing behind a robot
-  // that waited on a person in an aisle, and a robot leaving a drop-off station through the queue
-  // in front of it, each failing its task after 60 s.
-  const bool waitedLong = o.mode == msg::RobotMode::Waiting && o.waitingSinceNs >= 0 &&
-                          nsToSec(o.stampNs - o.waitingSinceNs) > kStandingWaitS;
-  return o.mode == msg::RobotMode::Loading || o.mode == msg::RobotMode::Charging ||
-         o.mode == msg::RobotMode::Fault || (o.mode == msg::RobotMode::Idle && !o.hasTask) || waitedLong;
-}
-
-namespace {
-// Where `p` lies against the axis through `origin` along its heading: how far along it (negative:
-// behind) and how far beside it.
-struct AxisOffset {
-  double along = 0.0;
-  double lateral = 0.0;
-};
-AxisOffset axisOffset(const Pose2& origin, Vec2 p) {
-  const Vec2 u = origin.heading();
-  const Vec2 rel = p - origin.position();
-  return {rel.dot(u), std::abs(rel.x * u.y - rel.y * u.x)};
-}
-}  // namespace
-
-bool Agent::behind(const Other& o) const {
-  const auto [along, lateral] = axisOffset({o.pos.x, o.pos.y, o.theta}, ekf_.pose().position());
-  return along < 0.0 && -along < 2.0 * p_.radius + 0.35 && lateral < 2.0 * p_.radius + 0.05;
-}
-
 planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
   planning::OccupancyGrid g = *grid_;
   const double res = g.resolution();
   // Centre-to-centre distance at contact plus room for the safety layer's slow-down zone.
   const double keep = 2.0 * p_.radius + 0.2;
-  const Vec2 self = ekf_.pose().position();
+  const Vec2 self = localizer_.pose().position();
   for (const auto& o : others_) {
     // Never wall in the goal: a robot parked on my goal is a wait, not a detour. (The robot's own
     // surroundings are opened again below.) Its neighbours (parking places 1 m apart) keep only
@@ -577,7 +411,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     // the straight line (the grid is inflated already, so the robot is a point here).
     oo.timeBudget = 0.05;
     oo.simplifyTime = 0.02;
-    oo.costThreshold = 1.2 * distance(ekf_.pose(), g.pose);
+    oo.costThreshold = 1.2 * distance(localizer_.pose(), g.pose);
     chosen = std::make_unique<planning::OmplPlanner>(oo);
   } else {
     chosen = std::make_unique<planning::AStarPlanner>();
@@ -590,7 +424,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   // robots parked next to it: two neighbours leaving together each blocked the other's way out
   // (both tasks failed after 60 s, three times over), and a robot coming home beside a parked
   // neighbour stood there for good.
-  const Pose2 here = ekf_.pose();
+  const Pose2 here = localizer_.pose();
   Pose2 from = here;
   Pose2 to = g.pose;
   std::vector<Pose2> head;
@@ -684,7 +518,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     planner_->reset();
   }
   if (fromStandstill) {
-    undockFrom_ = ekf_.pose().position();
+    undockFrom_ = localizer_.pose().position();
   }
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
@@ -714,97 +548,10 @@ void Agent::finishTask(msg::TaskState final, const std::string& reason, std::int
   }
   idleSinceNs_ = nowNs;
   holdSinceNs_ = -1;
-  movedNs_ = nowNs;
+  progress_.taskEnded(nowNs);
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;
-}
-
-double Agent::clearSpeed(double v, bool& blockedByRobot, std::string& blocker) const {
-  blockPoint_.reset();
-  if (!haveFrame_ || v <= 0.0) {
-    return v;
-  }
-  double allowed = v;
-  // Docking at a station next to a shelf or wall: the last few decimetres are driven slowly, so
-  // static points may come closer than the cruising stop gap (else the robot stalls short of it).
-  const double staticGap = docking_ ? 0.08 : p_.stopGap;
-  auto limit = [&](double gap, double keep) {
-    allowed = std::min(allowed, std::max(0.0, (gap - keep) / p_.headway));
-  };
-  for (const auto& d : frame_.detections) {
-    const double x = static_cast<double>(d.x);
-    const double y = static_cast<double>(d.y);
-    const double r = static_cast<double>(d.r);
-    if (x <= 0.0 || std::abs(y) > p_.radius + r + 0.05) {
-      continue;  // not in the corridor the robot sweeps
-    }
-    const double gap = std::hypot(x, y) - p_.radius - r;
-    const double before = allowed;
-    limit(gap, p_.stopGap);
-    if (allowed < before) {
-      blockPoint_ = ekf_.pose().transform({x, y});
-    }
-    if (allowed < before && allowed < 0.05) {
-      blockedByRobot = d.kind == msg::SourceKind::Robot;
-      blocker = blockedByRobot ? "robot" : "human";
-      if (blockedByRobot) {
-        // Name the robot: the known robot nearest to where the detection is.
-        const Vec2 at = ekf_.pose().transform({x, y});
-        double best = 1.0;
-        for (const auto& o : others_) {
-          if (distance(o.pos, at) < best) {
-            best = distance(o.pos, at);
-            blocker = o.id;
-          }
-        }
-      }
-    }
-  }
-  // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed.
-  const int n = static_cast<int>(frame_.ranges.size());
-  for (int i = 0; i < n; ++i) {
-    const double range = static_cast<double>(frame_.ranges[static_cast<std::size_t>(i)]);
-    if (!(range < static_cast<double>(frame_.range_max))) {
-      continue;
-    }
-    const double a = static_cast<double>(frame_.angle_min) + i * static_cast<double>(frame_.angle_increment);
-    const double ahead = range * std::cos(a);
-    if (ahead > 0.0 && std::abs(range * std::sin(a)) < p_.radius + 0.05) {
-      const double before = allowed;
-      limit(ahead - p_.radius, staticGap);
-      if (allowed < before) {
-        blockPoint_ = ekf_.pose().transform({ahead, range * std::sin(a)});
-      }
-    }
-  }
-  return allowed;
-}
-
-bool Agent::rearClear() const {
-  if (!haveFrame_) {
-    return false;
-  }
-  const double keep = p_.radius + 0.25;
-  for (const auto& d : frame_.detections) {
-    const double x = static_cast<double>(d.x);
-    const double y = static_cast<double>(d.y);
-    if (x < 0.0 && std::abs(y) < p_.radius + static_cast<double>(d.r) + 0.05 &&
-        -x - static_cast<double>(d.r) < keep) {
-      return false;
-    }
-  }
-  const int n = static_cast<int>(frame_.ranges.size());
-  for (int i = 0; i < n; ++i) {
-    const double range = static_cast<double>(frame_.ranges[static_cast<std::size_t>(i)]);
-    const double a = static_cast<double>(frame_.angle_min) + i * static_cast<double>(frame_.angle_increment);
-    const double ahead = range * std::cos(a);
-    if (range < static_cast<double>(frame_.range_max) && ahead < 0.0 &&
-        std::abs(range * std::sin(a)) < p_.radius + 0.05 && -ahead < keep) {
-      return false;
-    }
-  }
-  return true;
 }
 
 void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const {
@@ -828,34 +575,12 @@ void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, doubl
   }
   // Far off the carrot's bearing: turn in place first, so the robot does not sweep an arc
   // through its neighbours (robots park side by side) or into shelf ends.
-  const Vec2 toCarrot = r.target.position() - ekf_.pose().position();
-  const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
+  const Vec2 toCarrot = r.target.position() - localizer_.pose().position();
+  const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), localizer_.pose().theta);
   if (!r.final_approach && toCarrot.norm() > 0.05 && std::abs(bearing) > 0.7) {
     v = 0.0;
     w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
   }
-}
-
-bool Agent::heldUp(double& v, double& w, bool& byRobot, std::string& blocker) const {
-  const double allowed = clearSpeed(v, byRobot, blocker);
-  if (allowed < v - 1e-9) {
-    // Keep the curvature while slowing, so the robot stays on its path. Not while docking: there
-    // the turn toward the station is what frees the robot from the wall that limits its speed.
-    if (std::abs(v) > 1e-9 && !docking_) {
-      w *= allowed / v;
-    }
-    v = allowed;
-  }
-  if (v < 0.0 && !rearClear()) {
-    v = 0.0;  // the stop rule for reversing (the pose law backs onto a station it faces away from)
-  }
-  std::string crossing;
-  const bool crossOk = crossTrafficSafe(v, w, crossing);
-  if (!crossOk && allowed >= 0.05) {
-    byRobot = !crossing.empty() && crossing != "human";
-    blocker = crossing;  // empty: a static obstacle
-  }
-  return allowed < 0.05 || !crossOk;
 }
 
 double Agent::freeWidth(Vec2 p, Vec2 dir) const {
@@ -875,8 +600,8 @@ bool Agent::narrow(Vec2 p, Vec2 dir) const {
 }
 
 bool Agent::startReturn(std::int64_t nowNs) {
-  const Vec2 here = ekf_.pose().position();
-  const Vec2 heading{std::cos(ekf_.pose().theta), std::sin(ekf_.pose().theta)};
+  const Vec2 here = localizer_.pose().position();
+  const Vec2 heading{std::cos(localizer_.pose().theta), std::sin(localizer_.pose().theta)};
   if (trail_.size() < 2 || !narrow(here, heading)) {
     return false;
   }
@@ -938,73 +663,49 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   if (blockedSinceNs_ < 0) {
     blockedSinceNs_ = nowNs;
   }
-  const double blockedS = nsToSec(nowNs - blockedSinceNs_);
-  if (blockedS > 1.0 && countedStandoffNs_ != blockedSinceNs_) {
-    countedStandoffNs_ = blockedSinceNs_;
+  Standoff s;
+  s.nowNs = nowNs;
+  s.sinceNs = blockedSinceNs_;
+  s.byRobot = byRobot;
+  s.blocker = blocker;
+  s.blockPointKnown = blockPoint_.has_value();
+  s.homing = homing_;
+  s.position = localizer_.pose().position();
+  const StandoffDecision d = arbiter_.decide(s, others_);
+  if (d.newStandoff) {
     ++conduct_.standoffs;
-    for (const auto& o : others_) {
-      // Waiting on a robot that waits too: a cycle of the wait-for graph (or a chain into one).
-      // The priority rule below breaks any cycle.
-      if (byRobot && o.id == blocker && o.mode == msg::RobotMode::Waiting) {
-        ++conduct_.mutualBlocks;
-      }
-    }
   }
-  // Behind a robot that will stand there for a while (loading, charging, parked, faulted): plan
-  // around it now instead of queueing (the plan blocks the cells of every standing robot).
-  if (byRobot && blockedS > 1.0 &&
-      (lastStandingDetourNs_ < 0 || nsToSec(nowNs - lastStandingDetourNs_) > 3.0)) {
-    for (const auto& o : others_) {
-      if (o.id == blocker && standing(o)) {
-        // (A timer of its own: sharing the one of the detour around the blocking point below,
-        // this re-plan every 3 s, the same path each time, kept that one from ever running.)
-        lastStandingDetourNs_ = nowNs;
-        ++conduct_.detours;
-        // The clock keeps running: when the new plan leads into the same hold, the rules below
-        // (back off, detour around the point, fail) must still get their turn. Restarting it here
-        // kept a robot re-planning the same path every 3 s for minutes.
-        const std::int64_t since = blockedSinceNs_;
-        startGoal(nowNs);
-        blockedSinceNs_ = since;
-        return;
-      }
-    }
+  conduct_.mutualBlocks += static_cast<std::uint64_t>(d.waitCycles);
+  StandoffMove move = d.move;
+  if (move == StandoffMove::kPlanAroundStanding) {
+    ++conduct_.detours;
+    // The clock keeps running: when the new plan leads into the same hold, the rules below
+    // (back off, detour around the point, fail) must still get their turn. Restarting it here
+    // kept a robot re-planning the same path every 3 s for minutes.
+    const std::int64_t since = blockedSinceNs_;
+    startGoal(nowNs);
+    blockedSinceNs_ = since;
+    return;
   }
-  // A person who does not step aside, or two robots face to face: the one of lower priority backs
-  // off if nothing is behind, then tries another way around, rather than wait forever. Priority:
-  // a robot on an order before one driving home, then the smaller id. It is a total order, so in
-  // every wait cycle some robot waits on one of higher priority and yields.
-  bool yields = !byRobot;
-  if (byRobot && blocker != "robot") {
-    yields = p_.id > blocker;
-    for (const auto& o : others_) {
-      if (o.id == blocker && homing_ != !o.hasTask) {
-        yields = homing_;  // exactly one of the two drives home: that one yields
-      }
-      if (o.id == blocker && o.mode == msg::RobotMode::Waiting && behind(o)) {
-        // Right at the back of a robot that waits: it may be yielding itself (to a person, to a
-        // robot of higher priority) and need the room this one takes. Make it, whatever the
-        // priority; the one ahead faces away, so it does not wait on this one (no cycle).
-        yields = true;
-      }
+  if (move == StandoffMove::kYield) {
+    if (startReturn(nowNs)) {
+      v = 0.0;
+      w = 0.0;
+      return;
     }
+    if (rearClear()) {
+      phase_ = Phase::BackingOff;
+      phaseStartNs_ = nowNs;
+      backoffFrom_ = blockPoint_;
+      ++conduct_.backoffs;
+      return;
+    }
+    move = arbiter_.cannotYield(s);
   }
-  if (blockedS > p_.blockedBackoffS && yields && startReturn(nowNs)) {
-    v = 0.0;
-    w = 0.0;
-  } else if (blockedS > p_.blockedBackoffS && yields && rearClear()) {
-    phase_ = Phase::BackingOff;
-    phaseStartNs_ = nowNs;
-    backoffFrom_ = blockPoint_;
-    ++conduct_.backoffs;
-  } else if (blockedS > 2.0 * p_.blockedBackoffS && blockPoint_ &&
-             (lastDetourNs_ < 0 || nsToSec(nowNs - lastDetourNs_) > 2.0 * p_.blockedBackoffS)) {
-    // Try a way around what stands in the way, again every while: in a queue of robots nobody
-    // can back off, and the one ahead may have moved aside since the last attempt.
-    lastDetourNs_ = nowNs;
+  if (move == StandoffMove::kDetour) {
     ++conduct_.detours;
     startGoal(nowNs, blockPoint_);
-  } else if (blockedS > p_.blockedFailS) {
+  } else if (move == StandoffMove::kFail) {
     finishTask(msg::TaskState::Failed,
                "blocked by " + (blocker.empty() ? std::string("an obstacle") : blocker) + " for " +
                    std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
@@ -1015,31 +716,19 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
 }
 
 bool Agent::sensorStreamLost(std::int64_t nowNs) {
-  if (frameSinceStep_ || lastFrameNs_ < 0) {
-    // The first step starts the count: a robot that never gets a frame is reported too.
-    lastFrameNs_ = nowNs;
+  const StreamCheck c = localizer_.checkStream(nowNs);
+  if (c.change == StreamCheck::Change::kNone) {
+    return c.lost;
   }
-  const bool fresh = frameSinceStep_;
-  frameSinceStep_ = false;
-  const bool lost = !fresh && nsToSec(nowNs - lastFrameNs_) > p_.sensorTimeoutS;
-  if (lost == sensorLost_) {
-    return lost;
-  }
-  sensorLost_ = lost;
   std::string reason;
-  if (lost) {
-    lostSinceNs_ = nowNs;
-    reason = "sensor stream lost: no SensorFrame for " + std::to_string(nsToSec(nowNs - lastFrameNs_)) + " s";
+  if (c.change == StreamCheck::Change::kLost) {
+    reason = "sensor stream lost: no SensorFrame for " + std::to_string(c.silentS) + " s";
   } else {
     // The outage is not time spent blocked or without progress.
-    const std::int64_t outage = nowNs - lostSinceNs_;
     if (blockedSinceNs_ >= 0) {
-      blockedSinceNs_ += outage;
+      blockedSinceNs_ += c.outageNs;
     }
-    movedNs_ += outage;
-    if (closerNs_ >= 0) {
-      closerNs_ += outage;
-    }
+    progress_.afterSensorOutage(c.outageNs);
     if (planner_) {
       planner_->reset();
     }
@@ -1049,7 +738,7 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
         goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
     pendingStatus_ = msg::TaskStatus{p_.id, task_, revision_, reported_, progress, reason, nowNs};
   }
-  return lost;
+  return c.lost;
 }
 
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
@@ -1079,11 +768,12 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   if (pausedSinceNs_ >= 0) {
     const std::int64_t held = nowNs - pausedSinceNs_;
     pausedSinceNs_ = -1;
-    for (std::int64_t* t : {&blockedSinceNs_, &movedNs_, &phaseStartNs_, &holdSinceNs_}) {
+    for (std::int64_t* t : {&blockedSinceNs_, &phaseStartNs_, &holdSinceNs_}) {
       if (*t >= 0) {
         *t += held;
       }
     }
+    progress_.afterPause(held);
     if (planner_) {
       planner_->reset();
     }
@@ -1096,23 +786,23 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   }
   maybeReturnHome(nowNs);
   if (phase_ == Phase::Driving) {
-    auto r = follower_.step(ekf_.pose());
+    auto r = follower_.step(localizer_.pose());
     if (r && approach_ && r->final_approach && !path_.empty() &&
-        distance(ekf_.pose().position(), path_.back()) < 0.25) {
+        distance(localizer_.pose().position(), path_.back()) < 0.25) {
       // At the station's axis point: the last leg, straight in. Followed as one path, the local
       // planner cut the corner onto the axis and came in diagonally past the neighbours again.
-      path_ = {ekf_.pose().position(), approach_->position()};
+      path_ = {localizer_.pose().position(), approach_->position()};
       (void)follower_.setPath(path_, approach_->theta);
       approach_.reset();
       if (planner_) {
         planner_->reset();
       }
-      r = follower_.step(ekf_.pose());
+      r = follower_.step(localizer_.pose());
     }
     if (!r) {
       finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
-    } else if (!approach_ &&
-               (r->goal_reached || (r->final_approach && distance(ekf_.pose(), goals_[goal_].pose) < 0.15))) {
+    } else if (!approach_ && (r->goal_reached || (r->final_approach &&
+                                                  distance(localizer_.pose(), goals_[goal_].pose) < 0.15))) {
       enterDwell(nowNs);
     } else if (const Other* occupant = stationOccupant(); occupant != nullptr) {
       // Queue for the station a little way off instead of pushing into the robot on it.
@@ -1128,14 +818,12 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       // The robot on the station wants out (it reports waiting or moving: held up, most likely by
       // this queue, which stands where its way out begins). Back away up to 1 m more, so it can
       // pass; a queue robot and the occupant waiting on each other failed both tasks after 60 s.
-      const bool wantsOut =
-          occupant->mode == msg::RobotMode::Waiting || occupant->mode == msg::RobotMode::Moving;
-      if (wantsOut && distance(ekf_.pose(), goals_[goal_].pose) < kQueueDistance + 1.0 && rearClear()) {
+      const bool wantsOut = occupant->mode == Other::Mode::kWaiting || occupant->mode == Other::Mode::kMoving;
+      if (wantsOut && distance(localizer_.pose(), goals_[goal_].pose) < kQueueDistance + 1.0 && rearClear()) {
         v = -0.2;
         makingRoom_ = true;
       }
-      movedNs_ = nowNs;  // waiting in the queue is not being stuck
-      closerNs_ = nowNs;
+      progress_.queueing(nowNs);
     } else {
       holdSinceNs_ = -1;
       makingRoom_ = false;
@@ -1145,10 +833,10 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       // through the same stop rule and standoff handling below, so yielding, backing off and
       // detours work the same whichever planner drives.
       bool localBlocked = false;
-      if (undockFrom_ && distance(ekf_.pose().position(), *undockFrom_) > kUndockDistance) {
+      if (undockFrom_ && distance(localizer_.pose().position(), *undockFrom_) > kUndockDistance) {
         undockFrom_.reset();
       }
-      const bool planning = planner_ && !docking_ && !undockFrom_ && nowNs >= followUntilNs_;
+      const bool planning = planner_ && !docking_ && !undockFrom_ && !progress_.followerDrives(nowNs);
       if (planning) {
         const auto tw = planLocal(localBlocked);
         v = tw.v;
@@ -1160,37 +848,35 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         // Face the station, then drive straight onto it (see below). Always after a sampling
         // planner: it reaches the final approach off the path's last leg, from where the pose
         // law's curve onto the station's heading swept into the robots parked beside it.
-        const Vec2 to = r->target.position() - ekf_.pose().position();
-        const double b = angleDiff(std::atan2(to.y, to.x), ekf_.pose().theta);
+        const Vec2 to = r->target.position() - localizer_.pose().position();
+        const double b = angleDiff(std::atan2(to.y, to.x), localizer_.pose().theta);
         w = std::clamp(2.0 * b, -p_.wMax, p_.wMax);
         v = std::abs(b) > 0.25 ? 0.0 : std::min(0.3, to.norm());
       }
       mode = msg::RobotMode::Moving;
-      bool byRobot = false;
-      std::string blocker;
+      Blocker blocker;
       const double wanted = v;
       // A sampling planner accelerates from standstill within its dynamic window (a·dt = 0.1 m/s
       // per cycle), so any forward wish of it counts; the follower always asks for cruise.
-      bool held = heldUp(v, w, byRobot, blocker) && wanted > (planning ? 0.02 : 0.1);
+      bool held = heldUp(v, w, blocker) && wanted > (planning ? 0.02 : 0.1);
       if (!held && planning && std::abs(wanted) < 0.02 && std::abs(w) < 0.1) {
         // The planner stops the robot in front of something (every rollout ends in the stop
         // gap): as blocked as when the stop rule holds it. Counted only while the stop rule held
         // it, a homing robot facing one on an order in the wide top band alternated a second
         // "held" with seconds of the planner's standstill, its blocked clock restarted each time,
         // it never yielded, and the other's task failed after 60 s.
-        bool anyRobot = false;
-        std::string what;
-        localBlocked = clearSpeed(0.5, anyRobot, what) < 0.5;
+        Blocker any;
+        localBlocked = clearSpeed(0.5, any) < 0.5;
       }
       if (localBlocked && !held) {
         // The planner found no admissible move: name what is in the way (probing a speed it
         // would like) so the standoff rules know whom to yield to.
         held = true;
-        (void)clearSpeed(0.5, byRobot, blocker);
+        (void)clearSpeed(0.5, blocker);
       }
-      const Vec2 toCarrot = r->target.position() - ekf_.pose().position();
-      const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), ekf_.pose().theta);
-      if (held && !byRobot && blocker.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
+      const Vec2 toCarrot = r->target.position() - localizer_.pose().position();
+      const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), localizer_.pose().theta);
+      if (held && !blocker.robot && blocker.id.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
         // A wall or shelf ahead while the path bends away (a diagonal A* step into a band): turn
         // toward the carrot on the spot, which no static obstacle can stop, instead of waiting.
         // Docking too: the pose law's curve onto a station beside a wall runs through the wall, and
@@ -1202,25 +888,26 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         straightDock_ = r->final_approach;
       } else if (held) {
         mode = msg::RobotMode::Waiting;
-        onStandoff(nowNs, byRobot, blocker, v, w);
+        onStandoff(nowNs, blocker.robot, blocker.id, v, w);
       } else {
         blockedSinceNs_ = -1;
       }
-      watchPlanner(nowNs, planning && !held);
+      if (progress_.watchPlanner(nowNs, localizer_.pose().position(), planning && !held)) {
+        ++conduct_.plannerRecoveries;
+      }
     }
   } else if (phase_ == Phase::Returning) {
     mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
-    auto r = follower_.step(ekf_.pose());
-    const bool arrived =
-        !r || r->goal_reached ||
-        (r->final_approach && path_.size() > 0 && distance(ekf_.pose().position(), path_.back()) < 0.25);
-    bool byRobot = false;
-    std::string blocker;
+    auto r = follower_.step(localizer_.pose());
+    const bool arrived = !r || r->goal_reached ||
+                         (r->final_approach && path_.size() > 0 &&
+                          distance(localizer_.pose().position(), path_.back()) < 0.25);
+    Blocker blocker;
     if (!arrived) {
       docking_ = false;
       followerTwist(*r, v, w);
       const double wanted = v;
-      if (heldUp(v, w, byRobot, blocker) && wanted > 0.1) {
+      if (heldUp(v, w, blocker) && wanted > 0.1) {
         if (blockedSinceNs_ < 0) {
           blockedSinceNs_ = nowNs;
         }
@@ -1239,7 +926,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         goals_[goal_].action == msg::GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
     if (nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].duration_s) {
       ++goal_;
-      closerNs_ = -1;
+      progress_.newGoal();
       if (goal_ >= goals_.size()) {
         finishTask(msg::TaskState::Done, "", nowNs);
       } else {
@@ -1255,7 +942,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   }
   watchProgress(nowNs);
   if (phase_ == Phase::Driving) {
-    const Vec2 here = ekf_.pose().position();
+    const Vec2 here = localizer_.pose().position();
     if (trail_.empty() || distance(trail_.back(), here) > kTrailStep) {
       trail_.push_back(here);
       if (trail_.size() > kTrailPoints) {
@@ -1268,28 +955,6 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   (void)dt;
   report(out, nowNs, v, w, mode);
   return out;
-}
-
-void Agent::watchPlanner(std::int64_t nowNs, bool planning) {
-  // A sampling planner can sit in a local minimum that nothing else notices: the robot turns in
-  // place at an aisle corner, never held by the stop rule, never blocked (a 1.25 m passage turning
-  // into a corridor did that for minutes). After kStallS on one spot the follower, which tracks the
-  // path itself, drives for kRecoverS (Nav2 would run a recovery behaviour here).
-  constexpr double kStallS = 6.0;
-  constexpr double kRecoverS = 8.0;
-  const Vec2 here = ekf_.pose().position();
-  if (!planning) {
-    stallNs_ = -1;
-    return;
-  }
-  if (stallNs_ < 0 || distance(here, stallFrom_) > 0.1) {
-    stallFrom_ = here;
-    stallNs_ = nowNs;
-  } else if (nsToSec(nowNs - stallNs_) > kStallS) {
-    followUntilNs_ = nowNs + static_cast<std::int64_t>(kRecoverS * 1e9);
-    stallNs_ = -1;
-    ++conduct_.plannerRecoveries;
-  }
 }
 
 void Agent::endYield(std::int64_t nowNs) {
@@ -1307,39 +972,33 @@ void Agent::endYield(std::int64_t nowNs) {
 }
 
 void Agent::watchProgress(std::int64_t nowNs) {
-  const Vec2 here = ekf_.pose().position();
-  const bool travelling =
-      phase_ == Phase::Driving || phase_ == Phase::Returning || phase_ == Phase::BackingOff;
-  // Progress is getting closer to the goal, not moving: two robots yielding to each other by turns,
-  // or a robot backing out and trying again at an aisle mouth, move for ever and get nowhere (a
-  // 20-robot run once held two tasks en route for 600 s that way, each move resetting a "moved
-  // 0.1 m" watch).
+  ProgressSample sample;
+  sample.nowNs = nowNs;
+  sample.here = localizer_.pose().position();
+  sample.travelling = phase_ == Phase::Driving || phase_ == Phase::Returning || phase_ == Phase::BackingOff;
+  sample.returning = phase_ == Phase::Returning;
   if (goal_ < goals_.size()) {
-    const double toGoal = distance(here, goals_[goal_].pose.position());
-    if (!travelling || closerNs_ < 0 || toGoal < bestToGoal_ - 0.25) {
-      bestToGoal_ = toGoal;
-      closerNs_ = nowNs;
-    }
+    sample.goal = goals_[goal_].pose.position();
   }
-  if (!travelling || movedNs_ < 0 || distance(here, movedFrom_) > 0.1) {
-    movedFrom_ = here;
-    movedNs_ = nowNs;
-  }
-  // A last resort behind the standoff rules (whose timer restarts whenever the robot inches on):
-  // three times their limit, so a robot in a long queue is not failed for queueing.
-  const int limitS = static_cast<int>(3.0 * p_.blockedFailS);
-  if (closerNs_ >= 0 && nsToSec(nowNs - closerNs_) > 3.0 * p_.blockedFailS && (!task_.empty() || homing_)) {
-    finishTask(msg::TaskState::Failed,
-               "no progress towards " + goals_[goal_].station + " for " + std::to_string(limitS) + " s",
-               nowNs);
-  } else if (phase_ == Phase::Returning && nsToSec(nowNs - movedNs_) > 2.0 * p_.blockedBackoffS) {
-    endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
+  sample.hasOrder = !task_.empty() || homing_;
+  switch (progress_.check(sample)) {
+    case ProgressVerdict::kFailTask:
+      finishTask(msg::TaskState::Failed,
+                 "no progress towards " + goals_[goal_].station + " for " +
+                     std::to_string(progress_.failAfterS()) + " s",
+                 nowNs);
+      break;
+    case ProgressVerdict::kEndReturn:
+      endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
+      break;
+    case ProgressVerdict::kNone:
+      break;
   }
 }
 
 const Agent::Other* Agent::stationOccupant() const {
   const auto& g = goals_[goal_];
-  const Vec2 here = ekf_.pose().position();
+  const Vec2 here = localizer_.pose().position();
   const double toGoal = distance(here, g.pose.position());
   const double reach = makingRoom_ ? kQueueDistance + 1.3 : kQueueDistance;  // (hysteresis)
   if (homing_ || toGoal > reach || toGoal < kQueueDistance - 0.5) {
@@ -1362,27 +1021,27 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
   }
   // Someone waiting close by may be queueing for the station this robot stands on: leave at once.
   const bool wanted = std::any_of(others_.begin(), others_.end(), [&](const Other& o) {
-    return o.mode == msg::RobotMode::Waiting &&
-           distance(o.pos, ekf_.pose().position()) < kQueueDistance + 0.5;
+    return o.mode == Other::Mode::kWaiting &&
+           distance(o.pos, localizer_.pose().position()) < kQueueDistance + 0.5;
   });
   if (nsToSec(nowNs - idleSinceNs_) < (wanted ? std::min(1.0, p_.returnHomeS) : p_.returnHomeS) ||
-      nowNs < homeRetryNs_ || distance(ekf_.pose().position(), p_.start.position()) < 0.3) {
+      nowNs < homeRetryNs_ || distance(localizer_.pose().position(), p_.start.position()) < 0.3) {
     return;
   }
   homing_ = true;
   goals_ = {msg::Goal{p_.start, "home", msg::GoalAction::Park, 0.0}};
   goal_ = 0;
-  closerNs_ = -1;
+  progress_.newGoal();
   startGoal(nowNs);
 }
 
 void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
-  const Pose2 pose = ekf_.pose();
+  const Pose2 pose = localizer_.pose();
   out.command = {p_.id, v, w, nowNs, 0};
   out.state.robot_id = p_.id;
   out.state.stamp_ns = nowNs;
   out.state.pose = pose;
-  const auto& P = ekf_.covariance();
+  const auto& P = localizer_.covariance();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       out.state.covariance[static_cast<std::size_t>(3 * i + j)] = P(i, j);

@@ -9,6 +9,12 @@
 // room whatever the ids); in a passage too narrow for two, it backs out along the way it came (seed
 // 001's return path over its own trail) to the last place wide enough, and replans from there.
 // Stations are entered and left straight along their axis (docs/algorithms.md, sixth round).
+//
+// The agent wires parts, each in its own file with its own tests: the Localizer (pose estimate,
+// what the sensors see, sensor loss), the MotionGate (stop rule and cross-traffic check) and the
+// ProgressWatch (no progress towards the goal, a stalled local planner) and the StandoffArbiter
+// (what to do about a hold: the priority rule, yield, detour, fail). Task execution, planning and
+// carrying out the arbiter's moves (backing out along the trail, backing off) are still here.
 
 #include <cstdint>
 #include <memory>
@@ -20,11 +26,15 @@
 #include "fleet/avoidance/local_planner.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
-#include "fleet/estimation/pose_ekf.hpp"
 #include "fleet/planning/lane_map.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "fleet/transport/messages.hpp"
+#include "localizer.hpp"
+#include "motion_gate.hpp"
+#include "other_robot.hpp"
+#include "progress_watch.hpp"
 #include "risk_field.hpp"
+#include "standoff_arbiter.hpp"
 
 namespace fleet::agent {
 
@@ -95,16 +105,16 @@ class Agent {
   void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
   AgentOutput step(std::int64_t nowNs, double dt);
   /// True while the sensor stream is considered lost (as of the last step).
-  [[nodiscard]] bool sensorLost() const { return sensorLost_; }
+  [[nodiscard]] bool sensorLost() const { return localizer_.lost(); }
 
-  [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
+  [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
   [[nodiscard]] bool busy() const { return !task_.empty(); }
   /// The current order is paused by the operator: the robot stands still with it.
   [[nodiscard]] bool paused() const { return paused_ && !task_.empty(); }
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
   [[nodiscard]] bool homing() const { return homing_; }
-  [[nodiscard]] std::uint64_t framesRejected() const { return rejected_; }
+  [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
 
   /// What the robot did about being blocked (cumulative), for tests and the service's counters.
   struct Conduct {
@@ -123,8 +133,8 @@ class Agent {
   enum class Phase { Idle, Driving, Dwelling, BackingOff, Returning };
   /// The task stack for one cycle (the body of step() while sensors are live).
   AgentOutput drive(std::int64_t nowNs, double dt);
-  /// Tracks frame arrival against the step clock; on loss and on recovery queues a TaskStatus with
-  /// the reason and shifts the task's timers so the outage does not count as being blocked.
+  /// The localizer's stream watch; on loss and on recovery queues a TaskStatus with the reason and
+  /// shifts the task's timers so the outage does not count as being blocked.
   bool sensorStreamLost(std::int64_t nowNs);
   /// Command, state and predicted discs for the chosen twist and mode.
   void report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode);
@@ -136,18 +146,16 @@ class Agent {
   void finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs);
   /// At a goal: dwell there for its duration, reporting loading/unloading.
   void enterDwell(std::int64_t nowNs);
-  /// Something keeps the robot from moving: after a while back off, then detour, then fail.
+  /// Something keeps the robot from moving: does what the standoff arbiter decides (after a while
+  /// back off, then detour, then fail).
   void onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w);
   msg::TaskState taskStateFor(std::size_t goalIndex, bool dwelling) const;
-  /// Largest forward speed that keeps the stop gap to everything seen ahead, and whether a robot
-  /// (not a human) is what blocks.
-  double clearSpeed(double v, bool& blockedByRobot, std::string& blocker) const;
+  /// What the motion gate looks at this cycle.
+  [[nodiscard]] GateView gateView() const;
+  /// The gate's stop rule (see MotionGate); keeps where it found the robot blocked (blockPoint_).
+  double clearSpeed(double v, Blocker& blocker);
   /// Nothing within a short distance behind (backing off must not hit what it cannot see coming).
   [[nodiscard]] bool rearClear() const;
-  /// Scan points closer than maxRange, in the map frame (none before the first frame).
-  [[nodiscard]] std::vector<Vec2> scanPoints(double maxRange) const;
-  /// Points along the faces of the raw map's obstacles closer than `range` (map frame).
-  [[nodiscard]] std::vector<Vec2> mapPoints(double range) const;
   /// After backing off or backing out: re-plan around what blocked the robot, else plainly.
   void endYield(std::int64_t nowNs);
   /// Free width of the map across direction `dir` at `p` [m] (up to 2 x 3 m).
@@ -160,28 +168,18 @@ class Agent {
   /// The follower's command, scaled to cruise and limited (shared by driving and returning).
   void followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const;
   /// Stop rule and cross-traffic check on (v, w); true when the robot is held up.
-  bool heldUp(double& v, double& w, bool& byRobot, std::string& blocker) const;
+  bool heldUp(double& v, double& w, Blocker& blocker);
 
   AgentParams p_;
   std::shared_ptr<const planning::OccupancyGrid> grid_;
   std::shared_ptr<const planning::OccupancyGrid> raw_;
-  estimation::PoseEkf ekf_;
+  Localizer localizer_;  // pose, scan, detections, people, sensor loss
   control::PathFollower follower_;
   std::unique_ptr<avoidance::LocalPlanner> planner_;  // null: "follow"
   std::vector<Vec2> path_;                            // remaining path (world frame)
   /// One cycle of the configured avoidance planner; returns the twist and whether it is blocked.
   control::Twist planLocal(bool& blocked);
-  msg::SensorFrame frame_;
-  bool haveFrame_ = false;
-  bool haveTotals_ = false;  // the previous frame had wheel totals (SensorFrame.wheel_totals_valid)
-  double wheelLeft_ = 0.0;   // ... these
-  double wheelRight_ = 0.0;
-  bool frameSinceStep_ = false;
-  std::int64_t lastFrameNs_ = -1;  // step time at which the latest frame was seen
-  bool sensorLost_ = false;
   std::shared_ptr<const RiskField> risk_;
-  std::int64_t lostSinceNs_ = 0;
-  std::uint64_t rejected_ = 0;
 
   std::string task_;
   std::uint32_t revision_ = 0;
@@ -192,40 +190,14 @@ class Agent {
   Phase phase_ = Phase::Idle;
   std::int64_t phaseStartNs_ = 0;
   std::int64_t blockedSinceNs_ = -1;
-  std::int64_t countedStandoffNs_ = -1;  // the standoff already counted in conduct_
   std::optional<msg::TaskStatus> pendingStatus_;
   msg::TaskState reported_ = msg::TaskState::Queued;
-  struct Other {
-    std::string id;
-    Vec2 pos;
-    msg::RobotMode mode = msg::RobotMode::Idle;
-    bool hasTask = false;
-    Vec2 velocity;
-    double theta = 0.0;
-    std::int64_t waitingSinceNs = -1;  // stamp of its first state of the current wait (-1: not waiting)
-    std::int64_t stampNs = 0;          // stamp of its latest state
-  };
-  /// This robot stands right at the back of `o` (in the corridor `o` would back into).
-  [[nodiscard]] bool behind(const Other& o) const;
-  /// The follower's command through the safety layer, against the scan and the other robots
-  /// extrapolated at their reported velocities (crossings at intersections, which the stop rule's
-  /// straight-ahead corridor sees too late). Returns false when it had to stop the robot.
-  bool crossTrafficSafe(double& v, double& w, std::string& blocker) const;
-  avoidance::SafetyLayer safety_;
-  /// People seen in the latest frame (map frame) with a velocity from the frame before: a person
-  /// walking across the robot's way is outside the corridor the stop rule watches until too late.
-  struct Person {
-    Vec2 pos;
-    Vec2 velocity;
-    double radius = 0.25;
-  };
-  std::vector<Person> people_;
-  std::int64_t peopleStampNs_ = -1;
+  using Other = OtherRobot;
+  MotionGate gate_;  // stop rule and cross-traffic check
   std::vector<Other> others_;
   /// The planning grid with the robots that stand still for a while (parked, loading, charging,
   /// faulted) blocked, so a path goes around them instead of into a queue behind them.
   [[nodiscard]] planning::OccupancyGrid gridAroundStandingRobots(Vec2 goal) const;
-  static bool standing(const Other& o);
   /// The robot's disc at `p` is clear of the raw map's obstacles.
   [[nodiscard]] bool bodyFits(Vec2 p) const;
   /// Unblocks the goal's cell of `g` when the robot fits on the goal itself.
@@ -239,10 +211,8 @@ class Agent {
   /// The goal's pose (facing in), still to be driven to straight from its axis point once the
   /// path there is done; empty when the path leads onto the goal itself.
   std::optional<Pose2> approach_;
-  std::optional<Vec2> backoffFrom_;         // what blocked the robot when it started backing off
-  mutable std::optional<Vec2> blockPoint_;  // where the nearest obstacle ahead is (map frame)
-  std::int64_t lastDetourNs_ = -1;          // when the last detour around the blocking point was tried
-  std::int64_t lastStandingDetourNs_ = -1;  // ... around a standing robot (re-planned with it blocked)
+  std::optional<Vec2> backoffFrom_;  // what blocked the robot when it started backing off
+  std::optional<Vec2> blockPoint_;   // where the nearest obstacle ahead is (map frame)
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
@@ -261,20 +231,13 @@ class Agent {
   /// in place towards the path first, which from a row of parked robots is towards a neighbour,
   /// and stood there held by the stop rule.
   std::optional<Vec2> undockFrom_;
-  Vec2 stallFrom_;                   // where the local planner last moved the robot 0.1 m from
-  std::int64_t stallNs_ = -1;        // ... and when (-1: not driving with it)
-  std::int64_t followUntilNs_ = -1;  // the follower drives instead of the planner until then
-  Vec2 movedFrom_;                   // where the robot last moved 0.1 m from
-  std::int64_t movedNs_ = 0;         // ... and when
-  double bestToGoal_ = 0.0;          // the closest it has come to the current goal [m]
-  std::int64_t closerNs_ = -1;       // ... when that last improved by 0.25 m (-1: new goal)
-  /// A task whose robot has not moved for 3 x blockedFailS fails (whatever held it: a planner that
-  /// outputs nothing, a return that cannot finish); a return that has not moved for a while ends.
+  /// Whether the robot gets anywhere, and the planner's recoveries (see conduct().plannerRecoveries).
+  ProgressWatch progress_;
+  /// Acts on the progress watch: a task that comes no closer to its goal fails (whatever held it:
+  /// a planner that outputs nothing, a return that cannot finish); a return that stands still ends.
   void watchProgress(std::int64_t nowNs);
-  /// Driving with the local planner (`planning`, not held): switch to the follower for a while when
-  /// the robot has stood on one spot too long (see conduct().plannerRecoveries).
-  void watchPlanner(std::int64_t nowNs, bool planning);
   std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
+  StandoffArbiter arbiter_;  // what to do about a hold: wait, yield, detour, fail
   Conduct conduct_;
 };
 

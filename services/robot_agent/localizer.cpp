@@ -1,0 +1,156 @@
+#include "localizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fleet/core/clock.hpp"
+
+namespace fleet::agent {
+namespace {
+
+estimation::PoseEkf makeEkf(const LocalizerParams& p) {
+  estimation::EkfParams ep;
+  ep.wheel_base = p.wheelBase;
+  ep.compass_variance = 0.02 * 0.02;
+  ep.bearing_variance = 0.01 * 0.01;
+  Eigen::Matrix3d p0 = Eigen::Matrix3d::Zero();
+  p0.diagonal() << 0.01, 0.01, 0.001;
+  auto e = estimation::PoseEkf::create(ep, p.start, p0);
+  return std::move(*e);  // parameters are constants above: cannot fail
+}
+
+}  // namespace
+
+std::vector<Vec2> Perception::scanPoints(double maxRange) const {
+  std::vector<Vec2> pts;
+  for (const auto& ray : scan) {
+    if (ray.range < maxRange) {
+      pts.push_back(ray.map);
+    }
+  }
+  return pts;
+}
+
+Localizer::Localizer(LocalizerParams params) : p_(std::move(params)), ekf_(makeEkf(p_)) {
+  seen_.pose = ekf_.pose();
+}
+
+void Localizer::onReading(const SensorReading& f) {
+  // With the wheel totals the motion since the last reading received is exact, however many were
+  // lost in between. Without them (ds* are increments since the previous reading sent), whatever
+  // the robot moved while none arrived is missing from the estimate: after a gap longer than the
+  // sensor timeout (the robot kept its last command that long, then braked) widen the covariance
+  // by that much, so the landmark bearings, which the Mahalanobis gate would otherwise reject as
+  // outliers, can pull the estimate back.
+  double dsLeft = f.dsLeft;
+  double dsRight = f.dsRight;
+  const bool totals =
+      f.wheelTotalsValid && std::isfinite(f.wheelLeftTotal) && std::isfinite(f.wheelRightTotal);
+  if (totals && haveTotals_) {
+    dsLeft = f.wheelLeftTotal - wheelLeft_;
+    dsRight = f.wheelRightTotal - wheelRight_;
+  }
+  if (totals) {
+    wheelLeft_ = f.wheelLeftTotal;
+    wheelRight_ = f.wheelRightTotal;
+  }
+  const bool motionKnown = totals && haveTotals_;
+  haveTotals_ = totals;
+  if (!motionKnown && seen_.valid && nsToSec(f.stampNs - lastStampNs_) > p_.sensorTimeoutS) {
+    const double t = std::min(nsToSec(f.stampNs - lastStampNs_), p_.sensorTimeoutS);
+    const double d = p_.vMax * t + p_.vMax * p_.vMax / (2.0 * p_.accelMax);
+    const double a = p_.wMax * t + p_.wMax * p_.wMax / (2.0 * p_.alphaMax);
+    Eigen::Matrix3d widened = ekf_.covariance();
+    widened += Eigen::Vector3d(d * d, d * d, a * a).asDiagonal();
+    (void)ekf_.reset(ekf_.pose(), widened);
+  }
+  if (ekf_.predict(dsLeft, dsRight) != estimation::UpdateStatus::kAccepted) {
+    ++rejected_;
+  }
+  if (f.compassValid && ekf_.updateCompass(f.compass) != estimation::UpdateStatus::kAccepted) {
+    ++rejected_;
+  }
+  for (const auto& [seenId, bearing] : f.bearings) {
+    for (const auto& [id, pos] : p_.landmarks) {
+      if (id == seenId &&
+          ekf_.updateBearing(pos, static_cast<double>(bearing)) != estimation::UpdateStatus::kAccepted) {
+        ++rejected_;
+      }
+    }
+  }
+  track(f);
+  lastStampNs_ = f.stampNs;
+  seen_.valid = true;
+  readingSinceCheck_ = true;
+}
+
+void Localizer::track(const SensorReading& f) {
+  // Everything in the map frame as of this reading's estimate (it holds until the next reading).
+  const Pose2 pose = ekf_.pose();
+  seen_.pose = pose;
+  seen_.scan.clear();
+  for (std::size_t i = 0; i < f.ranges.size(); ++i) {
+    const double range = static_cast<double>(f.ranges[i]);
+    if (range < static_cast<double>(f.rangeMax)) {
+      const double a =
+          static_cast<double>(f.angleMin) + static_cast<double>(i) * static_cast<double>(f.angleIncrement);
+      const Vec2 local{range * std::cos(a), range * std::sin(a)};
+      seen_.scan.push_back({range, local, pose.transform(local)});
+    }
+  }
+  seen_.detections.clear();
+  for (const auto& d : f.sightings) {
+    const Vec2 local{static_cast<double>(d.x), static_cast<double>(d.y)};
+    seen_.detections.push_back({d.kind, local, static_cast<double>(d.r), pose.transform(local)});
+  }
+  // Track people from reading to reading (nearest previous detection within 0.5 m) for a velocity.
+  std::vector<Person> seen;
+  const double dtFrame =
+      peopleStampNs_ >= 0 && f.stampNs > peopleStampNs_ ? nsToSec(f.stampNs - peopleStampNs_) : 0.0;
+  for (const auto& d : f.sightings) {
+    if (d.kind != SeenKind::kHuman || !std::isfinite(d.x) || !std::isfinite(d.y)) {
+      continue;
+    }
+    Person p{
+        pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}), {}, static_cast<double>(d.r)};
+    const Person* prev = nullptr;
+    for (const auto& q : seen_.people) {
+      if (distance(q.pos, p.pos) < 0.5 &&
+          (prev == nullptr || distance(q.pos, p.pos) < distance(prev->pos, p.pos))) {
+        prev = &q;
+      }
+    }
+    if (prev != nullptr && dtFrame > 0.0 && dtFrame < 1.0) {
+      // Smoothed: detections jitter by a few centimetres per frame.
+      p.velocity = prev->velocity * 0.5 + ((p.pos - prev->pos) / dtFrame) * 0.5;
+    }
+    seen.push_back(p);
+  }
+  seen_.people = std::move(seen);
+  peopleStampNs_ = f.stampNs;
+}
+
+StreamCheck Localizer::checkStream(std::int64_t nowNs) {
+  if (readingSinceCheck_ || lastReadingNs_ < 0) {
+    lastReadingNs_ = nowNs;
+  }
+  const bool fresh = readingSinceCheck_;
+  readingSinceCheck_ = false;
+  StreamCheck c;
+  c.lost = !fresh && nsToSec(nowNs - lastReadingNs_) > p_.sensorTimeoutS;
+  if (c.lost == lost_) {
+    return c;
+  }
+  lost_ = c.lost;
+  if (c.lost) {
+    lostSinceNs_ = nowNs;
+    c.change = StreamCheck::Change::kLost;
+    c.silentS = nsToSec(nowNs - lastReadingNs_);
+  } else {
+    c.change = StreamCheck::Change::kBack;
+    c.outageNs = nowNs - lostSinceNs_;
+  }
+  return c;
+}
+
+}  // namespace fleet::agent

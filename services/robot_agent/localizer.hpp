@@ -1,0 +1,134 @@
+#pragma once
+
+// Sensor readings to what the robot knows of itself and its surroundings: the pose estimate (EKF on
+// wheel odometry, compass and landmark bearings), the scan and the detections in the map frame, the
+// people tracked from reading to reading, and whether the reading stream has been lost.
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "fleet/core/pose2.hpp"
+#include "fleet/estimation/pose_ekf.hpp"
+
+namespace fleet::agent {
+
+enum class SeenKind { kRobot, kHuman };
+
+/// One sensor reading as the robot's driver sends it (robot frame, the sensor's precision).
+struct SensorReading {
+  struct Sighting {
+    SeenKind kind = SeenKind::kRobot;
+    float x = 0;  ///< robot frame [m]
+    float y = 0;
+    float r = 0;  ///< radius [m]
+  };
+  std::int64_t stampNs = 0;
+  double dsLeft = 0;  ///< wheel travel since the previous reading sent [m]
+  double dsRight = 0;
+  bool wheelTotalsValid = false;  ///< the totals below are set (older drivers leave them out)
+  double wheelLeftTotal = 0;      ///< [m] since the driver started
+  double wheelRightTotal = 0;
+  bool compassValid = false;
+  double compass = 0;
+  std::vector<std::pair<std::int32_t, float>> bearings;  ///< landmark id, bearing [rad]
+  float angleMin = 0;  ///< the range scan: ray i at angleMin + i · angleIncrement
+  float angleIncrement = 0;
+  float rangeMax = 0;  ///< a range not below this is no return
+  std::vector<float> ranges;
+  std::vector<Sighting> sightings;
+};
+
+/// A scan ray with a return, in the robot frame and in the map frame.
+struct ScanRay {
+  double range = 0.0;
+  Vec2 local;
+  Vec2 map;
+};
+
+/// Something the sensor recognised (a robot or a person), in the robot frame and in the map frame.
+struct Detection {
+  SeenKind kind = SeenKind::kRobot;
+  Vec2 local;
+  double radius = 0.0;
+  Vec2 map;
+};
+
+/// A person seen in the latest reading (map frame) with a velocity from the reading before: a
+/// person walking across the robot's way is outside the corridor the stop rule watches until too
+/// late.
+struct Person {
+  Vec2 pos;
+  Vec2 velocity;
+  double radius = 0.25;
+};
+
+/// What the robot knows as of the latest reading.
+struct Perception {
+  bool valid = false;  ///< a reading has arrived (else the lists are empty)
+  Pose2 pose;
+  std::vector<ScanRay> scan;  ///< in the sensor's ray order
+  std::vector<Detection> detections;
+  std::vector<Person> people;
+
+  /// The scan's points closer than maxRange, in the map frame.
+  [[nodiscard]] std::vector<Vec2> scanPoints(double maxRange) const;
+};
+
+/// The stream watch's answer for one cycle.
+struct StreamCheck {
+  enum class Change { kNone, kLost, kBack };
+  bool lost = false;  ///< no reading for longer than the timeout
+  Change change = Change::kNone;
+  double silentS = 0.0;       ///< on kLost: how long no reading has come
+  std::int64_t outageNs = 0;  ///< on kBack: how long the stream was lost
+};
+
+struct LocalizerParams {
+  Pose2 start;
+  double wheelBase = 0.4;
+  double sensorTimeoutS = 0.5;  ///< no reading for this long (of the cycle clock): the stream is lost
+  /// How far the robot may have rolled unseen in a gap (its last command held, then braking).
+  double vMax = 0.8;
+  double wMax = 1.5;
+  double accelMax = 1.0;
+  double alphaMax = 3.0;
+  std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+};
+
+class Localizer {
+ public:
+  explicit Localizer(LocalizerParams params);
+
+  void onReading(const SensorReading& r);
+  /// Once per cycle, before anything uses the perception: tracks reading arrival against the
+  /// cycle clock (the first call starts the count: a robot that never gets a reading is lost too).
+  StreamCheck checkStream(std::int64_t nowNs);
+
+  [[nodiscard]] const Perception& perception() const { return seen_; }
+  [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
+  [[nodiscard]] const Eigen::Matrix3d& covariance() const { return ekf_.covariance(); }
+  [[nodiscard]] bool lost() const { return lost_; }
+  /// EKF updates refused (outliers, bad input), cumulative.
+  [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
+
+ private:
+  void track(const SensorReading& r);
+
+  LocalizerParams p_;
+  estimation::PoseEkf ekf_;
+  Perception seen_;
+  std::int64_t lastStampNs_ = 0;  // stamp of the previous reading (valid once seen_.valid)
+  bool haveTotals_ = false;       // the previous reading had wheel totals
+  double wheelLeft_ = 0.0;        // ... these
+  double wheelRight_ = 0.0;
+  std::int64_t peopleStampNs_ = -1;
+  std::uint64_t rejected_ = 0;
+
+  bool readingSinceCheck_ = false;
+  std::int64_t lastReadingNs_ = -1;  // cycle time at which the latest reading was seen
+  bool lost_ = false;
+  std::int64_t lostSinceNs_ = 0;
+};
+
+}  // namespace fleet::agent

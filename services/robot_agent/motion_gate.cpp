@@ -1,0 +1,185 @@
+#include "motion_gate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "map_faces.hpp"
+
+namespace fleet::agent {
+
+MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blocker& blocker) const {
+  Clearance c;
+  c.speed = v;
+  if (!view.seen.valid || v <= 0.0) {
+    return c;
+  }
+  double allowed = v;
+  // Docking at a station next to a shelf or wall: the last few decimetres are driven slowly, so
+  // static points may come closer than the cruising stop gap (else the robot stalls short of it).
+  const double staticGap = view.docking ? 0.08 : p_.stopGap;
+  auto limit = [&](double gap, double keep) {
+    allowed = std::min(allowed, std::max(0.0, (gap - keep) / p_.headway));
+  };
+  for (const auto& d : view.seen.detections) {
+    const double x = d.local.x;
+    const double y = d.local.y;
+    const double r = d.radius;
+    if (x <= 0.0 || std::abs(y) > p_.radius + r + 0.05) {
+      continue;  // not in the corridor the robot sweeps
+    }
+    const double gap = std::hypot(x, y) - p_.radius - r;
+    const double before = allowed;
+    limit(gap, p_.stopGap);
+    if (allowed < before) {
+      c.blockPoint = d.map;
+    }
+    if (allowed < before && allowed < 0.05) {
+      blocker.robot = d.kind == SeenKind::kRobot;
+      blocker.id = blocker.robot ? "robot" : "human";
+      if (blocker.robot) {
+        // Name the robot: the known robot nearest to where the detection is.
+        const Vec2 at = d.map;
+        double best = 1.0;
+        for (const auto& o : view.others) {
+          if (distance(o.pos, at) < best) {
+            best = distance(o.pos, at);
+            blocker.id = o.id;
+          }
+        }
+      }
+    }
+  }
+  // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed.
+  for (const auto& ray : view.seen.scan) {
+    const double ahead = ray.local.x;
+    if (ahead > 0.0 && std::abs(ray.local.y) < p_.radius + 0.05) {
+      const double before = allowed;
+      limit(ahead - p_.radius, staticGap);
+      if (allowed < before) {
+        c.blockPoint = ray.map;
+      }
+    }
+  }
+  c.speed = allowed;
+  return c;
+}
+
+bool MotionGate::rearClear(const GateView& view) const {
+  if (!view.seen.valid) {
+    return false;
+  }
+  const double keep = p_.radius + 0.25;
+  for (const auto& d : view.seen.detections) {
+    const double x = d.local.x;
+    const double y = d.local.y;
+    if (x < 0.0 && std::abs(y) < p_.radius + d.radius + 0.05 && -x - d.radius < keep) {
+      return false;
+    }
+  }
+  for (const auto& ray : view.seen.scan) {
+    const double ahead = ray.local.x;
+    if (ahead < 0.0 && std::abs(ray.local.y) < p_.radius + 0.05 && -ahead < keep) {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool MotionGate::crossTrafficSafe(const GateView& view, double& v, double& w, std::string& blocker) const {
+  const Pose2 pose = view.seen.pose;
+  std::vector<avoidance::MovingDisc> discs;
+  // Only what is ahead or beside: whoever comes from behind keeps the distance (its own stop rule
+  // does); counting it here froze whole queues, each robot held by the one closing in behind it.
+  // (Driving backwards, "ahead" is behind: a robot reversing onto its parking place backed into
+  // a person standing behind it, whom this check ignored.)
+  const Vec2 heading = Vec2{std::cos(pose.theta), std::sin(pose.theta)} * (v < 0.0 ? -1.0 : 1.0);
+  auto relevant = [&](Vec2 at) {
+    const Vec2 rel = at - pose.position();
+    return rel.norm() < 3.0 && rel.dot(heading) > -p_.radius;
+  };
+  for (const auto& o : view.others) {
+    if (relevant(o.pos)) {
+      discs.push_back({o.pos, o.velocity, p_.radius});
+    }
+  }
+  for (const auto& h : view.seen.people) {
+    if (relevant(h.pos)) {
+      discs.push_back({h.pos, h.velocity, h.radius});
+    }
+  }
+  avoidance::LocalView local;
+  local.robot = {pose, view.current, p_.radius};
+  local.discs = discs;
+  local.limits = p_.limits;
+  local.dt = 0.1;
+  auto passes = [&](const avoidance::SafetyResult& r) {
+    return !r.blocked && !(r.overruled && std::abs(r.twist.v) < 0.05 && std::abs(v) > 0.1);
+  };
+  const auto r = discs.empty() ? avoidance::SafetyResult{{v, w}} : safety_.filter(local, {v, w});
+  if (passes(r)) {
+    v = r.twist.v;
+    w = r.twist.omega;
+    // Then the scan: a shelf corner beside the straight corridor of the stop rule is still in the
+    // way of a curving robot (one brushed a corner in a 100-robot run). A stop for it is static.
+    // (The map's obstacle faces too: a shelf corner between two rays is there all the same.)
+    std::vector<Vec2> scan = view.seen.scanPoints(1.5);
+    const std::vector<Vec2> walls = mapFaces(view.map, pose.position(), 1.0);
+    scan.insert(scan.end(), walls.begin(), walls.end());
+    if (scan.empty() || view.docking) {
+      return true;  // (docking: the stop rule's docking gap governs the last decimetres)
+    }
+    local.scan = scan;
+    const auto s = safety_.filter(local, {v, w});
+    v = s.twist.v;
+    w = s.twist.omega;
+    if (passes(s)) {
+      return true;
+    }
+    blocker.clear();
+    return false;
+  }
+  // Name the robot in the way: the nearest one ahead.
+  double best = 1e9;
+  for (const auto& o : view.others) {
+    const Vec2 rel = o.pos - pose.position();
+    const double ahead = rel.x * std::cos(pose.theta) + rel.y * std::sin(pose.theta);
+    if (ahead > 0.0 && rel.norm() < best) {
+      best = rel.norm();
+      blocker = o.id;
+    }
+  }
+  for (const auto& h : view.seen.people) {
+    if (distance(h.pos, pose.position()) < best) {
+      best = distance(h.pos, pose.position());
+      blocker = "human";
+    }
+  }
+  v = r.twist.v;
+  w = r.twist.omega;
+  return false;
+}
+
+MotionGate::Hold MotionGate::heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const {
+  const Clearance clear = clearSpeed(view, v, blocker);
+  const double allowed = clear.speed;
+  if (allowed < v - 1e-9) {
+    // Keep the curvature while slowing, so the robot stays on its path. Not while docking: there
+    // the turn toward the station is what frees the robot from the wall that limits its speed.
+    if (std::abs(v) > 1e-9 && !view.docking) {
+      w *= allowed / v;
+    }
+    v = allowed;
+  }
+  if (v < 0.0 && !rearClear(view)) {
+    v = 0.0;  // the stop rule for reversing (the pose law backs onto a station it faces away from)
+  }
+  std::string crossing;
+  const bool crossOk = crossTrafficSafe(view, v, w, crossing);
+  if (!crossOk && allowed >= 0.05) {
+    blocker.robot = !crossing.empty() && crossing != "human";
+    blocker.id = crossing;  // empty: a static obstacle
+  }
+  return {allowed < 0.05 || !crossOk, clear.blockPoint};
+}
+
+}  // namespace fleet::agent

@@ -1,0 +1,77 @@
+#pragma once
+
+// The last word on a twist before it drives the robot: the stop rule (keep a gap, growing with
+// speed, to whatever the sensors see in the corridor the robot sweeps), the same behind it when
+// reversing, and the cross-traffic check (the safety layer against the robots and people around,
+// extrapolated at their velocities, then against the scan and the map's obstacle faces). It says
+// whether the robot is held up and by what, so the standoff rules know whom to yield to.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/avoidance/safety_layer.hpp"
+#include "fleet/control/twist.hpp"
+#include "fleet/control/velocity_limits.hpp"
+#include "fleet/planning/occupancy_grid.hpp"
+#include "localizer.hpp"
+#include "other_robot.hpp"
+
+namespace fleet::agent {
+
+struct GateParams {
+  double radius = 0.3;
+  double stopGap = 0.35;  ///< m of free space kept ahead at standstill
+  double headway = 1.0;   ///< s: the stop distance grows with speed
+  control::VelocityLimits limits;
+};
+
+/// What the gate looks at in one cycle (non-owning: the caller keeps it alive for the call).
+struct GateView {
+  const Perception& seen;                 ///< pose, scan, detections and people
+  const std::vector<OtherRobot>& others;  ///< as they report themselves
+  const planning::OccupancyGrid& map;     ///< the raw map (its obstacle faces near the robot)
+  control::Twist current;                 ///< the command of the previous cycle
+  bool docking = false;                   ///< on the final approach to a goal: static points may come closer
+};
+
+/// What holds the robot up: a robot (its id, or "robot" when it cannot be named), "human", or
+/// nothing named (empty: a static obstacle).
+struct Blocker {
+  bool robot = false;
+  std::string id;
+};
+
+class MotionGate {
+ public:
+  explicit MotionGate(GateParams params) : p_(params) {}
+
+  struct Clearance {
+    double speed = 0.0;              ///< largest forward speed that keeps the stop gap
+    std::optional<Vec2> blockPoint;  ///< where the nearest thing that limits it is (map frame)
+  };
+  /// The stop rule for a forward speed `v`. Names what blocks in `blocker` when a detection stops
+  /// the robot (left as it is otherwise).
+  [[nodiscard]] Clearance clearSpeed(const GateView& view, double v, Blocker& blocker) const;
+  /// Nothing within a short distance behind (backing off must not hit what it cannot see coming).
+  [[nodiscard]] bool rearClear(const GateView& view) const;
+  /// (v, w) through the safety layer against the robots and people ahead or beside, extrapolated
+  /// at their velocities (crossings at intersections, which the stop rule's straight-ahead corridor
+  /// sees too late), then against the scan and the map's faces. False when it had to stop the
+  /// robot; `blocker` then names the robot or person in the way (empty: a static obstacle).
+  bool crossTrafficSafe(const GateView& view, double& v, double& w, std::string& blocker) const;
+
+  struct Hold {
+    bool held = false;
+    std::optional<Vec2> blockPoint;  ///< as clearSpeed found it
+  };
+  /// Stop rule and cross-traffic check on (v, w), which come out limited; held: the robot is held.
+  Hold heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const;
+
+ private:
+  GateParams p_;
+  /// The library's default zones, not AgentParams::safety (those are the local planner's).
+  avoidance::SafetyLayer safety_;
+};
+
+}  // namespace fleet::agent

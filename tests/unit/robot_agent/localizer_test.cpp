@@ -1,0 +1,150 @@
+// The localizer alone: readings in, the pose estimate, the scan and detections in the map frame,
+// the people tracked from reading to reading, and the stream watch out.
+
+#include "localizer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace fleet;
+using agent::Localizer;
+using agent::SeenKind;
+using agent::SensorReading;
+using agent::StreamCheck;
+
+namespace {
+
+constexpr std::int64_t kTick = 100'000'000;  // 0.1 s
+
+agent::LocalizerParams params(Pose2 start = {1.0, 1.0, 0.0}) {
+  agent::LocalizerParams p;
+  p.start = start;
+  p.wheelBase = 0.4;
+  p.sensorTimeoutS = 0.5;
+  return p;
+}
+
+// Straight ahead at `v` for one tick, as the driver reports it.
+SensorReading straight(std::int64_t stampNs, double v) {
+  SensorReading r;
+  r.stampNs = stampNs;
+  r.dsLeft = v * 0.1;
+  r.dsRight = v * 0.1;
+  r.rangeMax = 8.0f;
+  return r;
+}
+
+}  // namespace
+
+TEST(Localizer, DeadReckonsTheWheelTravel) {
+  Localizer loc(params());
+  for (int k = 1; k <= 10; ++k) {
+    loc.onReading(straight(k * kTick, 0.5));
+  }
+  EXPECT_NEAR(loc.pose().x, 1.5, 1e-9);
+  EXPECT_NEAR(loc.pose().y, 1.0, 1e-9);
+  EXPECT_EQ(loc.perception().pose, loc.pose()) << "the perception is as of the latest estimate";
+  EXPECT_EQ(loc.rejected(), 0u);
+}
+
+TEST(Localizer, WheelTotalsKeepTheMotionOfLostReadings) {
+  Localizer loc(params());
+  double total = 0.0;
+  for (int k = 1; k <= 30; ++k) {
+    total += 0.05;  // 0.5 m/s
+    auto r = straight(k * kTick, 0.5);
+    r.wheelTotalsValid = true;
+    r.wheelLeftTotal = total;
+    r.wheelRightTotal = total;
+    if (k < 10 || k > 20) {  // readings 10..20 are lost on the way
+      loc.onReading(r);
+    }
+  }
+  EXPECT_NEAR(loc.pose().x, 2.5, 1e-9) << "1.5 m driven, 0.55 m of it unseen";
+}
+
+TEST(Localizer, WithoutTotalsAGapWidensTheCovariance) {
+  Localizer loc(params());
+  loc.onReading(straight(kTick, 0.5));
+  const double before = loc.covariance()(0, 0);
+  loc.onReading(straight(2 * kTick, 0.5));
+  const double afterShortGap = loc.covariance()(0, 0);
+  loc.onReading(straight(12 * kTick, 0.5));  // 1 s without a reading
+  EXPECT_LT(afterShortGap - before, 0.01);
+  EXPECT_GT(loc.covariance()(0, 0) - afterShortGap, 0.5) << "(0.8·0.5 + 0.8²/2)² ≈ 0.52 added";
+}
+
+TEST(Localizer, ScanAndDetectionsInTheMapFrame) {
+  Localizer loc(params({1.0, 1.0, M_PI / 2}));
+  EXPECT_FALSE(loc.perception().valid);
+  EXPECT_TRUE(loc.perception().scanPoints(10.0).empty());
+  SensorReading r;
+  r.stampNs = kTick;
+  r.angleMin = 0.0f;
+  r.angleIncrement = static_cast<float>(M_PI / 2);
+  r.rangeMax = 8.0f;
+  r.ranges = {2.0f, 8.0f, 1.0f, 4.0f};  // ahead, left (no return), behind, right
+  r.sightings = {{SeenKind::kRobot, 1.0f, 0.5f, 0.3f}};
+  loc.onReading(r);
+  const auto& seen = loc.perception();
+  ASSERT_TRUE(seen.valid);
+  ASSERT_EQ(seen.scan.size(), 3u);
+  EXPECT_NEAR(seen.scan[0].map.x, 1.0, 1e-6);
+  EXPECT_NEAR(seen.scan[0].map.y, 3.0, 1e-6);
+  EXPECT_NEAR(seen.scan[0].local.x, 2.0, 1e-6);
+  EXPECT_NEAR(seen.scan[1].map.y, 0.0, 1e-6);
+  EXPECT_NEAR(seen.scan[2].map.x, 5.0, 1e-6);
+  EXPECT_EQ(seen.scanPoints(3.0).size(), 2u) << "the point 4 m off is beyond 3 m";
+  ASSERT_EQ(seen.detections.size(), 1u);
+  EXPECT_NEAR(seen.detections[0].map.x, 0.5, 1e-6);
+  EXPECT_NEAR(seen.detections[0].map.y, 2.0, 1e-6);
+  EXPECT_NEAR(seen.detections[0].radius, 0.3, 1e-6);
+  EXPECT_TRUE(seen.people.empty()) << "a robot is no person";
+}
+
+TEST(Localizer, TracksAPersonForAVelocity) {
+  Localizer loc(params());
+  for (int k = 1; k <= 3; ++k) {
+    auto r = straight(k * kTick, 0.0);
+    r.sightings = {{SeenKind::kHuman, 2.0f, static_cast<float>(-1.0 + 0.1 * k), 0.25f},
+                   {SeenKind::kHuman, NAN, 0.0f, 0.25f}};
+    loc.onReading(r);
+  }
+  const auto& people = loc.perception().people;
+  ASSERT_EQ(people.size(), 1u) << "a detection without a position is dropped";
+  EXPECT_NEAR(people[0].pos.x, 3.0, 1e-6);
+  // 1 m/s walked; smoothed half and half from 0: 0.5, then 0.75.
+  EXPECT_NEAR(people[0].velocity.y, 0.75, 1e-5);
+  EXPECT_NEAR(people[0].velocity.x, 0.0, 1e-9);
+}
+
+TEST(Localizer, TheStreamIsLostAfterTheTimeoutAndBackWithTheNextReading) {
+  Localizer loc(params());
+  std::int64_t now = 0;
+  loc.onReading(straight(now, 0.0));
+  EXPECT_EQ(loc.checkStream(now).change, StreamCheck::Change::kNone);
+  // No readings: 0.5 s is within the timeout, 0.6 s is not.
+  for (int k = 1; k <= 5; ++k) {
+    const auto c = loc.checkStream(now + k * kTick);
+    EXPECT_FALSE(c.lost) << k;
+  }
+  const auto lost = loc.checkStream(now + 6 * kTick);
+  EXPECT_TRUE(lost.lost);
+  EXPECT_EQ(lost.change, StreamCheck::Change::kLost);
+  EXPECT_NEAR(lost.silentS, 0.6, 1e-9);
+  EXPECT_TRUE(loc.lost());
+  EXPECT_EQ(loc.checkStream(now + 7 * kTick).change, StreamCheck::Change::kNone) << "said once";
+  loc.onReading(straight(now + 20 * kTick, 0.0));
+  const auto back = loc.checkStream(now + 20 * kTick);
+  EXPECT_FALSE(back.lost);
+  EXPECT_EQ(back.change, StreamCheck::Change::kBack);
+  EXPECT_EQ(back.outageNs, 14 * kTick);
+  EXPECT_FALSE(loc.lost());
+}
+
+TEST(Localizer, ARobotThatNeverGetsAReadingIsLostToo) {
+  Localizer loc(params());
+  EXPECT_FALSE(loc.checkStream(0).lost) << "the first check starts the count";
+  EXPECT_TRUE(loc.checkStream(6 * kTick).lost);
+}

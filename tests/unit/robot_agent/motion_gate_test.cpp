@@ -1,0 +1,181 @@
+// The motion gate alone: a perception, the other robots and a map in, the stop rule's speed, the
+// rear check, the cross-traffic check and what holds the robot up out.
+
+#include "motion_gate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "map_faces.hpp"
+
+using namespace fleet;
+using agent::Blocker;
+using agent::GateView;
+using agent::MotionGate;
+using agent::OtherRobot;
+using agent::Perception;
+using agent::SeenKind;
+
+namespace {
+
+agent::GateParams params() {
+  agent::GateParams p;
+  p.radius = 0.3;
+  p.stopGap = 0.35;
+  p.headway = 1.0;
+  p.limits = {0.8, -0.3, 1.5, 1.0, 3.0};
+  return p;
+}
+
+// The robot at (2, 2) facing +x, having seen (robot frame) `points` and `seen`.
+Perception perception(const std::vector<Vec2>& points, const std::vector<agent::Detection>& seen = {}) {
+  Perception p;
+  p.valid = true;
+  p.pose = {2.0, 2.0, 0.0};
+  for (const Vec2 q : points) {
+    p.scan.push_back({q.norm(), q, p.pose.transform(q)});
+  }
+  for (auto d : seen) {
+    d.map = p.pose.transform(d.local);
+    p.detections.push_back(d);
+  }
+  return p;
+}
+
+const planning::OccupancyGrid& emptyMap() {
+  static const planning::OccupancyGrid map(40, 40, 0.25, Vec2{0, 0});
+  return map;
+}
+
+}  // namespace
+
+TEST(MotionGate, NothingSeenKeepsTheSpeed) {
+  const MotionGate gate(params());
+  const Perception seen = perception({});
+  const std::vector<OtherRobot> others;
+  Blocker b;
+  const auto c = gate.clearSpeed({seen, others, emptyMap(), {}, false}, 0.8, b);
+  EXPECT_EQ(c.speed, 0.8);
+  EXPECT_FALSE(c.blockPoint);
+  Perception none;
+  EXPECT_EQ(gate.clearSpeed({none, others, emptyMap(), {}, false}, 0.8, b).speed, 0.8)
+      << "no reading yet: nothing to go by";
+}
+
+TEST(MotionGate, APointAheadLimitsTheSpeedToKeepTheGap) {
+  const MotionGate gate(params());
+  // 1 m ahead in the corridor, and one beside it (0.4 m off the axis) that does not count.
+  const Perception seen = perception({{1.0, 0.0}, {0.5, 0.4}});
+  const std::vector<OtherRobot> others;
+  Blocker b;
+  const auto c = gate.clearSpeed({seen, others, emptyMap(), {}, false}, 0.8, b);
+  EXPECT_NEAR(c.speed, (1.0 - 0.3 - 0.35) / 1.0, 1e-12);
+  ASSERT_TRUE(c.blockPoint);
+  EXPECT_NEAR(c.blockPoint->x, 3.0, 1e-12);
+  EXPECT_FALSE(b.robot);
+  EXPECT_TRUE(b.id.empty()) << "a static point is named by nobody";
+  // Docking: static points may come to 8 cm.
+  const Perception close = perception({{0.45, 0.0}});
+  EXPECT_EQ(gate.clearSpeed({close, others, emptyMap(), {}, false}, 0.8, b).speed, 0.0);
+  EXPECT_NEAR(gate.clearSpeed({close, others, emptyMap(), {}, true}, 0.8, b).speed, 0.07, 1e-12);
+}
+
+TEST(MotionGate, ARobotInTheWayIsNamedByTheNearestKnownRobot) {
+  const MotionGate gate(params());
+  const Perception seen = perception({}, {{SeenKind::kRobot, {0.8, 0.1}, 0.3, {}}});
+  std::vector<OtherRobot> others(2);
+  others[0].id = "r7";
+  others[0].pos = {2.85, 2.05};
+  others[1].id = "r9";
+  others[1].pos = {5.0, 2.0};
+  Blocker b;
+  const auto c = gate.clearSpeed({seen, others, emptyMap(), {}, false}, 0.8, b);
+  EXPECT_EQ(c.speed, 0.0);
+  EXPECT_TRUE(b.robot);
+  EXPECT_EQ(b.id, "r7");
+  // Unknown robot: "robot"; a person: "human".
+  Blocker unknown;
+  (void)gate.clearSpeed({seen, {}, emptyMap(), {}, false}, 0.8, unknown);
+  EXPECT_EQ(unknown.id, "robot");
+  const Perception person = perception({}, {{SeenKind::kHuman, {0.8, 0.0}, 0.25, {}}});
+  Blocker h;
+  (void)gate.clearSpeed({person, others, emptyMap(), {}, false}, 0.8, h);
+  EXPECT_FALSE(h.robot);
+  EXPECT_EQ(h.id, "human");
+}
+
+TEST(MotionGate, TheRearIsClearUnlessSomethingIsCloseBehind) {
+  const MotionGate gate(params());
+  const std::vector<OtherRobot> others;
+  EXPECT_TRUE(gate.rearClear({perception({{1.0, 0.0}, {-1.0, 0.0}}), others, emptyMap(), {}, false}));
+  EXPECT_FALSE(gate.rearClear({perception({{-0.5, 0.1}}), others, emptyMap(), {}, false}));
+  EXPECT_FALSE(gate.rearClear(
+      {perception({}, {{SeenKind::kHuman, {-0.7, 0.0}, 0.25, {}}}), others, emptyMap(), {}, false}));
+  const Perception none;
+  EXPECT_FALSE(gate.rearClear({none, others, emptyMap(), {}, false})) << "blind: not clear";
+}
+
+TEST(MotionGate, HeldUpByARobotCrossingFromTheSide) {
+  const MotionGate gate(params());
+  // 0.9 m ahead and 0.9 m to the right, driving across the path at 0.8 m/s: outside the stop
+  // rule's corridor, on collision course all the same.
+  const Perception seen = perception({});
+  std::vector<OtherRobot> others(1);
+  others[0].id = "r2";
+  others[0].pos = {2.9, 1.1};
+  others[0].velocity = {0.0, 0.8};
+  double v = 0.8;
+  double w = 0.0;
+  Blocker b;
+  (void)gate.heldUp({seen, others, emptyMap(), {0.8, 0.0}, false}, v, w, b);
+  EXPECT_LT(v, 0.5) << "did not slow for the crossing robot";
+  // A robot standing off to the side (not crossing) does not hold the robot.
+  others[0].pos = {3.5, 1.0};
+  others[0].velocity = {};
+  double v2 = 0.8;
+  double w2 = 0.0;
+  Blocker b2;
+  EXPECT_FALSE(gate.heldUp({seen, others, emptyMap(), {0.8, 0.0}, false}, v2, w2, b2).held);
+  EXPECT_NEAR(v2, 0.8, 1e-9);
+}
+
+TEST(MotionGate, HeldUpByAPointAheadKeepsTheCurvatureAndTheBlockPoint) {
+  const MotionGate gate(params());
+  const Perception seen = perception({{0.66, 0.0}});
+  const std::vector<OtherRobot> others;
+  double v = 0.8;
+  double w = 0.4;
+  Blocker b;
+  const auto h = gate.heldUp({seen, others, emptyMap(), {0.8, 0.4}, false}, v, w, b);
+  EXPECT_TRUE(h.held) << "0.01 m/s allowed";
+  EXPECT_LT(v, 0.05);
+  EXPECT_NEAR(w / v, 0.5, 1e-6) << "slowed along the same arc";
+  ASSERT_TRUE(h.blockPoint);
+  EXPECT_NEAR(h.blockPoint->x, 2.66, 1e-12);
+}
+
+TEST(MotionGate, ReversingStopsForWhatIsBehind) {
+  const MotionGate gate(params());
+  const std::vector<OtherRobot> others;
+  double v = -0.2;
+  double w = 0.0;
+  Blocker b;
+  (void)gate.heldUp({perception({{-0.5, 0.0}}), others, emptyMap(), {}, false}, v, w, b);
+  EXPECT_EQ(v, 0.0);
+  v = -0.2;
+  (void)gate.heldUp({perception({{1.5, 0.0}}), others, emptyMap(), {}, false}, v, w, b);
+  EXPECT_EQ(v, -0.2);
+}
+
+TEST(MapFaces, OnlyTheFacesTurnedTowardsTheRobotWithinRange) {
+  planning::OccupancyGrid map(20, 20, 0.25, Vec2{0, 0});
+  map.setBlocked({10, 10});  // the cell [2.5, 2.75] x [2.5, 2.75]
+  const auto pts = agent::mapFaces(map, {2.0, 2.625}, 1.0);
+  // The robot is left of the cell: only its left face (x = 2.5), in points every 0.0833 m.
+  ASSERT_EQ(pts.size(), 4u);
+  for (const Vec2 q : pts) {
+    EXPECT_NEAR(q.x, 2.5, 1e-12);
+  }
+  EXPECT_TRUE(agent::mapFaces(map, {0.5, 0.5}, 1.0).empty()) << "out of range";
+}
