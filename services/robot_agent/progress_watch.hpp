@@ -76,12 +76,15 @@ class ProgressWatch {
       closerNs_ += outageNs;
     }
   }
-  /// The operator held the order for `heldNs`: that time does not count for the moved clock.
+  /// The operator held the order for `heldNs`: that time does not count.
   void afterPause(std::int64_t heldNs) {
-    // The closer clock is not shifted: a pause longer than 3 x blockedFailS fails the task on the
-    // first cycle after it (kept as it was; a later, measured change).
     if (movedNs_ >= 0) {
       movedNs_ += heldNs;
+    }
+    // Until 2026-11-25 only the moved clock was shifted, so a pause longer than 3 x blockedFailS
+    // failed the task with "no progress" on the first cycle after resuming.
+    if (closerNs_ >= 0) {
+      closerNs_ += heldNs;
     }
   }
 

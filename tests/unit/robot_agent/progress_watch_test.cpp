@@ -86,6 +86,18 @@ TEST(ProgressWatch, ASensorOutageDoesNotCountAsTimeWithoutProgress) {
   EXPECT_EQ(watch.check(driving(281.0, {0.0, 0.0})), ProgressVerdict::kFailTask);
 }
 
+TEST(ProgressWatch, AnOperatorsPauseDoesNotCountAsTimeWithoutProgress) {
+  ProgressWatch watch({60.0, 4.0});
+  watch.newOrder();
+  ASSERT_EQ(watch.check(driving(0.0, {0.0, 0.0})), ProgressVerdict::kNone);
+  // Held for five minutes, then standing a while longer: 190 s of the order's time, 10 s of it
+  // unpaused, so no failure yet; the failure comes 180 s after the pause.
+  watch.afterPause(300 * kSecond);
+  EXPECT_EQ(watch.check(driving(310.0, {0.0, 0.0})), ProgressVerdict::kNone);
+  EXPECT_EQ(watch.check(driving(479.0, {0.0, 0.0})), ProgressVerdict::kNone);
+  EXPECT_EQ(watch.check(driving(481.0, {0.0, 0.0})), ProgressVerdict::kFailTask);
+}
+
 TEST(ProgressWatch, QueueingForAStationRestartsTheClock) {
   ProgressWatch watch({60.0, 4.0});
   watch.newOrder();
