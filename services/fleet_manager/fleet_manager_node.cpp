@@ -37,6 +37,11 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
   return a.dump();
 }
 
+// The wire's kinds are the library's, in the same order (idl/fleet.idl TaskKind).
+TaskKind fromMsg(msg::TaskKind k) {
+  return static_cast<TaskKind>(static_cast<int>(k));
+}
+
 }  // namespace
 
 Settings readSettings(Config& cfg) {
@@ -241,10 +246,15 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       return;
     }
     DispatchResult r;
-    auto results = dispatcher_->submit(batch, nowNs, &r);
+    std::vector<std::vector<FieldError>> fields;
+    auto results = dispatcher_->submit(batch, nowNs, &r, &fields);
     for (std::size_t i = 0; i < results.size(); ++i) {
       const auto& req = *batchReq[i];
-      if (results[i]) {
+      if (!fields[i].empty()) {
+        ++metrics_.rejected;
+        out.acks.push_back(
+            ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected, fieldsJson(fields[i]), nowNs));
+      } else if (results[i]) {
         const bool created = results[i]->created;
         ++(created ? metrics_.stored : metrics_.duplicates);
         out.acks.push_back(ack(req, created ? msg::AckResult::Stored : msg::AckResult::Duplicate,
@@ -290,32 +300,20 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       }
       continue;
     }
-    nlohmann::json body;
-    try {
-      body = nlohmann::json::parse(req.body);
-    } catch (const nlohmann::json::exception& e) {
-      ++metrics_.rejected;
-      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
-                             fieldsJson({{"", std::string("body is not valid JSON: ") + e.what()}}), nowNs));
-      continue;
-    }
-    auto parsed = parseTask(body, &dispatcher_->stations());
-    if (!parsed) {
-      ++metrics_.rejected;
-      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
-                             fieldsJson(parsed.error().fields), nowNs));
-      continue;
-    }
-    if (parsed->id != req.task_id) {
-      ++metrics_.rejected;
-      out.acks.push_back(ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
-                             fieldsJson({{"id", "does not match the request's task_id"}}), nowNs));
-      continue;
-    }
-    if (parsed->createdNs == 0) {
-      parsed->createdNs = req.created_ns != 0 ? req.created_ns : nowNs;
-    }
-    batch.push_back(std::move(*parsed));
+    // The typed fields are the task; the dispatcher validates it, once, against the site.
+    Task t;
+    t.id = req.task_id;
+    t.kind = fromMsg(req.kind);
+    t.pickup = req.pickup;
+    t.dropoff = req.dropoff;
+    t.station = req.station;
+    t.robot = req.robot;
+    t.loadNs = req.load_ns;
+    t.unloadNs = req.unload_ns;
+    t.priority = req.priority;
+    t.deadlineNs = req.deadline_ns;
+    t.createdNs = req.created_ns != 0 ? req.created_ns : nowNs;
+    batch.push_back(std::move(t));
     batchReq.push_back(&req);
   }
   flush();

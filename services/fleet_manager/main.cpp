@@ -31,9 +31,9 @@ void writeMetrics(const std::string& path, const nlohmann::json& j) {
 }
 
 int run(const manager::Settings& settings) {
-  auto stations = service::loadStationMap(settings.stationsFile);
-  if (!stations) {
-    spdlog::critical("{}", stations.error().message);
+  auto loaded = service::loadSiteStations(settings.stationsFile);
+  if (!loaded) {
+    spdlog::critical("{}", loaded.error().message);
     return 2;
   }
   WallClock wall;
@@ -43,10 +43,11 @@ int run(const manager::Settings& settings) {
 
   // Travel costs follow paths on the site's map when the stations come from a site.
   std::shared_ptr<const planning::OccupancyGrid> siteMap;
-  if (auto site = service::loadSiteFile(settings.stationsFile)) {
-    siteMap = std::make_shared<const planning::OccupancyGrid>(site->drivable());
+  if (loaded->site) {
+    siteMap = std::make_shared<const planning::OccupancyGrid>(loaded->site->drivable());
   }
-  auto created = manager::FleetManagerNode::create(settings, std::move(*stations), clock.nowNs(), siteMap);
+  auto created =
+      manager::FleetManagerNode::create(settings, std::move(loaded->stations), clock.nowNs(), siteMap);
   if (!created) {
     spdlog::critical("fleet manager: cannot open task store {}: {}", settings.db, created.error().message);
     return 2;

@@ -9,6 +9,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_map_node.hpp"
 
@@ -128,8 +129,20 @@ int main(int argc, char** argv) {
     logging::setup("risk_map", level);
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
                                     : Config::fromFile(configPath);
-    const auto settings = riskmap::readSettings(cfg);
+    auto settings = riskmap::readSettings(cfg);
     cfg.finish();
+    if (!settings.site.empty()) {
+      const auto site = service::loadSiteFile(settings.site);
+      if (!site) {
+        throw ConfigError({site.error().message});
+      }
+      const auto& m = site->map;
+      settings.fusion.grid =
+          riskmap::gridOverSite(m.origin(), m.width() * m.resolution(), m.height() * m.resolution(),
+                                settings.fusion.grid.resolution);
+      spdlog::info("risk map: grid {} x {} cells of {} m over site '{}'", settings.fusion.grid.width,
+                   settings.fusion.grid.height, settings.fusion.grid.resolution, site->name);
+    }
     service::installStopHandlers();
     return run(settings, id);
   } catch (const ConfigError& e) {

@@ -1,5 +1,7 @@
 #include "risk_map_node.hpp"
 
+#include <cmath>
+
 #include "fleet/core/clock.hpp"
 #include "fleet/risk/gaussian.hpp"
 #include "fleet/risk/overlap_ratio.hpp"
@@ -11,8 +13,17 @@ namespace fleet::riskmap {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"grid", "levels", "dt", "steps", "rate_hz", "model", "gaussian_floor",
-                         "stale_after_s", "regions", "human_human", "clock", "lockstep", "tile_size"});
+                         "stale_after_s", "regions", "human_human", "clock", "lockstep", "tile_size",
+                         "site"});
+  s.site = cfg.string("site", "");
   auto g = cfg.child("grid");
+  if (!s.site.empty()) {
+    for (const char* k : {"origin_x", "origin_y", "width", "height"}) {
+      if (g.has(k)) {
+        g.problem(k, "comes from the site; remove it or the 'site' key");
+      }
+    }
+  }
   g.rejectUnknownKeys({"origin_x", "origin_y", "resolution", "width", "height"});
   s.fusion.grid.originX = g.number("origin_x", 0.0, {-1e5, 1e5});
   s.fusion.grid.originY = g.number("origin_y", 0.0, {-1e5, 1e5});
@@ -35,6 +46,17 @@ Settings readSettings(Config& cfg) {
     cfg.problem("lockstep", "requires \"clock\": \"sim\"");
   }
   return s;
+}
+
+risk::GridSpec gridOverSite(Vec2 origin, double widthM, double heightM, double resolution) {
+  risk::GridSpec g;
+  g.originX = origin.x;
+  g.originY = origin.y;
+  g.resolution = resolution;
+  // A hair below a whole cell count is that count (30 m / 0.1 m is 299.99999999999994).
+  g.width = static_cast<int>(std::ceil(widthM / resolution - 1e-6));
+  g.height = static_cast<int>(std::ceil(heightM / resolution - 1e-6));
+  return g;
 }
 
 std::shared_ptr<const risk::RiskModel> makeModel(const Settings& s) {

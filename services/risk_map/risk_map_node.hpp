@@ -17,6 +17,9 @@ namespace fleet::riskmap {
 
 struct Settings {
   risk::FusionConfig fusion;
+  /// A site (or a scenario naming one): the grid then covers the site's map at `grid.resolution`
+  /// (see gridOverSite), and grid.origin_x/origin_y/width/height must not be given.
+  std::string site;
   std::string model = "gaussian";  // or "overlap" (the thesis ratio)
   double gaussianFloor = 1e-4;
   double rateHz = 10.0;
@@ -28,6 +31,8 @@ struct Settings {
 
 /// Reads the settings; every problem is recorded in `cfg` (call cfg.finish() after).
 Settings readSettings(Config& cfg);
+/// The risk grid over a map's rectangle (origin, size) at `resolution`: every map cell covered.
+risk::GridSpec gridOverSite(Vec2 origin, double widthM, double heightM, double resolution);
 
 /// The pair model named in the settings.
 std::shared_ptr<const risk::RiskModel> makeModel(const Settings& s);

@@ -338,12 +338,11 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
     m.dropoff = t.dropoff;
     m.station = t.station;
     m.robot = t.robot;
-    m.load_s = nsToSec(t.loadNs);
-    m.unload_s = nsToSec(t.unloadNs);
+    m.load_ns = t.loadNs;
+    m.unload_ns = t.unloadNs;
     m.priority = t.priority;
     m.deadline_ns = t.deadlineNs;
     m.created_ns = t.createdNs != 0 ? t.createdNs : now;
-    m.body = toJson(t).dump();
     requests.push_back(std::move(m));
   }
   const auto acks = gateway_.submit(requests, std::chrono::milliseconds(settings_.ackTimeoutMs));
@@ -354,7 +353,7 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
     auto [status, item] = outcome((*parsed)[i], acks[i]);
     if (status == 201 || status == 200) {
       ++(status == 201 ? counters_.tasksAccepted : counters_.tasksDuplicate);
-      view_.onAccepted((*parsed)[i].id, requests[i].body, acks[i]->state, now);
+      view_.onAccepted((*parsed)[i].id, toJson((*parsed)[i]).dump(), acks[i]->state, now);
     }
     if (i == 0) {
       first = status;

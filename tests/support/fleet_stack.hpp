@@ -73,13 +73,11 @@ inline msg::Task transportTask(const std::string& id, const std::string& pickup,
   msg::Task t;
   t.task_id = id;
   t.request_id = "req-" + id;
-  t.body = nlohmann::json{{"id", id},
-                          {"kind", "transport"},
-                          {"pickup", pickup},
-                          {"dropoff", dropoff},
-                          {"load_duration_ns", 2'000'000'000},
-                          {"unload_duration_ns", 2'000'000'000}}
-               .dump();
+  t.kind = msg::TaskKind::Transport;
+  t.pickup = pickup;
+  t.dropoff = dropoff;
+  t.load_ns = 2'000'000'000;
+  t.unload_ns = 2'000'000'000;
   return t;
 }
 

@@ -122,9 +122,13 @@ Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {
 }
 
 std::vector<Expected<SubmitResult>> Dispatcher::submit(const std::vector<Task>& tasks, std::int64_t nowNs,
-                                                       DispatchResult* out) {
+                                                       DispatchResult* out,
+                                                       std::vector<std::vector<FieldError>>* fields) {
   std::vector<Expected<SubmitResult>> results;
   results.reserve(tasks.size());
+  if (fields != nullptr) {
+    fields->assign(tasks.size(), {});
+  }
   std::vector<Task> valid;
   std::vector<std::size_t> where;
   for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -133,8 +137,12 @@ std::vector<Expected<SubmitResult>> Dispatcher::submit(const std::vector<Task>& 
       const bool station = std::any_of(errs.begin(), errs.end(), [](const FieldError& e) {
         return e.reason.starts_with("unknown station");
       });
-      results.emplace_back(unexpected(station ? errc::kUnknownStation : errc::kInvalid,
-                                      makeValidationError(std::move(errs)).message));
+      auto e = makeValidationError(std::move(errs));
+      results.emplace_back(
+          unexpected(station ? errc::kUnknownStation : errc::kInvalid, std::move(e.message)));
+      if (fields != nullptr) {
+        (*fields)[i] = std::move(e.fields);
+      }
       continue;
     }
     results.emplace_back(unexpected(errc::kStorage, "not stored"));

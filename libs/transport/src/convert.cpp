@@ -81,12 +81,11 @@ void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
   putStr(out.dropoff, in.dropoff, "Task.dropoff");
   putStr(out.station, in.station, "Task.station");
   putStr(out.robot, in.robot, "Task.robot");
-  out.load_s = in.load_s;
-  out.unload_s = in.unload_s;
+  out.load_ns = in.load_ns;
+  out.unload_ns = in.unload_ns;
   out.priority = in.priority;
   out.deadline_ns = in.deadline_ns;
   out.created_ns = in.created_ns;
-  putStr(out.body, in.body, "Task.body");
   out.cancel = in.cancel;
   out.control = static_cast<fleet_TaskControl>(in.control);
 }
@@ -99,12 +98,11 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.dropoff = getStr(in.dropoff);
   m.station = getStr(in.station);
   m.robot = getStr(in.robot);
-  m.load_s = in.load_s;
-  m.unload_s = in.unload_s;
+  m.load_ns = in.load_ns;
+  m.unload_ns = in.unload_ns;
   m.priority = in.priority;
   m.deadline_ns = in.deadline_ns;
   m.created_ns = in.created_ns;
-  m.body = getStr(in.body);
   m.cancel = in.cancel;
   m.control = getEnum(in.control, msg::TaskControl::Resume);
   return m;

@@ -79,7 +79,7 @@ StationMap stationMapOf(const site::Site& s) {
   return m;
 }
 
-Expected<StationMap> loadStationMap(const std::string& path) {
+Expected<SiteStations> loadSiteStations(const std::string& path) {
   auto doc = readJson(path);
   if (!doc) {
     return unexpected(doc.error());
@@ -89,13 +89,23 @@ Expected<StationMap> loadStationMap(const std::string& path) {
     if (!s) {
       return unexpected(s.error());
     }
-    return stationMapOf(*s);
+    SiteStations out{std::move(*s), {}};
+    out.stations = stationMapOf(*out.site);
+    return out;
   }
   auto m = StationMap::fromJson(*doc);
   if (!m) {
     return unexpected("invalid", path + ": " + m.error().message);
   }
-  return m;
+  return SiteStations{std::nullopt, std::move(*m)};
+}
+
+Expected<StationMap> loadStationMap(const std::string& path) {
+  auto s = loadSiteStations(path);
+  if (!s) {
+    return unexpected(s.error());
+  }
+  return std::move(s->stations);
 }
 
 }  // namespace fleet::service

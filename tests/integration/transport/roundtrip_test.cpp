@@ -103,18 +103,18 @@ std::string maxId() {
 }  // namespace
 
 TEST_F(RoundTrip, Task) {
-  msg::Task a{
-      "t-1",        "req-1", msg::TaskKind::Transport, "P-12", "D-3", "", "", 5, 7.5, 3, 123456789, 42,
-      R"({"a":1})", false};
-  msg::Task b{maxId(), maxId(), msg::TaskKind::Park,    "",  "", "PARK-1", "r-9", 0, 0, -5,
-              0,       0,       std::string(4096, 'b'), true};
+  msg::Task a{"t-1",  "req-1",       msg::TaskKind::Transport,
+              "P-12", "D-3",         "",
+              "",     5'000'000'001, 7'500'000'000,
+              3,      123456789,     42,
+              false};
+  msg::Task b{maxId(), maxId(), msg::TaskKind::Park, "", "", "PARK-1", "r-9", 0, 0, -5, 0, 0, true};
   msg::Task c = a;
   c.task_id = "t-2";
-  c.body = kNonAscii;
   c.control = msg::TaskControl::Resume;
   msg::Task d = a;
   d.task_id = "t-3";
-  d.body.clear();
+  d.pickup = kNonAscii;
   d.control = msg::TaskControl::Pause;
   expectRoundTrip<msg::Task>({a, b, c, d});
 }

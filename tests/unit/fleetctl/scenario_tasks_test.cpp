@@ -153,5 +153,43 @@ TEST(ScenarioTasks, SmallWarehouseListIsTheDemoLoad) {
   EXPECT_NO_THROW(sim::loadScenario(path));
 }
 
+// fleetctl's copy of a scenario that names its site: the path made absolute (the run's copy lives
+// elsewhere), the site's stations at hand, and a template's robot description taken into it.
+TEST(ScenarioSite, ARunsCopyFindsTheSiteAndItsStations) {
+  const std::string path = std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.json";
+  const json raw = json::parse(std::ifstream(path));
+  ASSERT_EQ(raw["site"], "small_warehouse.site.json");
+  const json s = resolveScenarioSite(raw, path);
+  EXPECT_EQ(s["site"], std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.site.json");
+  EXPECT_EQ(scenarioStations(s).size(), 32u);
+  EXPECT_EQ(scenarioStations(raw).size(), 0u);  // not resolved: no stations of its own
+  const json t = inlineSiteRobot(raw, path);
+  EXPECT_FALSE(t.contains("site"));
+  EXPECT_DOUBLE_EQ(t["robot_defaults"]["radius"].get<double>(), 0.3);
+  EXPECT_EQ(t["robot_defaults"]["sensors"]["rays"], 72);
+  EXPECT_DOUBLE_EQ(t["robot_defaults"]["sensors"]["range_sigma"].get<double>(), 0.01);  // the scenario's own
+  try {
+    (void)resolveScenarioSite(json{{"site", "nowhere.site.json"}}, path);
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot read the site file"), std::string::npos);
+  }
+}
+
+TEST(ScenarioSite, AnInlineScenarioSplitsIntoASiteAndTheRest) {
+  json inlineScenario = stations();
+  inlineScenario["map"] = {{"rows", {"....", "...."}}, {"resolution", 1.0}};
+  inlineScenario["robot_defaults"] = {{"radius", 0.2}, {"battery", {{"initial", 0.5}}}};
+  inlineScenario["robots"] = json::array();
+  const auto [site, rest] = splitSite(inlineScenario);
+  EXPECT_EQ(site["format"], "fleet-site/1");
+  EXPECT_EQ(site["stations"].size(), 5u);
+  EXPECT_DOUBLE_EQ(site["robot"]["radius"].get<double>(), 0.2);
+  EXPECT_FALSE(rest.contains("map"));
+  EXPECT_FALSE(rest.contains("stations"));
+  EXPECT_FALSE(rest["robot_defaults"].contains("radius"));
+  EXPECT_TRUE(rest["robot_defaults"].contains("battery"));
+}
+
 }  // namespace
 }  // namespace fleet::ctl

@@ -43,6 +43,22 @@ TEST(RiskMapNode, SettingsErrorsNameTheKey) {
   EXPECT_THAT(msg, HasSubstr("rm.json: gird: unknown key"));
 }
 
+TEST(RiskMapNode, AGridOverASiteCoversEveryCellOfIt) {
+  auto cfg = Config::fromText(R"({"site": "s.json", "grid": {"resolution": 0.1, "width": 300}})", "rm.json");
+  const auto s = riskmap::readSettings(cfg);
+  EXPECT_EQ(s.site, "s.json");
+  ASSERT_FALSE(cfg.ok());
+  EXPECT_THAT(cfg.problems()[0], HasSubstr("rm.json: grid.width: comes from the site"));
+  // 30 m / 0.1 m is 299.99999999999994 in doubles: still 300 cells, and 0.25 m cells cover 30 m
+  // with 120; a map 30.05 m wide needs 301 cells of 0.1 m.
+  const auto g = riskmap::gridOverSite({-1.0, 2.0}, 30.0, 20.0, 0.1);
+  EXPECT_EQ(g.width, 300);
+  EXPECT_EQ(g.height, 200);
+  EXPECT_DOUBLE_EQ(g.originX, -1.0);
+  EXPECT_EQ(riskmap::gridOverSite({}, 30.0, 20.0, 0.25).width, 120);
+  EXPECT_EQ(riskmap::gridOverSite({}, 30.05, 20.0, 0.1).width, 301);
+}
+
 TEST(RiskMapNode, BadSamplesAreRefusedAndStateKept) {
   auto node = riskmap::RiskMapNode::create(small());
   ASSERT_TRUE(node);

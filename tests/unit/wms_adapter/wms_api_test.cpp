@@ -17,6 +17,20 @@ namespace {
 /// A manager in memory: stores tasks by id, answers duplicates and conflicts like the real one.
 class FakeGateway : public TaskGateway {
  public:
+  /// What makes two requests the same task (the manager compares canonical bodies).
+  static std::string fields(const msg::Task& r) {
+    return json{static_cast<int>(r.kind),
+                r.pickup,
+                r.dropoff,
+                r.station,
+                r.robot,
+                r.load_ns,
+                r.unload_ns,
+                r.priority,
+                r.deadline_ns}
+        .dump();
+  }
+
   std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
                                                   std::chrono::milliseconds) override {
     std::vector<std::optional<msg::TaskAck>> out;
@@ -35,9 +49,9 @@ class FakeGateway : public TaskGateway {
         a.state = r.cancel ? msg::TaskState::Cancelled : msg::TaskState::EnRoute;
         controls.push_back(r.control);
       } else if (auto it = bodies.find(r.task_id); it != bodies.end()) {
-        a.result = it->second == r.body ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
+        a.result = it->second == fields(r) ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
       } else {
-        bodies[r.task_id] = r.body;
+        bodies[r.task_id] = fields(r);
       }
       out.emplace_back(a);
     }

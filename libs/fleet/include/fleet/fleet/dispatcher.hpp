@@ -96,9 +96,12 @@ class Dispatcher {
   Expected<DispatchResult> recover(std::int64_t nowNs);
 
   /// Validates against the station map and stores durably (one group commit). Per task: the stored
-  /// record, or an error (invalid / unknown_station → 400, conflict → 409, storage → 503).
+  /// record, or an error (invalid / unknown_station → 400, conflict → 409, storage → 503). With
+  /// `fields`, an invalid task's field errors are also returned there, one list per task (empty
+  /// for the others): the one validation of a task on its way into the store.
   std::vector<Expected<SubmitResult>> submit(const std::vector<Task>& tasks, std::int64_t nowNs,
-                                             DispatchResult* out = nullptr);
+                                             DispatchResult* out = nullptr,
+                                             std::vector<std::vector<FieldError>>* fields = nullptr);
 
   void onRobotState(const RobotObservation& o);
   /// DDS liveliness lost: the robot's task is requeued at once.

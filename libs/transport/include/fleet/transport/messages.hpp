@@ -39,12 +39,11 @@ struct Task {
   std::string dropoff;
   std::string station;
   std::string robot;
-  double load_s = 0;
-  double unload_s = 0;
+  std::int64_t load_ns = 0;
+  std::int64_t unload_ns = 0;
   std::int32_t priority = 0;
   std::int64_t deadline_ns = 0;
   std::int64_t created_ns = 0;
-  std::string body;
   bool cancel = false;
   TaskControl control = TaskControl::None;
   bool operator==(const Task&) const = default;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "fleet/core/expected.hpp"
@@ -15,9 +16,15 @@ namespace fleet::service {
 Expected<site::Site> loadSiteFile(const std::string& path, bool checkGeometry = true,
                                   double mapResolution = 1.0);
 
-/// The stations the fleet manager and the WMS adapter check tasks against: those of the site
-/// named above, or, for older setups, of a stations file ({"stations": [...]}) or a scenario
-/// that carries its stations inline.
+/// What the fleet manager and the WMS adapter read: the site (when the file is one, or a scenario
+/// naming one) and the stations they check tasks against — the site's, or, for older setups,
+/// those of a stations file ({"stations": [...]}) or of a scenario that carries them inline.
+struct SiteStations {
+  std::optional<site::Site> site;
+  StationMap stations;
+};
+Expected<SiteStations> loadSiteStations(const std::string& path);
+/// Just the stations of loadSiteStations.
 Expected<StationMap> loadStationMap(const std::string& path);
 
 /// A site's stations as the fleet library holds them (one kind each).

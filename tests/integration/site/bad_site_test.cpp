@@ -1,0 +1,93 @@
+// Every service refuses a bad site at start: exit code 2, every problem named with the file and the
+// key path, and nothing started half-way (no task database created).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code = -1;
+  std::string output;
+};
+
+Outcome run(const std::string& cmd) {
+  Outcome r;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  std::array<char, 512> buf{};
+  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
+    r.output += buf.data();
+  }
+  const int status = p != nullptr ? pclose(p) : -1;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class BadSite : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("bad_site_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    auto site =
+        nlohmann::json::parse(std::ifstream(FLEET_SOURCE_DIR "/sim/scenarios/passage_head_on.site.json"));
+    site["stations"][0]["kind"] = "dock";
+    site["stations"][1]["pose"] = {0.25, 0.25, 0.0};  // in the wall
+    site["colour"] = "blue";
+    std::ofstream(dir_ / "bad.site.json") << site.dump(1);
+    auto scenario =
+        nlohmann::json::parse(std::ifstream(FLEET_SOURCE_DIR "/sim/scenarios/passage_head_on.json"));
+    scenario["site"] = "bad.site.json";
+    std::ofstream(dir_ / "scenario.json") << scenario.dump(1);
+    std::ofstream(dir_ / "risk_map.json") << R"({"site": ")" + (dir_ / "bad.site.json").string() + R"("})";
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void expectRefused(const Outcome& r, const std::string& who) {
+    EXPECT_EQ(r.code, 2) << who << ":\n" << r.output;
+    const std::string file = (dir_ / "bad.site.json").string();
+    EXPECT_NE(r.output.find(file + ": colour: unknown key"), std::string::npos) << who << ":\n" << r.output;
+    EXPECT_NE(r.output.find(file + ": stations[0].kind: expected one of"), std::string::npos) << who << ":\n"
+                                                                                              << r.output;
+  }
+  fs::path dir_;
+};
+
+TEST_F(BadSite, EveryServiceRefusesItWithExitCode2AndEveryProblemNamed) {
+  const std::string bin = FLEET_BINARY_DIR;
+  const std::string site = (dir_ / "bad.site.json").string();
+  expectRefused(run(bin + "/services/fleetctl/fleetctl site check " + site), "fleetctl site check");
+  expectRefused(run(bin + "/services/fleet_manager/fleet_manager --stations " + site + " --db " +
+                    (dir_ / "fleet.db").string() + " --log-level warn"),
+                "fleet_manager");
+  EXPECT_FALSE(fs::exists(dir_ / "fleet.db")) << "the manager opened its database before checking the site";
+  expectRefused(run(bin + "/services/wms_adapter/wms_adapter --stations " + site + " --port 0"),
+                "wms_adapter");
+  expectRefused(run(bin + "/services/risk_map/risk_map --config " + (dir_ / "risk_map.json").string()),
+                "risk_map");
+  expectRefused(run(bin + "/sim/src/fleet-sim --scenario " + (dir_ / "scenario.json").string() +
+                    " --clock lockstep --participants 0 --duration 1"),
+                "fleet-sim");
+}
+
+TEST_F(BadSite, AStationInTheWallIsReportedOnceTheFileParses) {
+  auto site = nlohmann::json::parse(std::ifstream(dir_ / "bad.site.json"));
+  site.erase("colour");
+  site["stations"][0]["kind"] = "pickup";
+  std::ofstream(dir_ / "bad.site.json") << site.dump(1);
+  const auto r = run(std::string(FLEET_BINARY_DIR) + "/services/fleetctl/fleetctl site check " +
+                     (dir_ / "bad.site.json").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("stations[1].pose: station '"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("is inside an obstacle"), std::string::npos) << r.output;
+}
+
+}  // namespace
