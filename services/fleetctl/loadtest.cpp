@@ -1,10 +1,12 @@
 #include "loadtest.hpp"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <httplib.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sqlite3.h>
+#include <sys/file.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -31,6 +33,26 @@
 
 namespace fleet::ctl {
 namespace {
+
+// A DDS domain no other run on this machine uses: two fleets on one domain take each other's
+// orders (robots are keyed by id, and every fleet has an r1). Runs and tests hold a lock file per
+// domain for their lifetime (the convention of tests/support/test_process.hpp); the lock is
+// released when this process ends.
+int lockFreeDomain() {
+  const int start = static_cast<int>(std::random_device{}() % 120);
+  for (int k = 0; k < 120; ++k) {
+    const int d = 100 + (start + k) % 120;
+    const std::string path = "/tmp/fleet-test-dds-domain-" + std::to_string(d) + ".lock";
+    const int fd = open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+    if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0) {
+      return d;  // fd stays open: the lock lives as long as the process
+    }
+    if (fd >= 0) {
+      close(fd);
+    }
+  }
+  return 100 + start;
+}
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -497,7 +519,7 @@ int Run::run() {
   int domain = o.domain;
   if (domain < 0) {
     const char* env = std::getenv("FLEET_DDS_DOMAIN");
-    domain = env ? std::atoi(env) : 100 + static_cast<int>(std::random_device{}() % 100);
+    domain = env ? std::atoi(env) : lockFreeDomain();
   }
   std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", std::to_string(domain)}};
   const double drop = dropFraction(faults);
