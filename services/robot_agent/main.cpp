@@ -16,11 +16,15 @@
 
 #include "agent.hpp"
 #include "fleet/avoidance/planner_config.hpp"
+#include "fleet/core/angles.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
+#include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/site_stations.hpp"
 #include "fleet/sim/scenario.hpp"
+#include "fleet/site/reachability.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_field.hpp"
 #include "worker_pool.hpp"
@@ -30,6 +34,23 @@ using namespace std::chrono_literals;
 using nlohmann::json;
 
 namespace {
+
+/// What the agents need of the world: the map, the landmarks and their robots with their starts.
+/// From a site and a list of robots (a deployment) or from a simulator scenario.
+struct World {
+  std::shared_ptr<const planning::OccupancyGrid> map;
+  std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+  struct Robot {
+    std::string id;
+    Pose2 start;
+    double radius = 0.3;
+    double wheelBase = 0.4;
+    control::VelocityLimits limits;
+  };
+  std::vector<Robot> robots;
+  double dt = 0.1;  // control period, s
+  std::string name;
+};
 
 std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
   auto g = std::make_shared<planning::OccupancyGrid>(m.width, m.height, m.resolution, m.origin);
@@ -41,6 +62,75 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
     }
   }
   return g;
+}
+
+World fromScenario(const sim::Scenario& scn) {
+  World w;
+  w.map = gridOf(scn.map);
+  for (const auto& l : scn.landmarks) {
+    w.landmarks.emplace_back(l.id, l.position);
+  }
+  for (const auto& r : scn.robots) {
+    w.robots.push_back({r.id, r.start, r.radius, r.wheelBase, r.limits});
+  }
+  w.dt = scn.dt;
+  w.name = scn.name;
+  return w;
+}
+
+/// `--robot ID@PLACE`: PLACE is a station of the site or "x,y,theta" in the map frame. Every
+/// problem is collected (ConfigError): a bad id, an unknown station, a start the robot does not
+/// fit on, an id given twice.
+World fromSite(const site::Site& st, const std::vector<std::string>& specs) {
+  World w;
+  w.map = std::make_shared<const planning::OccupancyGrid>(st.map);
+  for (const auto& l : st.landmarks) {
+    w.landmarks.emplace_back(l.id, l.position);
+  }
+  w.name = st.name;
+  std::vector<std::string> problems;
+  for (const auto& spec : specs) {
+    const auto at = spec.find('@');
+    const std::string robot = spec.substr(0, at);
+    const std::string place = at == std::string::npos ? "" : spec.substr(at + 1);
+    const std::string where = "--robot " + spec + ": ";
+    if (!isValidId(robot) || place.empty()) {
+      problems.push_back(where +
+                         "expected ID@STATION or ID@x,y,theta with an id of 1 to 63 of A-Z a-z 0-9 _ . : -");
+      continue;
+    }
+    World::Robot r{robot, {}, st.robot.radius, st.robot.wheelBase, st.robot.limits};
+    if (const auto* station = st.station(place)) {
+      r.start = station->pose;
+    } else {
+      double x = 0, y = 0, th = 0;
+      char tail = 0;
+      if (std::sscanf(place.c_str(), "%lf,%lf,%lf%c", &x, &y, &th, &tail) != 3 || !std::isfinite(x) ||
+          !std::isfinite(y) || !std::isfinite(th)) {
+        problems.push_back(where + "'" + place + "' is neither a station of site '" + st.name +
+                           "' nor x,y,theta");
+        continue;
+      }
+      r.start = {x, y, wrapAngle(th)};
+    }
+    if (!site::discFits(st.map, r.start.position(), r.radius)) {
+      problems.push_back(where + "a robot of radius " + std::to_string(r.radius) +
+                         " m does not fit at its start");
+    }
+    for (const auto& o : w.robots) {
+      if (o.id == robot) {
+        problems.push_back(where + "robot '" + robot + "' is given twice");
+      }
+    }
+    w.robots.push_back(r);
+  }
+  if (specs.empty()) {
+    problems.push_back("--site needs at least one --robot ID@STATION");
+  }
+  if (!problems.empty()) {
+    throw ConfigError(problems);
+  }
+  return w;
 }
 
 struct Options {
@@ -83,11 +173,11 @@ json cycleMetrics(const std::string& id, bool lockstep, std::size_t robots, unsi
       {"cycle_ms", {{"p50", q(0.5)}, {"p99", q(0.99)}, {"max", cycleMs.empty() ? 0.0 : cycleMs.back()}}}};
 }
 
-int run(const sim::Scenario& scn, const Options& opt) {
+int run(const World& scn, const Options& opt) {
   const auto& only = opt.only;
   const bool lockstep = opt.lockstep;
   const std::string& id = opt.id;
-  auto raw = gridOf(scn.map);
+  const auto& raw = scn.map;
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::shared_ptr<const planning::LaneMap> lanes;
   if (opt.useLanes) {
@@ -122,9 +212,7 @@ int run(const sim::Scenario& scn, const Options& opt) {
     p.lanes = lanes;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
-    for (const auto& l : scn.landmarks) {
-      p.landmarks.emplace_back(l.id, l.position);
-    }
+    p.landmarks = scn.landmarks;
     agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
     byId[r.id] = agents.back().get();
   }
@@ -367,7 +455,14 @@ int main(int argc, char** argv) {
                "plan on the lane map (one-way narrow aisles, keep-right bands) instead of plain A*; "
                "off by default: 20 robots finish ~15 % fewer tasks with it (docs/benchmarks.md)");
   app.add_flag("--no-lanes", noLanes, "plain A* (the default; wins over --lanes)");
-  app.add_option("--scenario", scenario, "scenario JSON (map, robots, landmarks)")->required();
+  std::string sitePath;
+  std::vector<std::string> robotSpecs;
+  auto* scenarioOpt =
+      app.add_option("--scenario", scenario, "simulator scenario (its site, its robots and their starts)");
+  app.add_option("--site", sitePath, "site file (site.json, a ROS map .yaml or a .map): a deployment")
+      ->excludes(scenarioOpt);
+  app.add_option("--robot", robotSpecs,
+                 "with --site: a robot and where it stands, ID@STATION or ID@x,y,theta (repeat)");
   app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
   app.add_option("--id", id, "participant id in lockstep");
@@ -385,7 +480,23 @@ int main(int argc, char** argv) {
     if (!configFile.empty()) {
       applyConfigFile(configFile, opt, app.count("--local-planner") > 0, app.count("--global-planner") > 0);
     }
-    const auto scn = sim::loadScenario(scenario);
+    World world;
+    if (!sitePath.empty()) {
+      auto st = service::loadSiteFile(sitePath);
+      if (!st) {
+        throw ConfigError({st.error().message});
+      }
+      world = fromSite(*st, robotSpecs);
+    } else if (!scenario.empty()) {
+      if (!robotSpecs.empty()) {
+        throw ConfigError(
+            {"--robot goes with --site; a scenario names its robots (select them with --robots)"});
+      }
+      world = fromScenario(sim::loadScenario(scenario));
+    } else {
+      throw ConfigError(
+          {"give --site FILE --robot ID@STATION ... (a deployment) or --scenario FILE (the simulator)"});
+    }
     std::stringstream ss(robots);
     for (std::string r; std::getline(ss, r, ',');) {
       if (!r.empty()) {
@@ -397,7 +508,7 @@ int main(int argc, char** argv) {
     opt.useRisk = !noRisk;
     service::installStopHandlers();
     opt.useLanes = lanes && !noLanes;
-    return run(scn, opt);
+    return run(world, opt);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -71,3 +71,48 @@ TEST(RobotAgentConfig, GoodFileRunsTheConfiguredPlanner) {
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("dwa"), std::string::npos) << r.output;
 }
+
+namespace {
+
+/// robot_agent as deployed: a site and the robots standing on it, no simulator scenario.
+AgentRun agentOnSite(const std::string& robots, int seconds) {
+  const std::string cmd = "FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) +
+                          " timeout --preserve-status -s INT " + std::to_string(seconds) +
+                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent --site " FLEET_SOURCE_DIR
+                          "/sim/scenarios/small_warehouse_12_parking.site.json --clock wall " +
+                          robots + " 2>&1";
+  AgentRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 512> buf{};
+  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
+    r.output += buf.data();
+  }
+  const int status = p != nullptr ? pclose(p) : -1;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+}  // namespace
+
+TEST(RobotAgentSite, RunsTheRobotsGivenOnASite) {
+  const AgentRun r = agentOnSite("--robot r1@PARK-1 --robot r2@5.0,1.25,1.5708", 3);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 robot"), std::string::npos) << r.output;
+}
+
+TEST(RobotAgentSite, BadRobotsAreNamedAndNothingStarts) {
+  const AgentRun r = agentOnSite(
+      "--robot r1@NOPE --robot 'r 2@PARK-2' --robot r3@0.1,0.1,0 --robot r4@PARK-4 "
+      "--robot r4@PARK-5",
+      20);
+  EXPECT_EQ(r.code, 2) << r.output;
+  for (const char* what :
+       {"--robot r1@NOPE: 'NOPE' is neither a station of site 'small-warehouse-12-parking'",
+        "--robot r 2@PARK-2: expected ID@STATION", "--robot r3@0.1,0.1,0: a robot of radius",
+        "--robot r4@PARK-5: robot 'r4' is given twice"}) {
+    EXPECT_NE(r.output.find(what), std::string::npos) << what << " not in:\n" << r.output;
+  }
+  const AgentRun none = agentOnSite("", 20);
+  EXPECT_EQ(none.code, 2) << none.output;
+  EXPECT_NE(none.output.find("--site needs at least one --robot"), std::string::npos) << none.output;
+}
