@@ -21,17 +21,12 @@ struct AgentRun {
   std::string output;
 };
 
-/// Runs robot_agent with a config file until it exits (bad config) or `seconds` pass (`timeout`
-/// ends a good one, which would otherwise run until stopped).
-AgentRun agentWith(const std::string& configText, int seconds) {
-  const fs::path cfg = fs::temp_directory_path() / ("agent_cfg_" + std::to_string(getpid()) + ".json");
-  std::ofstream(cfg) << configText;
+/// Runs robot_agent with `args` until it exits (bad input) or `seconds` pass (`timeout` ends a good
+/// run, which would otherwise go on until stopped).
+AgentRun runAgent(const std::string& args, int seconds) {
   const std::string cmd = "FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) +
                           " timeout --preserve-status -s INT " + std::to_string(seconds) +
-                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent " +
-                          "--scenario " FLEET_SOURCE_DIR
-                          "/sim/scenarios/one_robot.json --clock wall --config " +
-                          cfg.string() + " 2>&1";
+                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent " + args + " 2>&1";
   AgentRun r;
   FILE* p = popen(cmd.c_str(), "r");
   std::array<char, 512> buf{};
@@ -40,6 +35,15 @@ AgentRun agentWith(const std::string& configText, int seconds) {
   }
   const int status = p != nullptr ? pclose(p) : -1;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+AgentRun agentWith(const std::string& configText, int seconds) {
+  const fs::path cfg = fs::temp_directory_path() / ("agent_cfg_" + std::to_string(getpid()) + ".json");
+  std::ofstream(cfg) << configText;
+  auto r = runAgent(
+      "--scenario " FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json --clock wall --config " + cfg.string(),
+      seconds);
   fs::remove(cfg);
   return r;
 }
@@ -76,20 +80,9 @@ namespace {
 
 /// robot_agent as deployed: a site and the robots standing on it, no simulator scenario.
 AgentRun agentOnSite(const std::string& robots, int seconds) {
-  const std::string cmd = "FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) +
-                          " timeout --preserve-status -s INT " + std::to_string(seconds) +
-                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent --site " FLEET_SOURCE_DIR
-                          "/sim/scenarios/small_warehouse_12_parking.site.json --clock wall " +
-                          robots + " 2>&1";
-  AgentRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  std::array<char, 512> buf{};
-  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
-    r.output += buf.data();
-  }
-  const int status = p != nullptr ? pclose(p) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return runAgent(
+      "--site " FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse_12_parking.site.json --clock wall " + robots,
+      seconds);
 }
 
 }  // namespace
