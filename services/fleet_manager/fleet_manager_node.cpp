@@ -1,5 +1,7 @@
 #include "fleet_manager_node.hpp"
 
+#include "fleet/service/task_wire.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -35,11 +37,6 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
     a.push_back({{"path", f.path}, {"reason", f.reason}});
   }
   return a.dump();
-}
-
-// The wire's kinds are the library's, in the same order (idl/fleet.idl TaskKind).
-TaskKind fromMsg(msg::TaskKind k) {
-  return static_cast<TaskKind>(static_cast<int>(k));
 }
 
 }  // namespace
@@ -301,19 +298,7 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       continue;
     }
     // The typed fields are the task; the dispatcher validates it, once, against the site.
-    Task t;
-    t.id = req.task_id;
-    t.kind = fromMsg(req.kind);
-    t.pickup = req.pickup;
-    t.dropoff = req.dropoff;
-    t.station = req.station;
-    t.robot = req.robot;
-    t.loadNs = req.load_ns;
-    t.unloadNs = req.unload_ns;
-    t.priority = req.priority;
-    t.deadlineNs = req.deadline_ns;
-    t.createdNs = req.created_ns != 0 ? req.created_ns : nowNs;
-    batch.push_back(std::move(t));
+    batch.push_back(service::fromWire(req, nowNs));
     batchReq.push_back(&req);
   }
   flush();

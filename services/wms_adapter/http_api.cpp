@@ -6,6 +6,7 @@
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/task.hpp"
+#include "fleet/service/task_wire.hpp"
 
 namespace fleet::wms {
 namespace {
@@ -41,10 +42,6 @@ json viewJson(const TaskView& v) {
     j["task"] = json::parse(v.body, nullptr, false);
   }
   return j;
-}
-
-msg::TaskKind toMsgKind(TaskKind k) {
-  return static_cast<msg::TaskKind>(static_cast<int>(k));
 }
 
 /// Per-item outcome of a submit as (HTTP status, JSON).
@@ -329,21 +326,8 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
   }
   const std::int64_t now = clock_.nowNs();
   std::vector<msg::Task> requests;
-  for (auto& t : *parsed) {
-    msg::Task m;
-    m.task_id = t.id;
-    m.request_id = nextRequestId();
-    m.kind = toMsgKind(t.kind);
-    m.pickup = t.pickup;
-    m.dropoff = t.dropoff;
-    m.station = t.station;
-    m.robot = t.robot;
-    m.load_ns = t.loadNs;
-    m.unload_ns = t.unloadNs;
-    m.priority = t.priority;
-    m.deadline_ns = t.deadlineNs;
-    m.created_ns = t.createdNs != 0 ? t.createdNs : now;
-    requests.push_back(std::move(m));
+  for (const auto& t : *parsed) {
+    requests.push_back(service::toWire(t, nextRequestId(), now));
   }
   const auto acks = gateway_.submit(requests, std::chrono::milliseconds(settings_.ackTimeoutMs));
   json results = json::array();

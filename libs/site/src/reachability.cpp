@@ -175,6 +175,24 @@ std::int32_t regionOf(const OccupancyGrid& g, const DiscRegions& r, Vec2 p, doub
   return best;
 }
 
+std::int32_t floorRegion(const DiscRegions& r, const std::vector<std::int32_t>& stationRegions) {
+  std::vector<std::size_t> count(r.size.size(), 0);
+  for (const auto l : stationRegions) {
+    if (l > 0 && static_cast<std::size_t>(l) < count.size()) {
+      ++count[static_cast<std::size_t>(l)];
+    }
+  }
+  std::int32_t best = 0;
+  for (std::size_t l = 1; l < count.size(); ++l) {
+    const auto b = static_cast<std::size_t>(best);
+    if (count[l] > 0 &&
+        (best == 0 || count[l] > count[b] || (count[l] == count[b] && r.size[l] > r.size[b]))) {
+      best = static_cast<std::int32_t>(l);
+    }
+  }
+  return best;
+}
+
 DiscRegions cellRegions(const OccupancyGrid& g) {
   DiscRegions r;
   r.width = g.width();

@@ -414,7 +414,7 @@ std::vector<SiteProblem> checkSite(const Site& s) {
   const double r = s.robot.radius;
   const auto regions = discRegions(g, r);
   std::vector<std::int32_t> regionOfStation(s.stations.size(), 0);
-  std::map<std::int32_t, std::size_t> stationsIn;
+  std::vector<bool> placed(s.stations.size(), false);  // passed the checks above: in, free, fits
   for (std::size_t i = 0; i < s.stations.size(); ++i) {
     const auto& st = s.stations[i];
     const std::string key = "stations[" + std::to_string(i) + "]";
@@ -439,7 +439,7 @@ std::vector<SiteProblem> checkSite(const Site& s) {
       continue;
     }
     regionOfStation[i] = regionOf(g, regions, p, r);
-    ++stationsIn[regionOfStation[i]];
+    placed[i] = true;
     if (st.approachGiven && st.approach &&
         !(discFits(g, *st.approach, r) && segmentFits(g, *st.approach, p, r))) {
       out.push_back({key + ".approach", "station '" + st.name + "': a robot of radius " + fmt(r) +
@@ -454,24 +454,13 @@ std::vector<SiteProblem> checkSite(const Site& s) {
       }
     }
   }
-  // The region holding most stations is the site's floor; a station elsewhere is cut off from it.
-  std::int32_t main = 0;
-  std::size_t most = 0;
-  for (const auto& [reg, count] : stationsIn) {
-    if (reg != 0 && (count > most || (count == most && regions.size[static_cast<std::size_t>(reg)] >
-                                                           regions.size[static_cast<std::size_t>(main)]))) {
-      main = reg;
-      most = count;
-    }
-  }
+  const std::int32_t main = floorRegion(regions, regionOfStation);
+  const auto most =
+      static_cast<std::size_t>(std::count(regionOfStation.begin(), regionOfStation.end(), main));
   for (std::size_t i = 0; i < s.stations.size(); ++i) {
     const auto& st = s.stations[i];
-    if (regionOfStation[i] == main || !s.map.cellAt(st.pose.position())) {
-      continue;
-    }
-    const auto c = *s.map.cellAt(st.pose.position());
-    if (s.map.blocked(c) || s.layers.noGo[s.map.index(c)] || !discFits(g, st.pose.position(), r)) {
-      continue;  // already reported
+    if (!placed[i] || regionOfStation[i] == main) {
+      continue;  // fine, or already reported
     }
     out.push_back({"stations[" + std::to_string(i) + "].pose",
                    "station '" + st.name + "' is unreachable for a robot of radius " + fmt(r) +

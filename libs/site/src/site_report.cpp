@@ -1,7 +1,6 @@
 #include "fleet/site/site_report.hpp"
 
 #include <algorithm>
-#include <map>
 #include <sstream>
 
 #include "fleet/site/reachability.hpp"
@@ -35,21 +34,11 @@ SiteReport analyseSite(const Site& site, double radius) {
   for (std::int32_t l = 1; l <= static_cast<std::int32_t>(regions.count()); ++l) {
     r.floorArea = std::max(r.floorArea, regions.area(l));
   }
-  // Same floor rule as checkSite: the region holding most stations.
-  std::map<std::int32_t, std::size_t> count;
   std::vector<std::int32_t> reg;
   for (const auto& st : s.stations) {
     reg.push_back(regionOf(g, regions, st.pose.position(), r.radius));
-    ++count[reg.back()];
   }
-  std::int32_t floor = 0;
-  std::size_t most = 0;
-  for (const auto& [l, n] : count) {
-    if (l != 0 && n > most) {
-      floor = l;
-      most = n;
-    }
-  }
+  const std::int32_t floor = floorRegion(regions, reg);
   for (std::size_t i = 0; i < s.stations.size(); ++i) {
     const auto& st = s.stations[i];
     StationReach sr;

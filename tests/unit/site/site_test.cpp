@@ -214,7 +214,16 @@ TEST(Reachability, RegionsAgreeWithABruteForceSweepOnRandomMaps) {
   }
 }
 
-TEST(Reachability, GrowingTheRadiusNeverJoinsRegions) {
+TEST(Reachability, TheFloorIsTheRegionWithMostStationsAndOnATieTheLarger) {
+  DiscRegions r;
+  r.size = {0, 5, 9, 7};
+  EXPECT_EQ(floorRegion(r, {1, 2}), 2);        // one station each: the larger region
+  EXPECT_EQ(floorRegion(r, {1, 1, 2}), 1);     // most stations wins over size
+  EXPECT_EQ(floorRegion(r, {3, 0, 3, 2}), 3);  // a walled-in station (0) counts for no region
+  EXPECT_EQ(floorRegion(r, {0, 0}), 0);
+}
+
+TEST(Reachability, GrowingTheRadiusNeverGrowsTheDrivableArea) {
   const auto g = gridOf({"@@@@@@@@@@@@", "@.......@..@", "@.......@..@", "@..@@@@.....", "@..@@@@.@@@@",
                          "@..........@", "@..........@", "@@@@@@@@@@@@"});
   double previousArea = 1e300;

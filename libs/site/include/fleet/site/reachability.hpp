@@ -44,6 +44,11 @@ DiscRegions discRegions(const planning::OccupancyGrid& g, double radius);
 /// reachable from it on a straight segment; 0 when the disc does not fit at `p` or is walled in.
 std::int32_t regionOf(const planning::OccupancyGrid& g, const DiscRegions& r, Vec2 p, double radius);
 
+/// The site's floor: of the regions the stations stand in (`stationRegions`, 0 = none), the one
+/// holding most of them, the larger on a tie; 0 when no station is in any region. A station
+/// elsewhere is cut off from the others.
+std::int32_t floorRegion(const DiscRegions& r, const std::vector<std::int32_t>& stationRegions);
+
 /// Plain 4-connected components of the free cells (what cell connectivity alone would say); one
 /// lattice point per cell centre.
 DiscRegions cellRegions(const planning::OccupancyGrid& g);
