@@ -161,7 +161,9 @@ TEST(FleetCharging, LowRobotFinishesItsTaskThenChargesToTheTargetWithoutContact)
       chargingS += dt;
       bool near = false;
       for (const auto& c : chargers) {
-        near = near || std::hypot(x - c[0], y - c[1]) < 0.5;
+        // The simulator charges within 0.5 m of the true pose; the replay rounds each coordinate to
+        // 1 mm, so a robot charging at 0.4998 m can read 0.5002 m (a CI run failed on that).
+        near = near || std::hypot(x - c[0], y - c[1]) < 0.5 + 1e-3;
       }
       chargingFarFromAStation += near ? 0 : 1;
     }
