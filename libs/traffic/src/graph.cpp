@@ -14,7 +14,8 @@ NodeId Graph::addNode(Vec2 position) {
 }
 
 void Graph::addEdge(NodeId a, NodeId b, double duration) {
-  if (!valid(a) || !valid(b) || a == b) throw std::invalid_argument("Graph::addEdge: bad nodes");
+  if (!valid(a) || !valid(b) || a == b)
+    throw std::invalid_argument("Graph::addEdge: bad nodes");
   auto& out = edges_[static_cast<std::size_t>(a)];
   for (auto& e : out) {
     if (e.to == b) {
@@ -26,26 +27,32 @@ void Graph::addEdge(NodeId a, NodeId b, double duration) {
 }
 
 void Graph::addConflict(NodeId a, NodeId b) {
-  if (!valid(a) || !valid(b)) throw std::invalid_argument("Graph::addConflict: bad nodes");
-  if (a == b) return;
+  if (!valid(a) || !valid(b))
+    throw std::invalid_argument("Graph::addConflict: bad nodes");
+  if (a == b)
+    return;
   auto insert = [](std::vector<NodeId>& v, NodeId x) {
     auto it = std::lower_bound(v.begin(), v.end(), x);
-    if (it != v.end() && *it == x) return false;
+    if (it != v.end() && *it == x)
+      return false;
     v.insert(it, x);
     return true;
   };
-  if (insert(conflicts_[static_cast<std::size_t>(a)], b)) ++conflictCount_;
+  if (insert(conflicts_[static_cast<std::size_t>(a)], b))
+    ++conflictCount_;
   insert(conflicts_[static_cast<std::size_t>(b)], a);
 }
 
 bool Graph::conflicting(NodeId a, NodeId b) const {
-  if (a == b) return true;
+  if (a == b)
+    return true;
   const auto c = conflicts(a);
   return std::binary_search(c.begin(), c.end(), b);
 }
 
 bool Graph::setEdgeOpen(NodeId a, NodeId b, bool open) {
-  if (!valid(a)) return false;
+  if (!valid(a))
+    return false;
   for (auto& e : edges_[static_cast<std::size_t>(a)]) {
     if (e.to == b) {
       e.open = open;
@@ -56,9 +63,11 @@ bool Graph::setEdgeOpen(NodeId a, NodeId b, bool open) {
 }
 
 const Edge* Graph::edge(NodeId a, NodeId b) const {
-  if (!valid(a)) return nullptr;
+  if (!valid(a))
+    return nullptr;
   for (const auto& e : edges(a)) {
-    if (e.to == b && e.open) return &e;
+    if (e.to == b && e.open)
+      return &e;
   }
   return nullptr;
 }

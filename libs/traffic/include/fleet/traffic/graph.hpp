@@ -35,9 +35,7 @@ class Graph {
   [[nodiscard]] bool valid(NodeId v) const { return v >= 0 && static_cast<std::size_t>(v) < size(); }
   [[nodiscard]] Vec2 position(NodeId v) const { return position_[static_cast<std::size_t>(v)]; }
   /// Out-edges of v, closed ones included (check Edge::open and isOpen(to)).
-  [[nodiscard]] std::span<const Edge> edges(NodeId v) const {
-    return edges_[static_cast<std::size_t>(v)];
-  }
+  [[nodiscard]] std::span<const Edge> edges(NodeId v) const { return edges_[static_cast<std::size_t>(v)]; }
   /// The nodes other than v that a robot at v excludes, sorted.
   [[nodiscard]] std::span<const NodeId> conflicts(NodeId v) const {
     return conflicts_[static_cast<std::size_t>(v)];
@@ -55,9 +53,7 @@ class Graph {
   /// The open edge a→b, or nullptr.
   [[nodiscard]] const Edge* edge(NodeId a, NodeId b) const;
   /// An open edge from an open node to an open node.
-  [[nodiscard]] bool passable(NodeId a, const Edge& e) const {
-    return e.open && isOpen(a) && isOpen(e.to);
-  }
+  [[nodiscard]] bool passable(NodeId a, const Edge& e) const { return e.open && isOpen(a) && isOpen(e.to); }
 
  private:
   std::vector<Vec2> position_;

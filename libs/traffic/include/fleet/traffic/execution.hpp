@@ -1,0 +1,140 @@
+#pragma once
+
+// Executing a multi-robot plan on robots that are not on time: the action dependency graph of Hönig
+// et al. ("Persistent and robust execution of MAPF schedules in warehouses", RA-L 2019), grown one
+// planner step at a time for lifelong operation, and releasing each robot's route a few nodes at a
+// time as VDA 5050 orders do (a base it may drive, a horizon it may expect).
+//
+// The plan is a sequence of configurations (one node per robot per step). Each robot's route is its
+// sequence of distinct nodes; entering a route node is an action. The only dependency kept is the
+// one that matters for safety: a robot may enter node v only after every robot that stood on a node
+// conflicting with v earlier in the plan has reached the first node of its route that no longer
+// conflicts with v. Only the last visitor of each node needs to be recorded: that visitor itself
+// entered only after its predecessors had left. Dependencies point to the same or earlier plan steps,
+// so they cannot form a cycle unless one step has a cycle of robots each entering what the next one
+// leaves (a rotation); append() refuses such a step. Hence robots that only drive released nodes
+// never stand on conflicting nodes, and the execution cannot deadlock however late any robot is —
+// a late robot holds back only the robots that depend on it.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fleet/traffic/graph.hpp"
+
+namespace fleet::traffic {
+
+/// A step the plan cannot be executed with (names the robots and the nodes).
+class PlanStepError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+struct ReleaseOptions {
+  /// The base reaches at least this far (m along the route) past the robot's last reported node
+  /// when the dependencies allow: the stopping distance plus the distance driven during the
+  /// release latency, so a robot on time never brakes at the end of its base.
+  double baseAhead = 1.5;
+  /// At most this many nodes in the base (bounds how much is committed if the robot goes away).
+  std::size_t maxBaseNodes = 12;
+  /// Planned nodes after the base that are sent as the horizon (may change).
+  std::size_t horizonNodes = 8;
+};
+
+/// What a robot may drive (base) and what it may expect after that (horizon). `base.front()` is
+/// the robot's last reported node.
+struct Release {
+  std::vector<NodeId> base;
+  std::vector<NodeId> horizon;
+  std::int64_t baseEndStep = 0;  ///< plan step at which the base's last node is reached
+};
+
+enum class Report {
+  Accepted,     ///< progress moved on
+  Duplicate,    ///< the node it already reported
+  NotReleased,  ///< not among its released nodes ahead: ignored, the robot stays held
+  UnknownRobot,
+};
+const char* toString(Report r);
+
+class Execution {
+ public:
+  /// Robots start on `starts` (plan step 0); they must not conflict.
+  Execution(const Graph& graph, std::span<const NodeId> starts, ReleaseOptions options = {});
+
+  [[nodiscard]] std::size_t robots() const { return routes_.size(); }
+  /// Number of configurations appended after the start.
+  [[nodiscard]] std::int64_t plannedSteps() const { return step_; }
+
+  /// Appends the planner's next configuration (same node = the robot waits). Throws PlanStepError
+  /// naming robots and nodes when a robot moves along no open edge, two robots end on conflicting
+  /// nodes, or robots each enter what the next one leaves in a cycle; nothing is appended then.
+  void append(std::span<const NodeId> next);
+
+  /// The robot reports it has arrived at `node`. Accepted only for a released node ahead of its
+  /// last report (reports may skip nodes: reaching a node implies passing the ones before it).
+  Report reached(std::size_t robot, NodeId node);
+
+  /// Extends the robot's base as far as its dependencies and the options allow and returns it
+  /// with the horizon. Never shrinks what was released before.
+  Release release(std::size_t robot);
+
+  /// The robots whose progress the next unreleased node of `robot` waits for (empty: nothing, or
+  /// the route ends).
+  [[nodiscard]] std::vector<std::size_t> waitingOn(std::size_t robot) const;
+
+  /// Last reported node, last released node, last planned node of a robot.
+  [[nodiscard]] NodeId at(std::size_t robot) const;
+  [[nodiscard]] NodeId releasedEnd(std::size_t robot) const;
+  [[nodiscard]] NodeId plannedEnd(std::size_t robot) const;
+  /// Plan step of the robot's last reported node (how far along the plan it is).
+  [[nodiscard]] std::int64_t progressStep(std::size_t robot) const;
+  /// Route nodes planned but not yet reported (including released ones).
+  [[nodiscard]] std::size_t pendingNodes(std::size_t robot) const;
+
+  /// Drops every planned node that was not released yet, so the planner can start again from
+  /// the released ends (returned, one per robot; they never conflict). Dependencies of what stays
+  /// released are kept.
+  std::vector<NodeId> truncateToReleased();
+
+ private:
+  struct Dependency {
+    std::uint32_t robot;
+    std::int64_t index;  ///< that robot must have reached route index >= this
+  };
+  struct Entry {
+    NodeId node;
+    std::int64_t step;
+    double distance;  ///< m from the previous route node
+    std::vector<Dependency> deps;
+  };
+  struct Route {
+    std::vector<Entry> entries;  ///< entries_[i] is route index first + i
+    std::int64_t first = 0;      ///< route index of entries.front()
+    std::int64_t progress = 0;   ///< last reported route index
+    std::int64_t released = 0;   ///< last released route index
+    [[nodiscard]] std::int64_t last() const { return first + static_cast<std::int64_t>(entries.size()) - 1; }
+    [[nodiscard]] const Entry& operator[](std::int64_t i) const {
+      return entries[static_cast<std::size_t>(i - first)];
+    }
+  };
+  struct Visit {
+    std::int32_t robot = -1;
+    std::int64_t index = 0;
+  };
+
+  [[nodiscard]] bool satisfied(const Entry& e) const;
+  void prune(std::size_t robot);
+  void rebuildVisitors();
+
+  const Graph& graph_;
+  ReleaseOptions options_;
+  std::vector<Route> routes_;
+  std::vector<Visit> lastVisit_;  ///< per node: the robot that entered it last in the plan
+  std::int64_t step_ = 0;
+};
+
+}  // namespace fleet::traffic

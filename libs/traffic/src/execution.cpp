@@ -1,0 +1,290 @@
+#include "fleet/traffic/execution.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+namespace fleet::traffic {
+
+const char* toString(Report r) {
+  switch (r) {
+    case Report::Accepted:
+      return "accepted";
+    case Report::Duplicate:
+      return "duplicate";
+    case Report::NotReleased:
+      return "not released";
+    case Report::UnknownRobot:
+      return "unknown robot";
+  }
+  return "?";
+}
+
+Execution::Execution(const Graph& graph, std::span<const NodeId> starts, ReleaseOptions options)
+    : graph_(graph), options_(options), lastVisit_(graph.size()) {
+  routes_.resize(starts.size());
+  for (std::size_t r = 0; r < starts.size(); ++r) {
+    if (!graph_.valid(starts[r])) {
+      throw PlanStepError("robot " + std::to_string(r) + " starts on node " + std::to_string(starts[r]) +
+                          ", which is not on the graph");
+    }
+    for (std::size_t q = 0; q < r; ++q) {
+      if (graph_.conflicting(starts[q], starts[r])) {
+        throw PlanStepError("robots " + std::to_string(q) + " and " + std::to_string(r) +
+                            " start on conflicting nodes " + std::to_string(starts[q]) + " and " +
+                            std::to_string(starts[r]));
+      }
+    }
+    routes_[r].entries.push_back(Entry{starts[r], 0, 0.0, {}});
+    lastVisit_[static_cast<std::size_t>(starts[r])] = Visit{static_cast<std::int32_t>(r), 0};
+  }
+}
+
+void Execution::append(std::span<const NodeId> next) {
+  const std::size_t n = routes_.size();
+  if (next.size() != n) {
+    throw PlanStepError("a plan step has " + std::to_string(next.size()) + " nodes for " + std::to_string(n) +
+                        " robots");
+  }
+  auto fail = [](const std::string& what) { throw PlanStepError("plan step refused: " + what); };
+  // Moves along the graph.
+  std::vector<std::size_t> movers;
+  for (std::size_t r = 0; r < n; ++r) {
+    const NodeId from = routes_[r].entries.back().node;
+    const NodeId to = next[r];
+    if (!graph_.valid(to))
+      fail("robot " + std::to_string(r) + " to node " + std::to_string(to) + " off the graph");
+    if (to == from)
+      continue;
+    const Edge* e = graph_.edge(from, to);
+    if (e == nullptr || !graph_.isOpen(to)) {
+      fail("robot " + std::to_string(r) + " from node " + std::to_string(from) + " to " + std::to_string(to) +
+           ": no open edge");
+    }
+    movers.push_back(r);
+  }
+  // The configuration is conflict-free (pairs only meet through a node or its conflict set).
+  std::vector<std::pair<NodeId, std::size_t>> at;
+  at.reserve(n);
+  for (std::size_t r = 0; r < n; ++r)
+    at.emplace_back(next[r], r);
+  std::sort(at.begin(), at.end());
+  for (std::size_t i = 1; i < n; ++i) {
+    if (at[i].first == at[i - 1].first) {
+      fail("robots " + std::to_string(at[i - 1].second) + " and " + std::to_string(at[i].second) +
+           " on node " + std::to_string(at[i].first));
+    }
+  }
+  auto robotOn = [&](NodeId v) -> std::int64_t {
+    auto it = std::lower_bound(at.begin(), at.end(), std::pair<NodeId, std::size_t>{v, 0});
+    return (it != at.end() && it->first == v) ? static_cast<std::int64_t>(it->second) : -1;
+  };
+  if (graph_.hasConflicts()) {
+    for (std::size_t r = 0; r < n; ++r) {
+      for (NodeId x : graph_.conflicts(next[r])) {
+        const auto q = robotOn(x);
+        if (q >= 0 && static_cast<std::size_t>(q) != r) {
+          fail("robots " + std::to_string(r) + " and " + std::to_string(q) + " on conflicting nodes " +
+               std::to_string(next[r]) + " and " + std::to_string(x));
+        }
+      }
+    }
+  }
+  // New entries first, so a dependency can point at a move of this same step.
+  const std::int64_t step = step_ + 1;
+  for (std::size_t r : movers) {
+    auto& route = routes_[r];
+    const NodeId from = route.entries.back().node;
+    route.entries.push_back(
+        Entry{next[r], step, (graph_.position(next[r]) - graph_.position(from)).norm(), {}});
+  }
+  auto undo = [&] {
+    for (std::size_t r : movers)
+      routes_[r].entries.pop_back();
+  };
+  // Dependencies: wait until the last visitor of every node excluding the target has moved on to
+  // the first node of its route that no longer conflicts with the target.
+  std::vector<std::int64_t> need(n, -1);
+  std::vector<std::vector<std::size_t>> sameStep(n);
+  for (std::size_t r : movers) {
+    auto& entry = routes_[r].entries.back();
+    const NodeId v = entry.node;
+    std::fill(need.begin(), need.end(), -1);
+    auto visitor = [&](NodeId x) {
+      const Visit lv = lastVisit_[static_cast<std::size_t>(x)];
+      if (lv.robot < 0 || static_cast<std::size_t>(lv.robot) == r)
+        return;
+      const auto q = static_cast<std::size_t>(lv.robot);
+      const Route& qr = routes_[q];
+      std::int64_t i = std::max(lv.index + 1, qr.first);
+      while (i <= qr.last() && graph_.conflicting(qr[i].node, v))
+        ++i;
+      // i <= last: the configuration check guarantees q's current node does not conflict.
+      need[q] = std::max(need[q], i);
+    };
+    visitor(v);
+    for (NodeId x : graph_.conflicts(v))
+      visitor(x);
+    for (std::size_t q = 0; q < n; ++q) {
+      if (need[q] < 0 || routes_[q].progress >= need[q])
+        continue;
+      entry.deps.push_back(Dependency{static_cast<std::uint32_t>(q), need[q]});
+      const bool movesNow = routes_[q].entries.back().step == step;
+      if (movesNow && need[q] == routes_[q].last())
+        sameStep[r].push_back(q);
+    }
+  }
+  // A cycle of same-step dependencies (a rotation, or a swap) could never be executed.
+  std::vector<std::uint8_t> mark(n, 0);  // 0 new, 1 on the stack, 2 done
+  std::vector<std::size_t> cycle;
+  auto dfs = [&](auto&& self, std::size_t r) -> bool {
+    mark[r] = 1;
+    cycle.push_back(r);
+    for (std::size_t q : sameStep[r]) {
+      if (mark[q] == 1) {
+        cycle.push_back(q);
+        return true;
+      }
+      if (mark[q] == 0 && self(self, q))
+        return true;
+    }
+    mark[r] = 2;
+    cycle.pop_back();
+    return false;
+  };
+  for (std::size_t r : movers) {
+    if (mark[r] == 0 && dfs(dfs, r)) {
+      undo();
+      std::ostringstream os;
+      os << "robots";
+      for (std::size_t q : cycle)
+        os << ' ' << q;
+      os << " each enter what the next one leaves (a cycle cannot be executed)";
+      fail(os.str());
+    }
+  }
+  for (std::size_t r : movers) {
+    const auto& route = routes_[r];
+    lastVisit_[static_cast<std::size_t>(route.entries.back().node)] =
+        Visit{static_cast<std::int32_t>(r), route.last()};
+  }
+  step_ = step;
+}
+
+bool Execution::satisfied(const Entry& e) const {
+  return std::all_of(e.deps.begin(), e.deps.end(),
+                     [&](const Dependency& d) { return routes_[d.robot].progress >= d.index; });
+}
+
+Report Execution::reached(std::size_t robot, NodeId node) {
+  if (robot >= routes_.size())
+    return Report::UnknownRobot;
+  auto& route = routes_[robot];
+  if (route[route.progress].node == node)
+    return Report::Duplicate;
+  for (std::int64_t i = route.progress + 1; i <= route.released; ++i) {
+    if (route[i].node == node) {
+      route.progress = i;
+      prune(robot);
+      return Report::Accepted;
+    }
+  }
+  return Report::NotReleased;
+}
+
+void Execution::prune(std::size_t robot) {
+  auto& route = routes_[robot];
+  const auto drop = route.progress - route.first;
+  if (drop <= 0)
+    return;
+  route.entries.erase(route.entries.begin(), route.entries.begin() + drop);
+  route.first = route.progress;
+}
+
+Release Execution::release(std::size_t robot) {
+  Release out;
+  if (robot >= routes_.size())
+    return out;
+  auto& route = routes_[robot];
+  double ahead = 0.0;
+  for (std::int64_t i = route.progress + 1; i <= route.released; ++i)
+    ahead += route[i].distance;
+  while (route.released < route.last() && ahead < options_.baseAhead &&
+         static_cast<std::size_t>(route.released - route.progress) < options_.maxBaseNodes) {
+    const Entry& e = route[route.released + 1];
+    if (!satisfied(e))
+      break;
+    ++route.released;
+    ahead += e.distance;
+  }
+  for (std::int64_t i = route.progress; i <= route.released; ++i)
+    out.base.push_back(route[i].node);
+  const std::int64_t end =
+      std::min(route.last(), route.released + static_cast<std::int64_t>(options_.horizonNodes));
+  for (std::int64_t i = route.released + 1; i <= end; ++i)
+    out.horizon.push_back(route[i].node);
+  out.baseEndStep = route[route.released].step;
+  return out;
+}
+
+std::vector<std::size_t> Execution::waitingOn(std::size_t robot) const {
+  std::vector<std::size_t> out;
+  if (robot >= routes_.size())
+    return out;
+  const auto& route = routes_[robot];
+  if (route.released >= route.last())
+    return out;
+  for (const auto& d : route[route.released + 1].deps) {
+    if (routes_[d.robot].progress < d.index)
+      out.push_back(d.robot);
+  }
+  return out;
+}
+
+NodeId Execution::at(std::size_t robot) const {
+  return routes_.at(robot)[routes_[robot].progress].node;
+}
+NodeId Execution::releasedEnd(std::size_t robot) const {
+  return routes_.at(robot)[routes_[robot].released].node;
+}
+NodeId Execution::plannedEnd(std::size_t robot) const {
+  return routes_.at(robot).entries.back().node;
+}
+std::int64_t Execution::progressStep(std::size_t robot) const {
+  return routes_.at(robot)[routes_[robot].progress].step;
+}
+std::size_t Execution::pendingNodes(std::size_t robot) const {
+  const auto& route = routes_.at(robot);
+  return static_cast<std::size_t>(route.last() - route.progress);
+}
+
+std::vector<NodeId> Execution::truncateToReleased() {
+  std::vector<NodeId> ends;
+  for (auto& route : routes_) {
+    route.entries.resize(static_cast<std::size_t>(route.released - route.first + 1));
+    ends.push_back(route.entries.back().node);
+  }
+  rebuildVisitors();
+  return ends;
+}
+
+void Execution::rebuildVisitors() {
+  struct Item {
+    std::int64_t step;
+    std::int32_t robot;
+    std::int64_t index;
+    NodeId node;
+  };
+  std::vector<Item> items;
+  for (std::size_t r = 0; r < routes_.size(); ++r) {
+    const auto& route = routes_[r];
+    for (std::int64_t i = route.first; i <= route.last(); ++i) {
+      items.push_back(Item{route[i].step, static_cast<std::int32_t>(r), i, route[i].node});
+    }
+  }
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.step < b.step; });
+  std::fill(lastVisit_.begin(), lastVisit_.end(), Visit{});
+  for (const auto& it : items)
+    lastVisit_[static_cast<std::size_t>(it.node)] = Visit{it.robot, it.index};
+}
+
+}  // namespace fleet::traffic

@@ -1,0 +1,277 @@
+#include "fleet/traffic/execution.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace fleet::traffic {
+namespace {
+
+/// A w×h 4-connected grid with unit spacing; `exclusion` > 0 makes every node exclude the nodes
+/// within that many cells (Chebyshev), as a roadmap's footprint does.
+Graph grid(int w, int h, int exclusion = 0, const std::vector<int>& blocked = {}) {
+  Graph g;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x)
+      g.addNode({static_cast<double>(x), static_cast<double>(y)});
+  }
+  auto id = [w](int x, int y) { return static_cast<NodeId>(y * w + x); };
+  auto free = [&](NodeId v) { return std::find(blocked.begin(), blocked.end(), v) == blocked.end(); };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (!free(id(x, y))) {
+        g.setOpen(id(x, y), false);
+        continue;
+      }
+      if (x + 1 < w && free(id(x + 1, y))) {
+        g.addEdge(id(x, y), id(x + 1, y));
+        g.addEdge(id(x + 1, y), id(x, y));
+      }
+      if (y + 1 < h && free(id(x, y + 1))) {
+        g.addEdge(id(x, y), id(x, y + 1));
+        g.addEdge(id(x, y + 1), id(x, y));
+      }
+      for (int dy = -exclusion; dy <= exclusion; ++dy) {
+        for (int dx = -exclusion; dx <= exclusion; ++dx) {
+          const int X = x + dx, Y = y + dy;
+          if (X >= 0 && Y >= 0 && X < w && Y < h && (dx || dy))
+            g.addConflict(id(x, y), id(X, Y));
+        }
+      }
+    }
+  }
+  return g;
+}
+
+TEST(Execution, AFollowerEntersOnlyAfterTheLeaderHasLeft) {
+  const Graph g = grid(4, 1);
+  const std::vector<NodeId> start{1, 0};  // robot 0 leads, robot 1 follows in the same step
+  Execution ex(g, start);
+  ex.append(std::vector<NodeId>{2, 1});
+  ex.append(std::vector<NodeId>{3, 2});
+  EXPECT_EQ(ex.plannedSteps(), 2);
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0}));
+  EXPECT_EQ(ex.waitingOn(1), (std::vector<std::size_t>{0}));
+  const auto lead = ex.release(0);
+  EXPECT_EQ(lead.base, (std::vector<NodeId>{1, 2, 3}));  // nothing ahead of the leader waits
+  EXPECT_TRUE(lead.horizon.empty());
+  EXPECT_EQ(lead.baseEndStep, 2);
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0}));  // released is not reached
+  ASSERT_EQ(ex.reached(0, 2), Report::Accepted);
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0, 1}));  // node 2 waits for the leader again
+  EXPECT_EQ(ex.release(1).horizon, (std::vector<NodeId>{2}));
+  EXPECT_EQ(ex.waitingOn(1), (std::vector<std::size_t>{0}));
+  ASSERT_EQ(ex.reached(0, 3), Report::Accepted);
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0, 1, 2}));
+  EXPECT_TRUE(ex.waitingOn(1).empty());
+}
+
+TEST(Execution, RefusedStepsNameTheRobotsAndChangeNothing) {
+  const Graph g = grid(3, 3);
+  Execution ex(g, std::vector<NodeId>{0, 1});
+  auto refused = [&](std::vector<NodeId> next, const std::string& what) {
+    try {
+      ex.append(next);
+      ADD_FAILURE() << "accepted a step with " << what;
+    } catch (const PlanStepError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(ex.plannedSteps(), 0);
+    EXPECT_EQ(ex.plannedEnd(0), 0);
+    EXPECT_EQ(ex.plannedEnd(1), 1);
+  };
+  refused({1, 0}, "each enter what the next one leaves");  // a swap
+  refused({1, 1}, "on node 1");
+  refused({8, 1}, "no open edge");
+  refused({0}, "1 nodes for 2 robots");
+  refused({0, 99}, "off the graph");
+  EXPECT_THROW(Execution(g, std::vector<NodeId>{4, 4}), PlanStepError);
+}
+
+TEST(Execution, ARotationIsRefused) {
+  const Graph g = grid(2, 2);  // nodes 0 1 / 2 3, a cycle 0-1-3-2
+  Execution ex(g, std::vector<NodeId>{0, 1, 3, 2});
+  EXPECT_THROW(ex.append(std::vector<NodeId>{1, 3, 2, 0}), PlanStepError);
+  ex.append(std::vector<NodeId>{0, 1, 3, 2});  // all wait: fine
+  EXPECT_EQ(ex.plannedSteps(), 1);
+}
+
+TEST(Execution, ConflictSetsKeepRobotsApartNotOnlyNodes) {
+  const Graph g = grid(5, 1, 1);  // a node excludes its neighbours
+  Execution ex(g, std::vector<NodeId>{2, 0});
+  EXPECT_THROW(ex.append(std::vector<NodeId>{2, 1}), PlanStepError);
+  ex.append(std::vector<NodeId>{3, 0});
+  ex.append(std::vector<NodeId>{4, 1});  // follows at a distance of two nodes
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0}));
+  ex.release(0);
+  ASSERT_EQ(ex.reached(0, 3), Report::Accepted);  // 3 excludes 2 and 4, no longer 1
+  EXPECT_EQ(ex.release(1).base, (std::vector<NodeId>{0, 1}));
+}
+
+TEST(Execution, BadReportsAreRefusedAndTheRobotStaysHeld) {
+  const Graph g = grid(6, 1);
+  Execution ex(g, std::vector<NodeId>{0}, ReleaseOptions{2.0, 12, 8});
+  for (NodeId v = 1; v < 6; ++v)
+    ex.append(std::vector<NodeId>{v});
+  EXPECT_EQ(ex.reached(0, 1), Report::NotReleased);  // nothing released yet
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{0, 1, 2}));
+  EXPECT_EQ(ex.reached(0, 5), Report::NotReleased);
+  EXPECT_EQ(ex.reached(3, 1), Report::UnknownRobot);
+  EXPECT_EQ(ex.reached(0, 0), Report::Duplicate);
+  EXPECT_EQ(ex.reached(0, 2), Report::Accepted);     // skipping a node's report is fine
+  EXPECT_EQ(ex.reached(0, 1), Report::NotReleased);  // out of order: behind it
+  EXPECT_EQ(ex.at(0), 2);
+  EXPECT_EQ(ex.progressStep(0), 2);
+}
+
+/// Random plans executed by robots that are late at random: at every tick no two robots occupy
+/// conflicting nodes (a moving robot occupies both ends of its edge), and every route is driven to
+/// its end (no deadlock). Plans are drawn step by step as a planner would: robots decide in random
+/// order, a robot may follow one that decided to move away, and half-way the unreleased plan is
+/// dropped and planning starts again from the released ends.
+void randomExecution(int exclusion, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  const int w = 12, h = 9;
+  std::vector<int> blocked;
+  for (int i = 0; i < 14; ++i)
+    blocked.push_back(static_cast<int>(rng() % (w * h)));
+  const Graph g = grid(w, h, exclusion, blocked);
+  // Starts: free nodes that do not conflict.
+  std::vector<NodeId> pos;
+  std::vector<NodeId> order(g.size());
+  for (std::size_t i = 0; i < g.size(); ++i)
+    order[i] = static_cast<NodeId>(i);
+  std::shuffle(order.begin(), order.end(), rng);
+  const std::size_t robots = exclusion ? 7 : 18;
+  for (NodeId v : order) {
+    if (pos.size() == robots)
+      break;
+    if (!g.isOpen(v))
+      continue;
+    if (std::none_of(pos.begin(), pos.end(), [&](NodeId p) { return g.conflicting(p, v); }))
+      pos.push_back(v);
+  }
+  ASSERT_EQ(pos.size(), robots);
+  Execution ex(g, pos, ReleaseOptions{2.0, 4, 3});
+
+  auto planSteps = [&](int steps) {
+    for (int s = 0; s < steps; ++s) {
+      std::vector<NodeId> next(robots, kNoNode);
+      std::vector<std::size_t> turn(robots);
+      for (std::size_t r = 0; r < robots; ++r)
+        turn[r] = r;
+      std::shuffle(turn.begin(), turn.end(), rng);
+      for (std::size_t r : turn) {
+        std::vector<NodeId> cand{pos[r]};
+        for (const auto& e : g.edges(pos[r])) {
+          if (g.passable(pos[r], e))
+            cand.push_back(e.to);
+        }
+        std::shuffle(cand.begin() + 1, cand.end(), rng);
+        std::rotate(cand.begin(), cand.begin() + 1, cand.end());  // waiting is the last resort
+        for (NodeId c : cand) {
+          bool ok = true;
+          for (std::size_t q = 0; q < robots && ok; ++q) {
+            if (q == r)
+              continue;
+            if (next[q] != kNoNode) {
+              ok = !g.conflicting(next[q], c);  // decided robots: their next node
+            } else {
+              ok = !g.conflicting(pos[q], c);  // undecided robots may stay
+            }
+          }
+          if (ok) {
+            next[r] = c;
+            break;
+          }
+        }
+        ASSERT_NE(next[r], kNoNode);  // waiting is always possible
+      }
+      ex.append(next);
+      pos = next;
+    }
+  };
+
+  // Execution: a moving robot takes 1-4 ticks per edge.
+  std::vector<NodeId> at(robots), target(robots, kNoNode);
+  std::vector<int> left(robots, 0);
+  for (std::size_t r = 0; r < robots; ++r)
+    at[r] = ex.at(r);
+  auto occupied = [&](std::size_t r) {
+    std::vector<NodeId> o{at[r]};
+    if (target[r] != kNoNode)
+      o.push_back(target[r]);
+    return o;
+  };
+  auto checkApart = [&](int tick) {
+    for (std::size_t a = 0; a < robots; ++a) {
+      for (std::size_t b = a + 1; b < robots; ++b) {
+        for (NodeId x : occupied(a)) {
+          for (NodeId y : occupied(b)) {
+            ASSERT_FALSE(g.conflicting(x, y))
+                << "tick " << tick << ": robots " << a << " and " << b << " on " << x << " and " << y;
+          }
+        }
+      }
+    }
+  };
+  auto drive = [&](int ticks, int& tick) {
+    for (int t = 0; t < ticks; ++t, ++tick) {
+      for (std::size_t r = 0; r < robots; ++r) {
+        if (target[r] != kNoNode) {
+          if (--left[r] == 0) {
+            at[r] = target[r];
+            target[r] = kNoNode;
+            ASSERT_EQ(ex.reached(r, at[r]), Report::Accepted);
+          }
+          continue;
+        }
+        if (rng() % 3 == 0)
+          continue;  // late
+        const auto rel = ex.release(r);
+        ASSERT_EQ(rel.base.front(), at[r]);
+        if (rel.base.size() > 1) {
+          target[r] = rel.base[1];
+          left[r] = 1 + static_cast<int>(rng() % 4);
+        }
+      }
+      checkApart(tick);
+    }
+  };
+  int tick = 0;
+  planSteps(40);
+  drive(60, tick);
+  pos = ex.truncateToReleased();
+  planSteps(40);
+  // Drive until every robot has reached the end of its route.
+  for (int round = 0; round < 400; ++round) {
+    bool done = true;
+    for (std::size_t r = 0; r < robots; ++r)
+      done = done && ex.pendingNodes(r) == 0 && target[r] == kNoNode;
+    if (done)
+      return;
+    drive(1, tick);
+  }
+  for (std::size_t r = 0; r < robots; ++r) {
+    ADD_FAILURE() << "robot " << r << " stuck with " << ex.pendingNodes(r) << " nodes to go, waiting on "
+                  << ex.waitingOn(r).size() << " robots";
+  }
+}
+
+TEST(Execution, RandomPlansLateRobotsNeverMeetNorDeadlockOnAGrid) {
+  for (std::uint32_t seed = 1; seed <= 25; ++seed) {
+    SCOPED_TRACE(seed);
+    randomExecution(0, seed);
+  }
+}
+
+TEST(Execution, RandomPlansLateRobotsNeverMeetNorDeadlockWithFootprints) {
+  for (std::uint32_t seed = 1; seed <= 25; ++seed) {
+    SCOPED_TRACE(seed);
+    randomExecution(1, seed);
+  }
+}
+
+}  // namespace
+}  // namespace fleet::traffic
