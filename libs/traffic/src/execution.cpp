@@ -257,6 +257,11 @@ std::size_t Execution::pendingNodes(std::size_t robot) const {
   return static_cast<std::size_t>(route.last() - route.progress);
 }
 
+void Execution::retract(std::size_t robot) {
+  auto& route = routes_.at(robot);
+  route.released = std::min(route.released, route.progress + 1);
+}
+
 std::vector<NodeId> Execution::truncateToReleased() {
   std::vector<NodeId> ends;
   for (auto& route : routes_) {

@@ -399,4 +399,99 @@ msg::GroundTruth Traits<msg::GroundTruth>::fromC(const C& in) {
   return m;
 }
 
+// ---- Traffic
+namespace {
+fleet_RouteNode putNode(const msg::RouteNode& n) {
+  return {n.node, n.x, n.y};
+}
+msg::RouteNode getNode(const fleet_RouteNode& c) {
+  return {c.node, c.x, c.y};
+}
+}  // namespace
+
+void Traits<msg::Roadmap>::toC(const msg::Roadmap& in, C& out, Arena& arena) {
+  putStr(out.site, in.site, "Roadmap.site");
+  out.epoch = in.epoch;
+  out.revision = in.revision;
+  if (in.kinds.size() != in.nodes.size() || in.open.size() != in.nodes.size()) {
+    throw MessageError("Roadmap: kinds and open must have one entry per node");
+  }
+  putSeq(out.nodes, in.nodes, 0, arena, "Roadmap.nodes",
+         [](const msg::RouteNode& n, fleet_RouteNode& c) { c = putNode(n); });
+  putSeq(out.kinds, in.kinds, 0, arena, "Roadmap.kinds", [](std::uint8_t k, std::uint8_t& c) { c = k; });
+  putSeq(out.open, in.open, 0, arena, "Roadmap.open", [](bool o, bool& c) { c = o; });
+  putSeq(out.edges, in.edges, 0, arena, "Roadmap.edges", [](const msg::RoadmapEdge& e, fleet_RoadmapEdge& c) {
+    c = fleet_RoadmapEdge{e.from, e.to, e.duration_s, e.open};
+  });
+  out.stamp_ns = in.stamp_ns;
+}
+msg::Roadmap Traits<msg::Roadmap>::fromC(const C& in) {
+  msg::Roadmap m;
+  m.site = getStr(in.site);
+  m.epoch = in.epoch;
+  m.revision = in.revision;
+  m.nodes = getSeq(in.nodes, getNode);
+  m.kinds = getSeq(in.kinds, [](std::uint8_t k) { return k; });
+  m.open = getSeq(in.open, [](bool o) { return o; });
+  m.edges = getSeq(in.edges, [](const fleet_RoadmapEdge& c) {
+    return msg::RoadmapEdge{c.from, c.to, c.duration_s, c.open};
+  });
+  m.stamp_ns = in.stamp_ns;
+  return m;
+}
+
+void Traits<msg::TrafficRelease>::toC(const msg::TrafficRelease& in, C& out, Arena& arena) {
+  putStr(out.robot_id, in.robot_id, "TrafficRelease.robot_id");
+  out.epoch = in.epoch;
+  out.seq = in.seq;
+  putSeq(out.base, in.base, 64, arena, "TrafficRelease.base",
+         [](const msg::RouteNode& n, fleet_RouteNode& c) { c = putNode(n); });
+  putSeq(out.horizon, in.horizon, 32, arena, "TrafficRelease.horizon",
+         [](const msg::RouteNode& n, fleet_RouteNode& c) { c = putNode(n); });
+  out.ends_at_goal = in.ends_at_goal;
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TrafficRelease Traits<msg::TrafficRelease>::fromC(const C& in) {
+  msg::TrafficRelease m;
+  m.robot_id = getStr(in.robot_id);
+  m.epoch = in.epoch;
+  m.seq = in.seq;
+  m.base = getSeq(in.base, getNode);
+  m.horizon = getSeq(in.horizon, getNode);
+  m.ends_at_goal = in.ends_at_goal;
+  m.stamp_ns = in.stamp_ns;
+  return m;
+}
+
+void Traits<msg::TrafficProgress>::toC(const msg::TrafficProgress& in, C& out, Arena&) {
+  putStr(out.robot_id, in.robot_id, "TrafficProgress.robot_id");
+  out.epoch = in.epoch;
+  out.node = in.node;
+  out.pose = putPose(in.pose);
+  out.has_goal = in.has_goal;
+  out.goal = putPose(in.goal);
+  putStr(out.goal_station, in.goal_station, "TrafficProgress.goal_station");
+  out.priority = in.priority;
+  out.holding = in.holding;
+  out.blocked = in.blocked;
+  out.follows = in.follows;
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TrafficProgress Traits<msg::TrafficProgress>::fromC(const C& in) {
+  msg::TrafficProgress m;
+  m.robot_id = getStr(in.robot_id);
+  m.epoch = in.epoch;
+  m.node = in.node;
+  m.pose = getPose(in.pose);
+  m.has_goal = in.has_goal;
+  m.goal = getPose(in.goal);
+  m.goal_station = getStr(in.goal_station);
+  m.priority = in.priority;
+  m.holding = in.holding;
+  m.blocked = in.blocked;
+  m.follows = in.follows;
+  m.stamp_ns = in.stamp_ns;
+  return m;
+}
+
 }  // namespace fleet::transport

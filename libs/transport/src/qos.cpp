@@ -62,6 +62,15 @@ QosProfile clock() {
 QosProfile groundTruth() {
   return {true, false, 64, 0, 1000};
 }
+QosProfile roadmap() {
+  return {true, true, 1, 0, 1000};
+}
+QosProfile trafficRelease() {
+  return {true, true, 1, 0, 1000};
+}
+QosProfile trafficProgress() {
+  return {true, true, 1, 0, 1000};
+}
 
 bool byName(std::string_view name, QosProfile& out) {
   const std::string n(name);
@@ -91,6 +100,12 @@ bool byName(std::string_view name, QosProfile& out) {
     out = clock();
   else if (n == "ground_truth")
     out = groundTruth();
+  else if (n == "roadmap")
+    out = roadmap();
+  else if (n == "traffic_release")
+    out = trafficRelease();
+  else if (n == "traffic_progress")
+    out = trafficProgress();
   else
     return false;
   return true;

@@ -214,3 +214,37 @@ TEST_F(RoundTrip, GroundTruth) {
   g.contacts.push_back({kNonAscii, "b2", 0.2});
   expectRoundTrip<msg::GroundTruth>({msg::GroundTruth{}, g});
 }
+
+TEST_F(RoundTrip, Traffic) {
+  msg::Roadmap m{"small-warehouse", 3, 7, {}, {}, {}, {}, 99};
+  for (int i = 0; i < 3000; ++i) {
+    m.nodes.push_back({i, i * 0.5, -i * 0.25});
+    m.kinds.push_back(static_cast<std::uint8_t>(i % 6));
+    m.open.push_back(i % 7 != 0);
+    m.edges.push_back({i, (i + 1) % 3000, 0.625F, i % 5 != 0});
+  }
+  expectRoundTrip<msg::Roadmap>({m});  // keep-last 1, no key: one sample
+
+  msg::TrafficRelease full{maxId(), 4294967295U, 12, {}, {}, true, -5};
+  for (int i = 0; i < 64; ++i)
+    full.base.push_back({i, i * 0.1, 2.0});
+  for (int i = 0; i < 32; ++i)
+    full.horizon.push_back({100 + i, -1.0, i * 0.1});
+  expectRoundTrip<msg::TrafficRelease>({msg::TrafficRelease{"r-1", 1, 1, {}, {}, false, 0}, full});
+
+  msg::TrafficProgress p{"r-1", 2, 17, {1, 2, 0.5}, true, {3, 4, -1}, "P-1", -3, true, false, true, 42};
+  msg::TrafficProgress q{kNonAscii, 0, -1, {}, false, {}, "", 0, false, true, false, 0};
+  expectRoundTrip<msg::TrafficProgress>({p, q});
+}
+
+TEST(Traffic, OversizedReleasesAreRefusedNamingTheField) {
+  msg::TrafficRelease r{"r-1", 1, 1, std::vector<msg::RouteNode>(65), {}, false, 0};
+  Arena arena;
+  fleet_TrafficRelease c{};
+  try {
+    Traits<msg::TrafficRelease>::toC(r, c, arena);
+    ADD_FAILURE() << "65 base nodes accepted";
+  } catch (const MessageError& e) {
+    EXPECT_NE(std::string(e.what()).find("TrafficRelease.base"), std::string::npos) << e.what();
+  }
+}

@@ -100,6 +100,12 @@ class Execution {
   /// released are kept.
   std::vector<NodeId> truncateToReleased();
 
+  /// A robot that stops following its route (faulted, held by a person, taken over): cuts what was
+  /// released to it back to the node it may be driving into (its next one after the last reported),
+  /// so the others' routes can be planned around where it really is. Call truncateToReleased()
+  /// after it. Robots must then be sent the shorter release.
+  void retract(std::size_t robot);
+
  private:
   struct Dependency {
     std::uint32_t robot;

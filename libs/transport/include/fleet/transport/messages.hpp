@@ -247,6 +247,61 @@ struct GroundTruth {
   bool operator==(const GroundTruth&) const = default;
 };
 
+/// A roadmap node as it travels with releases (id and position).
+struct RouteNode {
+  std::int32_t node = -1;
+  double x = 0;
+  double y = 0;
+  bool operator==(const RouteNode&) const = default;
+};
+
+struct RoadmapEdge {
+  std::int32_t from = -1;
+  std::int32_t to = -1;
+  float duration_s = 0;
+  bool open = true;
+  bool operator==(const RoadmapEdge&) const = default;
+};
+
+struct Roadmap {
+  std::string site;
+  std::uint32_t epoch = 0;
+  std::uint32_t revision = 0;
+  std::vector<RouteNode> nodes;
+  std::vector<std::uint8_t> kinds;
+  std::vector<bool> open;
+  std::vector<RoadmapEdge> edges;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const Roadmap&) const = default;
+};
+
+struct TrafficRelease {
+  std::string robot_id;
+  std::uint32_t epoch = 0;
+  std::uint32_t seq = 0;
+  std::vector<RouteNode> base;     ///< at most 64; base[0]: the node last reported
+  std::vector<RouteNode> horizon;  ///< at most 32
+  bool ends_at_goal = false;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TrafficRelease&) const = default;
+};
+
+struct TrafficProgress {
+  std::string robot_id;
+  std::uint32_t epoch = 0;
+  std::int32_t node = -1;
+  Pose2 pose;
+  bool has_goal = false;
+  Pose2 goal;
+  std::string goal_station;
+  std::int32_t priority = 0;
+  bool holding = false;
+  bool blocked = false;
+  bool follows = true;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TrafficProgress&) const = default;
+};
+
 const char* toString(TaskState s);
 const char* toString(TaskKind k);
 const char* toString(RobotMode m);

@@ -33,6 +33,9 @@ QosProfile sensor(bool lockstep);   // SensorFrame: best-effort, reliable in loc
 QosProfile command(bool lockstep);  // VelocityCommand: likewise
 QosProfile clock();                 // Clock / StepDone: reliable, keep-last 1 (per key)
 QosProfile groundTruth();           // reliable, keep-last 64
+QosProfile roadmap();               // reliable, transient-local, keep-last 1
+QosProfile trafficRelease();        // reliable, transient-local, keep-last 1 per robot
+QosProfile trafficProgress();       // reliable, transient-local, keep-last 1 per robot
 /// Looks a profile up by name (the names above, snake_case); false when unknown.
 bool byName(std::string_view name, QosProfile& out);
 }  // namespace qos

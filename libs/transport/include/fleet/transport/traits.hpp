@@ -57,6 +57,9 @@ FLEET_DECLARE_TRAITS(VelocityCommand, fleet_VelocityCommand, "VelocityCommand", 
 FLEET_DECLARE_TRAITS(Clock, fleet_Clock, "Clock", qos::clock())
 FLEET_DECLARE_TRAITS(StepDone, fleet_StepDone, "StepDone", qos::clock())
 FLEET_DECLARE_TRAITS(GroundTruth, fleet_GroundTruth, "GroundTruth", qos::groundTruth())
+FLEET_DECLARE_TRAITS(Roadmap, fleet_Roadmap, "Roadmap", qos::roadmap())
+FLEET_DECLARE_TRAITS(TrafficRelease, fleet_TrafficRelease, "TrafficRelease", qos::trafficRelease())
+FLEET_DECLARE_TRAITS(TrafficProgress, fleet_TrafficProgress, "TrafficProgress", qos::trafficProgress())
 
 #undef FLEET_DECLARE_TRAITS
 
