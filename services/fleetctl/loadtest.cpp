@@ -582,6 +582,23 @@ int Run::run() {
        {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "warn"},
        env,
        log("risk_map")}};
+  if (o.traffic == "reserved") {
+    if (!scenario.contains("site") || !scenario["site"].is_string()) {
+      std::cerr << "fleetctl loadtest: --traffic reserved needs a scenario with a site (its roadmap)\n";
+      return 2;
+    }
+    writeFile(out / "traffic_manager.json", json{{"site", scenario["site"].get<std::string>()},
+                                                 {"clock", "sim"},
+                                                 {"lockstep", !o.wallClock},
+                                                 {"seed", o.seed}}
+                                                .dump(1));
+    specs.push_back({"traffic_manager",
+                     bin("services/traffic_manager/traffic_manager"),
+                     {"--config", fs::absolute(out / "traffic_manager.json").string(), "--id",
+                      "traffic_manager", "--log-level", "info"},
+                     env,
+                     log("traffic_manager")});
+  }
   // Robots: a process of their own for each stalled robot, the rest round robin over --agents.
   std::set<std::string> alone;
   for (const auto& f : faults) {
@@ -622,6 +639,8 @@ int Run::run() {
                                      o.globalPlanner,
                                      "--return-home",
                                      std::to_string(o.returnHomeS),
+                                     "--traffic",
+                                     o.traffic,
                                      "--log-level",
                                      "warn"};
     if (o.lanes) {

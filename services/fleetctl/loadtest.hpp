@@ -39,6 +39,8 @@ struct LoadtestOptions {
   int stationCapacity = 2;              // the fleet manager's station_capacity (0: no limit)
   std::string travelCost = "path";      // the fleet manager's travel_cost (path | straight)
   double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)
+  /// "reactive" or "reserved" (a traffic_manager process plans every robot; the agents follow it).
+  std::string traffic = "reactive";
   int stepTimeoutMs = 300;
   /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents
   /// at their configured rate (their achieved rate is reported), and nothing waits for anyone.

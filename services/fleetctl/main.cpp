@@ -6,6 +6,7 @@
 //   fleetctl follow [--count N]      print task events as they happen
 //   fleetctl health | metrics
 //   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet
+//   fleetctl traffic-bench --map F.map --agents N --steps T   the lifelong planner alone on a grid
 
 #include <httplib.h>
 
@@ -18,6 +19,8 @@
 #include "loadtest.hpp"
 #include "site_check.hpp"
 #include "task_file.hpp"
+#include "traffic_bench.hpp"
+#include "traffic_sim.hpp"
 
 using nlohmann::json;
 
@@ -141,6 +144,12 @@ int main(int argc, char** argv) {
   loadtest
       ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")
       ->capture_default_str();
+  loadtest
+      ->add_option("--traffic", lt.traffic,
+                   "reactive: robots avoid each other on their own; reserved: a traffic manager plans them "
+                   "all together and releases their routes")
+      ->check(CLI::IsMember({"reactive", "reserved"}))
+      ->capture_default_str();
   loadtest->add_option("--duration", lt.durationS, "simulated seconds")
       ->check(CLI::Range(1.0, 86400.0))
       ->capture_default_str();
@@ -195,10 +204,76 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-3, 100.0))
       ->capture_default_str();
   siteCheck->add_flag("--json", siteJson, "print the report as JSON");
+  std::string siteSvg;
+  siteCheck->add_option("--svg", siteSvg, "draw the map, the roadmap and the stations into this SVG file");
   site->require_subcommand(1);
-  CLI11_PARSE(app, argc, argv);
+  auto* trafficBench = app.add_subcommand(
+      "traffic-bench",
+      "the lifelong multi-agent planner alone on a MovingAI grid: throughput, planning time, the plan");
+  fleet::ctl::TrafficBenchOptions tb;
+  bool noRotationPass = false;
+  trafficBench->add_option("--map", tb.map, "MovingAI .map file")->required();
+  trafficBench->add_option("--agents", tb.agents, "agents")->capture_default_str();
+  trafficBench->add_option("--steps", tb.steps, "steps (lifelong mode)")->capture_default_str();
+  trafficBench->add_option("--seed", tb.seed, "seed of starts, goals, tasks and the planner")
+      ->capture_default_str();
+  trafficBench->add_option("--out", tb.out,
+                           "write the plan (every step, every agent's cell, the goals) as JSON");
+  trafficBench->add_flag("--no-rotation-pass", noRotationPass,
+                         "allow rotations (cycles of agents each following the next), as pibt2 does");
+  trafficBench->add_option("--rotations", tb.rotations, "avoid | cancel | allow")->capture_default_str();
+  trafficBench
+      ->add_option("--escape-after", tb.escapeAfter,
+                   "steps without coming closer to its goal before an agent is escalated (0: plain PIBT)")
+      ->capture_default_str();
+  trafficBench
+      ->add_option("--escape-progress", tb.escapeProgress,
+                   "cells an escalated agent gains on where it was escalated before it drops back")
+      ->capture_default_str();
+  trafficBench->add_flag("--mapd", tb.mapd,
+                         "pickup and delivery (pibt2's MAPD setting) instead of lifelong MAPF");
+  trafficBench->add_option("--pd", tb.pd,
+                           "pibt2 .pd file: pickup, delivery and endpoint cells (with --mapd)");
+  trafficBench->add_option("--tasks", tb.tasks, "MAPD: tasks in all")->capture_default_str();
+  trafficBench->add_option("--frequency", tb.frequency, "MAPD: new tasks per step")->capture_default_str();
+  trafficBench->add_option("--max-steps", tb.maxSteps, "MAPD: give up after this many steps")
+      ->capture_default_str();
+  auto* trafficSim = app.add_subcommand(
+      "traffic-sim",
+      "the traffic layer driving a virtual fleet on a site (no simulator): tasks/h, stalls, safety");
+  fleet::ctl::TrafficSimOptions ts;
+  trafficSim->add_option("--site", ts.site, "site.json")->required();
+  trafficSim->add_option("--robots", ts.robots, "robots")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  trafficSim->add_option("--duration", ts.duration, "simulated seconds")
+      ->check(CLI::Range(1.0, 1e7))
+      ->capture_default_str();
+  trafficSim->add_option("--seeds", ts.seeds, "a seed or a range, e.g. 1-8")->capture_default_str();
+  trafficSim->add_option("--spacing", ts.spacing, "roadmap lattice spacing in m (0: default)")
+      ->check(CLI::Range(0.0, 10.0));
+  trafficSim->add_option("--stop-chance", ts.stopChance, "per edge: chance a robot stops on it up to 10 s")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  trafficSim->add_flag("--json", ts.json, "print the results as JSON");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    // traffic-bench promises exit code 2 for any bad input (a word where a number goes, too).
+    return rc != 0 && trafficBench->parsed() ? 2 : rc;
+  }
+  if (*trafficBench) {
+    if (noRotationPass) {
+      tb.rotations = "allow";
+    }
+    return fleet::ctl::runTrafficBench(tb);
+  }
+  if (*trafficSim) {
+    return fleet::ctl::runTrafficSim(ts);
+  }
   if (*siteCheck) {
-    return fleet::ctl::siteCheck(siteFile, siteRadius, mapResolution, siteJson);
+    return fleet::ctl::siteCheck(siteFile, siteRadius, mapResolution, siteJson, siteSvg);
   }
   if (*loadtest) {
     lt.generateTasks = lt.generateTasks || rateOpt->count() > 0 || tasksOpt->count() > 0;

@@ -121,6 +121,10 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
   if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
     throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
   }
+  if (p_.traffic != "reactive" && p_.traffic != "reserved") {
+    throw std::invalid_argument("traffic: '" + p_.traffic + "' is not reactive or reserved");
+  }
+  reserved_ = p_.traffic == "reserved";
   if (p_.localPlanner != "follow") {
     auto inner = p_.localPlanner == "dwa" ? Expected<std::unique_ptr<avoidance::LocalPlanner>>(
                                                 std::make_unique<avoidance::DynamicWindowPlanner>(p_.dwa))
@@ -390,6 +394,10 @@ bool Agent::onAxis(Vec2 p, const Pose2& station) const {
 }
 
 void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
+  if (reserved_) {
+    beginLeg(nowNs);  // the route comes with the releases
+    return;
+  }
   const auto& g = goals_[goal_];
   // Leaving a station or parking place (not re-planning on the way): see undockFrom_.
   const bool fromStandstill = phase_ == Phase::Idle || phase_ == Phase::Dwelling;
@@ -749,6 +757,8 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   AgentOutput out;
   v_ = 0.0;
   w_ = 0.0;
+  heldSinceNs_ = -1;  // (reserved traffic: holding, not blocked)
+  blocked_ = false;
   report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
   return out;
 }
@@ -762,6 +772,8 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     }
     v_ = 0.0;
     w_ = 0.0;
+    heldSinceNs_ = -1;  // (reserved traffic: holding, not blocked)
+    blocked_ = false;
     report(out, nowNs, 0.0, 0.0, msg::RobotMode::Waiting);
     return out;
   }
@@ -781,6 +793,14 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   double v = 0.0;
   double w = 0.0;
   msg::RobotMode mode = msg::RobotMode::Idle;
+  if (reserved_) {
+    followRelease(nowNs, dt, v, w, mode);
+    watchProgress(nowNs);
+    v_ = v;
+    w_ = w;
+    report(out, nowNs, v, w, mode);
+    return out;
+  }
   if ((!task_.empty() || homing_) && phase_ == Phase::Idle) {
     startGoal(nowNs);
   }
@@ -980,6 +1000,12 @@ void Agent::watchProgress(std::int64_t nowNs) {
   if (goal_ < goals_.size()) {
     sample.goal = goals_[goal_].pose.position();
   }
+  if (reserved_) {
+    // Progress is along the released nodes (a route on the roadmap may lead away from the goal for
+    // a while). Waiting for a release is waiting on another robot, not being stuck: no clock runs.
+    sample.travelling = phase_ == Phase::Driving && baseAhead_;
+    sample.goal = releases_.next();
+  }
   sample.hasOrder = !task_.empty() || homing_;
   switch (progress_.check(sample)) {
     case ProgressVerdict::kFailTask:
@@ -1074,6 +1100,9 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   }
   out.status = std::move(pendingStatus_);
   pendingStatus_.reset();
+  if (reserved_) {
+    out.traffic = trafficProgress(nowNs);
+  }
 }
 
 }  // namespace fleet::agent

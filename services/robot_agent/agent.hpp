@@ -15,6 +15,13 @@
 // ProgressWatch (no progress towards the goal, a stalled local planner) and the StandoffArbiter
 // (what to do about a hold: the priority rule, yield, detour, fail). Task execution, planning and
 // carrying out the arbiter's moves (backing out along the trail, backing off) are still here.
+//
+// With AgentParams::traffic "reserved" the traffic manager's releases are the route instead
+// (onRelease, the ReleaseTracker): the robot drives the released nodes with the same local stack
+// behind the same motion gate, stops at the end of what was released, reports each node it reaches
+// (AgentOutput::traffic), and none of the conduct above runs (no standoff arbiter, back-offs,
+// returns, detours or global planning): robots that follow their releases are kept apart by the
+// traffic manager's plan, the gate stays for people and the unexpected.
 
 #include <cstdint>
 #include <memory>
@@ -33,6 +40,7 @@
 #include "motion_gate.hpp"
 #include "other_robot.hpp"
 #include "progress_watch.hpp"
+#include "release_tracker.hpp"
 #include "risk_field.hpp"
 #include "standoff_arbiter.hpp"
 
@@ -80,6 +88,9 @@ struct AgentParams {
   /// One-way aisles of the map (shared by every agent of a process); null: plain A*. Set, it
   /// replaces the global planner.
   std::shared_ptr<const planning::LaneMap> lanes;
+  /// "reactive": robots keep clear of each other by the standoff conduct (the default for now);
+  /// "reserved": the route comes from the traffic manager's releases (see onRelease).
+  std::string traffic = "reactive";
 };
 
 struct AgentOutput {
@@ -87,6 +98,9 @@ struct AgentOutput {
   msg::RobotState state;
   msg::PredictedDiscs discs;
   std::optional<msg::TaskStatus> status;  // on every task state change
+  /// Reserved traffic only: on every node reached, on a change of goal, holding or blocked, and at
+  /// least once a second.
+  std::optional<msg::TrafficProgress> traffic;
 };
 
 class Agent {
@@ -100,6 +114,9 @@ class Agent {
   void onOtherRobot(const msg::RobotState& s);
   /// A new revision replaces the current order (an empty task id cancels).
   void onAssignment(const msg::TaskAssignment& a);
+  /// Reserved traffic: the traffic manager's release for this robot (others, stale ones and ones
+  /// that do not start at the node it last reported are ignored and counted). Reactive: ignored.
+  void onRelease(const msg::TrafficRelease& r);
   /// The latest risk map (shared by every agent of the process): the local planner's risk term and
   /// the global planner's cell cost. Null: no risk information.
   void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
@@ -115,6 +132,12 @@ class Agent {
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
   [[nodiscard]] bool homing() const { return homing_; }
   [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
+  /// Follows the traffic manager's releases (AgentParams::traffic "reserved").
+  [[nodiscard]] bool reserved() const { return reserved_; }
+  /// Releases taken and ignored (cumulative).
+  [[nodiscard]] const ReleaseCounts& releases() const { return releases_.counts(); }
+  /// The last roadmap node reached (-1 before any release).
+  [[nodiscard]] std::int32_t trafficNode() const { return releases_.node(); }
 
   /// What the robot did about being blocked (cumulative), for tests and the service's counters.
   struct Conduct {
@@ -169,6 +192,18 @@ class Agent {
   void followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const;
   /// Stop rule and cross-traffic check on (v, w); true when the robot is held up.
   bool heldUp(double& v, double& w, Blocker& blocker);
+  /// Reserved traffic: the task stack for one cycle (in place of the reactive phases).
+  void followRelease(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode);
+  /// Reserved traffic: the twist along the released base (none: stand still).
+  void driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode);
+  /// Reserved traffic: a leg towards the current goal begins (no plan: the releases are the route).
+  void beginLeg(std::int64_t nowNs);
+  /// Reserved traffic: where the robot is going (the task's goal; idle, its home), if anywhere.
+  [[nodiscard]] std::optional<msg::Goal> trafficGoal() const;
+  /// Reserved traffic: the base ends on the current goal (its last leg is the docking).
+  [[nodiscard]] bool baseEndsAtGoal() const;
+  /// Reserved traffic: the progress report for this cycle, if one is due.
+  std::optional<msg::TrafficProgress> trafficProgress(std::int64_t nowNs);
 
   AgentParams p_;
   std::shared_ptr<const planning::OccupancyGrid> grid_;
@@ -239,6 +274,18 @@ class Agent {
   std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
   StandoffArbiter arbiter_;  // what to do about a hold: wait, yield, detour, fail
   Conduct conduct_;
+
+  // Reserved traffic.
+  bool reserved_ = false;
+  ReleaseTracker releases_;                           // what may be driven, the last node reached
+  std::uint64_t followedRevision_ = 0;                // the release the follower's path was built from
+  std::vector<Vec2> basePath_;                        // ... that path (from where the robot was then)
+  bool baseAhead_ = false;                            // driving along the base this cycle (progress watch)
+  bool dockingLeg_ = false;                           // on the base's last leg onto the goal
+  std::int64_t heldSinceNs_ = -1;                     // the gate has held the robot since (a person, ...)
+  Vec2 heldAt_;                                       // ... here
+  bool blocked_ = false;                              // ... for more than a second
+  std::optional<msg::TrafficProgress> lastProgress_;  // the last report sent
 };
 
 /// The planning grid from a scenario's occupancy cells, inflated by `radius`.

@@ -147,7 +147,8 @@ struct Options {
   double returnHomeS = 5.0;
   bool useRisk = true;
   bool useLanes = false;
-  std::string metricsFile;  // empty: none
+  std::string traffic = "reactive";  // or "reserved": follow the traffic manager's releases
+  std::string metricsFile;           // empty: none
 };
 
 /// What the process achieved: cycles, the rate against the configured one, overruns (wall mode)
@@ -210,6 +211,7 @@ int run(const World& scn, const Options& opt) {
     p.returnHomeS = opt.returnHomeS;
     p.riskWeightGlobal = opt.riskWeightGlobal;
     p.lanes = lanes;
+    p.traffic = opt.traffic;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
     p.landmarks = scn.landmarks;
@@ -231,6 +233,15 @@ int run(const World& scn, const Options& opt) {
   transport::Writer<msg::PredictedDiscs> discs(part);
   transport::Writer<msg::TaskStatus> statuses(part);
   transport::Writer<msg::StepDone> stepDone(part);
+  // Reserved traffic only: a reactive agent neither reads releases nor tells the traffic manager
+  // anything (it counts as a robot that does not follow).
+  const bool reserved = opt.traffic == "reserved";
+  std::optional<transport::Reader<msg::TrafficRelease>> releases;
+  std::optional<transport::Writer<msg::TrafficProgress>> trafficProgress;
+  if (reserved) {
+    releases.emplace(part);
+    trafficProgress.emplace(part);
+  }
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
@@ -239,8 +250,9 @@ int run(const World& scn, const Options& opt) {
                             static_cast<unsigned>(agents.size())));
   agent::WorkerPool pool(threads);
   std::vector<agent::AgentOutput> outs(agents.size());
-  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}", id, agents.size(),
-               lockstep ? "lockstep" : "wall", pool.threads(), opt.localPlanner, opt.useRisk ? "on" : "off");
+  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}, {} traffic", id,
+               agents.size(), lockstep ? "lockstep" : "wall", pool.threads(), opt.localPlanner,
+               opt.useRisk ? "on" : "off", opt.traffic);
   std::uint64_t badRiskMaps = 0;
 
   bool haveClock = false;
@@ -270,6 +282,13 @@ int run(const World& scn, const Options& opt) {
         it->second->onAssignment(a);
       }
     }
+    if (releases) {
+      for (const auto& r : releases->take()) {
+        if (auto it = byId.find(r.robot_id); it != byId.end()) {
+          it->second->onRelease(r);
+        }
+      }
+    }
     if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
       // Only the newest map matters; it is decoded once and shared read-only by every agent.
       if (auto field = agent::RiskField::fromMessage(maps.back())) {
@@ -295,6 +314,9 @@ int run(const World& scn, const Options& opt) {
       if (out.status) {
         statuses.write(*out.status);
         spdlog::debug("{}: task {} {}", a->id(), out.status->task_id, msg::toString(out.status->state));
+      }
+      if (out.traffic && trafficProgress) {
+        trafficProgress->write(*out.traffic);
       }
     }
     // Robots of this process learn each other's state directly, exactly one cycle later. Over DDS
@@ -338,6 +360,17 @@ int run(const World& scn, const Options& opt) {
     m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
                     {"backoffs", c.backoffs},   {"returns", c.returns},
                     {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};
+    agent::ReleaseCounts rc;
+    for (const auto& a : agents) {
+      rc.accepted += a->releases().accepted;
+      rc.foreign += a->releases().foreign;
+      rc.stale += a->releases().stale;
+      rc.offNode += a->releases().offNode;
+      rc.malformed += a->releases().malformed;
+    }
+    m["traffic"] = {
+        {"mode", opt.traffic},       {"releases_taken", rc.accepted},  {"ignored_foreign", rc.foreign},
+        {"ignored_stale", rc.stale}, {"ignored_off_node", rc.offNode}, {"ignored_malformed", rc.malformed}};
     std::ofstream f(opt.metricsFile + ".tmp");
     f << m.dump(1) << "\n";
     f.close();
@@ -396,20 +429,25 @@ int run(const World& scn, const Options& opt) {
 
 /// The --config file: planner choice and parameters (docs/operator-guide.md, robot agent). Command
 /// line options given explicitly win over the file. Every problem is reported at once.
-void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, bool globalFromCli) {
+void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, bool globalFromCli,
+                     bool trafficFromCli) {
   Config cfg = Config::fromFile(path);
   const std::string local = cfg.string("local_planner", opt.localPlanner);
   const std::string global = cfg.string("global_planner", opt.globalPlanner, {"astar", "wavefront", "ompl"});
+  const std::string traffic = cfg.string("traffic", opt.traffic, {"reactive", "reserved"});
   Config dwa = cfg.child("dwa");
   Config safety = cfg.child("safety");
   opt.dwa = avoidance::dwaParams(dwa, opt.dwa);
   opt.safety = avoidance::safetyParams(safety);
-  cfg.rejectUnknownKeys({"local_planner", "global_planner", "dwa", "safety"});
+  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "safety"});
   if (!localFromCli) {
     opt.localPlanner = local;
   }
   if (!globalFromCli) {
     opt.globalPlanner = global;
+  }
+  if (!trafficFromCli) {
+    opt.traffic = traffic;
   }
   if (opt.localPlanner != "follow") {
     if (auto p = avoidance::makePlanner(opt.localPlanner); !p) {
@@ -455,6 +493,11 @@ int main(int argc, char** argv) {
                "plan on the lane map (one-way narrow aisles, keep-right bands) instead of plain A*; "
                "off by default: 20 robots finish ~15 % fewer tasks with it (docs/benchmarks.md)");
   app.add_flag("--no-lanes", noLanes, "plain A* (the default; wins over --lanes)");
+  app.add_option(
+         "--traffic", opt.traffic,
+         "reactive (default: robots keep clear of each other by standoffs, yielding and detours) or "
+         "reserved (drive only what the traffic manager releases: TrafficRelease in, TrafficProgress out)")
+      ->check(CLI::IsMember({"reactive", "reserved"}));
   std::string sitePath;
   std::vector<std::string> robotSpecs;
   auto* scenarioOpt =
@@ -472,13 +515,14 @@ int main(int argc, char** argv) {
                  "10 s in wall mode and at exit");
   std::string configFile;
   app.add_option("-c,--config", configFile,
-                 "JSON file: local_planner, global_planner, dwa {weights, samples, horizon...}, safety "
-                 "{zones} (docs/operator-guide.md); options given on the command line win");
+                 "JSON file: local_planner, global_planner, traffic, dwa {weights, samples, horizon...}, "
+                 "safety {zones} (docs/operator-guide.md); options given on the command line win");
   CLI11_PARSE(app, argc, argv);
   try {
     logging::setup("robot_agent", level);
     if (!configFile.empty()) {
-      applyConfigFile(configFile, opt, app.count("--local-planner") > 0, app.count("--global-planner") > 0);
+      applyConfigFile(configFile, opt, app.count("--local-planner") > 0, app.count("--global-planner") > 0,
+                      app.count("--traffic") > 0);
     }
     World world;
     if (!sitePath.empty()) {

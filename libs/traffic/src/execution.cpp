@@ -252,9 +252,35 @@ NodeId Execution::plannedEnd(std::size_t robot) const {
 std::int64_t Execution::progressStep(std::size_t robot) const {
   return routes_.at(robot)[routes_[robot].progress].step;
 }
+std::int64_t Execution::nextUnreleasedStep(std::size_t robot) const {
+  const auto& route = routes_.at(robot);
+  return route.released < route.last() ? route[route.released + 1].step : -1;
+}
+
 std::size_t Execution::pendingNodes(std::size_t robot) const {
   const auto& route = routes_.at(robot);
   return static_cast<std::size_t>(route.last() - route.progress);
+}
+
+std::size_t Execution::addRobot(NodeId start) {
+  if (!graph_.valid(start)) {
+    throw PlanStepError("a robot cannot join on node " + std::to_string(start) + ": not on the graph");
+  }
+  for (std::size_t q = 0; q < routes_.size(); ++q) {
+    const auto& route = routes_[q];
+    for (std::int64_t i = route.progress; i <= route.last(); ++i) {
+      if (graph_.conflicting(route[i].node, start)) {
+        throw PlanStepError("a robot cannot join on node " + std::to_string(start) + ": robot " +
+                            std::to_string(q) + " holds or is planned on conflicting node " +
+                            std::to_string(route[i].node));
+      }
+    }
+  }
+  Route route;
+  route.entries.push_back(Entry{start, step_, 0.0, {}});
+  routes_.push_back(std::move(route));
+  lastVisit_[static_cast<std::size_t>(start)] = Visit{static_cast<std::int32_t>(routes_.size() - 1), 0};
+  return routes_.size() - 1;
 }
 
 void Execution::retract(std::size_t robot) {

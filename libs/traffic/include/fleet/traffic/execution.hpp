@@ -92,6 +92,8 @@ class Execution {
   [[nodiscard]] NodeId plannedEnd(std::size_t robot) const;
   /// Plan step of the robot's last reported node (how far along the plan it is).
   [[nodiscard]] std::int64_t progressStep(std::size_t robot) const;
+  /// Plan step of the robot's first planned node not released yet, -1 when everything is released.
+  [[nodiscard]] std::int64_t nextUnreleasedStep(std::size_t robot) const;
   /// Route nodes planned but not yet reported (including released ones).
   [[nodiscard]] std::size_t pendingNodes(std::size_t robot) const;
 
@@ -99,6 +101,11 @@ class Execution {
   /// the released ends (returned, one per robot; they never conflict). Dependencies of what stays
   /// released are kept.
   std::vector<NodeId> truncateToReleased();
+
+  /// A robot joins on `start`. Refused (PlanStepError naming the robot in the way) when a robot
+  /// holds or is released a node conflicting with it; call truncateToReleased() first so planned
+  /// but unreleased nodes do not count. Returns the new robot's index.
+  std::size_t addRobot(NodeId start);
 
   /// A robot that stops following its route (faulted, held by a person, taken over): cuts what was
   /// released to it back to the node it may be driving into (its next one after the last reported),

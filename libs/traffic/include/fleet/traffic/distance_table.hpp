@@ -1,0 +1,87 @@
+#pragma once
+
+// Per-goal distance tables: for a goal g, the shortest time from every node to g along open edges.
+// The planner asks for the distance of a handful of nodes to each agent's goal every step; one
+// backward search per goal answers all of them, so tables are computed on first use and kept in a
+// bounded least-recently-used cache (a lifelong run keeps asking for the same goals: stations,
+// shelves). Breadth-first search when every edge lasts the same, Dijkstra otherwise.
+//
+// Closed nodes and edges are honoured: nothing passes through a closed node, but a robot standing
+// on one gets the distance of leaving it (it may drive off, nothing may drive on). After closing or
+// reopening anything, or adding nodes or edges, call invalidate(). Nodes blocked by setBlocked()
+// (fixed obstacles the graph does not know about) count as closed.
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "fleet/traffic/graph.hpp"
+
+namespace fleet::traffic {
+
+class DistanceTable {
+ public:
+  static constexpr float kUnreachable = std::numeric_limits<float>::infinity();
+
+  /// Keeps at most `maxBytes` of tables (at least one table, and at least reserve()'s count).
+  explicit DistanceTable(const Graph& graph, std::size_t maxBytes = std::size_t{256} << 20);
+
+  /// Distances from every node to `goal` (kUnreachable where there is no route, and everywhere when
+  /// the goal is closed). The span stays valid until capacity() other goals have been asked for
+  /// after it, or invalidate().
+  std::span<const float> to(NodeId goal);
+  float distance(NodeId from, NodeId goal) { return to(goal)[static_cast<std::size_t>(from)]; }
+
+  /// Keep room for at least `tables` goals at once (a planner holding every agent's goal table
+  /// through a step needs agents + 1), whatever the byte budget says.
+  void reserve(std::size_t tables);
+  /// The graph changed (opened or closed something, or grew): drop every table.
+  void invalidate();
+  /// Treats `v` as closed (or not) on top of the graph: the planner's fixed obstacles (robots out of
+  /// its control stand there), except as a goal (the route still leads up to it). Tables are
+  /// dropped at the next query when anything changed.
+  void setBlocked(NodeId v, bool blocked);
+  [[nodiscard]] bool blocked(NodeId v) const { return blocked_[static_cast<std::size_t>(v)] != 0; }
+
+  [[nodiscard]] std::size_t capacity() const { return capacity_; }
+  [[nodiscard]] std::size_t cached() const { return used_; }
+  /// Tables computed since construction (misses), for benchmarks and tests.
+  [[nodiscard]] std::uint64_t computed() const { return computed_; }
+  /// true when every edge has the same duration (breadth-first search).
+  [[nodiscard]] bool unitDurations() const { return unit_; }
+
+ private:
+  void buildReverse();
+  void compute(NodeId goal, std::vector<float>& d);
+  std::size_t acquireSlot();
+  void touch(std::size_t slot);
+  void unlink(std::size_t slot);
+
+  const Graph& graph_;
+  std::size_t maxBytes_;
+  std::size_t capacity_ = 1;
+  bool unit_ = true;
+  float unitDuration_ = 1.0F;
+  // Reverse adjacency (who can drive into v, and how long that takes), compressed rows.
+  std::vector<std::uint32_t> revStart_;
+  std::vector<NodeId> revFrom_;
+  std::vector<float> revDuration_;
+  // Cache: slot per goal, slots on an intrusive LRU list (head = most recent).
+  std::vector<std::int32_t> slotOfGoal_;
+  std::vector<NodeId> goalOfSlot_;
+  std::vector<std::vector<float>> tables_;
+  std::vector<std::int32_t> prev_;
+  std::vector<std::int32_t> next_;
+  std::int32_t head_ = -1;
+  std::int32_t tail_ = -1;
+  std::size_t used_ = 0;
+  std::uint64_t computed_ = 0;
+  std::vector<std::uint8_t> blocked_;
+  bool dirty_ = false;
+  // Search scratch, kept to avoid allocating per table.
+  std::vector<NodeId> queue_;
+  std::vector<std::pair<float, NodeId>> heap_;
+};
+
+}  // namespace fleet::traffic

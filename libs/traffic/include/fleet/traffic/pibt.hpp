@@ -1,0 +1,169 @@
+#pragma once
+
+// Lifelong PIBT: Priority Inheritance with Backtracking (Okumura, Machida, Défago, Tamura, AIJ 2022;
+// Kei18/pibt2), one step at a time on a traffic Graph, for agents whose goals change at any step.
+//
+// Each step the agents are taken in priority order; an agent reserves the best node it can reach in
+// one move (nearest to its goal), and every undecided agent standing on a node that reservation
+// excludes inherits its priority and must move away first (recursively); if one of them cannot, the
+// reservation is given up and the next node tried (backtracking), staying put last. On a roadmap a
+// reservation of u excludes u and conflicts(u) for everyone else, and a swap is two agents each
+// moving into what the other excludes now. Moving into a node its agent is leaving is allowed (the
+// MAPF convention). Agents outside the planner's control (faulted, paused, a vendor's vehicle) are
+// fixed obstacles on their node.
+//
+// Priorities: task priority first, then agents with a goal before those without, then the number
+// of steps since the agent last reached a goal, then a per-agent random number (seeded). Three
+// additions, documented in docs/algorithms.md ("Traffic: lifelong planner"):
+// - Rotations: a closed cycle of agents each following the next is legal in MAPF but deadlocks
+//   robots executing by dependencies; by default the planner never closes one (Rotations::kAvoid).
+// - Escape: plain PIBT can stall for ever (a dead-end spur whose occupant must come out before a
+//   higher-priority agent can go in: each waits for the other's node and priority inheritance
+//   only ever pushes the side with nowhere to go). When agents that have neither moved nor come
+//   closer to their goals for `escapeAfter` steps wait for each other's nodes in a cycle, one of
+//   them (the one escalated least since it last made progress, then the one of lowest priority)
+//   is escalated above every other priority until it has gained `escapeProgress` on where it was
+//   escalated or reached its goal; if it stays stuck for another `escapeAfter` steps it drops back
+//   and the next member gets its turn.
+// - Fixed agents' nodes are taken out of the routes (DistanceTable::setBlocked), since PIBT only
+//   moves greedily and would otherwise wait behind a stopped robot for ever.
+//
+// Deterministic for a seed: same graph, starts, goals and calls, same plan.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fleet/traffic/distance_table.hpp"
+#include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/rotation_pass.hpp"
+
+namespace fleet::traffic {
+
+enum class Rotations : std::uint8_t {
+  kAllow,   ///< the MAPF convention (pibt2's PIBT): a cycle of agents may move all at once
+  kCancel,  ///< plan as kAllow, then RotationPass stops each cycle and everyone following it
+  kAvoid,   ///< never close a cycle while planning; RotationPass stays behind it as a net
+};
+
+struct PibtOptions {
+  std::uint64_t seed = 1;
+  Rotations rotations = Rotations::kAvoid;
+  /// Steps standing still without coming closer to its goal before an agent that waits in a cycle
+  /// can be escalated; 0: never (plain PIBT).
+  int escapeAfter = 16;
+  /// Distance an escalated agent gains on where it was escalated before it drops back (cells on a
+  /// unit grid, the edges' duration unit on a roadmap).
+  double escapeProgress = 16.0;
+  std::size_t distanceCacheBytes = std::size_t{256} << 20;
+};
+
+struct PibtStats {
+  std::uint64_t steps = 0;
+  std::uint64_t rotationStops = 0;  ///< agents RotationPass stopped (kCancel; 0 with kAvoid)
+  std::uint64_t escalations = 0;
+  std::uint64_t escalationRequeues = 0;  ///< escalated agents that stayed stuck and dropped back
+};
+
+class Pibt {
+ public:
+  /// `starts` must be valid, distinct and free of conflicts (std::invalid_argument otherwise).
+  Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions options = {});
+
+  [[nodiscard]] std::size_t size() const { return now_.size(); }
+  [[nodiscard]] const std::vector<NodeId>& positions() const { return now_; }
+
+  /// kNoNode: no goal (the agent stays unless someone needs its node).
+  void setGoal(std::size_t agent, NodeId goal);
+  [[nodiscard]] NodeId goal(std::size_t agent) const { return goal_[agent]; }
+  /// Higher first; every other priority rule only breaks ties of this one.
+  void setTaskPriority(std::size_t agent, int priority) { task_[agent] = priority; }
+  /// An agent out of control is a fixed obstacle on its node until it is controlled again.
+  void setControlled(std::size_t agent, bool controlled);
+  [[nodiscard]] bool controlled(std::size_t agent) const { return controlled_[agent] != 0; }
+  /// Moves an agent (a robot reported somewhere else, a vendor's vehicle moved). Refused (false) when
+  /// the node is invalid or conflicts with another agent's node.
+  bool setPosition(std::size_t agent, NodeId v);
+  /// Moves every agent at once (planning starts again from where the robots' releases end) and
+  /// appends agents when `positions` is longer than size() (robots joining; they start without a
+  /// goal, controlled). Goals, task priorities, the steps since each reached its goal and the
+  /// distance cache are kept, so re-planning does not reset PIBT's fairness. std::invalid_argument
+  /// (nothing changed) when the positions are invalid or conflict.
+  void reset(std::span<const NodeId> positions);
+
+  /// Plans and takes one step: every agent's node at the next step, conflict-free (and rotation-free
+  /// unless Rotations::kAllow).
+  const std::vector<NodeId>& step();
+
+  [[nodiscard]] bool escalated(std::size_t agent) const { return escalatedAt_[agent] >= 0; }
+  /// Steps since the agent last reached its goal (its PIBT priority).
+  [[nodiscard]] int elapsed(std::size_t agent) const { return elapsed_[agent]; }
+  [[nodiscard]] const PibtStats& stats() const { return stats_; }
+  DistanceTable& distances() { return distances_; }
+  [[nodiscard]] const DistanceTable& distances() const { return distances_; }
+  /// Call after opening or closing nodes or edges (or adding any): drops the cached distances.
+  void graphChanged();
+
+ private:
+  struct Candidate {
+    NodeId node;
+    float distance;
+    std::uint32_t tieBreak;  ///< nodes nobody stands on first, then random
+  };
+
+  bool plan(std::int32_t agent, std::int32_t parent, std::size_t depth);
+  [[nodiscard]] bool available(std::int32_t agent, NodeId u) const;
+  [[nodiscard]] bool leavesAncestorsAlone(std::int32_t agent, std::int32_t parent, NodeId u) const;
+  [[nodiscard]] bool closesCycle(std::int32_t agent, NodeId u);
+  [[nodiscard]] bool before(std::int32_t a, std::int32_t b) const;
+  void updateProgress(std::size_t agent);
+  [[nodiscard]] std::int32_t blocker(std::size_t agent) const;
+  void escapeDeadlocks();
+  void resizeForGraph();
+  void cover(NodeId v, int delta);
+  /// An agent other than `except` standing on what v excludes, or -1.
+  [[nodiscard]] std::int32_t standingOn(NodeId v, std::int32_t except) const;
+  std::uint64_t random();
+
+  const Graph& graph_;
+  PibtOptions options_;
+  DistanceTable distances_;
+  RotationPass rotationPass_;
+  PibtStats stats_;
+  std::uint64_t rng_;
+  bool grid_ = true;  ///< no conflict sets: a node excludes only itself (fast paths)
+
+  // Per agent.
+  std::vector<NodeId> now_;
+  std::vector<NodeId> next_;
+  std::vector<NodeId> goal_;
+  std::vector<const float*> table_;
+  std::vector<int> task_;
+  std::vector<int> elapsed_;
+  std::vector<double> epsilon_;
+  std::vector<std::uint8_t> controlled_;
+  std::vector<std::uint8_t> onStack_;
+  std::vector<float> best_;                ///< nearest it has been to its goal since the goal was set
+  std::vector<int> stalled_;               ///< steps since best_ last improved
+  std::vector<std::int64_t> escalatedAt_;  ///< step of (re-)escalation, -1 when not escalated
+  std::vector<std::uint64_t> escalationDraw_;
+  std::vector<float> escalationDistance_;
+  std::vector<int> escalationIdle_;     ///< steps escalated without coming closer
+  std::vector<int> still_;              ///< steps since it last moved
+  std::vector<int> tries_;              ///< escalations since it last came closer to its goal
+  std::vector<std::uint32_t> visited_;  ///< stamps for the cycle search
+  std::uint32_t stamp_ = 0;
+
+  // Per node.
+  std::vector<std::int32_t> agentAt_;     ///< agent standing there now, -1
+  std::vector<std::int32_t> reservedBy_;  ///< agent going there next step, -1
+  std::vector<int> fixedCover_;           ///< fixed agents excluding the node (routes avoid it)
+
+  std::vector<std::int32_t> order_;
+  std::vector<Candidate> candidates_;  ///< (max degree + 1) per recursion depth
+  std::size_t stride_ = 1;
+  std::vector<std::int32_t> search_;  ///< cycle search stack
+  std::vector<std::int32_t> chain_;   ///< wait-for chain in escapeDeadlocks()
+};
+
+}  // namespace fleet::traffic

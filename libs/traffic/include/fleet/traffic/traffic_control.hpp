@@ -1,0 +1,133 @@
+#pragma once
+
+// The traffic layer in one object, free of DDS: the lifelong planner (Pibt) plans every robot's
+// moves a few steps ahead of the fleet, the plan is executed by dependencies (Execution), and each
+// robot is released its route a few nodes at a time. A traffic manager service wraps it; the virtual
+// fleet (virtual_fleet.hpp) drives it in tests and benchmarks.
+//
+// Planning runs ahead of the robots, not of a clock: a step is added while the robot furthest along
+// its route has fewer than `planAhead` steps planned past it. A robot that falls `maxLag` steps
+// behind the plan (a person in the aisle, a slow dock) holds back only the robots that depend on it;
+// the unreleased plan is then dropped and planned again from where everyone's release ends, so the
+// fleet does not keep planning around where the late robot was supposed to be. Held robots (docking,
+// faulted, paused, a vendor's vehicle that does not follow) are obstacles the plan goes around.
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "fleet/traffic/execution.hpp"
+#include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/pibt.hpp"
+
+namespace fleet::traffic {
+
+struct TrafficOptions {
+  std::int64_t planAhead = 6;  ///< steps planned past the robot furthest along
+  std::int64_t maxLag = 24;    ///< steps a robot may be behind the plan before it is re-planned
+  std::int64_t maxStepsPerUpdate = 64;
+  /// A robot planned to stand still this many steps short of its goal makes the robots standing
+  /// in its way (on nodes its next few nodes exclude) drive away for `evadeSteps` (PIBT moves
+  /// robots one step at a time; a robot whose footprint reaches past the next node cannot clear
+  /// the way in one step, so a dock exit or a queue behind a waiting robot would stay shut).
+  int evadeAfter = 6;
+  int evadeSteps = 10;
+  int evadeLookahead = 3;
+  ReleaseOptions release;
+  PibtOptions pibt;
+};
+
+/// A station robots dock at one at a time: its dock node and the nodes to wait on in line,
+/// nearest to the station first.
+struct StationLine {
+  NodeId dock = kNoNode;
+  std::vector<NodeId> queue;
+};
+
+struct TrafficStats {
+  std::uint64_t steps = 0;    ///< planner steps
+  std::uint64_t replans = 0;  ///< unreleased plan dropped and planned again
+  std::uint64_t refusedReports = 0;
+  std::uint64_t evasions = 0;  ///< robots sent out of another's way
+};
+
+class TrafficControl {
+ public:
+  /// Robots start on `starts` (valid, free of conflicts: std::invalid_argument otherwise).
+  TrafficControl(const Graph& graph, std::span<const NodeId> starts, TrafficOptions options = {});
+
+  [[nodiscard]] std::size_t robots() const { return goal_.size(); }
+  /// A robot joins on `start` (refused with PlanStepError when another robot holds or is released a
+  /// node conflicting with it: try again when it has moved on). Returns its index.
+  std::size_t addRobot(NodeId start);
+
+  /// kNoNode: none (the robot stays where it is unless someone needs the place). Refused (false)
+  /// for a node off the graph or closed.
+  bool setGoal(std::size_t robot, NodeId goal, int priority = 0);
+  [[nodiscard]] NodeId goal(std::size_t robot) const { return goal_.at(robot); }
+  /// Stations whose dock takes one robot at a time. A robot whose goal is such a dock joins its
+  /// line: the first in line is planned to the dock, the next ones to the queue nodes in order (the
+  /// last queue node for everyone beyond), so robots wait in line instead of crowding the dock's
+  /// only way in and out. The line moves up when the robot at the dock gets another goal.
+  void setStations(std::vector<StationLine> stations);
+  /// Robots in line for the station whose dock is `dock`, the one at the dock first.
+  [[nodiscard]] std::vector<std::size_t> line(NodeId dock) const;
+
+  /// A held robot stands where it is and is planned around (docking, faulted, paused, manual).
+  void setHeld(std::size_t robot, bool held);
+  [[nodiscard]] bool held(std::size_t robot) const { return held_.at(robot) != 0; }
+
+  /// The robot reports it has arrived at `node`; refused reports leave it held where it was.
+  Report reached(std::size_t robot, NodeId node);
+  /// Last node the robot reported, and whether that is its goal.
+  [[nodiscard]] NodeId at(std::size_t robot) const { return execution_.at(robot); }
+  [[nodiscard]] bool arrived(std::size_t robot) const;
+
+  /// Plans as far ahead as the options say (re-planning first if a robot fell too far behind).
+  /// Returns the number of steps planned.
+  int update();
+  /// What the robot may drive now and what it may expect after that.
+  Release release(std::size_t robot) { return execution_.release(robot); }
+  [[nodiscard]] std::vector<std::size_t> waitingOn(std::size_t robot) const {
+    return execution_.waitingOn(robot);
+  }
+
+  /// Call after closing or reopening nodes or edges: plans again from the released ends.
+  void graphChanged();
+
+  [[nodiscard]] const TrafficStats& stats() const { return stats_; }
+  [[nodiscard]] const PibtStats& plannerStats() const { return planner_->stats(); }
+  [[nodiscard]] const Execution& execution() const { return execution_; }
+  [[nodiscard]] const Pibt& planner() const { return *planner_; }
+
+ private:
+  void replan();
+  void leaveLine(std::size_t robot);
+  void updateLine(std::size_t station);
+  void plannerGoal(std::size_t robot, NodeId goal);
+  void afterStep();
+  void clearWayFor(std::size_t robot);
+  [[nodiscard]] bool needsPlanning() const;
+
+  const Graph& graph_;
+  TrafficOptions options_;
+  std::unique_ptr<Pibt> planner_;
+  Execution execution_;
+  std::vector<NodeId> goal_;
+  std::vector<std::uint8_t> held_;
+  std::vector<int> priority_;
+  std::vector<StationLine> stations_;
+  std::vector<std::vector<std::size_t>> lines_;  ///< per station, robots in line
+  std::vector<std::int64_t> leaving_;            ///< per station: robot still on its dock after its turn, -1
+  std::vector<std::size_t> firstClear_;          ///< per station: first queue node clear of the dock's ways
+  std::vector<std::int32_t> stationOfDock_;      ///< per node: station index, -1
+  std::vector<std::int32_t> inLine_;             ///< per robot: station index, -1
+  std::vector<NodeId> target_;                   ///< per robot: the planner's goal (line place, evasion)
+  std::vector<int> stall_;                       ///< planned steps standing short of its target
+  std::vector<NodeId> lastEnd_;                  ///< planned end after the previous step
+  std::vector<std::int64_t> evadeUntil_;         ///< step its evasion ends, -1
+  TrafficStats stats_;
+};
+
+}  // namespace fleet::traffic

@@ -1,0 +1,64 @@
+#pragma once
+
+// A fleet of point robots that do exactly what the traffic layer releases to them, late at random:
+// every edge takes its planned duration stretched by a random factor, now and then a robot stops
+// for a while on an edge (a person in the aisle), and it dwells at each station. Tasks are drawn at
+// random (pickup station, then drop-off station) and chained: a robot that finishes one takes the
+// next at once (saturated, no trip home), so throughput measures the traffic layer, not the task
+// supply. It checks what the traffic layer promises: robots never hold conflicting nodes, their
+// centres never come closer than the roadmap's contact distance, nobody waits for ever.
+//
+// It is not the simulator: no kinematics beyond the edge durations, no sensors, no local avoidance.
+// It answers "how good is the plan and its execution" in milliseconds per simulated minute, and is
+// the reference the full-stack figures are compared with.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fleet/traffic/roadmap.hpp"
+#include "fleet/traffic/traffic_control.hpp"
+
+namespace fleet::traffic {
+
+struct VirtualFleetOptions {
+  std::size_t robots = 20;
+  std::uint64_t seed = 1;
+  double duration = 600.0;   ///< s simulated
+  double dt = 0.1;           ///< s between traffic updates
+  double dwell = 2.0;        ///< s at the pickup and again at the drop-off
+  double jitter = 0.2;       ///< every edge takes its duration × U(1, 1 + jitter)
+  double stopChance = 0.01;  ///< per edge: the robot stops on it for U(0, stopMax) s
+  double stopMax = 10.0;
+  bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
+  TrafficOptions traffic;
+};
+
+struct VirtualFleetResult {
+  std::size_t robots = 0;
+  double duration = 0.0;
+  std::size_t tasksDone = 0;
+  double tasksPerHour = 0.0;
+  double meanTaskTime = 0.0;       ///< s from taking a task to leaving its drop-off
+  double minSeparation = 0.0;      ///< m between two robot centres, over the whole run
+  std::size_t contacts = 0;        ///< ticks with two centres closer than the roadmap's contact distance
+  std::size_t holdViolations = 0;  ///< ticks with two robots holding conflicting nodes
+  double longestWait = 0.0;        ///< s the longest a robot with a task went without reaching a node
+  std::uint64_t plannerSteps = 0;
+  std::uint64_t replans = 0;
+  std::uint64_t refusedReports = 0;
+  double updateP50Ms = 0.0;  ///< wall time of one traffic update (planning and releases)
+  double updateP99Ms = 0.0;
+  double density = 0.0;  ///< robots ÷ roadmap nodes
+  /// Robots waiting longer than a minute at the end: where, for what, behind whom.
+  std::vector<std::string> stalls;
+};
+
+/// Runs the virtual fleet on `roadmap`. Robots start on the parking docks (then on spread-out lane
+/// nodes if there are more robots than parking places). Throws std::invalid_argument when the
+/// roadmap has no pickup or no drop-off station or the robots do not fit.
+VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& options);
+
+std::string formatResult(const VirtualFleetResult& r);
+
+}  // namespace fleet::traffic

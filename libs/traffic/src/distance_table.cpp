@@ -1,0 +1,205 @@
+#include "fleet/traffic/distance_table.hpp"
+
+#include <algorithm>
+#include <functional>
+
+namespace fleet::traffic {
+
+DistanceTable::DistanceTable(const Graph& graph, std::size_t maxBytes) : graph_(graph), maxBytes_(maxBytes) {
+  invalidate();
+}
+
+void DistanceTable::buildReverse() {
+  const std::size_t n = graph_.size();
+  revStart_.assign(n + 1, 0);
+  unit_ = true;
+  bool first = true;
+  for (std::size_t a = 0; a < n; ++a) {
+    for (const Edge& e : graph_.edges(static_cast<NodeId>(a))) {
+      if (!e.open) {
+        continue;
+      }
+      ++revStart_[static_cast<std::size_t>(e.to) + 1];
+      const auto d = static_cast<float>(e.duration);
+      if (first) {
+        unitDuration_ = d;
+        first = false;
+      } else if (d != unitDuration_) {
+        unit_ = false;
+      }
+    }
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    revStart_[v + 1] += revStart_[v];
+  }
+  revFrom_.assign(revStart_[n], kNoNode);
+  revDuration_.assign(revStart_[n], 0.0F);
+  std::vector<std::uint32_t> fill(revStart_.begin(), revStart_.end() - 1);
+  for (std::size_t a = 0; a < n; ++a) {
+    for (const Edge& e : graph_.edges(static_cast<NodeId>(a))) {
+      if (!e.open) {
+        continue;
+      }
+      const std::uint32_t k = fill[static_cast<std::size_t>(e.to)]++;
+      revFrom_[k] = static_cast<NodeId>(a);
+      revDuration_[k] = static_cast<float>(e.duration);
+    }
+  }
+}
+
+void DistanceTable::setBlocked(NodeId v, bool blocked) {
+  auto& b = blocked_[static_cast<std::size_t>(v)];
+  if ((b != 0) != blocked) {
+    b = blocked ? 1 : 0;
+    dirty_ = true;
+  }
+}
+
+void DistanceTable::invalidate() {
+  dirty_ = false;
+  blocked_.resize(graph_.size(), 0);
+  buildReverse();
+  const std::size_t n = std::max<std::size_t>(graph_.size(), 1);
+  const std::size_t byBudget = maxBytes_ / (n * sizeof(float));
+  capacity_ = std::max<std::size_t>({byBudget, capacity_, 1});
+  slotOfGoal_.assign(graph_.size(), -1);
+  goalOfSlot_.clear();
+  tables_.clear();
+  prev_.clear();
+  next_.clear();
+  head_ = tail_ = -1;
+  used_ = 0;
+}
+
+void DistanceTable::reserve(std::size_t tables) {
+  capacity_ = std::max(capacity_, tables);
+}
+
+void DistanceTable::unlink(std::size_t slot) {
+  if (prev_[slot] >= 0) {
+    next_[static_cast<std::size_t>(prev_[slot])] = next_[slot];
+  } else {
+    head_ = next_[slot];
+  }
+  if (next_[slot] >= 0) {
+    prev_[static_cast<std::size_t>(next_[slot])] = prev_[slot];
+  } else {
+    tail_ = prev_[slot];
+  }
+  prev_[slot] = next_[slot] = -1;
+}
+
+void DistanceTable::touch(std::size_t slot) {
+  const auto s = static_cast<std::int32_t>(slot);
+  if (head_ == s) {
+    return;
+  }
+  if (prev_[slot] >= 0 || next_[slot] >= 0 || tail_ == s) {
+    unlink(slot);
+  }
+  next_[slot] = head_;
+  prev_[slot] = -1;
+  if (head_ >= 0) {
+    prev_[static_cast<std::size_t>(head_)] = s;
+  }
+  head_ = s;
+  if (tail_ < 0) {
+    tail_ = s;
+  }
+}
+
+std::size_t DistanceTable::acquireSlot() {
+  if (used_ < capacity_) {
+    // Slots are created on demand, so a short run never pays for the whole budget.
+    if (used_ == tables_.size()) {
+      tables_.emplace_back();
+      goalOfSlot_.push_back(kNoNode);
+      prev_.push_back(-1);
+      next_.push_back(-1);
+    }
+    return used_++;
+  }
+  const auto slot = static_cast<std::size_t>(tail_);
+  unlink(slot);
+  slotOfGoal_[static_cast<std::size_t>(goalOfSlot_[slot])] = -1;
+  return slot;
+}
+
+std::span<const float> DistanceTable::to(NodeId goal) {
+  if (dirty_) {
+    invalidate();
+  }
+  const auto g = static_cast<std::size_t>(goal);
+  std::int32_t slot = slotOfGoal_[g];
+  if (slot < 0) {
+    const std::size_t s = acquireSlot();
+    compute(goal, tables_[s]);
+    goalOfSlot_[s] = goal;
+    slot = static_cast<std::int32_t>(s);
+    slotOfGoal_[g] = slot;
+    ++computed_;
+  }
+  touch(static_cast<std::size_t>(slot));
+  return tables_[static_cast<std::size_t>(slot)];
+}
+
+void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
+  d.assign(graph_.size(), kUnreachable);
+  const auto open = [&](NodeId v) { return graph_.isOpen(v) && blocked_[static_cast<std::size_t>(v)] == 0; };
+  // A blocked goal (a robot stands there) is still where the route leads: the way up to it is what
+  // an agent waiting for it needs. A closed one is not reachable at all.
+  if (!graph_.isOpen(goal)) {
+    return;
+  }
+  d[static_cast<std::size_t>(goal)] = 0.0F;
+  if (unit_) {
+    queue_.clear();
+    queue_.push_back(goal);
+    for (std::size_t head = 0; head < queue_.size(); ++head) {
+      const NodeId u = queue_[head];
+      const float du = d[static_cast<std::size_t>(u)] + unitDuration_;
+      for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
+           k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
+        const NodeId p = revFrom_[k];
+        auto& dp = d[static_cast<std::size_t>(p)];
+        if (dp != kUnreachable) {
+          continue;
+        }
+        dp = du;
+        // A closed node learns how far it is from the goal (a robot on it may drive off) but
+        // routes never pass through it.
+        if (open(p)) {
+          queue_.push_back(p);
+        }
+      }
+    }
+    return;
+  }
+  heap_.clear();
+  heap_.emplace_back(0.0F, goal);
+  const auto later = std::greater<>{};
+  while (!heap_.empty()) {
+    std::pop_heap(heap_.begin(), heap_.end(), later);
+    const auto [du, u] = heap_.back();
+    heap_.pop_back();
+    if (du > d[static_cast<std::size_t>(u)]) {
+      continue;
+    }
+    if (u != goal && !open(u)) {
+      continue;
+    }
+    for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
+         k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
+      const NodeId p = revFrom_[k];
+      const float nd = du + revDuration_[k];
+      auto& dp = d[static_cast<std::size_t>(p)];
+      if (nd < dp) {
+        dp = nd;
+        heap_.emplace_back(nd, p);
+        std::push_heap(heap_.begin(), heap_.end(), later);
+      }
+    }
+  }
+}
+
+}  // namespace fleet::traffic

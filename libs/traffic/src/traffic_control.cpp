@@ -1,0 +1,318 @@
+#include "fleet/traffic/traffic_control.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fleet::traffic {
+
+TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> starts, TrafficOptions options)
+    : graph_(graph),
+      options_(options),
+      planner_(std::make_unique<Pibt>(graph, starts, options.pibt)),
+      execution_(graph, starts, options.release),
+      goal_(starts.size(), kNoNode),
+      held_(starts.size(), 0),
+      priority_(starts.size(), 0),
+      stationOfDock_(graph.size(), -1),
+      inLine_(starts.size(), -1),
+      target_(starts.size(), kNoNode),
+      stall_(starts.size(), 0),
+      lastEnd_(starts.begin(), starts.end()),
+      evadeUntil_(starts.size(), -1) {}
+
+void TrafficControl::setStations(std::vector<StationLine> stations) {
+  for (std::size_t r = 0; r < robots(); ++r)
+    leaveLine(r);
+  stations_ = std::move(stations);
+  lines_.assign(stations_.size(), {});
+  leaving_.assign(stations_.size(), -1);
+  // Robots wait only where they leave the dock's ways in and out free: a queue node next to a dock
+  // approached along a row excludes the nodes a robot leaving the dock must drive through.
+  firstClear_.assign(stations_.size(), 0);
+  for (std::size_t i = 0; i < stations_.size(); ++i) {
+    const auto& st = stations_[i];
+    if (!graph_.valid(st.dock))
+      continue;
+    std::vector<NodeId> ways{st.dock};
+    for (const Edge& e : graph_.edges(st.dock))
+      ways.push_back(e.to);
+    for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
+      if (graph_.edge(v, st.dock) != nullptr)
+        ways.push_back(v);
+    }
+    std::size_t k = 0;
+    while (k < st.queue.size() && std::any_of(ways.begin(), ways.end(),
+                                              [&](NodeId w) { return graph_.conflicting(w, st.queue[k]); })) {
+      ++k;
+    }
+    firstClear_[i] = std::min(k, st.queue.empty() ? 0 : st.queue.size() - 1);
+  }
+  std::fill(stationOfDock_.begin(), stationOfDock_.end(), -1);
+  for (std::size_t i = 0; i < stations_.size(); ++i) {
+    if (graph_.valid(stations_[i].dock)) {
+      stationOfDock_[static_cast<std::size_t>(stations_[i].dock)] = static_cast<std::int32_t>(i);
+    }
+  }
+  for (std::size_t r = 0; r < robots(); ++r) {
+    const NodeId g = goal_[r];
+    goal_[r] = kNoNode;
+    setGoal(r, g, priority_[r]);
+  }
+}
+
+std::vector<std::size_t> TrafficControl::line(NodeId dock) const {
+  if (!graph_.valid(dock) || stationOfDock_[static_cast<std::size_t>(dock)] < 0)
+    return {};
+  return lines_[static_cast<std::size_t>(stationOfDock_[static_cast<std::size_t>(dock)])];
+}
+
+void TrafficControl::plannerGoal(std::size_t robot, NodeId goal) {
+  target_[robot] = goal;
+  if (evadeUntil_[robot] >= 0)
+    return;  // takes effect when the evasion ends
+  planner_->setGoal(robot, goal);
+  planner_->setTaskPriority(robot, priority_[robot]);
+}
+
+void TrafficControl::leaveLine(std::size_t robot) {
+  const auto s = inLine_[robot];
+  if (s < 0)
+    return;
+  auto& l = lines_[static_cast<std::size_t>(s)];
+  // The robot whose turn it was keeps the dock until it has driven off it: the next in line
+  // waits at the head of the queue instead of pushing into the only way out.
+  const NodeId dock = stations_[static_cast<std::size_t>(s)].dock;
+  if (!l.empty() && l.front() == robot && graph_.conflicting(planner_->positions()[robot], dock)) {
+    leaving_[static_cast<std::size_t>(s)] = static_cast<std::int64_t>(robot);
+  }
+  l.erase(std::remove(l.begin(), l.end(), robot), l.end());
+  inLine_[robot] = -1;
+  updateLine(static_cast<std::size_t>(s));
+}
+
+void TrafficControl::updateLine(std::size_t station) {
+  const auto& st = stations_[station];
+  const auto& l = lines_[station];
+  const std::size_t shift = leaving_[station] >= 0 ? 1 : 0;
+  for (std::size_t k = 0; k < l.size(); ++k) {
+    const std::size_t place = k + shift;
+    NodeId g = st.dock;
+    if (place > 0 && !st.queue.empty()) {
+      g = st.queue[std::min(firstClear_[station] + place - 1, st.queue.size() - 1)];
+    }
+    plannerGoal(l[k], g);
+  }
+}
+
+std::size_t TrafficControl::addRobot(NodeId start) {
+  execution_.truncateToReleased();
+  std::size_t r = 0;
+  try {
+    r = execution_.addRobot(start);
+  } catch (...) {
+    replan();  // the planner starts again from the released ends either way
+    throw;
+  }
+  goal_.push_back(kNoNode);
+  held_.push_back(0);
+  priority_.push_back(0);
+  inLine_.push_back(-1);
+  target_.push_back(kNoNode);
+  stall_.push_back(0);
+  lastEnd_.push_back(start);
+  evadeUntil_.push_back(-1);
+  replan();
+  return r;
+}
+
+bool TrafficControl::setGoal(std::size_t robot, NodeId goal, int priority) {
+  if (robot >= robots())
+    return false;
+  if (goal != kNoNode && (!graph_.valid(goal) || !graph_.isOpen(goal)))
+    return false;
+  if (goal == goal_[robot] && priority == priority_[robot]) {
+    return true;
+  }
+  leaveLine(robot);
+  goal_[robot] = goal;
+  priority_[robot] = priority;
+  const auto s = goal == kNoNode ? -1 : stationOfDock_[static_cast<std::size_t>(goal)];
+  if (s >= 0) {
+    lines_[static_cast<std::size_t>(s)].push_back(robot);
+    inLine_[robot] = s;
+    updateLine(static_cast<std::size_t>(s));
+  } else {
+    plannerGoal(robot, goal);
+  }
+  return true;
+}
+
+void TrafficControl::setHeld(std::size_t robot, bool held) {
+  if (robot >= robots() || (held_[robot] != 0) == held)
+    return;
+  held_[robot] = held ? 1 : 0;
+  if (held) {
+    // Plan around where it really is, not where the plan would have taken it.
+    if (execution_.at(robot) != execution_.plannedEnd(robot)) {
+      execution_.retract(robot);
+      replan();
+    }
+  }
+  planner_->setControlled(robot, !held);
+}
+
+Report TrafficControl::reached(std::size_t robot, NodeId node) {
+  const Report r = execution_.reached(robot, node);
+  if (r == Report::NotReleased || r == Report::UnknownRobot)
+    ++stats_.refusedReports;
+  return r;
+}
+
+bool TrafficControl::arrived(std::size_t robot) const {
+  return goal_.at(robot) != kNoNode && execution_.at(robot) == goal_[robot];
+}
+
+bool TrafficControl::needsPlanning() const {
+  // Plan while a robot on its way has fewer than two nodes planned ahead of where it is.
+  for (std::size_t r = 0; r < robots(); ++r) {
+    if (held_[r] != 0)
+      continue;
+    // An evasion lasts a number of planned steps: keep planning until it is over.
+    if (evadeUntil_[r] >= 0)
+      return true;
+    const NodeId t = target_[r];
+    if (t != kNoNode && execution_.plannedEnd(r) != t && execution_.pendingNodes(r) < 2)
+      return true;
+  }
+  return false;
+}
+
+int TrafficControl::update() {
+  int steps = 0;
+  while (steps < options_.maxStepsPerUpdate && needsPlanning()) {
+    // Do not plan far past a robot that is behind: what it has not been released yet is planned
+    // again from where its release ends, and the others around where it really is.
+    std::int64_t oldest = -1;
+    for (std::size_t r = 0; r < robots(); ++r) {
+      const auto s = execution_.nextUnreleasedStep(r);
+      if (s >= 0 && (oldest < 0 || s < oldest))
+        oldest = s;
+    }
+    if (oldest >= 0 && execution_.plannedSteps() - oldest >= options_.maxLag)
+      replan();
+    execution_.append(planner_->step());
+    afterStep();
+    ++steps;
+  }
+  stats_.steps += static_cast<std::uint64_t>(steps);
+  return steps;
+}
+
+void TrafficControl::afterStep() {
+  const auto now = execution_.plannedSteps();
+  for (std::size_t i = 0; i < stations_.size(); ++i) {
+    const auto q = leaving_[i];
+    if (q >= 0 &&
+        !graph_.conflicting(planner_->positions()[static_cast<std::size_t>(q)], stations_[i].dock)) {
+      leaving_[i] = -1;
+      updateLine(i);
+    }
+  }
+  for (std::size_t r = 0; r < robots(); ++r) {
+    if (evadeUntil_[r] >= 0 && now >= evadeUntil_[r]) {
+      evadeUntil_[r] = -1;
+      planner_->setGoal(r, target_[r]);
+    }
+  }
+  for (std::size_t r = 0; r < robots(); ++r) {
+    const NodeId t = evadeUntil_[r] >= 0 ? planner_->goal(r) : target_[r];
+    const auto& pos = planner_->positions();
+    if (held_[r] != 0 || t == kNoNode || pos[r] == t) {
+      stall_[r] = 0;
+      lastEnd_[r] = execution_.plannedEnd(r);
+      continue;
+    }
+    // Planned to stand still this step?
+    const bool moved = execution_.plannedEnd(r) != kNoNode && lastEnd_[r] != execution_.plannedEnd(r);
+    lastEnd_[r] = execution_.plannedEnd(r);
+    stall_[r] = moved ? 0 : stall_[r] + 1;
+    if (stall_[r] >= options_.evadeAfter) {
+      stall_[r] = 0;
+      clearWayFor(r);
+    }
+  }
+}
+
+void TrafficControl::clearWayFor(std::size_t robot) {
+  const NodeId goal = evadeUntil_[robot] >= 0 ? planner_->goal(robot) : target_[robot];
+  if (goal == kNoNode)
+    return;
+  const auto dist = planner_->distances().to(goal);
+  const auto& pos = planner_->positions();
+  // Its next few nodes on a shortest way to its goal.
+  std::vector<NodeId> path;
+  NodeId v = pos[robot];
+  for (int k = 0; k < options_.evadeLookahead && v != goal; ++k) {
+    NodeId best = kNoNode;
+    double bestCost = static_cast<double>(dist[static_cast<std::size_t>(v)]);
+    for (const Edge& e : graph_.edges(v)) {
+      if (!graph_.passable(v, e))
+        continue;
+      const double c = e.duration + static_cast<double>(dist[static_cast<std::size_t>(e.to)]);
+      if (c < bestCost + 1e-6 && (best == kNoNode || c < bestCost)) {
+        best = e.to;
+        bestCost = c;
+      }
+    }
+    if (best == kNoNode)
+      break;
+    path.push_back(best);
+    v = best;
+  }
+  auto blocks = [&](NodeId w) {
+    return std::any_of(path.begin(), path.end(), [&](NodeId p) { return graph_.conflicting(p, w); });
+  };
+  for (std::size_t q = 0; q < robots(); ++q) {
+    if (q == robot || held_[q] != 0 || evadeUntil_[q] >= 0 || !blocks(pos[q]))
+      continue;
+    // The nearest node (in edges) clear of that path, away from the stalled robot.
+    std::vector<NodeId> frontier{pos[q]};
+    std::vector<std::uint8_t> seen(graph_.size(), 0);
+    seen[static_cast<std::size_t>(pos[q])] = 1;
+    NodeId refuge = kNoNode;
+    for (int depth = 0; depth < 12 && refuge == kNoNode && !frontier.empty(); ++depth) {
+      std::vector<NodeId> next;
+      for (NodeId u : frontier) {
+        for (const Edge& e : graph_.edges(u)) {
+          const auto w = static_cast<std::size_t>(e.to);
+          if (!graph_.passable(u, e) || seen[w] != 0)
+            continue;
+          seen[w] = 1;
+          if (graph_.conflicting(e.to, pos[robot]))
+            continue;  // not through the stalled robot
+          if (!blocks(e.to) && e.to != goal && refuge == kNoNode)
+            refuge = e.to;
+          next.push_back(e.to);
+        }
+      }
+      frontier = std::move(next);
+    }
+    if (refuge == kNoNode)
+      continue;
+    planner_->setGoal(q, refuge);
+    evadeUntil_[q] = execution_.plannedSteps() + options_.evadeSteps;
+    ++stats_.evasions;
+  }
+}
+
+void TrafficControl::replan() {
+  const auto ends = execution_.truncateToReleased();
+  planner_->reset(ends);
+  ++stats_.replans;
+}
+
+void TrafficControl::graphChanged() {
+  replan();
+}
+
+}  // namespace fleet::traffic

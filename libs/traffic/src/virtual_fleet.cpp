@@ -1,0 +1,247 @@
+#include "fleet/traffic/virtual_fleet.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace fleet::traffic {
+namespace {
+
+struct Bot {
+  NodeId at = kNoNode;     // last node reached
+  NodeId to = kNoNode;     // driving towards (kNoNode: standing)
+  NodeId prev = kNoNode;   // the node before `at` (for turning)
+  double left = 0.0;       // s to go on the current edge
+  double total = 0.0;      // s the current edge takes
+  double dwellLeft = 0.0;  // s of dwell left at a station
+  int phase = 0;           // 0: to the pickup, 1: to the drop-off
+  NodeId pickup = kNoNode;
+  NodeId dropoff = kNoNode;
+  double taskStart = 0.0;
+  double lastProgress = 0.0;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty())
+    return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(
+      std::min<double>(static_cast<double>(v.size() - 1), std::floor(p * static_cast<double>(v.size()))));
+  return v[i];
+}
+
+}  // namespace
+
+VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& o) {
+  const Graph& g = roadmap.graph;
+  std::vector<NodeId> pickups, dropoffs, parking;
+  for (const auto& s : roadmap.stations) {
+    if (s.dock == kNoNode)
+      continue;
+    if (s.kind == site::StationKind::Pickup)
+      pickups.push_back(s.dock);
+    if (s.kind == site::StationKind::Dropoff)
+      dropoffs.push_back(s.dock);
+    if (s.kind == site::StationKind::Parking)
+      parking.push_back(s.dock);
+  }
+  if (pickups.empty() || dropoffs.empty()) {
+    throw std::invalid_argument("virtual fleet: the roadmap needs a pickup and a drop-off station");
+  }
+  // Starts: parking docks, then lane nodes that conflict with nothing taken so far.
+  std::vector<NodeId> starts;
+  auto fits = [&](NodeId v) {
+    return g.isOpen(v) &&
+           std::none_of(starts.begin(), starts.end(), [&](NodeId s) { return g.conflicting(s, v); });
+  };
+  for (NodeId v : parking) {
+    if (starts.size() < o.robots && fits(v))
+      starts.push_back(v);
+  }
+  for (NodeId v = 0; static_cast<std::size_t>(v) < g.size() && starts.size() < o.robots; ++v) {
+    if (roadmap.kind(v) == NodeKind::Lane && fits(v))
+      starts.push_back(v);
+  }
+  if (starts.size() < o.robots) {
+    throw std::invalid_argument("virtual fleet: " + std::to_string(o.robots) +
+                                " robots do not fit on the roadmap (" + std::to_string(starts.size()) +
+                                " do)");
+  }
+
+  std::mt19937_64 rng(o.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  TrafficOptions topt = o.traffic;
+  topt.pibt.seed = o.seed;
+  TrafficControl traffic(g, starts, topt);
+  if (o.stationLines) {
+    std::vector<StationLine> lines;
+    for (const auto& st : roadmap.stations) {
+      if (st.dock != kNoNode &&
+          (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
+           st.kind == site::StationKind::Charging)) {
+        lines.push_back({st.dock, st.queue});
+      }
+    }
+    traffic.setStations(std::move(lines));
+  }
+  std::vector<Bot> bots(o.robots);
+  auto newTask = [&](std::size_t r, double now) {
+    Bot& b = bots[r];
+    b.pickup = pickups[rng() % pickups.size()];
+    b.dropoff = dropoffs[rng() % dropoffs.size()];
+    b.phase = 0;
+    b.taskStart = now;
+    b.lastProgress = now;
+    traffic.setGoal(r, b.pickup);
+  };
+  for (std::size_t r = 0; r < o.robots; ++r) {
+    bots[r].at = starts[r];
+    newTask(r, 0.0);
+  }
+
+  VirtualFleetResult res;
+  res.robots = o.robots;
+  res.duration = o.duration;
+  res.minSeparation = std::numeric_limits<double>::infinity();
+  res.density = static_cast<double>(o.robots) / static_cast<double>(g.size());
+  std::vector<double> updateMs, taskTimes;
+  const double contact = roadmap.separation.contact - roadmap.separation.margin;
+  std::vector<Vec2> where(o.robots);
+
+  for (double now = 0.0; now < o.duration; now += o.dt) {
+    const auto t0 = std::chrono::steady_clock::now();
+    traffic.update();
+    std::vector<Release> rel(o.robots);
+    for (std::size_t r = 0; r < o.robots; ++r)
+      rel[r] = traffic.release(r);
+    updateMs.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+
+    for (std::size_t r = 0; r < o.robots; ++r) {
+      Bot& b = bots[r];
+      if (b.dwellLeft > 0.0) {
+        b.dwellLeft -= o.dt;
+        if (b.dwellLeft > 0.0)
+          continue;
+        traffic.setHeld(r, false);
+        if (b.phase == 0) {
+          b.phase = 1;
+          traffic.setGoal(r, b.dropoff);
+        } else {
+          ++res.tasksDone;
+          taskTimes.push_back(now - b.taskStart);
+          newTask(r, now);
+        }
+        b.lastProgress = now;
+        continue;
+      }
+      if (b.to == kNoNode) {
+        // Standing: take the next released node, if any.
+        if (rel[r].base.size() > 1 && rel[r].base.front() == b.at) {
+          b.to = rel[r].base[1];
+          const Edge* e = g.edge(b.at, b.to);
+          double d = e != nullptr ? e->duration : 1.0;
+          if (b.prev != kNoNode)
+            d += roadmap.extraTurn(b.prev, b.at, b.to);
+          d *= 1.0 + o.jitter * unit(rng);
+          if (unit(rng) < o.stopChance)
+            d += o.stopMax * unit(rng);
+          b.left = b.total = d;
+        } else if (traffic.goal(r) != kNoNode && b.at == traffic.goal(r)) {
+          b.dwellLeft = o.dwell;
+          traffic.setHeld(r, true);
+        }
+      }
+      if (b.to != kNoNode) {
+        b.left -= o.dt;
+        if (b.left <= 0.0) {
+          b.prev = b.at;
+          b.at = b.to;
+          b.to = kNoNode;
+          traffic.reached(r, b.at);
+          b.lastProgress = now;
+        }
+      }
+      res.longestWait = std::max(res.longestWait, now - b.lastProgress);
+    }
+    // What the traffic layer promises.
+    for (std::size_t r = 0; r < o.robots; ++r) {
+      const Bot& b = bots[r];
+      where[r] = b.to == kNoNode
+                     ? g.position(b.at)
+                     : g.position(b.at) + (g.position(b.to) - g.position(b.at)) * (1.0 - b.left / b.total);
+    }
+    bool contactNow = false, holdNow = false;
+    for (std::size_t a = 0; a < o.robots; ++a) {
+      for (std::size_t c = a + 1; c < o.robots; ++c) {
+        const double d = (where[a] - where[c]).norm();
+        res.minSeparation = std::min(res.minSeparation, d);
+        if (d < contact)
+          contactNow = true;
+        const NodeId ha[2] = {bots[a].at, bots[a].to};
+        const NodeId hc[2] = {bots[c].at, bots[c].to};
+        for (NodeId x : ha) {
+          for (NodeId y : hc) {
+            if (x != kNoNode && y != kNoNode && g.conflicting(x, y))
+              holdNow = true;
+          }
+        }
+      }
+    }
+    res.contacts += contactNow ? 1 : 0;
+    res.holdViolations += holdNow ? 1 : 0;
+  }
+  for (std::size_t r = 0; r < o.robots; ++r) {
+    const Bot& b = bots[r];
+    if (o.duration - b.lastProgress < 60.0)
+      continue;
+    std::ostringstream os;
+    os << "robot " << r << " at node " << b.at << " (" << g.position(b.at).x << ", " << g.position(b.at).y
+       << ") for " << (o.duration - b.lastProgress) << " s, goal " << traffic.goal(r) << ", held "
+       << traffic.held(r) << ", planned " << traffic.execution().pendingNodes(r)
+       << " nodes ahead, released to " << traffic.execution().releasedEnd(r) << ", waiting on";
+    for (auto q : traffic.waitingOn(r))
+      os << " " << q << "@" << bots[q].at;
+    const auto rel = traffic.release(r);
+    os << "; release now: base " << rel.base.size() << " horizon " << rel.horizon.size() << " dwell "
+       << b.dwellLeft << " to " << b.to << " progress step " << traffic.execution().progressStep(r) << " of "
+       << traffic.execution().plannedSteps();
+    res.stalls.push_back(os.str());
+  }
+  res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / o.duration;
+  double sum = 0.0;
+  for (double t : taskTimes)
+    sum += t;
+  res.meanTaskTime = taskTimes.empty() ? 0.0 : sum / static_cast<double>(taskTimes.size());
+  res.plannerSteps = traffic.stats().steps;
+  res.replans = traffic.stats().replans;
+  res.refusedReports = traffic.stats().refusedReports;
+  res.updateP50Ms = percentile(updateMs, 0.5);
+  res.updateP99Ms = percentile(updateMs, 0.99);
+  if (o.robots < 2)
+    res.minSeparation = 0.0;
+  return res;
+}
+
+std::string formatResult(const VirtualFleetResult& r) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(1);
+  os << r.robots << " robots, " << r.duration << " s: " << r.tasksDone << " tasks (" << r.tasksPerHour
+     << "/h, mean " << r.meanTaskTime << " s), min separation ";
+  os.precision(2);
+  os << r.minSeparation << " m, contacts " << r.contacts << ", hold violations " << r.holdViolations
+     << ", longest wait ";
+  os.precision(1);
+  os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans
+     << ", update p50/p99 ";
+  os.precision(3);
+  os << r.updateP50Ms << "/" << r.updateP99Ms << " ms, density " << r.density;
+  return os.str();
+}
+
+}  // namespace fleet::traffic

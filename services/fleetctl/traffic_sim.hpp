@@ -1,0 +1,26 @@
+#pragma once
+
+// `fleetctl traffic-sim`: the traffic layer (roadmap, lifelong planner, execution by dependencies,
+// station lines) driving a virtual fleet of robots that do exactly what is released to them, late
+// at random (libs/traffic virtual_fleet.hpp). Seconds of wall time per simulated hour: the quick way
+// to see whether the traffic layer keeps a fleet moving on a site before running the full stack.
+
+#include <cstdint>
+#include <string>
+
+namespace fleet::ctl {
+
+struct TrafficSimOptions {
+  std::string site;
+  int robots = 20;
+  double duration = 600.0;
+  std::string seeds = "1";  ///< "1-8" or "3"
+  double spacing = 0.0;     ///< roadmap lattice spacing (m); 0: the default
+  double stopChance = 0.01;
+  bool json = false;
+};
+
+/// Exit code: 0 ran (whatever the figures), 1 a promise broken (contact, conflicting holds), 2 bad input.
+int runTrafficSim(const TrafficSimOptions& options);
+
+}  // namespace fleet::ctl

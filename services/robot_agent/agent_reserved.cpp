@@ -1,0 +1,344 @@
+// The agent in reserved traffic (AgentParams::traffic "reserved"): the traffic manager's releases
+// are the route. The robot drives the released base with its local stack behind the motion gate,
+// stops at the base's end unless a newer release extends it, docks when the base ends on its goal,
+// and reports every node it reaches. None of the reactive conduct runs here (no standoff arbiter,
+// no back-offs, returns along the trail, detours or global planning): the traffic manager's plan
+// keeps robots that follow it apart, so what the gate still stops for is people and the unexpected,
+// and that is reported (blocked) for the traffic manager to plan around.
+
+#include <algorithm>
+#include <cmath>
+
+#include "agent.hpp"
+#include "fleet/core/angles.hpp"
+#include "fleet/core/clock.hpp"
+
+namespace fleet::agent {
+namespace {
+
+/// Within this distance of its goal the robot is there (the reactive docking's tolerance).
+constexpr double kAtGoal = 0.15;
+/// A base ending this close to the goal ends on it: the last leg docks onto the goal's pose itself.
+constexpr double kGoalOnNode = 0.3;
+/// Left of the base [m] below which the robot stands at its end.
+constexpr double kAtEnd = 0.02;
+/// The local planner drives while the robot is this close to the base [m]; further off, the
+/// follower steers it back. The roadmap keeps robots apart only near their nodes: a sampling
+/// planner swerving round a person would leave them (the stop rule holds the robot instead, and
+/// the traffic manager re-plans around the person).
+constexpr double kMaxCrossTrack = 0.25;
+/// The follower drives the first metre off a station or parking place (the roadmap's straight
+/// leg from a dock to its approach node), as in reactive traffic.
+constexpr double kLeaveDistance = 1.0;
+/// Held by the gate this long [s]: reported blocked ...
+constexpr double kBlockedAfterS = 1.0;
+/// ... until it has moved this far [m] from where the hold began.
+constexpr double kHoldOver = 0.1;
+/// A progress report at least this often [s], whatever changed.
+constexpr double kHeartbeatS = 1.0;
+/// The local planner sees this much of the base ahead [m]. Given the whole base, a sampling
+/// planner measured its progress to the base's end: on a base that bends back (round a corner and
+/// back along the next aisle) the robot got no closer to that end for a while, DWA took it for a
+/// local minimum and swerved off the base to escape it.
+constexpr double kPlannerWindow = 2.0;
+/// Base nodes where the way turns by more than this [rad] are corners: the robot drives straight
+/// onto the node and turns there on the spot, as the roadmap's edges assume. Left to the local
+/// planner or the follower, it rounded a right angle in an arc that cut 0.17 m off it (DWA), or
+/// turned 0.5 m early (the follower's carrot) at speed and slid off the base while it braked.
+constexpr double kSharpTurn = 0.6;
+/// ... coming onto the node at most this fast [m/s] (it slides a centimetre while it brakes) ...
+constexpr double kTurnSpeed = 0.15;
+/// ... from this far before it [m] ...
+constexpr double kCornerApproach = 0.8;
+/// ... until it is this close [m] (then it turns to the next leg).
+constexpr double kOnCorner = 0.05;
+
+/// The stretch of the polyline `pts` from arc length `from` on, `length` long.
+std::vector<Vec2> stretch(const std::vector<Vec2>& pts, double from, double length) {
+  std::vector<Vec2> out;
+  double s = 0.0;
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const Vec2 a = pts[i];
+    const Vec2 ab = pts[i + 1] - a;
+    const double seg = ab.norm();
+    if (seg < 1e-9) {
+      continue;
+    }
+    if (s + seg > from) {
+      if (out.empty()) {
+        out.push_back(a + ab * (std::max(0.0, from - s) / seg));
+      }
+      if (s + seg >= from + length) {
+        out.push_back(a + ab * ((from + length - s) / seg));
+        return out;
+      }
+      out.push_back(pts[i + 1]);
+    }
+    s += seg;
+  }
+  if (out.empty()) {
+    out.push_back(pts.back());
+  }
+  return out;
+}
+
+}  // namespace
+
+void Agent::onRelease(const msg::TrafficRelease& r) {
+  if (!reserved_) {
+    return;
+  }
+  if (r.robot_id != p_.id) {
+    releases_.noteForeign();
+    return;
+  }
+  Release rel;
+  rel.epoch = r.epoch;
+  rel.seq = r.seq;
+  rel.endsAtGoal = r.ends_at_goal;
+  rel.base.reserve(r.base.size());
+  for (const auto& n : r.base) {
+    rel.base.push_back({n.node, {n.x, n.y}});
+  }
+  (void)releases_.offer(rel, localizer_.pose().position());
+}
+
+std::optional<msg::Goal> Agent::trafficGoal() const {
+  if (!task_.empty() && goal_ < goals_.size()) {
+    return goals_[goal_];
+  }
+  if (p_.returnHomeS >= 0.0) {
+    // Idle: its parking place. The trip home is planned by the traffic manager like any other.
+    return msg::Goal{p_.start, "", msg::GoalAction::Park, 0.0};
+  }
+  return std::nullopt;
+}
+
+bool Agent::baseEndsAtGoal() const {
+  const auto end = releases_.end();
+  const auto goal = trafficGoal();
+  return releases_.endsAtGoal() && end && goal && distance(*end, goal->pose.position()) < kGoalOnNode;
+}
+
+void Agent::beginLeg(std::int64_t nowNs) {
+  if (phase_ == Phase::Idle || phase_ == Phase::Dwelling) {
+    undockFrom_ = localizer_.pose().position();
+  }
+  phase_ = Phase::Driving;
+  phaseStartNs_ = nowNs;
+  const auto st = taskStateFor(goal_, false);
+  if (st != reported_) {
+    reported_ = st;
+    pendingStatus_ = msg::TaskStatus{
+        p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
+        "",    nowNs};
+  }
+}
+
+void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
+  if (!task_.empty() && phase_ == Phase::Idle) {
+    startGoal(nowNs);
+  }
+  if (phase_ == Phase::Dwelling) {
+    heldSinceNs_ = -1;
+    blocked_ = false;
+    baseAhead_ = false;
+    dockingLeg_ = false;
+    mode =
+        goals_[goal_].action == msg::GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
+    if (nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].duration_s) {
+      ++goal_;
+      progress_.newGoal();
+      if (goal_ >= goals_.size()) {
+        finishTask(msg::TaskState::Done, "", nowNs);
+      } else {
+        startGoal(nowNs);
+      }
+    }
+    return;
+  }
+  driveBase(nowNs, dt, v, w, mode);
+}
+
+void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
+  const Pose2 pose = localizer_.pose();
+  const Vec2 here = pose.position();
+  if (releases_.advance(here)) {
+    progress_.newGoal();  // progress is measured to the next node from now on
+  }
+  const auto goal = trafficGoal();
+  const bool toGoal = baseEndsAtGoal();
+  dockingLeg_ = toGoal && releases_.onLastLeg();
+  docking_ = false;
+  baseAhead_ = false;
+  v = 0.0;
+  w = 0.0;
+  // Standing (at the end of the base, on the goal, or with nothing released): waiting on the
+  // traffic manager, which is waiting on other robots; nothing holds it up.
+  mode = task_.empty() ? msg::RobotMode::Idle : msg::RobotMode::Waiting;
+  auto standStill = [&] {
+    v = 0.0;
+    w = 0.0;
+    heldSinceNs_ = -1;
+    blocked_ = false;
+  };
+  if (toGoal && distance(here, goal->pose.position()) < kAtGoal) {
+    standStill();
+    dockingLeg_ = false;
+    standsAt_ = goal->pose;
+    if (!task_.empty() && phase_ == Phase::Driving) {
+      enterDwell(nowNs);
+    }
+    return;
+  }
+  const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath();
+  if (!releases_.nodesAhead() && newRelease) {
+    standStill();  // nothing released beyond the node it is on
+    return;
+  }
+  if (newRelease) {
+    std::vector<Vec2> pts = releases_.ahead(here);
+    if (toGoal) {
+      pts.back() = goal->pose.position();  // dock on the goal's pose itself
+    }
+    const Vec2 last = pts.back() - pts[pts.size() - 2];
+    const double heading = last.norm() > 1e-6 ? std::atan2(last.y, last.x) : pose.theta;
+    if (!follower_.setPath(pts, heading)) {
+      standStill();
+      return;
+    }
+    basePath_ = pts;
+    followedRevision_ = releases_.revision();
+    progress_.newGoal();
+    // (The local planner is not reset: an extension continues the path it is driving.)
+  }
+  const auto r = follower_.step(pose);
+  if (!r) {
+    standStill();  // a non-finite estimate: nothing sensible to drive
+    return;
+  }
+  const double left = follower_.pathLength() - r->progress;
+  const Vec2 toEnd = basePath_.back() - here;
+  const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
+  // At the end, or the end no longer ahead of the robot: turning round for the last centimetres
+  // would sweep the body over what was not released.
+  if (left < kAtEnd || (r->final_approach && toEnd.norm() < kAtGoal && toEnd.dot(facing) < kAtEnd)) {
+    standStill();
+    return;
+  }
+  baseAhead_ = true;
+  docking_ = dockingLeg_ && r->final_approach;
+  if (undockFrom_ && distance(here, *undockFrom_) > kLeaveDistance) {
+    undockFrom_.reset();
+  }
+  const auto turn = releases_.nextTurn(kSharpTurn);
+  const bool cornering = turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;
+  const bool planning = planner_ && !r->final_approach && !cornering && !undockFrom_ &&
+                        r->cross_track < kMaxCrossTrack && !progress_.followerDrives(nowNs);
+  bool localBlocked = false;
+  if (planning) {
+    path_ = stretch(basePath_, r->progress, kPlannerWindow);
+    const auto tw = planLocal(localBlocked);
+    v = tw.v;
+    w = tw.omega;
+  } else if (r->final_approach || cornering) {
+    // Onto the corner, or the last stretch: face it and drive straight there (onto a station:
+    // slowly, as reactive docking does). The pose law's curve could bulge off the base.
+    // (Turning on the spot only when far off: told to at speed, the robot slides on while it brakes.)
+    const Vec2 to = cornering ? turn->at - here : toEnd;
+    const double b = angleDiff(std::atan2(to.y, to.x), pose.theta);
+    w = std::clamp(2.0 * b, -p_.wMax, p_.wMax);
+    if (docking_) {
+      v = std::abs(b) > 0.25 ? 0.0 : std::min(0.3, to.norm());
+    } else {
+      v = std::abs(b) > 0.7 ? 0.0 : p_.vMax;
+    }
+  } else {
+    followerTwist(*r, v, w);
+  }
+  v = std::max(v, 0.0);  // never backwards off the base
+  // Stop at the end of the base: no faster than the robot can brake from within what is left,
+  // one control period late. (An extension in time lifts the limit before it bites.)
+  double cap = stoppingSpeed(left, p_.limits.accel_max, dt);
+  if (turn) {
+    // Down to the turning speed by the time it is on the corner (kOnCorner, with as much again for
+    // the braking's lag behind the command).
+    cap = std::min(
+        cap, std::max(kTurnSpeed, stoppingSpeed(turn->distance - 2.0 * kOnCorner, p_.limits.accel_max, dt)));
+  }
+  if (v > cap) {
+    w *= cap / v;
+    v = cap;
+  }
+  mode = msg::RobotMode::Moving;
+  Blocker blocker;
+  const double wanted = v;
+  bool held = heldUp(v, w, blocker) && wanted > (planning ? 0.02 : 0.1);
+  if (!held && planning && std::abs(wanted) < 0.02 && std::abs(w) < 0.1 && cap > 0.1) {
+    // The planner stops in front of something (every rollout ends in the stop gap): held as well.
+    Blocker any;
+    localBlocked = clearSpeed(0.5, any) < 0.5;
+  }
+  if (localBlocked && !held) {
+    held = true;
+    (void)clearSpeed(0.5, blocker);  // name what is in the way
+  }
+  const Vec2 toCarrot = r->target.position() - here;
+  const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), pose.theta);
+  if (held && !blocker.robot && blocker.id.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
+    // A wall ahead while the base bends away: turn towards the carrot on the spot (as reactive).
+    v = 0.0;
+    w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
+    held = false;
+  }
+  // Waiting on a robot the traffic manager knows is a dependency, not a block; a person, something
+  // not on the map or a robot the sensors cannot name is what the plan does not know about.
+  const bool byKnownRobot = blocker.robot && std::any_of(others_.begin(), others_.end(),
+                                                         [&](const Other& o) { return o.id == blocker.id; });
+  if (held) {
+    mode = msg::RobotMode::Waiting;
+  }
+  // A hold lasts until the robot has got on: a sampling planner turning this way and that in front
+  // of a person is not held every cycle, and a blocked flag that flapped with it would have the
+  // traffic manager re-plan on every report.
+  if (heldSinceNs_ >= 0 && distance(here, heldAt_) > kHoldOver) {
+    heldSinceNs_ = -1;
+  }
+  if (held && !byKnownRobot && heldSinceNs_ < 0) {
+    heldSinceNs_ = nowNs;
+    heldAt_ = here;
+  }
+  blocked_ = heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS;
+  if (progress_.watchPlanner(nowNs, here, planning && !held)) {
+    ++conduct_.plannerRecoveries;
+  }
+}
+
+std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {
+  msg::TrafficProgress p;
+  p.robot_id = p_.id;
+  p.epoch = releases_.epoch();
+  p.node = releases_.node();
+  p.pose = localizer_.pose();
+  if (const auto g = trafficGoal()) {
+    p.has_goal = true;
+    p.goal = g->pose;
+    p.goal_station = g->station;
+  }
+  p.priority = 0;  // (TaskAssignment carries no priority yet)
+  p.holding = phase_ == Phase::Dwelling || paused() || localizer_.lost() || dockingLeg_;
+  p.blocked = blocked_;
+  p.follows = true;
+  p.stamp_ns = nowNs;
+  const auto& q = lastProgress_;
+  const bool changed = !q || q->epoch != p.epoch || q->node != p.node || q->has_goal != p.has_goal ||
+                       !(q->goal == p.goal) || q->goal_station != p.goal_station || q->holding != p.holding ||
+                       q->blocked != p.blocked;
+  if (!changed && nsToSec(nowNs - q->stamp_ns) < kHeartbeatS) {
+    return std::nullopt;
+  }
+  lastProgress_ = p;
+  return p;
+}
+
+}  // namespace fleet::agent

@@ -1,0 +1,161 @@
+// traffic_manager: plans every robot's moves together on the site's roadmap and releases each
+// robot its route a few nodes at a time (TrafficRelease), from the robots' TrafficProgress. See
+// docs/operator-guide.md for the configuration keys.
+
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+
+#include "fleet/core/clock.hpp"
+#include "fleet/core/logging.hpp"
+#include "fleet/service/runtime.hpp"
+#include "fleet/service/site_stations.hpp"
+#include "fleet/transport/dds.hpp"
+#include "traffic_node.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+
+namespace {
+
+int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id) {
+  WallClock wall;
+  // The incarnation: robots tell a restarted manager's releases from the previous one's.
+  const auto epoch = static_cast<std::uint32_t>((wall.nowNs() / 1'000'000) & 0x7fffffff) | 1U;
+  trafficmgr::TrafficNode node(site, settings, epoch);
+  const auto& rm = node.roadmap();
+  spdlog::info("traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}", site.name,
+               rm.graph.size(), rm.edgeCount(), rm.stations.size(), epoch);
+  for (const auto& p : rm.problems) {
+    spdlog::warn("traffic manager: roadmap: {}", p.what);
+  }
+  transport::Participant p;
+  transport::Reader<msg::TrafficProgress> progress(p);
+  transport::Writer<msg::TrafficRelease> releases(p);
+  transport::Writer<msg::Roadmap> roadmapOut(p);
+  transport::Reader<msg::Clock> clockIn(p);
+  transport::Writer<msg::StepDone> stepDone(p);
+  transport::WaitSet ws(p);
+  ws.attach(progress);
+  ws.attach(clockIn);
+  service::RateLimitedLog badInput;
+  const bool simClock = settings.clock == "sim";
+  std::int64_t now = simClock ? 0 : wall.nowNs();
+  bool haveClock = !simClock;
+  const std::int64_t period = secToNs(1.0 / settings.rateHz);
+  std::int64_t nextTick = now;
+  auto lastRegister = std::chrono::steady_clock::now() - 10s;
+  auto lastStats = std::chrono::steady_clock::now();
+  bool roadmapSent = false;
+
+  auto ingest = [&] {
+    for (const auto& m : progress.take()) {
+      if (!haveClock)
+        continue;
+      if (auto problem = node.onProgress(m, now)) {
+        badInput.warn("progress:" + m.robot_id, *problem);
+      }
+    }
+  };
+  auto cycle = [&] {
+    if (!roadmapSent) {
+      roadmapOut.write(node.roadmapMessage(now));
+      roadmapSent = true;
+    }
+    for (const auto& r : node.tick(now)) {
+      try {
+        releases.write(r);
+      } catch (const std::exception& e) {
+        badInput.warn("release", std::string("release to \"") + r.robot_id + "\" not sent: " + e.what());
+      }
+    }
+  };
+
+  while (!service::stopRequested()) {
+    if (settings.lockstep && !haveClock && std::chrono::steady_clock::now() - lastRegister > 1s) {
+      stepDone.write({id, msg::StepDone::kRegister});
+      lastRegister = std::chrono::steady_clock::now();
+    }
+    const auto wait =
+        simClock
+            ? 100ms
+            : std::chrono::milliseconds(std::max<std::int64_t>(0, (nextTick - wall.nowNs()) / 1'000'000));
+    ws.wait(wait);
+    if (simClock) {
+      for (const auto& c : clockIn.take()) {
+        now = c.sim_time_ns;
+        if (!haveClock) {
+          nextTick = now;
+          haveClock = true;
+        }
+        ingest();
+        if (now >= nextTick) {
+          cycle();
+          nextTick += period * std::max<std::int64_t>(1, (now - nextTick) / period + 1);
+        }
+        if (settings.lockstep && c.lockstep)
+          stepDone.write({id, c.step});
+      }
+      ingest();
+    } else {
+      now = wall.nowNs();
+      ingest();
+      if (now >= nextTick) {
+        cycle();
+        nextTick = std::max(nextTick + period, now);
+      }
+    }
+    if (std::chrono::steady_clock::now() - lastStats > 10s) {
+      const auto& c = node.counters();
+      spdlog::info(
+          "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, "
+          "{} "
+          "re-plans, tick {:.2f} ms (max {:.2f})",
+          node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps,
+          c.replans, c.lastTickMs, c.maxTickMs);
+      lastStats = std::chrono::steady_clock::now();
+    }
+  }
+  if (settings.lockstep)
+    stepDone.write({id, msg::StepDone::kLeave});
+  spdlog::info("traffic manager: stopped");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"traffic_manager: plans all robots together on the site's roadmap and releases their routes"};
+  std::string configPath;
+  std::string sitePath;
+  std::string level = "info";
+  std::string id = "traffic_manager";
+  app.add_option("-c,--config", configPath, "JSON configuration file");
+  app.add_option("--site", sitePath, "site.json (overrides the config's \"site\")");
+  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  app.add_option("--id", id, "participant id in lockstep");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    logging::setup("traffic_manager", level);
+    Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
+                                    : Config::fromFile(configPath);
+    auto settings = trafficmgr::readSettings(cfg);
+    cfg.finish();
+    if (!sitePath.empty())
+      settings.site = sitePath;
+    if (settings.site.empty())
+      throw ConfigError({"no site: give --site FILE or \"site\" in the config"});
+    const auto site = service::loadSiteFile(settings.site);
+    if (!site)
+      throw ConfigError({site.error().message});
+    service::installStopHandlers();
+    return run(*site, settings, id);
+  } catch (const ConfigError& e) {
+    spdlog::critical("{}", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    spdlog::critical("traffic manager: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,247 @@
+#include "traffic_node.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace fleet::trafficmgr {
+
+using traffic::kNoNode;
+using traffic::NodeId;
+
+Settings readSettings(Config& cfg) {
+  Settings s;
+  cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
+                         "lockstep", "plan_ahead", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes",
+                         "seed", "roadmap"});
+  s.site = cfg.string("site", "");
+  s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
+  s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
+  s.robotTimeoutS = cfg.number("robot_timeout_s", 5.0, {0.0, 3600.0, true});
+  s.placeTolerance = cfg.number("place_tolerance", 0.5, {0.0, 10.0, true});
+  s.clock = cfg.string("clock", "wall", {"wall", "sim"});
+  s.lockstep = cfg.boolean("lockstep", false);
+  if (s.lockstep && s.clock != "sim")
+    cfg.problem("lockstep", "requires \"clock\": \"sim\"");
+  s.traffic.planAhead = cfg.integer("plan_ahead", s.traffic.planAhead, {1, 1000});
+  s.traffic.maxLag = cfg.integer("max_lag", s.traffic.maxLag, {1, 100000});
+  s.traffic.release.baseAhead = cfg.number("base_ahead", s.traffic.release.baseAhead, {0.0, 100.0});
+  s.traffic.release.maxBaseNodes = static_cast<std::size_t>(
+      cfg.integer("max_base_nodes", static_cast<std::int64_t>(s.traffic.release.maxBaseNodes), {1, 63}));
+  s.traffic.release.horizonNodes = static_cast<std::size_t>(
+      cfg.integer("horizon_nodes", static_cast<std::int64_t>(s.traffic.release.horizonNodes), {0, 32}));
+  s.traffic.pibt.seed = static_cast<std::uint64_t>(cfg.integer("seed", 1, {0, 1e15}));
+  auto r = cfg.child("roadmap");
+  r.rejectUnknownKeys({"spacing", "cruise_speed", "margin", "queue_length", "diagonals"});
+  s.roadmap.spacing = r.number("spacing", 0.0, {0.0, 10.0});
+  s.roadmap.cruiseSpeed = r.number("cruise_speed", s.roadmap.cruiseSpeed, {0.0, 10.0, true});
+  s.roadmap.margin = r.number("margin", s.roadmap.margin, {0.0, 2.0});
+  s.roadmap.queueLength = static_cast<int>(r.integer("queue_length", s.roadmap.queueLength, {0, 50}));
+  s.roadmap.diagonals = r.boolean("diagonals", s.roadmap.diagonals);
+  return s;
+}
+
+TrafficNode::TrafficNode(const site::Site& site, Settings settings, std::uint32_t epoch)
+    : settings_(std::move(settings)),
+      epoch_(epoch),
+      roadmap_(traffic::buildRoadmap(site, settings_.roadmap)) {
+  control_ =
+      std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, settings_.traffic);
+}
+
+msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {
+  msg::Roadmap m;
+  m.epoch = epoch_;
+  m.stamp_ns = nowNs;
+  const auto& g = roadmap_.graph;
+  for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {
+    m.nodes.push_back({v, g.position(v).x, g.position(v).y});
+    m.kinds.push_back(static_cast<std::uint8_t>(roadmap_.kind(v)));
+    m.open.push_back(g.isOpen(v));
+    for (const auto& e : g.edges(v)) {
+      m.edges.push_back({v, e.to, static_cast<float>(e.duration), e.open});
+    }
+  }
+  return m;
+}
+
+int TrafficNode::indexOf(const std::string& robot) const {
+  auto it = robots_.find(robot);
+  return it == robots_.end() ? -1 : it->second.index;
+}
+
+std::size_t TrafficNode::robotsPlaced() const {
+  return byIndex_.size();
+}
+
+NodeId TrafficNode::goalNode(const msg::TrafficProgress& p, std::string& why) const {
+  if (!p.has_goal)
+    return kNoNode;
+  if (!p.goal_station.empty()) {
+    const auto* s = roadmap_.station(p.goal_station);
+    if (s != nullptr && s->dock != kNoNode)
+      return s->dock;
+    if (s == nullptr) {
+      why = "goal station \"" + p.goal_station + "\" is not on the site";
+    } else {
+      why = "goal station \"" + p.goal_station + "\" has no roadmap node (the robot does not fit there)";
+    }
+    return kNoNode;
+  }
+  const Vec2 g{p.goal.x, p.goal.y};
+  const NodeId v = roadmap_.nearest(g);
+  if (v == kNoNode || (roadmap_.graph.position(v) - g).norm() > settings_.placeTolerance) {
+    std::ostringstream os;
+    os << "goal (" << p.goal.x << ", " << p.goal.y << ") is more than " << settings_.placeTolerance
+       << " m from the roadmap";
+    why = os.str();
+    return kNoNode;
+  }
+  return v;
+}
+
+NodeId TrafficNode::placeNode(const msg::TrafficProgress& p) const {
+  const Vec2 at{p.pose.x, p.pose.y};
+  const auto& g = roadmap_.graph;
+  if (p.node >= 0 && g.valid(p.node) && (g.position(p.node) - at).norm() <= settings_.placeTolerance)
+    return p.node;
+  const NodeId v = roadmap_.nearest(at);
+  if (v == kNoNode || (g.position(v) - at).norm() > settings_.placeTolerance)
+    return kNoNode;
+  return v;
+}
+
+std::optional<std::string> TrafficNode::onProgress(const msg::TrafficProgress& p, std::int64_t nowNs) {
+  ++counters_.reports;
+  if (startNs_ < 0)
+    startNs_ = nowNs;  // the settling time runs from the first thing heard
+  auto refuse = [&](const std::string& what) -> std::optional<std::string> {
+    ++counters_.refused;
+    return "progress from \"" + p.robot_id + "\": " + what;
+  };
+  if (p.robot_id.empty())
+    return refuse("no robot id");
+  if (!std::isfinite(p.pose.x) || !std::isfinite(p.pose.y) || !std::isfinite(p.goal.x) ||
+      !std::isfinite(p.goal.y)) {
+    return refuse("a pose is not finite");
+  }
+  const auto& g = roadmap_.graph;
+  if (p.node < -1 || (p.node >= 0 && !g.valid(p.node))) {
+    return refuse("node " + std::to_string(p.node) + " is not on the roadmap (0.." +
+                  std::to_string(g.size() - 1) + ")");
+  }
+  Robot& r = robots_[p.robot_id];
+  r.last = p;
+  r.heardNs = nowNs;
+  std::optional<std::string> problem;
+  if (r.index >= 0) {
+    const auto idx = static_cast<std::size_t>(r.index);
+    if (p.epoch == epoch_ && p.node >= 0) {
+      const auto rep = control_->reached(idx, p.node);
+      if (rep == traffic::Report::NotReleased) {
+        ++counters_.refused;
+        problem = "progress from \"" + p.robot_id + "\": node " + std::to_string(p.node) +
+                  " was not released to it (held at node " + std::to_string(control_->at(idx)) + ")";
+      }
+    }
+    apply(r, nowNs);
+  }
+  std::string why;
+  if (goalNode(p, why) == kNoNode && !why.empty() && !problem) {
+    ++counters_.refused;
+    problem = "progress from \"" + p.robot_id + "\": " + why;
+  }
+  return problem;
+}
+
+void TrafficNode::apply(Robot& r, std::int64_t nowNs) {
+  const auto idx = static_cast<std::size_t>(r.index);
+  const bool timedOut = static_cast<double>(nowNs - r.heardNs) * 1e-9 > settings_.robotTimeoutS;
+  const bool held = r.last.holding || r.last.blocked || !r.last.follows || timedOut;
+  control_->setHeld(idx, held);
+  std::string why;
+  const NodeId goal = goalNode(r.last, why);
+  if (goal != r.goal || r.last.priority != r.priority) {
+    if (!control_->setGoal(idx, goal, r.last.priority))
+      control_->setGoal(idx, kNoNode);
+    r.goal = goal;
+    r.priority = r.last.priority;
+  }
+}
+
+void TrafficNode::place(std::int64_t nowNs) {
+  for (auto& [id, r] : robots_) {
+    if (r.index >= 0)
+      continue;
+    const NodeId v = placeNode(r.last);
+    if (v == kNoNode)
+      continue;
+    try {
+      r.index = static_cast<int>(control_->addRobot(v));
+    } catch (const traffic::PlanStepError&) {
+      continue;  // a robot holds a conflicting node: try again next tick
+    }
+    byIndex_.push_back(id);
+    r.sent = msg::TrafficRelease{};
+    apply(r, nowNs);
+  }
+}
+
+msg::TrafficRelease TrafficNode::toMessage(const std::string& id, const traffic::Release& rel,
+                                           const Robot& r) const {
+  msg::TrafficRelease m;
+  m.robot_id = id;
+  m.epoch = epoch_;
+  const auto& g = roadmap_.graph;
+  for (std::size_t i = 0; i < rel.base.size() && i < 64; ++i) {
+    m.base.push_back({rel.base[i], g.position(rel.base[i]).x, g.position(rel.base[i]).y});
+  }
+  for (std::size_t i = 0; i < rel.horizon.size() && i < 32; ++i) {
+    m.horizon.push_back({rel.horizon[i], g.position(rel.horizon[i]).x, g.position(rel.horizon[i]).y});
+  }
+  m.ends_at_goal = r.goal != kNoNode && !rel.base.empty() && rel.base.back() == r.goal;
+  return m;
+}
+
+std::vector<msg::TrafficRelease> TrafficNode::tick(std::int64_t nowNs) {
+  std::vector<msg::TrafficRelease> out;
+  if (startNs_ < 0)
+    startNs_ = nowNs;
+  if (static_cast<double>(nowNs - startNs_) * 1e-9 < settings_.settleS)
+    return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto& [id, r] : robots_) {
+    if (r.index >= 0)
+      apply(r, nowNs);  // time-outs
+  }
+  place(nowNs);
+  counters_.plannedSteps += static_cast<std::uint64_t>(control_->update());
+  counters_.replans = control_->stats().replans;
+  for (auto& [id, r] : robots_) {
+    if (r.index < 0 || !r.last.follows)
+      continue;
+    auto m = toMessage(id, control_->release(static_cast<std::size_t>(r.index)), r);
+    if (m.base == r.sent.base && m.horizon == r.sent.horizon && m.ends_at_goal == r.sent.ends_at_goal)
+      continue;
+    m.seq = r.sent.seq + 1;
+    m.stamp_ns = nowNs;
+    r.sent = m;
+    out.push_back(m);
+    ++counters_.releases;
+  }
+  counters_.lastTickMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  counters_.maxTickMs = std::max(counters_.maxTickMs, counters_.lastTickMs);
+  return out;
+}
+
+std::vector<msg::TrafficRelease> TrafficNode::allReleases() const {
+  std::vector<msg::TrafficRelease> out;
+  for (const auto& [id, r] : robots_) {
+    if (r.index >= 0 && r.sent.seq > 0)
+      out.push_back(r.sent);
+  }
+  return out;
+}
+
+}  // namespace fleet::trafficmgr

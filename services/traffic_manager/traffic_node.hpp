@@ -1,0 +1,106 @@
+#pragma once
+
+// The traffic manager without its DDS wiring: builds the roadmap from the site, places robots on it
+// from their progress reports, plans everyone together (libs/traffic TrafficControl) and says which
+// releases to publish.
+//
+// Robots are learnt from their reports, so a restarted manager rebuilds its state from what robots
+// report: it waits `settleS` first (robots drive to the end of what the previous manager released
+// and stop there), then places each robot on the node it last reported if it stands on it, else on
+// the nearest node within `placeTolerance`. A robot that cannot be placed yet (off the roadmap, or
+// another robot holds a conflicting node) is tried again on every tick and gets no release.
+// Robots that do not follow releases, that hold (docked, paused, faulted) or are blocked by
+// something the plan does not know, and robots not heard from for `robotTimeoutS`, are obstacles
+// the plan goes around.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/core/config.hpp"
+#include "fleet/site/site.hpp"
+#include "fleet/traffic/roadmap.hpp"
+#include "fleet/traffic/traffic_control.hpp"
+#include "fleet/transport/messages.hpp"
+
+namespace fleet::trafficmgr {
+
+struct Settings {
+  std::string site;             ///< site.json (required)
+  double rateHz = 10.0;         ///< planning and release cycle
+  double settleS = 3.0;         ///< wait for reports before planning (robots stop at their base ends)
+  double robotTimeoutS = 5.0;   ///< a robot not heard from this long is an obstacle where it was
+  double placeTolerance = 0.5;  ///< m from a roadmap node to be placed on it
+  std::string clock = "wall";   ///< or "sim"
+  bool lockstep = false;
+  traffic::RoadmapOptions roadmap;
+  traffic::TrafficOptions traffic;
+};
+
+/// Reads the settings; every problem is recorded in `cfg` (call cfg.finish() after).
+Settings readSettings(Config& cfg);
+
+class TrafficNode {
+ public:
+  TrafficNode(const site::Site& site, Settings settings, std::uint32_t epoch);
+
+  [[nodiscard]] std::uint32_t epoch() const { return epoch_; }
+  [[nodiscard]] const traffic::Roadmap& roadmap() const { return roadmap_; }
+  [[nodiscard]] msg::Roadmap roadmapMessage(std::int64_t nowNs) const;
+
+  /// A robot's report. Returns what was wrong with it (the report is then ignored in part or in
+  /// whole, and the robot stays held where it was); nothing otherwise.
+  std::optional<std::string> onProgress(const msg::TrafficProgress& p, std::int64_t nowNs);
+
+  /// Places robots, plans, and returns the releases that changed since they were last returned.
+  std::vector<msg::TrafficRelease> tick(std::int64_t nowNs);
+  /// The latest release of every placed robot (to publish again, e.g. after a reconnect).
+  [[nodiscard]] std::vector<msg::TrafficRelease> allReleases() const;
+
+  struct Counters {
+    std::uint64_t reports = 0;
+    std::uint64_t refused = 0;
+    std::uint64_t releases = 0;
+    std::uint64_t plannedSteps = 0;
+    std::uint64_t replans = 0;
+    double lastTickMs = 0.0;
+    double maxTickMs = 0.0;
+  };
+  [[nodiscard]] const Counters& counters() const { return counters_; }
+  [[nodiscard]] std::size_t robotsKnown() const { return robots_.size(); }
+  [[nodiscard]] std::size_t robotsPlaced() const;
+  /// Robot's index in the planner, -1 when not placed.
+  [[nodiscard]] int indexOf(const std::string& robot) const;
+  [[nodiscard]] const traffic::TrafficControl* control() const { return control_.get(); }
+
+ private:
+  struct Robot {
+    msg::TrafficProgress last;
+    std::int64_t heardNs = 0;
+    int index = -1;
+    traffic::NodeId goal = traffic::kNoNode;
+    int priority = 0;
+    msg::TrafficRelease sent;
+    bool dirty = false;
+  };
+  [[nodiscard]] traffic::NodeId goalNode(const msg::TrafficProgress& p, std::string& why) const;
+  [[nodiscard]] traffic::NodeId placeNode(const msg::TrafficProgress& p) const;
+  void place(std::int64_t nowNs);
+  void apply(Robot& r, std::int64_t nowNs);
+  [[nodiscard]] msg::TrafficRelease toMessage(const std::string& id, const traffic::Release& rel,
+                                              const Robot& r) const;
+
+  Settings settings_;
+  std::uint32_t epoch_;
+  traffic::Roadmap roadmap_;
+  std::unique_ptr<traffic::TrafficControl> control_;
+  std::map<std::string, Robot> robots_;
+  std::vector<std::string> byIndex_;
+  std::int64_t startNs_ = -1;
+  Counters counters_;
+};
+
+}  // namespace fleet::trafficmgr

@@ -1,0 +1,187 @@
+#include "fleet/traffic/distance_table.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "pibt_test_support.hpp"
+
+using namespace fleet;
+using namespace fleet::traffic;
+using fleet::traffic::test::gridOf;
+
+namespace {
+
+constexpr float kInf = DistanceTable::kUnreachable;
+
+/// Floyd-Warshall over open edges between open nodes, plus the way off a closed node: the slow,
+/// obvious answer to compare with.
+std::vector<std::vector<double>> allPairs(const Graph& g) {
+  const std::size_t n = g.size();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<double>> d(n, std::vector<double>(n, inf));
+  for (std::size_t v = 0; v < n; ++v) {
+    d[v][v] = 0.0;
+    for (const Edge& e : g.edges(static_cast<NodeId>(v))) {
+      if (e.open && g.isOpen(e.to) && g.isOpen(static_cast<NodeId>(v))) {
+        d[v][static_cast<std::size_t>(e.to)] = std::min(d[v][static_cast<std::size_t>(e.to)], e.duration);
+      }
+    }
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < n; ++j) {
+        d[i][j] = std::min(d[i][j], d[i][k] + d[k][j]);
+      }
+    }
+  }
+  // A closed node (not the goal) may still drive off along an open edge to an open node.
+  for (std::size_t v = 0; v < n; ++v) {
+    if (g.isOpen(static_cast<NodeId>(v))) {
+      continue;
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      d[v][j] = j == v ? 0.0 : inf;
+      for (const Edge& e : g.edges(static_cast<NodeId>(v))) {
+        if (e.open && g.isOpen(e.to)) {
+          d[v][j] = std::min(d[v][j], e.duration + d[static_cast<std::size_t>(e.to)][j]);
+        }
+      }
+    }
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!g.isOpen(static_cast<NodeId>(j))) {
+      for (std::size_t i = 0; i < n; ++i) {
+        d[i][j] = inf;
+      }
+    }
+  }
+  return d;
+}
+
+void expectSameAsAllPairs(const Graph& g, DistanceTable& t) {
+  const auto ref = allPairs(g);
+  for (std::size_t goal = 0; goal < g.size(); ++goal) {
+    const auto d = t.to(static_cast<NodeId>(goal));
+    for (std::size_t v = 0; v < g.size(); ++v) {
+      if (std::isinf(ref[v][goal])) {
+        EXPECT_EQ(d[v], kInf) << v << " -> " << goal;
+      } else {
+        EXPECT_NEAR(d[v], ref[v][goal], 1e-4) << v << " -> " << goal;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TEST(DistanceTable, BreadthFirstOnAGridMatchesManhattanAroundAWall) {
+  const GridMap m = gridOf({
+      ".....",
+      ".@@@.",
+      ".....",
+  });
+  DistanceTable t(m.graph);
+  EXPECT_TRUE(t.unitDurations());
+  const auto d = t.to(m.node(0, 1));
+  EXPECT_EQ(d[static_cast<std::size_t>(m.node(0, 1))], 0.0F);
+  EXPECT_EQ(d[static_cast<std::size_t>(m.node(4, 1))], 6.0F);  // around the wall
+  EXPECT_EQ(d[static_cast<std::size_t>(m.node(2, 0))], 3.0F);
+  EXPECT_EQ(t.distance(m.node(4, 1), m.node(0, 1)), 6.0F);
+  expectSameAsAllPairs(m.graph, t);
+}
+
+TEST(DistanceTable, RandomWeightedDirectedGraphsMatchFloydWarshall) {
+  std::mt19937_64 rng(3);
+  for (int round = 0; round < 20; ++round) {
+    Graph g;
+    const int n = 12 + round % 7;
+    for (int i = 0; i < n; ++i) {
+      g.addNode({static_cast<double>(i), 0.0});
+    }
+    std::uniform_int_distribution<int> node(0, n - 1);
+    std::uniform_real_distribution<double> dur(0.5, 3.0);
+    for (int e = 0; e < n * 3; ++e) {
+      const int a = node(rng);
+      const int b = node(rng);
+      if (a != b) {
+        // Unit durations in half the rounds: the breadth-first path.
+        g.addEdge(a, b, round % 2 == 0 ? 1.0 : dur(rng));
+      }
+    }
+    DistanceTable t(g);
+    EXPECT_EQ(t.unitDurations(), round % 2 == 0);
+    expectSameAsAllPairs(g, t);
+    // Close some nodes and edges: routes avoid them, a robot on a closed node may still drive off.
+    for (int k = 0; k < 3; ++k) {
+      g.setOpen(node(rng), false);
+      const int a = node(rng);
+      if (!g.edges(a).empty()) {
+        g.setEdgeOpen(a, g.edges(a)[0].to, false);
+      }
+    }
+    t.invalidate();
+    expectSameAsAllPairs(g, t);
+  }
+}
+
+TEST(DistanceTable, ClosingWithoutInvalidateKeepsOldTablesInvalidateDropsThem) {
+  const GridMap m = gridOf({"....."});
+  Graph g = m.graph;
+  DistanceTable t(g);
+  EXPECT_EQ(t.distance(0, 4), 4.0F);
+  g.setOpen(2, false);
+  EXPECT_EQ(t.distance(0, 4), 4.0F);  // cached: the caller has to say the graph changed
+  t.invalidate();
+  EXPECT_EQ(t.distance(0, 4), kInf);
+  EXPECT_EQ(t.distance(2, 4), 2.0F);  // standing on the closed node: it may drive off
+  EXPECT_EQ(t.distance(0, 2), kInf);  // a closed goal cannot be reached
+  g.setOpen(2, true);
+  g.setEdgeOpen(2, 3, false);  // one way: 3 -> 2 still open
+  t.invalidate();
+  EXPECT_EQ(t.distance(0, 4), kInf);
+  EXPECT_EQ(t.distance(4, 0), 4.0F);
+}
+
+TEST(DistanceTable, BoundedCacheRecomputesEvictedGoalsAndKeepsRecentOnes) {
+  const GridMap m = gridOf({"........"});
+  // A budget of two tables (8 nodes x 4 bytes each).
+  DistanceTable t(m.graph, 2 * 8 * sizeof(float));
+  EXPECT_EQ(t.capacity(), 2U);
+  (void)t.to(0);
+  (void)t.to(1);
+  EXPECT_EQ(t.computed(), 2U);
+  (void)t.to(0);  // hit; 1 is now the least recently used
+  EXPECT_EQ(t.computed(), 2U);
+  (void)t.to(2);  // evicts 1
+  EXPECT_EQ(t.computed(), 3U);
+  EXPECT_EQ(t.cached(), 2U);
+  EXPECT_EQ(t.distance(7, 0), 7.0F);  // still cached
+  EXPECT_EQ(t.computed(), 3U);
+  EXPECT_EQ(t.distance(7, 1), 6.0F);  // recomputed, correctly
+  EXPECT_EQ(t.computed(), 4U);
+  t.reserve(5);  // a planner holding five goals at once overrides the budget
+  for (NodeId g = 0; g < 5; ++g) {
+    (void)t.to(g);
+  }
+  const std::uint64_t before = t.computed();
+  for (NodeId g = 0; g < 5; ++g) {
+    EXPECT_EQ(t.distance(7, g), static_cast<float>(7 - g));
+  }
+  EXPECT_EQ(t.computed(), before);
+}
+
+TEST(DistanceTable, BlockedNodesAreRoutedAroundButStayReachableAsGoals) {
+  const GridMap m = gridOf({
+      ".....",
+      ".....",
+  });
+  DistanceTable t(m.graph);
+  EXPECT_EQ(t.distance(m.node(0, 0), m.node(4, 0)), 4.0F);
+  t.setBlocked(m.node(2, 0), true);                         // a stopped robot in the top lane
+  EXPECT_EQ(t.distance(m.node(0, 0), m.node(4, 0)), 6.0F);  // round it through the bottom lane
+  EXPECT_EQ(t.distance(m.node(0, 0), m.node(2, 0)), 2.0F);  // up to it, for whoever waits for it
+  EXPECT_EQ(t.distance(m.node(2, 0), m.node(4, 0)), 2.0F);  // and off it
+  t.setBlocked(m.node(2, 0), false);
+  EXPECT_EQ(t.distance(m.node(0, 0), m.node(4, 0)), 4.0F);
+}

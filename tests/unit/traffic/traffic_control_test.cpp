@@ -1,0 +1,111 @@
+#include "fleet/traffic/traffic_control.hpp"
+
+#include <gtest/gtest.h>
+
+#include "fleet/site/site_loader.hpp"
+#include "fleet/traffic/roadmap.hpp"
+#include "fleet/traffic/virtual_fleet.hpp"
+
+namespace fleet::traffic {
+namespace {
+
+Roadmap smallWarehouse() {
+  const auto site =
+      site::loadSite(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.site.json");
+  return buildRoadmap(site);
+}
+
+/// Robots follow the releases, late at random. What holds whatever the planner does: no two robots
+/// ever hold conflicting nodes, their centres keep the contact distance, no report is refused.
+/// (How much work they get done is the planner's business: measured in docs/benchmarks.md, where
+/// the 20-robot fleet still jams; see the issue notes.)
+TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    o.seed = seed;
+    const auto r = runVirtualFleet(map, o);
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_EQ(r.holdViolations, 0U);
+    EXPECT_EQ(r.contacts, 0U);
+    EXPECT_EQ(r.refusedReports, 0U);
+    EXPECT_GE(r.minSeparation, map.separation.contact - map.separation.margin);
+  }
+}
+
+/// A robot parked in a dock whose only way out is excluded by a robot standing on the lane in
+/// front: PIBT moves one node per step and the robot outside cannot clear the exit in one step, so
+/// plain PIBT leaves both where they are for ever. The stalled robot makes the other drive away.
+TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
+  Roadmap map = smallWarehouse();
+  const NodeId park = map.station("PARK-1")->dock;
+  // The lane node just right of the dock's exit (PARK-1 at (3, 0.9) is left by (3, 1.9)): it
+  // excludes the exit, and every node it can step to excludes the exit or the dock.
+  const NodeId exit = map.graph.edges(park)[0].to;
+  const NodeId front = map.nearest({3.25, 1.75});
+  ASSERT_TRUE(map.graph.conflicting(front, exit));
+  ASSERT_NE(front, kNoNode);
+  const std::vector<NodeId> starts{park, front};
+  const NodeId goal0 = map.station("P-4")->dock, goal1 = map.station("P-1")->dock;
+  for (bool evade : {false, true}) {
+    TrafficOptions opt;
+    opt.evadeAfter = evade ? 6 : 1000000;
+    TrafficControl tc(map.graph, starts, opt);
+    tc.setGoal(0, goal0);
+    tc.setGoal(1, goal1);
+    bool left = false;
+    for (int t = 0; t < 200; ++t) {
+      tc.update();
+      for (std::size_t r = 0; r < 2; ++r) {
+        const auto rel = tc.release(r);
+        if (rel.base.size() > 1) {
+          EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
+        }
+      }
+      left = left || tc.at(0) != park;
+    }
+    EXPECT_EQ(left, evade) << (evade ? "with" : "without") << " evasion";
+    if (evade) {
+      EXPECT_TRUE(tc.arrived(0));
+      EXPECT_TRUE(tc.arrived(1));
+      EXPECT_GE(tc.stats().evasions, 1U);
+    }
+  }
+}
+
+TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
+  Roadmap map = smallWarehouse();
+  const auto* d1 = map.station("D-1");
+  ASSERT_GE(d1->queue.size(), 2U);
+  std::vector<NodeId> starts;
+  for (const char* p : {"PARK-1", "PARK-5", "PARK-9"})
+    starts.push_back(map.station(p)->dock);
+  TrafficControl tc(map.graph, starts);
+  tc.setStations({{d1->dock, d1->queue}});
+  for (std::size_t r = 0; r < 3; ++r)
+    tc.setGoal(r, d1->dock);
+  EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{0, 1, 2}));
+  EXPECT_EQ(tc.planner().goal(0), d1->dock);
+  EXPECT_EQ(tc.planner().goal(1), d1->queue[0]);
+  EXPECT_EQ(tc.planner().goal(2), d1->queue[1]);
+  tc.setGoal(0, map.station("P-1")->dock);  // robot 0 is done: the line moves up
+  EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{1, 2}));
+  EXPECT_EQ(tc.planner().goal(1), d1->dock);
+  EXPECT_EQ(tc.planner().goal(2), d1->queue[0]);
+}
+
+TEST(VirtualFleet, ALoneRobot) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 1;
+  o.duration = 1200.0;
+  const auto r = runVirtualFleet(map, o);
+  std::cout << formatResult(r) << "\n";
+  EXPECT_GT(r.tasksDone, 10U);
+  EXPECT_EQ(r.refusedReports, 0U);
+}
+
+}  // namespace
+}  // namespace fleet::traffic

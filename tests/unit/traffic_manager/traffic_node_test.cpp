@@ -1,0 +1,170 @@
+#include "traffic_node.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fleet/site/site_loader.hpp"
+
+namespace fleet::trafficmgr {
+namespace {
+
+constexpr std::int64_t kS = 1'000'000'000;
+
+const site::Site& smallWarehouse() {
+  static const site::Site s =
+      site::loadSite(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.site.json");
+  return s;
+}
+
+Settings settings() {
+  Settings s;
+  s.settleS = 2.0;
+  return s;
+}
+
+msg::TrafficProgress at(const std::string& id, const Pose2& pose, const std::string& goalStation = "",
+                        std::int32_t node = -1, std::uint32_t epoch = 0) {
+  msg::TrafficProgress p;
+  p.robot_id = id;
+  p.epoch = epoch;
+  p.node = node;
+  p.pose = pose;
+  p.has_goal = !goalStation.empty();
+  p.goal_station = goalStation;
+  p.follows = true;
+  return p;
+}
+
+Pose2 stationPose(const std::string& name) {
+  for (const auto& s : smallWarehouse().stations) {
+    if (s.name == name)
+      return s.pose;
+  }
+  return {};
+}
+
+TEST(TrafficNode, WaitsForReportsThenPlacesAndReleases) {
+  TrafficNode node(smallWarehouse(), settings(), 7);
+  EXPECT_FALSE(node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0));
+  EXPECT_FALSE(node.onProgress(at("r2", stationPose("PARK-2"), "D-1"), 0));
+  EXPECT_TRUE(node.tick(0).empty());
+  EXPECT_TRUE(node.tick(1 * kS).empty());  // still settling
+  const auto rel = node.tick(2 * kS);
+  ASSERT_EQ(rel.size(), 2U);
+  EXPECT_EQ(node.robotsPlaced(), 2U);
+  for (const auto& r : rel) {
+    EXPECT_EQ(r.epoch, 7U);
+    EXPECT_EQ(r.seq, 1U);
+    ASSERT_GE(r.base.size(), 2U) << r.robot_id;  // something to drive at once
+    const auto dock = node.roadmap().station(r.robot_id == "r1" ? "PARK-1" : "PARK-2")->dock;
+    EXPECT_EQ(r.base.front().node, dock);
+    EXPECT_FALSE(r.ends_at_goal);
+  }
+  // Nothing changed: nothing new to send.
+  EXPECT_TRUE(node.tick(2 * kS + kS / 10).empty());
+}
+
+TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {
+  TrafficNode node(smallWarehouse(), settings(), 3);
+  node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+  const auto goal = node.roadmap().station("P-1")->dock;
+  msg::TrafficRelease last;
+  std::int64_t now = 2 * kS;
+  for (int i = 0; i < 600 && !(last.ends_at_goal && last.base.size() == 1); ++i, now += kS / 10) {
+    for (const auto& r : node.tick(now)) {
+      EXPECT_GT(r.seq, last.seq);
+      last = r;
+    }
+    if (last.base.size() > 1) {
+      // The robot drives to the next released node and reports it.
+      auto p = at("r1", {last.base[1].x, last.base[1].y, 0}, "P-1", last.base[1].node, 3);
+      EXPECT_FALSE(node.onProgress(p, now));
+    }
+  }
+  ASSERT_FALSE(last.base.empty());
+  EXPECT_EQ(last.base.back().node, goal);
+  EXPECT_TRUE(last.ends_at_goal);
+}
+
+TEST(TrafficNode, BadReportsAreRefusedWithAReasonAndChangeNothing) {
+  TrafficNode node(smallWarehouse(), settings(), 5);
+  node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+  const auto first = node.tick(2 * kS);
+  ASSERT_EQ(first.size(), 1U);
+  const auto held = first[0].base.front().node;
+  auto refused = [&](msg::TrafficProgress p, const std::string& what) {
+    const auto problem = node.onProgress(p, 2 * kS);
+    ASSERT_TRUE(problem.has_value()) << "accepted: " << what;
+    EXPECT_NE(problem->find(what), std::string::npos) << *problem;
+  };
+  // A node it was never released (far away), in this epoch.
+  const auto far = node.roadmap().station("D-4")->dock;
+  refused(at("r1", stationPose("PARK-1"), "P-1", far, 5), "was not released");
+  refused(at("r1", stationPose("PARK-1"), "P-1", 999999, 5), "not on the roadmap");
+  refused(at("", stationPose("PARK-1"), "P-1"), "no robot id");
+  refused(at("r1", {std::nan(""), 0, 0}, "P-1"), "not finite");
+  refused(at("r1", stationPose("PARK-1"), "NOWHERE", held, 5), "\"NOWHERE\" is not on the site");
+  auto offMap = at("r1", stationPose("PARK-1"), "", held, 5);
+  offMap.has_goal = true;
+  offMap.goal = {500, 500, 0};
+  refused(offMap, "from the roadmap");
+  EXPECT_EQ(node.control()->at(0), held);
+  EXPECT_GE(node.counters().refused, 6U);
+}
+
+TEST(TrafficNode, ARobotOffTheRoadmapIsNotPlacedUntilItComesBack) {
+  TrafficNode node(smallWarehouse(), settings(), 9);
+  node.onProgress(at("r1", {-20, -20, 0}, "P-1"), 0);
+  EXPECT_TRUE(node.tick(3 * kS).empty());
+  EXPECT_EQ(node.robotsPlaced(), 0U);
+  node.onProgress(at("r1", stationPose("PARK-3"), "P-1"), 3 * kS);
+  EXPECT_EQ(node.tick(3 * kS + kS / 10).size(), 1U);
+}
+
+TEST(TrafficNode, ARestartedManagerPlacesRobotsWhereTheyReported) {
+  TrafficNode before(smallWarehouse(), settings(), 1);
+  before.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+  const auto rel = before.tick(2 * kS);
+  ASSERT_EQ(rel.size(), 1U);
+  ASSERT_GE(rel[0].base.size(), 2U);
+  const auto& n = rel[0].base[1];
+  // The robot reached base[1] under the old epoch; a new manager hears that report first.
+  TrafficNode after(smallWarehouse(), settings(), 2);
+  after.onProgress(at("r1", {n.x, n.y, 0}, "P-1", n.node, 1), 10 * kS);
+  const auto again = after.tick(12 * kS);
+  ASSERT_EQ(again.size(), 1U);
+  EXPECT_EQ(again[0].epoch, 2U);
+  EXPECT_EQ(again[0].base.front().node, n.node);
+}
+
+TEST(TrafficNode, HoldingAndSilentRobotsArePlannedAround) {
+  auto s = settings();
+  s.robotTimeoutS = 3.0;
+  TrafficNode node(smallWarehouse(), s, 4);
+  auto p = at("r1", stationPose("PARK-1"), "P-1");
+  p.holding = true;
+  node.onProgress(p, 0);
+  node.onProgress(at("r2", stationPose("PARK-2"), "P-2"), 0);
+  node.tick(2 * kS);
+  ASSERT_NE(node.control(), nullptr);
+  EXPECT_TRUE(node.control()->held(static_cast<std::size_t>(node.indexOf("r1"))));
+  EXPECT_FALSE(node.control()->held(static_cast<std::size_t>(node.indexOf("r2"))));
+  node.tick(4 * kS);  // r1 and r2 silent for 4 s
+  EXPECT_TRUE(node.control()->held(static_cast<std::size_t>(node.indexOf("r2"))));
+}
+
+TEST(TrafficNode, SettingsNameWhatIsWrong) {
+  Config bad = Config::fromText(R"({"rate_hz": -1, "lockstep": true, "roadmap": {"spacng": 1}})", "test");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  std::string all;
+  for (const auto& p : bad.problems())
+    all += p + "\n";
+  EXPECT_NE(all.find("rate_hz"), std::string::npos) << all;
+  EXPECT_NE(all.find("lockstep"), std::string::npos) << all;
+  EXPECT_NE(all.find("spacng"), std::string::npos) << all;
+}
+
+}  // namespace
+}  // namespace fleet::trafficmgr
