@@ -41,11 +41,12 @@ constexpr double kHeartbeatS = 1.0;
 /// back along the next aisle) the robot got no closer to that end for a while, DWA took it for a
 /// local minimum and swerved off the base to escape it.
 constexpr double kPlannerWindow = 2.0;
-/// Base nodes where the way turns by more than this [rad] are corners: the robot drives straight
+/// Base nodes where the way turns by more than this [rad] (more than the 45° of a diagonal on the
+/// roadmap lattice, which the planner drives round) are corners: the robot drives straight
 /// onto the node and turns there on the spot, as the roadmap's edges assume. Left to the local
 /// planner or the follower, it rounded a right angle in an arc that cut 0.17 m off it (DWA), or
 /// turned 0.5 m early (the follower's carrot) at speed and slid off the base while it braked.
-constexpr double kSharpTurn = 0.6;
+constexpr double kSharpTurn = 0.9;
 /// ... coming onto the node at most this fast [m/s] (it slides a centimetre while it brakes) ...
 constexpr double kTurnSpeed = 0.15;
 /// ... from this far before it [m] ...

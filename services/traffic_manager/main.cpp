@@ -49,6 +49,14 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   auto lastStats = std::chrono::steady_clock::now();
   bool roadmapSent = false;
 
+  auto logStats = [&] {
+    const auto& c = node.counters();
+    spdlog::info(
+        "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
+        "re-plans, tick {:.2f} ms (max {:.2f})",
+        node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
+        c.lastTickMs, c.maxTickMs);
+  };
   auto ingest = [&] {
     for (const auto& m : progress.take()) {
       if (!haveClock)
@@ -107,18 +115,13 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
       }
     }
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
-      const auto& c = node.counters();
-      spdlog::info(
-          "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, "
-          "{} "
-          "re-plans, tick {:.2f} ms (max {:.2f})",
-          node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps,
-          c.replans, c.lastTickMs, c.maxTickMs);
+      logStats();
       lastStats = std::chrono::steady_clock::now();
     }
   }
   if (settings.lockstep)
     stepDone.write({id, msg::StepDone::kLeave});
+  logStats();
   spdlog::info("traffic manager: stopped");
   return 0;
 }

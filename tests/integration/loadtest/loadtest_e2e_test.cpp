@@ -262,6 +262,47 @@ TEST(LoadtestE2E, AFleetRunsOnASiteWithAROSMap) {
   EXPECT_NEAR(risk["grid"]["height"].get<double>(), 200, 1);
 }
 
+TEST(LoadtestE2E, ALoneRobotDeliversUnderReservedTraffic) {
+  // The whole chain of issue 18: the traffic manager builds the roadmap from the site, places the
+  // robot from its first TrafficProgress, plans it and releases its route a few nodes at a time; the
+  // agent (--traffic reserved) drives only what it was released and reports the nodes it reaches.
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-reserved-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const std::vector<std::string> args = {"loadtest",
+                                         "--scenario",
+                                         FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json",
+                                         "--traffic",
+                                         "reserved",
+                                         "--tasks",
+                                         "2",
+                                         "--until-done",
+                                         "--duration",
+                                         "600",
+                                         "--max-speed",
+                                         "0",
+                                         "--out",
+                                         out.string(),
+                                         "--domain",
+                                         std::to_string(fleet::test::uniqueDomain()),
+                                         "--report-script",
+                                         "",
+                                         "--wall-limit",
+                                         "150"};
+  fleet::test::ChildProcess run(kFleetctl, args);
+  ASSERT_EQ(run.wait(std::chrono::seconds(200)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  EXPECT_EQ(r["accounting"]["done"], 2) << r["accounting"].dump();
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+  EXPECT_EQ(r["safety"]["contacts"]["robot_shelf"], 0);
+  // The traffic manager ran, placed the robot and released it nodes; nothing it got was refused.
+  std::ostringstream logText;
+  logText << std::ifstream(out / "traffic_manager.log").rdbuf();
+  const std::string text = logText.str();
+  EXPECT_NE(text.find("1 robots (1 placed)"), std::string::npos) << text;
+  EXPECT_EQ(text.find("refused):"), std::string::npos);
+  EXPECT_NE(text.find("(0 refused)"), std::string::npos) << text;
+}
+
 TEST(LoadtestE2E, BadScenarioTaskListIsRefusedBeforeAnythingStarts) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("loadtest-badlist-" + std::to_string(getpid()));
   fs::remove_all(dir);
