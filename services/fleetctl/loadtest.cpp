@@ -729,7 +729,9 @@ int Run::run() {
     say(gSignal ? "interrupted" : "the WMS adapter did not report a healthy fleet manager within 30 s");
     return gSignal ? 130 : 1;
   }
-  const int participants = 1 + static_cast<int>(agentNames.size());
+  // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
+  // only when all have registered (a traffic manager it does not wait for falls behind the robots).
+  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0);
   std::vector<std::string> simArgs = {"--scenario",  scn,
                                       "--duration",  std::to_string(o.durationS),
                                       "--replay",    fs::absolute(out / "replay.jsonl.gz").string(),
