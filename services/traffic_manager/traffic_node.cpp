@@ -12,8 +12,8 @@ using traffic::NodeId;
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
-                         "lockstep", "plan_ahead", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes",
-                         "seed", "roadmap"});
+                         "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
+                         "roadmap"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -23,7 +23,6 @@ Settings readSettings(Config& cfg) {
   s.lockstep = cfg.boolean("lockstep", false);
   if (s.lockstep && s.clock != "sim")
     cfg.problem("lockstep", "requires \"clock\": \"sim\"");
-  s.traffic.planAhead = cfg.integer("plan_ahead", s.traffic.planAhead, {1, 1000});
   s.traffic.maxLag = cfg.integer("max_lag", s.traffic.maxLag, {1, 100000});
   s.traffic.release.baseAhead = cfg.number("base_ahead", s.traffic.release.baseAhead, {0.0, 100.0});
   s.traffic.release.maxBaseNodes = static_cast<std::size_t>(

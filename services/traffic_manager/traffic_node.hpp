@@ -84,7 +84,6 @@ class TrafficNode {
     traffic::NodeId goal = traffic::kNoNode;
     int priority = 0;
     msg::TrafficRelease sent;
-    bool dirty = false;
   };
   [[nodiscard]] traffic::NodeId goalNode(const msg::TrafficProgress& p, std::string& why) const;
   [[nodiscard]] traffic::NodeId placeNode(const msg::TrafficProgress& p) const;

@@ -206,10 +206,6 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
        << " nodes ahead, released to " << traffic.execution().releasedEnd(r) << ", waiting on";
     for (auto q : traffic.waitingOn(r))
       os << " " << q << "@" << bots[q].at;
-    const auto rel = traffic.release(r);
-    os << "; release now: base " << rel.base.size() << " horizon " << rel.horizon.size() << " dwell "
-       << b.dwellLeft << " to " << b.to << " progress step " << traffic.execution().progressStep(r) << " of "
-       << traffic.execution().plannedSteps();
     res.stalls.push_back(os.str());
   }
   res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / o.duration;

@@ -5,9 +5,9 @@
 // robot is released its route a few nodes at a time. A traffic manager service wraps it; the virtual
 // fleet (virtual_fleet.hpp) drives it in tests and benchmarks.
 //
-// Planning runs ahead of the robots, not of a clock: a step is added while the robot furthest along
-// its route has fewer than `planAhead` steps planned past it. A robot that falls `maxLag` steps
-// behind the plan (a person in the aisle, a slow dock) holds back only the robots that depend on it;
+// Planning runs ahead of the robots, not of a clock: a step is added while a robot on its way has
+// fewer than two nodes planned past its last report. A robot that falls `maxLag` steps behind the
+// plan (a person in the aisle, a slow dock) holds back only the robots that depend on it;
 // the unreleased plan is then dropped and planned again from where everyone's release ends, so the
 // fleet does not keep planning around where the late robot was supposed to be. Held robots (docking,
 // faulted, paused, a vendor's vehicle that does not follow) are obstacles the plan goes around.
@@ -24,8 +24,7 @@
 namespace fleet::traffic {
 
 struct TrafficOptions {
-  std::int64_t planAhead = 6;  ///< steps planned past the robot furthest along
-  std::int64_t maxLag = 24;    ///< steps a robot may be behind the plan before it is re-planned
+  std::int64_t maxLag = 24;  ///< steps a robot may be behind the plan before it is re-planned
   std::int64_t maxStepsPerUpdate = 64;
   /// A robot planned to stand still this many steps short of its goal makes the robots standing
   /// in its way (on nodes its next few nodes exclude) drive away for `evadeSteps` (PIBT moves
