@@ -255,6 +255,21 @@ int main(int argc, char** argv) {
   trafficSim->add_option("--stop-chance", ts.stopChance, "per edge: chance a robot stops on it up to 10 s")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  trafficSim
+      ->add_option("--stop-gap", ts.stopGap,
+                   "m of free space the robot's motion gate needs ahead of a driving robot (default: the "
+                   "roadmap's)")
+      ->check(CLI::Range(0.0, 5.0));
+  trafficSim
+      ->add_option("--detour-after", ts.detourAfter,
+                   "planner steps a robot stands short of its goal before it is routed round "
+                   "robots standing in its way (0: never; default: the traffic layer's)")
+      ->check(CLI::Range(0, 100000));
+  trafficSim
+      ->add_option("--detour-penalty", ts.detourPenalty,
+                   "s added to a route for entering what a standing robot excludes (default: the "
+                   "traffic layer's)")
+      ->check(CLI::Range(0.0, 1e6));
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");
   try {
     app.parse(argc, argv);

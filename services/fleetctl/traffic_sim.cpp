@@ -30,6 +30,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
   }
   traffic::RoadmapOptions ro;
   ro.spacing = o.spacing;
+  if (o.stopGap >= 0.0)
+    ro.stopGap = o.stopGap;
   auto roadmap = traffic::buildRoadmap(*site, ro);
   int rc = 0;
   nlohmann::json all = nlohmann::json::array();
@@ -39,6 +41,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.duration = o.duration;
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
+    if (o.detourAfter >= 0)
+      v.traffic.pibt.detourAfter = o.detourAfter;
+    if (o.detourPenalty >= 0.0)
+      v.traffic.pibt.detourPenalty = static_cast<float>(o.detourPenalty);
     traffic::VirtualFleetResult r;
     try {
       r = traffic::runVirtualFleet(roadmap, v);

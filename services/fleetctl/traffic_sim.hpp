@@ -17,6 +17,9 @@ struct TrafficSimOptions {
   std::string seeds = "1";  ///< "1-8" or "3"
   double spacing = 0.0;     ///< roadmap lattice spacing (m); 0: the default
   double stopChance = 0.01;
+  double stopGap = -1.0;        ///< m the motion gate keeps ahead of a driving robot; <0: the default
+  int detourAfter = -1;         ///< planner steps before a detour round standing robots; -1: the default
+  double detourPenalty = -1.0;  ///< s added for entering what a standing robot excludes; <0: the default
   bool json = false;
 };
 

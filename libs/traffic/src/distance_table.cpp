@@ -175,6 +175,23 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
     }
     return;
   }
+  dijkstra(goal, {}, d);
+}
+
+void DistanceTable::withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& d) {
+  if (dirty_) {
+    invalidate();
+  }
+  d.assign(graph_.size(), kUnreachable);
+  if (!graph_.valid(goal) || !graph_.isOpen(goal) || extra.size() != graph_.size()) {
+    return;
+  }
+  d[static_cast<std::size_t>(goal)] = 0.0F;
+  dijkstra(goal, extra, d);
+}
+
+void DistanceTable::dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d) {
+  const auto open = [&](NodeId v) { return graph_.isOpen(v) && blocked_[static_cast<std::size_t>(v)] == 0; };
   heap_.clear();
   heap_.emplace_back(0.0F, goal);
   const auto later = std::greater<>{};
@@ -182,16 +199,15 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
     std::pop_heap(heap_.begin(), heap_.end(), later);
     const auto [du, u] = heap_.back();
     heap_.pop_back();
-    if (du > d[static_cast<std::size_t>(u)]) {
+    if (du > d[static_cast<std::size_t>(u)] || (u != goal && !open(u))) {
       continue;
     }
-    if (u != goal && !open(u)) {
-      continue;
-    }
+    // Driving p→u costs the edge plus what standing in u's way costs (nothing for the goal).
+    const float enter = u == goal || extra.empty() ? 0.0F : extra[static_cast<std::size_t>(u)];
     for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
          k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
       const NodeId p = revFrom_[k];
-      const float nd = du + revDuration_[k];
+      const float nd = du + revDuration_[k] + enter;
       auto& dp = d[static_cast<std::size_t>(p)];
       if (nd < dp) {
         dp = nd;

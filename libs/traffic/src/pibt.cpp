@@ -37,6 +37,8 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   escalationDistance_.assign(n, 0.0F);
   escalationIdle_.assign(n, 0);
   still_.assign(n, 0);
+  detour_.assign(n, {});
+  detourFrom_.assign(n, 0.0F);
   tries_.assign(n, 0);
   visited_.assign(n, 0);
   epsilon_.resize(n);
@@ -96,6 +98,9 @@ void Pibt::graphChanged() {
   resizeForGraph();
   std::fill(table_.begin(), table_.end(), nullptr);
   std::fill(best_.begin(), best_.end(), DistanceTable::kUnreachable);
+  for (auto& d : detour_) {
+    d.clear();
+  }
 }
 
 void Pibt::setGoal(std::size_t agent, NodeId goal) {
@@ -106,6 +111,7 @@ void Pibt::setGoal(std::size_t agent, NodeId goal) {
     return;
   }
   goal_[agent] = goal;
+  dropDetour(agent);
   best_[agent] = DistanceTable::kUnreachable;
   stalled_[agent] = 0;
   tries_[agent] = 0;
@@ -131,6 +137,7 @@ void Pibt::setControlled(std::size_t agent, bool controlled) {
     cover(now_[agent], controlled ? -1 : 1);
   }
   controlled_[agent] = controlled ? 1 : 0;
+  dropDetour(agent);
   escalatedAt_[agent] = -1;
   stalled_[agent] = 0;
 }
@@ -212,6 +219,8 @@ void Pibt::reset(std::span<const NodeId> positions) {
     escalationDistance_.resize(n, 0.0F);
     escalationIdle_.resize(n, 0);
     still_.resize(n, 0);
+    detour_.resize(n);
+    detourFrom_.resize(n, 0.0F);
     tries_.resize(n, 0);
     visited_.resize(n, 0);
     for (std::size_t i = old; i < n; ++i)
@@ -446,9 +455,16 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
 const std::vector<NodeId>& Pibt::step() {
   const std::size_t n = now_.size();
   distances_.reserve(n + 1);
+  if (options_.detourAfter > 0) {
+    planDetours();
+  }
   order_.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    table_[i] = goal_[i] != kNoNode && controlled_[i] != 0 ? distances_.to(goal_[i]).data() : nullptr;
+    if (goal_[i] == kNoNode || controlled_[i] == 0) {
+      table_[i] = nullptr;
+    } else {
+      table_[i] = detour_[i].empty() ? distances_.to(goal_[i]).data() : detour_[i].data();
+    }
     if (controlled_[i] != 0) {
       next_[i] = kNoNode;
       order_.push_back(static_cast<std::int32_t>(i));
@@ -615,6 +631,69 @@ void Pibt::escapeDeadlocks() {
     escalationIdle_[p] = 0;
     ++tries_[p];
     ++stats_.escalations;
+  }
+}
+
+void Pibt::dropDetour(std::size_t agent) {
+  if (!detour_[agent].empty()) {
+    detour_[agent].clear();
+    best_[agent] = DistanceTable::kUnreachable;
+  }
+}
+
+void Pibt::planDetours() {
+  const std::size_t n = now_.size();
+  int budget = options_.maxDetoursPerStep;
+  bool covered = false;
+  std::vector<int>& cover = standCover_;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (controlled_[i] == 0 || goal_[i] == kNoNode || now_[i] == goal_[i]) {
+      dropDetour(i);
+      continue;
+    }
+    if (!detour_[i].empty() && distances_.distance(now_[i], goal_[i]) < detourFrom_[i]) {
+      dropDetour(i);  // past what it went round: the shortest way is its way again
+    }
+    if (budget == 0 || stalled_[i] < options_.detourAfter || still_[i] < options_.detourAfter) {
+      continue;
+    }
+    if (!covered) {
+      // What every agent that has stood still as long excludes, counted per node.
+      cover.assign(graph_.size(), 0);
+      for (std::size_t b = 0; b < n; ++b) {
+        if (controlled_[b] != 0 && still_[b] >= options_.detourAfter) {
+          ++cover[idx(now_[b])];
+          for (const NodeId w : graph_.conflicts(now_[b])) {
+            ++cover[idx(w)];
+          }
+        }
+      }
+      covered = true;
+    }
+    // Its own footprint is no obstacle to it.
+    --cover[idx(now_[i])];
+    for (const NodeId w : graph_.conflicts(now_[i])) {
+      --cover[idx(w)];
+    }
+    extra_.resize(graph_.size());
+    for (std::size_t v = 0; v < graph_.size(); ++v) {
+      extra_[v] = cover[v] > 0 ? options_.detourPenalty : 0.0F;
+    }
+    ++cover[idx(now_[i])];
+    for (const NodeId w : graph_.conflicts(now_[i])) {
+      ++cover[idx(w)];
+    }
+    const float from = distances_.distance(now_[i], goal_[i]);
+    distances_.withExtraCost(goal_[i], extra_, detour_[i]);
+    --budget;
+    ++stats_.detours;
+    if (detour_[i][idx(now_[i])] == DistanceTable::kUnreachable) {
+      detour_[i].clear();
+      continue;
+    }
+    detourFrom_[i] = from;
+    best_[i] = detour_[i][idx(now_[i])];
+    stalled_[i] = 0;
   }
 }
 

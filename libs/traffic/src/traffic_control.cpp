@@ -5,6 +5,11 @@
 
 namespace fleet::traffic {
 
+namespace {
+/// Above any task priority a WMS sends (they are small integers).
+constexpr int kLeavingBoost = 1 << 20;
+}  // namespace
+
 TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> starts, TrafficOptions options)
     : graph_(graph),
       options_(options),
@@ -172,24 +177,35 @@ bool TrafficControl::arrived(std::size_t robot) const {
   return goal_.at(robot) != kNoNode && execution_.at(robot) == goal_[robot];
 }
 
-bool TrafficControl::needsPlanning() const {
-  // Plan while a robot on its way has fewer than two nodes planned ahead of where it is.
+TrafficControl::Need TrafficControl::needsPlanning() const {
+  // Plan while a robot on its way has fewer than two nodes planned ahead of where it is. A robot the
+  // plan has kept standing for a while (behind one waiting in line, at a closed way) needs the
+  // others to move first: more steps now would only plan everyone else far ahead of their robots
+  // and force a re-plan, so it asks for a step now and then, not at once.
+  Need need = Need::None;
   for (std::size_t r = 0; r < robots(); ++r) {
     if (held_[r] != 0)
       continue;
     // An evasion lasts a number of planned steps: keep planning until it is over.
     if (evadeUntil_[r] >= 0)
-      return true;
+      return Need::Now;
     const NodeId t = target_[r];
-    if (t != kNoNode && execution_.plannedEnd(r) != t && execution_.pendingNodes(r) < 2)
-      return true;
+    if (t != kNoNode && execution_.plannedEnd(r) != t && execution_.pendingNodes(r) < 2) {
+      if (stall_[r] < options_.standingSteps)
+        return Need::Now;
+      need = Need::Later;
+    }
   }
-  return false;
+  return need;
 }
 
 int TrafficControl::update() {
   int steps = 0;
-  while (steps < options_.maxStepsPerUpdate && needsPlanning()) {
+  ++sinceStep_;
+  while (steps < options_.maxStepsPerUpdate) {
+    const Need need = needsPlanning();
+    if (need == Need::None || (need == Need::Later && (steps > 0 || sinceStep_ < options_.standingEvery)))
+      break;
     // Do not plan far past a robot that is behind: what it has not been released yet is planned
     // again from where its release ends, and the others around where it really is.
     std::int64_t oldest = -1;
@@ -200,9 +216,18 @@ int TrafficControl::update() {
     }
     if (oldest >= 0 && execution_.plannedSteps() - oldest >= options_.maxLag)
       replan();
+    // A robot driving off a dock goes first: the robots in line for the dock would otherwise
+    // (they have waited longer, so PIBT ranks them higher) push it back onto the dock whenever
+    // its way out passes them, and it would never leave.
+    for (const auto q : leaving_) {
+      if (q >= 0)
+        planner_->setTaskPriority(static_cast<std::size_t>(q),
+                                  priority_[static_cast<std::size_t>(q)] + kLeavingBoost);
+    }
     execution_.append(planner_->step());
     afterStep();
     ++steps;
+    sinceStep_ = 0;
   }
   stats_.steps += static_cast<std::uint64_t>(steps);
   return steps;
@@ -214,6 +239,7 @@ void TrafficControl::afterStep() {
     const auto q = leaving_[i];
     if (q >= 0 &&
         !graph_.conflicting(planner_->positions()[static_cast<std::size_t>(q)], stations_[i].dock)) {
+      planner_->setTaskPriority(static_cast<std::size_t>(q), priority_[static_cast<std::size_t>(q)]);
       leaving_[i] = -1;
       updateLine(i);
     }

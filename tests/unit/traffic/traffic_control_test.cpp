@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "fleet/site/site_loader.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/virtual_fleet.hpp"
@@ -49,14 +51,23 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   ASSERT_NE(front, kNoNode);
   const std::vector<NodeId> starts{park, front};
   const NodeId goal0 = map.station("P-4")->dock, goal1 = map.station("P-1")->dock;
-  for (bool evade : {false, true}) {
+  // Evasion alone gets it off the dock, detours alone get both robots to their goals (the robot in
+  // front goes round the parked one's exit instead of waiting on it), and so do both together (the
+  // default); neither: both stay for ever. (Evasion alone no longer gets both to their goals here
+  // since steps for robots the plan keeps standing are paced: they swap places back and forth.)
+  enum class Way { Neither, Evasion, Detour, Both };
+  for (Way way : {Way::Neither, Way::Evasion, Way::Detour, Way::Both}) {
+    const bool evade = way != Way::Neither;
     TrafficOptions opt;
-    opt.evadeAfter = evade ? 6 : 1000000;
+    if (way != Way::Both) {
+      opt.evadeAfter = way == Way::Evasion ? 6 : 1000000;
+      opt.pibt.detourAfter = way == Way::Detour ? 4 : 0;
+    }
     TrafficControl tc(map.graph, starts, opt);
     tc.setGoal(0, goal0);
     tc.setGoal(1, goal1);
     bool left = false;
-    for (int t = 0; t < 200; ++t) {
+    for (int t = 0; t < 600; ++t) {
       tc.update();
       for (std::size_t r = 0; r < 2; ++r) {
         const auto rel = tc.release(r);
@@ -66,11 +77,16 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
       }
       left = left || tc.at(0) != park;
     }
-    EXPECT_EQ(left, evade) << (evade ? "with" : "without") << " evasion";
-    if (evade) {
-      EXPECT_TRUE(tc.arrived(0));
-      EXPECT_TRUE(tc.arrived(1));
+    EXPECT_EQ(left, evade) << "way " << static_cast<int>(way);
+    if (way == Way::Detour || way == Way::Both) {
+      EXPECT_TRUE(tc.arrived(0)) << "way " << static_cast<int>(way);
+      EXPECT_TRUE(tc.arrived(1)) << "way " << static_cast<int>(way);
+    }
+    if (way == Way::Evasion) {
       EXPECT_GE(tc.stats().evasions, 1U);
+    }
+    if (way == Way::Detour) {
+      EXPECT_GE(tc.plannerStats().detours, 1U);
     }
   }
 }
@@ -94,6 +110,28 @@ TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{1, 2}));
   EXPECT_EQ(tc.planner().goal(1), d1->dock);
   EXPECT_EQ(tc.planner().goal(2), d1->queue[0]);
+}
+
+/// Five robots chained on random tasks. Before detours, pacing and leaving docks first, three
+/// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
+/// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the
+/// robot waiting for it). A lone robot does 6 or 7.
+TEST(VirtualFleet, FiveRobotsKeepWorkingOnTheSmallWarehouse) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 5;
+  o.duration = 600.0;
+  std::size_t least = 1000;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    o.seed = seed;
+    const auto r = runVirtualFleet(map, o);
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_EQ(r.holdViolations, 0U);
+    EXPECT_EQ(r.contacts, 0U);
+    EXPECT_LT(r.longestWait, 120.0);
+    least = std::min(least, r.tasksDone);
+  }
+  EXPECT_GE(least, 15U);
 }
 
 TEST(VirtualFleet, ALoneRobot) {

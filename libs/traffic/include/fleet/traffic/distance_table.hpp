@@ -44,6 +44,12 @@ class DistanceTable {
   void setBlocked(NodeId v, bool blocked);
   [[nodiscard]] bool blocked(NodeId v) const { return blocked_[static_cast<std::size_t>(v)] != 0; }
 
+  /// Distances to `goal` where driving into node v costs `extra[v]` on top of the edge's duration
+  /// (soft obstacles: robots that have stood in the way for a while, which a detour may be worth
+  /// going round). Dijkstra, not cached; `extra[goal]` is ignored and closed or blocked nodes are
+  /// honoured as in to(). `extra` has one entry per node.
+  void withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& out);
+
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
   [[nodiscard]] std::size_t cached() const { return used_; }
   /// Tables computed since construction (misses), for benchmarks and tests.
@@ -54,6 +60,8 @@ class DistanceTable {
  private:
   void buildReverse();
   void compute(NodeId goal, std::vector<float>& d);
+  /// Dijkstra from `goal` (d[goal] already 0), entering v costing extra[v] more when given.
+  void dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d);
   std::size_t acquireSlot();
   void touch(std::size_t slot);
   void unlink(std::size_t slot);

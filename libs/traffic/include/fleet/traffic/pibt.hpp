@@ -55,6 +55,16 @@ struct PibtOptions {
   /// Distance an escalated agent gains on where it was escalated before it drops back (cells on a
   /// unit grid, the edges' duration unit on a roadmap).
   double escapeProgress = 16.0;
+  /// Steps an agent stands without coming closer to its goal before it is routed round the agents
+  /// that have stood still that long too (a detour table: entering what such an agent excludes
+  /// costs `detourPenalty` more). PIBT ranks moves by distance alone, so an agent whose shortest way
+  /// passes an agent waiting in line, or one stuck itself, otherwise waits for ever beside a free
+  /// way round. 0: never (plain PIBT).
+  int detourAfter = 0;
+  /// Extra cost (the edges' duration unit) of entering what a standing agent excludes.
+  float detourPenalty = 30.0F;
+  /// Detour tables computed per step at most (each is one search of the whole graph).
+  int maxDetoursPerStep = 4;
   std::size_t distanceCacheBytes = std::size_t{256} << 20;
 };
 
@@ -63,6 +73,7 @@ struct PibtStats {
   std::uint64_t rotationStops = 0;  ///< agents RotationPass stopped (kCancel; 0 with kAvoid)
   std::uint64_t escalations = 0;
   std::uint64_t escalationRequeues = 0;  ///< escalated agents that stayed stuck and dropped back
+  std::uint64_t detours = 0;             ///< detour tables computed
 };
 
 class Pibt {
@@ -119,6 +130,8 @@ class Pibt {
   void updateProgress(std::size_t agent);
   [[nodiscard]] std::int32_t blocker(std::size_t agent) const;
   void escapeDeadlocks();
+  void planDetours();
+  void dropDetour(std::size_t agent);
   void resizeForGraph();
   void cover(NodeId v, int delta);
   /// An agent other than `except` standing on what v excludes, or -1.
@@ -148,10 +161,14 @@ class Pibt {
   std::vector<std::int64_t> escalatedAt_;  ///< step of (re-)escalation, -1 when not escalated
   std::vector<std::uint64_t> escalationDraw_;
   std::vector<float> escalationDistance_;
-  std::vector<int> escalationIdle_;     ///< steps escalated without coming closer
-  std::vector<int> still_;              ///< steps since it last moved
-  std::vector<int> tries_;              ///< escalations since it last came closer to its goal
-  std::vector<std::uint32_t> visited_;  ///< stamps for the cycle search
+  std::vector<int> escalationIdle_;         ///< steps escalated without coming closer
+  std::vector<int> still_;                  ///< steps since it last moved
+  std::vector<int> tries_;                  ///< escalations since it last came closer to its goal
+  std::vector<std::uint32_t> visited_;      ///< stamps for the cycle search
+  std::vector<std::vector<float>> detour_;  ///< detour table to its goal, empty when none
+  std::vector<float> detourFrom_;           ///< regular distance when the detour was taken
+  std::vector<float> extra_;                ///< per node scratch: detour penalties
+  std::vector<int> standCover_;             ///< per node scratch: standing agents excluding it
   std::uint32_t stamp_ = 0;
 
   // Per node.

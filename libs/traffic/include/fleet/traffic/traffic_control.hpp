@@ -26,6 +26,10 @@ namespace fleet::traffic {
 struct TrafficOptions {
   std::int64_t maxLag = 24;  ///< steps a robot may be behind the plan before it is re-planned
   std::int64_t maxStepsPerUpdate = 64;
+  /// A robot planned to stand this many steps in a row stops asking for steps at once; while only
+  /// such robots want planning, one step is planned every `standingEvery` updates.
+  int standingSteps = 2;
+  int standingEvery = 5;
   /// A robot planned to stand still this many steps short of its goal makes the robots standing
   /// in its way (on nodes its next few nodes exclude) drive away for `evadeSteps` (PIBT moves
   /// robots one step at a time; a robot whose footprint reaches past the next node cannot clear
@@ -34,7 +38,9 @@ struct TrafficOptions {
   int evadeSteps = 10;
   int evadeLookahead = 3;
   ReleaseOptions release;
-  PibtOptions pibt;
+  /// Detours on: on a roadmap robots wait in line at stations and stand at docks, and an agent
+  /// whose shortest way passes one would otherwise wait beside a free way round (docs/algorithms.md).
+  PibtOptions pibt{.detourAfter = 4};
 };
 
 /// A station robots dock at one at a time: its dock node and the nodes to wait on in line,
@@ -107,7 +113,8 @@ class TrafficControl {
   void plannerGoal(std::size_t robot, NodeId goal);
   void afterStep();
   void clearWayFor(std::size_t robot);
-  [[nodiscard]] bool needsPlanning() const;
+  enum class Need : std::uint8_t { None, Later, Now };
+  [[nodiscard]] Need needsPlanning() const;
 
   const Graph& graph_;
   TrafficOptions options_;
@@ -127,6 +134,7 @@ class TrafficControl {
   std::vector<NodeId> lastEnd_;                  ///< planned end after the previous step
   std::vector<std::int64_t> evadeUntil_;         ///< step its evasion ends, -1
   TrafficStats stats_;
+  int sinceStep_ = 0;  ///< update() calls since the last planned step
 };
 
 }  // namespace fleet::traffic
