@@ -162,6 +162,7 @@ TEST(FleetScenario, TwentyRobotsDeliverWithRiskSteppingWithoutContact) {
   for (const auto& agent : r["agents"]) {
     recoveries += agent["conduct"]["planner_recoveries"].get<int>();
   }
-  EXPECT_LE(recoveries, 2) << r["agents"].dump();
+  // 0-4 per 100-task run with risk_stepping (docs/benchmarks.md); a planner that never moves: 291.
+  EXPECT_LE(recoveries, 5) << r["agents"].dump();
   fs::remove_all(out);
 }
