@@ -213,6 +213,9 @@ int main(int argc, char** argv) {
   fleet::ctl::TrafficBenchOptions tb;
   bool noRotationPass = false;
   trafficBench->add_option("--map", tb.map, "MovingAI .map file")->required();
+  trafficBench->add_option("--scen", tb.scen,
+                           "MovingAI .scen of the same map: agents start (and first head) where its rows say "
+                           "(bad rows skipped and counted on stderr)");
   trafficBench->add_option("--agents", tb.agents, "agents")->capture_default_str();
   trafficBench->add_option("--steps", tb.steps, "steps (lifelong mode)")->capture_default_str();
   trafficBench->add_option("--seed", tb.seed, "seed of starts, goals, tasks and the planner")

@@ -9,6 +9,8 @@
 #include <numeric>
 #include <vector>
 
+#include "fleet/planning/map_io.hpp"
+#include "fleet/planning/movingai_scen.hpp"
 #include "fleet/traffic/grid_map.hpp"
 #include "fleet/traffic/pibt.hpp"
 
@@ -138,13 +140,68 @@ void printPlannerStats(const traffic::Pibt& p) {
               static_cast<unsigned long long>(p.distances().computed()));
 }
 
+/// Agent i starts and first heads where the i-th usable row of the .scen says (the MAPF benchmark's
+/// convention); a row whose start another agent already has is passed over, as is every row the
+/// reader skips. Both are counted on stderr by reason, and too few rows is bad input.
+struct ScenAgents {
+  std::vector<NodeId> starts;
+  std::vector<NodeId> goals;
+};
+Expected<ScenAgents> scenAgents(const traffic::GridMap& map, const TrafficBenchOptions& o) {
+  auto grid = planning::loadMovingAiMap(o.map);
+  if (!grid) {
+    return unexpected(grid.error().code, grid.error().message);
+  }
+  auto scen = planning::loadMovingAiScen(o.scen, &*grid, o.map);
+  if (!scen) {
+    return unexpected(scen.error().code, scen.error().message);
+  }
+  auto skipped = scen->skippedBy();
+  ScenAgents out;
+  std::vector<bool> taken(map.freeCells(), false);
+  for (const auto& e : scen->entries) {
+    if (out.starts.size() == static_cast<std::size_t>(o.agents)) {
+      break;
+    }
+    const NodeId s = map.node(e.startX, e.startY);
+    if (taken[static_cast<std::size_t>(s)]) {
+      ++skipped["duplicate_start"];
+      continue;
+    }
+    taken[static_cast<std::size_t>(s)] = true;
+    out.starts.push_back(s);
+    out.goals.push_back(map.node(e.goalX, e.goalY));
+  }
+  for (const auto& [reason, count] : skipped) {
+    std::cerr << "fleetctl traffic-bench: " << o.scen << ": " << count << " row(s) skipped: " << reason
+              << "\n";
+  }
+  if (out.starts.size() < static_cast<std::size_t>(o.agents)) {
+    return unexpected("scen_rows", o.scen + ": " + std::to_string(out.starts.size()) +
+                                       " usable rows with distinct starts, " + std::to_string(o.agents) +
+                                       " agents asked for");
+  }
+  return out;
+}
+
 int lifelong(const traffic::GridMap& map, const TrafficBenchOptions& o) {
   Random rng(o.seed);
-  std::vector<NodeId> cells(map.freeCells());
-  std::iota(cells.begin(), cells.end(), 0);
-  rng.shuffle(cells);
   const auto n = static_cast<std::size_t>(o.agents);
-  std::vector<NodeId> starts(cells.begin(), cells.begin() + static_cast<std::ptrdiff_t>(n));
+  std::vector<NodeId> starts;
+  std::vector<NodeId> firstGoals;
+  if (o.scen.empty()) {
+    std::vector<NodeId> cells(map.freeCells());
+    std::iota(cells.begin(), cells.end(), 0);
+    rng.shuffle(cells);
+    starts.assign(cells.begin(), cells.begin() + static_cast<std::ptrdiff_t>(n));
+  } else {
+    auto agents = scenAgents(map, o);
+    if (!agents) {
+      return bad(agents.error().message);
+    }
+    starts = std::move(agents->starts);
+    firstGoals = std::move(agents->goals);
+  }
   traffic::PibtOptions po;
   po.seed = o.seed;
   po.rotations = rotationsOf(o.rotations);
@@ -164,7 +221,14 @@ int lifelong(const traffic::GridMap& map, const TrafficBenchOptions& o) {
     }
   };
   for (std::size_t i = 0; i < n; ++i) {
-    newGoal(i, starts[i], 0);
+    if (!firstGoals.empty() && firstGoals[i] != starts[i]) {
+      planner.setGoal(i, firstGoals[i]);
+      if (record) {
+        rec.goals.push_back({0, i, firstGoals[i]});
+      }
+    } else {
+      newGoal(i, starts[i], 0);
+    }
   }
   if (record) {
     rec.configs.reserve(static_cast<std::size_t>(o.steps) + 1);
@@ -190,6 +254,9 @@ int lifelong(const traffic::GridMap& map, const TrafficBenchOptions& o) {
   std::printf("mode=lifelong\nmap=%s\nwidth=%d\nheight=%d\nfree_cells=%zu\nagents=%zu\nsteps=%d\nseed=%llu\n",
               map.source.c_str(), map.width, map.height, map.freeCells(), n, o.steps,
               static_cast<unsigned long long>(o.seed));
+  if (!o.scen.empty()) {
+    std::printf("scen=%s\n", o.scen.c_str());
+  }
   std::printf("rotations=%s\nescape_after=%d\ngoals_reached=%zu\nthroughput=%.3f\n", o.rotations.c_str(),
               o.escapeAfter, reached, static_cast<double>(reached) / o.steps);
   printTimes(ms);
@@ -423,6 +490,9 @@ int runTrafficBench(const TrafficBenchOptions& o) {
   }
   if (map->freeCells() < 2) {
     return bad(o.map + ": fewer than two free cells");
+  }
+  if (!o.scen.empty() && o.mapd) {
+    return bad("--scen is for lifelong mode; MAPD starts agents on the .pd file's endpoints");
   }
   if (!o.mapd) {
     if (static_cast<std::size_t>(o.agents) > map->freeCells()) {

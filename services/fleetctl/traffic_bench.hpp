@@ -4,8 +4,9 @@
 // 4-neighbour or a wait per step, the MAPF convention), so its figures compare with the literature's
 // and anyone can check the written plan with an independent checker (scripts/check-plan.py).
 //
-// Lifelong MAPF (default): N agents on random distinct cells, each given a new random goal as soon as
-// it reaches one; prints throughput (goals reached per step) and planning time per step.
+// Lifelong MAPF (default): N agents on random distinct cells (or on a .scen file's starts, heading
+// first for its goals), each given a new random goal as soon as it reaches one; prints throughput
+// (goals reached per step) and planning time per step.
 // MAPD (--mapd --pd FILE.pd): Kei18/pibt2's pickup-and-delivery setting — tasks appear at a
 // frequency between random pickup and delivery cells of the .pd file, a free agent heads for the
 // nearest open pickup and takes the task when it gets there; prints service time, makespan and
@@ -18,6 +19,9 @@ namespace fleet::ctl {
 
 struct TrafficBenchOptions {
   std::string map;
+  /// MovingAI .scen for the same map: agent i starts (and first heads) where its i-th usable row
+  /// says; empty: random distinct cells.
+  std::string scen;
   int agents = 100;
   int steps = 1000;
   std::uint64_t seed = 1;

@@ -126,9 +126,16 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
   }
   reserved_ = p_.traffic == "reserved";
   if (p_.localPlanner != "follow") {
-    auto inner = p_.localPlanner == "dwa" ? Expected<std::unique_ptr<avoidance::LocalPlanner>>(
-                                                std::make_unique<avoidance::DynamicWindowPlanner>(p_.dwa))
-                                          : avoidance::makePlanner(p_.localPlanner);
+    using PlannerPtr = Expected<std::unique_ptr<avoidance::LocalPlanner>>;
+    const bool stepping = p_.localPlanner == "risk_stepping" || p_.localPlanner == "risk_stepping_weighted";
+    auto steppingParams = p_.riskStepping;
+    if (p_.localPlanner == "risk_stepping_weighted") {
+      steppingParams.rule = avoidance::SteppingRule::kWeighted;
+    }
+    auto inner = p_.localPlanner == "dwa"
+                     ? PlannerPtr(std::make_unique<avoidance::DynamicWindowPlanner>(p_.dwa))
+                 : stepping ? PlannerPtr(std::make_unique<avoidance::RiskSteppingPlanner>(steppingParams))
+                            : avoidance::makePlanner(p_.localPlanner);
     if (!inner) {
       throw std::invalid_argument("local planner: " + inner.error().message);
     }

@@ -31,6 +31,7 @@
 
 #include "fleet/avoidance/dynamic_window.hpp"
 #include "fleet/avoidance/local_planner.hpp"
+#include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
 #include "fleet/planning/lane_map.hpp"
@@ -79,7 +80,9 @@ struct AgentParams {
   /// docks on stations and the same stop rule and standoff handling apply.
   std::string localPlanner = "dwa";
   avoidance::DwaParams dwa = agentDwaDefaults();  ///< when localPlanner is "dwa" (from --config)
-  avoidance::SafetyParams safety;                 ///< the safety layer behind every libs/avoidance planner
+  /// When localPlanner is "risk_stepping" (from --config); "risk_stepping_weighted" forces the weighted rule.
+  avoidance::RiskSteppingParams riskStepping;
+  avoidance::SafetyParams safety;  ///< the safety layer behind every libs/avoidance planner
   control::VelocityLimits limits{0.8, -0.3, 1.5, 1.0, 3.0};
   /// Global planner on the inflated grid: "astar" (with the risk map as cell cost when one is
   /// received), "wavefront" (distance field from the goal, then descent) or "ompl" (Informed RRT*,

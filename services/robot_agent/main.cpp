@@ -140,6 +140,7 @@ struct Options {
   std::string localPlanner = "dwa";
   std::string globalPlanner = "astar";
   avoidance::DwaParams dwa = agent::agentDwaDefaults();
+  avoidance::RiskSteppingParams riskStepping;
   avoidance::SafetyParams safety;
   unsigned threads = 0;  // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
@@ -205,6 +206,7 @@ int run(const World& scn, const Options& opt) {
     p.wMax = r.limits.omega_max;
     p.localPlanner = opt.localPlanner;
     p.dwa = opt.dwa;
+    p.riskStepping = opt.riskStepping;
     p.safety = opt.safety;
     p.globalPlanner = opt.globalPlanner;
     p.sensorTimeoutS = opt.sensorTimeoutS;
@@ -436,10 +438,12 @@ void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, b
   const std::string global = cfg.string("global_planner", opt.globalPlanner, {"astar", "wavefront", "ompl"});
   const std::string traffic = cfg.string("traffic", opt.traffic, {"reactive", "reserved"});
   Config dwa = cfg.child("dwa");
+  Config stepping = cfg.child("risk_stepping");
   Config safety = cfg.child("safety");
   opt.dwa = avoidance::dwaParams(dwa, opt.dwa);
+  opt.riskStepping = avoidance::riskSteppingParams(stepping, opt.riskStepping);
   opt.safety = avoidance::safetyParams(safety);
-  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "safety"});
+  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety"});
   if (!localFromCli) {
     opt.localPlanner = local;
   }
@@ -473,8 +477,9 @@ int main(int argc, char** argv) {
          "astar (default; the risk map as cell cost), wavefront, or ompl (Informed RRT*, 50 ms per plan)")
       ->check(CLI::IsMember({"astar", "wavefront", "ompl"}));
   app.add_option("--local-planner", opt.localPlanner,
-                 "dwa (default; with the risk map's term), vo, potential_field, ... (a libs/avoidance "
-                 "planner behind the safety layer) or follow (the Lyapunov path follower)");
+                 "dwa (default; with the risk map's term), risk_stepping (thesis 000 §3.2.3), "
+                 "risk_stepping_weighted, vo, potential_field, ... (a libs/avoidance planner behind "
+                 "the safety layer) or follow (the Lyapunov path follower)");
   app.add_option("--threads", opt.threads, "worker threads stepping the agents (0: hardware concurrency)")
       ->check(CLI::Range(0u, 256u));
   app.add_option("--sensor-timeout", opt.sensorTimeoutS,
@@ -516,6 +521,7 @@ int main(int argc, char** argv) {
   std::string configFile;
   app.add_option("-c,--config", configFile,
                  "JSON file: local_planner, global_planner, traffic, dwa {weights, samples, horizon...}, "
+                 "risk_stepping {rule: iso_level | weighted, levels, ...}, "
                  "safety {zones} (docs/operator-guide.md); options given on the command line win");
   CLI11_PARSE(app, argc, argv);
   try {

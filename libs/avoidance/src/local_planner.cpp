@@ -24,6 +24,11 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<BugPlanner>(BugVariant::kBug2));
   if (name == "risk_stepping")
     return Ptr(std::make_unique<RiskSteppingPlanner>());
+  if (name == "risk_stepping_weighted") {
+    RiskSteppingParams p;
+    p.rule = SteppingRule::kWeighted;
+    return Ptr(std::make_unique<RiskSteppingPlanner>(p));
+  }
   if (name == "elastic_strips")
     return Ptr(std::make_unique<ElasticStripsPlanner>(ElasticVariant::kOriginal));
   if (name == "elastic_strips_bvh")

@@ -62,6 +62,29 @@ DwaParams dwaParams(Config& cfg, const DwaParams& defaults) {
   return p;
 }
 
+RiskSteppingParams riskSteppingParams(Config& cfg, const RiskSteppingParams& defaults) {
+  RiskSteppingParams p = defaults;
+  const std::string rule =
+      cfg.string("rule", std::string(steppingRuleName(p.rule)), {"iso_level", "weighted"});
+  p.rule = rule == "weighted" ? SteppingRule::kWeighted : SteppingRule::kIsoLevel;
+  p.levels = static_cast<int>(cfg.integer("levels", p.levels, {1.0, 255.0}));
+  p.step_time = cfg.number("step_time", p.step_time, kPositive);
+  p.candidates = static_cast<int>(cfg.integer("candidates", p.candidates, {1.0, 200.0}));
+  p.fan = cfg.number("fan", p.fan, {0.0, 3.14159});
+  p.risk_samples = static_cast<int>(cfg.integer("risk_samples", p.risk_samples, {1.0, 100.0}));
+  p.w_progress = cfg.number("w_progress", p.w_progress, kNonNegative);
+  p.min_clearance = cfg.number("min_clearance", p.min_clearance, kNonNegative);
+  p.k_omega = cfg.number("k_omega", p.k_omega, kPositive);
+  p.lookahead = cfg.number("lookahead", p.lookahead, kPositive);
+  cfg.rejectUnknownKeys({"rule", "levels", "step_time", "candidates", "fan", "risk_samples", "w_progress",
+                         "min_clearance", "k_omega", "lookahead"});
+  if (cfg.ok()) {
+    if (auto v = p.validate(); !v)
+      cfg.problem("", v.error().message);
+  }
+  return p;
+}
+
 SafetyParams safetyParams(Config& cfg) {
   SafetyParams p;
   p.stop_margin = cfg.number("stop_margin", p.stop_margin, kNonNegative);

@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "fleet/avoidance/clearance.hpp"
+#include "fleet/avoidance/dynamic_window.hpp"
 #include "fleet/core/angles.hpp"
+#include "fleet/risk/iso_levels.hpp"
 #include "fleet/risk/query.hpp"
 
 namespace fleet::avoidance {
@@ -16,27 +18,58 @@ RiskLookup riskLookup(const risk::ProbabilityGrid& grid) {
   };
 }
 
+std::string_view steppingRuleName(SteppingRule rule) {
+  return rule == SteppingRule::kWeighted ? "weighted" : "iso_level";
+}
+
 Expected<void> RiskSteppingParams::validate() const {
-  if (!(step_time > 0.0) || candidates < 1 || !(fan >= 0.0) || risk_samples < 1 || w_progress < 0.0 ||
-      min_clearance < 0.0 || !(k_omega > 0.0)) {
-    return fleet::unexpected("invalid_risk_stepping_params", "positive step, counts and gains");
+  if (!(step_time > 0.0) || candidates < 1 || !(fan >= 0.0) || risk_samples < 1 || !(w_progress >= 0.0) ||
+      !(min_clearance >= 0.0) || !(k_omega > 0.0) || !(lookahead > 0.0) || levels < 1 ||
+      levels > risk::kMaxLevels) {
+    return fleet::unexpected("invalid_risk_stepping_params",
+                             "positive step, counts, gains and lookahead; 1 <= levels <= 255");
   }
   return {};
 }
 
+namespace {
+
+struct Candidate {
+  Vec2 point;
+  double pmax = 0.0;
+  int level = 0;
+  double progress = 0.0;
+};
+
+/// True when a should be chosen over b.
+bool better(SteppingRule rule, double w_progress, const Candidate& a, const Candidate& b) {
+  if (rule == SteppingRule::kWeighted) {
+    return (1.0 - a.pmax) + w_progress * a.progress > (1.0 - b.pmax) + w_progress * b.progress;
+  }
+  if (a.level != b.level)
+    return a.level < b.level;
+  if (a.progress != b.progress)
+    return a.progress > b.progress;
+  // Equal progress happens on symmetric fans; the lower probability inside the level is the
+  // thesis's preference carried one step further.
+  return a.pmax < b.pmax;
+}
+
+}  // namespace
+
 SteppingChoice RiskSteppingPlanner::choose(const LocalView& view) const {
   const Vec2 p = view.robot.pose.position();
-  const Vec2 goal = view.goal();
-  const double dg = fastDistance(p, goal);
+  const Vec2 target = carrotOnPath(view.path, p, params_.lookahead);
+  const double dg = fastDistance(p, target);
   const double step = std::min(view.limits.v_max * params_.step_time, dg);
-  const double base = std::atan2(goal.y - p.y, goal.x - p.x);
+  const double base = std::atan2(target.y - p.y, target.x - p.x);
   const double r = view.robot.radius;
   // Where the robot already is closer than min_clearance, accept any candidate that does not get
   // closer still, so it can always leave.
   const double here = arcClearance({p.x, p.y, 0.0}, {0.0, 0.0}, 0.0, view.scan, r, 1.0);
   const double threshold = std::min(params_.min_clearance, here - 1e-6);
-  SteppingChoice best;
-  double best_score = -1e300;
+  Candidate best;
+  bool found = false;
   for (int i = 0; i < params_.candidates; ++i) {
     const double frac =
         params_.candidates == 1 ? 0.5 : static_cast<double>(i) / static_cast<double>(params_.candidates - 1);
@@ -55,20 +88,21 @@ SteppingChoice RiskSteppingPlanner::choose(const LocalView& view) const {
     }
     if (clr < threshold || clr <= 0.0)
       continue;
-    double pmax = 0.0;
+    // The robot passes every point of the segment, so the candidate carries the segment's worst P.
+    Candidate cand{c, 0.0, 0, (dg - fastDistance(c, target)) / std::max(step, 1e-9)};  // progress in [−1, 1]
     for (int k = 1; k <= params_.risk_samples; ++k) {
-      pmax = std::max(pmax, view.riskAt(p + (c - p) * (static_cast<double>(k) /
-                                                       static_cast<double>(params_.risk_samples))));
+      cand.pmax = std::max(cand.pmax, view.riskAt(p + (c - p) * (static_cast<double>(k) /
+                                                                 static_cast<double>(params_.risk_samples))));
     }
-    const double safety = 1.0 - pmax;
-    const double progress = (dg - fastDistance(c, goal)) / std::max(step, 1e-9);  // in [−1, 1]
-    const double score = safety + params_.w_progress * progress;
-    if (score > best_score) {
-      best_score = score;
-      best = {c, safety, true};
+    cand.level = risk::isoLevel(cand.pmax, params_.levels);
+    if (!found || better(params_.rule, params_.w_progress, cand, best)) {
+      best = cand;
+      found = true;
     }
   }
-  return best;
+  if (!found)
+    return {};
+  return {best.point, 1.0 - best.pmax, best.level, true};
 }
 
 Command RiskSteppingPlanner::plan(const LocalView& view) {

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -168,9 +169,17 @@ BENCHMARK_CAPTURE(BM_CircleSwap, dwa, "dwa")->Arg(8)->Arg(100)->Unit(benchmark::
 
 // The harness comparison table of docs/benchmarks.md: every planner (behind the safety layer) on
 // every harness scenario, one deterministic run each; only the µs depend on the machine.
-const char* const kPlanners[] = {
-    "dwa", "potential_field", "bug1", "bug2", "risk_stepping", "elastic_strips", "elastic_strips_bvh",
-    "vo",  "vo_keep_right",   "orca"};
+const char* const kPlanners[] = {"dwa",
+                                 "potential_field",
+                                 "bug1",
+                                 "bug2",
+                                 "risk_stepping",
+                                 "risk_stepping_weighted",
+                                 "elastic_strips",
+                                 "elastic_strips_bvh",
+                                 "vo",
+                                 "vo_keep_right",
+                                 "orca"};
 
 Scenario harnessScenario(int which) {
   switch (which) {
@@ -210,7 +219,8 @@ void BM_Harness(benchmark::State& state) {
   state.counters["us_per_call"] = r.compute_mean_us;
 }
 BENCHMARK(BM_Harness)
-    ->ArgsProduct({benchmark::CreateDenseRange(0, 9, 1), {0, 1, 2, 3}})
+    ->ArgsProduct({benchmark::CreateDenseRange(0, static_cast<int>(std::size(kPlanners)) - 1, 1),
+                   {0, 1, 2, 3}})
     ->Unit(benchmark::kSecond)
     ->Iterations(1);
 

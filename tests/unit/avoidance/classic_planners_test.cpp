@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "fleet/avoidance/bug.hpp"
@@ -169,6 +170,66 @@ TEST(RiskStepping, PicksTheLowestRiskReachableCandidate) {
   EXPECT_NEAR(straight.point.y, 0.0, 1e-9);
 }
 
+TEST(RiskStepping, TheIsoLevelRuleNeverTradesRiskForProgressTheWeightedOneDoes) {
+  // Straight at the goal the segment's P is 0.11 (level 2 of K = 10); 0.6 rad or more off it, 0.09
+  // (level 1). The weighted score prefers straight (0.89 + 0.3·1 against 0.91 + 0.3·0.78); thesis
+  // §3.2.3 steps into the highest-complement level, and there goes as far towards the goal as it
+  // can: the level-1 candidates nearest the goal's bearing, ±4/24·4 rad on the 25-point ±2 rad fan.
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  const std::vector<Vec2> path{{4.0, 0.0}};
+  v.path = path;
+  v.risk = [](Vec2 q) { return std::abs(std::atan2(q.y, q.x)) < 0.6 ? 0.11 : 0.09; };
+
+  const auto thesis = RiskSteppingPlanner().choose(v);
+  ASSERT_TRUE(thesis.found);
+  EXPECT_EQ(thesis.level, 1);
+  EXPECT_NEAR(thesis.safety, 0.91, 1e-12);
+  EXPECT_NEAR(std::abs(std::atan2(thesis.point.y, thesis.point.x)), 4.0 * 4.0 / 24.0, 1e-9);
+
+  RiskSteppingParams wp;
+  wp.rule = SteppingRule::kWeighted;
+  const auto weighted = RiskSteppingPlanner(wp).choose(v);
+  ASSERT_TRUE(weighted.found);
+  EXPECT_EQ(weighted.level, 2);
+  EXPECT_NEAR(weighted.point.y, 0.0, 1e-9);
+  EXPECT_GT(weighted.point.x, 0.4);
+}
+
+TEST(RiskStepping, DrivesRoundARiskierPatchTheWeightedRuleCrosses) {
+  // P = 0.11 over a box on the straight line to the goal, 0.09 everywhere else.
+  const auto inBox = [](Vec2 q, double margin) {
+    return q.x > 1.0 + margin && q.x < 2.5 - margin && std::abs(q.y) < 0.5 - margin;
+  };
+  const RiskLookup risk = [&](Vec2 q) { return inBox(q, 0.0) ? 0.11 : 0.09; };
+  const auto entered = [&](const test::RunResult& r) {
+    return std::any_of(r.trace.begin(), r.trace.end(),
+                       [&](const Pose2& q) { return inBox(q.position(), 0.1); });
+  };
+  RiskSteppingPlanner thesis;
+  const auto a = test::drive(thesis, {0, 0, 0}, {{4.0, 0.0}}, {}, 600, risk);
+  EXPECT_TRUE(a.reached);
+  EXPECT_FALSE(entered(a));
+  RiskSteppingParams wp;
+  wp.rule = SteppingRule::kWeighted;
+  RiskSteppingPlanner weighted(wp);
+  const auto b = test::drive(weighted, {0, 0, 0}, {{4.0, 0.0}}, {}, 600, risk);
+  EXPECT_TRUE(b.reached);
+  EXPECT_TRUE(entered(b));
+}
+
+TEST(RiskStepping, AimsAtTheCarrotOnThePathNotAtItsEnd) {
+  // An L-shaped path whose end lies behind a wall: the first step follows the path's first leg.
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  const std::vector<Vec2> path{{0.0, 0.0}, {3.0, 0.0}, {3.0, -3.0}};
+  v.path = path;
+  const auto c = RiskSteppingPlanner().choose(v);
+  ASSERT_TRUE(c.found);
+  EXPECT_NEAR(c.point.y, 0.0, 1e-9);
+  EXPECT_GT(c.point.x, 0.4);
+}
+
 TEST(RiskStepping, CandidatesThroughObstaclesAreUnreachable) {
   const auto scan = test::wall({0.5, -0.1}, {0.5, 0.1});
   LocalView v;
@@ -193,6 +254,9 @@ TEST(Factory, BuildsEveryPlannerByName) {
     ASSERT_TRUE(p.has_value()) << n;
     EXPECT_EQ((*p)->name(), n);
   }
+  auto weighted = makePlanner("risk_stepping_weighted");
+  ASSERT_TRUE(weighted.has_value());
+  EXPECT_EQ((*weighted)->name(), "risk_stepping_weighted");
   EXPECT_FALSE(makePlanner("teleport").has_value());
 }
 

@@ -47,6 +47,25 @@ TEST(PlannerConfig, EveryBadDwaKeyIsNamed) {
   EXPECT_THROW(cfg.finish(), ConfigError);
 }
 
+TEST(PlannerConfig, RiskSteppingRuleAndLevelsComeFromConfig) {
+  Config cfg = Config::fromText(R"({"risk_stepping": {"rule": "weighted", "levels": 5, "lookahead": 1.5}})",
+                                "agent.json");
+  Config c = cfg.child("risk_stepping");
+  const RiskSteppingParams p = riskSteppingParams(c);
+  EXPECT_TRUE(cfg.ok());
+  EXPECT_EQ(p.rule, SteppingRule::kWeighted);
+  EXPECT_EQ(p.levels, 5);
+  EXPECT_DOUBLE_EQ(p.lookahead, 1.5);
+  EXPECT_EQ(RiskSteppingParams{}.rule, SteppingRule::kIsoLevel);
+
+  Config bad = Config::fromText(R"({"rule": "greedy", "levels": 0, "fan_out": 1})", "r.json");
+  (void)riskSteppingParams(bad);
+  EXPECT_EQ(bad.problems().size(), 3u);
+  EXPECT_TRUE(mentions(bad, "r.json: rule"));
+  EXPECT_TRUE(mentions(bad, "r.json: levels"));
+  EXPECT_TRUE(mentions(bad, "r.json: fan_out: unknown key"));
+}
+
 TEST(PlannerConfig, SafetyZonesAndTheirOrder) {
   Config ok = Config::fromText(R"({"stop_margin": 0.1, "slow_margin": 0.5, "slow_ratio": 0.4})", "s.json");
   const SafetyParams p = safetyParams(ok);

@@ -36,6 +36,21 @@ for key in solved=1 service_time= makespan= comp_time_ms=; do
 done
 python3 "$src/scripts/check-plan.py" "$work/tiny.map" "$work/mapd.json" --rotations || fail "mapd plan refused"
 
+# Starts from a MovingAI .scen: agent i stands on row i's start and heads first for its goal.
+smap=$src/tests/unit/planning/data/ost003d.map
+scen=$src/tests/unit/planning/data/ost003d-random-1.scen
+"$fleetctl" traffic-bench --map "$smap" --scen "$scen" --agents 50 --steps 60 --seed 2 \
+  --out "$work/scen.json" >/dev/null || fail "traffic-bench --scen exited with $?"
+python3 "$src/scripts/check-plan.py" "$smap" "$work/scen.json" --rotations >/dev/null || fail "scen plan refused"
+python3 - "$scen" "$work/scen.json" <<'PY' || fail "starts or first goals differ from the .scen rows"
+import json, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1]).readlines()[1:51]]
+d = json.load(open(sys.argv[2]))
+assert d["plan"][0] == [[int(r[4]), int(r[5])] for r in rows], "starts"
+first = {a: g for t, a, g in d["goals"] if t == 0}
+assert [first[i] for i in range(50)] == [[int(r[6]), int(r[7])] for r in rows], "first goals"
+PY
+
 expect2() {
   local what=$1
   shift
@@ -55,4 +70,8 @@ expect2 "bad pd" --map "$map" --mapd --pd "$work/tiny.map.pd" --agents 5
 expect2 "bad frequency" --map "$work/tiny.map" --mapd --pd "$work/tiny.map.pd" --agents 2 --frequency -1
 expect2 "too many mapd agents" --map "$work/tiny.map" --mapd --pd "$work/tiny.map.pd" --agents 5
 expect2 "unknown rotations" --map "$map" --agents 5 --rotations sometimes
+expect2 "scen of another map" --map "$work/tiny.map" --scen "$scen" --agents 2 --steps 5
+expect2 "more agents than scen rows" --map "$smap" --scen "$scen" --agents 1001 --steps 5
+expect2 "missing scen" --map "$smap" --scen "$work/nope.scen" --agents 2 --steps 5
+expect2 "scen with mapd" --map "$work/tiny.map" --mapd --pd "$work/tiny.map.pd" --scen "$scen" --agents 2
 echo PASS

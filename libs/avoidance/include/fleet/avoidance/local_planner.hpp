@@ -70,9 +70,10 @@ class LocalPlanner {
   virtual void reset() {}
 };
 
-/// The planner named in config: "dwa", "potential_field", "bug1", "bug2", "risk_stepping",
-/// "elastic_strips", "elastic_strips_bvh", "vo", "vo_keep_right", "orca"
-/// (the former sampling "rvo" never resolved a swap and was removed: "orca" is the reciprocal one).
+/// The planner named in config: "dwa", "potential_field", "bug1", "bug2", "risk_stepping" (thesis
+/// §3.2.3 by iso-level), "risk_stepping_weighted" (safety + progress), "elastic_strips",
+/// "elastic_strips_bvh", "vo", "vo_keep_right", "orca" (the former sampling "rvo" never resolved a swap and
+/// was removed: "orca" is the reciprocal one).
 Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name);
 
 }  // namespace fleet::avoidance
