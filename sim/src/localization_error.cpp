@@ -39,6 +39,17 @@ void LocalizationErrorLog::estimate(std::size_t robot, std::int64_t stampNs, con
   if (bins_.size() <= b) {
     bins_.resize(b + 1);
   }
+  if (robots_.size() <= robot) {
+    robots_.resize(robot + 1);
+  }
+  Robot& r = robots_[robot];
+  if (pos > r.posMax) {
+    r.posMax = pos;
+    r.posMaxT = s;
+  }
+  r.posLast = pos;
+  r.headMax = std::max(r.headMax, head);
+  r.seen = true;
   Bin& bin = bins_[b];
   bin.posSum += pos;
   bin.posMax = std::max(bin.posMax, pos);
@@ -78,7 +89,7 @@ nlohmann::json stats(std::vector<float> pos, std::vector<float> head) {
 
 }  // namespace
 
-nlohmann::json LocalizationErrorLog::toJson() const {
+nlohmann::json LocalizationErrorLog::toJson(const std::vector<std::string>& names) const {
   nlohmann::json series = nlohmann::json::array();
   for (std::size_t b = 0; b < bins_.size(); ++b) {
     const Bin& bin = bins_[b];
@@ -103,7 +114,19 @@ nlohmann::json LocalizationErrorLog::toJson() const {
   for (const auto& [from, to] : hidden_) {
     hidden.push_back({from, to});
   }
+  nlohmann::json perRobot = nlohmann::json::array();
+  for (std::size_t i = 0; i < robots_.size(); ++i) {
+    const Robot& r = robots_[i];
+    if (r.seen) {
+      perRobot.push_back({{"robot", i < names.size() ? nlohmann::json(names[i]) : nlohmann::json(i)},
+                          {"pos_max", r.posMax},
+                          {"pos_max_t", r.posMaxT},
+                          {"pos_last", r.posLast},
+                          {"head_max", r.headMax}});
+    }
+  }
   return {{"bin_s", binS_},
+          {"per_robot", perRobot},
           {"hidden", hidden},
           {"series", series},
           {"overall", stats(pos_, head_)},

@@ -432,7 +432,11 @@ class Simulator {
       }
     }
     if (!o_.localization.empty()) {
-      if (!writeText(o_.localization, errors_.toJson().dump(1) + "\n")) {
+      std::vector<std::string> ids;
+      for (const auto& r : w_.scenario().robots) {
+        ids.push_back(r.id);
+      }
+      if (!writeText(o_.localization, errors_.toJson(ids).dump(1) + "\n")) {
         spdlog::error("cannot write '{}'", o_.localization);
         return 1;
       }

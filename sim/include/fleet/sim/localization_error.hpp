@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -31,8 +32,10 @@ class LocalizationErrorLog {
   [[nodiscard]] std::size_t unmatched() const { return unmatched_; }
   /// {"bin_s", "hidden": [[from, to]...], "series": [{"t", "pos_mean", "pos_max", "head_mean",
   /// "head_max", "hidden"}...], "overall"/"hidden_stretches"/"visible_stretches": {"samples",
-  /// "pos_rmse", "pos_p95", "pos_max", "head_rmse", "head_p95", "head_max"}, "unmatched"}.
-  [[nodiscard]] nlohmann::json toJson() const;
+  /// "pos_rmse", "pos_p95", "pos_max", "head_rmse", "head_p95", "head_max"}, "per_robot":
+  /// [{"robot", "pos_max", "pos_max_t", "pos_last", "head_max"}...], "unmatched"}. `names`: the
+  /// robots' ids by index (else the index).
+  [[nodiscard]] nlohmann::json toJson(const std::vector<std::string>& names = {}) const;
 
   static constexpr std::size_t kHistory = 32;
 
@@ -51,6 +54,14 @@ class LocalizationErrorLog {
   std::vector<std::pair<std::int64_t, std::vector<Pose2>>> history_;  // ring of kHistory instants
   std::size_t next_ = 0;
   std::vector<Bin> bins_;
+  struct Robot {
+    double posMax = 0.0;
+    double posMaxT = 0.0;
+    double posLast = 0.0;
+    double headMax = 0.0;
+    bool seen = false;
+  };
+  std::vector<Robot> robots_;
   // Per sample, for the percentiles: position error [m], |heading error| [rad], hidden.
   std::vector<float> pos_;
   std::vector<float> head_;
