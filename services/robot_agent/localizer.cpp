@@ -132,7 +132,9 @@ void Localizer::updateLines(const SensorReading& f) {
   }
   // Matched once against the estimate after the compass; the updates then run one by one, each
   // re-linearised at the estimate the previous one left (and gated again by the filter).
-  const auto m = estimation::matchLines(ekf_.pose(), ekf_.covariance(), *p_.walls, lines, p_.lineGate);
+  estimation::LineGate gate = p_.lineGate;
+  gate.max_range = scan.range_max + 1.0;
+  const auto m = estimation::matchLines(ekf_.pose(), ekf_.covariance(), *p_.walls, lines, gate);
   lineStats_.noWallFacing += m.no_wall_facing;
   lineStats_.outsideGate += m.outside_gate;
   lineStats_.noOverlap += m.no_overlap;

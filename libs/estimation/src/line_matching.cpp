@@ -34,6 +34,13 @@ bool sameLine(const MapLine& p, const MapLine& q, const LineGate& g) {
          std::abs(angleDiff(p.beta, q.beta)) <= g.same_line_beta;
 }
 
+double distanceToSegment(Vec2 p, const MapSegment& s) {
+  const Vec2 ab = s.b - s.a;
+  const double len2 = ab.dot(ab);
+  const double t = len2 > 0.0 ? std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return distance(p, s.a + ab * t);
+}
+
 double ellipseExcess(Vec2 e, const MapSegment& s) {
   return distance(e, s.a) + distance(e, s.b) - distance(s.a, s.b);
 }
@@ -60,8 +67,9 @@ LineMatchResult matchLines(const Pose2& pose, const Eigen::Matrix3d& P, std::spa
     for (std::size_t j = 0; j < map.size(); ++j) {
       const MapSegment& s = map[j];
       const Vec2 n = s.normal / s.normal.norm();
-      if ((pose.position() - s.a).dot(n) < gate.min_distance) {
-        continue;  // behind the face or on it
+      if ((pose.position() - s.a).dot(n) < gate.min_distance ||
+          (gate.max_range > 0.0 && distanceToSegment(pose.position(), s) > gate.max_range)) {
+        continue;  // behind the face, on it, or out of the scanner's reach
       }
       facing = true;
       const MapLine line = lineOf(s);

@@ -109,6 +109,21 @@ TEST(LineMatching, OnlyWallsFacingTheRobotAreCandidates) {
   EXPECT_EQ(m.no_wall_facing, 1u);
 }
 
+TEST(LineMatching, WallsOutOfRangeAreNotLookedAt) {
+  const Pose2 pose{2.0, 0.5, 0.0};
+  const std::vector<MapSegment> map{kFront};  // 1.5 m away
+  const std::vector<ExtractedLine> obs{seen(pose, kFront, {1.0, 2.0}, {3.0, 2.0})};
+  LineGate g;
+  g.max_range = 2.0;
+  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, obs, g).matches.size(), 1u);
+  g.max_range = 1.0;
+  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, obs, g).no_wall_facing, 1u);
+  // Distance to the segment, not to its line: the same wall 3 m to the side is out of a 2 m range.
+  const Pose2 aside{7.5, 1.0, 0.0};
+  g.max_range = 2.0;
+  EXPECT_EQ(matchLines(aside, cov(0.02, 0.01), map, obs, g).no_wall_facing, 1u);
+}
+
 TEST(LineMatching, TwoDifferentWallsInTheGateAreAmbiguousAndSkipped) {
   // Two parallel faces 0.4 m apart, both facing the robot, and an estimate too loose to tell.
   const MapSegment nearWall{{0, 2}, {4, 2}, {0, -1}};

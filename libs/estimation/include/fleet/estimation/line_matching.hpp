@@ -37,6 +37,9 @@ struct LineGate {
   /// is ambiguous and skipped rather than risk the wrong one.
   double same_line_rho = 0.05;
   double same_line_beta = 0.05;
+  /// Walls further than this from the robot [m] are not looked at (the scanner's range and a margin):
+  /// the matching cost then follows the walls in range, not the site's size. <= 0: every wall.
+  double max_range = 0.0;
 };
 
 struct LineMatch {
@@ -49,7 +52,7 @@ struct LineMatch {
 /// What became of each observed line; every one that is not matched has exactly one reason.
 struct LineMatchResult {
   std::vector<LineMatch> matches;  ///< in observation order
-  std::size_t no_wall_facing = 0;  ///< no wall of the map faces the robot
+  std::size_t no_wall_facing = 0;  ///< no wall in range faces the robot
   std::size_t outside_gate = 0;    ///< no facing wall inside the Mahalanobis gate
   std::size_t no_overlap = 0;      ///< inside the gate only for walls its end points lie off
   std::size_t ambiguous = 0;       ///< walls on two different lines pass every test
