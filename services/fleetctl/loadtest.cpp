@@ -343,8 +343,19 @@ struct Run {
     const auto now = Clock::now();
     for (std::size_t i = 0; i < faults.size(); ++i) {
       const Fault& f = faults[i];
-      if (f.kind == Fault::Kind::DropDds || f.kind == Fault::Kind::HideLandmarks) {
-        continue;  // set up before the start (the simulator runs the hiding on its own clock)
+      if (f.kind == Fault::Kind::DropDds) {
+        continue;
+      }
+      if (f.kind == Fault::Kind::HideLandmarks) {
+        // The simulator hides them on its own clock (--hide-landmarks): only logged here.
+        if (!faultStarted[i] && simS >= f.atS) {
+          faultStarted[i] = true;
+          logFault("landmarks hidden (fleet-sim) for " + std::to_string(static_cast<int>(f.downS)) + " s");
+        } else if (faultStarted[i] && !faultEnded[i] && simS >= f.atS + f.downS) {
+          faultEnded[i] = true;
+          logFault("landmarks visible again");
+        }
+        continue;
       }
       const std::string who = f.kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(f);
       if (!faultStarted[i] && simS >= f.atS) {
