@@ -41,6 +41,18 @@ double distanceToSegment(Vec2 p, const MapSegment& s) {
   return distance(p, s.a + ab * t);
 }
 
+/// Further than `range` from p: the bounding-box test first, since it rejects most walls of a site.
+bool outOfRange(Vec2 p, const MapSegment& s, double range) {
+  if (range <= 0.0) {
+    return false;
+  }
+  if (std::min(s.a.x, s.b.x) - range > p.x || std::max(s.a.x, s.b.x) + range < p.x ||
+      std::min(s.a.y, s.b.y) - range > p.y || std::max(s.a.y, s.b.y) + range < p.y) {
+    return true;
+  }
+  return distanceToSegment(p, s) > range;
+}
+
 double ellipseExcess(Vec2 e, const MapSegment& s) {
   return distance(e, s.a) + distance(e, s.b) - distance(s.a, s.b);
 }
@@ -67,8 +79,8 @@ LineMatchResult matchLines(const Pose2& pose, const Eigen::Matrix3d& P, std::spa
     for (std::size_t j = 0; j < map.size(); ++j) {
       const MapSegment& s = map[j];
       const Vec2 n = s.normal / s.normal.norm();
-      if ((pose.position() - s.a).dot(n) < gate.min_distance ||
-          (gate.max_range > 0.0 && distanceToSegment(pose.position(), s) > gate.max_range)) {
+      if (outOfRange(pose.position(), s, gate.max_range) ||
+          (pose.position() - s.a).dot(n) < gate.min_distance) {
         continue;  // behind the face, on it, or out of the scanner's reach
       }
       facing = true;
