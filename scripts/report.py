@@ -90,6 +90,61 @@ def svg_lines(series, w=520, h=240, xlabel="", ylabel="", why="nothing recorded"
     return f'{svg_open(w, h)}{frame}{"".join(paths)}{"".join(legend)}</svg>'
 
 
+def svg_error(runs, hidden, key, scale=1.0, w=640, h=260, ylabel="", why="no localization samples"):
+    """Error over time of one or more runs [(label, series)], the mean over robots solid and the
+    worst robot dashed, with the stretches in which landmarks were hidden shaded."""
+    runs = [(name, s) for name, s in runs if s]
+    if not runs:
+        return no_data(why, w, h)
+    x1 = max(p["t"] for _, s in runs for p in s)
+    y1 = max(p[key + "_max"] * scale for _, s in runs for p in s) or 1
+    sx, sy, frame = svg_frame(w, h, 0, x1, y1, "simulated time (s)", ylabel, right=150)
+    shade = "".join(f'<rect x="{sx(a):.1f}" y="20" width="{max(0.0, sx(min(b, x1)) - sx(a)):.1f}" height="{h-60}" '
+                    f'fill="#f3e7c9"/>' for a, b in hidden if a < x1)
+    paths, legend = [], [f'<rect x="{w-142}" y="12" width="12" height="10" fill="#f3e7c9"/>'
+                         f'<text x="{w-126}" y="21">landmarks hidden</text>']
+    for i, (name, s) in enumerate(runs):
+        c = COLORS[i % len(COLORS)]
+        for j, (stat, dash) in enumerate((("mean", ""), ("max", ' stroke-dasharray="4 3"'))):
+            d = " ".join(f'{"M" if k == 0 else "L"}{sx(p["t"]):.1f},{sy(p[key + "_" + stat] * scale):.1f}'
+                         for k, p in enumerate(s))
+            paths.append(f'<path d="{d}" fill="none" stroke="{c}" stroke-width="{1.8 if not dash else 1}"{dash}/>')
+            y = 40 + (2 * i + j) * 16
+            legend.append(f'<line x1="{w-142}" y1="{y-4}" x2="{w-130}" y2="{y-4}" stroke="{c}" stroke-width="2"{dash}/>'
+                          f'<text x="{w-126}" y="{y}">{html.escape(name)} {"mean" if not j else "worst robot"}</text>')
+    return f'{svg_open(w, h)}{shade}{frame}{"".join(paths)}{"".join(legend)}</svg>'
+
+
+def localization_html(run, lt):
+    """Each robot's own pose estimate against the truth (fleet-sim --localization) and what the
+    localizers did with their scan lines (the agents' metrics)."""
+    path = os.path.join(run, "localization.json")
+    if not os.path.exists(path):
+        return ""
+    loc = json.load(open(path))
+    hidden = sorted(tuple(h) for h in loc.get("hidden", []))
+    rows = ""
+    for key, label in (("overall", "whole run"), ("hidden_stretches", "landmarks hidden"), ("visible_stretches", "landmarks visible")):
+        st = loc.get(key, {})
+        if st.get("samples"):
+            rows += (f"<tr><td>{label}</td><td>{st['samples']}</td><td>{st['pos_rmse']*100:.2f}</td><td>{st['pos_p95']*100:.2f}</td>"
+                     f"<td>{st['pos_max']*100:.2f}</td><td>{math.degrees(st['head_rmse']):.2f}</td><td>{math.degrees(st['head_max']):.2f}</td></tr>")
+    lines = {}
+    for a in (lt or {}).get("agents", []):
+        for k, v in a.get("localization", {}).items():
+            lines[k] = (lines.get(k, 0) + v) if not isinstance(v, bool) else v
+    counts = "".join(f"<tr><td>{html.escape(k)}</td><td>{v}</td></tr>" for k, v in lines.items())
+    series = loc.get("series", [])
+    return f"""<h2 id="localization">Localization error</h2>
+<p class="note" style="max-width:900px">Each robot's published pose estimate against the simulator's truth of the same instant
+(lockstep stamps), per second: the mean over robots and the worst robot. Line updates:
+{'on' if lines.get('line_updates', True) else '<b>off</b>'}{'; landmarks hidden ' + ', '.join(f'{a:g}–{b:g} s' for a, b in hidden) if hidden else ''}.</p>
+<div class="grid"><div><h3>Position error</h3>{svg_error([('run', series)], hidden, 'pos', 100, ylabel='position error (cm)')}</div>
+<div><h3>Heading error</h3>{svg_error([('run', series)], hidden, 'head', 180 / math.pi, ylabel='|heading error| (°)')}</div></div>
+<div class="grid"><div><table><tr><th>samples</th><th>n</th><th>pos RMSE (cm)</th><th>pos p95 (cm)</th><th>pos max (cm)</th><th>heading RMSE (°)</th><th>heading max (°)</th></tr>{rows}</table></div>
+<div><table><tr><th>scan lines (all agents)</th><th>count</th></tr>{counts}</table></div></div>"""
+
+
 def svg_line(points, w=520, h=240, xlabel="", ylabel="", why="nothing recorded", diagonal=None):
     """One line; diagonal=(label) also draws y = x, dashed, for reference."""
     if not points:
@@ -381,7 +436,7 @@ iframe{{border:1px solid #aaa;width:100%;max-width:1200px;height:790px}} nav a{{
 <p>{summary['robots']} robots, {summary['humans']} humans, {sim_s:.0f} s of simulated time.
 <b>{done}</b> of {summary['tasks']['submitted']} tasks done ({summary['tasks']['per_hour']:.0f} per simulated hour);
 <b class="{'bad' if sum(v or 0 for k, v in contacts.items() if k != 'steps_with_contact') else ''}">{contacts.get('robot_robot', '—')} robot–robot and {contacts.get('robot_human', '—')} robot–human contacts</b>.</p>
-<nav><a href="#throughput">Throughput &amp; latency</a><a href="#safety">Safety</a><a href="#risk">Risk map</a>{'<a href="#loadtest">Load test</a>' if lt else ''}<a href="#replay">Replay</a><a href="#raw">Raw summary</a></nav>
+<nav><a href="#throughput">Throughput &amp; latency</a><a href="#safety">Safety</a><a href="#risk">Risk map</a><a href="#localization">Localization</a>{'<a href="#loadtest">Load test</a>' if lt else ''}<a href="#replay">Replay</a><a href="#raw">Raw summary</a></nav>
 <h2 id="throughput">Throughput and latency</h2>
 <p class="note" style="max-width:900px">All times are seconds of simulated time, from the fleet manager's task database (every task it stored).
 Percentiles are nearest-rank; a task restarted before the manager had a clock gives no samples.</p>
@@ -404,6 +459,7 @@ long it stays). A negative gap is an overlap; a gap of "—": no such pair ever 
 <div class="grid"><div>{svg_lines(risk, w=640, h=260, xlabel='simulated time (s)', ylabel='area (m²)', legend_title='collision p', why='no risk map in the replay (was the risk map service running?)')}</div>
 <p class="note">Area of the warehouse floor whose collision probability exceeds each iso-level's lower bound, for each risk map
 the simulator recorded. Level l of K holds p in ((l−1)/K, l/K].</p></div>
+{localization_html(run, lt)}
 {loadtest_html(lt)}
 <h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded.
 The viewer is embedded in this page; <a href="viewer.html">open it on its own</a> (viewer.html, next to this page in the run folder).</p>

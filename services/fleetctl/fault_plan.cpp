@@ -25,8 +25,15 @@ bool integer(const std::string& s, int& out) {
   return ec == std::errc() && p == s.data() + s.size() && out >= 0;
 }
 
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 /// Splits "T[+D]" into the time and the optional down time (a trailing "s" is allowed on both).
-Expected<std::pair<double, double>> timing(std::string s, double defaultDown, bool downRequired) {
+Expected<std::pair<double, double>> timing(std::string s, double defaultDown, bool downRequired,
+                                           double maxDown = 600, const std::string& unit = "wall seconds") {
   std::string down;
   if (const auto plus = s.find('+'); plus != std::string::npos) {
     down = s.substr(plus + 1);
@@ -45,11 +52,11 @@ Expected<std::pair<double, double>> timing(std::string s, double defaultDown, bo
   }
   double d = defaultDown;
   if (down.empty() && downRequired) {
-    return unexpected("invalid", "expected '+D' (how many wall seconds it lasts) after the time");
+    return unexpected("invalid", "expected '+D' (how many " + unit + " it lasts) after the time");
   }
-  if (!down.empty() && (!number(down, d) || d <= 0 || d > 600)) {
-    return unexpected("invalid",
-                      "expected a duration in wall seconds in (0, 600] after '+', got \"" + down + "\"");
+  if (!down.empty() && (!number(down, d) || d <= 0 || d > maxDown)) {
+    return unexpected("invalid", "expected a duration in " + unit + " in (0, " + fmt(maxDown) +
+                                     "] after '+', got \"" + down + "\"");
   }
   return std::make_pair(at, d);
 }
@@ -67,7 +74,8 @@ Expected<Fault> parseOne(const std::string& spec) {
   const auto at = spec.find('@');
   if (at == std::string::npos) {
     return unexpected("invalid",
-                      "expected kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D or drop-dds=F");
+                      "expected kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, "
+                      "hide-landmarks@T+D or drop-dds=F");
   }
   const std::string head = spec.substr(0, at);
   std::string tail = spec.substr(at + 1);
@@ -109,14 +117,18 @@ Expected<Fault> parseOne(const std::string& spec) {
     std::tie(f.atS, f.downS) = *t;
     return f;
   }
-  return unexpected(
-      "invalid", "unknown fault \"" + head + "\" (known: kill-agent, kill-manager, stall:ROBOT, drop-dds)");
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+  if (head == "hide-landmarks") {
+    f.kind = Fault::Kind::HideLandmarks;
+    auto t = timing(tail, 0.0, true, 86400, "simulated seconds");
+    if (!t) {
+      return unexpected("invalid", "hide-landmarks: " + t.error().message);
+    }
+    std::tie(f.atS, f.downS) = *t;
+    return f;
+  }
+  return unexpected("invalid",
+                    "unknown fault \"" + head +
+                        "\" (known: kill-agent, kill-manager, stall:ROBOT, hide-landmarks, drop-dds)");
 }
 
 }  // namespace
@@ -154,6 +166,8 @@ std::string describe(const Fault& f) {
       return "stall:" + f.robot + "@" + fmt(f.atS) + "+" + fmt(f.downS);
     case Fault::Kind::DropDds:
       return "drop-dds=" + fmt(f.fraction);
+    case Fault::Kind::HideLandmarks:
+      return "hide-landmarks@" + fmt(f.atS) + "+" + fmt(f.downS);
   }
   return "";
 }

@@ -6,6 +6,9 @@
 //   kill-manager@T[+D]     SIGKILL the fleet manager at T, restart it D s later (default 1)
 //   stall:ROBOT@T+D        SIGSTOP the agent process of ROBOT (it runs alone) at T, SIGCONT D s later
 //   drop-dds=F             every process drops the fraction F (0..0.5) of its outgoing DDS packets
+//   hide-landmarks@T+D     no robot sees a landmark from T for D *simulated* seconds (the simulator
+//                          leaves the bearings out of every SensorFrame): localization on odometry,
+//                          compass and laser lines alone
 
 #include <string>
 #include <vector>
@@ -15,10 +18,10 @@
 namespace fleet::ctl {
 
 struct Fault {
-  enum class Kind { KillAgent, KillManager, StallRobot, DropDds };
+  enum class Kind { KillAgent, KillManager, StallRobot, DropDds, HideLandmarks };
   Kind kind = Kind::KillAgent;
   double atS = 0.0;     // simulated seconds
-  double downS = 0.0;   // wall seconds
+  double downS = 0.0;   // wall seconds (hide-landmarks: simulated seconds)
   int agent = 0;        // kill-agent: which agent process
   std::string robot;    // stall: which robot
   double fraction = 0;  // drop-dds

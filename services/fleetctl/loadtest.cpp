@@ -346,6 +346,17 @@ struct Run {
       if (f.kind == Fault::Kind::DropDds) {
         continue;
       }
+      if (f.kind == Fault::Kind::HideLandmarks) {
+        // The simulator hides them on its own clock (--hide-landmarks): only logged here.
+        if (!faultStarted[i] && simS >= f.atS) {
+          faultStarted[i] = true;
+          logFault("landmarks hidden (fleet-sim) for " + std::to_string(static_cast<int>(f.downS)) + " s");
+        } else if (faultStarted[i] && !faultEnded[i] && simS >= f.atS + f.downS) {
+          faultEnded[i] = true;
+          logFault("landmarks visible again");
+        }
+        continue;
+      }
       const std::string who = f.kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(f);
       if (!faultStarted[i] && simS >= f.atS) {
         faultStarted[i] = true;
@@ -732,13 +743,20 @@ int Run::run() {
   // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
   // only when all have registered (a traffic manager it does not wait for falls behind the robots).
   const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0);
-  std::vector<std::string> simArgs = {"--scenario",  scn,
-                                      "--duration",  std::to_string(o.durationS),
-                                      "--replay",    fs::absolute(out / "replay.jsonl.gz").string(),
-                                      "--summary",   fs::absolute(out / "sim_summary.json").string(),
-                                      "--html",      fs::absolute(out / "viewer.html").string(),
-                                      "--log-level", "warn",
+  std::vector<std::string> simArgs = {"--scenario",     scn,
+                                      "--duration",     std::to_string(o.durationS),
+                                      "--replay",       fs::absolute(out / "replay.jsonl.gz").string(),
+                                      "--summary",      fs::absolute(out / "sim_summary.json").string(),
+                                      "--html",         fs::absolute(out / "viewer.html").string(),
+                                      "--localization", fs::absolute(out / "localization.json").string(),
+                                      "--log-level",    "warn",
                                       "--clock"};
+  for (const auto& f : faults) {
+    if (f.kind == Fault::Kind::HideLandmarks) {
+      simArgs.insert(simArgs.begin(),
+                     {"--hide-landmarks", describe(f).substr(std::string("hide-landmarks@").size())});
+    }
+  }
   if (o.wallClock) {
     simArgs.emplace_back("wall");
   } else {

@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   loadtest->add_option(
       "--fault", lt.faults,
-      "kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, drop-dds=F (T simulated s, D wall s)");
+      "kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, drop-dds=F (T simulated s, D wall s), "
+      "hide-landmarks@T+D (T and D simulated s)");
   loadtest->add_option("--out", lt.out, "run folder (report, logs, database)")->capture_default_str();
   loadtest->add_option("--bin", lt.binDir, "build tree with the services")->capture_default_str();
   loadtest->add_option("--report-script", lt.reportScript, "scripts/report.py ('' = no HTML report)");

@@ -31,6 +31,8 @@ LocalizerParams localizerParams(const AgentParams& p) {
   lp.accelMax = p.limits.accel_max;
   lp.alphaMax = p.limits.alpha_max;
   lp.landmarks = p.landmarks;
+  lp.walls = p.walls;
+  lp.lineUpdates = p.lineUpdates;
   return lp;
 }
 

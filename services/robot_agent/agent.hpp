@@ -75,6 +75,9 @@ struct AgentParams {
   double predictionHorizonS = 3.0;
   double predictionDt = 0.5;
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+  /// The site's wall faces for the localizer's laser-line updates (shared; null: none).
+  std::shared_ptr<const std::vector<estimation::MapSegment>> walls;
+  bool lineUpdates = true;  ///< false: the localizer fuses no laser lines (config localization.lines)
   /// Any libs/avoidance planner name ("dwa", "vo", ...): that planner drives along the path, behind
   /// the safety layer; "follow": the Lyapunov path follower. Either way the follower's pose law
   /// docks on stations and the same stop rule and standoff handling apply.
@@ -135,6 +138,7 @@ class Agent {
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
   [[nodiscard]] bool homing() const { return homing_; }
   [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
+  [[nodiscard]] const LineStats& lineStats() const { return localizer_.lineStats(); }
   /// Follows the traffic manager's releases (AgentParams::traffic "reserved").
   [[nodiscard]] bool reserved() const { return reserved_; }
   /// Releases taken and ignored (cumulative).

@@ -21,6 +21,18 @@ estimation::PoseEkf makeEkf(const LocalizerParams& p) {
 
 }  // namespace
 
+estimation::LineExtractionParams agentLineExtraction() {
+  estimation::LineExtractionParams p;
+  p.seed_points = 4;
+  p.min_points = 5;
+  p.min_length = 0.5;
+  // Rays 5° apart land 0.35 m apart at 4 m and further on a wall seen at a slant; a cross aisle
+  // (1.5 m and more) still ends a run.
+  p.max_point_gap = 0.75;
+  p.point_sigma = 0.01;
+  return p;
+}
+
 std::vector<Vec2> Perception::scanPoints(double maxRange) const {
   std::vector<Vec2> pts;
   for (const auto& ray : scan) {
@@ -64,16 +76,28 @@ void Localizer::onReading(const SensorReading& f) {
     widened += Eigen::Vector3d(d * d, d * d, a * a).asDiagonal();
     (void)ekf_.reset(ekf_.pose(), widened);
   }
+  // Seed 003's order (eq. 3.33's z = [φ, r_1, ψ_1, …, r_N, ψ_N, γ] and Table 3.3's rows): odometry,
+  // compass, laser lines, camera bearings. The compass first makes the heading good before the lines
+  // are matched, since a heading error turns every predicted line about the robot.
+  updates_.clear();
+  updates_.push_back(Update::kOdometry);
   if (ekf_.predict(dsLeft, dsRight) != estimation::UpdateStatus::kAccepted) {
     ++rejected_;
   }
-  if (f.compassValid && ekf_.updateCompass(f.compass) != estimation::UpdateStatus::kAccepted) {
-    ++rejected_;
+  if (f.compassValid) {
+    updates_.push_back(Update::kCompass);
+    if (ekf_.updateCompass(f.compass) != estimation::UpdateStatus::kAccepted) {
+      ++rejected_;
+    }
   }
+  updateLines(f);
   for (const auto& [seenId, bearing] : f.bearings) {
     for (const auto& [id, pos] : p_.landmarks) {
-      if (id == seenId &&
-          ekf_.updateBearing(pos, static_cast<double>(bearing)) != estimation::UpdateStatus::kAccepted) {
+      if (id != seenId) {
+        continue;
+      }
+      updates_.push_back(Update::kBearing);
+      if (ekf_.updateBearing(pos, static_cast<double>(bearing)) != estimation::UpdateStatus::kAccepted) {
         ++rejected_;
       }
     }
@@ -82,6 +106,48 @@ void Localizer::onReading(const SensorReading& f) {
   lastStampNs_ = f.stampNs;
   seen_.valid = true;
   readingSinceCheck_ = true;
+}
+
+void Localizer::updateLines(const SensorReading& f) {
+  if (!p_.lineUpdates || !p_.walls || p_.walls->empty() || f.ranges.empty()) {
+    return;
+  }
+  estimation::LaserScan scan;
+  scan.angle_min = static_cast<double>(f.angleMin);
+  scan.angle_increment = static_cast<double>(f.angleIncrement);
+  scan.range_min = 0.05;
+  // A ray without a return reads exactly rangeMax: keep it out of the fits.
+  scan.range_max = static_cast<double>(f.rangeMax) - 1e-3;
+  scan.ranges.assign(f.ranges.begin(), f.ranges.end());
+  std::vector<estimation::ExtractedLine> lines = estimation::extractLines(scan, p_.lines);
+  ++lineStats_.scans;
+  if (lines.empty()) {
+    ++lineStats_.scansNoLines;
+    return;
+  }
+  lineStats_.extracted += lines.size();
+  for (auto& l : lines) {
+    l.line.var_r += p_.lineRangeSigma * p_.lineRangeSigma;
+    l.line.var_psi += p_.lineAngleSigma * p_.lineAngleSigma;
+  }
+  // Matched once against the estimate after the compass; the updates then run one by one, each
+  // re-linearised at the estimate the previous one left (and gated again by the filter).
+  estimation::LineGate gate = p_.lineGate;
+  gate.max_range = scan.range_max + 1.0;
+  const auto m = estimation::matchLines(ekf_.pose(), ekf_.covariance(), *p_.walls, lines, gate);
+  lineStats_.noWallFacing += m.no_wall_facing;
+  lineStats_.outsideGate += m.outside_gate;
+  lineStats_.noOverlap += m.no_overlap;
+  lineStats_.ambiguous += m.ambiguous;
+  for (const auto& match : m.matches) {
+    ++lineStats_.matched;
+    updates_.push_back(Update::kLine);
+    if (ekf_.updateLine(match.line, lines[match.observation].line) == estimation::UpdateStatus::kAccepted) {
+      ++lineStats_.accepted;
+    } else {
+      ++lineStats_.rejectedByFilter;
+    }
+  }
 }
 
 void Localizer::track(const SensorReading& f) {

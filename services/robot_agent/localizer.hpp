@@ -1,14 +1,18 @@
 #pragma once
 
 // Sensor readings to what the robot knows of itself and its surroundings: the pose estimate (EKF on
-// wheel odometry, compass and landmark bearings), the scan and the detections in the map frame, the
-// people tracked from reading to reading, and whether the reading stream has been lost.
+// wheel odometry, compass, laser lines matched to the site's walls and landmark bearings, in the
+// order of seed 003), the scan and the detections in the map frame, the people tracked from reading
+// to reading, and whether the reading stream has been lost.
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "fleet/core/pose2.hpp"
+#include "fleet/estimation/line_extraction.hpp"
+#include "fleet/estimation/line_matching.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
 
 namespace fleet::agent {
@@ -84,6 +88,10 @@ struct StreamCheck {
   std::int64_t outageNs = 0;  ///< on kBack: how long the stream was lost
 };
 
+/// Line extraction tuned for the simulator's scanner (72 rays over 360°, 5° apart, σ 1 cm): a 1 m
+/// shelf end 2 m away gives 6 points, so the seed and the minimum are small.
+estimation::LineExtractionParams agentLineExtraction();
+
 struct LocalizerParams {
   Pose2 start;
   double wheelBase = 0.4;
@@ -94,7 +102,36 @@ struct LocalizerParams {
   double accelMax = 1.0;
   double alphaMax = 3.0;
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
+  /// The site's wall faces (site::wallSegments), shared by every robot of a process. Null or empty:
+  /// no line updates.
+  std::shared_ptr<const std::vector<estimation::MapSegment>> walls;
+  bool lineUpdates = true;  ///< false: odometry, compass and bearings only (the comparison runs)
+  estimation::LineExtractionParams lines = agentLineExtraction();
+  estimation::LineGate lineGate;
+  /// Added to each fitted line's variances: what the fit does not know of (a scan point on a corner
+  /// or on someone in front of the wall, the map's cells against the real faces).
+  double lineRangeSigma = 0.01;  ///< m
+  double lineAngleSigma = 0.01;  ///< rad
 };
+
+/// Why the line updates of a reading did or did not happen, cumulative. Every extracted line ends
+/// in exactly one of matched (then accepted or rejectedByFilter), noWallFacing, outsideGate,
+/// noOverlap or ambiguous.
+struct LineStats {
+  std::uint64_t scans = 0;         ///< readings with a scan looked at
+  std::uint64_t scansNoLines = 0;  ///< ... in which no line was found ("no_lines")
+  std::uint64_t extracted = 0;
+  std::uint64_t matched = 0;
+  std::uint64_t accepted = 0;
+  std::uint64_t rejectedByFilter = 0;  ///< matched, then refused by the EKF's own gate after earlier updates
+  std::uint64_t noWallFacing = 0;      ///< "no_wall_facing"
+  std::uint64_t outsideGate = 0;       ///< "outside_gate"
+  std::uint64_t noOverlap = 0;         ///< "no_overlap"
+  std::uint64_t ambiguous = 0;         ///< "ambiguous"
+};
+
+/// The corrections one reading went through, in the order they ran.
+enum class Update { kOdometry, kCompass, kLine, kBearing };
 
 class Localizer {
  public:
@@ -111,9 +148,13 @@ class Localizer {
   [[nodiscard]] bool lost() const { return lost_; }
   /// EKF updates refused (outliers, bad input), cumulative.
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
+  [[nodiscard]] const LineStats& lineStats() const { return lineStats_; }
+  /// Of the latest reading (one entry per correction tried, accepted or not).
+  [[nodiscard]] const std::vector<Update>& lastUpdates() const { return updates_; }
 
  private:
   void track(const SensorReading& r);
+  void updateLines(const SensorReading& r);
 
   LocalizerParams p_;
   estimation::PoseEkf ekf_;
@@ -124,6 +165,8 @@ class Localizer {
   double wheelRight_ = 0.0;
   std::int64_t peopleStampNs_ = -1;
   std::uint64_t rejected_ = 0;
+  LineStats lineStats_;
+  std::vector<Update> updates_;
 
   bool readingSinceCheck_ = false;
   std::int64_t lastReadingNs_ = -1;  // cycle time at which the latest reading was seen

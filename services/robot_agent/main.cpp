@@ -25,6 +25,7 @@
 #include "fleet/service/site_stations.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "fleet/site/reachability.hpp"
+#include "fleet/site/wall_segments.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_field.hpp"
 #include "worker_pool.hpp"
@@ -148,6 +149,7 @@ struct Options {
   double returnHomeS = 5.0;
   bool useRisk = true;
   bool useLanes = false;
+  bool lineUpdates = true;           // localization.lines: laser lines matched to the site's walls
   std::string traffic = "reactive";  // or "reserved": follow the traffic manager's releases
   std::string metricsFile;           // empty: none
 };
@@ -186,6 +188,14 @@ int run(const World& scn, const Options& opt) {
     lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
     spdlog::info("robot agent: {} one-way aisle cells", lanes->oneWayCells());
   }
+  // The walls every localizer matches its scan lines against: faces of 0.5 m and more (the line
+  // extractor keeps nothing shorter).
+  auto walls = std::make_shared<std::vector<estimation::MapSegment>>();
+  for (const auto& w : site::wallSegments(*raw, agent::agentLineExtraction().min_length)) {
+    walls->push_back({w.a, w.b, w.normal});
+  }
+  spdlog::info("robot agent: {} wall faces for the line updates ({})", walls->size(),
+               opt.lineUpdates ? "on" : "off: localization.lines is false");
   std::vector<std::unique_ptr<agent::Agent>> agents;
   std::map<std::string, agent::Agent*> byId;
   for (const auto& r : scn.robots) {
@@ -217,6 +227,8 @@ int run(const World& scn, const Options& opt) {
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
     p.landmarks = scn.landmarks;
+    p.walls = walls;
+    p.lineUpdates = opt.lineUpdates;
     agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
     byId[r.id] = agents.back().get();
   }
@@ -362,6 +374,31 @@ int run(const World& scn, const Options& opt) {
     m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
                     {"backoffs", c.backoffs},   {"returns", c.returns},
                     {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};
+    agent::LineStats ls;
+    for (const auto& a : agents) {
+      const auto& l = a->lineStats();
+      ls.scans += l.scans;
+      ls.scansNoLines += l.scansNoLines;
+      ls.extracted += l.extracted;
+      ls.matched += l.matched;
+      ls.accepted += l.accepted;
+      ls.rejectedByFilter += l.rejectedByFilter;
+      ls.noWallFacing += l.noWallFacing;
+      ls.outsideGate += l.outsideGate;
+      ls.noOverlap += l.noOverlap;
+      ls.ambiguous += l.ambiguous;
+    }
+    m["localization"] = {{"line_updates", opt.lineUpdates},
+                         {"scans", ls.scans},
+                         {"skipped_no_lines", ls.scansNoLines},
+                         {"lines_extracted", ls.extracted},
+                         {"lines_matched", ls.matched},
+                         {"lines_accepted", ls.accepted},
+                         {"lines_rejected_by_filter", ls.rejectedByFilter},
+                         {"unmatched_no_wall_facing", ls.noWallFacing},
+                         {"unmatched_outside_gate", ls.outsideGate},
+                         {"unmatched_no_overlap", ls.noOverlap},
+                         {"unmatched_ambiguous", ls.ambiguous}};
     agent::ReleaseCounts rc;
     for (const auto& a : agents) {
       rc.accepted += a->releases().accepted;
@@ -443,7 +480,11 @@ void applyConfigFile(const std::string& path, Options& opt, bool localFromCli, b
   opt.dwa = avoidance::dwaParams(dwa, opt.dwa);
   opt.riskStepping = avoidance::riskSteppingParams(stepping, opt.riskStepping);
   opt.safety = avoidance::safetyParams(safety);
-  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety"});
+  Config localization = cfg.child("localization");
+  opt.lineUpdates = localization.boolean("lines", opt.lineUpdates);
+  localization.rejectUnknownKeys({"lines"});
+  cfg.rejectUnknownKeys(
+      {"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety", "localization"});
   if (!localFromCli) {
     opt.localPlanner = local;
   }
@@ -522,7 +563,8 @@ int main(int argc, char** argv) {
   app.add_option("-c,--config", configFile,
                  "JSON file: local_planner, global_planner, traffic, dwa {weights, samples, horizon...}, "
                  "risk_stepping {rule: iso_level | weighted, levels, ...}, "
-                 "safety {zones} (docs/operator-guide.md); options given on the command line win");
+                 "safety {zones}, localization {lines} (docs/operator-guide.md); options given on the "
+                 "command line win");
   CLI11_PARSE(app, argc, argv);
   try {
     logging::setup("robot_agent", level);

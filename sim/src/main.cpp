@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/sim/localization_error.hpp"
 #include "fleet/sim/lockstep.hpp"
 #include "fleet/sim/replay.hpp"
 #include "fleet/sim/world.hpp"
@@ -66,9 +68,35 @@ SensorOutage parseOutage(const std::string& text) {
   return o;
 }
 
+/// T+D in simulated seconds: no landmark bearing in any SensorFrame during [T, T+D).
+std::pair<double, double> parseHidden(const std::string& text) {
+  const auto plus = text.find('+');
+  try {
+    std::size_t usedT = 0;
+    std::size_t usedD = 0;
+    if (plus == std::string::npos) {
+      throw std::invalid_argument("shape");
+    }
+    const std::string t = text.substr(0, plus);
+    const std::string d = text.substr(plus + 1);
+    const double from = std::stod(t, &usedT);
+    const double len = std::stod(d, &usedD);
+    if (usedT != t.size() || usedD != d.size() || !(from >= 0.0) || !(len > 0.0) ||
+        !std::isfinite(from + len)) {
+      throw std::invalid_argument("values");
+    }
+    return {from, from + len};
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--hide-landmarks: expected T+D (T >= 0 and D > 0 simulated seconds), got '" +
+                                text + "'");
+  }
+}
+
 struct Options {
   std::string scenario;
   std::vector<SensorOutage> outages;
+  std::vector<std::pair<double, double>> hiddenLandmarks;  // [from, to) simulated s
+  std::string localization;                                // error log file; empty: none
   std::optional<std::string> clock;
   std::optional<std::uint64_t> seed;
   std::optional<double> duration;
@@ -88,7 +116,8 @@ struct Options {
 const char* kUsage =
     "usage: fleet-sim --scenario FILE [--clock wall|lockstep] [--seed N] [--duration S]\n"
     "                 [--participants N] [--start-timeout-ms MS] [--step-timeout-ms MS]\n"
-    "                 [--max-speed F] [--sensor-outage ROBOT@T+D ...]\n"
+    "                 [--max-speed F] [--sensor-outage ROBOT@T+D ...] [--hide-landmarks T+D ...]\n"
+    "                 [--localization OUT.json]\n"
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
     "                 [--validate] [--log-level LEVEL]\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
@@ -126,6 +155,10 @@ bool parseArgs(int argc, char** argv, Options& o) {
       }
     } else if (a == "--sensor-outage") {
       o.outages.push_back(parseOutage(next()));
+    } else if (a == "--hide-landmarks") {
+      o.hiddenLandmarks.push_back(parseHidden(next()));
+    } else if (a == "--localization") {
+      o.localization = next();
     } else if (a == "--replay") {
       o.replay = next();
     } else if (a == "--summary") {
@@ -196,7 +229,8 @@ class Simulator {
         cmdR_(p_, transport::qos::command(lockstep)),
         doneR_(p_),
         stateR_(p_),
-        riskR_(p_) {}
+        riskR_(p_),
+        errors_(1.0, o.hiddenLandmarks) {}
 
   int run() {
     if (!o_.replay.empty()) {
@@ -309,6 +343,9 @@ class Simulator {
       const int i = w_.robotIndex(s.robot_id);
       if (i >= 0) {
         w_.setLabel(static_cast<std::size_t>(i), msg::toString(s.mode), s.task_id);
+        if (lockstep_) {  // stamps are simulated time only in lockstep
+          errors_.estimate(static_cast<std::size_t>(i), s.stamp_ns, s.pose);
+        }
       }
     }
   }
@@ -316,7 +353,20 @@ class Simulator {
   void publish() {
     const std::int64_t st = stamp();
     const double now = static_cast<double>(w_.timeNs()) * 1e-9;
-    for (const auto& r : w_.sensorFrames(!o_.noScan)) {
+    const bool hidden = std::any_of(o_.hiddenLandmarks.begin(), o_.hiddenLandmarks.end(),
+                                    [&](const auto& h) { return now >= h.first && now < h.second; });
+    if (lockstep_) {
+      std::vector<Pose2> truth;
+      truth.reserve(w_.robots().size());
+      for (const auto& r : w_.robots()) {
+        truth.push_back(r.pose);
+      }
+      errors_.truth(w_.timeNs(), truth);
+    }
+    for (auto& r : w_.sensorFrames(!o_.noScan)) {
+      if (hidden) {
+        r.landmarks.clear();  // after the draws: the sensor noise stream stays the same
+      }
       const bool silent = std::any_of(o_.outages.begin(), o_.outages.end(), [&](const SensorOutage& o) {
         return w_.robotIndex(o.robot) == static_cast<int>(r.robot) && now >= o.fromS && now < o.toS;
       });
@@ -381,6 +431,18 @@ class Simulator {
         return 1;
       }
     }
+    if (!o_.localization.empty()) {
+      std::vector<std::string> ids;
+      for (const auto& r : w_.scenario().robots) {
+        ids.push_back(r.id);
+      }
+      if (!writeText(o_.localization, errors_.toJson(ids).dump(1) + "\n")) {
+        spdlog::error("cannot write '{}'", o_.localization);
+        return 1;
+      }
+      spdlog::info("localization error: {} estimates compared, {} of no instant held", errors_.samples(),
+                   errors_.unmatched());
+    }
     if (!o_.summary.empty() && !writeText(o_.summary, s.dump(2) + "\n")) {
       spdlog::error("cannot write summary '{}'", o_.summary);
       return 1;
@@ -419,6 +481,7 @@ class Simulator {
   transport::Reader<msg::RiskMap> riskR_;
   sim::LockstepBarrier barrier_;
   std::optional<sim::ReplayWriter> replay_;
+  sim::LocalizationErrorLog errors_;
   int ignoredLogged_ = 0;
 };
 

@@ -93,6 +93,19 @@ TEST(RobotAgentConfig, TheTrafficModeComesFromTheFileUnlessTheCommandLineSaysOth
   EXPECT_NE(badCli.code, 0) << badCli.output;
 }
 
+TEST(RobotAgentConfig, LineUpdatesAreOnByDefaultAndTheFileCanTurnThemOff) {
+  const AgentRun on = agentWith(R"({})", 3);
+  EXPECT_EQ(on.code, 0) << on.output;
+  EXPECT_NE(on.output.find("wall faces for the line updates (on)"), std::string::npos) << on.output;
+  const AgentRun off = agentWith(R"({"localization": {"lines": false}})", 3);
+  EXPECT_EQ(off.code, 0) << off.output;
+  EXPECT_NE(off.output.find("off: localization.lines is false"), std::string::npos) << off.output;
+  const AgentRun bad = agentWith(R"({"localization": {"lines": "sometimes", "landmarks": false}})", 20);
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("localization.lines"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("localization.landmarks: unknown key"), std::string::npos) << bad.output;
+}
+
 namespace {
 
 /// robot_agent as deployed: a site and the robots standing on it, no simulator scenario.

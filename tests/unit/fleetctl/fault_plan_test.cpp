@@ -39,6 +39,19 @@ TEST(FaultPlan, DescribeParsesBackToTheSameFault) {
   }
 }
 
+TEST(FaultPlan, HideLandmarksTakesSimulatedSecondsAndParsesBack) {
+  auto f = parseFaults({"hide-landmarks@100+300", "hide-landmarks@500s+1200s"});
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_EQ((*f)[0].kind, Fault::Kind::HideLandmarks);
+  EXPECT_DOUBLE_EQ((*f)[0].atS, 100);
+  EXPECT_DOUBLE_EQ((*f)[0].downS, 300);
+  EXPECT_DOUBLE_EQ((*f)[1].downS, 1200) << "simulated seconds: longer than a process may be down";
+  EXPECT_EQ(describe((*f)[0]), "hide-landmarks@100+300");
+  auto bad = parseFaults({"hide-landmarks@100"});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("how many simulated seconds"), std::string::npos) << bad.error().message;
+}
+
 TEST(FaultPlan, NoDropWithoutDropFault) {
   auto f = parseFaults({"kill-manager@1"});
   ASSERT_TRUE(f);

@@ -5,7 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
+
+#include "fleet/core/angles.hpp"
 
 using namespace fleet;
 using agent::Localizer;
@@ -147,4 +151,113 @@ TEST(Localizer, ARobotThatNeverGetsAReadingIsLostToo) {
   Localizer loc(params());
   EXPECT_FALSE(loc.checkStream(0).lost) << "the first check starts the count";
   EXPECT_TRUE(loc.checkStream(6 * kTick).lost);
+}
+
+// ---- Laser lines matched to the site's walls (seed 003 §3.1.2) ----
+
+namespace {
+
+// A 6 × 4 m room, its inner faces looking in.
+std::shared_ptr<const std::vector<estimation::MapSegment>> room(Vec2 shift = {}) {
+  auto w = std::make_shared<std::vector<estimation::MapSegment>>();
+  const Vec2 s = shift;
+  w->push_back({Vec2{0, 0} + s, Vec2{6, 0} + s, {0, 1}});
+  w->push_back({Vec2{0, 4} + s, Vec2{6, 4} + s, {0, -1}});
+  w->push_back({Vec2{0, 0} + s, Vec2{0, 4} + s, {1, 0}});
+  w->push_back({Vec2{6, 0} + s, Vec2{6, 4} + s, {-1, 0}});
+  return w;
+}
+
+// The simulator's scanner (72 rays over 360° from -π, 8 m, a miss reads 8 m exactly) in the room,
+// from the true pose.
+SensorReading scanFrom(const Pose2& truth, std::int64_t stampNs) {
+  SensorReading r = straight(stampNs, 0.0);
+  r.angleMin = static_cast<float>(-kPi);
+  r.angleIncrement = static_cast<float>(2.0 * kPi / 72.0);
+  r.rangeMax = 8.0f;
+  for (int i = 0; i < 72; ++i) {
+    const double a = truth.theta - kPi + i * 2.0 * kPi / 72.0;
+    const double c = std::cos(a);
+    const double s = std::sin(a);
+    double t = 8.0;
+    if (c > 1e-9)
+      t = std::min(t, (6.0 - truth.x) / c);
+    if (c < -1e-9)
+      t = std::min(t, -truth.x / c);
+    if (s > 1e-9)
+      t = std::min(t, (4.0 - truth.y) / s);
+    if (s < -1e-9)
+      t = std::min(t, -truth.y / s);
+    r.ranges.push_back(static_cast<float>(t));
+  }
+  return r;
+}
+
+agent::LocalizerParams withWalls(Pose2 start, bool lines = true, Vec2 shift = {}) {
+  auto p = params(start);
+  p.walls = room(shift);
+  p.lineUpdates = lines;
+  return p;
+}
+
+}  // namespace
+
+TEST(LocalizerLines, UpdatesRunInTheThesisOrderOdometryCompassLinesBearings) {
+  const Pose2 truth{2.0, 1.5, 0.3};
+  auto p = withWalls(truth);
+  p.landmarks = {{7, {5.0, 3.0}}};
+  Localizer loc(p);
+  SensorReading r = scanFrom(truth, kTick);
+  r.compassValid = true;
+  r.compass = 0.3;
+  r.bearings = {{7, static_cast<float>(std::atan2(1.5, 3.0) - 0.3)}};
+  loc.onReading(r);
+  const auto& u = loc.lastUpdates();
+  ASSERT_GE(u.size(), 5u) << "odometry, compass, >= 2 lines, the bearing";
+  EXPECT_EQ(u.front(), agent::Update::kOdometry);
+  EXPECT_EQ(u[1], agent::Update::kCompass);
+  for (std::size_t i = 2; i + 1 < u.size(); ++i) {
+    EXPECT_EQ(u[i], agent::Update::kLine) << "update " << i;
+  }
+  EXPECT_EQ(u.back(), agent::Update::kBearing);
+  EXPECT_EQ(loc.lineStats().accepted, u.size() - 3);
+}
+
+TEST(LocalizerLines, WallsPullADriftedEstimateBackAndWithoutLinesItStaysOff) {
+  const Pose2 truth{2.0, 1.5, 0.0};
+  const Pose2 start{2.15, 1.4, 0.0};  // 18 cm off, inside the start covariance (σ 0.1 m)
+  Localizer with(withWalls(start));
+  Localizer without(withWalls(start, false));
+  for (int k = 1; k <= 10; ++k) {
+    with.onReading(scanFrom(truth, k * kTick));
+    without.onReading(scanFrom(truth, k * kTick));
+  }
+  EXPECT_LT(distance(with.pose(), truth), 0.01);
+  EXPECT_GT(with.lineStats().accepted, 20u);
+  EXPECT_NEAR(distance(without.pose(), truth), distance(start, truth), 1e-9);
+  EXPECT_EQ(without.lineStats().scans, 0u) << "line updates off: scans are not even looked at";
+}
+
+TEST(LocalizerLines, AScanWithoutLinesAndWallsThatMatchNothingAreSkippedWithAReason) {
+  const Pose2 truth{2.0, 1.5, 0.0};
+  // No return at all (open space beyond 8 m): no line.
+  Localizer empty(withWalls(truth));
+  SensorReading open = straight(kTick, 0.5);
+  open.angleMin = static_cast<float>(-kPi);
+  open.angleIncrement = static_cast<float>(2.0 * kPi / 72.0);
+  open.ranges.assign(72, 8.0f);
+  empty.onReading(open);
+  empty.onReading(straight(2 * kTick, 0.5));  // and one with no scan: not counted as a scan
+  EXPECT_EQ(empty.lineStats().scans, 1u);
+  EXPECT_EQ(empty.lineStats().scansNoLines, 1u);
+  EXPECT_NEAR(empty.pose().x, 2.1, 1e-9) << "the estimator keeps dead reckoning";
+  // The map is 3 m off the room the scanner is in: every line is outside the gate or looks at
+  // walls from behind; nothing is fused and the estimate stays where odometry has it.
+  Localizer shifted(withWalls(truth, true, {3.0, 0.0}));
+  shifted.onReading(scanFrom(truth, kTick));
+  const auto& s = shifted.lineStats();
+  EXPECT_GT(s.extracted, 0u);
+  EXPECT_EQ(s.matched, 0u);
+  EXPECT_EQ(s.outsideGate + s.noOverlap + s.ambiguous + s.noWallFacing, s.extracted);
+  EXPECT_EQ(shifted.pose(), truth);
 }
