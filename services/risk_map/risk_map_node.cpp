@@ -75,7 +75,9 @@ risk::Source toSource(const msg::PredictedDiscs& m) {
   s.discs.reserve(m.discs.size());
   for (const auto& d : m.discs) {
     s.discs.push_back({static_cast<double>(d.x), static_cast<double>(d.y), static_cast<double>(d.r),
-                       static_cast<double>(d.sigma)});
+                       static_cast<double>(d.sigma),
+                       risk::Cov2{static_cast<double>(d.cov_xx), static_cast<double>(d.cov_xy),
+                                  static_cast<double>(d.cov_yy)}});
   }
   return s;
 }
@@ -117,6 +119,7 @@ Expected<void> RiskMapNode::accept(const msg::PredictedDiscs& m, std::int64_t no
   auto r = engine_.upsert(toSource(m), now_ns);
   if (!r) {
     ++rejected_;
+    ++rejectedBy_[r.error().code];
     return r;
   }
   ++accepted_;

@@ -6,13 +6,6 @@
 
 namespace fleet::risk {
 
-/// Symmetric 2×2 covariance [[xx, xy], [xy, yy]] (m²).
-struct Cov2 {
-  double xx = 0.0;
-  double xy = 0.0;
-  double yy = 0.0;
-};
-
 /// P(‖x‖ ≤ R) for x ~ N(μ, σ² I) with ‖μ‖ = d: the noncentral χ² (k = 2) CDF at R²/σ² with
 /// λ = d²/σ², i.e. 1 − Q₁(d/σ, R/σ), as a Poisson-mixture series in which every addition is of
 /// positive terms: for b = R²/(2σ²) <= 150 summed upwards from e^{−a}, e^{−b} (a few multiplications
