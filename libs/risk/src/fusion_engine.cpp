@@ -169,17 +169,24 @@ const FusionResult& FusionEngine::fuse(std::int64_t t_ref_ns) {
 }
 
 void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
-  // Uniform buckets of side >= the largest reach sum, over the bounding box of the centres, filled by
-  // counting sort: every partner of a disc lies in its own or one of the 8 neighbouring buckets.
+  // Uniform buckets over the bounding box of the centres, filled by counting sort. Their side is twice
+  // the 90th percentile of the reaches rather than of the largest: a few very uncertain discs (people
+  // late in the horizon) would otherwise make every bucket hold dozens of discs. Partners of two discs
+  // with reach <= side/2 lie in the same or a neighbouring bucket; the few larger ("wide") discs search
+  // as many buckets as their own reach plus the largest needs.
   double minX = discs[0].disc.x, maxX = minX, minY = discs[0].disc.y, maxY = minY, maxR = 0.0;
+  reachScratch_.clear();
   for (const auto& s : discs) {
     minX = std::min(minX, s.disc.x);
     maxX = std::max(maxX, s.disc.x);
     minY = std::min(minY, s.disc.y);
     maxY = std::max(maxY, s.disc.y);
     maxR = std::max(maxR, s.reach);
+    reachScratch_.push_back(s.reach);
   }
-  double size = std::max(2.0 * maxR, 1e-6);
+  const auto q = static_cast<std::ptrdiff_t>(reachScratch_.size() * 9 / 10);
+  std::nth_element(reachScratch_.begin(), reachScratch_.begin() + q, reachScratch_.end());
+  double size = std::max(2.0 * reachScratch_[static_cast<std::size_t>(q)], 1e-6);
   const double cap = 4.0 * static_cast<double>(discs.size()) + 64.0;
   double nx = std::floor((maxX - minX) / size) + 1.0;
   double ny = std::floor((maxY - minY) / size) + 1.0;
@@ -193,23 +200,33 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
   bucketSize_ = size;
   bucketsX_ = static_cast<int>(nx);
   bucketsY_ = static_cast<int>(ny);
+  maxReachInHash_ = maxR;
   const std::size_t nb = static_cast<std::size_t>(bucketsX_) * static_cast<std::size_t>(bucketsY_);
   bucketStart_.assign(nb + 1, 0);
   bucketOf_.resize(discs.size());
+  wide_.clear();
   for (std::size_t i = 0; i < discs.size(); ++i) {
     const int bx = std::min(bucketsX_ - 1, static_cast<int>((discs[i].disc.x - minX) / size));
     const int by = std::min(bucketsY_ - 1, static_cast<int>((discs[i].disc.y - minY) / size));
     bucketOf_[i] = static_cast<std::uint32_t>(by * bucketsX_ + bx);
     ++bucketStart_[bucketOf_[i] + 1];
+    if (discs[i].reach > 0.5 * size) {
+      wide_.push_back(static_cast<std::uint32_t>(i));
+    }
   }
   for (std::size_t b = 0; b < nb; ++b) {
     bucketStart_[b + 1] += bucketStart_[b];
   }
   order_.resize(discs.size());
+  sorted_.resize(discs.size());
   auto& fill = bucketFill_;
   fill.assign(bucketStart_.begin(), bucketStart_.end() - 1);
   for (std::size_t i = 0; i < discs.size(); ++i) {
-    order_[fill[bucketOf_[i]]++] = static_cast<std::uint32_t>(i);
+    const std::uint32_t slot = fill[bucketOf_[i]]++;
+    order_[slot] = static_cast<std::uint32_t>(i);
+    // Contiguous copies of what the candidate test reads: the scan streams through them instead of
+    // following order_ into the larger StepDisc records.
+    sorted_[slot] = HashEntry{discs[i].disc.x, discs[i].disc.y, discs[i].reach, discs[i].reach > 0.5 * size};
   }
 }
 
@@ -458,13 +475,25 @@ void FusionEngine::recompute(bool full) {
         discMax_[j] = std::max(discMax_[j], p);
       }
     };
+    const HashEntry* he = sorted_.data();
+    auto near = [](const HashEntry& a, const HashEntry& b) {
+      const double dx = a.x - b.x;
+      const double dy = a.y - b.y;
+      const double rs = a.reach + b.reach;
+      return dx * dx + dy * dy < rs * rs;
+    };
     for (int by = 0; by < bucketsY_; ++by) {
       for (int bx = 0; bx < bucketsX_; ++bx) {
         const std::size_t b = static_cast<std::size_t>(by * bucketsX_ + bx);
         for (std::uint32_t u = bucketStart_[b]; u < bucketStart_[b + 1]; ++u) {
+          if (he[u].wide) {
+            continue;  // its pairs are found from the wide discs' side below
+          }
           const std::uint32_t i = order_[u];
           for (std::uint32_t v = u + 1; v < bucketStart_[b + 1]; ++v) {
-            visitPair(i, order_[v]);
+            if (!he[v].wide && near(he[u], he[v])) {
+              visitPair(i, order_[v]);
+            }
           }
           // Forward half of the 8-neighbourhood, so every pair of buckets is visited once.
           constexpr int kNeighbours[4][2] = {{1, -1}, {1, 0}, {1, 1}, {0, 1}};
@@ -476,7 +505,28 @@ void FusionEngine::recompute(bool full) {
             }
             const std::size_t c = static_cast<std::size_t>(ny * bucketsX_ + nx);
             for (std::uint32_t v = bucketStart_[c]; v < bucketStart_[c + 1]; ++v) {
-              visitPair(i, order_[v]);
+              if (!he[v].wide && near(he[u], he[v])) {
+                visitPair(i, order_[v]);
+              }
+            }
+          }
+        }
+      }
+    }
+    // A wide disc pairs with every narrow disc and with the wide discs after it in list order.
+    for (const std::uint32_t i : wide_) {
+      const StepDisc& a = list[i];
+      const HashEntry self{a.disc.x, a.disc.y, a.reach, true};
+      const int m = static_cast<int>(std::floor((a.reach + maxReachInHash_) / bucketSize_)) + 1;
+      const int bx = static_cast<int>(bucketOf_[i] % static_cast<std::uint32_t>(bucketsX_));
+      const int by = static_cast<int>(bucketOf_[i] / static_cast<std::uint32_t>(bucketsX_));
+      for (int y = std::max(0, by - m); y <= std::min(bucketsY_ - 1, by + m); ++y) {
+        for (int x = std::max(0, bx - m); x <= std::min(bucketsX_ - 1, bx + m); ++x) {
+          const std::size_t c = static_cast<std::size_t>(y * bucketsX_ + x);
+          for (std::uint32_t v = bucketStart_[c]; v < bucketStart_[c + 1]; ++v) {
+            const std::uint32_t j = order_[v];
+            if ((!he[v].wide || j > i) && near(self, he[v])) {
+              visitPair(i, j);
             }
           }
         }

@@ -362,9 +362,14 @@ double gaussianCollisionProbabilityWhitened(Vec2 mean, const Cov2& cov, double R
   return std::clamp(sum * h / (2.0 * kPi), 0.0, 1.0);
 }
 
-Gaussian::Gaussian(double floor)
+Gaussian::Gaussian(double floor, GaussianEvaluation evaluation)
     : floor_(std::clamp(floor, 1e-300, 1.0)),
-      tailSigmas_(std::sqrt(2.0 * std::log(1.0 / floor_)) * 1.001 + 1e-9) {}
+      tailSigmas_(std::sqrt(2.0 * std::log(1.0 / floor_)) * 1.001 + 1e-9),
+      evaluation_(evaluation) {
+  if (evaluation_ == GaussianEvaluation::kFast) {
+    warmGaussianTable();
+  }
+}
 
 double Gaussian::pair(const Disc& a, const Disc& b) const {
   const double d = centreDistance(a, b);
@@ -384,7 +389,9 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
     return p < floor_ ? 0.0 : p;
   }
   const double sigma = std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma);
-  const double p = gaussianCollisionProbability(d, a.r + b.r, sigma);
+  const double p = evaluation_ == GaussianEvaluation::kFast
+                       ? gaussianCollisionProbabilityTabulated(d, a.r + b.r, sigma)
+                       : gaussianCollisionProbability(d, a.r + b.r, sigma);
   return p < floor_ ? 0.0 : p;
 }
 

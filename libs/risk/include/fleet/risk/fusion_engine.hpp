@@ -136,6 +136,14 @@ class FusionEngine {
   std::vector<std::uint32_t> bucketStart_;
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> bucketOf_;
+  struct HashEntry {
+    double x, y, reach;
+    bool wide;  // reach above half a bucket: searched from its own side
+  };
+  std::vector<HashEntry> sorted_;  // the discs in bucket order
+  std::vector<std::uint32_t> wide_;
+  std::vector<double> reachScratch_;
+  double maxReachInHash_ = 0.0;
   double bucketMinX_ = 0.0;
   double bucketMinY_ = 0.0;
   double bucketSize_ = 1.0;

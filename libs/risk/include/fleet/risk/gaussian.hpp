@@ -13,6 +13,19 @@ namespace fleet::risk {
 /// point with lgamma (~1e-12 absolute at a, b in the thousands). sigma = 0 gives the indicator d < R.
 double gaussianCollisionProbability(double d, double R, double sigma);
 
+/// Largest R/σ the table of gaussianCollisionProbabilityTabulated covers; beyond it the exact series.
+inline constexpr double kGaussianTableMaxRatio = 32.0;
+/// Tolerance of the tabulated isotropic probability against the exact series (tested).
+inline constexpr double kGaussianTableTolerance = 1e-6;
+
+/// gaussianCollisionProbability(d, R, sigma) by bicubic interpolation in a table over v = R/σ ∈ [0, 32]
+/// and w = (d − R)/σ ∈ [−9, 9] (steps 1/32, floats, 2.4 MB, built on first use from the exact series):
+/// within kGaussianTableTolerance of it, ~5× faster. Outside the table: the exact series, or 0/1 beyond
+/// 9 σ of the rim as there.
+double gaussianCollisionProbabilityTabulated(double d, double R, double sigma);
+/// Builds the table now (a service calls it at start-up rather than in its first fusion).
+void warmGaussianTable();
+
 /// P(‖x‖ ≤ R) for x ~ N(mean, cov) (anisotropic), the production path. In the covariance's eigenbasis
 /// (x1 along the minor axis, sigma s1 <= s2) the x2 integral over the chord |x2| ≤ √(R² − x1²) is a
 /// difference of two normal CDFs; the remaining x1 integral, substituted x1 = R sin θ (no square-root
@@ -36,13 +49,19 @@ double gaussianCollisionProbabilityWhitened(Vec2 mean, const Cov2& cov, double R
 /// from the angular width of the Gaussian). Slower; kept as the independent cross-check.
 double gaussianCollisionProbabilityPolar(Vec2 mean, const Cov2& cov, double R, int thetaSteps = 0);
 
-/// Probability that two discs with independent Gaussian centre errors (isotropic, each disc's sigma)
-/// overlap: relative position ~ N(μa − μb, (σa² + σb²) I), collision iff ‖x‖ ≤ ra + rb.
-/// Values below `floor` are reported as 0 so that culling pairs farther than cullDistance (where the
-/// tail bound exp(−(d−R)²/(2σ²)) < floor) changes nothing.
+/// How the Gaussian model evaluates a pair: the exact series and quadrature, or the fast path (the
+/// isotropic table and the anisotropic quadrature with tabulated normal functions), within
+/// kGaussianTableTolerance of the exact value (tested; docs/algorithms.md).
+enum class GaussianEvaluation { kExact, kFast };
+
+/// Probability that two discs with independent Gaussian centre errors overlap: relative position
+/// ~ N(μa − μb, Ca + Cb) (C = σ² I for an isotropic disc), collision iff ‖x‖ ≤ ra + rb; the isotropic
+/// formula when both discs are isotropic, else the anisotropic one. Values below `floor` are reported
+/// as 0 so that culling pairs farther than cullDistance (where the tail bound exp(−(d−R)²/(2σ²)) <
+/// floor, σ² = λmax(Ca) + λmax(Cb)) changes nothing.
 class Gaussian final : public RiskModel {
  public:
-  explicit Gaussian(double floor = 1e-4);
+  explicit Gaussian(double floor = 1e-4, GaussianEvaluation evaluation = GaussianEvaluation::kExact);
 
   [[nodiscard]] double pair(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
@@ -53,6 +72,7 @@ class Gaussian final : public RiskModel {
  private:
   double floor_;
   double tailSigmas_;  // sqrt(2 ln(1/floor)), slightly padded
+  GaussianEvaluation evaluation_;
 };
 
 }  // namespace fleet::risk

@@ -1,0 +1,90 @@
+// The Gaussian model's fast path against the exact series and quadrature (and, through them, the
+// scipy reference the exact isotropic series is checked against in gaussian_test.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "fleet/risk/gaussian.hpp"
+
+namespace fleet::risk {
+namespace {
+
+TEST(GaussianFast, TableWithinToleranceOfTheExactSeriesOverItsDomain) {
+  // A sweep off the table's nodes (steps of 1/16 in R/σ and (d − R)/σ) plus random points.
+  double worst = 0.0;
+  for (double v = 0.013; v < kGaussianTableMaxRatio; v += 0.0517) {
+    for (double w = -9.3; w < 9.3; w += 0.0291) {
+      const double d = std::max(0.0, v + w);
+      const double exact = gaussianCollisionProbability(d, v, 1.0);
+      worst = std::max(worst, std::abs(gaussianCollisionProbabilityTabulated(d, v, 1.0) - exact));
+    }
+  }
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> ud(0.0, 3.0), ur(0.2, 1.5), us(0.01, 1.5);
+  for (int i = 0; i < 200000; ++i) {
+    const double d = ud(rng), R = ur(rng), s = us(rng);
+    worst = std::max(worst, std::abs(gaussianCollisionProbabilityTabulated(d, R, s) -
+                                     gaussianCollisionProbability(d, R, s)));
+  }
+  std::printf("largest |table - exact| = %.3g\n", worst);
+  RecordProperty("max_abs_diff", std::to_string(worst));
+  EXPECT_LT(worst, kGaussianTableTolerance);
+  EXPECT_GT(worst, 0.0);  // it is an interpolation: not the exact series in disguise
+}
+
+TEST(GaussianFast, TableMatchesTheScipyReferenceWithinTolerance) {
+  std::ifstream in(std::string(FLEET_SOURCE_DIR) + "/tests/unit/risk/gaussian_reference.csv");
+  ASSERT_TRUE(in);
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') {
+      continue;
+    }
+    std::stringstream ss(line);
+    double d = 0, R = 0, s = 0, p = 0;
+    char c = 0;
+    ss >> d >> c >> R >> c >> s >> c >> p;
+    EXPECT_NEAR(gaussianCollisionProbabilityTabulated(d, R, s), p, kGaussianTableTolerance)
+        << d << " " << R << " " << s;
+    ++rows;
+  }
+  EXPECT_GT(rows, 100);
+}
+
+TEST(GaussianFast, ModelPairsWithinToleranceAndFloorConsistent) {
+  const Gaussian exact(1e-4, GaussianEvaluation::kExact);
+  const Gaussian fast(1e-4, GaussianEvaluation::kFast);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0;
+  for (int i = 0; i < 100000; ++i) {
+    const Disc a{0, 0, 0.3 + 0.3 * u(rng), 0.01 + 0.5 * u(rng)};
+    const double th = 6.283 * u(rng), d = 3.0 * u(rng);
+    Disc b{d * std::cos(th), d * std::sin(th), 0.3 + 0.3 * u(rng), 0.01 + 0.5 * u(rng)};
+    if (i % 2 == 0) {  // anisotropic half
+      const double l1 = std::pow(0.02 + 0.6 * u(rng), 2), l2 = l1 * (0.05 + 0.95 * u(rng)),
+                   t = 3.1416 * u(rng);
+      const double c = std::cos(t), s = std::sin(t);
+      b.cov = Cov2{c * c * l1 + s * s * l2, c * s * (l1 - l2), s * s * l1 + c * c * l2};
+      b.sigma = b.sigmaMax();
+    }
+    const double pe = exact.pair(a, b), pf = fast.pair(a, b);
+    EXPECT_EQ(fast.pair(b, a), pf);
+    // Either both within tolerance, or the exact value lies within tolerance of the floor (one of them
+    // is then reported as 0).
+    if (std::abs(pe - 1e-4) > kGaussianTableTolerance) {
+      ASSERT_NEAR(pf, pe, kGaussianTableTolerance) << i;
+      worst = std::max(worst, std::abs(pf - pe));
+    }
+  }
+  std::printf("largest |fast - exact| over model pairs = %.3g\n", worst);
+}
+
+}  // namespace
+}  // namespace fleet::risk
