@@ -22,6 +22,7 @@ struct Settings {
   std::string site;
   std::string model = "gaussian";  // or "overlap" (the thesis ratio)
   double gaussianFloor = 1e-4;
+  std::string gaussianEval = "fast";  // or "exact" (the series and quadrature; the fast path is within 1e-6)
   double rateHz = 10.0;
   double staleAfterS = 1.0;  // a source not heard from for this long is dropped
   bool regions = true;

@@ -384,8 +384,11 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
     }
     const Cov2 ca = a.covariance();
     const Cov2 cb = b.covariance();
-    const double p = gaussianCollisionProbability(
-        Vec2{b.x - a.x, b.y - a.y}, Cov2{ca.xx + cb.xx, ca.xy + cb.xy, ca.yy + cb.yy}, a.r + b.r, floor_);
+    const Vec2 mean{b.x - a.x, b.y - a.y};
+    const Cov2 sum{ca.xx + cb.xx, ca.xy + cb.xy, ca.yy + cb.yy};
+    const double p = evaluation_ == GaussianEvaluation::kFast
+                         ? gaussianCollisionProbabilityFast(mean, sum, a.r + b.r, floor_)
+                         : gaussianCollisionProbability(mean, sum, a.r + b.r, floor_);
     return p < floor_ ? 0.0 : p;
   }
   const double sigma = std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma);

@@ -36,6 +36,10 @@ void warmGaussianTable();
 /// Returns 0 when the tail bound exp(−((|mean| − R)/s2)²/2) is below `floor` (default: only beyond 9 s2).
 double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double floor = 0.0);
 
+/// The same quadrature on the fast path: 1 − Φ from a table, a 7.5 σ window and a coarser step (see
+/// gaussian_anisotropic.cpp); within kGaussianTableTolerance of gaussianCollisionProbability.
+double gaussianCollisionProbabilityFast(Vec2 mean, const Cov2& cov, double R, double floor = 0.0);
+
 /// The previous anisotropic implementation, kept as the reference for tests and benchmarks: whitened
 /// coordinates z = L⁻¹(x − mean) (cov = L Lᵀ), where each ray from the mean crosses the transformed disc
 /// in one interval [ρ1, ρ2] with radial integral e^{−ρ1²/2} − e^{−ρ2²/2}; the angle by the periodic
