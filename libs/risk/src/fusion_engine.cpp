@@ -463,7 +463,8 @@ void FusionEngine::recompute(bool full) {
       }
       ++result_.stats.pairsTested;
       const double d = centreDistance(a.disc, b.disc);
-      const double inter = discIntersectionArea(a.disc.r, b.disc.r, d);
+      // Most pairs of the Gaussian model's reach do not touch: no call for their zero area.
+      const double inter = d < a.disc.r + b.disc.r ? discIntersectionArea(a.disc.r, b.disc.r, d) : 0.0;
       interSum += inter;
       if (active_[i] == 0 && active_[j] == 0) {
         return;

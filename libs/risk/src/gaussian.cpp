@@ -372,7 +372,10 @@ Gaussian::Gaussian(double floor, GaussianEvaluation evaluation)
 }
 
 double Gaussian::pair(const Disc& a, const Disc& b) const {
-  const double d = centreDistance(a, b);
+  return pairAt(a, b, centreDistance(a, b));
+}
+
+double Gaussian::pairAt(const Disc& a, const Disc& b, double d) const {
   if (d >= cullDistance(a, b)) {
     return 0.0;
   }
@@ -380,7 +383,7 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
     // Independent errors: the relative position's covariance is the sum of the two. The quadrature is
     // not bitwise even in the mean, so the pair is put in one order to keep pair(a, b) == pair(b, a).
     if (a.x > b.x || (a.x == b.x && a.y > b.y)) {
-      return pair(b, a);
+      return pairAt(b, a, d);
     }
     const Cov2 ca = a.covariance();
     const Cov2 cb = b.covariance();

@@ -68,12 +68,18 @@ class Gaussian final : public RiskModel {
   explicit Gaussian(double floor = 1e-4, GaussianEvaluation evaluation = GaussianEvaluation::kExact);
 
   [[nodiscard]] double pair(const Disc& a, const Disc& b) const override;
+  /// pair(a, b) with the centre distance the engine has already computed (the same expression).
+  [[nodiscard]] double pairWithIntersection(const Disc& a, const Disc& b, double d,
+                                            double /*intersectionArea*/) const override {
+    return pairAt(a, b, d);
+  }
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double reach(const Disc& a) const override;
   [[nodiscard]] std::string_view name() const override { return "gaussian"; }
   [[nodiscard]] double floor() const { return floor_; }
 
  private:
+  [[nodiscard]] double pairAt(const Disc& a, const Disc& b, double d) const;
   double floor_;
   double tailSigmas_;  // sqrt(2 ln(1/floor)), slightly padded
   GaussianEvaluation evaluation_;
