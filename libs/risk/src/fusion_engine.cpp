@@ -452,6 +452,21 @@ void FusionEngine::recompute(bool full) {
     }
     buildHash(list);
     double interSum = 0.0;
+    // Only each disc's maximum is painted: a pair scoring below both active discs' maxima so far
+    // changes nothing, and the model may skip scoring it (pairAbove). Touching pairs, which score
+    // highest, go first; the others are scored after the scan.
+    auto scorePair = [&](std::uint32_t i, std::uint32_t j, double d, double inter) {
+      constexpr double kNone = 2.0;
+      const double known =
+          std::min(active_[i] != 0 ? discMax_[i] : kNone, active_[j] != 0 ? discMax_[j] : kNone);
+      const double p = model_->pairAbove(list[i].disc, list[j].disc, d, inter, known);
+      if (p > 0.0) {
+        ++result_.stats.pairsPositive;
+        discMax_[i] = std::max(discMax_[i], p);
+        discMax_[j] = std::max(discMax_[j], p);
+      }
+    };
+    deferred_.clear();
     auto visitPair = [&](std::uint32_t i, std::uint32_t j) {
       const StepDisc& a = list[i];
       const StepDisc& b = list[j];
@@ -469,11 +484,10 @@ void FusionEngine::recompute(bool full) {
       if (active_[i] == 0 && active_[j] == 0) {
         return;
       }
-      const double p = model_->pairWithIntersection(a.disc, b.disc, d, inter);
-      if (p > 0.0) {
-        ++result_.stats.pairsPositive;
-        discMax_[i] = std::max(discMax_[i], p);
-        discMax_[j] = std::max(discMax_[j], p);
+      if (d < a.disc.r + b.disc.r) {
+        scorePair(i, j, d, inter);
+      } else {
+        deferred_.push_back(DeferredPair{i, j, d});
       }
     };
     const HashEntry* he = sorted_.data();
@@ -532,6 +546,9 @@ void FusionEngine::recompute(bool full) {
           }
         }
       }
+    }
+    for (const DeferredPair& q : deferred_) {
+      scorePair(q.i, q.j, q.d, 0.0);
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {

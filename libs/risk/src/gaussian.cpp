@@ -375,6 +375,19 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
   return pairAt(a, b, centreDistance(a, b));
 }
 
+double Gaussian::pairAbove(const Disc& a, const Disc& b, double d, double /*intersectionArea*/,
+                           double known) const {
+  const double gap = d - (a.r + b.r);
+  if (known > 0.0 && gap > 0.0) {
+    const double sa = a.sigmaMax();
+    const double sb = b.sigmaMax();
+    if (std::exp(-0.5 * gap * gap / (sa * sa + sb * sb)) < known) {
+      return 0.0;  // P <= the bound < known: this pair cannot raise the maximum
+    }
+  }
+  return pairAt(a, b, d);
+}
+
 double Gaussian::pairAt(const Disc& a, const Disc& b, double d) const {
   if (d >= cullDistance(a, b)) {
     return 0.0;

@@ -73,6 +73,10 @@ class Gaussian final : public RiskModel {
                                             double /*intersectionArea*/) const override {
     return pairAt(a, b, d);
   }
+  /// 0 without evaluating P when its tail bound exp(−(d − R)²/2σ²) (σ² = λmax(Ca) + λmax(Cb)) is
+  /// already below `known`.
+  [[nodiscard]] double pairAbove(const Disc& a, const Disc& b, double d, double intersectionArea,
+                                 double known) const override;
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double reach(const Disc& a) const override;
   [[nodiscard]] std::string_view name() const override { return "gaussian"; }
