@@ -119,3 +119,65 @@ TEST(GaussianFast, AnisotropicQuadratureWithinToleranceOfTheExactOne) {
 
 }  // namespace
 }  // namespace fleet::risk
+
+#include "fleet/risk/fusion_engine.hpp"
+
+namespace fleet::risk {
+namespace {
+
+// The service's configuration (fast path) against the exact model on the same mixed scene, cell for
+// cell: within the stated tolerance, a level only changing where p is that close to a boundary.
+TEST(GaussianFast, FusedMapWithinToleranceOfTheExactModel) {
+  FusionConfig cfg;
+  cfg.grid = GridSpec{0.0, 0.0, 0.1, 200, 120};
+  cfg.steps = 20;
+  std::vector<Source> scene;
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 120; ++i) {
+    Source s;
+    s.id = "s";
+    s.id += std::to_string(i);
+    s.kind = u(rng) < 0.25 ? SourceKind::kHuman : SourceKind::kRobot;
+    const double x = 20 * u(rng), y = 12 * u(rng), th = 6.283 * u(rng), v = 0.3 + 1.2 * u(rng);
+    for (int k = 0; k < 20; ++k) {
+      const double t = 0.1 * k;
+      Disc d{x + v * std::cos(th) * t, y + v * std::sin(th) * t, 0.3 + 0.2 * u(rng), 0.03 + 0.05 * t};
+      if (s.kind == SourceKind::kRobot && i % 2 == 0) {
+        const double l1 = std::pow(0.03 + 0.2 * v * t, 2), l2 = std::pow(0.03 + 0.05 * t, 2);
+        const double c = std::cos(th), sn = std::sin(th);
+        d.cov = Cov2{c * c * l1 + sn * sn * l2, c * sn * (l1 - l2), sn * sn * l1 + c * c * l2};
+        d.sigma = d.sigmaMax();
+      }
+      s.discs.push_back(d);
+    }
+    scene.push_back(std::move(s));
+  }
+  auto run = [&](GaussianEvaluation e) {
+    auto engine = FusionEngine::create(cfg, std::make_shared<Gaussian>(1e-4, e));
+    EXPECT_TRUE(engine.has_value());
+    for (const auto& s : scene) {
+      EXPECT_TRUE(engine->upsert(s));
+    }
+    return engine->fuse(0);
+  };
+  const FusionResult exact = run(GaussianEvaluation::kExact);
+  const FusionResult fast = run(GaussianEvaluation::kFast);
+  double worst = 0.0;
+  std::size_t nonzero = 0;
+  for (std::size_t c = 0; c < exact.probability.p.size(); ++c) {
+    const double pe = exact.probability.p[c], pf = fast.probability.p[c];
+    nonzero += pe > 0.0 ? 1 : 0;
+    worst = std::max(worst, std::abs(pe - pf));
+    ASSERT_NEAR(pf, pe, kGaussianTableTolerance) << "cell " << c;
+    if (exact.levels.level[c] != fast.levels.level[c]) {
+      const double boundary = std::round(pe * 10.0) / 10.0;
+      EXPECT_NEAR(pe, boundary, kGaussianTableTolerance) << "cell " << c;
+    }
+  }
+  EXPECT_GT(nonzero, 2000u);
+  std::printf("fused map: largest |fast - exact| = %.3g over %zu non-zero cells\n", worst, nonzero);
+}
+
+}  // namespace
+}  // namespace fleet::risk
