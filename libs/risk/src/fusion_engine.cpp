@@ -552,7 +552,7 @@ void FusionEngine::recompute(bool full) {
     }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {
-        paints_.push_back(Paint{list[i].disc, discMax_[i]});
+        paints_.push_back(Paint{list[i].disc.x, list[i].disc.y, list[i].disc.r, discMax_[i]});
       }
     }
     // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
@@ -579,9 +579,9 @@ void FusionEngine::recompute(bool full) {
     for (std::size_t n = 0; n < paints_.size(); ++n) {
       const Paint& pt = paints_[n];
       const auto tx = static_cast<std::size_t>(
-          std::clamp((pt.disc.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
+          std::clamp((pt.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
       const auto ty = static_cast<std::size_t>(
-          std::clamp((pt.disc.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
+          std::clamp((pt.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
       paintTile_[n] = static_cast<std::uint32_t>(ty * static_cast<std::size_t>(tilesX_) + tx);
       ++tileStart_[paintTile_[n] + 1];
     }
@@ -596,7 +596,7 @@ void FusionEngine::recompute(bool full) {
     // level with max gives the classified grid without a pass over the cells.
     const int K = config_.levels;
     for (const Paint& pt : sortedPaints_) {
-      paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
+      paintDisc(Disc{pt.x, pt.y, pt.r}, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }
     result_.stats.discsPainted = paints_.size();
   }

@@ -115,8 +115,8 @@ class FusionEngine {
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
-  struct Paint {
-    Disc disc;
+  struct Paint {  // what painting reads of a disc (not its uncertainty), and the score
+    double x, y, r;
     double p;
   };
   struct RowSpan {
