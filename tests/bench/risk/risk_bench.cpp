@@ -62,6 +62,22 @@ void BM_PairGaussianIsotropic(benchmark::State& state) {
 }
 BENCHMARK(BM_PairGaussianIsotropic);
 
+// The same pairs by the fast path's table (the risk map service's default).
+void BM_PairGaussianIsotropicFast(benchmark::State& state) {
+  const auto s = makePairs(0.3);
+  warmGaussianTable();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Disc& a = s.a[i & 1023];
+    const Disc& b = s.b[i & 1023];
+    benchmark::DoNotOptimize(gaussianCollisionProbabilityTabulated(
+        centreDistance(a, b), a.r + b.r, std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma)));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianIsotropicFast);
+
 // Relative positions and covariances for the anisotropic model: the isotropic pair set with the summed
 // variance as the major eigenvalue, the minor one `minRatio`…1 times that (log-uniform below 0.2,
 // uniform 0.2–1 as in the recorded figures), random orientation.
@@ -98,6 +114,18 @@ void BM_PairGaussianAnisotropic(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
 }
 BENCHMARK(BM_PairGaussianAnisotropic);
+
+void BM_PairGaussianAnisotropicFast(benchmark::State& state) {
+  const auto p = anisotropicPairs(0.2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t k = i & 1023;
+    benchmark::DoNotOptimize(gaussianCollisionProbabilityFast(p.mean[k], p.cov[k], p.R[k]));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianAnisotropicFast);
 
 // ---------------------------------------------------------------- warehouse scenes
 // Robots (80 %) drive along aisles (horizontal every 3 m, vertical every 5 m) at 0.5–1.5 m/s, humans
