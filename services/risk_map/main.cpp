@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <string>
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
@@ -101,9 +102,16 @@ int run(const riskmap::Settings& settings, const std::string& id) {
       }
     }
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
+      std::string reasons;
+      for (const auto& [code, n] : node.rejectedByReason()) {
+        reasons += (reasons.empty() ? " (" : ", ") + code + ": " + std::to_string(n);
+      }
+      if (!reasons.empty()) {
+        reasons += ")";
+      }
       spdlog::info(
-          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected, {} stale dropped",
-          node.sources(), published, node.accepted(), node.rejected(), node.dropped_stale());
+          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected{}, {} stale dropped",
+          node.sources(), published, node.accepted(), node.rejected(), reasons, node.dropped_stale());
       lastStats = std::chrono::steady_clock::now();
     }
   }

@@ -13,8 +13,8 @@ namespace fleet::riskmap {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"grid", "levels", "dt", "steps", "rate_hz", "model", "gaussian_floor",
-                         "stale_after_s", "regions", "human_human", "clock", "lockstep", "tile_size",
-                         "site"});
+                         "gaussian_eval", "stale_after_s", "regions", "human_human", "clock", "lockstep",
+                         "tile_size", "site"});
   s.site = cfg.string("site", "");
   auto g = cfg.child("grid");
   if (!s.site.empty()) {
@@ -37,6 +37,7 @@ Settings readSettings(Config& cfg) {
   s.fusion.policy.humanHuman = cfg.boolean("human_human", false);
   s.model = cfg.string("model", "gaussian", {"gaussian", "overlap"});
   s.gaussianFloor = cfg.number("gaussian_floor", 1e-4, {0.0, 0.5, true});
+  s.gaussianEval = cfg.string("gaussian_eval", "fast", {"fast", "exact"});
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.staleAfterS = cfg.number("stale_after_s", 1.0, {0.0, 3600.0, true});
   s.regions = cfg.boolean("regions", true);
@@ -63,7 +64,9 @@ std::shared_ptr<const risk::RiskModel> makeModel(const Settings& s) {
   if (s.model == "overlap") {
     return std::make_shared<risk::OverlapRatio>();
   }
-  return std::make_shared<risk::Gaussian>(s.gaussianFloor);
+  return std::make_shared<risk::Gaussian>(s.gaussianFloor, s.gaussianEval == "exact"
+                                                               ? risk::GaussianEvaluation::kExact
+                                                               : risk::GaussianEvaluation::kFast);
 }
 
 risk::Source toSource(const msg::PredictedDiscs& m) {
@@ -75,7 +78,9 @@ risk::Source toSource(const msg::PredictedDiscs& m) {
   s.discs.reserve(m.discs.size());
   for (const auto& d : m.discs) {
     s.discs.push_back({static_cast<double>(d.x), static_cast<double>(d.y), static_cast<double>(d.r),
-                       static_cast<double>(d.sigma)});
+                       static_cast<double>(d.sigma),
+                       risk::Cov2{static_cast<double>(d.cov_xx), static_cast<double>(d.cov_xy),
+                                  static_cast<double>(d.cov_yy)}});
   }
   return s;
 }
@@ -117,6 +122,7 @@ Expected<void> RiskMapNode::accept(const msg::PredictedDiscs& m, std::int64_t no
   auto r = engine_.upsert(toSource(m), now_ns);
   if (!r) {
     ++rejected_;
+    ++rejectedBy_[r.error().code];
     return r;
   }
   ++accepted_;

@@ -22,6 +22,7 @@ struct Settings {
   std::string site;
   std::string model = "gaussian";  // or "overlap" (the thesis ratio)
   double gaussianFloor = 1e-4;
+  std::string gaussianEval = "fast";  // or "exact" (the series and quadrature; the fast path is within 1e-6)
   double rateHz = 10.0;
   double staleAfterS = 1.0;  // a source not heard from for this long is dropped
   bool regions = true;
@@ -37,7 +38,8 @@ risk::GridSpec gridOverSite(Vec2 origin, double widthM, double heightM, double r
 /// The pair model named in the settings.
 std::shared_ptr<const risk::RiskModel> makeModel(const Settings& s);
 
-/// A DDS sample as the risk library's source (float fields widened exactly).
+/// A DDS sample as the risk library's source (float fields widened exactly; a disc with a non-zero
+/// covariance is anisotropic, one with cov_xx = cov_xy = cov_yy = 0 isotropic with its sigma).
 risk::Source toSource(const msg::PredictedDiscs& m);
 
 /// The fused result as the wire message.
@@ -57,6 +59,8 @@ class RiskMapNode {
   [[nodiscard]] std::size_t sources() const { return engine_.sourceCount(); }
   [[nodiscard]] std::uint64_t accepted() const { return accepted_; }
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
+  /// Rejected samples by the library's error code (e.g. "bad_covariance", "non_finite_covariance").
+  [[nodiscard]] const std::map<std::string, std::uint64_t>& rejectedByReason() const { return rejectedBy_; }
   [[nodiscard]] std::uint64_t dropped_stale() const { return staleDropped_; }
   [[nodiscard]] const Settings& settings() const { return settings_; }
   [[nodiscard]] const risk::FusionEngine& engine() const { return engine_; }
@@ -68,6 +72,7 @@ class RiskMapNode {
   std::map<std::string, std::int64_t> lastHeard_;
   std::uint64_t accepted_ = 0;
   std::uint64_t rejected_ = 0;
+  std::map<std::string, std::uint64_t> rejectedBy_;
   std::uint64_t staleDropped_ = 0;
 };
 

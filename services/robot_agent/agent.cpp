@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "axis_offset.hpp"
+#include "disc_prediction.hpp"
 #include "fleet/avoidance/rotation_shim.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/core/angles.hpp"
@@ -1089,21 +1090,16 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   out.state.task_id = task_;
   out.state.radius = static_cast<float>(p_.radius);
 
-  // Predicted discs: the current command held over the horizon, σ growing from the EKF's.
+  // Predicted discs: the current command held over the horizon, the EKF's covariance grown along it.
   out.discs.source_id = p_.id;
   out.discs.kind = msg::SourceKind::Robot;
   out.discs.t0_ns = nowNs;
   out.discs.dt = static_cast<float>(p_.predictionDt);
-  const double sigma0 = std::sqrt(std::max(P(0, 0), P(1, 1)));
-  Pose2 q = pose;
-  const int steps = static_cast<int>(p_.predictionHorizonS / p_.predictionDt) + 1;
-  for (int k = 0; k < steps; ++k) {
-    const double t = k * p_.predictionDt;
-    out.discs.discs.push_back({static_cast<float>(q.x), static_cast<float>(q.y),
-                               static_cast<float>(p_.radius), static_cast<float>(sigma0 + 0.1 * t)});
-    q = {q.x + v * std::cos(q.theta) * p_.predictionDt, q.y + v * std::sin(q.theta) * p_.predictionDt,
-         wrapAngle(q.theta + w * p_.predictionDt)};
-  }
+  DiscPredictionParams prediction;
+  prediction.radius = p_.radius;
+  prediction.dt = p_.predictionDt;
+  prediction.horizonS = p_.predictionHorizonS;
+  out.discs.discs = predictDiscs(pose, P, v, w, prediction);
   if (pendingStatus_ && (homing_ || pendingStatus_->task_id.empty())) {
     pendingStatus_.reset();  // the trip home is not a task
   }

@@ -169,17 +169,24 @@ const FusionResult& FusionEngine::fuse(std::int64_t t_ref_ns) {
 }
 
 void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
-  // Uniform buckets of side >= the largest reach sum, over the bounding box of the centres, filled by
-  // counting sort: every partner of a disc lies in its own or one of the 8 neighbouring buckets.
+  // Uniform buckets over the bounding box of the centres, filled by counting sort. Their side is twice
+  // the 90th percentile of the reaches rather than of the largest: a few very uncertain discs (people
+  // late in the horizon) would otherwise make every bucket hold dozens of discs. Partners of two discs
+  // with reach <= side/2 lie in the same or a neighbouring bucket; the few larger ("wide") discs search
+  // as many buckets as their own reach plus the largest needs.
   double minX = discs[0].disc.x, maxX = minX, minY = discs[0].disc.y, maxY = minY, maxR = 0.0;
+  reachScratch_.clear();
   for (const auto& s : discs) {
     minX = std::min(minX, s.disc.x);
     maxX = std::max(maxX, s.disc.x);
     minY = std::min(minY, s.disc.y);
     maxY = std::max(maxY, s.disc.y);
     maxR = std::max(maxR, s.reach);
+    reachScratch_.push_back(s.reach);
   }
-  double size = std::max(2.0 * maxR, 1e-6);
+  const auto q = static_cast<std::ptrdiff_t>(reachScratch_.size() * 9 / 10);
+  std::nth_element(reachScratch_.begin(), reachScratch_.begin() + q, reachScratch_.end());
+  double size = std::max(2.0 * reachScratch_[static_cast<std::size_t>(q)], 1e-6);
   const double cap = 4.0 * static_cast<double>(discs.size()) + 64.0;
   double nx = std::floor((maxX - minX) / size) + 1.0;
   double ny = std::floor((maxY - minY) / size) + 1.0;
@@ -193,23 +200,33 @@ void FusionEngine::buildHash(const std::vector<StepDisc>& discs) {
   bucketSize_ = size;
   bucketsX_ = static_cast<int>(nx);
   bucketsY_ = static_cast<int>(ny);
+  maxReachInHash_ = maxR;
   const std::size_t nb = static_cast<std::size_t>(bucketsX_) * static_cast<std::size_t>(bucketsY_);
   bucketStart_.assign(nb + 1, 0);
   bucketOf_.resize(discs.size());
+  wide_.clear();
   for (std::size_t i = 0; i < discs.size(); ++i) {
     const int bx = std::min(bucketsX_ - 1, static_cast<int>((discs[i].disc.x - minX) / size));
     const int by = std::min(bucketsY_ - 1, static_cast<int>((discs[i].disc.y - minY) / size));
     bucketOf_[i] = static_cast<std::uint32_t>(by * bucketsX_ + bx);
     ++bucketStart_[bucketOf_[i] + 1];
+    if (discs[i].reach > 0.5 * size) {
+      wide_.push_back(static_cast<std::uint32_t>(i));
+    }
   }
   for (std::size_t b = 0; b < nb; ++b) {
     bucketStart_[b + 1] += bucketStart_[b];
   }
   order_.resize(discs.size());
+  sorted_.resize(discs.size());
   auto& fill = bucketFill_;
   fill.assign(bucketStart_.begin(), bucketStart_.end() - 1);
   for (std::size_t i = 0; i < discs.size(); ++i) {
-    order_[fill[bucketOf_[i]]++] = static_cast<std::uint32_t>(i);
+    const std::uint32_t slot = fill[bucketOf_[i]]++;
+    order_[slot] = static_cast<std::uint32_t>(i);
+    // Contiguous copies of what the candidate test reads: the scan streams through them instead of
+    // following order_ into the larger StepDisc records.
+    sorted_[slot] = HashEntry{discs[i].disc.x, discs[i].disc.y, discs[i].reach, discs[i].reach > 0.5 * size};
   }
 }
 
@@ -435,6 +452,21 @@ void FusionEngine::recompute(bool full) {
     }
     buildHash(list);
     double interSum = 0.0;
+    // Only each disc's maximum is painted: a pair scoring below both active discs' maxima so far
+    // changes nothing, and the model may skip scoring it (pairAbove). Touching pairs, which score
+    // highest, go first; the others are scored after the scan.
+    auto scorePair = [&](std::uint32_t i, std::uint32_t j, double d, double inter) {
+      constexpr double kNone = 2.0;
+      const double known =
+          std::min(active_[i] != 0 ? discMax_[i] : kNone, active_[j] != 0 ? discMax_[j] : kNone);
+      const double p = model_->pairAbove(list[i].disc, list[j].disc, d, inter, known);
+      if (p > 0.0) {
+        ++result_.stats.pairsPositive;
+        discMax_[i] = std::max(discMax_[i], p);
+        discMax_[j] = std::max(discMax_[j], p);
+      }
+    };
+    deferred_.clear();
     auto visitPair = [&](std::uint32_t i, std::uint32_t j) {
       const StepDisc& a = list[i];
       const StepDisc& b = list[j];
@@ -446,25 +478,37 @@ void FusionEngine::recompute(bool full) {
       }
       ++result_.stats.pairsTested;
       const double d = centreDistance(a.disc, b.disc);
-      const double inter = discIntersectionArea(a.disc.r, b.disc.r, d);
+      // Most pairs of the Gaussian model's reach do not touch: no call for their zero area.
+      const double inter = d < a.disc.r + b.disc.r ? discIntersectionArea(a.disc.r, b.disc.r, d) : 0.0;
       interSum += inter;
       if (active_[i] == 0 && active_[j] == 0) {
         return;
       }
-      const double p = model_->pairWithIntersection(a.disc, b.disc, d, inter);
-      if (p > 0.0) {
-        ++result_.stats.pairsPositive;
-        discMax_[i] = std::max(discMax_[i], p);
-        discMax_[j] = std::max(discMax_[j], p);
+      if (d < a.disc.r + b.disc.r) {
+        scorePair(i, j, d, inter);
+      } else {
+        deferred_.push_back(DeferredPair{i, j, d});
       }
+    };
+    const HashEntry* he = sorted_.data();
+    auto near = [](const HashEntry& a, const HashEntry& b) {
+      const double dx = a.x - b.x;
+      const double dy = a.y - b.y;
+      const double rs = a.reach + b.reach;
+      return dx * dx + dy * dy < rs * rs;
     };
     for (int by = 0; by < bucketsY_; ++by) {
       for (int bx = 0; bx < bucketsX_; ++bx) {
         const std::size_t b = static_cast<std::size_t>(by * bucketsX_ + bx);
         for (std::uint32_t u = bucketStart_[b]; u < bucketStart_[b + 1]; ++u) {
+          if (he[u].wide) {
+            continue;  // its pairs are found from the wide discs' side below
+          }
           const std::uint32_t i = order_[u];
           for (std::uint32_t v = u + 1; v < bucketStart_[b + 1]; ++v) {
-            visitPair(i, order_[v]);
+            if (!he[v].wide && near(he[u], he[v])) {
+              visitPair(i, order_[v]);
+            }
           }
           // Forward half of the 8-neighbourhood, so every pair of buckets is visited once.
           constexpr int kNeighbours[4][2] = {{1, -1}, {1, 0}, {1, 1}, {0, 1}};
@@ -476,15 +520,39 @@ void FusionEngine::recompute(bool full) {
             }
             const std::size_t c = static_cast<std::size_t>(ny * bucketsX_ + nx);
             for (std::uint32_t v = bucketStart_[c]; v < bucketStart_[c + 1]; ++v) {
-              visitPair(i, order_[v]);
+              if (!he[v].wide && near(he[u], he[v])) {
+                visitPair(i, order_[v]);
+              }
             }
           }
         }
       }
     }
+    // A wide disc pairs with every narrow disc and with the wide discs after it in list order.
+    for (const std::uint32_t i : wide_) {
+      const StepDisc& a = list[i];
+      const HashEntry self{a.disc.x, a.disc.y, a.reach, true};
+      const int m = static_cast<int>(std::floor((a.reach + maxReachInHash_) / bucketSize_)) + 1;
+      const int bx = static_cast<int>(bucketOf_[i] % static_cast<std::uint32_t>(bucketsX_));
+      const int by = static_cast<int>(bucketOf_[i] / static_cast<std::uint32_t>(bucketsX_));
+      for (int y = std::max(0, by - m); y <= std::min(bucketsY_ - 1, by + m); ++y) {
+        for (int x = std::max(0, bx - m); x <= std::min(bucketsX_ - 1, bx + m); ++x) {
+          const std::size_t c = static_cast<std::size_t>(y * bucketsX_ + x);
+          for (std::uint32_t v = bucketStart_[c]; v < bucketStart_[c + 1]; ++v) {
+            const std::uint32_t j = order_[v];
+            if ((!he[v].wide || j > i) && near(self, he[v])) {
+              visitPair(i, j);
+            }
+          }
+        }
+      }
+    }
+    for (const DeferredPair& q : deferred_) {
+      scorePair(q.i, q.j, q.d, 0.0);
+    }
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (active_[i] != 0 && discMax_[i] > 0.0) {
-        paints_.push_back(Paint{list[i].disc, discMax_[i]});
+        paints_.push_back(Paint{list[i].disc.x, list[i].disc.y, list[i].disc.r, discMax_[i]});
       }
     }
     // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)
@@ -511,9 +579,9 @@ void FusionEngine::recompute(bool full) {
     for (std::size_t n = 0; n < paints_.size(); ++n) {
       const Paint& pt = paints_[n];
       const auto tx = static_cast<std::size_t>(
-          std::clamp((pt.disc.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
+          std::clamp((pt.x - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
       const auto ty = static_cast<std::size_t>(
-          std::clamp((pt.disc.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
+          std::clamp((pt.y - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
       paintTile_[n] = static_cast<std::uint32_t>(ty * static_cast<std::size_t>(tilesX_) + tx);
       ++tileStart_[paintTile_[n] + 1];
     }
@@ -528,7 +596,7 @@ void FusionEngine::recompute(bool full) {
     // level with max gives the classified grid without a pass over the cells.
     const int K = config_.levels;
     for (const Paint& pt : sortedPaints_) {
-      paintDisc(pt.disc, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
+      paintDisc(Disc{pt.x, pt.y, pt.r}, pt.p, static_cast<std::uint8_t>(isoLevel(pt.p, K)));
     }
     result_.stats.discsPainted = paints_.size();
   }

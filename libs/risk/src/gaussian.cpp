@@ -362,28 +362,69 @@ double gaussianCollisionProbabilityWhitened(Vec2 mean, const Cov2& cov, double R
   return std::clamp(sum * h / (2.0 * kPi), 0.0, 1.0);
 }
 
-Gaussian::Gaussian(double floor)
+Gaussian::Gaussian(double floor, GaussianEvaluation evaluation)
     : floor_(std::clamp(floor, 1e-300, 1.0)),
-      tailSigmas_(std::sqrt(2.0 * std::log(1.0 / floor_)) * 1.001 + 1e-9) {}
+      tailSigmas_(std::sqrt(2.0 * std::log(1.0 / floor_)) * 1.001 + 1e-9),
+      evaluation_(evaluation) {
+  if (evaluation_ == GaussianEvaluation::kFast) {
+    warmGaussianTable();
+  }
+}
 
 double Gaussian::pair(const Disc& a, const Disc& b) const {
-  const double sigma = std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma);
-  const double d = centreDistance(a, b);
+  return pairAt(a, b, centreDistance(a, b));
+}
+
+double Gaussian::pairAbove(const Disc& a, const Disc& b, double d, double /*intersectionArea*/,
+                           double known) const {
+  const double gap = d - (a.r + b.r);
+  if (known > 0.0 && gap > 0.0) {
+    const double sa = a.sigmaMax();
+    const double sb = b.sigmaMax();
+    if (std::exp(-0.5 * gap * gap / (sa * sa + sb * sb)) < known) {
+      return 0.0;  // P <= the bound < known: this pair cannot raise the maximum
+    }
+  }
+  return pairAt(a, b, d);
+}
+
+double Gaussian::pairAt(const Disc& a, const Disc& b, double d) const {
   if (d >= cullDistance(a, b)) {
     return 0.0;
   }
-  const double p = gaussianCollisionProbability(d, a.r + b.r, sigma);
+  if (a.anisotropic() || b.anisotropic()) {
+    // Independent errors: the relative position's covariance is the sum of the two. The quadrature is
+    // not bitwise even in the mean, so the pair is put in one order to keep pair(a, b) == pair(b, a).
+    if (a.x > b.x || (a.x == b.x && a.y > b.y)) {
+      return pairAt(b, a, d);
+    }
+    const Cov2 ca = a.covariance();
+    const Cov2 cb = b.covariance();
+    const Vec2 mean{b.x - a.x, b.y - a.y};
+    const Cov2 sum{ca.xx + cb.xx, ca.xy + cb.xy, ca.yy + cb.yy};
+    const double p = evaluation_ == GaussianEvaluation::kFast
+                         ? gaussianCollisionProbabilityFast(mean, sum, a.r + b.r, floor_)
+                         : gaussianCollisionProbability(mean, sum, a.r + b.r, floor_);
+    return p < floor_ ? 0.0 : p;
+  }
+  const double sigma = std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma);
+  const double p = evaluation_ == GaussianEvaluation::kFast
+                       ? gaussianCollisionProbabilityTabulated(d, a.r + b.r, sigma)
+                       : gaussianCollisionProbability(d, a.r + b.r, sigma);
   return p < floor_ ? 0.0 : p;
 }
 
 double Gaussian::cullDistance(const Disc& a, const Disc& b) const {
   // P(‖x − μ‖ ≥ t) = exp(−t²/(2σ²)) for a 2D isotropic Gaussian, and collision needs ‖x − μ‖ ≥ d − R,
-  // so beyond R + σ·sqrt(2 ln(1/floor)) the probability is below the floor.
-  return a.r + b.r + std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma) * tailSigmas_;
+  // so beyond R + σ·sqrt(2 ln(1/floor)) the probability is below the floor. For anisotropic errors the
+  // same bound holds with σ² = λmax(Ca + Cb) <= λmax(Ca) + λmax(Cb).
+  const double sa = a.sigmaMax();
+  const double sb = b.sigmaMax();
+  return a.r + b.r + std::sqrt(sa * sa + sb * sb) * tailSigmas_;
 }
 
 double Gaussian::reach(const Disc& a) const {
-  return a.r + a.sigma * tailSigmas_;
+  return a.r + a.sigmaMax() * tailSigmas_;
 }
 
 }  // namespace fleet::risk

@@ -1,5 +1,6 @@
 // Anisotropic Gaussian collision probability by an eigen-axis trapezoid rule (docs/algorithms.md, risk).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -10,36 +11,91 @@ namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
 constexpr double kInvSqrt2Pi = 0.39894228040143267794;
-// Normal mass beyond 9 sigma is Φ(−9) = 1.1e-19: nodes and terms out there are left out.
-constexpr double kWindow = 9.0;
-constexpr double kSkipT2 = 8.5 * 8.5;
-// Trapezoid step as a fraction of the narrowest feature (in θ) of the integrand: the trapezoid rule
-// on a Gaussian of unit width errs by ~2·exp(−2π²/Δt²), 1e-13 at Δt = 0.8 (see kStepFraction's test).
-constexpr double kStepFraction = 0.85;
 // Upper bound on the step when both sigmas are large against R (the circle itself is the feature).
 constexpr double kMaxStep = std::numbers::pi / 8.0;
 // Below this eigenvalue split (relative) the covariance is isotropic to ~1e-12 in P: Marcum-Q series.
 constexpr double kIsotropicSplit = 1e-12;
 
+// The exact evaluation. Normal mass beyond 9 sigma is Φ(−9) = 1.1e-19: nodes and terms out there are
+// left out. Trapezoid step as a fraction of the narrowest feature (in θ) of the integrand: the trapezoid
+// rule on a Gaussian of unit width errs by ~2·exp(−2π²/Δt²), 1e-13 at Δt = 0.8 (see kStepFraction's
+// test).
+struct ExactNormal {
+  static constexpr double kWindow = 9.0;
+  static constexpr double kSkipT2 = 8.5 * 8.5;
+  static constexpr double kStepFraction = 0.85;
+  static double upperTail(double x) { return 0.5 * std::erfc(x * kInvSqrt2); }  // 1 − Φ(x)
+  static double isotropic(double d, double R, double sigma) {
+    return gaussianCollisionProbability(d, R, sigma);
+  }
+};
+
+// The fast path: 1 − Φ from a cubic table (step 1/64, error ≤ 2e-9), a window of 7.5 sigma (Φ(−7.5) =
+// 3e-14), nodes up to 7 sigma (e^{−24.5} = 2e-11 of the peak) and a step of one feature width (trapezoid
+// error ~2·exp(−2π²) = 5e-9 of P): within kGaussianTableTolerance, measured in gaussian_fast_test.
+struct TabulatedNormal {
+  static constexpr double kWindow = 7.5;
+  static constexpr double kSkipT2 = 7.0 * 7.0;
+  static constexpr double kStepFraction = 1.0;
+  static constexpr double kStep = 1.0 / 64.0;
+  static constexpr int kPad = 2;
+  static constexpr int kNodes = static_cast<int>(2.0 * kWindow / kStep) + 1 + 2 * kPad;
+  struct Table {
+    std::array<double, kNodes> q{};
+    Table() {
+      for (int i = 0; i < kNodes; ++i) {
+        q[static_cast<std::size_t>(i)] = ExactNormal::upperTail((i - kPad) * kStep - kWindow);
+      }
+    }
+  };
+  static const Table& table() {
+    static const Table t;
+    return t;
+  }
+  static double upperTail(double x) {
+    if (x >= kWindow) {
+      return 0.0;
+    }
+    if (x <= -kWindow) {
+      return 1.0;
+    }
+    const double f = (x + kWindow) / kStep + kPad;
+    const int i = static_cast<int>(f);
+    const double t = f - i;
+    const double tm1 = t - 1.0;
+    const double tm2 = t - 2.0;
+    const double tp1 = t + 1.0;
+    const double* q = table().q.data() + (i - 1);
+    return -t * tm1 * tm2 * (1.0 / 6.0) * q[0] + tp1 * tm1 * tm2 * 0.5 * q[1] - tp1 * t * tm2 * 0.5 * q[2] +
+           tp1 * t * tm1 * (1.0 / 6.0) * q[3];
+  }
+  static double isotropic(double d, double R, double sigma) {
+    return gaussianCollisionProbabilityTabulated(d, R, sigma);
+  }
+};
+
 // P(−w ≤ x2 ≤ w) for x2 ~ N(m2, s2²), m2 ≥ 0, w ≥ 0: the chord's share of the major-axis normal. Each
-// tail by erfc so that small probabilities keep their relative accuracy.
+// tail as an upper tail so that small probabilities keep their relative accuracy.
+template <class N>
 double chordProbability(double w, double m2, double invS2) {
   const double a = (w - m2) * invS2;
-  if (a < -kWindow) {
+  if (a < -N::kWindow) {
     return 0.0;
   }
-  const double nb = (w + m2) * invS2;  // −b, b = (−w − m2)/s2 ≤ a
-  const double lowTail = nb > kWindow ? 0.0 : 0.5 * std::erfc(nb * kInvSqrt2);  // Φ(b)
+  const double nb = (w + m2) * invS2;                               // −b, b = (−w − m2)/s2 ≤ a
+  const double lowTail = nb > N::kWindow ? 0.0 : N::upperTail(nb);  // Φ(b)
   if (a <= 0.0) {
-    return 0.5 * std::erfc(-a * kInvSqrt2) - lowTail;  // Φ(a) − Φ(b), both lower tails
+    return N::upperTail(-a) - lowTail;  // Φ(a) − Φ(b), both lower tails
   }
-  const double highTail = a > kWindow ? 0.0 : 0.5 * std::erfc(a * kInvSqrt2);  // 1 − Φ(a)
+  const double highTail = a > N::kWindow ? 0.0 : N::upperTail(a);  // 1 − Φ(a)
   return 1.0 - highTail - lowTail;
 }
 
-}  // namespace
-
-double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double floor) {
+template <class N>
+double anisotropicProbability(Vec2 mean, const Cov2& cov, double R, double floor) {
+  constexpr double kWindow = N::kWindow;
+  constexpr double kSkipT2 = N::kSkipT2;
+  constexpr double kStepFraction = N::kStepFraction;
   if (!(R > 0.0)) {
     return 0.0;
   }
@@ -60,7 +116,7 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double
     return 1.0;
   }
   if (split <= kIsotropicSplit * lmax) {
-    return gaussianCollisionProbability(dist, R, std::sqrt(0.5 * (cov.xx + cov.yy)));
+    return N::isotropic(dist, R, std::sqrt(0.5 * (cov.xx + cov.yy)));
   }
   // Major axis (eigenvector of lmax) from the row of (cov − lmax I) that does not cancel.
   double ex = 0.0;
@@ -85,7 +141,7 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double
     if (!(std::abs(m1) < R)) {
       return 0.0;
     }
-    return std::clamp(chordProbability(std::sqrt((R - m1) * (R + m1)), m2, invS2), 0.0, 1.0);
+    return std::clamp(chordProbability<N>(std::sqrt((R - m1) * (R + m1)), m2, invS2), 0.0, 1.0);
   }
   const double s1 = std::sqrt(lmin);
   const double lo = m1 - kWindow * s1;
@@ -159,7 +215,7 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double
       }
       // Nodes beyond 8.5 s1 from the mean weigh < 2e-16 of the peak: no chord (erfc) for them.
       if (t * t < kSkipT2) {
-        sum += w * std::exp(-0.5 * t * t) * chordProbability(w, m2, invS2);
+        sum += w * std::exp(-0.5 * t * t) * chordProbability<N>(w, m2, invS2);
       }
       const double ns = s - s * vh + sh - vc * sh;
       vc = vc + vh - vc * vh + s * sh;
@@ -167,6 +223,16 @@ double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double
     }
   }
   return std::clamp(sum * h * invS1 * kInvSqrt2Pi, 0.0, 1.0);
+}
+
+}  // namespace
+
+double gaussianCollisionProbability(Vec2 mean, const Cov2& cov, double R, double floor) {
+  return anisotropicProbability<ExactNormal>(mean, cov, R, floor);
+}
+
+double gaussianCollisionProbabilityFast(Vec2 mean, const Cov2& cov, double R, double floor) {
+  return anisotropicProbability<TabulatedNormal>(mean, cov, R, floor);
 }
 
 }  // namespace fleet::risk

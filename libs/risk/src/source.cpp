@@ -40,6 +40,22 @@ Expected<void> validateSource(const Source& source, const SourceLimits& limits,
       return unexpected("bad_sigma", where + " has sigma " + std::to_string(d.sigma) +
                                          " m; expected 0 <= sigma <= " + std::to_string(limits.maxSigma));
     }
+    if (!std::isfinite(d.cov.xx) || !std::isfinite(d.cov.xy) || !std::isfinite(d.cov.yy)) {
+      return unexpected("non_finite_covariance", where + " has a NaN or infinite covariance entry");
+    }
+    // Positive semi-definite, with a relative slack for a singular covariance rounded to float on the
+    // wire (xy² can then exceed xx·yy by a few ulps).
+    if (d.cov.xx < 0.0 || d.cov.yy < 0.0 || d.cov.xy * d.cov.xy > d.cov.xx * d.cov.yy * (1.0 + 1e-5)) {
+      return unexpected("bad_covariance", where + " has covariance [[" + std::to_string(d.cov.xx) + ", " +
+                                              std::to_string(d.cov.xy) + "], [" + std::to_string(d.cov.xy) +
+                                              ", " + std::to_string(d.cov.yy) +
+                                              "]] m², which is not positive semi-definite");
+    }
+    if (d.sigmaMax() > limits.maxSigma) {
+      return unexpected("bad_covariance",
+                        where + " has a standard deviation of " + std::to_string(d.sigmaMax()) +
+                            " m along its major axis; expected <= " + std::to_string(limits.maxSigma));
+    }
     if (std::abs(d.x) > limits.maxAbsCoordinate || std::abs(d.y) > limits.maxAbsCoordinate) {
       return unexpected(
           "out_of_range",
@@ -80,6 +96,13 @@ AlignedSource alignSource(const Source& source, const TimeBase& base) {
     const Disc& b = source.discs[i0 + 1];
     slot = Disc{a.x + (b.x - a.x) * f, a.y + (b.y - a.y) * f, a.r + (b.r - a.r) * f,
                 a.sigma + (b.sigma - a.sigma) * f};
+    if (a.anisotropic() || b.anisotropic()) {
+      // A convex combination of two covariances is one (PSD stays PSD); an isotropic end enters as σ²I.
+      const Cov2 ca = a.covariance();
+      const Cov2 cb = b.covariance();
+      slot->cov = Cov2{ca.xx + (cb.xx - ca.xx) * f, ca.xy + (cb.xy - ca.xy) * f, ca.yy + (cb.yy - ca.yy) * f};
+      slot->sigma = slot->sigmaMax();
+    }
   }
   return out;
 }

@@ -219,7 +219,7 @@ void Traits<msg::PredictedDiscs>::toC(const msg::PredictedDiscs& in, C& out, Are
   out.t0_ns = in.t0_ns;
   out.dt = in.dt;
   putSeq(out.discs, in.discs, 64, arena, "PredictedDiscs.discs", [](const msg::Disc& d, fleet_Disc& c) {
-    c = {d.x, d.y, d.r, d.sigma};
+    c = {d.x, d.y, d.r, d.sigma, d.cov_xx, d.cov_xy, d.cov_yy};
   });
 }
 msg::PredictedDiscs Traits<msg::PredictedDiscs>::fromC(const C& in) {
@@ -228,7 +228,9 @@ msg::PredictedDiscs Traits<msg::PredictedDiscs>::fromC(const C& in) {
   m.kind = getEnum(in.kind, msg::SourceKind::Human);
   m.t0_ns = in.t0_ns;
   m.dt = in.dt;
-  m.discs = getSeq(in.discs, [](const fleet_Disc& c) { return msg::Disc{c.x, c.y, c.r, c.sigma}; });
+  m.discs = getSeq(in.discs, [](const fleet_Disc& c) {
+    return msg::Disc{c.x, c.y, c.r, c.sigma, c.cov_xx, c.cov_xy, c.cov_yy};
+  });
   return m;
 }
 

@@ -62,6 +62,22 @@ void BM_PairGaussianIsotropic(benchmark::State& state) {
 }
 BENCHMARK(BM_PairGaussianIsotropic);
 
+// The same pairs by the fast path's table (the risk map service's default).
+void BM_PairGaussianIsotropicFast(benchmark::State& state) {
+  const auto s = makePairs(0.3);
+  warmGaussianTable();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Disc& a = s.a[i & 1023];
+    const Disc& b = s.b[i & 1023];
+    benchmark::DoNotOptimize(gaussianCollisionProbabilityTabulated(
+        centreDistance(a, b), a.r + b.r, std::sqrt(a.sigma * a.sigma + b.sigma * b.sigma)));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianIsotropicFast);
+
 // Relative positions and covariances for the anisotropic model: the isotropic pair set with the summed
 // variance as the major eigenvalue, the minor one `minRatio`…1 times that (log-uniform below 0.2,
 // uniform 0.2–1 as in the recorded figures), random orientation.
@@ -99,11 +115,26 @@ void BM_PairGaussianAnisotropic(benchmark::State& state) {
 }
 BENCHMARK(BM_PairGaussianAnisotropic);
 
+void BM_PairGaussianAnisotropicFast(benchmark::State& state) {
+  const auto p = anisotropicPairs(0.2);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const std::size_t k = i & 1023;
+    benchmark::DoNotOptimize(gaussianCollisionProbabilityFast(p.mean[k], p.cov[k], p.R[k]));
+    ++i;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_PairGaussianAnisotropicFast);
+
 // ---------------------------------------------------------------- warehouse scenes
 // Robots (80 %) drive along aisles (horizontal every 3 m, vertical every 5 m) at 0.5–1.5 m/s, humans
 // (20 %) walk in random directions at 0.5–1.4 m/s; radius 0.3–0.6 m (humans 0.3–0.4 m); sigma grows
-// with the prediction step (robots 0.05 + 0.01 k m, humans 0.1 + 0.03 k m).
-std::vector<Source> warehouse(int sources, int steps, double w, double h, std::uint64_t seed) {
+// with the prediction step (robots 0.05 + 0.01 k m, humans 0.1 + 0.03 k m). With `anisotropic`, robots'
+// discs carry a covariance instead: that sigma along their motion, half of it across (people stay
+// isotropic), so the reaches and candidate pairs are those of the isotropic scene.
+std::vector<Source> warehouse(int sources, int steps, double w, double h, std::uint64_t seed,
+                              bool anisotropic = false) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   std::vector<Source> out;
@@ -142,6 +173,11 @@ std::vector<Source> warehouse(int sources, int steps, double w, double h, std::u
     for (int k = 0; k < steps; ++k) {
       const double t = 0.1 * k;
       src.discs.push_back({x + vx * t, y + vy * t, r, human ? 0.1 + 0.03 * k : 0.05 + 0.01 * k});
+      if (anisotropic && !human) {
+        const double along = 0.05 + 0.01 * k, across = 0.5 * along;
+        const double a2 = along * along, c2 = across * across;
+        src.discs.back().cov = vx != 0.0 ? Cov2{a2, 0.0, c2} : Cov2{c2, 0.0, a2};
+      }
     }
     out.push_back(std::move(src));
   }
@@ -158,11 +194,13 @@ FusionConfig warehouseConfig(double w, double h, double res, int steps) {
   return c;
 }
 
+// 0 the overlap ratio, 1 the Gaussian as the risk map service runs it (fast path), 3 the exact Gaussian.
 std::shared_ptr<const RiskModel> modelOf(int which) {
   if (which == 0) {
     return std::make_shared<OverlapRatio>();
   }
-  return std::make_shared<Gaussian>(1e-4);
+  return std::make_shared<Gaussian>(1e-4,
+                                    which == 3 ? GaussianEvaluation::kExact : GaussianEvaluation::kFast);
 }
 
 FusionEngine loaded(const FusionConfig& cfg, const std::vector<Source>& scene, int model) {
@@ -174,13 +212,16 @@ FusionEngine loaded(const FusionConfig& cfg, const std::vector<Source>& scene, i
 }
 
 // Full fusion + levels + regions + RLE of the 100 m × 50 m warehouse at 0.1 m, K = 10.
-// Args: sources, steps, model (0 overlap ratio, 1 Gaussian).
+// Args: sources, steps, model (0 overlap ratio, 1 Gaussian as the service runs it, 2 the same with the
+// robots' discs anisotropic, 3 the exact Gaussian, 4 the exact Gaussian with anisotropic robots).
 void BM_FuseWarehouse(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const int steps = static_cast<int>(state.range(1));
-  const auto scene = warehouse(n, steps, 100.0, 50.0, 7);
-  auto engine = loaded(warehouseConfig(100.0, 50.0, 0.1, steps), scene, static_cast<int>(state.range(2)));
-  std::size_t regions = 0, runs = 0, painted = 0, pairs = 0;
+  const int model = static_cast<int>(state.range(2));
+  const auto scene = warehouse(n, steps, 100.0, 50.0, 7, model == 2 || model == 4);
+  auto engine =
+      loaded(warehouseConfig(100.0, 50.0, 0.1, steps), scene, model == 2 ? 1 : (model == 4 ? 3 : model));
+  std::size_t regions = 0, runs = 0, painted = 0, pairs = 0, tested = 0;
   RegionExtractor extractor;
   for (auto _ : state) {
     engine.invalidate();
@@ -191,8 +232,10 @@ void BM_FuseWarehouse(benchmark::State& state) {
     runs = rle.size();
     painted = r.stats.discsPainted;
     pairs = r.stats.pairsPositive;
+    tested = r.stats.pairsTested;
     benchmark::DoNotOptimize(reg.data());
   }
+  state.counters["pairs_tested"] = static_cast<double>(tested);
   state.counters["regions"] = static_cast<double>(regions);
   state.counters["rle_runs"] = static_cast<double>(runs);
   state.counters["discs_painted"] = static_cast<double>(painted);
@@ -202,6 +245,9 @@ BENCHMARK(BM_FuseWarehouse)
     ->ArgNames({"sources", "steps", "gauss"})
     ->Args({1000, 30, 0})
     ->Args({1000, 30, 1})
+    ->Args({1000, 30, 2})
+    ->Args({1000, 30, 3})
+    ->Args({1000, 30, 4})
     ->Unit(benchmark::kMillisecond)
     ->Repetitions(9)
     ->ReportAggregatesOnly(true);

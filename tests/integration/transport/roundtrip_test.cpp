@@ -161,6 +161,11 @@ TEST_F(RoundTrip, PredictedDiscs) {
   for (int i = 0; i < 64; ++i) {
     b.discs.push_back({i * 0.1f, -i * 0.2f, 0.4f, 0.01f * static_cast<float>(i)});
   }
+  // Anisotropic discs: every covariance entry must come back in its own field (a swap would not).
+  for (int i = 0; i < 8; ++i) {
+    const float f = static_cast<float>(i);
+    a.discs.push_back({f, 2.0f * f, 0.3f, 0.5f, 0.25f + f, -0.01f * f, 0.04f + 0.5f * f});
+  }
   expectRoundTrip<msg::PredictedDiscs>({a, b});
 }
 

@@ -33,7 +33,7 @@ struct FusionStats {
   bool fullRecompute = false;
   std::size_t discs = 0;          // discs present over all steps
   std::size_t pairsTested = 0;    // candidate pairs from the spatial hash within reach
-  std::size_t pairsPositive = 0;  // pairs with score > 0
+  std::size_t pairsPositive = 0;  // pairs scored > 0 (not those the model bounded below both maxima)
   std::size_t discsPainted = 0;
   std::size_t cellsVisited = 0;
   std::size_t tilesRecomputed = 0;
@@ -115,8 +115,8 @@ class FusionEngine {
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
-  struct Paint {
-    Disc disc;
+  struct Paint {  // what painting reads of a disc (not its uncertainty), and the score
+    double x, y, r;
     double p;
   };
   struct RowSpan {
@@ -136,6 +136,19 @@ class FusionEngine {
   std::vector<std::uint32_t> bucketStart_;
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> bucketOf_;
+  struct HashEntry {
+    double x, y, reach;
+    bool wide;  // reach above half a bucket: searched from its own side
+  };
+  std::vector<HashEntry> sorted_;  // the discs in bucket order
+  struct DeferredPair {
+    std::uint32_t i, j;
+    double d;
+  };
+  std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
+  std::vector<std::uint32_t> wide_;
+  std::vector<double> reachScratch_;
+  double maxReachInHash_ = 0.0;
   double bucketMinX_ = 0.0;
   double bucketMinY_ = 0.0;
   double bucketSize_ = 1.0;

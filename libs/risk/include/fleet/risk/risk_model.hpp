@@ -29,6 +29,13 @@ class RiskModel {
                                                     double /*intersectionArea*/) const {
     return pair(a, b);
   }
+  /// For a caller that keeps maxima of scores: pairWithIntersection(a, b, d, area) when that exceeds
+  /// `known`, else any value <= known — a model with a cheap upper bound may return 0 for pairs that
+  /// cannot raise the maximum. The default scores every pair.
+  [[nodiscard]] virtual double pairAbove(const Disc& a, const Disc& b, double d, double intersectionArea,
+                                         double /*known*/) const {
+    return pairWithIntersection(a, b, d, intersectionArea);
+  }
 };
 
 }  // namespace fleet::risk

@@ -31,7 +31,8 @@ struct SourceLimits {
 };
 
 /// Error codes: "invalid_id", "empty", "too_many_steps", "bad_dt", "non_finite", "bad_radius",
-/// "bad_sigma", "out_of_range", "future_timestamp". The message names the disc index and value.
+/// "bad_sigma", "non_finite_covariance", "bad_covariance" (not positive semi-definite, or a major-axis
+/// σ above maxSigma), "out_of_range", "future_timestamp". The message names the disc index and value.
 /// The timestamp check runs only when now_ns is given.
 Expected<void> validateSource(const Source& source, const SourceLimits& limits,
                               std::optional<std::int64_t> now_ns = std::nullopt);
@@ -44,8 +45,8 @@ struct TimeBase {
   bool operator==(const TimeBase&) const = default;
 };
 
-/// The source's disc at each step of the time base, linearly interpolated (x, y, r, sigma) between
-/// its samples. Steps before t0 or after the last sample by more than half a source step are empty
+/// The source's disc at each step of the time base, linearly interpolated (x, y, r, sigma, covariance)
+/// between its samples. Steps before t0 or after the last sample by more than half a source step are empty
 /// (no prediction there); within that half step the end disc is held. A one-disc source is a snapshot
 /// held over the whole horizon.
 AlignedSource alignSource(const Source& source, const TimeBase& base);

@@ -119,6 +119,10 @@ struct Disc {
   float y = 0;
   float r = 0;
   float sigma = 0;
+  // Position covariance (m²); all zero means isotropic with `sigma`.
+  float cov_xx = 0;
+  float cov_xy = 0;
+  float cov_yy = 0;
   bool operator==(const Disc&) const = default;
 };
 
