@@ -13,7 +13,7 @@ Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
                          "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
-                         "roadmap"});
+                         "detour_after", "detour_penalty", "roadmap"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -30,6 +30,10 @@ Settings readSettings(Config& cfg) {
   s.traffic.release.horizonNodes = static_cast<std::size_t>(
       cfg.integer("horizon_nodes", static_cast<std::int64_t>(s.traffic.release.horizonNodes), {0, 32}));
   s.traffic.pibt.seed = static_cast<std::uint64_t>(cfg.integer("seed", 1, {0, 1e15}));
+  s.traffic.pibt.detourAfter =
+      static_cast<int>(cfg.integer("detour_after", s.traffic.pibt.detourAfter, {0, 100000}));
+  s.traffic.pibt.detourPenalty =
+      static_cast<float>(cfg.number("detour_penalty", s.traffic.pibt.detourPenalty, {0.0, 1e6}));
   auto r = cfg.child("roadmap");
   r.rejectUnknownKeys({"spacing", "cruise_speed", "margin", "queue_length", "diagonals"});
   s.roadmap.spacing = r.number("spacing", 0.0, {0.0, 10.0});

@@ -155,7 +155,8 @@ TEST(TrafficNode, HoldingAndSilentRobotsArePlannedAround) {
 }
 
 TEST(TrafficNode, SettingsNameWhatIsWrong) {
-  Config bad = Config::fromText(R"({"rate_hz": -1, "lockstep": true, "roadmap": {"spacng": 1}})", "test");
+  Config bad = Config::fromText(
+      R"({"rate_hz": -1, "lockstep": true, "detour_after": -2, "roadmap": {"spacng": 1}})", "test");
   readSettings(bad);
   ASSERT_FALSE(bad.ok());
   std::string all;
@@ -164,6 +165,17 @@ TEST(TrafficNode, SettingsNameWhatIsWrong) {
   EXPECT_NE(all.find("rate_hz"), std::string::npos) << all;
   EXPECT_NE(all.find("lockstep"), std::string::npos) << all;
   EXPECT_NE(all.find("spacng"), std::string::npos) << all;
+  EXPECT_NE(all.find("detour_after"), std::string::npos) << all;
+}
+
+TEST(TrafficNode, DetoursAreOnByDefaultAndCanBeTurnedOff) {
+  Config none = Config::fromText("{}", "test");
+  EXPECT_EQ(readSettings(none).traffic.pibt.detourAfter, 4);
+  Config off = Config::fromText(R"({"detour_after": 0, "detour_penalty": 12.5})", "test");
+  const Settings s = readSettings(off);
+  ASSERT_TRUE(off.ok());
+  EXPECT_EQ(s.traffic.pibt.detourAfter, 0);
+  EXPECT_FLOAT_EQ(s.traffic.pibt.detourPenalty, 12.5F);
 }
 
 }  // namespace
