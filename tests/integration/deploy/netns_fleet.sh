@@ -77,7 +77,10 @@ ctl() { ip netns exec "fleet-C-$ID" "$B/services/fleetctl/fleetctl" --url http:/
 for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
 ctl submit "$dir/tasks.csv" | tee "$dir/submit.txt"
 grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the task"
-on B fleet-sim "$B/sim/src/fleet-sim" --scenario "$scenario" --clock lockstep --participants 2 --duration 150 \
+# The manager runs on the wall clock and learns the robot only once the simulator steps, while
+# lockstep runs ~250x real time: the assignment can land ~90 s into the simulation (it did once,
+# and 150 s then left the robot 56 s for a ~75 s task). 600 s leaves room and takes ~2 s of wall time.
+on B fleet-sim "$B/sim/src/fleet-sim" --scenario "$scenario" --clock lockstep --participants 2 --duration 600 \
   --summary "$dir/summary.json" --log-level info
 
 state=""
