@@ -670,18 +670,15 @@ void Pibt::planDetours() {
       }
       covered = true;
     }
-    // Its own footprint is no obstacle to it.
-    --cover[idx(now_[i])];
-    for (const NodeId w : graph_.conflicts(now_[i])) {
-      --cover[idx(w)];
-    }
+    // Its own footprint is no obstacle to it: there only the others standing count.
     extra_.resize(graph_.size());
     for (std::size_t v = 0; v < graph_.size(); ++v) {
       extra_[v] = cover[v] > 0 ? options_.detourPenalty : 0.0F;
     }
-    ++cover[idx(now_[i])];
+    const auto own = [&](NodeId w) { extra_[idx(w)] = cover[idx(w)] > 1 ? options_.detourPenalty : 0.0F; };
+    own(now_[i]);
     for (const NodeId w : graph_.conflicts(now_[i])) {
-      ++cover[idx(w)];
+      own(w);
     }
     const float from = distances_.distance(now_[i], goal_[i]);
     distances_.withExtraCost(goal_[i], extra_, detour_[i]);

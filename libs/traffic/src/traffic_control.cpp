@@ -76,7 +76,16 @@ void TrafficControl::plannerGoal(std::size_t robot, NodeId goal) {
   if (evadeUntil_[robot] >= 0)
     return;  // takes effect when the evasion ends
   planner_->setGoal(robot, goal);
-  planner_->setTaskPriority(robot, priority_[robot]);
+  plannerPriority(robot);
+}
+
+void TrafficControl::plannerPriority(std::size_t robot) {
+  // A robot driving off a dock goes first: the robots in line for the dock would otherwise (they
+  // have waited longer, so PIBT ranks them higher) push it back onto the dock whenever its way out
+  // passes them, and it would never leave.
+  const bool leaving =
+      std::find(leaving_.begin(), leaving_.end(), static_cast<std::int64_t>(robot)) != leaving_.end();
+  planner_->setTaskPriority(robot, priority_[robot] + (leaving ? kLeavingBoost : 0));
 }
 
 void TrafficControl::leaveLine(std::size_t robot) {
@@ -89,6 +98,7 @@ void TrafficControl::leaveLine(std::size_t robot) {
   const NodeId dock = stations_[static_cast<std::size_t>(s)].dock;
   if (!l.empty() && l.front() == robot && graph_.conflicting(planner_->positions()[robot], dock)) {
     leaving_[static_cast<std::size_t>(s)] = static_cast<std::int64_t>(robot);
+    plannerPriority(robot);
   }
   l.erase(std::remove(l.begin(), l.end(), robot), l.end());
   inLine_[robot] = -1;
@@ -216,14 +226,6 @@ int TrafficControl::update() {
     }
     if (oldest >= 0 && execution_.plannedSteps() - oldest >= options_.maxLag)
       replan();
-    // A robot driving off a dock goes first: the robots in line for the dock would otherwise
-    // (they have waited longer, so PIBT ranks them higher) push it back onto the dock whenever
-    // its way out passes them, and it would never leave.
-    for (const auto q : leaving_) {
-      if (q >= 0)
-        planner_->setTaskPriority(static_cast<std::size_t>(q),
-                                  priority_[static_cast<std::size_t>(q)] + kLeavingBoost);
-    }
     execution_.append(planner_->step());
     afterStep();
     ++steps;
@@ -239,8 +241,8 @@ void TrafficControl::afterStep() {
     const auto q = leaving_[i];
     if (q >= 0 &&
         !graph_.conflicting(planner_->positions()[static_cast<std::size_t>(q)], stations_[i].dock)) {
-      planner_->setTaskPriority(static_cast<std::size_t>(q), priority_[static_cast<std::size_t>(q)]);
       leaving_[i] = -1;
+      plannerPriority(static_cast<std::size_t>(q));
       updateLine(i);
     }
   }

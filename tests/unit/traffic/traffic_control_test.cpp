@@ -21,11 +21,9 @@ Roadmap smallWarehouse() {
 /// ever hold conflicting nodes, their centres keep the contact distance, no report is refused.
 /// (How much work they get done is the planner's business: measured in docs/benchmarks.md, where
 /// the 20-robot fleet still jams; see the issue notes.)
-TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
-  Roadmap map = smallWarehouse();
-  VirtualFleetOptions o;
-  o.robots = 20;
-  o.duration = 300.0;
+/// Seeds 1–3 of the virtual fleet, each checked against every promise; returns the results.
+std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
+  std::vector<VirtualFleetResult> out;
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     o.seed = seed;
     const auto r = runVirtualFleet(map, o);
@@ -33,8 +31,20 @@ TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
     EXPECT_EQ(r.holdViolations, 0U);
     EXPECT_EQ(r.contacts, 0U);
     EXPECT_EQ(r.refusedReports, 0U);
-    EXPECT_GE(r.minSeparation, map.separation.contact - map.separation.margin);
+    if (o.robots > 1) {
+      EXPECT_GE(r.minSeparation, map.separation.contact - map.separation.margin);
+    }
+    out.push_back(r);
   }
+  return out;
+}
+
+TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  runSeeds(map, o);
 }
 
 /// A robot parked in a dock whose only way out is excluded by a robot standing on the lane in
@@ -121,17 +131,11 @@ TEST(VirtualFleet, FiveRobotsKeepWorkingOnTheSmallWarehouse) {
   VirtualFleetOptions o;
   o.robots = 5;
   o.duration = 600.0;
-  std::size_t least = 1000;
-  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    o.seed = seed;
-    const auto r = runVirtualFleet(map, o);
+  for (const auto& r : runSeeds(map, o)) {
     SCOPED_TRACE(formatResult(r));
-    EXPECT_EQ(r.holdViolations, 0U);
-    EXPECT_EQ(r.contacts, 0U);
     EXPECT_LT(r.longestWait, 120.0);
-    least = std::min(least, r.tasksDone);
+    EXPECT_GE(r.tasksDone, 15U);
   }
-  EXPECT_GE(least, 15U);
 }
 
 TEST(VirtualFleet, ALoneRobot) {

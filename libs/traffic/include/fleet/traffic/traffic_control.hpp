@@ -111,6 +111,7 @@ class TrafficControl {
   void leaveLine(std::size_t robot);
   void updateLine(std::size_t station);
   void plannerGoal(std::size_t robot, NodeId goal);
+  void plannerPriority(std::size_t robot);
   void afterStep();
   void clearWayFor(std::size_t robot);
   enum class Need : std::uint8_t { None, Later, Now };
