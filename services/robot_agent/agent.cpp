@@ -15,7 +15,6 @@
 #include "fleet/planning/return_path.hpp"
 #include "fleet/planning/wavefront.hpp"
 #include "map_faces.hpp"
-#include "risk_astar.hpp"
 
 #include <stdexcept>
 
@@ -120,10 +119,8 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits}),
       standsAt_(p_.start),
       progress_(ProgressLimits{p_.blockedFailS, p_.blockedBackoffS}),
-      arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}) {
-  if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
-    throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
-  }
+      arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}),
+      route_(RouteOptions{p_.globalPlanner, p_.lanes, p_.riskWeightGlobal, p_.radius}, grid_, raw_) {
   if (p_.traffic != "reactive" && p_.traffic != "reserved") {
     throw std::invalid_argument("traffic: '" + p_.traffic + "' is not reactive or reserved");
   }
@@ -350,29 +347,12 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
     // 0.25 m from shelf faces (the local planner then crawled past each shelf corner).
     g.setBlocked(*c, false);
   }
-  openGoal(g, goal);
+  openGoal(g, *raw_, goal, p_.radius);
   return g;
 }
 
 bool Agent::bodyFits(Vec2 p) const {
-  const auto c = raw_->cellAt(p);
-  bool fits = c && !raw_->blocked(*c);
-  for (int k = 0; fits && k < 8; ++k) {
-    const double a = k * kPi / 4.0;
-    const auto e = raw_->cellAt(p + Vec2{std::cos(a), std::sin(a)} * p_.radius);
-    fits = e && !raw_->blocked(*e);
-  }
-  return fits;
-}
-
-void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
-  // A station closer to a wall than the planning margin (parking places along a wall) lies in a
-  // blocked cell. Planning to it then fell back to the raw map, whose paths hug walls and shelf
-  // corners that the stop rule will not let the robot pass: open just the goal's cell, so the path
-  // keeps its margin up to the last cell and then steps onto the station.
-  if (const auto c = g.cellAt(goal); c && g.blocked(*c) && bodyFits(goal)) {
-    g.setBlocked(*c, false);
-  }
+  return agent::bodyFits(*raw_, p, p_.radius);
 }
 
 std::optional<Vec2> Agent::axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const {
@@ -411,30 +391,6 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   const auto& g = goals_[goal_];
   // Leaving a station or parking place (not re-planning on the way): see undockFrom_.
   const bool fromStandstill = phase_ == Phase::Idle || phase_ == Phase::Dwelling;
-  // Lanes and risk together: the risk map's probability scales each cell's cost as in risk_astar.
-  planning::CellCostFactor riskFactor;
-  if (risk_) {
-    riskFactor = [r = risk_, w = p_.riskWeightGlobal, gr = grid_](planning::Cell c) {
-      return 1.0 + w * r->at(gr->cellCenter(c));
-    };
-  }
-  std::unique_ptr<planning::GlobalPlanner> chosen;
-  if (p_.lanes) {
-    chosen = std::make_unique<planning::LanePlanner>(p_.lanes, riskFactor);
-  } else if (p_.globalPlanner == "wavefront") {
-    chosen = std::make_unique<planning::WavefrontPlanner>();
-  } else if (p_.globalPlanner == "ompl") {
-    planning::OmplOptions oo;
-    // Planned inside the agent's cycle: a short budget, and stop at the first path within 20 % of
-    // the straight line (the grid is inflated already, so the robot is a point here).
-    oo.timeBudget = 0.05;
-    oo.simplifyTime = 0.02;
-    oo.costThreshold = 1.2 * distance(localizer_.pose(), g.pose);
-    chosen = std::make_unique<planning::OmplPlanner>(oo);
-  } else {
-    chosen = std::make_unique<planning::AStarPlanner>();
-  }
-  planning::GlobalPlanner& astar = *chosen;
   const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
   // Stations are left and entered straight along their axis, through a point kAxisDistance in
   // front of them (a dock's pre-dock pose, VDA 5050's approach pose). A path straight from a
@@ -489,24 +445,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
         // The robot's own cell (the disc covers it when it stands close): a plan must start.
         detour.setBlocked(*c, false);
       }
-      return astar.plan(detour, start, end);  // no way around: the caller keeps its path
+      return route_.detour(detour, start, end);  // no way around: the caller keeps its path
     }
-    Expected<planning::Path> path = unexpected("no_path", "not planned");
-    if (risk_ && !p_.lanes && p_.globalPlanner == "astar") {
-      RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
-      path = riskAware.plan(around, start, end);
-    } else {
-      path = astar.plan(around, start, end);
-    }
-    if (!path) {
-      planning::OccupancyGrid plain = *grid_;  // boxed in by standing robots: wait them out
-      openGoal(plain, end.position());
-      path = astar.plan(plain, start, end);
-    }
-    if (!path) {
-      path = astar.plan(*raw_, start, end);  // a start or goal hugging a shelf
-    }
-    return path;
+    return route_.route(around, start, end);
   };
   Expected<planning::Path> path = plan(from, to);
   approach_.reset();

@@ -34,15 +34,16 @@
 #include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
+#include "fleet/messages/messages.hpp"
 #include "fleet/planning/lane_map.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/risk/risk_lookup.hpp"
 #include "localizer.hpp"
 #include "motion_gate.hpp"
 #include "other_robot.hpp"
 #include "progress_watch.hpp"
 #include "release_tracker.hpp"
-#include "risk_field.hpp"
+#include "route_planner.hpp"
 #include "standoff_arbiter.hpp"
 
 namespace fleet::agent {
@@ -125,7 +126,10 @@ class Agent {
   void onRelease(const msg::TrafficRelease& r);
   /// The latest risk map (shared by every agent of the process): the local planner's risk term and
   /// the global planner's cell cost. Null: no risk information.
-  void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
+  void onRiskMap(std::shared_ptr<const risk::RiskLookup> risk) {
+    route_.setRisk(risk);
+    risk_ = std::move(risk);
+  }
   AgentOutput step(std::int64_t nowNs, double dt);
   /// True while the sensor stream is considered lost (as of the last step).
   [[nodiscard]] bool sensorLost() const { return localizer_.lost(); }
@@ -221,7 +225,7 @@ class Agent {
   std::vector<Vec2> path_;                            // remaining path (world frame)
   /// One cycle of the configured avoidance planner; returns the twist and whether it is blocked.
   control::Twist planLocal(bool& blocked);
-  std::shared_ptr<const RiskField> risk_;
+  std::shared_ptr<const risk::RiskLookup> risk_;
 
   std::string task_;
   std::uint32_t revision_ = 0;
@@ -242,8 +246,6 @@ class Agent {
   [[nodiscard]] planning::OccupancyGrid gridAroundStandingRobots(Vec2 goal) const;
   /// The robot's disc at `p` is clear of the raw map's obstacles.
   [[nodiscard]] bool bodyFits(Vec2 p) const;
-  /// Unblocks the goal's cell of `g` when the robot fits on the goal itself.
-  void openGoal(planning::OccupancyGrid& g, Vec2 goal) const;
   /// The point kAxisDistance in front of `station` (along its heading) when it is free on `g` and
   /// the straight leg to it is clear of walls and standing robots; the way in and out.
   [[nodiscard]] std::optional<Vec2> axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const;
@@ -281,6 +283,7 @@ class Agent {
   std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
   StandoffArbiter arbiter_;  // what to do about a hold: wait, yield, detour, fail
   Conduct conduct_;
+  RoutePlanner route_;  // global paths: the planner chosen once, cost layers, the fallback chain
 
   // Reserved traffic.
   bool reserved_ = false;

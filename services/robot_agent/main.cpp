@@ -305,7 +305,7 @@ int run(const World& scn, const Options& opt) {
     }
     if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
       // Only the newest map matters; it is decoded once and shared read-only by every agent.
-      if (auto field = agent::RiskField::fromMessage(maps.back())) {
+      if (auto field = agent::riskLookupOf(maps.back())) {
         for (auto& a : agents) {
           a->onRiskMap(*field);
         }
