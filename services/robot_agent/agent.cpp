@@ -116,11 +116,12 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
       follower_(followerParams()),
-      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits}),
+      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit}),
       standsAt_(p_.start),
       progress_(ProgressLimits{p_.blockedFailS, p_.blockedBackoffS}),
       arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}),
-      route_(RouteOptions{p_.globalPlanner, p_.lanes, p_.riskWeightGlobal, p_.radius}, grid_, raw_) {
+      route_(RouteOptions{p_.globalPlanner, p_.lanes, p_.riskWeightGlobal, p_.radius, p_.zoneLayers}, grid_,
+             raw_) {
   if (p_.traffic != "reactive" && p_.traffic != "reserved") {
     throw std::invalid_argument("traffic: '" + p_.traffic + "' is not reactive or reserved");
   }

@@ -24,6 +24,7 @@
 // traffic manager's plan, the gate stays for people and the unexpected.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -95,6 +96,11 @@ struct AgentParams {
   /// One-way aisles of the map (shared by every agent of a process); null: plain A*. Set, it
   /// replaces the global planner.
   std::shared_ptr<const planning::LaneMap> lanes;
+  /// The site's zones: cost layers every global path keeps to (one-way, speed limits as travel
+  /// time; no-go zones are blocked in the maps given to the agent) and the speed limit at a point
+  /// (m/s; +inf or empty: none), which the motion gate enforces.
+  planning::CostLayers zoneLayers;
+  std::function<double(Vec2)> speedLimit;
   /// "reactive": robots keep clear of each other by the standoff conduct (the default for now);
   /// "reserved": the route comes from the traffic manager's releases (see onRelease).
   std::string traffic = "reactive";

@@ -60,6 +60,10 @@ RoutePlanner::RoutePlanner(RouteOptions opt, std::shared_ptr<const planning::Occ
     ruleLayers_.push_back(std::make_shared<planning::LaneCost>(opt_.lanes));
     kind = "astar";
   }
+  if (!opt_.rules.empty()) {
+    ruleLayers_.insert(ruleLayers_.end(), opt_.rules.begin(), opt_.rules.end());
+    kind = "astar";
+  }
   auto made = makeGlobalPlanner(kind, ruleLayers_);
   if (!made) {
     throw std::invalid_argument(made.error().message);

@@ -28,6 +28,9 @@ struct RouteOptions {
   /// most (1 + riskWeight)× the shortest one.
   double riskWeight = 1.0;
   double radius = 0.3;  ///< the robot's disc, for opening a goal that lies in the planning margin
+  /// More rules every path keeps (the site's one-way and speed-limit zones, site/zone_costs.hpp);
+  /// set, the planner is the layered A* as with lanes.
+  planning::CostLayers rules;
 };
 
 /// The global planner called `kind` with `layers` (only "astar" takes layers). Error

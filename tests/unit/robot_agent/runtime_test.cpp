@@ -44,6 +44,15 @@ Expected<planning::GridPath> riskAstar(const planning::OccupancyGrid& g, plannin
   return planning::astar(g, s, t, layers);
 }
 
+agent::RouteOptions routeOptions(std::string kind, std::shared_ptr<const planning::LaneMap> lanes,
+                                 double riskWeight) {
+  agent::RouteOptions o;
+  o.planner = std::move(kind);
+  o.lanes = std::move(lanes);
+  o.riskWeight = riskWeight;
+  return o;
+}
+
 }  // namespace
 
 TEST(RiskLookup, LooksUpTheLevelUpperBoundOfTheCellAndZeroOffTheMap) {
@@ -139,18 +148,14 @@ TEST(RoutePlanner, IsBuiltOnceByNameAndRefusesUnknownPlanners) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().code, "unknown_planner");
   EXPECT_NE(bad.error().message.find("'dijkstra'"), std::string::npos);
-  EXPECT_THROW(agent::RoutePlanner(agent::RouteOptions{"rrt", nullptr, 1.0, 0.3}, grid, grid),
-               std::invalid_argument);
+  EXPECT_THROW(agent::RoutePlanner(routeOptions("rrt", nullptr, 1.0), grid, grid), std::invalid_argument);
   auto lanes = std::make_shared<const planning::LaneMap>(
       planning::LaneMap::derive(planning::OccupancyGrid(5, 5, 0.5)));
-  EXPECT_THROW(agent::RoutePlanner(agent::RouteOptions{"astar", lanes, 1.0, 0.3}, grid, grid),
-               std::invalid_argument)
+  EXPECT_THROW(agent::RoutePlanner(routeOptions("astar", lanes, 1.0), grid, grid), std::invalid_argument)
       << "a lane map of another size";
   // Lanes are a rule of every path: they make the planner the layered A* whatever was asked.
   auto fits = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*grid));
-  EXPECT_STREQ(
-      agent::RoutePlanner(agent::RouteOptions{"wavefront", fits, 1.0, 0.3}, grid, grid).plannerName(),
-      "astar");
+  EXPECT_STREQ(agent::RoutePlanner(routeOptions("wavefront", fits, 1.0), grid, grid).plannerName(), "astar");
 }
 
 TEST(RoutePlanner, WeighsRiskInTheFirstTryOnly) {
@@ -164,7 +169,7 @@ TEST(RoutePlanner, WeighsRiskInTheFirstTryOnly) {
   }
   const auto risk = agent::riskLookupOf(riskMap(40, 21, 1.0, {}, 4, levels));
   ASSERT_TRUE(risk);
-  agent::RoutePlanner route(agent::RouteOptions{"astar", nullptr, 3.0, 0.3}, grid, grid);
+  agent::RoutePlanner route(routeOptions("astar", nullptr, 3.0), grid, grid);
   const Pose2 from{2.5, 5.5, 0.0};
   const Pose2 to{37.5, 5.5, 0.0};
   auto crossesBand = [&](const planning::Path& p) {
@@ -200,6 +205,43 @@ TEST(RoutePlanner, WeighsRiskInTheFirstTryOnly) {
   EXPECT_TRUE(crossesBand(*route.route(*grid, from, to)));
 }
 
+TEST(RoutePlanner, TheSiteRulesApplyToEveryTry) {
+  // Two corridors (y < 2.5 and y > 2.5 m) joined at both ends; a rule prices moving left in the
+  // lower one x1000 (a one-way zone). From its right end to its left end the route takes the upper
+  // corridor, in the first try and in the fallback alike, and the planner asked for (wavefront)
+  // becomes the layered A*.
+  struct EastboundBelow final : planning::CostLayer {
+    double factor(planning::Cell from, planning::Cell to) const override {
+      return to.x < from.x && to.y < 5 ? 1000.0 : 1.0;
+    }
+    const char* name() const override { return "eastbound_below"; }
+  };
+  planning::OccupancyGrid map(20, 10, 0.5);
+  for (int x = 2; x < 18; ++x) {
+    map.setBlocked({x, 5});
+  }
+  auto grid = std::make_shared<const planning::OccupancyGrid>(map);
+  auto opt = routeOptions("wavefront", nullptr, 1.0);
+  opt.rules.push_back(std::make_shared<EastboundBelow>());
+  agent::RoutePlanner route(opt, grid, grid);
+  EXPECT_STREQ(route.plannerName(), "astar");
+  auto usesUpper = [](const planning::Path& p) {
+    return std::any_of(p.poses.begin(), p.poses.end(), [](const Pose2& q) { return q.y > 2.75; });
+  };
+  const Pose2 from{8.25, 1.25, kPi};
+  const Pose2 to{2.25, 1.25, kPi};
+  const auto first = route.route(*grid, from, to);
+  ASSERT_TRUE(first);
+  EXPECT_TRUE(usesUpper(*first));
+  planning::OccupancyGrid goalBlocked = map;  // the first try fails: the fallback plans
+  goalBlocked.setBlocked(*map.cellAt(to.position()));
+  const auto fallback = route.route(goalBlocked, from, to);
+  ASSERT_TRUE(fallback);
+  EXPECT_TRUE(usesUpper(*fallback));
+  agent::RoutePlanner plain(routeOptions("astar", nullptr, 1.0), grid, grid);
+  EXPECT_FALSE(usesUpper(*plain.route(*grid, from, to))) << "without the rule: straight along the lower one";
+}
+
 TEST(RoutePlanner, OpensAGoalInThePlanningMarginWhenTheBodyFits) {
   // A parking place 0.45 m from a wall: its cell is blocked on the grid inflated by 0.5 m, but a
   // 0.3 m robot fits on it.
@@ -216,7 +258,7 @@ TEST(RoutePlanner, OpensAGoalInThePlanningMarginWhenTheBodyFits) {
   planning::OccupancyGrid g = *grid;
   agent::openGoal(g, raw, place, 0.3);
   EXPECT_FALSE(g.blocked(*g.cellAt(place)));
-  agent::RoutePlanner route(agent::RouteOptions{"astar", nullptr, 1.0, 0.3}, grid, rawPtr);
+  agent::RoutePlanner route(routeOptions("astar", nullptr, 1.0), grid, rawPtr);
   const auto p = route.route(*grid, Pose2{2.05, 1.5, 0.0}, Pose2{place.x, place.y, 0.0});
   ASSERT_TRUE(p) << p.error().message;
   for (const auto& q : p->poses) {
