@@ -46,6 +46,7 @@
 #include "release_tracker.hpp"
 #include "route_planner.hpp"
 #include "standoff_arbiter.hpp"
+#include "task_runner.hpp"
 
 namespace fleet::agent {
 
@@ -142,11 +143,11 @@ class Agent {
 
   [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
-  [[nodiscard]] bool busy() const { return !task_.empty(); }
+  [[nodiscard]] bool busy() const { return tasks_.busy(); }
   /// The current order is paused by the operator: the robot stands still with it.
-  [[nodiscard]] bool paused() const { return paused_ && !task_.empty(); }
+  [[nodiscard]] bool paused() const { return tasks_.paused(); }
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
-  [[nodiscard]] bool homing() const { return homing_; }
+  [[nodiscard]] bool homing() const { return tasks_.homing(); }
   [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
   [[nodiscard]] const LineStats& lineStats() const { return localizer_.lineStats(); }
   /// Follows the traffic manager's releases (AgentParams::traffic "reserved").
@@ -170,7 +171,6 @@ class Agent {
   [[nodiscard]] const Conduct& conduct() const { return conduct_; }
 
  private:
-  enum class Phase { Idle, Driving, Dwelling, BackingOff, Returning };
   /// The task stack for one cycle (the body of step() while sensors are live).
   AgentOutput drive(std::int64_t nowNs, double dt);
   /// The localizer's stream watch; on loss and on recovery queues a TaskStatus with the reason and
@@ -183,13 +183,12 @@ class Agent {
   /// Plans to the current goal; with `avoid`, the cells around that point count as blocked (a
   /// detour around whatever stands in the way).
   void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
-  void finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs);
+  void finishTask(TaskStage final, const std::string& reason, std::int64_t nowNs);
   /// At a goal: dwell there for its duration, reporting loading/unloading.
   void enterDwell(std::int64_t nowNs);
   /// Something keeps the robot from moving: does what the standoff arbiter decides (after a while
   /// back off, then detour, then fail).
   void onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w);
-  msg::TaskState taskStateFor(std::size_t goalIndex, bool dwelling) const;
   /// What the motion gate looks at this cycle.
   [[nodiscard]] GateView gateView() const;
   /// The gate's stop rule (see MotionGate); keeps where it found the robot blocked (blockPoint_).
@@ -216,7 +215,7 @@ class Agent {
   /// Reserved traffic: a leg towards the current goal begins (no plan: the releases are the route).
   void beginLeg(std::int64_t nowNs);
   /// Reserved traffic: where the robot is going (the task's goal; idle, its home), if anywhere.
-  [[nodiscard]] std::optional<msg::Goal> trafficGoal() const;
+  [[nodiscard]] std::optional<TaskGoal> trafficGoal() const;
   /// Reserved traffic: the base ends on the current goal (its last leg is the docking).
   [[nodiscard]] bool baseEndsAtGoal() const;
   /// Reserved traffic: the progress report for this cycle, if one is due.
@@ -233,17 +232,9 @@ class Agent {
   control::Twist planLocal(bool& blocked);
   std::shared_ptr<const risk::RiskLookup> risk_;
 
-  std::string task_;
-  std::uint32_t revision_ = 0;
-  bool paused_ = false;              // the order says hold (TaskAssignment.paused)
+  TaskRunner tasks_;                 // the order, its goals, the phase and the task states reported
   std::int64_t pausedSinceNs_ = -1;  // holding since (its length is added to the task's timers)
-  std::vector<msg::Goal> goals_;
-  std::size_t goal_ = 0;
-  Phase phase_ = Phase::Idle;
-  std::int64_t phaseStartNs_ = 0;
   std::int64_t blockedSinceNs_ = -1;
-  std::optional<msg::TaskStatus> pendingStatus_;
-  msg::TaskState reported_ = msg::TaskState::Queued;
   using Other = OtherRobot;
   MotionGate gate_;  // stop rule and cross-traffic check
   std::vector<Other> others_;
@@ -266,7 +257,6 @@ class Agent {
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
-  bool homing_ = false;
   bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
   /// The pose law's curve onto this goal was blocked by a wall: turn to face it and drive straight.
   bool straightDock_ = false;
