@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <random>
 #include <set>
@@ -534,6 +535,49 @@ int Run::run() {
   }
   std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", std::to_string(domain)}};
   const double drop = dropFraction(faults);
+  // DDS Security: each process joins as its identity of the folder (scripts/dds-security).
+  const auto identityOf = [](const std::string& process) -> std::string {
+    if (process.rfind("agent-", 0) == 0) {
+      return "agents";
+    }
+    static const std::map<std::string, std::string> kIdentity = {{"fleet_manager", "fleet-manager"},
+                                                                 {"wms_adapter", "wms-adapter"},
+                                                                 {"risk_map", "risk-map"},
+                                                                 {"traffic_manager", "traffic-manager"},
+                                                                 {"fleet-sim", "simulator"}};
+    const auto it = kIdentity.find(process);
+    return it == kIdentity.end() ? process : it->second;
+  };
+  if (!o.ddsSecurity.empty()) {
+    if (drop > 0) {
+      std::cerr << "fleetctl loadtest: --dds-security and a drop-packets fault both need their own "
+                   "CYCLONEDDS_URI; give one of them\n";
+      return 2;
+    }
+    std::vector<std::string> missing;
+    for (const char* id :
+         {"fleet-manager", "wms-adapter", "risk-map", "traffic-manager", "simulator", "agents"}) {
+      if (!fs::exists(fs::path(o.ddsSecurity) / id / "cyclonedds.xml")) {
+        missing.emplace_back(id);
+      }
+    }
+    if (!missing.empty()) {
+      std::string names;
+      for (const auto& m : missing) {
+        names += (names.empty() ? "" : ", ") + m;
+      }
+      std::cerr << "fleetctl loadtest: --dds-security " << o.ddsSecurity << ": no identity for " << names
+                << " (make them with: scripts/dds-security deployment " << o.ddsSecurity << " agents)\n";
+      return 2;
+    }
+  }
+  const auto secure = [&](ProcessSpec& s) {
+    if (!o.ddsSecurity.empty()) {
+      s.env.emplace_back(
+          "CYCLONEDDS_URI",
+          "file://" + fs::absolute(fs::path(o.ddsSecurity) / identityOf(s.name) / "cyclonedds.xml").string());
+    }
+  };
   if (drop > 0) {
     writeFile(out / "cyclonedds.xml", cycloneConfig(drop));
     env.emplace_back("CYCLONEDDS_URI", "file://" + fs::absolute(out / "cyclonedds.xml").string());
@@ -709,6 +753,9 @@ int Run::run() {
   for (const auto& f : faults) {
     say("fault planned: " + describe(f));
   }
+  for (auto& s : specs) {
+    secure(s);
+  }
   for (const auto& s : specs) {
     if (!sup.start(s)) {
       say("cannot start " + s.name);
@@ -767,7 +814,9 @@ int Run::run() {
       simArgs.push_back(a);
     }
   }
-  sup.start({"fleet-sim", bin("sim/src/fleet-sim"), simArgs, env, log("fleet-sim")});
+  ProcessSpec simSpec{"fleet-sim", bin("sim/src/fleet-sim"), simArgs, env, log("fleet-sim")};
+  secure(simSpec);
+  sup.start(simSpec);
 
   int code = 0;
   bool wallLimited = false;

@@ -41,6 +41,10 @@ struct LoadtestOptions {
   double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)
   /// "reactive" or "reserved" (a traffic_manager process plans every robot; the agents follow it).
   std::string traffic = "reactive";
+  /// A folder made by scripts/dds-security ("deployment DIR agents"): every process joins with its
+  /// identity (fleet-manager, wms-adapter, risk-map, traffic-manager, simulator; every agent
+  /// process as "agents"). Empty: no DDS Security.
+  std::string ddsSecurity;
   int stepTimeoutMs = 300;
   /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents
   /// at their configured rate (their achieved rate is reported), and nothing waits for anyone.

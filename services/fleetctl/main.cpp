@@ -150,6 +150,9 @@ int main(int argc, char** argv) {
                    "all together and releases their routes")
       ->check(CLI::IsMember({"reactive", "reserved"}))
       ->capture_default_str();
+  loadtest->add_option("--dds-security", lt.ddsSecurity,
+                       "run every process with its DDS Security identity from this folder (made by "
+                       "scripts/dds-security deployment DIR)");
   loadtest->add_option("--duration", lt.durationS, "simulated seconds")
       ->check(CLI::Range(1.0, 86400.0))
       ->capture_default_str();

@@ -415,3 +415,50 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
   EXPECT_NE(html.find("0 lost, 0 duplicated"), std::string::npos);
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
+
+TEST(LoadtestE2E, AFleetRunsUnderDdsSecurity) {
+  // Every process with its own identity (scripts/dds-security): the fleet delivers as without.
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-secure-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  const fs::path ids = out.string() + "-ids";
+  fs::remove_all(ids);
+  ASSERT_EQ(
+      std::system((FLEET_SOURCE_DIR "/scripts/dds-security deployment " + ids.string() + " agents >/dev/null")
+                      .c_str()),
+      0);
+  std::vector<std::string> args = {"loadtest",
+                                   "--scenario",
+                                   FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json",
+                                   "--rate",
+                                   "2",
+                                   "--tasks",
+                                   "2",
+                                   "--until-done",
+                                   "--duration",
+                                   "900",
+                                   "--max-speed",
+                                   "0",
+                                   "--out",
+                                   out.string(),
+                                   "--domain",
+                                   std::to_string(fleet::test::uniqueDomain()),
+                                   "--report-script",
+                                   "",
+                                   "--wall-limit",
+                                   "120",
+                                   "--dds-security",
+                                   ids.string()};
+  fleet::test::ChildProcess run(kFleetctl, args);
+  ASSERT_EQ(run.wait(std::chrono::seconds(180)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  EXPECT_EQ(r["accounting"]["done"], 2) << r["accounting"].dump();
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+  // A missing identity is named before anything starts.
+  fs::remove_all(ids / "risk-map");
+  fleet::test::ChildProcess bad(kFleetctl, args);
+  EXPECT_EQ(bad.wait(std::chrono::seconds(60)), 2);
+  if (!HasFailure()) {
+    fs::remove_all(out);
+    fs::remove_all(ids);
+  }
+}

@@ -1,0 +1,100 @@
+// DDS Security end to end (issue 19 item 1): identities made by scripts/dds-security, Cyclone DDS's
+// security plugins, and participants that should or should not get a Task to the fleet manager.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "test_process.hpp"
+
+using namespace fleet;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kProbe = FLEET_BINARY_DIR "/tests/integration/security/dds_probe";
+const std::string kScript = FLEET_SOURCE_DIR "/scripts/dds-security";
+
+int sh(const std::string& cmd) {
+  return std::system((cmd + " >/dev/null 2>&1").c_str());
+}
+
+std::map<std::string, int> counts(const std::filesystem::path& file) {
+  std::map<std::string, int> out;
+  std::ifstream in(file);
+  std::string prefix;
+  int n = 0;
+  while (in >> prefix >> n) {
+    out[prefix] = n;
+  }
+  return out;
+}
+
+class DdsSecurity : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    domain_ = std::to_string(test::uniqueDomain());
+    dir_ = std::filesystem::temp_directory_path() / ("fleet_dds_security_" + domain_);
+    std::filesystem::remove_all(dir_);
+    ASSERT_EQ(sh(kScript + " deployment " + (dir_ / "site").string() + " agents"), 0);
+    // The same names under another site's CA: valid certificates, but not this site's.
+    ASSERT_EQ(sh(kScript + " init " + (dir_ / "other").string()), 0);
+    ASSERT_EQ(sh(kScript + " identity " + (dir_ / "other").string() + " wms-adapter wms-adapter"), 0);
+  }
+  void TearDown() override {
+    if (!HasFailure()) {
+      std::filesystem::remove_all(dir_);
+    }
+  }
+  /// Environment of a process running as `identity` of `site` ("" : no security at all).
+  std::vector<std::pair<std::string, std::string>> as(const std::string& site,
+                                                      const std::string& identity) const {
+    std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain_}};
+    env.emplace_back("CYCLONEDDS_URI",
+                     site.empty() ? "" : "file://" + (dir_ / site / identity / "cyclonedds.xml").string());
+    return env;
+  }
+  std::string domain_;
+  std::filesystem::path dir_;
+};
+
+}  // namespace
+
+TEST_F(DdsSecurity, OnlyTheAdaptersCertificateGetsATaskToTheManager) {
+  const auto got = dir_ / "manager.txt";
+  const auto plainGot = dir_ / "plain.txt";
+  test::ChildProcess manager(kProbe, {"read", "16", got.string()}, as("site", "fleet-manager"));
+  test::ChildProcess plainReader(kProbe, {"read", "16", plainGot.string()}, as("", ""));
+  std::this_thread::sleep_for(1s);
+  test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
+  test::ChildProcess plain(kProbe, {"write", "12", "plain"}, as("", ""));
+  test::ChildProcess robot(kProbe, {"write", "12", "robot"}, as("site", "agents"));
+  test::ChildProcess foreign(kProbe, {"write", "12", "foreign"}, as("other", "wms-adapter"));
+  EXPECT_EQ(adapter.wait(40s), 0);
+  EXPECT_EQ(plain.wait(40s), 0) << "an unsecured participant runs, alone";
+  EXPECT_EQ(robot.wait(40s), 3) << "a robot's permissions do not include writing Task";
+  EXPECT_EQ(foreign.wait(40s), 0) << "another site's certificate is valid for itself";
+  ASSERT_EQ(manager.wait(40s), 0);
+  ASSERT_EQ(plainReader.wait(40s), 0);
+  const auto m = counts(got);
+  EXPECT_GT(m.count("adapter") ? m.at("adapter") : 0, 50) << "the secured adapter's tasks arrive";
+  EXPECT_EQ(m.count("plain"), 0u) << "no certificate: not admitted";
+  EXPECT_EQ(m.count("foreign"), 0u) << "another site's CA: not authenticated";
+  EXPECT_EQ(m.count("robot"), 0u);
+  const auto p = counts(plainGot);
+  EXPECT_EQ(p.count("adapter"), 0u) << "an unsecured reader sees nothing of the secured fleet";
+  EXPECT_GT(p.count("plain") ? p.at("plain") : 0, 50)
+      << "(the unsecured pair talks among itself: the probe works)";
+}
+
+TEST_F(DdsSecurity, AReadOnlyObserverCannotWrite) {
+  test::ChildProcess observer(kProbe, {"write", "2", "observer"}, as("site", "observer"));
+  EXPECT_EQ(observer.wait(40s), 3);
+  const auto got = dir_ / "observer.txt";
+  test::ChildProcess reader(kProbe, {"read", "2", got.string()}, as("site", "observer"));
+  EXPECT_EQ(reader.wait(40s), 0) << "but it may read Task";
+}
