@@ -262,12 +262,11 @@ TEST(LoadtestE2E, AFleetRunsOnASiteWithAROSMap) {
   EXPECT_NEAR(risk["grid"]["height"].get<double>(), 200, 1);
 }
 
-// DISABLED: intermittent. About 1 run in 4 (more often beside other tests) the robot stops after
-// ~25 m and stands idle for the rest of the run while the traffic manager has placed it and
-// released it nodes (2026-11-25, run folder kept by the test: r1 idle 527.8 s, 52 releases, 635
-// reports, none refused). Cause not found yet; issue 18's note. Run it with
-// --gtest_also_run_disabled_tests.
-TEST(LoadtestE2E, DISABLED_ALoneRobotDeliversUnderReservedTraffic) {
+// Disabled from 2026-11-25 to 11-26: about 1 run in 4 the robot stood idle after ~25 m while the
+// traffic manager had placed it and released it nodes. On the build with paced planning and the
+// leaving robot first (session of 2026-11-26) it passed 18 of 18 runs, 12 of them three at a time
+// beside three other builds; re-enabled. If it comes back, the run folder is kept (see below).
+TEST(LoadtestE2E, ALoneRobotDeliversUnderReservedTraffic) {
   // The whole chain of issue 18: the traffic manager builds the roadmap from the site, places the
   // robot from its first TrafficProgress, plans it and releases its route a few nodes at a time; the
   // agent (--traffic reserved) drives only what it was released and reports the nodes it reaches.
