@@ -118,20 +118,20 @@ Expected<RiskMapNode> RiskMapNode::create(const Settings& s) {
   return RiskMapNode(s, std::move(*engine));
 }
 
-Expected<void> RiskMapNode::accept(const msg::PredictedDiscs& m, std::int64_t now_ns) {
-  auto r = engine_.upsert(toSource(m), now_ns);
+Expected<void> RiskMapNode::accept(const msg::PredictedDiscs& m, std::int64_t nowNs) {
+  auto r = engine_.upsert(toSource(m), nowNs);
   if (!r) {
     ++rejected_;
     ++rejectedBy_[r.error().code];
     return r;
   }
   ++accepted_;
-  lastHeard_[m.source_id] = now_ns;
+  lastHeard_[m.source_id] = nowNs;
   return {};
 }
 
-msg::RiskMap RiskMapNode::fuse(std::int64_t now_ns) {
-  const std::int64_t cutoff = now_ns - secToNs(settings_.staleAfterS);
+msg::RiskMap RiskMapNode::fuse(std::int64_t nowNs) {
+  const std::int64_t cutoff = nowNs - secToNs(settings_.staleAfterS);
   for (auto it = lastHeard_.begin(); it != lastHeard_.end();) {
     if (it->second < cutoff) {
       engine_.remove(it->first);
@@ -141,8 +141,8 @@ msg::RiskMap RiskMapNode::fuse(std::int64_t now_ns) {
       ++it;
     }
   }
-  const auto& r = engine_.fuse(now_ns);
-  return toMessage(r, now_ns, static_cast<std::uint32_t>(engine_.sourceCount()), settings_.regions);
+  const auto& r = engine_.fuse(nowNs);
+  return toMessage(r, nowNs, static_cast<std::uint32_t>(engine_.sourceCount()), settings_.regions);
 }
 
 }  // namespace fleet::riskmap

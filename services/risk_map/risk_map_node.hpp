@@ -10,8 +10,8 @@
 
 #include "fleet/core/config.hpp"
 #include "fleet/core/expected.hpp"
-#include "fleet/risk/fusion_engine.hpp"
 #include "fleet/messages/messages.hpp"
+#include "fleet/risk/fusion_engine.hpp"
 
 namespace fleet::riskmap {
 
@@ -52,9 +52,9 @@ class RiskMapNode {
 
   /// Validates and stores a sample (the latest per source wins). Bad samples are refused with the
   /// library's error code and message and leave the stored state untouched.
-  Expected<void> accept(const msg::PredictedDiscs& m, std::int64_t now_ns);
-  /// Drops stale sources, fuses at now_ns and returns the message to publish.
-  msg::RiskMap fuse(std::int64_t now_ns);
+  Expected<void> accept(const msg::PredictedDiscs& m, std::int64_t nowNs);
+  /// Drops stale sources, fuses at nowNs and returns the message to publish.
+  msg::RiskMap fuse(std::int64_t nowNs);
 
   [[nodiscard]] std::size_t sources() const { return engine_.sourceCount(); }
   [[nodiscard]] std::uint64_t accepted() const { return accepted_; }

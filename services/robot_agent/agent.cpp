@@ -28,8 +28,8 @@ LocalizerParams localizerParams(const AgentParams& p) {
   lp.sensorTimeoutS = p.sensorTimeoutS;
   lp.vMax = p.vMax;
   lp.wMax = p.wMax;
-  lp.accelMax = p.limits.accel_max;
-  lp.alphaMax = p.limits.alpha_max;
+  lp.accelMax = p.limits.accelMax;
+  lp.alphaMax = p.limits.alphaMax;
   lp.landmarks = p.landmarks;
   lp.walls = p.walls;
   lp.lineUpdates = p.lineUpdates;
@@ -92,8 +92,8 @@ OtherRobot::Mode modeOf(msg::RobotMode m) {
 control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
   fp.lookahead = kLookahead;
-  fp.goal_tolerance_xy = 0.15;
-  fp.goal_tolerance_theta = 0.25;
+  fp.goalToleranceXy = 0.15;
+  fp.goalToleranceTheta = 0.25;
   return fp;
 }
 
@@ -219,7 +219,7 @@ control::Twist Agent::planLocal(bool& blocked) {
   view.discs = discs;
   view.limits = p_.limits;
   view.dt = 0.1;
-  view.goal_tolerance = 0.15;
+  view.goalTolerance = 0.15;
   if (risk_) {
     view.risk = [r = risk_](Vec2 q) { return r->at(q); };
   }
@@ -510,11 +510,11 @@ void Agent::finishTask(TaskStage final, const std::string& reason, std::int64_t 
 void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const {
   v = r.cmd.v;
   w = r.cmd.omega;
-  if (!r.final_approach) {
-    // The far-field law gives v = k_v·ρ·cos α with ρ ≈ the lookahead: scale v so the robot
+  if (!r.finalApproach) {
+    // The far-field law gives v = kV·ρ·cos α with ρ ≈ the lookahead: scale v so the robot
     // tracks its path at cruise speed. ω keeps the law's gains (scaling it too made the robot
     // weave in the aisles: the loop gain grows with it while the actuation lags a cycle).
-    v *= p_.vMax / (kLookahead * control::LyapunovGains{}.k_v);
+    v *= p_.vMax / (kLookahead * control::LyapunovGains{}.kV);
   }
   // Clamp keeping the curvature: a turn limited by ω_max is driven slower, not wider.
   if (std::abs(w) > p_.wMax) {
@@ -530,7 +530,7 @@ void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, doubl
   // through its neighbours (robots park side by side) or into shelf ends.
   const Vec2 toCarrot = r.target.position() - localizer_.pose().position();
   const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), localizer_.pose().theta);
-  if (!r.final_approach && toCarrot.norm() > 0.05 && std::abs(bearing) > 0.7) {
+  if (!r.finalApproach && toCarrot.norm() > 0.05 && std::abs(bearing) > 0.7) {
     v = 0.0;
     w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
   }
@@ -739,7 +739,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   maybeReturnHome(nowNs);
   if (tasks_.phase() == Phase::Driving) {
     auto r = follower_.step(localizer_.pose());
-    if (r && approach_ && r->final_approach && !path_.empty() &&
+    if (r && approach_ && r->finalApproach && !path_.empty() &&
         distance(localizer_.pose().position(), path_.back()) < 0.25) {
       // At the station's axis point: the last leg, straight in. Followed as one path, the local
       // planner cut the corner onto the axis and came in diagonally past the neighbours again.
@@ -753,8 +753,8 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     }
     if (!r) {
       finishTask(TaskStage::Failed, "path follower: " + r.error().message, nowNs);
-    } else if (!approach_ && (r->goal_reached || (r->final_approach &&
-                                                  distance(localizer_.pose(), tasks_.goal().pose) < 0.15))) {
+    } else if (!approach_ && (r->goalReached ||
+                              (r->finalApproach && distance(localizer_.pose(), tasks_.goal().pose) < 0.15))) {
       enterDwell(nowNs);
     } else if (const Other* occupant = stationOccupant(); occupant != nullptr) {
       // Queue for the station a little way off instead of pushing into the robot on it.
@@ -779,7 +779,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     } else {
       holdSinceNs_ = -1;
       makingRoom_ = false;
-      docking_ = r->final_approach && !approach_;
+      docking_ = r->finalApproach && !approach_;
       // The configured planner drives the path; the follower's pose law docks (a sampling
       // planner stops near the goal, not on it with the goal's heading). Either command then goes
       // through the same stop rule and standoff handling below, so yielding, backing off and
@@ -837,7 +837,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         v = 0.0;
         w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
         blockedSinceNs_ = -1;
-        straightDock_ = r->final_approach;
+        straightDock_ = r->finalApproach;
       } else if (held) {
         mode = msg::RobotMode::Waiting;
         onStandoff(nowNs, blocker.robot, blocker.id, v, w);
@@ -851,9 +851,9 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   } else if (tasks_.phase() == Phase::Returning) {
     mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
     auto r = follower_.step(localizer_.pose());
-    const bool arrived = !r || r->goal_reached ||
-                         (r->final_approach && path_.size() > 0 &&
-                          distance(localizer_.pose().position(), path_.back()) < 0.25);
+    const bool arrived =
+        !r || r->goalReached ||
+        (r->finalApproach && path_.size() > 0 && distance(localizer_.pose().position(), path_.back()) < 0.25);
     Blocker blocker;
     if (!arrived) {
       docking_ = false;

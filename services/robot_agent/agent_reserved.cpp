@@ -214,26 +214,26 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
   // At the end, or the end no longer ahead of the robot: turning round for the last centimetres
   // would sweep the body over what was not released.
-  if (left < kAtEnd || (r->final_approach && toEnd.norm() < kAtGoal && toEnd.dot(facing) < kAtEnd)) {
+  if (left < kAtEnd || (r->finalApproach && toEnd.norm() < kAtGoal && toEnd.dot(facing) < kAtEnd)) {
     standStill();
     return;
   }
   baseAhead_ = true;
-  docking_ = dockingLeg_ && r->final_approach;
+  docking_ = dockingLeg_ && r->finalApproach;
   if (undockFrom_ && distance(here, *undockFrom_) > kLeaveDistance) {
     undockFrom_.reset();
   }
   const auto turn = releases_.nextTurn(kSharpTurn);
   const bool cornering = turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;
-  const bool planning = planner_ && !r->final_approach && !cornering && !undockFrom_ &&
-                        r->cross_track < kMaxCrossTrack && !progress_.followerDrives(nowNs);
+  const bool planning = planner_ && !r->finalApproach && !cornering && !undockFrom_ &&
+                        r->crossTrack < kMaxCrossTrack && !progress_.followerDrives(nowNs);
   bool localBlocked = false;
   if (planning) {
     path_ = stretch(basePath_, r->progress, kPlannerWindow);
     const auto tw = planLocal(localBlocked);
     v = tw.v;
     w = tw.omega;
-  } else if (r->final_approach || cornering) {
+  } else if (r->finalApproach || cornering) {
     // Onto the corner, or the last stretch: face it and drive straight there (onto a station:
     // slowly, as reactive docking does). The pose law's curve could bulge off the base.
     // (Turning on the spot only when far off: told to at speed, the robot slides on while it brakes.)
@@ -251,12 +251,12 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   v = std::max(v, 0.0);  // never backwards off the base
   // Stop at the end of the base: no faster than the robot can brake from within what is left,
   // one control period late. (An extension in time lifts the limit before it bites.)
-  double cap = stoppingSpeed(left, p_.limits.accel_max, dt);
+  double cap = stoppingSpeed(left, p_.limits.accelMax, dt);
   if (turn) {
     // Down to the turning speed by the time it is on the corner (kOnCorner, with as much again for
     // the braking's lag behind the command).
     cap = std::min(
-        cap, std::max(kTurnSpeed, stoppingSpeed(turn->distance - 2.0 * kOnCorner, p_.limits.accel_max, dt)));
+        cap, std::max(kTurnSpeed, stoppingSpeed(turn->distance - 2.0 * kOnCorner, p_.limits.accelMax, dt)));
   }
   if (v > cap) {
     w *= cap / v;

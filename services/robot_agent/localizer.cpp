@@ -10,9 +10,9 @@ namespace {
 
 estimation::PoseEkf makeEkf(const LocalizerParams& p) {
   estimation::EkfParams ep;
-  ep.wheel_base = p.wheelBase;
-  ep.compass_variance = 0.02 * 0.02;
-  ep.bearing_variance = 0.01 * 0.01;
+  ep.wheelBase = p.wheelBase;
+  ep.compassVariance = 0.02 * 0.02;
+  ep.bearingVariance = 0.01 * 0.01;
   Eigen::Matrix3d p0 = Eigen::Matrix3d::Zero();
   p0.diagonal() << 0.01, 0.01, 0.001;
   auto e = estimation::PoseEkf::create(ep, p.start, p0);
@@ -23,13 +23,13 @@ estimation::PoseEkf makeEkf(const LocalizerParams& p) {
 
 estimation::LineExtractionParams agentLineExtraction() {
   estimation::LineExtractionParams p;
-  p.seed_points = 4;
-  p.min_points = 5;
-  p.min_length = 0.5;
+  p.seedPoints = 4;
+  p.minPoints = 5;
+  p.minLength = 0.5;
   // Rays 5° apart land 0.35 m apart at 4 m and further on a wall seen at a slant; a cross aisle
   // (1.5 m and more) still ends a run.
-  p.max_point_gap = 0.75;
-  p.point_sigma = 0.01;
+  p.maxPointGap = 0.75;
+  p.pointSigma = 0.01;
   return p;
 }
 
@@ -115,7 +115,7 @@ void Localizer::updateLines(const SensorReading& f) {
   estimation::LaserScan scan;
   scan.angle_min = static_cast<double>(f.angleMin);
   scan.angle_increment = static_cast<double>(f.angleIncrement);
-  scan.range_min = 0.05;
+  scan.rangeMin = 0.05;
   // A ray without a return reads exactly rangeMax: keep it out of the fits.
   scan.range_max = static_cast<double>(f.rangeMax) - 1e-3;
   scan.ranges.assign(f.ranges.begin(), f.ranges.end());
@@ -127,17 +127,17 @@ void Localizer::updateLines(const SensorReading& f) {
   }
   lineStats_.extracted += lines.size();
   for (auto& l : lines) {
-    l.line.var_r += p_.lineRangeSigma * p_.lineRangeSigma;
-    l.line.var_psi += p_.lineAngleSigma * p_.lineAngleSigma;
+    l.line.varR += p_.lineRangeSigma * p_.lineRangeSigma;
+    l.line.varPsi += p_.lineAngleSigma * p_.lineAngleSigma;
   }
   // Matched once against the estimate after the compass; the updates then run one by one, each
   // re-linearised at the estimate the previous one left (and gated again by the filter).
   estimation::LineGate gate = p_.lineGate;
-  gate.max_range = scan.range_max + 1.0;
+  gate.maxRange = scan.range_max + 1.0;
   const auto m = estimation::matchLines(ekf_.pose(), ekf_.covariance(), *p_.walls, lines, gate);
-  lineStats_.noWallFacing += m.no_wall_facing;
-  lineStats_.outsideGate += m.outside_gate;
-  lineStats_.noOverlap += m.no_overlap;
+  lineStats_.noWallFacing += m.noWallFacing;
+  lineStats_.outsideGate += m.outsideGate;
+  lineStats_.noOverlap += m.noOverlap;
   lineStats_.ambiguous += m.ambiguous;
   for (const auto& match : m.matches) {
     ++lineStats_.matched;

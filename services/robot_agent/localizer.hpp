@@ -124,9 +124,9 @@ struct LineStats {
   std::uint64_t matched = 0;
   std::uint64_t accepted = 0;
   std::uint64_t rejectedByFilter = 0;  ///< matched, then refused by the EKF's own gate after earlier updates
-  std::uint64_t noWallFacing = 0;      ///< "no_wall_facing"
-  std::uint64_t outsideGate = 0;       ///< "outside_gate"
-  std::uint64_t noOverlap = 0;         ///< "no_overlap"
+  std::uint64_t noWallFacing = 0;      ///< "noWallFacing"
+  std::uint64_t outsideGate = 0;       ///< "outsideGate"
+  std::uint64_t noOverlap = 0;         ///< "noOverlap"
   std::uint64_t ambiguous = 0;         ///< "ambiguous"
 };
 

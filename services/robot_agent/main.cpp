@@ -214,7 +214,7 @@ int run(const World& scn, const Options& opt) {
   // The walls every localizer matches its scan lines against: faces of 0.5 m and more (the line
   // extractor keeps nothing shorter).
   auto walls = std::make_shared<std::vector<estimation::MapSegment>>();
-  for (const auto& w : site::wallSegments(*scn.map, agent::agentLineExtraction().min_length)) {
+  for (const auto& w : site::wallSegments(*scn.map, agent::agentLineExtraction().minLength)) {
     walls->push_back({w.a, w.b, w.normal});
   }
   spdlog::info("robot agent: {} wall faces for the line updates ({})", walls->size(),
@@ -235,8 +235,8 @@ int run(const World& scn, const Options& opt) {
     p.start = r.start;
     p.radius = r.radius;
     p.wheelBase = r.wheelBase;
-    p.vMax = std::min(0.8, r.limits.v_max);
-    p.wMax = r.limits.omega_max;
+    p.vMax = std::min(0.8, r.limits.vMax);
+    p.wMax = r.limits.omegaMax;
     p.localPlanner = opt.localPlanner;
     p.dwa = opt.dwa;
     p.riskStepping = opt.riskStepping;
@@ -250,7 +250,7 @@ int run(const World& scn, const Options& opt) {
     p.speedLimit = speedLimit;
     p.traffic = opt.traffic;
     p.limits = r.limits;
-    p.limits.v_max = p.vMax;
+    p.limits.vMax = p.vMax;
     p.landmarks = scn.landmarks;
     p.walls = walls;
     p.lineUpdates = opt.lineUpdates;

@@ -256,7 +256,7 @@ CommandOutcome World::command(std::size_t i, double v, double w) {
   RobotBody& r = robots_[i];
   r.command = {v, w};
   r.commandTime = time();
-  if (v > lim.v_max || v < lim.v_min || std::abs(w) > lim.omega_max) {
+  if (v > lim.vMax || v < lim.vMin || std::abs(w) > lim.omegaMax) {
     ++counters_.clampedCommands;
     return CommandOutcome::Clamped;
   }

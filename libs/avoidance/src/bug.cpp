@@ -52,9 +52,8 @@ std::pair<Vec2, double> nearestObstacle(const LocalView& view) {
 }  // namespace
 
 Expected<void> BugParams::validate() const {
-  if (!(follow_gap > 0.0) || !(hit_gap >= follow_gap) || !(mline_tolerance > 0.0) ||
-      !(loop_tolerance > 0.0) || !(cruise > 0.0) || !(k_heading > 0.0) || !(k_gap >= 0.0) ||
-      leave_margin < 0.0) {
+  if (!(followGap > 0.0) || !(hitGap >= followGap) || !(mlineTolerance > 0.0) || !(loopTolerance > 0.0) ||
+      !(cruise > 0.0) || !(kHeading > 0.0) || !(kGap >= 0.0) || leaveMargin < 0.0) {
     return fleet::unexpected("invalid_bug_params",
                              "gaps, tolerances, gains and cruise speed must be positive");
   }
@@ -70,16 +69,16 @@ void BugPlanner::reset() {
 Twist BugPlanner::steerTowards(const LocalView& view, Vec2 direction) const {
   const double err = angleDiff(std::atan2(direction.y, direction.x), view.robot.pose.theta);
   const double v = params_.cruise * std::max(0.0, std::cos(err));
-  const double w = std::clamp(params_.k_heading * err, -view.limits.omega_max, view.limits.omega_max);
-  return {std::min(v, view.limits.v_max), w};
+  const double w = std::clamp(params_.kHeading * err, -view.limits.omegaMax, view.limits.omegaMax);
+  return {std::min(v, view.limits.vMax), w};
 }
 
 bool BugPlanner::blockedTowards(const LocalView& view, Vec2 direction) const {
-  // Anything inside a corridor one body wide reaching hit_gap beyond the body, in that direction?
+  // Anything inside a corridor one body wide reaching hitGap beyond the body, in that direction?
   const Vec2 p = view.robot.pose.position();
   const Vec2 u = direction.normalized();
   const double r = view.robot.radius;
-  const double reach = r + params_.hit_gap;
+  const double reach = r + params_.hitGap;
   auto inCorridor = [&](Vec2 q, double qr) {
     const Vec2 d = q - p;
     const double along = d.dot(u);
@@ -103,8 +102,8 @@ Twist BugPlanner::followBoundary(const LocalView& view) const {
     return steerTowards(view, goal_ - p);
   const Vec2 n = (p - q).normalized();  // away from the obstacle
   const Vec2 tangent{n.y, -n.x};        // obstacle on the right
-  const double gap_err = (d - view.robot.radius) - params_.follow_gap;
-  const Vec2 dir = tangent + (-n) * std::clamp(params_.k_gap * gap_err, -1.0, 1.0);
+  const double gap_err = (d - view.robot.radius) - params_.followGap;
+  const Vec2 dir = tangent + (-n) * std::clamp(params_.kGap * gap_err, -1.0, 1.0);
   return steerTowards(view, dir);
 }
 
@@ -121,7 +120,7 @@ Command BugPlanner::plan(const LocalView& view) {
   const double step = fastDistance(p, last_position_);
   last_position_ = p;
   const double dg = fastDistance(p, goal_);
-  if (dg <= view.goal_tolerance) {
+  if (dg <= view.goalTolerance) {
     mode_ = BugMode::kDone;
     return {{}, PlanStatus::kGoalReached, false};
   }
@@ -142,15 +141,15 @@ Command BugPlanner::plan(const LocalView& view) {
   }
 
   travelled_since_hit_ += step;
-  if (fastDistance(p, hit_) > 2.0 * params_.loop_tolerance)
+  if (fastDistance(p, hit_) > 2.0 * params_.loopTolerance)
     left_hit_area_ = true;
-  const bool back_at_hit = left_hit_area_ && fastDistance(p, hit_) < params_.loop_tolerance;
+  const bool back_at_hit = left_hit_area_ && fastDistance(p, hit_) < params_.loopTolerance;
 
   if (mode_ == BugMode::kFollow) {
     if (variant_ == BugVariant::kBug2) {
       // Leave rule: on the m-line, strictly closer to the goal than H, and free towards the goal.
-      const bool on_mline = distanceToLine(start_, goal_, p) < params_.mline_tolerance;
-      if (on_mline && dg < fastDistance(hit_, goal_) - params_.leave_margin &&
+      const bool on_mline = distanceToLine(start_, goal_, p) < params_.mlineTolerance;
+      if (on_mline && dg < fastDistance(hit_, goal_) - params_.leaveMargin &&
           !blockedTowards(view, goal_ - p)) {
         mode_ = BugMode::kGoToGoal;
         return {steerTowards(view, goal_ - p), PlanStatus::kMoving, false};
@@ -173,8 +172,8 @@ Command BugPlanner::plan(const LocalView& view) {
   }
 
   // Bug1, second lap: follow on to L, then leave, unless the obstacle still blocks the goal there.
-  if (fastDistance(p, leave_) < params_.loop_tolerance) {
-    if (blockedTowards(view, goal_ - p) && fastDistance(leave_, hit_) < params_.loop_tolerance) {
+  if (fastDistance(p, leave_) < params_.loopTolerance) {
+    if (blockedTowards(view, goal_ - p) && fastDistance(leave_, hit_) < params_.loopTolerance) {
       mode_ = BugMode::kDone;
       return {{}, PlanStatus::kUnreachable, false};
     }

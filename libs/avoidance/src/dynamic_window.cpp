@@ -13,9 +13,9 @@ namespace fleet::avoidance {
 using control::DiffDriveKinematics;
 
 Expected<void> DwaParams::validate() const {
-  if (v_samples < 1 || omega_samples < 1 || !(sim_time > 0.0) || !(clearance_cap > 0.0) ||
-      !(lookahead > 0.0) || risk_samples < 1 || disc_samples < 1 || w_heading < 0.0 || w_clearance < 0.0 ||
-      w_velocity < 0.0 || w_progress < 0.0 || w_risk < 0.0) {
+  if (vSamples < 1 || omegaSamples < 1 || !(simTime > 0.0) || !(clearanceCap > 0.0) || !(lookahead > 0.0) ||
+      riskSamples < 1 || discSamples < 1 || wHeading < 0.0 || wClearance < 0.0 || wVelocity < 0.0 ||
+      wProgress < 0.0 || wRisk < 0.0) {
     return fleet::unexpected("invalid_dwa_params", "sample counts >= 1, times/distances > 0, weights >= 0");
   }
   return {};
@@ -56,22 +56,22 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
   const Pose2& pose = view.robot.pose;
   const Vec2 goal = view.goal();
   samples_.clear();
-  if (fastDistance(pose.position(), goal) <= view.goal_tolerance)
+  if (fastDistance(pose.position(), goal) <= view.goalTolerance)
     return {{}, PlanStatus::kGoalReached, false};
 
   const auto& lim = view.limits;
-  const double T = params_.sim_time;
+  const double T = params_.simTime;
   const Twist cur = view.robot.twist;
   // Dynamic window: velocities reachable within one cycle, intersected with the speed bounds.
-  const double v_lo = std::max(params_.allow_reverse ? lim.v_min : 0.0, cur.v - lim.accel_max * view.dt);
-  const double v_hi = std::min(lim.v_max, cur.v + lim.accel_max * view.dt);
-  const double w_lo = std::max(-lim.omega_max, cur.omega - lim.alpha_max * view.dt);
-  const double w_hi = std::min(lim.omega_max, cur.omega + lim.alpha_max * view.dt);
+  const double v_lo = std::max(params_.allowReverse ? lim.vMin : 0.0, cur.v - lim.accelMax * view.dt);
+  const double v_hi = std::min(lim.vMax, cur.v + lim.accelMax * view.dt);
+  const double w_lo = std::max(-lim.omegaMax, cur.omega - lim.alphaMax * view.dt);
+  const double w_hi = std::min(lim.omegaMax, cur.omega + lim.alphaMax * view.dt);
 
   const Vec2 carrot = carrotOnPath(view.path, pose.position(), params_.lookahead);
   const double carrot_d0 = fastDistance(pose.position(), carrot);
-  const double reach = std::max(std::max(lim.v_max, -lim.v_min) * T, params_.clearance_length) +
-                       view.robot.radius + params_.clearance_cap;
+  const double reach = std::max(std::max(lim.vMax, -lim.vMin) * T, params_.clearanceLength) +
+                       view.robot.radius + params_.clearanceCap;
   nearbyPoints(view.scan, pose.position(), reach, near_);
 
   // Progress bookkeeping for the local-minimum escape (towards the goal, which does not move
@@ -81,17 +81,17 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
     best_carrot_distance_ = goal_d;
     last_goal_ = goal;
     no_progress_ = 1;
-  } else if (goal_d < best_carrot_distance_ - params_.stuck_progress) {
+  } else if (goal_d < best_carrot_distance_ - params_.stuckProgress) {
     best_carrot_distance_ = goal_d;
     no_progress_ = 1;
-  } else if (++no_progress_ > params_.stuck_cycles && escape_left_ == 0) {
-    escape_left_ = params_.escape_cycles;
+  } else if (++no_progress_ > params_.stuckCycles && escape_left_ == 0) {
+    escape_left_ = params_.escapeCycles;
   }
   const bool escape = escape_left_ > 0;
   if (escape && --escape_left_ == 0)
     no_progress_ = 0;
-  const double w_heading = escape ? 0.0 : params_.w_heading;
-  const double w_progress = escape ? 0.0 : params_.w_progress;
+  const double wHeading = escape ? 0.0 : params_.wHeading;
+  const double wProgress = escape ? 0.0 : params_.wProgress;
 
   // Position on the sample's arc at time t (exact integration, without integrateExact's angle
   // wrapping, which the rollouts do not need).
@@ -107,9 +107,9 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
     return p0 + Vec2{R * (std::sin(th) - s0), -R * (std::cos(th) - c0)};
   };
 
-  const int nv = params_.v_samples;
-  const int nw = params_.omega_samples;
-  const double vmax_abs = std::max(lim.v_max, 1e-9);
+  const int nv = params_.vSamples;
+  const int nw = params_.omegaSamples;
+  const double vmax_abs = std::max(lim.vMax, 1e-9);
   // Pass 1 (cheap): heading, velocity and progress of every sample, and the best score it could
   // still reach (clearance term at its cap, no risk).
   const std::size_t count = static_cast<std::size_t>(nv) * static_cast<std::size_t>(nw);
@@ -140,8 +140,8 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
               : 0.0;
       // Discs and risk are cheap next to the scan arcs: compute them here so the bound is tight.
       double clr_discs = std::numeric_limits<double>::infinity();
-      for (int k = 1; k <= params_.disc_samples && !view.discs.empty(); ++k) {
-        const double t = T * static_cast<double>(k) / static_cast<double>(params_.disc_samples);
+      for (int k = 1; k <= params_.discSamples && !view.discs.empty(); ++k) {
+        const double t = T * static_cast<double>(k) / static_cast<double>(params_.discSamples);
         const Vec2 p = along(s.twist, t);
         for (const MovingDisc& d : view.discs) {
           clr_discs = std::min(clr_discs,
@@ -150,15 +150,15 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       }
       disc_clr_[idx] = clr_discs;
       if (view.risk) {
-        for (int k = 1; k <= params_.risk_samples; ++k) {
-          const double t = T * static_cast<double>(k) / static_cast<double>(params_.risk_samples);
+        for (int k = 1; k <= params_.riskSamples; ++k) {
+          const double t = T * static_cast<double>(k) / static_cast<double>(params_.riskSamples);
           s.risk = std::max(s.risk, view.risk(along(s.twist, t)));
         }
       }
       // The clearance term can only be lower than the disc clearance alone.
-      const double clr_bound = std::clamp(clr_discs, 0.0, params_.clearance_cap) / params_.clearance_cap;
-      upper_[idx] = w_heading * s.heading + params_.w_clearance * clr_bound +
-                    params_.w_velocity * s.velocity + w_progress * s.progress - params_.w_risk * s.risk;
+      const double clr_bound = std::clamp(clr_discs, 0.0, params_.clearanceCap) / params_.clearanceCap;
+      upper_[idx] = wHeading * s.heading + params_.wClearance * clr_bound + params_.wVelocity * s.velocity +
+                    wProgress * s.progress - params_.wRisk * s.risk;
       order_[idx] = idx;
     }
   }
@@ -170,15 +170,15 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       return upper_[x] != upper_[y] ? upper_[x] > upper_[y] : x < y;
     });
   }
-  // Admissible: a rollout keeping min_clearance; once the robot is already closer than that (a
+  // Admissible: a rollout keeping minClearance; once the robot is already closer than that (a
   // shelf corner cut, a person who stepped close), one that brings it no closer than it is now —
   // otherwise every sample, turning away included, is inadmissible and the robot can never leave
   // (the safety layer's rule: approaching is forbidden, moving away is allowed).
-  double clr_now = arcClearance(pose, Twist{}, 0.0, near_, view.robot.radius, params_.clearance_cap);
+  double clr_now = arcClearance(pose, Twist{}, 0.0, near_, view.robot.radius, params_.clearanceCap);
   for (const MovingDisc& d : view.discs) {
     clr_now = std::min(clr_now, fastDistance(p0, d.position) - view.robot.radius - d.radius);
   }
-  const double admissible_clr = std::min(params_.min_clearance, clr_now - 1e-3);
+  const double admissible_clr = std::min(params_.minClearance, clr_now - 1e-3);
   std::size_t best_idx = count;
   double best_score = -std::numeric_limits<double>::infinity();
   for (const std::size_t idx : order_) {
@@ -194,18 +194,18 @@ Command DynamicWindowPlanner::plan(const LocalView& view) {
       continue;
     }
     const double clr = std::min(
-        arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearance_cap), disc_clr_[idx]);
+        arcClearance(pose, s.twist, T, near_, view.robot.radius, params_.clearanceCap), disc_clr_[idx]);
     s.admissible = clr >= admissible_clr;
     // Fox et al.'s "dist" is the free length of the sample's circular arc, not of the short
-    // rollout: score the same curvature over clearance_length so that, approaching an obstacle,
+    // rollout: score the same curvature over clearanceLength so that, approaching an obstacle,
     // arcs bending away score better long before the straight one becomes inadmissible.
-    const double v_eval = std::max(std::abs(v), params_.curvature_speed_floor * vmax_abs);
-    const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearance_length, near_,
-                                    view.robot.radius, params_.clearance_cap);
+    const double v_eval = std::max(std::abs(v), params_.curvatureSpeedFloor * vmax_abs);
+    const double ext = arcClearance(pose, Twist{1.0, w / v_eval}, params_.clearanceLength, near_,
+                                    view.robot.radius, params_.clearanceCap);
     const double clr_term = std::min(clr, ext);
-    s.clearance = std::clamp(clr_term, 0.0, params_.clearance_cap) / params_.clearance_cap;
-    s.score = w_heading * s.heading + params_.w_clearance * s.clearance + params_.w_velocity * s.velocity +
-              w_progress * s.progress - params_.w_risk * s.risk;
+    s.clearance = std::clamp(clr_term, 0.0, params_.clearanceCap) / params_.clearanceCap;
+    s.score = wHeading * s.heading + params_.wClearance * s.clearance + params_.wVelocity * s.velocity +
+              wProgress * s.progress - params_.wRisk * s.risk;
     if (s.admissible && (s.score > best_score || (s.score == best_score && idx < best_idx))) {
       best_score = s.score;
       best_idx = idx;

@@ -12,50 +12,50 @@
 
 namespace fleet::avoidance {
 
-Vec2 elasticInternalForce(Vec2 prev, Vec2 cur, Vec2 next, double k_c) {
+Vec2 elasticInternalForce(Vec2 prev, Vec2 cur, Vec2 next, double kC) {
   const double d_minus = fastDistance(cur, prev);
   const double d_plus = fastDistance(next, cur);
   const double sum = d_minus + d_plus;
   const double ratio = sum > 0.0 ? d_minus / sum : 0.5;
-  return ((next - prev) * ratio - (cur - prev)) * k_c;
+  return ((next - prev) * ratio - (cur - prev)) * kC;
 }
 
-Vec2 elasticExternalForce(Vec2 robot, Vec2 obstacle, double d_obs_min, double threshold, double k_r) {
+Vec2 elasticExternalForce(Vec2 robot, Vec2 obstacle, double d_obs_min, double threshold, double kR) {
   if (!(d_obs_min < threshold))
     return {};
-  return (robot - obstacle).normalized() * (k_r * (threshold - d_obs_min));
+  return (robot - obstacle).normalized() * (kR * (threshold - d_obs_min));
 }
 
-LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double d_safe) {
+LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double dSafe) {
   LeftRightMinimum out;
-  out.min_left = d_safe;
-  out.min_right = d_safe;
+  out.minLeft = dSafe;
+  out.minRight = dSafe;
   const std::size_t half = ranges.size() / 2;
   for (std::size_t i = 0; i < ranges.size(); ++i) {
     const double a = ranges[i];
-    if (!(a < d_safe))
+    if (!(a < dSafe))
       continue;
-    if (i < half && a < out.min_left) {
-      out.min_left = a;
-      out.left_index = static_cast<int>(i);
+    if (i < half && a < out.minLeft) {
+      out.minLeft = a;
+      out.leftIndex = static_cast<int>(i);
     }
-    if (i >= half && a < out.min_right) {
-      out.min_right = a;
-      out.right_index = static_cast<int>(i);
+    if (i >= half && a < out.minRight) {
+      out.minRight = a;
+      out.rightIndex = static_cast<int>(i);
     }
   }
-  out.found = out.left_index >= 0 || out.right_index >= 0;
+  out.found = out.leftIndex >= 0 || out.rightIndex >= 0;
   return out;
 }
 
-geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double d_safe) {
+geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double dSafe) {
   // Axes: along L→R and across it; the box holds the four corners L, R, L + d·h, R + d·h (a
   // rectangle when h is square to L→R, else the rectangle around that parallelogram).
   Vec2 u = right - left;
   const double len = std::sqrt(u.squaredNorm());
   u = len > 1e-9 ? u * (1.0 / len) : heading.perp();
   const Vec2 w = u.perp();
-  const Vec2 corners[4] = {left, right, left + heading * d_safe, right + heading * d_safe};
+  const Vec2 corners[4] = {left, right, left + heading * dSafe, right + heading * dSafe};
   double lo_u = std::numeric_limits<double>::infinity(), hi_u = -lo_u, lo_w = lo_u, hi_w = -lo_u;
   for (const Vec2& c : corners) {
     lo_u = std::min(lo_u, c.dot(u));
@@ -80,8 +80,7 @@ geometry::Obb2 robotBox(Vec2 robot, Vec2 next, Vec2 heading, double radius) {
 }
 
 Expected<void> ElasticStripsParams::validate() const {
-  if (!(k_c >= 0.0) || !(k_r >= 0.0) || !(d_safe > 0.0) || !(spacing > 0.0) || !(k_omega > 0.0) ||
-      beams < 2) {
+  if (!(kC >= 0.0) || !(kR >= 0.0) || !(dSafe > 0.0) || !(spacing > 0.0) || !(kOmega > 0.0) || beams < 2) {
     return fleet::unexpected("invalid_elastic_strips_params",
                              "non-negative gains, positive distances, beams >= 2");
   }
@@ -91,7 +90,7 @@ Expected<void> ElasticStripsParams::validate() const {
 Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) {
   const double r = view.robot.radius;
   if (variant_ == ElasticVariant::kOriginal) {
-    // Single nearest reading, threshold d_o = d_safe + d_r on the centre distance (eq. 2.20).
+    // Single nearest reading, threshold d_o = dSafe + d_r on the centre distance (eq. 2.20).
     double best = std::numeric_limits<double>::infinity();
     Vec2 obs;
     for (const Vec2& q : view.scan) {
@@ -108,11 +107,11 @@ Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) {
         obs = d.position;
       }
     }
-    return elasticExternalForce(at, obs, best, params_.d_safe + r, params_.k_r);
+    return elasticExternalForce(at, obs, best, params_.dSafe + r, params_.kR);
   }
-  // Two-sided variant: a BVH over the readings answers "what lies within d_safe of the body", the
+  // Two-sided variant: a BVH over the readings answers "what lies within dSafe of the body", the
   // hits are binned into a scan (left half = bearings 0..π, right half = π..2π relative to the
-  // heading), and the nearest left and right readings each push with threshold d_safe on the
+  // heading), and the nearest left and right readings each push with threshold dSafe on the
   // surface distance (eq. 2.27, 2.28).
   std::vector<geometry::Primitive> prims;
   prims.reserve(view.scan.size() + view.discs.size());
@@ -128,7 +127,7 @@ Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) {
   std::vector<double> ranges(static_cast<std::size_t>(beams), std::numeric_limits<double>::infinity());
   std::vector<Vec2> pts(static_cast<std::size_t>(beams));
   std::vector<std::uint8_t> moving(static_cast<std::size_t>(beams), 0);  // the reading is a disc
-  for (const int idx : bvh.overlappingDisc(at, params_.d_safe + r)) {
+  for (const int idx : bvh.overlappingDisc(at, params_.dSafe + r)) {
     const auto& pr = prims[static_cast<std::size_t>(idx)];
     const Vec2 rel = pr.center - at;
     const double dist = std::sqrt(rel.squaredNorm()) - pr.radius - r;
@@ -142,44 +141,44 @@ Vec2 ElasticStripsPlanner::externalForce(const LocalView& view, Vec2 at) {
       moving[static_cast<std::size_t>(b)] = static_cast<std::size_t>(idx) >= view.scan.size() ? 1 : 0;
     }
   }
-  const LeftRightMinimum m = leftRightMinimum(ranges, params_.d_safe);
+  const LeftRightMinimum m = leftRightMinimum(ranges, params_.dSafe);
   if (!m.found) {
     contact_ = Contact::kNone;
     return {};
   }
-  if (m.left_index < 0 || m.right_index < 0) {
+  if (m.leftIndex < 0 || m.rightIndex < 0) {
     // One collision point: no boxes, the original Elastic Strips (thesis §2.3.1): the nearest
-    // reading, threshold d_o = d_safe + d_r on the centre distance.
+    // reading, threshold d_o = dSafe + d_r on the centre distance.
     contact_ = Contact::kOnePoint;
-    const Vec2 q = pts[static_cast<std::size_t>(m.left_index >= 0 ? m.left_index : m.right_index)];
-    return elasticExternalForce(at, q, fastDistance(at, q), params_.d_safe + r, params_.k_r);
+    const Vec2 q = pts[static_cast<std::size_t>(m.leftIndex >= 0 ? m.leftIndex : m.rightIndex)];
+    return elasticExternalForce(at, q, fastDistance(at, q), params_.dSafe + r, params_.kR);
   }
   // Two collision points: OBB-O from them, OBB-R from the robot's size and direction of motion; the
   // two forces act only when the boxes meet (the obstacles lie in this step's way).
-  const Vec2 L = pts[static_cast<std::size_t>(m.left_index)];
-  const Vec2 R = pts[static_cast<std::size_t>(m.right_index)];
+  const Vec2 L = pts[static_cast<std::size_t>(m.leftIndex)];
+  const Vec2 R = pts[static_cast<std::size_t>(m.rightIndex)];
   const Vec2 h{std::cos(theta), std::sin(theta)};
   const Vec2 robot = view.robot.pose.position();
-  if (!geometry::overlaps(robotBox(robot, at, h, r), obstacleBox(L, R, h, params_.d_safe))) {
+  if (!geometry::overlaps(robotBox(robot, at, h, r), obstacleBox(L, R, h, params_.dSafe))) {
     contact_ = Contact::kBoxesApart;
     return {};
   }
   contact_ = Contact::kBoxesMeet;
-  const Vec2 f_left = elasticExternalForce(at, L, m.min_left, params_.d_safe, params_.k_r);
-  const Vec2 f_right = elasticExternalForce(at, R, m.min_right, params_.d_safe, params_.k_r);
-  const bool discs = moving[static_cast<std::size_t>(m.left_index)] != 0 ||
-                     moving[static_cast<std::size_t>(m.right_index)] != 0;
+  const Vec2 f_left = elasticExternalForce(at, L, m.minLeft, params_.dSafe, params_.kR);
+  const Vec2 f_right = elasticExternalForce(at, R, m.minRight, params_.dSafe, params_.kR);
+  const bool discs = moving[static_cast<std::size_t>(m.leftIndex)] != 0 ||
+                     moving[static_cast<std::size_t>(m.rightIndex)] != 0;
   if (discs || fastDistance(L, R) >= 2.0 * r)
     return f_left + f_right;  // a gap the robot fits through, or robots/people: both push (2.28)
   // Static readings too close together to pass between: one obstacle to go around. Their symmetric
   // pushes would cancel sideways and hold the robot in front of it (the seed's open question 6), so
   // only the nearer reading pushes, towards the side where the obstacle recedes; a tie passes right.
-  return m.min_left <= m.min_right ? f_left : f_right;
+  return m.minLeft <= m.minRight ? f_left : f_right;
 }
 
 Command ElasticStripsPlanner::plan(const LocalView& view) {
   const Vec2 p = view.robot.pose.position();
-  if (fastDistance(p, view.goal()) <= view.goal_tolerance)
+  if (fastDistance(p, view.goal()) <= view.goalTolerance)
     return {{}, PlanStatus::kGoalReached, false};
   // Strip control points: P^{j−1} = where the robot was last cycle, P^j = the robot, P^{j+1} = the
   // next strip point along the path, `spacing` ahead.
@@ -194,7 +193,7 @@ Command ElasticStripsPlanner::plan(const LocalView& view) {
   const Vec2 prev = have_prev_ && fastDistance(prev_, p) > 1e-6 ? prev_ : p - (next - p);
   prev_ = p;
   have_prev_ = true;
-  const Vec2 f_int = elasticInternalForce(prev, p, next, params_.k_c);
+  const Vec2 f_int = elasticInternalForce(prev, p, next, params_.kC);
   // No external force on the strip's end point: the goal is the strip's fixed end (a wall just
   // behind a goal would otherwise push the last point back and the robot would stop short of it).
   const bool end_point = fastDistance(next, view.goal()) < 1e-9;
@@ -206,8 +205,8 @@ Command ElasticStripsPlanner::plan(const LocalView& view) {
   const double err = angleDiff(std::atan2(d.y, d.x), view.robot.pose.theta);
   const double dist = std::sqrt(d.squaredNorm());
   const double v =
-      std::min(view.limits.v_max, dist / std::max(view.dt * 5.0, 1e-3)) * std::max(0.0, std::cos(err));
-  const double w = std::clamp(params_.k_omega * err, -view.limits.omega_max, view.limits.omega_max);
+      std::min(view.limits.vMax, dist / std::max(view.dt * 5.0, 1e-3)) * std::max(0.0, std::cos(err));
+  const double w = std::clamp(params_.kOmega * err, -view.limits.omegaMax, view.limits.omegaMax);
   return {{v, w}, PlanStatus::kMoving, false};
 }
 

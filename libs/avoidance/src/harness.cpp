@@ -50,7 +50,7 @@ struct HumanState {
 
 }  // namespace
 
-Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planner_name, bool with_safety,
+Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planner_name, bool withSafety,
                                      SafetyParams safety) {
   if (auto v = sc.limits.validate(); !v)
     return fleet::unexpected(v.error());
@@ -60,7 +60,7 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
     auto p = makePlanner(planner_name);
     if (!p)
       return fleet::unexpected(p.error());
-    if (with_safety) {
+    if (withSafety) {
       planners.push_back(std::make_unique<SafePlanner>(std::move(*p), safety));
     } else {
       planners.push_back(std::move(*p));
@@ -81,8 +81,8 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
   std::vector<std::vector<Vec2>> routes(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 g = sc.robots[i].goal;
-    if (sc.global_path) {
-      const auto inflated = sc.grid.inflated(sc.robots[i].radius + sc.path_margin);
+    if (sc.globalPath) {
+      const auto inflated = sc.grid.inflated(sc.robots[i].radius + sc.pathMargin);
       planning::AStarPlanner astar;
       auto planned = astar.plan(inflated, sc.robots[i].start, {g.x, g.y, 0.0});
       if (!planned)
@@ -107,8 +107,8 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
   std::vector<HumanState> humans;
   for (const auto& h : sc.humans) {
     HumanState s;
-    s.pos = h.random_walk ? h.a + (h.b - h.a) * 0.5 : h.a;
-    s.vel = h.random_walk ? Vec2{h.speed, 0.0} : (h.b - h.a).normalized() * h.speed;
+    s.pos = h.randomWalk ? h.a + (h.b - h.a) * 0.5 : h.a;
+    s.vel = h.randomWalk ? Vec2{h.speed, 0.0} : (h.b - h.a).normalized() * h.speed;
     humans.push_back(s);
   }
 
@@ -116,16 +116,16 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
   res.planner = std::string(planner_name);
   res.scenario = sc.name;
   res.robots = static_cast<int>(n);
-  res.min_separation = std::numeric_limits<double>::infinity();
+  res.minSeparation = std::numeric_limits<double>::infinity();
   std::vector<double> compute_us;
   std::vector<std::uint8_t> in_contact(n * (n + 1 + sc.humans.size()), 0);
   std::vector<Vec2> scan;
   std::vector<MovingDisc> discs;
   std::vector<Twist> cmds(n);
-  const double range2 = sc.sensing_range * sc.sensing_range;
+  const double range2 = sc.sensingRange * sc.sensingRange;
 
   int step = 0;
-  for (; step < sc.max_steps; ++step) {
+  for (; step < sc.maxSteps; ++step) {
     if (std::all_of(done.begin(), done.end(), [](bool d) { return d; }))
       break;
     // Plan all robots on the same snapshot, then move them together.
@@ -162,7 +162,7 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
       view.discs = discs;
       view.limits = sc.limits;
       view.dt = sc.dt;
-      view.goal_tolerance = sc.goal_tolerance;
+      view.goalTolerance = sc.goalTolerance;
       const auto t0 = std::chrono::steady_clock::now();
       const Command c = planners[i]->plan(view);
       const auto t1 = std::chrono::steady_clock::now();
@@ -189,7 +189,7 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
     for (std::size_t h = 0; h < humans.size(); ++h) {
       auto& s = humans[h];
       const auto& spec = sc.humans[h];
-      if (spec.random_walk) {
+      if (spec.randomWalk) {
         if (uni(rng) < 0.05) {
           const double a = 2.0 * kPi * uni(rng);
           s.vel = Vec2{std::cos(a), std::sin(a)} * spec.speed;
@@ -219,22 +219,22 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
       const Vec2 p = pose[i].position();
       const double ri = sc.robots[i].radius;
       auto note = [&](std::size_t slot, double gap) {
-        res.min_separation = std::min(res.min_separation, gap);
+        res.minSeparation = std::min(res.minSeparation, gap);
         const bool touch = gap < -1e-9;
         auto& flag = in_contact[i * stride + slot];
         if (touch && flag == 0) {
           ++res.collisions;
           if (slot < n) {
-            ++res.robot_collisions;
+            ++res.robotCollisions;
           } else if (slot == n) {
-            ++res.static_collisions;
+            ++res.staticCollisions;
           } else {
-            ++res.human_collisions;
+            ++res.humanCollisions;
             if (std::abs(twist[i].v) > 1e-3)
-              ++res.human_hits_while_moving;
+              ++res.humanHitsWhileMoving;
             const Vec2 to_h = humans[slot - n - 1].pos - p;
             if (pose[i].heading().dot(to_h) * twist[i].v > 0.05 * std::sqrt(to_h.squaredNorm()))
-              ++res.human_hits_by_robot;
+              ++res.humanHitsByRobot;
           }
         }
         flag = touch ? 1 : 0;
@@ -269,24 +269,24 @@ Expected<ScenarioResult> runScenario(const Scenario& sc, std::string_view planne
   if (res.reached < res.robots)
     res.makespan = static_cast<double>(step) * sc.dt;
   if (res.reached > 0) {
-    res.mean_time_to_goal = t_sum / res.reached;
-    res.mean_path_length = l_sum / res.reached;
+    res.meanTimeToGoal = t_sum / res.reached;
+    res.meanPathLength = l_sum / res.reached;
   }
   for (std::size_t i = 0; i < n; ++i) {
-    res.mean_remaining += fastDistance(pose[i].position(), sc.robots[i].goal) / static_cast<double>(n);
-    res.mean_travelled += length[i] / static_cast<double>(n);
+    res.meanRemaining += fastDistance(pose[i].position(), sc.robots[i].goal) / static_cast<double>(n);
+    res.meanTravelled += length[i] / static_cast<double>(n);
   }
-  res.agent_steps = static_cast<std::int64_t>(compute_us.size());
+  res.agentSteps = static_cast<std::int64_t>(compute_us.size());
   if (!compute_us.empty()) {
     double s = 0.0;
     for (const double c : compute_us)
       s += c;
-    res.compute_mean_us = s / static_cast<double>(compute_us.size());
+    res.computeMeanUs = s / static_cast<double>(compute_us.size());
     const std::size_t k = std::min(compute_us.size() - 1,
                                    static_cast<std::size_t>(0.99 * static_cast<double>(compute_us.size())));
     std::nth_element(compute_us.begin(), compute_us.begin() + static_cast<std::ptrdiff_t>(k),
                      compute_us.end());
-    res.compute_p99_us = compute_us[k];
+    res.computeP99Us = compute_us[k];
   }
   return res;
 }
@@ -300,7 +300,7 @@ Scenario circleSwap(int n, double circle_radius, double robot_radius) {
     const Vec2 p{circle_radius * std::cos(a), circle_radius * std::sin(a)};
     sc.robots.push_back({{p.x, p.y, wrapAngle(a + kPi)}, -p, robot_radius});
   }
-  sc.max_steps = static_cast<int>(40.0 * circle_radius / (sc.limits.v_max * sc.dt)) + 2000;
+  sc.maxSteps = static_cast<int>(40.0 * circle_radius / (sc.limits.vMax * sc.dt)) + 2000;
   return sc;
 }
 
@@ -329,7 +329,7 @@ Scenario aisleCrossing(int robots_each_way, int crossing_humans, std::uint32_t s
     sc.humans.push_back({{x, -4.5 + 0.8 * h}, {x, 4.5}, 1.0, 0.3, false});
   }
   sc.humans.push_back({{3.0, -1.2}, {21.0, 1.2}, 0.8, 0.3, true});
-  sc.max_steps = 2500;
+  sc.maxSteps = 2500;
   return sc;
 }
 
@@ -337,7 +337,7 @@ Scenario obstacleCourse() {
   Scenario sc;
   sc.name = "obstacle_course";
   // 18 m × 12 m at 0.1 m with a wall around it; boxes (centre x, centre y, half width, half
-  // height) leave 3.6 m to the walls, more than Table 2.3's d_safe of 1 m on each side.
+  // height) leave 3.6 m to the walls, more than Table 2.3's dSafe of 1 m on each side.
   sc.grid = planning::OccupancyGrid(180, 120, 0.1, {0.0, -6.0});
   struct Box {
     double cx, cy, hx, hy;
@@ -354,10 +354,10 @@ Scenario obstacleCourse() {
         sc.grid.setBlocked({x, y});
     }
   }
-  // The goal lies 0.9 m in front of the end wall, as stations do: inside Elastic Strips' d_safe.
+  // The goal lies 0.9 m in front of the end wall, as stations do: inside Elastic Strips' dSafe.
   sc.robots.push_back({{1.0, 0.0, 0.0}, {17.0, 0.0}, 0.35});
-  sc.max_steps = 4000;  // Bug1 tours every box it meets once and a half at 0.3 m/s: ~70 m
-  sc.global_path = true;
+  sc.maxSteps = 4000;  // Bug1 tours every box it meets once and a half at 0.3 m/s: ~70 m
+  sc.globalPath = true;
   return sc;
 }
 
@@ -367,7 +367,7 @@ Scenario aisleCrossingAlone(int crossing_humans, std::uint32_t seed) {
   sc.robots.resize(1);
   sc.robots[0].start = {0.5, 0.0, 0.0};
   sc.robots[0].goal = {23.0, 0.0};
-  sc.global_path = true;
+  sc.globalPath = true;
   return sc;
 }
 

@@ -39,7 +39,7 @@ Expected<std::unique_ptr<LocalPlanner>> makePlanner(std::string_view name) {
     return Ptr(std::make_unique<OrcaPlanner>());
   if (name == "vo_keep_right") {
     VelocityObstacleParams p;
-    p.right_bias = 1.0;
+    p.rightBias = 1.0;
     return Ptr(std::make_unique<VelocityObstaclePlanner>(p));
   }
   return fleet::unexpected("unknown_planner", "no local planner named '" + std::string(name) + "'");

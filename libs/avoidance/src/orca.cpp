@@ -167,17 +167,17 @@ OrcaHalfPlane orcaHalfPlane(Vec2 v_a, Vec2 rel_pos, Vec2 rel_vel, double R, doub
   return {v_a + u * share, n};
 }
 
-Vec2 orcaSolve(std::span<const OrcaHalfPlane> planes, std::size_t hard, Vec2 v_pref, double v_max) {
+Vec2 orcaSolve(std::span<const OrcaHalfPlane> planes, std::size_t hard, Vec2 v_pref, double vMax) {
   Vec2 result;
-  const std::size_t fail = lp2(planes, v_max, v_pref, false, result);
+  const std::size_t fail = lp2(planes, vMax, v_pref, false, result);
   if (fail < planes.size())
-    lp3(planes, std::min(hard, fail), fail, v_max, result);
+    lp3(planes, std::min(hard, fail), fail, vMax, result);
   return result;
 }
 
 Expected<void> OrcaParams::validate() const {
-  if (!(tau > 0.0) || !(tau_static > 0.0) || margin < 0.0 || tracking_error < 0.0 || right_bias < 0.0 ||
-      !(k_omega > 0.0) || static_range < 0.0 || max_static < 0) {
+  if (!(tau > 0.0) || !(tauStatic > 0.0) || margin < 0.0 || trackingError < 0.0 || rightBias < 0.0 ||
+      !(kOmega > 0.0) || staticRange < 0.0 || maxStatic < 0) {
     return fleet::unexpected("invalid_orca_params",
                              "need tau, tau_static, k_omega > 0 and non-negative margin, tracking_error, "
                              "static_range, max_static");
@@ -191,39 +191,39 @@ Command OrcaPlanner::plan(const LocalView& view) {
   const Vec2 goal = view.goal();
   const double dg = fastDistance(p, goal);
   last_v_ = {};
-  if (dg <= view.goal_tolerance)
+  if (dg <= view.goalTolerance)
     return {{}, PlanStatus::kGoalReached, false};
-  const double vmax = view.limits.v_max;
+  const double vmax = view.limits.vMax;
   const Vec2 carrot = carrotOnPath(view.path, p, 1.5);
   // Brake on the last stretch (v ≤ sqrt(2·a·d)) so the tolerance is not overshot.
-  const double v_goal = std::min(vmax, std::sqrt(2.0 * view.limits.accel_max * dg));
+  const double v_goal = std::min(vmax, std::sqrt(2.0 * view.limits.accelMax * dg));
   const Vec2 v_pref = (carrot - p).normalized() * v_goal;
   // The velocity the robot is really executing (it moves along its heading).
   const Vec2 v_cur = pose.heading() * view.robot.twist.v;
-  const double r = view.robot.radius + params_.margin + params_.tracking_error;
+  const double r = view.robot.radius + params_.margin + params_.trackingError;
 
   planes_.clear();
   // Static points first: hard constraints, full responsibility (they do not move).
-  if (params_.max_static > 0 && !view.scan.empty()) {
+  if (params_.maxStatic > 0 && !view.scan.empty()) {
     thread_local std::vector<std::pair<double, Vec2>> near;
     near.clear();
-    const double range2 = (params_.static_range + r) * (params_.static_range + r);
+    const double range2 = (params_.staticRange + r) * (params_.staticRange + r);
     for (const Vec2& q : view.scan) {
       const double d2 = (q - p).squaredNorm();
       if (d2 <= range2)
         near.emplace_back(d2, q);
     }
-    const std::size_t k = std::min(near.size(), static_cast<std::size_t>(params_.max_static));
+    const std::size_t k = std::min(near.size(), static_cast<std::size_t>(params_.maxStatic));
     std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(k), near.end(),
                       [](const auto& a, const auto& b) { return a.first < b.first; });
     for (std::size_t i = 0; i < k; ++i) {
-      planes_.push_back(orcaHalfPlane(v_cur, near[i].second - p, v_cur, r, params_.tau_static, view.dt, 1.0));
+      planes_.push_back(orcaHalfPlane(v_cur, near[i].second - p, v_cur, r, params_.tauStatic, view.dt, 1.0));
     }
   }
   const std::size_t hard = planes_.size();
   for (const MovingDisc& d : view.discs) {
     planes_.push_back(orcaHalfPlane(v_cur, d.position - p, v_cur - d.velocity,
-                                    r + d.radius + params_.tracking_error, params_.tau, view.dt, 0.5));
+                                    r + d.radius + params_.trackingError, params_.tau, view.dt, 0.5));
   }
   // Perfectly symmetric encounters (circle swap) are a fixed point of ORCA: every robot's optimum
   // is to slow down straight ahead. A shared convention breaks the symmetry: while the preferred
@@ -234,8 +234,8 @@ Command OrcaPlanner::plan(const LocalView& view) {
   Vec2 opt = v_pref;
   for (std::size_t i = hard; i < planes_.size(); ++i) {
     if (view.discs[i - hard].velocity.squaredNorm() > 0.05 * 0.05 && violation(planes_[i], v_pref) > 0.0) {
-      const double c = std::cos(params_.right_bias);
-      const double s = std::sin(params_.right_bias);
+      const double c = std::cos(params_.rightBias);
+      const double s = std::sin(params_.rightBias);
       opt = Vec2{c * v_pref.x + s * v_pref.y, -s * v_pref.x + c * v_pref.y};
       break;
     }
@@ -247,7 +247,7 @@ Command OrcaPlanner::plan(const LocalView& view) {
     return {{}, PlanStatus::kMoving, false};
   const double err = angleDiff(std::atan2(v.y, v.x), pose.theta);
   const double fwd = speed * std::max(0.0, std::cos(err));
-  const double w = std::clamp(params_.k_omega * err, -view.limits.omega_max, view.limits.omega_max);
+  const double w = std::clamp(params_.kOmega * err, -view.limits.omegaMax, view.limits.omegaMax);
   return {{fwd, w}, PlanStatus::kMoving, false};
 }
 

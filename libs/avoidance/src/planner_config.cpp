@@ -15,25 +15,25 @@ DwaParams dwaParams(Config& cfg, const DwaParams& defaults) {
   const auto count = [&](const char* key, int fallback) {
     return static_cast<int>(cfg.integer(key, fallback, {1.0, 200.0}));
   };
-  p.v_samples = count("v_samples", p.v_samples);
-  p.omega_samples = count("omega_samples", p.omega_samples);
-  p.sim_time = cfg.number("sim_time", p.sim_time, {0.1, 10.0});
-  p.w_heading = cfg.number("w_heading", p.w_heading, kNonNegative);
-  p.w_clearance = cfg.number("w_clearance", p.w_clearance, kNonNegative);
-  p.w_velocity = cfg.number("w_velocity", p.w_velocity, kNonNegative);
-  p.w_progress = cfg.number("w_progress", p.w_progress, kNonNegative);
-  p.w_risk = cfg.number("w_risk", p.w_risk, kNonNegative);
-  p.clearance_cap = cfg.number("clearance_cap", p.clearance_cap, kPositive);
-  p.clearance_length = cfg.number("clearance_length", p.clearance_length, kPositive);
-  p.curvature_speed_floor = cfg.number("curvature_speed_floor", p.curvature_speed_floor, {0.0, 1.0});
-  p.min_clearance = cfg.number("min_clearance", p.min_clearance, kNonNegative);
+  p.vSamples = count("v_samples", p.vSamples);
+  p.omegaSamples = count("omega_samples", p.omegaSamples);
+  p.simTime = cfg.number("sim_time", p.simTime, {0.1, 10.0});
+  p.wHeading = cfg.number("w_heading", p.wHeading, kNonNegative);
+  p.wClearance = cfg.number("w_clearance", p.wClearance, kNonNegative);
+  p.wVelocity = cfg.number("w_velocity", p.wVelocity, kNonNegative);
+  p.wProgress = cfg.number("w_progress", p.wProgress, kNonNegative);
+  p.wRisk = cfg.number("w_risk", p.wRisk, kNonNegative);
+  p.clearanceCap = cfg.number("clearance_cap", p.clearanceCap, kPositive);
+  p.clearanceLength = cfg.number("clearance_length", p.clearanceLength, kPositive);
+  p.curvatureSpeedFloor = cfg.number("curvature_speed_floor", p.curvatureSpeedFloor, {0.0, 1.0});
+  p.minClearance = cfg.number("min_clearance", p.minClearance, kNonNegative);
   p.lookahead = cfg.number("lookahead", p.lookahead, kPositive);
-  p.risk_samples = count("risk_samples", p.risk_samples);
-  p.disc_samples = count("disc_samples", p.disc_samples);
-  p.allow_reverse = cfg.boolean("allow_reverse", p.allow_reverse);
-  p.stuck_cycles = count("stuck_cycles", p.stuck_cycles);
-  p.stuck_progress = cfg.number("stuck_progress", p.stuck_progress, kNonNegative);
-  p.escape_cycles = count("escape_cycles", p.escape_cycles);
+  p.riskSamples = count("risk_samples", p.riskSamples);
+  p.discSamples = count("disc_samples", p.discSamples);
+  p.allowReverse = cfg.boolean("allow_reverse", p.allowReverse);
+  p.stuckCycles = count("stuck_cycles", p.stuckCycles);
+  p.stuckProgress = cfg.number("stuck_progress", p.stuckProgress, kNonNegative);
+  p.escapeCycles = count("escape_cycles", p.escapeCycles);
   p.prune = cfg.boolean("prune", p.prune);
   cfg.rejectUnknownKeys({"v_samples",
                          "omega_samples",
@@ -68,13 +68,13 @@ RiskSteppingParams riskSteppingParams(Config& cfg, const RiskSteppingParams& def
       cfg.string("rule", std::string(steppingRuleName(p.rule)), {"iso_level", "weighted"});
   p.rule = rule == "weighted" ? SteppingRule::kWeighted : SteppingRule::kIsoLevel;
   p.levels = static_cast<int>(cfg.integer("levels", p.levels, {1.0, 255.0}));
-  p.step_time = cfg.number("step_time", p.step_time, kPositive);
+  p.stepTime = cfg.number("step_time", p.stepTime, kPositive);
   p.candidates = static_cast<int>(cfg.integer("candidates", p.candidates, {1.0, 200.0}));
   p.fan = cfg.number("fan", p.fan, {0.0, 3.14159});
-  p.risk_samples = static_cast<int>(cfg.integer("risk_samples", p.risk_samples, {1.0, 100.0}));
-  p.w_progress = cfg.number("w_progress", p.w_progress, kNonNegative);
-  p.min_clearance = cfg.number("min_clearance", p.min_clearance, kNonNegative);
-  p.k_omega = cfg.number("k_omega", p.k_omega, kPositive);
+  p.riskSamples = static_cast<int>(cfg.integer("risk_samples", p.riskSamples, {1.0, 100.0}));
+  p.wProgress = cfg.number("w_progress", p.wProgress, kNonNegative);
+  p.minClearance = cfg.number("min_clearance", p.minClearance, kNonNegative);
+  p.kOmega = cfg.number("k_omega", p.kOmega, kPositive);
   p.lookahead = cfg.number("lookahead", p.lookahead, kPositive);
   cfg.rejectUnknownKeys({"rule", "levels", "step_time", "candidates", "fan", "risk_samples", "w_progress",
                          "min_clearance", "k_omega", "lookahead"});
@@ -87,14 +87,14 @@ RiskSteppingParams riskSteppingParams(Config& cfg, const RiskSteppingParams& def
 
 SafetyParams safetyParams(Config& cfg) {
   SafetyParams p;
-  p.stop_margin = cfg.number("stop_margin", p.stop_margin, kNonNegative);
-  p.slow_margin = cfg.number("slow_margin", p.slow_margin, kNonNegative);
-  p.slow_time = cfg.number("slow_time", p.slow_time, kNonNegative);
-  p.slow_ratio = cfg.number("slow_ratio", p.slow_ratio, {0.0, 1.0, true});
-  p.sample_step = cfg.number("sample_step", p.sample_step, {0.001, 1.0});
+  p.stopMargin = cfg.number("stop_margin", p.stopMargin, kNonNegative);
+  p.slowMargin = cfg.number("slow_margin", p.slowMargin, kNonNegative);
+  p.slowTime = cfg.number("slow_time", p.slowTime, kNonNegative);
+  p.slowRatio = cfg.number("slow_ratio", p.slowRatio, {0.0, 1.0, true});
+  p.sampleStep = cfg.number("sample_step", p.sampleStep, {0.001, 1.0});
   cfg.rejectUnknownKeys({"stop_margin", "slow_margin", "slow_time", "slow_ratio", "sample_step"});
-  if (p.slow_margin < p.stop_margin)
-    cfg.problem("slow_margin", "must be >= stop_margin (" + std::to_string(p.stop_margin) + ")");
+  if (p.slowMargin < p.stopMargin)
+    cfg.problem("slow_margin", "must be >= stop_margin (" + std::to_string(p.stopMargin) + ")");
   return p;
 }
 

@@ -10,7 +10,7 @@
 namespace fleet::avoidance {
 
 Expected<void> RotationShimParams::validate() const {
-  if (!(start_angle > 0.0 && start_angle < kPi) || !(stop_angle > 0.0 && stop_angle <= start_angle) ||
+  if (!(startAngle > 0.0 && startAngle < kPi) || !(stopAngle > 0.0 && stopAngle <= startAngle) ||
       !(lookahead > 0.0) || !(omega > 0.0)) {
     return fleet::unexpected("invalid_rotation_shim_params",
                              "0 < stop_angle <= start_angle < pi, lookahead > 0, omega > 0");
@@ -27,10 +27,10 @@ Command RotationShim::plan(const LocalView& view) {
   }
   const Vec2 target = carrotOnPath(view.path, p, params_.lookahead);
   const double err = angleDiff(std::atan2(target.y - p.y, target.x - p.x), view.robot.pose.theta);
-  rotating_ = std::abs(err) > (rotating_ ? params_.stop_angle : params_.start_angle);
+  rotating_ = std::abs(err) > (rotating_ ? params_.stopAngle : params_.startAngle);
   if (!rotating_)
     return inner_->plan(view);
-  const double w = std::min(params_.omega, view.limits.omega_max);
+  const double w = std::min(params_.omega, view.limits.omegaMax);
   return {{0.0, err > 0.0 ? w : -w}, PlanStatus::kMoving, false};
 }
 

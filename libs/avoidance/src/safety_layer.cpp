@@ -32,8 +32,8 @@ double clearanceAt(const LocalView& view, Vec2 p, double tau) {
 }  // namespace
 
 Expected<void> SafetyParams::validate() const {
-  if (!(stop_margin >= 0.0) || !(slow_margin >= stop_margin) || !(slow_time >= 0.0) ||
-      !(slow_ratio > 0.0 && slow_ratio <= 1.0) || !(sample_step > 0.0)) {
+  if (!(stopMargin >= 0.0) || !(slowMargin >= stopMargin) || !(slowTime >= 0.0) ||
+      !(slowRatio > 0.0 && slowRatio <= 1.0) || !(sampleStep > 0.0)) {
     return fleet::unexpected("invalid_safety_params",
                              "need 0 <= stop_margin <= slow_margin, slow_time >= 0, 0 < slow_ratio <= 1, "
                              "sample_step > 0");
@@ -43,23 +43,23 @@ Expected<void> SafetyParams::validate() const {
 
 bool SafetyLayer::profileSafe(const LocalView& view, Twist cmd) const {
   const auto& lim = view.limits;
-  const double h = params_.sample_step;
+  const double h = params_.sampleStep;
   Pose2 pose = view.robot.pose;
   Twist tw = view.robot.twist;
   double prev = clearanceAt(view, pose.position(), 0.0);
   double t = 0.0;
-  // One cycle towards cmd, then brake to a stop at accel_max while keeping the turn rate.
-  const double brake_time = (std::abs(tw.v) + lim.accel_max * view.dt) / std::max(lim.accel_max, 1e-9);
+  // One cycle towards cmd, then brake to a stop at accelMax while keeping the turn rate.
+  const double brake_time = (std::abs(tw.v) + lim.accelMax * view.dt) / std::max(lim.accelMax, 1e-9);
   const double total = view.dt + brake_time + h;
   while (t < total) {
     const bool first_cycle = t < view.dt - 1e-12;
     const Twist target = first_cycle ? cmd : Twist{0.0, cmd.omega};
-    tw.v = approach(tw.v, target.v, lim.accel_max * h);
-    tw.omega = approach(tw.omega, target.omega, lim.alpha_max * h);
+    tw.v = approach(tw.v, target.v, lim.accelMax * h);
+    tw.omega = approach(tw.omega, target.omega, lim.alphaMax * h);
     pose = control::DiffDriveKinematics::integrateExact(pose, tw, h);
     t += h;
     const double c = clearanceAt(view, pose.position(), t);
-    if (c < params_.stop_margin && c < prev - 1e-9)
+    if (c < params_.stopMargin && c < prev - 1e-9)
       return false;
     prev = c;
     if (!first_cycle && tw.v == 0.0 && view.discs.empty())
@@ -69,7 +69,7 @@ bool SafetyLayer::profileSafe(const LocalView& view, Twist cmd) const {
 }
 
 double SafetyLayer::timeToCollision(const LocalView& view, Twist cmd, double horizon) const {
-  const double h = params_.sample_step;
+  const double h = params_.sampleStep;
   for (double t = h; t <= horizon + 1e-12; t += h) {
     const Pose2 p = control::DiffDriveKinematics::integrateExact(view.robot.pose, cmd, t);
     if (clearanceAt(view, p.position(), t) <= 0.0)
@@ -86,9 +86,9 @@ SafetyResult SafetyLayer::filter(const LocalView& view, Twist request) const {
     out.blocked = true;
     return out;
   }
-  Twist req{std::clamp(request.v, lim.v_min, lim.v_max),
-            std::clamp(request.omega, -lim.omega_max, lim.omega_max)};
-  out.time_to_collision = timeToCollision(view, req, params_.slow_time);
+  Twist req{std::clamp(request.v, lim.vMin, lim.vMax),
+            std::clamp(request.omega, -lim.omegaMax, lim.omegaMax)};
+  out.timeToCollision = timeToCollision(view, req, params_.slowTime);
   static constexpr std::array<double, 5> kScales{1.0, 0.75, 0.5, 0.25, 0.0};
   bool found = false;
   for (const double s : kScales) {
@@ -103,16 +103,16 @@ SafetyResult SafetyLayer::filter(const LocalView& view, Twist request) const {
     out.twist = {};
     out.blocked = true;
   }
-  // Slow-down zone: something within slow_margin of where the (possibly scaled) command goes.
+  // Slow-down zone: something within slowMargin of where the (possibly scaled) command goes.
   if (found && out.twist.v != 0.0) {
-    const double cap = params_.slow_ratio * std::max(lim.v_max, -lim.v_min);
+    const double cap = params_.slowRatio * std::max(lim.vMax, -lim.vMin);
     if (std::abs(out.twist.v) > cap) {
       double min_c = std::numeric_limits<double>::infinity();
-      for (double t = params_.sample_step; t <= params_.slow_time + 1e-12; t += params_.sample_step) {
+      for (double t = params_.sampleStep; t <= params_.slowTime + 1e-12; t += params_.sampleStep) {
         const Pose2 p = control::DiffDriveKinematics::integrateExact(view.robot.pose, out.twist, t);
         min_c = std::min(min_c, clearanceAt(view, p.position(), t));
       }
-      if (min_c < params_.slow_margin) {
+      if (min_c < params_.slowMargin) {
         out.twist.v = std::copysign(cap, out.twist.v);
         out.slowed = true;
       }

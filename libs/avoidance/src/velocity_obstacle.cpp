@@ -25,7 +25,7 @@ double discTimeToCollision(Vec2 rel, Vec2 vel, double R) {
 }
 
 Expected<void> VelocityObstacleParams::validate() const {
-  if (headings < 1 || speeds < 1 || w_ttc < 0.0 || !(horizon > 0.0) || margin < 0.0 || !(k_omega > 0.0)) {
+  if (headings < 1 || speeds < 1 || wTtc < 0.0 || !(horizon > 0.0) || margin < 0.0 || !(kOmega > 0.0)) {
     return fleet::unexpected("invalid_vo_params", "counts >= 1, horizon > 0, non-negative weights");
   }
   return {};
@@ -36,9 +36,9 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
   const Vec2 p = pose.position();
   const Vec2 goal = view.goal();
   const double dg = fastDistance(p, goal);
-  if (dg <= view.goal_tolerance)
+  if (dg <= view.goalTolerance)
     return {{}, PlanStatus::kGoalReached, false};
-  const double vmax = view.limits.v_max;
+  const double vmax = view.limits.vMax;
   const Vec2 carrot = carrotOnPath(view.path, p, 1.5);
   // Slow down on the last stretch so the goal tolerance is not overshot.
   const Vec2 v_pref = (carrot - p).normalized() * std::min(vmax, dg / 1.0);
@@ -59,10 +59,10 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
     }
     for (const Vec2& q : view.scan)
       ttc = std::min(ttc, discTimeToCollision(q - p, cand, r));
-    const double pen = ttc < params_.horizon ? params_.w_ttc / std::max(ttc, 1e-3) : 0.0;
+    const double pen = ttc < params_.horizon ? params_.wTtc / std::max(ttc, 1e-3) : 0.0;
     double cost = pen + std::sqrt((cand - v_pref).squaredNorm());
-    if (params_.right_bias > 0.0 && conflict) {
-      cost += params_.right_bias * std::max(0.0, v_pref.normalized().cross(cand));
+    if (params_.rightBias > 0.0 && conflict) {
+      cost += params_.rightBias * std::max(0.0, v_pref.normalized().cross(cand));
     }
     if (cost < best_cost) {
       best_cost = cost;
@@ -83,7 +83,7 @@ Command VelocityObstaclePlanner::plan(const LocalView& view) {
     return {{}, PlanStatus::kMoving, false};
   const double err = angleDiff(std::atan2(best_v.y, best_v.x), pose.theta);
   const double v = speed * std::max(0.0, std::cos(err));
-  const double w = std::clamp(params_.k_omega * err, -view.limits.omega_max, view.limits.omega_max);
+  const double w = std::clamp(params_.kOmega * err, -view.limits.omegaMax, view.limits.omegaMax);
   return {{v, w}, PlanStatus::kMoving, false};
 }
 

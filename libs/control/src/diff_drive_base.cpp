@@ -4,9 +4,9 @@
 
 namespace fleet::control {
 
-Expected<DiffDriveBase> DiffDriveBase::create(double wheel_base, const VelocityLimits& limits,
+Expected<DiffDriveBase> DiffDriveBase::create(double wheelBase, const VelocityLimits& limits,
                                               const Pose2& start) {
-  auto kin = DiffDriveKinematics::create(wheel_base);
+  auto kin = DiffDriveKinematics::create(wheelBase);
   if (!kin) {
     return fleet::unexpected(kin.error());
   }

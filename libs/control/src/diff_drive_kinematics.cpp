@@ -4,11 +4,11 @@
 
 namespace fleet::control {
 
-Expected<DiffDriveKinematics> DiffDriveKinematics::create(double wheel_base) {
-  if (!std::isfinite(wheel_base) || wheel_base <= 0.0) {
+Expected<DiffDriveKinematics> DiffDriveKinematics::create(double wheelBase) {
+  if (!std::isfinite(wheelBase) || wheelBase <= 0.0) {
     return fleet::unexpected("invalid_wheel_base", "wheel_base must be finite and > 0 (metres)");
   }
-  return DiffDriveKinematics(wheel_base);
+  return DiffDriveKinematics(wheelBase);
 }
 
 WheelSpeeds DiffDriveKinematics::toWheelSpeeds(Twist t) const {

@@ -19,22 +19,22 @@ Twist globalLaw(const PolarError& e, const LyapunovGains& g) {
   const double ca = std::cos(e.alpha);
   // sin α/α → 1; the series keeps the law smooth through α = 0.
   const double sinc = std::abs(e.alpha) < 1e-6 ? 1.0 - e.alpha * e.alpha / 6.0 : std::sin(e.alpha) / e.alpha;
-  return {g.k_v * e.rho * ca, g.k_alpha * e.alpha + g.k_v * ca * sinc * (e.alpha + g.h * e.phi)};
+  return {g.kV * e.rho * ca, g.kAlpha * e.alpha + g.kV * ca * sinc * (e.alpha + g.h * e.phi)};
 }
 
 Expected<void> LyapunovParams::validate() const {
-  const bool positive = gains.k_v > 0.0 && gains.k_alpha > 0.0 && gains.k_theta > 0.0 && gains.h > 0.0;
-  if (!positive || !std::isfinite(gains.k_v) || !std::isfinite(gains.k_alpha) ||
-      !std::isfinite(gains.k_theta) || !std::isfinite(gains.h)) {
+  const bool positive = gains.kV > 0.0 && gains.kAlpha > 0.0 && gains.kTheta > 0.0 && gains.h > 0.0;
+  if (!positive || !std::isfinite(gains.kV) || !std::isfinite(gains.kAlpha) || !std::isfinite(gains.kTheta) ||
+      !std::isfinite(gains.h)) {
     return fleet::unexpected("invalid_gains", "k_v, k_alpha, k_theta and h must be finite and > 0");
   }
-  if (!(eps_rho >= 0.0) || !(eps_theta >= 0.0) || !std::isfinite(eps_rho) || !std::isfinite(eps_theta)) {
+  if (!(epsRho >= 0.0) || !(epsTheta >= 0.0) || !std::isfinite(epsRho) || !std::isfinite(epsTheta)) {
     return fleet::unexpected("invalid_region", "eps_rho and eps_theta must be finite and >= 0");
   }
-  if (!(local_exit_factor >= 1.0) || !std::isfinite(local_exit_factor)) {
+  if (!(localExitFactor >= 1.0) || !std::isfinite(localExitFactor)) {
     return fleet::unexpected("invalid_region", "local_exit_factor must be finite and >= 1");
   }
-  if (!(reverse_hysteresis >= 0.0) || reverse_hysteresis >= 0.5 * kPi) {
+  if (!(reverseHysteresis >= 0.0) || reverseHysteresis >= 0.5 * kPi) {
     return fleet::unexpected("invalid_hysteresis", "reverse_hysteresis must be in [0, pi/2)");
   }
   return {};
@@ -54,29 +54,29 @@ Expected<PoseControlOutput> LyapunovPoseController::step(const Pose2& estimate, 
   if (in_local_ && !(goal == local_goal_)) {
     in_local_ = false;
   }
-  const double grow = in_local_ ? params_.local_exit_factor : 1.0;
-  in_local_ = params_.law == PoseLaw::kTwoRegion && out.error.rho < grow * params_.eps_rho &&
-              std::abs(theta_e) < grow * params_.eps_theta;
+  const double grow = in_local_ ? params_.localExitFactor : 1.0;
+  in_local_ = params_.law == PoseLaw::kTwoRegion && out.error.rho < grow * params_.epsRho &&
+              std::abs(theta_e) < grow * params_.epsTheta;
   if (in_local_) {
     local_goal_ = goal;
     // Ω_L: φ and α are meaningless this close (they follow the feedback noise), so only the heading error
     // is driven to zero; ρ·cos α is the signed projection of the goal offset on the heading, so the
     // same v law also backs up when the goal is behind.
     out.region = ControlRegion::kLocal;
-    out.cmd = {g.k_v * out.error.rho * std::cos(out.error.alpha), -g.k_theta * theta_e};
+    out.cmd = {g.kV * out.error.rho * std::cos(out.error.alpha), -g.kTheta * theta_e};
     out.lyapunov = 0.5 * out.error.rho * out.error.rho + 0.5 * theta_e * theta_e;
     return out;
   }
 
   if (!have_direction_ || !(goal == direction_goal_)) {
-    reverse_ = params_.allow_reverse && std::abs(out.error.alpha) > 0.5 * kPi;
+    reverse_ = params_.allowReverse && std::abs(out.error.alpha) > 0.5 * kPi;
     have_direction_ = true;
     direction_goal_ = goal;
-  } else if (params_.allow_reverse) {
+  } else if (params_.allowReverse) {
     const double a = std::abs(out.error.alpha);
-    if (!reverse_ && a > 0.5 * kPi + params_.reverse_hysteresis) {
+    if (!reverse_ && a > 0.5 * kPi + params_.reverseHysteresis) {
       reverse_ = true;
-    } else if (reverse_ && a < 0.5 * kPi - params_.reverse_hysteresis) {
+    } else if (reverse_ && a < 0.5 * kPi - params_.reverseHysteresis) {
       reverse_ = false;
     }
   }

@@ -10,18 +10,17 @@ namespace {
 
 LyapunovParams trackingParams(LyapunovParams p) {
   p.law = PoseLaw::kSingleLaw;
-  p.allow_reverse = false;
+  p.allowReverse = false;
   return p;
 }
 
 }  // namespace
 
 Expected<void> PathFollowerParams::validate() const {
-  if (!std::isfinite(lookahead) || lookahead <= 0.0 || !std::isfinite(search_window) ||
-      search_window <= 0.0) {
+  if (!std::isfinite(lookahead) || lookahead <= 0.0 || !std::isfinite(searchWindow) || searchWindow <= 0.0) {
     return fleet::unexpected("invalid_lookahead", "lookahead and search_window must be finite and > 0");
   }
-  if (!(goal_tolerance_xy > 0.0) || !(goal_tolerance_theta > 0.0)) {
+  if (!(goalToleranceXy > 0.0) || !(goalToleranceTheta > 0.0)) {
     return fleet::unexpected("invalid_tolerance", "goal tolerances must be > 0");
   }
   return controller.validate();
@@ -103,7 +102,7 @@ Expected<PathFollowerOutput> PathFollower::step(const Pose2& estimate) {
     best_s = 0.0;
   }
   for (std::size_t i = segment_; i + 1 < points_.size(); ++i) {
-    if (cumulative_[i] > progress_ + params_.search_window) {
+    if (cumulative_[i] > progress_ + params_.searchWindow) {
       break;
     }
     const Vec2 a = points_[i];
@@ -125,17 +124,17 @@ Expected<PathFollowerOutput> PathFollower::step(const Pose2& estimate) {
   progress_ = std::max(progress_, best_s);
   segment_ = best_seg;
   out.progress = progress_;
-  out.cross_track = std::sqrt(best_d2);
+  out.crossTrack = std::sqrt(best_d2);
 
   const double carrot = progress_ + params_.lookahead;
   const Pose2 goal{points_.back().x, points_.back().y, final_heading_};
   if (carrot >= total) {
-    out.final_approach = true;
+    out.finalApproach = true;
     out.target = goal;
     const PolarError e = polarError(estimate, goal);
-    if (e.rho < params_.goal_tolerance_xy &&
-        std::abs(angleDiff(estimate.theta, goal.theta)) < params_.goal_tolerance_theta) {
-      out.goal_reached = true;
+    if (e.rho < params_.goalToleranceXy &&
+        std::abs(angleDiff(estimate.theta, goal.theta)) < params_.goalToleranceTheta) {
+      out.goalReached = true;
       return out;
     }
     auto r = final_.step(estimate, goal);

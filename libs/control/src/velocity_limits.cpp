@@ -6,15 +6,15 @@
 namespace fleet::control {
 
 Expected<void> VelocityLimits::validate() const {
-  const bool finite = std::isfinite(v_max) && std::isfinite(v_min) && std::isfinite(omega_max) &&
-                      std::isfinite(accel_max) && std::isfinite(alpha_max);
+  const bool finite = std::isfinite(vMax) && std::isfinite(vMin) && std::isfinite(omegaMax) &&
+                      std::isfinite(accelMax) && std::isfinite(alphaMax);
   if (!finite) {
     return fleet::unexpected("invalid_limits", "velocity limits must be finite");
   }
-  if (v_max < 0.0 || v_min > 0.0) {
+  if (vMax < 0.0 || vMin > 0.0) {
     return fleet::unexpected("invalid_limits", "need v_min <= 0 <= v_max");
   }
-  if (omega_max < 0.0 || accel_max <= 0.0 || alpha_max <= 0.0) {
+  if (omegaMax < 0.0 || accelMax <= 0.0 || alphaMax <= 0.0) {
     return fleet::unexpected("invalid_limits", "need omega_max >= 0, accel_max > 0, alpha_max > 0");
   }
   return {};
@@ -24,13 +24,13 @@ namespace {
 
 Twist clampSpeed(const VelocityLimits& l, Twist t, bool& saturated) {
   double scale = 1.0;
-  if (t.v > l.v_max) {
-    scale = std::min(scale, l.v_max / t.v);
-  } else if (t.v < l.v_min) {
-    scale = std::min(scale, l.v_min / t.v);
+  if (t.v > l.vMax) {
+    scale = std::min(scale, l.vMax / t.v);
+  } else if (t.v < l.vMin) {
+    scale = std::min(scale, l.vMin / t.v);
   }
-  if (std::abs(t.omega) > l.omega_max) {
-    scale = std::min(scale, l.omega_max / std::abs(t.omega));
+  if (std::abs(t.omega) > l.omegaMax) {
+    scale = std::min(scale, l.omegaMax / std::abs(t.omega));
   }
   if (scale < 1.0) {
     saturated = true;
@@ -70,8 +70,8 @@ LimitedTwist applyLimits(const VelocityLimits& limits, Twist desired, Twist prev
     return out;
   }
   const Twist target = clampSpeed(limits, desired, out.saturated);
-  out.twist.v = rateLimit(previous.v, target.v, limits.accel_max * dt, out.saturated);
-  out.twist.omega = rateLimit(previous.omega, target.omega, limits.alpha_max * dt, out.saturated);
+  out.twist.v = rateLimit(previous.v, target.v, limits.accelMax * dt, out.saturated);
+  out.twist.omega = rateLimit(previous.omega, target.omega, limits.alphaMax * dt, out.saturated);
   return out;
 }
 

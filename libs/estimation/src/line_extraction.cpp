@@ -71,20 +71,20 @@ LineFit toLineFit(const Fit& f, double n, double sigma) {
   out.psi = f.psi;
   const double e = -f.centroid.x * f.s + f.centroid.y * f.c;
   const double s2 = sigma * sigma;
-  out.var_psi = f.spread > 0.0 ? s2 / f.spread : std::numeric_limits<double>::infinity();
-  out.var_r = s2 / n + e * e * out.var_psi;
-  out.cov_r_psi = e * out.var_psi;
-  out.rms_residual = std::sqrt(f.mean_sq_residual);
+  out.varPsi = f.spread > 0.0 ? s2 / f.spread : std::numeric_limits<double>::infinity();
+  out.varR = s2 / n + e * e * out.varPsi;
+  out.covRPsi = e * out.varPsi;
+  out.rmsResidual = std::sqrt(f.mean_sq_residual);
   return out;
 }
 
 }  // namespace
 
-Expected<LineFit> fitLine(std::span<const Vec2> points, double point_sigma) {
+Expected<LineFit> fitLine(std::span<const Vec2> points, double pointSigma) {
   if (points.size() < 2) {
     return fleet::unexpected("too_few_points", "a line fit needs at least 2 points");
   }
-  if (!std::isfinite(point_sigma) || point_sigma <= 0.0) {
+  if (!std::isfinite(pointSigma) || pointSigma <= 0.0) {
     return fleet::unexpected("invalid_sigma", "point_sigma must be finite and > 0");
   }
   Sums m;
@@ -98,17 +98,16 @@ Expected<LineFit> fitLine(std::span<const Vec2> points, double point_sigma) {
   if (!(f.spread > 0.0)) {
     return fleet::unexpected("degenerate_points", "all points coincide");
   }
-  return toLineFit(f, m.n, point_sigma);
+  return toLineFit(f, m.n, pointSigma);
 }
 
 Expected<void> LineExtractionParams::validate() const {
-  if (seed_points < 3 || min_points < seed_points) {
+  if (seedPoints < 3 || minPoints < seedPoints) {
     return fleet::unexpected("invalid_line_params", "need seed_points >= 3 and min_points >= seed_points");
   }
-  const bool ok = min_threshold > 0.0 && max_threshold >= min_threshold && threshold_factor > 0.0 &&
-                  max_point_gap > 0.0 && min_length >= 0.0 && point_sigma > 0.0 &&
-                  std::isfinite(max_threshold) && std::isfinite(max_point_gap) &&
-                  std::isfinite(point_sigma) && std::isfinite(threshold_factor);
+  const bool ok = minThreshold > 0.0 && maxThreshold >= minThreshold && thresholdFactor > 0.0 &&
+                  maxPointGap > 0.0 && minLength >= 0.0 && pointSigma > 0.0 && std::isfinite(maxThreshold) &&
+                  std::isfinite(maxPointGap) && std::isfinite(pointSigma) && std::isfinite(thresholdFactor);
   if (!ok) {
     return fleet::unexpected("invalid_line_params", "thresholds, gap and sigma must be finite and > 0");
   }
@@ -125,7 +124,7 @@ std::vector<ExtractedLine> extractLines(const LaserScan& scan, const LineExtract
   pts.reserve(scan.ranges.size());
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const double r = scan.ranges[i];
-    if (!std::isfinite(r) || r < scan.range_min || r > scan.range_max) {
+    if (!std::isfinite(r) || r < scan.rangeMin || r > scan.range_max) {
       continue;
     }
     const double a = scan.angle_min + static_cast<double>(i) * scan.angle_increment;
@@ -133,31 +132,31 @@ std::vector<ExtractedLine> extractLines(const LaserScan& scan, const LineExtract
   }
   const std::size_t n = pts.size();
   std::size_t start = 0;
-  while (start + params.seed_points <= n) {
+  while (start + params.seedPoints <= n) {
     Sums m;
     bool contiguous = true;
-    for (std::size_t i = start; i < start + params.seed_points; ++i) {
-      if (i > start && distance(pts[i], pts[i - 1]) > params.max_point_gap) {
+    for (std::size_t i = start; i < start + params.seedPoints; ++i) {
+      if (i > start && distance(pts[i], pts[i - 1]) > params.maxPointGap) {
         contiguous = false;
       }
       m.add(pts[i]);
     }
     Fit f = fitSums(m);
     double seed_max = 0.0;
-    for (std::size_t i = start; i < start + params.seed_points; ++i) {
+    for (std::size_t i = start; i < start + params.seedPoints; ++i) {
       seed_max = std::max(seed_max, f.distance(pts[i]));
     }
-    if (!contiguous || seed_max > params.max_threshold) {
+    if (!contiguous || seed_max > params.maxThreshold) {
       ++start;
       continue;
     }
     // Each segment gets its own threshold from its seed's residual (the thesis's dynamic threshold).
-    const double threshold = std::clamp(params.threshold_factor * std::sqrt(f.mean_sq_residual),
-                                        params.min_threshold, params.max_threshold);
-    std::size_t last = start + params.seed_points - 1;
+    const double threshold = std::clamp(params.thresholdFactor * std::sqrt(f.mean_sq_residual),
+                                        params.minThreshold, params.maxThreshold);
+    std::size_t last = start + params.seedPoints - 1;
     std::size_t misses = 0;
     for (std::size_t i = last + 1; i < n; ++i) {
-      if (distance(pts[i], pts[last]) > params.max_point_gap) {
+      if (distance(pts[i], pts[last]) > params.maxPointGap) {
         break;
       }
       if (f.distance(pts[i]) <= threshold) {
@@ -165,16 +164,16 @@ std::vector<ExtractedLine> extractLines(const LaserScan& scan, const LineExtract
         f = fitSums(m);
         last = i;
         misses = 0;
-      } else if (++misses > params.max_misses) {
+      } else if (++misses > params.maxMisses) {
         break;
       }
     }
     const std::size_t count = static_cast<std::size_t>(m.n);
     const double length = distance(pts[start], pts[last]);
-    if (count >= params.min_points && length >= params.min_length && f.spread > 0.0) {
-      const LineFit lf = toLineFit(f, m.n, params.point_sigma);
+    if (count >= params.minPoints && length >= params.minLength && f.spread > 0.0) {
+      const LineFit lf = toLineFit(f, m.n, params.pointSigma);
       ExtractedLine line;
-      line.line = {lf.r, lf.psi, lf.var_r, lf.var_psi, lf.cov_r_psi};
+      line.line = {lf.r, lf.psi, lf.varR, lf.varPsi, lf.covRPsi};
       line.first = pts[start];
       line.last = pts[last];
       line.points = count;

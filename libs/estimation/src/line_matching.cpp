@@ -30,8 +30,7 @@ struct Candidate {
 };
 
 bool sameLine(const MapLine& p, const MapLine& q, const LineGate& g) {
-  return std::abs(p.rho - q.rho) <= g.same_line_rho &&
-         std::abs(angleDiff(p.beta, q.beta)) <= g.same_line_beta;
+  return std::abs(p.rho - q.rho) <= g.sameLineRho && std::abs(angleDiff(p.beta, q.beta)) <= g.sameLineBeta;
 }
 
 double distanceToSegment(Vec2 p, const MapSegment& s) {
@@ -65,12 +64,12 @@ LineMatchResult matchLines(const Pose2& pose, const Eigen::Matrix3d& P, std::spa
   // The end-point test is on the estimate, so it must allow for how far off the estimate may be.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(P.topLeftCorner<2, 2>());
   const double sigmaPos = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
-  const double tolerance = gate.endpoint_tolerance + 6.0 * sigmaPos;
+  const double tolerance = gate.endpointTolerance + 6.0 * sigmaPos;
   std::vector<Candidate> candidates;
   for (std::size_t i = 0; i < observed.size(); ++i) {
     const ExtractedLine& obs = observed[i];
     Eigen::Matrix2d R;
-    R << obs.line.var_r, obs.line.cov_r_psi, obs.line.cov_r_psi, obs.line.var_psi;
+    R << obs.line.varR, obs.line.covRPsi, obs.line.covRPsi, obs.line.varPsi;
     const Vec2 first = pose.transform(obs.first);
     const Vec2 last = pose.transform(obs.last);
     bool facing = false;
@@ -79,8 +78,8 @@ LineMatchResult matchLines(const Pose2& pose, const Eigen::Matrix3d& P, std::spa
     for (std::size_t j = 0; j < map.size(); ++j) {
       const MapSegment& s = map[j];
       const Vec2 n = s.normal / s.normal.norm();
-      if (outOfRange(pose.position(), s, gate.max_range) ||
-          (pose.position() - s.a).dot(n) < gate.min_distance) {
+      if (outOfRange(pose.position(), s, gate.maxRange) ||
+          (pose.position() - s.a).dot(n) < gate.minDistance) {
         continue;  // behind the face, on it, or out of the scanner's reach
       }
       facing = true;
@@ -103,7 +102,7 @@ LineMatchResult matchLines(const Pose2& pose, const Eigen::Matrix3d& P, std::spa
       candidates.push_back({j, d2, line});
     }
     if (candidates.empty()) {
-      ++(!facing ? out.no_wall_facing : (!gated ? out.outside_gate : out.no_overlap));
+      ++(!facing ? out.noWallFacing : (!gated ? out.outsideGate : out.noOverlap));
       continue;
     }
     const auto best = std::min_element(candidates.begin(), candidates.end(),

@@ -6,9 +6,9 @@
 
 namespace fleet::estimation {
 
-OdometryModel odometryModel(const Pose2& pose, double ds_left, double ds_right, double wheel_base) {
+OdometryModel odometryModel(const Pose2& pose, double ds_left, double ds_right, double wheelBase) {
   const double ds = 0.5 * (ds_right + ds_left);
-  const double dtheta = (ds_right - ds_left) / wheel_base;
+  const double dtheta = (ds_right - ds_left) / wheelBase;
   const double mid = pose.theta + 0.5 * dtheta;
   const double c = std::cos(mid);
   const double s = std::sin(mid);
@@ -18,10 +18,10 @@ OdometryModel odometryModel(const Pose2& pose, double ds_left, double ds_right, 
       0.0, 1.0, ds * c,      //
       0.0, 0.0, 1.0;
   // ∂Δs/∂εL = ∂Δs/∂εR = 1/2, ∂Δθ/∂εR = 1/L = −∂Δθ/∂εL; the midpoint heading moves by half of Δθ.
-  const double k = ds / (2.0 * wheel_base);
+  const double k = ds / (2.0 * wheelBase);
   m.W << 0.5 * c + k * s, 0.5 * c - k * s,  //
       0.5 * s - k * c, 0.5 * s + k * c,     //
-      -1.0 / wheel_base, 1.0 / wheel_base;
+      -1.0 / wheelBase, 1.0 / wheelBase;
   return m;
 }
 
@@ -36,10 +36,10 @@ LinePrediction predictLine(const Pose2& pose, const MapLine& line) {
   const double cb = std::cos(line.beta);
   const double sb = std::sin(line.beta);
   LinePrediction p;
-  p.signed_distance = line.rho - pose.x * cb - pose.y * sb;
+  p.signedDistance = line.rho - pose.x * cb - pose.y * sb;
   // With the robot on the far side of the line (C < 0) the normal toward the line flips by π.
-  const double sign = p.signed_distance >= 0.0 ? 1.0 : -1.0;
-  p.r = std::abs(p.signed_distance);
+  const double sign = p.signedDistance >= 0.0 ? 1.0 : -1.0;
+  p.r = std::abs(p.signedDistance);
   p.psi = wrapAngle(line.beta - pose.theta + (sign > 0.0 ? 0.0 : kPi));
   p.H << -sign * cb, -sign * sb, 0.0,  //
       0.0, 0.0, -1.0;

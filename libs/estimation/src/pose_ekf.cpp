@@ -25,22 +25,21 @@ bool positiveFinite(double v) {
 }
 
 bool validLineObservation(const LineObservation& o) {
-  return std::isfinite(o.r) && std::isfinite(o.psi) && positiveFinite(o.var_r) && positiveFinite(o.var_psi) &&
-         std::isfinite(o.cov_r_psi) && o.cov_r_psi * o.cov_r_psi < o.var_r * o.var_psi;
+  return std::isfinite(o.r) && std::isfinite(o.psi) && positiveFinite(o.varR) && positiveFinite(o.varPsi) &&
+         std::isfinite(o.covRPsi) && o.covRPsi * o.covRPsi < o.varR * o.varPsi;
 }
 
 }  // namespace
 
 Expected<void> EkfParams::validate() const {
-  if (!positiveFinite(wheel_base) || !std::isfinite(delta) || delta < 0.0) {
+  if (!positiveFinite(wheelBase) || !std::isfinite(delta) || delta < 0.0) {
     return fleet::unexpected("invalid_ekf_params", "wheel_base must be > 0 and delta >= 0");
   }
-  if (!positiveFinite(compass_variance) || !positiveFinite(bearing_variance) ||
-      !std::isfinite(compass_offset)) {
+  if (!positiveFinite(compassVariance) || !positiveFinite(bearingVariance) || !std::isfinite(compassOffset)) {
     return fleet::unexpected("invalid_ekf_params", "sensor variances must be finite and > 0");
   }
-  if (!positiveFinite(gate_1dof) || !positiveFinite(gate_2dof) || !std::isfinite(min_line_distance) ||
-      min_line_distance < 0.0) {
+  if (!positiveFinite(gate1dof) || !positiveFinite(gate2dof) || !std::isfinite(minLineDistance) ||
+      minLineDistance < 0.0) {
     return fleet::unexpected("invalid_ekf_params", "gates must be > 0 and min_line_distance >= 0");
   }
   return {};
@@ -76,10 +75,10 @@ Expected<void> PoseEkf::reset(const Pose2& pose, const Eigen::Matrix3d& P0) {
 
 UpdateStatus PoseEkf::predict(double ds_left, double ds_right) {
   if (!std::isfinite(ds_left) || !std::isfinite(ds_right)) {
-    ++stats_.odometry.rejected_non_finite;
+    ++stats_.odometry.rejectedNonFinite;
     return UpdateStatus::kRejectedNonFinite;
   }
-  const OdometryModel m = odometryModel(pose(), ds_left, ds_right, params_.wheel_base);
+  const OdometryModel m = odometryModel(pose(), ds_left, ds_right, params_.wheelBase);
   const Eigen::Matrix2d Q = odometryNoise(ds_left, ds_right, params_.delta);
   x_ << m.pose.x, m.pose.y, m.pose.theta;
   P_ = m.A * P_ * m.A.transpose() + m.W * Q * m.W.transpose();
@@ -96,12 +95,12 @@ UpdateStatus PoseEkf::correct(const Eigen::Matrix<double, M, 1>& innovation,
   const MatM S = H * P_ * H.transpose() + R;
   const Eigen::LLT<MatM> llt(S);
   if (llt.info() != Eigen::Success) {
-    ++stats.rejected_geometry;
+    ++stats.rejectedGeometry;
     return UpdateStatus::kRejectedGeometry;
   }
   const double d2 = innovation.dot(llt.solve(innovation));
   if (!(d2 <= gate)) {
-    ++stats.rejected_gate;
+    ++stats.rejectedGate;
     return UpdateStatus::kRejectedGate;
   }
   // K = P Hᵀ S⁻¹, solved through the Cholesky factor rather than an explicit inverse.
@@ -117,58 +116,58 @@ UpdateStatus PoseEkf::correct(const Eigen::Matrix<double, M, 1>& innovation,
 }
 
 UpdateStatus PoseEkf::updateCompass(double reading) {
-  return updateCompass(reading, params_.compass_variance);
+  return updateCompass(reading, params_.compassVariance);
 }
 
 UpdateStatus PoseEkf::updateCompass(double reading, double variance) {
   if (!std::isfinite(reading) || !positiveFinite(variance)) {
-    ++stats_.compass.rejected_non_finite;
+    ++stats_.compass.rejectedNonFinite;
     return UpdateStatus::kRejectedNonFinite;
   }
   Eigen::Matrix<double, 1, 1> innov;
-  innov(0) = angleDiff(reading - params_.compass_offset, x_(2));
+  innov(0) = angleDiff(reading - params_.compassOffset, x_(2));
   const Eigen::Matrix<double, 1, 3> H(0.0, 0.0, 1.0);
   const Eigen::Matrix<double, 1, 1> R = Eigen::Matrix<double, 1, 1>::Constant(variance);
-  return correct<1>(innov, H, R, params_.gate_1dof, stats_.compass);
+  return correct<1>(innov, H, R, params_.gate1dof, stats_.compass);
 }
 
 UpdateStatus PoseEkf::updateBearing(Vec2 landmark, double bearing) {
-  return updateBearing(landmark, bearing, params_.bearing_variance);
+  return updateBearing(landmark, bearing, params_.bearingVariance);
 }
 
 UpdateStatus PoseEkf::updateBearing(Vec2 landmark, double bearing, double variance) {
   if (!landmark.isFinite() || !std::isfinite(bearing) || !positiveFinite(variance)) {
-    ++stats_.bearing.rejected_non_finite;
+    ++stats_.bearing.rejectedNonFinite;
     return UpdateStatus::kRejectedNonFinite;
   }
   const BearingPrediction b = predictBearing(pose(), landmark);
   if (b.range < 1e-6) {
-    ++stats_.bearing.rejected_geometry;
+    ++stats_.bearing.rejectedGeometry;
     return UpdateStatus::kRejectedGeometry;
   }
   Eigen::Matrix<double, 1, 1> innov;
   innov(0) = angleDiff(bearing, b.gamma);
   const Eigen::Matrix<double, 1, 1> R = Eigen::Matrix<double, 1, 1>::Constant(variance);
-  return correct<1>(innov, Eigen::Matrix<double, 1, 3>(b.H), R, params_.gate_1dof, stats_.bearing);
+  return correct<1>(innov, Eigen::Matrix<double, 1, 3>(b.H), R, params_.gate1dof, stats_.bearing);
 }
 
 UpdateStatus PoseEkf::updateLine(const MapLine& map_line, const LineObservation& obs) {
   if (!std::isfinite(map_line.rho) || !std::isfinite(map_line.beta) || !std::isfinite(obs.r) ||
       !validLineObservation(obs)) {
-    ++stats_.line.rejected_non_finite;
+    ++stats_.line.rejectedNonFinite;
     return UpdateStatus::kRejectedNonFinite;
   }
   const LinePrediction p = predictLine(pose(), map_line);
-  if (p.r < params_.min_line_distance) {
-    ++stats_.line.rejected_geometry;
+  if (p.r < params_.minLineDistance) {
+    ++stats_.line.rejectedGeometry;
     return UpdateStatus::kRejectedGeometry;
   }
   const Eigen::Vector2d innov(obs.r - p.r, angleDiff(obs.psi, p.psi));
   Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
-  R(0, 0) = obs.var_r;
-  R(1, 1) = obs.var_psi;
-  R(0, 1) = R(1, 0) = obs.cov_r_psi;
-  return correct<2>(innov, p.H, R, params_.gate_2dof, stats_.line);
+  R(0, 0) = obs.varR;
+  R(1, 1) = obs.varPsi;
+  R(0, 1) = R(1, 0) = obs.covRPsi;
+  return correct<2>(innov, p.H, R, params_.gate2dof, stats_.line);
 }
 
 LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
@@ -177,22 +176,22 @@ LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
   std::vector<bool> used(map.size(), false);
   for (const LineObservation& obs : observations) {
     if (!validLineObservation(obs)) {
-      ++stats_.line.rejected_non_finite;
-      ++result.rejected_non_finite;
+      ++stats_.line.rejectedNonFinite;
+      ++result.rejectedNonFinite;
       continue;
     }
     Eigen::Matrix2d R = Eigen::Matrix2d::Zero();
-    R(0, 0) = obs.var_r;
-    R(1, 1) = obs.var_psi;
-    R(0, 1) = R(1, 0) = obs.cov_r_psi;
-    double best = params_.gate_2dof;
+    R(0, 0) = obs.varR;
+    R(1, 1) = obs.varPsi;
+    R(0, 1) = R(1, 0) = obs.covRPsi;
+    double best = params_.gate2dof;
     std::size_t best_j = map.size();
     for (std::size_t j = 0; j < map.size(); ++j) {
       if (used[j]) {
         continue;
       }
       const LinePrediction p = predictLine(pose(), map[j]);
-      if (p.r < params_.min_line_distance) {
+      if (p.r < params_.minLineDistance) {
         continue;
       }
       const Eigen::Vector2d innov(obs.r - p.r, angleDiff(obs.psi, p.psi));
@@ -211,7 +210,7 @@ LineBatchResult PoseEkf::updateLines(std::span<const MapLine> map,
       }
     }
     if (best_j == map.size()) {
-      ++stats_.lines_unmatched;
+      ++stats_.linesUnmatched;
       ++result.unmatched;
       continue;
     }

@@ -15,7 +15,7 @@ LaneMap LaneMap::derive(const OccupancyGrid& raw, const LaneParams& p) {
   LaneMap m;
   m.width_ = raw.width();
   m.height_ = raw.height();
-  m.factor_ = std::max(1.0, p.wrong_way_factor);
+  m.factor_ = std::max(1.0, p.wrongWayFactor);
   m.dir_.assign(raw.size(), LaneDir{});
   const int w = raw.width();
   const int h = raw.height();
@@ -55,7 +55,7 @@ LaneMap LaneMap::derive(const OccupancyGrid& raw, const LaneParams& p) {
       y = e;
     }
   }
-  const int narrow = static_cast<int>(std::floor(p.max_aisle_width / raw.resolution() + 1e-9));
+  const int narrow = static_cast<int>(std::floor(p.maxAisleWidth / raw.resolution() + 1e-9));
   // An aisle is named by the line of its near wall, so every segment of one aisle line (cut by
   // cross aisles) gets the same direction; neighbouring lines alternate, which gives every block
   // of shelves a loop around it.
@@ -65,9 +65,9 @@ LaneMap LaneMap::derive(const OccupancyGrid& raw, const LaneParams& p) {
     if (hrun[i] == 0) {
       continue;
     }
-    if (hrun[i] < narrow && vrun[i] >= p.min_aspect * hrun[i]) {
+    if (hrun[i] < narrow && vrun[i] >= p.minAspect * hrun[i]) {
       vertical[hstart[i]].push_back(i);
-    } else if (vrun[i] < narrow && hrun[i] >= p.min_aspect * vrun[i]) {
+    } else if (vrun[i] < narrow && hrun[i] >= p.minAspect * vrun[i]) {
       horizontal[vstart[i]].push_back(i);
     }
   }
@@ -88,16 +88,16 @@ LaneMap LaneMap::derive(const OccupancyGrid& raw, const LaneParams& p) {
   // Wider corridors (the bands along the walls) get two lanes, keep right: heading +x the right
   // hand is -y, so the lower half runs +x and the upper half -x; heading +y the right hand is +x.
   // Robots meeting in a band pass side by side instead of nose to nose.
-  const int twoLane = static_cast<int>(std::floor(p.max_two_lane_width / raw.resolution() + 1e-9));
+  const int twoLane = static_cast<int>(std::floor(p.maxTwoLaneWidth / raw.resolution() + 1e-9));
   for (std::size_t i = 0; i < raw.size(); ++i) {
     if (hrun[i] == 0 || m.dir_[i] != LaneDir{}) {
       continue;
     }
     const Cell c = raw.cellOf(i);
-    if (hrun[i] >= narrow && hrun[i] <= twoLane && vrun[i] >= p.min_aspect * hrun[i]) {
+    if (hrun[i] >= narrow && hrun[i] <= twoLane && vrun[i] >= p.minAspect * hrun[i]) {
       const bool rightHalf = 2 * (c.x - hstart[i]) >= hrun[i];
       m.dir_[i] = {0, static_cast<std::int8_t>(rightHalf ? 1 : -1)};
-    } else if (vrun[i] >= narrow && vrun[i] <= twoLane && hrun[i] >= p.min_aspect * vrun[i]) {
+    } else if (vrun[i] >= narrow && vrun[i] <= twoLane && hrun[i] >= p.minAspect * vrun[i]) {
       const bool upperHalf = 2 * (c.y - vstart[i]) >= vrun[i];
       m.dir_[i] = {static_cast<std::int8_t>(upperHalf ? -1 : 1), 0};
     }

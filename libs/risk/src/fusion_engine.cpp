@@ -68,8 +68,8 @@ void FusionEngine::noteChanged(const AlignedSource& aligned) {
   }
 }
 
-Expected<void> FusionEngine::upsert(Source source, std::optional<std::int64_t> now_ns) {
-  if (auto ok = validateSource(source, config_.limits, now_ns); !ok) {
+Expected<void> FusionEngine::upsert(Source source, std::optional<std::int64_t> nowNs) {
+  if (auto ok = validateSource(source, config_.limits, nowNs); !ok) {
     return ok;
   }
   auto it = sources_.find(source.id);
@@ -152,8 +152,8 @@ void FusionEngine::markDirtyTiles(double maxReach) {
   pendingDirty_.clear();
 }
 
-const FusionResult& FusionEngine::fuse(std::int64_t t_ref_ns) {
-  const TimeBase base{t_ref_ns, config_.dt, config_.steps};
+const FusionResult& FusionEngine::fuse(std::int64_t tRefNs) {
+  const TimeBase base{tRefNs, config_.dt, config_.steps};
   const bool full = !haveResult_ || !(base == result_.time);
   result_.time = base;
   for (auto& [id, e] : sources_) {

@@ -9,7 +9,7 @@
 namespace fleet::risk {
 
 Expected<void> validateSource(const Source& source, const SourceLimits& limits,
-                              std::optional<std::int64_t> now_ns) {
+                              std::optional<std::int64_t> nowNs) {
   if (!isValidId(source.id)) {
     return unexpected("invalid_id",
                       "source id '" + source.id + "' is not 1-63 characters of [A-Za-z0-9_.:-]");
@@ -62,9 +62,9 @@ Expected<void> validateSource(const Source& source, const SourceLimits& limits,
           where + " lies farther than " + std::to_string(limits.maxAbsCoordinate) + " m from the map origin");
     }
   }
-  if (now_ns.has_value() && source.t0_ns - *now_ns > limits.maxFutureNs) {
+  if (nowNs.has_value() && source.t0_ns - *nowNs > limits.maxFutureNs) {
     return unexpected("future_timestamp", "source '" + source.id + "' has t0 " +
-                                              std::to_string(source.t0_ns - *now_ns) + " ns in the future");
+                                              std::to_string(source.t0_ns - *nowNs) + " ns in the future");
   }
   return {};
 }
@@ -83,7 +83,7 @@ AlignedSource alignSource(const Source& source, const TimeBase& base) {
       slot = source.discs[0];
       continue;
     }
-    const std::int64_t t = base.t_ref_ns + std::llround(static_cast<double>(k) * base.dt * 1e9);
+    const std::int64_t t = base.tRefNs + std::llround(static_cast<double>(k) * base.dt * 1e9);
     double s = static_cast<double>(t - source.t0_ns) / srcStepNs;
     const double last = static_cast<double>(n - 1);
     if (!(s >= -0.5 && s <= last + 0.5)) {

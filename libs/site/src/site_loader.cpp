@@ -205,7 +205,7 @@ void readMasks(Config& c, const std::string& baseDir, Site& s) {
     std::map<double, Zone> byLimit;
     for (const auto& sc :
          speedCells(*mask, s.map, type == "absolute" ? SpeedMaskType::Absolute : SpeedMaskType::Percent, base,
-                    mult, s.robot.limits.v_max)) {
+                    mult, s.robot.limits.vMax)) {
       auto& lz = byLimit[sc.limit];
       lz.cells.push_back(sc.cell);
     }
@@ -250,11 +250,11 @@ bool readPoint(Config& c, const std::string& key, Vec2& out, bool required, doub
 
 void readLimits(Config& l, control::VelocityLimits& v) {
   l.rejectUnknownKeys({"v_max", "v_min", "w_max", "accel_max", "alpha_max"});
-  v.v_max = l.number("v_max", v.v_max, {0.0, 20.0});
-  v.v_min = l.number("v_min", v.v_min, {-20.0, 0.0});
-  v.omega_max = l.number("w_max", v.omega_max, {0.0, 20.0});
-  v.accel_max = l.number("accel_max", v.accel_max, {0.0, 100.0, true});
-  v.alpha_max = l.number("alpha_max", v.alpha_max, {0.0, 100.0, true});
+  v.vMax = l.number("v_max", v.vMax, {0.0, 20.0});
+  v.vMin = l.number("v_min", v.vMin, {-20.0, 0.0});
+  v.omegaMax = l.number("w_max", v.omegaMax, {0.0, 20.0});
+  v.accelMax = l.number("accel_max", v.accelMax, {0.0, 100.0, true});
+  v.alphaMax = l.number("alpha_max", v.alphaMax, {0.0, 100.0, true});
 }
 
 void readRobotDescription(Config& c, RobotDescription& r) {

@@ -535,8 +535,8 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
     }
   }
 
-  r.turnRate_ = std::max(1e-3, s.robot.limits.omega_max);
-  r.turnAccel_ = std::max(1e-3, s.robot.limits.alpha_max);
+  r.turnRate_ = std::max(1e-3, s.robot.limits.omegaMax);
+  r.turnAccel_ = std::max(1e-3, s.robot.limits.alphaMax);
   // Turning: an edge's duration includes the smallest turn any way into its start needs (a lower
   // bound without knowing where the robot came from; exact at nodes with one way in).
   const auto nn = static_cast<NodeId>(r.graph.size());

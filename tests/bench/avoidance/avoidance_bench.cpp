@@ -137,7 +137,7 @@ void BM_CircleSwap(benchmark::State& state, const char* planner) {
   ScenarioResult mine{};
   for (auto _ : state) {
     Scenario sc = circleSwap(n, R);
-    sc.max_steps = 3000;  // 300 s simulated: the straight-line crossing takes 40 s at n = 100
+    sc.maxSteps = 3000;  // 300 s simulated: the straight-line crossing takes 40 s at n = 100
     auto m = runScenario(sc, planner);
     auto b = runScenario(sc, "vo");
     if (!m || !b) {
@@ -148,16 +148,16 @@ void BM_CircleSwap(benchmark::State& state, const char* planner) {
     base = *b;
   }
   state.counters["reached"] = mine.reached;
-  state.counters["robot_overlaps"] = mine.robot_collisions;
-  state.counters["min_sep_m"] = mine.min_separation;
+  state.counters["robot_overlaps"] = mine.robotCollisions;
+  state.counters["min_sep_m"] = mine.minSeparation;
   state.counters["makespan_s"] = mine.makespan;
-  state.counters["us_per_agent_step"] = mine.compute_mean_us;
+  state.counters["us_per_agent_step"] = mine.computeMeanUs;
   state.counters["vo_reached"] = base.reached;
-  state.counters["vo_overlaps"] = base.robot_collisions;
+  state.counters["vo_overlaps"] = base.robotCollisions;
   state.counters["vo_makespan_s"] = base.makespan;
-  state.counters["vo_us_per_agent_step"] = base.compute_mean_us;
+  state.counters["vo_us_per_agent_step"] = base.computeMeanUs;
   state.counters["compute_ratio_vs_vo"] =
-      base.compute_mean_us > 0 ? mine.compute_mean_us / base.compute_mean_us : 0;
+      base.computeMeanUs > 0 ? mine.computeMeanUs / base.computeMeanUs : 0;
 }
 BENCHMARK_CAPTURE(BM_CircleSwap, vo_keep_right, "vo_keep_right")
     ->Arg(8)
@@ -209,14 +209,14 @@ void BM_Harness(benchmark::State& state) {
   state.SetLabel(std::string(planner) + " " + sc.name);
   state.counters["reached"] = r.reached;
   state.counters["robots"] = r.robots;
-  state.counters["static_contacts"] = r.static_collisions;
-  state.counters["robot_contacts"] = r.robot_collisions;
-  state.counters["human_contacts"] = r.human_collisions;
-  state.counters["driven_into_human"] = r.human_hits_by_robot;
-  state.counters["min_gap_m"] = r.min_separation;
-  state.counters["mean_time_s"] = r.mean_time_to_goal;
-  state.counters["mean_path_m"] = r.mean_path_length;
-  state.counters["us_per_call"] = r.compute_mean_us;
+  state.counters["static_contacts"] = r.staticCollisions;
+  state.counters["robot_contacts"] = r.robotCollisions;
+  state.counters["human_contacts"] = r.humanCollisions;
+  state.counters["driven_into_human"] = r.humanHitsByRobot;
+  state.counters["min_gap_m"] = r.minSeparation;
+  state.counters["mean_time_s"] = r.meanTimeToGoal;
+  state.counters["mean_path_m"] = r.meanPathLength;
+  state.counters["us_per_call"] = r.computeMeanUs;
 }
 BENCHMARK(BM_Harness)
     ->ArgsProduct({benchmark::CreateDenseRange(0, static_cast<int>(std::size(kPlanners)) - 1, 1),

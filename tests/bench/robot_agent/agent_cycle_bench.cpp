@@ -90,7 +90,7 @@ Fleet makeFleet(const std::string& scenario, int n, const std::string& planner) 
     p.wheelBase = r.wheelBase;
     p.localPlanner = planner;
     p.limits = r.limits;
-    p.limits.v_max = p.vMax = std::min(0.8, r.limits.v_max);
+    p.limits.vMax = p.vMax = std::min(0.8, r.limits.vMax);
     f.wheelBase = r.wheelBase;
     f.agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
     f.truth.push_back(r.start);

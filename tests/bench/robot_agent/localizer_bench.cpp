@@ -40,7 +40,7 @@ const Setup& setup(const std::string& name) {
     }
   }
   auto walls = std::make_shared<std::vector<estimation::MapSegment>>();
-  for (const auto& f : site::wallSegments(grid, agent::agentLineExtraction().min_length)) {
+  for (const auto& f : site::wallSegments(grid, agent::agentLineExtraction().minLength)) {
     walls->push_back({f.a, f.b, f.normal});
   }
   s.walls = walls;

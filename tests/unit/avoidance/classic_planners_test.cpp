@@ -21,7 +21,7 @@ TEST(PotentialField, AttractiveForceWorkedExample) {
 }
 
 TEST(PotentialField, KhatibRepulsionWorkedExample) {
-  // k_rep = 1, ρ0 = 1, obstacle at the origin, q = (0.5, 0): Khatib's form gives (4, 0); the
+  // kRep = 1, ρ0 = 1, obstacle at the origin, q = (0.5, 0): Khatib's form gives (4, 0); the
   // seed's printed (3.8) would give (1, 0).
   const Vec2 f = repulsiveForce({0.5, 0}, {0, 0}, 0.5, 1.0, 1.0);
   EXPECT_NEAR(f.x, 4.0, 1e-12);
@@ -51,7 +51,7 @@ TEST(PotentialField, TotalForceSumsEveryReading) {
   const std::vector<Vec2> one{{0.5, 0}};
   const std::vector<Vec2> two{{0.5, 0}, {0.5, 0}};
   PotentialFieldParams p;
-  p.k_rep = 1.0;
+  p.kRep = 1.0;
   v.scan = one;
   const Vec2 f1 = totalForce(v, p);
   v.scan = two;
@@ -66,7 +66,7 @@ TEST(PotentialField, ReachesGoalPastAnOffsetObstacleWithinLimits) {
   LocalView probe;
   const auto r = test::drive(pf, {0, 0, 0}, {{5.0, 0.0}}, scan, 800);
   EXPECT_TRUE(r.reached);
-  EXPECT_GT(r.min_clearance, 0.0);
+  EXPECT_GT(r.minClearance, 0.0);
 }
 
 std::vector<Vec2> uTrap() {
@@ -81,7 +81,7 @@ std::vector<Vec2> uTrap() {
 
 TEST(PotentialField, UShapeTrapIsDetectedAndReported) {
   PotentialFieldParams p;
-  p.escape_with_bug2 = false;
+  p.escapeWithBug2 = false;
   PotentialFieldPlanner pf(p);
   const auto scan = uTrap();
   const auto r = test::drive(pf, {0, 0, 0}, {{6.0, 0.0}}, scan, 600);
@@ -96,7 +96,7 @@ TEST(PotentialField, Bug2EscapeLeavesTheTrapAndReachesTheGoal) {
   const auto r = test::drive(pf, {0, 0, 0}, {{6.0, 0.0}}, scan, 3000);
   EXPECT_TRUE(r.reached);
   EXPECT_GT(pf.stuckDetections(), 0);
-  EXPECT_GT(r.min_clearance, 0.0);
+  EXPECT_GT(r.minClearance, 0.0);
 }
 
 TEST(Bug, BothReachGoalPastABoxAndBug2IsShorter) {
@@ -113,8 +113,8 @@ TEST(Bug, BothReachGoalPastABoxAndBug2IsShorter) {
   EXPECT_TRUE(r2.reached);
   EXPECT_EQ(b1.hits(), 1);
   EXPECT_EQ(b2.hits(), 1);
-  EXPECT_GT(r1.min_clearance, 0.0);
-  EXPECT_GT(r2.min_clearance, 0.0);
+  EXPECT_GT(r1.minClearance, 0.0);
+  EXPECT_GT(r2.minClearance, 0.0);
   EXPECT_LT(r2.path_length, r1.path_length);
   // Bug1 went all the way round: at least the box perimeter plus the detour to L.
   EXPECT_GT(r1.path_length, 2.0 * (1.6 + 1.6) + 6.0);
@@ -244,7 +244,7 @@ TEST(RiskStepping, CandidatesThroughObstaclesAreUnreachable) {
   EXPECT_GT(std::abs(c.point.y), 0.2);
   const auto r = test::drive(rs, {0, 0, 0}, {{4.0, 0.0}}, scan, 400, {}, 0.2);
   EXPECT_TRUE(r.reached);
-  EXPECT_GT(r.min_clearance, 0.0);
+  EXPECT_GT(r.minClearance, 0.0);
 }
 
 TEST(Factory, BuildsEveryPlannerByName) {

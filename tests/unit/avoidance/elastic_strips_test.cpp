@@ -21,7 +21,7 @@ TEST(ElasticStrips, InternalForceWorkedExample) {
 }
 
 TEST(ElasticStrips, OriginalExternalForceWorkedExample) {
-  // d_safe 1000, d_r 350 -> d_o 1350; d_obs,min 1000, K_r 0.6 -> |F| = 210, from obstacle to robot.
+  // dSafe 1000, d_r 350 -> d_o 1350; d_obs,min 1000, K_r 0.6 -> |F| = 210, from obstacle to robot.
   const Vec2 f = elasticExternalForce({0, 1000}, {0, 0}, 1000.0, 1000.0 + 350.0, 0.6);
   EXPECT_NEAR(f.x, 0.0, 1e-9);
   EXPECT_NEAR(f.y, 210.0, 1e-9);
@@ -30,7 +30,7 @@ TEST(ElasticStrips, OriginalExternalForceWorkedExample) {
 }
 
 TEST(ElasticStrips, TwoSidedExternalForceWorkedExample) {
-  // d_L 800, threshold d_safe 1000, K_r 0.6 -> 120.
+  // d_L 800, threshold dSafe 1000, K_r 0.6 -> 120.
   const Vec2 f = elasticExternalForce({800, 0}, {0, 0}, 800.0, 1000.0, 0.6);
   EXPECT_NEAR(f.x, 120.0, 1e-9);
   EXPECT_EQ(elasticExternalForce({1000, 0}, {0, 0}, 1000.0, 1000.0, 0.6), (Vec2{0, 0}));
@@ -40,15 +40,15 @@ TEST(ElasticStrips, LeftRightMinimumWorkedExample) {
   const std::vector<double> a{1200, 900, 1500, 700};
   const auto m = leftRightMinimum(a, 1000.0);
   EXPECT_TRUE(m.found);
-  EXPECT_EQ(m.min_left, 900.0);
-  EXPECT_EQ(m.min_right, 700.0);
-  EXPECT_EQ(m.left_index, 1);
-  EXPECT_EQ(m.right_index, 3);
+  EXPECT_EQ(m.minLeft, 900.0);
+  EXPECT_EQ(m.minRight, 700.0);
+  EXPECT_EQ(m.leftIndex, 1);
+  EXPECT_EQ(m.rightIndex, 3);
   const std::vector<double> far{1200, 1000, 1500, 1700};
   EXPECT_FALSE(leftRightMinimum(far, 1000.0).found);
 }
 
-// Table 2.3 case 1 in metres: start (0, 0), goal (3.5, 5), K_c 0.8, K_r 0.6, d_safe 1 m, d_r 0.35 m.
+// Table 2.3 case 1 in metres: start (0, 0), goal (3.5, 5), K_c 0.8, K_r 0.6, dSafe 1 m, d_r 0.35 m.
 // The thesis gives no obstacle; we put a 0.3 m disc centred on the start–goal line (documented).
 TEST(ElasticStrips, Table23Case1TwoSidedVariantReachesGoal) {
   const Vec2 goal{3.5, 5.0};
@@ -56,7 +56,7 @@ TEST(ElasticStrips, Table23Case1TwoSidedVariantReachesGoal) {
   ElasticStripsPlanner improved(ElasticVariant::kBvhTwoSided);
   const auto r = test::drive(improved, {0, 0, std::atan2(5.0, 3.5)}, {goal}, obstacle, 1500, {}, 0.35);
   EXPECT_TRUE(r.reached);
-  EXPECT_GT(r.min_clearance, 0.0);
+  EXPECT_GT(r.minClearance, 0.0);
 }
 
 TEST(ElasticStrips, Table23Case1OriginalDoesNotGetPast) {
@@ -76,8 +76,8 @@ TEST(ElasticStrips, Table23Case1OriginalDoesNotGetPast) {
 // surfaces for a 0.7 m robot), and in cases 3-4 a third disc 0.3 m off the line further on.
 struct Table23Case {
   Vec2 goal;
-  double k_c;
-  double k_r;
+  double kC;
+  double kR;
   int obstacles;
 };
 
@@ -114,42 +114,42 @@ struct Table23Runs {
 Table23Runs runTable23(const Table23Case& c) {
   const auto scan = table23Obstacles(c);
   ElasticStripsParams prm;
-  prm.k_c = c.k_c;
-  prm.k_r = c.k_r;
+  prm.kC = c.kC;
+  prm.kR = c.kR;
   const Pose2 start{0, 0, std::atan2(c.goal.y, c.goal.x)};
   ElasticStripsPlanner original(ElasticVariant::kOriginal, prm);
   ElasticStripsPlanner improved(ElasticVariant::kBvhTwoSided, prm);
   Table23Runs r{test::drive(original, start, {c.goal}, scan, 3000, {}, 0.35),
                 test::drive(improved, start, {c.goal}, scan, 3000, {}, 0.35)};
   std::cout << "goal (" << c.goal.x << ", " << c.goal.y << "): original reached " << r.original.reached
-            << " in " << r.original.steps << " steps, clearance " << r.original.min_clearance
-            << " m, turning " << totalTurning(r.original) << " rad; two-sided reached " << r.twoSided.reached
-            << " in " << r.twoSided.steps << " steps, clearance " << r.twoSided.min_clearance
-            << " m, turning " << totalTurning(r.twoSided) << " rad\n";
+            << " in " << r.original.steps << " steps, clearance " << r.original.minClearance << " m, turning "
+            << totalTurning(r.original) << " rad; two-sided reached " << r.twoSided.reached << " in "
+            << r.twoSided.steps << " steps, clearance " << r.twoSided.minClearance << " m, turning "
+            << totalTurning(r.twoSided) << " rad\n";
   return r;
 }
 
 // Limitation 3 of the original (seed 000 §3): pushed away from the nearest disc of the gate it is
 // pushed into the other one. The two-sided variant with the thesis's boxes passes the gate without
 // touching either disc and turns a third less (the thesis: both reach, the improved path is
-// smoother). Without the boxes (forces from every reading within d_safe) it stopped in front of the
+// smoother). Without the boxes (forces from every reading within dSafe) it stopped in front of the
 // gate, the two pushes balancing (docs/algorithms.md).
 TEST(ElasticStrips, Table23Case2GateOriginalTouchesTwoSidedPassesWithoutContact) {
   const auto r = runTable23({{4.0, 3.5}, 0.8, 0.6, 2});
   EXPECT_TRUE(r.original.reached);
-  EXPECT_LT(r.original.min_clearance, 0.0);
+  EXPECT_LT(r.original.minClearance, 0.0);
   EXPECT_TRUE(r.twoSided.reached);
-  EXPECT_GT(r.twoSided.min_clearance, 0.0);
+  EXPECT_GT(r.twoSided.minClearance, 0.0);
   EXPECT_LT(totalTurning(r.twoSided), totalTurning(r.original));
 }
 
 TEST(ElasticStrips, ObstacleBoxSpansBothReadingsAndDSafeAlongTheMotion) {
-  // L and R 1 m ahead, 0.5 m either side; d_safe 1 m along +x: the box covers x in [1, 2], y in [-0.5, 0.5].
+  // L and R 1 m ahead, 0.5 m either side; dSafe 1 m along +x: the box covers x in [1, 2], y in [-0.5, 0.5].
   const geometry::Obb2 o = obstacleBox({1.0, 0.5}, {1.0, -0.5}, {1.0, 0.0}, 1.0);
   EXPECT_NEAR(o.center.x, 1.5, 1e-12);
   EXPECT_NEAR(o.center.y, 0.0, 1e-12);
   EXPECT_NEAR(o.half.x, 0.5, 1e-12);  // along L→R
-  EXPECT_NEAR(o.half.y, 0.5, 1e-12);  // across it: d_safe / 2
+  EXPECT_NEAR(o.half.y, 0.5, 1e-12);  // across it: dSafe / 2
   // The robot's swept footprint: r behind the robot to r past the next control point.
   const geometry::Obb2 far = robotBox({0.0, 0.0}, {0.3, 0.0}, {1.0, 0.0}, 0.35);
   EXPECT_NEAR(far.center.x, 0.15, 1e-12);
@@ -164,12 +164,12 @@ TEST(ElasticStrips, ObstacleBoxSpansBothReadingsAndDSafeAlongTheMotion) {
 }
 
 TEST(ElasticStrips, TwoSidedPushesOnlyWhenTheBoxesMeetAndOnePointFallsBackToTheOriginal) {
-  ElasticStripsParams prm;  // Table 2.3 case 1: K_r 0.6, d_safe 1 m
+  ElasticStripsParams prm;  // Table 2.3 case 1: K_r 0.6, dSafe 1 m
   const std::vector<Vec2> path{{6.0, 0.0}};
   LocalView v;
   v.robot.radius = 0.35;
   v.path = path;
-  // A gate 1.2 m wide, its posts 1.25 m ahead: within d_safe + r of the next point (0.3 m ahead), but
+  // A gate 1.2 m wide, its posts 1.25 m ahead: within dSafe + r of the next point (0.3 m ahead), but
   // the step's footprint (to 0.65 m) does not reach the gate's box: no external force yet.
   std::vector<Vec2> gate{{1.25, 0.6}, {1.25, -0.6}};
   v.scan = gate;
@@ -184,7 +184,7 @@ TEST(ElasticStrips, TwoSidedPushesOnlyWhenTheBoxesMeetAndOnePointFallsBackToTheO
   (void)near.plan(v);
   EXPECT_EQ(near.lastContact(), ElasticStripsPlanner::Contact::kBoxesMeet);
   EXPECT_NEAR(near.lastForce().y, 0.0, 1e-9);
-  // One post only: the original's single-reading force (threshold d_safe + r on the centre distance).
+  // One post only: the original's single-reading force (threshold dSafe + r on the centre distance).
   std::vector<Vec2> post{{1.25, 0.6}};
   v.scan = post;
   v.robot.pose = {0.5, 0.0, 0.0};
@@ -207,9 +207,9 @@ TEST(ElasticStrips, Table23Cases3And4TwoSidedReachesWithoutContactAndSmoother) {
   for (const Table23Case& c : {Table23Case{{5.0, 4.0}, 0.6, 0.3, 3}, Table23Case{{6.0, 5.5}, 0.6, 0.3, 3}}) {
     const auto r = runTable23(c);
     EXPECT_TRUE(r.twoSided.reached) << c.goal.x;
-    EXPECT_GT(r.twoSided.min_clearance, 0.0) << c.goal.x;
+    EXPECT_GT(r.twoSided.minClearance, 0.0) << c.goal.x;
     EXPECT_TRUE(r.original.reached) << c.goal.x;
-    EXPECT_LT(r.original.min_clearance, 0.0) << c.goal.x;
+    EXPECT_LT(r.original.minClearance, 0.0) << c.goal.x;
     EXPECT_LT(totalTurning(r.twoSided), 0.5 * totalTurning(r.original)) << c.goal.x;
   }
 }

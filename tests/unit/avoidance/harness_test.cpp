@@ -21,17 +21,17 @@ TEST(Harness, CircleSwapWithVelocityObstaclesIsCollisionFree) {
   const auto r = runScenario(circleSwap(8, 4.0), "vo");
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->reached, 8);
-  EXPECT_EQ(r->robot_collisions, 0);
-  EXPECT_GT(r->min_separation, 0.0);
-  EXPECT_EQ(r->agent_steps > 0, true);
+  EXPECT_EQ(r->robotCollisions, 0);
+  EXPECT_GT(r->minSeparation, 0.0);
+  EXPECT_EQ(r->agentSteps > 0, true);
   // Every robot travels at least the diameter.
-  EXPECT_GE(r->mean_path_length, 8.0 - 2.0 * 0.15);
+  EXPECT_GE(r->meanPathLength, 8.0 - 2.0 * 0.15);
 }
 
 TEST(Harness, SafetyLayerKeepsDwaSwapFreeOfRobotContacts) {
   const auto r = runScenario(circleSwap(6, 3.0), "dwa");
   ASSERT_TRUE(r.has_value());
-  EXPECT_EQ(r->robot_collisions, 0);
+  EXPECT_EQ(r->robotCollisions, 0);
   EXPECT_GT(r->overruled, 0);
 }
 
@@ -40,9 +40,9 @@ TEST(Harness, AisleCrossingNoShelfOrRobotContacts) {
     const auto r = runScenario(aisleCrossing(2, 2, 3), planner);
     ASSERT_TRUE(r.has_value());
     EXPECT_EQ(r->reached, 4) << planner;
-    EXPECT_EQ(r->static_collisions, 0) << planner;
-    EXPECT_EQ(r->robot_collisions, 0) << planner;
-    EXPECT_EQ(r->collisions, r->robot_collisions + r->static_collisions + r->human_collisions);
+    EXPECT_EQ(r->staticCollisions, 0) << planner;
+    EXPECT_EQ(r->robotCollisions, 0) << planner;
+    EXPECT_EQ(r->collisions, r->robotCollisions + r->staticCollisions + r->humanCollisions);
   }
 }
 

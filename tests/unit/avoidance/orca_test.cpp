@@ -116,7 +116,7 @@ TEST(Orca, CircleSwapSmallGroupsReachTheirGoalsWithoutContact) {
     ASSERT_TRUE(r.has_value());
     EXPECT_EQ(r->reached, n) << n;
     EXPECT_EQ(r->collisions, 0) << n;
-    EXPECT_GT(r->min_separation, 0.0) << n;
+    EXPECT_GT(r->minSeparation, 0.0) << n;
   }
 }
 
@@ -126,11 +126,11 @@ TEST(Orca, CircleSwapSmallGroupsReachTheirGoalsWithoutContact) {
 // had arrived, the last two circled outside the ring of arrived robots for ever (98/100).
 TEST(Orca, HundredRobotSwapEveryRobotHomeWithoutContact) {
   Scenario sc = circleSwap(100, 20.0);
-  sc.max_steps = 3000;
+  sc.maxSteps = 3000;
   const auto r = runScenario(sc, "orca");
   ASSERT_TRUE(r.has_value());
   EXPECT_EQ(r->collisions, 0);
-  EXPECT_GT(r->min_separation, 0.0);
+  EXPECT_GT(r->minSeparation, 0.0);
   EXPECT_EQ(r->reached, 100);
 }
 

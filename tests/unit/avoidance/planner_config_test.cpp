@@ -23,16 +23,16 @@ TEST(PlannerConfig, DwaWeightsAndSamplesComeFromConfig) {
   Config d = cfg.child("dwa");
   const DwaParams p = dwaParams(d);
   EXPECT_TRUE(cfg.ok());
-  EXPECT_DOUBLE_EQ(p.w_risk, 2.5);
-  EXPECT_DOUBLE_EQ(p.w_heading, 0.4);
-  EXPECT_EQ(p.v_samples, 14);
-  EXPECT_EQ(p.omega_samples, 12);
-  EXPECT_DOUBLE_EQ(p.sim_time, 2.0);
-  EXPECT_TRUE(p.allow_reverse);
+  EXPECT_DOUBLE_EQ(p.wRisk, 2.5);
+  EXPECT_DOUBLE_EQ(p.wHeading, 0.4);
+  EXPECT_EQ(p.vSamples, 14);
+  EXPECT_EQ(p.omegaSamples, 12);
+  EXPECT_DOUBLE_EQ(p.simTime, 2.0);
+  EXPECT_TRUE(p.allowReverse);
   // Untouched keys keep the Nav2-like defaults.
-  EXPECT_DOUBLE_EQ(p.w_clearance, DwaParams{}.w_clearance);
+  EXPECT_DOUBLE_EQ(p.wClearance, DwaParams{}.wClearance);
   DynamicWindowPlanner planner(p);
-  EXPECT_EQ(planner.params().v_samples, 14);
+  EXPECT_EQ(planner.params().vSamples, 14);
 }
 
 TEST(PlannerConfig, EveryBadDwaKeyIsNamed) {
@@ -70,9 +70,9 @@ TEST(PlannerConfig, SafetyZonesAndTheirOrder) {
   Config ok = Config::fromText(R"({"stop_margin": 0.1, "slow_margin": 0.5, "slow_ratio": 0.4})", "s.json");
   const SafetyParams p = safetyParams(ok);
   EXPECT_TRUE(ok.ok());
-  EXPECT_DOUBLE_EQ(p.stop_margin, 0.1);
-  EXPECT_DOUBLE_EQ(p.slow_margin, 0.5);
-  EXPECT_DOUBLE_EQ(p.slow_ratio, 0.4);
+  EXPECT_DOUBLE_EQ(p.stopMargin, 0.1);
+  EXPECT_DOUBLE_EQ(p.slowMargin, 0.5);
+  EXPECT_DOUBLE_EQ(p.slowRatio, 0.4);
   EXPECT_TRUE(p.validate().has_value());
 
   Config bad = Config::fromText(R"({"stop_margin": 0.4, "slow_margin": 0.2, "slow_ratio": 0})", "s.json");

@@ -19,10 +19,10 @@ const char* const kPlanners[] = {
 
 void print(const ScenarioResult& r) {
   std::cout << r.scenario << " " << r.planner << ": reached " << r.reached << "/" << r.robots << " in "
-            << r.makespan << " s, path " << r.mean_path_length << " m, contacts static "
-            << r.static_collisions << " robot " << r.robot_collisions << " human " << r.human_collisions
-            << " (while moving " << r.human_hits_while_moving << ", driven into " << r.human_hits_by_robot
-            << "), min gap " << r.min_separation << " m, overruled " << r.overruled << "\n";
+            << r.makespan << " s, path " << r.meanPathLength << " m, contacts static " << r.staticCollisions
+            << " robot " << r.robotCollisions << " human " << r.humanCollisions << " (while moving "
+            << r.humanHitsWhileMoving << ", driven into " << r.humanHitsByRobot << "), min gap "
+            << r.minSeparation << " m, overruled " << r.overruled << "\n";
 }
 
 TEST(PlannerScenarios, EveryPlannerDrivesPastStaticBoxesWithoutContact) {
@@ -35,10 +35,10 @@ TEST(PlannerScenarios, EveryPlannerDrivesPastStaticBoxesWithoutContact) {
     EXPECT_EQ(r->collisions, 0) << name;
     // Past three boxes a detour is needed, but not a wander: at most twice the straight 16 m, except
     // for Bug1, which tours every obstacle it meets once and a half by design. Its bound (Lumelsky)
-    // is D + 1.5·Σ perimeters, the perimeters followed at r + follow_gap = 0.65 m from the boxes
+    // is D + 1.5·Σ perimeters, the perimeters followed at r + followGap = 0.65 m from the boxes
     // (1 × 2 m and twice 1.2 × 2.4 m): 2(w + h) + 2π·0.65 each.
     const double followed = (6.0 + 7.2 + 7.2) + 3.0 * 2.0 * 3.14159265 * 0.65;
-    EXPECT_LT(r->mean_path_length, std::string(name) == "bug1" ? 16.0 + 1.5 * followed : 32.0) << name;
+    EXPECT_LT(r->meanPathLength, std::string(name) == "bug1" ? 16.0 + 1.5 * followed : 32.0) << name;
   }
 }
 
@@ -49,10 +49,10 @@ TEST(PlannerScenarios, EveryPlannerCrossesTheAisleWhilePeopleWalkThrough) {
     ASSERT_TRUE(r.has_value()) << name;
     print(*r);
     EXPECT_EQ(r->reached, 1) << name;
-    EXPECT_EQ(r->static_collisions, 0) << name;
+    EXPECT_EQ(r->staticCollisions, 0) << name;
     // People here do not avoid: they walk into robots that stand or creep. No robot may drive into
     // a person (contact beginning while it moves towards them).
-    EXPECT_EQ(r->human_hits_by_robot, 0) << name;
+    EXPECT_EQ(r->humanHitsByRobot, 0) << name;
   }
 }
 

@@ -70,7 +70,7 @@ TEST(RotationShim, NearTheGoalTheWrappedPlannerDecidesAlone) {
 }
 
 TEST(Dwa, ARobotAlreadyInsideTheMinimumClearanceCanStillTurnAndLeave) {
-  // A wall 0.05 m from the robot's surface (inside min_clearance 0.10): before, every sample was
+  // A wall 0.05 m from the robot's surface (inside minClearance 0.10): before, every sample was
   // inadmissible and DWA reported blocked for ever; samples that do not close in stay admissible.
   const auto wall = test::wall({-2.0, 0.35}, {4.0, 0.35});  // robot radius 0.3 at y = 0
   const std::vector<Vec2> path{{3.0, -2.0}};

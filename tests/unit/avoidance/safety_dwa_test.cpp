@@ -61,7 +61,7 @@ TEST(ArcClearance, SweepsPastAHalfAndAFullTurnMatchDenseSampling) {
 // A planner that always asks for full speed straight ahead, whatever is there.
 class Reckless final : public LocalPlanner {
  public:
-  Command plan(const LocalView& v) override { return {{v.limits.v_max, 0.0}, PlanStatus::kMoving, false}; }
+  Command plan(const LocalView& v) override { return {{v.limits.vMax, 0.0}, PlanStatus::kMoving, false}; }
   [[nodiscard]] std::string_view name() const override { return "reckless"; }
 };
 
@@ -70,11 +70,11 @@ TEST(SafetyLayer, OverrulesAPlannerDrivingIntoAWall) {
   // Without the layer the reckless planner hits the wall.
   Reckless raw;
   const auto bad = test::drive(raw, {0, 0, 0}, {{5.0, 0.0}}, scan, 100);
-  EXPECT_LT(bad.min_clearance, 0.0);
+  EXPECT_LT(bad.minClearance, 0.0);
   SafePlanner safe(std::make_unique<Reckless>());
   const auto good = test::drive(safe, {0, 0, 0}, {{5.0, 0.0}}, scan, 200);
   EXPECT_GT(good.overruled, 0);
-  EXPECT_GE(good.min_clearance, 0.0);
+  EXPECT_GE(good.minClearance, 0.0);
   EXPECT_GT(good.trace.back().x, 1.0);  // it still drove up to the wall, then stopped
   EXPECT_EQ(safe.lastSafety().twist.v, 0.0);
 }
@@ -89,7 +89,7 @@ TEST(SafetyLayer, StopsForADiscCrossingItsPath) {
   const auto r = layer.filter(v, {0.45, 0.0});
   EXPECT_TRUE(r.overruled);
   EXPECT_LT(r.twist.v, 0.45);
-  EXPECT_LT(r.time_to_collision, 2.0);
+  EXPECT_LT(r.timeToCollision, 2.0);
   // Far away and moving away: untouched.
   discs[0] = {{5.0, 5.0}, {0.0, 1.0}, 0.3};
   const auto ok = layer.filter(v, {0.45, 0.0});
@@ -140,8 +140,8 @@ TEST(Dwa, SamplesStayInsideTheDynamicWindow) {
   (void)dwa.plan(v);
   ASSERT_EQ(dwa.lastSamples().size(), 400u);
   for (const auto& s : dwa.lastSamples()) {
-    EXPECT_LE(std::abs(s.twist.v - 0.2), v.limits.accel_max * v.dt + 1e-12);
-    EXPECT_LE(std::abs(s.twist.omega - 0.1), v.limits.alpha_max * v.dt + 1e-12);
+    EXPECT_LE(std::abs(s.twist.v - 0.2), v.limits.accelMax * v.dt + 1e-12);
+    EXPECT_LE(std::abs(s.twist.omega - 0.1), v.limits.alphaMax * v.dt + 1e-12);
     EXPECT_GE(s.twist.v, 0.0);
   }
 }
@@ -151,7 +151,7 @@ TEST(Dwa, ReachesGoalAroundAnObstacleWithoutTouchingIt) {
   SafePlanner p(std::make_unique<DynamicWindowPlanner>());
   const auto r = test::drive(p, {0, 0, 0}, {{5.0, 0.0}}, scan, 600);
   EXPECT_TRUE(r.reached);
-  EXPECT_GT(r.min_clearance, 0.0);
+  EXPECT_GT(r.minClearance, 0.0);
 }
 
 TEST(Dwa, RiskTermSteersToTheLowRiskSide) {
@@ -173,7 +173,7 @@ TEST(Dwa, RiskTermSteersToTheLowRiskSide) {
     // Without risk the scene is symmetric up to sampling; the risk weight is what decides.
     v.risk = [](Vec2) { return 0.0; };
     DwaParams no_risk;
-    no_risk.w_risk = 0.0;
+    no_risk.wRisk = 0.0;
     v.risk = [side](Vec2 p) { return side * p.y > 1e-9 ? 0.9 : 0.0; };
     DynamicWindowPlanner blind(no_risk);
     const Command cb = blind.plan(v);
@@ -230,13 +230,13 @@ TEST(Dwa, WeightsChangeTheChoice) {
   // With clearance weighted heavily the robot keeps farther from a wall it drives along.
   const auto scan = test::wall({0.0, 0.6}, {6.0, 0.6});
   DwaParams greedy;
-  greedy.w_clearance = 0.0;
+  greedy.wClearance = 0.0;
   DwaParams careful;
-  careful.w_clearance = 3.0;
+  careful.wClearance = 3.0;
   DynamicWindowPlanner a(greedy), b(careful);
   const auto ra = test::drive(a, {0, 0, 0}, {{6.0, 0.3}}, scan, 400);
   const auto rb = test::drive(b, {0, 0, 0}, {{6.0, 0.3}}, scan, 400);
-  EXPECT_GT(rb.min_clearance, ra.min_clearance);
+  EXPECT_GT(rb.minClearance, ra.minClearance);
 }
 
 }  // namespace

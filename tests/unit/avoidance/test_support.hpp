@@ -31,7 +31,7 @@ inline std::vector<Vec2> ring(Vec2 c, double r, int n = 64) {
 
 struct RunResult {
   bool reached = false;
-  double min_clearance = 1e9;  ///< surface clearance to the scan points
+  double minClearance = 1e9;  ///< surface clearance to the scan points
   int steps = 0;
   int overruled = 0;
   double path_length = 0.0;
@@ -40,7 +40,7 @@ struct RunResult {
 
 /// Close the loop on one robot among static points: plan, apply limits, integrate exactly.
 inline RunResult drive(LocalPlanner& planner, Pose2 start, std::vector<Vec2> path,
-                       const std::vector<Vec2>& scan, int max_steps, RiskLookup risk = {},
+                       const std::vector<Vec2>& scan, int maxSteps, RiskLookup risk = {},
                        double radius = 0.3) {
   RunResult r;
   LocalView v;
@@ -49,7 +49,7 @@ inline RunResult drive(LocalPlanner& planner, Pose2 start, std::vector<Vec2> pat
   v.path = path;
   v.scan = scan;
   v.risk = std::move(risk);
-  for (int k = 0; k < max_steps; ++k) {
+  for (int k = 0; k < maxSteps; ++k) {
     const Command c = planner.plan(v);
     if (c.overruled)
       ++r.overruled;
@@ -64,7 +64,7 @@ inline RunResult drive(LocalPlanner& planner, Pose2 start, std::vector<Vec2> pat
     v.robot.twist = lt.twist;
     r.trace.push_back(next);
     for (const Vec2& q : scan)
-      r.min_clearance = std::min(r.min_clearance, distance(q, next.position()) - radius);
+      r.minClearance = std::min(r.minClearance, distance(q, next.position()) - radius);
     r.steps = k + 1;
   }
   return r;

@@ -84,7 +84,7 @@ TEST(PolarError, MatchesDefinition) {
 }
 
 TEST(GlobalLaw, LyapunovDerivativeIsNegativeSemidefinite) {
-  // Analytic V̇_G = ρρ̇ + αα̇ + hφφ̇ with the error dynamics 4.7 must equal −k_v ρ² cos²α − k_α α².
+  // Analytic V̇_G = ρρ̇ + αα̇ + hφφ̇ with the error dynamics 4.7 must equal −kV ρ² cos²α − k_α α².
   const LyapunovGains g;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> ur(0.01, 5.0);
@@ -98,7 +98,7 @@ TEST(GlobalLaw, LyapunovDerivativeIsNegativeSemidefinite) {
     const double alpha_dot = -t.omega + t.v * std::sin(e.alpha) / e.rho;
     const double vdot = e.rho * rho_dot + e.alpha * alpha_dot + g.h * e.phi * phi_dot;
     const double expected =
-        -g.k_v * e.rho * e.rho * std::pow(std::cos(e.alpha), 2) - g.k_alpha * e.alpha * e.alpha;
+        -g.kV * e.rho * e.rho * std::pow(std::cos(e.alpha), 2) - g.kAlpha * e.alpha * e.alpha;
     EXPECT_NEAR(vdot, expected, 1e-9 * (1.0 + std::abs(expected)));
     EXPECT_LE(vdot, 1e-12);
   }
@@ -130,7 +130,7 @@ TEST(GlobalLaw, LyapunovNonIncreasingAlongDiscreteTrajectory) {
 }
 
 TEST(LyapunovPoseController, Sim1NoiseFreeBothLawsConverge) {
-  // Seed 003 Sim 1: (−2, 3.5, −60°) → (0, 0, 0°), k_v = 1, k_α = 2, k_θ = 1, h = 5, Δt = 0.1 s, 150 samples.
+  // Seed 003 Sim 1: (−2, 3.5, −60°) → (0, 0, 0°), kV = 1, k_α = 2, k_θ = 1, h = 5, Δt = 0.1 s, 150 samples.
   for (const PoseLaw law : {PoseLaw::kSingleLaw, PoseLaw::kTwoRegion}) {
     const SimRun run = simulate(withLaw(law), kSim1Start, kOrigin, 150, Noise{}, 1);
     const Pose2 end = run.poses.back();
@@ -207,7 +207,7 @@ TEST(LyapunovPoseController, DrivesBackwardsWhenGoalIsBehind) {
   EXPECT_LT(std::hypot(run.poses.back().x, run.poses.back().y), 0.01);
   EXPECT_LT(std::abs(run.poses.back().theta), deg2rad(0.5));
 
-  p.allow_reverse = false;
+  p.allowReverse = false;
   LyapunovPoseController fwd(p);
   auto f = fwd.step(start, kOrigin);
   ASSERT_TRUE(f.has_value());
@@ -223,8 +223,8 @@ TEST(LyapunovPoseController, LocalRegionUsesHeadingLaw) {
   auto out = ctl.step(est, goal);
   ASSERT_TRUE(out.has_value());
   EXPECT_EQ(out->region, ControlRegion::kLocal);
-  EXPECT_NEAR(out->cmd.omega, -p.gains.k_theta * 0.1, 1e-12);
-  EXPECT_NEAR(out->cmd.v, p.gains.k_v * 0.05 * std::cos(kPi - 0.6), 1e-12);
+  EXPECT_NEAR(out->cmd.omega, -p.gains.kTheta * 0.1, 1e-12);
+  EXPECT_NEAR(out->cmd.v, p.gains.kV * 0.05 * std::cos(kPi - 0.6), 1e-12);
   EXPECT_LT(out->cmd.v, 0.0);  // backs up toward the goal
   // The single law ignores the region.
   LyapunovParams s = p;
@@ -246,12 +246,12 @@ TEST(LyapunovPoseController, RejectsNonFinitePoses) {
 TEST(LyapunovParams, Validation) {
   EXPECT_TRUE(LyapunovParams{}.validate().has_value());
   LyapunovParams p;
-  p.gains.k_v = 0.0;
+  p.gains.kV = 0.0;
   EXPECT_FALSE(p.validate().has_value());
   p = {};
-  p.eps_rho = std::nan("");
+  p.epsRho = std::nan("");
   EXPECT_FALSE(p.validate().has_value());
   p = {};
-  p.local_exit_factor = 0.5;
+  p.localExitFactor = 0.5;
   EXPECT_FALSE(p.validate().has_value());
 }

@@ -24,12 +24,12 @@ struct FollowResult {
 };
 
 /// Closed loop with the speed/acceleration limits in between, as the robot agent runs it.
-FollowResult follow(PathFollower& f, Pose2 pose, int max_steps) {
+FollowResult follow(PathFollower& f, Pose2 pose, int maxSteps) {
   const VelocityLimits limits;
   FollowResult res;
   Twist prev{};
   double last_progress = 0.0;
-  for (int k = 0; k < max_steps; ++k) {
+  for (int k = 0; k < maxSteps; ++k) {
     auto out = f.step(pose);
     EXPECT_TRUE(out.has_value());
     res.steps = k;
@@ -37,10 +37,10 @@ FollowResult follow(PathFollower& f, Pose2 pose, int max_steps) {
       res.progress_monotone = false;
     }
     last_progress = out->progress;
-    if (!out->final_approach) {
-      res.max_cross_track = std::max(res.max_cross_track, out->cross_track);
+    if (!out->finalApproach) {
+      res.max_cross_track = std::max(res.max_cross_track, out->crossTrack);
     }
-    if (out->goal_reached) {
+    if (out->goalReached) {
       res.reached = true;
       break;
     }

@@ -11,20 +11,20 @@ using namespace fleet::control;
 TEST(VelocityLimits, Validation) {
   EXPECT_TRUE(VelocityLimits{}.validate().has_value());
   VelocityLimits l;
-  l.v_min = 0.1;
+  l.vMin = 0.1;
   EXPECT_FALSE(l.validate().has_value());
   l = {};
-  l.accel_max = 0.0;
+  l.accelMax = 0.0;
   EXPECT_FALSE(l.validate().has_value());
   l = {};
-  l.omega_max = std::numeric_limits<double>::infinity();
+  l.omegaMax = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(l.validate().has_value());
 }
 
 TEST(VelocityLimits, SaturationKeepsCurvature) {
   VelocityLimits l;
-  l.accel_max = 100.0;
-  l.alpha_max = 100.0;
+  l.accelMax = 100.0;
+  l.alphaMax = 100.0;
   const LimitedTwist r = applyLimits(l, Twist{0.9, 0.6}, Twist{0.45, 0.3}, 0.1);
   EXPECT_TRUE(r.saturated);
   EXPECT_NEAR(r.twist.v, 0.45, 1e-12);
@@ -54,11 +54,11 @@ TEST(VelocityLimits, RandomRequestsStayWithinBounds) {
   Twist prev{};
   for (int i = 0; i < 5000; ++i) {
     const LimitedTwist r = applyLimits(l, Twist{u(rng), u(rng)}, prev, 0.1);
-    EXPECT_LE(r.twist.v, l.v_max + 1e-12);
-    EXPECT_GE(r.twist.v, l.v_min - 1e-12);
-    EXPECT_LE(std::abs(r.twist.omega), l.omega_max + 1e-12);
-    EXPECT_LE(std::abs(r.twist.v - prev.v), l.accel_max * 0.1 + 1e-12);
-    EXPECT_LE(std::abs(r.twist.omega - prev.omega), l.alpha_max * 0.1 + 1e-12);
+    EXPECT_LE(r.twist.v, l.vMax + 1e-12);
+    EXPECT_GE(r.twist.v, l.vMin - 1e-12);
+    EXPECT_LE(std::abs(r.twist.omega), l.omegaMax + 1e-12);
+    EXPECT_LE(std::abs(r.twist.v - prev.v), l.accelMax * 0.1 + 1e-12);
+    EXPECT_LE(std::abs(r.twist.omega - prev.omega), l.alphaMax * 0.1 + 1e-12);
     prev = r.twist;
   }
 }

@@ -27,7 +27,7 @@ struct Outcome {
 /// under the speed/acceleration limits to the Sim 2 goals.
 Outcome driveTo(const Pose2& goal, bool use_ekf_corrections, unsigned seed) {
   const sim::SensorSetup s;
-  auto base = control::DiffDriveBase::create(s.wheel_base, control::VelocityLimits{}, Pose2{}).value();
+  auto base = control::DiffDriveBase::create(s.wheelBase, control::VelocityLimits{}, Pose2{}).value();
   PoseEkf ekf = PoseEkf::create(EkfParams{}, Pose2{}, Eigen::Matrix3d::Identity() * 1e-6).value();
   control::LyapunovPoseController ctl;
   const std::vector<MapLine> map = sim::roomMap();

@@ -131,8 +131,8 @@ TEST(FusionSimulation, CorruptedReadingsDoNotCorruptTheEstimate) {
     nan_compass += (k % 7 == 3) ? 1 : 0;
     off_compass += (k % 7 != 3 && k % 11 == 5) ? 1 : 0;
   }
-  EXPECT_EQ(stats.compass.rejected_non_finite, nan_compass);
-  EXPECT_GE(stats.compass.rejected_gate, off_compass);
-  EXPECT_GT(stats.lines_unmatched, 0u);
-  EXPECT_GT(stats.bearing.rejected_non_finite, 0u);
+  EXPECT_EQ(stats.compass.rejectedNonFinite, nan_compass);
+  EXPECT_GE(stats.compass.rejectedGate, off_compass);
+  EXPECT_GT(stats.linesUnmatched, 0u);
+  EXPECT_GT(stats.bearing.rejectedNonFinite, 0u);
 }

@@ -51,7 +51,7 @@ TEST(FitLine, ExactPointsAndErrors) {
   const LineFit h = fitLine(horizontal, 0.01).value();
   EXPECT_NEAR(h.r, 2.0, 1e-12);
   EXPECT_NEAR(h.psi, kPi / 2, 1e-12);
-  EXPECT_NEAR(h.rms_residual, 0.0, 1e-9);
+  EXPECT_NEAR(h.rmsResidual, 0.0, 1e-9);
   const std::vector<Vec2> diagonal{{2, 0}, {1, 1}, {0, 2}};
   const LineFit d = fitLine(diagonal, 0.01).value();
   EXPECT_NEAR(d.r, std::sqrt(2.0), 1e-12);
@@ -93,13 +93,13 @@ TEST(FitLine, CovarianceMatchesMonteCarlo) {
     srp += dr * dp;
   }
   const double N = kTrials;
-  const double var_r = srr / N - (sr / N) * (sr / N);
+  const double varR = srr / N - (sr / N) * (sr / N);
   const double var_p = spp / N - (sp / N) * (sp / N);
   const double cov = srp / N - (sr / N) * (sp / N);
-  EXPECT_NEAR(var_r / nominal.var_r, 1.0, 0.1);
-  EXPECT_NEAR(var_p / nominal.var_psi, 1.0, 0.1);
-  EXPECT_NEAR(cov / nominal.cov_r_psi, 1.0, 0.15);
-  EXPECT_GT(std::abs(nominal.cov_r_psi) / std::sqrt(nominal.var_r * nominal.var_psi), 0.5);
+  EXPECT_NEAR(varR / nominal.varR, 1.0, 0.1);
+  EXPECT_NEAR(var_p / nominal.varPsi, 1.0, 0.1);
+  EXPECT_NEAR(cov / nominal.covRPsi, 1.0, 0.15);
+  EXPECT_GT(std::abs(nominal.covRPsi) / std::sqrt(nominal.varR * nominal.varPsi), 0.5);
 }
 
 TEST(LineExtraction, TwoPerpendicularWalls) {
@@ -119,8 +119,8 @@ TEST(LineExtraction, TwoPerpendicularWalls) {
     EXPECT_LT(distance(lines[0].last, Vec2{3, 2}), 0.15);
     EXPECT_LT(distance(lines[1].first, Vec2{3, 2}), 0.15);
     for (const ExtractedLine& l : lines) {
-      EXPECT_GT(l.line.var_r, 0.0);
-      EXPECT_GT(l.line.var_psi, 0.0);
+      EXPECT_GT(l.line.varR, 0.0);
+      EXPECT_GT(l.line.varPsi, 0.0);
       EXPECT_GE(l.points, 12u);
     }
   }
@@ -139,7 +139,7 @@ TEST(LineExtraction, ScatteredPointsAndBadInputGiveNoLines) {
   scan.ranges.assign(361, std::nan(""));
   EXPECT_TRUE(extractLines(scan).empty());
   LineExtractionParams bad;
-  bad.seed_points = 2;
+  bad.seedPoints = 2;
   EXPECT_FALSE(bad.validate().has_value());
   EXPECT_TRUE(extractLines(castScan(Pose2{}, {{3.0, 0.0}}, 0.0, rng), bad).empty());
 }

@@ -67,7 +67,7 @@ TEST(LineMatching, TheGateIsMahalanobisAndWidensWithTheEstimatesUncertainty) {
   const std::vector<ExtractedLine> obs{seen(pose, kFront, {1.0, 2.3}, {3.0, 2.3}, 0.3)};
   const auto tight = matchLines(pose, cov(0.02, 0.01), map, obs);
   EXPECT_TRUE(tight.matches.empty());
-  EXPECT_EQ(tight.outside_gate, 1u);
+  EXPECT_EQ(tight.outsideGate, 1u);
   const auto loose = matchLines(pose, cov(0.3, 0.01), map, obs);
   EXPECT_EQ(loose.matches.size(), 1u);
   // χ²(2): d² = 0.09 / (0.02² + 1e-4) = 180 against 13.82; a 4 cm miss (d² = 3.2) passes.
@@ -75,10 +75,10 @@ TEST(LineMatching, TheGateIsMahalanobisAndWidensWithTheEstimatesUncertainty) {
   EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, near).matches.size(), 1u);
   LineGate strict;
   strict.mahalanobis = 2.0;
-  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, near, strict).outside_gate, 1u);
+  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, near, strict).outsideGate, 1u);
   // The heading: a line turned by 0.2 rad is no match at σθ = 0.01.
   const std::vector<ExtractedLine> turned{seen(pose, kFront, {1.0, 2.0}, {3.0, 2.0}, 0.0, 0.2)};
-  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, turned).outside_gate, 1u);
+  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, turned).outsideGate, 1u);
 }
 
 TEST(LineMatching, EndPointsOffTheWallFailTheOverlapTest) {
@@ -88,7 +88,7 @@ TEST(LineMatching, EndPointsOffTheWallFailTheOverlapTest) {
   const std::vector<ExtractedLine> gap{seen(pose, kFront, {4.5, 2.0}, {5.5, 2.0})};
   const auto m = matchLines(pose, cov(0.02, 0.01), map, gap);
   EXPECT_TRUE(m.matches.empty());
-  EXPECT_EQ(m.no_overlap, 1u);
+  EXPECT_EQ(m.noOverlap, 1u);
   // Sticking out 0.1 m past the end: inside T = 0.3 (2 × 0.1 < 0.3 + 6σ).
   const std::vector<ExtractedLine> over{seen(pose, kFront, {3.0, 2.0}, {4.1, 2.0})};
   EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, over).matches.size(), 1u);
@@ -106,7 +106,7 @@ TEST(LineMatching, OnlyWallsFacingTheRobotAreCandidates) {
   const std::vector<ExtractedLine> obs{seen(pose, kBack, {1.0, 3.0}, {3.0, 3.0})};
   const auto m = matchLines(pose, cov(1.0, 0.01), map, obs);
   EXPECT_TRUE(m.matches.empty()) << "the front face's line is in the gate at σ = 1 m, but it looks away";
-  EXPECT_EQ(m.no_wall_facing, 1u);
+  EXPECT_EQ(m.noWallFacing, 1u);
 }
 
 TEST(LineMatching, WallsOutOfRangeAreNotLookedAt) {
@@ -114,14 +114,14 @@ TEST(LineMatching, WallsOutOfRangeAreNotLookedAt) {
   const std::vector<MapSegment> map{kFront};  // 1.5 m away
   const std::vector<ExtractedLine> obs{seen(pose, kFront, {1.0, 2.0}, {3.0, 2.0})};
   LineGate g;
-  g.max_range = 2.0;
+  g.maxRange = 2.0;
   EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, obs, g).matches.size(), 1u);
-  g.max_range = 1.0;
-  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, obs, g).no_wall_facing, 1u);
+  g.maxRange = 1.0;
+  EXPECT_EQ(matchLines(pose, cov(0.02, 0.01), map, obs, g).noWallFacing, 1u);
   // Distance to the segment, not to its line: the same wall 3 m to the side is out of a 2 m range.
   const Pose2 aside{7.5, 1.0, 0.0};
-  g.max_range = 2.0;
-  EXPECT_EQ(matchLines(aside, cov(0.02, 0.01), map, obs, g).no_wall_facing, 1u);
+  g.maxRange = 2.0;
+  EXPECT_EQ(matchLines(aside, cov(0.02, 0.01), map, obs, g).noWallFacing, 1u);
 }
 
 TEST(LineMatching, TwoDifferentWallsInTheGateAreAmbiguousAndSkipped) {
@@ -150,11 +150,11 @@ TEST(LineMatching, EveryLineGetsOneOutcomeAndAnEmptyMapMatchesNothing) {
                                  seen(pose, kFront, {1.0, 2.0}, {3.0, 2.0}, 1.0),
                                  seen(pose, kFront, {5.5, 2.0}, {7.0, 2.0})};
   const auto m = matchLines(pose, cov(0.02, 0.01), map, obs);
-  EXPECT_EQ(m.matches.size() + m.outside_gate + m.no_overlap + m.ambiguous + m.no_wall_facing, obs.size());
+  EXPECT_EQ(m.matches.size() + m.outsideGate + m.noOverlap + m.ambiguous + m.noWallFacing, obs.size());
   EXPECT_EQ(m.matches.size(), 1u);
-  EXPECT_EQ(m.outside_gate, 1u);
-  EXPECT_EQ(m.no_overlap, 1u);
+  EXPECT_EQ(m.outsideGate, 1u);
+  EXPECT_EQ(m.noOverlap, 1u);
   const auto none = matchLines(pose, cov(0.02, 0.01), {}, obs);
-  EXPECT_EQ(none.no_wall_facing, 3u);
+  EXPECT_EQ(none.noWallFacing, 3u);
   EXPECT_TRUE(matchLines(pose, cov(0.02, 0.01), map, {}).matches.empty());
 }

@@ -81,7 +81,7 @@ TEST(LineModel, SeedExamples) {
   EXPECT_NEAR(p.psi, 0.0, 1e-12);
   // Robot at (3, 0, 0) behind the same wall: C = −1, r = 1, ψ = π.
   p = predictLine(Pose2{3, 0, 0}, MapLine{2.0, 0.0});
-  EXPECT_NEAR(p.signed_distance, -1.0, 1e-12);
+  EXPECT_NEAR(p.signedDistance, -1.0, 1e-12);
   EXPECT_NEAR(p.r, 1.0, 1e-12);
   EXPECT_NEAR(p.psi, kPi, 1e-12);
   // Heading π/2 turns the wall's normal to −π/2 in the robot frame.

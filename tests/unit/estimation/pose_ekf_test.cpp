@@ -40,7 +40,7 @@ TEST(PoseEkf, CreateValidates) {
   bad(0, 0) = -1.0;
   EXPECT_EQ(PoseEkf::create(EkfParams{}, Pose2{}, bad).error().code, "invalid_covariance");
   EkfParams p;
-  p.wheel_base = 0.0;
+  p.wheelBase = 0.0;
   EXPECT_EQ(PoseEkf::create(p, Pose2{}, Eigen::Matrix3d::Identity()).error().code, "invalid_ekf_params");
 }
 
@@ -80,7 +80,7 @@ TEST(PoseEkf, CompassPullsHeading) {
 
 TEST(PoseEkf, CompassOffsetAndWrapping) {
   EkfParams params;
-  params.compass_offset = 0.5;
+  params.compassOffset = 0.5;
   Eigen::Matrix3d P0 = Eigen::Matrix3d::Identity() * 0.01;
   PoseEkf ekf = PoseEkf::create(params, Pose2{0, 0, 3.1}, P0).value();
   // Map heading −3.1 is 0.083 rad from 3.1 across ±π; the estimate must move the short way.
@@ -123,8 +123,8 @@ TEST(PoseEkf, LineBatchMatchesToTheRightWalls) {
   const LineBatchResult r = ekf.updateLines(map, obs);
   EXPECT_EQ(r.accepted, 3u);
   EXPECT_EQ(r.unmatched, 1u);
-  EXPECT_EQ(r.rejected_non_finite, 1u);
-  EXPECT_EQ(ekf.stats().lines_unmatched, 1u);
+  EXPECT_EQ(r.rejectedNonFinite, 1u);
+  EXPECT_EQ(ekf.stats().linesUnmatched, 1u);
   EXPECT_LT(std::hypot(ekf.pose().x, ekf.pose().y), 0.01);
   EXPECT_LT(std::abs(ekf.pose().theta), 0.02);
 }
@@ -155,14 +155,14 @@ TEST(PoseEkf, RejectsNonFiniteAndOutliersWithoutTouchingState) {
   EXPECT_EQ(ekf.state(), x0);
   EXPECT_EQ(ekf.covariance(), P0);
   const EkfStats& s = ekf.stats();
-  EXPECT_EQ(s.odometry.rejected_non_finite, 2u);
-  EXPECT_EQ(s.compass.rejected_non_finite, 3u);
-  EXPECT_EQ(s.compass.rejected_gate, 1u);
-  EXPECT_EQ(s.bearing.rejected_non_finite, 2u);
-  EXPECT_EQ(s.bearing.rejected_geometry, 1u);
-  EXPECT_EQ(s.bearing.rejected_gate, 1u);
-  EXPECT_EQ(s.line.rejected_non_finite, 2u);
-  EXPECT_EQ(s.line.rejected_gate, 1u);
+  EXPECT_EQ(s.odometry.rejectedNonFinite, 2u);
+  EXPECT_EQ(s.compass.rejectedNonFinite, 3u);
+  EXPECT_EQ(s.compass.rejectedGate, 1u);
+  EXPECT_EQ(s.bearing.rejectedNonFinite, 2u);
+  EXPECT_EQ(s.bearing.rejectedGeometry, 1u);
+  EXPECT_EQ(s.bearing.rejectedGate, 1u);
+  EXPECT_EQ(s.line.rejectedNonFinite, 2u);
+  EXPECT_EQ(s.line.rejectedGate, 1u);
   EXPECT_EQ(s.compass.accepted + s.bearing.accepted + s.line.accepted + s.odometry.accepted, 0u);
   // The filter still works afterwards.
   EXPECT_EQ(ekf.updateCompass(0.51), UpdateStatus::kAccepted);

@@ -17,7 +17,7 @@
 namespace fleet::estimation::sim {
 
 struct SensorSetup {
-  double wheel_base = 0.6;
+  double wheelBase = 0.6;
   double delta = 0.0003;          // eq. 3.9
   double compass_var = 2.79e-4;   // §3.2
   double bearing_var = 2.992e-4;  // §3.4
@@ -72,7 +72,7 @@ inline Log squareDrive(unsigned seed, int laps, const SensorSetup& s = {}) {
   std::vector<Motion> plan;
   const int straight_steps = static_cast<int>(std::lround(2.0 / 0.03));
   const int turn_steps = static_cast<int>(std::ceil((kPi / 2) / 0.05));
-  const double wheel_turn = (kPi / 2) / turn_steps * s.wheel_base / 2;
+  const double wheel_turn = (kPi / 2) / turn_steps * s.wheelBase / 2;
   for (int lap = 0; lap < laps; ++lap) {
     for (int side = 0; side < 4; ++side) {
       for (int i = 0; i < straight_steps; ++i) {
@@ -90,7 +90,7 @@ inline Log squareDrive(unsigned seed, int laps, const SensorSetup& s = {}) {
   for (const Motion& m : plan) {
     ++k;
     Step st{};
-    truth = odometryModel(truth, m.dl, m.dr, s.wheel_base).pose;
+    truth = odometryModel(truth, m.dl, m.dr, s.wheelBase).pose;
     st.truth = truth;
     st.ds_left = m.dl + std::sqrt(s.delta * std::abs(m.dl)) * n01(rng);
     st.ds_right = m.dr + std::sqrt(s.delta * std::abs(m.dr)) * n01(rng);
@@ -122,10 +122,10 @@ enum class Config { kOdometry, kCompass, kLaser, kCamera };  // each adds to the
 template <class F>
 void runFilter(const Log& log, Config config, F&& each, const SensorSetup& s = {}) {
   EkfParams params;
-  params.wheel_base = s.wheel_base;
+  params.wheelBase = s.wheelBase;
   params.delta = s.delta;
-  params.compass_variance = s.compass_var;
-  params.bearing_variance = s.bearing_var;
+  params.compassVariance = s.compass_var;
+  params.bearingVariance = s.bearing_var;
   PoseEkf ekf = PoseEkf::create(params, log.start_estimate, log.P0).value();
   const std::vector<MapLine> map = roomMap();
   for (const Step& st : log.steps) {

@@ -109,7 +109,7 @@ TEST(LaneAstar, WithoutPenaltyEqualsPlainAstar) {
   const auto raw = smallWarehouse();
   const auto grid = raw.inflated(0.5);
   LaneParams p;
-  p.wrong_way_factor = 1.0;
+  p.wrongWayFactor = 1.0;
   const auto lanes = LaneMap::derive(raw, p);
   std::mt19937 rng(3);
   std::vector<Cell> free;

@@ -46,8 +46,8 @@ TEST(Scenario, ReadsMapStationsRobotsAndOverrides) {
   ASSERT_EQ(s.robots.size(), 2U);
   EXPECT_DOUBLE_EQ(s.robots[0].radius, 0.3);
   EXPECT_DOUBLE_EQ(s.robots[1].radius, 0.2);
-  EXPECT_DOUBLE_EQ(s.robots[1].limits.v_max, 0.5);
-  EXPECT_DOUBLE_EQ(s.robots[1].limits.omega_max, 1.5);  // from the defaults
+  EXPECT_DOUBLE_EQ(s.robots[1].limits.vMax, 0.5);
+  EXPECT_DOUBLE_EQ(s.robots[1].limits.omegaMax, 1.5);  // from the defaults
   EXPECT_DOUBLE_EQ(s.robots[1].start.x, 2.0);
   EXPECT_DOUBLE_EQ(s.robots[1].start.theta, 0.5);
   EXPECT_EQ(s.stations[0].kind, StationKind::Charging);
@@ -191,7 +191,7 @@ TEST(Scenario, NamingASiteIsTheSameAsCarryingItInline) {
     for (std::size_t i = 0; i < a.robots.size(); ++i) {
       EXPECT_EQ(a.robots[i].start, b.robots[i].start);
       EXPECT_DOUBLE_EQ(a.robots[i].radius, b.robots[i].radius);
-      EXPECT_DOUBLE_EQ(a.robots[i].limits.v_max, b.robots[i].limits.v_max);
+      EXPECT_DOUBLE_EQ(a.robots[i].limits.vMax, b.robots[i].limits.vMax);
       EXPECT_EQ(a.robots[i].sensors.rays, b.robots[i].sensors.rays);
       EXPECT_DOUBLE_EQ(a.robots[i].sensors.rangeSigma, b.robots[i].sensors.rangeSigma);
     }

@@ -77,7 +77,7 @@ TEST(SiteFiles, TheCorpusGoodSiteLoadsWithItsParts) {
   EXPECT_NEAR(s.stations[1].approach->y, 1.0, 1e-4);
   EXPECT_FALSE(s.stations[1].approachGiven);
   EXPECT_DOUBLE_EQ(s.robot.radius, 0.3);
-  EXPECT_DOUBLE_EQ(s.robot.limits.v_max, 1.0);
+  EXPECT_DOUBLE_EQ(s.robot.limits.vMax, 1.0);
   ASSERT_EQ(s.zones.size(), 3u);
   // Layers: the speed zone limits its cells, the no-go zone blocks them for planners.
   EXPECT_DOUBLE_EQ(s.speedLimitAt({4.75, 2.75}), static_cast<double>(0.3f));

@@ -5,14 +5,14 @@
 namespace fleet::avoidance {
 
 struct BugParams {
-  double follow_gap = 0.3;        ///< surface gap kept while following a boundary [m]
-  double hit_gap = 0.35;          ///< an obstacle this close (surface) ahead starts boundary following [m]
-  double mline_tolerance = 0.08;  ///< |distance to the m-line| that counts as "on it" [m]
-  double leave_margin = 0.1;      ///< Bug2 leaves only where dist(goal) < dist(H, goal) − margin [m]
-  double loop_tolerance = 0.25;   ///< back at H (or at L) when closer than this [m]
-  double k_heading = 2.0;         ///< ω = k·heading error
-  double k_gap = 2.0;             ///< steering gain on the gap error while following
-  double cruise = 0.3;            ///< forward speed [m/s]
+  double followGap = 0.3;        ///< surface gap kept while following a boundary [m]
+  double hitGap = 0.35;          ///< an obstacle this close (surface) ahead starts boundary following [m]
+  double mlineTolerance = 0.08;  ///< |distance to the m-line| that counts as "on it" [m]
+  double leaveMargin = 0.1;      ///< Bug2 leaves only where dist(goal) < dist(H, goal) − margin [m]
+  double loopTolerance = 0.25;   ///< back at H (or at L) when closer than this [m]
+  double kHeading = 2.0;         ///< ω = k·heading error
+  double kGap = 2.0;             ///< steering gain on the gap error while following
+  double cruise = 0.3;           ///< forward speed [m/s]
 
   [[nodiscard]] Expected<void> validate() const;
 };

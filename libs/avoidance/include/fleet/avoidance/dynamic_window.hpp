@@ -6,31 +6,31 @@
 
 namespace fleet::avoidance {
 
-/// Objective G = w_heading·heading + w_clearance·clearance + w_velocity·velocity
-///             + w_progress·progress − w_risk·risk, each term normalised to [0, 1].
+/// Objective G = wHeading·heading + wClearance·clearance + wVelocity·velocity
+///             + wProgress·progress − wRisk·risk, each term normalised to [0, 1].
 struct DwaParams {
-  int v_samples = 20;                   ///< Nav2 DWB vx_samples
-  int omega_samples = 20;               ///< Nav2 DWB vtheta_samples
-  double sim_time = 1.7;                ///< rollout horizon [s] (Nav2 DWB sim_time)
-  double w_heading = 0.8;               ///< end-pose heading towards the carrot (Fox et al.'s "heading")
-  double w_clearance = 0.3;             ///< surface clearance along the rollout, saturated at clearance_cap
-  double w_velocity = 0.3;              ///< forward speed / v_max
-  double w_progress = 1.0;              ///< decrease of the distance to the carrot over the rollout
-  double w_risk = 1.0;                  ///< max collision probability along the rollout (RiskLookup)
-  double clearance_cap = 1.0;           ///< [m]
-  double clearance_length = 2.0;        ///< arc length of the clearance term's extended arc [m]
-  double curvature_speed_floor = 0.25;  ///< curvature of a slow sample = ω / max(|v|, floor·v_max)
-  double min_clearance = 0.10;          ///< rollouts closer than this to anything are inadmissible [m]
-  double lookahead = 1.5;               ///< carrot distance along the path [m]
-  int risk_samples = 4;                 ///< risk lookups per rollout (evenly spaced, end included)
-  int disc_samples = 8;                 ///< time samples for the moving-disc check per rollout
-  bool allow_reverse = false;
-  /// Local-minimum escape: after stuck_cycles cycles without getting closer to the carrot by
-  /// stuck_progress, drop the heading and progress terms for escape_cycles cycles, so the robot
+  int vSamples = 20;                  ///< Nav2 DWB vx_samples
+  int omegaSamples = 20;              ///< Nav2 DWB vtheta_samples
+  double simTime = 1.7;               ///< rollout horizon [s] (Nav2 DWB sim_time)
+  double wHeading = 0.8;              ///< end-pose heading towards the carrot (Fox et al.'s "heading")
+  double wClearance = 0.3;            ///< surface clearance along the rollout, saturated at clearanceCap
+  double wVelocity = 0.3;             ///< forward speed / vMax
+  double wProgress = 1.0;             ///< decrease of the distance to the carrot over the rollout
+  double wRisk = 1.0;                 ///< max collision probability along the rollout (RiskLookup)
+  double clearanceCap = 1.0;          ///< [m]
+  double clearanceLength = 2.0;       ///< arc length of the clearance term's extended arc [m]
+  double curvatureSpeedFloor = 0.25;  ///< curvature of a slow sample = ω / max(|v|, floor·vMax)
+  double minClearance = 0.10;         ///< rollouts closer than this to anything are inadmissible [m]
+  double lookahead = 1.5;             ///< carrot distance along the path [m]
+  int riskSamples = 4;                ///< risk lookups per rollout (evenly spaced, end included)
+  int discSamples = 8;                ///< time samples for the moving-disc check per rollout
+  bool allowReverse = false;
+  /// Local-minimum escape: after stuckCycles cycles without getting closer to the carrot by
+  /// stuckProgress, drop the heading and progress terms for escapeCycles cycles, so the robot
   /// follows the most open arc (clearance + speed) around what blocks it.
-  int stuck_cycles = 15;
-  double stuck_progress = 0.05;  ///< [m]
-  int escape_cycles = 25;
+  int stuckCycles = 15;
+  double stuckProgress = 0.05;  ///< [m]
+  int escapeCycles = 25;
   /// Evaluate samples in decreasing order of their score bound and stop once none can beat the
   /// best (same choice as the exhaustive loop, which `prune = false` runs: the cross-check).
   bool prune = true;

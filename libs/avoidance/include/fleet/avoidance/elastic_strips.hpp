@@ -9,40 +9,40 @@
 namespace fleet::avoidance {
 
 /// Internal (contraction) force of seed 000 eq. 2.16 on control point P^j between P^{j−1} and
-/// P^{j+1}: k_c·( d⁻/(d⁻ + d⁺)·(P^{j+1} − P^{j−1}) − (P^j − P^{j−1}) ).
-Vec2 elasticInternalForce(Vec2 prev, Vec2 cur, Vec2 next, double k_c);
+/// P^{j+1}: kC·( d⁻/(d⁻ + d⁺)·(P^{j+1} − P^{j−1}) − (P^j − P^{j−1}) ).
+Vec2 elasticInternalForce(Vec2 prev, Vec2 cur, Vec2 next, double kC);
 
 /// External force of eq. 2.21: K_r·(threshold − d_obs,min)·(P_m − P_o)/|P_m − P_o| when
-/// d_obs,min < threshold, else 0. The original uses threshold d_o = d_safe + d_r; the thesis's
-/// two-sided variant (2.27) uses d_safe.
-Vec2 elasticExternalForce(Vec2 robot, Vec2 obstacle, double d_obs_min, double threshold, double k_r);
+/// d_obs,min < threshold, else 0. The original uses threshold d_o = dSafe + d_r; the thesis's
+/// two-sided variant (2.27) uses dSafe.
+Vec2 elasticExternalForce(Vec2 robot, Vec2 obstacle, double d_obs_min, double threshold, double kR);
 
-/// The thesis's obstacle-box scan (§2.3.1): nearest reading below d_safe in the first half of the
-/// scan (left) and in the second half (right); both start at d_safe.
+/// The thesis's obstacle-box scan (§2.3.1): nearest reading below dSafe in the first half of the
+/// scan (left) and in the second half (right); both start at dSafe.
 struct LeftRightMinimum {
-  double min_left = 0.0;
-  double min_right = 0.0;
-  int left_index = -1;
-  int right_index = -1;
-  bool found = false;  ///< false when no reading is below d_safe (the thesis's FALSE)
+  double minLeft = 0.0;
+  double minRight = 0.0;
+  int leftIndex = -1;
+  int rightIndex = -1;
+  bool found = false;  ///< false when no reading is below dSafe (the thesis's FALSE)
 };
-LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double d_safe);
+LeftRightMinimum leftRightMinimum(std::span<const double> ranges, double dSafe);
 
 /// The thesis's boxes (§2.3.1, Figs. 2.22-2.23): OBB-O spans the nearest left reading L, the nearest
-/// right reading R, and both moved d_safe along the direction of motion `heading` (unit); OBB-R is
+/// right reading R, and both moved dSafe along the direction of motion `heading` (unit); OBB-R is
 /// the robot's footprint swept over the step: width 2r, from r behind `robot` to r past `next`.
-geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double d_safe);
+geometry::Obb2 obstacleBox(Vec2 left, Vec2 right, Vec2 heading, double dSafe);
 geometry::Obb2 robotBox(Vec2 robot, Vec2 next, Vec2 heading, double radius);
 
 enum class ElasticVariant { kOriginal, kBvhTwoSided };
 
-/// Parameters in metres; defaults = Table 2.3 case 1 (K_c 0.8, K_r 0.6, d_safe 1000 mm, d_r 350 mm).
+/// Parameters in metres; defaults = Table 2.3 case 1 (K_c 0.8, K_r 0.6, dSafe 1000 mm, d_r 350 mm).
 struct ElasticStripsParams {
-  double k_c = 0.8;
-  double k_r = 0.6;
-  double d_safe = 1.0;
+  double kC = 0.8;
+  double kR = 0.6;
+  double dSafe = 1.0;
   double spacing = 0.3;  ///< control-point spacing of the strip [m]
-  double k_omega = 2.0;
+  double kOmega = 2.0;
   int beams = 72;  ///< the two-sided variant bins the scan into this many bearings
 
   [[nodiscard]] Expected<void> validate() const;
@@ -67,7 +67,7 @@ class ElasticStripsPlanner final : public LocalPlanner {
   [[nodiscard]] Vec2 lastForce() const { return force_; }
   /// Two-sided variant, last plan(): how the external force was decided.
   enum class Contact {
-    kNone,        ///< no reading within d_safe: no external force
+    kNone,        ///< no reading within dSafe: no external force
     kOnePoint,    ///< one side only: the original's single-reading force (the thesis's rule)
     kBoxesApart,  ///< readings on both sides, but OBB-R does not meet OBB-O: no external force
     kBoxesMeet,   ///< readings on both sides and the boxes overlap: the two forces (2.27, 2.28)

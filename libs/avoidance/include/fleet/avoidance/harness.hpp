@@ -23,7 +23,7 @@ struct ScenarioHuman {
   Vec2 b;
   double speed = 1.0;
   double radius = 0.3;
-  bool random_walk = false;
+  bool randomWalk = false;
 };
 
 struct Scenario {
@@ -33,14 +33,14 @@ struct Scenario {
   std::vector<ScenarioHuman> humans;
   control::VelocityLimits limits;
   double dt = 0.1;
-  int max_steps = 3000;
-  double sensing_range = 4.0;  ///< scan points and discs farther than this are not in the view
-  double goal_tolerance = 0.15;
+  int maxSteps = 3000;
+  double sensingRange = 4.0;  ///< scan points and discs farther than this are not in the view
+  double goalTolerance = 0.15;
   std::uint32_t seed = 1;
-  /// Give each robot an A* path on the grid inflated by its radius + path_margin (as the robot
+  /// Give each robot an A* path on the grid inflated by its radius + pathMargin (as the robot
   /// agent does) instead of only its goal. Planners that navigate by the goal alone (Bug) ignore it.
-  bool global_path = false;
-  double path_margin = 0.2;
+  bool globalPath = false;
+  double pathMargin = 0.2;
 };
 
 struct ScenarioResult {
@@ -48,30 +48,30 @@ struct ScenarioResult {
   std::string scenario;
   int robots = 0;
   int reached = 0;
-  int collisions = 0;         ///< overlap events (a pair or robot/obstacle entering contact), all kinds
-  int robot_collisions = 0;   ///< robot–robot
-  int static_collisions = 0;  ///< robot–shelf/wall
-  int human_collisions = 0;   ///< robot–human (humans do not avoid: a stopped robot can be walked into)
-  int human_hits_while_moving = 0;  ///< robot–human contacts that began while the robot was moving
-  int human_hits_by_robot = 0;     ///< ... while the robot drove towards the person at > 0.05 m/s (its fault)
-  double min_separation = 0.0;     ///< smallest surface gap robot–anything over the run [m]
-  double mean_time_to_goal = 0.0;  ///< over the robots that arrived [s]
-  double makespan = 0.0;           ///< time the last robot arrived (or the run ended) [s]
-  double mean_path_length = 0.0;   ///< over the robots that arrived [m]
-  double mean_remaining = 0.0;     ///< mean distance to goal at the end over all robots [m]
-  double mean_travelled = 0.0;     ///< mean path length over all robots [m]
-  std::int64_t agent_steps = 0;    ///< planner calls
-  double compute_mean_us = 0.0;    ///< per planner call (safety layer included)
-  double compute_p99_us = 0.0;
+  int collisions = 0;            ///< overlap events (a pair or robot/obstacle entering contact), all kinds
+  int robotCollisions = 0;       ///< robot–robot
+  int staticCollisions = 0;      ///< robot–shelf/wall
+  int humanCollisions = 0;       ///< robot–human (humans do not avoid: a stopped robot can be walked into)
+  int humanHitsWhileMoving = 0;  ///< robot–human contacts that began while the robot was moving
+  int humanHitsByRobot = 0;      ///< ... while the robot drove towards the person at > 0.05 m/s (its fault)
+  double minSeparation = 0.0;    ///< smallest surface gap robot–anything over the run [m]
+  double meanTimeToGoal = 0.0;   ///< over the robots that arrived [s]
+  double makespan = 0.0;         ///< time the last robot arrived (or the run ended) [s]
+  double meanPathLength = 0.0;   ///< over the robots that arrived [m]
+  double meanRemaining = 0.0;    ///< mean distance to goal at the end over all robots [m]
+  double meanTravelled = 0.0;    ///< mean path length over all robots [m]
+  std::int64_t agentSteps = 0;   ///< planner calls
+  double computeMeanUs = 0.0;    ///< per planner call (safety layer included)
+  double computeP99Us = 0.0;
   int overruled = 0;  ///< safety-layer interventions
 
   [[nodiscard]] bool success() const { return reached == robots && collisions == 0; }
 };
 
 /// Run every robot with its own instance of the named planner, wrapped by the safety layer when
-/// `with_safety`. Robots that arrive stop and stay as obstacles. Library-level (no DDS).
+/// `withSafety`. Robots that arrive stop and stay as obstacles. Library-level (no DDS).
 Expected<ScenarioResult> runScenario(const Scenario& scenario, std::string_view planner,
-                                     bool with_safety = true, SafetyParams safety = {});
+                                     bool withSafety = true, SafetyParams safety = {});
 
 /// N robots evenly on a circle of radius R, each going to its antipode.
 Scenario circleSwap(int n, double circle_radius, double robot_radius = 0.4);

@@ -40,8 +40,8 @@ struct LocalView {
   std::span<const MovingDisc> discs;  ///< other robots and humans
   RiskLookup risk;                    ///< optional
   control::VelocityLimits limits;
-  double dt = 0.1;              ///< control cycle [s]
-  double goal_tolerance = 0.1;  ///< [m]
+  double dt = 0.1;             ///< control cycle [s]
+  double goalTolerance = 0.1;  ///< [m]
 
   [[nodiscard]] Vec2 goal() const { return path.empty() ? robot.pose.position() : path.back(); }
   [[nodiscard]] double riskAt(Vec2 p) const { return risk ? risk(p) : 0.0; }

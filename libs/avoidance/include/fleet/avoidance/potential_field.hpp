@@ -7,26 +7,26 @@
 
 namespace fleet::avoidance {
 
-/// F_att = −k_att·(q − q_goal) (seed 002 eq. 3.6).
-Vec2 attractiveForce(Vec2 q, Vec2 goal, double k_att);
+/// F_att = −kAtt·(q − q_goal) (seed 002 eq. 3.6).
+Vec2 attractiveForce(Vec2 q, Vec2 goal, double kAtt);
 
-/// Khatib's repulsion, the gradient of U = ½·k_rep·(1/ρ − 1/ρ0)²:
-/// F = k_rep·(1/ρ − 1/ρ0)·(1/ρ²)·(q − q_obs)/ρ for ρ ≤ ρ0, else 0. (The seed's printed eq. 3.8
+/// Khatib's repulsion, the gradient of U = ½·kRep·(1/ρ − 1/ρ0)²:
+/// F = kRep·(1/ρ − 1/ρ0)·(1/ρ²)·(q − q_obs)/ρ for ρ ≤ ρ0, else 0. (The seed's printed eq. 3.8
 /// drops the 1/ρ² factor; see docs/algorithms.md.) `rho` is the distance used (surface distance
 /// when the robot has a radius); the direction is from q_obs to q.
-Vec2 repulsiveForce(Vec2 q, Vec2 q_obs, double rho, double k_rep, double rho0);
+Vec2 repulsiveForce(Vec2 q, Vec2 q_obs, double rho, double kRep, double rho0);
 
 struct PotentialFieldParams {
-  double k_att = 1.0;
-  double k_rep = 0.05;
-  double rho0 = 1.0;          ///< influence distance [m] (surface distance)
-  double attract_cap = 2.0;   ///< |F_att| saturates here, so far goals do not drown the repulsion
-  double k_v = 0.5;           ///< v = min(v_max, k_v·|F|)·max(0, cos heading error)
-  double k_omega = 2.0;       ///< ω = k_ω·heading error
-  double stuck_force = 0.05;  ///< |F| below this (away from the goal) = local minimum
-  int stuck_cycles = 20;      ///< ... or no progress by stuck_progress over this many cycles
-  double stuck_progress = 0.05;
-  bool escape_with_bug2 = true;  ///< documented escape: hand over to Bug2 until it leaves the boundary
+  double kAtt = 1.0;
+  double kRep = 0.05;
+  double rho0 = 1.0;         ///< influence distance [m] (surface distance)
+  double attractCap = 2.0;   ///< |F_att| saturates here, so far goals do not drown the repulsion
+  double kV = 0.5;           ///< v = min(vMax, kV·|F|)·max(0, cos heading error)
+  double kOmega = 2.0;       ///< ω = k_ω·heading error
+  double stuckForce = 0.05;  ///< |F| below this (away from the goal) = local minimum
+  int stuckCycles = 20;      ///< ... or no progress by stuckProgress over this many cycles
+  double stuckProgress = 0.05;
+  bool escapeWithBug2 = true;  ///< documented escape: hand over to Bug2 until it leaves the boundary
 
   [[nodiscard]] Expected<void> validate() const;
 };

@@ -16,7 +16,7 @@ enum class SteppingRule {
   /// iso-levels of def. 3.6; the step goes to the lowest-risk (highest 1−P) level that holds a
   /// reachable candidate, and progress only ranks the candidates inside that level.
   kIsoLevel,
-  /// safety + w_progress · progress over every reachable candidate: enough progress buys a riskier
+  /// safety + wProgress · progress over every reachable candidate: enough progress buys a riskier
   /// step. The project's earlier form, kept as a named variant ("risk_stepping_weighted").
   kWeighted,
 };
@@ -26,14 +26,14 @@ std::string_view steppingRuleName(SteppingRule rule);
 
 struct RiskSteppingParams {
   SteppingRule rule = SteppingRule::kIsoLevel;
-  int levels = 10;             ///< K of the iso-levels; the risk map service's default K
-  double step_time = 1.0;      ///< the next point is where v_max would take the robot in this time [s]
-  int candidates = 25;         ///< points on the reachable arc, spread over ±fan around the target
-  double fan = 2.0;            ///< half-angle of the fan [rad]
-  int risk_samples = 5;        ///< risk lookups along the segment to each candidate
-  double w_progress = 0.3;     ///< kWeighted only: weight of progress against 1 − P
-  double min_clearance = 0.1;  ///< candidates whose straight segment gets closer than this are unreachable
-  double k_omega = 2.0;
+  int levels = 10;            ///< K of the iso-levels; the risk map service's default K
+  double stepTime = 1.0;      ///< the next point is where vMax would take the robot in this time [s]
+  int candidates = 25;        ///< points on the reachable arc, spread over ±fan around the target
+  double fan = 2.0;           ///< half-angle of the fan [rad]
+  int riskSamples = 5;        ///< risk lookups along the segment to each candidate
+  double wProgress = 0.3;     ///< kWeighted only: weight of progress against 1 − P
+  double minClearance = 0.1;  ///< candidates whose straight segment gets closer than this are unreachable
+  double kOmega = 2.0;
   /// The target is the point this far along the path ahead [m], not the path's end: aimed at the
   /// end, a fan of straight steps walks into the shelf between the robot and a goal round a corner.
   double lookahead = 1.0;

@@ -7,10 +7,10 @@
 namespace fleet::avoidance {
 
 struct RotationShimParams {
-  double start_angle = 0.785;  ///< |heading error to the path| that makes the robot turn in place [rad]
-  double stop_angle = 0.2;     ///< ... until it is below this (hysteresis) [rad]
-  double lookahead = 1.0;      ///< the path point the heading error is measured to [m]
-  double omega = 1.0;          ///< turning rate, capped by the limits [rad/s]
+  double startAngle = 0.785;  ///< |heading error to the path| that makes the robot turn in place [rad]
+  double stopAngle = 0.2;     ///< ... until it is below this (hysteresis) [rad]
+  double lookahead = 1.0;     ///< the path point the heading error is measured to [m]
+  double omega = 1.0;         ///< turning rate, capped by the limits [rad/s]
 
   [[nodiscard]] Expected<void> validate() const;
 };

@@ -7,27 +7,27 @@ namespace fleet::avoidance {
 /// Zones in the spirit of Nav2's collision monitor, but measured along the motion the command
 /// would really produce rather than as fixed polygons.
 struct SafetyParams {
-  double stop_margin = 0.05;  ///< stop zone: surface clearance [m] the braking profile must keep
-  double slow_margin = 0.30;  ///< slow-down zone: clearance [m] along the arc within slow_time
-  double slow_time = 1.0;     ///< look-ahead of the slow-down zone [s]
-  double slow_ratio = 0.5;    ///< |v| cap in the slow-down zone, as a fraction of v_max
-  double sample_step = 0.05;  ///< time step of the profile check [s]
+  double stopMargin = 0.05;  ///< stop zone: surface clearance [m] the braking profile must keep
+  double slowMargin = 0.30;  ///< slow-down zone: clearance [m] along the arc within slowTime
+  double slowTime = 1.0;     ///< look-ahead of the slow-down zone [s]
+  double slowRatio = 0.5;    ///< |v| cap in the slow-down zone, as a fraction of vMax
+  double sampleStep = 0.05;  ///< time step of the profile check [s]
 
   [[nodiscard]] Expected<void> validate() const;
 };
 
 struct SafetyResult {
   Twist twist;
-  bool overruled = false;          ///< the request was changed (scaled down, slowed, or stopped)
-  bool blocked = false;            ///< no forward scaling of the request was safe; the robot is told to stop
-  bool slowed = false;             ///< the slow-down zone capped the speed
-  double time_to_collision = 0.0;  ///< of the unmodified request at constant velocity (inf = none)
+  bool overruled = false;        ///< the request was changed (scaled down, slowed, or stopped)
+  bool blocked = false;          ///< no forward scaling of the request was safe; the robot is told to stop
+  bool slowed = false;           ///< the slow-down zone capped the speed
+  double timeToCollision = 0.0;  ///< of the unmodified request at constant velocity (inf = none)
 };
 
 /// Every planner's command goes through this: it checks the motion the command produces over one
-/// cycle followed by braking at accel_max (so the robot can always still stop), against the scan
+/// cycle followed by braking at accelMax (so the robot can always still stop), against the scan
 /// points and the discs extrapolated at their velocities. Approaching anything closer than
-/// stop_margin is forbidden; moving away from it is allowed, so a robot that got too close can
+/// stopMargin is forbidden; moving away from it is allowed, so a robot that got too close can
 /// still leave.
 class SafetyLayer {
  public:
@@ -35,7 +35,7 @@ class SafetyLayer {
 
   [[nodiscard]] SafetyResult filter(const LocalView& view, Twist request) const;
 
-  /// True when the cycle-then-brake profile of `cmd` never approaches anything inside stop_margin.
+  /// True when the cycle-then-brake profile of `cmd` never approaches anything inside stopMargin.
   [[nodiscard]] bool profileSafe(const LocalView& view, Twist cmd) const;
 
   /// First time the robot disc touches an obstacle when `cmd` is held and discs keep their velocity.

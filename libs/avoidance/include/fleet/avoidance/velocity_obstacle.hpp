@@ -10,28 +10,28 @@ double discTimeToCollision(Vec2 rel, Vec2 vel, double R);
 
 struct VelocityObstacleParams {
   int headings = 24;     ///< candidate directions over the full circle (plus the preferred one)
-  int speeds = 5;        ///< candidate speeds in (0, v_max] (plus standing still)
-  double w_ttc = 1.0;    ///< penalty = w_ttc / ttc + |v − v_pref| (van den Berg et al. 2008)
+  int speeds = 5;        ///< candidate speeds in (0, vMax] (plus standing still)
+  double wTtc = 1.0;     ///< penalty = wTtc / ttc + |v − v_pref| (van den Berg et al. 2008)
   double horizon = 5.0;  ///< collisions later than this are ignored [s]
   double margin = 0.05;  ///< added to every combined radius [m]
-  double k_omega = 2.5;
+  double kOmega = 2.5;
   /// Cost per m/s of velocity to the left of the preferred one while a conflict is in view: a
   /// shared keep-right convention turns head-on symmetric encounters (circle swap) into a
   /// roundabout instead of a standoff. 0 = the plain baseline.
-  double right_bias = 0.0;
+  double rightBias = 0.0;
 
   [[nodiscard]] Expected<void> validate() const;
 };
 
 /// Sampling velocity-obstacle planner (the comparison baseline): world-frame velocity candidates
-/// scored by distance to the preferred velocity (v_max towards the carrot) plus a time-to-collision
+/// scored by distance to the preferred velocity (vMax towards the carrot) plus a time-to-collision
 /// penalty; the chosen velocity is then tracked as (v, ω).
 class VelocityObstaclePlanner final : public LocalPlanner {
  public:
   explicit VelocityObstaclePlanner(VelocityObstacleParams params = {}) : params_(params) {}
   Command plan(const LocalView& view) override;
   [[nodiscard]] std::string_view name() const override {
-    return params_.right_bias > 0.0 ? "vo_keep_right" : "vo";
+    return params_.rightBias > 0.0 ? "vo_keep_right" : "vo";
   }
 
  private:

@@ -13,7 +13,7 @@ namespace fleet::control {
 /// increments an encoder would have measured (noise is the simulator's business).
 class DiffDriveBase {
  public:
-  static Expected<DiffDriveBase> create(double wheel_base, const VelocityLimits& limits, const Pose2& start);
+  static Expected<DiffDriveBase> create(double wheelBase, const VelocityLimits& limits, const Pose2& start);
 
   struct StepResult {
     LimitedTwist applied;  ///< what was executed (flags: NaN request rejected, bounds hit)

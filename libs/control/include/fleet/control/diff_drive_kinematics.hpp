@@ -21,8 +21,8 @@ struct OdometryDelta {
 /// Differential-drive kinematics with axle length L (distance between the wheel contact points).
 class DiffDriveKinematics {
  public:
-  /// Fails unless wheel_base is finite and > 0.
-  static Expected<DiffDriveKinematics> create(double wheel_base);
+  /// Fails unless wheelBase is finite and > 0.
+  static Expected<DiffDriveKinematics> create(double wheelBase);
 
   [[nodiscard]] double wheelBase() const { return wheel_base_; }
 
@@ -41,7 +41,7 @@ class DiffDriveKinematics {
   static Pose2 integrateMidpoint(const Pose2& pose, Twist t, double dt);
 
  private:
-  explicit DiffDriveKinematics(double wheel_base) : wheel_base_(wheel_base) {}
+  explicit DiffDriveKinematics(double wheelBase) : wheel_base_(wheelBase) {}
   double wheel_base_;
 };
 

@@ -8,10 +8,10 @@ namespace fleet::control {
 
 /// Gains of seed 003 §4 (Sim 1 values as defaults).
 struct LyapunovGains {
-  double k_v = 1.0;      ///< v = k_v·ρ·cos α
-  double k_alpha = 2.0;  ///< weight of α in ω
-  double k_theta = 1.0;  ///< near-goal heading law ω = −k_θ·θe
-  double h = 5.0;        ///< weight of φ in V = ρ²/2 + (α² + hφ²)/2
+  double kV = 1.0;      ///< v = kV·ρ·cos α
+  double kAlpha = 2.0;  ///< weight of α in ω
+  double kTheta = 1.0;  ///< near-goal heading law ω = −k_θ·θe
+  double h = 5.0;       ///< weight of φ in V = ρ²/2 + (α² + hφ²)/2
 };
 
 /// Polar navigation variables of seed 003 eq. 4.6 (forward direction):
@@ -27,8 +27,8 @@ PolarError polarError(const Pose2& pose, const Pose2& goal);
 /// V_G = ρ²/2 + (α² + hφ²)/2 (eq. 4.10).
 double lyapunovGlobal(const PolarError& e, double h);
 
-/// Far-field law (eq. 4.11) for a forward-driving robot: v = k_v ρ cos α,
-/// ω = k_α α + k_v (cos α sin α / α)(α + hφ).
+/// Far-field law (eq. 4.11) for a forward-driving robot: v = kV ρ cos α,
+/// ω = k_α α + kV (cos α sin α / α)(α + hφ).
 Twist globalLaw(const PolarError& e, const LyapunovGains& g);
 
 enum class PoseLaw {
@@ -41,18 +41,18 @@ enum class ControlRegion { kGlobal, kLocal };
 struct LyapunovParams {
   LyapunovGains gains;
   PoseLaw law = PoseLaw::kTwoRegion;
-  /// Ω_L radius ε_ρ. Eq. 4.17 asks ε_ρ ≥ ε_ρ^max + ε_v^max/k_v; with the thesis's ±0.1 m feedback noise
+  /// Ω_L radius ε_ρ. Eq. 4.17 asks ε_ρ ≥ ε_ρ^max + ε_v^max/kV; with the thesis's ±0.1 m feedback noise
   /// (ε_ρ^max ≈ 0.14 m) and ε_v = 0.065 m/s this is ≈ 0.21 m.
-  double eps_rho = 0.21;
+  double epsRho = 0.21;
   /// Ω_L heading half-width ε_θ [rad] on |θ − θ_goal|; not in the seed (docs/algorithms.md).
-  double eps_theta = 0.3;
+  double epsTheta = 0.3;
   /// Drive backwards when the goal is behind (|α| > π/2), as the thesis's "v = −v" rule.
-  bool allow_reverse = true;
+  bool allowReverse = true;
   /// The direction flips only once |α| passes π/2 by this margin [rad], so noisy feedback cannot chatter.
-  double reverse_hysteresis = 0.1;
+  double reverseHysteresis = 0.1;
   /// Once in Ω_L the local law stays in charge until ρ or |θe| exceed this multiple of ε_ρ / ε_θ (or the
   /// goal changes): with bounded feedback noise ρ̂ alone can cross ε_ρ while the true ρ does not.
-  double local_exit_factor = 2.0;
+  double localExitFactor = 2.0;
 
   [[nodiscard]] Expected<void> validate() const;
 };

@@ -16,23 +16,23 @@ struct PathFollowerParams {
   double lookahead = 0.6;
   /// Projection search window [m] past the current progress; keeps a path that crosses itself from
   /// snapping to a later pass.
-  double search_window = 2.0;
+  double searchWindow = 2.0;
   /// Final-pose controller (the two-region law by default). Tracking uses the same gains with the
   /// single far-field law and no reversing, since the carrot always lies ahead on the path.
   LyapunovParams controller;
-  double goal_tolerance_xy = 0.02;       ///< [m]
-  double goal_tolerance_theta = 0.0087;  ///< [rad] (0.5°)
+  double goalToleranceXy = 0.02;       ///< [m]
+  double goalToleranceTheta = 0.0087;  ///< [rad] (0.5°)
 
   [[nodiscard]] Expected<void> validate() const;
 };
 
 struct PathFollowerOutput {
   Twist cmd;
-  Pose2 target;                 ///< carrot (or the final pose on the last stretch)
-  bool final_approach = false;  ///< the carrot reached the end; the final pose controller is in charge
-  bool goal_reached = false;    ///< within the goal tolerances (cmd is then zero)
-  double progress = 0.0;        ///< arc length of the robot's projection on the path [m]
-  double cross_track = 0.0;     ///< distance from the robot to the path [m]
+  Pose2 target;                ///< carrot (or the final pose on the last stretch)
+  bool finalApproach = false;  ///< the carrot reached the end; the final pose controller is in charge
+  bool goalReached = false;    ///< within the goal tolerances (cmd is then zero)
+  double progress = 0.0;       ///< arc length of the robot's projection on the path [m]
+  double crossTrack = 0.0;     ///< distance from the robot to the path [m]
 };
 
 /// Follows a polyline with the Lyapunov controller: each step projects the robot on the path (progress

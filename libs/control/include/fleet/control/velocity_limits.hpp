@@ -8,11 +8,11 @@ namespace fleet::control {
 /// Speed and acceleration bounds of the base. Defaults: the seed-003 robot's 0.45 m/s top speed; the
 /// other bounds are not in the seed and are our choice (see docs/algorithms.md).
 struct VelocityLimits {
-  double v_max = 0.45;     ///< forward speed bound [m/s], >= 0
-  double v_min = -0.45;    ///< reverse speed bound [m/s], <= 0
-  double omega_max = 1.5;  ///< |omega| bound [rad/s]
-  double accel_max = 0.5;  ///< |dv/dt| bound [m/s²]
-  double alpha_max = 2.0;  ///< |domega/dt| bound [rad/s²]
+  double vMax = 0.45;     ///< forward speed bound [m/s], >= 0
+  double vMin = -0.45;    ///< reverse speed bound [m/s], <= 0
+  double omegaMax = 1.5;  ///< |omega| bound [rad/s]
+  double accelMax = 0.5;  ///< |dv/dt| bound [m/s²]
+  double alphaMax = 2.0;  ///< |domega/dt| bound [rad/s²]
 
   [[nodiscard]] Expected<void> validate() const;
 };

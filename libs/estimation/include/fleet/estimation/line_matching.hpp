@@ -31,15 +31,15 @@ struct LineGate {
   /// T of eq. 3.28 [m]: each observed end point e (in the map frame, by the estimate) must satisfy
   /// |e − a| + |e − b| − |b − a| < T, i.e. lie inside the ellipse with foci at the wall's ends
   /// (2 × how far it may stick out past an end). Widened by 6 σ of the position estimate.
-  double endpoint_tolerance = 0.3;
-  double min_distance = 0.05;  ///< the robot must be this far in front of the face (ψ is undefined on it)
+  double endpointTolerance = 0.3;
+  double minDistance = 0.05;  ///< the robot must be this far in front of the face (ψ is undefined on it)
   /// Two candidate walls on different lines (|Δρ| or |Δβ| over these) both inside the gate: the line
   /// is ambiguous and skipped rather than risk the wrong one.
-  double same_line_rho = 0.05;
-  double same_line_beta = 0.05;
+  double sameLineRho = 0.05;
+  double sameLineBeta = 0.05;
   /// Walls further than this from the robot [m] are not looked at (the scanner's range and a margin):
   /// the matching cost then follows the walls in range, not the site's size. <= 0: every wall.
-  double max_range = 0.0;
+  double maxRange = 0.0;
 };
 
 struct LineMatch {
@@ -52,9 +52,9 @@ struct LineMatch {
 /// What became of each observed line; every one that is not matched has exactly one reason.
 struct LineMatchResult {
   std::vector<LineMatch> matches;  ///< in observation order
-  std::size_t no_wall_facing = 0;  ///< no wall in range faces the robot
-  std::size_t outside_gate = 0;    ///< no facing wall inside the Mahalanobis gate
-  std::size_t no_overlap = 0;      ///< inside the gate only for walls its end points lie off
+  std::size_t noWallFacing = 0;    ///< no wall in range faces the robot
+  std::size_t outsideGate = 0;     ///< no facing wall inside the Mahalanobis gate
+  std::size_t noOverlap = 0;       ///< inside the gate only for walls its end points lie off
   std::size_t ambiguous = 0;       ///< walls on two different lines pass every test
 };
 

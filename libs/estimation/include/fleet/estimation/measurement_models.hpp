@@ -14,7 +14,7 @@ struct OdometryModel {
   Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;  ///< columns: left wheel, right wheel
 };
-OdometryModel odometryModel(const Pose2& pose, double ds_left, double ds_right, double wheel_base);
+OdometryModel odometryModel(const Pose2& pose, double ds_left, double ds_right, double wheelBase);
 
 /// Q = diag(δ|ΔsL|, δ|ΔsR|) (eq. 3.9): wheel variance proportional to the distance it rolled.
 Eigen::Matrix2d odometryNoise(double ds_left, double ds_right, double delta);
@@ -31,7 +31,7 @@ struct MapLine {
 struct LinePrediction {
   double r = 0.0;
   double psi = 0.0;
-  double signed_distance = 0.0;  ///< C = ρ − x cos β − y sin β; |C| tiny means the robot is on the line
+  double signedDistance = 0.0;  ///< C = ρ − x cos β − y sin β; |C| tiny means the robot is on the line
   Eigen::Matrix<double, 2, 3> H;
 };
 LinePrediction predictLine(const Pose2& pose, const MapLine& line);

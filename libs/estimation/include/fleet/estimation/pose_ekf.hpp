@@ -14,14 +14,14 @@ namespace fleet::estimation {
 
 /// Filter constants. Defaults are the seed-003 identified values where the seed has one.
 struct EkfParams {
-  double wheel_base = 0.6;             ///< L [m]; not in the seed (docs/algorithms.md)
-  double delta = 0.0003;               ///< wheel noise variance per metre rolled (eq. 3.9)
-  double compass_variance = 2.79e-4;   ///< recalibrated CMPS03 [rad²]
-  double compass_offset = 0.0;         ///< compass reading of map heading 0 [rad], stored at start-up
-  double bearing_variance = 2.992e-4;  ///< omni-camera bearing [rad²]
-  double gate_1dof = 10.83;            ///< χ²(1) 99.9 % Mahalanobis gate
-  double gate_2dof = 13.82;            ///< χ²(2) 99.9 % gate (one line = (r, ψ))
-  double min_line_distance = 0.05;     ///< reject a line closer than this: its ψ is undefined on the line
+  double wheelBase = 0.6;             ///< L [m]; not in the seed (docs/algorithms.md)
+  double delta = 0.0003;              ///< wheel noise variance per metre rolled (eq. 3.9)
+  double compassVariance = 2.79e-4;   ///< recalibrated CMPS03 [rad²]
+  double compassOffset = 0.0;         ///< compass reading of map heading 0 [rad], stored at start-up
+  double bearingVariance = 2.992e-4;  ///< omni-camera bearing [rad²]
+  double gate1dof = 10.83;            ///< χ²(1) 99.9 % Mahalanobis gate
+  double gate2dof = 13.82;            ///< χ²(2) 99.9 % gate (one line = (r, ψ))
+  double minLineDistance = 0.05;      ///< reject a line closer than this: its ψ is undefined on the line
 
   [[nodiscard]] Expected<void> validate() const;
 };
@@ -35,12 +35,10 @@ enum class UpdateStatus {
 
 struct SensorStats {
   std::size_t accepted = 0;
-  std::size_t rejected_non_finite = 0;
-  std::size_t rejected_gate = 0;
-  std::size_t rejected_geometry = 0;
-  [[nodiscard]] std::size_t rejected() const {
-    return rejected_non_finite + rejected_gate + rejected_geometry;
-  }
+  std::size_t rejectedNonFinite = 0;
+  std::size_t rejectedGate = 0;
+  std::size_t rejectedGeometry = 0;
+  [[nodiscard]] std::size_t rejected() const { return rejectedNonFinite + rejectedGate + rejectedGeometry; }
 };
 
 struct EkfStats {
@@ -48,23 +46,23 @@ struct EkfStats {
   SensorStats compass;
   SensorStats bearing;
   SensorStats line;
-  std::size_t lines_unmatched = 0;  ///< observed lines with no map line inside the gate
+  std::size_t linesUnmatched = 0;  ///< observed lines with no map line inside the gate
 };
 
 /// A laser line feature in the robot frame (x_R cos ψ + y_R sin ψ = r) with its variances.
 struct LineObservation {
   double r = 0.0;
   double psi = 0.0;
-  double var_r = 1e-4;
-  double var_psi = 1e-3;
-  /// Correlation of r and ψ from the fit (not in the thesis's diagonal R, eq. 3.23); |cov|² < var_r·var_psi.
-  double cov_r_psi = 0.0;
+  double varR = 1e-4;
+  double varPsi = 1e-3;
+  /// Correlation of r and ψ from the fit (not in the thesis's diagonal R, eq. 3.23); |cov|² < varR·varPsi.
+  double covRPsi = 0.0;
 };
 
 struct LineBatchResult {
   std::size_t accepted = 0;
   std::size_t unmatched = 0;
-  std::size_t rejected_non_finite = 0;
+  std::size_t rejectedNonFinite = 0;
 };
 
 /// EKF over the planar pose (x, y, θ) of seed 003 ch. 3: odometry prediction and independent compass,
@@ -79,7 +77,7 @@ class PoseEkf {
   /// Prediction with the measured wheel increments [m] since the last call.
   UpdateStatus predict(double ds_left, double ds_right);
 
-  /// Compass heading as read (compass_offset is subtracted). Variance defaults to params.
+  /// Compass heading as read (compassOffset is subtracted). Variance defaults to params.
   UpdateStatus updateCompass(double reading);
   UpdateStatus updateCompass(double reading, double variance);
 

@@ -18,14 +18,14 @@ namespace fleet::planning {
 struct LaneParams {
   /// A corridor narrower than this [m] is a narrow aisle (one-way). The default lets two robots of
   /// 0.3 m radius pass each other with margin in anything at least 2 m wide.
-  double max_aisle_width = 2.0;
-  /// Corridors from max_aisle_width up to this width [m] get two lanes (keep right).
-  double max_two_lane_width = 8.0;
+  double maxAisleWidth = 2.0;
+  /// Corridors from maxAisleWidth up to this width [m] get two lanes (keep right).
+  double maxTwoLaneWidth = 8.0;
   /// ... provided the aisle or corridor runs at least this many times its width along its length.
-  double min_aspect = 2.0;
+  double minAspect = 2.0;
   /// A move against a lane costs this many times its length: a legal detour is taken unless it is
   /// more than this much longer (dead ends, a goal just behind the robot).
-  double wrong_way_factor = 10.0;
+  double wrongWayFactor = 10.0;
 };
 
 /// Direction of travel allowed in a cell: {0, 0} two-way, {±1, 0} a horizontal one-way aisle,

@@ -62,8 +62,8 @@ class FusionEngine {
  public:
   static Expected<FusionEngine> create(FusionConfig config, std::shared_ptr<const RiskModel> model);
 
-  /// Adds or replaces the source with this id after validateSource (now_ns enables the timestamp check).
-  Expected<void> upsert(Source source, std::optional<std::int64_t> now_ns = std::nullopt);
+  /// Adds or replaces the source with this id after validateSource (nowNs enables the timestamp check).
+  Expected<void> upsert(Source source, std::optional<std::int64_t> nowNs = std::nullopt);
   /// Removes a source; false when the id is unknown.
   bool remove(std::string_view id);
   /// Removes every source whose t0 is older than cutoff_ns; returns how many.
@@ -71,9 +71,9 @@ class FusionEngine {
   [[nodiscard]] std::size_t sourceCount() const { return sources_.size(); }
   [[nodiscard]] bool contains(std::string_view id) const;
 
-  /// Fuses every source onto the time base starting at t_ref_ns. The reference stays valid until the
+  /// Fuses every source onto the time base starting at tRefNs. The reference stays valid until the
   /// next call.
-  const FusionResult& fuse(std::int64_t t_ref_ns);
+  const FusionResult& fuse(std::int64_t tRefNs);
   [[nodiscard]] const FusionResult& result() const { return result_; }
   /// Makes the next fuse() recompute everything (e.g. after the caller changed its mind about the map).
   void invalidate() { haveResult_ = false; }

@@ -33,13 +33,13 @@ struct SourceLimits {
 /// Error codes: "invalid_id", "empty", "too_many_steps", "bad_dt", "non_finite", "bad_radius",
 /// "bad_sigma", "non_finite_covariance", "bad_covariance" (not positive semi-definite, or a major-axis
 /// σ above maxSigma), "out_of_range", "future_timestamp". The message names the disc index and value.
-/// The timestamp check runs only when now_ns is given.
+/// The timestamp check runs only when nowNs is given.
 Expected<void> validateSource(const Source& source, const SourceLimits& limits,
-                              std::optional<std::int64_t> now_ns = std::nullopt);
+                              std::optional<std::int64_t> nowNs = std::nullopt);
 
-/// Common time base of a fusion: step k is at t_ref_ns + k·dt.
+/// Common time base of a fusion: step k is at tRefNs + k·dt.
 struct TimeBase {
-  std::int64_t t_ref_ns = 0;
+  std::int64_t tRefNs = 0;
   double dt = 0.1;
   int steps = 30;
   bool operator==(const TimeBase&) const = default;

@@ -36,10 +36,10 @@ planning::OccupancyGrid readMapSection(Config c, const std::string& baseDir);
 /// [x, y] or, with `theta`, [x, y] / [x, y, theta]: records a problem and returns false otherwise.
 bool readPoint(Config& c, const std::string& key, Vec2& out, bool required, double* theta = nullptr);
 
-/// A "limits" object (v_max, v_min, w_max, accel_max, alpha_max) over `v`.
+/// A "limits" object (vMax, vMin, w_max, accelMax, alphaMax) over `v`.
 void readLimits(Config& l, control::VelocityLimits& v);
 
-/// The "robot" section's keys (radius, wheel_base, limits, sensors) over `r`.
+/// The "robot" section's keys (radius, wheelBase, limits, sensors) over `r`.
 void readRobotDescription(Config& c, RobotDescription& r);
 
 /// Derives what site.json leaves out (approach points) and rasterises the zones into `layers`.
