@@ -116,6 +116,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       grid_(std::move(grid)),
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
+      lastPlausiblePose_(p_.start),
       follower_(followerParams()),
       gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits}),
       standsAt_(p_.start),
@@ -266,6 +267,12 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
     paused_ = a.paused;  // a pause / resume, or re-published after a manager restart
     return;
   }
+  if (a.goals.empty()) {
+    // Nowhere to go: refuse the task at once instead of starting an order every phase of which
+    // assumes a first goal (the process's edge refuses it before; this keeps the Agent safe alone).
+    refuseAssignment(a, "assignment has no goals");
+    return;
+  }
   paused_ = a.paused;
   task_ = a.task_id;
   goals_ = a.goals;
@@ -274,6 +281,21 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
   progress_.newOrder();
   reported_ = msg::TaskState::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
+}
+
+void Agent::refuseAssignment(const msg::TaskAssignment& a, const std::string& why) {
+  if (a.robot_id != p_.id || a.task_id.empty()) {
+    return;
+  }
+  revision_ = a.revision;
+  homing_ = false;  // (a report during the trip home would be dropped)
+  task_.clear();
+  goals_.clear();
+  paused_ = false;
+  phase_ = Phase::Idle;
+  pendingStatus_ = msg::TaskStatus{
+      p_.id,     a.task_id, a.revision, msg::TaskState::Failed, 0.0F, ("refused: " + why).substr(0, 255),
+      a.stamp_ns};
 }
 
 msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
@@ -760,6 +782,21 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
 }
 
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
+  if (!localizer_.plausible()) {
+    // The estimate left the world (non-finite, or farther than any map): nothing it would plan or
+    // report means anything, and it does not come back by itself. Stop, give the task back and say
+    // so, rather than report an idle robot the manager would give the next task.
+    AgentOutput out;
+    v_ = 0.0;
+    w_ = 0.0;
+    heldSinceNs_ = -1;
+    blocked_ = false;
+    if (!task_.empty()) {
+      finishTask(msg::TaskState::Failed, "localization estimate implausible", nowNs);
+    }
+    report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
+    return out;
+  }
   if (!sensorStreamLost(nowNs)) {
     return drive(nowNs, dt);
   }
@@ -1072,12 +1109,19 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
 }
 
 void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
-  const Pose2 pose = localizer_.pose();
+  // An implausible estimate is reported as the last plausible pose with a covariance that says it
+  // is unknown: the fault stays visible to the manager and operators, whose edges refuse NaN.
+  const bool plausible = localizer_.plausible();
+  if (plausible) {
+    lastPlausiblePose_ = localizer_.pose();
+  }
+  const Pose2 pose = lastPlausiblePose_;
+  const Eigen::Matrix3d P =
+      plausible ? localizer_.covariance() : Eigen::Matrix3d(Eigen::Vector3d(1e12, 1e12, 1e3).asDiagonal());
   out.command = {p_.id, v, w, nowNs, 0};
   out.state.robot_id = p_.id;
   out.state.stamp_ns = nowNs;
   out.state.pose = pose;
-  const auto& P = localizer_.covariance();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       out.state.covariance[static_cast<std::size_t>(3 * i + j)] = P(i, j);
@@ -1099,7 +1143,9 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   prediction.radius = p_.radius;
   prediction.dt = p_.predictionDt;
   prediction.horizonS = p_.predictionHorizonS;
-  out.discs.discs = predictDiscs(pose, P, v, w, prediction);
+  if (plausible) {
+    out.discs.discs = predictDiscs(pose, P, v, w, prediction);
+  }
   if (pendingStatus_ && (homing_ || pendingStatus_->task_id.empty())) {
     pendingStatus_.reset();  // the trip home is not a task
   }
