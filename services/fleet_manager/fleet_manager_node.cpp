@@ -155,6 +155,13 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
     return unexpected(rec.error());
   }
   n->publish(std::move(*rec), nowNs, n->recovered_);
+  for (const auto& [id, r] : n->dispatcher_->openTasks()) {
+    // The previous incarnation's events are gone with its writer. The revision counts the task's
+    // transitions, as the event seq did, so an adapter that kept running sees no step back.
+    const auto seq = static_cast<std::uint32_t>(r.revision);
+    n->eventSeq_[id] = seq;
+    n->recovered_.events.push_back({id, toMsg(r.state), r.robotId, r.reason.substr(0, 255), nowNs, seq});
+  }
   return n;
 }
 
@@ -282,6 +289,11 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       }
       continue;
     }
+    if (req.control == msg::TaskControl::Query) {
+      flush();  // a query must see the tasks submitted before it
+      out.acks.push_back(query(req, nowNs));
+      continue;
+    }
     if (req.control != msg::TaskControl::None) {
       flush();  // a pause must see the tasks submitted before it
       const bool pause = req.control == msg::TaskControl::Pause;
@@ -302,6 +314,25 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
     batchReq.push_back(&req);
   }
   flush();
+}
+
+msg::TaskAck FleetManagerNode::query(const msg::Task& req, std::int64_t nowNs) {
+  auto r = store_->get(req.task_id);
+  if (!r) {
+    return refused(req, r.error(), nowNs);
+  }
+  nlohmann::json d = {{"robot", r->robotId},
+                      {"reason", r->reason.substr(0, 255)},
+                      {"updated_ns", r->updatedNs},
+                      {"revision", r->revision},
+                      {"task", toJson(r->task)}};
+  const auto replace = nlohmann::json::error_handler_t::replace;
+  std::string detail = d.dump(-1, ' ', false, replace);
+  if (detail.size() > 1023) {
+    d.erase("task");  // the state matters; the body is a nicety
+    detail = d.dump(-1, ' ', false, replace);
+  }
+  return ack(req, msg::AckResult::Stored, toMsg(r->state), std::move(detail), nowNs);
 }
 
 void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out) {
@@ -328,8 +359,8 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
   }
 }
 
-void FleetManagerNode::onRobotState(const msg::RobotState& s) {
-  dispatcher_->onRobotState({s.robot_id, s.pose, static_cast<double>(s.battery), s.stamp_ns});
+void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs) {
+  dispatcher_->onRobotState({s.robot_id, s.pose, static_cast<double>(s.battery), nowNs});
 }
 
 void FleetManagerNode::onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out) {

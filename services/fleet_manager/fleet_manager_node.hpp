@@ -82,10 +82,13 @@ class FleetManagerNode {
   /// each with a TaskAck, publishes the resulting events. Cancels are applied in order.
   void onRequests(const std::vector<msg::Task>& requests, std::int64_t nowNs, Outbox& out);
   void onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out);
-  void onRobotState(const msg::RobotState& s);
+  /// A robot's state, received at `nowNs` on the manager's clock: the lease runs on the receiver's
+  /// clock, so a robot whose clock is off (or stamps INT64_MAX) is neither lost nor kept for ever.
+  void onRobotState(const msg::RobotState& s, std::int64_t nowNs);
   void onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out);
   void tick(std::int64_t nowNs, Outbox& out);
-  /// Assignments to re-publish after a restart (from the store).
+  /// Assignments to re-publish after a restart (from the store), and each open task's state as a
+  /// TaskEvent, so an adapter that starts later learns every stored open task from the history.
   [[nodiscard]] const Outbox& recovered() const { return recovered_; }
 
   [[nodiscard]] const Dispatcher& dispatcher() const { return *dispatcher_; }
@@ -95,6 +98,8 @@ class FleetManagerNode {
  private:
   FleetManagerNode() = default;
   void publish(DispatchResult r, std::int64_t nowNs, Outbox& out);
+  /// The answer to a TC_QUERY request: the stored state, robot, reason and body (JSON in detail).
+  msg::TaskAck query(const msg::Task& req, std::int64_t nowNs);
   msg::TaskAssignment toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
   std::uint32_t nextRevision(const std::string& robot, std::int64_t nowNs);
 

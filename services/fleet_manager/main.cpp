@@ -12,6 +12,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/sample_edge.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
@@ -67,6 +68,12 @@ int run(const manager::Settings& settings) {
   ws.attach(statuses);
   ws.attach(states);
   service::RateLimitedLog badInput;
+  validation::Rejections rejections;  // samples refused at the edge, in the metrics as "samples"
+  auto metrics = [&] {
+    auto j = node.metricsJson();
+    j["samples"] = rejections.toJson();
+    return j;
+  };
 
   auto send = [&](manager::Outbox& out) {
     for (const auto& a : out.acks) {
@@ -101,12 +108,8 @@ int run(const manager::Settings& settings) {
     }
     const std::int64_t now = clock.nowNs();
     std::vector<msg::RobotState> gone;
-    for (const auto& s : states.takeWithLifecycle(gone)) {
-      if (!isValidId(s.robot_id) || !s.pose.isFinite() || !std::isfinite(s.battery)) {
-        badInput.warn("robot_state", "dropped RobotState with an invalid id, pose or battery");
-        continue;
-      }
-      node.onRobotState(s);
+    for (const auto& s : service::admitted(states.takeWithLifecycle(gone), rejections, badInput)) {
+      node.onRobotState(s, now);
     }
     // DDS liveliness: a robot whose RobotState writer is gone (agent process ended, lease lost) is
     // lost now, without waiting for the state lease.
@@ -115,12 +118,26 @@ int run(const manager::Settings& settings) {
         node.onRobotLost(g.robot_id, now, out);
       }
     }
-    auto reqs = tasks.take();
+    std::vector<msg::Task> reqs;
+    for (auto& r : tasks.take()) {
+      validation::Rejection why;
+      if (validation::admit(r, rejections, &why)) {
+        reqs.push_back(std::move(r));
+      } else if (isValidId(r.request_id)) {
+        // Answered at once, so the adapter need not wait for a timeout to learn it.
+        const std::string id = isValidId(r.task_id) ? r.task_id : "";
+        const nlohmann::json fields = nlohmann::json::array({{{"path", "request"}, {"reason", why.detail}}});
+        acks.write({r.request_id, id, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                    fields.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), now});
+      } else {
+        badInput.warn("Task:" + why.reason, "refused Task (cannot be answered): " + why.detail);
+      }
+    }
     bool changed = !reqs.empty();
     if (!reqs.empty()) {
       node.onRequests(reqs, now, out);
     }
-    for (const auto& s : statuses.take()) {
+    for (const auto& s : service::admitted(statuses.take(), rejections, badInput)) {
       node.onStatus(s, now, out);
       changed = true;
     }
@@ -132,18 +149,18 @@ int run(const manager::Settings& settings) {
     }
     send(out);
     if (!settings.metricsFile.empty() && std::chrono::steady_clock::now() - lastMetrics > 1s) {
-      writeMetrics(settings.metricsFile, node.metricsJson());
+      writeMetrics(settings.metricsFile, metrics());
       lastMetrics = std::chrono::steady_clock::now();
     }
     if (std::chrono::steady_clock::now() - lastLog > 10s) {
-      spdlog::info("fleet manager: {}", node.metricsJson().dump());
+      spdlog::info("fleet manager: {}", metrics().dump());
       lastLog = std::chrono::steady_clock::now();
     }
   }
   if (!settings.metricsFile.empty()) {
-    writeMetrics(settings.metricsFile, node.metricsJson());
+    writeMetrics(settings.metricsFile, metrics());
   }
-  spdlog::info("fleet manager: stopped; {}", node.metricsJson().dump());
+  spdlog::info("fleet manager: stopped; {}", metrics().dump());
   return 0;
 }
 

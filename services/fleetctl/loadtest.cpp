@@ -27,6 +27,7 @@
 #include "fault_plan.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/service/site_stations.hpp"
+#include "fleet/transport/dds.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
 #include "supervisor.hpp"
@@ -105,15 +106,7 @@ std::optional<json> readJson(const fs::path& p) {
 /// The loopback Cyclone configuration of deploy/cyclonedds-local.xml, plus Cyclone's own packet
 /// dropper (Internal/Test/XmitLossiness, per mille of outgoing packets) for the drop-dds fault.
 std::string cycloneConfig(double drop) {
-  std::ostringstream x;
-  x << "<CycloneDDS xmlns=\"https://cdds.io/config\"><Domain id=\"any\"><General><Interfaces>"
-       "<NetworkInterface name=\"lo\"/></Interfaces><AllowMulticast>false</AllowMulticast></General>"
-       "<Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
-       "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery>"
-       "<Internal><Test><XmitLossiness>"
-    << static_cast<int>(std::lround(drop * 1000.0))
-    << "</XmitLossiness></Test></Internal></Domain></CycloneDDS>\n";
-  return x.str();
+  return transport::loopbackConfig(false, static_cast<int>(std::lround(drop * 1000.0))) + "\n";
 }
 
 struct DbContents {

@@ -10,6 +10,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/sample_edge.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_map_node.hpp"
@@ -35,6 +36,7 @@ int run(const riskmap::Settings& settings, const std::string& id) {
   ws.attach(discs);
   ws.attach(clockIn);
   service::RateLimitedLog badInput;
+  validation::Rejections rejections;  // refused at the edge, before the fusion engine's own checks
   WallClock wall;
   const bool simClock = settings.clock == "sim";
   std::int64_t now = simClock ? 0 : wall.nowNs();
@@ -50,7 +52,7 @@ int run(const riskmap::Settings& settings, const std::string& id) {
                settings.rateHz, settings.clock);
 
   auto ingest = [&] {
-    for (const auto& m : discs.take()) {
+    for (const auto& m : service::admitted(discs.take(), rejections, badInput)) {
       if (!haveClock) {
         continue;
       }
@@ -62,8 +64,13 @@ int run(const riskmap::Settings& settings, const std::string& id) {
     }
   };
   auto publish = [&] {
-    out.write(node.fuse(now));
-    ++published;
+    try {
+      out.write(node.fuse(now));
+      ++published;
+    } catch (const transport::MessageError& e) {
+      // A map over the IDL's bounds (a huge grid of noise): skip it, never stop the service.
+      badInput.warn("risk_map_out", std::string("RiskMap not published: ") + e.what());
+    }
   };
 
   while (!service::stopRequested()) {
@@ -110,8 +117,10 @@ int run(const riskmap::Settings& settings, const std::string& id) {
         reasons += ")";
       }
       spdlog::info(
-          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected{}, {} stale dropped",
-          node.sources(), published, node.accepted(), node.rejected(), reasons, node.dropped_stale());
+          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected{}, {} stale dropped, "
+          "refused at the edge: {}",
+          node.sources(), published, node.accepted(), node.rejected(), reasons, node.dropped_stale(),
+          rejections.toJson().dump());
       lastStats = std::chrono::steady_clock::now();
     }
   }

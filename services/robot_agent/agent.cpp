@@ -107,6 +107,15 @@ TaskGoal goalOf(const msg::Goal& g) {
   return {g.pose, g.station, static_cast<GoalAction>(g.action), g.duration_s};
 }
 
+Order orderOf(const msg::TaskAssignment& a) {
+  Order o{a.task_id, a.revision, {}, a.paused, a.stamp_ns};
+  o.goals.reserve(a.goals.size());
+  for (const auto& g : a.goals) {
+    o.goals.push_back(goalOf(g));
+  }
+  return o;
+}
+
 msg::TaskState wireState(TaskStage st) {
   switch (st) {
     case TaskStage::Queued:
@@ -147,6 +156,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       grid_(std::move(grid)),
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
+      lastPlausiblePose_(p_.start),
       follower_(followerParams()),
       gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit}),
       standsAt_(p_.start),
@@ -283,16 +293,12 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
   if (a.robot_id != p_.id) {
     return;
   }
-  Order o{a.task_id, a.revision, {}, a.paused};
-  o.goals.reserve(a.goals.size());
-  for (const auto& g : a.goals) {
-    o.goals.push_back(goalOf(g));
-  }
-  switch (tasks_.accept(o)) {
+  switch (tasks_.accept(orderOf(a))) {
     case TaskRunner::OrderChange::kSame:
       return;
     case TaskRunner::OrderChange::kCancel:
     case TaskRunner::OrderChange::kPause:
+    case TaskRunner::OrderChange::kRefused:
       idleSinceNs_ = -1;
       return;
     case TaskRunner::OrderChange::kNewTask:
@@ -300,6 +306,12 @@ void Agent::onAssignment(const msg::TaskAssignment& a) {
       holdSinceNs_ = -1;
       progress_.newOrder();
       return;
+  }
+}
+
+void Agent::refuseAssignment(const msg::TaskAssignment& a, const std::string& why) {
+  if (a.robot_id == p_.id) {
+    tasks_.refuse(orderOf(a), why);
   }
 }
 
@@ -681,6 +693,21 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
 }
 
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
+  if (!localizer_.plausible()) {
+    // The estimate left the world (non-finite, or farther than any map): nothing it would plan or
+    // report means anything, and it does not come back by itself. Stop, give the task back and say
+    // so, rather than report an idle robot the manager would give the next task.
+    AgentOutput out;
+    v_ = 0.0;
+    w_ = 0.0;
+    heldSinceNs_ = -1;
+    blocked_ = false;
+    if (tasks_.busy()) {
+      finishTask(TaskStage::Failed, "localization estimate implausible", nowNs);
+    }
+    report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
+    return out;
+  }
   if (!sensorStreamLost(nowNs)) {
     return drive(nowNs, dt);
   }
@@ -992,12 +1019,19 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
 }
 
 void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode) {
-  const Pose2 pose = localizer_.pose();
+  // An implausible estimate is reported as the last plausible pose with a covariance that says it
+  // is unknown: the fault stays visible to the manager and operators, whose edges refuse NaN.
+  const bool plausible = localizer_.plausible();
+  if (plausible) {
+    lastPlausiblePose_ = localizer_.pose();
+  }
+  const Pose2 pose = lastPlausiblePose_;
+  const Eigen::Matrix3d P =
+      plausible ? localizer_.covariance() : Eigen::Matrix3d(Eigen::Vector3d(1e12, 1e12, 1e3).asDiagonal());
   out.command = {p_.id, v, w, nowNs, 0};
   out.state.robot_id = p_.id;
   out.state.stamp_ns = nowNs;
   out.state.pose = pose;
-  const auto& P = localizer_.covariance();
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       out.state.covariance[static_cast<std::size_t>(3 * i + j)] = P(i, j);
@@ -1019,7 +1053,9 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   prediction.radius = p_.radius;
   prediction.dt = p_.predictionDt;
   prediction.horizonS = p_.predictionHorizonS;
-  out.discs.discs = predictDiscs(pose, P, v, w, prediction);
+  if (plausible) {
+    out.discs.discs = predictDiscs(pose, P, v, w, prediction);
+  }
   if (auto r = tasks_.takeReport()) {
     out.status =
         msg::TaskStatus{p_.id, r->task, r->revision, wireState(r->stage), r->progress, r->reason, r->stampNs};

@@ -128,6 +128,9 @@ class Agent {
   void onOtherRobot(const msg::RobotState& s);
   /// A new revision replaces the current order (an empty task id cancels).
   void onAssignment(const msg::TaskAssignment& a);
+  /// An order for this robot that cannot be carried out (refused at the edge, or without goals):
+  /// drops the current order and reports the task failed with `why`.
+  void refuseAssignment(const msg::TaskAssignment& a, const std::string& why);
   /// Reserved traffic: the traffic manager's release for this robot (others, stale ones and ones
   /// that do not start at the node it last reported are ignored and counted). Reactive: ignored.
   void onRelease(const msg::TrafficRelease& r);
@@ -224,7 +227,8 @@ class Agent {
   AgentParams p_;
   std::shared_ptr<const planning::OccupancyGrid> grid_;
   std::shared_ptr<const planning::OccupancyGrid> raw_;
-  Localizer localizer_;  // pose, scan, detections, people, sensor loss
+  Localizer localizer_;      // pose, scan, detections, people, sensor loss
+  Pose2 lastPlausiblePose_;  // reported while the estimate is implausible (a fault)
   control::PathFollower follower_;
   std::unique_ptr<avoidance::LocalPlanner> planner_;  // null: "follow"
   std::vector<Vec2> path_;                            // remaining path (world frame)

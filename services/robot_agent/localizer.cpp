@@ -1,5 +1,7 @@
 #include "localizer.hpp"
 
+#include "fleet/validation/sample_checks.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -45,6 +47,12 @@ std::vector<Vec2> Perception::scanPoints(double maxRange) const {
 
 Localizer::Localizer(LocalizerParams params) : p_(std::move(params)), ekf_(makeEkf(p_)) {
   seen_.pose = ekf_.pose();
+}
+
+bool Localizer::plausible() const {
+  const Pose2 p = ekf_.pose();
+  return p.isFinite() && std::abs(p.x) <= validation::kMaxCoordinate &&
+         std::abs(p.y) <= validation::kMaxCoordinate && ekf_.covariance().allFinite();
 }
 
 void Localizer::onReading(const SensorReading& f) {

@@ -146,6 +146,9 @@ class Localizer {
   [[nodiscard]] Pose2 pose() const { return ekf_.pose(); }
   [[nodiscard]] const Eigen::Matrix3d& covariance() const { return ekf_.covariance(); }
   [[nodiscard]] bool lost() const { return lost_; }
+  /// The estimate is finite and inside the world (|x|, |y| within validation::kMaxCoordinate, the
+  /// covariance finite). False for good once the EKF has been fed motion no robot makes.
+  [[nodiscard]] bool plausible() const;
   /// EKF updates refused (outliers, bad input), cumulative.
   [[nodiscard]] std::uint64_t rejected() const { return rejected_; }
   [[nodiscard]] const LineStats& lineStats() const { return lineStats_; }

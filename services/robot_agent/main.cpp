@@ -22,6 +22,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/sample_edge.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "fleet/site/reachability.hpp"
@@ -293,6 +294,9 @@ int run(const World& scn, const Options& opt) {
                agents.size(), lockstep ? "lockstep" : "wall", pool.threads(), opt.localPlanner,
                opt.useRisk ? "on" : "off", opt.traffic);
   std::uint64_t badRiskMaps = 0;
+  validation::Rejections rejections;  // samples refused at this process's edge, by topic and reason
+  service::RateLimitedLog badInput;
+  auto admitted = [&](auto samples) { return service::admitted(std::move(samples), rejections, badInput); };
 
   bool haveClock = false;
   auto lastRegister = std::chrono::steady_clock::now() - 1s;
@@ -303,12 +307,12 @@ int run(const World& scn, const Options& opt) {
   cycleMs.reserve(1 << 16);
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
-    for (const auto& f : frames.take()) {
+    for (const auto& f : admitted(frames.take())) {
       if (auto it = byId.find(f.robot_id); it != byId.end()) {
         it->second->onFrame(f);
       }
     }
-    for (const auto& s : others.take()) {
+    for (const auto& s : admitted(others.take())) {
       if (byId.count(s.robot_id) != 0) {
         continue;  // hosted here: handed over in-process after the step (below)
       }
@@ -316,19 +320,28 @@ int run(const World& scn, const Options& opt) {
         a->onOtherRobot(s);
       }
     }
-    for (const auto& a : assignments.take()) {
-      if (auto it = byId.find(a.robot_id); it != byId.end()) {
-        it->second->onAssignment(a);
+    for (auto& a : assignments.take()) {
+      const auto it = byId.find(a.robot_id);
+      validation::Rejection why;
+      if (validation::admit(a, rejections, &why)) {
+        if (it != byId.end()) {
+          it->second->onAssignment(a);
+        }
+        continue;
+      }
+      badInput.warn(why.topic + ":" + why.reason, "refused " + why.topic + ": " + why.detail);
+      if (it != byId.end() && isValidId(a.task_id)) {
+        it->second->refuseAssignment(a, why.detail);  // the manager hears why and retries elsewhere
       }
     }
     if (releases) {
-      for (const auto& r : releases->take()) {
+      for (const auto& r : admitted(releases->take())) {
         if (auto it = byId.find(r.robot_id); it != byId.end()) {
           it->second->onRelease(r);
         }
       }
     }
-    if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
+    if (auto maps = admitted(riskMaps.take()); !maps.empty() && opt.useRisk) {
       // Only the newest map matters; it is decoded once and shared read-only by every agent.
       if (auto field = agent::riskLookupOf(maps.back())) {
         for (auto& a : agents) {
@@ -396,6 +409,7 @@ int run(const World& scn, const Options& opt) {
       c.detours += a->conduct().detours;
       c.plannerRecoveries += a->conduct().plannerRecoveries;
     }
+    m["samples"] = rejections.toJson();
     m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
                     {"backoffs", c.backoffs},   {"returns", c.returns},
                     {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};

@@ -22,12 +22,32 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
   if (o.task == task_ && o.goals == goals_) {
     return OrderChange::kPause;
   }
+  if (o.goals.empty()) {
+    // Nowhere to go: every phase of an order assumes a first goal (the process's edge refuses such
+    // orders before; this keeps the runner safe alone).
+    refuse(o, "assignment has no goals");
+    return OrderChange::kRefused;
+  }
   task_ = o.task;
   goals_ = o.goals;
   goal_ = 0;
   reported_ = TaskStage::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
   return OrderChange::kNewTask;
+}
+
+void TaskRunner::refuse(const Order& o, const std::string& why) {
+  if (o.task.empty()) {
+    return;
+  }
+  revision_ = o.revision;
+  homing_ = false;
+  task_.clear();
+  goals_.clear();
+  paused_ = false;
+  phase_ = Phase::Idle;
+  pending_ =
+      TaskReport{o.task, o.revision, TaskStage::Failed, 0.0f, ("refused: " + why).substr(0, 255), o.stampNs};
 }
 
 TaskStage TaskRunner::stageFor(std::size_t index, bool dwelling) const {

@@ -57,6 +57,7 @@ struct Order {
   std::uint32_t revision = 0;
   std::vector<TaskGoal> goals;
   bool paused = false;
+  std::int64_t stampNs = 0;  ///< when it was issued (a refusal is reported with it)
 };
 
 enum class Phase : std::uint8_t { Idle, Driving, Dwelling, BackingOff, Returning };
@@ -68,9 +69,14 @@ class TaskRunner {
     kCancel,   ///< no task any more
     kPause,    ///< the same task, held or resumed (or re-published after a manager restart)
     kNewTask,  ///< a new task (or new goals): starts on the next step
+    kRefused,  ///< a task with no goals: refused (reported failed), the robot drops what it had
   };
   /// A new revision replaces the current order, and any order replaces the trip home.
   OrderChange accept(const Order& o);
+
+  /// An order that cannot be carried out (refused at the process's edge, or without goals): drops
+  /// the current order and reports task `o.task` failed with "refused: <why>".
+  void refuse(const Order& o, const std::string& why);
 
   /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
   void leg(std::int64_t nowNs);

@@ -10,6 +10,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/sample_edge.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "traffic_node.hpp"
@@ -40,6 +41,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   ws.attach(progress);
   ws.attach(clockIn);
   service::RateLimitedLog badInput;
+  validation::Rejections rejections;  // refused at the edge, before the node's roadmap checks
   const bool simClock = settings.clock == "sim";
   std::int64_t now = simClock ? 0 : wall.nowNs();
   bool haveClock = !simClock;
@@ -53,12 +55,12 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     const auto& c = node.counters();
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
-        "re-plans, tick {:.2f} ms (max {:.2f})",
+        "re-plans, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
-        c.lastTickMs, c.maxTickMs);
+        c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
   };
   auto ingest = [&] {
-    for (const auto& m : progress.take()) {
+    for (const auto& m : service::admitted(progress.take(), rejections, badInput)) {
       if (!haveClock)
         continue;
       if (auto problem = node.onProgress(m, now)) {

@@ -1,5 +1,7 @@
 #include "dds_gateway.hpp"
 
+#include "fleet/validation/sample_checks.hpp"
+
 namespace fleet::wms {
 
 DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
@@ -27,6 +29,9 @@ void DdsGateway::loop() {
     if (!acks.empty()) {
       std::lock_guard lock(m_);
       for (auto& a : acks) {
+        if (!validation::admit(a, view_.rejections())) {
+          continue;  // its request times out (503, retry)
+        }
         auto it = pending_.find(a.request_id);
         if (it != pending_.end()) {
           it->second = std::move(a);
@@ -34,11 +39,15 @@ void DdsGateway::loop() {
       }
       cv_.notify_all();
     }
-    for (const auto& e : events_.take()) {
-      view_.onEvent(e);
+    for (auto& e : events_.take()) {
+      if (validation::admit(e, view_.rejections())) {
+        view_.onEvent(e);
+      }
     }
-    for (const auto& r : robots_.take()) {
-      view_.onRobot(r);
+    for (auto& r : robots_.take()) {
+      if (validation::admit(r, view_.rejections())) {
+        view_.onRobot(r);
+      }
     }
   }
 }

@@ -1,5 +1,7 @@
 #include "gateway.hpp"
 
+#include <nlohmann/json.hpp>
+
 namespace fleet::wms {
 namespace {
 constexpr std::size_t kEventBuffer = 10'000;
@@ -60,6 +62,29 @@ void FleetView::onAccepted(const std::string& id, const std::string& body, msg::
     insertion_.push_back(id);
   }
   it->second.body = body;
+}
+
+void FleetView::onStored(const msg::TaskAck& a, std::int64_t nowNs) {
+  const auto d = nlohmann::json::parse(a.detail, nullptr, false);
+  std::lock_guard lock(m_);
+  auto [it, inserted] = tasks_.try_emplace(a.task_id);
+  auto& v = it->second;
+  if (!inserted) {
+    return;  // an event came while the query was out: it is at least as new
+  }
+  v.id = a.task_id;
+  insertion_.push_back(a.task_id);
+  v.state = a.state;
+  v.updatedNs = nowNs;
+  if (d.is_object()) {
+    v.robot = d.value("robot", "");
+    v.reason = d.value("reason", "");
+    v.updatedNs = d.value("updated_ns", nowNs);
+    v.seq = d.value("revision", 0U);
+    if (d.contains("task")) {
+      v.body = d["task"].dump();
+    }
+  }
 }
 
 void FleetView::onRobot(const msg::RobotState& s) {

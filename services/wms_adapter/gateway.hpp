@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fleet/messages/messages.hpp"
+#include "fleet/validation/rejections.hpp"
 
 namespace fleet::wms {
 
@@ -36,6 +37,15 @@ class TaskGateway {
   /// is nothing in its slot.
   virtual std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
                                                           std::chrono::milliseconds timeout) = 0;
+  /// Asks the manager where task `id` stands (TC_QUERY); nothing on timeout.
+  virtual std::optional<msg::TaskAck> query(const std::string& id, const std::string& requestId,
+                                            std::chrono::milliseconds timeout) {
+    msg::Task q;
+    q.task_id = id;
+    q.request_id = requestId;
+    q.control = msg::TaskControl::Query;
+    return submit({q}, timeout)[0];
+  }
   /// Whether a fleet manager is matched on the Task topic.
   [[nodiscard]] virtual bool managerOnline() const = 0;
 };
@@ -47,6 +57,11 @@ class FleetView {
   void onEvent(const msg::TaskEvent& e);
   void onAccepted(const std::string& id, const std::string& body, msg::TaskState state, std::int64_t nowNs);
   void onRobot(const msg::RobotState& s);
+  /// A task as the manager's store has it (the answer to a query), for a task the view lacked.
+  void onStored(const msg::TaskAck& a, std::int64_t nowNs);
+  /// Samples refused (or repaired) on their way into the view, for /v1/metrics.
+  [[nodiscard]] validation::Rejections& rejections() { return rejections_; }
+  [[nodiscard]] const validation::Rejections& rejections() const { return rejections_; }
 
   [[nodiscard]] std::optional<TaskView> task(const std::string& id) const;
   [[nodiscard]] std::vector<TaskView> tasks(std::optional<msg::TaskState> state, std::size_t limit) const;
@@ -68,6 +83,7 @@ class FleetView {
   std::map<std::string, msg::RobotState> robots_;
   std::deque<msg::TaskEvent> events_;
   std::uint64_t eventCount_ = 0;
+  validation::Rejections rejections_;
 };
 
 }  // namespace fleet::wms

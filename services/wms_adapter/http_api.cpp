@@ -13,9 +13,15 @@ namespace {
 
 using nlohmann::json;
 
+/// JSON text; a string that is not UTF-8 (which the edge repairs, so none should arrive) is
+/// written with U+FFFD instead of making dump() throw.
+std::string dumpJson(const json& j) {
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
 void reply(httplib::Response& res, int status, const json& body) {
   res.status = status;
-  res.set_content(body.dump(), "application/json");
+  res.set_content(dumpJson(body), "application/json");
 }
 
 json error(const std::string& code, const std::string& message) {
@@ -190,6 +196,15 @@ void HttpApi::routes() {
   server_.Get(R"(/v1/tasks/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
     const std::string id = req.matches[1];
     auto v = view_.task(id);
+    if (!v && isValidId(id) && gateway_.managerOnline()) {
+      // Not in the view (an adapter started after the task's events, or the view forgot it): the
+      // manager's store decides.
+      const auto a = gateway_.query(id, nextRequestId(), std::chrono::milliseconds(settings_.ackTimeoutMs));
+      if (a && a->result == msg::AckResult::Stored) {
+        view_.onStored(*a, clock_.nowNs());
+        v = view_.task(id);
+      }
+    }
     if (!v) {
       reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
       return;
@@ -259,7 +274,8 @@ void HttpApi::routes() {
            {"tasks_duplicate", counters_.tasksDuplicate.load()},
            {"tasks_by_state", view_.countByState()},
            {"robots", view_.robots().size()},
-           {"fleet_manager_online", gateway_.managerOnline()}});
+           {"fleet_manager_online", gateway_.managerOnline()},
+           {"samples", view_.rejections().toJson()}});
   });
   // Server-sent events: every TaskEvent as `event: task` with the JSON of the event. The stream
   // ends when the client goes away or the server stops.
@@ -273,9 +289,12 @@ void HttpApi::routes() {
           std::string chunk;
           for (const auto& e : evs) {
             chunk += "event: task\ndata: " +
-                     json{{"id", e.task_id},    {"state", msg::toString(e.state)}, {"robot", e.robot_id},
-                          {"reason", e.reason}, {"stamp_ns", e.stamp_ns},          {"seq", e.seq}}
-                         .dump() +
+                     dumpJson({{"id", e.task_id},
+                               {"state", msg::toString(e.state)},
+                               {"robot", e.robot_id},
+                               {"reason", e.reason},
+                               {"stamp_ns", e.stamp_ns},
+                               {"seq", e.seq}}) +
                      "\n\n";
           }
           if (chunk.empty()) {

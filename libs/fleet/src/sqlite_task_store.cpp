@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "fleet/fleet/errors.hpp"
+#include "fleet/validation/utf8.hpp"
 
 namespace fleet {
 namespace {
@@ -141,7 +142,9 @@ struct SqliteTaskStore::Impl {
     r.state = *state;
     r.robotId = s.text(3);
     r.attempts = static_cast<std::int32_t>(s.integer(4));
-    r.reason = s.text(5);
+    // Databases written before reasons were repaired at the manager's edge may hold bytes that are
+    // not UTF-8 (a robot's error); every reader of a record turns reasons into JSON.
+    r.reason = validation::repairUtf8(s.text(5));
     r.task.createdNs = s.integer(6);
     r.updatedNs = s.integer(7);
     r.revision = s.integer(8);
@@ -509,7 +512,7 @@ Expected<std::vector<TransitionRecord>> SqliteTaskStore::history(std::string_vie
     }
     t.to = parseTaskState(s.text(3)).value_or(TaskState::Queued);
     t.robotId = s.text(4);
-    t.reason = s.text(5);
+    t.reason = validation::repairUtf8(s.text(5));
     t.stampNs = s.integer(6);
     out.push_back(std::move(t));
   }

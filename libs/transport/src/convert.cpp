@@ -104,7 +104,7 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.deadline_ns = in.deadline_ns;
   m.created_ns = in.created_ns;
   m.cancel = in.cancel;
-  m.control = getEnum(in.control, msg::TaskControl::Resume);
+  m.control = getEnum(in.control, msg::TaskControl::Query);
   return m;
 }
 
@@ -237,7 +237,7 @@ msg::PredictedDiscs Traits<msg::PredictedDiscs>::fromC(const C& in) {
 // ---- RiskMap
 namespace {
 void putRing(const msg::Ring& ring, fleet_Ring& c, Arena& arena, const char* field) {
-  putSeq(c.points, ring, 0, arena, field, [](const Vec2& p, fleet_Point2D& q) { q = {p.x, p.y}; });
+  putSeq(c.points, ring, 16384, arena, field, [](const Vec2& p, fleet_Point2D& q) { q = {p.x, p.y}; });
 }
 msg::Ring getRing(const fleet_Ring& c) {
   return getSeq(c.points, [](const fleet_Point2D& q) { return Vec2{q.x, q.y}; });
@@ -255,14 +255,14 @@ void Traits<msg::RiskMap>::toC(const msg::RiskMap& in, C& out, Arena& arena) {
   out.horizon_s = in.horizon_s;
   out.scene_index = in.scene_index;
   out.sources = in.sources;
-  putSeq(out.runs, in.runs, 0, arena, "RiskMap.runs", [](const msg::LevelRun& r, fleet_LevelRun& c) {
+  putSeq(out.runs, in.runs, 4194304, arena, "RiskMap.runs", [](const msg::LevelRun& r, fleet_LevelRun& c) {
     c = {r.level, r.count};
   });
-  putSeq(out.regions, in.regions, 0, arena, "RiskMap.regions",
+  putSeq(out.regions, in.regions, 16384, arena, "RiskMap.regions",
          [&arena](const msg::Region& r, fleet_Region& c) {
            c.level = r.level;
            putRing(r.outer, c.outer, arena, "RiskMap.regions[].outer");
-           putSeq(c.holes, r.holes, 0, arena, "RiskMap.regions[].holes",
+           putSeq(c.holes, r.holes, 256, arena, "RiskMap.regions[].holes",
                   [&arena](const msg::Ring& h, fleet_Ring& hc) {
                     putRing(h, hc, arena, "RiskMap.regions[].holes[]");
                   });
@@ -374,14 +374,14 @@ msg::StepDone Traits<msg::StepDone>::fromC(const C& in) {
 void Traits<msg::GroundTruth>::toC(const msg::GroundTruth& in, C& out, Arena& arena) {
   out.step = in.step;
   out.sim_time_ns = in.sim_time_ns;
-  putSeq(out.bodies, in.bodies, 0, arena, "GroundTruth.bodies", [](const msg::Body& b, fleet_Body& c) {
+  putSeq(out.bodies, in.bodies, 65536, arena, "GroundTruth.bodies", [](const msg::Body& b, fleet_Body& c) {
     putStr(c.id, b.id, "GroundTruth.bodies[].id");
     c.kind = static_cast<fleet_SourceKind>(b.kind);
     c.pose = putPose(b.pose);
     c.v = b.v;
     c.radius = b.radius;
   });
-  putSeq(out.contacts, in.contacts, 0, arena, "GroundTruth.contacts",
+  putSeq(out.contacts, in.contacts, 65536, arena, "GroundTruth.contacts",
          [](const msg::Contact& k, fleet_Contact& c) {
            putStr(c.a, k.a, "GroundTruth.contacts[].a");
            putStr(c.b, k.b, "GroundTruth.contacts[].b");
@@ -418,13 +418,15 @@ void Traits<msg::Roadmap>::toC(const msg::Roadmap& in, C& out, Arena& arena) {
   if (in.kinds.size() != in.nodes.size() || in.open.size() != in.nodes.size()) {
     throw MessageError("Roadmap: kinds and open must have one entry per node");
   }
-  putSeq(out.nodes, in.nodes, 0, arena, "Roadmap.nodes",
+  putSeq(out.nodes, in.nodes, 1048576, arena, "Roadmap.nodes",
          [](const msg::RouteNode& n, fleet_RouteNode& c) { c = putNode(n); });
-  putSeq(out.kinds, in.kinds, 0, arena, "Roadmap.kinds", [](std::uint8_t k, std::uint8_t& c) { c = k; });
-  putSeq(out.open, in.open, 0, arena, "Roadmap.open", [](bool o, bool& c) { c = o; });
-  putSeq(out.edges, in.edges, 0, arena, "Roadmap.edges", [](const msg::RoadmapEdge& e, fleet_RoadmapEdge& c) {
-    c = fleet_RoadmapEdge{e.from, e.to, e.duration_s, e.open};
-  });
+  putSeq(out.kinds, in.kinds, 1048576, arena, "Roadmap.kinds",
+         [](std::uint8_t k, std::uint8_t& c) { c = k; });
+  putSeq(out.open, in.open, 1048576, arena, "Roadmap.open", [](bool o, bool& c) { c = o; });
+  putSeq(out.edges, in.edges, 4194304, arena, "Roadmap.edges",
+         [](const msg::RoadmapEdge& e, fleet_RoadmapEdge& c) {
+           c = fleet_RoadmapEdge{e.from, e.to, e.duration_s, e.open};
+         });
   out.stamp_ns = in.stamp_ns;
 }
 msg::Roadmap Traits<msg::Roadmap>::fromC(const C& in) {

@@ -17,15 +17,27 @@ int check(int rc, const char* what) {
   return rc;
 }
 
-std::string loopbackConfig(bool writeBatch) {
-  return std::string(
-             "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface "
-             "name=\"lo\"/></Interfaces>"
-             "<AllowMulticast>false</AllowMulticast></General>"
-             "<Discovery><Peers><Peer "
-             "address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
-             "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery>") +
-         (writeBatch ? "<Internal><WriteBatch>true</WriteBatch></Internal>" : "") + "</Domain></CycloneDDS>";
+std::string loopbackConfig(bool writeBatch, int lossPerMille) {
+  // Repair of lost packets (docs/architecture.md, "Transport"): Cyclone 0.10 retransmits at most
+  // MaxRexmitMessageSize per message (default 1456 B: one fragment of a large sample per NACK round)
+  // and lets a writer's heartbeats, which drive the repair, thin out to one per 8 s. On loopback a
+  // retransmit may be as large as a first transmission, and heartbeats stay at least once a second.
+  // Loss on loopback is a receive buffer overflowing while its process waits for a CPU: ask for 4 MiB
+  // (Cyclone's default asks 1 MiB; the kernel grants at most net.core.rmem_max, accepted as it is).
+  std::string internal =
+      "<HeartbeatInterval max=\"1 s\">100 ms</HeartbeatInterval><SocketReceiveBufferSize max=\"4 MiB\"/>";
+  if (writeBatch) {
+    internal += "<WriteBatch>true</WriteBatch>";
+  }
+  if (lossPerMille > 0) {
+    internal += "<Test><XmitLossiness>" + std::to_string(lossPerMille) + "</XmitLossiness></Test>";
+  }
+  return "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+         "<AllowMulticast>false</AllowMulticast><MaxRexmitMessageSize>14720 "
+         "B</MaxRexmitMessageSize></General>"
+         "<Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers><ParticipantIndex>auto</ParticipantIndex>"
+         "<MaxAutoParticipantIndex>200</MaxAutoParticipantIndex></Discovery><Internal>" +
+         internal + "</Internal></Domain></CycloneDDS>";
 }
 
 int domainFromEnvironment() {

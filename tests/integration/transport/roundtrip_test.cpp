@@ -3,9 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <chrono>
-#include <iostream>
 #include <thread>
 
 #include "fleet/transport/dds.hpp"
@@ -60,34 +58,29 @@ class RoundTrip : public ::testing::Test {
         }
       }
     };
+    // No second write: a sample that does not come back is a failure of the transport, not of this
+    // test. (Until 2026-11-26 a missing echo was written again after 30 s; docs/architecture.md,
+    // "Transport", says what was found: Cyclone 0.10.2 can hold a reliable sample back after
+    // packet loss until its writer writes again, which is what the second write hid.)
     collect(30s);
-    if (got.size() < samples.size()) {
-      // Twice in about 8 clean-clone CI runs (full suite in parallel on 2 cores) one echo of the
-      // 40 kB RiskMap never came within 30 s; in 80 runs here, under a 20-robot load test or the
-      // headless-Chromium test, it always came. Cause unknown (reliable, transient-local,
-      // keep-all both ways). The samples that did not come back are written once more, and it is
-      // said on the output: this test is about every field coming back equal.
-      std::cout << Traits<T>::kTopic << ": " << got.size() << " of " << samples.size()
-                << " echoed within 30 s; writing the missing ones again\n";
-      for (const auto& s : samples) {
-        if (std::none_of(got.begin(), got.end(), [&](const T& g) { return g == s; })) {
-          w.write(s);
-        }
-      }
-      collect(30s);
-    }
     return got;
   }
 
   template <class T>
   void expectRoundTrip(const std::vector<T>& samples) {
     auto got = roundTrip(samples);
-    ASSERT_EQ(got.size(), samples.size()) << Traits<T>::kTopic;
+    ASSERT_EQ(got.size(), samples.size()) << Traits<T>::kTopic << ": echoes within 30 s";
+    // A reader hands out samples grouped by instance (key), not in writing order: each sample
+    // must come back equal, once.
+    std::vector<bool> used(got.size(), false);
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      // In order, unless a sample had to be written again (then anywhere).
-      EXPECT_TRUE(got[i] == samples[i] ||
-                  std::any_of(got.begin(), got.end(), [&](const T& g) { return g == samples[i]; }))
-          << Traits<T>::kTopic << " sample " << i << " differs";
+      bool found = false;
+      for (std::size_t k = 0; k < got.size() && !found; ++k) {
+        if (!used[k] && got[k] == samples[i]) {
+          used[k] = found = true;
+        }
+      }
+      EXPECT_TRUE(found) << Traits<T>::kTopic << " sample " << i << " differs";
     }
   }
 
@@ -111,9 +104,11 @@ TEST_F(RoundTrip, Task) {
   msg::Task b{maxId(), maxId(), msg::TaskKind::Park, "", "", "PARK-1", "r-9", 0, 0, -5, 0, 0, true};
   msg::Task c = a;
   c.task_id = "t-2";
+  c.request_id = "req-2";  // the key: one instance per request
   c.control = msg::TaskControl::Resume;
   msg::Task d = a;
   d.task_id = "t-3";
+  d.request_id = "req-3";
   d.pickup = kNonAscii;
   d.control = msg::TaskControl::Pause;
   expectRoundTrip<msg::Task>({a, b, c, d});

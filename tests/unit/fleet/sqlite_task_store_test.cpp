@@ -162,6 +162,23 @@ TEST(SqliteTaskStore, TransitionsFollowTheStateMachine) {
   EXPECT_EQ((*h)[3].robotId, "r1") << "the log keeps who held the task";
 }
 
+// Issue 19: a robot's error that was not UTF-8 was stored as it came, and every reader that made
+// JSON of the record threw, across restarts. Reasons are repaired when read back.
+TEST(SqliteTaskStore, ReasonsThatAreNotUtf8AreRepairedWhenRead) {
+  test::TempDir dir;
+  {
+    auto store = openStore(dir.file("tasks.db"));
+    ASSERT_TRUE(store->submit(transport("t1"), 1));
+    ASSERT_TRUE(store->transition("t1", S::Assigned, "r1", "", 2));
+    ASSERT_TRUE(store->transition("t1", S::Requeued, "", "motor \xFF fault", 3));
+  }
+  auto store = openStore(dir.file("tasks.db"));
+  EXPECT_EQ(store->get("t1")->reason, "motor \xEF\xBF\xBD fault");
+  EXPECT_EQ(store->openTasks()->front().reason, "motor \xEF\xBF\xBD fault");
+  EXPECT_EQ(store->history("t1")->back().reason, "motor \xEF\xBF\xBD fault");
+  EXPECT_NO_THROW((void)toJson(*store->get("t1")).dump());
+}
+
 TEST(SqliteTaskStore, PinnedTaskOnlyForItsRobot) {
   test::TempDir dir;
   auto store = openStore(dir.file("tasks.db"));

@@ -111,7 +111,7 @@ TEST_F(Node, TransportTaskIsAssignedWithStationGoalsAndFinishes) {
   auto node = open(0);
   manager::Outbox out;
   node->onRequests({request("t1", transport("t1"))}, 1'000'000, out);
-  node->onRobotState({"r1", 1'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  node->onRobotState({"r1", 1'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 1'000'000);
   out = {};
   node->tick(2'000'000, out);
   ASSERT_EQ(out.assignments.size(), 1u);
@@ -139,11 +139,12 @@ TEST_F(Node, LostRobotsTaskIsReassignedAndStaleReportsRevoked) {
   auto node = open(0);
   manager::Outbox out;
   node->onRequests({request("t1", transport("t1"))}, 0, out);
-  node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 0);
   node->tick(100'000'000, out);
   ASSERT_EQ(out.assignments.size(), 1u);
   // r1 falls silent; r2 appears.
-  node->onRobotState({"r2", 1'500'000'000, {4, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+  node->onRobotState({"r2", 1'500'000'000, {4, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f},
+                     1'500'000'000);
   out = {};
   node->tick(1'600'000'000, out);
   bool requeued = false;
@@ -154,7 +155,8 @@ TEST_F(Node, LostRobotsTaskIsReassignedAndStaleReportsRevoked) {
   ASSERT_FALSE(out.assignments.empty());
   EXPECT_EQ(out.assignments.back().robot_id, "r2");
   // r1 comes back and reports progress on a task it no longer holds: it is told to drop it.
-  node->onRobotState({"r1", 1'700'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Moving, 0.9f, "t1", 0.3f});
+  node->onRobotState({"r1", 1'700'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Moving, 0.9f, "t1", 0.3f},
+                     1'700'000'000);
   out = {};
   node->onStatus({"r1", "t1", 1, msg::TaskState::Loading, 0.5f, "", 1'700'000'000}, 1'700'000'000, out);
   ASSERT_EQ(out.assignments.size(), 1u);
@@ -167,7 +169,7 @@ TEST_F(Node, RestartRecoversOpenTasksAndAssignments) {
     auto node = open(0);
     manager::Outbox out;
     node->onRequests({request("t1", transport("t1")), request("t2", transport("t2"))}, 0, out);
-    node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f});
+    node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 0);
     node->tick(1, out);
   }
   auto node = open(10);
@@ -257,7 +259,7 @@ TEST_F(Node, ChargeTaskDwellsUntilTheManagerSeesTheTargetBattery) {
   settings_.chargeMaxS = 900.0;
   auto node = open(0);
   manager::Outbox out;
-  node->onRobotState({"r1", 1'000, {3, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.1f, "", 0.3f});
+  node->onRobotState({"r1", 1'000, {3, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.1f, "", 0.3f}, 1'000);
   node->tick(2'000, out);
   ASSERT_EQ(out.assignments.size(), 1u);
   const auto a = out.assignments[0];
@@ -269,11 +271,13 @@ TEST_F(Node, ChargeTaskDwellsUntilTheManagerSeesTheTargetBattery) {
   node->onStatus({"r1", a.task_id, a.revision, msg::TaskState::EnRoute, 0.0f, "", 3'000}, 3'000, out);
   std::int64_t now = 4'000;
   for (float b = 0.1f; b < 0.895f; b += 0.01f, now += 200'000'000) {
-    node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, b, a.task_id, 0.3f});
+    node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, b, a.task_id, 0.3f},
+                       now);
     node->tick(now, out);
   }
   EXPECT_TRUE(out.assignments.empty()) << "charging: no new order, no second charge task";
-  node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, 0.9f, a.task_id, 0.3f});
+  node->onRobotState({"r1", now, {0.05, 0, 0}, {}, 0, 0, msg::RobotMode::Charging, 0.9f, a.task_id, 0.3f},
+                     now);
   node->tick(now, out);
   ASSERT_FALSE(out.events.empty());
   EXPECT_EQ(out.events.back().task_id, a.task_id);
@@ -296,4 +300,82 @@ TEST(Settings, TravelCostIsPathByDefaultAndStraightOnRequest) {
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.problems()[0].find("manager.json: travel_cost: expected one of"), std::string::npos)
       << bad.problems()[0];
+}
+
+// Issue 19: leases used the robot's own stamp, so a robot whose clock ran 1.5 s behind was lost
+// at once and never got a task (and one stamping INT64_MAX was never lost). The lease now runs on
+// the manager's clock, from when the state was received.
+TEST_F(Node, LeaseRunsOnTheManagersClockNotTheRobots) {
+  settings_.leaseS = 1.0;
+  auto node = open(0);
+  manager::Outbox out;
+  const std::int64_t now = 10'000'000'000;
+  node->onRequests({request("t1", transport("t1"))}, now, out);
+  // r1's clock is 1.5 s behind the manager's; r2 stamps the largest stamp there is.
+  node->onRobotState({"r1", now - 1'500'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f},
+                     now);
+  node->onRobotState({"r2", INT64_MAX, {40, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, now);
+  out = {};
+  node->tick(now + 100'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u) << "a robot with a late clock still gets work";
+  EXPECT_EQ(out.assignments[0].robot_id, "r1");
+  // Both fall silent: both are lost after the lease, whatever they stamped.
+  out = {};
+  node->tick(now + 2'000'000'000, out);
+  EXPECT_EQ(node->dispatcher().robots().onlineCount(), 0u);
+}
+
+// Issue 19 item 5: after a restart the manager announces every open task's state, with the seq
+// going on from the task's stored revision (an adapter that kept running sees no step back).
+TEST_F(Node, RestartAnnouncesEveryOpenTaskAsAnEvent) {
+  {
+    auto node = open(0);
+    manager::Outbox out;
+    node->onRequests({request("t1", transport("t1")), request("t2", transport("t2"))}, 0, out);
+    node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 0);
+    node->tick(1, out);
+  }
+  auto node = open(10);
+  std::map<std::string, msg::TaskEvent> events;
+  for (const auto& e : node->recovered().events) {
+    events[e.task_id] = e;
+  }
+  ASSERT_EQ(events.size(), 2u);
+  const auto& assigned = events.begin()->second.state == msg::TaskState::Assigned ? events.begin()->second
+                                                                                  : events.rbegin()->second;
+  EXPECT_EQ(assigned.state, msg::TaskState::Assigned);
+  EXPECT_EQ(assigned.robot_id, "r1");
+  EXPECT_EQ(assigned.seq, 2u) << "queued (1), assigned (2)";
+  manager::Outbox out;
+  node->onStatus({"r1", assigned.task_id, node->recovered().assignments[0].revision, msg::TaskState::EnRoute,
+                  0.1f, "", 20},
+                 20, out);
+  ASSERT_FALSE(out.events.empty());
+  EXPECT_EQ(out.events.back().seq, 3u);
+}
+
+// Issue 19 item 5: the adapter asks for a task its view lacks; the manager answers from the store,
+// finished tasks included.
+TEST_F(Node, QueryAnswersFromTheStore) {
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRequests({request("t1", transport("t1"))}, 0, out);
+  node->onRequests({request("t1", "", true)}, 1, out);  // cancelled: no longer open
+  msg::Task q;
+  q.task_id = "t1";
+  q.request_id = "q-1";
+  q.control = msg::TaskControl::Query;
+  msg::Task missing = q;
+  missing.task_id = "nope";
+  missing.request_id = "q-2";
+  out = {};
+  node->onRequests({q, missing}, 2, out);
+  ASSERT_EQ(out.acks.size(), 2u);
+  EXPECT_EQ(out.acks[0].result, msg::AckResult::Stored);
+  EXPECT_EQ(out.acks[0].state, msg::TaskState::Cancelled);
+  const auto d = nlohmann::json::parse(out.acks[0].detail);
+  EXPECT_EQ(d["task"]["pickup"], "P-1");
+  EXPECT_EQ(d["reason"], "cancelled by request");
+  EXPECT_EQ(out.acks[1].result, msg::AckResult::NotFound);
+  EXPECT_TRUE(out.events.empty()) << "a query changes nothing";
 }

@@ -965,3 +965,69 @@ TEST(Agent, KeepsTheSiteSpeedLimitInsideAZoneAndCruisesOutside) {
   EXPECT_LE(fastestInside, limit + 1e-9);
   EXPECT_GT(fastestOutside, 0.5) << "the limit holds in the zone only";
 }
+
+// Issue 19: an assignment with a task id and no goals (on a transient-local topic, so it came again
+// after every restart) crashed the agent. The agent now refuses the task and keeps working.
+TEST(Agent, AssignmentWithATaskAndNoGoalsIsRefusedNotFollowed) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  msg::TaskAssignment empty;
+  empty.robot_id = "r1";
+  empty.task_id = "t-empty";
+  empty.revision = 3;
+  a.onAssignment(empty);
+  std::optional<msg::TaskStatus> report;
+  for (int k = 0; k < 50; ++k) {
+    a.onFrame(world.frame(0, 0, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    if (out.status) {
+      report = out.status;
+    }
+    EXPECT_EQ(out.command.v, 0.0);
+  }
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->task_id, "t-empty");
+  EXPECT_EQ(report->revision, 3u);
+  EXPECT_EQ(report->state, msg::TaskState::Failed);
+  EXPECT_NE(report->error.find("no goals"), std::string::npos) << report->error;
+  EXPECT_FALSE(a.busy());
+  // A proper order afterwards is carried out as usual.
+  a.onAssignment(transport());
+  EXPECT_TRUE(a.busy());
+}
+
+// Issue 19: one frame with finite but absurd wheel totals made the pose NaN for good while the robot
+// reported idle. The edge refuses such a frame; an Agent that is fed one anyway reports a fault and
+// gives its task back.
+TEST(Agent, ImplausibleEstimateReportsAFaultAndFailsTheTask) {
+  auto grid = emptyGrid();
+  agent::Agent a(params(), grid, grid);
+  World world;
+  world.wheelTotals = true;
+  a.onAssignment(transport());
+  for (int k = 0; k < 5; ++k) {
+    a.onFrame(world.frame(0, 0, 0.1));
+    (void)a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+  }
+  auto bad = world.frame(0, 0, 0.1);
+  bad.wheel_left_total = 1e308;
+  bad.wheel_right_total = -1e308;
+  a.onFrame(bad);
+  std::optional<msg::TaskStatus> report;
+  msg::RobotState last;
+  for (int k = 5; k < 20; ++k) {
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    if (out.status) {
+      report = out.status;
+    }
+    last = out.state;
+    EXPECT_EQ(out.command.v, 0.0);
+    a.onFrame(world.frame(0, 0, 0.1));
+  }
+  EXPECT_EQ(last.mode, msg::RobotMode::Fault);
+  EXPECT_TRUE(last.pose.isFinite()) << "the last plausible pose is reported, so the fault stays visible";
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->state, msg::TaskState::Failed);
+  EXPECT_FALSE(a.busy());
+}

@@ -137,6 +137,11 @@ TEST(TransportConfig, QosByNameAndDomainValidation) {
   EXPECT_EQ(domainFromEnvironment(), 12);
   EXPECT_THAT(std::string(loopbackConfig()), HasSubstr("<NetworkInterface name=\"lo\"/>"));
   EXPECT_THAT(std::string(loopbackConfig()), HasSubstr("<AllowMulticast>false</AllowMulticast>"));
+  // Repair of lost packets: full-size retransmits, heartbeats at least once a second.
+  EXPECT_THAT(std::string(loopbackConfig()),
+              HasSubstr("<MaxRexmitMessageSize>14720 B</MaxRexmitMessageSize>"));
+  EXPECT_THAT(std::string(loopbackConfig()), HasSubstr("<HeartbeatInterval max=\"1 s\">"));
+  EXPECT_THAT(std::string(loopbackConfig(false, 50)), HasSubstr("<XmitLossiness>50</XmitLossiness>"));
   try {
     check(DDS_RETCODE_BAD_PARAMETER, "dds_something");
     FAIL();

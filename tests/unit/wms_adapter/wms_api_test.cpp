@@ -268,3 +268,55 @@ TEST_F(Api, PauseAndResumeReachTheManagerAndAnswerWithTheState) {
   EXPECT_EQ(r->status, 503);
   EXPECT_THAT(r->body, HasSubstr("nothing was paused"));
 }
+
+// Issue 19: a TaskEvent reason that is not UTF-8 (from a robot's TaskStatus.error) made the adapter
+// exit while an event stream was open and made GET /v1/tasks answer 500 for good. Text that gets
+// past the edge unrepaired is now written with U+FFFD; the stream and the list keep working.
+TEST_F(Api, TextThatIsNotUtf8NeitherStopsTheStreamNorBreaksTheList) {
+  start();
+  std::string received;
+  std::thread reader([&] {
+    httplib::Client c("127.0.0.1", api_->port());
+    c.set_read_timeout(5, 0);
+    c.Get("/v1/events", [&](const char* data, std::size_t n) {
+      received.append(data, n);
+      return received.find("\"state\":\"done\"") == std::string::npos;
+    });
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  view_.onEvent({"t-7", msg::TaskState::Failed, "r1", "motor \xFF\xFE fault", 1, 1});
+  view_.onEvent({"t-8", msg::TaskState::Done, "r1", "", 2, 1});
+  reader.join();
+  EXPECT_THAT(received, HasSubstr("motor \xEF\xBF\xBD\xEF\xBF\xBD fault"));
+  auto r = client_->Get("/v1/tasks");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["count"], 2);
+  r = client_->Get("/v1/tasks/t-7");
+  ASSERT_EQ(r->status, 200);
+  EXPECT_EQ(json::parse(r->body)["reason"], "motor \xEF\xBF\xBD\xEF\xBF\xBD fault");
+}
+
+// Issue 19 item 5: a task the view does not hold (an adapter started after its events) is asked of
+// the manager before answering 404.
+TEST_F(Api, TaskMissingFromTheViewIsAskedOfTheManager) {
+  start();
+  ASSERT_EQ(post(kTask)->status, 201);
+  FleetView fresh;  // a restarted adapter's empty view, same manager
+  ApiSettings settings;
+  settings.port = 0;
+  settings.ackTimeoutMs = 200;
+  HttpApi second(settings, stations_, gateway_, fresh, clock_);
+  ASSERT_TRUE(second.bind());
+  std::thread serving([&] { second.serve(); });
+  httplib::Client c("127.0.0.1", second.port());
+  auto r = c.Get("/v1/tasks/t-1");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body)["id"], "t-1");
+  EXPECT_EQ(gateway_.controls.back(), msg::TaskControl::Query);
+  EXPECT_TRUE(fresh.task("t-1")) << "kept in the view";
+  EXPECT_EQ(c.Get("/v1/tasks/t-404")->status, 404);
+  second.stop();
+  serving.join();
+}

@@ -11,7 +11,7 @@ namespace fleet::avoidance {
 struct DwaParams {
   int vSamples = 20;                  ///< Nav2 DWB vx_samples
   int omegaSamples = 20;              ///< Nav2 DWB vtheta_samples
-  double simTime = 1.7;               ///< rollout horizon [s] (Nav2 DWB sim_time)
+  double simTime = 1.7;               ///< rollout horizon [s] (Nav2 DWB simTime)
   double wHeading = 0.8;              ///< end-pose heading towards the carrot (Fox et al.'s "heading")
   double wClearance = 0.3;            ///< surface clearance along the rollout, saturated at clearanceCap
   double wVelocity = 0.3;             ///< forward speed / vMax

@@ -13,7 +13,7 @@
 namespace fleet::msg {
 
 enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
-enum class TaskControl : std::uint8_t { None, Pause, Resume };
+enum class TaskControl : std::uint8_t { None, Pause, Resume, Query };
 enum class TaskState : std::uint8_t {
   Queued,
   Assigned,

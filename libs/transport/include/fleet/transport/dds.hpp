@@ -17,8 +17,10 @@ namespace fleet::transport {
 
 /// The loopback-only configuration used when CYCLONEDDS_URI is unset: interface lo, multicast
 /// off, unicast discovery with peer 127.0.0.1, room for 200 participants on the host.
-/// `writeBatch` adds Cyclone's Internal/WriteBatch (see ParticipantOptions).
-std::string loopbackConfig(bool writeBatch = false);
+/// Lost packets are repaired with retransmits as large as first transmissions and heartbeats at
+/// least once a second. `writeBatch` adds Cyclone's Internal/WriteBatch (see ParticipantOptions);
+/// `lossPerMille` drops that share of outgoing packets (Internal/Test/XmitLossiness: fault tests).
+std::string loopbackConfig(bool writeBatch = false, int lossPerMille = 0);
 
 /// Domain id from FLEET_DDS_DOMAIN (0..229), else 0. Tests set it to keep parallel runs apart.
 int domainFromEnvironment();
