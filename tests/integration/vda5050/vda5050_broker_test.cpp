@@ -16,7 +16,9 @@
 #include "fleet/sim/vda5050_vehicle.hpp"
 #include "fleet/vda5050/connection.hpp"
 #include "fleet/vda5050/order.hpp"
+#include "fleet/vda5050/order_builder.hpp"
 #include "fleet/vda5050/state.hpp"
+#include "fleet/vda5050/vehicle_registry.hpp"
 #include "mosquitto_broker.hpp"
 
 namespace fleet {
@@ -246,6 +248,145 @@ TEST(Vda5050Broker, TheVehicleReconnectsAfterABrokerRestart) {
     got = !(*link)->take(0).instant_actions.empty();
   }
   EXPECT_TRUE(got);
+}
+
+// The master control's core (order builder + vehicle registry) against the simulated vehicle,
+// all through the broker: releases become an order and a stitched update, the vehicle's state
+// comes back online; then bad input, a broker restart and the last will.
+TEST(Vda5050Broker, MasterControlCoreDrivesTheVehicleAndSurvivesBadInput) {
+  MosquittoBroker broker(kVehicles);
+  std::mutex mutex;
+  vda5050::VehicleRegistry registry("uagv", "small", {{"acme", "A1", "v1"}, {"acme", "A2", "v2"}});
+  std::vector<std::string> refused;
+  Recorder master(broker.port(), MosquittoBroker::kMasterUser, MosquittoBroker::kMasterPassword, "master");
+  // The registry sees what the recorder sees; fed from the test thread below.
+  std::size_t fed = 0;
+  const auto feed = [&] {
+    std::lock_guard lock(master.mutex);
+    for (; fed < master.messages.size(); ++fed) {
+      const auto out = registry.onMessage(master.messages[fed].first, master.messages[fed].second);
+      if (!out.accepted) {
+        refused.push_back(out.reason);
+      }
+    }
+  };
+  master.client->subscribe("uagv/v2/+/+/state", 0);
+  master.client->subscribe("uagv/v2/+/+/connection", 1);
+  master.client->subscribe("uagv/v2/+/+/factsheet", 0);
+
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // The vehicle in its own process, so that it can vanish without a clean disconnect.
+    auto link = sim::Vda5050Link::start(linkOptions(broker, "A1"));
+    sim::Vda5050VehicleConfig vc;
+    vc.manufacturer = "acme";
+    vc.serial = "A1";
+    vc.mapId = "small";
+    sim::Vda5050Vehicle vehicle(vc, Pose2{});
+    Pose2 pose;
+    double t = 0.0;
+    for (int k = 0; k < 3000 && link; ++k) {  // at most 30 s of wall time
+      auto in = (*link)->take(0);
+      for (const auto& o : in.orders) {
+        (void)vehicle.onOrder(o);
+      }
+      const auto c = vehicle.step(t, pose, false);
+      pose.x += c.v * std::cos(pose.theta) * 0.1;
+      pose.y += c.v * std::sin(pose.theta) * 0.1;
+      pose.theta += c.w * 0.1;
+      t += 0.1;
+      if (vehicle.stateDue(t) && (*link)->connected()) {
+        (*link)->publish(vehicle.takeState(t, 0));
+      }
+      if (vehicle.lastNodeId() == "n4") {
+        std::this_thread::sleep_for(300ms);
+        _exit(0);  // vanish: the broker publishes the last will
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    _exit(1);
+  }
+  const auto health = [&] { return registry.find("v1")->health; };
+  ASSERT_TRUE(waitFor([&] {
+    feed();
+    return health() == vda5050::VehicleHealth::kOnline;
+  })) << "no state from the vehicle";
+
+  // Bad input through the broker: a state failing the schema, an unknown serial, another map.
+  master.client->publish("uagv/v2/acme/A1/state", R"({"headerId": 1})", 0, false);
+  master.client->publish("uagv/v2/acme/Z9/state", "{}", 0, false);
+  ASSERT_TRUE(waitFor([&] {
+    feed();
+    return registry.refusals().count("bad_message") && registry.refusals().count("unknown_serial");
+  }));
+  // ... the vehicle's next good state brings it back.
+  ASSERT_TRUE(waitFor([&] {
+    feed();
+    return health() == vda5050::VehicleHealth::kOnline;
+  }));
+  EXPECT_EQ(registry.find("v2")->health, vda5050::VehicleHealth::kUnknown) << "A2 untouched";
+
+  // A broker restart in the middle: both sides reconnect.
+  broker.stop();
+  broker.start();
+  ASSERT_TRUE(waitFor([&] { return master.client->connected(); }, 15s));
+
+  // Releases as the traffic layer gives them: base n0..n2 then more, with a drop at n4.
+  vda5050::OrderBuilder builder({"acme", "A1", "small", 0.2});
+  const auto node = [](int n) { return vda5050::ReleaseNode{n, static_cast<double>(n), 0.0}; };
+  vda5050::ReleaseInput rel;
+  rel.base = {node(0), node(1), node(2)};
+  rel.horizon = {node(3)};
+  rel.actions = {{4, {"drop", "t1-drop", "HARD", {}, {}}}};
+  auto first = builder.start("t1", rel, 0);
+  ASSERT_TRUE(first) << first.error().message;
+  registry.ordered("v1", *first);
+  // Sent again every half second until the vehicle has it: after the restart its subscription
+  // may lag, and a repeated order is a duplicate the vehicle discards.
+  auto resent = std::chrono::steady_clock::now() - 1s;
+  const auto sendUntilHeld = [&](const vda5050::Order& o) {
+    if (std::chrono::steady_clock::now() - resent > 500ms) {
+      master.client->publish("uagv/v2/acme/A1/order", vda5050::toJson(o).dump(), 0, false);
+      resent = std::chrono::steady_clock::now();
+    }
+  };
+  ASSERT_TRUE(waitFor(
+      [&] {
+        feed();
+        const auto* v = registry.find("v1");
+        if (!v->state || v->state->orderId != "t1") {
+          sendUntilHeld(*first);
+        }
+        return v->state && v->state->lastNodeId == "n2" && v->state->newBaseRequest.value_or(false);
+      },
+      20s))
+      << "the vehicle did not reach the base end";
+  rel.base = {node(2), node(3), node(4)};
+  rel.horizon = {};
+  auto update = builder.extend(rel, registry.find("v1")->state->lastNodeSequenceId, 0);
+  ASSERT_TRUE(update && update->has_value());
+  registry.ordered("v1", **update);
+  resent = std::chrono::steady_clock::now() - 1s;
+
+  // It drives on to n4, then vanishes: the last will marks it offline.
+  ASSERT_TRUE(waitFor(
+      [&] {
+        feed();
+        const auto* v = registry.find("v1");
+        if (v->health == vda5050::VehicleHealth::kOnline && v->state->orderUpdateId == 0) {
+          sendUntilHeld(**update);
+        }
+        return health() == vda5050::VehicleHealth::kOffline;
+      },
+      20s))
+      << "health " << vda5050::toString(health()) << " (" << registry.find("v1")->reason << ")";
+  EXPECT_EQ(registry.find("v1")->state->lastNodeId, "n4");
+  EXPECT_EQ(registry.find("v1")->state->orderUpdateId, 1U);
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_FALSE(registry.refusals().count("node_never_ordered"));
 }
 
 }  // namespace
