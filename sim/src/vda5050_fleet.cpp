@@ -8,7 +8,8 @@ Vda5050FleetConfig readVda5050FleetConfig(Config c) {
   Vda5050FleetConfig out;
   c.rejectUnknownKeys({"broker", "interface", "manufacturer", "map_id", "protective_field", "vehicles"});
   auto broker = c.child("broker", true);
-  broker.rejectUnknownKeys({"host", "port"});
+  broker.rejectUnknownKeys({"host", "port", "ca_file"});
+  out.ca_file = broker.string("ca_file", "");
   out.host = broker.string("host", out.host);
   out.port = static_cast<int>(broker.requireInteger("port", {1, 65535}));
   out.interface_name = c.string("interface", out.interface_name);
@@ -54,6 +55,7 @@ Expected<std::unique_ptr<Vda5050Fleet>> Vda5050Fleet::start(const Vda5050FleetCo
     lo.serial = v.robot;
     lo.username = config.manufacturer + "-" + v.robot;
     lo.password = v.password;
+    lo.tls_ca_file = config.ca_file;
     auto link = Vda5050Link::start(lo);
     if (!link) {
       return unexpected(link.error());

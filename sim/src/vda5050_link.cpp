@@ -38,6 +38,7 @@ Expected<std::unique_ptr<Vda5050Link>> Vda5050Link::start(Vda5050LinkOptions opt
   co.client_id = link->options_.manufacturer + "-" + link->options_.serial;
   co.username = link->options_.username;
   co.password = link->options_.password;
+  co.tls_ca_file = link->options_.tls_ca_file;
   // The broker publishes this when the vehicle vanishes; its timestamp is the connect time, as
   // the specification allows.
   co.will =

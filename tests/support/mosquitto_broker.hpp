@@ -36,13 +36,19 @@ class MosquittoBroker {
   static constexpr const char* kMasterUser = "master";
   static constexpr const char* kMasterPassword = "master-secret";
 
-  explicit MosquittoBroker(std::vector<BrokerVehicle> vehicles, std::string interface_name = "uagv")
-      : vehicles_(std::move(vehicles)), interface_(std::move(interface_name)) {
+  /// `tls`: the listener speaks TLS only, with a certificate for 127.0.0.1 signed by a CA made
+  /// here (caFile()).
+  explicit MosquittoBroker(std::vector<BrokerVehicle> vehicles, bool tls = false,
+                           std::string interface_name = "uagv")
+      : vehicles_(std::move(vehicles)), interface_(std::move(interface_name)), tls_(tls) {
     static int counter = 0;
     dir_ = std::filesystem::temp_directory_path() /
            ("fleet-mosquitto-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
+    if (tls_) {
+      makeCertificates();
+    }
     for (int attempt = 0; attempt < 5; ++attempt) {
       port_ = freeLoopbackPort();
       writeConfig();
@@ -63,6 +69,7 @@ class MosquittoBroker {
   [[nodiscard]] int port() const { return port_; }
   [[nodiscard]] const std::string& interfaceName() const { return interface_; }
   [[nodiscard]] std::filesystem::path logFile() const { return dir_ / "mosquitto.log"; }
+  [[nodiscard]] std::string caFile() const { return tls_ ? (dir_ / "ca.crt").string() : std::string(); }
 
   void stop() {
     if (process_) {
@@ -112,12 +119,34 @@ class MosquittoBroker {
     return ok;
   }
 
+  void openssl(const std::vector<std::string>& args) {
+    ChildProcess p("/usr/bin/openssl", args);
+    if (p.wait(std::chrono::seconds(60)) != 0) {
+      throw std::runtime_error("openssl " + args.front() + " failed");
+    }
+  }
+
+  void makeCertificates() {
+    const auto f = [&](const char* name) { return (dir_ / name).string(); };
+    openssl({"req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "1", "-subj", "/CN=fleet-test-ca",
+             "-keyout", f("ca.key"), "-out", f("ca.crt")});
+    openssl({"req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=127.0.0.1", "-addext",
+             "subjectAltName=IP:127.0.0.1", "-keyout", f("server.key"), "-out", f("server.csr")});
+    openssl({"x509", "-req", "-in", f("server.csr"), "-CA", f("ca.crt"), "-CAkey", f("ca.key"),
+             "-CAcreateserial", "-days", "1", "-copy_extensions", "copyall", "-out", f("server.crt")});
+  }
+
   void writeConfig() {
     mqtt::BrokerConfig c;
     c.port = port_;
     c.password_file = (dir_ / "passwd").string();
     c.acl_file = (dir_ / "acl").string();
     c.log_file = (dir_ / "mosquitto.log").string();
+    if (tls_) {
+      c.tls_ca_file = (dir_ / "ca.crt").string();
+      c.tls_cert_file = (dir_ / "server.crt").string();
+      c.tls_key_file = (dir_ / "server.key").string();
+    }
     if (::getuid() == 0) {
       c.run_as_user = "root";
     }
@@ -157,6 +186,7 @@ class MosquittoBroker {
 
   std::vector<BrokerVehicle> vehicles_;
   std::string interface_;
+  bool tls_ = false;
   std::filesystem::path dir_;
   int port_ = 0;
   std::unique_ptr<ChildProcess> process_;

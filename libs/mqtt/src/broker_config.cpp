@@ -6,6 +6,11 @@ std::string mosquittoConf(const BrokerConfig& config) {
   std::string s;
   s += "per_listener_settings false\n";
   s += "listener " + std::to_string(config.port) + " " + config.bind_address + "\n";
+  if (!config.tls_cert_file.empty()) {
+    s += "cafile " + config.tls_ca_file + "\n";
+    s += "certfile " + config.tls_cert_file + "\n";
+    s += "keyfile " + config.tls_key_file + "\n";
+  }
   s += "allow_anonymous false\n";
   s += "password_file " + config.password_file + "\n";
   s += "acl_file " + config.acl_file + "\n";

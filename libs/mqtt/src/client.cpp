@@ -33,6 +33,15 @@ Expected<std::unique_ptr<Client>> Client::start(ClientOptions options, MessageHa
   if (!c->options_.username.empty()) {
     mosquitto_username_pw_set(c->handle_, c->options_.username.c_str(), c->options_.password.c_str());
   }
+  if (!c->options_.tls_ca_file.empty()) {
+    const auto opt = [](const std::string& s) { return s.empty() ? nullptr : s.c_str(); };
+    const int rc = mosquitto_tls_set(c->handle_, c->options_.tls_ca_file.c_str(), nullptr,
+                                     opt(c->options_.tls_cert_file), opt(c->options_.tls_key_file), nullptr);
+    if (rc != MOSQ_ERR_SUCCESS) {
+      return unexpected("mqtt.tls",
+                        "mqtt: TLS with CA '" + c->options_.tls_ca_file + "': " + mosquitto_strerror(rc));
+    }
+  }
   if (c->options_.will) {
     const auto& w = *c->options_.will;
     const int rc = mosquitto_will_set(c->handle_, w.topic.c_str(), static_cast<int>(w.payload.size()),

@@ -108,6 +108,25 @@ TEST(Vda5050Broker, TheAclConfinesEachVehicleToItsSubtree) {
   EXPECT_TRUE(a1.on("uagv/v2/acme/A2/order").empty()) << "A1 read A2's orders";
 }
 
+TEST(Vda5050Broker, OverTlsTheVehicleConnectsAndAPlainClientCannot) {
+  MosquittoBroker broker(kVehicles, /*tls=*/true);
+  auto lo = linkOptions(broker, "A1");
+  lo.tls_ca_file = broker.caFile();
+  auto link = sim::Vda5050Link::start(lo);
+  ASSERT_TRUE(link) << link.error().message;
+  ASSERT_TRUE(waitFor([&] { return (*link)->connected(); })) << "see " << broker.logFile();
+
+  Recorder plain(broker.port(), MosquittoBroker::kMasterUser, MosquittoBroker::kMasterPassword, "plain");
+  std::this_thread::sleep_for(1s);
+  EXPECT_FALSE(plain.client->connected()) << "a client without TLS got in";
+
+  mqtt::ClientOptions bad;
+  bad.port = broker.port();
+  bad.client_id = "x";
+  bad.tls_ca_file = "/nonexistent/ca.crt";
+  EXPECT_FALSE(mqtt::Client::start(bad, {}));
+}
+
 TEST(Vda5050Broker, WrongCredentialsAreRefused) {
   MosquittoBroker broker(kVehicles);
   Recorder intruder(broker.port(), "acme-A1", "guessed", "intruder");

@@ -5,7 +5,7 @@
 // simulator's loop, so in lockstep the vehicles step with the simulated world.
 //
 // Config file (fleet-sim --vda5050 FILE):
-//   {"broker": {"host": "127.0.0.1", "port": 18830}, "interface": "uagv",
+//   {"broker": {"host": "127.0.0.1", "port": 18830, "ca_file": ""}, "interface": "uagv",
 //    "manufacturer": "fleet-sim", "map_id": "small_warehouse", "protective_field": 1.0,
 //    "vehicles": [{"robot": "r3", "password": "..."}, ...]}
 // A vehicle's serial number is its robot id; its broker user is "<manufacturer>-<serial>".
@@ -25,6 +25,7 @@ namespace fleet::sim {
 struct Vda5050FleetConfig {
   std::string host = "127.0.0.1";
   int port = 0;
+  std::string ca_file;  // TLS: the CA of the broker's certificate; empty: plain TCP
   std::string interface_name = "uagv";
   std::string manufacturer = "fleet-sim";
   std::string map_id = "warehouse";

@@ -28,6 +28,7 @@ struct Vda5050LinkOptions {
   std::string serial;
   std::string username;
   std::string password;
+  std::string tls_ca_file;  // empty: plain TCP
 };
 
 struct Vda5050Inbox {

@@ -23,6 +23,10 @@ struct BrokerConfig {
   std::string password_file;
   std::string acl_file;
   std::string log_file;  // empty: stderr
+  /// TLS on the listener (all three set) or plain TCP (all empty).
+  std::string tls_ca_file;
+  std::string tls_cert_file;
+  std::string tls_key_file;
   /// mosquitto started as root drops to the user "mosquitto" unless told otherwise; set this to
   /// "root" when the files it reads belong to root and are private.
   std::string run_as_user;

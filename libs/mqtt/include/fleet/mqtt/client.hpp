@@ -36,6 +36,11 @@ struct ClientOptions {
   std::string password;
   std::optional<LastWill> will;
   int keepalive_s = 5;
+  /// TLS: the CA that signed the broker's certificate (empty: plain TCP), and optionally this
+  /// client's own certificate and key when the broker asks for one.
+  std::string tls_ca_file;
+  std::string tls_cert_file;
+  std::string tls_key_file;
 };
 
 /// (topic, payload) of every message on a subscribed topic, called on the network thread.
