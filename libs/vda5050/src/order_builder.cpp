@@ -90,18 +90,30 @@ Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
                                                   ", beyond the base sent");
   }
   const auto sent = static_cast<std::size_t>(base_.end() - from);
-  if (release.base.size() < sent) {
+  // The release starts at the node last reported to the traffic layer, which may lag behind the
+  // vehicle: find the sent base (from the vehicle's last node on) inside the release's base.
+  const int first = roadmapNode(from->nodeId);
+  std::size_t k = 0;
+  while (k < release.base.size() && release.base[k].node != first) {
+    ++k;
+  }
+  if (k == release.base.size()) {
+    return unexpected("vda5050.cannot_stitch", "release for '" + options_.serial + "' does not pass node " +
+                                                   from->nodeId +
+                                                   " where the vehicle is: cancel and start a new order");
+  }
+  if (release.base.size() - k < sent) {
     return std::optional<Order>{};  // the release is behind what was sent: nothing new
   }
   for (std::size_t i = 0; i < sent; ++i) {
-    if (release.base[i].node != roadmapNode(from[static_cast<std::ptrdiff_t>(i)].nodeId)) {
+    if (release.base[k + i].node != roadmapNode(from[static_cast<std::ptrdiff_t>(i)].nodeId)) {
       return unexpected("vda5050.cannot_stitch",
                         "release for '" + options_.serial + "' leaves the sent base at node " +
                             from[static_cast<std::ptrdiff_t>(i)].nodeId + " (release has n" +
-                            std::to_string(release.base[i].node) + "): cancel and start a new order");
+                            std::to_string(release.base[k + i].node) + "): cancel and start a new order");
     }
   }
-  if (release.base.size() == sent) {
+  if (release.base.size() - k == sent) {
     return std::optional<Order>{};  // the base did not grow; a horizon change alone is not worth an update
   }
   ++update_id_;
@@ -110,7 +122,7 @@ Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
   stitch.actions.clear();  // sent already with the node
   nodes.push_back(stitch);
   std::uint32_t seq = stitch.sequenceId + 2;
-  for (std::size_t i = sent; i < release.base.size(); ++i) {
+  for (std::size_t i = k + sent; i < release.base.size(); ++i) {
     nodes.push_back(makeNode(release.base[i], seq, true, release));
     base_.push_back(nodes.back());
     seq += 2;

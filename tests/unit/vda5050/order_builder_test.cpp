@@ -66,11 +66,24 @@ TEST(Vda5050OrderBuilder, MoreReleasedBecomesAnUpdateTheVehicleStitches) {
   EXPECT_TRUE(validateOrder(merged));
   EXPECT_EQ(baseEnd(merged)->nodeId, "n14");
 
+  // A release that still starts behind the vehicle (its last report lagged) is aligned.
+  auto r3 = release({11, 12, 13, 14, 15, 16}, {});
+  const auto lagging = b.extend(r3, 8, 0);  // the vehicle passed n14 (sequenceId 8)
+  ASSERT_TRUE(lagging) << lagging.error().message;
+  ASSERT_TRUE(lagging->has_value());
+  EXPECT_EQ((*lagging)->nodes.front().nodeId, "n14");
+  EXPECT_EQ((*lagging)->nodes.back().nodeId, "n16");
+  EXPECT_EQ(b.orderUpdateId(), 2U);
+  EXPECT_TRUE(validateOrder(**lagging));
+
   // The same release again adds nothing; a shorter one neither.
-  auto again = b.extend(r2, 2, 0);
+  auto again = b.extend(r3, 8, 0);
   ASSERT_TRUE(again);
   EXPECT_FALSE(again->has_value());
-  EXPECT_EQ(b.orderUpdateId(), 1U);
+  auto shorter = b.extend(r2, 8, 0);
+  ASSERT_TRUE(shorter);
+  EXPECT_FALSE(shorter->has_value());
+  EXPECT_EQ(b.orderUpdateId(), 2U);
 }
 
 TEST(Vda5050OrderBuilder, AReleaseOffTheSentBaseIsRefused) {
