@@ -2,8 +2,11 @@
 // vehicle and this test as the fleet manager and the traffic manager: a transport task (pick at
 // the end of the band, drop on the way back) is released in pieces; the vehicle must drive the
 // orders and updates the bridge makes of them, report every node, and the task must go Assigned,
-// EnRoute, Loading, Delivering, Unloading, Done. Then the vehicle is killed: its last will must
-// take it out of traffic control (TrafficProgress follows=false) and stop its RobotState.
+// EnRoute, Loading, Delivering, Unloading, Done. Before it, bad input on the broker (a state that
+// fails the checks, an unknown serial, another map) must fault r1 only until its next good state
+// and never stop the bridge; after it, a broker restart must be survived; then the vehicle is
+// killed: its last will must take it out of traffic control (TrafficProgress follows=false) and
+// stop its RobotState.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -14,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "fleet/mqtt/client.hpp"
 #include "fleet/transport/dds.hpp"
 #include "mosquitto_broker.hpp"
 #include "test_process.hpp"
@@ -111,6 +115,49 @@ TEST(Vda5050Bridge, AVehicleDoesATransportTaskFromReleasesAndLeavesTrafficContro
   };
   ASSERT_TRUE(until([&] { return robot_states > 0; }, 30s)) << "the bridge never reported r1";
 
+  // Bad input, published with the master's credentials onto r1's topics and a stranger's.
+  mqtt::ClientOptions mo;
+  mo.port = broker.port();
+  mo.client_id = "intruder";
+  mo.username = test::MosquittoBroker::kMasterUser;
+  mo.password = test::MosquittoBroker::kMasterPassword;
+  auto intruder = mqtt::Client::start(mo, {});
+  ASSERT_TRUE(intruder) << intruder.error().message;
+  ASSERT_TRUE(until([&] { return (*intruder)->connected(); }, 10s));
+  const auto badState = [&](const std::string& topic, const std::string& payload) {
+    ASSERT_TRUE((*intruder)->publish(topic, payload, 0, false));
+    ASSERT_TRUE(until([&] { return !follows; }, 10s)) << "not faulted by " << payload;
+    ASSERT_TRUE(until([&] { return follows; }, 10s)) << "not back after its next good state";
+  };
+  badState("uagv/v2/fleet-sim/r1/state", R"({"headerId": 1, "driving": "yes"})");
+  nlohmann::json elsewhere = {
+      {"headerId", 9},
+      {"timestamp", "2026-11-26T00:00:00.000Z"},
+      {"version", "2.1.0"},
+      {"manufacturer", "fleet-sim"},
+      {"serialNumber", "r1"},
+      {"orderId", ""},
+      {"orderUpdateId", 0},
+      {"lastNodeId", ""},
+      {"lastNodeSequenceId", 0},
+      {"driving", false},
+      {"operatingMode", "AUTOMATIC"},
+      {"nodeStates", nlohmann::json::array()},
+      {"edgeStates", nlohmann::json::array()},
+      {"actionStates", nlohmann::json::array()},
+      {"batteryState", {{"batteryCharge", 50.0}, {"charging", false}}},
+      {"errors", nlohmann::json::array()},
+      {"safetyState", {{"eStop", "NONE"}, {"fieldViolation", false}}},
+      {"agvPosition",
+       {{"x", 1.0}, {"y", 1.0}, {"theta", 0.0}, {"mapId", "other_site"}, {"positionInitialized", true}}}};
+  badState("uagv/v2/fleet-sim/r1/state", elsewhere.dump());
+  ASSERT_TRUE(
+      (*intruder)->publish("uagv/v2/fleet-sim/r9/state", elsewhere.dump(), 0, false));  // unknown serial
+  std::this_thread::sleep_for(500ms);
+  pump();
+  EXPECT_TRUE(follows) << "an unknown serial's message disturbed r1";
+  EXPECT_EQ(bridge.wait(0ms), -1) << "the bridge exited on bad input";
+
   msg::TaskAssignment a;
   a.robot_id = "r1";
   a.task_id = "t1";
@@ -136,6 +183,13 @@ TEST(Vda5050Bridge, AVehicleDoesATransportTaskFromReleasesAndLeavesTrafficContro
                                                 msg::TaskState::Loading,   msg::TaskState::Delivering,
                                                 msg::TaskState::Unloading, msg::TaskState::Done};
   EXPECT_EQ(seen, expected);
+
+  // A broker restart: the bridge and the vehicle reconnect, RobotState flows again.
+  broker.stop();
+  broker.start();
+  robot_states = 0;
+  ASSERT_TRUE(until([&] { return robot_states > 3; }, 30s)) << "no RobotState after the broker restart";
+  ASSERT_TRUE(follows);
 
   // The vehicle vanishes: the broker's last will takes it out of traffic control.
   sim->kill(SIGKILL);

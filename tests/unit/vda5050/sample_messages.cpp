@@ -4,6 +4,7 @@
 
 #include <iostream>
 
+#include "bridge_node.hpp"
 #include "fleet/sim/vda5050_vehicle.hpp"
 #include "fleet/vda5050/connection.hpp"
 #include "fleet/vda5050/instant_actions.hpp"
@@ -76,6 +77,33 @@ int main() {
   r.horizon = {};
   if (const auto up = builder.extend(r, 2, 0); up && up->has_value()) {
     print("order", vda5050::toJson(**up));
+  }
+  // What the bridge sends: orders for releases, pause, resume and cancel.
+  vdabridge::BridgeNode bridge({"uagv", "small", {{"fleet-sim", "AGV-1", "r1"}}, 0.2});
+  vdabridge::BridgeOutbox out;
+  sim::test::Rig fresh;
+  auto st = fresh.vehicle.takeState(0.0, 0);
+  st.header.manufacturer = "fleet-sim";
+  bridge.onMqtt("uagv/v2/fleet-sim/AGV-1/state", vda5050::toJson(st).dump(), out);
+  msg::TaskAssignment assignment;
+  assignment.robot_id = "r1";
+  assignment.task_id = "t9";
+  assignment.goals = {{{2.0, 0.0, 0.0}, "P-1", msg::GoalAction::Load, 3.0}};
+  assignment.paused = true;
+  bridge.onAssignment(assignment, 0, out);
+  assignment.paused = false;
+  bridge.onAssignment(assignment, 0, out);
+  msg::TrafficRelease release;
+  release.robot_id = "r1";
+  release.base = {{0, 0.0, 0.0}, {1, 1.0, 0.0}, {2, 2.0, 0.0}};
+  release.ends_at_goal = true;
+  bridge.onRelease(release);
+  bridge.tick(0, out);
+  assignment.task_id.clear();
+  bridge.onAssignment(assignment, 0, out);
+  for (const auto& m : out.mqtt) {
+    const auto topic = m.topic.substr(m.topic.rfind('/') + 1);
+    std::cout << topic << '\t' << m.payload << '\n';
   }
   return 0;
 }
