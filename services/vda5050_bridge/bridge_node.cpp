@@ -74,8 +74,10 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t now_ns,
   }
   auto& v = it->second;
   if (a.task_id != v.task_id) {
-    if (!v.task_id.empty() && v.has_order) {
-      instant(v, "cancelOrder", now_ns, out);  // the task was taken away: stop where it is
+    // A task taken away: stop where it is. A new task simply goes on with the current order: the
+    // traffic manager's next releases extend it towards the new goal.
+    if (a.task_id.empty() && !v.task_id.empty() && v.has_order) {
+      instant(v, "cancelOrder", now_ns, out);
       ++counters_.cancels;
       v.has_order = false;
     }
@@ -181,6 +183,9 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
     return;  // the vehicle has not taken the order yet
   }
   auto up = v.builder.extend(in, s.lastNodeSequenceId, now_ns);
+  if (!up && up.error().code == "vda5050.bad_progress") {
+    return;  // its state is older than the order it took: wait for the next
+  }
   if (!up) {
     ++counters_.cannot_stitch;
     out.warnings.push_back(v.entry.robot_id + ": " + up.error().message);
@@ -251,6 +256,9 @@ void BridgeNode::tick(std::int64_t now_ns, BridgeOutbox& out) {
     Pose2 pose;
     if (s.agvPosition) {
       pose = {s.agvPosition->x, s.agvPosition->y, s.agvPosition->theta};
+      if (!v.home) {
+        v.home = pose;
+      }
     }
     if (online) {
       msg::RobotState rs;
@@ -279,6 +287,9 @@ void BridgeNode::tick(std::int64_t now_ns, BridgeOutbox& out) {
       p.has_goal = true;
       p.goal = v.goals[v.goal].pose;
       p.goal_station = v.goals[v.goal].station;
+    } else if (v.home) {
+      p.has_goal = true;
+      p.goal = *v.home;
     }
     p.holding = !online || acting || s.paused.value_or(false);
     p.blocked = s.safetyState.fieldViolation;

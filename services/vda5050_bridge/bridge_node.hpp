@@ -10,6 +10,8 @@
 //    carries the goal's pick or drop action.
 //  - Goals: a goal is reached when its action finished (pick, drop) or, without one, when the
 //    vehicle stands on the goal's node with nothing left of its order.
+//  - Idle: without a task the vehicle's goal is where it was first seen (its parking place), so the
+//    traffic manager takes it home and out of the way, as robot agents return home.
 //  - Health (vda5050::VehicleRegistry): a vehicle that is not online (MANUAL, a FATAL error, a
 //    message that fails the checks, its last will) publishes no RobotState, so the fleet manager
 //    loses it and re-queues its task as for our robots, and its TrafficProgress says it does not
@@ -87,6 +89,7 @@ class BridgeNode {
     msg::TaskState reported = msg::TaskState::Queued;
     bool cancel_sent = false;
     std::uint32_t instant_header = 0;
+    std::optional<Pose2> home;  // where it was first seen: it parks there when it has no task
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, BridgeOutbox& out);

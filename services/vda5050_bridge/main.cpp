@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <mutex>
@@ -28,11 +29,13 @@ struct Settings {
   mqtt::ClientOptions broker;
   vdabridge::BridgeSettings bridge;
   double rate_hz = 10.0;
+  bool sim_clock = false;  // stamps and timing from the simulator's Clock (load tests)
 };
 
 Settings readSettings(Config& c) {
   Settings s;
-  c.rejectUnknownKeys({"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "vehicles"});
+  c.rejectUnknownKeys({"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "vehicles", "clock"});
+  s.sim_clock = c.string("clock", "wall", {"wall", "sim"}) == "sim";
   auto b = c.child("broker", true);
   b.rejectUnknownKeys({"host", "port", "username", "password", "ca_file", "client_id"});
   s.broker.host = b.string("host", "127.0.0.1");
@@ -79,6 +82,8 @@ int run(const Settings& settings) {
   transport::Writer<msg::RobotState> states(p);
   transport::Writer<msg::TaskStatus> statuses(p);
   transport::Writer<msg::TrafficProgress> progress(p);
+  transport::Reader<msg::Clock> clockIn(p);
+  std::int64_t simNow = -1;
   service::RateLimitedLog log;
   spdlog::info("vda5050 bridge: {} vehicle(s), broker {}:{}{}, map '{}'", settings.bridge.vehicles.size(),
                settings.broker.host, settings.broker.port,
@@ -91,7 +96,13 @@ int run(const Settings& settings) {
   while (!service::stopRequested()) {
     std::this_thread::sleep_until(next);
     next += period;
-    const auto now = wall.nowNs();
+    for (const auto& c : clockIn.take()) {
+      simNow = std::max(simNow, c.sim_time_ns);
+    }
+    if (settings.sim_clock && simNow < 0) {
+      continue;  // no simulated time yet
+    }
+    const auto now = settings.sim_clock ? simNow : wall.nowNs();
     vdabridge::BridgeOutbox out;
     std::deque<std::pair<std::string, std::string>> batch;
     {

@@ -67,8 +67,12 @@ OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
       action_states_.clear();
       running_.clear();
       errors_.clear();
-      // The first node is where the vehicle stands: reached at once when within tolerance.
       waiting_for_base_ = false;
+      // The first node is where the vehicle stands (the rules checked it): its state says so from
+      // the first message on (the next step reaches it and runs its actions).
+      if (!order_->nodes.empty() && !last_node_id_.empty() && order_->nodes.front().nodeId == last_node_id_) {
+        last_node_seq_ = order_->nodes.front().sequenceId;
+      }
       break;
     }
     case OrderDecision::kAcceptUpdate: {

@@ -2,6 +2,7 @@
 
 #include <mosquitto.h>
 
+#include <chrono>
 #include <mutex>
 
 namespace fleet::mqtt {
@@ -53,27 +54,55 @@ Expected<std::unique_ptr<Client>> Client::start(ClientOptions options, MessageHa
   mosquitto_connect_callback_set(c->handle_, &Client::onConnect);
   mosquitto_disconnect_callback_set(c->handle_, &Client::onDisconnect);
   mosquitto_message_callback_set(c->handle_, &Client::onMessage);
-  // Short, capped back-off: a restarted broker is found again within a second.
-  mosquitto_reconnect_delay_set(c->handle_, 1, 1, false);
-  // connect_async never blocks on a broker that is down; the loop thread keeps retrying.
-  int rc = mosquitto_connect_async(c->handle_, c->options_.host.c_str(), c->options_.port,
-                                   c->options_.keepalive_s);
-  if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO) {
+  mosquitto_threaded_set(c->handle_, true);
+  // The first attempt here, so that bad options fail at once; a broker that is down (refused,
+  // unreachable) is tried again by the network thread.
+  const int rc = mosquitto_connect_async(c->handle_, c->options_.host.c_str(), c->options_.port,
+                                         c->options_.keepalive_s);
+  if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO && rc != MOSQ_ERR_EAI) {
     return unexpected("mqtt.connect", "mqtt: connect to " + c->options_.host + ":" +
                                           std::to_string(c->options_.port) + ": " + mosquitto_strerror(rc));
   }
-  rc = mosquitto_loop_start(c->handle_);
-  if (rc != MOSQ_ERR_SUCCESS) {
-    return unexpected("mqtt.thread", std::string("mqtt: loop_start: ") + mosquitto_strerror(rc));
-  }
+  auto* raw = c.get();
+  const bool first_ok = rc == MOSQ_ERR_SUCCESS;
+  c->thread_ = std::thread([raw, first_ok] {
+    bool have_socket = first_ok;
+    while (true) {
+      if (!have_socket) {
+        // Once a second, in short sleeps so that stopping is quick.
+        for (int i = 0; i < 20 && !raw->stopping_.load(); ++i) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+        if (raw->stopping_.load()) {
+          return;
+        }
+        have_socket = mosquitto_reconnect_async(raw->handle_) == MOSQ_ERR_SUCCESS;
+        continue;
+      }
+      if (mosquitto_loop(raw->handle_, 100, 1) != MOSQ_ERR_SUCCESS) {
+        have_socket = false;
+        raw->connected_.store(false);
+      }
+    }
+  });
   return c;
 }
 
 Client::~Client() {
   if (handle_ != nullptr) {
     // A clean disconnect: the broker drops the last will (it is for connections that break).
+    if (connected_.load()) {
+      // Give queued messages (an OFFLINE before the disconnect) a moment to leave.
+      for (int i = 0; i < 20 && mosquitto_want_write(handle_); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+    // The network thread sends the disconnect and, its socket closed, sees stopping_ and ends.
+    stopping_.store(true);
     mosquitto_disconnect(handle_);
-    mosquitto_loop_stop(handle_, false);
+    if (thread_.joinable()) {
+      thread_.join();
+    }
     mosquitto_destroy(handle_);
   }
 }

@@ -127,6 +127,16 @@ TEST(Vda5050Broker, OverTlsTheVehicleConnectsAndAPlainClientCannot) {
   EXPECT_FALSE(mqtt::Client::start(bad, {}));
 }
 
+TEST(Vda5050Broker, AClientStartedBeforeTheBrokerConnectsWhenItComesUp) {
+  MosquittoBroker broker(kVehicles);
+  broker.stop();
+  Recorder early(broker.port(), MosquittoBroker::kMasterUser, MosquittoBroker::kMasterPassword, "early");
+  std::this_thread::sleep_for(1500ms);  // a failed first attempt or two
+  EXPECT_FALSE(early.client->connected());
+  broker.start();
+  EXPECT_TRUE(waitFor([&] { return early.client->connected(); }, 15s));
+}
+
 TEST(Vda5050Broker, WrongCredentialsAreRefused) {
   MosquittoBroker broker(kVehicles);
   Recorder intruder(broker.port(), "acme-A1", "guessed", "intruder");

@@ -1,8 +1,9 @@
 #pragma once
 
-// RAII over one libmosquitto client with its own network thread. libmosquitto reconnects by itself
-// after a lost connection or a broker restart; the client subscribes again on every connect, so a
-// caller never has to notice a restart except through connected() and the counters.
+// RAII over one libmosquitto client with its own network thread, which connects, and connects
+// again after a lost connection or a broker restart (or when the broker was not up yet), once a
+// second; the client subscribes again on every connect, so a caller never has to notice a restart
+// except through connected() and the counters.
 
 #include <atomic>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
@@ -79,6 +81,8 @@ class Client {
   std::atomic<bool> connected_{false};
   std::atomic<std::uint64_t> connects_{0};
   std::atomic<std::uint64_t> refusals_{0};
+  std::atomic<bool> stopping_{false};
+  std::thread thread_;
 };
 
 }  // namespace fleet::mqtt
