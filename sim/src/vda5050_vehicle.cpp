@@ -234,8 +234,10 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     if (stop_here) {
       vmax = std::min(vmax, 0.2 + 0.8 * dist);
     }
+    // Turn on the spot, then drive straight: the roadmap's edges are straight and keep clear of
+    // shelves only along them (driving while turning cut corners into shelves, 2026-11-26).
     cmd.w = std::clamp(2.0 * err, -config_.maxTurnRate, config_.maxTurnRate);
-    cmd.v = std::abs(err) > 0.6 ? 0.0 : vmax * std::cos(err);
+    cmd.v = std::abs(err) > 0.1 ? 0.0 : vmax;
     break;
   }
   const bool at_base_end = order_ && next_ < order_->nodes.size() && !order_->nodes[next_].released;
