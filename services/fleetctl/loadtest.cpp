@@ -768,7 +768,8 @@ int Run::run() {
   }
   // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
   // only when all have registered (a traffic manager it does not wait for falls behind the robots).
-  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0);
+  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0) +
+                           (vdaVehiclesFile.empty() ? 0 : 1);  // the VDA 5050 bridge
   std::vector<std::string> simArgs = {"--scenario",     scn,
                                       "--duration",     std::to_string(o.durationS),
                                       "--replay",       fs::absolute(out / "replay.jsonl.gz").string(),

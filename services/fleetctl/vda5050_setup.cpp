@@ -99,6 +99,7 @@ Expected<Vda5050Run> prepareVda5050(const fs::path& out, const std::vector<std::
              json{{"broker", {{"port", port}, {"username", "master"}, {"password", master_password}}},
                   {"map_id", map_id},
                   {"clock", sim_clock ? "sim" : "wall"},
+                  {"lockstep", sim_clock},
                   {"vehicles", bridge_vehicles}}
                  .dump(1))) {
     return unexpected("loadtest.vda5050", "cannot write the VDA 5050 files under " + out.string());

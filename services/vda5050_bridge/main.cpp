@@ -30,12 +30,20 @@ struct Settings {
   vdabridge::BridgeSettings bridge;
   double rate_hz = 10.0;
   bool sim_clock = false;  // stamps and timing from the simulator's Clock (load tests)
+  bool lockstep = false;   // ... and a lockstep participant (implies sim_clock)
 };
+
+constexpr const char* kParticipant = "vda5050_bridge";
 
 Settings readSettings(Config& c) {
   Settings s;
-  c.rejectUnknownKeys({"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "vehicles", "clock"});
+  c.rejectUnknownKeys(
+      {"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "vehicles", "clock", "lockstep"});
   s.sim_clock = c.string("clock", "wall", {"wall", "sim"}) == "sim";
+  s.lockstep = c.boolean("lockstep", false);
+  if (s.lockstep && !s.sim_clock) {
+    c.problem("lockstep", "needs \"clock\": \"sim\"");
+  }
   auto b = c.child("broker", true);
   b.rejectUnknownKeys({"host", "port", "username", "password", "ca_file", "client_id"});
   s.broker.host = b.string("host", "127.0.0.1");
@@ -83,6 +91,7 @@ int run(const Settings& settings) {
   transport::Writer<msg::TaskStatus> statuses(p);
   transport::Writer<msg::TrafficProgress> progress(p);
   transport::Reader<msg::Clock> clockIn(p);
+  transport::Writer<msg::StepDone> stepDone(p);
   std::int64_t simNow = -1;
   service::RateLimitedLog log;
   spdlog::info("vda5050 bridge: {} vehicle(s), broker {}:{}{}, map '{}'", settings.bridge.vehicles.size(),
@@ -93,16 +102,7 @@ int run(const Settings& settings) {
   auto next = std::chrono::steady_clock::now();
   auto lastStats = next;
   bool wasConnected = false;
-  while (!service::stopRequested()) {
-    std::this_thread::sleep_until(next);
-    next += period;
-    for (const auto& c : clockIn.take()) {
-      simNow = std::max(simNow, c.sim_time_ns);
-    }
-    if (settings.sim_clock && simNow < 0) {
-      continue;  // no simulated time yet
-    }
-    const auto now = settings.sim_clock ? simNow : wall.nowNs();
+  const auto cycle = [&](std::int64_t now) {
     vdabridge::BridgeOutbox out;
     std::deque<std::pair<std::string, std::string>> batch;
     {
@@ -151,6 +151,39 @@ int run(const Settings& settings) {
           c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch);
       lastStats = std::chrono::steady_clock::now();
     }
+  };
+
+  if (settings.lockstep) {
+    // A lockstep participant: one cycle per simulated step, acknowledged, so that the bridge keeps
+    // pace with the vehicles however fast or loaded the machine.
+    bool registered = false;
+    auto lastRegister = std::chrono::steady_clock::now() - 10s;
+    while (!service::stopRequested()) {
+      if (!registered && std::chrono::steady_clock::now() - lastRegister > 1s) {
+        stepDone.write({kParticipant, msg::StepDone::kRegister});
+        lastRegister = std::chrono::steady_clock::now();
+      }
+      clockIn.waitForData(100ms);
+      for (const auto& c : clockIn.take()) {
+        registered = true;
+        cycle(c.sim_time_ns);
+        if (c.lockstep) {
+          stepDone.write({kParticipant, c.step});
+        }
+      }
+    }
+    stepDone.write({kParticipant, msg::StepDone::kLeave});
+  }
+  while (!settings.lockstep && !service::stopRequested()) {
+    std::this_thread::sleep_until(next);
+    next += period;
+    for (const auto& c : clockIn.take()) {
+      simNow = std::max(simNow, c.sim_time_ns);
+    }
+    if (settings.sim_clock && simNow < 0) {
+      continue;  // no simulated time yet
+    }
+    cycle(settings.sim_clock ? simNow : wall.nowNs());
   }
   spdlog::info("vda5050 bridge: stopped");
   return 0;
