@@ -213,7 +213,12 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
       reachNode(now_s);  // a node without a position is a logical one: nothing to drive to
       continue;
     }
-    const double tol = std::max(config_.nodeTolerance, n.nodePosition->allowedDeviationXY.value_or(0.0));
+    // The node to stop on is approached slowly and reached closely: stops are at docks and parking
+    // places next to shelves, where braking late from speed ran the vehicle into the shelf.
+    const bool stop_here = next_ + 1 >= order_->nodes.size() || !order_->nodes[next_ + 1].released;
+    const double tol =
+        stop_here ? std::min(config_.nodeTolerance, 0.1)
+                  : std::max(config_.nodeTolerance, n.nodePosition->allowedDeviationXY.value_or(0.0));
     const double dx = n.nodePosition->x - pose.x;
     const double dy = n.nodePosition->y - pose.y;
     const double dist = std::hypot(dx, dy);
@@ -229,10 +234,8 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     if (next_ > 0 && next_ - 1 < order_->edges.size() && order_->edges[next_ - 1].maxSpeed) {
       vmax = std::min(vmax, *order_->edges[next_ - 1].maxSpeed);
     }
-    // Slow down for the last base node so the vehicle stops on it instead of overshooting.
-    const bool stop_here = next_ + 1 >= order_->nodes.size() || !order_->nodes[next_ + 1].released;
     if (stop_here) {
-      vmax = std::min(vmax, 0.2 + 0.8 * dist);
+      vmax = std::min(vmax, 0.05 + 0.6 * dist);
     }
     // Turn on the spot, then drive straight: the roadmap's edges are straight and keep clear of
     // shelves only along them (driving while turning cut corners into shelves, 2026-11-26).
