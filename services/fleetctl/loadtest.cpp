@@ -32,6 +32,7 @@
 #include "scenario_tasks.hpp"
 #include "supervisor.hpp"
 #include "task_ledger.hpp"
+#include "vda5050_setup.hpp"
 
 namespace fleet::ctl {
 namespace {
@@ -156,6 +157,7 @@ struct Run {
   json scenario;
   std::vector<std::string> agentNames;
   std::map<std::string, std::string> agentOfRobot;
+  std::string vdaVehiclesFile;  // fleet-sim --vda5050; empty: no VDA 5050 vehicles
   std::vector<Fault> faults;
   std::vector<bool> faultStarted, faultEnded;
   std::vector<Clock::time_point> faultEndAt;
@@ -647,6 +649,27 @@ int Run::run() {
                      env,
                      log("traffic_manager")});
   }
+  // VDA 5050 vehicles: the last N robots, with a broker and the bridge of their own.
+  std::set<std::string> vdaRobots;
+  if (o.vda5050 > 0) {
+    if (o.traffic != "reserved" || o.vda5050 > static_cast<int>(robots.size())) {
+      std::cerr << "fleetctl loadtest: --vda5050 " << o.vda5050 << " needs --traffic reserved and at most "
+                << robots.size() << " robots\n";
+      return 2;
+    }
+    const std::vector<std::string> ids(robots.end() - o.vda5050, robots.end());
+    vdaRobots.insert(ids.begin(), ids.end());
+    auto site = service::loadSiteFile(scenario["site"].get<std::string>());
+    auto vda = prepareVda5050(out, ids, site ? site->name : std::string("site"), freePort(),
+                              bin("services/vda5050_bridge/vda5050_bridge"), env, !o.wallClock);
+    if (!vda) {
+      std::cerr << "fleetctl loadtest: " << vda.error().message << "\n";
+      return 1;
+    }
+    specs.insert(specs.begin(), vda->broker);
+    specs.push_back(vda->bridge);
+    vdaVehiclesFile = vda->vehicles_file.string();
+  }
   // Robots: a process of their own for each stalled robot, the rest round robin over --agents.
   std::set<std::string> alone;
   for (const auto& f : faults) {
@@ -657,6 +680,9 @@ int Run::run() {
   std::vector<std::vector<std::string>> groups(static_cast<std::size_t>(o.agents));
   std::size_t next = 0;
   for (const auto& r : robots) {
+    if (vdaRobots.count(r)) {
+      continue;
+    }
     if (alone.count(r)) {
       agentOfRobot[r] = "agent-" + r;
       continue;
@@ -782,7 +808,8 @@ int Run::run() {
   }
   // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
   // only when all have registered (a traffic manager it does not wait for falls behind the robots).
-  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0);
+  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0) +
+                           (vdaVehiclesFile.empty() ? 0 : 1);  // the VDA 5050 bridge
   std::vector<std::string> simArgs = {"--scenario",     scn,
                                       "--duration",     std::to_string(o.durationS),
                                       "--replay",       fs::absolute(out / "replay.jsonl.gz").string(),
@@ -796,6 +823,9 @@ int Run::run() {
       simArgs.insert(simArgs.begin(),
                      {"--hide-landmarks", describe(f).substr(std::string("hide-landmarks@").size())});
     }
+  }
+  if (!vdaVehiclesFile.empty()) {
+    simArgs.insert(simArgs.begin(), {"--vda5050", vdaVehiclesFile});
   }
   if (o.wallClock) {
     simArgs.emplace_back("wall");

@@ -54,6 +54,9 @@ struct LoadtestOptions {
   /// long simulated ones.
   double maxSpeed = 4.0;
   double progressEveryS = 2.0;
+  /// The last N robots of the scenario run as VDA 5050 vehicles (fleet-sim --vda5050) behind a
+  /// vda5050_bridge and a Mosquitto broker of the run's own; needs reserved traffic.
+  int vda5050 = 0;
 };
 
 /// Runs the load test; returns the process exit code (0 ok, 3 lost or duplicated tasks, 1 error,

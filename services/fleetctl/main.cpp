@@ -190,6 +190,12 @@ int main(int argc, char** argv) {
   loadtest->add_option("--step-timeout-ms", lt.stepTimeoutMs, "lockstep step timeout of the simulator")
       ->check(CLI::Range(10, 60000))
       ->capture_default_str();
+  loadtest
+      ->add_option(
+          "--vda5050", lt.vda5050,
+          "the last N robots are VDA 5050 vehicles (simulated, over a Mosquitto broker of the run's own, "
+          "behind vda5050_bridge); needs --traffic reserved")
+      ->check(CLI::NonNegativeNumber);
   loadtest->add_flag("--wall-clock", lt.wallClock,
                      "run every service on the wall clock at 1x, as in production (default: lockstep); "
                      "reports the robot agents' achieved control rate");

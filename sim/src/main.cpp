@@ -21,6 +21,7 @@
 #include "fleet/sim/localization_error.hpp"
 #include "fleet/sim/lockstep.hpp"
 #include "fleet/sim/replay.hpp"
+#include "fleet/sim/vda5050_fleet.hpp"
 #include "fleet/sim/world.hpp"
 #include "fleet/transport/dds.hpp"
 
@@ -111,6 +112,7 @@ struct Options {
   bool noScan = false;
   bool validateOnly = false;
   std::string makeViewerFrom;  // convert an existing replay to HTML and exit
+  std::string vda5050;         // config of the robots that are VDA 5050 vehicles; empty: none
 };
 
 const char* kUsage =
@@ -119,7 +121,7 @@ const char* kUsage =
     "                 [--max-speed F] [--sensor-outage ROBOT@T+D ...] [--hide-landmarks T+D ...]\n"
     "                 [--localization OUT.json]\n"
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
-    "                 [--validate] [--log-level LEVEL]\n"
+    "                 [--vda5050 VEHICLES.json] [--validate] [--log-level LEVEL]\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
 
 bool parseArgs(int argc, char** argv, Options& o) {
@@ -167,6 +169,8 @@ bool parseArgs(int argc, char** argv, Options& o) {
       o.html = next();
     } else if (a == "--log-level") {
       o.logLevel = next();
+    } else if (a == "--vda5050") {
+      o.vda5050 = next();
     } else if (a == "--no-scan") {
       o.noScan = true;
     } else if (a == "--validate") {
@@ -233,6 +237,23 @@ class Simulator {
         errors_(1.0, o.hiddenLandmarks) {}
 
   int run() {
+    if (!o_.vda5050.empty()) {
+      sim::Vda5050FleetConfig config;
+      try {
+        config = sim::readVda5050FleetConfig(Config::fromFile(o_.vda5050));
+      } catch (const ConfigError& e) {
+        spdlog::error("--vda5050: {}", e.what());
+        return 2;
+      }
+      auto fleet = sim::Vda5050Fleet::start(config, w_);
+      if (!fleet) {
+        spdlog::error("{}", fleet.error().message);
+        return 2;
+      }
+      vda_ = std::move(*fleet);
+      spdlog::info("vda5050: {} robot(s) are VDA 5050 vehicles on broker {}:{}", config.vehicles.size(),
+                   config.host, config.port);
+    }
     if (!o_.replay.empty()) {
       auto r = sim::ReplayWriter::open(o_.replay);
       if (!r) {
@@ -275,6 +296,7 @@ class Simulator {
         pollStepDone();
       }
       applyCommands();
+      stepVehicles();
       w_.advance();
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -350,6 +372,18 @@ class Simulator {
     }
   }
 
+  void stepVehicles() {
+    if (!vda_) {
+      return;
+    }
+    vda_->step(w_, w_.time(), stamp());
+    for (const auto& warning : vda_->takeWarnings()) {
+      if (++vdaWarnings_ <= 50) {
+        spdlog::warn("vda5050: {}", warning);
+      }
+    }
+  }
+
   void publish() {
     const std::int64_t st = stamp();
     const double now = static_cast<double>(w_.timeNs()) * 1e-9;
@@ -370,7 +404,7 @@ class Simulator {
       const bool silent = std::any_of(o_.outages.begin(), o_.outages.end(), [&](const SensorOutage& o) {
         return w_.robotIndex(o.robot) == static_cast<int>(r.robot) && now >= o.fromS && now < o.toS;
       });
-      if (!silent) {
+      if (!silent && !(vda_ && vda_->controls(r.robot))) {
         sensorW_.write(toMsg(w_, r, st));
       }
     }
@@ -424,7 +458,14 @@ class Simulator {
   }
 
   int finish(double wallS) {
-    const auto s = sim::summary(w_);
+    auto s = sim::summary(w_);
+    if (vda_) {
+      s["vda5050"] = {{"states_sent", vda_->counters().states_sent},
+                      {"refused_messages", vda_->counters().refused_messages},
+                      {"rejected_orders", vda_->counters().rejected_orders},
+                      {"base_starved_stops", vda_->baseStarvedStops()}};
+      vda_.reset();  // OFFLINE on the connection topic, then a clean disconnect
+    }
     if (replay_) {
       if (auto r = replay_->close(); !r) {
         spdlog::error("{}", r.error().message);
@@ -483,6 +524,8 @@ class Simulator {
   std::optional<sim::ReplayWriter> replay_;
   sim::LocalizationErrorLog errors_;
   int ignoredLogged_ = 0;
+  std::unique_ptr<sim::Vda5050Fleet> vda_;
+  int vdaWarnings_ = 0;
 };
 
 }  // namespace

@@ -1,0 +1,36 @@
+#pragma once
+
+// The header every VDA 5050 message starts with, and the topic layout
+// interfaceName/majorVersion/manufacturer/serialNumber/topic (specification 2.1, section 6.1).
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace fleet::vda5050 {
+
+inline constexpr const char* kVersion = "2.1.0";
+inline constexpr const char* kMajorVersion = "v2";
+inline constexpr const char* kDefaultInterface = "uagv";
+
+struct Header {
+  std::uint32_t headerId = 0;
+  std::string timestamp;  // ISO 8601 UTC, "2026-11-26T03:00:00.000Z"
+  std::string version = kVersion;
+  std::string manufacturer;
+  std::string serialNumber;
+};
+
+/// "uagv/v2/<manufacturer>/<serialNumber>/<topic>".
+std::string topicName(const std::string& interface_name, const std::string& manufacturer,
+                      const std::string& serial, const std::string& topic);
+/// The subtree a vehicle is confined to: "uagv/v2/<manufacturer>/<serialNumber>/#".
+std::string vehicleSubtree(const std::string& interface_name, const std::string& manufacturer,
+                           const std::string& serial);
+/// ISO 8601 UTC with milliseconds for nanoseconds since the epoch.
+std::string isoTimestamp(std::int64_t ns_since_epoch);
+
+void writeHeader(nlohmann::json& j, const Header& h);
+
+}  // namespace fleet::vda5050

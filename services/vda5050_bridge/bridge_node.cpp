@@ -1,0 +1,302 @@
+#include "bridge_node.hpp"
+
+#include <algorithm>
+
+#include "fleet/vda5050/header.hpp"
+#include "fleet/vda5050/instant_actions.hpp"
+
+namespace fleet::vdabridge {
+
+using vda5050::VehicleHealth;
+
+namespace {
+
+const vda5050::ActionState* findAction(const vda5050::State& s, const std::string& id) {
+  for (const auto& a : s.actionStates) {
+    if (a.actionId == id) {
+      return &a;
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+BridgeNode::BridgeNode(BridgeSettings settings)
+    : settings_(std::move(settings)),
+      registry_(settings_.interface_name, settings_.map_id, settings_.vehicles) {
+  for (const auto& e : settings_.vehicles) {
+    vehicles_.emplace(e.robot_id,
+                      Vehicle(e, vda5050::OrderBuilder({e.manufacturer, e.serial, settings_.map_id,
+                                                        settings_.allowed_deviation})));
+  }
+}
+
+std::string BridgeNode::goalActionId(const Vehicle& v, std::size_t goal) const {
+  return v.task_id + "-g" + std::to_string(goal);
+}
+
+void BridgeNode::onMqtt(const std::string& topic, const std::string& payload, BridgeOutbox& out) {
+  const auto r = registry_.onMessage(topic, payload);
+  if (!r.accepted && !r.reason.empty()) {
+    ++counters_.refused_messages;
+    out.warnings.push_back((r.robot_id.empty() ? std::string("?") : r.robot_id) + ": refused: " + r.reason);
+  }
+  if (r.health_changed) {
+    const auto* v = registry_.find(r.robot_id);
+    out.warnings.push_back(r.robot_id + ": " + vda5050::toString(v->health) +
+                           (v->reason.empty() ? std::string() : " (" + v->reason + ")"));
+  }
+}
+
+void BridgeNode::instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out) {
+  vda5050::InstantActions ia;
+  ia.header = {v.instant_header++, vda5050::isoTimestamp(nowNs), vda5050::kVersion, v.entry.manufacturer,
+               v.entry.serial};
+  ia.actions.push_back({type, type + "-" + std::to_string(ia.header.headerId), "HARD", {}, {}});
+  out.mqtt.push_back(
+      {vda5050::topicName(settings_.interface_name, v.entry.manufacturer, v.entry.serial, "instantActions"),
+       vda5050::toJson(ia).dump(), 0, false});
+}
+
+void BridgeNode::sendOrder(Vehicle& v, const vda5050::Order& o, BridgeOutbox& out) {
+  registry_.ordered(v.entry.robot_id, o);
+  out.mqtt.push_back(
+      {vda5050::topicName(settings_.interface_name, v.entry.manufacturer, v.entry.serial, "order"),
+       vda5050::toJson(o).dump(), 0, false});
+  ++(o.orderUpdateId == 0 ? counters_.orders : counters_.updates);
+}
+
+void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, BridgeOutbox& out) {
+  auto it = vehicles_.find(a.robot_id);
+  if (it == vehicles_.end()) {
+    return;
+  }
+  auto& v = it->second;
+  if (a.task_id != v.task_id) {
+    // A task taken away: stop where it is. A new task simply goes on with the current order: the
+    // traffic manager's next releases extend it towards the new goal.
+    if (a.task_id.empty() && !v.task_id.empty() && v.has_order) {
+      instant(v, "cancelOrder", nowNs, out);
+      ++counters_.cancels;
+      v.has_order = false;
+    }
+    v.task_id = a.task_id;
+    v.goal = 0;
+    v.reported = msg::TaskState::Queued;
+  }
+  v.revision = a.revision;
+  v.goals = a.goals;
+  if (a.paused != v.paused) {
+    v.paused = a.paused;
+    instant(v, a.paused ? "startPause" : "stopPause", nowNs, out);
+  }
+  reportTask(v, nowNs, out);
+}
+
+void BridgeNode::onRelease(const msg::TrafficRelease& r) {
+  auto it = vehicles_.find(r.robot_id);
+  if (it != vehicles_.end()) {
+    it->second.release = r;
+  }
+}
+
+void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
+  while (!v.task_id.empty() && v.goal < v.goals.size()) {
+    const auto& g = v.goals[v.goal];
+    if (g.action == msg::GoalAction::Load || g.action == msg::GoalAction::Unload) {
+      const auto* a = findAction(*view.state, goalActionId(v, v.goal));
+      if (a == nullptr || a->actionStatus != "FINISHED") {
+        return;
+      }
+    } else {
+      const bool there =
+          v.release && v.release->ends_at_goal && !v.release->base.empty() &&
+          view.state->nodeStates.empty() &&
+          vda5050::OrderBuilder::roadmapNode(view.state->lastNodeId) == v.release->base.back().node;
+      if (!there) {
+        return;
+      }
+    }
+    ++v.goal;
+  }
+}
+
+void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
+                               BridgeOutbox& out) {
+  if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline) {
+    return;
+  }
+  const auto& r = *v.release;
+  vda5050::ReleaseInput in;
+  for (const auto& n : r.base) {
+    in.base.push_back({n.node, n.x, n.y});
+  }
+  for (const auto& n : r.horizon) {
+    in.horizon.push_back({n.node, n.x, n.y});
+  }
+  if (r.ends_at_goal && !v.task_id.empty() && v.goal < v.goals.size()) {
+    const auto& g = v.goals[v.goal];
+    if (g.action == msg::GoalAction::Load || g.action == msg::GoalAction::Unload) {
+      vda5050::Action a{
+          g.action == msg::GoalAction::Load ? "pick" : "drop", goalActionId(v, v.goal), "HARD", {}, {}};
+      if (!g.station.empty()) {
+        a.actionParameters.push_back({"stationId", g.station});
+      }
+      a.actionParameters.push_back({"duration", g.duration_s});
+      in.actions.emplace_back(r.base.back().node, std::move(a));
+    }
+  }
+  const auto& s = *view.state;
+  if (!v.has_order) {
+    if (!s.nodeStates.empty()) {
+      if (!v.cancel_sent) {  // an order of someone else's (a previous bridge): end it first
+        instant(v, "cancelOrder", nowNs, out);
+        ++counters_.cancels;
+        v.cancel_sent = true;
+      }
+      return;
+    }
+    // A new order starts where the vehicle stands: drop the release's nodes it has passed.
+    const int at = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
+    const auto here =
+        std::find_if(in.base.begin(), in.base.end(), [&](const auto& n) { return n.node == at; });
+    if (here != in.base.end()) {
+      in.base.erase(in.base.begin(), here);
+    }
+    if (in.base.size() < 2 && in.actions.empty()) {
+      return;  // holding on the node it stands on: nothing to drive
+    }
+    const std::string id =
+        (v.task_id.empty() ? v.entry.robot_id : v.task_id) + "-" + std::to_string(++v.orders_started);
+    auto o = v.builder.start(id, in, nowNs);
+    if (!o) {
+      out.warnings.push_back(v.entry.robot_id + ": " + o.error().message);
+      return;
+    }
+    v.has_order = true;
+    v.cancel_sent = false;
+    sendOrder(v, *o, out);
+    return;
+  }
+  if (s.orderId != v.builder.orderId()) {
+    return;  // the vehicle has not taken the order yet
+  }
+  auto up = v.builder.extend(in, s.lastNodeSequenceId, nowNs);
+  if (!up && up.error().code == "vda5050.bad_progress") {
+    return;  // its state is older than the order it took: wait for the next
+  }
+  if (!up) {
+    ++counters_.cannot_stitch;
+    out.warnings.push_back(v.entry.robot_id + ": " + up.error().message);
+    if (s.nodeStates.empty()) {
+      v.has_order = false;  // finished: the next tick starts a new order from where it stands
+    } else if (!v.cancel_sent) {
+      instant(v, "cancelOrder", nowNs, out);
+      ++counters_.cancels;
+      v.cancel_sent = true;
+      v.has_order = false;
+    }
+    return;
+  }
+  if (up->has_value()) {
+    sendOrder(v, **up, out);
+  }
+}
+
+void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
+  if (v.task_id.empty()) {
+    return;
+  }
+  msg::TaskState st = msg::TaskState::Assigned;
+  const auto* view = registry_.find(v.entry.robot_id);
+  if (v.goal >= v.goals.size()) {
+    st = msg::TaskState::Done;
+  } else if (view != nullptr && view->state && v.has_order) {
+    const auto& g = v.goals[v.goal];
+    const auto* a = findAction(*view->state, goalActionId(v, v.goal));
+    const bool running = a != nullptr && (a->actionStatus == "RUNNING" || a->actionStatus == "INITIALIZING");
+    if (g.action == msg::GoalAction::Load) {
+      st = running ? msg::TaskState::Loading : msg::TaskState::EnRoute;
+    } else if (g.action == msg::GoalAction::Unload) {
+      st = running ? msg::TaskState::Unloading : msg::TaskState::Delivering;
+    } else {
+      st = msg::TaskState::EnRoute;
+    }
+  }
+  if (st == v.reported) {
+    return;
+  }
+  v.reported = st;
+  msg::TaskStatus ts;
+  ts.robot_id = v.entry.robot_id;
+  ts.task_id = v.task_id;
+  ts.revision = v.revision;
+  ts.state = st;
+  ts.progress = v.goals.empty() ? 1.0F : static_cast<float>(v.goal) / static_cast<float>(v.goals.size());
+  ts.stamp_ns = nowNs;
+  out.statuses.push_back(std::move(ts));
+}
+
+void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
+  for (auto& [id, v] : vehicles_) {
+    const auto* view = registry_.find(id);
+    if (view == nullptr || !view->state) {
+      continue;
+    }
+    const auto& s = *view->state;
+    const bool online = view->health == VehicleHealth::kOnline;
+    if (online) {
+      trackGoals(v, *view);
+      followRelease(v, *view, nowNs, out);
+      reportTask(v, nowNs, out);
+    }
+    const bool acting = std::any_of(s.actionStates.begin(), s.actionStates.end(),
+                                    [](const auto& a) { return a.actionStatus == "RUNNING"; });
+    Pose2 pose;
+    if (s.agvPosition) {
+      pose = {s.agvPosition->x, s.agvPosition->y, s.agvPosition->theta};
+      if (!v.home) {
+        v.home = pose;
+      }
+    }
+    if (online) {
+      msg::RobotState rs;
+      rs.robot_id = id;
+      rs.stamp_ns = nowNs;
+      rs.pose = pose;
+      rs.v = s.velocity ? s.velocity->vx : 0.0;
+      rs.w = s.velocity ? s.velocity->omega : 0.0;
+      rs.mode = acting                                                           ? msg::RobotMode::Loading
+                : (s.paused.value_or(false) || s.newBaseRequest.value_or(false)) ? msg::RobotMode::Waiting
+                : s.driving                                                      ? msg::RobotMode::Moving
+                                                                                 : msg::RobotMode::Idle;
+      rs.battery = static_cast<float>(s.batteryState.batteryCharge / 100.0);
+      rs.task_id = v.task_id;
+      rs.radius = view->factsheet
+                      ? static_cast<float>(std::max(view->factsheet->width, view->factsheet->length) / 2.0)
+                      : 0.3F;
+      out.states.push_back(std::move(rs));
+    }
+    msg::TrafficProgress p;
+    p.robot_id = id;
+    p.epoch = v.release ? v.release->epoch : 0;
+    p.node = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
+    p.pose = pose;
+    if (!v.task_id.empty() && v.goal < v.goals.size()) {
+      p.has_goal = true;
+      p.goal = v.goals[v.goal].pose;
+      p.goal_station = v.goals[v.goal].station;
+    } else if (v.home) {
+      p.has_goal = true;
+      p.goal = *v.home;
+    }
+    p.holding = !online || acting || s.paused.value_or(false);
+    p.blocked = s.safetyState.fieldViolation;
+    p.follows = online;
+    p.stamp_ns = nowNs;
+    out.progress.push_back(std::move(p));
+  }
+}
+
+}  // namespace fleet::vdabridge

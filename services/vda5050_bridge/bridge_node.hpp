@@ -1,0 +1,108 @@
+#pragma once
+
+// The VDA 5050 bridge without its DDS and MQTT wiring: for each configured vehicle it plays the
+// part a robot agent plays for our own robots. Task assignments and the traffic manager's releases
+// come in; orders and instant actions go out to the vehicle; the vehicle's state becomes the
+// robot's RobotState, TrafficProgress and TaskStatus.
+//
+//  - Releases: the latest release of a vehicle is turned into an order or an update
+//    (vda5050::OrderBuilder) whenever it adds to what was sent; a release ending at the goal
+//    carries the goal's pick or drop action.
+//  - Goals: a goal is reached when its action finished (pick, drop) or, without one, when the
+//    vehicle stands on the goal's node with nothing left of its order.
+//  - Idle: without a task the vehicle's goal is where it was first seen (its parking place), so the
+//    traffic manager takes it home and out of the way, as robot agents return home.
+//  - Health (vda5050::VehicleRegistry): a vehicle that is not online (MANUAL, a FATAL error, a
+//    message that fails the checks, its last will) publishes no RobotState, so the fleet manager
+//    loses it and re-queues its task as for our robots, and its TrafficProgress says it does not
+//    follow releases, so the traffic manager plans around it.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/messages/messages.hpp"
+#include "fleet/vda5050/order_builder.hpp"
+#include "fleet/vda5050/vehicle_registry.hpp"
+
+namespace fleet::vdabridge {
+
+struct BridgeSettings {
+  std::string interface_name = "uagv";
+  std::string map_id;
+  std::vector<vda5050::VehicleEntry> vehicles;
+  double allowed_deviation = 0.2;  // m, the orders' allowedDeviationXY
+};
+
+struct MqttMessage {
+  std::string topic;
+  std::string payload;
+  int qos = 0;
+  bool retain = false;
+};
+
+struct BridgeOutbox {
+  std::vector<MqttMessage> mqtt;
+  std::vector<msg::RobotState> states;
+  std::vector<msg::TrafficProgress> progress;
+  std::vector<msg::TaskStatus> statuses;
+  std::vector<std::string> warnings;
+};
+
+struct BridgeCounters {
+  std::uint64_t orders = 0;
+  std::uint64_t updates = 0;
+  std::uint64_t cancels = 0;
+  std::uint64_t refused_messages = 0;
+  std::uint64_t cannot_stitch = 0;
+};
+
+class BridgeNode {
+ public:
+  explicit BridgeNode(BridgeSettings settings);
+
+  void onMqtt(const std::string& topic, const std::string& payload, BridgeOutbox& out);
+  void onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, BridgeOutbox& out);
+  void onRelease(const msg::TrafficRelease& r);
+  /// Orders for new releases, RobotState and TrafficProgress of every vehicle, task progress.
+  void tick(std::int64_t nowNs, BridgeOutbox& out);
+
+  [[nodiscard]] const BridgeCounters& counters() const { return counters_; }
+  [[nodiscard]] const vda5050::VehicleRegistry& registry() const { return registry_; }
+  [[nodiscard]] bool handles(const std::string& robot_id) const { return vehicles_.contains(robot_id); }
+
+ private:
+  struct Vehicle {
+    Vehicle(vda5050::VehicleEntry e, vda5050::OrderBuilder b) : entry(std::move(e)), builder(std::move(b)) {}
+    vda5050::VehicleEntry entry;
+    vda5050::OrderBuilder builder;
+    bool has_order = false;
+    int orders_started = 0;
+    std::optional<msg::TrafficRelease> release;
+    std::string task_id;
+    std::uint32_t revision = 0;
+    std::vector<msg::Goal> goals;
+    std::size_t goal = 0;
+    bool paused = false;
+    msg::TaskState reported = msg::TaskState::Queued;
+    bool cancel_sent = false;
+    std::uint32_t instant_header = 0;
+    std::optional<Pose2> home;  // where it was first seen: it parks there when it has no task
+  };
+
+  void sendOrder(Vehicle& v, const vda5050::Order& o, BridgeOutbox& out);
+  void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out);
+  void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
+  void trackGoals(Vehicle& v, const vda5050::VehicleView& view);
+  void reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out);
+  [[nodiscard]] std::string goalActionId(const Vehicle& v, std::size_t goal) const;
+
+  BridgeSettings settings_;
+  vda5050::VehicleRegistry registry_;
+  std::map<std::string, Vehicle> vehicles_;  // by robot id
+  BridgeCounters counters_;
+};
+
+}  // namespace fleet::vdabridge

@@ -1,0 +1,105 @@
+#pragma once
+
+// A simulated VDA 5050 vehicle: no robot agent, its own simple controller. It follows the released
+// nodes of its order, stops at the last base node until the order is extended, stops for a person
+// in its protective field as a safety scanner would, runs pick and drop actions at nodes, obeys
+// pause, resume and cancel, and accepts or rejects orders by the specification's rules
+// (vda5050/order_rules.hpp). No MQTT here: the simulator carries the messages.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/core/pose2.hpp"
+#include "fleet/vda5050/factsheet.hpp"
+#include "fleet/vda5050/instant_actions.hpp"
+#include "fleet/vda5050/order.hpp"
+#include "fleet/vda5050/order_rules.hpp"
+#include "fleet/vda5050/state.hpp"
+
+namespace fleet::sim {
+
+struct Vda5050VehicleConfig {
+  std::string manufacturer = "fleet-sim";
+  std::string serial;
+  std::string mapId;
+  double maxSpeed = 1.0;         // m/s
+  double maxTurnRate = 1.5;      // rad/s
+  double nodeTolerance = 0.15;   // m; a node's allowedDeviationXY wins when larger
+  double protectiveField = 1.0;  // m ahead of the front; a person inside stops the vehicle
+  double width = 0.6;
+  double length = 0.6;
+  double stateInterval = 1.0;   // s between state messages without an event
+  double actionDuration = 2.0;  // s a pick or drop takes
+};
+
+struct VehicleCommand {
+  double v = 0.0;
+  double w = 0.0;
+};
+
+class Vda5050Vehicle {
+ public:
+  Vda5050Vehicle(Vda5050VehicleConfig config, Pose2 start);
+
+  /// Accepts (new, stitched update), discards a duplicate, or rejects with an error in the state.
+  vda5050::OrderVerdict onOrder(const vda5050::Order& order);
+  void onInstantActions(const vda5050::InstantActions& message);
+  /// One control step at simulated time `now_s` from the true pose; `person_in_field` is what the
+  /// safety scanner sees.
+  VehicleCommand step(double now_s, const Pose2& pose, bool person_in_field);
+
+  /// True when a state message is due: the interval passed or something happened.
+  [[nodiscard]] bool stateDue(double now_s) const;
+  /// The state message now; resets the interval and the pending event.
+  vda5050::State takeState(double now_s, std::int64_t stamp_ns);
+  /// True once after a factsheetRequest instant action.
+  bool takeFactsheetRequest();
+  [[nodiscard]] vda5050::Factsheet factsheet(std::int64_t stamp_ns) const;
+  void setOperatingMode(std::string mode);
+
+  [[nodiscard]] const Vda5050VehicleConfig& config() const { return config_; }
+  /// Times the vehicle stopped at the end of its base with horizon nodes left (the base was not
+  /// extended in time).
+  [[nodiscard]] std::uint64_t baseStarvedStops() const { return starved_stops_; }
+  [[nodiscard]] bool paused() const { return paused_; }
+  [[nodiscard]] const std::string& lastNodeId() const { return last_node_id_; }
+
+  /// Whether a point (a person) is inside the protective field of a vehicle at `pose`: a
+  /// rectangle of the vehicle's width ahead of its front, `protectiveField` long.
+  [[nodiscard]] bool inProtectiveField(const Pose2& pose, double px, double py, double radius) const;
+
+ private:
+  [[nodiscard]] bool actionsRunning() const;
+  [[nodiscard]] vda5050::OrderProgress progress() const;
+  void reachNode(double now_s);
+  void runNodeActions(double now_s);
+  void cancel();
+  vda5050::ActionState* actionState(const std::string& id);
+  void event() { event_ = true; }
+
+  Vda5050VehicleConfig config_;
+  Pose2 pose_;
+  std::optional<vda5050::Order> order_;
+  std::size_t next_ = 0;  // index in order_->nodes of the node to reach next
+  std::string last_node_id_;
+  std::uint32_t last_node_seq_ = 0;
+  bool paused_ = false;
+  bool driving_ = false;
+  bool field_violation_ = false;
+  bool waiting_for_base_ = false;
+  std::string operating_mode_ = "AUTOMATIC";
+  std::vector<vda5050::ActionState> action_states_;
+  std::vector<std::pair<std::string, double>> running_;  // node action id, finish time
+  std::vector<vda5050::VehicleError> errors_;
+  std::uint32_t header_id_ = 0;
+  double last_state_s_ = -1e9;
+  bool event_ = true;
+  bool factsheet_requested_ = false;
+  std::uint64_t starved_stops_ = 0;
+  double distance_since_node_ = 0.0;
+  VehicleCommand last_command_;
+};
+
+}  // namespace fleet::sim

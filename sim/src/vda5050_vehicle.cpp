@@ -1,0 +1,349 @@
+#include "fleet/sim/vda5050_vehicle.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fleet/core/angles.hpp"
+
+namespace fleet::sim {
+
+using namespace fleet::vda5050;
+
+namespace {
+bool finished(const ActionState& a) {
+  return a.actionStatus == "FINISHED" || a.actionStatus == "FAILED";
+}
+}  // namespace
+
+Vda5050Vehicle::Vda5050Vehicle(Vda5050VehicleConfig config, Pose2 start)
+    : config_(std::move(config)), pose_(start) {}
+
+bool Vda5050Vehicle::actionsRunning() const {
+  return std::any_of(action_states_.begin(), action_states_.end(),
+                     [](const ActionState& a) { return !finished(a); });
+}
+
+OrderProgress Vda5050Vehicle::progress() const {
+  OrderProgress p;
+  if (order_) {
+    p.orderId = order_->orderId;
+    p.orderUpdateId = order_->orderUpdateId;
+    if (const auto end = baseEnd(*order_)) {
+      p.baseEndNodeId = end->nodeId;
+      p.baseEndSequenceId = end->sequenceId;
+    }
+    p.active = next_ < order_->nodes.size() || actionsRunning();
+  }
+  p.lastNodeId = last_node_id_;
+  p.lastNodeSequenceId = last_node_seq_;
+  return p;
+}
+
+ActionState* Vda5050Vehicle::actionState(const std::string& id) {
+  for (auto& a : action_states_) {
+    if (a.actionId == id) {
+      return &a;
+    }
+  }
+  return nullptr;
+}
+
+OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
+  auto verdict = judgeOrder(progress(), order);
+  if (!order.nodes.empty() && order.nodes.front().nodePosition &&
+      order.nodes.front().nodePosition->mapId != config_.mapId &&
+      verdict.decision != OrderDecision::kReject) {
+    verdict = {OrderDecision::kReject, "noRouteError",
+               "order '" + order.orderId + "' is on map '" + order.nodes.front().nodePosition->mapId +
+                   "', the vehicle is on '" + config_.mapId + "'"};
+  }
+  if (operating_mode_ != "AUTOMATIC" && verdict.decision != OrderDecision::kReject) {
+    verdict = {OrderDecision::kReject, "orderError", "the vehicle is in " + operating_mode_ + " mode"};
+  }
+  switch (verdict.decision) {
+    case OrderDecision::kAcceptNew: {
+      order_ = order;
+      next_ = 0;
+      action_states_.clear();
+      running_.clear();
+      errors_.clear();
+      waiting_for_base_ = false;
+      // The first node is where the vehicle stands (the rules checked it): its state says so from
+      // the first message on (the next step reaches it and runs its actions).
+      if (!order_->nodes.empty() && !last_node_id_.empty() && order_->nodes.front().nodeId == last_node_id_) {
+        last_node_seq_ = order_->nodes.front().sequenceId;
+      }
+      break;
+    }
+    case OrderDecision::kAcceptUpdate: {
+      const auto reached_seq = next_ > 0 ? order_->nodes[next_ - 1].sequenceId : 0U;
+      const bool any_reached = next_ > 0;
+      order_ = stitchOrder(*order_, order);
+      next_ = 0;
+      if (any_reached) {
+        while (next_ < order_->nodes.size() && order_->nodes[next_].sequenceId <= reached_seq) {
+          ++next_;
+        }
+      }
+      errors_.clear();
+      waiting_for_base_ = false;
+      break;
+    }
+    case OrderDecision::kDiscardDuplicate:
+      return verdict;
+    case OrderDecision::kReject:
+      errors_.push_back(
+          {verdict.errorType,
+           "WARNING",
+           verdict.description,
+           {{"orderId", order.orderId}, {"orderUpdateId", std::to_string(order.orderUpdateId)}}});
+      event();
+      return verdict;
+  }
+  for (const auto& n : order_->nodes) {
+    for (const auto& a : n.actions) {
+      if (actionState(a.actionId) == nullptr) {
+        action_states_.push_back({a.actionId, a.actionType, "WAITING", {}});
+      }
+    }
+  }
+  event();
+  return verdict;
+}
+
+void Vda5050Vehicle::cancel() {
+  if (order_) {
+    order_->nodes.erase(
+        order_->nodes.begin() + static_cast<std::ptrdiff_t>(std::min(next_, order_->nodes.size())),
+        order_->nodes.end());
+    next_ = order_->nodes.size();
+    const std::uint32_t passed = next_ > 0 ? order_->nodes[next_ - 1].sequenceId : 0U;
+    std::erase_if(order_->edges, [&](const Edge& e) { return next_ == 0 || e.sequenceId > passed; });
+  }
+  for (auto& a : action_states_) {
+    if (!finished(a)) {
+      a.actionStatus = "FAILED";
+      a.resultDescription = "cancelled";
+    }
+  }
+  running_.clear();
+  waiting_for_base_ = false;
+}
+
+void Vda5050Vehicle::onInstantActions(const InstantActions& message) {
+  for (const auto& a : message.actions) {
+    ActionState s{a.actionId, a.actionType, "FINISHED", {}};
+    if (a.actionType == "startPause") {
+      paused_ = true;
+    } else if (a.actionType == "stopPause") {
+      paused_ = false;
+    } else if (a.actionType == "cancelOrder") {
+      if (!order_ || next_ >= order_->nodes.size()) {
+        s.actionStatus = "FAILED";
+        s.resultDescription = "no order to cancel";
+        errors_.push_back(
+            {"noOrderToCancel", "WARNING", std::string("cancelOrder without an active order"), {}});
+      } else {
+        cancel();
+      }
+    } else if (a.actionType == "factsheetRequest") {
+      factsheet_requested_ = true;
+    } else if (a.actionType == "stateRequest") {
+      // The event below sends the state at once.
+    } else {
+      s.actionStatus = "FAILED";
+      s.resultDescription = "instant action '" + a.actionType + "' is not supported";
+    }
+    if (auto* existing = actionState(a.actionId)) {
+      *existing = s;
+    } else {
+      action_states_.push_back(s);
+    }
+  }
+  event();
+}
+
+void Vda5050Vehicle::reachNode(double now_s) {
+  const auto& n = order_->nodes[next_];
+  last_node_id_ = n.nodeId;
+  last_node_seq_ = n.sequenceId;
+  distance_since_node_ = 0.0;
+  ++next_;
+  runNodeActions(now_s);
+  event();
+}
+
+void Vda5050Vehicle::runNodeActions(double now_s) {
+  for (const auto& a : order_->nodes[next_ - 1].actions) {
+    if (auto* s = actionState(a.actionId); s != nullptr && s->actionStatus == "WAITING") {
+      if (a.actionType == "pick" || a.actionType == "drop") {
+        s->actionStatus = "RUNNING";
+        running_.emplace_back(a.actionId, now_s + config_.actionDuration);
+      } else {
+        s->actionStatus = "FAILED";
+        s->resultDescription = "action '" + a.actionType + "' is not supported";
+      }
+    }
+  }
+}
+
+VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person_in_field) {
+  distance_since_node_ += std::hypot(pose.x - pose_.x, pose.y - pose_.y);
+  pose_ = pose;
+  for (auto it = running_.begin(); it != running_.end();) {
+    if (now_s >= it->second) {
+      if (auto* s = actionState(it->first)) {
+        s->actionStatus = "FINISHED";
+      }
+      it = running_.erase(it);
+      event();
+    } else {
+      ++it;
+    }
+  }
+  if (field_violation_ != person_in_field) {
+    field_violation_ = person_in_field;
+    event();
+  }
+  VehicleCommand cmd;
+  const bool can_drive = order_ && operating_mode_ == "AUTOMATIC" && !paused_ && running_.empty();
+  while (can_drive && next_ < order_->nodes.size() && order_->nodes[next_].released) {
+    const auto& n = order_->nodes[next_];
+    if (!n.nodePosition) {
+      reachNode(now_s);  // a node without a position is a logical one: nothing to drive to
+      continue;
+    }
+    // The node to stop on is approached slowly and reached closely: stops are at docks and parking
+    // places next to shelves, where braking late from speed ran the vehicle into the shelf.
+    const bool stop_here = next_ + 1 >= order_->nodes.size() || !order_->nodes[next_ + 1].released;
+    const double tol =
+        stop_here ? std::min(config_.nodeTolerance, 0.1)
+                  : std::max(config_.nodeTolerance, n.nodePosition->allowedDeviationXY.value_or(0.0));
+    const double dx = n.nodePosition->x - pose.x;
+    const double dy = n.nodePosition->y - pose.y;
+    const double dist = std::hypot(dx, dy);
+    if (dist <= tol) {
+      reachNode(now_s);
+      if (!running_.empty()) {
+        break;  // HARD actions (pick, drop) at the node: stand still until they finish
+      }
+      continue;
+    }
+    const double err = angleDiff(std::atan2(dy, dx), pose.theta);
+    double vmax = config_.maxSpeed;
+    if (next_ > 0 && next_ - 1 < order_->edges.size() && order_->edges[next_ - 1].maxSpeed) {
+      vmax = std::min(vmax, *order_->edges[next_ - 1].maxSpeed);
+    }
+    if (stop_here) {
+      vmax = std::min(vmax, 0.05 + 0.6 * dist);
+    }
+    // Turn on the spot, then drive straight: the roadmap's edges are straight and keep clear of
+    // shelves only along them (driving while turning cut corners into shelves, 2026-11-26).
+    cmd.w = std::clamp(2.0 * err, -config_.maxTurnRate, config_.maxTurnRate);
+    cmd.v = std::abs(err) > 0.1 ? 0.0 : vmax;
+    break;
+  }
+  const bool at_base_end = order_ && next_ < order_->nodes.size() && !order_->nodes[next_].released;
+  if (at_base_end && !waiting_for_base_) {
+    ++starved_stops_;
+    event();
+  }
+  waiting_for_base_ = at_base_end;
+  if (person_in_field) {
+    cmd = {};
+  }
+  const bool driving = std::abs(cmd.v) > 1e-3 || std::abs(cmd.w) > 1e-3;
+  if (driving != driving_) {
+    driving_ = driving;
+    event();
+  }
+  last_command_ = cmd;
+  return cmd;
+}
+
+bool Vda5050Vehicle::stateDue(double now_s) const {
+  return event_ || now_s - last_state_s_ >= config_.stateInterval;
+}
+
+State Vda5050Vehicle::takeState(double now_s, std::int64_t stamp_ns) {
+  last_state_s_ = now_s;
+  event_ = false;
+  State s;
+  s.header = {header_id_++, isoTimestamp(stamp_ns), kVersion, config_.manufacturer, config_.serial};
+  if (order_) {
+    s.orderId = order_->orderId;
+    s.orderUpdateId = order_->orderUpdateId;
+    for (std::size_t i = next_; i < order_->nodes.size(); ++i) {
+      const auto& n = order_->nodes[i];
+      s.nodeStates.push_back({n.nodeId, n.sequenceId, n.released, n.nodePosition});
+    }
+    // Edges still ahead: those after the last node of this order the vehicle passed.
+    const std::uint32_t passed = next_ > 0 ? order_->nodes[next_ - 1].sequenceId : 0U;
+    for (const auto& e : order_->edges) {
+      if (next_ == 0 || e.sequenceId > passed) {
+        s.edgeStates.push_back({e.edgeId, e.sequenceId, e.released});
+      }
+    }
+  }
+  s.lastNodeId = last_node_id_;
+  s.lastNodeSequenceId = last_node_seq_;
+  s.driving = driving_;
+  s.paused = paused_;
+  s.newBaseRequest = waiting_for_base_;
+  s.distanceSinceLastNode = distance_since_node_;
+  s.operatingMode = operating_mode_;
+  s.agvPosition = AgvPosition{pose_.x, pose_.y, pose_.theta, config_.mapId, true};
+  s.velocity = Velocity{last_command_.v, 0.0, last_command_.w};
+  s.actionStates = action_states_;
+  s.batteryState = {100.0, false};
+  s.errors = errors_;
+  s.safetyState = {"NONE", field_violation_};
+  return s;
+}
+
+bool Vda5050Vehicle::takeFactsheetRequest() {
+  return std::exchange(factsheet_requested_, false);
+}
+
+Factsheet Vda5050Vehicle::factsheet(std::int64_t stamp_ns) const {
+  Factsheet f;
+  f.header = {0, isoTimestamp(stamp_ns), kVersion, config_.manufacturer, config_.serial};
+  f.seriesName = "fleet-sim VDA 5050 vehicle";
+  f.localizationTypes = {"NATURAL"};
+  f.navigationTypes = {"VIRTUAL_LINE_GUIDED"};
+  f.maxLoadMass = 100.0;
+  f.speedMin = 0.0;
+  f.speedMax = config_.maxSpeed;
+  f.accelerationMax = 1.0;
+  f.decelerationMax = 3.0;
+  f.heightMax = 0.4;
+  f.width = config_.width;
+  f.length = config_.length;
+  f.minOrderInterval = 0.1;
+  f.minStateInterval = 0.1;
+  f.defaultStateInterval = config_.stateInterval;
+  f.agvActions = {"pick",        "drop", "startPause", "stopPause", "cancelOrder", "factsheetRequest",
+                  "stateRequest"};
+  return f;
+}
+
+void Vda5050Vehicle::setOperatingMode(std::string mode) {
+  if (mode != operating_mode_) {
+    operating_mode_ = std::move(mode);
+    event();
+  }
+}
+
+bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, double radius) const {
+  const double c = std::cos(pose.theta);
+  const double s = std::sin(pose.theta);
+  const double dx = px - pose.x;
+  const double dy = py - pose.y;
+  const double ahead = c * dx + s * dy;
+  const double side = -s * dx + c * dy;
+  const double front = config_.length / 2.0;
+  return ahead + radius >= 0.0 && ahead - radius <= front + config_.protectiveField &&
+         std::abs(side) - radius <= config_.width / 2.0;
+}
+
+}  // namespace fleet::sim

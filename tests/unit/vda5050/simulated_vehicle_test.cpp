@@ -1,0 +1,156 @@
+#include "fleet/sim/vda5050_vehicle.hpp"
+
+#include <gtest/gtest.h>
+
+#include "order_fixtures.hpp"
+#include "vehicle_rig.hpp"
+
+namespace fleet::sim {
+namespace {
+
+using vda5050::OrderDecision;
+using vda5050::test::lineOrder;
+
+using test::Rig;
+
+TEST(Vda5050Vehicle, FollowsTheBaseAndStopsAtItsEnd) {
+  Rig r;
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 3)).decision, OrderDecision::kAcceptNew);
+  r.run(20.0);
+  EXPECT_NEAR(r.pose.x, 2.0, 0.2);  // n2 is the last base node; n3.. are horizon
+  auto s = r.state();
+  EXPECT_EQ(s.lastNodeId, "n2");
+  EXPECT_FALSE(s.driving);
+  EXPECT_TRUE(s.newBaseRequest.value_or(false));
+  ASSERT_EQ(s.nodeStates.size(), 3U);
+  EXPECT_FALSE(s.nodeStates[0].released);
+  EXPECT_EQ(r.vehicle.baseStarvedStops(), 1U);
+
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 1, 2, 4, 4)).decision, OrderDecision::kAcceptUpdate);
+  r.run(20.0);
+  EXPECT_NEAR(r.pose.x, 5.0, 0.2);
+  s = r.state();
+  EXPECT_EQ(s.lastNodeId, "n5");
+  EXPECT_EQ(s.orderUpdateId, 1U);
+  EXPECT_TRUE(s.nodeStates.empty());
+  EXPECT_TRUE(s.edgeStates.empty());
+}
+
+TEST(Vda5050Vehicle, RejectsAnUpdateThatDoesNotExtendTheBaseAndSaysWhy) {
+  Rig r;
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 3)).decision, OrderDecision::kAcceptNew);
+  r.run(3.0);
+  EXPECT_EQ(r.vehicle.onOrder(lineOrder("o1", 1, 3, 3, 3)).decision, OrderDecision::kReject);
+  auto s = r.state();
+  ASSERT_EQ(s.errors.size(), 1U);
+  EXPECT_EQ(s.errors[0].errorType, "orderUpdateError");
+  EXPECT_EQ(s.orderUpdateId, 0U);
+  // A new orderId while this one runs is refused too; the old order goes on.
+  EXPECT_EQ(r.vehicle.onOrder(lineOrder("o2", 0, 0, 2, 2)).decision, OrderDecision::kReject);
+  r.run(20.0);
+  EXPECT_EQ(r.state().lastNodeId, "n2");
+}
+
+TEST(Vda5050Vehicle, RefusesAnOrderOnAnotherMap) {
+  Rig r;
+  auto o = lineOrder("o1", 0, 0, 3, 3);
+  for (auto& n : o.nodes) {
+    n.nodePosition->mapId = "other";
+  }
+  const auto v = r.vehicle.onOrder(o);
+  EXPECT_EQ(v.decision, OrderDecision::kReject);
+  EXPECT_NE(v.description.find("other"), std::string::npos);
+}
+
+TEST(Vda5050Vehicle, APersonInTheProtectiveFieldStopsIt) {
+  Rig r;
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);
+  r.run(2.0);
+  const double x = r.pose.x;
+  EXPECT_GT(x, 0.3);
+  r.person = true;
+  r.run(3.0);
+  EXPECT_NEAR(r.pose.x, x, 0.15);  // at most the step in flight
+  auto s = r.state();
+  EXPECT_TRUE(s.safetyState.fieldViolation);
+  EXPECT_FALSE(s.driving);
+  r.person = false;
+  r.run(10.0);
+  EXPECT_GT(r.pose.x, x + 1.0);
+
+  // The field is ahead, not behind, and as wide as the vehicle.
+  const Pose2 p{0.0, 0.0, 0.0};
+  EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.0, 0.0, 0.25));
+  EXPECT_FALSE(r.vehicle.inProtectiveField(p, -1.5, 0.0, 0.25));
+  EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.0, 1.5, 0.25));
+  EXPECT_FALSE(r.vehicle.inProtectiveField(p, 3.0, 0.0, 0.25));
+}
+
+TEST(Vda5050Vehicle, PauseResumeAndCancel) {
+  Rig r;
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);
+  r.run(2.0);
+  vda5050::InstantActions ia;
+  ia.actions.push_back({"startPause", "p1", "HARD", {}, {}});
+  r.vehicle.onInstantActions(ia);
+  const double x = r.pose.x;
+  r.run(3.0);
+  EXPECT_NEAR(r.pose.x, x, 1e-9);
+  EXPECT_TRUE(r.state().paused.value_or(false));
+  ia.actions = {{"stopPause", "p2", "HARD", {}, {}}};
+  r.vehicle.onInstantActions(ia);
+  r.run(2.0);
+  EXPECT_GT(r.pose.x, x + 0.5);
+
+  ia.actions = {{"cancelOrder", "c1", "HARD", {}, {}}};
+  r.vehicle.onInstantActions(ia);
+  r.run(3.0);
+  auto s = r.state();
+  EXPECT_TRUE(s.nodeStates.empty());
+  EXPECT_TRUE(s.edgeStates.empty());
+  EXPECT_FALSE(s.driving);
+  // After a cancel a new order is welcome, from where the vehicle last passed a node.
+  const int last = std::stoi(s.lastNodeId.substr(1));
+  EXPECT_EQ(r.vehicle.onOrder(lineOrder("o2", 0, last, 2, 2)).decision, OrderDecision::kAcceptNew);
+
+  ia.actions = {{"dance", "d1", "NONE", {}, {}}};
+  r.vehicle.onInstantActions(ia);
+  s = r.state();
+  EXPECT_EQ(s.actionStates.back().actionStatus, "FAILED");
+}
+
+TEST(Vda5050Vehicle, PickAtANodeHoldsTheVehicleUntilFinished) {
+  Rig r;
+  auto o = lineOrder("o1", 0, 0, 3, 3);
+  o.nodes[1].actions.push_back({"pick", "pick-1", "HARD", {}, {}});
+  ASSERT_EQ(r.vehicle.onOrder(o).decision, OrderDecision::kAcceptNew);
+  EXPECT_EQ(r.state().actionStates.at(0).actionStatus, "WAITING");
+  bool seen_running = false;
+  for (int i = 0; i < 200 && r.pose.x < 1.5; ++i) {
+    r.run(0.1);
+    const auto s = r.state();
+    if (s.actionStates.at(0).actionStatus == "RUNNING") {
+      seen_running = true;
+      EXPECT_NEAR(r.pose.x, 1.0, 0.2);
+    }
+  }
+  EXPECT_TRUE(seen_running);
+  r.run(10.0);
+  EXPECT_EQ(r.state().actionStates.at(0).actionStatus, "FINISHED");
+  EXPECT_NEAR(r.pose.x, 2.0, 0.2);
+}
+
+TEST(Vda5050Vehicle, StateIsDueAtTheIntervalAndOnEvents) {
+  Rig r;
+  (void)r.state();
+  EXPECT_FALSE(r.vehicle.stateDue(r.t + 0.5));
+  EXPECT_TRUE(r.vehicle.stateDue(r.t + 1.0));
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 3, 3)).decision, OrderDecision::kAcceptNew);
+  EXPECT_TRUE(r.vehicle.stateDue(r.t));  // an accepted order is an event
+  const auto a = r.state();
+  const auto b = r.state();
+  EXPECT_EQ(b.header.headerId, a.header.headerId + 1);
+}
+
+}  // namespace
+}  // namespace fleet::sim
