@@ -1,0 +1,264 @@
+// Every service as a process: /metrics passes `promtool check metrics`, /livez and /readyz answer
+// truthfully, a real Prometheus on loopback scrapes a running lockstep fleet and answers a query;
+// a taken metrics port, a bad option and a bad log level exit 2; --version exits 0; JSON logs are
+// one object per line.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "test_process.hpp"
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kBin = FLEET_BINARY_DIR;
+const std::string kScenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
+const std::string kSite = FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse_12_parking.site.json";
+
+/// A loopback port free right now (bound to 0, read back, released).
+int freePort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+  socklen_t len = sizeof(a);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  close(fd);
+  return ntohs(a.sin_port);
+}
+
+struct Ran {
+  int code = -1;
+  std::string out;  // stdout and stderr
+};
+/// Runs a shell command line to its end (bounded by `timeout` in seconds).
+Ran run(const std::string& cmd, int timeoutS = 30) {
+  Ran r;
+  FILE* p = popen(("timeout " + std::to_string(timeoutS) + " " + cmd + " 2>&1").c_str(), "r");
+  char buf[4096];
+  while (std::fgets(buf, sizeof(buf), p) != nullptr) {
+    r.out += buf;
+  }
+  const int st = pclose(p);
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::optional<httplib::Result> get(int port, const std::string& path) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_connection_timeout(1s);
+  c.set_read_timeout(5s);
+  auto r = c.Get(path);
+  if (!r) {
+    return std::nullopt;
+  }
+  return r;
+}
+
+/// Waits until GET path answers `status` (at most `within`).
+bool waitFor(int port, const std::string& path, int status, std::chrono::seconds within) {
+  const auto end = std::chrono::steady_clock::now() + within;
+  while (std::chrono::steady_clock::now() < end) {
+    if (auto r = get(port, path); r && (*r)->status == status) {
+      return true;
+    }
+    std::this_thread::sleep_for(200ms);
+  }
+  return false;
+}
+
+/// The six services of a small lockstep fleet (one robot), each with its ops port.
+class Fleet {
+ public:
+  Fleet() {
+    domain_ = std::to_string(fleet::test::uniqueDomain());
+    dir_ = fs::temp_directory_path() / ("fleet-ops-" + domain_);
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::ofstream(dir_ / "manager.json") << nlohmann::json{
+        {"db", (dir_ / "fleet.db").string()},
+        {"stations", kScenario},
+        {"clock", "sim"}}.dump();
+    std::ofstream(dir_ / "risk_map.json")
+        << nlohmann::json{{"clock", "sim"}, {"lockstep", true}, {"rate_hz", 2}, {"site", kSite}}.dump();
+    std::ofstream(dir_ / "traffic.json") << nlohmann::json{{"site", kSite}, {"clock", "sim"}}.dump();
+    const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain_}};
+    auto start = [&](const std::string& name, const std::string& exe, std::vector<std::string> args) {
+      ports[name] = freePort();
+      args.insert(args.end(), {"--metrics-port", std::to_string(ports[name]), "--log-level", "warn"});
+      procs_.push_back(std::make_unique<fleet::test::ChildProcess>(kBin + exe, args, env));
+    };
+    start("fleet_manager", "/services/fleet_manager/fleet_manager",
+          {"--config", (dir_ / "manager.json").string()});
+    start("wms_adapter", "/services/wms_adapter/wms_adapter",
+          {"--stations", kScenario, "--port", std::to_string(freePort())});
+    start("risk_map", "/services/risk_map/risk_map", {"--config", (dir_ / "risk_map.json").string()});
+    start("traffic_manager", "/services/traffic_manager/traffic_manager",
+          {"--config", (dir_ / "traffic.json").string()});
+    start("robot_agent", "/services/robot_agent/robot_agent",
+          {"--scenario", kScenario, "--clock", "lockstep"});
+    start("fleet_sim", "/sim/src/fleet-sim",
+          {"--scenario", kScenario, "--clock", "lockstep", "--participants", "2", "--duration", "600",
+           "--max-speed", "5"});
+  }
+  ~Fleet() { fs::remove_all(dir_); }
+
+  std::map<std::string, int> ports;
+  const fs::path& dir() const { return dir_; }
+
+ private:
+  std::string domain_;
+  fs::path dir_;
+  std::vector<std::unique_ptr<fleet::test::ChildProcess>> procs_;
+};
+
+class OpsFleet : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { fleet_ = std::make_unique<Fleet>(); }
+  static void TearDownTestSuite() { fleet_.reset(); }
+  static std::unique_ptr<Fleet> fleet_;
+};
+std::unique_ptr<Fleet> OpsFleet::fleet_;
+
+}  // namespace
+
+TEST_F(OpsFleet, EveryServiceIsLiveThenReadyAndItsMetricsPassPromtool) {
+  ASSERT_EQ(fleet_->ports.size(), 6u);
+  for (const auto& [name, port] : fleet_->ports) {
+    ASSERT_TRUE(waitFor(port, "/livez", 200, 30s)) << name << " never live";
+    EXPECT_TRUE(waitFor(port, "/readyz", 200, 60s))
+        << name << " never ready: " << (*get(port, "/readyz"))->body;
+    auto m = get(port, "/metrics");
+    ASSERT_TRUE(m) << name;
+    EXPECT_EQ((*m)->get_header_value("Content-Type"), "text/plain; version=0.0.4; charset=utf-8");
+    EXPECT_NE((*m)->body.find("fleet_build_info{service=\"" + name + "\""), std::string::npos) << name;
+    EXPECT_NE((*m)->body.find(name + "_rejected_samples_total"), std::string::npos) << name;
+    const auto file = fleet_->dir() / (name + ".prom");
+    std::ofstream(file) << (*m)->body;
+    const auto check = run("promtool check metrics < " + file.string());
+    EXPECT_EQ(check.code, 0) << name << ": " << check.out;
+  }
+}
+
+TEST_F(OpsFleet, ThePortOfARunningServiceIsRefusedToASecondOneWithExitTwo) {
+  const int taken = fleet_->ports.at("fleet_manager");
+  const auto r = run(kBin + "/services/risk_map/risk_map --metrics-port " + std::to_string(taken));
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cannot listen on 127.0.0.1:" + std::to_string(taken)), std::string::npos) << r.out;
+}
+
+TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
+  ASSERT_TRUE(fs::exists("/usr/bin/prometheus")) << "prometheus is not installed (scripts/setup installs it)";
+  const int promPort = freePort();
+  std::string targets;
+  for (const auto& [name, port] : fleet_->ports) {
+    targets += "  - job_name: " + name +
+               "\n    static_configs:\n      - targets: ['127.0.0.1:" + std::to_string(port) + "']\n";
+  }
+  const auto cfg = fleet_->dir() / "prometheus.yml";
+  std::ofstream(cfg) << "global:\n  scrape_interval: 1s\n  scrape_timeout: 1s\nscrape_configs:\n" << targets;
+  fleet::test::ChildProcess prom(
+      "/usr/bin/prometheus",
+      {"--config.file=" + cfg.string(), "--storage.tsdb.path=" + (fleet_->dir() / "tsdb").string(),
+       "--web.listen-address=127.0.0.1:" + std::to_string(promPort), "--log.level=warn"});
+  httplib::Client c("127.0.0.1", promPort);
+  c.set_read_timeout(5s);
+  auto query = [&](const std::string& q) -> nlohmann::json {
+    auto r = c.Get("/api/v1/query", httplib::Params{{"query", q}}, httplib::Headers{});
+    if (!r || r->status != 200) {
+      return nullptr;
+    }
+    return nlohmann::json::parse(r->body, nullptr, false);
+  };
+  // Every target up, and the robot agent's control cycles counted (the fleet is running).
+  const auto end = std::chrono::steady_clock::now() + 90s;
+  nlohmann::json up;
+  nlohmann::json cycles;
+  while (std::chrono::steady_clock::now() < end) {
+    up = query("count(up == 1)");
+    cycles = query("sum(robot_agent_cycles_total)");
+    if (up.is_object() && !up["data"]["result"].empty() && up["data"]["result"][0]["value"][1] == "6" &&
+        cycles.is_object() && !cycles["data"]["result"].empty() &&
+        std::stod(cycles["data"]["result"][0]["value"][1].get<std::string>()) > 0) {
+      break;
+    }
+    std::this_thread::sleep_for(500ms);
+  }
+  ASSERT_TRUE(up.is_object()) << "Prometheus never answered on port " << promPort;
+  ASSERT_FALSE(up["data"]["result"].empty()) << up.dump();
+  EXPECT_EQ(up["data"]["result"][0]["value"][1], "6") << up.dump();
+  ASSERT_FALSE(cycles["data"]["result"].empty()) << cycles.dump();
+  EXPECT_GT(std::stod(cycles["data"]["result"][0]["value"][1].get<std::string>()), 0.0);
+  // A histogram query as a dashboard makes it.
+  const auto p99 =
+      query("histogram_quantile(0.99, sum by (le) (rate(robot_agent_cycle_seconds_bucket[1m])))");
+  ASSERT_TRUE(p99.is_object());
+  EXPECT_EQ(p99["status"], "success") << p99.dump();
+}
+
+TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {
+  const std::vector<std::string> bins = {"/services/fleet_manager/fleet_manager",
+                                         "/services/wms_adapter/wms_adapter",
+                                         "/services/risk_map/risk_map",
+                                         "/services/robot_agent/robot_agent",
+                                         "/services/traffic_manager/traffic_manager",
+                                         "/sim/src/fleet-sim",
+                                         "/services/fleetctl/fleetctl"};
+  for (const auto& b : bins) {
+    const auto v = run(kBin + b + " --version");
+    EXPECT_EQ(v.code, 0) << b << ": " << v.out;
+    EXPECT_NE(v.out.find(FLEET_TEST_VERSION), std::string::npos) << b << ": " << v.out;
+    const auto bad = run(kBin + b + " --no-such-option");
+    EXPECT_EQ(bad.code, 2) << b << ": " << bad.out;
+  }
+  // A bad log level is bad configuration (it was 1, a run-time failure).
+  for (const auto& b : {"/services/fleet_manager/fleet_manager", "/services/risk_map/risk_map",
+                        "/services/traffic_manager/traffic_manager", "/services/wms_adapter/wms_adapter",
+                        "/services/robot_agent/robot_agent"}) {
+    const auto r = run(kBin + b + " --log-level verbose");
+    EXPECT_EQ(r.code, 2) << b << ": " << r.out;
+    EXPECT_NE(r.out.find("unknown log level"), std::string::npos) << b << ": " << r.out;
+    const auto f = run(kBin + b + " --log-format xml");
+    EXPECT_EQ(f.code, 2) << b << ": " << f.out;
+  }
+  const auto sim = run(kBin + "/sim/src/fleet-sim --scenario " + kScenario + " --log-level verbose");
+  EXPECT_EQ(sim.code, 2) << sim.out;
+}
+
+TEST(OpsLogs, JsonFormatIsOneObjectPerLineWithTimeLevelAndService) {
+  // A configuration error logged as JSON: the multi-line problem list stays on one line.
+  const auto r =
+      run(kBin + "/services/fleet_manager/fleet_manager --log-format json --stations /nonexistent.json");
+  EXPECT_EQ(r.code, 2) << r.out;
+  std::istringstream lines(r.out);
+  int n = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const auto j = nlohmann::json::parse(line, nullptr, false);
+    ASSERT_TRUE(j.is_object()) << "not JSON: " << line;
+    EXPECT_TRUE(j.contains("time") && j.contains("level") && j.contains("msg")) << line;
+    EXPECT_EQ(j["service"], "fleet_manager") << line;
+    ++n;
+  }
+  EXPECT_GE(n, 1);
+}
