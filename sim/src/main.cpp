@@ -129,6 +129,13 @@ const char* kUsage =
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
 
 bool parseArgs(int argc, char** argv, Options& o) {
+  // As the other services read them (CLI11 envname): the options below win.
+  if (const char* port = std::getenv("FLEET_METRICS_PORT")) {
+    o.ops.port = std::stoi(port);
+  }
+  if (const char* host = std::getenv("FLEET_METRICS_HOST")) {
+    o.ops.host = host;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {

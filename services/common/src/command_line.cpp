@@ -14,8 +14,10 @@ void addVersion(CLI::App& app) {
 
 void addOpsOptions(CLI::App& app, OpsSettings& ops) {
   app.add_option("--metrics-port", ops.port,
-                 "serve /metrics, /livez and /readyz on this port (0 = any free port; off by default)");
-  app.add_option("--metrics-host", ops.host, "address of the metrics port (default 127.0.0.1)");
+                 "serve /metrics, /livez and /readyz on this port (0 = any free port; off by default)")
+      ->envname("FLEET_METRICS_PORT");
+  app.add_option("--metrics-host", ops.host, "address of the metrics port (default 127.0.0.1)")
+      ->envname("FLEET_METRICS_HOST");
 }
 
 std::optional<int> parse(CLI::App& app, int argc, char** argv) {

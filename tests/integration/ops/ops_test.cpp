@@ -161,6 +161,18 @@ TEST_F(OpsFleet, EveryServiceIsLiveThenReadyAndItsMetricsPassPromtool) {
   }
 }
 
+TEST_F(OpsFleet, FleetProbeAsTheContainersUseIt) {
+  const std::string probe = kBin + "/services/fleet_probe/fleet-probe";
+  const int port = fleet_->ports.at("fleet_manager");
+  ASSERT_TRUE(waitFor(port, "/livez", 200, 30s));
+  EXPECT_EQ(run("FLEET_METRICS_PORT=" + std::to_string(port) + " " + probe + " /livez").code, 0);
+  EXPECT_EQ(run(probe + " " + std::to_string(port) + " /livez").code, 0);
+  EXPECT_EQ(run(probe + " " + std::to_string(port) + " /no-such-page").code, 1);
+  EXPECT_EQ(run(probe + " " + std::to_string(freePort()) + " /livez").code, 1);  // nobody listens
+  EXPECT_EQ(run("env -u FLEET_METRICS_PORT " + probe + " /livez").code, 2);
+  EXPECT_EQ(run(probe + " 80x80 /livez").code, 2);
+}
+
 TEST_F(OpsFleet, ThePortOfARunningServiceIsRefusedToASecondOneWithExitTwo) {
   const int taken = fleet_->ports.at("fleet_manager");
   const auto r = run(kBin + "/services/risk_map/risk_map --metrics-port " + std::to_string(taken));
@@ -215,6 +227,25 @@ TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
       query("histogram_quantile(0.99, sum by (le) (rate(robot_agent_cycle_seconds_bucket[1m])))");
   ASSERT_TRUE(p99.is_object());
   EXPECT_EQ(p99["status"], "success") << p99.dump();
+  // Every query of the shipped Grafana dashboard is valid PromQL and finds series in a running fleet
+  // (a renamed metric would leave its panel empty).
+  std::ifstream dashFile(FLEET_SOURCE_DIR "/deploy/grafana-dashboard.json");
+  const auto dash = nlohmann::json::parse(dashFile);
+  int queries = 0;
+  for (const auto& panel : dash["panels"]) {
+    for (const auto& t : panel["targets"]) {
+      const std::string expr = t["expr"];
+      auto r = query(expr);
+      ASSERT_TRUE(r.is_object()) << expr;
+      EXPECT_EQ(r["status"], "success") << expr << ": " << r.dump();
+      // rate() over 5 m may still be empty this early; the series themselves must exist.
+      if (expr.find("rate(") == std::string::npos) {
+        EXPECT_FALSE(r["data"]["result"].empty()) << panel["title"] << ": " << expr;
+      }
+      ++queries;
+    }
+  }
+  EXPECT_GE(queries, 12);
 }
 
 TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {
