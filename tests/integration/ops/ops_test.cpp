@@ -165,7 +165,7 @@ TEST_F(OpsFleet, FleetProbeAsTheContainersUseIt) {
   const std::string probe = kBin + "/services/fleet_probe/fleet-probe";
   const int port = fleet_->ports.at("fleet_manager");
   ASSERT_TRUE(waitFor(port, "/livez", 200, 30s));
-  EXPECT_EQ(run("FLEET_METRICS_PORT=" + std::to_string(port) + " " + probe + " /livez").code, 0);
+  EXPECT_EQ(run("env FLEET_METRICS_PORT=" + std::to_string(port) + " " + probe + " /livez").code, 0);
   EXPECT_EQ(run(probe + " " + std::to_string(port) + " /livez").code, 0);
   EXPECT_EQ(run(probe + " " + std::to_string(port) + " /no-such-page").code, 1);
   EXPECT_EQ(run(probe + " " + std::to_string(freePort()) + " /livez").code, 1);  // nobody listens
