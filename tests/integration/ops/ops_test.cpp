@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -292,4 +293,73 @@ TEST(OpsLogs, JsonFormatIsOneObjectPerLineWithTimeLevelAndService) {
     ++n;
   }
   EXPECT_GE(n, 1);
+}
+
+TEST(OpsProbes, AnAdapterWithoutManagerIsLiveNotReadyAndLogsEveryRequest) {
+  // A fresh domain: no fleet manager answers. With a token set, /v1/health still answers without it.
+  const std::string domain = std::to_string(fleet::test::uniqueDomain());
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-adapter-" + domain);
+  fs::create_directories(dir);
+  const int api = freePort();
+  const int ops = freePort();
+  std::ofstream(dir / "token") << "s3cret\n";
+  std::ofstream(dir / "adapter.json")
+      << nlohmann::json{{"stations", kScenario},
+                        {"http", {{"port", api}, {"token_file", (dir / "token").string()}}}}
+             .dump();
+  fleet::test::ChildProcess adapter(
+      "/bin/sh",
+      {"-c", "exec " + kBin + "/services/wms_adapter/wms_adapter --config " +
+                 (dir / "adapter.json").string() + " --metrics-port " + std::to_string(ops) +
+                 " --log-format json 2> " + (dir / "log").string()},
+      {{"FLEET_DDS_DOMAIN", domain}});
+  ASSERT_TRUE(waitFor(ops, "/livez", 200, 30s));
+  auto ready = get(ops, "/readyz");
+  ASSERT_TRUE(ready);
+  EXPECT_EQ((*ready)->status, 503);
+  EXPECT_EQ((*ready)->body, "not ready: fleet_manager\n");
+  auto health = get(api, "/v1/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ((*health)->status, 503);  // the manager is unreachable; not 401 for lack of a token
+  EXPECT_EQ((*health)->body.find("s3cret"), std::string::npos);
+  EXPECT_EQ((*get(api, "/v1/tasks"))->status, 401);
+  auto m = get(ops, "/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE((*m)->body.find("wms_adapter_http_responses_total{code=\"401\"} 1"), std::string::npos)
+      << (*m)->body;
+  EXPECT_NE((*m)->body.find("wms_adapter_http_responses_total{code=\"503\"} 1"), std::string::npos)
+      << (*m)->body;
+  adapter.kill(SIGTERM);
+  EXPECT_EQ(adapter.wait(10s), 0);
+  std::ifstream log(dir / "log");
+  int access = 0;
+  for (std::string line; std::getline(log, line);) {
+    const auto j = nlohmann::json::parse(line, nullptr, false);
+    ASSERT_TRUE(j.is_object()) << "not JSON: " << line;
+    EXPECT_EQ(j["service"], "wms_adapter");
+    const std::string msg = j["msg"];
+    if (msg.rfind("access ", 0) == 0) {
+      ++access;
+      EXPECT_EQ(msg.find("s3cret"), std::string::npos) << msg;  // never the Authorization header
+    }
+  }
+  EXPECT_EQ(access, 2);
+  fs::remove_all(dir);
+}
+
+TEST(OpsProbes, ARobotAgentWithoutSensorsIsLiveNotReady) {
+  const std::string domain = std::to_string(fleet::test::uniqueDomain());
+  const int ops = freePort();
+  fleet::test::ChildProcess agent(
+      kBin + "/services/robot_agent/robot_agent",
+      {"--scenario", kScenario, "--metrics-port", std::to_string(ops), "--log-level", "warn"},
+      {{"FLEET_DDS_DOMAIN", domain}});
+  ASSERT_TRUE(waitFor(ops, "/livez", 200, 30s));
+  // Give the once-a-second readiness update a turn, then: nothing publishes SensorFrame here.
+  std::this_thread::sleep_for(1500ms);
+  auto ready = get(ops, "/readyz");
+  ASSERT_TRUE(ready);
+  EXPECT_EQ((*ready)->status, 503);
+  EXPECT_EQ((*ready)->body, "not ready: sensors\n");
+  EXPECT_EQ((*get(ops, "/livez"))->status, 200);  // still live: its loop turns without sensors
 }
