@@ -170,6 +170,10 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     }
     for (const auto& e : out.events) {
       events.write(e);
+      logging::ScopedField taskField("task", e.task_id);
+      logging::ScopedField robotField("robot", e.robot_id);
+      spdlog::debug("task {} {}{}{}", e.task_id, msg::toString(e.state), e.robot_id.empty() ? "" : " robot ",
+                    e.robot_id);
     }
     for (const auto& a : out.assignments) {
       assignments.write(a);

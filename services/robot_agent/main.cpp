@@ -366,7 +366,10 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
     // Agents step in parallel (each touches only its own state and const shared maps); outputs
     // are written afterwards in robot order, so the DDS traffic of a lockstep run does not depend
     // on thread timing.
-    pool.forEach(agents.size(), [&](std::size_t i) { outs[i] = agents[i]->step(now, dt); });
+    pool.forEach(agents.size(), [&](std::size_t i) {
+      logging::ScopedField robotField("robot", agents[i]->id());  // on whatever a step logs
+      outs[i] = agents[i]->step(now, dt);
+    });
     for (std::size_t i = 0; i < agents.size(); ++i) {
       auto& a = agents[i];
       auto& out = outs[i];
@@ -380,6 +383,8 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
             .counter("robot_agent_task_reports_total", "TaskStatus reports sent, by the state reported",
                      {{"state", std::string(msg::toString(out.status->state))}})
             .inc();
+        logging::ScopedField robotField("robot", a->id());
+        logging::ScopedField taskField("task", out.status->task_id);
         spdlog::debug("{}: task {} {}", a->id(), out.status->task_id, msg::toString(out.status->state));
       }
       if (out.traffic && trafficProgress) {

@@ -4,6 +4,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <stdexcept>
@@ -17,6 +18,8 @@ std::vector<std::pair<std::string, std::string>>& fields() {
   static std::vector<std::pair<std::string, std::string>> f;
   return f;
 }
+
+thread_local std::vector<std::pair<std::string, std::string>> tScoped;
 
 /// One JSON object per line: {"time":"...Z","level":"info","service":"...","msg":"...",...}.
 class JsonFormatter : public spdlog::formatter {
@@ -37,8 +40,20 @@ class JsonFormatter : public spdlog::formatter {
                                spdlog::level::to_string_view(msg.level).size())) +
         ",\"service\":" + jsonString(std::string(msg.logger_name.data(), msg.logger_name.size())) +
         ",\"msg\":" + jsonString(std::string(msg.payload.data(), msg.payload.size()));
+    std::vector<std::string> seen;
+    // Innermost scoped field first, then the process-wide ones; each key once.
+    auto add = [&](const std::string& k, const std::string& v) {
+      if (std::find(seen.begin(), seen.end(), k) == seen.end() && k != "time" && k != "level" &&
+          k != "service" && k != "msg") {
+        line += "," + jsonString(k) + ":" + jsonString(v);
+        seen.push_back(k);
+      }
+    };
+    for (auto it = tScoped.rbegin(); it != tScoped.rend(); ++it) {
+      add(it->first, it->second);
+    }
     for (const auto& [k, v] : fields()) {
-      line += "," + jsonString(k) + ":" + jsonString(v);
+      add(k, v);
     }
     line += "}\n";
     dest.append(line.data(), line.data() + line.size());
@@ -81,6 +96,13 @@ std::string jsonString(const std::string& s) {
     }
   }
   return out + "\"";
+}
+
+ScopedField::ScopedField(std::string key, std::string value) {
+  tScoped.emplace_back(std::move(key), std::move(value));
+}
+ScopedField::~ScopedField() {
+  tScoped.pop_back();
 }
 
 void setField(const std::string& key, const std::string& value) {

@@ -15,6 +15,16 @@ void setup(const std::string& service, const std::string& level = "info", const 
 /// Call before logging starts on other threads. Ignored by the text format.
 void setField(const std::string& key, const std::string& value);
 
+/// A field (e.g. "task", "robot") on the JSON lines this thread logs while the object lives, for a
+/// message about one task or robot. Nests; the innermost value of a key wins.
+class ScopedField {
+ public:
+  ScopedField(std::string key, std::string value);
+  ~ScopedField();
+  ScopedField(const ScopedField&) = delete;
+  ScopedField& operator=(const ScopedField&) = delete;
+};
+
 /// `s` as a JSON string literal (quotes included); newlines and control characters escaped, so a
 /// multi-line message stays one line.
 std::string jsonString(const std::string& s);
