@@ -63,6 +63,10 @@ int main(int argc, char** argv) {
   std::string url = "http://127.0.0.1:8080";
   std::string tokenFile;
   app.add_option("--url", url, "WMS adapter address, http[s]://HOST[:PORT]")->envname("FLEET_WMS_URL");
+  std::string caCert;
+  app.add_option("--ca-cert", caCert,
+                 "https: PEM file of the CA that signed the adapter's certificate (else the system's)")
+      ->envname("FLEET_WMS_CA_CERT");
   app.add_option("--token-file", tokenFile, "file holding the bearer token (else FLEET_WMS_TOKEN)");
 
   auto* submit = app.add_subcommand("submit", "submit tasks from a JSON or CSV file");
@@ -301,6 +305,13 @@ int main(int argc, char** argv) {
   }
   // https works when cpp-httplib is built with OpenSSL (Debian's is: CPPHTTPLIB_OPENSSL_SUPPORT).
   httplib::Client c(t.url.text());
+  if (!caCert.empty()) {
+    if (t.url.scheme != "https") {
+      std::fprintf(stderr, "fleetctl: --ca-cert goes with an https:// --url\n");
+      return 2;
+    }
+    c.set_ca_cert_path(caCert);
+  }
   c.set_read_timeout(30, 0);
   const auto h = headers(t);
 

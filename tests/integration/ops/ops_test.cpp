@@ -363,3 +363,36 @@ TEST(OpsProbes, ARobotAgentWithoutSensorsIsLiveNotReady) {
   EXPECT_EQ((*ready)->body, "not ready: sensors\n");
   EXPECT_EQ((*get(ops, "/livez"))->status, 200);  // still live: its loop turns without sensors
 }
+
+TEST(OpsFleetctl, SpeaksHttpsToAServerItsCaSigned) {
+  // A self-signed certificate for 127.0.0.1 and an https server answering /v1/health; fleetctl
+  // trusts it with --ca-cert, and refuses it without (the system CAs did not sign it).
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-tls-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const auto key = (dir / "key.pem").string();
+  const auto cert = (dir / "cert.pem").string();
+  const auto made =
+      run("openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=127.0.0.1 -addext "
+          "subjectAltName=IP:127.0.0.1 -keyout " +
+          key + " -out " + cert);
+  ASSERT_EQ(made.code, 0) << made.out;
+  httplib::SSLServer server(cert.c_str(), key.c_str());
+  ASSERT_TRUE(server.is_valid());
+  server.Get("/v1/health", [](const httplib::Request&, httplib::Response& res) {
+    res.set_content(R"({"status":"ok"})", "application/json");
+  });
+  const int port = server.bind_to_any_port("127.0.0.1");
+  std::thread t([&] { server.listen_after_bind(); });
+  const std::string url = " --url https://127.0.0.1:" + std::to_string(port);
+  const auto ok = run(kBin + "/services/fleetctl/fleetctl" + url + " --ca-cert " + cert + " health");
+  const auto untrusted = run(kBin + "/services/fleetctl/fleetctl" + url + " health");
+  const auto plain =
+      run(kBin + "/services/fleetctl/fleetctl --url http://127.0.0.1:1 --ca-cert " + cert + " health");
+  server.stop();
+  t.join();
+  fs::remove_all(dir);
+  EXPECT_EQ(ok.code, 0) << ok.out;
+  EXPECT_NE(ok.out.find("\"ok\""), std::string::npos) << ok.out;
+  EXPECT_EQ(untrusted.code, 1) << untrusted.out;
+  EXPECT_EQ(plain.code, 2) << plain.out;
+}
