@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "fleet_stack.hpp"
 #include "test_process.hpp"
 
 using namespace std::chrono_literals;
@@ -395,4 +396,59 @@ TEST(OpsFleetctl, SpeaksHttpsToAServerItsCaSigned) {
   EXPECT_NE(ok.out.find("\"ok\""), std::string::npos) << ok.out;
   EXPECT_EQ(untrusted.code, 1) << untrusted.out;
   EXPECT_EQ(plain.code, 2) << plain.out;
+}
+
+TEST(OpsBackup, AnOnlineBackupOfTheTaskDatabaseRestoresItsTasks) {
+  // The procedure of docs/operator-guide.md: `sqlite3 DB ".backup FILE"` while the manager runs (the
+  // online backup API: a consistent copy under WAL), then a manager started on the copy has the
+  // tasks (no robots here, so they stay queued).
+  const std::string domain = std::to_string(fleet::test::uniqueDomain());
+  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-backup-" + domain);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto config = [&](const std::string& db) {
+    const auto path = dir / (db + ".json");
+    std::ofstream(path) << nlohmann::json{{"db", (dir / db).string()}, {"stations", kScenario}}.dump();
+    return path.string();
+  };
+  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain}};
+  const int ops1 = freePort();
+  auto manager = std::make_unique<fleet::test::ChildProcess>(
+      kBin + "/services/fleet_manager/fleet_manager",
+      std::vector<std::string>{"--config", config("fleet.db"), "--metrics-port", std::to_string(ops1),
+                               "--log-level", "warn"},
+      env);
+  ASSERT_TRUE(waitFor(ops1, "/readyz", 200, 30s));
+  {
+    fleet::test::TaskClient client;
+    for (const char* id : {"b-1", "b-2", "b-3"}) {
+      auto ack = client.submit(fleet::test::transportTask(id, "P-1", "D-1"), 30s);
+      ASSERT_TRUE(ack) << id;
+      ASSERT_EQ(ack->result, fleet::msg::AckResult::Stored) << id << ": " << ack->detail;
+    }
+  }
+  const auto backup =
+      run("sqlite3 " + (dir / "fleet.db").string() + " \".backup '" + (dir / "backup.db").string() + "'\"");
+  ASSERT_EQ(backup.code, 0) << backup.out;
+  manager->kill(SIGTERM);
+  EXPECT_EQ(manager->wait(10s), 0);
+  manager.reset();
+
+  const int ops2 = freePort();
+  fleet::test::ChildProcess restored(
+      kBin + "/services/fleet_manager/fleet_manager",
+      {"--config", config("backup.db"), "--metrics-port", std::to_string(ops2), "--log-level", "warn"}, env);
+  ASSERT_TRUE(waitFor(ops2, "/readyz", 200, 30s));
+  std::string body;
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (std::chrono::steady_clock::now() < end) {
+    body = (*get(ops2, "/metrics"))->body;
+    if (body.find("fleet_manager_tasks{state=\"queued\"} 3\n") != std::string::npos) {
+      break;
+    }
+    std::this_thread::sleep_for(200ms);
+  }
+  EXPECT_NE(body.find("fleet_manager_tasks{state=\"queued\"} 3\n"), std::string::npos) << body;
+  fs::remove_all(dir);
 }
