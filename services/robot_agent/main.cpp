@@ -295,6 +295,7 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
   ops.watchMatchedReaders("VelocityCommand", [&] { return commands.matchedReaders(); });
   ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
   ops.watchMatchedReaders("TaskStatus", [&] { return statuses.matchedReaders(); });
+  std::uint64_t steps = 0;
   std::map<std::string, metrics::Gauge*> byMode;
   // Robots by mode, counted from the last cycle's states once a second (and readiness: a robot
   // agent can do its job once a sensor source, simulator or driver, is matched).
@@ -307,6 +308,9 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
       g->set(0.0);
     }
     for (const auto& o : outs) {
+      if (steps == 0) {
+        break;  // no cycle yet: the states are defaults, not the robots'
+      }
       const std::string mode(msg::toString(o.state.mode));
       auto [it, fresh] = byMode.try_emplace(mode, nullptr);
       if (fresh) {
@@ -321,7 +325,6 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
   auto lastRegister = std::chrono::steady_clock::now() - 1s;
   std::int64_t simNow = 0;
   double dt = scn.dt;
-  std::uint64_t steps = 0;
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
     for (const auto& f : frames.take()) {

@@ -18,9 +18,12 @@ void bindExclusively(httplib::Server& server) {
 
 OpsServer::OpsServer(const metrics::Registry& registry, const Health& health)
     : registry_(registry), health_(health), server_(std::make_unique<httplib::Server>()) {
-  // Two threads: a scrape and a probe at the same time; a flood of probes queues rather than
-  // spawning threads (each answer is a few atomic loads).
-  server_->new_task_queue = [] { return new httplib::ThreadPool(2); };
+  // A few threads, fixed: scrapes and probes at the same time; a flood of probes queues rather than
+  // spawning threads (each answer is a few atomic loads). A kept-alive connection holds its thread
+  // while idle, so idle ones are closed after a second.
+  server_->new_task_queue = [] { return new httplib::ThreadPool(4); };
+  server_->set_keep_alive_timeout(1);
+  server_->set_tcp_nodelay(true);  // small answers: no Nagle delay behind the previous one
   bindExclusively(*server_);
   server_->Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
     res.set_content(registry_.exposition(), "text/plain; version=0.0.4; charset=utf-8");

@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -173,6 +174,54 @@ TEST_F(OpsFleet, FleetProbeAsTheContainersUseIt) {
   EXPECT_EQ(run(probe + " " + std::to_string(freePort()) + " /livez").code, 1);  // nobody listens
   EXPECT_EQ(run("env -u FLEET_METRICS_PORT " + probe + " /livez").code, 2);
   EXPECT_EQ(run(probe + " 80x80 /livez").code, 2);
+}
+
+TEST_F(OpsFleet, AFloodOfProbesIsAnsweredAndTheServiceStaysLive) {
+  // 4 clients x 500 probes as fast as they go (a misconfigured prober): every one answered, and the
+  // manager still scrapes and turns afterwards.
+  const int port = fleet_->ports.at("fleet_manager");
+  ASSERT_TRUE(waitFor(port, "/readyz", 200, 30s));
+  std::atomic<int> ok{0};
+  std::vector<std::thread> clients;
+  for (int k = 0; k < 4; ++k) {
+    clients.emplace_back([&] {
+      httplib::Client c("127.0.0.1", port);
+      c.set_keep_alive(true);
+      c.set_read_timeout(10s);
+      for (int i = 0; i < 500; ++i) {
+        if (auto r = c.Get(i % 2 == 0 ? "/livez" : "/readyz"); r && r->status == 200) {
+          ++ok;
+        }
+      }
+    });
+  }
+  for (auto& t : clients) {
+    t.join();
+  }
+  EXPECT_EQ(ok.load(), 2000);
+  EXPECT_TRUE(waitFor(port, "/livez", 200, 5s));
+  auto m = get(port, "/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_EQ((*m)->status, 200);
+}
+
+TEST(OpsBadInput, ATaskDatabaseThatCannotBeOpenedIsOneLineAndExitTwo) {
+  // /proc refuses new files even to root: the database cannot be created there.
+  const auto r = run(kBin + "/services/fleet_manager/fleet_manager --db /proc/fleet-ops-test.db --stations " +
+                     kScenario + " --log-format json");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("cannot open task store /proc/fleet-ops-test.db"), std::string::npos) << r.out;
+  // A site that is not a site: one line naming the file, exit 2, before any port or DDS is opened.
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-badsite-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "site.json") << "{\"format\": \"fleet-site/1\", \"name\": ";
+  const auto s = run(kBin + "/services/risk_map/risk_map --config /dev/null");
+  const auto t =
+      run(kBin + "/services/traffic_manager/traffic_manager --site " + (dir / "site.json").string());
+  fs::remove_all(dir);
+  EXPECT_EQ(t.code, 2) << t.out;
+  EXPECT_NE(t.out.find("site.json"), std::string::npos) << t.out;
+  EXPECT_EQ(s.code, 2) << s.out;
 }
 
 TEST_F(OpsFleet, ThePortOfARunningServiceIsRefusedToASecondOneWithExitTwo) {
