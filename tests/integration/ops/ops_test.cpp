@@ -306,7 +306,9 @@ TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {
                                          "/services/robot_agent/robot_agent",
                                          "/services/traffic_manager/traffic_manager",
                                          "/sim/src/fleet-sim",
-                                         "/services/fleetctl/fleetctl"};
+                                         "/services/fleetctl/fleetctl",
+                                         "/services/risk_render/risk_render",
+                                         "/services/fleet_probe/fleet-probe"};
   for (const auto& b : bins) {
     const auto v = run(kBin + b + " --version");
     EXPECT_EQ(v.code, 0) << b << ": " << v.out;
