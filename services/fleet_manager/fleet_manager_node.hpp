@@ -13,7 +13,7 @@
 #include "fleet/fleet/sqlite_task_store.hpp"
 #include "fleet/metrics/histogram.hpp"
 #include "fleet/planning/distance_field_cache.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::manager {
 

@@ -11,7 +11,7 @@
 #include "fleet/core/config.hpp"
 #include "fleet/core/expected.hpp"
 #include "fleet/risk/fusion_engine.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::riskmap {
 

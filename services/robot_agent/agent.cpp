@@ -15,7 +15,6 @@
 #include "fleet/planning/return_path.hpp"
 #include "fleet/planning/wavefront.hpp"
 #include "map_faces.hpp"
-#include "risk_astar.hpp"
 
 #include <stdexcept>
 
@@ -98,6 +97,38 @@ control::PathFollowerParams followerParams() {
   return fp;
 }
 
+// The runner's actions are the wire's, in the same order.
+static_assert(static_cast<int>(GoalAction::Park) == static_cast<int>(msg::GoalAction::Park) &&
+              static_cast<int>(GoalAction::Charge) == static_cast<int>(msg::GoalAction::Charge) &&
+              static_cast<int>(GoalAction::Unload) == static_cast<int>(msg::GoalAction::Unload) &&
+              static_cast<int>(GoalAction::Load) == static_cast<int>(msg::GoalAction::Load));
+
+TaskGoal goalOf(const msg::Goal& g) {
+  return {g.pose, g.station, static_cast<GoalAction>(g.action), g.duration_s};
+}
+
+msg::TaskState wireState(TaskStage st) {
+  switch (st) {
+    case TaskStage::Queued:
+      return msg::TaskState::Queued;
+    case TaskStage::Assigned:
+      return msg::TaskState::Assigned;
+    case TaskStage::EnRoute:
+      return msg::TaskState::EnRoute;
+    case TaskStage::Loading:
+      return msg::TaskState::Loading;
+    case TaskStage::Delivering:
+      return msg::TaskState::Delivering;
+    case TaskStage::Unloading:
+      return msg::TaskState::Unloading;
+    case TaskStage::Done:
+      return msg::TaskState::Done;
+    case TaskStage::Failed:
+      return msg::TaskState::Failed;
+  }
+  return msg::TaskState::Failed;
+}
+
 }  // namespace
 
 avoidance::DwaParams agentDwaDefaults() {
@@ -117,13 +148,12 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
       follower_(followerParams()),
-      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits}),
+      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit}),
       standsAt_(p_.start),
       progress_(ProgressLimits{p_.blockedFailS, p_.blockedBackoffS}),
-      arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}) {
-  if (p_.globalPlanner != "astar" && p_.globalPlanner != "wavefront" && p_.globalPlanner != "ompl") {
-    throw std::invalid_argument("global planner: '" + p_.globalPlanner + "' is not astar, wavefront or ompl");
-  }
+      arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}),
+      route_(RouteOptions{p_.globalPlanner, p_.lanes, p_.riskWeightGlobal, p_.radius, p_.zoneLayers}, grid_,
+             raw_) {
   if (p_.traffic != "reactive" && p_.traffic != "reserved") {
     throw std::invalid_argument("traffic: '" + p_.traffic + "' is not reactive or reserved");
   }
@@ -250,48 +280,27 @@ void Agent::onOtherRobot(const msg::RobotState& s) {
 }
 
 void Agent::onAssignment(const msg::TaskAssignment& a) {
-  if (a.robot_id != p_.id || (a.revision == revision_ && a.task_id == task_)) {
-    return;  // not ours, or the same order again (transient-local re-delivery)
-  }
-  revision_ = a.revision;
-  homing_ = false;  // an order (or a cancel) replaces the trip home
-  idleSinceNs_ = -1;
-  if (a.task_id.empty()) {
-    task_.clear();
-    goals_.clear();
-    phase_ = Phase::Idle;
+  if (a.robot_id != p_.id) {
     return;
   }
-  if (a.task_id == task_ && a.goals == goals_) {
-    paused_ = a.paused;  // a pause / resume, or re-published after a manager restart
-    return;
+  Order o{a.task_id, a.revision, {}, a.paused};
+  o.goals.reserve(a.goals.size());
+  for (const auto& g : a.goals) {
+    o.goals.push_back(goalOf(g));
   }
-  paused_ = a.paused;
-  task_ = a.task_id;
-  goals_ = a.goals;
-  goal_ = 0;
-  holdSinceNs_ = -1;
-  progress_.newOrder();
-  reported_ = msg::TaskState::Assigned;
-  phase_ = Phase::Idle;  // started on the next step, which knows the time
-}
-
-msg::TaskState Agent::taskStateFor(std::size_t goalIndex, bool dwelling) const {
-  const auto action = goals_[goalIndex].action;
-  if (dwelling) {
-    if (action == msg::GoalAction::Load) {
-      return msg::TaskState::Loading;
-    }
-    if (action == msg::GoalAction::Unload) {
-      return msg::TaskState::Unloading;
-    }
+  switch (tasks_.accept(o)) {
+    case TaskRunner::OrderChange::kSame:
+      return;
+    case TaskRunner::OrderChange::kCancel:
+    case TaskRunner::OrderChange::kPause:
+      idleSinceNs_ = -1;
+      return;
+    case TaskRunner::OrderChange::kNewTask:
+      idleSinceNs_ = -1;
+      holdSinceNs_ = -1;
+      progress_.newOrder();
+      return;
   }
-  for (std::size_t i = 0; i < goalIndex; ++i) {
-    if (goals_[i].action == msg::GoalAction::Load) {
-      return msg::TaskState::Delivering;
-    }
-  }
-  return msg::TaskState::EnRoute;
 }
 
 planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
@@ -350,29 +359,12 @@ planning::OccupancyGrid Agent::gridAroundStandingRobots(Vec2 goal) const {
     // 0.25 m from shelf faces (the local planner then crawled past each shelf corner).
     g.setBlocked(*c, false);
   }
-  openGoal(g, goal);
+  openGoal(g, *raw_, goal, p_.radius);
   return g;
 }
 
 bool Agent::bodyFits(Vec2 p) const {
-  const auto c = raw_->cellAt(p);
-  bool fits = c && !raw_->blocked(*c);
-  for (int k = 0; fits && k < 8; ++k) {
-    const double a = k * kPi / 4.0;
-    const auto e = raw_->cellAt(p + Vec2{std::cos(a), std::sin(a)} * p_.radius);
-    fits = e && !raw_->blocked(*e);
-  }
-  return fits;
-}
-
-void Agent::openGoal(planning::OccupancyGrid& g, Vec2 goal) const {
-  // A station closer to a wall than the planning margin (parking places along a wall) lies in a
-  // blocked cell. Planning to it then fell back to the raw map, whose paths hug walls and shelf
-  // corners that the stop rule will not let the robot pass: open just the goal's cell, so the path
-  // keeps its margin up to the last cell and then steps onto the station.
-  if (const auto c = g.cellAt(goal); c && g.blocked(*c) && bodyFits(goal)) {
-    g.setBlocked(*c, false);
-  }
+  return agent::bodyFits(*raw_, p, p_.radius);
 }
 
 std::optional<Vec2> Agent::axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const {
@@ -408,33 +400,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     beginLeg(nowNs);  // the route comes with the releases
     return;
   }
-  const auto& g = goals_[goal_];
+  const auto& g = tasks_.goal();
   // Leaving a station or parking place (not re-planning on the way): see undockFrom_.
-  const bool fromStandstill = phase_ == Phase::Idle || phase_ == Phase::Dwelling;
-  // Lanes and risk together: the risk map's probability scales each cell's cost as in risk_astar.
-  planning::CellCostFactor riskFactor;
-  if (risk_) {
-    riskFactor = [r = risk_, w = p_.riskWeightGlobal, gr = grid_](planning::Cell c) {
-      return 1.0 + w * r->at(gr->cellCenter(c));
-    };
-  }
-  std::unique_ptr<planning::GlobalPlanner> chosen;
-  if (p_.lanes) {
-    chosen = std::make_unique<planning::LanePlanner>(p_.lanes, riskFactor);
-  } else if (p_.globalPlanner == "wavefront") {
-    chosen = std::make_unique<planning::WavefrontPlanner>();
-  } else if (p_.globalPlanner == "ompl") {
-    planning::OmplOptions oo;
-    // Planned inside the agent's cycle: a short budget, and stop at the first path within 20 % of
-    // the straight line (the grid is inflated already, so the robot is a point here).
-    oo.timeBudget = 0.05;
-    oo.simplifyTime = 0.02;
-    oo.costThreshold = 1.2 * distance(localizer_.pose(), g.pose);
-    chosen = std::make_unique<planning::OmplPlanner>(oo);
-  } else {
-    chosen = std::make_unique<planning::AStarPlanner>();
-  }
-  planning::GlobalPlanner& astar = *chosen;
+  const bool fromStandstill = tasks_.phase() == Phase::Idle || tasks_.phase() == Phase::Dwelling;
   const planning::OccupancyGrid around = gridAroundStandingRobots(g.pose.position());
   // Stations are left and entered straight along their axis, through a point kAxisDistance in
   // front of them (a dock's pre-dock pose, VDA 5050's approach pose). A path straight from a
@@ -489,24 +457,9 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
         // The robot's own cell (the disc covers it when it stands close): a plan must start.
         detour.setBlocked(*c, false);
       }
-      return astar.plan(detour, start, end);  // no way around: the caller keeps its path
+      return route_.detour(detour, start, end);  // no way around: the caller keeps its path
     }
-    Expected<planning::Path> path = unexpected("no_path", "not planned");
-    if (risk_ && !p_.lanes && p_.globalPlanner == "astar") {
-      RiskAStarPlanner riskAware([r = risk_](Vec2 q) { return r->at(q); }, p_.riskWeightGlobal);
-      path = riskAware.plan(around, start, end);
-    } else {
-      path = astar.plan(around, start, end);
-    }
-    if (!path) {
-      planning::OccupancyGrid plain = *grid_;  // boxed in by standing robots: wait them out
-      openGoal(plain, end.position());
-      path = astar.plan(plain, start, end);
-    }
-    if (!path) {
-      path = astar.plan(*raw_, start, end);  // a start or goal hugging a shelf
-    }
-    return path;
+    return route_.route(around, start, end);
   };
   Expected<planning::Path> path = plan(from, to);
   approach_.reset();
@@ -522,7 +475,7 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
     return;  // no way around: keep the current path and wait
   }
   if (!path || !follower_.setPath(path->poses)) {
-    finishTask(msg::TaskState::Failed,
+    finishTask(TaskStage::Failed,
                "no path to " + (g.station.empty() ? std::string("goal") : g.station) + ": " +
                    (path ? std::string("follower refused the path") : path.error().message),
                nowNs);
@@ -538,38 +491,20 @@ void Agent::startGoal(std::int64_t nowNs, std::optional<Vec2> avoid) {
   if (fromStandstill) {
     undockFrom_ = localizer_.pose().position();
   }
-  phase_ = Phase::Driving;
-  phaseStartNs_ = nowNs;
+  tasks_.leg(nowNs);
   blockedSinceNs_ = -1;
   straightDock_ = false;
   makingRoom_ = false;
-  const auto st = taskStateFor(goal_, false);
-  if (st != reported_) {
-    reported_ = st;
-    pendingStatus_ = msg::TaskStatus{
-        p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
-        "",    nowNs};
-  }
 }
 
-void Agent::finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs) {
-  if (homing_) {
-    // The trip home is no order of the manager's: nothing to report; retry later if it failed.
-    homing_ = false;
-    if (final != msg::TaskState::Done) {
-      homeRetryNs_ = nowNs + secToNs(30.0);
-    }
-  } else {
-    pendingStatus_ = msg::TaskStatus{
-        p_.id, task_, revision_, final, final == msg::TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255),
-        nowNs};
+void Agent::finishTask(TaskStage final, const std::string& reason, std::int64_t nowNs) {
+  if (tasks_.homing() && final != TaskStage::Done) {
+    homeRetryNs_ = nowNs + secToNs(30.0);  // the trip home failed: retry later
   }
+  tasks_.finish(final, reason, nowNs);
   idleSinceNs_ = nowNs;
   holdSinceNs_ = -1;
   progress_.taskEnded(nowNs);
-  task_.clear();
-  goals_.clear();
-  phase_ = Phase::Idle;
 }
 
 void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const {
@@ -655,8 +590,7 @@ bool Agent::startReturn(std::int64_t nowNs) {
     return false;
   }
   path_ = points;
-  phase_ = Phase::Returning;
-  phaseStartNs_ = nowNs;
+  tasks_.yieldBy(Phase::Returning, nowNs);
   blockedSinceNs_ = -1;
   backoffFrom_ = blockPoint_;
   trail_.clear();  // the way back is driven now; what it leaves behind starts a new trail
@@ -665,16 +599,8 @@ bool Agent::startReturn(std::int64_t nowNs) {
 }
 
 void Agent::enterDwell(std::int64_t nowNs) {
-  phase_ = Phase::Dwelling;
-  standsAt_ = goals_[goal_].pose;
-  phaseStartNs_ = nowNs;
-  const auto st = taskStateFor(goal_, true);
-  if (st != reported_ && (st == msg::TaskState::Loading || st == msg::TaskState::Unloading)) {
-    reported_ = st;
-    pendingStatus_ = msg::TaskStatus{
-        p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
-        "",    nowNs};
-  }
+  standsAt_ = tasks_.goal().pose;
+  tasks_.arrive(nowNs);
 }
 
 void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w) {
@@ -687,7 +613,7 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
   s.byRobot = byRobot;
   s.blocker = blocker;
   s.blockPointKnown = blockPoint_.has_value();
-  s.homing = homing_;
+  s.homing = tasks_.homing();
   s.position = localizer_.pose().position();
   const StandoffDecision d = arbiter_.decide(s, others_);
   if (d.newStandoff) {
@@ -712,8 +638,7 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
       return;
     }
     if (rearClear()) {
-      phase_ = Phase::BackingOff;
-      phaseStartNs_ = nowNs;
+      tasks_.yieldBy(Phase::BackingOff, nowNs);
       backoffFrom_ = blockPoint_;
       ++conduct_.backoffs;
       return;
@@ -724,7 +649,7 @@ void Agent::onStandoff(std::int64_t nowNs, bool byRobot, const std::string& bloc
     ++conduct_.detours;
     startGoal(nowNs, blockPoint_);
   } else if (move == StandoffMove::kFail) {
-    finishTask(msg::TaskState::Failed,
+    finishTask(TaskStage::Failed,
                "blocked by " + (blocker.empty() ? std::string("an obstacle") : blocker) + " for " +
                    std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
                nowNs);
@@ -751,11 +676,7 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
       planner_->reset();
     }
   }
-  if (!task_.empty()) {
-    const float progress =
-        goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
-    pendingStatus_ = msg::TaskStatus{p_.id, task_, revision_, reported_, progress, reason, nowNs};
-  }
+  tasks_.notice(reason, nowNs);
   return c.lost;
 }
 
@@ -775,7 +696,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
 
 AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   AgentOutput out;
-  if (paused_ && !task_.empty()) {
+  if (tasks_.paused()) {
     // Held by the operator: stand still with the task; the hold is no time blocked or dwelling.
     if (pausedSinceNs_ < 0) {
       pausedSinceNs_ = nowNs;
@@ -790,11 +711,12 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   if (pausedSinceNs_ >= 0) {
     const std::int64_t held = nowNs - pausedSinceNs_;
     pausedSinceNs_ = -1;
-    for (std::int64_t* t : {&blockedSinceNs_, &phaseStartNs_, &holdSinceNs_}) {
+    for (std::int64_t* t : {&blockedSinceNs_, &holdSinceNs_}) {
       if (*t >= 0) {
         *t += held;
       }
     }
+    tasks_.shiftClock(held);
     progress_.afterPause(held);
     if (planner_) {
       planner_->reset();
@@ -811,11 +733,11 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
     report(out, nowNs, v, w, mode);
     return out;
   }
-  if ((!task_.empty() || homing_) && phase_ == Phase::Idle) {
+  if (tasks_.hasOrder() && tasks_.phase() == Phase::Idle) {
     startGoal(nowNs);
   }
   maybeReturnHome(nowNs);
-  if (phase_ == Phase::Driving) {
+  if (tasks_.phase() == Phase::Driving) {
     auto r = follower_.step(localizer_.pose());
     if (r && approach_ && r->final_approach && !path_.empty() &&
         distance(localizer_.pose().position(), path_.back()) < 0.25) {
@@ -830,9 +752,9 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       r = follower_.step(localizer_.pose());
     }
     if (!r) {
-      finishTask(msg::TaskState::Failed, "path follower: " + r.error().message, nowNs);
+      finishTask(TaskStage::Failed, "path follower: " + r.error().message, nowNs);
     } else if (!approach_ && (r->goal_reached || (r->final_approach &&
-                                                  distance(localizer_.pose(), goals_[goal_].pose) < 0.15))) {
+                                                  distance(localizer_.pose(), tasks_.goal().pose) < 0.15))) {
       enterDwell(nowNs);
     } else if (const Other* occupant = stationOccupant(); occupant != nullptr) {
       // Queue for the station a little way off instead of pushing into the robot on it.
@@ -840,8 +762,8 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       if (holdSinceNs_ < 0) {
         holdSinceNs_ = nowNs;
       } else if (nsToSec(nowNs - holdSinceNs_) > p_.blockedFailS) {
-        finishTask(msg::TaskState::Failed,
-                   goals_[goal_].station + " occupied by " + occupant->id + " for " +
+        finishTask(TaskStage::Failed,
+                   tasks_.goal().station + " occupied by " + occupant->id + " for " +
                        std::to_string(static_cast<int>(p_.blockedFailS)) + " s",
                    nowNs);
       }
@@ -849,7 +771,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       // this queue, which stands where its way out begins). Back away up to 1 m more, so it can
       // pass; a queue robot and the occupant waiting on each other failed both tasks after 60 s.
       const bool wantsOut = occupant->mode == Other::Mode::kWaiting || occupant->mode == Other::Mode::kMoving;
-      if (wantsOut && distance(localizer_.pose(), goals_[goal_].pose) < kQueueDistance + 1.0 && rearClear()) {
+      if (wantsOut && distance(localizer_.pose(), tasks_.goal().pose) < kQueueDistance + 1.0 && rearClear()) {
         v = -0.2;
         makingRoom_ = true;
       }
@@ -926,7 +848,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
         ++conduct_.plannerRecoveries;
       }
     }
-  } else if (phase_ == Phase::Returning) {
+  } else if (tasks_.phase() == Phase::Returning) {
     mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
     auto r = follower_.step(localizer_.pose());
     const bool arrived = !r || r->goal_reached ||
@@ -951,27 +873,26 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       w = 0.0;
       endYield(nowNs);
     }
-  } else if (phase_ == Phase::Dwelling) {
-    mode =
-        goals_[goal_].action == msg::GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
-    if (nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].duration_s) {
-      ++goal_;
+  } else if (tasks_.phase() == Phase::Dwelling) {
+    mode = tasks_.goal().action == GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
+    if (tasks_.dwellOver(nowNs)) {
+      const bool more = tasks_.nextGoal();
       progress_.newGoal();
-      if (goal_ >= goals_.size()) {
-        finishTask(msg::TaskState::Done, "", nowNs);
+      if (!more) {
+        finishTask(TaskStage::Done, "", nowNs);
       } else {
         startGoal(nowNs);
       }
     }
-  } else if (phase_ == Phase::BackingOff) {
+  } else if (tasks_.phase() == Phase::BackingOff) {
     mode = msg::RobotMode::Waiting;
     v = rearClear() ? -0.2 : 0.0;
-    if (nsToSec(nowNs - phaseStartNs_) > 1.5) {
+    if (nsToSec(nowNs - tasks_.phaseStartNs()) > 1.5) {
       endYield(nowNs);
     }
   }
   watchProgress(nowNs);
-  if (phase_ == Phase::Driving) {
+  if (tasks_.phase() == Phase::Driving) {
     const Vec2 here = localizer_.pose().position();
     if (trail_.empty() || distance(trail_.back(), here) > kTrailStep) {
       trail_.push_back(here);
@@ -990,12 +911,12 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
 void Agent::endYield(std::int64_t nowNs) {
   // Replan from where it stands around what blocked it (the same path would lead straight back
   // into the standoff); with no way around, the plain plan.
-  phase_ = Phase::Idle;
+  tasks_.stop();
   if (backoffFrom_) {
     ++conduct_.detours;
     startGoal(nowNs, backoffFrom_);
   }
-  if (phase_ != Phase::Driving && (!task_.empty() || homing_)) {
+  if (tasks_.phase() != Phase::Driving && tasks_.hasOrder()) {
     startGoal(nowNs);
   }
   backoffFrom_.reset();
@@ -1005,22 +926,23 @@ void Agent::watchProgress(std::int64_t nowNs) {
   ProgressSample sample;
   sample.nowNs = nowNs;
   sample.here = localizer_.pose().position();
-  sample.travelling = phase_ == Phase::Driving || phase_ == Phase::Returning || phase_ == Phase::BackingOff;
-  sample.returning = phase_ == Phase::Returning;
-  if (goal_ < goals_.size()) {
-    sample.goal = goals_[goal_].pose.position();
+  sample.travelling = tasks_.phase() == Phase::Driving || tasks_.phase() == Phase::Returning ||
+                      tasks_.phase() == Phase::BackingOff;
+  sample.returning = tasks_.phase() == Phase::Returning;
+  if (tasks_.hasGoal()) {
+    sample.goal = tasks_.goal().pose.position();
   }
   if (reserved_) {
     // Progress is along the released nodes (a route on the roadmap may lead away from the goal for
     // a while). Waiting for a release is waiting on another robot, not being stuck: no clock runs.
-    sample.travelling = phase_ == Phase::Driving && baseAhead_;
+    sample.travelling = tasks_.phase() == Phase::Driving && baseAhead_;
     sample.goal = releases_.next();
   }
-  sample.hasOrder = !task_.empty() || homing_;
+  sample.hasOrder = tasks_.hasOrder();
   switch (progress_.check(sample)) {
     case ProgressVerdict::kFailTask:
-      finishTask(msg::TaskState::Failed,
-                 "no progress towards " + goals_[goal_].station + " for " +
+      finishTask(TaskStage::Failed,
+                 "no progress towards " + tasks_.goal().station + " for " +
                      std::to_string(progress_.failAfterS()) + " s",
                  nowNs);
       break;
@@ -1033,11 +955,11 @@ void Agent::watchProgress(std::int64_t nowNs) {
 }
 
 const Agent::Other* Agent::stationOccupant() const {
-  const auto& g = goals_[goal_];
+  const auto& g = tasks_.goal();
   const Vec2 here = localizer_.pose().position();
   const double toGoal = distance(here, g.pose.position());
   const double reach = makingRoom_ ? kQueueDistance + 1.3 : kQueueDistance;  // (hysteresis)
-  if (homing_ || toGoal > reach || toGoal < kQueueDistance - 0.5) {
+  if (tasks_.homing() || toGoal > reach || toGoal < kQueueDistance - 0.5) {
     return nullptr;  // far off, or already past the queue place: go on
   }
   for (const auto& o : others_) {
@@ -1049,7 +971,7 @@ const Agent::Other* Agent::stationOccupant() const {
 }
 
 void Agent::maybeReturnHome(std::int64_t nowNs) {
-  if (!task_.empty() || homing_ || phase_ != Phase::Idle || p_.returnHomeS < 0.0) {
+  if (tasks_.hasOrder() || tasks_.phase() != Phase::Idle || p_.returnHomeS < 0.0) {
     return;
   }
   if (idleSinceNs_ < 0) {
@@ -1064,9 +986,7 @@ void Agent::maybeReturnHome(std::int64_t nowNs) {
       nowNs < homeRetryNs_ || distance(localizer_.pose().position(), p_.start.position()) < 0.3) {
     return;
   }
-  homing_ = true;
-  goals_ = {msg::Goal{p_.start, "home", msg::GoalAction::Park, 0.0}};
-  goal_ = 0;
+  tasks_.goHome(TaskGoal{p_.start, "home", GoalAction::Park, 0.0});
   progress_.newGoal();
   startGoal(nowNs);
 }
@@ -1087,7 +1007,7 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   out.state.w = w;
   out.state.mode = mode;
   out.state.battery = static_cast<float>(battery_);
-  out.state.task_id = task_;
+  out.state.task_id = tasks_.task();
   out.state.radius = static_cast<float>(p_.radius);
 
   // Predicted discs: the current command held over the horizon, the EKF's covariance grown along it.
@@ -1100,11 +1020,10 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   prediction.dt = p_.predictionDt;
   prediction.horizonS = p_.predictionHorizonS;
   out.discs.discs = predictDiscs(pose, P, v, w, prediction);
-  if (pendingStatus_ && (homing_ || pendingStatus_->task_id.empty())) {
-    pendingStatus_.reset();  // the trip home is not a task
+  if (auto r = tasks_.takeReport()) {
+    out.status =
+        msg::TaskStatus{p_.id, r->task, r->revision, wireState(r->stage), r->progress, r->reason, r->stampNs};
   }
-  out.status = std::move(pendingStatus_);
-  pendingStatus_.reset();
   if (reserved_) {
     out.traffic = trafficProgress(nowNs);
   }

@@ -24,6 +24,7 @@
 // traffic manager's plan, the gate stays for people and the unexpected.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,16 +35,18 @@
 #include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
 #include "fleet/control/path_follower.hpp"
+#include "fleet/messages/messages.hpp"
 #include "fleet/planning/lane_map.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/risk/risk_lookup.hpp"
 #include "localizer.hpp"
 #include "motion_gate.hpp"
 #include "other_robot.hpp"
 #include "progress_watch.hpp"
 #include "release_tracker.hpp"
-#include "risk_field.hpp"
+#include "route_planner.hpp"
 #include "standoff_arbiter.hpp"
+#include "task_runner.hpp"
 
 namespace fleet::agent {
 
@@ -94,6 +97,11 @@ struct AgentParams {
   /// One-way aisles of the map (shared by every agent of a process); null: plain A*. Set, it
   /// replaces the global planner.
   std::shared_ptr<const planning::LaneMap> lanes;
+  /// The site's zones: cost layers every global path keeps to (one-way, speed limits as travel
+  /// time; no-go zones are blocked in the maps given to the agent) and the speed limit at a point
+  /// (m/s; +inf or empty: none), which the motion gate enforces.
+  planning::CostLayers zoneLayers;
+  std::function<double(Vec2)> speedLimit;
   /// "reactive": robots keep clear of each other by the standoff conduct (the default for now);
   /// "reserved": the route comes from the traffic manager's releases (see onRelease).
   std::string traffic = "reactive";
@@ -125,18 +133,21 @@ class Agent {
   void onRelease(const msg::TrafficRelease& r);
   /// The latest risk map (shared by every agent of the process): the local planner's risk term and
   /// the global planner's cell cost. Null: no risk information.
-  void onRiskMap(std::shared_ptr<const RiskField> risk) { risk_ = std::move(risk); }
+  void onRiskMap(std::shared_ptr<const risk::RiskLookup> risk) {
+    route_.setRisk(risk);
+    risk_ = std::move(risk);
+  }
   AgentOutput step(std::int64_t nowNs, double dt);
   /// True while the sensor stream is considered lost (as of the last step).
   [[nodiscard]] bool sensorLost() const { return localizer_.lost(); }
 
   [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
-  [[nodiscard]] bool busy() const { return !task_.empty(); }
+  [[nodiscard]] bool busy() const { return tasks_.busy(); }
   /// The current order is paused by the operator: the robot stands still with it.
-  [[nodiscard]] bool paused() const { return paused_ && !task_.empty(); }
+  [[nodiscard]] bool paused() const { return tasks_.paused(); }
   /// Driving back to its parking place with no order (see AgentParams::returnHomeS).
-  [[nodiscard]] bool homing() const { return homing_; }
+  [[nodiscard]] bool homing() const { return tasks_.homing(); }
   [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
   [[nodiscard]] const LineStats& lineStats() const { return localizer_.lineStats(); }
   /// Follows the traffic manager's releases (AgentParams::traffic "reserved").
@@ -160,7 +171,6 @@ class Agent {
   [[nodiscard]] const Conduct& conduct() const { return conduct_; }
 
  private:
-  enum class Phase { Idle, Driving, Dwelling, BackingOff, Returning };
   /// The task stack for one cycle (the body of step() while sensors are live).
   AgentOutput drive(std::int64_t nowNs, double dt);
   /// The localizer's stream watch; on loss and on recovery queues a TaskStatus with the reason and
@@ -173,13 +183,12 @@ class Agent {
   /// Plans to the current goal; with `avoid`, the cells around that point count as blocked (a
   /// detour around whatever stands in the way).
   void startGoal(std::int64_t nowNs, std::optional<Vec2> avoid = std::nullopt);
-  void finishTask(msg::TaskState final, const std::string& reason, std::int64_t nowNs);
+  void finishTask(TaskStage final, const std::string& reason, std::int64_t nowNs);
   /// At a goal: dwell there for its duration, reporting loading/unloading.
   void enterDwell(std::int64_t nowNs);
   /// Something keeps the robot from moving: does what the standoff arbiter decides (after a while
   /// back off, then detour, then fail).
   void onStandoff(std::int64_t nowNs, bool byRobot, const std::string& blocker, double& v, double& w);
-  msg::TaskState taskStateFor(std::size_t goalIndex, bool dwelling) const;
   /// What the motion gate looks at this cycle.
   [[nodiscard]] GateView gateView() const;
   /// The gate's stop rule (see MotionGate); keeps where it found the robot blocked (blockPoint_).
@@ -206,7 +215,7 @@ class Agent {
   /// Reserved traffic: a leg towards the current goal begins (no plan: the releases are the route).
   void beginLeg(std::int64_t nowNs);
   /// Reserved traffic: where the robot is going (the task's goal; idle, its home), if anywhere.
-  [[nodiscard]] std::optional<msg::Goal> trafficGoal() const;
+  [[nodiscard]] std::optional<TaskGoal> trafficGoal() const;
   /// Reserved traffic: the base ends on the current goal (its last leg is the docking).
   [[nodiscard]] bool baseEndsAtGoal() const;
   /// Reserved traffic: the progress report for this cycle, if one is due.
@@ -221,19 +230,11 @@ class Agent {
   std::vector<Vec2> path_;                            // remaining path (world frame)
   /// One cycle of the configured avoidance planner; returns the twist and whether it is blocked.
   control::Twist planLocal(bool& blocked);
-  std::shared_ptr<const RiskField> risk_;
+  std::shared_ptr<const risk::RiskLookup> risk_;
 
-  std::string task_;
-  std::uint32_t revision_ = 0;
-  bool paused_ = false;              // the order says hold (TaskAssignment.paused)
+  TaskRunner tasks_;                 // the order, its goals, the phase and the task states reported
   std::int64_t pausedSinceNs_ = -1;  // holding since (its length is added to the task's timers)
-  std::vector<msg::Goal> goals_;
-  std::size_t goal_ = 0;
-  Phase phase_ = Phase::Idle;
-  std::int64_t phaseStartNs_ = 0;
   std::int64_t blockedSinceNs_ = -1;
-  std::optional<msg::TaskStatus> pendingStatus_;
-  msg::TaskState reported_ = msg::TaskState::Queued;
   using Other = OtherRobot;
   MotionGate gate_;  // stop rule and cross-traffic check
   std::vector<Other> others_;
@@ -242,8 +243,6 @@ class Agent {
   [[nodiscard]] planning::OccupancyGrid gridAroundStandingRobots(Vec2 goal) const;
   /// The robot's disc at `p` is clear of the raw map's obstacles.
   [[nodiscard]] bool bodyFits(Vec2 p) const;
-  /// Unblocks the goal's cell of `g` when the robot fits on the goal itself.
-  void openGoal(planning::OccupancyGrid& g, Vec2 goal) const;
   /// The point kAxisDistance in front of `station` (along its heading) when it is free on `g` and
   /// the straight leg to it is clear of walls and standing robots; the way in and out.
   [[nodiscard]] std::optional<Vec2> axisPoint(const Pose2& station, const planning::OccupancyGrid& g) const;
@@ -258,7 +257,6 @@ class Agent {
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
-  bool homing_ = false;
   bool docking_ = false;  // on the final approach to a goal (see clearSpeed)
   /// The pose law's curve onto this goal was blocked by a wall: turn to face it and drive straight.
   bool straightDock_ = false;
@@ -281,6 +279,7 @@ class Agent {
   std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
   StandoffArbiter arbiter_;  // what to do about a hold: wait, yield, detour, fail
   Conduct conduct_;
+  RoutePlanner route_;  // global paths: the planner chosen once, cost layers, the fallback chain
 
   // Reserved traffic.
   bool reserved_ = false;

@@ -104,13 +104,13 @@ void Agent::onRelease(const msg::TrafficRelease& r) {
   (void)releases_.offer(rel, localizer_.pose().position());
 }
 
-std::optional<msg::Goal> Agent::trafficGoal() const {
-  if (!task_.empty() && goal_ < goals_.size()) {
-    return goals_[goal_];
+std::optional<TaskGoal> Agent::trafficGoal() const {
+  if (tasks_.busy() && tasks_.hasGoal()) {
+    return tasks_.goal();
   }
   if (p_.returnHomeS >= 0.0) {
     // Idle: its parking place. The trip home is planned by the traffic manager like any other.
-    return msg::Goal{p_.start, "", msg::GoalAction::Park, 0.0};
+    return TaskGoal{p_.start, "", GoalAction::Park, 0.0};
   }
   return std::nullopt;
 }
@@ -122,36 +122,27 @@ bool Agent::baseEndsAtGoal() const {
 }
 
 void Agent::beginLeg(std::int64_t nowNs) {
-  if (phase_ == Phase::Idle || phase_ == Phase::Dwelling) {
+  if (tasks_.phase() == Phase::Idle || tasks_.phase() == Phase::Dwelling) {
     undockFrom_ = localizer_.pose().position();
   }
-  phase_ = Phase::Driving;
-  phaseStartNs_ = nowNs;
-  const auto st = taskStateFor(goal_, false);
-  if (st != reported_) {
-    reported_ = st;
-    pendingStatus_ = msg::TaskStatus{
-        p_.id, task_, revision_, st, static_cast<float>(goal_) / static_cast<float>(goals_.size()),
-        "",    nowNs};
-  }
+  tasks_.leg(nowNs);
 }
 
 void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
-  if (!task_.empty() && phase_ == Phase::Idle) {
+  if (tasks_.busy() && tasks_.phase() == Phase::Idle) {
     startGoal(nowNs);
   }
-  if (phase_ == Phase::Dwelling) {
+  if (tasks_.phase() == Phase::Dwelling) {
     heldSinceNs_ = -1;
     blocked_ = false;
     baseAhead_ = false;
     dockingLeg_ = false;
-    mode =
-        goals_[goal_].action == msg::GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
-    if (nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].duration_s) {
-      ++goal_;
+    mode = tasks_.goal().action == GoalAction::Charge ? msg::RobotMode::Charging : msg::RobotMode::Loading;
+    if (tasks_.dwellOver(nowNs)) {
+      const bool more = tasks_.nextGoal();
       progress_.newGoal();
-      if (goal_ >= goals_.size()) {
-        finishTask(msg::TaskState::Done, "", nowNs);
+      if (!more) {
+        finishTask(TaskStage::Done, "", nowNs);
       } else {
         startGoal(nowNs);
       }
@@ -176,7 +167,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   w = 0.0;
   // Standing (at the end of the base, on the goal, or with nothing released): waiting on the
   // traffic manager, which is waiting on other robots; nothing holds it up.
-  mode = task_.empty() ? msg::RobotMode::Idle : msg::RobotMode::Waiting;
+  mode = !tasks_.busy() ? msg::RobotMode::Idle : msg::RobotMode::Waiting;
   auto standStill = [&] {
     v = 0.0;
     w = 0.0;
@@ -187,7 +178,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     standStill();
     dockingLeg_ = false;
     standsAt_ = goal->pose;
-    if (!task_.empty() && phase_ == Phase::Driving) {
+    if (tasks_.busy() && tasks_.phase() == Phase::Driving) {
       enterDwell(nowNs);
     }
     return;
@@ -327,7 +318,7 @@ std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {
     p.goal_station = g->station;
   }
   p.priority = 0;  // (TaskAssignment carries no priority yet)
-  p.holding = phase_ == Phase::Dwelling || paused() || localizer_.lost() || dockingLeg_;
+  p.holding = tasks_.phase() == Phase::Dwelling || paused() || localizer_.lost() || dockingLeg_;
   p.blocked = blocked_;
   p.follows = true;
   p.stamp_ns = nowNs;

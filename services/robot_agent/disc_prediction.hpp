@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "fleet/core/pose2.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::agent {
 

@@ -30,6 +30,7 @@
 #include "fleet/sim/scenario.hpp"
 #include "fleet/site/reachability.hpp"
 #include "fleet/site/wall_segments.hpp"
+#include "fleet/site/zone_costs.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_field.hpp"
 #include "worker_pool.hpp"
@@ -44,6 +45,7 @@ namespace {
 /// From a site and a list of robots (a deployment) or from a simulator scenario.
 struct World {
   std::shared_ptr<const planning::OccupancyGrid> map;
+  std::shared_ptr<const site::Site> site;  ///< its zones (null: a scenario with its map inline)
   std::vector<std::pair<std::int32_t, Vec2>> landmarks;
   struct Robot {
     std::string id;
@@ -72,6 +74,9 @@ std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
 World fromScenario(const sim::Scenario& scn) {
   World w;
   w.map = gridOf(scn.map);
+  if (scn.site && scn.site->map.width() == w.map->width() && scn.site->map.height() == w.map->height()) {
+    w.site = scn.site;
+  }
   for (const auto& l : scn.landmarks) {
     w.landmarks.emplace_back(l.id, l.position);
   }
@@ -89,6 +94,7 @@ World fromScenario(const sim::Scenario& scn) {
 World fromSite(const site::Site& st, const std::vector<std::string>& specs) {
   World w;
   w.map = std::make_shared<const planning::OccupancyGrid>(st.map);
+  w.site = std::make_shared<const site::Site>(st);
   for (const auto& l : st.landmarks) {
     w.landmarks.emplace_back(l.id, l.position);
   }
@@ -200,7 +206,24 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
   const auto& only = opt.only;
   const bool lockstep = opt.lockstep;
   const std::string& id = opt.id;
-  const auto& raw = scn.map;
+  // Robots plan on the map with the site's no-go zones blocked; the walls the localizer matches its
+  // scan lines against come from the map itself (a zone is no wall).
+  std::shared_ptr<const planning::OccupancyGrid> raw = scn.map;
+  planning::CostLayers zoneLayers;
+  std::function<double(Vec2)> speedLimit;
+  if (scn.site) {
+    const auto& noGo = scn.site->layers.noGo;
+    if (std::any_of(noGo.begin(), noGo.end(), [](std::uint8_t c) { return c != 0; })) {
+      raw = std::make_shared<const planning::OccupancyGrid>(scn.site->drivable());
+    }
+    zoneLayers = site::zoneCostLayers(scn.site, 0.8);
+    const auto& limits = scn.site->layers.speedLimit;
+    if (std::any_of(limits.begin(), limits.end(), [](float v) { return std::isfinite(v); })) {
+      speedLimit = [s = scn.site](Vec2 p) { return s->speedLimitAt(p); };
+    }
+    spdlog::info("robot agent: site '{}': {} zones, {} cost layers{}", scn.site->name, scn.site->zones.size(),
+                 zoneLayers.size(), speedLimit ? ", speed limits enforced" : "");
+  }
   std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::shared_ptr<const planning::LaneMap> lanes;
   if (opt.useLanes) {
@@ -210,7 +233,7 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
   // The walls every localizer matches its scan lines against: faces of 0.5 m and more (the line
   // extractor keeps nothing shorter).
   auto walls = std::make_shared<std::vector<estimation::MapSegment>>();
-  for (const auto& w : site::wallSegments(*raw, agent::agentLineExtraction().min_length)) {
+  for (const auto& w : site::wallSegments(*scn.map, agent::agentLineExtraction().min_length)) {
     walls->push_back({w.a, w.b, w.normal});
   }
   spdlog::info("robot agent: {} wall faces for the line updates ({})", walls->size(),
@@ -242,6 +265,8 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
     p.returnHomeS = opt.returnHomeS;
     p.riskWeightGlobal = opt.riskWeightGlobal;
     p.lanes = lanes;
+    p.zoneLayers = zoneLayers;
+    p.speedLimit = speedLimit;
     p.traffic = opt.traffic;
     p.limits = r.limits;
     p.limits.v_max = p.vMax;
@@ -354,7 +379,7 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
     }
     if (auto maps = riskMaps.take(); !maps.empty() && opt.useRisk) {
       // Only the newest map matters; it is decoded once and shared read-only by every agent.
-      if (auto field = agent::RiskField::fromMessage(maps.back())) {
+      if (auto field = agent::riskLookupOf(maps.back())) {
         for (auto& a : agents) {
           a->onRiskMap(*field);
         }

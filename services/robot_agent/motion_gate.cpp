@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "map_faces.hpp"
 
@@ -159,7 +160,22 @@ bool MotionGate::crossTrafficSafe(const GateView& view, double& v, double& w, st
   return false;
 }
 
+double MotionGate::zoneSpeed(const GateView& view, double v) const {
+  if (!p_.speedLimit) {
+    return std::numeric_limits<double>::infinity();
+  }
+  const Pose2& at = view.seen.pose;
+  const double ahead = std::max(p_.radius, std::abs(v) * p_.headway);
+  return std::min(p_.speedLimit(at.position()),
+                  p_.speedLimit(at.position() + at.heading() * (v < 0.0 ? -ahead : ahead)));
+}
+
 MotionGate::Hold MotionGate::heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const {
+  if (const double limit = zoneSpeed(view, v); std::abs(v) > limit) {
+    const double scaled = std::max(0.0, limit) * (v < 0.0 ? -1.0 : 1.0);
+    w *= std::abs(v) > 1e-9 ? scaled / v : 1.0;
+    v = scaled;
+  }
   const Clearance clear = clearSpeed(view, v, blocker);
   const double allowed = clear.speed;
   if (allowed < v - 1e-9) {

@@ -6,6 +6,7 @@
 // extrapolated at their velocities, then against the scan and the map's obstacle faces). It says
 // whether the robot is held up and by what, so the standoff rules know whom to yield to.
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +25,8 @@ struct GateParams {
   double stopGap = 0.35;  ///< m of free space kept ahead at standstill
   double headway = 1.0;   ///< s: the stop distance grows with speed
   control::VelocityLimits limits;
+  /// The site's speed limit at a map point [m/s] (+inf: none); empty: no zones.
+  std::function<double(Vec2)> speedLimit;
 };
 
 /// What the gate looks at in one cycle (non-owning: the caller keeps it alive for the call).
@@ -65,7 +68,11 @@ class MotionGate {
     bool held = false;
     std::optional<Vec2> blockPoint;  ///< as clearSpeed found it
   };
-  /// Stop rule and cross-traffic check on (v, w), which come out limited; held: the robot is held.
+  /// The site's speed limit for the robot now: the lowest at its position and at the point it
+  /// would reach within its headway (so it slows before a slow zone, not inside it); +inf: none.
+  [[nodiscard]] double zoneSpeed(const GateView& view, double v) const;
+  /// Speed zones, stop rule and cross-traffic check on (v, w), which come out limited (a speed
+  /// zone keeps the curvature and does not count as being held); held: the robot is held.
   Hold heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const;
 
  private:

@@ -24,7 +24,7 @@
 #include "fleet/site/site.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::trafficmgr {
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::wms {
 

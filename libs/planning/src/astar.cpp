@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <queue>
 
 namespace fleet::planning {
 
@@ -268,12 +269,88 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, Conne
                                        std::to_string(goal.y) + ")");
 }
 
+Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, const CostLayers& layers) {
+  if (layers.empty()) {
+    return astar(grid, start, goal, Connectivity::Eight);
+  }
+  if (grid.blocked(start) || grid.blocked(goal)) {
+    return unexpected("unreachable", "start or goal cell is blocked or outside the map");
+  }
+  // Costs are products of arbitrary factors, so the fixed-point keys of the plain search do not
+  // apply: doubles, a binary heap with lazy deletion, and parents kept per cell.
+  const std::size_t n = grid.size();
+  auto octile = [&](Cell c) {
+    const double dx = std::abs(c.x - goal.x);
+    const double dy = std::abs(c.y - goal.y);
+    return std::max(dx, dy) + (std::numbers::sqrt2 - 1.0) * std::min(dx, dy);
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> g(n, inf);
+  std::vector<std::int64_t> parent(n, -1);
+  using Item = std::pair<double, std::size_t>;  // f, cell
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  g[grid.index(start)] = 0.0;
+  open.emplace(octile(start), grid.index(start));
+  const std::size_t goalIdx = grid.index(goal);
+  int expanded = 0;
+  while (!open.empty()) {
+    const auto [f, idx] = open.top();
+    open.pop();
+    const Cell c = grid.cellOf(idx);
+    if (f > g[idx] + octile(c) + 1e-9) {
+      continue;  // superseded by a cheaper entry
+    }
+    ++expanded;
+    if (idx == goalIdx) {
+      break;
+    }
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (dx == 0 && dy == 0) {
+          continue;
+        }
+        const Cell q{c.x + dx, c.y + dy};
+        if (grid.blocked(q)) {
+          continue;
+        }
+        if (dx != 0 && dy != 0 && (grid.blocked({c.x + dx, c.y}) || grid.blocked({c.x, c.y + dy}))) {
+          continue;  // no corner cutting
+        }
+        double factor = 1.0;
+        for (const auto& layer : layers) {
+          factor *= std::max(1.0, layer->factor(c, q));  // NaN -> 1 too (max keeps the first)
+        }
+        const double len = (dx != 0 && dy != 0) ? std::numbers::sqrt2 : 1.0;
+        const double cand = g[idx] + len * factor;
+        const std::size_t qi = grid.index(q);
+        if (cand < g[qi]) {
+          g[qi] = cand;
+          parent[qi] = static_cast<std::int64_t>(idx);
+          open.emplace(cand + octile(q), qi);
+        }
+      }
+    }
+  }
+  if (!std::isfinite(g[goalIdx])) {
+    return unexpected("unreachable", "no path between the cells");
+  }
+  GridPath out;
+  out.cost = g[goalIdx];
+  out.expanded = expanded;
+  for (auto i = static_cast<std::int64_t>(goalIdx); i >= 0; i = parent[static_cast<std::size_t>(i)]) {
+    out.cells.push_back(grid.cellOf(static_cast<std::size_t>(i)));
+  }
+  std::reverse(out.cells.begin(), out.cells.end());
+  return out;
+}
+
 Expected<Path> AStarPlanner::plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) {
   const auto q = resolveQuery(grid, from, to);
   if (!q) {
     return unexpected(q.error());
   }
-  const auto gp = astar(grid, q->start, q->goal, conn_, landmarks_.get());
+  const auto gp = layers_.empty() ? astar(grid, q->start, q->goal, conn_, landmarks_.get())
+                                  : astar(grid, q->start, q->goal, layers_);
   if (!gp) {
     return unexpected(gp.error());
   }

@@ -140,7 +140,10 @@ Expected<Path> OmplPlanner::plan(const OccupancyGrid& rawGrid, Pose2 from, Pose2
   }
   ss.setStartAndGoalStates(start, goal, 1e-6);
   auto objective = std::make_shared<ob::PathLengthOptimizationObjective>(si);
-  objective->setCostThreshold(ob::Cost(opt_.costThreshold > 0.0 ? opt_.costThreshold : 0.0));
+  const double threshold = opt_.costThresholdRatio > 0.0
+                               ? opt_.costThresholdRatio * distance(from.position(), to.position())
+                               : opt_.costThreshold;
+  objective->setCostThreshold(ob::Cost(threshold > 0.0 ? threshold : 0.0));
   ss.setOptimizationObjective(objective);
   switch (opt_.algorithm) {
     case OmplAlgorithm::RRTstar: {
@@ -172,7 +175,7 @@ Expected<Path> OmplPlanner::plan(const OccupancyGrid& rawGrid, Pose2 from, Pose2
                                          std::to_string(opt_.timeBudget) + " s");
   }
   stats_.rawLength = ss.getSolutionPath().length();
-  stats_.thresholdMet = opt_.costThreshold > 0.0 && stats_.rawLength <= opt_.costThreshold;
+  stats_.thresholdMet = threshold > 0.0 && stats_.rawLength <= threshold;
   if (opt_.simplify) {
     ss.simplifySolution(opt_.simplifyTime);
   }

@@ -1,5 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <queue>
 #include <random>
 #include <thread>
 
@@ -212,6 +217,130 @@ TEST(AStar, ExactOnLargeGridsAndAcrossGridSizes) {
     ASSERT_EQ(rs.has_value(), fs.reachable(ss));
     if (rs) {
       EXPECT_NEAR(rs->cost, fs.at(ss), 1e-9);
+    }
+  }
+}
+
+namespace {
+
+// Dijkstra over the same moves (8-connected, no corner cutting) with the same layered costs: the
+// reference the one A* is checked against.
+double layeredDijkstra(const OccupancyGrid& g, Cell s, Cell t, const CostLayers& layers) {
+  std::vector<double> d(g.size(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  d[g.index(s)] = 0.0;
+  open.emplace(0.0, g.index(s));
+  while (!open.empty()) {
+    const auto [k, i] = open.top();
+    open.pop();
+    if (k > d[i]) {
+      continue;
+    }
+    const Cell c = g.cellOf(i);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Cell q{c.x + dx, c.y + dy};
+        if ((dx == 0 && dy == 0) || g.blocked(q) ||
+            (dx != 0 && dy != 0 && (g.blocked({c.x + dx, c.y}) || g.blocked({c.x, c.y + dy})))) {
+          continue;
+        }
+        double f = 1.0;
+        for (const auto& l : layers) {
+          f *= std::max(1.0, l->factor(c, q));
+        }
+        const double nd = d[i] + (dx != 0 && dy != 0 ? std::numbers::sqrt2 : 1.0) * f;
+        if (nd < d[g.index(q)]) {
+          d[g.index(q)] = nd;
+          open.emplace(nd, g.index(q));
+        }
+      }
+    }
+  }
+  return d[g.index(t)];
+}
+
+// Prices in [0.5, 4) per cell (below 1 counts as 1) and a direction rule: moving left costs 3x.
+CostLayers randomLayers(int w, int h, std::mt19937& rng) {
+  auto price = std::make_shared<std::vector<double>>(static_cast<std::size_t>(w * h));
+  std::uniform_real_distribution<double> u(0.5, 4.0);
+  for (auto& p : *price) {
+    p = u(rng);
+  }
+  struct Leftward final : CostLayer {
+    double factor(Cell from, Cell to) const override { return to.x < from.x ? 3.0 : 1.0; }
+    const char* name() const override { return "leftward"; }
+  };
+  return {std::make_shared<EnterCellCost>(
+              "price", [price, w](Cell c) { return (*price)[static_cast<std::size_t>(c.y * w + c.x)]; }),
+          std::make_shared<Leftward>()};
+}
+
+}  // namespace
+
+TEST(LayeredAStar, MatchesDijkstraOnRandomGridsWithRandomLayers) {
+  std::mt19937 rng(11);
+  std::bernoulli_distribution wall(0.25);
+  int solved = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    OccupancyGrid g(25, 18, 0.5);
+    for (int y = 0; y < 18; ++y) {
+      for (int x = 0; x < 25; ++x) {
+        if (wall(rng)) {
+          g.setBlocked({x, y});
+        }
+      }
+    }
+    const Cell s{0, 0};
+    const Cell t{24, 17};
+    g.setBlocked(s, false);
+    g.setBlocked(t, false);
+    const auto layers = randomLayers(25, 18, rng);
+    const auto got = astar(g, s, t, layers);
+    const double ref = layeredDijkstra(g, s, t, layers);
+    ASSERT_EQ(got.has_value(), std::isfinite(ref)) << "trial " << trial;
+    if (!got) {
+      continue;
+    }
+    ++solved;
+    EXPECT_NEAR(got->cost, ref, 1e-9) << "trial " << trial;
+    // The returned cells are a legal path whose layered cost is the reported cost.
+    double cost = 0.0;
+    for (std::size_t i = 1; i < got->cells.size(); ++i) {
+      const Cell a = got->cells[i - 1], b = got->cells[i];
+      ASSERT_LE(std::max(std::abs(a.x - b.x), std::abs(a.y - b.y)), 1);
+      double f = 1.0;
+      for (const auto& l : layers) {
+        f *= std::max(1.0, l->factor(a, b));
+      }
+      cost += (a.x != b.x && a.y != b.y ? std::numbers::sqrt2 : 1.0) * f;
+    }
+    EXPECT_NEAR(cost, got->cost, 1e-9);
+  }
+  EXPECT_GT(solved, 20);
+}
+
+TEST(LayeredAStar, WithoutLayersIsThePlainSearchAndLayersOnlyLengthen) {
+  std::mt19937 rng(5);
+  const auto grid = makeWarehouseGrid();
+  std::vector<Cell> free;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (grid.cells()[i] == 0) {
+      free.push_back(grid.cellOf(i));
+    }
+  }
+  std::uniform_int_distribution<std::size_t> pick(0, free.size() - 1);
+  const auto layers = randomLayers(grid.width(), grid.height(), rng);
+  for (int t = 0; t < 20; ++t) {
+    const Cell a = free[pick(rng)], b = free[pick(rng)];
+    const auto plain = astar(grid, a, b);
+    const auto none = astar(grid, a, b, CostLayers{});
+    const auto layered = astar(grid, a, b, layers);
+    ASSERT_EQ(plain.has_value(), none.has_value());
+    ASSERT_EQ(plain.has_value(), layered.has_value());
+    if (plain) {
+      EXPECT_EQ(plain->cells, none->cells) << "no layers: the fixed-point search itself";
+      EXPECT_GE(layered->cost, plain->cost - 1e-9) << "factors below 1 count as 1";
     }
   }
 }

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -931,4 +933,35 @@ TEST(Agent, MovingBackAndForthWithoutGettingCloserFailsTheTaskNamingTheGoal) {
   EXPECT_EQ(failed->error, "no progress towards P-1 for 180 s");
   EXPECT_GE(k, 1800);  // not before the limit
   EXPECT_LT(k, 1900);
+}
+
+TEST(Agent, KeepsTheSiteSpeedLimitInsideAZoneAndCruisesOutside) {
+  // A 0.25 m/s zone across the way from (1, 1) to the pickup at (5, 1), x in [2.5, 3.5].
+  auto grid = emptyGrid();
+  auto p = params();
+  const double limit = 0.25;
+  p.speedLimit = [limit](Vec2 q) {
+    return q.x >= 2.5 && q.x <= 3.5 ? limit : std::numeric_limits<double>::infinity();
+  };
+  agent::Agent a(p, grid, grid);
+  World world;
+  a.onAssignment(transport());
+  double v = 0;
+  double w = 0;
+  double fastestInside = 0.0;
+  double fastestOutside = 0.0;
+  bool loaded = false;
+  for (int k = 0; k < 1500 && !loaded; ++k) {
+    a.onFrame(world.frame(v, w, 0.1));
+    const auto out = a.step(static_cast<std::int64_t>(k) * 100'000'000, 0.1);
+    v = out.command.v;
+    w = out.command.w;
+    loaded = out.status && out.status->state == msg::TaskState::Loading;
+    const bool inside = world.truth.x >= 2.5 && world.truth.x <= 3.5;
+    (inside ? fastestInside : fastestOutside) =
+        std::max(inside ? fastestInside : fastestOutside, std::abs(v));
+  }
+  EXPECT_TRUE(loaded);
+  EXPECT_LE(fastestInside, limit + 1e-9);
+  EXPECT_GT(fastestOutside, 0.5) << "the limit holds in the zone only";
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "map_faces.hpp"
 
@@ -178,4 +179,28 @@ TEST(MapFaces, OnlyTheFacesTurnedTowardsTheRobotWithinRange) {
     EXPECT_NEAR(q.x, 2.5, 1e-12);
   }
   EXPECT_TRUE(agent::mapFaces(map, {0.5, 0.5}, 1.0).empty()) << "out of range";
+}
+
+TEST(MotionGate, SpeedZonesSlowTheRobotBeforeItEntersAndKeepTheCurvature) {
+  auto p = params();
+  const double slow = 0.3;  // (captured: gcc 12 warns on copying a captureless lambda's std::function)
+  p.speedLimit = [slow](Vec2 q) { return q.x > 2.5 ? slow : std::numeric_limits<double>::infinity(); };
+  const MotionGate gate(p);
+  const Perception seen = perception({});
+  const std::vector<OtherRobot> others;
+  const GateView view{seen, others, emptyMap(), {}, false};
+  // At (2, 2) facing +x: 0.8 m/s reaches the zone within the 1 s headway.
+  EXPECT_DOUBLE_EQ(gate.zoneSpeed(view, 0.8), 0.3);
+  double v = 0.8;
+  double w = 0.4;
+  Blocker b;
+  const auto hold = gate.heldUp(view, v, w, b);
+  EXPECT_DOUBLE_EQ(v, 0.3);
+  EXPECT_DOUBLE_EQ(w, 0.4 * 0.3 / 0.8) << "same curvature";
+  EXPECT_FALSE(hold.held) << "a speed zone is no hold";
+  // Slow enough not to reach it within the headway's look-ahead (at least the radius): unchanged.
+  EXPECT_TRUE(std::isinf(gate.zoneSpeed(view, 0.2)));
+  // Backing away from it: unchanged; without zones: unchanged.
+  EXPECT_TRUE(std::isinf(gate.zoneSpeed(view, -0.3)));
+  EXPECT_TRUE(std::isinf(MotionGate(params()).zoneSpeed(view, 0.8)));
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "fleet/core/expected.hpp"
+#include "fleet/planning/cost_layer.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "fleet/planning/path.hpp"
 #include "fleet/planning/wavefront.hpp"
@@ -50,17 +51,25 @@ Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal,
                          Connectivity conn = Connectivity::Eight,
                          const LandmarkHeuristic* landmarks = nullptr);
 
+/// The same search (8-connected, no corner cutting, octile heuristic) with each move's cost scaled
+/// by the product of the layers' factors (each counted as at least 1, so the heuristic stays
+/// admissible and the path is optimal for the layered cost). No layers: the fixed-point search
+/// above, exactly. Error "unreachable" when no path exists or start or goal is blocked.
+Expected<GridPath> astar(const OccupancyGrid& grid, Cell start, Cell goal, const CostLayers& layers);
+
+/// The grid planner every service uses: plain, with landmarks, or with cost layers.
 class AStarPlanner final : public GlobalPlanner {
  public:
   explicit AStarPlanner(Connectivity conn = Connectivity::Eight,
-                        std::shared_ptr<const LandmarkHeuristic> landmarks = nullptr)
-      : conn_(conn), landmarks_(std::move(landmarks)) {}
+                        std::shared_ptr<const LandmarkHeuristic> landmarks = nullptr, CostLayers layers = {})
+      : conn_(conn), landmarks_(std::move(landmarks)), layers_(std::move(layers)) {}
   [[nodiscard]] Expected<Path> plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) override;
   [[nodiscard]] const char* name() const override { return "astar"; }
 
  private:
   Connectivity conn_;
   std::shared_ptr<const LandmarkHeuristic> landmarks_;  ///< used only on a grid of matching shape
+  CostLayers layers_;  ///< non-empty: the layered search (8-connected; landmarks unused)
 };
 
 }  // namespace fleet::planning

@@ -6,13 +6,12 @@
 // intersections and open areas stay free in every direction.
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
+#include "fleet/planning/cost_layer.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
-#include "fleet/planning/path.hpp"
 
 namespace fleet::planning {
 
@@ -62,26 +61,18 @@ class LaneMap {
   std::vector<LaneDir> dir_;
 };
 
-/// Extra cost factor for entering a cell (e.g. 1 + w * collision probability); values below 1 count
-/// as 1 so the heuristic stays admissible.
-using CellCostFactor = std::function<double(Cell)>;
-
-/// A* over the 8-connected grid (no corner cutting) where a move against a lane costs
-/// `wrongWayFactor` times its length, times `factor` of the entered cell if given. The octile
-/// heuristic stays admissible (costs only grow). Errors: those of resolveQuery, "unreachable".
-Expected<std::vector<Cell>> laneAstar(const OccupancyGrid& grid, const LaneMap& lanes, Cell start, Cell goal,
-                                      const CellCostFactor& factor = {});
-
-class LanePlanner final : public GlobalPlanner {
+/// The lanes as a cost layer of the grid A* (astar.hpp): a move against the lane of either cell
+/// costs `wrongWayFactor` times its length, so a legal detour is taken unless it is that much longer.
+class LaneCost final : public CostLayer {
  public:
-  explicit LanePlanner(std::shared_ptr<const LaneMap> lanes, CellCostFactor factor = {})
-      : lanes_(std::move(lanes)), factor_(std::move(factor)) {}
-  [[nodiscard]] Expected<Path> plan(const OccupancyGrid& grid, Pose2 from, Pose2 to) override;
+  explicit LaneCost(std::shared_ptr<const LaneMap> lanes) : lanes_(std::move(lanes)) {}
+  [[nodiscard]] double factor(Cell from, Cell to) const override {
+    return lanes_->againstLane(from, to) ? lanes_->wrongWayFactor() : 1.0;
+  }
   [[nodiscard]] const char* name() const override { return "lanes"; }
 
  private:
   std::shared_ptr<const LaneMap> lanes_;
-  CellCostFactor factor_;
 };
 
 }  // namespace fleet::planning

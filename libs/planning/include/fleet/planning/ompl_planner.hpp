@@ -20,6 +20,9 @@ struct OmplOptions {
   double robotRadius = 0.0;  ///< metres; the grid is inflated by this radius
   double costThreshold =
       0.0;  ///< stop as soon as a path of at most this length is found (0: use the whole budget)
+  /// > 0: the threshold per query is this times the straight line from start to goal (a planner
+  /// built once for many queries); it then replaces costThreshold.
+  double costThresholdRatio = 0.0;
   bool simplify = true;
   double simplifyTime = 0.1;
   double range = 0.0;  ///< maximum extension of RRT* variants in metres (0: OMPL's default)

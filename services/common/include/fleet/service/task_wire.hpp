@@ -7,7 +7,7 @@
 #include <string>
 
 #include "fleet/fleet/task.hpp"
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 namespace fleet::service {
 

@@ -1,4 +1,4 @@
-#include "fleet/transport/messages.hpp"
+#include "fleet/messages/messages.hpp"
 
 #include <array>
 #include <string_view>

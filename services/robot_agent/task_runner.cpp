@@ -1,0 +1,128 @@
+#include "task_runner.hpp"
+
+#include <utility>
+
+#include "fleet/core/clock.hpp"
+
+namespace fleet::agent {
+
+TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
+  if (o.revision == revision_ && o.task == task_) {
+    return OrderChange::kSame;
+  }
+  revision_ = o.revision;
+  homing_ = false;  // an order (or a cancel) replaces the trip home
+  if (o.task.empty()) {
+    task_.clear();
+    goals_.clear();
+    phase_ = Phase::Idle;
+    return OrderChange::kCancel;
+  }
+  paused_ = o.paused;
+  if (o.task == task_ && o.goals == goals_) {
+    return OrderChange::kPause;
+  }
+  task_ = o.task;
+  goals_ = o.goals;
+  goal_ = 0;
+  reported_ = TaskStage::Assigned;
+  phase_ = Phase::Idle;  // started on the next step, which knows the time
+  return OrderChange::kNewTask;
+}
+
+TaskStage TaskRunner::stageFor(std::size_t index, bool dwelling) const {
+  const auto action = goals_[index].action;
+  if (dwelling) {
+    if (action == GoalAction::Load) {
+      return TaskStage::Loading;
+    }
+    if (action == GoalAction::Unload) {
+      return TaskStage::Unloading;
+    }
+  }
+  for (std::size_t i = 0; i < index; ++i) {
+    if (goals_[i].action == GoalAction::Load) {
+      return TaskStage::Delivering;
+    }
+  }
+  return TaskStage::EnRoute;
+}
+
+float TaskRunner::progress() const {
+  return goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
+}
+
+void TaskRunner::reportStage(TaskStage st, std::int64_t nowNs) {
+  reported_ = st;
+  pending_ = TaskReport{task_, revision_, st, progress(), "", nowNs};
+}
+
+void TaskRunner::leg(std::int64_t nowNs) {
+  phase_ = Phase::Driving;
+  phaseStartNs_ = nowNs;
+  if (const auto st = stageFor(goal_, false); st != reported_) {
+    reportStage(st, nowNs);
+  }
+}
+
+void TaskRunner::arrive(std::int64_t nowNs) {
+  phase_ = Phase::Dwelling;
+  phaseStartNs_ = nowNs;
+  const auto st = stageFor(goal_, true);
+  if (st != reported_ && (st == TaskStage::Loading || st == TaskStage::Unloading)) {
+    reportStage(st, nowNs);
+  }
+}
+
+bool TaskRunner::dwellOver(std::int64_t nowNs) const {
+  return nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].dwellS;
+}
+
+bool TaskRunner::nextGoal() {
+  ++goal_;
+  return goal_ < goals_.size();
+}
+
+void TaskRunner::yieldBy(Phase how, std::int64_t nowNs) {
+  phase_ = how;
+  phaseStartNs_ = nowNs;
+}
+
+void TaskRunner::finish(TaskStage final, const std::string& reason, std::int64_t nowNs) {
+  if (homing_) {
+    homing_ = false;  // the trip home is no order of the manager's: nothing to report
+  } else {
+    pending_ = TaskReport{
+        task_, revision_, final, final == TaskStage::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
+  }
+  task_.clear();
+  goals_.clear();
+  phase_ = Phase::Idle;
+}
+
+void TaskRunner::goHome(const TaskGoal& home) {
+  homing_ = true;
+  goals_ = {home};
+  goal_ = 0;
+}
+
+void TaskRunner::notice(const std::string& reason, std::int64_t nowNs) {
+  if (busy()) {
+    pending_ = TaskReport{task_, revision_, reported_, progress(), reason, nowNs};
+  }
+}
+
+void TaskRunner::shiftClock(std::int64_t heldNs) {
+  if (phaseStartNs_ >= 0) {
+    phaseStartNs_ += heldNs;
+  }
+}
+
+std::optional<TaskReport> TaskRunner::takeReport() {
+  if (pending_ && (homing_ || pending_->task.empty())) {
+    pending_.reset();  // the trip home is not a task
+  }
+  return std::exchange(pending_, std::nullopt);
+}
+
+}  // namespace fleet::agent

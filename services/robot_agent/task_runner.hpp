@@ -1,0 +1,131 @@
+#pragma once
+
+// The robot's task state machine: the order it carries (goals with their actions and dwell
+// times), where it is in it, and the task states it reports. It is the only part that changes
+// phase; the agent asks it what to do and tells it what happened (a leg begins, the robot arrived,
+// the dwell is over, it yields, the task ends). Its types are its own: the agent maps the wire's.
+//
+//   Idle ──leg()──► Driving ──arrive()──► Dwelling ──nextGoal()──► Driving ... ──finish()──► Idle
+//                   Driving ──yieldBy()──► BackingOff / Returning ──stop()──► Idle ──leg()──► ...
+//
+// Reports follow the task: Assigned on a new order, EnRoute / Delivering when a leg begins (once
+// per change), Loading / Unloading on arriving at such a goal, Done / Failed / Cancelled at the
+// end; the trip home is an order of the robot's own and is never reported.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fleet/core/pose2.hpp"
+
+namespace fleet::agent {
+
+enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
+
+struct TaskGoal {
+  Pose2 pose;
+  std::string station;
+  GoalAction action = GoalAction::None;
+  double dwellS = 0.0;
+  bool operator==(const TaskGoal&) const = default;
+};
+
+/// What the robot says of its task (the wire's TaskState values the agent reports).
+enum class TaskStage : std::uint8_t {
+  Queued,
+  Assigned,
+  EnRoute,
+  Loading,
+  Delivering,
+  Unloading,
+  Done,
+  Failed
+};
+
+struct TaskReport {
+  std::string task;
+  std::uint32_t revision = 0;
+  TaskStage stage = TaskStage::Queued;
+  float progress = 0.0f;  ///< goals done / goals
+  std::string reason;     ///< why it failed, or a notice (sensor loss); at most 255 bytes
+  std::int64_t stampNs = 0;
+};
+
+struct Order {
+  std::string task;  ///< empty: cancel
+  std::uint32_t revision = 0;
+  std::vector<TaskGoal> goals;
+  bool paused = false;
+};
+
+enum class Phase : std::uint8_t { Idle, Driving, Dwelling, BackingOff, Returning };
+
+class TaskRunner {
+ public:
+  enum class OrderChange : std::uint8_t {
+    kSame,     ///< the order again (transient-local re-delivery): nothing changes
+    kCancel,   ///< no task any more
+    kPause,    ///< the same task, held or resumed (or re-published after a manager restart)
+    kNewTask,  ///< a new task (or new goals): starts on the next step
+  };
+  /// A new revision replaces the current order, and any order replaces the trip home.
+  OrderChange accept(const Order& o);
+
+  /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
+  void leg(std::int64_t nowNs);
+  /// At the current goal: Dwelling; reports Loading / Unloading for such goals.
+  void arrive(std::int64_t nowNs);
+  [[nodiscard]] bool dwellOver(std::int64_t nowNs) const;
+  /// The dwell is done: on to the next goal; false when there is none (the task is then done).
+  bool nextGoal();
+  /// Yielding to someone: BackingOff (a little, straight back) or Returning (along the trail).
+  void yieldBy(Phase how, std::int64_t nowNs);
+  /// Standing without a leg (after yielding, or to re-plan on the next step).
+  void stop() { phase_ = Phase::Idle; }
+  /// The task (or the trip home) ends: reports `final` with `reason` unless homing; Idle.
+  void finish(TaskStage final, const std::string& reason, std::int64_t nowNs);
+  /// The robot's own order: drive to `home` and park, never reported.
+  void goHome(const TaskGoal& home);
+  /// A notice about the task in its current stage (e.g. sensor loss), if there is a task.
+  void notice(const std::string& reason, std::int64_t nowNs);
+  /// The operator's hold lasted `heldNs`: the phase's clock starts that much later.
+  void shiftClock(std::int64_t heldNs);
+  /// The report due, if any (taken once).
+  std::optional<TaskReport> takeReport();
+
+  [[nodiscard]] Phase phase() const { return phase_; }
+  [[nodiscard]] std::int64_t phaseStartNs() const { return phaseStartNs_; }
+  /// Carries a task of the manager's (not the trip home).
+  [[nodiscard]] bool busy() const { return !task_.empty(); }
+  [[nodiscard]] bool homing() const { return homing_; }
+  /// Has somewhere to go: a task or the trip home.
+  [[nodiscard]] bool hasOrder() const { return busy() || homing_; }
+  [[nodiscard]] bool paused() const { return paused_ && busy(); }
+  [[nodiscard]] const std::string& task() const { return task_; }
+  [[nodiscard]] std::uint32_t revision() const { return revision_; }
+  [[nodiscard]] std::size_t goalIndex() const { return goal_; }
+  [[nodiscard]] bool hasGoal() const { return goal_ < goals_.size(); }
+  /// The current goal (hasGoal() must hold).
+  [[nodiscard]] const TaskGoal& goal() const { return goals_[goal_]; }
+  [[nodiscard]] const std::vector<TaskGoal>& goals() const { return goals_; }
+
+ private:
+  /// The stage the task is in while driving to, or dwelling at, goal `index`.
+  [[nodiscard]] TaskStage stageFor(std::size_t index, bool dwelling) const;
+  [[nodiscard]] float progress() const;
+  void reportStage(TaskStage st, std::int64_t nowNs);
+
+  std::string task_;
+  std::uint32_t revision_ = 0;
+  bool paused_ = false;
+  bool homing_ = false;
+  std::vector<TaskGoal> goals_;
+  std::size_t goal_ = 0;
+  Phase phase_ = Phase::Idle;
+  std::int64_t phaseStartNs_ = 0;
+  TaskStage reported_ = TaskStage::Queued;
+  std::optional<TaskReport> pending_;
+};
+
+}  // namespace fleet::agent

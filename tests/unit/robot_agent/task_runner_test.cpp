@@ -1,0 +1,149 @@
+// The task runner alone: orders in, phases and the task states reported out.
+
+#include "task_runner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+using namespace fleet;
+using agent::GoalAction;
+using agent::Order;
+using agent::Phase;
+using agent::TaskGoal;
+using agent::TaskRunner;
+using agent::TaskStage;
+
+namespace {
+
+constexpr std::int64_t kSec = 1'000'000'000;
+
+Order transport(std::uint32_t revision = 1, bool paused = false) {
+  return Order{"t1",
+               revision,
+               {TaskGoal{{5.0, 1.0, 0.0}, "P-1", GoalAction::Load, 2.0},
+                TaskGoal{{5.0, 6.0, 1.57}, "D-1", GoalAction::Unload, 1.0}},
+               paused};
+}
+
+std::vector<TaskStage> stages(TaskRunner& r) {
+  std::vector<TaskStage> out;
+  while (auto rep = r.takeReport()) {
+    out.push_back(rep->stage);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
+  TaskRunner r;
+  EXPECT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
+  EXPECT_TRUE(r.busy());
+  EXPECT_EQ(r.phase(), Phase::Idle) << "started on the next step";
+  EXPECT_FALSE(r.takeReport()) << "Assigned is the manager's to say";
+  r.leg(1 * kSec);
+  auto rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->stage, TaskStage::EnRoute);
+  EXPECT_EQ(rep->task, "t1");
+  EXPECT_EQ(rep->revision, 1u);
+  EXPECT_EQ(rep->progress, 0.0f);
+  EXPECT_EQ(rep->stampNs, 1 * kSec);
+  r.leg(2 * kSec);  // a re-plan: same stage, nothing new to say
+  EXPECT_FALSE(r.takeReport());
+  r.arrive(3 * kSec);
+  EXPECT_EQ(r.phase(), Phase::Dwelling);
+  EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Loading});
+  EXPECT_FALSE(r.dwellOver(4 * kSec));
+  EXPECT_TRUE(r.dwellOver(5 * kSec));
+  EXPECT_TRUE(r.nextGoal());
+  EXPECT_EQ(r.goal().station, "D-1");
+  r.leg(5 * kSec);
+  rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->stage, TaskStage::Delivering);
+  EXPECT_EQ(rep->progress, 0.5f);
+  r.arrive(9 * kSec);
+  EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Unloading});
+  EXPECT_FALSE(r.nextGoal());
+  r.finish(TaskStage::Done, "", 10 * kSec);
+  rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->stage, TaskStage::Done);
+  EXPECT_EQ(rep->progress, 1.0f);
+  EXPECT_FALSE(r.busy());
+  EXPECT_EQ(r.phase(), Phase::Idle);
+}
+
+TEST(TaskRunner, RepeatsPausesAndCancels) {
+  TaskRunner r;
+  ASSERT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kNewTask);
+  r.leg(0);
+  (void)r.takeReport();
+  EXPECT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kSame) << "transient-local re-delivery";
+  EXPECT_EQ(r.accept(transport(2, true)), TaskRunner::OrderChange::kPause);
+  EXPECT_TRUE(r.paused());
+  EXPECT_EQ(r.phase(), Phase::Driving) << "a pause keeps the task where it was";
+  EXPECT_EQ(r.accept(transport(3, false)), TaskRunner::OrderChange::kPause);
+  EXPECT_FALSE(r.paused());
+  Order other = transport(4);
+  other.goals.pop_back();
+  EXPECT_EQ(r.accept(other), TaskRunner::OrderChange::kNewTask) << "new goals: a new task";
+  EXPECT_EQ(r.goalIndex(), 0u);
+  EXPECT_EQ(r.accept(Order{"", 5, {}, false}), TaskRunner::OrderChange::kCancel);
+  EXPECT_FALSE(r.busy());
+  EXPECT_FALSE(r.hasGoal());
+  EXPECT_FALSE(r.takeReport()) << "a cancel is the manager's own";
+}
+
+TEST(TaskRunner, TheTripHomeIsNeverReportedAndAnOrderReplacesIt) {
+  TaskRunner r;
+  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
+  EXPECT_TRUE(r.homing());
+  EXPECT_TRUE(r.hasOrder());
+  EXPECT_FALSE(r.busy());
+  r.leg(0);
+  EXPECT_FALSE(r.takeReport());
+  r.finish(TaskStage::Failed, "no path", kSec);
+  EXPECT_FALSE(r.takeReport());
+  EXPECT_FALSE(r.homing());
+  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
+  EXPECT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
+  EXPECT_FALSE(r.homing());
+  EXPECT_EQ(r.goal().station, "P-1");
+}
+
+TEST(TaskRunner, NoticesNeedATaskAndFailuresKeepAtMost255BytesOfReason) {
+  TaskRunner r;
+  r.notice("sensor stream lost", 0);
+  EXPECT_FALSE(r.takeReport());
+  ASSERT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
+  r.leg(0);
+  (void)r.takeReport();
+  r.notice("sensor stream lost", kSec);
+  auto rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->stage, TaskStage::EnRoute) << "a notice says the stage the task is in";
+  EXPECT_EQ(rep->reason, "sensor stream lost");
+  r.finish(TaskStage::Failed, std::string(400, 'x'), 2 * kSec);
+  rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->reason.size(), 255u);
+  EXPECT_EQ(rep->progress, 0.0f);
+}
+
+TEST(TaskRunner, AnOperatorHoldMovesTheDwellClock) {
+  TaskRunner r;
+  ASSERT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
+  r.arrive(10 * kSec);  // dwell 2 s
+  r.shiftClock(5 * kSec);
+  EXPECT_FALSE(r.dwellOver(16 * kSec));
+  EXPECT_TRUE(r.dwellOver(17 * kSec));
+  r.yieldBy(Phase::BackingOff, 20 * kSec);
+  EXPECT_EQ(r.phase(), Phase::BackingOff);
+  EXPECT_EQ(r.phaseStartNs(), 20 * kSec);
+  r.stop();
+  EXPECT_EQ(r.phase(), Phase::Idle);
+}
