@@ -11,9 +11,9 @@
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
+#include "fleet/messages/messages.hpp"
 #include "fleet/metrics/histogram.hpp"
 #include "fleet/planning/distance_field_cache.hpp"
-#include "fleet/messages/messages.hpp"
 
 namespace fleet::manager {
 
