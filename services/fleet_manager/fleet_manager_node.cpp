@@ -216,11 +216,7 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
     } else if (e.state == TaskState::Assigned) {
       auto it = queuedAt_.find(e.taskId);
       if (it != queuedAt_.end()) {
-        metrics_.assignLatencyMs.push_back(static_cast<double>(e.stampNs - it->second) / 1e6);
-        if (metrics_.assignLatencyMs.size() > 10000) {
-          metrics_.assignLatencyMs.erase(metrics_.assignLatencyMs.begin(),
-                                         metrics_.assignLatencyMs.begin() + 5000);
-        }
+        assignLatency_->observe(static_cast<double>(e.stampNs - it->second) / 1e9);
         queuedAt_.erase(it);
       }
     }
@@ -371,13 +367,16 @@ void FleetManagerNode::tick(std::int64_t nowNs, Outbox& out) {
   publish(dispatcher_->tick(nowNs), nowNs, out);
 }
 
+std::vector<double> FleetManagerNode::assignLatencyBuckets() {
+  return metrics::exponentialBuckets(0.01, 2.0, 16);
+}
+
 nlohmann::json FleetManagerNode::metricsJson() const {
   const auto& c = dispatcher_->counters();
-  auto lat = metrics_.assignLatencyMs;
-  std::sort(lat.begin(), lat.end());
-  auto pct = [&](double q) {
-    return lat.empty() ? 0.0 : lat[static_cast<std::size_t>(q * static_cast<double>(lat.size() - 1))];
-  };
+  // Percentiles estimated from the histogram's buckets (error at most the bucket's width: the
+  // bounds double, so within a factor of two of the true value, linear inside the bucket).
+  const auto lat = assignLatency_->snapshot();
+  auto pct = [&](double q) { return lat.quantile(q) * 1e3; };
   return {{"queued", dispatcher_->waitingCount()},
           {"active", dispatcher_->activeCount()},
           {"submitted", c.submitted},
@@ -391,7 +390,7 @@ nlohmann::json FleetManagerNode::metricsJson() const {
           {"duplicates", metrics_.duplicates},
           {"rejected", metrics_.rejected},
           {"assignments", metrics_.assignments},
-          {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.size()}}}};
+          {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.count}}}};
 }
 
 }  // namespace fleet::manager

@@ -11,8 +11,9 @@
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
-#include "fleet/planning/distance_field_cache.hpp"
 #include "fleet/messages/messages.hpp"
+#include "fleet/metrics/histogram.hpp"
+#include "fleet/planning/distance_field_cache.hpp"
 
 namespace fleet::manager {
 
@@ -67,7 +68,6 @@ struct Metrics {
   std::int64_t duplicates = 0;
   std::int64_t rejected = 0;
   std::int64_t assignments = 0;
-  std::vector<double> assignLatencyMs;  // queued → assigned, recent window
 };
 
 class FleetManagerNode {
@@ -93,6 +93,11 @@ class FleetManagerNode {
 
   [[nodiscard]] const Dispatcher& dispatcher() const { return *dispatcher_; }
   [[nodiscard]] const Metrics& metrics() const { return metrics_; }
+  /// Bucket bounds of the queued → assigned latency (seconds): 10 ms to ~5.5 min, doubling.
+  [[nodiscard]] static std::vector<double> assignLatencyBuckets();
+  /// Records the queued → assigned latency into `h` (the service's metrics registry) from now on
+  /// instead of the node's own histogram; call before the first tick. `h` must outlive the node.
+  void recordAssignLatencyInto(metrics::Histogram& h) { assignLatency_ = &h; }
   [[nodiscard]] nlohmann::json metricsJson() const;
 
  private:
@@ -111,6 +116,8 @@ class FleetManagerNode {
   std::map<std::string, std::int64_t> queuedAt_;
   Outbox recovered_;
   Metrics metrics_;
+  metrics::Histogram ownAssignLatency_{assignLatencyBuckets()};
+  metrics::Histogram* assignLatency_ = &ownAssignLatency_;
 };
 
 }  // namespace fleet::manager

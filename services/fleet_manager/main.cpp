@@ -11,8 +11,11 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
@@ -31,7 +34,88 @@ void writeMetrics(const std::string& path, const nlohmann::json& j) {
   std::rename(tmp.c_str(), path.c_str());
 }
 
-int run(const manager::Settings& settings) {
+/// The manager's Prometheus metrics, mirrored from the node once a second (the node counts in plain
+/// integers on the loop's thread; the registry's counters advance by the difference).
+class ManagerMetrics {
+ public:
+  explicit ManagerMetrics(service::ServiceOps& ops) : r_(ops.registry()) {
+    for (const char* outcome : {"done", "failed", "cancelled", "requeued"}) {
+      outcomes_.push_back({&r_.counter("fleet_manager_tasks_total",
+                                       "Tasks that reached an outcome (requeued: given back to the queue)",
+                                       {{"outcome", outcome}})});
+    }
+    for (const char* result : {"stored", "duplicate", "rejected"}) {
+      requests_.push_back({&r_.counter("fleet_manager_task_requests_total",
+                                       "Task requests received over DDS, by result", {{"result", result}})});
+    }
+    for (const char* state : {"queued", "active"}) {
+      tasks_.push_back(
+          &r_.gauge("fleet_manager_tasks", "Open tasks: queued (waiting) or active", {{"state", state}}));
+    }
+    for (const char* state : {"idle", "busy", "lost"}) {
+      robots_.push_back(
+          &r_.gauge("fleet_manager_robots", "Robots known to the manager, by state", {{"state", state}}));
+    }
+  }
+  metrics::Histogram& assignLatency() {
+    return r_.histogram("fleet_manager_assign_latency_seconds",
+                        "Time from queued to assigned, per assignment",
+                        manager::FleetManagerNode::assignLatencyBuckets());
+  }
+  metrics::Histogram& loopSeconds() {
+    return r_.histogram("fleet_manager_loop_seconds",
+                        "Wall time of one turn of the manager's loop (work only)",
+                        metrics::exponentialBuckets(1e-5, 2.0, 18));
+  }
+  void update(const manager::FleetManagerNode& node) {
+    const auto& c = node.dispatcher().counters();
+    const auto& m = node.metrics();
+    outcomes_[0].to(c.done);
+    outcomes_[1].to(c.failed);
+    outcomes_[2].to(c.cancelled);
+    outcomes_[3].to(c.requeued);
+    requests_[0].to(m.stored);
+    requests_[1].to(m.duplicates);
+    requests_[2].to(m.rejected);
+    tasks_[0]->set(static_cast<double>(node.dispatcher().waitingCount()));
+    tasks_[1]->set(static_cast<double>(node.dispatcher().activeCount()));
+    double idle = 0;
+    double busy = 0;
+    double lost = 0;
+    for (const auto& r : node.dispatcher().robots().all()) {
+      (r.lost ? lost : (r.taskId.empty() ? idle : busy)) += 1.0;
+    }
+    robots_[0]->set(idle);
+    robots_[1]->set(busy);
+    robots_[2]->set(lost);
+  }
+
+ private:
+  /// A counter following a cumulative count kept elsewhere.
+  struct Mirrored {
+    metrics::Counter* counter;
+    std::int64_t last = 0;
+    void to(std::int64_t now) {
+      if (now > last) {
+        counter->inc(static_cast<std::uint64_t>(now - last));
+        last = now;
+      }
+    }
+  };
+  metrics::Registry& r_;
+  std::vector<Mirrored> outcomes_;
+  std::vector<Mirrored> requests_;
+  std::vector<metrics::Gauge*> tasks_;
+  std::vector<metrics::Gauge*> robots_;
+};
+
+int run(const manager::Settings& settings, const service::OpsSettings& opsSettings) {
+  service::ServiceOps ops("fleet_manager");
+  ops.health().setReady("site", false);
+  ops.health().setReady("task_store", false);
+  if (!ops.start(opsSettings)) {
+    return service::kExitUsage;
+  }
   auto loaded = service::loadSiteStations(settings.stationsFile);
   if (!loaded) {
     spdlog::critical("{}", loaded.error().message);
@@ -54,6 +138,11 @@ int run(const manager::Settings& settings) {
     return 2;
   }
   auto& node = **created;
+  ops.health().setReady("site", true);
+  ops.health().setReady("task_store", true);
+  ManagerMetrics pm(ops);
+  node.recordAssignLatencyInto(pm.assignLatency());
+  auto& loopSeconds = pm.loopSeconds();
 
   transport::Participant p;
   transport::Reader<msg::Task> tasks(p);
@@ -74,6 +163,13 @@ int run(const manager::Settings& settings) {
     j["samples"] = rejections.toJson();
     return j;
   };
+  badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
+  ops.watchMatchedWriters("Task", [&] { return tasks.matchedWriters(); });
+  ops.watchMatchedWriters("TaskStatus", [&] { return statuses.matchedWriters(); });
+  ops.watchMatchedWriters("RobotState", [&] { return states.matchedWriters(); });
+  ops.watchMatchedReaders("TaskAck", [&] { return acks.matchedReaders(); });
+  ops.watchMatchedReaders("TaskEvent", [&] { return events.matchedReaders(); });
+  ops.watchMatchedReaders("TaskAssignment", [&] { return assignments.matchedReaders(); });
 
   auto send = [&](manager::Outbox& out) {
     for (const auto& a : out.acks) {
@@ -81,6 +177,10 @@ int run(const manager::Settings& settings) {
     }
     for (const auto& e : out.events) {
       events.write(e);
+      logging::ScopedField taskField("task", e.task_id);
+      logging::ScopedField robotField("robot", e.robot_id);
+      spdlog::debug("task {} {}{}{}", e.task_id, msg::toString(e.state), e.robot_id.empty() ? "" : " robot ",
+                    e.robot_id);
     }
     for (const auto& a : out.assignments) {
       assignments.write(a);
@@ -103,6 +203,7 @@ int run(const manager::Settings& settings) {
   manager::Outbox out;
   while (!service::stopRequested()) {
     ws.wait(20ms);
+    const auto turnStart = std::chrono::steady_clock::now();
     for (const auto& c : clockIn.take()) {
       sim.set(c.sim_time_ns);
     }
@@ -148,6 +249,10 @@ int run(const manager::Settings& settings) {
       nextTick = now + tickNs;
     }
     send(out);
+    loopSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - turnStart).count());
+    if (ops.refresh()) {
+      pm.update(node);
+    }
     if (!settings.metricsFile.empty() && std::chrono::steady_clock::now() - lastMetrics > 1s) {
       writeMetrics(settings.metricsFile, metrics());
       lastMetrics = std::chrono::steady_clock::now();
@@ -169,17 +274,19 @@ int run(const manager::Settings& settings) {
 int main(int argc, char** argv) {
   CLI::App app{"fleet_manager: durable task store, assignment and tracking"};
   std::string configPath;
-  std::string level = "info";
+  service::CommonOptions common;
   std::string db;
   std::string stations;
   app.add_option("-c,--config", configPath, "JSON configuration file");
   app.add_option("--db", db, "SQLite task database (overrides the config)");
   app.add_option("--stations", stations,
                  "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
-  CLI11_PARSE(app, argc, argv);
+  service::addCommonOptions(app, common);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("fleet_manager", level);
+    service::setupLogging("fleet_manager", common);
     nlohmann::json overrides = nlohmann::json::object();
     Config cfg =
         configPath.empty() ? Config::fromJson(overrides, "(command line)") : Config::fromFile(configPath);
@@ -194,7 +301,7 @@ int main(int argc, char** argv) {
     const auto settings = manager::readSettings(full);
     full.finish();
     service::installStopHandlers();
-    return run(settings);
+    return run(settings, common.ops);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -16,35 +16,22 @@
 #include <fstream>
 #include <iostream>
 
+#include "fleet/service/command_line.hpp"
 #include "loadtest.hpp"
 #include "site_check.hpp"
 #include "task_file.hpp"
 #include "traffic_bench.hpp"
 #include "traffic_sim.hpp"
+#include "url.hpp"
 
 using nlohmann::json;
 
 namespace {
 
 struct Target {
-  std::string host = "127.0.0.1";
-  int port = 8080;
+  fleet::ctl::Url url;
   std::string token;
 };
-
-Target parseUrl(const std::string& url) {
-  Target t;
-  std::string rest = url;
-  if (rest.rfind("http://", 0) == 0) {
-    rest = rest.substr(7);
-  }
-  const auto colon = rest.find(':');
-  t.host = rest.substr(0, colon);
-  if (colon != std::string::npos) {
-    t.port = std::atoi(rest.substr(colon + 1).c_str());
-  }
-  return t;
-}
 
 httplib::Headers headers(const Target& t) {
   if (t.token.empty()) {
@@ -72,9 +59,14 @@ int show(const httplib::Result& r) {
 int main(int argc, char** argv) {
   CLI::App app{"fleetctl: operate the warehouse fleet through the WMS adapter"};
   app.require_subcommand(1);
+  fleet::service::addVersion(app);
   std::string url = "http://127.0.0.1:8080";
   std::string tokenFile;
-  app.add_option("--url", url, "WMS adapter address")->envname("FLEET_WMS_URL");
+  app.add_option("--url", url, "WMS adapter address, http[s]://HOST[:PORT]")->envname("FLEET_WMS_URL");
+  std::string caCert;
+  app.add_option("--ca-cert", caCert,
+                 "https: PEM file of the CA that signed the adapter's certificate (else the system's)")
+      ->envname("FLEET_WMS_CA_CERT");
   app.add_option("--token-file", tokenFile, "file holding the bearer token (else FLEET_WMS_TOKEN)");
 
   auto* submit = app.add_subcommand("submit", "submit tasks from a JSON or CSV file");
@@ -284,12 +276,9 @@ int main(int argc, char** argv) {
                    "traffic layer's)")
       ->check(CLI::Range(0.0, 1e6));
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    // traffic-bench promises exit code 2 for any bad input (a word where a number goes, too).
-    return rc != 0 && trafficBench->parsed() ? 2 : rc;
+  // Exit codes as every binary's: 0 after --help/--version, 2 for any usage error.
+  if (auto code = fleet::service::parse(app, argc, argv)) {
+    return *code;
   }
   if (*trafficBench) {
     if (noRotationPass) {
@@ -308,7 +297,13 @@ int main(int argc, char** argv) {
     return fleet::ctl::runLoadtest(lt);
   }
 
-  Target t = parseUrl(url);
+  Target t;
+  if (auto u = fleet::ctl::parseUrl(url)) {
+    t.url = *u;
+  } else {
+    std::fprintf(stderr, "fleetctl: %s\n", u.error().message.c_str());
+    return 2;
+  }
   if (!tokenFile.empty()) {
     std::ifstream in(tokenFile);
     if (!in || !std::getline(in, t.token)) {
@@ -317,7 +312,15 @@ int main(int argc, char** argv) {
   } else if (const char* env = std::getenv("FLEET_WMS_TOKEN")) {
     t.token = env;
   }
-  httplib::Client c(t.host, t.port);
+  // https works when cpp-httplib is built with OpenSSL (Debian's is: CPPHTTPLIB_OPENSSL_SUPPORT).
+  httplib::Client c(t.url.text());
+  if (!caCert.empty()) {
+    if (t.url.scheme != "https") {
+      std::fprintf(stderr, "fleetctl: --ca-cert goes with an https:// --url\n");
+      return 2;
+    }
+    c.set_ca_cert_path(caCert);
+  }
   c.set_read_timeout(30, 0);
   const auto h = headers(t);
 

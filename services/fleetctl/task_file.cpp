@@ -42,7 +42,14 @@ Expected<std::vector<std::string>> splitCsv(const std::string& line) {
 
 }  // namespace
 
-Expected<nlohmann::json> csvToTasks(const std::string& text, const std::string& origin) {
+std::string withoutBom(const std::string& text) {
+  return text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text;
+}
+
+Expected<nlohmann::json> csvToTasks(const std::string& textIn, const std::string& origin) {
+  // Excel's "CSV UTF-8" starts with a byte-order mark; without dropping it the first column would
+  // be "\xEF\xBB\xBFid", an unknown column.
+  const std::string text = withoutBom(textIn);
   static const std::set<std::string> kText = {"id", "kind", "pickup", "dropoff", "station", "robot"};
   static const std::set<std::string> kInt = {"priority", "deadline_ns"};
   static const std::set<std::string> kSeconds = {"load_s", "unload_s"};
@@ -126,7 +133,7 @@ Expected<nlohmann::json> loadTaskFile(const std::string& path) {
   }
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string text = ss.str();
+  const std::string text = withoutBom(ss.str());
   if (path.size() >= 4 && path.substr(path.size() - 4) == ".csv") {
     return csvToTasks(text, path);
   }

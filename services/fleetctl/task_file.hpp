@@ -11,8 +11,11 @@
 
 namespace fleet::ctl {
 
-/// Parses CSV text into the JSON array the HTTP API takes. Field types are checked here; the
-/// semantics (stations, kinds) are the server's job.
+/// `text` without a leading UTF-8 byte-order mark (as Excel writes "CSV UTF-8").
+std::string withoutBom(const std::string& text);
+
+/// Parses CSV text (a leading byte-order mark is skipped) into the JSON array the HTTP API takes. Field types
+/// are checked here; the semantics (stations, kinds) are the server's job.
 Expected<nlohmann::json> csvToTasks(const std::string& text, const std::string& origin);
 
 /// Reads a .json or .csv file into a JSON array of task objects.

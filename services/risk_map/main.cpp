@@ -9,8 +9,11 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_map_node.hpp"
@@ -20,7 +23,20 @@ using namespace std::chrono_literals;
 
 namespace {
 
-int run(const riskmap::Settings& settings, const std::string& id) {
+int run(const riskmap::Settings& settings, const std::string& id, const service::OpsSettings& opsSettings) {
+  service::ServiceOps ops("risk_map");
+  ops.health().setReady("published", false);
+  if (!ops.start(opsSettings)) {
+    return service::kExitUsage;
+  }
+  auto& fuseSeconds =
+      ops.registry().histogram("risk_map_fuse_seconds", "Wall time of one fusion (one RiskMap)",
+                               metrics::exponentialBuckets(1e-5, 2.0, 18));
+  auto& mapsPublished = ops.registry().counter("risk_map_maps_published_total", "RiskMap samples published");
+  auto& samplesAccepted =
+      ops.registry().counter("risk_map_samples_accepted_total", "PredictedDiscs samples fused");
+  auto& sources =
+      ops.registry().gauge("risk_map_sources", "Sources (robots, people trackers) currently fused");
   auto created = riskmap::RiskMapNode::create(settings);
   if (!created) {
     spdlog::critical("risk map: {}", created.error().message);
@@ -37,6 +53,9 @@ int run(const riskmap::Settings& settings, const std::string& id) {
   ws.attach(clockIn);
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // refused at the edge, before the fusion engine's own checks
+  badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
+  ops.watchMatchedWriters("PredictedDiscs", [&] { return discs.matchedWriters(); });
+  ops.watchMatchedReaders("RiskMap", [&] { return out.matchedReaders(); });
   WallClock wall;
   const bool simClock = settings.clock == "sim";
   std::int64_t now = simClock ? 0 : wall.nowNs();
@@ -57,16 +76,23 @@ int run(const riskmap::Settings& settings, const std::string& id) {
         continue;
       }
       auto ok = node.accept(m, now);
-      if (!ok) {
+      if (ok) {
+        samplesAccepted.inc();
+      } else {
         badInput.warn(ok.error().code,
                       "dropped PredictedDiscs from \"" + m.source_id + "\": " + ok.error().message);
       }
     }
   };
   auto publish = [&] {
+    const auto t0 = std::chrono::steady_clock::now();
     try {
-      out.write(node.fuse(now));
+      auto map = node.fuse(now);
+      fuseSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      out.write(map);
       ++published;
+      mapsPublished.inc();
+      ops.health().setReady("published", true);
     } catch (const transport::MessageError& e) {
       // A map over the IDL's bounds (a huge grid of noise): skip it, never stop the service.
       badInput.warn("risk_map_out", std::string("RiskMap not published: ") + e.what());
@@ -108,6 +134,9 @@ int run(const riskmap::Settings& settings, const std::string& id) {
         nextFuse = std::max(nextFuse + period, now);
       }
     }
+    if (ops.refresh()) {
+      sources.set(static_cast<double>(node.sources()));
+    }
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
       std::string reasons;
       for (const auto& [code, n] : node.rejectedByReason()) {
@@ -136,14 +165,16 @@ int run(const riskmap::Settings& settings, const std::string& id) {
 int main(int argc, char** argv) {
   CLI::App app{"risk_map: collision-probability iso-level map service"};
   std::string configPath;
-  std::string level = "info";
+  service::CommonOptions common;
   std::string id = "risk_map";
   app.add_option("-c,--config", configPath, "JSON configuration file");
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  service::addCommonOptions(app, common);
   app.add_option("--id", id, "participant id in lockstep");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("risk_map", level);
+    service::setupLogging("risk_map", common);
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
                                     : Config::fromFile(configPath);
     auto settings = riskmap::readSettings(cfg);
@@ -161,7 +192,7 @@ int main(int argc, char** argv) {
                    settings.fusion.grid.height, settings.fusion.grid.resolution, site->name);
     }
     service::installStopHandlers();
-    return run(settings, id);
+    return run(settings, id, common.ops);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -16,6 +16,7 @@
 #include "fleet/risk/reference_algorithm.hpp"
 #include "fleet/risk/regions.hpp"
 #include "fleet/risk/thesis_cases.hpp"
+#include "fleet/service/command_line.hpp"
 #include "png_writer.hpp"
 #include "svg_writer.hpp"
 
@@ -75,7 +76,11 @@ bool engineAgrees(const fleet::risk::ThesisCase& c, const fleet::risk::Probabili
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
+  if (argc == 2 && std::string(argv[1]) == "--version") {
+    std::printf("risk_render %s\n", fleet::service::version());
+    return 0;
+  }
+  if (argc != 2 || argv[1][0] == '-') {
     std::fprintf(stderr, "usage: %s <output-dir>\n", argv[0]);
     return 2;
   }

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -21,8 +22,11 @@
 #include "fleet/core/config.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "fleet/site/reachability.hpp"
@@ -161,16 +165,19 @@ struct Options {
   std::string metricsFile;           // empty: none
 };
 
+/// Cycle-time buckets (seconds): 10 µs to ~1.3 s, each 2^(1/4) (~19 %) wider than the one before,
+/// so a percentile estimated inside a bucket is off by less than one bucket's width: at most ~19 %
+/// of its value (docs/operator-guide.md#metrics).
+std::vector<double> cycleBuckets() {
+  return metrics::exponentialBuckets(1e-5, std::pow(2.0, 0.25), 68);
+}
+
 /// What the process achieved: cycles, the rate against the configured one, overruns (wall mode)
-/// and the wall time of a cycle (all agents stepped and their outputs written).
+/// and the wall time of a cycle (all agents stepped and their outputs written), its percentiles
+/// estimated from the histogram's buckets (max exact).
 json cycleMetrics(const std::string& id, bool lockstep, std::size_t robots, unsigned threads, double dt,
                   std::uint64_t cycles, double elapsedS, std::uint64_t overruns,
-                  std::vector<double> cycleMs) {
-  std::sort(cycleMs.begin(), cycleMs.end());
-  auto q = [&](double p) {
-    return cycleMs.empty() ? 0.0
-                           : cycleMs[static_cast<std::size_t>(p * static_cast<double>(cycleMs.size() - 1))];
-  };
+                  const metrics::HistogramSnapshot& cycle) {
   return json{
       {"id", id},
       {"clock", lockstep ? "lockstep" : "wall"},
@@ -181,10 +188,22 @@ json cycleMetrics(const std::string& id, bool lockstep, std::size_t robots, unsi
       {"elapsed_s", elapsedS},
       {"achieved_hz", elapsedS > 0.0 ? static_cast<double>(cycles) / elapsedS : 0.0},
       {"overruns", overruns},
-      {"cycle_ms", {{"p50", q(0.5)}, {"p99", q(0.99)}, {"max", cycleMs.empty() ? 0.0 : cycleMs.back()}}}};
+      {"cycle_ms",
+       {{"p50", cycle.quantile(0.5) * 1e3}, {"p99", cycle.quantile(0.99) * 1e3}, {"max", cycle.max * 1e3}}}};
 }
 
-int run(const World& scn, const Options& opt) {
+int run(const World& scn, const Options& opt, const service::OpsSettings& opsSettings) {
+  service::ServiceOps ops("robot_agent");
+  ops.health().setReady("sensors", false);
+  if (!ops.start(opsSettings)) {
+    return service::kExitUsage;
+  }
+  auto& cycleSeconds = ops.registry().histogram(
+      "robot_agent_cycle_seconds",
+      "Wall time of one control cycle (every hosted robot stepped, outputs written)", cycleBuckets());
+  auto& cyclesTotal = ops.registry().counter("robot_agent_cycles_total", "Control cycles run");
+  auto& overrunsTotal = ops.registry().counter("robot_agent_cycle_overruns_total",
+                                               "Wall mode: cycles that took longer than the period");
   const auto& only = opt.only;
   const bool lockstep = opt.lockstep;
   const std::string& id = opt.id;
@@ -296,15 +315,46 @@ int run(const World& scn, const Options& opt) {
   std::uint64_t badRiskMaps = 0;
   validation::Rejections rejections;  // samples refused at this process's edge, by topic and reason
   service::RateLimitedLog badInput;
+  badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
   auto admitted = [&](auto samples) { return service::admitted(std::move(samples), rejections, badInput); };
+  if (agents.size() == 1) {
+    logging::setField("robot", agents.front()->id());
+  }
+  ops.watchMatchedWriters("SensorFrame", [&] { return frames.matchedWriters(); });
+  ops.watchMatchedWriters("TaskAssignment", [&] { return assignments.matchedWriters(); });
+  ops.watchMatchedReaders("VelocityCommand", [&] { return commands.matchedReaders(); });
+  ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
+  ops.watchMatchedReaders("TaskStatus", [&] { return statuses.matchedReaders(); });
+  std::uint64_t steps = 0;
+  std::map<std::string, metrics::Gauge*> byMode;
+  // Robots by mode, counted from the last cycle's states once a second (and readiness: a robot
+  // agent can do its job once a sensor source, simulator or driver, is matched).
+  auto refreshOps = [&] {
+    if (!ops.refresh()) {
+      return;
+    }
+    ops.health().setReady("sensors", frames.matchedWriters() > 0);
+    for (auto& [m, g] : byMode) {
+      g->set(0.0);
+    }
+    for (const auto& o : outs) {
+      if (steps == 0) {
+        break;  // no cycle yet: the states are defaults, not the robots'
+      }
+      const std::string mode(msg::toString(o.state.mode));
+      auto [it, fresh] = byMode.try_emplace(mode, nullptr);
+      if (fresh) {
+        it->second = &ops.registry().gauge("robot_agent_robots", "Robots hosted by this process, by mode",
+                                           {{"mode", mode}});
+      }
+      it->second->add(1.0);
+    }
+  };
 
   bool haveClock = false;
   auto lastRegister = std::chrono::steady_clock::now() - 1s;
   std::int64_t simNow = 0;
   double dt = scn.dt;
-  std::uint64_t steps = 0;
-  std::vector<double> cycleMs;
-  cycleMs.reserve(1 << 16);
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
     for (const auto& f : admitted(frames.take())) {
@@ -347,15 +397,21 @@ int run(const World& scn, const Options& opt) {
         for (auto& a : agents) {
           a->onRiskMap(*field);
         }
-      } else if (badRiskMaps++ % 100 == 0) {
-        spdlog::warn("robot agent {}: RiskMap ignored ({} so far): {}", id, badRiskMaps,
-                     field.error().message);
+      } else {
+        ops.rejected("risk_map").inc();
+        if (badRiskMaps++ % 100 == 0) {
+          spdlog::warn("robot agent {}: RiskMap ignored ({} so far): {}", id, badRiskMaps,
+                       field.error().message);
+        }
       }
     }
     // Agents step in parallel (each touches only its own state and const shared maps); outputs
     // are written afterwards in robot order, so the DDS traffic of a lockstep run does not depend
     // on thread timing.
-    pool.forEach(agents.size(), [&](std::size_t i) { outs[i] = agents[i]->step(now, dt); });
+    pool.forEach(agents.size(), [&](std::size_t i) {
+      logging::ScopedField robotField("robot", agents[i]->id());  // on whatever a step logs
+      outs[i] = agents[i]->step(now, dt);
+    });
     for (std::size_t i = 0; i < agents.size(); ++i) {
       auto& a = agents[i];
       auto& out = outs[i];
@@ -365,6 +421,12 @@ int run(const World& scn, const Options& opt) {
       discs.write(out.discs);
       if (out.status) {
         statuses.write(*out.status);
+        ops.registry()
+            .counter("robot_agent_task_reports_total", "TaskStatus reports sent, by the state reported",
+                     {{"state", std::string(msg::toString(out.status->state))}})
+            .inc();
+        logging::ScopedField robotField("robot", a->id());
+        logging::ScopedField taskField("task", out.status->task_id);
         spdlog::debug("{}: task {} {}", a->id(), out.status->task_id, msg::toString(out.status->state));
       }
       if (out.traffic && trafficProgress) {
@@ -382,10 +444,10 @@ int run(const World& scn, const Options& opt) {
       }
     });
     ++steps;
-    if (cycleMs.size() < (1u << 22)) {  // 4 M cycles: 5 days at 10 Hz, 32 MB
-      cycleMs.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cycleStart).count());
-    }
+    cyclesTotal.inc();
+    // Constant cost and memory whatever the uptime (a bucket increment, no sample kept).
+    cycleSeconds.observe(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - cycleStart).count());
   };
 
   auto wallNext = std::chrono::steady_clock::now();
@@ -398,7 +460,8 @@ int run(const World& scn, const Options& opt) {
     }
     const auto from = lockstep && firstCycle ? *firstCycle : started;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count();
-    auto m = cycleMetrics(id, lockstep, agents.size(), pool.threads(), dt, steps, elapsed, overruns, cycleMs);
+    auto m = cycleMetrics(id, lockstep, agents.size(), pool.threads(), dt, steps, elapsed, overruns,
+                          cycleSeconds.snapshot());
     // How the robots of this process dealt with each other (docs/algorithms.md, fleet conduct).
     agent::Agent::Conduct c;
     for (const auto& a : agents) {
@@ -465,6 +528,7 @@ int run(const World& scn, const Options& opt) {
         lastRegister = std::chrono::steady_clock::now();
       }
       ws.wait(100ms);
+      refreshOps();
       for (const auto& c : clockIn.take()) {
         haveClock = true;
         simNow = c.sim_time_ns;
@@ -481,6 +545,7 @@ int run(const World& scn, const Options& opt) {
       wallNext += period;
       if (const auto t = std::chrono::steady_clock::now(); t > wallNext) {
         ++overruns;  // a cycle took longer than the period: do not burst to catch up
+        overrunsTotal.inc();
         wallNext = t;
       }
       if (++rateCycles; std::chrono::steady_clock::now() - rateSince >= 10s) {
@@ -495,6 +560,7 @@ int run(const World& scn, const Options& opt) {
         simNow = c.sim_time_ns;
       }
       cycle(WallClock{}.nowNs());
+      refreshOps();
     }
   }
   if (lockstep) {
@@ -549,7 +615,6 @@ int main(int argc, char** argv) {
   std::string robots;
   std::string clock = "wall";
   std::string id = "agents";
-  std::string level = "info";
   Options opt;
   bool noRisk = false;
   app.add_option(
@@ -594,7 +659,8 @@ int main(int argc, char** argv) {
   app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
   app.add_option("--id", id, "participant id in lockstep");
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  service::CommonOptions common;
+  service::addCommonOptions(app, common);
   app.add_option("--metrics", opt.metricsFile,
                  "write cycle metrics (achieved rate, overruns, cycle time p50/p99) to this JSON file every "
                  "10 s in wall mode and at exit");
@@ -604,9 +670,11 @@ int main(int argc, char** argv) {
                  "risk_stepping {rule: iso_level | weighted, levels, ...}, "
                  "safety {zones}, localization {lines} (docs/operator-guide.md); options given on the "
                  "command line win");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("robot_agent", level);
+    service::setupLogging("robot_agent", common);
     if (!configFile.empty()) {
       applyConfigFile(configFile, opt, app.count("--local-planner") > 0, app.count("--global-planner") > 0,
                       app.count("--traffic") > 0);
@@ -639,7 +707,7 @@ int main(int argc, char** argv) {
     opt.useRisk = !noRisk;
     service::installStopHandlers();
     opt.useLanes = lanes && !noLanes;
-    return run(world, opt);
+    return run(world, opt, common.ops);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -9,8 +9,11 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "traffic_node.hpp"
@@ -20,7 +23,21 @@ using namespace std::chrono_literals;
 
 namespace {
 
-int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id) {
+int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id,
+        const service::OpsSettings& opsSettings) {
+  service::ServiceOps ops("traffic_manager");
+  if (!ops.start(opsSettings)) {
+    return service::kExitUsage;
+  }
+  auto& tickSeconds =
+      ops.registry().histogram("traffic_manager_tick_seconds", "Wall time of one planning tick (all robots)",
+                               metrics::exponentialBuckets(1e-5, 2.0, 20));
+  auto& releasesSent =
+      ops.registry().counter("traffic_manager_releases_total", "TrafficRelease samples sent");
+  auto& robotsKnown =
+      ops.registry().gauge("traffic_manager_robots", "Robots by state in the planner", {{"state", "known"}});
+  auto& robotsPlaced =
+      ops.registry().gauge("traffic_manager_robots", "Robots by state in the planner", {{"state", "placed"}});
   WallClock wall;
   // The incarnation: robots tell a restarted manager's releases from the previous one's.
   const auto epoch = static_cast<std::uint32_t>((wall.nowNs() / 1'000'000) & 0x7fffffff) | 1U;
@@ -42,6 +59,11 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   ws.attach(clockIn);
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // refused at the edge, before the node's roadmap checks
+  badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
+  ops.watchMatchedWriters("TrafficProgress", [&] { return progress.matchedWriters(); });
+  ops.watchMatchedReaders("TrafficRelease", [&] { return releases.matchedReaders(); });
+  // The roadmap is built (the node exists): what this service needs to do its job.
+  ops.health().setReady("roadmap", node.roadmap().graph.size() > 0);
   const bool simClock = settings.clock == "sim";
   std::int64_t now = simClock ? 0 : wall.nowNs();
   bool haveClock = !simClock;
@@ -73,9 +95,13 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
       roadmapOut.write(node.roadmapMessage(now));
       roadmapSent = true;
     }
-    for (const auto& r : node.tick(now)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto out = node.tick(now);
+    tickSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    for (const auto& r : out) {
       try {
         releases.write(r);
+        releasesSent.inc();
       } catch (const std::exception& e) {
         badInput.warn("release", std::string("release to \"") + r.robot_id + "\" not sent: " + e.what());
       }
@@ -116,6 +142,10 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         nextTick = std::max(nextTick + period, now);
       }
     }
+    if (ops.refresh()) {
+      robotsKnown.set(static_cast<double>(node.robotsKnown()));
+      robotsPlaced.set(static_cast<double>(node.robotsPlaced()));
+    }
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
       logStats();
       lastStats = std::chrono::steady_clock::now();
@@ -134,15 +164,17 @@ int main(int argc, char** argv) {
   CLI::App app{"traffic_manager: plans all robots together on the site's roadmap and releases their routes"};
   std::string configPath;
   std::string sitePath;
-  std::string level = "info";
+  service::CommonOptions common;
   std::string id = "traffic_manager";
   app.add_option("-c,--config", configPath, "JSON configuration file");
   app.add_option("--site", sitePath, "site.json (overrides the config's \"site\")");
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
+  service::addCommonOptions(app, common);
   app.add_option("--id", id, "participant id in lockstep");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("traffic_manager", level);
+    service::setupLogging("traffic_manager", common);
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
                                     : Config::fromFile(configPath);
     auto settings = trafficmgr::readSettings(cfg);
@@ -155,7 +187,7 @@ int main(int argc, char** argv) {
     if (!site)
       throw ConfigError({site.error().message});
     service::installStopHandlers();
-    return run(*site, settings, id);
+    return run(*site, settings, id, common.ops);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -1,11 +1,15 @@
 #include "http_api.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <random>
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/task.hpp"
+#include "fleet/service/ops_server.hpp"
 #include "fleet/service/task_wire.hpp"
 
 namespace fleet::wms {
@@ -121,6 +125,7 @@ HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& 
     return new httplib::ThreadPool(static_cast<std::size_t>(n));
   };
   server_.set_payload_max_length(settings_.maxBodyBytes);
+  service::bindExclusively(server_);  // a second adapter on a taken port fails instead of sharing it
   routes();
 }
 
@@ -144,10 +149,24 @@ void HttpApi::stop() {
   server_.stop();
 }
 
+namespace {
+// httplib runs a request's pre- and post-routing handlers on the same worker thread.
+thread_local std::chrono::steady_clock::time_point requestStart;
+}  // namespace
+
+void HttpApi::instrument(metrics::Registry& registry) {
+  registry_ = &registry;
+  requestSeconds_ = &registry.histogram("wms_adapter_http_request_duration_seconds",
+                                        "Time from a request's routing to its response being ready",
+                                        metrics::exponentialBuckets(1e-4, 2.0, 18));
+}
+
 void HttpApi::routes() {
   server_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     ++counters_.requests;
-    if (!settings_.token.empty()) {
+    requestStart = std::chrono::steady_clock::now();
+    // Health tells nothing secret and a probe carries no token: it is never refused with 401.
+    if (!settings_.token.empty() && req.path != "/v1/health") {
       const std::string expected = "Bearer " + settings_.token;
       if (req.get_header_value("Authorization") != expected) {
         res.set_header("WWW-Authenticate", "Bearer");
@@ -157,7 +176,20 @@ void HttpApi::routes() {
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  server_.set_post_routing_handler([this](const httplib::Request&, httplib::Response& res) {
+  server_.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (registry_ != nullptr) {
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - requestStart).count();
+      registry_
+          ->counter("wms_adapter_http_responses_total", "HTTP responses of the WMS API, by status code",
+                    {{"code", std::to_string(res.status)}})
+          .inc();
+      requestSeconds_->observe(seconds);
+      // The access log: client, method, path (no query string: short lines, nothing a client put
+      // there by mistake), status, body bytes, time. Never the Authorization header.
+      spdlog::info("access {} {} {} {} {} {:.6f}s", req.remote_addr, req.method, req.path, res.status,
+                   res.body.size(), seconds);
+    }
     if (res.status >= 500) {
       ++counters_.status5xx;
     } else if (res.status >= 400) {

@@ -11,6 +11,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/station_map.hpp"
+#include "fleet/metrics/registry.hpp"
 #include "gateway.hpp"
 
 namespace fleet::wms {
@@ -49,6 +50,9 @@ class HttpApi {
   void serve();
   void stop();
   [[nodiscard]] const ApiCounters& counters() const { return counters_; }
+  /// Counts responses by status code and times requests in `registry` (the ops port's), and
+  /// writes one access-log line per request at info level. Call before serve().
+  void instrument(metrics::Registry& registry);
 
  private:
   void routes();
@@ -72,6 +76,8 @@ class HttpApi {
   std::atomic<std::uint64_t> requestCounter_{0};
   std::string instance_;
   ApiCounters counters_;
+  metrics::Registry* registry_ = nullptr;
+  metrics::Histogram* requestSeconds_ = nullptr;
 };
 
 }  // namespace fleet::wms

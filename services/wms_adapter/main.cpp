@@ -9,7 +9,10 @@
 
 #include "dds_gateway.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "http_api.hpp"
 
@@ -18,17 +21,19 @@ using namespace fleet;
 int main(int argc, char** argv) {
   CLI::App app{"wms_adapter: HTTP/JSON task intake for the fleet"};
   std::string configPath;
-  std::string level = "info";
+  service::CommonOptions common;
   std::string stationsPath;
   int port = -1;
   app.add_option("-c,--config", configPath, "JSON configuration file");
   app.add_option("--stations", stationsPath,
                  "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   app.add_option("--port", port, "HTTP port (overrides the config; 0 = any free port)");
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
-  CLI11_PARSE(app, argc, argv);
+  service::addCommonOptions(app, common);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("wms_adapter", level);
+    service::setupLogging("wms_adapter", common);
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(command line)")
                                     : Config::fromFile(configPath);
     cfg.rejectUnknownKeys({"http", "stations"});
@@ -45,20 +50,47 @@ int main(int argc, char** argv) {
       throw ConfigError({stations.error().message});
     }
     service::installStopHandlers();
+    service::ServiceOps ops("wms_adapter");
+    ops.health().setReady("fleet_manager", false);
+    if (!ops.start(common.ops)) {
+      return service::kExitUsage;
+    }
     transport::Participant participant;
     wms::FleetView view;
     wms::DdsGateway gateway(participant, view);
     WallClock clock;
     wms::HttpApi http(api, *stations, gateway, view, clock);
+    http.instrument(ops.registry());
     if (!http.bind()) {
       spdlog::critical("wms adapter: cannot listen on {}:{}", api.host, api.port);
-      return 1;
+      return service::kExitUsage;
     }
     spdlog::info("wms adapter: listening on http://{}:{} ({} stations, auth {})", api.host, http.port(),
                  stations->size(), api.token.empty() ? "off" : "bearer token");
     std::thread server([&] { http.serve(); });
+    auto& managerOnline = ops.registry().gauge("wms_adapter_fleet_manager_online",
+                                               "1 when the fleet manager answers over DDS, else 0");
+    auto& tasksAccepted = ops.registry().counter(
+        "wms_adapter_tasks_total", "Tasks posted through the API, by result", {{"result", "accepted"}});
+    auto& tasksDuplicate = ops.registry().counter(
+        "wms_adapter_tasks_total", "Tasks posted through the API, by result", {{"result", "duplicate"}});
+    std::int64_t accepted = 0;
+    std::int64_t duplicate = 0;
     while (!service::stopRequested()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (ops.refresh()) {
+        // Readiness is the manager being reachable: without it no task can be stored. Liveness
+        // (this loop turning) never depends on it.
+        const bool up = gateway.managerOnline();
+        ops.health().setReady("fleet_manager", up);
+        managerOnline.set(up ? 1.0 : 0.0);
+        const auto a = http.counters().tasksAccepted.load();
+        const auto d = http.counters().tasksDuplicate.load();
+        tasksAccepted.inc(static_cast<std::uint64_t>(a - accepted));
+        tasksDuplicate.inc(static_cast<std::uint64_t>(d - duplicate));
+        accepted = a;
+        duplicate = d;
+      }
     }
     http.stop();
     server.join();

@@ -18,6 +18,8 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/sim/localization_error.hpp"
 #include "fleet/sim/lockstep.hpp"
 #include "fleet/sim/replay.hpp"
@@ -109,6 +111,8 @@ struct Options {
   std::string summary;
   std::string html;
   std::string logLevel = "info";
+  std::string logFormat = "text";
+  fleet::service::OpsSettings ops;
   bool noScan = false;
   bool validateOnly = false;
   std::string makeViewerFrom;  // convert an existing replay to HTML and exit
@@ -121,10 +125,19 @@ const char* kUsage =
     "                 [--max-speed F] [--sensor-outage ROBOT@T+D ...] [--hide-landmarks T+D ...]\n"
     "                 [--localization OUT.json]\n"
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
-    "                 [--vda5050 VEHICLES.json] [--validate] [--log-level LEVEL]\n"
+    "                 [--vda5050 VEHICLES.json] [--validate] [--log-level LEVEL] [--log-format text|json]\n"
+    "                 [--metrics-port PORT] [--metrics-host ADDR]\n"
+    "       fleet-sim --version\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
 
 bool parseArgs(int argc, char** argv, Options& o) {
+  // As the other services read them (CLI11 envname): the options below win.
+  if (const char* port = std::getenv("FLEET_METRICS_PORT")) {
+    o.ops.port = std::stoi(port);
+  }
+  if (const char* host = std::getenv("FLEET_METRICS_HOST")) {
+    o.ops.host = host;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -171,6 +184,15 @@ bool parseArgs(int argc, char** argv, Options& o) {
       o.logLevel = next();
     } else if (a == "--vda5050") {
       o.vda5050 = next();
+    } else if (a == "--log-format") {
+      o.logFormat = next();
+    } else if (a == "--metrics-port") {
+      o.ops.port = std::stoi(next());
+    } else if (a == "--metrics-host") {
+      o.ops.host = next();
+    } else if (a == "--version") {
+      std::cout << "fleet-sim " << fleet::service::version() << "\n";
+      std::exit(0);
     } else if (a == "--no-scan") {
       o.noScan = true;
     } else if (a == "--validate") {
@@ -222,8 +244,16 @@ msg::SensorFrame toMsg(const sim::World& w, const sim::SensorReading& r, std::in
 
 class Simulator {
  public:
-  Simulator(sim::World& w, const Options& o, bool lockstep)
-      : w_(w),
+  Simulator(sim::World& w, const Options& o, bool lockstep, service::ServiceOps& ops)
+      : ops_(ops),
+        stepSeconds_(ops.registry().histogram(
+            "fleet_sim_step_seconds", "Wall time of one simulation step (commands applied, world advanced)",
+            metrics::exponentialBuckets(1e-5, 2.0, 20))),
+        steps_(ops.registry().counter("fleet_sim_steps_total", "Simulation steps done")),
+        stepTimeouts_(ops.registry().counter("fleet_sim_step_timeouts_total",
+                                             "Lockstep steps that timed out waiting for a participant")),
+        simSeconds_(ops.registry().gauge("fleet_sim_simulated_seconds", "Simulated time")),
+        w_(w),
         o_(o),
         lockstep_(lockstep),
         sensorW_(p_, transport::qos::sensor(lockstep)),
@@ -234,7 +264,18 @@ class Simulator {
         doneR_(p_),
         stateR_(p_),
         riskR_(p_),
-        errors_(1.0, o.hiddenLandmarks) {}
+        errors_(1.0, o.hiddenLandmarks) {
+    ops_.registry()
+        .gauge("fleet_sim_bodies", "Bodies in the world", {{"kind", "robot"}})
+        .set(static_cast<double>(w_.robots().size()));
+    ops_.registry()
+        .gauge("fleet_sim_bodies", "Bodies in the world", {{"kind", "human"}})
+        .set(static_cast<double>(w_.humans().size()));
+    ops_.watchMatchedReaders("SensorFrame", [this] { return sensorW_.matchedReaders(); });
+    ops_.watchMatchedReaders("Clock", [this] { return clockW_.matchedReaders(); });
+    ops_.watchMatchedWriters("VelocityCommand", [this] { return cmdR_.matchedWriters(); });
+    ops_.watchMatchedWriters("StepDone", [this] { return doneR_.matchedWriters(); });
+  }
 
   int run() {
     if (!o_.vda5050.empty()) {
@@ -295,9 +336,16 @@ class Simulator {
         std::this_thread::sleep_until(due);
         pollStepDone();
       }
+      const auto t0 = std::chrono::steady_clock::now();
       applyCommands();
       stepVehicles();
       w_.advance();
+      stepSeconds_.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      steps_.inc();
+      simSeconds_.set(w_.time());
+      if (ops_.refresh()) {
+        contacts();
+      }
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return finish(wall);
@@ -315,6 +363,7 @@ class Simulator {
         break;
       }
       doneR_.waitForData(50ms);
+      ops_.refresh();
       pollStepDone();
     }
     spdlog::info("lockstep: {} participant(s) registered", barrier_.registered());
@@ -336,6 +385,7 @@ class Simulator {
     while (!barrier_.complete(k) && !gStop) {
       if (std::chrono::steady_clock::now() > deadline) {
         ++w_.counters().stepTimeouts;
+        stepTimeouts_.inc();
         const auto missing = barrier_.missing(k);
         std::string who;
         for (const auto& m : missing) {
@@ -348,6 +398,7 @@ class Simulator {
         return;
       }
       doneR_.waitForData(5ms);
+      ops_.health().beat();
       pollStepDone();
     }
   }
@@ -355,6 +406,9 @@ class Simulator {
   void applyCommands() {
     for (const auto& c : cmdR_.take()) {
       if (w_.command(c.robot_id, c.v, c.w) == sim::CommandOutcome::Ignored) {
+        ops_.rejected(w_.robotIndex(c.robot_id) < 0 ? "velocity_command_unknown_robot"
+                                                    : "velocity_command_not_finite")
+            .inc();
         if (++ignoredLogged_ <= 10) {
           spdlog::warn("ignored VelocityCommand for '{}' (v={}, w={}): {}", c.robot_id, c.v, c.w,
                        w_.robotIndex(c.robot_id) < 0 ? "unknown robot" : "not finite");
@@ -457,6 +511,22 @@ class Simulator {
     clockW_.write({w_.step(), lockstep_ ? w_.timeNs() : st, secToNs(w_.scenario().dt), lockstep_});
   }
 
+  /// Contacts so far, by pair kind (the world counts them; the counters follow).
+  void contacts() {
+    const auto& m = w_.metrics();
+    const std::pair<const char*, std::uint64_t> kinds[] = {
+        {"robot_robot", static_cast<std::uint64_t>(m.robotRobotContacts)},
+        {"robot_human", static_cast<std::uint64_t>(m.robotHumanContacts)},
+        {"robot_shelf", static_cast<std::uint64_t>(m.robotShelfContacts)}};
+    for (const auto& [kind, n] : kinds) {
+      auto& c = ops_.registry().counter("fleet_sim_contacts_total", "Contacts between bodies, by kind",
+                                        {{"kind", kind}});
+      if (n > c.value()) {
+        c.inc(n - c.value());
+      }
+    }
+  }
+
   int finish(double wallS) {
     auto s = sim::summary(w_);
     if (vda_) {
@@ -507,6 +577,11 @@ class Simulator {
     return 0;
   }
 
+  service::ServiceOps& ops_;
+  metrics::Histogram& stepSeconds_;
+  metrics::Counter& steps_;
+  metrics::Counter& stepTimeouts_;
+  metrics::Gauge& simSeconds_;
   sim::World& w_;
   const Options& o_;
   bool lockstep_;
@@ -537,7 +612,7 @@ int main(int argc, char** argv) {
       std::cerr << kUsage;
       return 2;
     }
-    logging::setup("fleet-sim", o.logLevel);
+    logging::setup("fleet-sim", o.logLevel, o.logFormat);
   } catch (const std::exception& e) {
     std::cerr << "fleet-sim: " << e.what() << "\n" << kUsage;
     return 2;
@@ -578,8 +653,12 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   try {
+    service::ServiceOps ops("fleet_sim");
+    if (!ops.start(o.ops)) {
+      return 2;
+    }
     sim::World world(std::move(*sc));
-    Simulator s(world, o, lockstep);
+    Simulator s(world, o, lockstep, ops);
     return s.run();
   } catch (const std::exception& e) {
     spdlog::critical("fleet-sim failed: {}", e.what());

@@ -29,6 +29,9 @@ void requestStop() {
 }
 
 void RateLimitedLog::warn(const std::string& key, const std::string& message) {
+  if (onEach_) {
+    onEach_(key);
+  }
   std::lock_guard lock(m_);
   auto& e = entries_[key];
   ++e.count;

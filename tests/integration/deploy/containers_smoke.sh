@@ -2,7 +2,8 @@
 # CI smoke test of the service containers: builds the images from the host build, starts the
 # small-fleet pod (simulator, risk map, fleet manager, WMS adapter, robot agent) with
 # `podman play kube --network none`, posts a transport task over HTTP from inside the pod and
-# asserts that every container started and stays healthy and that the task reached `done` (which
+# asserts that every container started and stays healthy (liveness), ready, with metrics, not as
+# root, and that the task reached `done` (which
 # needs DDS traffic between all five services). Exit 77 (ctest skip) only when podman cannot run
 # containers on this machine at all. Usage: containers_smoke.sh SOURCE_DIR BUILD_DIR
 set -uo pipefail
@@ -66,7 +67,18 @@ for c in fleet-manager wms-adapter risk-map robot-agent; do
   h=1
   for _ in 1 2 3; do podman healthcheck run "$POD-$c" >/dev/null && { h=0; break; }; sleep 1; done
   ((h == 0)) || fail "$POD-$c is unhealthy"
-  echo "$POD-$c running and healthy"
+  # Ready (the Pod's readinessProbe), serving metrics, and not root.
+  # The agent is ready while a sensor source is matched: once the simulator has ended it must say so.
+  if [[ $c == robot-agent && $(podman inspect --format '{{.State.Status}}' "$POD-fleet-sim") == exited ]]; then
+    [[ $(podman exec "$POD-$c" /usr/local/bin/fleet-probe /readyz 2>&1) == "not ready: sensors" ]] ||
+      fail "$POD-$c does not report its lost sensors"
+  else
+    podman exec "$POD-$c" /usr/local/bin/fleet-probe /readyz >/dev/null || fail "$POD-$c is not ready"
+  fi
+  podman exec "$POD-$c" /usr/local/bin/fleet-probe /metrics | grep '^fleet_build_info' >/dev/null ||
+    fail "$POD-$c serves no metrics"
+  [[ $(podman exec "$POD-$c" id -u) == 65532 ]] || fail "$POD-$c runs as $(podman exec "$POD-$c" id -u), not 65532"
+  echo "$POD-$c running, healthy, ready, not root"
 done
 sim=$(podman inspect --format '{{.State.Status}} {{.State.ExitCode}}' "$POD-fleet-sim")
 [[ $sim == "running 0" || $sim == "exited 0" ]] || fail "the simulator ended badly ($sim)"

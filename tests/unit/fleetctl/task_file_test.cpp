@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "task_file.hpp"
 
 using namespace fleet::ctl;
@@ -57,4 +59,20 @@ TEST(TaskFile, JsonShapes) {
   EXPECT_THAT(bad.error().message, HasSubstr("not valid JSON"));
   EXPECT_FALSE(loadTaskFile(write("tf_num.json", "42")));
   EXPECT_FALSE(loadTaskFile("/nonexistent.json"));
+}
+
+TEST(TaskFile, CsvSavedByExcelWithAByteOrderMarkIsRead) {
+  auto t = csvToTasks("\xEF\xBB\xBFid,kind,pickup,dropoff\r\nt1,transport,P-1,D-1\r\n", "excel.csv");
+  ASSERT_TRUE(t) << t.error().message;
+  ASSERT_EQ(t->size(), 1u);
+  EXPECT_EQ((*t)[0]["id"], "t1");
+  const auto dir = std::filesystem::temp_directory_path() / ("fleetctl-bom-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "tasks.json") << "\xEF\xBB\xBF[{\"id\": \"t2\"}]";
+  auto j = loadTaskFile((dir / "tasks.json").string());
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(j) << j.error().message;
+  EXPECT_EQ((*j)[0]["id"], "t2");
+  // Only a leading mark is dropped.
+  EXPECT_EQ(withoutBom("a\xEF\xBB\xBF"), "a\xEF\xBB\xBF");
 }

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <unordered_map>
@@ -24,6 +25,9 @@ class RateLimitedLog {
   explicit RateLimitedLog(std::chrono::milliseconds interval = std::chrono::seconds(5))
       : interval_(interval) {}
   void warn(const std::string& key, const std::string& message);
+  /// Called with the key of every warning, logged or suppressed (e.g. to count rejected samples
+  /// by reason in the metrics). Set before use from several threads.
+  void onEach(std::function<void(const std::string&)> f) { onEach_ = std::move(f); }
   [[nodiscard]] std::uint64_t count(const std::string& key) const;
   [[nodiscard]] std::uint64_t total() const;
 
@@ -34,6 +38,7 @@ class RateLimitedLog {
     std::uint64_t count = 0;
   };
   std::chrono::milliseconds interval_;
+  std::function<void(const std::string&)> onEach_;
   mutable std::mutex m_;
   std::unordered_map<std::string, Entry> entries_;
 };

@@ -1,0 +1,58 @@
+#pragma once
+
+// One service's operations surface: its metrics registry, its health, and the ops port serving
+// both. Every service names its metrics `<service>_...` (fleet_manager_, robot_agent_, ...), gets
+// `<service>_rejected_samples_total{reason}` for dropped input and `fleet_build_info`, and
+// `fleet_dds_matched_{readers,writers}{topic}` for the DDS endpoints it watches.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fleet/metrics/registry.hpp"
+#include "fleet/service/health.hpp"
+#include "fleet/service/ops_server.hpp"
+
+namespace fleet::service {
+
+class ServiceOps {
+ public:
+  /// `service`: the metric prefix, e.g. "fleet_manager".
+  explicit ServiceOps(std::string service);
+
+  [[nodiscard]] metrics::Registry& registry() { return registry_; }
+  [[nodiscard]] Health& health() { return health_; }
+  [[nodiscard]] const std::string& prefix() const { return service_; }
+
+  /// Opens the ops port when asked; on failure logs one line naming the port and returns false
+  /// (the caller exits 2).
+  [[nodiscard]] bool start(const OpsSettings& s);
+  [[nodiscard]] int port() const { return server_.port(); }
+
+  /// `<service>_rejected_samples_total{reason}`.
+  metrics::Counter& rejected(const std::string& reason);
+
+  /// A DDS endpoint whose matched count is published as a gauge by refresh(). `count` is called on
+  /// the thread calling refresh() (the service's loop), never by the scrape.
+  void watchMatchedReaders(const std::string& topic, std::function<std::uint32_t()> count);
+  void watchMatchedWriters(const std::string& topic, std::function<std::uint32_t()> count);
+  /// Beats the liveness and, at most once a second, updates the matched gauges. Returns true when
+  /// it did the once-a-second part (so a loop can hang its own slow gauges on it).
+  bool refresh();
+
+ private:
+  struct Watched {
+    metrics::Gauge* gauge;
+    std::function<std::uint32_t()> count;
+  };
+  std::string service_;
+  metrics::Registry registry_;
+  Health health_;
+  OpsServer server_;
+  std::vector<Watched> watched_;
+  std::chrono::steady_clock::time_point lastRefresh_{};
+};
+
+}  // namespace fleet::service
