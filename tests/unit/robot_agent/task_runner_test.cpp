@@ -147,3 +147,28 @@ TEST(TaskRunner, AnOperatorHoldMovesTheDwellClock) {
   r.stop();
   EXPECT_EQ(r.phase(), Phase::Idle);
 }
+
+TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailed) {
+  TaskRunner r;
+  ASSERT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kNewTask);
+  r.leg(0);
+  (void)r.takeReport();
+  Order empty{"t9", 2, {}, false, 5 * kSec};
+  EXPECT_EQ(r.accept(empty), TaskRunner::OrderChange::kRefused);
+  EXPECT_FALSE(r.busy()) << "the robot drops what it had";
+  EXPECT_EQ(r.phase(), Phase::Idle);
+  auto rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->task, "t9");
+  EXPECT_EQ(rep->revision, 2u);
+  EXPECT_EQ(rep->stage, TaskStage::Failed);
+  EXPECT_EQ(rep->reason, "refused: assignment has no goals");
+  EXPECT_EQ(rep->stampNs, 5 * kSec);
+  // Refused at the process's edge (whatever the order holds), and nothing for an empty task id.
+  r.refuse(transport(3), "bad pose");
+  rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->reason, "refused: bad pose");
+  r.refuse(Order{"", 4, {}, false, 0}, "x");
+  EXPECT_FALSE(r.takeReport());
+}
