@@ -82,6 +82,32 @@ std::vector<std::string> baseArgs(const fs::path& out, int robots, double durati
 /// done (a task takes 55-90 s for a lone robot on this site), ~45 s of wall time at 3.5x.
 constexpr double kFaultRunS = 150;
 
+/// A run of `tasks` tasks on `scenario` until every one ends (at most `durationS` simulated and
+/// `wallLimitS` of wall time), uncapped, no HTML report, on a domain of its own; then `extra`.
+std::vector<std::string> untilDoneArgs(const std::string& scenario, const fs::path& out, int durationS,
+                                       int wallLimitS, std::vector<std::string> extra = {}) {
+  std::vector<std::string> args = {"loadtest",
+                                   "--scenario",
+                                   scenario,
+                                   "--tasks",
+                                   "2",
+                                   "--until-done",
+                                   "--duration",
+                                   std::to_string(durationS),
+                                   "--max-speed",
+                                   "0",
+                                   "--out",
+                                   out.string(),
+                                   "--domain",
+                                   std::to_string(fleet::test::uniqueDomain()),
+                                   "--report-script",
+                                   "",
+                                   "--wall-limit",
+                                   std::to_string(wallLimitS)};
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
 /// An 8-robot, kFaultRunS load test with `faults`; its loadtest.json (empty when the run failed).
 json runWithFaults(const fs::path& out, std::initializer_list<const char*> faults) {
   fs::remove_all(out);
@@ -258,26 +284,8 @@ TEST(LoadtestE2E, ScenarioTaskListIsPostedExactlyEachAtItsTime) {
 TEST(LoadtestE2E, AFleetRunsOnASiteWithAROSMap) {
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-ros-" + std::to_string(getpid()));
   fs::remove_all(out);
-  const std::vector<std::string> args = {"loadtest",
-                                         "--scenario",
-                                         FLEET_SOURCE_DIR "/sim/scenarios/ros_warehouse.json",
-                                         "--rate",
-                                         "2",
-                                         "--tasks",
-                                         "2",
-                                         "--until-done",
-                                         "--duration",
-                                         "900",
-                                         "--max-speed",
-                                         "0",
-                                         "--out",
-                                         out.string(),
-                                         "--domain",
-                                         std::to_string(fleet::test::uniqueDomain()),
-                                         "--report-script",
-                                         "",
-                                         "--wall-limit",
-                                         "120"};
+  const auto args =
+      untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/ros_warehouse.json", out, 900, 120, {"--rate", "2"});
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(180)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
@@ -304,26 +312,8 @@ TEST(LoadtestE2E, ALoneRobotDeliversUnderReservedTraffic) {
   // agent (--traffic reserved) drives only what it was released and reports the nodes it reaches.
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-reserved-" + std::to_string(getpid()));
   fs::remove_all(out);
-  const std::vector<std::string> args = {"loadtest",
-                                         "--scenario",
-                                         FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json",
-                                         "--traffic",
-                                         "reserved",
-                                         "--tasks",
-                                         "2",
-                                         "--until-done",
-                                         "--duration",
-                                         "600",
-                                         "--max-speed",
-                                         "0",
-                                         "--out",
-                                         out.string(),
-                                         "--domain",
-                                         std::to_string(fleet::test::uniqueDomain()),
-                                         "--report-script",
-                                         "",
-                                         "--wall-limit",
-                                         "150"};
+  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 600, 150,
+                                  {"--traffic", "reserved"});
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(200)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
@@ -457,28 +447,8 @@ TEST(LoadtestE2E, AFleetRunsUnderDdsSecurity) {
       std::system((FLEET_SOURCE_DIR "/scripts/dds-security deployment " + ids.string() + " agents >/dev/null")
                       .c_str()),
       0);
-  std::vector<std::string> args = {"loadtest",
-                                   "--scenario",
-                                   FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json",
-                                   "--rate",
-                                   "2",
-                                   "--tasks",
-                                   "2",
-                                   "--until-done",
-                                   "--duration",
-                                   "900",
-                                   "--max-speed",
-                                   "0",
-                                   "--out",
-                                   out.string(),
-                                   "--domain",
-                                   std::to_string(fleet::test::uniqueDomain()),
-                                   "--report-script",
-                                   "",
-                                   "--wall-limit",
-                                   "120",
-                                   "--dds-security",
-                                   ids.string()};
+  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 900, 120,
+                                  {"--rate", "2", "--dds-security", ids.string()});
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(180)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
