@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include "dds_gateway.hpp"
@@ -76,6 +77,26 @@ int main(int argc, char** argv) {
         "wms_adapter_tasks_total", "Tasks posted through the API, by result", {{"result", "duplicate"}});
     std::int64_t accepted = 0;
     std::int64_t duplicate = 0;
+    // DDS samples refused at the edge (libs/validation) as wms_adapter_rejected_samples_total, by
+    // topic as the other services' are (ServiceOps::rejected keeps the key's part before ':').
+    std::map<std::string, std::uint64_t> refusedSeen;
+    auto exportRefused = [&] {
+      const auto j = view.rejections().toJson();
+      if (!j.contains("rejected")) {
+        return;
+      }
+      for (const auto& [topic, reasons] : j["rejected"].items()) {
+        for (const auto& [reason, n] : reasons.items()) {
+          const std::string key = topic + ":" + reason;
+          const auto now = n.get<std::uint64_t>();
+          auto& seen = refusedSeen[key];
+          if (now > seen) {
+            ops.rejected(key).inc(now - seen);
+            seen = now;
+          }
+        }
+      }
+    };
     while (!service::stopRequested()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       if (ops.refresh()) {
@@ -90,6 +111,7 @@ int main(int argc, char** argv) {
         tasksDuplicate.inc(static_cast<std::uint64_t>(d - duplicate));
         accepted = a;
         duplicate = d;
+        exportRefused();
       }
     }
     http.stop();

@@ -399,6 +399,43 @@ TEST(OpsProbes, AnAdapterWithoutManagerIsLiveNotReadyAndLogsEveryRequest) {
   fs::remove_all(dir);
 }
 
+TEST(OpsProbes, SamplesTheAdapterRefusesAreCountedInItsMetrics) {
+  // A TaskEvent whose task id is not an id (issue 19's edge checks): refused, and counted where
+  // an operations stack looks, as every other service's refusals are.
+  const std::string domain = std::to_string(fleet::test::uniqueDomain());
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-refused-" + domain);
+  fs::create_directories(dir);
+  const int api = freePort();
+  const int ops = freePort();
+  std::ofstream(dir / "adapter.json")
+      << nlohmann::json{{"stations", kScenario}, {"http", {{"port", api}}}}.dump();
+  fleet::test::ChildProcess adapter(kBin + "/services/wms_adapter/wms_adapter",
+                                    {"--config", (dir / "adapter.json").string(), "--metrics-port",
+                                     std::to_string(ops), "--log-level", "warn"},
+                                    {{"FLEET_DDS_DOMAIN", domain}});
+  ASSERT_TRUE(waitFor(ops, "/livez", 200, 30s));
+  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
+  fleet::transport::Participant p;
+  fleet::transport::Writer<fleet::msg::TaskEvent> events(p);
+  fleet::msg::TaskEvent bad;
+  bad.task_id = "not an id!";
+  bad.state = fleet::msg::TaskState::Done;
+  // (The reason label is the topic, as for every service: ServiceOps keeps label values few.)
+  const std::string counted = "wms_adapter_rejected_samples_total{reason=\"TaskEvent\"}";
+  std::string body;
+  for (int k = 0; k < 100 && body.find(counted) == std::string::npos; ++k) {
+    events.write(bad);
+    std::this_thread::sleep_for(200ms);
+    if (auto m = get(ops, "/metrics"); m && *m) {
+      body = (*m)->body;
+    }
+  }
+  EXPECT_NE(body.find(counted), std::string::npos) << body;
+  adapter.kill(SIGTERM);
+  EXPECT_EQ(adapter.wait(10s), 0);
+  fs::remove_all(dir);
+}
+
 TEST(OpsProbes, ARobotAgentWithoutSensorsIsLiveNotReady) {
   const std::string domain = std::to_string(fleet::test::uniqueDomain());
   const int ops = freePort();
