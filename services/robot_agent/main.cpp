@@ -33,7 +33,7 @@
 #include "fleet/site/wall_segments.hpp"
 #include "fleet/site/zone_costs.hpp"
 #include "fleet/transport/dds.hpp"
-#include "risk_field.hpp"
+#include "risk_lookup_of.hpp"
 #include "worker_pool.hpp"
 
 using namespace fleet;

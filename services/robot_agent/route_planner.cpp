@@ -69,11 +69,12 @@ RoutePlanner::RoutePlanner(RouteOptions opt, std::shared_ptr<const planning::Occ
     throw std::invalid_argument(made.error().message);
   }
   rules_ = std::move(*made);
+  layered_ = kind == "astar";
 }
 
 void RoutePlanner::setRisk(std::shared_ptr<const risk::RiskLookup> risk) {
   preferred_.reset();
-  if (!risk || std::string(rules_->name()) != "astar") {
+  if (!risk || !layered_) {
     return;  // wavefront and OMPL plan on the grid alone
   }
   planning::CostLayers layers = ruleLayers_;

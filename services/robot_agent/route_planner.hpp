@@ -72,7 +72,8 @@ class RoutePlanner {
   std::shared_ptr<const planning::OccupancyGrid> grid_;
   std::shared_ptr<const planning::OccupancyGrid> raw_;
   planning::CostLayers ruleLayers_;
-  std::unique_ptr<planning::GlobalPlanner> rules_;      // the site's rules only
+  bool layered_ = false;                            // the planner is the A* (the only one that takes layers)
+  std::unique_ptr<planning::GlobalPlanner> rules_;  // the site's rules only
   std::unique_ptr<planning::GlobalPlanner> preferred_;  // ... and the risk map (null: same as rules_)
 };
 

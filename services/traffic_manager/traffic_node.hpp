@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "fleet/core/config.hpp"
+#include "fleet/messages/messages.hpp"
 #include "fleet/site/site.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
-#include "fleet/messages/messages.hpp"
 
 namespace fleet::trafficmgr {
 

@@ -44,7 +44,8 @@ planning::CostLayers zoneCostLayers(const std::shared_ptr<const Site>& site, dou
   if (std::any_of(l.oneWay.begin(), l.oneWay.end(), [](float v) { return std::isfinite(v); })) {
     out.push_back(std::make_shared<OneWayCost>(site, wrongWayFactor));
   }
-  if (std::any_of(l.speedLimit.begin(), l.speedLimit.end(), [cruise](float v) { return static_cast<double>(v) < cruise; })) {
+  if (std::any_of(l.speedLimit.begin(), l.speedLimit.end(),
+                  [cruise](float v) { return static_cast<double>(v) < cruise; })) {
     out.push_back(std::make_shared<SpeedZoneCost>(site, cruise));
   }
   return out;

@@ -12,7 +12,7 @@
 #include "agent.hpp"
 #include "fleet/planning/astar.hpp"
 #include "fleet/risk/rle.hpp"
-#include "risk_field.hpp"
+#include "risk_lookup_of.hpp"
 #include "route_planner.hpp"
 #include "worker_pool.hpp"
 

@@ -1,4 +1,4 @@
-#include "risk_field.hpp"
+#include "risk_lookup_of.hpp"
 
 namespace fleet::agent {
 
