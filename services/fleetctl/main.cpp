@@ -276,6 +276,9 @@ int main(int argc, char** argv) {
                    "traffic layer's)")
       ->check(CLI::Range(0.0, 1e6));
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");
+  trafficSim->add_option(
+      "--html", ts.html,
+      "write a replay page of the first seed's run (roadmap, robots, releases) to this file");
   // Exit codes as every binary's: 0 after --help/--version, 2 for any usage error.
   if (auto code = fleet::service::parse(app, argc, argv)) {
     return *code;

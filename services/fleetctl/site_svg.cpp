@@ -43,34 +43,33 @@ std::string escape(const std::string& s) {
   return out;
 }
 
-// Map metres to page pixels: y flipped, a margin around, a legend band on top.
-struct Frame {
-  Vec2 origin;
-  double height = 0.0;  // m
-  double scale = 1.0;   // px per m
-  double pad = 90.0;    // room for station names beside docks at the map's edge
-  double top = 110.0;   // legend band
-  [[nodiscard]] double x(double mx) const { return pad + (mx - origin.x) * scale; }
-  [[nodiscard]] double y(double my) const { return top + (height - (my - origin.y)) * scale; }
-  [[nodiscard]] double len(double m) const { return m * scale; }
-};
-
 }  // namespace
 
-std::string siteSvg(const site::Site& site, const traffic::Roadmap& roadmap) {
+SvgFrame siteSvgFrame(const site::Site& site) {
   const auto& map = site.map;
   const double res = map.resolution();
   const double w = map.width() * res;
   const double h = map.height() * res;
-  Frame f;
+  SvgFrame f;
   f.origin = map.origin();
   f.height = h;
   // Fit a 1,400 × 1,000 px window (at least 4 px per metre: a large site makes a larger page).
   f.scale = std::clamp(std::min((1400.0 - 2.0 * f.pad) / std::max(w, 1e-3),
                                 (1000.0 - f.top - 2.0 * f.pad) / std::max(h, 1e-3)),
                        4.0, 150.0);
-  const double pageW = std::max(2.0 * f.pad + f.len(w), 1100.0);
-  const double pageH = f.top + 2.0 * f.pad + f.len(h);
+  f.pageW = std::max(2.0 * f.pad + f.len(w), 1100.0);
+  f.pageH = f.top + 2.0 * f.pad + f.len(h);
+  return f;
+}
+
+std::string siteSvg(const site::Site& site, const traffic::Roadmap& roadmap) {
+  const auto& map = site.map;
+  const SvgFrame f = siteSvgFrame(site);
+  const double res = map.resolution();
+  const double w = map.width() * res;
+  const double h = map.height() * res;
+  const double pageW = f.pageW;
+  const double pageH = f.pageH;
   std::ostringstream os;
   os << std::fixed << std::setprecision(1);
   os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << pageW << "\" height=\"" << pageH

@@ -1,6 +1,7 @@
 #include "traffic_sim.hpp"
 
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -8,6 +9,7 @@
 #include "fleet/service/site_stations.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/virtual_fleet.hpp"
+#include "traffic_sim_view.hpp"
 
 namespace fleet::ctl {
 
@@ -45,6 +47,9 @@ int runTrafficSim(const TrafficSimOptions& o) {
       v.traffic.pibt.detourAfter = o.detourAfter;
     if (o.detourPenalty >= 0.0)
       v.traffic.pibt.detourPenalty = static_cast<float>(o.detourPenalty);
+    const bool record = !o.html.empty() && seed == first;
+    if (record)
+      v.recordEvery = 0.5;
     traffic::VirtualFleetResult r;
     try {
       r = traffic::runVirtualFleet(roadmap, v);
@@ -54,6 +59,16 @@ int runTrafficSim(const TrafficSimOptions& o) {
     }
     if (r.contacts > 0 || r.holdViolations > 0)
       rc = 1;
+    if (record) {
+      std::ofstream out(o.html);
+      out << trafficSimHtml(*site, roadmap, r,
+                            "traffic-sim " + site->name + ", " + std::to_string(o.robots) + " robots, seed " +
+                                std::to_string(seed));
+      if (!out) {
+        std::cerr << "fleetctl traffic-sim: cannot write " << o.html << "\n";
+        return 2;
+      }
+    }
     if (o.json) {
       all.push_back({{"seed", seed},
                      {"robots", r.robots},

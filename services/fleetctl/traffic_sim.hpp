@@ -21,6 +21,7 @@ struct TrafficSimOptions {
   int detourAfter = -1;         ///< planner steps before a detour round standing robots; -1: the default
   double detourPenalty = -1.0;  ///< s added for entering what a standing robot excludes; <0: the default
   bool json = false;
+  std::string html;  ///< write a replay page of the first seed's run here (empty: none)
 };
 
 /// Exit code: 0 ran (whatever the figures), 1 a promise broken (contact, conflicting holds), 2 bad input.

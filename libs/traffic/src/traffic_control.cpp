@@ -1,6 +1,7 @@
 #include "fleet/traffic/traffic_control.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 namespace fleet::traffic {
@@ -38,13 +39,22 @@ void TrafficControl::setStations(std::vector<StationLine> stations) {
     const auto& st = stations_[i];
     if (!graph_.valid(st.dock))
       continue;
+    // The ways in and out: the dock's neighbours, and the approach's (a robot leaving the dock
+    // drives on from the approach sideways, through nodes the queue's head may exclude).
     std::vector<NodeId> ways{st.dock};
-    for (const Edge& e : graph_.edges(st.dock))
-      ways.push_back(e.to);
-    for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
-      if (graph_.edge(v, st.dock) != nullptr)
-        ways.push_back(v);
-    }
+    auto addNeighbours = [&](NodeId u) {
+      for (const Edge& e : graph_.edges(u))
+        ways.push_back(e.to);
+      for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
+        if (graph_.edge(v, u) != nullptr)
+          ways.push_back(v);
+      }
+    };
+    addNeighbours(st.dock);
+    if (graph_.valid(st.approach))
+      addNeighbours(st.approach);
+    std::erase_if(ways,
+                  [&](NodeId w) { return std::find(st.queue.begin(), st.queue.end(), w) != st.queue.end(); });
     std::size_t k = 0;
     while (k < st.queue.size() && std::any_of(ways.begin(), ways.end(),
                                               [&](NodeId w) { return graph_.conflicting(w, st.queue[k]); })) {
@@ -103,6 +113,32 @@ void TrafficControl::leaveLine(std::size_t robot) {
   l.erase(std::remove(l.begin(), l.end(), robot), l.end());
   inLine_[robot] = -1;
   updateLine(static_cast<std::size_t>(s));
+}
+
+void TrafficControl::orderLine(std::size_t station) {
+  auto& l = lines_[station];
+  if (l.size() < 2)
+    return;
+  const auto& st = stations_[station];
+  const auto& pos = planner_->positions();
+  // Place along the line where the robot stands: dock, approach, then the queue from its head.
+  auto place = [&](std::size_t r) -> std::size_t {
+    const NodeId v = pos[r];
+    if (v == st.dock)
+      return 0;
+    if (v == st.approach)
+      return 1;
+    const auto it = std::find(st.queue.begin(), st.queue.end(), v);
+    return it == st.queue.end() ? std::numeric_limits<std::size_t>::max()
+                                : 2 + static_cast<std::size_t>(it - st.queue.begin());
+  };
+  auto sorted = l;
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [&](std::size_t a, std::size_t b) { return place(a) < place(b); });
+  if (sorted != l) {
+    l = std::move(sorted);
+    updateLine(station);
+  }
 }
 
 void TrafficControl::updateLine(std::size_t station) {
@@ -237,6 +273,8 @@ int TrafficControl::update() {
 
 void TrafficControl::afterStep() {
   const auto now = execution_.plannedSteps();
+  for (std::size_t i = 0; i < stations_.size(); ++i)
+    orderLine(i);
   for (std::size_t i = 0; i < stations_.size(); ++i) {
     const auto q = leaving_[i];
     if (q >= 0 &&

@@ -83,7 +83,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       if (st.dock != kNoNode &&
           (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
            st.kind == site::StationKind::Charging)) {
-        lines.push_back({st.dock, st.queue});
+        lines.push_back({st.dock, st.queue, st.approach});
       }
     }
     traffic.setStations(std::move(lines));
@@ -111,6 +111,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   std::vector<double> updateMs, taskTimes;
   const double contact = roadmap.separation.contact - roadmap.separation.margin;
   std::vector<Vec2> where(o.robots);
+  double nextFrame = 0.0;
 
   for (double now = 0.0; now < o.duration; now += o.dt) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -194,6 +195,18 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     res.contacts += contactNow ? 1 : 0;
     res.holdViolations += holdNow ? 1 : 0;
+    if (o.recordEvery > 0.0 && now + 1e-9 >= nextFrame) {
+      nextFrame += o.recordEvery;
+      FleetFrame f;
+      f.time = now;
+      f.tasksDone = res.tasksDone;
+      for (std::size_t r = 0; r < o.robots; ++r) {
+        const Bot& b = bots[r];
+        f.robots.push_back({where[r], b.phase == 0 ? b.pickup : b.dropoff, b.phase, b.dwellLeft > 0.0,
+                            std::move(rel[r].base), std::move(rel[r].horizon)});
+      }
+      res.frames.push_back(std::move(f));
+    }
   }
   for (std::size_t r = 0; r < o.robots; ++r) {
     const Bot& b = bots[r];
@@ -206,6 +219,17 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
        << " nodes ahead, released to " << traffic.execution().releasedEnd(r) << ", waiting on";
     for (auto q : traffic.waitingOn(r))
       os << " " << q << "@" << bots[q].at;
+    // Where it could go and who stands in the way: what the planner saw.
+    os << "; target " << traffic.target(r) << ", ways out:";
+    for (const Edge& e : g.edges(b.at)) {
+      if (!g.passable(b.at, e))
+        continue;
+      os << " " << e.to << " " << toString(roadmap.kind(e.to));
+      for (std::size_t q = 0; q < o.robots; ++q) {
+        if (q != r && g.conflicting(e.to, bots[q].at))
+          os << " [" << q << "]";
+      }
+    }
     res.stalls.push_back(os.str());
   }
   res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / o.duration;

@@ -2,33 +2,21 @@
 // key path, and nothing started half-way (no task database created).
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "run_command.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int code = -1;
-  std::string output;
-};
+using fleet::test::Outcome;
 
 Outcome run(const std::string& cmd) {
-  Outcome r;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  std::array<char, 512> buf{};
-  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
-    r.output += buf.data();
-  }
-  const int status = p != nullptr ? pclose(p) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return fleet::test::runCommand(cmd);
 }
 
 class BadSite : public ::testing::Test {

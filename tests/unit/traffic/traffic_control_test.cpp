@@ -122,6 +122,56 @@ TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   EXPECT_EQ(tc.planner().goal(2), d1->queue[0]);
 }
 
+/// The line's order is where robots stand, not when they joined: robot 0 joined first but is far
+/// away, robot 1 stands in the queue. The queue is one way toward the station, so with robot 0
+/// first robot 1 would wait for it and robot 0 could never get past robot 1 (seen in the virtual
+/// fleet: three robots in a drop-off's queue behind an empty dock, for 200 s).
+TEST(TrafficControl, RobotsStandingInTheQueueGoBeforeRobotsOnTheirWay) {
+  Roadmap map = smallWarehouse();
+  const auto* d1 = map.station("D-1");
+  ASSERT_GE(d1->queue.size(), 2U);
+  const std::vector<NodeId> starts{map.station("PARK-1")->dock, d1->queue[1]};
+  TrafficControl tc(map.graph, starts);
+  tc.setStations({{d1->dock, d1->queue, d1->approach}});
+  tc.setGoal(0, d1->dock);
+  tc.setGoal(1, d1->dock);
+  EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{0, 1}));
+  tc.update();
+  EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{1, 0}));
+  EXPECT_EQ(tc.planner().goal(1), d1->dock);
+}
+
+/// While the robot that was at the dock drives off it, the next in line waits where it leaves the
+/// approach's ways out free, not only the dock's: a robot leaving a drop-off goes on sideways from
+/// the approach, and a robot waiting on the queue's head shut that way (seen in the virtual fleet:
+/// the leaving robot and three waiting ones stood for 220 s at D-3).
+TEST(TrafficControl, TheNextInLineWaitsClearOfTheWaysOutOfTheApproach) {
+  Roadmap map = smallWarehouse();
+  const auto* d3 = map.station("D-3");
+  ASSERT_NE(d3->approach, kNoNode);
+  ASSERT_GE(d3->queue.size(), 2U);
+  std::vector<NodeId> exits;
+  for (const Edge& e : map.graph.edges(d3->approach)) {
+    if (e.to != d3->dock && std::find(d3->queue.begin(), d3->queue.end(), e.to) == d3->queue.end())
+      exits.push_back(e.to);
+  }
+  ASSERT_FALSE(exits.empty());
+  auto shuts = [&](NodeId q) {
+    return std::any_of(exits.begin(), exits.end(), [&](NodeId x) { return map.graph.conflicting(x, q); });
+  };
+  ASSERT_TRUE(shuts(d3->queue[0]));  // the case: the head of the queue is in the way out
+  const std::vector<NodeId> starts{d3->dock, map.station("PARK-1")->dock};
+  TrafficControl tc(map.graph, starts);
+  tc.setStations({{d3->dock, d3->queue, d3->approach}});
+  tc.setGoal(0, d3->dock);
+  tc.setGoal(1, d3->dock);
+  tc.setGoal(0, map.station("P-1")->dock);  // robot 0 is done and drives off
+  EXPECT_EQ(tc.line(d3->dock), (std::vector<std::size_t>{1}));
+  const NodeId wait = tc.planner().goal(1);
+  EXPECT_NE(std::find(d3->queue.begin(), d3->queue.end(), wait), d3->queue.end());
+  EXPECT_FALSE(shuts(wait));
+}
+
 /// Five robots chained on random tasks. Before detours, pacing and leaving docks first, three
 /// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
 /// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the

@@ -44,10 +44,12 @@ struct TrafficOptions {
 };
 
 /// A station robots dock at one at a time: its dock node and the nodes to wait on in line,
-/// nearest to the station first.
+/// nearest to the station first, and the approach node between the queue and the dock (kNoNode:
+/// none).
 struct StationLine {
   NodeId dock = kNoNode;
   std::vector<NodeId> queue;
+  NodeId approach = kNoNode;
 };
 
 struct TrafficStats {
@@ -71,10 +73,16 @@ class TrafficControl {
   /// for a node off the graph or closed.
   bool setGoal(std::size_t robot, NodeId goal, int priority = 0);
   [[nodiscard]] NodeId goal(std::size_t robot) const { return goal_.at(robot); }
+  /// Where the planner is taking it now: its goal, its place in a station's line or where it is
+  /// sent out of another robot's way.
+  [[nodiscard]] NodeId target(std::size_t robot) const { return target_.at(robot); }
   /// Stations whose dock takes one robot at a time. A robot whose goal is such a dock joins its
   /// line: the first in line is planned to the dock, the next ones to the queue nodes in order (the
   /// last queue node for everyone beyond), so robots wait in line instead of crowding the dock's
-  /// only way in and out. The line moves up when the robot at the dock gets another goal.
+  /// only way in and out. The line moves up when the robot at the dock gets another goal. Robots
+  /// already standing in the queue (or on the approach or the dock) keep the order they stand in
+  /// and go before those still on their way: the queue is one way, so a robot that joined the line
+  /// earlier but arrives later could never get past them.
   void setStations(std::vector<StationLine> stations);
   /// Robots in line for the station whose dock is `dock`, the one at the dock first.
   [[nodiscard]] std::vector<std::size_t> line(NodeId dock) const;
@@ -110,6 +118,7 @@ class TrafficControl {
   void replan();
   void leaveLine(std::size_t robot);
   void updateLine(std::size_t station);
+  void orderLine(std::size_t station);
   void plannerGoal(std::size_t robot, NodeId goal);
   void plannerPriority(std::size_t robot);
   void afterStep();

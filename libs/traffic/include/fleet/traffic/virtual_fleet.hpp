@@ -31,7 +31,25 @@ struct VirtualFleetOptions {
   double stopChance = 0.01;  ///< per edge: the robot stops on it for U(0, stopMax) s
   double stopMax = 10.0;
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
+  /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
+  double recordEvery = 0.0;
   TrafficOptions traffic;
+};
+
+/// One robot in a recorded frame.
+struct RobotFrame {
+  Vec2 position;
+  NodeId target = kNoNode;  ///< its task's station dock (kNoNode: none)
+  int phase = 0;            ///< 0 to the pickup, 1 to the drop-off
+  bool dwelling = false;
+  std::vector<NodeId> base;     ///< released: it may drive these
+  std::vector<NodeId> horizon;  ///< planned after the base
+};
+
+struct FleetFrame {
+  double time = 0.0;
+  std::size_t tasksDone = 0;
+  std::vector<RobotFrame> robots;
 };
 
 struct VirtualFleetResult {
@@ -52,6 +70,7 @@ struct VirtualFleetResult {
   double density = 0.0;  ///< robots ÷ roadmap nodes
   /// Robots waiting longer than a minute at the end: where, for what, behind whom.
   std::vector<std::string> stalls;
+  std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0
 };
 
 /// Runs the virtual fleet on `roadmap`. Robots start on the parking docks (then on spread-out lane

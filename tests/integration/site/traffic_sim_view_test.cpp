@@ -1,0 +1,82 @@
+// `fleetctl traffic-sim --html`: the replay page holds the run it shows (every frame, every robot,
+// released nodes on the roadmap), and a page it cannot write is bad input (exit 2).
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "run_command.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kFleetctl = std::string(FLEET_BINARY_DIR) + "/services/fleetctl/fleetctl";
+const std::string kSite = std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/small_warehouse.site.json";
+
+TEST(TrafficSimView, ThePageReplaysTheRunItReports) {
+  const fs::path page =
+      fs::temp_directory_path() / ("traffic_sim_view_" + std::to_string(getpid()) + ".html");
+  const auto r =
+      fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                              " --robots 3 --duration 60 --seeds 1 --json --html " + page.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto printed = nlohmann::json::parse(r.output.substr(r.output.find('[')));
+  std::ifstream in(page);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string html = ss.str();
+  fs::remove(page);
+  const auto at = html.find("const DATA = ");
+  ASSERT_NE(at, std::string::npos);
+  const auto begin = at + 13;
+  const auto end = html.find(";\n", begin);
+  const auto data = nlohmann::json::parse(html.substr(begin, end - begin));
+  const auto& nodes = data["nodes"];
+  const auto& frames = data["frames"];
+  ASSERT_GE(frames.size(), 119U);  // one every 0.5 s over 60 s
+  ASSERT_LE(frames.size(), 121U);
+  double lastT = -1.0;
+  std::size_t lastDone = 0;
+  bool released = false;
+  for (const auto& f : frames) {
+    EXPECT_GT(f["t"].get<double>(), lastT);
+    lastT = f["t"].get<double>();
+    EXPECT_GE(f["done"].get<std::size_t>(), lastDone);
+    lastDone = f["done"].get<std::size_t>();
+    ASSERT_EQ(f["r"].size(), 3U);
+    for (const auto& robot : f["r"]) {
+      const double x = robot[0].get<double>();
+      const double y = robot[1].get<double>();
+      EXPECT_TRUE(x >= 0.0 && x <= 30.0 && y >= 0.0 && y <= 20.0) << robot.dump();
+      for (int k : {5, 6}) {
+        for (const auto& v : robot[static_cast<std::size_t>(k)]) {
+          ASSERT_LT(v.get<std::size_t>(), nodes.size());
+        }
+      }
+      // The base starts where the robot last reported: within one edge (≤ 1 m) of its disc.
+      const auto& base = robot[5];
+      ASSERT_FALSE(base.empty());
+      const auto& b0 = nodes[base[0].get<std::size_t>()];
+      EXPECT_LE(std::hypot(b0[0].get<double>() - x, b0[1].get<double>() - y), 1.0) << robot.dump();
+      released = released || base.size() > 1;
+    }
+  }
+  EXPECT_TRUE(released);
+  // The last frame's count is the run's count (the frame is taken before the last tick's tasks).
+  EXPECT_LE(lastDone, printed[0]["tasks_done"].get<std::size_t>());
+}
+
+TEST(TrafficSimView, APageItCannotWriteIsBadInput) {
+  const auto r = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                                         " --robots 2 --duration 5 --html /nonexistent-dir/x.html");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent-dir/x.html"), std::string::npos) << r.output;
+}
+
+}  // namespace
