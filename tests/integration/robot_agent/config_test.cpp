@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "run_command.hpp"
 #include "test_process.hpp"
 
 namespace fs = std::filesystem;
@@ -26,16 +27,9 @@ struct AgentRun {
 AgentRun runAgent(const std::string& args, int seconds) {
   const std::string cmd = "FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) +
                           " timeout --preserve-status -s INT " + std::to_string(seconds) +
-                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent " + args + " 2>&1";
-  AgentRun r;
-  FILE* p = popen(cmd.c_str(), "r");
-  std::array<char, 512> buf{};
-  while (p != nullptr && fgets(buf.data(), buf.size(), p) != nullptr) {
-    r.output += buf.data();
-  }
-  const int status = p != nullptr ? pclose(p) : -1;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+                          " " FLEET_BINARY_DIR "/services/robot_agent/robot_agent " + args;
+  const auto o = fleet::test::runCommand(cmd);
+  return {o.code, o.output};
 }
 
 AgentRun agentWith(const std::string& configText, int seconds) {
