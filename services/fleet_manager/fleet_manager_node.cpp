@@ -356,7 +356,8 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
 }
 
 void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs) {
-  dispatcher_->onRobotState({s.robot_id, s.pose, static_cast<double>(s.battery), nowNs});
+  dispatcher_->onRobotState(
+      {s.robot_id, s.pose, static_cast<double>(s.battery), nowNs, s.mode == msg::RobotMode::Fault});
 }
 
 void FleetManagerNode::onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out) {

@@ -52,7 +52,7 @@ class ManagerMetrics {
       tasks_.push_back(
           &r_.gauge("fleet_manager_tasks", "Open tasks: queued (waiting) or active", {{"state", state}}));
     }
-    for (const char* state : {"idle", "busy", "lost"}) {
+    for (const char* state : {"idle", "busy", "lost", "fault"}) {
       robots_.push_back(
           &r_.gauge("fleet_manager_robots", "Robots known to the manager, by state", {{"state", state}}));
     }
@@ -82,12 +82,14 @@ class ManagerMetrics {
     double idle = 0;
     double busy = 0;
     double lost = 0;
+    double fault = 0;
     for (const auto& r : node.dispatcher().robots().all()) {
-      (r.lost ? lost : (r.taskId.empty() ? idle : busy)) += 1.0;
+      (r.lost ? lost : (r.fault ? fault : (r.taskId.empty() ? idle : busy))) += 1.0;
     }
     robots_[0]->set(idle);
     robots_[1]->set(busy);
     robots_[2]->set(lost);
+    robots_[3]->set(fault);
   }
 
  private:

@@ -27,7 +27,8 @@ nlohmann::json toJson(const RobotInfo& r) {
   return {{"id", r.id},           {"x", r.pose.x},
           {"y", r.pose.y},        {"theta", r.pose.theta},
           {"battery", r.battery}, {"last_seen_ns", r.lastSeenNs},
-          {"lost", r.lost},       {"task", r.taskId}};
+          {"lost", r.lost},       {"fault", r.fault},
+          {"task", r.taskId}};
 }
 
 }  // namespace fleet

@@ -20,6 +20,7 @@ RobotRegistry::Update RobotRegistry::observe(const RobotObservation& o) {
     r.pose = o.pose;
     r.battery = o.battery;
     r.lastSeenNs = o.stampNs;
+    r.fault = o.fault;
     robots_.emplace(o.id, std::move(r));
     return Update::New;
   }
@@ -30,6 +31,7 @@ RobotRegistry::Update RobotRegistry::observe(const RobotObservation& o) {
   r.pose = o.pose;
   r.battery = o.battery;
   r.lastSeenNs = o.stampNs;
+  r.fault = o.fault;
   if (r.lost) {
     r.lost = false;
     r.taskId.clear();

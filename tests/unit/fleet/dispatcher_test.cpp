@@ -117,6 +117,24 @@ TEST_F(DispatcherTest, AssignsNearestAndTracksProgress) {
   EXPECT_EQ(dispatcher->onTaskStatus("near", "t1", S::Done, "", 3).error().code, errc::kNotFound);
 }
 
+/// A robot in fault mode fails whatever it is given at once; offering it tasks only burned their
+/// attempts until it was held back after three failures.
+TEST_F(DispatcherTest, ARobotInFaultModeIsOfferedNoTaskUntilItRecovers) {
+  dispatcher->onRobotState({"near", {3, 0, 0}, 0.9, 0, true});
+  robot("far", 40, 0.9, 0);
+  dispatcher->submit({transport("t1")}, 0);
+  auto out = dispatcher->tick(kSec / 10);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "far");
+  EXPECT_FALSE(dispatcher->robots().find("near")->idle());
+  dispatcher->submit({transport("t2")}, kSec / 5);
+  EXPECT_TRUE(dispatcher->tick(kSec / 4).assignments.empty());
+  robot("near", 3, 0.9, kSec / 2);  // out of fault mode
+  out = dispatcher->tick(kSec);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "near");
+}
+
 TEST_F(DispatcherTest, LostRobotTaskIsRequeuedAndReassigned) {
   robot("a", 1, 0.9, 0);
   robot("b", 30, 0.9, 0);

@@ -19,12 +19,14 @@ struct RobotInfo {
   double battery = 1.0;         ///< state of charge in [0, 1]
   std::int64_t lastSeenNs = 0;  ///< stamp of the newest state received
   bool lost = false;            ///< lease expired (or liveliness lost) and no state since
+  bool fault = false;           ///< its newest state says it is in fault mode
   std::string taskId;           ///< task the manager assigned it; empty when idle
 
-  [[nodiscard]] bool idle() const { return !lost && taskId.empty(); }
+  /// Can take a task: alive, not in fault mode (it would fail the task at once) and free.
+  [[nodiscard]] bool idle() const { return !lost && !fault && taskId.empty(); }
 };
 
-/// `{"id", "x", "y", "theta", "battery", "last_seen_ns", "lost", "task"}` for `GET /v1/robots`.
+/// `{"id", "x", "y", "theta", "battery", "last_seen_ns", "lost", "fault", "task"}` for `GET /v1/robots`.
 nlohmann::json toJson(const RobotInfo& r);
 
 /// One `RobotState` sample, reduced to what allocation needs.
@@ -33,6 +35,7 @@ struct RobotObservation {
   Pose2 pose;
   double battery = 1.0;
   std::int64_t stampNs = 0;
+  bool fault = false;
 };
 
 /// Lease after which a silent robot is lost: `missed` state periods at `rateHz`.
