@@ -998,7 +998,7 @@ const Agent::Other* Agent::stationOccupant() const {
 }
 
 void Agent::maybeReturnHome(std::int64_t nowNs) {
-  if (tasks_.hasOrder() || tasks_.phase() != Phase::Idle || p_.returnHomeS < 0.0) {
+  if (tasks_.hasOrder() || tasks_.paused() || tasks_.phase() != Phase::Idle || p_.returnHomeS < 0.0) {
     return;
   }
   if (idleSinceNs_ < 0) {
@@ -1043,6 +1043,7 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   out.state.battery = static_cast<float>(battery_);
   out.state.task_id = tasks_.task();
   out.state.radius = static_cast<float>(p_.radius);
+  out.state.paused = tasks_.paused();
 
   // Predicted discs: the current command held over the horizon, the EKF's covariance grown along it.
   out.discs.source_id = p_.id;
