@@ -14,6 +14,8 @@ let closeStream = null;
 let lastDrawVersion = -1;
 let lastDrawAt = 0;
 let animatingUntil = 0;
+let glideMs = 300; // how long a robot takes to reach its new pose: the time between updates
+let lastRobotsAt = 0;
 
 window.fleetDashboard = {
   model,
@@ -36,6 +38,10 @@ function onMessage(name, data) {
     model.snapshot(data, now);
     model.log(`connected: ${model.robots.size} robots, ${model.openTasks().length} open tasks`);
   } else if (name === 'robots') {
+    if (lastRobotsAt) {
+      glideMs = 0.8 * glideMs + 0.2 * Math.min(1000, Math.max(50, now - lastRobotsAt));
+    }
+    lastRobotsAt = now;
     for (const r of data.robots || []) {
       const old = model.robots.get(r.id);
       r.from = old ? drawnPose(old, now) : r.pose;
@@ -45,18 +51,18 @@ function onMessage(name, data) {
     if (data.fleet_manager) {
       model.managerOnline = data.fleet_manager !== 'unreachable';
     }
-    animatingUntil = now + 300;
+    animatingUntil = now + glideMs;
   } else if (name === 'task') {
     model.task(data);
   }
 }
 
-/** Robots glide to each new pose over 300 ms instead of jumping at the update rate. */
+/** Robots glide to each new pose until the next update is due instead of jumping at the update rate. */
 function drawnPose(r, now) {
   if (!r.from || !r.movedAt) {
     return r.pose;
   }
-  const f = Math.min(1, (now - r.movedAt) / 300);
+  const f = Math.min(1, (now - r.movedAt) / glideMs);
   let dt = r.pose.theta - r.from.theta;
   dt = Math.atan2(Math.sin(dt), Math.cos(dt));
   return {

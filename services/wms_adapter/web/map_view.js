@@ -21,7 +21,7 @@ export class MapView {
     this.site = null;
     this.background = null;
     this.selected = '';
-    this.frameTimes = new Float64Array(600); // rAF timestamps, a ring (for the frame-rate figure)
+    this.frameTimes = new Float64Array(4096); // rAF timestamps, a ring (for the frame-rate figure)
     this.frames = 0;
     new ResizeObserver(() => this.resize()).observe(canvas);
     this.resize();
