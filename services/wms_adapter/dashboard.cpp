@@ -77,6 +77,25 @@ json robotJson(const msg::RobotState& r) {
           {"stamp_ns", r.stamp_ns}};
 }
 
+json riskJson(const msg::RiskMap& m) {
+  if (m.runs.size() > 500'000) {
+    return nullptr;
+  }
+  std::vector<std::uint32_t> runs;
+  runs.reserve(2 * m.runs.size());
+  for (const auto& r : m.runs) {
+    runs.push_back(r.level);
+    runs.push_back(r.count);
+  }
+  return {{"stamp_ns", m.stamp_ns},
+          {"origin", {m.origin_x, m.origin_y}},
+          {"resolution", m.resolution},
+          {"width", m.width},
+          {"height", m.height},
+          {"levels", m.levels},
+          {"runs", runs}};
+}
+
 json sitePictureOf(const std::string& path) {
   auto loaded = service::loadSiteStations(path);
   if (!loaded) {
@@ -340,6 +359,8 @@ void Dashboard::stream(httplib::Response& res) {
     bool sentSnapshot = false;
     std::uint64_t events = 0;
     std::unordered_map<std::string, std::int64_t> sent;  // robot -> stamp sent last
+    std::uint64_t risk = 0;                              // risk maps sent: the view's count
+    std::chrono::steady_clock::time_point riskSentAt;
   };
   auto cur = std::make_shared<Cursor>();
   cur->events = d_.view.eventCursor();
@@ -358,6 +379,18 @@ void Dashboard::stream(httplib::Response& res) {
       }
       return items;
     };
+    // The risk map at most once a second: it is the largest message and changes least visibly.
+    auto riskEvent = [&](bool force) -> std::string {
+      const auto [count, map] = d_.view.risk();
+      const auto now = std::chrono::steady_clock::now();
+      if (!map || count == cur->risk || (!force && now - cur->riskSentAt < std::chrono::seconds(1))) {
+        return {};
+      }
+      cur->risk = count;
+      cur->riskSentAt = now;
+      const json j = riskJson(*map);
+      return j.is_null() ? std::string() : "event: risk\ndata: " + j.dump() + "\n\n";
+    };
     if (!cur->sentSnapshot) {
       cur->sentSnapshot = true;
       json tasks = json::array();
@@ -373,7 +406,7 @@ void Dashboard::stream(httplib::Response& res) {
                    {"tasks", tasks},
                    {"fleet_manager", d_.gateway.managerOnline() ? "online" : "unreachable"}}
                   .dump(-1, ' ', false, json::error_handler_t::replace) +
-              "\n\n";
+              "\n\n" + riskEvent(true);
       return sink.write(chunk.data(), chunk.size());
     }
     std::vector<msg::TaskEvent> evs;
@@ -393,6 +426,7 @@ void Dashboard::stream(httplib::Response& res) {
               .dump(-1, ' ', false, json::error_handler_t::replace) +
           "\n\n";
     }
+    chunk += riskEvent(false);
     if (chunk.empty()) {
       chunk = ": keep-alive\n\n";
     }

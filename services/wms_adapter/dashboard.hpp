@@ -22,6 +22,10 @@ namespace fleet::wms {
 /// A robot as the API shows it (GET /v1/robots, /v1/robots/{id}, the stream).
 nlohmann::json robotJson(const msg::RobotState& r);
 
+/// A risk map for the page: grid, K and the level runs flattened ([level, count, level, count, ...],
+/// row-major from the origin); null for a map too large to send (over 500,000 runs).
+nlohmann::json riskJson(const msg::RiskMap& m);
+
 /// What the page draws of the site: its map (rows of '#' and '.', top row first), stations and
 /// the robots' home parking places (from a scenario), as GET /v1/site returns it.
 nlohmann::json sitePictureOf(const std::string& path);

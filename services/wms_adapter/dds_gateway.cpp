@@ -5,10 +5,11 @@
 namespace fleet::wms {
 
 DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
-    : view_(view), tasks_(p), acks_(p), events_(p), robots_(p), ws_(p) {
+    : view_(view), tasks_(p), acks_(p), events_(p), robots_(p), risk_(p), ws_(p) {
   ws_.attach(acks_);
   ws_.attach(events_);
   ws_.attach(robots_);
+  ws_.attach(risk_);
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -48,6 +49,10 @@ void DdsGateway::loop() {
       if (validation::admit(r, view_.rejections())) {
         view_.onRobot(r);
       }
+    }
+    auto maps = risk_.take();
+    if (!maps.empty() && validation::admit(maps.back(), view_.rejections())) {
+      view_.onRisk(std::move(maps.back()));  // only the newest matters
     }
   }
 }

@@ -30,6 +30,7 @@ class DdsGateway final : public TaskGateway {
   transport::Reader<msg::TaskAck> acks_;
   transport::Reader<msg::TaskEvent> events_;
   transport::Reader<msg::RobotState> robots_;
+  transport::Reader<msg::RiskMap> risk_;  // for the dashboard's iso-level layer
   transport::WaitSet ws_;
   std::mutex writeMutex_;
   std::mutex m_;

@@ -77,7 +77,7 @@ export class Api {
     const open = () => {
       es = new EventSource('/v1/stream');
       es.addEventListener('open', () => handlers.state('live', 'ok'));
-      for (const name of ['snapshot', 'robots', 'task']) {
+      for (const name of ['snapshot', 'robots', 'task', 'risk']) {
         es.addEventListener(name, (ev) => {
           let data;
           try {

@@ -54,6 +54,8 @@ function onMessage(name, data) {
     animatingUntil = now + glideMs;
   } else if (name === 'task') {
     model.task(data);
+  } else if (name === 'risk') {
+    model.setRisk(data);
   }
 }
 
@@ -77,7 +79,8 @@ function frame(t) {
   if (model.version !== lastDrawVersion || now < animatingUntil || now - lastDrawAt > 1000) {
     lastDrawVersion = model.version;
     lastDrawAt = now;
-    view.draw({ robots: new Map([...model.robots].map(([id, r]) => [id, { ...r, pose: drawnPose(r, now) }])) }, t);
+    const robots = new Map([...model.robots].map(([id, r]) => [id, { ...r, pose: drawnPose(r, now) }]));
+    view.draw({ robots, risk: model.risk }, t);
     panels.update(now);
   }
   requestAnimationFrame(frame);
@@ -157,6 +160,7 @@ async function start() {
     },
     robots: (d) => onMessage('robots', d),
     task: (d) => onMessage('task', d),
+    risk: (d) => onMessage('risk', d),
     state: (text, level) => {
       setStatus(text, level);
       if (level !== 'ok') {
@@ -196,6 +200,9 @@ for (const [mode, colour] of Object.entries(MODE_COLOURS)) {
   span.append(dot, mode);
   legend.append(span);
 }
+const riskKey = document.createElement('span');
+riskKey.textContent = '· risk iso-levels: yellow (low) to red (high)';
+legend.append(riskKey);
 
 requestAnimationFrame(frame);
 start();

@@ -14,6 +14,7 @@ export class FleetModel {
     this.latestStampNs = 0;
     this.firstStampNs = 0;
     this.managerOnline = true;
+    this.risk = null; // the risk map's latest iso-level grid (GET /v1/stream `risk`)
     this.version = 0; // grows with every change, so views redraw only when needed
   }
 
@@ -26,6 +27,11 @@ export class FleetModel {
       this.stamp(t.stamp_ns);
     }
     this.managerOnline = data.fleet_manager !== 'unreachable';
+    this.version++;
+  }
+
+  setRisk(risk) {
+    this.risk = risk;
     this.version++;
   }
 

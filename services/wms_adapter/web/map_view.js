@@ -21,6 +21,8 @@ export class MapView {
     this.site = null;
     this.background = null;
     this.selected = '';
+    this.riskLayer = null; // the risk map's iso-levels as an image, one pixel per cell
+    this.riskOf = null;
     this.frameTimes = new Float64Array(4096); // rAF timestamps, a ring (for the frame-rate figure)
     this.frames = 0;
     new ResizeObserver(() => this.resize()).observe(canvas);
@@ -130,6 +132,9 @@ export class MapView {
     }
     const g = this.ctx;
     g.drawImage(this.background, 0, 0);
+    if (model.risk) {
+      this.drawRisk(model.risk);
+    }
     const wall = Date.now();
     const labels = this.scale > 14 * this.dpr;
     g.font = `${10 * this.dpr}px system-ui, sans-serif`;
@@ -173,6 +178,43 @@ export class MapView {
         g.fillText(r.id, px + rad + 2, py + rad + 8 * this.dpr);
       }
     }
+  }
+
+  /** Iso-levels from white (level 1) to red (level K), translucent; level 0 (no risk) is clear. */
+  drawRisk(risk) {
+    if (this.riskOf !== risk) {
+      this.riskOf = risk;
+      const c = document.createElement('canvas');
+      c.width = risk.width;
+      c.height = risk.height;
+      const img = c.getContext('2d').createImageData(risk.width, risk.height);
+      const k = Math.max(1, risk.levels);
+      let cell = 0;
+      for (let i = 0; i + 1 < risk.runs.length; i += 2) {
+        const level = risk.runs[i];
+        const end = Math.min(cell + risk.runs[i + 1], risk.width * risk.height);
+        for (; cell < end; cell++) {
+          if (level > 0) {
+            // Row-major from the origin (y up); the image's rows go down.
+            const x = cell % risk.width;
+            const y = risk.height - 1 - Math.floor(cell / risk.width);
+            const o = 4 * (y * risk.width + x);
+            const f = level / k;
+            img.data[o] = 255;
+            img.data[o + 1] = Math.round(200 * (1 - f));
+            img.data[o + 2] = 0;
+            img.data[o + 3] = Math.round(60 + 140 * f);
+          }
+        }
+      }
+      c.getContext('2d').putImageData(img, 0, 0);
+      this.riskLayer = c;
+    }
+    const [x0, y1] = this.toCanvas(risk.origin[0], risk.origin[1] + risk.height * risk.resolution);
+    const g = this.ctx;
+    g.imageSmoothingEnabled = false;
+    g.drawImage(this.riskLayer, x0, y1, risk.width * risk.resolution * this.scale, risk.height * risk.resolution * this.scale);
+    g.imageSmoothingEnabled = true;
   }
 
   /** Frames per second over the last `windowMs` of frame timestamps. */

@@ -215,10 +215,18 @@ TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
     view_.onRobot(robot("r2", 8.0, 2.0, 2));
     view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1});
+    msg::RiskMap m;
+    m.width = 4;
+    m.height = 2;
+    m.resolution = 0.5;
+    m.levels = 3;
+    m.runs = {{0, 5}, {3, 2}, {1, 1}};
+    view_.onRisk(m);
   });
   auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
     got.append(data, n);
-    return got.find("event: robots") == std::string::npos || got.find("event: task") == std::string::npos;
+    return got.find("event: robots") == std::string::npos || got.find("event: task") == std::string::npos ||
+           got.find("event: risk") == std::string::npos;
   });
   feeder.join();
   ASSERT_THAT(got, HasSubstr("event: snapshot"));
@@ -233,4 +241,9 @@ TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
   EXPECT_EQ(u["robots"][0]["id"], "r2");
   EXPECT_DOUBLE_EQ(u["robots"][0]["pose"]["x"].get<double>(), 8.0);
   EXPECT_THAT(got, HasSubstr(R"("id":"t<1>")"));
+  const auto risk = got.find("event: risk\ndata: ");
+  ASSERT_NE(risk, std::string::npos);
+  const json rj = json::parse(got.substr(risk + 18, got.find("\n\n", risk) - risk - 18));
+  EXPECT_EQ(rj["levels"], 3);
+  EXPECT_EQ(rj["runs"], json::array({0, 5, 3, 2, 1, 1})) << "levels and counts, flattened";
 }
