@@ -998,7 +998,7 @@ const Agent::Other* Agent::stationOccupant() const {
 }
 
 void Agent::maybeReturnHome(std::int64_t nowNs) {
-  if (tasks_.hasOrder() || tasks_.paused() || tasks_.phase() != Phase::Idle || p_.returnHomeS < 0.0) {
+  if (tasks_.hasOrder() || tasks_.phase() != Phase::Idle || p_.returnHomeS < 0.0) {
     return;
   }
   if (idleSinceNs_ < 0) {
