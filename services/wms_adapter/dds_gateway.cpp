@@ -1,15 +1,22 @@
 #include "dds_gateway.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include "fleet/validation/sample_checks.hpp"
 
 namespace fleet::wms {
 
 DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
-    : view_(view), tasks_(p), acks_(p), events_(p), robots_(p), risk_(p), ws_(p) {
+    : view_(view), tasks_(p), acks_(p), events_(p), robots_(p), ws_(p) {
   ws_.attach(acks_);
   ws_.attach(events_);
   ws_.attach(robots_);
-  ws_.attach(risk_);
+  try {
+    risk_ = std::make_unique<transport::Reader<msg::RiskMap>>(p);
+    ws_.attach(*risk_);
+  } catch (const std::exception& e) {
+    spdlog::warn("wms adapter: no risk map for the dashboard ({})", e.what());
+  }
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -50,7 +57,7 @@ void DdsGateway::loop() {
         view_.onRobot(r);
       }
     }
-    auto maps = risk_.take();
+    auto maps = risk_ ? risk_->take() : std::vector<msg::RiskMap>{};
     if (!maps.empty() && validation::admit(maps.back(), view_.rejections())) {
       view_.onRisk(std::move(maps.back()));  // only the newest matters
     }
