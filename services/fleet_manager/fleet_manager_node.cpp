@@ -234,6 +234,7 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
     a.robot_id = robot;
     a.revision = nextRevision(robot, nowNs);
     a.stamp_ns = nowNs;
+    a.paused = dispatcher_->robotHeld(robot);  // a held robot stands still without an order too
     out.assignments.push_back(a);
   }
 }
@@ -288,6 +289,20 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
     if (req.control == msg::TaskControl::Query) {
       flush();  // a query must see the tasks submitted before it
       out.acks.push_back(query(req, nowNs));
+      continue;
+    }
+    if (req.control == msg::TaskControl::HoldRobot || req.control == msg::TaskControl::ReleaseRobot) {
+      flush();
+      const bool hold = req.control == msg::TaskControl::HoldRobot;
+      auto r = dispatcher_->setRobotHeld(req.robot, hold, nowNs);
+      if (r) {
+        const RobotInfo* info = dispatcher_->robots().find(req.robot);
+        out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Queued,
+                               info != nullptr ? info->taskId : std::string(), nowNs));
+        publish(std::move(*r), nowNs, out);
+      } else {
+        out.acks.push_back(refused(req, r.error(), nowNs));
+      }
       continue;
     }
     if (req.control != msg::TaskControl::None) {

@@ -806,6 +806,7 @@ int Run::run() {
     say(gSignal ? "interrupted" : "the WMS adapter did not report a healthy fleet manager within 30 s");
     return gSignal ? 130 : 1;
   }
+  say("live dashboard: http://127.0.0.1:" + std::to_string(port) + "/dashboard/ (open it in a browser)");
   // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
   // only when all have registered (a traffic manager it does not wait for falls behind the robots).
   const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0) +

@@ -1043,6 +1043,7 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   out.state.battery = static_cast<float>(battery_);
   out.state.task_id = tasks_.task();
   out.state.radius = static_cast<float>(p_.radius);
+  out.state.paused = tasks_.paused();
 
   // Predicted discs: the current command held over the horizon, the EKF's covariance grown along it.
   out.discs.source_id = p_.id;

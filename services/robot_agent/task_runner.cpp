@@ -11,14 +11,14 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
     return OrderChange::kSame;
   }
   revision_ = o.revision;
-  homing_ = false;  // an order (or a cancel) replaces the trip home
+  homing_ = false;     // an order (or a cancel) replaces the trip home
+  paused_ = o.paused;  // an empty paused order holds the idle robot where it is
   if (o.task.empty()) {
     task_.clear();
     goals_.clear();
     phase_ = Phase::Idle;
     return OrderChange::kCancel;
   }
-  paused_ = o.paused;
   if (o.task == task_ && o.goals == goals_) {
     return OrderChange::kPause;
   }

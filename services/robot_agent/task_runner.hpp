@@ -107,7 +107,8 @@ class TaskRunner {
   [[nodiscard]] bool homing() const { return homing_; }
   /// Has somewhere to go: a task or the trip home.
   [[nodiscard]] bool hasOrder() const { return busy() || homing_; }
-  [[nodiscard]] bool paused() const { return paused_ && busy(); }
+  /// Held by the operator: with a task (paused), or idle (a robot hold: no trip home either).
+  [[nodiscard]] bool paused() const { return paused_; }
   [[nodiscard]] const std::string& task() const { return task_; }
   [[nodiscard]] std::uint32_t revision() const { return revision_; }
   [[nodiscard]] std::size_t goalIndex() const { return goal_; }

@@ -1,5 +1,7 @@
 #include "dds_gateway.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include "fleet/validation/sample_checks.hpp"
 
 namespace fleet::wms {
@@ -9,6 +11,12 @@ DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
   ws_.attach(acks_);
   ws_.attach(events_);
   ws_.attach(robots_);
+  try {
+    risk_ = std::make_unique<transport::Reader<msg::RiskMap>>(p);
+    ws_.attach(*risk_);
+  } catch (const std::exception& e) {
+    spdlog::warn("wms adapter: no risk map for the dashboard ({})", e.what());
+  }
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -48,6 +56,10 @@ void DdsGateway::loop() {
       if (validation::admit(r, view_.rejections())) {
         view_.onRobot(r);
       }
+    }
+    auto maps = risk_ ? risk_->take() : std::vector<msg::RiskMap>{};
+    if (!maps.empty() && validation::admit(maps.back(), view_.rejections())) {
+      view_.onRisk(std::move(maps.back()));  // only the newest matters
     }
   }
 }

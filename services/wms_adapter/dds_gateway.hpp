@@ -1,6 +1,7 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <thread>
 #include <unordered_map>
 
@@ -30,6 +31,9 @@ class DdsGateway final : public TaskGateway {
   transport::Reader<msg::TaskAck> acks_;
   transport::Reader<msg::TaskEvent> events_;
   transport::Reader<msg::RobotState> robots_;
+  // For the dashboard's iso-level layer; none where the DDS permissions (made before the dashboard)
+  // do not let the adapter read RiskMap: the adapter runs on without the layer.
+  std::unique_ptr<transport::Reader<msg::RiskMap>> risk_;
   transport::WaitSet ws_;
   std::mutex writeMutex_;
   std::mutex m_;

@@ -92,6 +92,18 @@ void FleetView::onRobot(const msg::RobotState& s) {
   robots_[s.robot_id] = s;
 }
 
+void FleetView::onRisk(msg::RiskMap m) {
+  auto shared = std::make_shared<const msg::RiskMap>(std::move(m));
+  std::lock_guard lock(m_);
+  risk_ = std::move(shared);
+  ++riskCount_;
+}
+
+std::pair<std::uint64_t, std::shared_ptr<const msg::RiskMap>> FleetView::risk() const {
+  std::lock_guard lock(m_);
+  return {riskCount_, risk_};
+}
+
 std::optional<TaskView> FleetView::task(const std::string& id) const {
   std::lock_guard lock(m_);
   auto it = tasks_.find(id);

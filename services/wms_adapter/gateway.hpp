@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -57,6 +58,8 @@ class FleetView {
   void onEvent(const msg::TaskEvent& e);
   void onAccepted(const std::string& id, const std::string& body, msg::TaskState state, std::int64_t nowNs);
   void onRobot(const msg::RobotState& s);
+  /// The risk map service's latest map (for the dashboard's iso-level layer).
+  void onRisk(msg::RiskMap m);
   /// A task as the manager's store has it (the answer to a query), for a task the view lacked.
   void onStored(const msg::TaskAck& a, std::int64_t nowNs);
   /// Samples refused (or repaired) on their way into the view, for /v1/metrics.
@@ -66,6 +69,8 @@ class FleetView {
   [[nodiscard]] std::optional<TaskView> task(const std::string& id) const;
   [[nodiscard]] std::vector<TaskView> tasks(std::optional<msg::TaskState> state, std::size_t limit) const;
   [[nodiscard]] std::vector<msg::RobotState> robots() const;
+  /// The latest risk map and a count that grows with every new one (0, nullptr: none yet).
+  [[nodiscard]] std::pair<std::uint64_t, std::shared_ptr<const msg::RiskMap>> risk() const;
   [[nodiscard]] std::map<std::string, std::int64_t> countByState() const;
 
   /// Events after `cursor` (a running count), waiting up to `timeout` for one to arrive. Returns the
@@ -81,6 +86,8 @@ class FleetView {
   std::map<std::string, TaskView> tasks_;
   std::deque<std::string> insertion_;
   std::map<std::string, msg::RobotState> robots_;
+  std::shared_ptr<const msg::RiskMap> risk_;
+  std::uint64_t riskCount_ = 0;
   std::deque<msg::TaskEvent> events_;
   std::uint64_t eventCount_ = 0;
   validation::Rejections rejections_;

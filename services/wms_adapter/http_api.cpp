@@ -162,19 +162,15 @@ void HttpApi::instrument(metrics::Registry& registry) {
 }
 
 void HttpApi::routes() {
+  dashboard_ = std::make_unique<Dashboard>(
+      server_, DashboardDeps{settings_.token, stations_, gateway_, view_, clock_,
+                             [this] { return nextRequestId(); }, settings_.ackTimeoutMs});
   server_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     ++counters_.requests;
     requestStart = std::chrono::steady_clock::now();
-    // Health tells nothing secret and a probe carries no token: it is never refused with 401.
-    if (!settings_.token.empty() && req.path != "/v1/health") {
-      const std::string expected = "Bearer " + settings_.token;
-      if (req.get_header_value("Authorization") != expected) {
-        res.set_header("WWW-Authenticate", "Bearer");
-        reply(res, 401, error("unauthorized", "missing or wrong bearer token"));
-        return httplib::Server::HandlerResponse::Handled;
-      }
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
+    // Bearer token or browser session; health and the page's static files need neither.
+    return dashboard_->admit(req, res) ? httplib::Server::HandlerResponse::Unhandled
+                                       : httplib::Server::HandlerResponse::Handled;
   });
   server_.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     if (registry_ != nullptr) {
@@ -280,13 +276,7 @@ void HttpApi::routes() {
   server_.Get("/v1/robots", [this](const httplib::Request&, httplib::Response& res) {
     json items = json::array();
     for (const auto& r : view_.robots()) {
-      items.push_back({{"id", r.robot_id},
-                       {"pose", {{"x", r.pose.x}, {"y", r.pose.y}, {"theta", r.pose.theta}}},
-                       {"v", r.v},
-                       {"mode", msg::toString(r.mode)},
-                       {"battery", r.battery},
-                       {"task", r.task_id},
-                       {"stamp_ns", r.stamp_ns}});
+      items.push_back(robotJson(r));
     }
     reply(res, 200, {{"robots", items}, {"count", items.size()}});
   });

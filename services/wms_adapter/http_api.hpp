@@ -8,6 +8,7 @@
 #include <atomic>
 #include <string>
 
+#include "dashboard.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/station_map.hpp"
@@ -53,6 +54,8 @@ class HttpApi {
   /// Counts responses by status code and times requests in `registry` (the ops port's), and
   /// writes one access-log line per request at info level. Call before serve().
   void instrument(metrics::Registry& registry);
+  /// The operator dashboard served with the API (dashboard.hpp).
+  [[nodiscard]] Dashboard& dashboard() { return *dashboard_; }
 
  private:
   void routes();
@@ -76,6 +79,7 @@ class HttpApi {
   std::atomic<std::uint64_t> requestCounter_{0};
   std::string instance_;
   ApiCounters counters_;
+  std::unique_ptr<Dashboard> dashboard_;
   metrics::Registry* registry_ = nullptr;
   metrics::Histogram* requestSeconds_ = nullptr;
 };

@@ -62,12 +62,14 @@ int main(int argc, char** argv) {
     WallClock clock;
     wms::HttpApi http(api, *stations, gateway, view, clock);
     http.instrument(ops.registry());
+    http.dashboard().setSite(wms::sitePictureOf(stationsPath));
     if (!http.bind()) {
       spdlog::critical("wms adapter: cannot listen on {}:{}", api.host, api.port);
       return service::kExitUsage;
     }
     spdlog::info("wms adapter: listening on http://{}:{} ({} stations, auth {})", api.host, http.port(),
                  stations->size(), api.token.empty() ? "off" : "bearer token");
+    spdlog::info("wms adapter: dashboard at http://{}:{}/dashboard/", api.host, http.port());
     std::thread server([&] { http.serve(); });
     auto& managerOnline = ops.registry().gauge("wms_adapter_fleet_manager_online",
                                                "1 when the fleet manager answers over DDS, else 0");

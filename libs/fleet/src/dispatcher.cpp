@@ -319,6 +319,25 @@ Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool p
   return out;
 }
 
+Expected<DispatchResult> Dispatcher::setRobotHeld(const std::string& robotId, bool held, std::int64_t nowNs) {
+  const RobotInfo* info = registry_.find(robotId);
+  if (info == nullptr) {
+    return unexpected(errc::kNotFound, "no robot with id \"" + robotId + "\"");
+  }
+  if (held) {
+    held_.insert(robotId);
+  } else {
+    held_.erase(robotId);
+  }
+  const auto it = info->taskId.empty() ? open_.end() : open_.find(info->taskId);
+  if (it != open_.end() && isActive(it->second.state)) {
+    return setPaused(it->first, held, nowNs);
+  }
+  DispatchResult out;
+  out.revoked.push_back(robotId);  // idle: an empty order, paused while held
+  return out;
+}
+
 void Dispatcher::completeCharged(std::int64_t nowNs, DispatchResult& out) {
   std::vector<TransitionRequest> steps;
   std::map<std::string, std::string, std::less<>> robotOf;  // task id -> robot
@@ -365,7 +384,7 @@ void Dispatcher::completeCharged(std::int64_t nowNs, DispatchResult& out) {
 void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
   const auto chargers = stations_.ofKind(StationKind::Charging);
   for (const auto& r : registry_.idleRobots()) {
-    if (r.battery >= cfg_.policy.batteryThreshold) {
+    if (r.battery >= cfg_.policy.batteryThreshold || robotHeld(r.id)) {
       continue;
     }
     const bool pending = std::any_of(open_.begin(), open_.end(), [&](const auto& kv) {
@@ -458,7 +477,7 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   auto idle = registry_.idleRobots();
   std::erase_if(idle, [&](const RobotInfo& r) {
     const auto it = failStreak_.find(r.id);
-    return it != failStreak_.end() && it->second.holdUntilNs > nowNs;
+    return robotHeld(r.id) || (it != failStreak_.end() && it->second.holdUntilNs > nowNs);
   });
   if (waiting.empty() || idle.empty()) {
     return;

@@ -56,6 +56,15 @@ std::vector<const Station*> StationMap::ofKind(StationKind k) const {
   return out;
 }
 
+std::vector<const Station*> StationMap::all() const {
+  std::vector<const Station*> out;
+  out.reserve(stations_.size());
+  for (const auto& kv : stations_) {
+    out.push_back(&kv.second);
+  }
+  return out;
+}
+
 Expected<StationMap> StationMap::fromJson(const nlohmann::json& doc) {
   std::vector<std::string> problems;
   const nlohmann::json* list = &doc;

@@ -104,7 +104,7 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.deadline_ns = in.deadline_ns;
   m.created_ns = in.created_ns;
   m.cancel = in.cancel;
-  m.control = getEnum(in.control, msg::TaskControl::Query);
+  m.control = getEnum(in.control, msg::TaskControl::ReleaseRobot);
   return m;
 }
 
@@ -196,6 +196,7 @@ void Traits<msg::RobotState>::toC(const msg::RobotState& in, C& out, Arena&) {
   out.battery = in.battery;
   putStr(out.task_id, in.task_id, "RobotState.task_id");
   out.radius = in.radius;
+  out.paused = in.paused;
 }
 msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   msg::RobotState m;
@@ -209,6 +210,7 @@ msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   m.battery = in.battery;
   m.task_id = getStr(in.task_id);
   m.radius = in.radius;
+  m.paused = in.paused;
   return m;
 }
 

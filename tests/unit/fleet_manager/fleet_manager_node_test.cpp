@@ -379,3 +379,60 @@ TEST_F(Node, QueryAnswersFromTheStore) {
   EXPECT_EQ(out.acks[1].result, msg::AckResult::NotFound);
   EXPECT_TRUE(out.events.empty()) << "a query changes nothing";
 }
+
+namespace {
+msg::Task robotControl(const std::string& robot, msg::TaskControl c) {
+  msg::Task t;
+  t.task_id = robot;
+  t.robot = robot;
+  t.request_id = "req-" + std::to_string(++gRequest);
+  t.control = c;
+  return t;
+}
+}  // namespace
+
+TEST_F(Node, AHeldRobotGetsNoTaskAndStandsStillUntilReleased) {
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 0);
+  node->onRequests(
+      {robotControl("r1", msg::TaskControl::HoldRobot), robotControl("r9", msg::TaskControl::HoldRobot)}, 0,
+      out);
+  ASSERT_EQ(out.acks.size(), 2u);
+  EXPECT_EQ(out.acks[0].result, msg::AckResult::Stored);
+  EXPECT_EQ(out.acks[1].result, msg::AckResult::NotFound) << "a robot never seen";
+  ASSERT_EQ(out.assignments.size(), 1u) << "the idle robot is told to hold where it is";
+  EXPECT_EQ(out.assignments[0].robot_id, "r1");
+  EXPECT_TRUE(out.assignments[0].task_id.empty());
+  EXPECT_TRUE(out.assignments[0].paused);
+  out = {};
+  node->onRequests({request("t1", transport("t1"))}, 1'000, out);
+  out = {};
+  node->tick(100'000'000, out);
+  EXPECT_TRUE(out.assignments.empty()) << "a held robot was given a task";
+  node->onRequests({robotControl("r1", msg::TaskControl::ReleaseRobot)}, 200'000'000, out);
+  node->tick(300'000'000, out);
+  ASSERT_FALSE(out.assignments.empty());
+  EXPECT_EQ(out.assignments.back().task_id, "t1");
+  EXPECT_FALSE(out.assignments.back().paused);
+}
+
+TEST_F(Node, HoldingABusyRobotPausesItsTaskAndReleasingResumesIt) {
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRequests({request("t1", transport("t1"))}, 0, out);
+  node->onRobotState({"r1", 0, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 0);
+  node->tick(100'000'000, out);
+  out = {};
+  node->onRequests({robotControl("r1", msg::TaskControl::HoldRobot)}, 200'000'000, out);
+  ASSERT_EQ(out.acks.size(), 1u);
+  EXPECT_EQ(out.acks[0].detail, "t1") << "the ack names the robot's task";
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task_id, "t1");
+  EXPECT_TRUE(out.assignments[0].paused);
+  out = {};
+  node->onRequests({robotControl("r1", msg::TaskControl::ReleaseRobot)}, 300'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task_id, "t1");
+  EXPECT_FALSE(out.assignments[0].paused);
+}

@@ -439,6 +439,34 @@ TEST(Agent, NewOrderPreemptsTheTripHome) {
   EXPECT_EQ(statuses.back().state, msg::TaskState::Done);
 }
 
+TEST(Agent, AHeldIdleRobotStandsStillInsteadOfDrivingHomeUntilReleased) {
+  auto grid = emptyGrid();
+  auto p = params();
+  p.returnHomeS = 0.5;
+  agent::Agent a(p, grid, grid);
+  World world;
+  a.onAssignment(transport());
+  int k = 0;
+  (void)run(a, world, k, 1500, [&] { return !a.busy() && k > 10; });
+  (void)run(a, world, k, 20, [] { return false; });
+  ASSERT_TRUE(a.homing()) << "idle away from home: on its way back";
+  msg::TaskAssignment hold;
+  hold.robot_id = p.id;
+  hold.revision = 20;
+  hold.paused = true;  // the manager's answer to TC_HOLD_ROBOT for an idle robot
+  a.onAssignment(hold);
+  const Vec2 heldAt = world.truth.position();
+  (void)run(a, world, k, 100, [] { return false; });  // 10 s, far beyond returnHomeS
+  EXPECT_FALSE(a.homing());
+  EXPECT_TRUE(a.paused());
+  EXPECT_LT(distance(world.truth.position(), heldAt), 0.05) << "a held robot drove on";
+  hold.revision = 21;
+  hold.paused = false;
+  a.onAssignment(hold);
+  (void)run(a, world, k, 1500, [&] { return distance(world.truth.position(), p.start.position()) < 0.2; });
+  EXPECT_LT(distance(world.truth.position(), p.start.position()), 0.2) << "released, it goes home";
+}
+
 TEST(Agent, PlansAroundARobotParkedOnItsWay) {
   auto grid = emptyGrid();
   agent::Agent a(params(), grid, grid);

@@ -98,6 +98,16 @@ TEST(TaskRunner, RepeatsPausesAndCancels) {
   EXPECT_FALSE(r.takeReport()) << "a cancel is the manager's own";
 }
 
+TEST(TaskRunner, AnEmptyPausedOrderHoldsTheIdleRobotAndReplacesTheTripHome) {
+  TaskRunner r;
+  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
+  EXPECT_EQ(r.accept(Order{"", 1, {}, true}), TaskRunner::OrderChange::kCancel);
+  EXPECT_TRUE(r.paused()) << "a robot held by the operator while idle";
+  EXPECT_FALSE(r.hasOrder()) << "the trip home is given up";
+  EXPECT_EQ(r.accept(Order{"", 2, {}, false}), TaskRunner::OrderChange::kCancel);
+  EXPECT_FALSE(r.paused());
+}
+
 TEST(TaskRunner, TheTripHomeIsNeverReportedAndAnOrderReplacesIt) {
   TaskRunner r;
   r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -61,8 +62,9 @@ struct AssignmentOrder {
 /// What a call changed; the service publishes it. Everything in it is already committed.
 struct DispatchResult {
   std::vector<AssignmentOrder> assignments;
-  /// Robots whose task was withdrawn (cancelled) or completed by the dispatcher (charged): publish
-  /// an empty assignment. A robot never appears both here and in `assignments` of one result.
+  /// Robots whose task was withdrawn (cancelled) or completed by the dispatcher (charged), or that
+  /// were held or released idle: publish an empty assignment (paused while the robot is held). A
+  /// robot never appears both here and in `assignments` of one result.
   std::vector<std::string> revoked;
   std::vector<TaskEvent> events;
   std::vector<Error> errors;  ///< problems that did not stop the call (a store error on one task)
@@ -117,6 +119,11 @@ class Dispatcher {
   /// re-sent to its robot with `paused` set, and the robot stands still with it until resumed.
   /// Errors as cancel (not_found, illegal_transition for a finished task).
   Expected<DispatchResult> setPaused(const std::string& taskId, bool paused, std::int64_t nowNs);
+  /// Operator hold of a robot (in memory): its active task is paused (setPaused) and it gets no new
+  /// task until released, which resumes that task; idle, it is sent an empty paused order (it
+  /// stands where it is). not_found for a robot never seen.
+  Expected<DispatchResult> setRobotHeld(const std::string& robotId, bool held, std::int64_t nowNs);
+  [[nodiscard]] bool robotHeld(std::string_view robotId) const { return held_.count(robotId) > 0; }
 
   /// Periodic work: expire leases (requeue the lost robots' tasks), complete the charge tasks whose
   /// robot is charged (releasing it), send low robots to charge, and assign waiting tasks to idle
@@ -160,6 +167,7 @@ class Dispatcher {
   /// Task id -> the robot that failed it last: the retry goes to another idle robot if there is
   /// one (a robot boxed in at its parking place failed the same task three times in a row).
   std::map<std::string, std::string, std::less<>> failedBy_;
+  std::set<std::string, std::less<>> held_;  // robots held by the operator
 };
 
 }  // namespace fleet

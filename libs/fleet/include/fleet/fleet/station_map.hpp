@@ -33,6 +33,8 @@ class StationMap {
   Expected<void> add(Station s);
   [[nodiscard]] const Station* find(std::string_view name) const;
   [[nodiscard]] std::vector<const Station*> ofKind(StationKind k) const;
+  /// Every station, by name.
+  [[nodiscard]] std::vector<const Station*> all() const;
   [[nodiscard]] std::size_t size() const { return stations_.size(); }
   [[nodiscard]] bool empty() const { return stations_.empty(); }
 

@@ -13,7 +13,7 @@
 namespace fleet::msg {
 
 enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
-enum class TaskControl : std::uint8_t { None, Pause, Resume, Query };
+enum class TaskControl : std::uint8_t { None, Pause, Resume, Query, HoldRobot, ReleaseRobot };
 enum class TaskState : std::uint8_t {
   Queued,
   Assigned,
@@ -111,6 +111,7 @@ struct RobotState {
   float battery = 1;
   std::string task_id;
   float radius = 0;
+  bool paused = false;  ///< held by the operator
   bool operator==(const RobotState&) const = default;
 };
 

@@ -1,0 +1,106 @@
+#include "browser_session.hpp"
+
+#include <openssl/evp.h>
+#include <openssl/hmac.h>
+#include <openssl/rand.h>
+
+#include <array>
+#include <charconv>
+#include <stdexcept>
+
+namespace fleet::wms {
+namespace {
+
+std::string hex(const unsigned char* p, std::size_t n) {
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string s;
+  s.reserve(2 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s += kDigits[p[i] >> 4];
+    s += kDigits[p[i] & 15];
+  }
+  return s;
+}
+
+}  // namespace
+
+BrowserSessions::BrowserSessions(std::string token, std::int64_t lifetimeS)
+    : token_(std::move(token)), lifetimeS_(lifetimeS) {}
+
+std::string BrowserSessions::mac(std::string_view what) const {
+  std::array<unsigned char, EVP_MAX_MD_SIZE> out{};
+  unsigned int n = 0;
+  if (HMAC(EVP_sha256(), token_.data(), static_cast<int>(token_.size()),
+           reinterpret_cast<const unsigned char*>(what.data()), what.size(), out.data(), &n) == nullptr) {
+    throw std::runtime_error("HMAC-SHA256 failed");
+  }
+  return hex(out.data(), n);
+}
+
+std::string BrowserSessions::issue(std::int64_t nowS) const {
+  std::array<unsigned char, 16> nonce{};
+  if (RAND_bytes(nonce.data(), static_cast<int>(nonce.size())) != 1) {
+    throw std::runtime_error("no random bytes for a session");
+  }
+  const std::string body = std::to_string(nowS + lifetimeS_) + "." + hex(nonce.data(), nonce.size());
+  return body + "." + mac("session." + body);
+}
+
+std::optional<std::string> BrowserSessions::csrfOf(std::string_view cookie, std::int64_t nowS) const {
+  if (token_.empty() || cookie.size() > 256) {
+    return std::nullopt;
+  }
+  const auto dot1 = cookie.find('.');
+  const auto dot2 = dot1 == std::string_view::npos ? dot1 : cookie.find('.', dot1 + 1);
+  if (dot2 == std::string_view::npos) {
+    return std::nullopt;
+  }
+  const std::string_view body = cookie.substr(0, dot2);
+  if (!sameSecret(cookie.substr(dot2 + 1), mac("session." + std::string(body)))) {
+    return std::nullopt;
+  }
+  std::int64_t expires = 0;
+  const auto [end, ec] = std::from_chars(cookie.data(), cookie.data() + dot1, expires);
+  if (ec != std::errc{} || end != cookie.data() + dot1 || expires < nowS) {
+    return std::nullopt;
+  }
+  return mac("csrf." + std::string(body));
+}
+
+std::string BrowserSessions::setCookie(const std::string& value) const {
+  return std::string(kSessionCookie) + "=" + value +
+         "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" + std::to_string(lifetimeS_);
+}
+
+std::string BrowserSessions::clearCookie() {
+  return std::string(kSessionCookie) + "=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0";
+}
+
+std::string cookieValue(std::string_view header, std::string_view name) {
+  while (!header.empty()) {
+    const auto semi = header.find(';');
+    std::string_view part = header.substr(0, semi);
+    header = semi == std::string_view::npos ? std::string_view{} : header.substr(semi + 1);
+    while (!part.empty() && part.front() == ' ') {
+      part.remove_prefix(1);
+    }
+    const auto eq = part.find('=');
+    if (eq != std::string_view::npos && part.substr(0, eq) == name) {
+      return std::string(part.substr(eq + 1));
+    }
+  }
+  return {};
+}
+
+bool sameSecret(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) {
+    return false;
+  }
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  }
+  return diff == 0;
+}
+
+}  // namespace fleet::wms

@@ -1,0 +1,437 @@
+#include "dashboard.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <unordered_map>
+
+#include "fleet/core/ids.hpp"
+#include "fleet/fleet/task.hpp"
+#include "fleet/service/site_stations.hpp"
+#include "fleet/service/task_wire.hpp"
+#include "request_auth.hpp"
+#include "web_files.hpp"
+
+namespace fleet::wms {
+namespace {
+
+using nlohmann::json;
+
+void send(httplib::Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+}
+
+json problem(const std::string& code, const std::string& message) {
+  return {{"error", code}, {"message", message}};
+}
+
+json invalidField(const std::string& path, const std::string& reason) {
+  return {{"error", "invalid"}, {"fields", json::array({{{"path", path}, {"reason", reason}}})}};
+}
+
+json kindsOf(const Station& s) {
+  json k = json::array();
+  for (auto kind : {StationKind::Pickup, StationKind::Dropoff, StationKind::Charging, StationKind::Parking}) {
+    if (s.has(kind)) {
+      k.push_back(std::string(toString(kind)));
+    }
+  }
+  return k;
+}
+
+/// The station of `kind` nearest to `p` in a straight line, or nothing.
+const Station* nearest(const StationMap& stations, StationKind kind, Vec2 p) {
+  const Station* best = nullptr;
+  double bestD = std::numeric_limits<double>::infinity();
+  for (const Station* s : stations.ofKind(kind)) {
+    const double d = distance(s->pose.position(), p);
+    if (d < bestD) {
+      bestD = d;
+      best = s;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+json robotJson(const msg::RobotState& r) {
+  // One number for how well the pose is known: the position's standard deviation (largest axis
+  // bound by the trace). A huge one means the robot does not know where it is.
+  const double var = r.covariance[0] + r.covariance[4];
+  return {{"id", r.robot_id},
+          {"pose", {{"x", r.pose.x}, {"y", r.pose.y}, {"theta", r.pose.theta}}},
+          {"heading_deg", r.pose.theta * 180.0 / M_PI},
+          {"v", r.v},
+          {"w", r.w},
+          {"mode", msg::toString(r.mode)},
+          {"fault", r.mode == msg::RobotMode::Fault},
+          {"paused", r.paused},
+          {"battery", r.battery},
+          {"task", r.task_id},
+          {"radius", r.radius},
+          {"position_sigma", std::isfinite(var) && var >= 0 ? std::sqrt(var) : -1.0},
+          {"stamp_ns", r.stamp_ns}};
+}
+
+json riskJson(const msg::RiskMap& m) {
+  if (m.runs.size() > 500'000) {
+    return nullptr;
+  }
+  std::vector<std::uint32_t> runs;
+  runs.reserve(2 * m.runs.size());
+  for (const auto& r : m.runs) {
+    runs.push_back(r.level);
+    runs.push_back(r.count);
+  }
+  return {{"stamp_ns", m.stamp_ns},
+          {"origin", {m.origin_x, m.origin_y}},
+          {"resolution", m.resolution},
+          {"width", m.width},
+          {"height", m.height},
+          {"levels", m.levels},
+          {"runs", runs}};
+}
+
+json sitePictureOf(const std::string& path) {
+  auto loaded = service::loadSiteStations(path);
+  if (!loaded) {
+    return {{"error", loaded.error().message}};
+  }
+  json out = {{"name", loaded->site ? loaded->site->name : path}};
+  json stations = json::array();
+  for (const Station* s : loaded->stations.all()) {
+    stations.push_back({{"name", s->name},
+                        {"x", s->pose.x},
+                        {"y", s->pose.y},
+                        {"theta", s->pose.theta},
+                        {"kinds", kindsOf(*s)}});
+  }
+  out["stations"] = stations;
+  if (loaded->site) {
+    const auto& g = loaded->site->map;
+    json rows = json::array();
+    for (int y = g.height() - 1; y >= 0; --y) {
+      std::string row(static_cast<std::size_t>(g.width()), '.');
+      for (int x = 0; x < g.width(); ++x) {
+        if (g.blocked({x, y})) {
+          row[static_cast<std::size_t>(x)] = '#';
+        }
+      }
+      rows.push_back(std::move(row));
+    }
+    out["map"] = {{"width", g.width()},
+                  {"height", g.height()},
+                  {"resolution", g.resolution()},
+                  {"origin", {g.origin().x, g.origin().y}},
+                  {"rows", rows}};
+  }
+  // A scenario names each robot's parking place: where "send home" sends it.
+  std::ifstream in(path);
+  const json doc = json::parse(in, nullptr, false);
+  json homes = json::object();
+  if (doc.is_object() && doc.contains("robots") && doc["robots"].is_array()) {
+    for (const auto& r : doc["robots"]) {
+      if (r.is_object() && r.value("id", json()).is_string() &&
+          r.value("start_station", json()).is_string()) {
+        homes[r["id"].get<std::string>()] = r["start_station"];
+      }
+    }
+  }
+  out["homes"] = homes;
+  return out;
+}
+
+Dashboard::Dashboard(httplib::Server& server, DashboardDeps deps) : d_(std::move(deps)), sessions_(d_.token) {
+  routes(server);
+}
+
+std::int64_t Dashboard::nowS() const {
+  return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+bool Dashboard::admit(const httplib::Request& req, httplib::Response& res) const {
+  return admitRequest(d_.token, sessions_, req, res, nowS());
+}
+
+void Dashboard::setSite(json site) {
+  std::lock_guard lock(siteMutex_);
+  homes_.clear();
+  if (site.contains("homes")) {
+    for (const auto& [robot, station] : site["homes"].items()) {
+      homes_[robot] = station.get<std::string>();
+    }
+  }
+  site_ = std::move(site);
+}
+
+void Dashboard::routes(httplib::Server& server) {
+  server.Get("/", [](const httplib::Request&, httplib::Response& res) { res.set_redirect("/dashboard/"); });
+  server.Get(R"(/dashboard/(.*))", [](const httplib::Request& req, httplib::Response& res) {
+    std::string name = req.matches[1];
+    if (name.empty()) {
+      name = "index.html";
+    }
+    const WebFile* f = webFile(name);
+    if (f == nullptr) {
+      send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
+      return;
+    }
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    res.set_header("Content-Security-Policy",
+                   "default-src 'self'; img-src 'self' data:; style-src 'self'; frame-ancestors 'none'");
+    res.set_content(std::string(f->body), std::string(f->type));
+  });
+  auto sessionHandler = [this](const httplib::Request& req, httplib::Response& res) { session(req, res); };
+  server.Get("/v1/session", sessionHandler);
+  server.Post("/v1/session", sessionHandler);
+  server.Delete("/v1/session", sessionHandler);
+  server.Get("/v1/site", [this](const httplib::Request&, httplib::Response& res) {
+    std::lock_guard lock(siteMutex_);
+    if (site_.is_null()) {
+      send(res, 404, problem("not_found", "this adapter has no site picture"));
+      return;
+    }
+    send(res, 200, site_);
+  });
+  server.Get(R"(/v1/robots/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+    const std::string id = req.matches[1];
+    for (const auto& r : d_.view.robots()) {
+      if (r.robot_id == id) {
+        send(res, 200, robotJson(r));
+        return;
+      }
+    }
+    send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
+  });
+  server.Post(R"(/v1/robots/([^/]+)/([^/]+))",
+              [this](const httplib::Request& req, httplib::Response& res) { robotAction(req, res); });
+  server.Get("/v1/stream", [this](const httplib::Request&, httplib::Response& res) { stream(res); });
+}
+
+void Dashboard::session(const httplib::Request& req, httplib::Response& res) {
+  // admit() has let this request through: bearer token, a session, or no authentication at all.
+  if (d_.token.empty()) {
+    send(res, 200, {{"auth", "off"}, {"csrf", ""}});
+    return;
+  }
+  if (req.method == "DELETE") {
+    res.set_header("Set-Cookie", BrowserSessions::clearCookie());
+    send(res, 200, {{"auth", "none"}});
+    return;
+  }
+  if (req.method == "POST") {
+    // Made from the bearer token (the login form sends it once, in the header, never in a URL).
+    const std::string cookie = sessions_.issue(nowS());
+    res.set_header("Set-Cookie", sessions_.setCookie(cookie));
+    send(res, 201,
+         {{"auth", "session"},
+          {"csrf", *sessions_.csrfOf(cookie, nowS())},
+          {"expires_in_s", sessions_.lifetimeS()}});
+    return;
+  }
+  const auto csrf = sessions_.csrfOf(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
+  send(res, 200, {{"auth", csrf ? "session" : "bearer"}, {"csrf", csrf ? *csrf : ""}});
+}
+
+void Dashboard::robotAction(const httplib::Request& req, httplib::Response& res) {
+  const std::string id = req.matches[1];
+  const std::string action = req.matches[2];
+  if (action != "pause" && action != "resume" && action != "home" && action != "charge") {
+    send(res, 404, problem("not_found", "no robot action \"" + action + "\" (pause, resume, home, charge)"));
+    return;
+  }
+  if (!isValidId(id)) {
+    send(res, 400, invalidField("id", "not a valid robot id (1-63 characters of A-Z a-z 0-9 _ . : -)"));
+    return;
+  }
+  std::optional<msg::RobotState> robot;
+  for (auto& r : d_.view.robots()) {
+    if (r.robot_id == id) {
+      robot = r;
+    }
+  }
+  if (!robot) {
+    send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
+    return;
+  }
+  if (!d_.gateway.managerOnline()) {
+    res.set_header("Retry-After", "2");
+    send(res, 503, problem("unavailable", "the fleet manager is unreachable; nothing was sent"));
+    return;
+  }
+  if (action == "pause" || action == "resume") {
+    hold(id, action == "pause", res);
+  } else {
+    sendTo(*robot, action, req, res);
+  }
+}
+
+void Dashboard::hold(const std::string& robot, bool held, httplib::Response& res) {
+  msg::Task m;
+  m.task_id = robot;
+  m.robot = robot;
+  m.request_id = d_.requestId();
+  m.control = held ? msg::TaskControl::HoldRobot : msg::TaskControl::ReleaseRobot;
+  const auto a = d_.gateway.submit({m}, std::chrono::milliseconds(d_.ackTimeoutMs))[0];
+  if (!a) {
+    res.set_header("Retry-After", "2");
+    send(res, 503,
+         problem("unavailable", "the fleet manager did not acknowledge in time; retry (it is idempotent)"));
+  } else if (a->result == msg::AckResult::Stored) {
+    send(res, 200, {{"robot", robot}, {"paused", held}, {"task", a->detail}});
+  } else if (a->result == msg::AckResult::NotFound) {
+    send(res, 404, problem("not_found", "the fleet manager knows no robot \"" + robot + "\""));
+  } else {
+    send(res, 409, problem("conflict", a->detail));
+  }
+}
+
+void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, const httplib::Request& req,
+                       httplib::Response& res) {
+  const bool home = action == "home";
+  std::string station;
+  if (!req.body.empty()) {
+    const json body = json::parse(req.body, nullptr, false);
+    if (!body.is_object() || (body.contains("station") && !body["station"].is_string())) {
+      send(res, 400, invalidField("station", "expected a JSON object with an optional string \"station\""));
+      return;
+    }
+    station = body.value("station", "");
+  }
+  if (station.empty() && home) {
+    std::lock_guard lock(siteMutex_);
+    const auto it = homes_.find(robot.robot_id);
+    station = it != homes_.end() ? it->second : "";
+  }
+  if (station.empty()) {
+    const Station* s =
+        nearest(d_.stations, home ? StationKind::Parking : StationKind::Charging, robot.pose.position());
+    if (s == nullptr) {
+      send(res, 409,
+           problem("conflict",
+                   std::string("the site has no ") + (home ? "parking" : "charging") + " station"));
+      return;
+    }
+    station = s->name;
+  }
+  const std::int64_t now = d_.clock.nowNs();
+  const std::string id = action + "-" + robot.robot_id + "-" + std::to_string(now / 1'000'000);
+  const json taskJson = {{"id", id},
+                         {"kind", home ? "park" : "charge"},
+                         {"station", station},
+                         {"robot", robot.robot_id},
+                         {"priority", 100}};
+  auto task = parseTask(taskJson, &d_.stations);
+  if (!task) {
+    json fields = json::array();
+    for (const auto& f : task.error().fields) {
+      fields.push_back({{"path", f.path}, {"reason", f.reason}});
+    }
+    send(res, 400, {{"error", "invalid"}, {"message", task.error().message}, {"fields", fields}});
+    return;
+  }
+  const auto a = d_.gateway.submit({service::toWire(*task, d_.requestId(), now)},
+                                   std::chrono::milliseconds(d_.ackTimeoutMs))[0];
+  if (!a) {
+    send(res, 503, problem("unavailable", "the fleet manager did not acknowledge the task in time"));
+    return;
+  }
+  if (a->result != msg::AckResult::Stored && a->result != msg::AckResult::Duplicate) {
+    send(res, a->result == msg::AckResult::Invalid ? 400 : 409, problem("refused", a->detail));
+    return;
+  }
+  d_.view.onAccepted(id, toJson(*task).dump(), a->state, now);
+  send(res, 201,
+       {{"robot", robot.robot_id}, {"task", id}, {"station", station}, {"state", msg::toString(a->state)}});
+}
+
+void Dashboard::stream(httplib::Response& res) {
+  // One stream for the page: a snapshot first (robots, recent tasks), then robot states that
+  // changed (at most every streamPeriodMs) and every task event. A page that reconnects gets a
+  // new snapshot, so it catches up after a lost connection or an adapter restart.
+  struct Cursor {
+    bool sentSnapshot = false;
+    std::uint64_t events = 0;
+    std::unordered_map<std::string, std::int64_t> sent;  // robot -> stamp sent last
+    std::uint64_t risk = 0;                              // risk maps sent: the view's count
+    std::chrono::steady_clock::time_point riskSentAt;
+  };
+  auto cur = std::make_shared<Cursor>();
+  cur->events = d_.view.eventCursor();
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  res.set_chunked_content_provider("text/event-stream", [this, cur](std::size_t, httplib::DataSink& sink) {
+    std::string chunk;
+    auto robotsJson = [&](bool all) {
+      json items = json::array();
+      for (const auto& r : d_.view.robots()) {
+        auto& last = cur->sent[r.robot_id];
+        if (all || r.stamp_ns != last) {
+          last = r.stamp_ns;
+          items.push_back(robotJson(r));
+        }
+      }
+      return items;
+    };
+    // The risk map at most once a second: it is the largest message and changes least visibly.
+    auto riskEvent = [&](bool force) -> std::string {
+      const auto [count, map] = d_.view.risk();
+      const auto now = std::chrono::steady_clock::now();
+      if (!map || count == cur->risk || (!force && now - cur->riskSentAt < std::chrono::seconds(1))) {
+        return {};
+      }
+      cur->risk = count;
+      cur->riskSentAt = now;
+      const json j = riskJson(*map);
+      return j.is_null() ? std::string() : "event: risk\ndata: " + j.dump() + "\n\n";
+    };
+    if (!cur->sentSnapshot) {
+      cur->sentSnapshot = true;
+      json tasks = json::array();
+      for (const auto& t : d_.view.tasks(std::nullopt, 500)) {
+        tasks.push_back({{"id", t.id},
+                         {"state", msg::toString(t.state)},
+                         {"robot", t.robot},
+                         {"reason", t.reason},
+                         {"stamp_ns", t.updatedNs}});
+      }
+      chunk = "retry: 1000\nevent: snapshot\ndata: " +
+              json{{"robots", robotsJson(true)},
+                   {"tasks", tasks},
+                   {"fleet_manager", d_.gateway.managerOnline() ? "online" : "unreachable"}}
+                  .dump(-1, ' ', false, json::error_handler_t::replace) +
+              "\n\n" + riskEvent(true);
+      return sink.write(chunk.data(), chunk.size());
+    }
+    std::vector<msg::TaskEvent> evs;
+    cur->events = d_.view.eventsAfter(cur->events, std::chrono::milliseconds(d_.streamPeriodMs), evs);
+    for (const auto& e : evs) {
+      chunk += "event: task\ndata: " +
+               json{{"id", e.task_id},    {"state", msg::toString(e.state)}, {"robot", e.robot_id},
+                    {"reason", e.reason}, {"stamp_ns", e.stamp_ns},          {"seq", e.seq}}
+                   .dump(-1, ' ', false, json::error_handler_t::replace) +
+               "\n\n";
+    }
+    const json robots = robotsJson(false);
+    if (!robots.empty()) {
+      chunk +=
+          "event: robots\ndata: " +
+          json{{"robots", robots}, {"fleet_manager", d_.gateway.managerOnline() ? "online" : "unreachable"}}
+              .dump(-1, ' ', false, json::error_handler_t::replace) +
+          "\n\n";
+    }
+    chunk += riskEvent(false);
+    if (chunk.empty()) {
+      chunk = ": keep-alive\n\n";
+    }
+    return sink.write(chunk.data(), chunk.size());
+  });
+}
+
+}  // namespace fleet::wms

@@ -1,0 +1,129 @@
+// What the page knows of the fleet, fed by the stream: robots (with when each was last heard of),
+// tasks, recent events, and the live figures computed from them.
+
+const TERMINAL = new Set(['done', 'failed', 'cancelled', 'rejected']);
+export const STALE_MS = 5000; // a robot not heard of for this long is drawn as lost
+
+export class FleetModel {
+  constructor() {
+    this.robots = new Map(); // id -> robot JSON + receivedAt
+    this.tasks = new Map(); // id -> {id, state, robot, reason, stamp_ns, queuedNs, assignedNs}
+    this.events = []; // newest last, at most 200
+    this.doneStamps = []; // stamp_ns of done events
+    this.latencies = []; // queued -> assigned, s
+    this.latestStampNs = 0;
+    this.firstStampNs = 0;
+    this.managerOnline = true;
+    this.risk = null; // the risk map's latest iso-level grid (GET /v1/stream `risk`)
+    this.version = 0; // grows with every change, so views redraw only when needed
+  }
+
+  snapshot(data, now) {
+    this.robots.clear();
+    this.robotsUpdate(data.robots || [], now);
+    for (const t of data.tasks || []) {
+      const old = this.tasks.get(t.id) || {};
+      this.tasks.set(t.id, { ...old, ...t });
+      this.stamp(t.stamp_ns);
+    }
+    this.managerOnline = data.fleet_manager !== 'unreachable';
+    this.version++;
+  }
+
+  setRisk(risk) {
+    this.risk = risk;
+    this.version++;
+  }
+
+  robotsUpdate(robots, now) {
+    for (const r of robots) {
+      r.receivedAt = now;
+      this.robots.set(r.id, r);
+    }
+    this.version++;
+  }
+
+  task(e) {
+    const t = this.tasks.get(e.id) || { id: e.id };
+    if (e.state === 'queued' || e.state === 'requeued') {
+      t.queuedNs = e.stamp_ns;
+    } else if (e.state === 'assigned' && t.queuedNs !== undefined) {
+      this.latencies.push((e.stamp_ns - t.queuedNs) / 1e9);
+      if (this.latencies.length > 200) {
+        this.latencies.shift();
+      }
+      t.queuedNs = undefined;
+    }
+    if (e.state === 'done') {
+      this.doneStamps.push(e.stamp_ns);
+    }
+    Object.assign(t, { state: e.state, robot: e.robot, reason: e.reason, stamp_ns: e.stamp_ns });
+    this.tasks.set(e.id, t);
+    this.stamp(e.stamp_ns);
+    this.log(`${e.id}: ${e.state}${e.robot ? ' (' + e.robot + ')' : ''}${e.reason ? ' — ' + e.reason : ''}`);
+    // Finished tasks stay listed for a while, but the map of tasks does not grow for ever.
+    if (this.tasks.size > 2000) {
+      for (const [id, old] of this.tasks) {
+        if (TERMINAL.has(old.state)) {
+          this.tasks.delete(id);
+          if (this.tasks.size <= 1500) {
+            break;
+          }
+        }
+      }
+    }
+    this.version++;
+  }
+
+  log(text) {
+    this.events.push({ at: new Date(), text });
+    if (this.events.length > 200) {
+      this.events.shift();
+    }
+    this.version++;
+  }
+
+  stamp(ns) {
+    if (!ns) {
+      return;
+    }
+    this.latestStampNs = Math.max(this.latestStampNs, ns);
+    if (!this.firstStampNs || ns < this.firstStampNs) {
+      this.firstStampNs = ns;
+    }
+  }
+
+  openTasks() {
+    return [...this.tasks.values()].filter((t) => !TERMINAL.has(t.state));
+  }
+
+  /** Figures for the panel: name -> text. Times are the fleet's clock (simulated in a simulation). */
+  figures(now) {
+    const byMode = {};
+    let stale = 0;
+    for (const r of this.robots.values()) {
+      if (now - r.receivedAt > STALE_MS) {
+        stale++;
+        continue;
+      }
+      const k = r.fault ? 'fault' : r.paused ? 'paused' : r.mode;
+      byMode[k] = (byMode[k] || 0) + 1;
+    }
+    const hourNs = 3600e9;
+    const since = this.latestStampNs - hourNs;
+    const doneHour = this.doneStamps.filter((s) => s >= since).length;
+    const spanS = Math.min(3600, (this.latestStampNs - this.firstStampNs) / 1e9);
+    const sorted = [...this.latencies].sort((a, b) => a - b);
+    const median = sorted.length ? sorted[Math.floor(sorted.length / 2)] : null;
+    const open = this.openTasks();
+    return {
+      robots: `${this.robots.size - stale} live` + (stale ? `, ${stale} not heard of` : ''),
+      'by state': Object.entries(byMode).map(([k, n]) => `${k} ${n}`).join(', ') || '—',
+      'tasks open': `${open.length} (${open.filter((t) => t.state === 'queued' || t.state === 'requeued').length} waiting)`,
+      'tasks done': String(this.doneStamps.length),
+      'done per hour': spanS > 30 ? (doneHour * 3600 / spanS).toFixed(1) : '—',
+      'assignment latency': median === null ? '—' : `median ${median.toFixed(2)} s (${sorted.length} tasks)`,
+      'fleet manager': this.managerOnline ? 'online' : 'unreachable',
+    };
+  }
+}

@@ -1,0 +1,154 @@
+// The side panels: figures, the selected robot and its actions, the task form, the task queue and
+// recent events. Updated from the model a few times a second, always through textContent (task ids
+// and reasons come from outside and are never parsed as HTML).
+
+const QUEUE_ROWS = 100;
+const EVENT_ROWS = 50;
+
+export class Panels {
+  constructor(model, view, { act, confirmThen }) {
+    this.model = model;
+    this.view = view;
+    this.act = act;
+    this.confirmThen = confirmThen;
+    this.lastUpdate = 0;
+    this.lastVersion = -1;
+    this.selected = '';
+
+    view.canvas.addEventListener('click', (ev) => {
+      const rect = view.canvas.getBoundingClientRect();
+      this.select(view.robotAt(model, ev.clientX - rect.left, ev.clientY - rect.top));
+    });
+    for (const button of document.querySelectorAll('[data-robot-action]')) {
+      button.addEventListener('click', () => this.robotAction(button.dataset.robotAction));
+    }
+    document.getElementById('task-form').addEventListener('submit', (ev) => {
+      ev.preventDefault();
+      const pickup = document.getElementById('task-pickup').value;
+      const dropoff = document.getElementById('task-dropoff').value;
+      const id = 'ui-' + new Date().toISOString().replace(/[-:.TZ]/g, '').slice(0, 14) + '-' +
+                 Math.floor(Math.random() * 1e4);
+      this.confirmThen(`Submit transport task ${id}: ${pickup} → ${dropoff}?`, () =>
+        this.act(`task ${id}`, 'POST', '/v1/tasks', { id, kind: 'transport', pickup, dropoff }));
+    });
+  }
+
+  setStations(stations) {
+    const fill = (id, kind) => {
+      const sel = document.getElementById(id);
+      sel.replaceChildren();
+      for (const s of stations.filter((s) => s.kinds.includes(kind))) {
+        sel.append(new Option(s.name, s.name));
+      }
+    };
+    fill('task-pickup', 'pickup');
+    fill('task-dropoff', 'dropoff');
+  }
+
+  select(id) {
+    this.selected = id;
+    this.view.selected = id;
+    this.model.version++;
+  }
+
+  robotAction(action) {
+    const id = this.selected;
+    if (!id) {
+      return;
+    }
+    const what = { pause: 'Pause', resume: 'Resume', home: 'Send home', charge: 'Send to charge' }[action];
+    this.confirmThen(`${what}: robot ${id}?`, () =>
+      this.act(`${action} ${id}`, 'POST', `/v1/robots/${encodeURIComponent(id)}/${action}`));
+  }
+
+  update(now) {
+    if (this.model.version === this.lastVersion && now - this.lastUpdate < 1000) {
+      return;
+    }
+    if (now - this.lastUpdate < 250) {
+      return; // the DOM a few times a second is plenty; the canvas runs every frame
+    }
+    this.lastUpdate = now;
+    this.lastVersion = this.model.version;
+    this.figures(now);
+    this.robot(now);
+    this.queue();
+    this.events();
+  }
+
+  figures(now) {
+    fillList(document.getElementById('figure-list'), this.model.figures(now));
+  }
+
+  robot(now) {
+    const r = this.model.robots.get(this.selected);
+    document.getElementById('robot-name').textContent = r ? r.id : this.selected ? this.selected + ' (gone)' : '—';
+    document.getElementById('robot-hint').hidden = !!r;
+    for (const b of document.querySelectorAll('[data-robot-action]')) {
+      b.disabled = !r;
+    }
+    if (!r) {
+      fillList(document.getElementById('robot-details'), {});
+      return;
+    }
+    const age = (now - r.receivedAt) / 1000;
+    fillList(document.getElementById('robot-details'), {
+      state: (r.fault ? 'FAULT' : r.mode) + (r.paused ? ' (paused)' : ''),
+      task: r.task || '—',
+      battery: `${Math.round(r.battery * 100)} %`,
+      position: `${r.pose.x.toFixed(2)}, ${r.pose.y.toFixed(2)} m`,
+      heading: `${Math.round(r.heading_deg)}°`,
+      speed: `${r.v.toFixed(2)} m/s`,
+      'pose σ': r.position_sigma < 0 || r.position_sigma > 100 ? 'unknown' : `${(r.position_sigma * 100).toFixed(1)} cm`,
+      heard: age < 2 ? 'now' : `${age.toFixed(0)} s ago`,
+    });
+  }
+
+  queue() {
+    const open = this.model.openTasks().sort((a, b) => (a.stamp_ns || 0) - (b.stamp_ns || 0));
+    document.getElementById('queue-count').textContent = `(${open.length})`;
+    const body = document.querySelector('#queue tbody');
+    const rows = open.slice(0, QUEUE_ROWS).map((t) => {
+      const tr = document.createElement('tr');
+      tr.dataset.task = t.id;
+      for (const text of [t.id, t.state || '?', t.robot || '']) {
+        const td = document.createElement('td');
+        td.textContent = text;
+        tr.append(td);
+      }
+      const td = document.createElement('td');
+      const cancel = document.createElement('button');
+      cancel.type = 'button';
+      cancel.textContent = 'cancel';
+      cancel.addEventListener('click', () =>
+        this.confirmThen(`Cancel task ${t.id}?`, () =>
+          this.act(`cancel ${t.id}`, 'DELETE', `/v1/tasks/${encodeURIComponent(t.id)}`)));
+      td.append(cancel);
+      tr.append(td);
+      return tr;
+    });
+    body.replaceChildren(...rows);
+  }
+
+  events() {
+    const list = document.getElementById('events');
+    const items = this.model.events.slice(-EVENT_ROWS).reverse().map((e) => {
+      const li = document.createElement('li');
+      li.textContent = `${e.at.toLocaleTimeString()} ${e.text}`;
+      return li;
+    });
+    list.replaceChildren(...items);
+  }
+}
+
+function fillList(dl, entries) {
+  const nodes = [];
+  for (const [k, v] of Object.entries(entries)) {
+    const dt = document.createElement('dt');
+    dt.textContent = k;
+    const dd = document.createElement('dd');
+    dd.textContent = v;
+    nodes.push(dt, dd);
+  }
+  dl.replaceChildren(...nodes);
+}

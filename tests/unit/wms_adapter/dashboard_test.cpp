@@ -1,0 +1,249 @@
+// The dashboard's side of the WMS adapter against a fake manager (no DDS): the page without login,
+// browser sessions (cookie flags, CSRF, token never accepted in a URL, other tokens and expired
+// sessions refused), the robot API (snapshot, hold/release, home, charge, bad ids) and the stream.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "browser_session.hpp"
+#include "http_api.hpp"
+
+using namespace fleet;
+using namespace fleet::wms;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+namespace {
+
+/// Acknowledges everything as stored and remembers the requests; knows robots r1 and r2.
+class RecordingGateway : public TaskGateway {
+ public:
+  std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
+                                                  std::chrono::milliseconds) override {
+    std::vector<std::optional<msg::TaskAck>> out;
+    for (const auto& r : requests) {
+      seen.push_back(r);
+      msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
+      const bool robotControl =
+          r.control == msg::TaskControl::HoldRobot || r.control == msg::TaskControl::ReleaseRobot;
+      if (robotControl && r.robot != "r1" && r.robot != "r2") {
+        a.result = msg::AckResult::NotFound;
+      }
+      out.emplace_back(a);
+    }
+    return out;
+  }
+  [[nodiscard]] bool managerOnline() const override { return true; }
+  std::vector<msg::Task> seen;
+};
+
+msg::RobotState robot(const std::string& id, double x, double y, std::int64_t stamp) {
+  msg::RobotState r;
+  r.robot_id = id;
+  r.pose = {x, y, 0.5};
+  r.stamp_ns = stamp;
+  r.mode = msg::RobotMode::Moving;
+  r.battery = 0.8f;
+  r.radius = 0.3f;
+  return r;
+}
+
+class Dash : public ::testing::Test {
+ protected:
+  void start(const std::string& token) {
+    ApiSettings s;
+    s.port = 0;
+    s.token = token;
+    s.ackTimeoutMs = 200;
+    api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
+    api_->dashboard().setSite(
+        json{{"name", "test"}, {"stations", json::array()}, {"homes", {{"r1", "PARK-1"}}}});
+    ASSERT_TRUE(api_->bind());
+    thread_ = std::thread([this] { api_->serve(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
+    view_.onRobot(robot("r1", 1.0, 1.0, 1));
+    view_.onRobot(robot("r2", 9.0, 1.0, 1));
+  }
+  void TearDown() override {
+    if (api_) {
+      api_->stop();
+      thread_.join();
+    }
+  }
+  /// POST /v1/session with the token: the session cookie ("fleet_session=...") and the CSRF token.
+  std::pair<std::string, std::string> login(const std::string& token) {
+    auto r = client_->Post("/v1/session", {{"Authorization", "Bearer " + token}}, "", "text/plain");
+    EXPECT_TRUE(r && r->status == 201);
+    const std::string setCookie = r->get_header_value("Set-Cookie");
+    return {setCookie.substr(0, setCookie.find(';')), json::parse(r->body)["csrf"].get<std::string>()};
+  }
+  StationMap stations_ = *StationMap::fromJson(json::parse(R"({"stations": [
+    {"name": "P-1", "x": 1, "y": 1, "kinds": ["pickup"]},
+    {"name": "D-1", "x": 5, "y": 1, "kinds": ["dropoff"]},
+    {"name": "PARK-1", "x": 0, "y": 3, "kinds": ["parking"]},
+    {"name": "PARK-2", "x": 9, "y": 3, "kinds": ["parking"]},
+    {"name": "CHG-1", "x": 0, "y": 0, "kinds": ["charging"]},
+    {"name": "CHG-2", "x": 10, "y": 0, "kinds": ["charging"]}]})"));
+  RecordingGateway gateway_;
+  FleetView view_;
+  WallClock clock_;
+  std::unique_ptr<HttpApi> api_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+}  // namespace
+
+TEST_F(Dash, ThePageNeedsNoLoginButTheDataDoes) {
+  start("s3cret");
+  auto page = client_->Get("/dashboard/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_THAT(page->get_header_value("Content-Type"), HasSubstr("text/html"));
+  EXPECT_THAT(page->body, HasSubstr("dashboard.js"));
+  auto js = client_->Get("/dashboard/map_view.js");
+  ASSERT_TRUE(js);
+  EXPECT_THAT(js->get_header_value("Content-Type"), HasSubstr("javascript"));
+  EXPECT_EQ(client_->Get("/dashboard/nope.js")->status, 404);
+  EXPECT_EQ(client_->Get("/v1/robots")->status, 401);
+  EXPECT_EQ(client_->Get("/v1/stream")->status, 401);
+  EXPECT_EQ(client_->Get("/v1/session")->status, 401) << "the page shows its login prompt on this";
+  EXPECT_EQ(client_->Get("/v1/robots?token=s3cret")->status, 401) << "a token in a URL is never accepted";
+}
+
+TEST_F(Dash, ASessionCookieReadsAndActsOnlyWithItsCsrfToken) {
+  start("s3cret");
+  auto wrong = client_->Post("/v1/session", {{"Authorization", "Bearer nope"}}, "", "text/plain");
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  EXPECT_TRUE(wrong->get_header_value("Set-Cookie").empty());
+  auto r = client_->Post("/v1/session", {{"Authorization", "Bearer s3cret"}}, "", "text/plain");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 201);
+  const std::string setCookie = r->get_header_value("Set-Cookie");
+  EXPECT_THAT(setCookie, HasSubstr("HttpOnly"));
+  EXPECT_THAT(setCookie, HasSubstr("SameSite=Strict"));
+  EXPECT_THAT(setCookie, ::testing::Not(HasSubstr("s3cret")));
+  const auto [cookie, csrf] = login("s3cret");
+  ASSERT_FALSE(csrf.empty());
+
+  auto robots = client_->Get("/v1/robots", {{"Cookie", cookie}});
+  ASSERT_TRUE(robots);
+  EXPECT_EQ(robots->status, 200);
+  EXPECT_EQ(json::parse(robots->body)["count"], 2);
+  auto session = client_->Get("/v1/session", {{"Cookie", cookie}});
+  EXPECT_EQ(json::parse(session->body)["csrf"], csrf) << "a reloaded page gets its CSRF token back";
+
+  auto noCsrf = client_->Post("/v1/robots/r1/pause", {{"Cookie", cookie}}, "", "text/plain");
+  ASSERT_TRUE(noCsrf);
+  EXPECT_EQ(noCsrf->status, 403);
+  auto badCsrf =
+      client_->Post("/v1/robots/r1/pause", {{"Cookie", cookie}, {kCsrfHeader, csrf + "0"}}, "", "text/plain");
+  EXPECT_EQ(badCsrf->status, 403);
+  EXPECT_TRUE(gateway_.seen.empty()) << "a refused request reached the manager";
+  auto ok = client_->Post("/v1/robots/r1/pause", {{"Cookie", cookie}, {kCsrfHeader, csrf}}, "", "text/plain");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+
+  std::string tampered = cookie;
+  tampered.back() = tampered.back() == '0' ? '1' : '0';
+  auto forged = client_->Get("/v1/robots", {{"Cookie", tampered}});
+  EXPECT_EQ(forged->status, 401) << "a tampered cookie";
+}
+
+TEST(BrowserSessions, ExpireAndEndWhenTheTokenChanges) {
+  const BrowserSessions s("token-a", 60);
+  const std::string c = s.issue(1000);
+  EXPECT_TRUE(s.csrfOf(c, 1059));
+  EXPECT_FALSE(s.csrfOf(c, 1061)) << "expired";
+  EXPECT_FALSE(BrowserSessions("token-b", 60).csrfOf(c, 1000)) << "made from another token";
+  EXPECT_TRUE(BrowserSessions("token-a", 60).csrfOf(c, 1000)) << "survives a restart with the same token";
+  EXPECT_FALSE(s.csrfOf("garbage", 1000));
+  EXPECT_FALSE(s.csrfOf("", 1000));
+  EXPECT_NE(s.issue(1000), c) << "each session has its own nonce";
+  EXPECT_EQ(cookieValue("a=1; fleet_session=xyz; b=2", kSessionCookie), "xyz");
+  EXPECT_EQ(cookieValue("a=1", kSessionCookie), "");
+}
+
+TEST_F(Dash, PauseAndResumeHoldTheRobotThroughTheManager) {
+  start("");
+  auto p = client_->Post("/v1/robots/r1/pause", "", "text/plain");
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->status, 200);
+  EXPECT_EQ(json::parse(p->body)["paused"], true);
+  auto q = client_->Post("/v1/robots/r1/resume", "", "text/plain");
+  EXPECT_EQ(q->status, 200);
+  ASSERT_EQ(gateway_.seen.size(), 2u);
+  EXPECT_EQ(gateway_.seen[0].control, msg::TaskControl::HoldRobot);
+  EXPECT_EQ(gateway_.seen[0].robot, "r1");
+  EXPECT_EQ(gateway_.seen[1].control, msg::TaskControl::ReleaseRobot);
+  EXPECT_EQ(client_->Post("/v1/robots/r7/pause", "", "text/plain")->status, 404) << "a robot never seen";
+  auto odd = client_->Post("/v1/robots/r%24%3Cb%3E/pause", "", "text/plain");
+  EXPECT_EQ(odd->status, 400);
+  EXPECT_THAT(odd->body, HasSubstr("robot id"));
+  EXPECT_EQ(client_->Post("/v1/robots/r1/dance", "", "text/plain")->status, 404);
+}
+
+TEST_F(Dash, HomeGoesToTheRobotsParkingPlaceAndChargeToTheNearestCharger) {
+  start("");
+  auto home = client_->Post("/v1/robots/r2/home", "", "text/plain");
+  ASSERT_TRUE(home);
+  EXPECT_EQ(home->status, 201) << home->body;
+  EXPECT_EQ(json::parse(home->body)["station"], "PARK-2") << "r2 has no home named: the nearest parking";
+  auto home1 = client_->Post("/v1/robots/r1/home", "", "text/plain");
+  EXPECT_EQ(json::parse(home1->body)["station"], "PARK-1") << "r1's home from the scenario";
+  auto charge = client_->Post("/v1/robots/r2/charge", "", "text/plain");
+  EXPECT_EQ(json::parse(charge->body)["station"], "CHG-2");
+  ASSERT_EQ(gateway_.seen.size(), 3u);
+  EXPECT_EQ(gateway_.seen[0].kind, msg::TaskKind::Park);
+  EXPECT_EQ(gateway_.seen[0].robot, "r2");
+  EXPECT_EQ(gateway_.seen[2].kind, msg::TaskKind::Charge);
+  auto chosen = client_->Post("/v1/robots/r2/charge", R"({"station": "CHG-1"})", "application/json");
+  EXPECT_EQ(json::parse(chosen->body)["station"], "CHG-1");
+  auto wrongKind = client_->Post("/v1/robots/r2/charge", R"({"station": "P-1"})", "application/json");
+  EXPECT_EQ(wrongKind->status, 400) << wrongKind->body;
+  auto notJson = client_->Post("/v1/robots/r2/home", "{", "application/json");
+  EXPECT_EQ(notJson->status, 400);
+}
+
+TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
+  start("");
+  std::string got;
+  std::thread feeder([this] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    view_.onRobot(robot("r2", 8.0, 2.0, 2));
+    view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1});
+    msg::RiskMap m;
+    m.width = 4;
+    m.height = 2;
+    m.resolution = 0.5;
+    m.levels = 3;
+    m.runs = {{0, 5}, {3, 2}, {1, 1}};
+    view_.onRisk(m);
+  });
+  auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
+    got.append(data, n);
+    return got.find("event: robots") == std::string::npos || got.find("event: task") == std::string::npos ||
+           got.find("event: risk") == std::string::npos;
+  });
+  feeder.join();
+  ASSERT_THAT(got, HasSubstr("event: snapshot"));
+  const auto snap = got.find("event: snapshot\ndata: ");
+  const auto snapEnd = got.find("\n\n", snap);
+  const json s = json::parse(got.substr(snap + 22, snapEnd - snap - 22));
+  EXPECT_EQ(s["robots"].size(), 2u);
+  const auto upd = got.find("event: robots\ndata: ");
+  ASSERT_NE(upd, std::string::npos);
+  const json u = json::parse(got.substr(upd + 20, got.find("\n\n", upd) - upd - 20));
+  ASSERT_EQ(u["robots"].size(), 1u) << "only the robot that changed";
+  EXPECT_EQ(u["robots"][0]["id"], "r2");
+  EXPECT_DOUBLE_EQ(u["robots"][0]["pose"]["x"].get<double>(), 8.0);
+  EXPECT_THAT(got, HasSubstr(R"("id":"t<1>")"));
+  const auto risk = got.find("event: risk\ndata: ");
+  ASSERT_NE(risk, std::string::npos);
+  const json rj = json::parse(got.substr(risk + 18, got.find("\n\n", risk) - risk - 18));
+  EXPECT_EQ(rj["levels"], 3);
+  EXPECT_EQ(rj["runs"], json::array({0, 5, 3, 2, 1, 1})) << "levels and counts, flattened";
+}
