@@ -91,7 +91,8 @@ Config Config::fromText(std::string_view text, std::string origin) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // Not only parse_error: a number beyond a double (1e999) is out_of_range.406 (found by fuzzing).
     throw ConfigError({origin + ": not valid JSON: " + e.what()});
   }
   return fromJson(std::move(doc), std::move(origin));

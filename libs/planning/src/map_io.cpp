@@ -271,7 +271,7 @@ Expected<OccupancyGrid> loadImageMap(const std::string& sideFilePath) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(*text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a number beyond a double is out_of_range.406
     return unexpected("map_format", sideFilePath + ": invalid JSON: " + e.what());
   }
   ImageMapInfo info;

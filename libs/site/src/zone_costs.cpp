@@ -17,7 +17,8 @@ double OneWayCost::factor(planning::Cell from, planning::Cell to) const {
       continue;
     }
     const float phi = oneWay[map.index(c)];
-    if (std::isfinite(phi) && dir.dot({std::cos(phi), std::sin(phi)}) < -1e-9) {
+    if (std::isfinite(phi) &&
+        dir.dot({static_cast<double>(std::cos(phi)), static_cast<double>(std::sin(phi))}) < -1e-9) {
       return factor_;
     }
   }

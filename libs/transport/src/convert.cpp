@@ -185,11 +185,13 @@ msg::TaskStatus Traits<msg::TaskStatus>::fromC(const C& in) {
 }
 
 // ---- RobotState
+// fleet_Matrix3 is nine doubles in row-major order (idl/fleet.idl says why it is not an array).
+static_assert(sizeof(fleet_Matrix3) == sizeof(std::array<double, 9>));
 void Traits<msg::RobotState>::toC(const msg::RobotState& in, C& out, Arena&) {
   putStr(out.robot_id, in.robot_id, "RobotState.robot_id");
   out.stamp_ns = in.stamp_ns;
   out.pose = putPose(in.pose);
-  std::memcpy(out.covariance, in.covariance.data(), sizeof(out.covariance));
+  std::memcpy(&out.covariance, in.covariance.data(), sizeof(out.covariance));
   out.v = in.v;
   out.w = in.w;
   out.mode = static_cast<fleet_RobotMode>(in.mode);
@@ -203,7 +205,7 @@ msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   m.robot_id = getStr(in.robot_id);
   m.stamp_ns = in.stamp_ns;
   m.pose = getPose(in.pose);
-  std::memcpy(m.covariance.data(), in.covariance, sizeof(in.covariance));
+  std::memcpy(m.covariance.data(), &in.covariance, sizeof(in.covariance));
   m.v = in.v;
   m.w = in.w;
   m.mode = getEnum(in.mode, msg::RobotMode::Fault);

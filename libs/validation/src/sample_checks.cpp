@@ -45,6 +45,14 @@ class Checker {
     within(x, -kMaxCoordinate, kMaxCoordinate, field);
     return within(y, -kMaxCoordinate, kMaxCoordinate, field);
   }
+  // The wire's float fields, widened on purpose (clang's -Wdouble-promotion names every implicit one).
+  Checker& finite(float v, const char* field) { return finite(static_cast<double>(v), field); }
+  Checker& within(float v, double lo, double hi, const char* field) {
+    return within(static_cast<double>(v), lo, hi, field);
+  }
+  Checker& position(float x, float y, const char* field) {
+    return position(static_cast<double>(x), static_cast<double>(y), field);
+  }
   Checker& pose(const Pose2& p, const char* field) {
     position(p.x, p.y, field);
     return finite(p.theta, field);

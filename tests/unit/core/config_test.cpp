@@ -66,6 +66,13 @@ TEST(Config, SyntaxErrorAndMissingFile) {
               HasSubstr("arr: (top level): expected a JSON object"));
 }
 
+// Found by tests/fuzz (config): nlohmann reports a number beyond a double as out_of_range, not
+// parse_error, and it escaped Config as something other than ConfigError.
+TEST(Config, NumberBeyondADoubleIsAConfigError) {
+  EXPECT_THAT(messageOf([&] { (void)Config::fromText(R"({"speed": 1e999})", "big.json"); }),
+              HasSubstr("big.json: not valid JSON"));
+}
+
 TEST(Config, ArraysAndUnknownKeys) {
   auto c = Config::fromText(
       R"({"robots": [{"id": "r1", "radius": 0.3}, {"id": "r2", "radius": -1}, 5], "robtos": 1})", "scn.json");

@@ -221,7 +221,8 @@ TEST(SegmentPath, RubberBandFromSkeletonAndFarEndsStarts) {
     }
     ++idx;
   }
-  const auto& t6 = seedCases()[5];
+  // A copy: a reference into seedCases()'s returned vector dangled (use after free under ASan).
+  const auto t6 = seedCases()[5];
   RubberBandOptions opt;
   opt.start.assign(t6.segs.size(), 0.0);
   EXPECT_GE(shortestPathRubberBand(t6.p, t6.q, t6.segs, opt).merges, 1);

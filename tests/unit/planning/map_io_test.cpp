@@ -128,6 +128,11 @@ TEST(ImageMap, MalformedInputsGiveClearErrors) {
   e = loadImageMap(dir + "/broken.json");
   ASSERT_FALSE(e.has_value());
   EXPECT_NE(e.error().message.find("broken.json: invalid JSON"), std::string::npos);
+  // A number beyond a double is nlohmann's out_of_range, not parse_error: still an error value.
+  writeFile(dir + "/huge.json", R"({"image": "short.pgm", "resolution": 1e999})");
+  e = loadImageMap(dir + "/huge.json");
+  ASSERT_FALSE(e.has_value());
+  EXPECT_NE(e.error().message.find("huge.json: invalid JSON"), std::string::npos);
   writeFile(dir + "/rot.json", R"({"image": "short.pgm", "resolution": 0.1, "origin": [0, 0, 0.3]})");
   e = loadImageMap(dir + "/rot.json");
   ASSERT_FALSE(e.has_value());
