@@ -94,7 +94,8 @@ ApiSettings readApiSettings(Config& cfg) {
   auto h = cfg.child("http");
   h.rejectUnknownKeys({"host", "port", "token_file", "audit_log", "tls_certificate", "tls_key",
                        "max_body_bytes", "max_batch", "ack_timeout_ms", "max_in_flight", "threads",
-                       "max_connections", "max_streams", "backlog", "request_timeout_ms"});
+                       "max_connections", "max_streams", "backlog", "request_timeout_ms", "rate_per_client",
+                       "rate_burst"});
   s.host = h.string("host", s.host);
   s.port = static_cast<int>(h.integer("port", s.port, {0, 65535}));
   l.maxBodyBytes = static_cast<std::size_t>(
@@ -109,6 +110,8 @@ ApiSettings readApiSettings(Config& cfg) {
   l.maxStreams = static_cast<int>(h.integer("max_streams", l.maxStreams, {0, 100000}));
   l.backlog = static_cast<int>(h.integer("backlog", l.backlog, {1, 65535}));
   l.requestTimeoutMs = static_cast<int>(h.integer("request_timeout_ms", l.requestTimeoutMs, {100, 600000}));
+  l.ratePerClient = h.number("rate_per_client", l.ratePerClient, {0, 1e6});
+  l.rateBurst = static_cast<int>(h.integer("rate_burst", l.rateBurst, {1, 1000000}));
   s.auditLog = h.string("audit_log", "");
   s.tls.certificateFile = h.string("tls_certificate", "");
   s.tls.privateKeyFile = h.string("tls_key", "");
@@ -311,6 +314,7 @@ void HttpApi::routes() {
              {"refused_connections", h.refusedConnections.load()},
              {"refused_streams", h.refusedStreams.load()},
              {"busy", h.busy.load()},
+             {"rate_limited", h.rateLimited.load()},
              {"too_large", h.tooLarge.load()},
              {"timed_out", h.timedOut.load()},
              {"tls_failures", h.tlsFailures.load()},
@@ -379,7 +383,6 @@ void HttpApi::postTasks(const Request& req, Response& res) {
     ids.push_back(t.id);
   }
   res.audit = json{{"tasks", ids}}.dump();
-  const TaskIdLocks::Hold hold(taskIds_, ids);
   const std::int64_t now = clock_.nowNs();
   std::vector<msg::Task> requests;
   for (const auto& t : *parsed) {
@@ -436,7 +439,6 @@ void HttpApi::deleteTask(const Request& req, Response& res) {
   if (!admitTaskRequest(id, "cancelled", res)) {
     return;
   }
-  const TaskIdLocks::Hold hold(taskIds_, {id});
   msg::Task m;
   m.task_id = id;
   m.request_id = nextRequestId();
@@ -460,7 +462,6 @@ void HttpApi::controlTask(const Request& req, Response& res, bool pause) {
   if (!admitTaskRequest(id, pause ? "paused" : "resumed", res)) {
     return;
   }
-  const TaskIdLocks::Hold hold(taskIds_, {id});
   msg::Task m;
   m.task_id = id;
   m.request_id = nextRequestId();

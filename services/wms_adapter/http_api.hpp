@@ -16,7 +16,6 @@
 #include "fleet/metrics/registry.hpp"
 #include "gateway.hpp"
 #include "http_server.hpp"
-#include "task_id_locks.hpp"
 #include "token_store.hpp"
 
 namespace fleet::wms {
@@ -85,7 +84,6 @@ class HttpApi {
   TokenStore tokens_;
   AccessControl access_{tokens_};
   AuditLog audit_;
-  TaskIdLocks taskIds_;
   HttpServer server_;
   std::atomic<std::uint64_t> requestCounter_{0};
   std::string instance_;

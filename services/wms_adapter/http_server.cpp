@@ -8,6 +8,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include <regex>
 #include <stdexcept>
 #include <thread>
+#include <unordered_map>
 
 namespace fleet::wms {
 namespace {
@@ -157,6 +159,13 @@ struct HttpServer::Impl {
   std::deque<std::function<void()>> jobs;
   bool stopping = false;
 
+  /// Token buckets by client address (I/O thread only).
+  struct Bucket {
+    double tokens = 0;
+    SteadyClock::time_point last;
+  };
+  std::unordered_map<std::string, Bucket> buckets;
+
   std::optional<ssl::context> tls;
   // Declared last: destroying it destroys the sessions its queue still holds, which use the above.
   net::io_context io{1};
@@ -166,6 +175,8 @@ struct HttpServer::Impl {
   void accept();
   void startSession(tcp::socket socket);
   void dispatch(const std::shared_ptr<Request>& req, std::function<void(Response)> done);
+  /// Takes a token of `client`'s bucket; else the seconds until one is there.
+  std::optional<int> overRate(const std::string& client);
   void worker();
 };
 
@@ -506,6 +517,29 @@ void HttpServer::Impl::startSession(tcp::socket socket) {
   }
 }
 
+std::optional<int> HttpServer::Impl::overRate(const std::string& client) {
+  const auto now = SteadyClock::now();
+  const double burst = std::max(1, limits.rateBurst);
+  if (buckets.size() > 10'000) {
+    // Forget the clients whose buckets have filled up again: they are as if new.
+    std::erase_if(buckets, [&](const auto& kv) {
+      return kv.second.tokens +
+                 std::chrono::duration<double>(now - kv.second.last).count() * limits.ratePerClient >=
+             burst;
+    });
+  }
+  auto [it, fresh] = buckets.try_emplace(client, Bucket{burst, now});
+  auto& b = it->second;
+  b.tokens =
+      std::min(burst, b.tokens + std::chrono::duration<double>(now - b.last).count() * limits.ratePerClient);
+  b.last = now;
+  if (b.tokens >= 1) {
+    b.tokens -= 1;
+    return std::nullopt;
+  }
+  return static_cast<int>(std::ceil((1 - b.tokens) / limits.ratePerClient));
+}
+
 void HttpServer::Impl::dispatch(const std::shared_ptr<Request>& req, std::function<void(Response)> done) {
   const Route* route = nullptr;
   std::smatch m;
@@ -521,6 +555,15 @@ void HttpServer::Impl::dispatch(const std::shared_ptr<Request>& req, std::functi
   }
   for (const auto& g : m) {
     req->matches.push_back(g.str());
+  }
+  if (limits.ratePerClient > 0 && route->scope != Scope::Public) {
+    if (const auto wait = overRate(req->remote_addr)) {
+      ++stats.rateLimited;
+      auto slow = errorResponse(429, "rate_limited", "more requests than http.rate_per_client allows; retry");
+      slow.set_header("Retry-After", std::to_string(*wait));
+      done(std::move(slow));
+      return;
+    }
   }
   Response res;
   if (gate && !gate(*req, res, route->scope)) {

@@ -16,7 +16,9 @@
 // - hold a thread with an event stream: a stream is polled from the I/O thread (EventSource must
 //   not block) and holds no worker; beyond `maxStreams` open streams, 503 with Retry-After;
 // - make the kernel reset connections: the listen backlog is `backlog`, and beyond `maxConnections`
-//   open connections a new one is read and answered 503 with Retry-After, then closed.
+//   open connections a new one is read and answered 503 with Retry-After, then closed;
+// - send faster than `ratePerClient` (when set) from one address: 429 with Retry-After (public
+//   routes, the health probe, are exempt).
 //
 // Request and Response carry the few accessors of cpp-httplib's that the handlers use, spelled as
 // there, so a handler written for httplib::Server moves over by changing the two type names.
@@ -89,6 +91,8 @@ struct ServerLimits {
   int writeTimeoutMs = 30000;    // a response (or a stream's next chunk) must be taken within this
   int streamPollMs = 100;        // how often an event stream's source is asked
   int streamKeepAliveMs = 1000;  // an idle stream sends a comment this often
+  double ratePerClient = 0;      // requests per second per client address (token bucket); 0 = no limit
+  int rateBurst = 20;            // requests a client may send at once before its rate applies
 };
 
 /// PEM files for https; both empty = plain http.
@@ -105,6 +109,7 @@ struct ServerStats {
   std::atomic<std::int64_t> refusedConnections{0};  // 503 at maxConnections
   std::atomic<std::int64_t> refusedStreams{0};      // 503 at maxStreams
   std::atomic<std::int64_t> busy{0};                // 429 at maxInFlight
+  std::atomic<std::int64_t> rateLimited{0};         // 429 past ratePerClient
   std::atomic<std::int64_t> tooLarge{0};            // 413 / 431
   std::atomic<std::int64_t> timedOut{0};            // connections closed for a request too slow
   std::atomic<std::int64_t> tlsFailures{0};         // failed TLS handshakes

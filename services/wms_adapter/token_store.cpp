@@ -2,6 +2,7 @@
 
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
+#include <spdlog/spdlog.h>
 #include <sys/stat.h>
 
 #include <fstream>
@@ -168,11 +169,13 @@ void TokenStore::refreshLocked() const {
   stamp_ = *stamp;  // a bad file is reported once, not re-parsed on every request
   if (!entries) {
     problem_ = entries.error().message + "; the tokens read before stay";
+    spdlog::warn("wms adapter: token file: {}", problem_);
     return;
   }
   entries_ = std::move(*entries);
   problem_.clear();
   ++reloads_;
+  spdlog::info("wms adapter: token file \"{}\" re-read: {} tokens", path_, entries_.size());
 }
 
 bool TokenStore::enabled() const {

@@ -85,9 +85,7 @@ inline StationMap stations() {
     {"name": "D-1", "x": 5, "y": 1, "kinds": ["dropoff"]}]})"));
 }
 
-/// Serves the API in front of a gateway of type G (FakeGateway, or one that models a fault).
-template <class G>
-class ApiWith : public ::testing::Test {
+class Api : public ::testing::Test {
  protected:
   void start(ApiSettings s = {}) {
     s.port = 0;
@@ -107,14 +105,13 @@ class ApiWith : public ::testing::Test {
     return client_->Post("/v1/tasks", h, body, "application/json");
   }
   StationMap stations_ = stations();
-  G gateway_;
+  FakeGateway gateway_;
   FleetView view_;
   WallClock clock_;
   std::unique_ptr<HttpApi> api_;
   std::thread thread_;
   std::unique_ptr<httplib::Client> client_;
 };
-using Api = ApiWith<FakeGateway>;
 
 /// A client socket that does exactly what a test says, however rude: partial heads, endless
 /// chunked bodies, requests it never reads the answer of.
