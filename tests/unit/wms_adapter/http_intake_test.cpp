@@ -6,6 +6,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <atomic>
 #include <thread>
@@ -172,6 +173,12 @@ TEST_F(Intake, ABurstOfConnectionsIsAnsweredWith429NotReset) {
   start();  // the defaults: 16 workers, 16 in flight, backlog 1024
   gateway_.delay = std::chrono::milliseconds(300);
   constexpr int kClients = 400;
+  // Both ends of 400 connections live in this process: more descriptors than a soft limit of 1024
+  // leaves room for on some machines.
+  rlimit files{};
+  getrlimit(RLIMIT_NOFILE, &files);
+  files.rlim_cur = std::max<rlim_t>(files.rlim_cur, std::min<rlim_t>(files.rlim_max, 4096));
+  setrlimit(RLIMIT_NOFILE, &files);
   std::vector<std::unique_ptr<RawClient>> clients;
   for (int i = 0; i < kClients; ++i) {
     clients.push_back(std::make_unique<RawClient>(api_->port()));
