@@ -54,8 +54,13 @@ Expected<std::vector<TokenStore::Entry>> TokenStore::parse(std::string_view text
   if (lines.empty()) {
     return unexpected("no_tokens", origin + ": no token in the file");
   }
-  if (lines.size() == 1 && lines[0].size() == 1) {
-    return std::vector<Entry>{{{"token", allScopes()}, digestOf(lines[0][0])}};
+  if (lines.size() == 1 && lines[0].size() != 3) {
+    // The format before names and scopes: the line is the token, spaces and all.
+    std::string token;
+    for (const auto& f : lines[0]) {
+      token += (token.empty() ? "" : " ") + f;
+    }
+    return std::vector<Entry>{{{"token", allScopes()}, digestOf(token)}};
   }
   static const std::regex kName("[A-Za-z0-9._-]{1,64}");
   std::set<std::string> names;

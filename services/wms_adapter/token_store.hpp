@@ -11,8 +11,8 @@
 //     wms      read,submit          6f1c0c5e0b6d4c5e9a3e...
 //     floor    read,operate         0d7e1b9a44c1f2aa51b0...
 //
-// A file of a single line holding only a token (the format before scopes) is one token named
-// "token" with every scope.
+// A file of a single line that is not "name scopes token" (the format before scopes: the line is
+// the token) is one token named "token" with every scope.
 
 #include <array>
 #include <cstdint>

@@ -78,6 +78,10 @@ TEST(TokenFile, NamesScopesAndTokensOrAnErrorNamingTheLine) {
   auto legacy = TokenStore::parse("s3cret\n", "tokens");
   ASSERT_TRUE(legacy);
   EXPECT_EQ((*legacy)[0].who.scopes.size(), 3u) << "a lone token (the old format) has every scope";
+  // The old format took the whole first line: a placeholder with spaces (deploy/kube) still loads.
+  legacy = TokenStore::parse("REPLACE-ME: kubectl create secret generic x\n", "tokens");
+  ASSERT_TRUE(legacy);
+  EXPECT_EQ((*legacy)[0].digest, TokenStore::digestOf("REPLACE-ME: kubectl create secret generic x"));
   EXPECT_THAT(TokenStore::parse("wms write " + kWms, "tokens").error().message,
               HasSubstr("tokens:1: scope \"write\""));
   EXPECT_THAT(TokenStore::parse("a read " + kWms + "\nb read short", "tokens").error().message,
