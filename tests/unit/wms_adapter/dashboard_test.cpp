@@ -116,6 +116,10 @@ TEST_F(Dash, ThePageNeedsNoLoginButTheDataDoes) {
   ASSERT_TRUE(js);
   EXPECT_THAT(js->get_header_value("Content-Type"), HasSubstr("javascript"));
   EXPECT_EQ(client_->Get("/dashboard/nope.js")->status, 404);
+  auto root = client_->Get("/");
+  ASSERT_TRUE(root);
+  EXPECT_EQ(root->status, 302);
+  EXPECT_EQ(root->get_header_value("Location"), "/dashboard/");
   EXPECT_EQ(client_->Get("/v1/robots")->status, 401);
   EXPECT_EQ(client_->Get("/v1/stream")->status, 401);
   EXPECT_EQ(client_->Get("/v1/session")->status, 401) << "the page shows its login prompt on this";

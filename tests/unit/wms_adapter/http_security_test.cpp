@@ -192,6 +192,11 @@ TEST_F(Security, HttpsWithACertificateFromTheSiteScript) {
   auto r = tls.Post("/v1/tasks", bearer(kWms), kTask, "application/json");
   ASSERT_TRUE(r) << "https failed: " << httplib::to_string(r.error());
   EXPECT_EQ(r->status, 201);
+  auto session = tls.Post("/v1/session", bearer(kFloor), "", "text/plain");
+  ASSERT_TRUE(session);
+  EXPECT_EQ(session->status, 201);
+  EXPECT_THAT(session->get_header_value("Set-Cookie"), HasSubstr("; Secure"))
+      << "a dashboard session made over https must never be sent over plain http";
   EXPECT_FALSE(client_->Get("/v1/health")) << "plain http is served on the https port";
   httplib::SSLClient untrusted("localhost", api_->port());
   untrusted.enable_server_certificate_verification(true);
