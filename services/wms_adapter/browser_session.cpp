@@ -22,41 +22,52 @@ std::string hex(const unsigned char* p, std::size_t n) {
   return s;
 }
 
-}  // namespace
-
-BrowserSessions::BrowserSessions(std::string token, std::int64_t lifetimeS)
-    : token_(std::move(token)), lifetimeS_(lifetimeS) {}
-
-std::string BrowserSessions::mac(std::string_view what) const {
+/// HMAC-SHA256 of `what` keyed by a token's digest, in hex.
+std::string mac(const TokenStore::Digest& key, std::string_view what) {
   std::array<unsigned char, EVP_MAX_MD_SIZE> out{};
   unsigned int n = 0;
-  if (HMAC(EVP_sha256(), token_.data(), static_cast<int>(token_.size()),
+  if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()),
            reinterpret_cast<const unsigned char*>(what.data()), what.size(), out.data(), &n) == nullptr) {
     throw std::runtime_error("HMAC-SHA256 failed");
   }
   return hex(out.data(), n);
 }
 
-std::string BrowserSessions::issue(std::int64_t nowS) const {
+}  // namespace
+
+BrowserSessions::BrowserSessions(const TokenStore& tokens, bool secure, std::int64_t lifetimeS)
+    : tokens_(tokens), secure_(secure), lifetimeS_(lifetimeS) {}
+
+// The cookie is "<expiry>.<nonce>.<mac>.<name>": the name last, as it may hold dots itself.
+std::optional<std::string> BrowserSessions::issue(const std::string& name, std::int64_t nowS) const {
+  const auto entry = tokens_.named(name);
+  if (!entry) {
+    return std::nullopt;
+  }
   std::array<unsigned char, 16> nonce{};
   if (RAND_bytes(nonce.data(), static_cast<int>(nonce.size())) != 1) {
     throw std::runtime_error("no random bytes for a session");
   }
   const std::string body = std::to_string(nowS + lifetimeS_) + "." + hex(nonce.data(), nonce.size());
-  return body + "." + mac("session." + body);
+  return body + "." + mac(entry->digest, "session." + body + "." + name) + "." + name;
 }
 
-std::optional<std::string> BrowserSessions::csrfOf(std::string_view cookie, std::int64_t nowS) const {
-  if (token_.empty() || cookie.size() > 256) {
+std::optional<BrowserSessions::Session> BrowserSessions::check(std::string_view cookie,
+                                                               std::int64_t nowS) const {
+  if (cookie.size() > 512) {
     return std::nullopt;
   }
   const auto dot1 = cookie.find('.');
   const auto dot2 = dot1 == std::string_view::npos ? dot1 : cookie.find('.', dot1 + 1);
-  if (dot2 == std::string_view::npos) {
+  const auto dot3 = dot2 == std::string_view::npos ? dot2 : cookie.find('.', dot2 + 1);
+  if (dot3 == std::string_view::npos) {
     return std::nullopt;
   }
-  const std::string_view body = cookie.substr(0, dot2);
-  if (!sameSecret(cookie.substr(dot2 + 1), mac("session." + std::string(body)))) {
+  const std::string body(cookie.substr(0, dot2));
+  const std::string name(cookie.substr(dot3 + 1));
+  const auto entry = tokens_.named(name);
+  if (!entry || !sameSecret(cookie.substr(dot2 + 1, dot3 - dot2 - 1),
+                            mac(entry->digest, "session." + body + "." + name))) {
     return std::nullopt;
   }
   std::int64_t expires = 0;
@@ -64,16 +75,17 @@ std::optional<std::string> BrowserSessions::csrfOf(std::string_view cookie, std:
   if (ec != std::errc{} || end != cookie.data() + dot1 || expires < nowS) {
     return std::nullopt;
   }
-  return mac("csrf." + std::string(body));
+  return Session{entry->who, mac(entry->digest, "csrf." + body + "." + name)};
 }
 
 std::string BrowserSessions::setCookie(const std::string& value) const {
-  return std::string(kSessionCookie) + "=" + value +
-         "; Path=/; HttpOnly; SameSite=Strict; Max-Age=" + std::to_string(lifetimeS_);
+  return std::string(kSessionCookie) + "=" + value + "; Path=/; HttpOnly; SameSite=Strict" +
+         (secure_ ? "; Secure" : "") + "; Max-Age=" + std::to_string(lifetimeS_);
 }
 
-std::string BrowserSessions::clearCookie() {
-  return std::string(kSessionCookie) + "=; Path=/; HttpOnly; SameSite=Strict; Max-Age=0";
+std::string BrowserSessions::clearCookie() const {
+  return std::string(kSessionCookie) + "=; Path=/; HttpOnly; SameSite=Strict" + (secure_ ? "; Secure" : "") +
+         "; Max-Age=0";
 }
 
 std::string cookieValue(std::string_view header, std::string_view name) {

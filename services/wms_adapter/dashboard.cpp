@@ -11,7 +11,6 @@
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/service/task_wire.hpp"
-#include "request_auth.hpp"
 #include "web_files.hpp"
 
 namespace fleet::wms {
@@ -19,7 +18,7 @@ namespace {
 
 using nlohmann::json;
 
-void send(httplib::Response& res, int status, const json& body) {
+void send(Response& res, int status, const json& body) {
   res.status = status;
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
 }
@@ -145,17 +144,13 @@ json sitePictureOf(const std::string& path) {
   return out;
 }
 
-Dashboard::Dashboard(httplib::Server& server, DashboardDeps deps) : d_(std::move(deps)), sessions_(d_.token) {
+Dashboard::Dashboard(HttpServer& server, DashboardDeps deps) : d_(std::move(deps)) {
   routes(server);
 }
 
 std::int64_t Dashboard::nowS() const {
   return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
-}
-
-bool Dashboard::admit(const httplib::Request& req, httplib::Response& res) const {
-  return admitRequest(d_.token, sessions_, req, res, nowS());
 }
 
 void Dashboard::setSite(json site) {
@@ -169,29 +164,42 @@ void Dashboard::setSite(json site) {
   site_ = std::move(site);
 }
 
-void Dashboard::routes(httplib::Server& server) {
-  server.Get("/", [](const httplib::Request&, httplib::Response& res) { res.set_redirect("/dashboard/"); });
-  server.Get(R"(/dashboard/(.*))", [](const httplib::Request& req, httplib::Response& res) {
-    std::string name = req.matches[1];
-    if (name.empty()) {
-      name = "index.html";
-    }
-    const WebFile* f = webFile(name);
-    if (f == nullptr) {
-      send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
-      return;
-    }
-    res.set_header("Cache-Control", "no-cache");
-    res.set_header("X-Content-Type-Options", "nosniff");
-    res.set_header("Content-Security-Policy",
-                   "default-src 'self'; img-src 'self' data:; style-src 'self'; frame-ancestors 'none'");
-    res.set_content(std::string(f->body), std::string(f->type));
-  });
-  auto sessionHandler = [this](const httplib::Request& req, httplib::Response& res) { session(req, res); };
-  server.Get("/v1/session", sessionHandler);
-  server.Post("/v1/session", sessionHandler);
-  server.Delete("/v1/session", sessionHandler);
-  server.Get("/v1/site", [this](const httplib::Request&, httplib::Response& res) {
+void Dashboard::routes(HttpServer& server) {
+  using Run = HttpServer::Run;
+  server.route(
+      "GET", "/", Scope::Public,
+      [](const Request&, Response& res) {
+        res.status = 302;
+        res.set_header("Location", "/dashboard/");
+      },
+      Run::Inline);
+  // The page's files carry no data: no login (the page asks for the token itself).
+  server.route(
+      "GET", R"(/dashboard/(.*))", Scope::Public,
+      [](const Request& req, Response& res) {
+        std::string name = req.matches[1];
+        if (name.empty()) {
+          name = "index.html";
+        }
+        const WebFile* f = webFile(name);
+        if (f == nullptr) {
+          send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
+          return;
+        }
+        res.set_header("Cache-Control", "no-cache");
+        res.set_header("X-Content-Type-Options", "nosniff");
+        res.set_header("Content-Security-Policy",
+                       "default-src 'self'; img-src 'self' data:; style-src 'self'; frame-ancestors 'none'");
+        res.set_content(std::string(f->body), std::string(f->type));
+      },
+      Run::Inline);
+  // Any token may make a session (it acts with that token's scopes); logging out with the cookie
+  // needs the CSRF token like every other change.
+  for (const char* method : {"GET", "POST", "DELETE"}) {
+    server.route(method, "/v1/session", Scope::Read,
+                 [this](const Request& req, Response& res) { session(req, res); });
+  }
+  server.route("GET", "/v1/site", Scope::Read, [this](const Request&, Response& res) {
     std::lock_guard lock(siteMutex_);
     if (site_.is_null()) {
       send(res, 404, problem("not_found", "this adapter has no site picture"));
@@ -199,7 +207,7 @@ void Dashboard::routes(httplib::Server& server) {
     }
     send(res, 200, site_);
   });
-  server.Get(R"(/v1/robots/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+  server.route("GET", R"(/v1/robots/([^/]+))", Scope::Read, [this](const Request& req, Response& res) {
     const std::string id = req.matches[1];
     for (const auto& r : d_.view.robots()) {
       if (r.robot_id == id) {
@@ -209,39 +217,62 @@ void Dashboard::routes(httplib::Server& server) {
     }
     send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
   });
-  server.Post(R"(/v1/robots/([^/]+)/([^/]+))",
-              [this](const httplib::Request& req, httplib::Response& res) { robotAction(req, res); });
-  server.Get("/v1/stream", [this](const httplib::Request&, httplib::Response& res) { stream(res); });
+  // Commanding a robot is an operator's: the same scope as pausing a task.
+  server.route("POST", R"(/v1/robots/([^/]+)/([^/]+))", Scope::Operate,
+               [this](const Request& req, Response& res) { robotAction(req, res); });
+  server.route(
+      "GET", "/v1/stream", Scope::Read,
+      [this](const Request&, Response& res) {
+        res.set_header("Cache-Control", "no-cache");
+        res.set_header("X-Accel-Buffering", "no");
+        res.setEventStream("text/event-stream", stream());
+      },
+      Run::Inline);
 }
 
-void Dashboard::session(const httplib::Request& req, httplib::Response& res) {
-  // admit() has let this request through: bearer token, a session, or no authentication at all.
-  if (d_.token.empty()) {
+void Dashboard::session(const Request& req, Response& res) {
+  // The gate has let this request through: bearer token, a session, or no authentication at all.
+  if (!d_.sessions.enabled()) {
     send(res, 200, {{"auth", "off"}, {"csrf", ""}});
     return;
   }
   if (req.method == "DELETE") {
-    res.set_header("Set-Cookie", BrowserSessions::clearCookie());
+    res.audit = json{{"session", "logout"}}.dump();
+    res.set_header("Set-Cookie", d_.sessions.clearCookie());
     send(res, 200, {{"auth", "none"}});
     return;
   }
   if (req.method == "POST") {
     // Made from the bearer token (the login form sends it once, in the header, never in a URL).
-    const std::string cookie = sessions_.issue(nowS());
-    res.set_header("Set-Cookie", sessions_.setCookie(cookie));
-    send(res, 201,
-         {{"auth", "session"},
-          {"csrf", *sessions_.csrfOf(cookie, nowS())},
-          {"expires_in_s", sessions_.lifetimeS()}});
+    res.audit = json{{"session", "login"}}.dump();
+    const auto cookie = d_.sessions.issue(req.principal, nowS());
+    const auto s = cookie ? d_.sessions.check(*cookie, nowS()) : std::nullopt;
+    if (!s) {
+      send(res, 401, problem("unauthorized", "the token \"" + req.principal + "\" is no longer valid"));
+      return;
+    }
+    res.set_header("Set-Cookie", d_.sessions.setCookie(*cookie));
+    send(res, 201, {{"auth", "session"}, {"csrf", s->csrf}, {"expires_in_s", d_.sessions.lifetimeS()}});
     return;
   }
-  const auto csrf = sessions_.csrfOf(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
-  send(res, 200, {{"auth", csrf ? "session" : "bearer"}, {"csrf", csrf ? *csrf : ""}});
+  const auto s = d_.sessions.check(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
+  json scopes = json::array();
+  if (s) {
+    for (const auto scope : s->who.scopes) {
+      scopes.push_back(toString(scope));
+    }
+  }
+  send(res, 200,
+       {{"auth", s ? "session" : "bearer"},
+        {"csrf", s ? s->csrf : ""},
+        {"name", req.principal},
+        {"scopes", scopes}});
 }
 
-void Dashboard::robotAction(const httplib::Request& req, httplib::Response& res) {
+void Dashboard::robotAction(const Request& req, Response& res) {
   const std::string id = req.matches[1];
   const std::string action = req.matches[2];
+  res.audit = json{{"robot", id}, {"action", action}}.dump(-1, ' ', false, json::error_handler_t::replace);
   if (action != "pause" && action != "resume" && action != "home" && action != "charge") {
     send(res, 404, problem("not_found", "no robot action \"" + action + "\" (pause, resume, home, charge)"));
     return;
@@ -272,7 +303,7 @@ void Dashboard::robotAction(const httplib::Request& req, httplib::Response& res)
   }
 }
 
-void Dashboard::hold(const std::string& robot, bool held, httplib::Response& res) {
+void Dashboard::hold(const std::string& robot, bool held, Response& res) {
   msg::Task m;
   m.task_id = robot;
   m.robot = robot;
@@ -292,8 +323,8 @@ void Dashboard::hold(const std::string& robot, bool held, httplib::Response& res
   }
 }
 
-void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, const httplib::Request& req,
-                       httplib::Response& res) {
+void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, const Request& req,
+                       Response& res) {
   const bool home = action == "home";
   std::string station;
   if (!req.body.empty()) {
@@ -351,23 +382,24 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
        {{"robot", robot.robot_id}, {"task", id}, {"station", station}, {"state", msg::toString(a->state)}});
 }
 
-void Dashboard::stream(httplib::Response& res) {
+EventSource Dashboard::stream() {
   // One stream for the page: a snapshot first (robots, recent tasks), then robot states that
   // changed (at most every streamPeriodMs) and every task event. A page that reconnects gets a
-  // new snapshot, so it catches up after a lost connection or an adapter restart.
+  // new snapshot, so it catches up after a lost connection or an adapter restart. The server
+  // asks for the next text every poll interval from its I/O thread: nothing here waits, and the
+  // server sends keep-alives when there is nothing to say.
   struct Cursor {
     bool sentSnapshot = false;
     std::uint64_t events = 0;
     std::unordered_map<std::string, std::int64_t> sent;  // robot -> stamp sent last
-    std::uint64_t risk = 0;                              // risk maps sent: the view's count
+    std::chrono::steady_clock::time_point robotsSentAt;
+    std::uint64_t risk = 0;  // risk maps sent: the view's count
     std::chrono::steady_clock::time_point riskSentAt;
   };
   auto cur = std::make_shared<Cursor>();
   cur->events = d_.view.eventCursor();
-  res.set_header("Cache-Control", "no-cache");
-  res.set_header("X-Accel-Buffering", "no");
-  res.set_chunked_content_provider("text/event-stream", [this, cur](std::size_t, httplib::DataSink& sink) {
-    std::string chunk;
+  return [this, cur]() -> std::optional<std::string> {
+    const auto now = std::chrono::steady_clock::now();
     auto robotsJson = [&](bool all) {
       json items = json::array();
       for (const auto& r : d_.view.robots()) {
@@ -377,12 +409,12 @@ void Dashboard::stream(httplib::Response& res) {
           items.push_back(robotJson(r));
         }
       }
+      cur->robotsSentAt = now;
       return items;
     };
     // The risk map at most once a second: it is the largest message and changes least visibly.
     auto riskEvent = [&](bool force) -> std::string {
       const auto [count, map] = d_.view.risk();
-      const auto now = std::chrono::steady_clock::now();
       if (!map || count == cur->risk || (!force && now - cur->riskSentAt < std::chrono::seconds(1))) {
         return {};
       }
@@ -391,6 +423,7 @@ void Dashboard::stream(httplib::Response& res) {
       const json j = riskJson(*map);
       return j.is_null() ? std::string() : "event: risk\ndata: " + j.dump() + "\n\n";
     };
+    const char* manager = d_.gateway.managerOnline() ? "online" : "unreachable";
     if (!cur->sentSnapshot) {
       cur->sentSnapshot = true;
       json tasks = json::array();
@@ -401,16 +434,14 @@ void Dashboard::stream(httplib::Response& res) {
                          {"reason", t.reason},
                          {"stamp_ns", t.updatedNs}});
       }
-      chunk = "retry: 1000\nevent: snapshot\ndata: " +
-              json{{"robots", robotsJson(true)},
-                   {"tasks", tasks},
-                   {"fleet_manager", d_.gateway.managerOnline() ? "online" : "unreachable"}}
-                  .dump(-1, ' ', false, json::error_handler_t::replace) +
-              "\n\n" + riskEvent(true);
-      return sink.write(chunk.data(), chunk.size());
+      return "retry: 1000\nevent: snapshot\ndata: " +
+             json{{"robots", robotsJson(true)}, {"tasks", tasks}, {"fleet_manager", manager}}.dump(
+                 -1, ' ', false, json::error_handler_t::replace) +
+             "\n\n" + riskEvent(true);
     }
+    std::string chunk;
     std::vector<msg::TaskEvent> evs;
-    cur->events = d_.view.eventsAfter(cur->events, std::chrono::milliseconds(d_.streamPeriodMs), evs);
+    cur->events = d_.view.eventsAfter(cur->events, std::chrono::milliseconds(0), evs);
     for (const auto& e : evs) {
       chunk += "event: task\ndata: " +
                json{{"id", e.task_id},    {"state", msg::toString(e.state)}, {"robot", e.robot_id},
@@ -418,20 +449,17 @@ void Dashboard::stream(httplib::Response& res) {
                    .dump(-1, ' ', false, json::error_handler_t::replace) +
                "\n\n";
     }
-    const json robots = robotsJson(false);
-    if (!robots.empty()) {
-      chunk +=
-          "event: robots\ndata: " +
-          json{{"robots", robots}, {"fleet_manager", d_.gateway.managerOnline() ? "online" : "unreachable"}}
-              .dump(-1, ' ', false, json::error_handler_t::replace) +
-          "\n\n";
+    if (now - cur->robotsSentAt >= std::chrono::milliseconds(d_.streamPeriodMs)) {
+      const json robots = robotsJson(false);
+      if (!robots.empty()) {
+        chunk += "event: robots\ndata: " +
+                 json{{"robots", robots}, {"fleet_manager", manager}}.dump(-1, ' ', false,
+                                                                           json::error_handler_t::replace) +
+                 "\n\n";
+      }
     }
-    chunk += riskEvent(false);
-    if (chunk.empty()) {
-      chunk = ": keep-alive\n\n";
-    }
-    return sink.write(chunk.data(), chunk.size());
-  });
+    return chunk + riskEvent(false);
+  };
 }
 
 }  // namespace fleet::wms

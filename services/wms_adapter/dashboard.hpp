@@ -3,12 +3,12 @@
 // The live operator dashboard's side of the WMS adapter (docs/operator-guide.md#dashboard): the
 // page's static files (built into the binary), browser sessions, the robot API (snapshot, one
 // robot, hold/release, send home or to charge), the site picture and one SSE stream of robot
-// states and task events for the page.
-
-#include <httplib.h>
+// states and task events for the page. Who may use which route is the API's scope model
+// (access_control.hpp): the page's files are public, data needs "read", robot actions "operate".
 
 #include <functional>
 #include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -16,6 +16,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/fleet/station_map.hpp"
 #include "gateway.hpp"
+#include "http_server.hpp"
 
 namespace fleet::wms {
 
@@ -31,7 +32,7 @@ nlohmann::json riskJson(const msg::RiskMap& m);
 nlohmann::json sitePictureOf(const std::string& path);
 
 struct DashboardDeps {
-  std::string token;  // the API's bearer token (empty: no authentication)
+  const BrowserSessions& sessions;  // the API's (AccessControl admits their cookies)
   const StationMap& stations;
   TaskGateway& gateway;
   FleetView& view;
@@ -43,24 +44,22 @@ struct DashboardDeps {
 
 class Dashboard {
  public:
-  Dashboard(httplib::Server& server, DashboardDeps deps);
-  /// The API's authentication check (request_auth.hpp) with this dashboard's sessions.
-  bool admit(const httplib::Request& req, httplib::Response& res) const;
+  /// Registers the dashboard's routes on `server`.
+  Dashboard(HttpServer& server, DashboardDeps deps);
   /// The picture GET /v1/site returns (sitePictureOf); before it is set, 404.
   void setSite(nlohmann::json site);
 
  private:
-  void routes(httplib::Server& server);
-  void session(const httplib::Request& req, httplib::Response& res);
-  void robotAction(const httplib::Request& req, httplib::Response& res);
-  void hold(const std::string& robot, bool held, httplib::Response& res);
-  void sendTo(const msg::RobotState& robot, const std::string& action, const httplib::Request& req,
-              httplib::Response& res);
-  void stream(httplib::Response& res);
+  void routes(HttpServer& server);
+  void session(const Request& req, Response& res);
+  void robotAction(const Request& req, Response& res);
+  void hold(const std::string& robot, bool held, Response& res);
+  void sendTo(const msg::RobotState& robot, const std::string& action, const Request& req, Response& res);
+  /// The page's event stream; polled by the server from its I/O thread, so it never blocks.
+  [[nodiscard]] EventSource stream();
   [[nodiscard]] std::int64_t nowS() const;
 
   DashboardDeps d_;
-  BrowserSessions sessions_;
   std::mutex siteMutex_;
   nlohmann::json site_;
   std::map<std::string, std::string> homes_;  // robot -> its parking place, from the site picture

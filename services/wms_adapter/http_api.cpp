@@ -4,12 +4,10 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <random>
 
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/task.hpp"
-#include "fleet/service/ops_server.hpp"
 #include "fleet/service/task_wire.hpp"
 
 namespace fleet::wms {
@@ -23,7 +21,7 @@ std::string dumpJson(const json& j) {
   return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-void reply(httplib::Response& res, int status, const json& body) {
+void reply(Response& res, int status, const json& body) {
   res.status = status;
   res.set_content(dumpJson(body), "application/json");
 }
@@ -92,23 +90,38 @@ std::pair<int, json> outcome(const Task& t, const std::optional<msg::TaskAck>& a
 
 ApiSettings readApiSettings(Config& cfg) {
   ApiSettings s;
+  auto& l = s.limits;
   auto h = cfg.child("http");
-  h.rejectUnknownKeys({"host", "port", "token_file", "max_body_bytes", "max_batch", "ack_timeout_ms",
-                       "max_in_flight", "threads"});
+  h.rejectUnknownKeys({"host", "port", "token_file", "audit_log", "tls_certificate", "tls_key",
+                       "max_body_bytes", "max_batch", "ack_timeout_ms", "max_in_flight", "threads",
+                       "max_connections", "max_streams", "backlog", "request_timeout_ms", "rate_per_client",
+                       "rate_burst"});
   s.host = h.string("host", s.host);
   s.port = static_cast<int>(h.integer("port", s.port, {0, 65535}));
-  s.maxBodyBytes = static_cast<std::size_t>(
-      h.integer("max_body_bytes", static_cast<std::int64_t>(s.maxBodyBytes), {1024, 256.0 * 1024 * 1024}));
+  l.maxBodyBytes = static_cast<std::size_t>(
+      h.integer("max_body_bytes", static_cast<std::int64_t>(l.maxBodyBytes), {1024, 256.0 * 1024 * 1024}));
   s.maxBatch =
       static_cast<std::size_t>(h.integer("max_batch", static_cast<std::int64_t>(s.maxBatch), {1, 100000}));
   s.ackTimeoutMs = static_cast<int>(h.integer("ack_timeout_ms", s.ackTimeoutMs, {1, 600000}));
-  s.maxInFlight = static_cast<int>(h.integer("max_in_flight", s.maxInFlight, {1, 100000}));
-  s.threads = static_cast<int>(h.integer("threads", s.threads, {1, 256}));
-  const std::string tokenFile = h.string("token_file", "");
-  if (!tokenFile.empty()) {
-    std::ifstream in(tokenFile);
-    if (!in || !std::getline(in, s.token) || s.token.empty()) {
-      h.problem("token_file", "cannot read a token from \"" + tokenFile + "\"");
+  l.threads = static_cast<int>(h.integer("threads", l.threads, {1, 256}));
+  // Beyond the workers a request would only wait: by default it is refused (429) instead.
+  l.maxInFlight = static_cast<int>(h.integer("max_in_flight", l.threads, {1, 100000}));
+  l.maxConnections = static_cast<int>(h.integer("max_connections", l.maxConnections, {1, 100000}));
+  l.maxStreams = static_cast<int>(h.integer("max_streams", l.maxStreams, {0, 100000}));
+  l.backlog = static_cast<int>(h.integer("backlog", l.backlog, {1, 65535}));
+  l.requestTimeoutMs = static_cast<int>(h.integer("request_timeout_ms", l.requestTimeoutMs, {100, 600000}));
+  l.ratePerClient = h.number("rate_per_client", l.ratePerClient, {0, 1e6});
+  l.rateBurst = static_cast<int>(h.integer("rate_burst", l.rateBurst, {1, 1000000}));
+  s.auditLog = h.string("audit_log", "");
+  s.tls.certificateFile = h.string("tls_certificate", "");
+  s.tls.privateKeyFile = h.string("tls_key", "");
+  if (s.tls.certificateFile.empty() != s.tls.privateKeyFile.empty()) {
+    h.problem("tls_key", "https needs both tls_certificate and tls_key");
+  }
+  s.tokenFile = h.string("token_file", "");
+  if (!s.tokenFile.empty()) {
+    if (auto t = TokenStore::fromFile(s.tokenFile); !t) {
+      h.problem("token_file", t.error().message);
     }
   } else if (const char* env = std::getenv("FLEET_WMS_TOKEN"); env != nullptr) {
     s.token = env;
@@ -116,16 +129,32 @@ ApiSettings readApiSettings(Config& cfg) {
   return s;
 }
 
+namespace {
+TokenStore tokenStoreOf(const ApiSettings& s) {
+  if (!s.tokenFile.empty()) {
+    auto t = TokenStore::fromFile(s.tokenFile);
+    if (!t) {
+      throw ConfigError({"http.token_file: " + t.error().message});
+    }
+    return std::move(*t);
+  }
+  return s.token.empty() ? TokenStore() : TokenStore::single("token", s.token);
+}
+}  // namespace
+
 HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& gateway, FleetView& view,
                  const Clock& clock)
-    : settings_(std::move(settings)), stations_(stations), gateway_(gateway), view_(view), clock_(clock) {
+    : settings_(std::move(settings)),
+      stations_(stations),
+      gateway_(gateway),
+      view_(view),
+      clock_(clock),
+      tokens_(tokenStoreOf(settings_)),
+      sessions_(tokens_, settings_.tls.enabled()),
+      audit_(settings_.auditLog),
+      server_(settings_.limits, settings_.tls) {
   std::random_device rd;
   instance_ = std::to_string(rd() % 1'000'000);
-  server_.new_task_queue = [n = settings_.threads] {
-    return new httplib::ThreadPool(static_cast<std::size_t>(n));
-  };
-  server_.set_payload_max_length(settings_.maxBodyBytes);
-  service::bindExclusively(server_);  // a second adapter on a taken port fails instead of sharing it
   routes();
 }
 
@@ -134,25 +163,15 @@ std::string HttpApi::nextRequestId() {
 }
 
 bool HttpApi::bind() {
-  if (settings_.port == 0) {
-    port_ = server_.bind_to_any_port(settings_.host);
-    return port_ > 0;
-  }
-  port_ = settings_.port;
-  return server_.bind_to_port(settings_.host, settings_.port);
+  return server_.bind(settings_.host, settings_.port);
 }
 
 void HttpApi::serve() {
-  server_.listen_after_bind();
+  server_.serve();
 }
 void HttpApi::stop() {
   server_.stop();
 }
-
-namespace {
-// httplib runs a request's pre- and post-routing handlers on the same worker thread.
-thread_local std::chrono::steady_clock::time_point requestStart;
-}  // namespace
 
 void HttpApi::instrument(metrics::Registry& registry) {
   registry_ = &registry;
@@ -161,67 +180,50 @@ void HttpApi::instrument(metrics::Registry& registry) {
                                         metrics::exponentialBuckets(1e-4, 2.0, 18));
 }
 
-void HttpApi::routes() {
-  dashboard_ = std::make_unique<Dashboard>(
-      server_, DashboardDeps{settings_.token, stations_, gateway_, view_, clock_,
-                             [this] { return nextRequestId(); }, settings_.ackTimeoutMs});
-  server_.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    ++counters_.requests;
-    requestStart = std::chrono::steady_clock::now();
-    // Bearer token or browser session; health and the page's static files need neither.
-    return dashboard_->admit(req, res) ? httplib::Server::HandlerResponse::Unhandled
-                                       : httplib::Server::HandlerResponse::Handled;
-  });
-  server_.set_post_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (registry_ != nullptr) {
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - requestStart).count();
-      registry_
-          ->counter("wms_adapter_http_responses_total", "HTTP responses of the WMS API, by status code",
-                    {{"code", std::to_string(res.status)}})
-          .inc();
-      requestSeconds_->observe(seconds);
-      // The access log: client, method, path (no query string: short lines, nothing a client put
-      // there by mistake), status, body bytes, time. Never the Authorization header.
-      spdlog::info("access {} {} {} {} {} {:.6f}s", req.remote_addr, req.method, req.path, res.status,
-                   res.body.size(), seconds);
-    }
-    if (res.status >= 500) {
-      ++counters_.status5xx;
-    } else if (res.status >= 400) {
-      ++counters_.status4xx;
-    } else {
-      ++counters_.status2xx;
-    }
-  });
-  server_.set_error_handler([](const httplib::Request&, httplib::Response& res) {
-    if (res.body.empty()) {
-      const std::string code = res.status == 413 ? "too_large" : res.status == 404 ? "not_found" : "error";
-      reply(res, res.status,
-            error(code, code == "too_large" ? "the body is larger than the configured limit"
-                                            : "HTTP " + std::to_string(res.status)));
-    }
-  });
-  server_.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
-    std::string what = "internal error";
-    try {
-      std::rethrow_exception(ep);
-    } catch (const std::exception& e) {
-      what = e.what();
-    } catch (...) {
-    }
-    reply(res, 500, error("internal", what));
-  });
+void HttpApi::observe(const Request& req, const Response& res, double seconds) {
+  ++counters_.requests;
+  if (registry_ != nullptr) {
+    registry_
+        ->counter("wms_adapter_http_responses_total", "HTTP responses of the WMS API, by status code",
+                  {{"code", std::to_string(res.status)}})
+        .inc();
+    requestSeconds_->observe(seconds);
+    // The access log: client, who, method, path (no query string: short lines, nothing a client
+    // put there by mistake), status, body bytes, time. Never the Authorization header.
+    spdlog::info("access {} {} {} {} {} {} {:.6f}s", req.remote_addr,
+                 req.principal.empty() ? "-" : req.principal, req.method, req.path, res.status,
+                 res.body.size(), seconds);
+  }
+  audit_.record(req, res,
+                std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    std::chrono::system_clock::now().time_since_epoch())
+                    .count());
+  if (res.status >= 500) {
+    ++counters_.status5xx;
+  } else if (res.status >= 400) {
+    ++counters_.status4xx;
+  } else {
+    ++counters_.status2xx;
+  }
+}
 
-  server_.Post("/v1/tasks",
-               [this](const httplib::Request& req, httplib::Response& res) { postTasks(req, res); });
-  server_.Delete(R"(/v1/tasks/([^/]+))",
-                 [this](const httplib::Request& req, httplib::Response& res) { deleteTask(req, res); });
-  server_.Post(R"(/v1/tasks/([^/]+)/pause)",
-               [this](const httplib::Request& req, httplib::Response& res) { controlTask(req, res, true); });
-  server_.Post(R"(/v1/tasks/([^/]+)/resume)",
-               [this](const httplib::Request& req, httplib::Response& res) { controlTask(req, res, false); });
-  server_.Get(R"(/v1/tasks/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
+void HttpApi::routes() {
+  server_.setGate(
+      [this](Request& req, Response& res, Scope scope) { return access_.admit(req, res, scope); });
+  server_.setObserver([this](const Request& req, const Response& res, double s) { observe(req, res, s); });
+  using Run = HttpServer::Run;
+  dashboard_ = std::make_unique<Dashboard>(
+      server_, DashboardDeps{sessions_, stations_, gateway_, view_, clock_,
+                             [this] { return nextRequestId(); }, settings_.ackTimeoutMs});
+  server_.route("POST", "/v1/tasks", Scope::Submit,
+                [this](const Request& req, Response& res) { postTasks(req, res); });
+  server_.route("DELETE", R"(/v1/tasks/([^/]+))", Scope::Submit,
+                [this](const Request& req, Response& res) { deleteTask(req, res); });
+  server_.route("POST", R"(/v1/tasks/([^/]+)/pause)", Scope::Operate,
+                [this](const Request& req, Response& res) { controlTask(req, res, true); });
+  server_.route("POST", R"(/v1/tasks/([^/]+)/resume)", Scope::Operate,
+                [this](const Request& req, Response& res) { controlTask(req, res, false); });
+  server_.route("GET", R"(/v1/tasks/([^/]+))", Scope::Read, [this](const Request& req, Response& res) {
     const std::string id = req.matches[1];
     auto v = view_.task(id);
     if (!v && isValidId(id) && gateway_.managerOnline()) {
@@ -239,7 +241,7 @@ void HttpApi::routes() {
     }
     reply(res, 200, viewJson(*v));
   });
-  server_.Get("/v1/tasks", [this](const httplib::Request& req, httplib::Response& res) {
+  server_.route("GET", "/v1/tasks", Scope::Read, [this](const Request& req, Response& res) {
     std::optional<msg::TaskState> state;
     if (req.has_param("state")) {
       msg::TaskState s{};
@@ -273,19 +275,25 @@ void HttpApi::routes() {
     }
     reply(res, 200, {{"tasks", items}, {"count", items.size()}});
   });
-  server_.Get("/v1/robots", [this](const httplib::Request&, httplib::Response& res) {
+  server_.route("GET", "/v1/robots", Scope::Read, [this](const Request&, Response& res) {
     json items = json::array();
     for (const auto& r : view_.robots()) {
       items.push_back(robotJson(r));
     }
     reply(res, 200, {{"robots", items}, {"count", items.size()}});
   });
-  server_.Get("/v1/health", [this](const httplib::Request&, httplib::Response& res) {
-    const bool up = gateway_.managerOnline();
-    reply(res, up ? 200 : 503,
-          {{"status", up ? "ok" : "degraded"}, {"fleet_manager", up ? "online" : "unreachable"}});
-  });
-  server_.Get("/v1/metrics", [this](const httplib::Request&, httplib::Response& res) {
+  // Health tells nothing secret and a probe carries no token: public, and answered on the I/O
+  // thread so that busy workers never make the adapter look dead.
+  server_.route(
+      "GET", "/v1/health", Scope::Public,
+      [this](const Request&, Response& res) {
+        const bool up = gateway_.managerOnline();
+        reply(res, up ? 200 : 503,
+              {{"status", up ? "ok" : "degraded"}, {"fleet_manager", up ? "online" : "unreachable"}});
+      },
+      Run::Inline);
+  server_.route("GET", "/v1/metrics", Scope::Read, [this](const Request&, Response& res) {
+    const auto& h = server_.stats();
     reply(res, 200,
           {{"requests", counters_.requests.load()},
            {"responses",
@@ -297,17 +305,32 @@ void HttpApi::routes() {
            {"tasks_by_state", view_.countByState()},
            {"robots", view_.robots().size()},
            {"fleet_manager_online", gateway_.managerOnline()},
-           {"samples", view_.rejections().toJson()}});
+           {"samples", view_.rejections().toJson()},
+           {"http",
+            {{"open_connections", h.openConnections.load()},
+             {"open_streams", h.openStreams.load()},
+             {"refused_connections", h.refusedConnections.load()},
+             {"refused_streams", h.refusedStreams.load()},
+             {"busy", h.busy.load()},
+             {"rate_limited", h.rateLimited.load()},
+             {"too_large", h.tooLarge.load()},
+             {"timed_out", h.timedOut.load()},
+             {"tls_failures", h.tlsFailures.load()},
+             {"token_reloads", tokens_.reloads()},
+             {"token_file_problem", tokens_.lastProblem()},
+             {"audit_write_failures", audit_.writeFailures()}}}});
   });
   // Server-sent events: every TaskEvent as `event: task` with the JSON of the event. The stream
-  // ends when the client goes away or the server stops.
-  server_.Get("/v1/events", [this](const httplib::Request&, httplib::Response& res) {
-    auto cursor = std::make_shared<std::uint64_t>(view_.eventCursor());
-    res.set_header("Cache-Control", "no-cache");
-    res.set_chunked_content_provider(
-        "text/event-stream", [this, cursor](std::size_t, httplib::DataSink& sink) {
+  // holds no worker: the server polls it (never blocking) from its I/O thread. It ends when the
+  // client goes away or the server stops.
+  server_.route(
+      "GET", "/v1/events", Scope::Read,
+      [this](const Request&, Response& res) {
+        auto cursor = std::make_shared<std::uint64_t>(view_.eventCursor());
+        res.set_header("Cache-Control", "no-cache");
+        res.setEventStream("text/event-stream", [this, cursor]() -> std::optional<std::string> {
           std::vector<msg::TaskEvent> evs;
-          *cursor = view_.eventsAfter(*cursor, std::chrono::milliseconds(1000), evs);
+          *cursor = view_.eventsAfter(*cursor, std::chrono::milliseconds(0), evs);
           std::string chunk;
           for (const auto& e : evs) {
             chunk += "event: task\ndata: " +
@@ -319,25 +342,13 @@ void HttpApi::routes() {
                                {"seq", e.seq}}) +
                      "\n\n";
           }
-          if (chunk.empty()) {
-            chunk = ": keep-alive\n\n";
-          }
-          return sink.write(chunk.data(), chunk.size());
+          return chunk;
         });
-  });
+      },
+      Run::Inline);
 }
 
-void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
-  struct InFlight {
-    std::atomic<int>& n;
-    explicit InFlight(std::atomic<int>& c) : n(c) { ++n; }
-    ~InFlight() { --n; }
-  } guard(inFlight_);
-  if (inFlight_.load() > settings_.maxInFlight) {
-    res.set_header("Retry-After", "1");
-    reply(res, 429, error("busy", "too many requests in flight; retry"));
-    return;
-  }
+void HttpApi::postTasks(const Request& req, Response& res) {
   json body = json::parse(req.body, nullptr, false);
   if (body.is_discarded()) {
     reply(res, 400, {{"error", "invalid_json"}, {"message", "the body is not valid JSON"}});
@@ -365,6 +376,11 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
     reply(res, 503, error("unavailable", "the fleet manager is unreachable; nothing was stored"));
     return;
   }
+  std::vector<std::string> ids;
+  for (const auto& t : *parsed) {
+    ids.push_back(t.id);
+  }
+  res.audit = json{{"tasks", ids}}.dump();
   const std::int64_t now = clock_.nowNs();
   std::vector<msg::Task> requests;
   for (const auto& t : *parsed) {
@@ -399,7 +415,7 @@ void HttpApi::postTasks(const httplib::Request& req, httplib::Response& res) {
   reply(res, status, {{"results", results}});
 }
 
-bool HttpApi::admitTaskRequest(const std::string& id, const char* verb, httplib::Response& res) {
+bool HttpApi::admitTaskRequest(const std::string& id, const char* verb, Response& res) {
   if (!isValidId(id)) {
     reply(res, 400,
           {{"error", "invalid"},
@@ -415,8 +431,9 @@ bool HttpApi::admitTaskRequest(const std::string& id, const char* verb, httplib:
   return true;
 }
 
-void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
+void HttpApi::deleteTask(const Request& req, Response& res) {
   const std::string id = req.matches[1];
+  res.audit = json{{"task", id}, {"action", "cancel"}}.dump();
   if (!admitTaskRequest(id, "cancelled", res)) {
     return;
   }
@@ -437,8 +454,9 @@ void HttpApi::deleteTask(const httplib::Request& req, httplib::Response& res) {
   }
 }
 
-void HttpApi::controlTask(const httplib::Request& req, httplib::Response& res, bool pause) {
+void HttpApi::controlTask(const Request& req, Response& res, bool pause) {
   const std::string id = req.matches[1];
+  res.audit = json{{"task", id}, {"action", pause ? "pause" : "resume"}}.dump();
   if (!admitTaskRequest(id, pause ? "paused" : "resumed", res)) {
     return;
   }

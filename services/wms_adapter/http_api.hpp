@@ -1,34 +1,40 @@
 #pragma once
 
 // The WMS adapter's HTTP/JSON API (docs/openapi.yaml). Listens on 127.0.0.1 unless configured
-// otherwise; with a bearer token configured, every request without it gets 401.
-
-#include <httplib.h>
+// otherwise; with tokens configured, every request but the health probe needs a bearer token that
+// grants the route's scope (read, submit, operate); https with a certificate configured.
 
 #include <atomic>
+#include <memory>
 #include <string>
 
+#include "access_control.hpp"
+#include "audit_log.hpp"
+#include "browser_session.hpp"
 #include "dashboard.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/station_map.hpp"
 #include "fleet/metrics/registry.hpp"
 #include "gateway.hpp"
+#include "http_server.hpp"
+#include "token_store.hpp"
 
 namespace fleet::wms {
 
 struct ApiSettings {
   std::string host = "127.0.0.1";
-  int port = 8080;    // 0 = any free port
-  std::string token;  // empty = no authentication
-  std::size_t maxBodyBytes = 1 << 20;
+  int port = 8080;        // 0 = any free port
+  std::string tokenFile;  // tokens with names and scopes, re-read when it changes
+  std::string token;      // one token with every scope (FLEET_WMS_TOKEN); neither = no authentication
+  std::string auditLog;   // empty: audit lines go to the service log
+  TlsFiles tls;
+  ServerLimits limits;
   std::size_t maxBatch = 1000;
   int ackTimeoutMs = 5000;
-  int maxInFlight = 64;  // concurrent POST/DELETE requests before 429
-  int threads = 8;
 };
 
-/// Reads `http.*` keys; the token comes from `token_file` (first line) or FLEET_WMS_TOKEN.
+/// Reads `http.*` keys; without `token_file`, the token comes from FLEET_WMS_TOKEN.
 ApiSettings readApiSettings(Config& cfg);
 
 struct ApiCounters {
@@ -42,15 +48,20 @@ struct ApiCounters {
 
 class HttpApi {
  public:
+  /// Throws ConfigError when the token file, the certificate or the audit log cannot be used.
   HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& gateway, FleetView& view,
           const Clock& clock);
   /// Binds the socket; false when the address is taken. port() tells the port bound.
   bool bind();
-  [[nodiscard]] int port() const { return port_; }
+  [[nodiscard]] int port() const { return server_.port(); }
   /// Serves until stop() (blocking).
   void serve();
   void stop();
   [[nodiscard]] const ApiCounters& counters() const { return counters_; }
+  [[nodiscard]] const ServerStats& serverStats() const { return server_.stats(); }
+  [[nodiscard]] const TokenStore& tokens() const { return tokens_; }
+  /// The scope check every route goes through; for routes that check by themselves.
+  [[nodiscard]] const AccessControl& access() const { return access_; }
   /// Counts responses by status code and times requests in `registry` (the ops port's), and
   /// writes one access-log line per request at info level. Call before serve().
   void instrument(metrics::Registry& registry);
@@ -59,13 +70,14 @@ class HttpApi {
 
  private:
   void routes();
-  void postTasks(const httplib::Request& req, httplib::Response& res);
-  void deleteTask(const httplib::Request& req, httplib::Response& res);
+  void observe(const Request& req, const Response& res, double seconds);
+  void postTasks(const Request& req, Response& res);
+  void deleteTask(const Request& req, Response& res);
   /// A request on task `id` (cancel, pause, resume): a valid id and a reachable manager, else the
   /// 400 / 503 reply is written ("nothing was <verb>") and false returned.
-  bool admitTaskRequest(const std::string& id, const char* verb, httplib::Response& res);
+  bool admitTaskRequest(const std::string& id, const char* verb, Response& res);
   /// POST /v1/tasks/{id}/pause and /resume.
-  void controlTask(const httplib::Request& req, httplib::Response& res, bool pause);
+  void controlTask(const Request& req, Response& res, bool pause);
   std::string nextRequestId();
 
   ApiSettings settings_;
@@ -73,9 +85,11 @@ class HttpApi {
   TaskGateway& gateway_;
   FleetView& view_;
   const Clock& clock_;
-  httplib::Server server_;
-  int port_ = 0;
-  std::atomic<int> inFlight_{0};
+  TokenStore tokens_;
+  BrowserSessions sessions_;  // cookies for the dashboard's page, made from a token
+  AccessControl access_{tokens_, &sessions_};
+  AuditLog audit_;
+  HttpServer server_;
   std::atomic<std::uint64_t> requestCounter_{0};
   std::string instance_;
   ApiCounters counters_;

@@ -67,9 +67,14 @@ int main(int argc, char** argv) {
       spdlog::critical("wms adapter: cannot listen on {}:{}", api.host, api.port);
       return service::kExitUsage;
     }
-    spdlog::info("wms adapter: listening on http://{}:{} ({} stations, auth {})", api.host, http.port(),
-                 stations->size(), api.token.empty() ? "off" : "bearer token");
-    spdlog::info("wms adapter: dashboard at http://{}:{}/dashboard/", api.host, http.port());
+    spdlog::info("wms adapter: listening on {}://{}:{} ({} stations, auth {}, audit to {})",
+                 api.tls.enabled() ? "https" : "http", api.host, http.port(), stations->size(),
+                 !http.tokens().enabled() ? "off"
+                 : api.tokenFile.empty()  ? "one bearer token (FLEET_WMS_TOKEN)"
+                                          : "bearer tokens from " + api.tokenFile,
+                 api.auditLog.empty() ? "the service log" : api.auditLog);
+    spdlog::info("wms adapter: dashboard at {}://{}:{}/dashboard/", api.tls.enabled() ? "https" : "http",
+                 api.host, http.port());
     std::thread server([&] { http.serve(); });
     auto& managerOnline = ops.registry().gauge("wms_adapter_fleet_manager_online",
                                                "1 when the fleet manager answers over DDS, else 0");

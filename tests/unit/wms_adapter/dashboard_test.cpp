@@ -5,15 +5,21 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <random>
 #include <thread>
 
+#include "api_fixture.hpp"
 #include "browser_session.hpp"
 #include "http_api.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
+using fleet::wms::testing::RawClient;
 using nlohmann::json;
 using ::testing::HasSubstr;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -54,8 +60,11 @@ class Dash : public ::testing::Test {
  protected:
   void start(const std::string& token) {
     ApiSettings s;
-    s.port = 0;
     s.token = token;
+    start(s);
+  }
+  void start(ApiSettings s) {
+    s.port = 0;
     s.ackTimeoutMs = 200;
     api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
     api_->dashboard().setSite(
@@ -107,10 +116,14 @@ TEST_F(Dash, ThePageNeedsNoLoginButTheDataDoes) {
   ASSERT_TRUE(js);
   EXPECT_THAT(js->get_header_value("Content-Type"), HasSubstr("javascript"));
   EXPECT_EQ(client_->Get("/dashboard/nope.js")->status, 404);
+  auto root = client_->Get("/");
+  ASSERT_TRUE(root);
+  EXPECT_EQ(root->status, 302);
+  EXPECT_EQ(root->get_header_value("Location"), "/dashboard/");
   EXPECT_EQ(client_->Get("/v1/robots")->status, 401);
   EXPECT_EQ(client_->Get("/v1/stream")->status, 401);
   EXPECT_EQ(client_->Get("/v1/session")->status, 401) << "the page shows its login prompt on this";
-  EXPECT_EQ(client_->Get("/v1/robots?token=s3cret")->status, 401) << "a token in a URL is never accepted";
+  EXPECT_EQ(client_->Get("/v1/robots?token=s3cret")->status, 400) << "a token in a URL is never accepted";
 }
 
 TEST_F(Dash, ASessionCookieReadsAndActsOnlyWithItsCsrfToken) {
@@ -154,17 +167,26 @@ TEST_F(Dash, ASessionCookieReadsAndActsOnlyWithItsCsrfToken) {
 }
 
 TEST(BrowserSessions, ExpireAndEndWhenTheTokenChanges) {
-  const BrowserSessions s("token-a", 60);
-  const std::string c = s.issue(1000);
-  EXPECT_TRUE(s.csrfOf(c, 1059));
-  EXPECT_FALSE(s.csrfOf(c, 1061)) << "expired";
-  EXPECT_FALSE(BrowserSessions("token-b", 60).csrfOf(c, 1000)) << "made from another token";
-  EXPECT_TRUE(BrowserSessions("token-a", 60).csrfOf(c, 1000)) << "survives a restart with the same token";
-  EXPECT_FALSE(s.csrfOf("garbage", 1000));
-  EXPECT_FALSE(s.csrfOf("", 1000));
-  EXPECT_NE(s.issue(1000), c) << "each session has its own nonce";
+  const auto tokenA = TokenStore::single("token", "token-a");
+  const BrowserSessions s(tokenA, false, 60);
+  const std::string c = *s.issue("token", 1000);
+  EXPECT_TRUE(s.check(c, 1059));
+  EXPECT_FALSE(s.check(c, 1061)) << "expired";
+  const auto tokenB = TokenStore::single("token", "token-b");
+  EXPECT_FALSE(BrowserSessions(tokenB, false, 60).check(c, 1000)) << "made from another token";
+  const auto tokenA2 = TokenStore::single("token", "token-a");
+  EXPECT_TRUE(BrowserSessions(tokenA2, false, 60).check(c, 1000)) << "survives a restart with the same token";
+  const auto renamed = TokenStore::single("other", "token-a");
+  EXPECT_FALSE(BrowserSessions(renamed, false, 60).check(c, 1000)) << "the name is part of the session";
+  EXPECT_FALSE(s.issue("nobody", 1000)) << "no token has that name";
+  EXPECT_FALSE(s.check("garbage", 1000));
+  EXPECT_FALSE(s.check("", 1000));
+  EXPECT_NE(*s.issue("token", 1000), c) << "each session has its own nonce";
   EXPECT_EQ(cookieValue("a=1; fleet_session=xyz; b=2", kSessionCookie), "xyz");
   EXPECT_EQ(cookieValue("a=1", kSessionCookie), "");
+  EXPECT_THAT(s.setCookie(c), ::testing::Not(HasSubstr("Secure")));
+  EXPECT_THAT(BrowserSessions(tokenA, true, 60).setCookie(c), HasSubstr("; Secure"))
+      << "served over https, the cookie is never sent over plain http";
 }
 
 TEST_F(Dash, PauseAndResumeHoldTheRobotThroughTheManager) {
@@ -246,4 +268,120 @@ TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
   const json rj = json::parse(got.substr(risk + 18, got.find("\n\n", risk) - risk - 18));
   EXPECT_EQ(rj["levels"], 3);
   EXPECT_EQ(rj["runs"], json::array({0, 5, 3, 2, 1, 1})) << "levels and counts, flattened";
+}
+
+namespace {
+
+/// A token file with a read-only and an operator token, and an audit log, in a directory of its own.
+class DashScopes : public Dash {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("wms-dash-" + std::to_string(std::random_device{}()));
+    fs::create_directories(dir_);
+    writeTokens("viewer read " + kViewer + "\nfloor read,operate " + kFloor + "\n");
+  }
+  void TearDown() override {
+    Dash::TearDown();
+    fs::remove_all(dir_);
+  }
+  void writeTokens(const std::string& text) {
+    std::ofstream(dir_ / "tokens.new") << text;
+    fs::rename(dir_ / "tokens.new", dir_ / "tokens");
+  }
+  void startWithTokens() {
+    ApiSettings s;
+    s.tokenFile = (dir_ / "tokens").string();
+    s.auditLog = (dir_ / "audit.log").string();
+    start(s);
+  }
+  [[nodiscard]] std::vector<json> auditLines() const {
+    std::ifstream in(dir_ / "audit.log");
+    std::vector<json> out;
+    for (std::string l; std::getline(in, l);) {
+      out.push_back(json::parse(l));
+    }
+    return out;
+  }
+  httplib::Result pause(const std::pair<std::string, std::string>& session) {
+    return client_->Post("/v1/robots/r1/pause", {{"Cookie", session.first}, {kCsrfHeader, session.second}},
+                         "", "text/plain");
+  }
+  const std::string kViewer = "viewer-0123456789abcdef";
+  const std::string kFloor = "floor-0123456789abcdef01";
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(DashScopes, AReadOnlyTokensSessionReadsButCannotActAndEveryActionIsAudited) {
+  startWithTokens();
+  const auto viewer = login(kViewer);
+  auto robots = client_->Get("/v1/robots", {{"Cookie", viewer.first}});
+  ASSERT_TRUE(robots);
+  EXPECT_EQ(robots->status, 200);
+  auto refused = pause(viewer);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 403) << "a session acts with its token's scopes, and \"viewer\" may only read";
+  EXPECT_THAT(refused->body, HasSubstr("operate"));
+  EXPECT_TRUE(gateway_.seen.empty()) << "a refused action reached the manager";
+
+  const auto floor = login(kFloor);
+  auto me = client_->Get("/v1/session", {{"Cookie", floor.first}});
+  EXPECT_EQ(json::parse(me->body)["name"], "floor");
+  EXPECT_EQ(json::parse(me->body)["scopes"], json::array({"read", "operate"}));
+  auto ok = pause(floor);
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200) << ok->body;
+  EXPECT_EQ(client_
+                ->Post("/v1/robots/r2/home", {{"Cookie", floor.first}, {kCsrfHeader, floor.second}}, "",
+                       "text/plain")
+                ->status,
+            201);
+  EXPECT_EQ(client_->Delete("/v1/session", {{"Cookie", floor.first}, {kCsrfHeader, floor.second}})->status,
+            200);
+
+  const auto lines = auditLines();
+  ASSERT_EQ(lines.size(), 6u);  // two logins, the refused pause, the pause, home, logout
+  EXPECT_EQ(lines[0]["who"], "viewer");
+  EXPECT_EQ(lines[0]["what"]["session"], "login");
+  EXPECT_EQ(lines[1]["who"], "viewer");
+  EXPECT_EQ(lines[1]["path"], "/v1/robots/r1/pause");
+  EXPECT_EQ(lines[1]["status"], 403);
+  EXPECT_EQ(lines[3]["who"], "floor");
+  EXPECT_EQ(lines[3]["what"], json::parse(R"({"robot": "r1", "action": "pause"})"));
+  EXPECT_EQ(lines[4]["what"]["action"], "home");
+  EXPECT_EQ(lines[5]["what"]["session"], "logout");
+  for (const auto& l : lines) {
+    EXPECT_EQ(l.dump().find("0123456789abcdef"), std::string::npos) << "a token in the audit log";
+  }
+
+  // The token file decides, also for sessions made before an edit: "floor" removed, its cookie ends.
+  writeTokens("viewer read " + kViewer + "\n");
+  EXPECT_EQ(client_->Get("/v1/robots", {{"Cookie", floor.first}})->status, 401);
+  EXPECT_EQ(client_->Get("/v1/robots", {{"Cookie", viewer.first}})->status, 200);
+}
+
+TEST_F(Dash, OpenStreamsHoldNoWorkerAndCountAgainstTheStreamLimit) {
+  ApiSettings s;
+  s.limits.threads = 2;
+  s.limits.maxInFlight = 2;
+  s.limits.maxStreams = 6;
+  start(s);
+  std::vector<std::unique_ptr<RawClient>> pages;
+  for (int i = 0; i < 6; ++i) {  // three times the worker threads
+    pages.push_back(std::make_unique<RawClient>(api_->port()));
+    pages.back()->send("GET /v1/stream HTTP/1.1\r\nHost: x\r\n\r\n");
+    ASSERT_THAT(pages.back()->receive("event: snapshot"), HasSubstr("event: snapshot"));
+  }
+  EXPECT_EQ(api_->serverStats().openStreams.load(), 6);
+  client_->set_read_timeout(8, 0);
+  auto p = client_->Post("/v1/robots/r1/pause", "", "text/plain");
+  ASSERT_TRUE(p) << "POST /v1/robots/r1/pause did not answer with the dashboard's streams open";
+  EXPECT_EQ(p->status, 200);
+  auto seventh = client_->Get("/v1/stream");
+  ASSERT_TRUE(seventh);
+  EXPECT_EQ(seventh->status, 503) << "http.max_streams counts the dashboard's streams";
+  view_.onRobot(robot("r2", 7.0, 2.0, 3));
+  EXPECT_THAT(pages.front()->receive("event: robots"), HasSubstr("event: robots"));
+  EXPECT_THAT(pages.back()->receive("event: robots"), HasSubstr("\"x\":7.0"));
 }

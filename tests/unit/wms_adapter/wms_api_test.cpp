@@ -5,100 +5,15 @@
 
 #include <thread>
 
-#include "http_api.hpp"
+#include "api_fixture.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
 using nlohmann::json;
+using namespace fleet::wms::testing;
 using ::testing::HasSubstr;
 
 namespace {
-
-/// A manager in memory: stores tasks by id, answers duplicates and conflicts like the real one.
-class FakeGateway : public TaskGateway {
- public:
-  /// What makes two requests the same task (the manager compares canonical bodies).
-  static std::string fields(const msg::Task& r) {
-    return json{static_cast<int>(r.kind),
-                r.pickup,
-                r.dropoff,
-                r.station,
-                r.robot,
-                r.load_ns,
-                r.unload_ns,
-                r.priority,
-                r.deadline_ns}
-        .dump();
-  }
-
-  std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
-                                                  std::chrono::milliseconds) override {
-    std::vector<std::optional<msg::TaskAck>> out;
-    if (delay.count() > 0) {
-      std::this_thread::sleep_for(delay);
-    }
-    for (const auto& r : requests) {
-      if (silent) {
-        out.emplace_back();
-        continue;
-      }
-      msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
-      if (r.cancel || r.control != msg::TaskControl::None) {
-        auto it = bodies.find(r.task_id);
-        a.result = it == bodies.end() ? msg::AckResult::NotFound : msg::AckResult::Stored;
-        a.state = r.cancel ? msg::TaskState::Cancelled : msg::TaskState::EnRoute;
-        controls.push_back(r.control);
-      } else if (auto it = bodies.find(r.task_id); it != bodies.end()) {
-        a.result = it->second == fields(r) ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
-      } else {
-        bodies[r.task_id] = fields(r);
-      }
-      out.emplace_back(a);
-    }
-    return out;
-  }
-  [[nodiscard]] bool managerOnline() const override { return online; }
-  std::map<std::string, std::string> bodies;
-  std::vector<msg::TaskControl> controls;
-  bool online = true;
-  bool silent = false;
-  std::chrono::milliseconds delay{0};  // a slow manager
-};
-
-StationMap stations() {
-  return *StationMap::fromJson(json::parse(R"({"stations": [
-    {"name": "P-1", "x": 1, "y": 1, "kinds": ["pickup"]},
-    {"name": "D-1", "x": 5, "y": 1, "kinds": ["dropoff"]}]})"));
-}
-
-class Api : public ::testing::Test {
- protected:
-  void start(ApiSettings s = {}) {
-    s.port = 0;
-    s.ackTimeoutMs = 200;
-    api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
-    ASSERT_TRUE(api_->bind());
-    thread_ = std::thread([this] { api_->serve(); });
-    client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
-  }
-  void TearDown() override {
-    if (api_) {
-      api_->stop();
-      thread_.join();
-    }
-  }
-  httplib::Result post(const std::string& body, const httplib::Headers& h = {}) {
-    return client_->Post("/v1/tasks", h, body, "application/json");
-  }
-  StationMap stations_ = stations();
-  FakeGateway gateway_;
-  FleetView view_;
-  WallClock clock_;
-  std::unique_ptr<HttpApi> api_;
-  std::thread thread_;
-  std::unique_ptr<httplib::Client> client_;
-};
-
 const std::string kTask = R"({"id": "t-1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})";
 }  // namespace
 
@@ -157,7 +72,7 @@ TEST_F(Api, BatchReportsEachItem) {
 
 TEST_F(Api, NotFoundTooLargeUnknownStateAndCancel) {
   ApiSettings s;
-  s.maxBodyBytes = 2048;
+  s.limits.maxBodyBytes = 2048;
   s.maxBatch = 2;
   start(s);
   EXPECT_EQ(client_->Get("/v1/tasks/nope")->status, 404);
@@ -190,7 +105,7 @@ TEST_F(Api, ManagerUnreachableGives503AndNothingIsClaimed) {
 
 TEST_F(Api, TooManyRequestsInFlightGet429) {
   ApiSettings s;
-  s.maxInFlight = 1;
+  s.limits.maxInFlight = 1;
   start(s);
   gateway_.delay = std::chrono::milliseconds(500);
   int slowStatus = 0;

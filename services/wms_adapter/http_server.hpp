@@ -1,0 +1,169 @@
+#pragma once
+
+// The WMS adapter's HTTP(S) server, on Boost.Beast (see the commit that brought it: Debian's
+// cpp-httplib 0.11 holds one worker thread per connection for its whole life, has a listen backlog
+// of 5 compiled in, reads a chunked body whole before any limit, and has no in-flight bound that
+// answers instead of queueing).
+//
+// What one client cannot do to it:
+// - hold a thread by being slow: sockets are read and written asynchronously on one I/O thread, and
+//   a request (head and body) must arrive within `requestTimeoutMs` of the connection waiting for
+//   it, else the connection is closed;
+// - send an unbounded body: Beast's parser stops at `maxBodyBytes` whether the body comes with a
+//   Content-Length (refused before it is read) or chunked (refused at the chunk that crosses it): 413;
+// - fill the worker threads: handlers run on `threads` workers; beyond `maxInFlight` requests
+//   being handled, a request gets 429 with Retry-After at once instead of waiting;
+// - hold a thread with an event stream: a stream is polled from the I/O thread (EventSource must
+//   not block) and holds no worker; beyond `maxStreams` open streams, 503 with Retry-After;
+// - make the kernel reset connections: the listen backlog is `backlog`, and beyond `maxConnections`
+//   open connections a new one is read and answered 503 with Retry-After, then closed (WebSocket
+//   connections, like event streams, hold no worker and count against `maxStreams`);
+// - send faster than `ratePerClient` (when set) from one address: 429 with Retry-After (public
+//   routes, the health probe, are exempt).
+//
+// Request and Response carry the few accessors of cpp-httplib's that the handlers use, spelled as
+// there, so a handler written for httplib::Server moves over by changing the two type names.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "scope.hpp"
+
+namespace fleet::wms {
+
+struct Request {
+  std::string method;  // "GET", "POST", ...
+  std::string target;  // as sent (path and query); never logged: a client may put secrets there
+  std::string path;    // percent-decoded path without the query
+  std::multimap<std::string, std::string> params;  // decoded query parameters
+  std::vector<std::pair<std::string, std::string>> headers;
+  std::string body;
+  std::vector<std::string> matches;  // the route pattern's groups, [0] = the whole path
+  std::string remote_addr;
+  std::string principal;          // who made the request (the token's name), set by the gate
+  bool webSocketUpgrade = false;  // a WebSocket handshake (GET with Upgrade: websocket)
+
+  [[nodiscard]] std::string get_header_value(const std::string& name) const;
+  [[nodiscard]] bool has_header(const std::string& name) const;
+  [[nodiscard]] bool has_param(const std::string& name) const { return params.count(name) > 0; }
+  [[nodiscard]] std::string get_param_value(const std::string& name) const;
+};
+
+/// Called on the I/O thread every poll interval: the text to send now (may be empty), or nothing
+/// to end the stream. Must not block.
+using EventSource = std::function<std::optional<std::string>()>;
+
+/// A WebSocket connection's two directions: text messages to push (`outgoing`, polled like an
+/// event stream; nothing = close) and a callback for each text message the client sends (may be
+/// empty: push only). Both run on the I/O thread and must not block.
+struct WebSocketChannel {
+  EventSource outgoing;
+  std::function<void(const std::string&)> incoming;
+};
+
+struct Response {
+  int status = 200;
+  std::string body;
+  std::string contentType = "text/plain";
+  std::vector<std::pair<std::string, std::string>> headers;
+  EventSource events;          // set: the response is an open-ended stream of this content type
+  WebSocketChannel webSocket;  // outgoing set: accept the WebSocket handshake and run this channel
+  std::string audit;           // what the request changed, for the audit log (JSON text), set by handlers
+
+  void set_content(std::string content, std::string type) {
+    body = std::move(content);
+    contentType = std::move(type);
+  }
+  void set_header(const std::string& name, const std::string& value);
+  [[nodiscard]] std::string get_header_value(const std::string& name) const;
+  /// Streams what `source` yields (server-sent events: "text/event-stream").
+  void setEventStream(std::string type, EventSource source) {
+    contentType = std::move(type);
+    events = std::move(source);
+  }
+  /// Accepts the request's WebSocket handshake (a route answering a non-upgrade GET gets 400).
+  void acceptWebSocket(WebSocketChannel channel) { webSocket = std::move(channel); }
+};
+
+struct ServerLimits {
+  std::size_t maxBodyBytes = 1 << 20;
+  std::size_t maxHeaderBytes = 16 * 1024;
+  int maxConnections = 512;      // open connections; more are answered 503
+  int maxStreams = 64;           // open event streams; more are answered 503
+  int maxInFlight = 16;          // requests being handled or waiting for a worker; more get 429
+  int threads = 16;              // handler threads
+  int backlog = 1024;            // listen(2) backlog (the kernel caps it at net.core.somaxconn)
+  int requestTimeoutMs = 10000;  // a whole request (head and body) must arrive within this
+  int writeTimeoutMs = 30000;    // a response (or a stream's next chunk) must be taken within this
+  int streamPollMs = 100;        // how often an event stream's source is asked
+  int streamKeepAliveMs = 1000;  // an idle stream sends a comment this often
+  double ratePerClient = 0;      // requests per second per client address (token bucket); 0 = no limit
+  int rateBurst = 20;            // requests a client may send at once before its rate applies
+};
+
+/// PEM files for https; both empty = plain http.
+struct TlsFiles {
+  std::string certificateFile;  // the server's certificate (chain), PEM
+  std::string privateKeyFile;   // its key, PEM
+  [[nodiscard]] bool enabled() const { return !certificateFile.empty(); }
+};
+
+/// Counts since start, for metrics.
+struct ServerStats {
+  std::atomic<std::int64_t> openConnections{0};
+  std::atomic<std::int64_t> openStreams{0};
+  std::atomic<std::int64_t> refusedConnections{0};  // 503 at maxConnections
+  std::atomic<std::int64_t> refusedStreams{0};      // 503 at maxStreams
+  std::atomic<std::int64_t> busy{0};                // 429 at maxInFlight
+  std::atomic<std::int64_t> rateLimited{0};         // 429 past ratePerClient
+  std::atomic<std::int64_t> tooLarge{0};            // 413 / 431
+  std::atomic<std::int64_t> timedOut{0};            // connections closed for a request too slow
+  std::atomic<std::int64_t> tlsFailures{0};         // failed TLS handshakes
+};
+
+class HttpServer {
+ public:
+  using Handler = std::function<void(const Request&, Response&)>;
+  /// Runs before a route's handler, on the I/O thread (must be quick): false = refused, with the
+  /// reply written into the response. It may set Request::principal.
+  using Gate = std::function<bool(Request&, Response&, Scope)>;
+  /// Runs after every response is made, on the I/O thread (also the ones the server makes itself:
+  /// 413, 429, 503, ...; those carry the API's error body {"error": code, "message": text}).
+  using Observer = std::function<void(const Request&, const Response&, double seconds)>;
+  /// Where a handler runs: on a worker (may block), or on the I/O thread (never blocks; probes).
+  enum class Run { Worker, Inline };
+
+  explicit HttpServer(ServerLimits limits, TlsFiles tls = {});
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  /// `pattern` is an ECMAScript regex matched against the whole decoded path. Call before serve().
+  void route(const std::string& method, const std::string& pattern, Scope scope, Handler handler,
+             Run run = Run::Worker);
+  void setGate(Gate gate);
+  void setObserver(Observer observer);
+
+  /// Binds and listens; false (and why in lastError()) when the address cannot be bound.
+  bool bind(const std::string& host, int port);
+  [[nodiscard]] int port() const;
+  [[nodiscard]] const std::string& lastError() const;
+  /// Serves until stop() (blocking).
+  void serve();
+  void stop();
+  [[nodiscard]] const ServerStats& stats() const;
+
+  struct Impl;  // Beast stays out of this header (and out of every file that includes it)
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fleet::wms

@@ -1,0 +1,182 @@
+#pragma once
+
+// What the WMS adapter's API tests share: a manager in memory behind the TaskGateway interface, a
+// small station map, and a fixture that serves the API on a free loopback port.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "http_api.hpp"
+
+namespace fleet::wms::testing {
+
+using nlohmann::json;
+
+/// A manager in memory: stores tasks by id, answers duplicates and conflicts like the real one.
+class FakeGateway : public TaskGateway {
+ public:
+  /// What makes two requests the same task (the manager compares canonical bodies).
+  static std::string fields(const msg::Task& r) {
+    return json{static_cast<int>(r.kind),
+                r.pickup,
+                r.dropoff,
+                r.station,
+                r.robot,
+                r.load_ns,
+                r.unload_ns,
+                r.priority,
+                r.deadline_ns}
+        .dump();
+  }
+
+  std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
+                                                  std::chrono::milliseconds) override {
+    std::vector<std::optional<msg::TaskAck>> out;
+    if (delay.count() > 0) {
+      std::this_thread::sleep_for(delay);
+    }
+    std::lock_guard lock(m_);  // the API calls from several workers at once
+    for (const auto& r : requests) {
+      if (silent) {
+        out.emplace_back();
+        continue;
+      }
+      msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
+      if (r.cancel || r.control != msg::TaskControl::None) {
+        auto it = bodies.find(r.task_id);
+        a.result = it == bodies.end() ? msg::AckResult::NotFound : msg::AckResult::Stored;
+        a.state = r.cancel ? msg::TaskState::Cancelled : msg::TaskState::EnRoute;
+        controls.push_back(r.control);
+      } else if (auto it = bodies.find(r.task_id); it != bodies.end()) {
+        a.result = it->second == fields(r) ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
+      } else {
+        bodies[r.task_id] = fields(r);
+      }
+      out.emplace_back(a);
+    }
+    return out;
+  }
+  [[nodiscard]] bool managerOnline() const override { return online; }
+  std::map<std::string, std::string> bodies;
+  std::vector<msg::TaskControl> controls;
+  bool online = true;
+  bool silent = false;
+  std::chrono::milliseconds delay{0};  // a slow manager
+
+ private:
+  std::mutex m_;
+};
+
+inline StationMap stations() {
+  return *StationMap::fromJson(json::parse(R"({"stations": [
+    {"name": "P-1", "x": 1, "y": 1, "kinds": ["pickup"]},
+    {"name": "D-1", "x": 5, "y": 1, "kinds": ["dropoff"]}]})"));
+}
+
+class Api : public ::testing::Test {
+ protected:
+  void start(ApiSettings s = {}) {
+    s.port = 0;
+    s.ackTimeoutMs = 200;
+    api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
+    ASSERT_TRUE(api_->bind());
+    thread_ = std::thread([this] { api_->serve(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
+  }
+  void TearDown() override {
+    if (api_) {
+      api_->stop();
+      thread_.join();
+    }
+  }
+  httplib::Result post(const std::string& body, const httplib::Headers& h = {}) {
+    return client_->Post("/v1/tasks", h, body, "application/json");
+  }
+  StationMap stations_ = stations();
+  FakeGateway gateway_;
+  FleetView view_;
+  WallClock clock_;
+  std::unique_ptr<HttpApi> api_;
+  std::thread thread_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+/// A client socket that does exactly what a test says, however rude: partial heads, endless
+/// chunked bodies, requests it never reads the answer of.
+class RawClient {
+ public:
+  explicit RawClient(int port) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  }
+  ~RawClient() { ::close(fd_); }
+  RawClient(const RawClient&) = delete;
+  RawClient& operator=(const RawClient&) = delete;
+  [[nodiscard]] bool connected() const { return connected_; }
+  [[nodiscard]] int fd() const { return fd_; }
+  /// False once the server has closed (or reset) the connection.
+  bool send(const std::string& data) {
+    return ::send(fd_, data.data(), data.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(data.size());
+  }
+  /// What arrives until the peer closes, `until` appears, or `limit` passes (a bound so that a
+  /// broken server fails the test instead of hanging it).
+  std::string receive(const std::string& until = "",
+                      std::chrono::milliseconds limit = std::chrono::seconds(20)) {
+    std::string out;
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < end) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 50) <= 0) {
+        continue;
+      }
+      char buf[4096];
+      const auto n = ::recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) {
+        closedByPeer_ = true;
+        break;
+      }
+      out.append(buf, static_cast<std::size_t>(n));
+      if (!until.empty() && out.find(until) != std::string::npos) {
+        break;
+      }
+    }
+    return out;
+  }
+  [[nodiscard]] bool closedByPeer() const { return closedByPeer_; }
+
+ private:
+  int fd_ = -1;
+  bool connected_ = false;
+  bool closedByPeer_ = false;
+};
+
+/// The status code of a raw HTTP response ("HTTP/1.1 413 ..." -> 413), 0 if there is none.
+inline int statusOf(const std::string& response) {
+  if (response.rfind("HTTP/1.", 0) != 0 || response.size() < 12) {
+    return 0;
+  }
+  return std::atoi(response.substr(9, 3).c_str());
+}
+
+inline std::string rawPost(const std::string& path, const std::string& body, const std::string& extra = "") {
+  return "POST " + path + " HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n" + extra +
+         "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body;
+}
+
+}  // namespace fleet::wms::testing
