@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -787,6 +788,12 @@ int Run::run() {
   postHttp = std::make_unique<httplib::Client>("127.0.0.1", port);
   postHttp->set_connection_timeout(2, 0);
   postHttp->set_read_timeout(10, 0);
+  // The adapter started here inherits FLEET_WMS_TOKEN from this environment and then asks for it
+  // on every request; without it the run stalled at "0.0 s sim" on 401s.
+  if (const char* token = std::getenv("FLEET_WMS_TOKEN"); token != nullptr && *token != '\0') {
+    http->set_bearer_token_auth(token);
+    postHttp->set_bearer_token_auth(token);
+  }
   const auto t0 = Clock::now();
   auto wall = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   bool healthy = false;

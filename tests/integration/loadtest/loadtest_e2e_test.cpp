@@ -302,6 +302,23 @@ TEST(LoadtestE2E, AFleetRunsOnASiteWithAROSMap) {
   EXPECT_NEAR(risk["grid"]["height"].get<double>(), 200, 1);
 }
 
+// With FLEET_WMS_TOKEN set in the operator's shell, the adapter the load test starts asks for that
+// token on every request; the load test's own client did not send it and the run stalled at
+// "0.0 s sim" on 401s.
+TEST(LoadtestE2E, RunsWithTheApiTokenOfItsEnvironment) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-token-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  ASSERT_EQ(setenv("FLEET_WMS_TOKEN", "loadtest-e2e-token-0123456789", 1), 0);
+  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 400, 120);
+  fleet::test::ChildProcess run(kFleetctl, args);
+  const int rc = run.wait(std::chrono::seconds(180));
+  unsetenv("FLEET_WMS_TOKEN");
+  ASSERT_EQ(rc, 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  EXPECT_EQ(r["accounting"]["done"], 2) << r["accounting"].dump();
+  EXPECT_EQ(r["accounting"]["lost"], 0);
+}
+
 // Disabled from 2026-11-25 to 11-26: about 1 run in 4 the robot stood idle after ~25 m while the
 // traffic manager had placed it and released it nodes. On the build with paced planning and the
 // leaving robot first (session of 2026-11-26) it passed 18 of 18 runs, 12 of them three at a time
