@@ -30,6 +30,11 @@ int runTrafficSim(const TrafficSimOptions& o) {
     std::cerr << "fleetctl traffic-sim: --seeds " << o.seeds << ": give a seed or a range like 1-8\n";
     return 2;
   }
+  // A page that cannot be written is bad input: say so before a run that may take minutes.
+  if (!o.html.empty() && !std::ofstream(o.html)) {
+    std::cerr << "fleetctl traffic-sim: cannot write " << o.html << "\n";
+    return 2;
+  }
   traffic::RoadmapOptions ro;
   ro.spacing = o.spacing;
   if (o.stopGap >= 0.0)
