@@ -50,7 +50,7 @@ class MosquittoBroker {
       makeCertificates();
     }
     for (int attempt = 0; attempt < 5; ++attempt) {
-      port_ = freeLoopbackPort();
+      port_ = freePort();
       writeConfig();
       if (startOnce()) {
         return;
@@ -87,27 +87,6 @@ class MosquittoBroker {
   }
 
  private:
-  static int freeLoopbackPort() {
-    for (int tries = 0; tries < 20; ++tries) {
-      const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-      sockaddr_in a{};
-      a.sin_family = AF_INET;
-      a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-      a.sin_port = 0;
-      socklen_t len = sizeof a;
-      int port = 0;
-      if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-          ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
-        port = ntohs(a.sin_port);
-      }
-      ::close(fd);
-      if (port > 0 && port != 1883 && port != 8883) {
-        return port;
-      }
-    }
-    throw std::runtime_error("no free loopback port");
-  }
-
   static bool accepts(int port) {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in a{};

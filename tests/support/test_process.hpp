@@ -3,14 +3,18 @@
 // A child process for multi-process tests: started with fork/exec, killed (SIGKILL) when the
 // object goes out of scope so a failing test never leaves orphans.
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/prctl.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
@@ -106,6 +110,31 @@ inline int uniqueDomain() {
     return 10 + start;
   }();
   return domain;
+}
+
+/// A TCP port on 127.0.0.1 that no other test process takes and no outgoing connection is given:
+/// each process owns the 40 ports 20000 + 40 * uniqueDomain() + k (all below the kernel's
+/// ephemeral range, 32768 and up), and each call returns the next of them that binds now. A port
+/// the kernel picks (bind to 0) can be handed to some client's connect() before the service under
+/// test binds it, which failed CI once ("cannot listen on 127.0.0.1:34918").
+inline int freePort() {
+  static int next = 0;
+  for (int tries = 0; tries < 40; ++tries) {
+    const int port = 20000 + 40 * uniqueDomain() + (next++ % 40);
+    const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    const bool ok = fd >= 0 && bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    if (fd >= 0) {
+      close(fd);
+    }
+    if (ok) {
+      return port;
+    }
+  }
+  throw std::runtime_error("no free port in this test process's block");
 }
 
 }  // namespace fleet::test

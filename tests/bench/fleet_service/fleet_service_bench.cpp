@@ -48,7 +48,7 @@ struct Fleet {
         {"stations", (dir / "stations.json").string()},
         {"lease_s", 5.0},
         {"sync", "full"}}.dump();
-    port = 30000 + static_cast<int>(getpid() % 20000);
+    port = test::freePort();
     manager = std::make_unique<test::ChildProcess>(
         FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
         std::vector<std::string>{"--config", (dir / "manager.json").string(), "--log-level", "warn"},

@@ -31,20 +31,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int freePort() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t n = sizeof a;
-  int port = 0;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &n) == 0) {
-    port = ntohs(a.sin_port);
-  }
-  ::close(s);
-  return port;
-}
+using fleet::test::freePort;
 
 /// one_robot.json with three robots at parking places 1, 4 and 7, its site by absolute path.
 std::string writeScenario(const fs::path& dir) {

@@ -46,7 +46,7 @@ class FleetE2E : public ::testing::Test {
         {"tick_s", 0.05},
         {"lease_s", 2.0},
         {"sync", "normal"}}.dump();
-    port_ = 20000 + static_cast<int>(getpid() % 20000);
+    port_ = test::freePort();
     startManager();
     startAdapter();
     http_ = std::make_unique<httplib::Client>("127.0.0.1", port_);

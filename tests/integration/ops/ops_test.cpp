@@ -38,18 +38,7 @@ const std::string kScenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
 const std::string kSite = FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse_12_parking.site.json";
 
 /// A loopback port free right now (bound to 0, read back, released).
-int freePort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t len = sizeof(a);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  close(fd);
-  return ntohs(a.sin_port);
-}
+using fleet::test::freePort;
 
 struct Ran {
   int code = -1;
