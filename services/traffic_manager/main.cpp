@@ -80,6 +80,10 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         "re-plans, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
         c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
+    // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
+    // is slow (a minute of its clock, sim or wall).
+    for (const auto& line : node.stalled(now, 60.0))
+      spdlog::warn("traffic manager: {}", line);
   };
   auto ingest = [&] {
     for (const auto& m : service::admitted(progress.take(), rejections, badInput)) {

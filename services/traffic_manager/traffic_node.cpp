@@ -13,7 +13,7 @@ Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
                          "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
-                         "detour_after", "detour_penalty", "roadmap"});
+                         "detour_after", "detour_penalty", "station_lines", "roadmap"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -21,6 +21,7 @@ Settings readSettings(Config& cfg) {
   s.placeTolerance = cfg.number("place_tolerance", 0.5, {0.0, 10.0, true});
   s.clock = cfg.string("clock", "wall", {"wall", "sim"});
   s.lockstep = cfg.boolean("lockstep", false);
+  s.stationLines = cfg.boolean("station_lines", s.stationLines);
   if (s.lockstep && s.clock != "sim")
     cfg.problem("lockstep", "requires \"clock\": \"sim\"");
   s.traffic.maxLag = cfg.integer("max_lag", s.traffic.maxLag, {1, 100000});
@@ -50,6 +51,8 @@ TrafficNode::TrafficNode(const site::Site& site, Settings settings, std::uint32_
       roadmap_(traffic::buildRoadmap(site, settings_.roadmap)) {
   control_ =
       std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, settings_.traffic);
+  if (settings_.stationLines)
+    control_->setStations(traffic::stationLines(roadmap_));
 }
 
 msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {
@@ -136,6 +139,10 @@ std::optional<std::string> TrafficNode::onProgress(const msg::TrafficProgress& p
   Robot& r = robots_[p.robot_id];
   r.last = p;
   r.heardNs = nowNs;
+  if (p.node != r.lastNode || r.movedNs == 0) {
+    r.lastNode = p.node;
+    r.movedNs = nowNs;
+  }
   std::optional<std::string> problem;
   if (r.index >= 0) {
     const auto idx = static_cast<std::size_t>(r.index);
@@ -243,6 +250,26 @@ std::vector<msg::TrafficRelease> TrafficNode::allReleases() const {
   for (const auto& [id, r] : robots_) {
     if (r.index >= 0 && r.sent.seq > 0)
       out.push_back(r.sent);
+  }
+  return out;
+}
+
+std::vector<std::string> TrafficNode::stalled(std::int64_t nowNs, double minS) const {
+  std::vector<std::string> out;
+  for (const auto& [id, r] : robots_) {
+    if (r.index < 0 || r.goal == kNoNode || control_->arrived(static_cast<std::size_t>(r.index)))
+      continue;
+    const double still = static_cast<double>(nowNs - r.movedNs) * 1e-9;
+    if (still < minS)
+      continue;
+    std::ostringstream os;
+    os << "robot \"" << id << "\" (index " << r.index << ") reached no new node for "
+       << static_cast<int>(still) << " s: " << control_->explain(static_cast<std::size_t>(r.index));
+    if (r.last.blocked)
+      os << "; it reports itself blocked";
+    if (!r.last.follows)
+      os << "; it does not follow releases";
+    out.push_back(os.str());
   }
   return out;
 }

@@ -36,6 +36,9 @@ struct Settings {
   double placeTolerance = 0.5;  ///< m from a roadmap node to be placed on it
   std::string clock = "wall";   ///< or "sim"
   bool lockstep = false;
+  /// Robots sent to a pickup, drop-off or charger wait in line on its queue nodes, one at the dock
+  /// (false: they are planned straight to the dock and wait wherever the planner leaves them).
+  bool stationLines = true;
   traffic::RoadmapOptions roadmap;
   traffic::TrafficOptions traffic;
 };
@@ -75,6 +78,9 @@ class TrafficNode {
   /// Robot's index in the planner, -1 when not placed.
   [[nodiscard]] int indexOf(const std::string& robot) const;
   [[nodiscard]] const traffic::TrafficControl* control() const { return control_.get(); }
+  /// Robots with a goal that reached no new node for `minS` seconds, each with what holds it
+  /// (TrafficControl::explain): what an operator reads when the fleet stands still.
+  [[nodiscard]] std::vector<std::string> stalled(std::int64_t nowNs, double minS) const;
 
  private:
   struct Robot {
@@ -84,6 +90,8 @@ class TrafficNode {
     traffic::NodeId goal = traffic::kNoNode;
     int priority = 0;
     msg::TrafficRelease sent;
+    traffic::NodeId lastNode = traffic::kNoNode;
+    std::int64_t movedNs = 0;  ///< when it last reported a node other than lastNode
   };
   [[nodiscard]] traffic::NodeId goalNode(const msg::TrafficProgress& p, std::string& why) const;
   [[nodiscard]] traffic::NodeId placeNode(const msg::TrafficProgress& p) const;

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
+
+#include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::traffic {
 
@@ -10,6 +13,18 @@ namespace {
 /// Above any task priority a WMS sends (they are small integers).
 constexpr int kLeavingBoost = 1 << 20;
 }  // namespace
+
+std::vector<StationLine> stationLines(const Roadmap& roadmap) {
+  std::vector<StationLine> lines;
+  for (const auto& st : roadmap.stations) {
+    if (st.dock != kNoNode &&
+        (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
+         st.kind == site::StationKind::Charging)) {
+      lines.push_back({st.dock, st.queue, st.approach});
+    }
+  }
+  return lines;
+}
 
 TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> starts, TrafficOptions options)
     : graph_(graph),
@@ -379,6 +394,35 @@ void TrafficControl::replan() {
 
 void TrafficControl::graphChanged() {
   replan();
+}
+
+std::string TrafficControl::explain(std::size_t robot) const {
+  const NodeId at = execution_.at(robot);
+  std::ostringstream os;
+  os << "at node " << at;
+  if (graph_.valid(at))
+    os << " (" << graph_.position(at).x << ", " << graph_.position(at).y << ")";
+  os << ", goal " << goal_.at(robot) << ", target " << target_.at(robot) << (held(robot) ? ", held" : "")
+     << ", planned " << execution_.pendingNodes(robot) << " nodes ahead, released to "
+     << execution_.releasedEnd(robot) << ", waiting on";
+  const auto waits = waitingOn(robot);
+  if (waits.empty())
+    os << " nobody";
+  for (auto q : waits)
+    os << " " << q << "@" << execution_.at(q);
+  os << "; ways out:";
+  if (graph_.valid(at)) {
+    for (const Edge& e : graph_.edges(at)) {
+      if (!graph_.passable(at, e))
+        continue;
+      os << " " << e.to;
+      for (std::size_t q = 0; q < robots(); ++q) {
+        if (q != robot && graph_.conflicting(e.to, execution_.at(q)))
+          os << " [" << q << "]";
+      }
+    }
+  }
+  return os.str();
 }
 
 }  // namespace fleet::traffic

@@ -77,17 +77,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   TrafficOptions topt = o.traffic;
   topt.pibt.seed = o.seed;
   TrafficControl traffic(g, starts, topt);
-  if (o.stationLines) {
-    std::vector<StationLine> lines;
-    for (const auto& st : roadmap.stations) {
-      if (st.dock != kNoNode &&
-          (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
-           st.kind == site::StationKind::Charging)) {
-        lines.push_back({st.dock, st.queue, st.approach});
-      }
-    }
-    traffic.setStations(std::move(lines));
-  }
+  if (o.stationLines)
+    traffic.setStations(stationLines(roadmap));
   std::vector<Bot> bots(o.robots);
   auto newTask = [&](std::size_t r, double now) {
     Bot& b = bots[r];

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "fleet/site/site_loader.hpp"
@@ -176,6 +177,72 @@ TEST(TrafficNode, DetoursAreOnByDefaultAndCanBeTurnedOff) {
   ASSERT_TRUE(off.ok());
   EXPECT_EQ(s.traffic.pibt.detourAfter, 0);
   EXPECT_FLOAT_EQ(s.traffic.pibt.detourPenalty, 12.5F);
+}
+
+TEST(TrafficNode, RobotsSentToOneStationWaitInItsLine) {
+  // Both are sent to P-1: the first is planned to its dock, the second to its queue, not to the
+  // dock's only way in. With the lines off (as before they were wired in) both target the dock.
+  for (const bool lines : {true, false}) {
+    auto s = settings();
+    s.stationLines = lines;
+    TrafficNode node(smallWarehouse(), s, 2);
+    node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+    node.onProgress(at("r2", stationPose("PARK-2"), "P-1"), 0);
+    node.tick(2 * kS);
+    const auto* p1 = node.roadmap().station("P-1");
+    ASSERT_NE(p1, nullptr);
+    ASSERT_FALSE(p1->queue.empty());
+    const auto& tc = *node.control();
+    const auto r1 = static_cast<std::size_t>(node.indexOf("r1"));
+    const auto r2 = static_cast<std::size_t>(node.indexOf("r2"));
+    EXPECT_EQ(tc.goal(r1), p1->dock);
+    EXPECT_EQ(tc.goal(r2), p1->dock);
+    if (lines) {
+      EXPECT_EQ(tc.line(p1->dock).size(), 2U);
+      const auto first = tc.line(p1->dock).front();
+      const auto second = first == r1 ? r2 : r1;
+      EXPECT_EQ(tc.target(first), p1->dock);
+      EXPECT_NE(std::find(p1->queue.begin(), p1->queue.end(), tc.target(second)), p1->queue.end())
+          << "the second in line is planned to node " << tc.target(second);
+    } else {
+      EXPECT_TRUE(tc.line(p1->dock).empty());
+      EXPECT_EQ(tc.target(r1), p1->dock);
+      EXPECT_EQ(tc.target(r2), p1->dock);
+    }
+  }
+  Config off = Config::fromText(R"({"station_lines": false})", "test");
+  EXPECT_FALSE(readSettings(off).stationLines);
+  Config on = Config::fromText("{}", "test");
+  EXPECT_TRUE(readSettings(on).stationLines);
+}
+
+TEST(TrafficNode, ARobotThatReachesNoNewNodeIsReportedWithWhatHoldsIt) {
+  TrafficNode node(smallWarehouse(), settings(), 9);
+  node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+  const auto rel = node.tick(2 * kS);
+  ASSERT_EQ(rel.size(), 1U);
+  const auto start = rel[0].base.front().node;
+  EXPECT_TRUE(node.stalled(2 * kS, 60.0).empty());
+  // It keeps reporting its first node and never moves on.
+  std::int64_t now = 2 * kS;
+  for (; now < 70 * kS; now += kS) {
+    node.onProgress(at("r1", stationPose("PARK-1"), "P-1", start, 9), now);
+    node.tick(now);
+  }
+  const auto report = node.stalled(now, 60.0);
+  ASSERT_EQ(report.size(), 1U);
+  EXPECT_NE(report[0].find("\"r1\""), std::string::npos) << report[0];
+  EXPECT_NE(report[0].find("at node " + std::to_string(start)), std::string::npos) << report[0];
+  EXPECT_NE(report[0].find("ways out:"), std::string::npos) << report[0];
+  EXPECT_TRUE(node.stalled(now, 600.0).empty());
+  // Once it moves on, it is not reported any more.
+  const auto next = node.tick(now);
+  (void)next;
+  const auto& last = node.allReleases();
+  ASSERT_EQ(last.size(), 1U);
+  ASSERT_GE(last[0].base.size(), 2U);
+  node.onProgress(at("r1", {last[0].base[1].x, last[0].base[1].y, 0}, "P-1", last[0].base[1].node, 9), now);
+  EXPECT_TRUE(node.stalled(now + kS, 60.0).empty());
 }
 
 }  // namespace

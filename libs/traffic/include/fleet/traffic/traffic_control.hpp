@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "fleet/traffic/execution.hpp"
@@ -51,6 +52,12 @@ struct StationLine {
   std::vector<NodeId> queue;
   NodeId approach = kNoNode;
 };
+
+class Roadmap;
+
+/// The lines of a roadmap's pickup, drop-off and charging stations (their dock, queue and approach
+/// nodes); parking places take no line: a robot parks where it is sent and leaves when it is needed.
+std::vector<StationLine> stationLines(const Roadmap& roadmap);
 
 struct TrafficStats {
   std::uint64_t steps = 0;    ///< planner steps
@@ -105,6 +112,11 @@ class TrafficControl {
   [[nodiscard]] std::vector<std::size_t> waitingOn(std::size_t robot) const {
     return execution_.waitingOn(robot);
   }
+
+  /// One line on where the robot is and what holds it: its node, goal and target, whether it is
+  /// held, how far it is planned and released, the robots it waits on (index@node), and each way
+  /// out of its node with the robots whose node excludes it. For reports of robots that do not move.
+  [[nodiscard]] std::string explain(std::size_t robot) const;
 
   /// Call after closing or reopening nodes or edges: plans again from the released ends.
   void graphChanged();
