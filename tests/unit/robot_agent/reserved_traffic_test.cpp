@@ -257,7 +257,7 @@ TEST_P(ReservedPlanner, ReportsEveryNodeItReachesInOrderWhenItIsThere) {
   EXPECT_EQ(nodes, expected) << "every node once, in order (0: the release's first, reported at once)";
 }
 
-TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAfterASecond) {
+TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAfterThreeSeconds) {
   Sim sim(GetParam());
   sim.people = {{4.5, kY}};
   sim.agent->onAssignment(order(kFarPickup));
@@ -283,8 +283,9 @@ TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAf
   }
   ASSERT_TRUE(heldAt) << "never held up by the person";
   ASSERT_TRUE(blockedAt) << "never reported blocked";
-  EXPECT_GT(*blockedAt - *heldAt, 1.0) << "blocked is reported after a second of being held";
-  EXPECT_LT(*blockedAt - *heldAt, 1.5);
+  // (3 s, not less: a person walking past should not make the traffic manager plan round the robot.)
+  EXPECT_GT(*blockedAt - *heldAt, 3.0) << "blocked is reported after three seconds of being held";
+  EXPECT_LT(*blockedAt - *heldAt, 3.5);
   EXPECT_FALSE(unblocked) << "the blocked flag flapped";
   EXPECT_LT(std::abs(sim.truth.x - xAt10), 0.05) << "did not stop";
   EXPECT_GE(sim.minToPeople, 0.25 + 0.3 + 0.1) << "came too close to the person";
