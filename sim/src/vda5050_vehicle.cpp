@@ -215,7 +215,22 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     }
     // The node to stop on is approached slowly and reached closely: stops are at docks and parking
     // places next to shelves, where braking late from speed ran the vehicle into the shelf.
-    const bool stop_here = next_ + 1 >= order_->nodes.size() || !order_->nodes[next_ + 1].released;
+    const bool last = next_ + 1 >= order_->nodes.size() || !order_->nodes[next_ + 1].released;
+    // So is a node where the way turns: the vehicle turns there on the spot, and one that reached
+    // it at speed slid on past it (0.1-0.2 m into a parking place's back wall when the base
+    // turned back out of the place, 2026-11-26).
+    bool corner = false;
+    if (!last && order_->nodes[next_ + 1].nodePosition) {
+      const auto& m = *order_->nodes[next_ + 1].nodePosition;
+      // The way in: from the node before (the pose's bearing swings as the vehicle nears the node).
+      Vec2 from{pose.x, pose.y};
+      if (next_ > 0 && order_->nodes[next_ - 1].nodePosition)
+        from = {order_->nodes[next_ - 1].nodePosition->x, order_->nodes[next_ - 1].nodePosition->y};
+      const double in = std::atan2(n.nodePosition->y - from.y, n.nodePosition->x - from.x);
+      const double out = std::atan2(m.y - n.nodePosition->y, m.x - n.nodePosition->x);
+      corner = std::abs(angleDiff(out, in)) > 0.1;
+    }
+    const bool stop_here = last || corner;
     const double tol =
         stop_here ? std::min(config_.nodeTolerance, 0.1)
                   : std::max(config_.nodeTolerance, n.nodePosition->allowedDeviationXY.value_or(0.0));

@@ -36,6 +36,40 @@ TEST(Vda5050Vehicle, FollowsTheBaseAndStopsAtItsEnd) {
   EXPECT_TRUE(s.edgeStates.empty());
 }
 
+/// An order through `points` (all released), node ids p0, p1, ...
+vda5050::Order pathOrder(const std::vector<Vec2>& points) {
+  vda5050::Order o = lineOrder("o1", 0, 0, static_cast<int>(points.size()), static_cast<int>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    o.nodes[i].nodeId = "p" + std::to_string(i);
+    o.nodes[i].nodePosition->x = points[i].x;
+    o.nodes[i].nodePosition->y = points[i].y;
+    if (i > 0) {
+      o.edges[i - 1].startNodeId = o.nodes[i - 1].nodeId;
+      o.edges[i - 1].endNodeId = o.nodes[i].nodeId;
+    }
+  }
+  return o;
+}
+
+// Into a parking place and straight back out (the roadmap's dock leg, driven there and back when
+// the next goal is already planned), and round a right angle: a vehicle that reaches such a node
+// at cruise speed slides on past it while it brakes (into the place's back wall, in a mixed-fleet
+// run). With the speed following the command at 1 m/s², it stays within 5 cm of each turn node.
+TEST(Vda5050Vehicle, SlowsForANodeWhereTheWayTurnsAndDoesNotOvershootIt) {
+  for (const bool reverse : {true, false}) {
+    Rig r;
+    r.accel = 1.0;
+    const std::vector<Vec2> path = reverse
+                                       ? std::vector<Vec2>{{0, 0}, {1, 0}, {2, 0}, {3, 0}, {2, 0}, {1, 0}}
+                                       : std::vector<Vec2>{{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {3, 2}};
+    ASSERT_EQ(r.vehicle.onOrder(pathOrder(path)).decision, OrderDecision::kAcceptNew);
+    double furthest = 0.0;
+    r.run(20.0, [&] { furthest = std::max(furthest, r.pose.x); });
+    EXPECT_LT(furthest, 3.05) << (reverse ? "back out of the place" : "round the corner");
+    EXPECT_EQ(r.state().lastNodeId, "p5");
+  }
+}
+
 TEST(Vda5050Vehicle, RejectsAnUpdateThatDoesNotExtendTheBaseAndSaysWhy) {
   Rig r;
   ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 3)).decision, OrderDecision::kAcceptNew);
