@@ -1,17 +1,28 @@
 #!/usr/bin/env python3
-"""deploy/compose.yaml cannot be run here (no docker; Debian's podman-compose 1.0.3 cannot express
-network_mode, docs/operator-guide.md#compose), so this checks that it describes the same fleet as
-deploy/fleet-pod.yaml, which containers_smoke runs in CI: per service the same image, entrypoint and
-arguments, environment, mounts and health check, and the network namespace shared with a manager
-that has no network. Usage: compose_matches_pod.py SOURCE_DIR"""
+"""Checks, without podman, that deploy/compose.yaml describes the same fleet as deploy/fleet-pod.yaml
+(which containers_smoke runs) and that its network settings hang together; compose_fleet runs it.
+Per service: the same image, entrypoint and arguments (the adapter reads its stations from the
+wms_adapter.json that scripts/containers writes, which must name the pod's stations and listen on
+all addresses of its container), environment, mounts, health check, read-only root filesystem and
+no privilege escalation. Network: every service on the project network `fleet`, none in another's
+namespace; the compose DDS profile (in the images) with multicast off and exactly the DDS services'
+names as unicast peers; only the adapter publishes a port, on 127.0.0.1. Usage:
+compose_matches_pod.py SOURCE_DIR"""
+import json
+import os
+import subprocess
 import sys
+import tempfile
+import xml.etree.ElementTree as ET
 
 import yaml
 
 src = sys.argv[1]
-compose = yaml.safe_load(open(f"{src}/deploy/compose.yaml"))["services"]
+doc = yaml.safe_load(open(f"{src}/deploy/compose.yaml"))
+compose = doc["services"]
 pod = {c["name"]: c for c in yaml.safe_load(open(f"{src}/deploy/fleet-pod.yaml"))["spec"]["containers"]}
 problems = []
+PROFILE = "cyclonedds-compose.xml"
 
 
 def check(cond, what):
@@ -19,14 +30,25 @@ def check(cond, what):
         problems.append(what)
 
 
+with tempfile.TemporaryDirectory() as t:
+    subprocess.run([f"{src}/scripts/containers", "files", t], check=True, stdout=subprocess.DEVNULL)
+    adapter_cfg = json.load(open(f"{t}/config/wms_adapter.json"))
+
 check(set(pod) <= set(compose), f"services missing in compose.yaml: {sorted(set(pod) - set(compose))}")
 for name, c in pod.items():
     s = compose.get(name)
     if s is None:
         continue
     check(s.get("image") == c["image"], f"{name}: image {s.get('image')} != pod's {c['image']}")
-    # The pod's arguments with the run's duration filled in as compose has it.
-    args = [a.replace("__DURATION__", "180") for a in c.get("args", [])]
+    # The pod's arguments with the run's duration as compose fills it in.
+    args = [a.replace("__DURATION__", "${FLEET_SIM_SECONDS:-180}") for a in c.get("args", [])]
+    if name == "wms-adapter" and "--stations" in args:
+        i = args.index("--stations")
+        check(adapter_cfg.get("stations") == args[i + 1],
+              f"wms_adapter.json names stations {adapter_cfg.get('stations')}, the pod {args[i + 1]}")
+        check(adapter_cfg.get("http", {}).get("host") == "0.0.0.0",
+              "wms_adapter.json: http.host must be 0.0.0.0, or the published port reaches nothing")
+        args[i:i + 2] = ["--config", "/etc/fleet/wms_adapter.json"]
     check(s.get("command") == args, f"{name}: command {s.get('command')} != pod's args {args}")
     entry = [a.replace('"$@"', '"$$@"') for a in c.get("command", [])] or None
     check(s.get("entrypoint") == entry, f"{name}: entrypoint {s.get('entrypoint')} != pod's command {entry}")
@@ -42,15 +64,40 @@ for name, c in pod.items():
     if probe:
         check(s.get("healthcheck", {}).get("test") == ["CMD"] + probe,
               f"{name}: healthcheck {s.get('healthcheck')} != pod's probe {probe}")
-    http = c.get("livenessProbe", {}).get("httpGet")
-    if http:
-        check("healthcheck" in s and str(http["port"]) in " ".join(s["healthcheck"]["test"]),
-              f"{name}: no health check on port {http['port']}")
-    # One private loopback for the whole fleet, as in the --network none pod.
-    expected = "none" if name == "fleet-manager" else "service:fleet-manager"
-    check(s.get("network_mode") == expected, f"{name}: network_mode {s.get('network_mode')} != {expected}")
+    sc = c.get("securityContext", {})
+    if sc.get("readOnlyRootFilesystem"):
+        check(s.get("read_only") is True, f"{name}: the pod's root filesystem is read-only, compose's not")
+    if sc.get("allowPrivilegeEscalation") is False:
+        check("no-new-privileges" in s.get("security_opt", []), f"{name}: no security_opt no-new-privileges")
+
+# The network: one project bridge network, each service in its own namespace on it.
+check("fleet" in (doc.get("networks") or {}), "no project network `fleet` under networks:")
+dds = [n for n in compose if n != "fleetctl"]
+for name, s in compose.items():
+    check("network_mode" not in s, f"{name}: network_mode {s.get('network_mode')}: every service joins `fleet`")
+    check(s.get("networks") == ["fleet"], f"{name}: networks {s.get('networks')} != ['fleet']")
+    ports = s.get("ports", [])
+    if name == "wms-adapter":
+        check(len(ports) == 1 and str(ports[0]).startswith("127.0.0.1:") and str(ports[0]).endswith(":8080"),
+              f"wms-adapter: ports {ports}: the API only, on the host's loopback")
+    else:
+        check(not ports, f"{name}: publishes {ports}")
+    if name in dds:
+        check(s.get("environment", {}).get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE}",
+              f"{name}: CYCLONEDDS_URI {s.get('environment', {}).get('CYCLONEDDS_URI')} is not the compose profile")
+check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_URL") == "http://wms-adapter:8080",
+      "fleetctl: FLEET_WMS_URL is not the adapter's service name")
+
+ns = {"c": "https://cdds.io/config"}
+general = ET.parse(f"{src}/deploy/{PROFILE}").getroot().find("c:Domain", ns)
+peers = [p.get("address") for p in general.findall("c:Discovery/c:Peers/c:Peer", ns)]
+check(sorted(peers) == sorted(dds), f"{PROFILE}: peers {peers} != the DDS services {dds}")
+check(general.findtext("c:General/c:AllowMulticast", namespaces=ns) == "false", f"{PROFILE}: multicast is not off")
+runtime = open(f"{src}/deploy/runtime.Containerfile").read()
+check(any(line.startswith("COPY ") and PROFILE in line and "/usr/share/fleet/" in line for line in runtime.splitlines()),
+      f"deploy/runtime.Containerfile does not put {PROFILE} into /usr/share/fleet/")
 
 for p in problems:
     print("compose.yaml:", p)
-print(f"{len(pod)} services compared, {len(problems)} problems")
+print(f"{len(pod)} services compared, {len(peers)} DDS peers, {len(problems)} problems")
 sys.exit(1 if problems else 0)

@@ -13,16 +13,8 @@ cd "$SRC"
 t0=$SECONDS
 fail() { echo "FAIL: $*"; exit 1; }
 
-command -v podman >/dev/null || fail "podman is not installed (scripts/setup installs it)"
-if ! out=$(podman info 2>&1); then
-  echo "SKIP: podman cannot run here: $(tail -n 3 <<<"$out")"
-  exit 77
-fi
-scripts/containers build || fail "building the images failed"
-if ! out=$(podman run --rm --network none localhost/bookworm-min true 2>&1); then
-  echo "SKIP: podman cannot start a container here: $(tail -n 3 <<<"$out")"
-  exit 77
-fi
+# shellcheck source=podman_images.sh
+source "$(dirname "${BASH_SOURCE[0]}")/podman_images.sh"
 echo "images built after $((SECONDS - t0)) s"
 
 export POD=fleet-smoke-$$

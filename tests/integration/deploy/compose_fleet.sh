@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# CI test of deploy/compose.yaml with podman-compose: builds the images from the host build, starts
+# the five services each in its own container on the project's bridge network (DDS by unicast to
+# the service names, no multicast), posts a transport task from the host to the WMS adapter's API
+# published on 127.0.0.1, and asserts that the task reaches `done` (DDS between all five
+# containers), that every service is healthy, that no container joined a multicast group, and that
+# fleetctl in the network reaches the adapter by its service name. Everything the run created
+# (containers, network, files) is removed, also on failure. Exit 77 (ctest skip) only when podman
+# cannot run containers here at all. Usage: compose_fleet.sh SOURCE_DIR BUILD_DIR
+set -uo pipefail
+SRC=$1
+export BUILD_DIR=$2
+cd "$SRC" || exit 1
+t0=$SECONDS
+fail() { echo "FAIL: $*"; exit 1; }
+
+command -v podman-compose >/dev/null || fail "podman-compose is not installed (scripts/setup installs it)"
+# shellcheck source=podman_images.sh
+source "$(dirname "${BASH_SOURCE[0]}")/podman_images.sh"
+echo "images built after $((SECONDS - t0)) s"
+
+# Leftovers of a run that was killed (ctest's timeout kills without clean-up); runs still going
+# elsewhere keep theirs.
+for n in $(podman network ls --format '{{.Name}}' | grep -E '^fleet-compose-[0-9]+_fleet$'); do
+  pid=${n#fleet-compose-}
+  pid=${pid%_fleet}
+  kill -0 "$pid" 2>/dev/null && continue
+  podman ps -aq --filter "label=io.podman.compose.project=fleet-compose-$pid" | xargs -r podman rm -f -t 1 >/dev/null 2>&1
+  podman network rm -f "$n" >/dev/null 2>&1
+done
+
+P=fleet-compose-$$
+NET=${P}_fleet
+SERVICES=(fleet-manager wms-adapter risk-map robot-agent fleet-sim)
+dir=$(mktemp -d /tmp/fleet-compose.XXXXXX)
+compose() { timeout 120 podman-compose -p "$P" -f deploy/compose.yaml "$@"; }
+cleanup() {
+  if [[ ${ok:-0} != 1 ]]; then
+    for s in "${SERVICES[@]}"; do
+      echo "--- log of ${P}_${s}_1"
+      podman logs --tail 30 "${P}_${s}_1" 2>&1
+    done
+  fi
+  compose down >/dev/null 2>&1
+  # podman-compose 1.0.3 leaves the network (and a container whose start it lost) behind.
+  podman ps -aq --filter "label=io.podman.compose.project=$P" | xargs -r podman rm -f -t 1 >/dev/null 2>&1
+  podman network rm -f "$NET" >/dev/null 2>&1
+  rm -rf "$dir"
+}
+trap cleanup EXIT
+
+# A loopback port for the API outside the ephemeral range and outside the blocks of the C++ tests
+# (20000-28399, tests/support/test_process.hpp).
+port=""
+for k in $(seq 0 99); do
+  p=$((28400 + ($$ + k * 37) % 3000))
+  if python3 -c 'import socket,sys; s=socket.socket(); s.bind(("127.0.0.1", int(sys.argv[1])))' "$p" 2>/dev/null; then
+    port=$p
+    break
+  fi
+done
+[[ -n $port ]] || fail "no free loopback port for the API"
+
+scripts/containers files "$dir" sim/scenarios/one_robot.json 150 1 >/dev/null || fail "writing the mounted files failed"
+export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
+# fleetctl is left out: podman-compose 1.0.3 ignores `profiles: [cli]`.
+compose up -d "${SERVICES[@]}" >"$dir/up.log" 2>&1 || { tail -n 30 "$dir/up.log"; fail "podman-compose up failed"; }
+echo "podman-compose up after $((SECONDS - t0)) s"
+
+[[ $(podman network inspect --format '{{.DNSEnabled}}' "$NET" 2>/dev/null) == true ]] ||
+  fail "network $NET has no DNS: the service names do not resolve (podman's CNI backend needs golang-github-containernetworking-plugin-dnsname; scripts/setup installs it)"
+declare -A ip
+for s in "${SERVICES[@]}"; do
+  c=${P}_${s}_1
+  [[ $(podman inspect --format '{{.State.Status}}' "$c" 2>/dev/null) == running ]] || fail "$c did not start"
+  ip[$s]=$(podman inspect --format "{{(index .NetworkSettings.Networks \"$NET\").IPAddress}}" "$c")
+  [[ -n ${ip[$s]} ]] || fail "$c is not on $NET"
+done
+echo "containers: $(for s in "${SERVICES[@]}"; do printf '%s=%s ' "$s" "${ip[$s]}"; done)"
+[[ $(podman port "${P}_wms-adapter_1") == "8080/tcp -> 127.0.0.1:$port" ]] ||
+  fail "the API is not published on 127.0.0.1:$port only: $(podman port "${P}_wms-adapter_1")"
+
+ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port" "$@"; }
+for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
+ctl submit "$dir/config/tasks.csv" | tee "$dir/submit.txt"
+grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the task"
+touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
+
+state=""
+deadline=$((SECONDS + 120))
+while ((SECONDS < deadline)); do
+  state=$(ctl task job-000 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
+  [[ $state == "done" || $state == "failed" ]] && break
+  sleep 1
+done
+echo "task job-000: $state after $((SECONDS - t0)) s"
+[[ $state == "done" ]] || fail "the task did not reach done (last state '$state')"
+
+for s in fleet-manager wms-adapter risk-map robot-agent; do
+  c=${P}_${s}_1
+  [[ $(podman inspect --format '{{.State.Status}}' "$c") == running ]] || fail "$c is no longer running"
+  # A probe is a podman exec: on a loaded machine one may time out, so up to three tries.
+  h=1
+  for _ in 1 2 3; do podman healthcheck run "$c" >/dev/null 2>&1 && { h=0; break; }; sleep 1; done
+  ((h == 0)) || fail "$c is unhealthy"
+  # Multicast off: no group joined but the all-hosts group every interface is in (224.0.0.1).
+  groups=$(podman exec "$c" cat /proc/net/igmp | awk 'length($1) == 8 && $1 ~ /^[0-9A-F]+$/ && $1 != "010000E0" {print $1}')
+  [[ -z $groups ]] || fail "$c joined multicast groups $groups"
+  echo "$c running, healthy, no multicast group"
+done
+sim=$(podman inspect --format '{{.State.Status}} {{.State.ExitCode}}' "${P}_fleet-sim_1")
+[[ $sim == "running 0" || $sim == "exited 0" ]] || fail "the simulator ended badly ($sim)"
+
+# The compose file's fleetctl: a client in the network, reaching the adapter by service name.
+compose run --rm --no-deps -T fleetctl task job-000 >"$dir/run.log" 2>&1
+grep -q '"state": "done"' "$dir/run.log" || { tail -n 20 "$dir/run.log"; fail "fleetctl in the network did not reach wms-adapter:8080"; }
+echo "fleetctl in the network: job-000 done"
+ok=1
+echo "PASS: compose fleet test in $((SECONDS - t0)) s"
