@@ -24,6 +24,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "fault_plan.hpp"
 #include "fleet/core/config.hpp"
@@ -412,6 +413,8 @@ struct Run {
   }
 
   int run();
+  /// --serve: the adapter (kept running, on `port`) and the report's files on loopback until Ctrl-C.
+  void serveUntilInterrupted(int port);
 };
 
 int Run::run() {
@@ -941,8 +944,10 @@ int Run::run() {
   // The manager first: agents that exit while it runs lose their DDS liveliness, and it would
   // (rightly) requeue every active task as "robot lost" after the run had ended.
   sup.stop("fleet_manager", 5.0);
-  sup.stopAll(5.0);
-  say("fleet stopped");
+  // --serve keeps the adapter: its view holds the run's final state (robots, tasks, roadmap).
+  const bool serving = o.serve && code == 0;
+  sup.stopAll(5.0, serving ? "wms_adapter" : "");
+  say(serving ? "fleet stopped (but the WMS adapter, for the dashboard)" : "fleet stopped");
 
   // Reconcile the acknowledged tasks with the manager's database.
   const auto contents = readDb(db);
@@ -1043,7 +1048,60 @@ int Run::run() {
   if (code == 0 && (!acc.lost.empty() || !acc.duplicated.empty())) {
     code = 3;
   }
+  if (serving) {
+    serveUntilInterrupted(port);
+  }
   return code;
+}
+
+void Run::serveUntilInterrupted(int port) {
+  // The run folder holds the task database and logs: only the report's own files are served.
+  httplib::Server files;
+  const std::vector<std::tuple<std::string, fs::path, std::string>> served = {
+      {"/", out / "index.html", "text/html; charset=utf-8"},
+      {"/index.html", out / "index.html", "text/html; charset=utf-8"},
+      {"/viewer.html", out / "viewer.html", "text/html; charset=utf-8"},
+      {"/loadtest.json", out / "loadtest.json", "application/json"},
+      {"/summary.json", out / "sim_summary.json", "application/json"}};
+  for (const auto& [route, path, type] : served) {
+    files.Get(route, [path, type](const httplib::Request&, httplib::Response& res) {
+      std::ifstream in(path, std::ios::binary);
+      if (!in) {
+        res.status = 404;
+        res.set_content("this run left no " + path.filename().string() + "\n", "text/plain");
+        return;
+      }
+      std::ostringstream body;
+      body << in.rdbuf();
+      res.set_content(body.str(), type);
+    });
+  }
+  const int filesPort = files.bind_to_any_port("127.0.0.1");
+  if (filesPort <= 0) {
+    say("cannot serve the report on 127.0.0.1; it is in " + (fs::absolute(out) / "index.html").string());
+  }
+  std::thread server([&] {
+    if (filesPort > 0) {
+      files.listen_after_bind();
+    }
+  });
+  say("serving until Ctrl-C: the dashboard on the run's final state at http://127.0.0.1:" +
+      std::to_string(port) +
+      "/dashboard/ (the fleet is stopped: robots stand where they last reported, actions are refused)" +
+      (filesPort > 0 ? "; the report with its replay at http://127.0.0.1:" + std::to_string(filesPort) + "/"
+                     : std::string()));
+  while (gSignal == 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+    if (auto gone = sup.reapUnexpected(); !gone.empty()) {
+      say("the WMS adapter exited with status " + std::to_string(gone[0].second) + "; see " +
+          (out / "wms_adapter.log").string());
+      break;
+    }
+  }
+  files.stop();
+  server.join();
+  sup.stopAll(5.0);
+  say("stopped serving");
 }
 
 }  // namespace

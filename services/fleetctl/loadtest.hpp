@@ -57,6 +57,9 @@ struct LoadtestOptions {
   /// The last N robots of the scenario run as VDA 5050 vehicles (fleet-sim --vda5050) behind a
   /// vda5050_bridge and a Mosquitto broker of the run's own; needs reserved traffic.
   int vda5050 = 0;
+  /// After a run that ended normally, keep the WMS adapter up (the dashboard on the run's final
+  /// state) and serve the report with its replay on another loopback port, until Ctrl-C.
+  bool serve = false;
 };
 
 /// Runs the load test; returns the process exit code (0 ok, 3 lost or duplicated tasks, 1 error,

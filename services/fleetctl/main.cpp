@@ -191,6 +191,9 @@ int main(int argc, char** argv) {
   loadtest->add_flag("--wall-clock", lt.wallClock,
                      "run every service on the wall clock at 1x, as in production (default: lockstep); "
                      "reports the robot agents' achieved control rate");
+  loadtest->add_flag("--serve", lt.serve,
+                     "after the run, keep the dashboard up on its final state and serve the report (with "
+                     "its replay) on 127.0.0.1 until Ctrl-C");
   auto* site = app.add_subcommand("site", "site files");
   auto* siteCheck = site->add_subcommand("check", "validate a site or map file and print what it holds");
   std::string siteFile;

@@ -168,17 +168,19 @@ void Supervisor::stop(const std::string& name, double graceS) {
   ::kill(-pid, SIGKILL);  // anything left in the group
 }
 
-void Supervisor::stopAll(double graceS) {
+void Supervisor::stopAll(double graceS, const std::string& keep) {
   for (auto it = order_.rbegin(); it != order_.rend(); ++it) {
     auto c = children_.find(*it);
-    if (c != children_.end() && c->second.pid > 0) {
+    if (c != children_.end() && c->second.pid > 0 && *it != keep) {
       c->second.expectedExit = true;
       ::kill(-c->second.pid, SIGCONT);
       ::kill(-c->second.pid, SIGTERM);
     }
   }
   for (auto it = order_.rbegin(); it != order_.rend(); ++it) {
-    stop(*it, graceS);
+    if (*it != keep) {
+      stop(*it, graceS);
+    }
   }
 }
 

@@ -44,8 +44,9 @@ class Supervisor {
   std::vector<std::pair<std::string, int>> reapUnexpected();
   /// Waits up to `graceS` for `name` to exit on its own; true when it did.
   bool waitExit(const std::string& name, double graceS);
-  /// SIGTERM to every group (in reverse start order), SIGKILL after `graceS`, reap all.
-  void stopAll(double graceS);
+  /// SIGTERM to every group (in reverse start order), SIGKILL after `graceS`, reap all; but the
+  /// process called `keep`, when one is named.
+  void stopAll(double graceS, const std::string& keep = "");
   /// Stops one process the same way.
   void stop(const std::string& name, double graceS);
 

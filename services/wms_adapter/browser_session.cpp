@@ -52,6 +52,11 @@ std::optional<std::string> BrowserSessions::issue(const std::string& name, std::
   return body + "." + mac(entry->digest, "session." + body + "." + name) + "." + name;
 }
 
+std::optional<Principal> BrowserSessions::principal(std::string_view name) const {
+  auto entry = tokens_.named(name);
+  return entry ? std::optional<Principal>(std::move(entry->who)) : std::nullopt;
+}
+
 std::optional<BrowserSessions::Session> BrowserSessions::check(std::string_view cookie,
                                                                std::int64_t nowS) const {
   if (cookie.size() > 512) {

@@ -40,6 +40,8 @@ class BrowserSessions {
   /// The Set-Cookie header value that removes the session cookie.
   [[nodiscard]] std::string clearCookie() const;
   [[nodiscard]] std::int64_t lifetimeS() const { return lifetimeS_; }
+  /// Who the token named `name` is now (its scopes as the token file says), or nothing.
+  [[nodiscard]] std::optional<Principal> principal(std::string_view name) const;
   /// False when no token is configured (authentication off: no sessions needed).
   [[nodiscard]] bool enabled() const { return tokens_.enabled(); }
 

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <set>
 #include <unordered_map>
 
 #include "fleet/core/ids.hpp"
@@ -154,14 +155,76 @@ std::int64_t Dashboard::nowS() const {
 }
 
 void Dashboard::setSite(json site) {
-  std::lock_guard lock(siteMutex_);
-  homes_.clear();
-  if (site.contains("homes")) {
-    for (const auto& [robot, station] : site["homes"].items()) {
-      homes_[robot] = station.get<std::string>();
+  {
+    std::lock_guard lock(siteMutex_);
+    homes_.clear();
+    if (site.contains("homes")) {
+      for (const auto& [robot, station] : site["homes"].items()) {
+        homes_[robot] = station.get<std::string>();
+      }
+    }
+    site_ = std::move(site);
+  }
+  std::lock_guard traffic(trafficMutex_);
+  roadmap_ = std::make_shared<RoadmapLayer>();  // queues are named after the site's stations
+}
+
+std::shared_ptr<const Dashboard::RoadmapLayer> Dashboard::roadmapLayer() {
+  const auto [count, map] = d_.view.roadmap();
+  std::lock_guard lock(trafficMutex_);
+  if (!map || count == roadmap_->count) {
+    return roadmap_;
+  }
+  // Once per roadmap (the traffic manager sends one per incarnation and per closure), on whichever
+  // thread asks first.
+  json stations = json::array();
+  {
+    std::lock_guard site(siteMutex_);
+    if (site_.is_object() && site_.contains("stations")) {
+      stations = site_["stations"];
     }
   }
-  site_ = std::move(site);
+  auto layer = std::make_shared<RoadmapLayer>();
+  layer->count = count;
+  layer->map = map;
+  layer->queues = stationQueues(*map, stations);
+  const json j = roadmapJson(*map, layer->queues);
+  layer->json = (j.is_null() ? json{{"too_large", true},
+                                    {"epoch", map->epoch},
+                                    {"node_count", map->nodes.size()},
+                                    {"edge_count", map->edges.size()}}
+                             : j)
+                    .dump(-1, ' ', false, json::error_handler_t::replace);
+  roadmap_ = std::move(layer);
+  return roadmap_;
+}
+
+std::string Dashboard::queuesText() {
+  const auto layer = roadmapLayer();
+  if (!layer->map || layer->queues.empty()) {
+    return {};
+  }
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard lock(trafficMutex_);
+  if (queuesFor_ != layer->count || now - queuesAt_ >= std::chrono::milliseconds(d_.streamPeriodMs)) {
+    queuesText_ = json{{"queues", queuesJson(layer->queues, *layer->map, d_.view.robots())}}.dump(
+        -1, ' ', false, json::error_handler_t::replace);
+    queuesAt_ = now;
+    queuesFor_ = layer->count;
+  }
+  return queuesText_;
+}
+
+json Dashboard::trafficSnapshot() {
+  const auto layer = roadmapLayer();
+  json releases = json::array();
+  for (const auto& [robot, r] : d_.view.releases().second) {
+    releases.push_back(releaseJson(*r));
+  }
+  const std::string queues = queuesText();
+  return {{"roadmap", layer->map ? json::parse(layer->json) : json()},
+          {"releases", releases},
+          {"queues", queues.empty() ? json::array() : json::parse(queues)["queues"]}};
 }
 
 void Dashboard::routes(HttpServer& server) {
@@ -207,6 +270,8 @@ void Dashboard::routes(HttpServer& server) {
     }
     send(res, 200, site_);
   });
+  server.route("GET", "/v1/traffic", Scope::Read,
+               [this](const Request&, Response& res) { send(res, 200, trafficSnapshot()); });
   server.route("GET", R"(/v1/robots/([^/]+))", Scope::Read, [this](const Request& req, Response& res) {
     const std::string id = req.matches[1];
     for (const auto& r : d_.view.robots()) {
@@ -232,8 +297,20 @@ void Dashboard::routes(HttpServer& server) {
 
 void Dashboard::session(const Request& req, Response& res) {
   // The gate has let this request through: bearer token, a session, or no authentication at all.
+  // The page offers only what the caller's scopes allow (the server refuses the rest anyway).
+  auto scopesJson = [](const std::set<Scope>& scopes) {
+    json out = json::array();
+    for (const auto scope : scopes) {
+      out.push_back(toString(scope));
+    }
+    return out;
+  };
   if (!d_.sessions.enabled()) {
-    send(res, 200, {{"auth", "off"}, {"csrf", ""}});
+    send(res, 200,
+         {{"auth", "off"},
+          {"csrf", ""},
+          {"name", req.principal},
+          {"scopes", scopesJson({Scope::Read, Scope::Submit, Scope::Operate})}});
     return;
   }
   if (req.method == "DELETE") {
@@ -255,18 +332,16 @@ void Dashboard::session(const Request& req, Response& res) {
     send(res, 201, {{"auth", "session"}, {"csrf", s->csrf}, {"expires_in_s", d_.sessions.lifetimeS()}});
     return;
   }
-  const auto s = d_.sessions.check(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
-  json scopes = json::array();
-  if (s) {
-    for (const auto scope : s->who.scopes) {
-      scopes.push_back(toString(scope));
-    }
-  }
+  // A request with an Authorization header is the bearer token's, whatever cookie it carries.
+  const auto s = req.get_header_value("Authorization").empty()
+                     ? d_.sessions.check(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS())
+                     : std::nullopt;
+  const auto who = s ? std::optional<Principal>(s->who) : d_.sessions.principal(req.principal);
   send(res, 200,
        {{"auth", s ? "session" : "bearer"},
         {"csrf", s ? s->csrf : ""},
         {"name", req.principal},
-        {"scopes", scopes}});
+        {"scopes", scopesJson(who ? who->scopes : std::set<Scope>{})}});
 }
 
 void Dashboard::robotAction(const Request& req, Response& res) {
@@ -395,6 +470,11 @@ EventSource Dashboard::stream() {
     std::chrono::steady_clock::time_point robotsSentAt;
     std::uint64_t risk = 0;  // risk maps sent: the view's count
     std::chrono::steady_clock::time_point riskSentAt;
+    std::uint64_t roadmap = 0;   // the roadmap sent: the view's count
+    std::uint64_t releases = 0;  // the view's release count when they were last looked at
+    FleetView::Releases releasesSent;
+    std::chrono::steady_clock::time_point releasesSentAt;
+    std::string queues;  // the queues event's data sent last
   };
   auto cur = std::make_shared<Cursor>();
   cur->events = d_.view.eventCursor();
@@ -423,6 +503,60 @@ EventSource Dashboard::stream() {
       const json j = riskJson(*map);
       return j.is_null() ? std::string() : "event: risk\ndata: " + j.dump() + "\n\n";
     };
+    // The traffic layer: the roadmap once (and again when it changes), then the releases that
+    // changed (all of them after a new roadmap: the page replaces its set when "all" is true), the
+    // station queues when who waits in them changes.
+    auto roadmapEvent = [&]() -> std::string {
+      const auto layer = roadmapLayer();
+      if (!layer->map || layer->count == cur->roadmap) {
+        return {};
+      }
+      cur->roadmap = layer->count;
+      cur->releasesSent.clear();
+      cur->releases = 0;
+      return "event: roadmap\ndata: " + layer->json + "\n\n";
+    };
+    auto releasesEvent = [&](bool force) -> std::string {
+      if (!force && now - cur->releasesSentAt < std::chrono::milliseconds(d_.streamPeriodMs)) {
+        return {};
+      }
+      auto [count, current] = d_.view.releases();
+      if (count == cur->releases) {
+        return {};
+      }
+      const bool all = cur->releasesSent.empty();
+      cur->releases = count;
+      cur->releasesSentAt = now;
+      json changed = json::array();
+      json removed = json::array();
+      for (const auto& [robot, r] : current) {
+        const auto it = cur->releasesSent.find(robot);
+        if (it == cur->releasesSent.end() || it->second != r) {
+          changed.push_back(releaseJson(*r));
+        }
+      }
+      for (const auto& [robot, r] : cur->releasesSent) {
+        if (!current.contains(robot)) {
+          removed.push_back(robot);
+        }
+      }
+      cur->releasesSent = std::move(current);
+      if (!all && changed.empty() && removed.empty()) {
+        return {};
+      }
+      return "event: releases\ndata: " +
+             json{{"all", all}, {"releases", changed}, {"removed", removed}}.dump(
+                 -1, ' ', false, json::error_handler_t::replace) +
+             "\n\n";
+    };
+    auto queuesEvent = [&]() -> std::string {
+      std::string q = queuesText();
+      if (q.empty() || q == cur->queues) {
+        return {};
+      }
+      cur->queues = q;
+      return "event: queues\ndata: " + q + "\n\n";
+    };
     const char* manager = d_.gateway.managerOnline() ? "online" : "unreachable";
     if (!cur->sentSnapshot) {
       cur->sentSnapshot = true;
@@ -434,10 +568,16 @@ EventSource Dashboard::stream() {
                          {"reason", t.reason},
                          {"stamp_ns", t.updatedNs}});
       }
-      return "retry: 1000\nevent: snapshot\ndata: " +
-             json{{"robots", robotsJson(true)}, {"tasks", tasks}, {"fleet_manager", manager}}.dump(
-                 -1, ' ', false, json::error_handler_t::replace) +
-             "\n\n" + riskEvent(true);
+      std::string snapshot =
+          "retry: 1000\nevent: snapshot\ndata: " +
+          json{{"robots", robotsJson(true)}, {"tasks", tasks}, {"fleet_manager", manager}}.dump(
+              -1, ' ', false, json::error_handler_t::replace) +
+          "\n\n";
+      // One after the other (the operands of + are not sequenced): the roadmap before the releases.
+      snapshot += roadmapEvent();
+      snapshot += releasesEvent(true);
+      snapshot += queuesEvent();
+      return snapshot + riskEvent(true);
     }
     std::string chunk;
     std::vector<msg::TaskEvent> evs;
@@ -458,6 +598,9 @@ EventSource Dashboard::stream() {
                  "\n\n";
       }
     }
+    chunk += roadmapEvent();
+    chunk += releasesEvent(false);
+    chunk += queuesEvent();
     return chunk + riskEvent(false);
   };
 }

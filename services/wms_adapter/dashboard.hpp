@@ -3,11 +3,13 @@
 // The live operator dashboard's side of the WMS adapter (docs/operator-guide.md#dashboard): the
 // page's static files (built into the binary), browser sessions, the robot API (snapshot, one
 // robot, hold/release, send home or to charge), the site picture and one SSE stream of robot
-// states and task events for the page. Who may use which route is the API's scope model
+// states, task events and the traffic layer for the page. Who may use which route is the API's scope model
 // (access_control.hpp): the page's files are public, data needs "read", robot actions "operate".
 
+#include <chrono>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -17,6 +19,7 @@
 #include "fleet/fleet/station_map.hpp"
 #include "gateway.hpp"
 #include "http_server.hpp"
+#include "traffic_layer.hpp"
 
 namespace fleet::wms {
 
@@ -48,6 +51,9 @@ class Dashboard {
   Dashboard(HttpServer& server, DashboardDeps deps);
   /// The picture GET /v1/site returns (sitePictureOf); before it is set, 404.
   void setSite(nlohmann::json site);
+  /// What GET /v1/traffic returns: the roadmap (null before there is one, or too large to draw),
+  /// every robot's release and the station queues now.
+  [[nodiscard]] nlohmann::json trafficSnapshot();
 
  private:
   void routes(HttpServer& server);
@@ -59,7 +65,25 @@ class Dashboard {
   [[nodiscard]] EventSource stream();
   [[nodiscard]] std::int64_t nowS() const;
 
+  /// The current roadmap as the page gets it (made once per roadmap, shared by every stream) and
+  /// its station queues; the view's roadmap count it was made from (0: none yet).
+  struct RoadmapLayer {
+    std::uint64_t count = 0;
+    std::shared_ptr<const msg::Roadmap> map;
+    std::string json;  // the `roadmap` event's data
+    std::vector<StationQueue> queues;
+  };
+  [[nodiscard]] std::shared_ptr<const RoadmapLayer> roadmapLayer();
+  /// Who waits in each station queue (queuesJson), made at most every streamPeriodMs for all
+  /// streams; empty without a roadmap.
+  [[nodiscard]] std::string queuesText();
+
   DashboardDeps d_;
+  std::mutex trafficMutex_;
+  std::shared_ptr<const RoadmapLayer> roadmap_ = std::make_shared<RoadmapLayer>();
+  std::string queuesText_;
+  std::chrono::steady_clock::time_point queuesAt_;
+  std::uint64_t queuesFor_ = 0;  // the roadmap count queuesText_ was made for
   std::mutex siteMutex_;
   nlohmann::json site_;
   std::map<std::string, std::string> homes_;  // robot -> its parking place, from the site picture

@@ -6,17 +6,31 @@
 
 namespace fleet::wms {
 
+namespace {
+
+/// A reader the dashboard wants but the adapter can do without: DDS permissions made before the
+/// dashboard (scripts/dds-security) do not let the adapter read these topics.
+template <class T>
+void optionalReader(transport::Participant& p, transport::WaitSet& ws,
+                    std::unique_ptr<transport::Reader<T>>& out, const char* what) {
+  try {
+    out = std::make_unique<transport::Reader<T>>(p);
+    ws.attach(*out);
+  } catch (const std::exception& e) {
+    spdlog::warn("wms adapter: no {} for the dashboard ({})", what, e.what());
+  }
+}
+
+}  // namespace
+
 DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
     : view_(view), tasks_(p), acks_(p), events_(p), robots_(p), ws_(p) {
   ws_.attach(acks_);
   ws_.attach(events_);
   ws_.attach(robots_);
-  try {
-    risk_ = std::make_unique<transport::Reader<msg::RiskMap>>(p);
-    ws_.attach(*risk_);
-  } catch (const std::exception& e) {
-    spdlog::warn("wms adapter: no risk map for the dashboard ({})", e.what());
-  }
+  optionalReader(p, ws_, risk_, "risk map");
+  optionalReader(p, ws_, roadmap_, "roadmap");
+  optionalReader(p, ws_, releases_, "traffic releases");
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -60,6 +74,15 @@ void DdsGateway::loop() {
     auto maps = risk_ ? risk_->take() : std::vector<msg::RiskMap>{};
     if (!maps.empty() && validation::admit(maps.back(), view_.rejections())) {
       view_.onRisk(std::move(maps.back()));  // only the newest matters
+    }
+    auto roadmaps = roadmap_ ? roadmap_->take() : std::vector<msg::Roadmap>{};
+    if (!roadmaps.empty() && validation::admit(roadmaps.back(), view_.rejections())) {
+      view_.onRoadmap(std::move(roadmaps.back()));
+    }
+    for (auto& r : releases_ ? releases_->take() : std::vector<msg::TrafficRelease>{}) {
+      if (validation::admit(r, view_.rejections())) {
+        view_.onRelease(r);
+      }
     }
   }
 }

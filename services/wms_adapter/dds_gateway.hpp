@@ -11,7 +11,8 @@
 namespace fleet::wms {
 
 /// TaskGateway over DDS: writes Task requests, matches TaskAcks to waiting requests, and feeds the
-/// FleetView from TaskEvent and RobotState on a background thread.
+/// FleetView from TaskEvent and RobotState (and, for the dashboard, RiskMap, Roadmap and
+/// TrafficRelease) on a background thread.
 class DdsGateway final : public TaskGateway {
  public:
   DdsGateway(transport::Participant& p, FleetView& view);
@@ -34,6 +35,9 @@ class DdsGateway final : public TaskGateway {
   // For the dashboard's iso-level layer; none where the DDS permissions (made before the dashboard)
   // do not let the adapter read RiskMap: the adapter runs on without the layer.
   std::unique_ptr<transport::Reader<msg::RiskMap>> risk_;
+  // The traffic layer (roadmap, releases), likewise optional; only read, never written.
+  std::unique_ptr<transport::Reader<msg::Roadmap>> roadmap_;
+  std::unique_ptr<transport::Reader<msg::TrafficRelease>> releases_;
   transport::WaitSet ws_;
   std::mutex writeMutex_;
   std::mutex m_;

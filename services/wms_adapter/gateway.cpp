@@ -104,6 +104,45 @@ std::pair<std::uint64_t, std::shared_ptr<const msg::RiskMap>> FleetView::risk() 
   return {riskCount_, risk_};
 }
 
+void FleetView::onRoadmap(msg::Roadmap m) {
+  auto shared = std::make_shared<const msg::Roadmap>(std::move(m));
+  std::lock_guard lock(m_);
+  std::erase_if(releases_, [&](const auto& kv) { return kv.second->epoch < shared->epoch; });
+  roadmap_ = std::move(shared);
+  ++roadmapCount_;
+  ++releaseCount_;
+}
+
+void FleetView::onRelease(const msg::TrafficRelease& r) {
+  auto shared = std::make_shared<const msg::TrafficRelease>(r);
+  std::lock_guard lock(m_);
+  if (roadmap_ && r.epoch < roadmap_->epoch) {
+    return;  // a previous traffic manager's, delivered late
+  }
+  auto it = releases_.find(r.robot_id);
+  if (it == releases_.end()) {
+    if (releases_.size() >= kMaxReleaseRobots) {
+      return;
+    }
+    releases_.emplace(r.robot_id, std::move(shared));
+  } else if (r.epoch >= it->second->epoch) {
+    it->second = std::move(shared);
+  } else {
+    return;
+  }
+  ++releaseCount_;
+}
+
+std::pair<std::uint64_t, std::shared_ptr<const msg::Roadmap>> FleetView::roadmap() const {
+  std::lock_guard lock(m_);
+  return {roadmapCount_, roadmap_};
+}
+
+std::pair<std::uint64_t, FleetView::Releases> FleetView::releases() const {
+  std::lock_guard lock(m_);
+  return {releaseCount_, releases_};
+}
+
 std::optional<TaskView> FleetView::task(const std::string& id) const {
   std::lock_guard lock(m_);
   auto it = tasks_.find(id);

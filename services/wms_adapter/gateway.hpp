@@ -60,6 +60,13 @@ class FleetView {
   void onRobot(const msg::RobotState& s);
   /// The risk map service's latest map (for the dashboard's iso-level layer).
   void onRisk(msg::RiskMap m);
+  /// The traffic manager's roadmap (the dashboard's traffic layer). One of a new epoch (a
+  /// restarted traffic manager) drops the releases of earlier epochs.
+  void onRoadmap(msg::Roadmap m);
+  /// A robot's latest release. One of an epoch before the roadmap's is stale and ignored, as is a
+  /// robot beyond the first kMaxReleaseRobots.
+  void onRelease(const msg::TrafficRelease& r);
+  static constexpr std::size_t kMaxReleaseRobots = 10'000;
   /// A task as the manager's store has it (the answer to a query), for a task the view lacked.
   void onStored(const msg::TaskAck& a, std::int64_t nowNs);
   /// Samples refused (or repaired) on their way into the view, for /v1/metrics.
@@ -71,6 +78,11 @@ class FleetView {
   [[nodiscard]] std::vector<msg::RobotState> robots() const;
   /// The latest risk map and a count that grows with every new one (0, nullptr: none yet).
   [[nodiscard]] std::pair<std::uint64_t, std::shared_ptr<const msg::RiskMap>> risk() const;
+  /// The latest roadmap and a count that grows with every new one (0, nullptr: none yet).
+  [[nodiscard]] std::pair<std::uint64_t, std::shared_ptr<const msg::Roadmap>> roadmap() const;
+  /// Every robot's latest release, by robot id, and a count that grows with every change.
+  using Releases = std::map<std::string, std::shared_ptr<const msg::TrafficRelease>>;
+  [[nodiscard]] std::pair<std::uint64_t, Releases> releases() const;
   [[nodiscard]] std::map<std::string, std::int64_t> countByState() const;
 
   /// Events after `cursor` (a running count), waiting up to `timeout` for one to arrive. Returns the
@@ -88,6 +100,10 @@ class FleetView {
   std::map<std::string, msg::RobotState> robots_;
   std::shared_ptr<const msg::RiskMap> risk_;
   std::uint64_t riskCount_ = 0;
+  std::shared_ptr<const msg::Roadmap> roadmap_;
+  std::uint64_t roadmapCount_ = 0;
+  Releases releases_;
+  std::uint64_t releaseCount_ = 0;
   std::deque<msg::TaskEvent> events_;
   std::uint64_t eventCount_ = 0;
   validation::Rejections rejections_;

@@ -3,8 +3,9 @@
 // writes the simulator's ground truth to $DASH_DIR/truth.json and restarts the adapter when
 // $DASH_DIR/restart.request appears. Exit 0 when every check passed; each check prints one line.
 //
-// Env: DASH_URL (the page), DASH_TOKEN (the adapter's bearer token), DASH_DIR, DASH_SHOTS (folder
-// for the screenshots).
+// Env: DASH_URL (the page), DASH_TOKEN (an operator's token: read, submit, operate),
+// DASH_VIEWER_TOKEN (a read-only token), DASH_RELEASED (the robot the test released a route to),
+// DASH_DIR, DASH_SHOTS (folder for the screenshots).
 
 import fs from 'node:fs';
 import path from 'node:path';
@@ -12,6 +13,8 @@ import puppeteer from 'puppeteer-core';
 
 const url = process.env.DASH_URL;
 const token = process.env.DASH_TOKEN;
+const viewerToken = process.env.DASH_VIEWER_TOKEN;
+const released = process.env.DASH_RELEASED;
 const dir = process.env.DASH_DIR;
 const shots = process.env.DASH_SHOTS;
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
@@ -31,6 +34,63 @@ function truth() {
   } catch {
     return null;
   }
+}
+
+/** Where robot `id` (the first one when null) is on the screen, in CSS pixels. */
+async function robotOnScreen(id) {
+  return globalThis.page.evaluate((robotId) => {
+    const v = window.fleetDashboard.view;
+    const robots = window.fleetDashboard.model.robots;
+    const r = robotId ? robots.get(robotId) : robots.values().next().value;
+    const [px, py] = v.toCanvas(r.pose.x, r.pose.y);
+    const rect = v.canvas.getBoundingClientRect();
+    return [rect.left + px / v.dpr, rect.top + py / v.dpr];
+  }, id);
+}
+
+/** The canvas at the middle of each segment of robot `id`'s released base but the first (the robot
+ * stands on it), and whether it is the robot's colour (drawn translucent over the floor). */
+async function routePixels(id) {
+  return globalThis.page.evaluate((robotId) => {
+    const { view: v, model: m } = window.fleetDashboard;
+    const probe = document.createElement('canvas').getContext('2d', { willReadFrequently: true });
+    probe.fillStyle = '#fff';
+    probe.fillRect(0, 0, 1, 1);
+    probe.globalAlpha = 0.8;
+    probe.fillStyle = window.fleetDashboard.robotColour(robotId);
+    probe.fillRect(0, 0, 1, 1);
+    const want = [...probe.getImageData(0, 0, 1, 1).data].slice(0, 3);
+    const xy = m.releases.get(robotId).base_xy;
+    const g = v.canvas.getContext('2d');
+    const out = [];
+    for (let i = 2; i + 3 < xy.length; i += 2) {
+      const [px, py] = v.toCanvas((xy[i] + xy[i + 2]) / 2, (xy[i + 1] + xy[i + 3]) / 2);
+      const rgb = [...g.getImageData(Math.round(px), Math.round(py), 1, 1).data].slice(0, 3);
+      out.push({ rgb, match: rgb.every((c, k) => Math.abs(c - want[k]) < 45) });
+    }
+    return out;
+  }, id);
+}
+
+/** The canvas at the middle of the first 40 lanes of the roadmap away from every robot. */
+async function lanePixels() {
+  return globalThis.page.evaluate(() => {
+    const { view: v, model: m } = window.fleetDashboard;
+    const n = m.roadmap.nodes;
+    const g = v.canvas.getContext('2d');
+    const out = [];
+    for (let i = 0; i + 1 < m.roadmap.lanes.length && out.length < 40; i += 2) {
+      const [a, b] = [m.roadmap.lanes[i], m.roadmap.lanes[i + 1]];
+      const x = (n[2 * a] + n[2 * b]) / 2;
+      const y = (n[2 * a + 1] + n[2 * b + 1]) / 2;
+      if ([...m.robots.values()].some((r) => Math.hypot(r.pose.x - x, r.pose.y - y) < 1.5)) {
+        continue;
+      }
+      const [px, py] = v.toCanvas(x, y);
+      out.push([...g.getImageData(Math.round(px), Math.round(py), 1, 1).data].slice(0, 3));
+    }
+    return out;
+  });
 }
 
 async function until(what, fn, ms) {
@@ -56,6 +116,7 @@ const browser = await puppeteer.launch({
 });
 try {
   const page = await browser.newPage();
+  globalThis.page = page;
   await page.setViewport({ width: 1400, height: 900 });
   page.on('pageerror', (e) => check(false, `no script error on the page: ${e.message}`));
   const shot = (name) => page.screenshot({ path: path.join(shots, name) });
@@ -84,7 +145,37 @@ try {
   await shot('1-wrong-token.png');
   check(!(await page.evaluate(() => location.href)).includes('not-the-token'), 'the token is not in the URL');
 
-  // 2. The right token: the robots, where the simulator has them.
+  // 1b. A read-only token: the data, but no action is offered (the server would refuse it).
+  await page.$eval('#login-token', (el) => { el.value = ''; });
+  await page.type('#login-token', viewerToken);
+  await page.click('#login-submit');
+  await page.waitForFunction(() => window.fleetDashboard.ready, { timeout: 15000 });
+  await until('a read-only session sees the robots', () => model(() => window.fleetDashboard.model.robots.size > 0), 10000);
+  const first = await robotOnScreen(null);
+  await page.mouse.click(first[0], first[1]);
+  await page.waitForFunction(() => document.getElementById('robot-name').textContent !== '—', { timeout: 5000 });
+  await sleep(400);
+  const gated = await page.evaluate(() => {
+    const submit = document.querySelector('#task-form button[type=submit]');
+    const note = document.getElementById('scope-note');
+    return {
+      robot: [...document.querySelectorAll('[data-robot-action]')].map((b) => [b.disabled, b.title]),
+      submit: [submit.disabled, submit.title],
+      cancels: document.querySelectorAll('#queue button').length,
+      note: note.hidden ? '' : note.textContent,
+      who: document.getElementById('who').textContent,
+    };
+  });
+  check(gated.robot.every(([off, why]) => off && why.includes('"operate"')),
+        `a read-only session is offered no robot action (${gated.robot.map((b) => b[1]).join('; ')})`);
+  check(gated.submit[0] && gated.submit[1].includes('"submit"'), `nor the task form (${gated.submit[1]})`);
+  check(gated.cancels === 0, 'nor cancelling tasks');
+  check(gated.note.includes('"viewer"') && gated.who.startsWith('viewer'), `and is told why: ${gated.note}`);
+  await shot('1b-read-only.png');
+  await page.click('#logout');
+  await page.waitForSelector('#login[open]', { timeout: 10000 });
+
+  // 2. The operator's token: the robots, where the simulator has them.
   await page.$eval('#login-token', (el) => { el.value = ''; });
   await page.type('#login-token', token);
   await page.click('#login-submit');
@@ -108,6 +199,45 @@ try {
   check(seen.length === want && worst < 0.3,
         `${seen.length} robots on the page, ${want} in the simulator; farthest ${worst.toFixed(3)} m from ground truth`);
   await shot('2-live.png');
+  const operatorActions = await page.evaluate(() =>
+    [...document.querySelectorAll('[data-robot-action]')].filter((b) => !b.disabled).length);
+  check(operatorActions === 4, `the operator is offered the robot's four actions (${operatorActions} enabled)`);
+
+  // 2b. The traffic layer: the traffic manager's roadmap and its station queues, faint; the route
+  // released to one robot (this test published it) solid, then dashed, in that robot's colour.
+  const traffic = await until('the page has the roadmap, its station queues and the release', () => model((id) => {
+    const m = window.fleetDashboard.model;
+    const ok = m.roadmap && !m.roadmap.too_large && m.roadmap.queues.length > 0 && m.queues.length > 0 &&
+      m.releases.has(id);
+    return ok ? { nodes: m.roadmap.nodes.length / 2, queues: m.roadmap.queues.length, base: m.releases.get(id).base.length,
+      horizon: m.releases.get(id).horizon.length } : null;
+  }, released), 30000);
+  if (traffic) {
+    check(traffic.base === 5 && traffic.horizon === 4,
+          `roadmap of ${traffic.nodes} nodes, ${traffic.queues} station queues; ${released}: ${traffic.base} nodes released, ${traffic.horizon} planned`);
+    check(!(await page.$eval('#station-queues', (el) => el.hidden)), 'the station queues card is shown');
+    await page.click('[data-layer=risk]'); // its colours are not what is looked for here
+    await sleep(300);
+    const routeOn = await routePixels(released);
+    const lanesOn = await lanePixels();
+    await page.click('[data-layer=routes]');
+    await page.click('[data-layer=roadmap]');
+    await sleep(500);
+    const routeOff = await routePixels(released);
+    const lanesOff = await lanePixels();
+    await page.click('[data-layer=routes]');
+    await page.click('[data-layer=roadmap]');
+    await page.click('[data-layer=risk]');
+    const inColour = routeOn.filter((p) => p.match).length;
+    check(inColour >= routeOn.length / 2,
+          `${released}'s released route is drawn in its colour (${inColour} of ${routeOn.length} points: ${JSON.stringify(routeOn.map((p) => p.rgb))})`);
+    check(routeOff.filter((p) => p.match).length < inColour, 'the routes layer switches off');
+    const changed = lanesOn.filter((p, i) => p.join() !== lanesOff[i].join()).length;
+    check(changed >= lanesOn.length / 2, `the roadmap is drawn (${changed} of ${lanesOn.length} lane points change when its layer is off)`);
+    check(lanesOn.every((p) => Math.min(...p) > 150), 'faintly (no lane point darker than 150)');
+    await sleep(500);
+    await shot('2b-traffic.png');
+  }
 
   // 3. A task from the page's form (with its confirmation).
   await page.select('#task-pickup', 'P-2');
@@ -127,13 +257,7 @@ try {
   // 4. Pause its robot from the page: click it on the map, Pause, confirm.
   if (robot) {
     await sleep(1500); // let it drive a little
-    const at = await model((id) => {
-      const v = window.fleetDashboard.view;
-      const r = window.fleetDashboard.model.robots.get(id);
-      const [px, py] = v.toCanvas(r.pose.x, r.pose.y);
-      const rect = v.canvas.getBoundingClientRect();
-      return [rect.left + px / v.dpr, rect.top + py / v.dpr];
-    }, robot);
+    const at = await robotOnScreen(robot);
     await page.mouse.click(at[0], at[1]);
     await page.waitForFunction((id) => document.getElementById('robot-name').textContent === id, { timeout: 5000 }, robot);
     await page.click('[data-robot-action=pause]');

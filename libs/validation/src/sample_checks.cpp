@@ -281,8 +281,19 @@ std::optional<Rejection> check(const msg::Roadmap& m) {
   c.size(m.nodes.size(), kMaxRoadmapNodes, "nodes").size(m.edges.size(), kMaxRoadmapEdges, "edges");
   c.require(m.kinds.size() == m.nodes.size() && m.open.size() == m.nodes.size(), "structure",
             "kinds and open must have one entry per node");
-  for (const auto& n : m.nodes) {
-    c.position(n.x, n.y, "nodes[]");
+  // Edges and releases name nodes by id, and readers look a node up by its index.
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    c.position(m.nodes[i].x, m.nodes[i].y, "nodes[]");
+    if (m.nodes[i].node != static_cast<std::int32_t>(i)) {
+      c.require(
+          false, "structure",
+          "nodes[" + std::to_string(i) + "] has id " + std::to_string(m.nodes[i].node) + ", not its index");
+    }
+  }
+  for (const auto k : m.kinds) {
+    if (k > kMaxRoadmapNodeKind) {
+      c.require(false, "enum", "kinds[] = " + std::to_string(k) + " is not a known node kind (0..5)");
+    }
   }
   const auto count = static_cast<std::int64_t>(m.nodes.size());
   for (const auto& e : m.edges) {

@@ -2,6 +2,9 @@
 // the page never sees, plus a CSRF token kept in memory only), JSON requests with plain error
 // messages, and the SSE stream with reconnects.
 
+/** What GET /v1/stream sends (docs/openapi.yaml). */
+export const STREAM_EVENTS = ['snapshot', 'robots', 'task', 'risk', 'roadmap', 'releases', 'queues'];
+
 export class ApiError extends Error {
   constructor(status, message) {
     super(message);
@@ -14,11 +17,16 @@ export class Api {
     this.csrf = '';
   }
 
-  /** The current session: 'off' (no authentication), 'session', or throws ApiError(401). */
+  /**
+   * The current session: {auth: 'off' (no authentication) | 'session' | 'bearer', name, scopes},
+   * or throws ApiError(401).
+   */
   async session() {
     const body = await this.request('GET', '/v1/session');
     this.csrf = body.csrf || '';
-    return body.auth;
+    // No list (a server that does not say): offer everything; the server refuses what it must.
+    const scopes = Array.isArray(body.scopes) ? body.scopes : ['read', 'submit', 'operate'];
+    return { auth: body.auth, name: body.name || '', scopes };
   }
 
   /** Makes a session from the token: the token travels once, in a header, never in a URL. */
@@ -67,8 +75,9 @@ export class Api {
   }
 
   /**
-   * Opens the stream. `handlers`: snapshot, robots, task (parsed data), state(text, level) for the
-   * connection, unauthorized() when the session is gone. Reconnects by itself; returns a closer.
+   * Opens the stream. `handlers`: one per event name in STREAM_EVENTS (parsed data), state(text,
+   * level) for the connection, unauthorized() when the session is gone. Reconnects by itself;
+   * returns a closer.
    */
   stream(handlers) {
     let es = null;
@@ -77,7 +86,7 @@ export class Api {
     const open = () => {
       es = new EventSource('/v1/stream');
       es.addEventListener('open', () => handlers.state('live', 'ok'));
-      for (const name of ['snapshot', 'robots', 'task', 'risk']) {
+      for (const name of STREAM_EVENTS) {
         es.addEventListener(name, (ev) => {
           let data;
           try {

@@ -1,9 +1,9 @@
 // The live operator dashboard: logs in (a session made from the bearer token), loads the site,
 // follows the adapter's stream and draws the fleet; operator actions ask for confirmation first.
 
-import { Api, ApiError } from './api.js';
+import { Api, ApiError, STREAM_EVENTS } from './api.js';
 import { FleetModel } from './fleet_model.js';
-import { MapView, MODE_COLOURS } from './map_view.js';
+import { LAYERS, MapView, MODE_COLOURS, robotColour } from './map_view.js';
 import { Panels } from './panels.js';
 
 const api = new Api();
@@ -20,6 +20,7 @@ let lastRobotsAt = 0;
 window.fleetDashboard = {
   model,
   view,
+  robotColour,
   ready: false,
   fps: (ms) => view.fps(ms),
   /** Feeds one stream message as if it came from the adapter (replay benchmarks). */
@@ -36,6 +37,7 @@ function onMessage(name, data) {
   const now = Date.now();
   if (name === 'snapshot') {
     model.snapshot(data, now);
+    layerAvailability();
     model.log(`connected: ${model.robots.size} robots, ${model.openTasks().length} open tasks`);
   } else if (name === 'robots') {
     if (lastRobotsAt) {
@@ -56,6 +58,13 @@ function onMessage(name, data) {
     model.task(data);
   } else if (name === 'risk') {
     model.setRisk(data);
+  } else if (name === 'roadmap') {
+    model.setRoadmap(data);
+    layerAvailability();
+  } else if (name === 'releases') {
+    model.releasesUpdate(data);
+  } else if (name === 'queues') {
+    model.setQueues(data);
   }
 }
 
@@ -80,7 +89,7 @@ function frame(t) {
     lastDrawVersion = model.version;
     lastDrawAt = now;
     const robots = new Map([...model.robots].map(([id, r]) => [id, { ...r, pose: drawnPose(r, now) }]));
-    view.draw({ robots, risk: model.risk }, t);
+    view.draw({ robots, risk: model.risk, roadmap: model.roadmap, releases: model.releases, queues: model.queues }, t);
     panels.update(now);
   }
   requestAnimationFrame(frame);
@@ -124,6 +133,7 @@ function showLogin(message) {
   setStatus('not logged in', 'bad');
   document.getElementById('login-error').textContent = message || '';
   document.getElementById('logout').hidden = true;
+  document.getElementById('who').textContent = '';
   const dlg = document.getElementById('login');
   if (!dlg.open) {
     dlg.showModal();
@@ -132,8 +142,11 @@ function showLogin(message) {
 
 async function start() {
   try {
-    const auth = await api.session();
-    document.getElementById('logout').hidden = auth !== 'session';
+    const session = await api.session();
+    document.getElementById('logout').hidden = session.auth !== 'session';
+    document.getElementById('who').textContent =
+      session.auth === 'off' ? 'no login (authentication off)' : `${session.name} · ${session.scopes.join(', ')}`;
+    panels.setScopes(session.name, session.scopes);
   } catch (e) {
     if (e.status === 401) {
       showLogin('');
@@ -152,15 +165,14 @@ async function start() {
     model.log(`no site picture: ${e.message}`);
   }
   setStatus('connecting…', 'warn');
+  const handlers = Object.fromEntries(STREAM_EVENTS.map((name) => [name, (d) => onMessage(name, d)]));
   closeStream = api.stream({
+    ...handlers,
     snapshot: (d) => {
       onMessage('snapshot', d);
       window.fleetDashboard.ready = true;
       setStatus('live');
     },
-    robots: (d) => onMessage('robots', d),
-    task: (d) => onMessage('task', d),
-    risk: (d) => onMessage('risk', d),
     state: (text, level) => {
       setStatus(text, level);
       if (level !== 'ok') {
@@ -203,6 +215,46 @@ for (const [mode, colour] of Object.entries(MODE_COLOURS)) {
 const riskKey = document.createElement('span');
 riskKey.textContent = '· risk iso-levels: yellow (low) to red (high)';
 legend.append(riskKey);
+const routeKey = document.createElement('span');
+routeKey.id = 'route-key';
+const solid = document.createElement('i');
+solid.className = 'swatch';
+const dashed = document.createElement('i');
+dashed.className = 'swatch dashed';
+routeKey.append('· routes in each robot\'s colour (its ring): ', solid, 'released ', dashed, 'planned');
+legend.append(routeKey);
+
+// Layer switches, remembered in this browser.
+const layerBoxes = {};
+for (const [key, label] of Object.entries(LAYERS)) {
+  const stored = localStorage.getItem('fleet.layer.' + key);
+  view.layers[key] = stored === null ? true : stored === '1';
+  const box = document.createElement('input');
+  box.type = 'checkbox';
+  box.checked = view.layers[key];
+  box.dataset.layer = key;
+  box.addEventListener('change', () => {
+    view.layers[key] = box.checked;
+    localStorage.setItem('fleet.layer.' + key, box.checked ? '1' : '0');
+    model.version++;
+  });
+  const row = document.createElement('label');
+  row.append(box, ' ' + label);
+  document.getElementById('layers').append(row);
+  layerBoxes[key] = row;
+}
+
+/** The traffic layers say when there is nothing to show (no traffic manager: reactive traffic). */
+function layerAvailability() {
+  const why = !model.roadmap ? 'no roadmap: the fleet runs without a traffic manager'
+    : model.roadmap.too_large ? 'the roadmap is too large to draw' : '';
+  for (const key of ['roadmap', 'routes', 'queues']) {
+    layerBoxes[key].classList.toggle('unavailable', !!why);
+    layerBoxes[key].title = why;
+  }
+  document.getElementById('route-key').hidden = !!why;
+}
+layerAvailability();
 
 requestAnimationFrame(frame);
 start();

@@ -1,8 +1,27 @@
 // What the page knows of the fleet, fed by the stream: robots (with when each was last heard of),
-// tasks, recent events, and the live figures computed from them.
+// tasks, recent events, the traffic layer (roadmap, releases, station queues), and the live
+// figures computed from them.
 
 const TERMINAL = new Set(['done', 'failed', 'cancelled', 'rejected']);
 export const STALE_MS = 5000; // a robot not heard of for this long is drawn as lost
+
+/**
+ * Whether robot `r` counts as lost: not heard of for STALE_MS while others were (`newest`: when
+ * the latest robot update arrived). When the whole fleet is quiet — a run that ended, a paused
+ * simulation — robots stay where they were last seen and the figures say how long ago that was.
+ */
+export function isStale(r, newest) {
+  return newest - r.receivedAt > STALE_MS;
+}
+
+/** When the latest robot update arrived (0: none). */
+export function newestUpdate(robots) {
+  let newest = 0;
+  for (const r of robots.values()) {
+    newest = Math.max(newest, r.receivedAt || 0);
+  }
+  return newest;
+}
 
 export class FleetModel {
   constructor() {
@@ -15,11 +34,18 @@ export class FleetModel {
     this.firstStampNs = 0;
     this.managerOnline = true;
     this.risk = null; // the risk map's latest iso-level grid (GET /v1/stream `risk`)
+    this.roadmap = null; // the traffic manager's roadmap (`roadmap`); null: none (reactive traffic)
+    this.releases = new Map(); // robot -> its release (`releases`): base and horizon
+    this.queues = []; // per station queue: {station, at, waiting: [robot, ...], length}
     this.version = 0; // grows with every change, so views redraw only when needed
   }
 
   snapshot(data, now) {
     this.robots.clear();
+    // The traffic layer follows the snapshot in the same stream (when there is one to send).
+    this.roadmap = null;
+    this.releases.clear();
+    this.queues = [];
     this.robotsUpdate(data.robots || [], now);
     for (const t of data.tasks || []) {
       const old = this.tasks.get(t.id) || {};
@@ -32,6 +58,30 @@ export class FleetModel {
 
   setRisk(risk) {
     this.risk = risk;
+    this.version++;
+  }
+
+  setRoadmap(roadmap) {
+    this.roadmap = roadmap;
+    this.version++;
+  }
+
+  /** A `releases` message: the whole set when `all`, else the releases that changed. */
+  releasesUpdate(data) {
+    if (data.all) {
+      this.releases.clear();
+    }
+    for (const r of data.releases || []) {
+      this.releases.set(r.robot, r);
+    }
+    for (const id of data.removed || []) {
+      this.releases.delete(id);
+    }
+    this.version++;
+  }
+
+  setQueues(data) {
+    this.queues = data.queues || [];
     this.version++;
   }
 
@@ -101,8 +151,9 @@ export class FleetModel {
   figures(now) {
     const byMode = {};
     let stale = 0;
+    const newest = newestUpdate(this.robots);
     for (const r of this.robots.values()) {
-      if (now - r.receivedAt > STALE_MS) {
+      if (isStale(r, newest)) {
         stale++;
         continue;
       }
@@ -117,7 +168,8 @@ export class FleetModel {
     const median = sorted.length ? sorted[Math.floor(sorted.length / 2)] : null;
     const open = this.openTasks();
     return {
-      robots: `${this.robots.size - stale} live` + (stale ? `, ${stale} not heard of` : ''),
+      robots: `${this.robots.size - stale} live` + (stale ? `, ${stale} not heard of` : '') +
+        (newest && now - newest > STALE_MS ? ` — no update for ${Math.round((now - newest) / 1000)} s` : ''),
       'by state': Object.entries(byMode).map(([k, n]) => `${k} ${n}`).join(', ') || '—',
       'tasks open': `${open.length} (${open.filter((t) => t.state === 'queued' || t.state === 'requeued').length} waiting)`,
       'tasks done': String(this.doneStamps.length),

@@ -1,8 +1,12 @@
 // The site map on one canvas: walls and shelves drawn once into an offscreen canvas, then every
-// frame the stations and robots over it (no DOM node per robot). Robots are discs with a heading
-// line, coloured by state; paused ones carry two bars, lost ones are hollow.
+// frame the layers and robots over it (no DOM node per robot). Robots are discs with a heading
+// line, coloured by state; paused ones carry two bars, lost ones (not heard of while others are)
+// are hollow. Layers, each of which the page can switch off: the risk map's iso-levels, the
+// roadmap (faint, drawn once into a canvas of its own), each robot's route (its released base
+// solid, the planned horizon dashed, in the robot's own colour, which also rings the robot) and
+// the station queues (how many wait).
 
-import { STALE_MS } from './fleet_model.js';
+import { isStale, newestUpdate } from './fleet_model.js';
 
 export const MODE_COLOURS = {
   idle: '#8a93a6',
@@ -14,6 +18,26 @@ export const MODE_COLOURS = {
   fault: '#d0021b',
 };
 
+/** The layers the page can switch on and off (all on by default). */
+export const LAYERS = {
+  risk: 'risk map',
+  roadmap: 'roadmap',
+  routes: 'routes (released solid, planned dashed)',
+  queues: 'station queues',
+};
+
+/** A colour of the robot's own, the same on every page and visit (from its id). */
+export function robotColour(id) {
+  let h = 2166136261;
+  for (let i = 0; i < id.length; i++) {
+    h = Math.imul(h ^ id.charCodeAt(i), 16777619);
+  }
+  // Golden-angle steps spread neighbouring hashes around the wheel; a few lightness levels more.
+  const hue = Math.round(((h >>> 0) % 360) * 137.508) % 360;
+  const light = [42, 34, 50][(h >>> 9) % 3];
+  return `hsl(${hue}, 75%, ${light}%)`;
+}
+
 export class MapView {
   constructor(canvas) {
     this.canvas = canvas;
@@ -23,6 +47,9 @@ export class MapView {
     this.selected = '';
     this.riskLayer = null; // the risk map's iso-levels as an image, one pixel per cell
     this.riskOf = null;
+    this.roadmapLayer = null; // the roadmap drawn at the current size
+    this.roadmapOf = null;
+    this.layers = Object.fromEntries(Object.keys(LAYERS).map((k) => [k, true]));
     this.frameTimes = new Float64Array(4096); // rAF timestamps, a ring (for the frame-rate figure)
     this.frames = 0;
     new ResizeObserver(() => this.resize()).observe(canvas);
@@ -33,6 +60,7 @@ export class MapView {
     this.site = site;
     this.bounds = siteBounds(site);
     this.background = null;
+    this.roadmapLayer = null;
     this.resize();
   }
 
@@ -44,6 +72,7 @@ export class MapView {
       this.canvas.width = w;
       this.canvas.height = h;
       this.background = null;
+      this.roadmapLayer = null;
     }
     const b = this.bounds || { x0: 0, y0: 0, x1: 10, y1: 10 };
     const pad = 12 * dpr;
@@ -132,10 +161,21 @@ export class MapView {
     }
     const g = this.ctx;
     g.drawImage(this.background, 0, 0);
-    if (model.risk) {
+    if (model.risk && this.layers.risk) {
       this.drawRisk(model.risk);
     }
-    const wall = Date.now();
+    const roadmap = model.roadmap && !model.roadmap.too_large ? model.roadmap : null;
+    if (roadmap && this.layers.roadmap) {
+      this.drawRoadmap(roadmap);
+    }
+    const routes = this.layers.routes && model.releases && model.releases.size > 0;
+    if (routes) {
+      this.drawReleases(model.releases);
+    }
+    if (roadmap && this.layers.queues && model.queues) {
+      this.drawQueues(roadmap, model.queues);
+    }
+    const newest = newestUpdate(model.robots);
     const labels = this.scale > 14 * this.dpr;
     g.font = `${10 * this.dpr}px system-ui, sans-serif`;
     g.lineWidth = 1.5 * this.dpr;
@@ -143,7 +183,7 @@ export class MapView {
       const [px, py] = this.toCanvas(r.pose.x, r.pose.y);
       const rad = Math.max(3 * this.dpr, (r.radius || 0.3) * this.scale);
       const colour = r.fault ? MODE_COLOURS.fault : MODE_COLOURS[r.mode] || '#555';
-      const stale = wall - r.receivedAt > STALE_MS;
+      const stale = isStale(r, newest);
       g.beginPath();
       g.arc(px, py, rad, 0, 2 * Math.PI);
       if (stale) {
@@ -165,6 +205,14 @@ export class MapView {
         g.fillRect(px - rad * 0.45, py - rad * 0.5, rad * 0.3, rad);
         g.fillRect(px + rad * 0.15, py - rad * 0.5, rad * 0.3, rad);
       }
+      if (routes && model.releases.has(r.id)) {
+        g.beginPath();
+        g.arc(px, py, rad + 1.5 * this.dpr, 0, 2 * Math.PI);
+        g.strokeStyle = robotColour(r.id);
+        g.lineWidth = 2.5 * this.dpr;
+        g.stroke();
+        g.lineWidth = 1.5 * this.dpr;
+      }
       if (r.id === this.selected) {
         g.beginPath();
         g.arc(px, py, rad + 4 * this.dpr, 0, 2 * Math.PI);
@@ -178,6 +226,139 @@ export class MapView {
         g.fillText(r.id, px + rad + 2, py + rad + 8 * this.dpr);
       }
     }
+  }
+
+  /** The roadmap, faint: lanes grey, one-way lanes blue, queue lines purple, closed lanes red. */
+  drawRoadmap(m) {
+    if (this.roadmapOf !== m || !this.roadmapLayer) {
+      this.roadmapOf = m;
+      const c = document.createElement('canvas');
+      c.width = this.canvas.width;
+      c.height = this.canvas.height;
+      const g = c.getContext('2d');
+      const at = (v) => this.toCanvas(m.nodes[2 * v], m.nodes[2 * v + 1]);
+      const QUEUE = 3;
+      const stroke = (pairs, colour, width, dash, keep = () => true) => {
+        g.beginPath();
+        for (let i = 0; i + 1 < pairs.length; i += 2) {
+          if (!keep(pairs[i], pairs[i + 1])) {
+            continue;
+          }
+          const [x0, y0] = at(pairs[i]);
+          const [x1, y1] = at(pairs[i + 1]);
+          g.moveTo(x0, y0);
+          g.lineTo(x1, y1);
+        }
+        g.strokeStyle = colour;
+        g.lineWidth = width * this.dpr;
+        g.setLineDash(dash.map((d) => d * this.dpr));
+        g.stroke();
+      };
+      const queueLine = (a, b) => m.kinds[a] === QUEUE && m.kinds[b] === QUEUE ||
+        m.kinds[a] === QUEUE && m.kinds[b] !== 0;
+      g.lineCap = 'round';
+      stroke(m.lanes || [], 'rgba(120, 130, 150, 0.22)', 0.8, []);
+      stroke(m.one_way || [], 'rgba(47, 111, 222, 0.3)', 0.8, [], (a, b) => !queueLine(a, b));
+      stroke(m.one_way || [], 'rgba(155, 48, 208, 0.55)', 2.5, [], queueLine);
+      stroke(m.closed_lanes || [], 'rgba(208, 2, 27, 0.45)', 1, [3, 3]);
+      g.setLineDash([]);
+      // Queue places as small rings (robots wait on them), closed nodes as red dots.
+      const ring = Math.max(2, 0.12 * this.scale);
+      g.strokeStyle = 'rgba(155, 48, 208, 0.7)';
+      g.lineWidth = 1.2 * this.dpr;
+      for (let v = 0; v < m.kinds.length; v++) {
+        if (m.kinds[v] === QUEUE) {
+          const [x, y] = at(v);
+          g.beginPath();
+          g.arc(x, y, ring, 0, 2 * Math.PI);
+          g.stroke();
+        }
+      }
+      g.fillStyle = 'rgba(208, 2, 27, 0.6)';
+      for (const v of m.closed || []) {
+        const [x, y] = at(v);
+        g.fillRect(x - ring / 2, y - ring / 2, ring, ring);
+      }
+      this.roadmapLayer = c;
+    }
+    this.ctx.drawImage(this.roadmapLayer, 0, 0);
+  }
+
+  /** Each robot's release in its own colour: the base (may drive) solid, the horizon dashed. */
+  drawReleases(releases) {
+    const g = this.ctx;
+    const line = (xy, from) => {
+      g.beginPath();
+      if (from) {
+        g.moveTo(...this.toCanvas(from[0], from[1]));
+      }
+      for (let i = 0; i + 1 < xy.length; i += 2) {
+        const [x, y] = this.toCanvas(xy[i], xy[i + 1]);
+        if (i === 0 && !from) {
+          g.moveTo(x, y);
+        } else {
+          g.lineTo(x, y);
+        }
+      }
+      g.stroke();
+    };
+    g.lineCap = 'round';
+    g.lineJoin = 'round';
+    const width = Math.max(2 * this.dpr, 0.12 * this.scale);
+    for (const r of releases.values()) {
+      const base = r.base_xy || [];
+      const horizon = r.horizon_xy || [];
+      g.strokeStyle = robotColour(r.robot);
+      if (horizon.length >= 2) {
+        g.globalAlpha = 0.75;
+        g.lineWidth = Math.max(1.2 * this.dpr, width * 0.45);
+        g.setLineDash([5 * this.dpr, 4 * this.dpr]);
+        line(horizon, base.length >= 2 ? base.slice(-2) : null);
+        g.setLineDash([]);
+      }
+      if (base.length >= 4) {
+        g.globalAlpha = 0.8;
+        g.lineWidth = width;
+        line(base, null);
+      }
+      if (base.length >= 2 && r.ends_at_goal) {
+        // The base ends at the robot's goal: a small bar across its end.
+        const [x, y] = this.toCanvas(base[base.length - 2], base[base.length - 1]);
+        g.globalAlpha = 0.9;
+        g.fillStyle = g.strokeStyle;
+        g.fillRect(x - width, y - width, 2 * width, 2 * width);
+      }
+    }
+    g.globalAlpha = 1;
+    g.lineCap = 'butt';
+    g.lineJoin = 'miter';
+  }
+
+  /** A purple count beside each station with robots waiting in its queue. */
+  drawQueues(roadmap, queues) {
+    const g = this.ctx;
+    const docks = new Map((roadmap.queues || []).map((q) => [q.station, q]));
+    g.font = `bold ${10 * this.dpr}px system-ui, sans-serif`;
+    g.textBaseline = 'middle';
+    for (const q of queues) {
+      const shape = docks.get(q.station);
+      if (!shape || !q.waiting || !q.waiting.length) {
+        continue;
+      }
+      // At the tail end of the queue, where a robot joining it would look.
+      const v = shape.nodes[shape.nodes.length - 1];
+      const [x, y] = this.toCanvas(roadmap.nodes[2 * v], roadmap.nodes[2 * v + 1]);
+      const text = `${q.waiting.length} waiting`;
+      const w = g.measureText(text).width + 8 * this.dpr;
+      const h = 14 * this.dpr;
+      const bx = x + 8 * this.dpr;
+      const by = y - h / 2;
+      g.fillStyle = 'rgba(155, 48, 208, 0.9)';
+      g.fillRect(bx, by, w, h);
+      g.fillStyle = '#fff';
+      g.fillText(text, bx + 4 * this.dpr, y);
+    }
+    g.textBaseline = 'alphabetic';
   }
 
   /** Iso-levels from white (level 1) to red (level K), translucent; level 0 (no risk) is clear. */

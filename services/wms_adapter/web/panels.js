@@ -1,6 +1,8 @@
-// The side panels: figures, the selected robot and its actions, the task form, the task queue and
-// recent events. Updated from the model a few times a second, always through textContent (task ids
-// and reasons come from outside and are never parsed as HTML).
+// The side panels: figures, the selected robot and its actions, the task form, the task queue,
+// the station queues and recent events. Updated from the model a few times a second, always
+// through textContent (task ids and reasons come from outside and are never parsed as HTML).
+// Actions the session's scopes do not allow are greyed out (the server would refuse them: 403),
+// and robot actions while the fleet manager is unreachable (503).
 
 const QUEUE_ROWS = 100;
 const EVENT_ROWS = 50;
@@ -14,6 +16,8 @@ export class Panels {
     this.lastUpdate = 0;
     this.lastVersion = -1;
     this.selected = '';
+    this.scopes = new Set(['read', 'submit', 'operate']); // until the session says otherwise
+    this.who = '';
 
     view.canvas.addEventListener('click', (ev) => {
       const rect = view.canvas.getBoundingClientRect();
@@ -31,6 +35,41 @@ export class Panels {
       this.confirmThen(`Submit transport task ${id}: ${pickup} → ${dropoff}?`, () =>
         this.act(`task ${id}`, 'POST', '/v1/tasks', { id, kind: 'transport', pickup, dropoff }));
     });
+  }
+
+  /** What the session may do (GET /v1/session): actions needing another scope are greyed out. */
+  setScopes(name, scopes) {
+    this.who = name;
+    this.scopes = new Set(scopes);
+    for (const el of document.querySelectorAll('[data-scope]')) {
+      this.gate(el, !!el.dataset.robotAction); // robot actions wait for a selected robot (robot())
+    }
+    const missing = ['submit', 'operate'].filter((s) => !this.scopes.has(s));
+    const note = document.getElementById('scope-note');
+    note.textContent = missing.length
+      ? `Logged in as "${name}" without the ${missing.map((s) => `"${s}"`).join(' and ')} ` +
+        `scope${missing.length > 1 ? 's' : ''}: ` +
+        `${missing.includes('operate') ? 'robot actions' : ''}${missing.length === 2 ? ' and ' : ''}` +
+        `${missing.includes('submit') ? 'submitting and cancelling tasks' : ''} are not offered.`
+      : '';
+    note.hidden = !missing.length;
+    this.model.version++;
+  }
+
+  allowed(scope) {
+    return this.scopes.has(scope);
+  }
+
+  /** Greys out `el` when its scope is missing (saying why), else when `otherwise` holds. */
+  gate(el, otherwise, why = '') {
+    const scope = el.dataset.scope;
+    if (scope && !this.allowed(scope)) {
+      el.disabled = true;
+      el.title = `the token "${this.who}" lacks the "${scope}" scope`;
+      return;
+    }
+    el.disabled = otherwise;
+    el.title = otherwise ? why : '';
   }
 
   setStations(stations) {
@@ -73,6 +112,7 @@ export class Panels {
     this.figures(now);
     this.robot(now);
     this.queue();
+    this.stationQueues();
     this.events();
   }
 
@@ -84,8 +124,9 @@ export class Panels {
     const r = this.model.robots.get(this.selected);
     document.getElementById('robot-name').textContent = r ? r.id : this.selected ? this.selected + ' (gone)' : '—';
     document.getElementById('robot-hint').hidden = !!r;
+    const offline = !this.model.managerOnline;
     for (const b of document.querySelectorAll('[data-robot-action]')) {
-      b.disabled = !r;
+      this.gate(b, !r || offline, offline ? 'the fleet manager is unreachable' : 'select a robot on the map');
     }
     if (!r) {
       fillList(document.getElementById('robot-details'), {});
@@ -108,6 +149,10 @@ export class Panels {
     const open = this.model.openTasks().sort((a, b) => (a.stamp_ns || 0) - (b.stamp_ns || 0));
     document.getElementById('queue-count').textContent = `(${open.length})`;
     const body = document.querySelector('#queue tbody');
+    const cancellable = this.allowed('submit');
+    const offline = !this.model.managerOnline;
+    const unreachable = 'the fleet manager is unreachable';
+    this.gate(document.querySelector('#task-form button[type=submit]'), offline, unreachable);
     const rows = open.slice(0, QUEUE_ROWS).map((t) => {
       const tr = document.createElement('tr');
       tr.dataset.task = t.id;
@@ -117,16 +162,47 @@ export class Panels {
         tr.append(td);
       }
       const td = document.createElement('td');
-      const cancel = document.createElement('button');
-      cancel.type = 'button';
-      cancel.textContent = 'cancel';
-      cancel.addEventListener('click', () =>
-        this.confirmThen(`Cancel task ${t.id}?`, () =>
-          this.act(`cancel ${t.id}`, 'DELETE', `/v1/tasks/${encodeURIComponent(t.id)}`)));
-      td.append(cancel);
+      if (cancellable) {  // not offered at all without the scope: one greyed button per row is noise
+        const cancel = document.createElement('button');
+        cancel.type = 'button';
+        cancel.textContent = 'cancel';
+        cancel.dataset.scope = 'submit';
+        cancel.disabled = offline;
+        cancel.title = offline ? unreachable : '';
+        cancel.addEventListener('click', () =>
+          this.confirmThen(`Cancel task ${t.id}?`, () =>
+            this.act(`cancel ${t.id}`, 'DELETE', `/v1/tasks/${encodeURIComponent(t.id)}`)));
+        td.append(cancel);
+      }
       tr.append(td);
       return tr;
     });
+    body.replaceChildren(...rows);
+  }
+
+  /** Who waits in line at each station (from the roadmap's queues; empty without a traffic manager). */
+  stationQueues() {
+    const card = document.getElementById('station-queues');
+    const queues = this.model.queues || [];
+    card.hidden = !this.model.roadmap;
+    const body = document.querySelector('#station-queue-list tbody');
+    const rows = queues
+      .filter((q) => q.at || (q.waiting && q.waiting.length))
+      .map((q) => {
+        const tr = document.createElement('tr');
+        for (const text of [q.station, q.at || '—', (q.waiting || []).join(' ← ') || '—']) {
+          const td = document.createElement('td');
+          td.textContent = text;
+          tr.append(td);
+        }
+        return tr;
+      });
+    const waiting = queues.reduce((n, q) => n + ((q.waiting && q.waiting.length) || 0), 0);
+    document.getElementById('station-queue-count').textContent = `(${waiting} waiting)`;
+    const empty = document.getElementById('station-queue-empty');
+    empty.hidden = rows.length > 0;
+    empty.textContent = this.model.roadmap && this.model.roadmap.too_large
+      ? 'The roadmap is too large to draw.' : 'Nobody waits at a station.';
     body.replaceChildren(...rows);
   }
 

@@ -346,6 +346,74 @@ TEST(LoadtestE2E, ALoneRobotDeliversUnderReservedTraffic) {
   EXPECT_NE(text.find("(0 refused)"), std::string::npos) << text;
 }
 
+// --serve (scripts/demo --serve): after the run the fleet stops but the WMS adapter, whose
+// dashboard shows the final state, and the report's files are served on loopback, until Ctrl-C.
+TEST(LoadtestE2E, ServeKeepsTheDashboardUpOnTheFinalStateUntilInterrupted) {
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-serve-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  const int port = fleet::test::freePort();
+  auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out / "run", 400, 120,
+                            {"--serve", "--port", std::to_string(port)});
+  std::string line = "exec '" + kFleetctl + "'";
+  for (const auto& a : args) {
+    line += " '" + a + "'";
+  }
+  fleet::test::ChildProcess run("/bin/sh", {"-c", line + " > '" + (out / "stdout.txt").string() + "' 2>&1"});
+  auto said = [&] {
+    std::ostringstream text;
+    text << std::ifstream(out / "stdout.txt").rdbuf();
+    return text.str();
+  };
+  for (int i = 0; i < 1800 && said().find("serving until Ctrl-C") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const std::string text = said();
+  ASSERT_NE(text.find("serving until Ctrl-C"), std::string::npos) << text;
+  EXPECT_NE(text.find("fleet stopped (but the WMS adapter, for the dashboard)"), std::string::npos) << text;
+  EXPECT_EQ(processesMentioning((out / "run" / "manager.json").string()), 0)
+      << "the fleet manager still runs";
+  // The adapter answers with the run's final state: the robot, the two tasks done.
+  const auto get = [](int p, const std::string& path) {
+    const std::string cmd =
+        "curl -s -o /dev/null -w '%{http_code}' http://127.0.0.1:" + std::to_string(p) + path;
+    std::string code;
+    if (FILE* f = popen(cmd.c_str(), "r")) {
+      char buf[16] = {};
+      code = std::fgets(buf, sizeof buf, f) != nullptr ? buf : "";
+      pclose(f);
+    }
+    return code;
+  };
+  const auto body = [&](const std::string& path) {
+    std::string got;
+    if (FILE* f = popen(("curl -s http://127.0.0.1:" + std::to_string(port) + path).c_str(), "r")) {
+      char buf[4096];
+      std::size_t n = 0;
+      while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
+        got.append(buf, n);
+      }
+      pclose(f);
+    }
+    return json::parse(got, nullptr, false);
+  };
+  EXPECT_EQ(get(port, "/dashboard/"), "200");
+  EXPECT_EQ(body("/v1/robots").value("count", 0), 1);
+  EXPECT_EQ(body("/v1/tasks?state=done").value("count", 0), 2) << body("/v1/tasks").dump();
+  const auto at = text.find("the report with its replay at http://127.0.0.1:");
+  ASSERT_NE(at, std::string::npos) << text;
+  const int files =
+      std::atoi(text.c_str() + at + std::string("the report with its replay at http://127.0.0.1:").size());
+  EXPECT_EQ(get(files, "/loadtest.json"), "200");
+  EXPECT_EQ(get(files, "/fleet.db"), "404") << "only the report's files are served";
+  EXPECT_EQ(get(files, "/index.html"), "404") << "this run wrote no HTML report";
+
+  run.kill(SIGINT);
+  EXPECT_EQ(run.wait(std::chrono::seconds(30)), 0) << "the run itself went well";
+  EXPECT_EQ(get(port, "/dashboard/"), "000") << "the adapter stopped with it";
+  EXPECT_NE(said().find("stopped serving"), std::string::npos);
+}
+
 TEST(LoadtestE2E, BadScenarioTaskListIsRefusedBeforeAnythingStarts) {
   const fs::path dir = fs::path(::testing::TempDir()) / ("loadtest-badlist-" + std::to_string(getpid()));
   fs::remove_all(dir);

@@ -168,3 +168,48 @@ TEST(SampleChecks, TaskRequestNeedsValidIds) {
   t.pickup = "\xFF";
   EXPECT_EQ(reasonOf(check(t)), "utf8");
 }
+
+TEST(SampleChecks, RoadmapAndReleasesNameNodesThatExist) {
+  msg::Roadmap m;
+  m.nodes = {{0, 1.0, 1.0}, {1, 1.5, 1.0}, {2, 2.0, 1.0}};
+  m.kinds = {0, 3, 1};
+  m.open = {true, true, true};
+  m.edges = {{0, 1, 0.6F, true}, {1, 2, 0.6F, true}};
+  EXPECT_FALSE(check(m));
+  auto renumbered = m;
+  renumbered.nodes[1].node = 7;
+  EXPECT_EQ(reasonOf(check(renumbered)), "structure") << "a node's id is its index";
+  auto dangling = m;
+  dangling.edges.push_back({2, 3, 0.5F, true});
+  EXPECT_EQ(reasonOf(check(dangling)), "structure");
+  auto kind = m;
+  kind.kinds[2] = 9;
+  EXPECT_EQ(reasonOf(check(kind)), "enum");
+  auto short_ = m;
+  short_.open.pop_back();
+  EXPECT_EQ(reasonOf(check(short_)), "structure");
+  auto far = m;
+  far.nodes[0].x = 1e300;
+  EXPECT_EQ(reasonOf(check(far)), "implausible");
+  auto slow = m;
+  slow.edges[0].duration_s = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_EQ(reasonOf(check(slow)), "non_finite");
+
+  msg::TrafficRelease r;
+  r.robot_id = "r1";
+  r.base = {{0, 1.0, 1.0}, {1, 1.5, 1.0}};
+  r.horizon = {{2, 2.0, 1.0}};
+  EXPECT_FALSE(check(r));
+  auto negative = r;
+  negative.horizon[0].node = -4;
+  EXPECT_EQ(reasonOf(check(negative)), "implausible");
+  auto nan = r;
+  nan.base[1].y = std::nan("");
+  EXPECT_EQ(reasonOf(check(nan)), "non_finite");
+  auto noId = r;
+  noId.robot_id = "r 1";
+  EXPECT_EQ(reasonOf(check(noId)), "id");
+  auto longBase = r;
+  longBase.base.assign(65, {0, 1.0, 1.0});
+  EXPECT_EQ(reasonOf(check(longBase)), "too_large");
+}

@@ -1,18 +1,21 @@
 // The dashboard's side of the WMS adapter against a fake manager (no DDS): the page without login,
 // browser sessions (cookie flags, CSRF, token never accepted in a URL, other tokens and expired
-// sessions refused), the robot API (snapshot, hold/release, home, charge, bad ids) and the stream.
+// sessions refused), the robot API (snapshot, hold/release, home, charge, bad ids), the stream and
+// its traffic layer (roadmap, releases, station queues), and the scopes the page is told.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <thread>
 
 #include "api_fixture.hpp"
 #include "browser_session.hpp"
 #include "http_api.hpp"
+#include "traffic_layer.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
@@ -54,6 +57,58 @@ msg::RobotState robot(const std::string& id, double x, double y, std::int64_t st
   r.battery = 0.8f;
   r.radius = 0.3f;
   return r;
+}
+
+/// A station P-1 at (5, 1) on a lane 0-1-2 (y = 5): dock 3, approach 4 above it, a queue of two
+/// (5 head, 6 tail) above that, entered at the tail from lane node 1 and left sideways to node 2.
+msg::Roadmap smallRoadmap(std::uint32_t epoch = 7) {
+  msg::Roadmap m;
+  m.epoch = epoch;
+  m.nodes = {{0, 3.0, 5.0}, {1, 4.0, 5.0}, {2, 6.0, 5.0},  {3, 5.0, 1.0},
+             {4, 5.0, 2.0}, {5, 5.0, 3.0}, {6, 5.004, 4.0}};
+  m.kinds = {0, 0, 0, 1, 2, 3, 3};
+  m.open = {true, true, true, true, true, true, true};
+  auto both = [&](std::int32_t a, std::int32_t b) {
+    m.edges.push_back({a, b, 1.0F, true});
+    m.edges.push_back({b, a, 1.0F, true});
+  };
+  both(0, 1);
+  both(1, 2);
+  both(2, 4);
+  both(3, 4);
+  m.edges.push_back({5, 4, 1.0F, true});   // the head drives on to the approach
+  m.edges.push_back({6, 5, 1.0F, true});   // the tail to the head
+  m.edges.push_back({5, 2, 1.0F, true});   // left sideways
+  m.edges.push_back({1, 6, 1.0F, true});   // joined at the tail
+  m.edges.push_back({0, 2, 2.0F, false});  // a closed lane
+  return m;
+}
+
+msg::TrafficRelease release(const std::string& robot, std::uint32_t epoch, std::uint32_t seq,
+                            std::vector<std::int32_t> base, std::vector<std::int32_t> horizon) {
+  const auto m = smallRoadmap();
+  msg::TrafficRelease r;
+  r.robot_id = robot;
+  r.epoch = epoch;
+  r.seq = seq;
+  for (const auto v : base) {
+    r.base.push_back(m.nodes[static_cast<std::size_t>(v)]);
+  }
+  for (const auto v : horizon) {
+    r.horizon.push_back(m.nodes[static_cast<std::size_t>(v)]);
+  }
+  return r;
+}
+
+/// The data of every `event: name` in an SSE text, in order.
+std::vector<json> eventsNamed(const std::string& text, const std::string& name) {
+  std::vector<json> out;
+  const std::string head = "event: " + name + "\ndata: ";
+  for (auto at = text.find(head); at != std::string::npos; at = text.find(head, at + 1)) {
+    const auto start = at + head.size();
+    out.push_back(json::parse(text.substr(start, text.find("\n\n", start) - start)));
+  }
+  return out;
 }
 
 class Dash : public ::testing::Test {
@@ -270,6 +325,135 @@ TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
   EXPECT_EQ(rj["runs"], json::array({0, 5, 3, 2, 1, 1})) << "levels and counts, flattened";
 }
 
+TEST_F(Dash, StationQueuesAreReadOffTheRoadmapsShapeAndNamedAfterTheSite) {
+  const auto m = smallRoadmap();
+  const json stations =
+      json::parse(R"([{"name": "P-1", "x": 5.0, "y": 1.0}, {"name": "D-1", "x": 9, "y": 9}])");
+  const auto queues = stationQueues(m, stations);
+  ASSERT_EQ(queues.size(), 1u);
+  EXPECT_EQ(queues[0].station, "P-1");
+  EXPECT_EQ(queues[0].dock, 3);
+  EXPECT_EQ(queues[0].nodes, (std::vector<std::int32_t>{5, 6})) << "head first, then back to the tail";
+  EXPECT_EQ(stationQueues(m, json::array())[0].station, "node 3") << "a dock the site does not name";
+
+  const json j = roadmapJson(m, queues);
+  EXPECT_EQ(j["epoch"], 7);
+  EXPECT_EQ(j["nodes"].size(), 14u);
+  EXPECT_EQ(j["nodes"][13], 4.0) << "positions to the centimetre";
+  EXPECT_EQ(j["kinds"], json::array({0, 0, 0, 1, 2, 3, 3}));
+  EXPECT_EQ(j["lanes"], json::array({0, 1, 1, 2, 2, 4, 3, 4})) << "a lane driven both ways once";
+  EXPECT_EQ(j["one_way"], json::array({5, 4, 6, 5, 5, 2, 1, 6}));
+  EXPECT_EQ(j["closed_lanes"], json::array({0, 2}));
+  EXPECT_EQ(j["queues"][0], json::parse(R"({"station": "P-1", "dock": 3, "nodes": [5, 6]})"));
+
+  // r1 waits at the head, r2 behind it, r3 is at the station; r4 drives by, r5 is elsewhere.
+  std::vector<msg::RobotState> robots = {robot("r2", 5.0, 4.1, 1), robot("r1", 5.1, 3.0, 1),
+                                         robot("r3", 5.0, 1.05, 1), robot("r4", 5.5, 3.0, 1),
+                                         robot("r5", 1.0, 1.0, 1)};
+  const json q = queuesJson(queues, m, robots);
+  EXPECT_EQ(q, json::parse(R"([{"station": "P-1", "at": "r3", "waiting": ["r1", "r2"], "length": 2}])"));
+  EXPECT_EQ(queuesJson(queues, m, {})[0]["waiting"], json::array());
+
+  msg::Roadmap huge;
+  huge.nodes.assign(kMaxDrawnNodes + 1, {0, 0.0, 0.0});
+  huge.kinds.assign(huge.nodes.size(), 0);
+  huge.open.assign(huge.nodes.size(), true);
+  EXPECT_TRUE(roadmapJson(huge, {}).is_null()) << "too large to draw";
+}
+
+TEST_F(Dash, ReleasesOfAnEarlierTrafficManagerAreDropped) {
+  view_.onRelease(release("r1", 5, 3, {0, 1}, {2}));
+  view_.onRoadmap(smallRoadmap(7));
+  EXPECT_TRUE(view_.releases().second.empty()) << "epoch 5 is a previous traffic manager's";
+  view_.onRelease(release("r1", 6, 4, {0, 1}, {2}));
+  EXPECT_TRUE(view_.releases().second.empty()) << "late, from an earlier epoch";
+  const auto before = view_.releases().first;
+  view_.onRelease(release("r1", 7, 1, {0, 1}, {2}));
+  view_.onRelease(release("r2", 7, 1, {2}, {}));
+  const auto [count, releases] = view_.releases();
+  EXPECT_EQ(count, before + 2);
+  ASSERT_EQ(releases.size(), 2u);
+  EXPECT_EQ(releases.at("r1")->base.size(), 2u);
+
+  const json j = releaseJson(*releases.at("r1"));
+  EXPECT_EQ(j["robot"], "r1");
+  EXPECT_EQ(j["base"], json::array({0, 1}));
+  EXPECT_EQ(j["horizon"], json::array({2}));
+  EXPECT_EQ(j["base_xy"], json::array({3.0, 5.0, 4.0, 5.0}));
+  EXPECT_EQ(j["horizon_xy"], json::array({6.0, 5.0}));
+}
+
+TEST_F(Dash, TheStreamSendsTheRoadmapOnceThenReleasesAndQueuesAsTheyChange) {
+  start("");
+  view_.onRoadmap(smallRoadmap(7));
+  view_.onRelease(release("r1", 7, 1, {0, 1}, {6, 5}));
+  view_.onRobot(robot("r2", 5.0, 3.0, 2));  // waiting at the head of P-1's queue
+  std::string got;
+  std::thread feeder([this] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    view_.onRelease(release("r1", 7, 2, {1, 6}, {5}));
+    view_.onRelease(release("r2", 7, 1, {5}, {}));
+    view_.onRobot(robot("r1", 5.0, 4.0, 3));  // joins the queue behind r2
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    view_.onRoadmap(smallRoadmap(9));  // a restarted traffic manager
+  });
+  // Until the second roadmap and the releases after it have arrived.
+  auto secondRoadmapAt = [&] {
+    const auto first = got.find("event: roadmap");
+    return first == std::string::npos ? first : got.find("event: roadmap", first + 1);
+  };
+  auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
+    got.append(data, n);
+    const auto at = secondRoadmapAt();
+    return at == std::string::npos || got.find("event: releases", at) == std::string::npos;
+  });
+  feeder.join();
+  const auto roadmaps = eventsNamed(got, "roadmap");
+  ASSERT_EQ(roadmaps.size(), 2u) << "the roadmap once, and again when it changed";
+  EXPECT_EQ(roadmaps[0]["epoch"], 7);
+  EXPECT_EQ(roadmaps[0]["queues"][0]["station"], "node 3") << "the test's site names no station there";
+  EXPECT_EQ(roadmaps[1]["epoch"], 9);
+  EXPECT_LT(got.find("event: roadmap"), got.find("event: releases")) << "the page needs the nodes first";
+
+  const auto before = eventsNamed(got.substr(0, secondRoadmapAt()), "releases");
+  ASSERT_GE(before.size(), 2u);
+  EXPECT_EQ(before[0]["all"], true) << "the first is the whole set";
+  ASSERT_EQ(before[0]["releases"].size(), 1u);
+  EXPECT_EQ(before[0]["releases"][0]["horizon"], json::array({6, 5}));
+  std::map<std::string, json> changed;
+  for (std::size_t i = 1; i < before.size(); ++i) {
+    EXPECT_EQ(before[i]["all"], false);
+    for (const auto& rel : before[i]["releases"]) {
+      const auto id = rel["robot"].get<std::string>();
+      EXPECT_FALSE(changed.contains(id)) << "a release sent twice: " << rel;
+      changed[id] = rel;
+    }
+  }
+  ASSERT_EQ(changed.size(), 2u) << "only what changed: r1's new release and r2's first";
+  EXPECT_EQ(changed["r1"]["seq"], 2);
+  EXPECT_EQ(changed["r2"]["base"], json::array({5}));
+  const auto after = eventsNamed(got.substr(secondRoadmapAt()), "releases");
+  ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(after[0]["all"], true) << "a new roadmap: the set starts again";
+  EXPECT_EQ(after[0]["releases"], json::array()) << "the old traffic manager's releases are gone";
+
+  const auto queues = eventsNamed(got, "queues");
+  ASSERT_GE(queues.size(), 2u);
+  EXPECT_EQ(queues[0]["queues"][0]["waiting"], json::array({"r2"}));
+  EXPECT_EQ(queues[1]["queues"][0]["waiting"], json::array({"r2", "r1"}));
+  for (std::size_t i = 1; i < queues.size(); ++i) {
+    EXPECT_NE(queues[i], queues[i - 1]) << "sent only when who waits changes";
+  }
+
+  auto traffic = client_->Get("/v1/traffic");
+  ASSERT_TRUE(traffic);
+  ASSERT_EQ(traffic->status, 200);
+  const json t = json::parse(traffic->body);
+  EXPECT_EQ(t["roadmap"]["epoch"], 9);
+  EXPECT_EQ(t["releases"], json::array());
+  EXPECT_EQ(t["queues"][0]["waiting"], json::array({"r2", "r1"}));
+}
+
 namespace {
 
 /// A token file with a read-only and an operator token, and an audit log, in a directory of its own.
@@ -384,4 +568,35 @@ TEST_F(Dash, OpenStreamsHoldNoWorkerAndCountAgainstTheStreamLimit) {
   view_.onRobot(robot("r2", 7.0, 2.0, 3));
   EXPECT_THAT(pages.front()->receive("event: robots"), HasSubstr("event: robots"));
   EXPECT_THAT(pages.back()->receive("event: robots"), HasSubstr("\"x\":7.0"));
+}
+
+TEST_F(DashScopes, ThePageIsToldItsScopesAndMarksEveryActionWithTheScopeItNeeds) {
+  startWithTokens();
+  auto scopesOf = [&](const httplib::Headers& h) {
+    auto r = client_->Get("/v1/session", h);
+    EXPECT_TRUE(r && r->status == 200);
+    return r ? json::parse(r->body)["scopes"] : json();
+  };
+  EXPECT_EQ(scopesOf({{"Cookie", login(kViewer).first}}), json::array({"read"}));
+  EXPECT_EQ(scopesOf({{"Cookie", login(kFloor).first}}), json::array({"read", "operate"}));
+  EXPECT_EQ(scopesOf({{"Authorization", "Bearer " + kViewer}}), json::array({"read"}))
+      << "a bearer request is told its token's scopes too";
+
+  // The page greys out what the scopes do not allow: each action button says which scope it needs.
+  const std::string page = client_->Get("/dashboard/")->body;
+  for (const char* action : {"pause", "resume", "home", "charge"}) {
+    EXPECT_THAT(page, HasSubstr(std::string("data-robot-action=\"") + action + "\" data-scope=\"operate\""));
+  }
+  EXPECT_THAT(page, HasSubstr(R"(<button type="submit" data-scope="submit")")) << "the task form";
+  const std::string panels = client_->Get("/dashboard/panels.js")->body;
+  EXPECT_THAT(panels, HasSubstr("dataset.scope = 'submit'")) << "each task's cancel button";
+}
+
+TEST_F(Dash, WithoutAuthenticationThePageMayDoEverything) {
+  start("");
+  auto r = client_->Get("/v1/session");
+  ASSERT_TRUE(r);
+  const json s = json::parse(r->body);
+  EXPECT_EQ(s["auth"], "off");
+  EXPECT_EQ(s["scopes"], json::array({"read", "submit", "operate"}));
 }
