@@ -78,4 +78,16 @@ GridMap fromOccupancyGrid(const planning::OccupancyGrid& g) {
   return m;
 }
 
+planning::OccupancyGrid toOccupancyGrid(const GridMap& m) {
+  planning::OccupancyGrid g(m.width, m.height, m.resolution, m.origin);
+  for (int y = 0; y < m.height; ++y) {
+    for (int x = 0; x < m.width; ++x) {
+      if (m.blocked(x, y)) {
+        g.setBlocked({x, y});
+      }
+    }
+  }
+  return g;
+}
+
 }  // namespace fleet::sim

@@ -13,6 +13,7 @@
 
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
+#include "fleet/sim/grid_map.hpp"
 #include "fleet/sim/scenario.hpp"
 #include "worker_pool.hpp"
 
@@ -24,18 +25,6 @@ double threadCpuS() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::shared_ptr<const planning::OccupancyGrid> gridOf(const sim::GridMap& m) {
-  auto g = std::make_shared<planning::OccupancyGrid>(m.width, m.height, m.resolution, m.origin);
-  for (int y = 0; y < m.height; ++y) {
-    for (int x = 0; x < m.width; ++x) {
-      if (m.blocked(x, y)) {
-        g->setBlocked({x, y});
-      }
-    }
-  }
-  return g;
 }
 
 double percentile(std::vector<double> v, double q) {
@@ -71,7 +60,7 @@ struct Fleet {
 
 Fleet makeFleet(const std::string& scenario, int n, const std::string& planner) {
   const auto scn = sim::loadScenario(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/" + scenario);
-  auto raw = gridOf(scn.map);
+  auto raw = std::make_shared<const planning::OccupancyGrid>(sim::toOccupancyGrid(scn.map));
   const double radius = scn.robots.front().radius;
   auto grid = agent::inflate(*raw, radius + 0.2);
   Fleet f;

@@ -50,5 +50,7 @@ bool nearestBlocked(const GridMap& map, Vec2 p, double reach, double& dist, Vec2
 /// The simulator's copy of a planning grid (loaded by libs/planning: MovingAI, image + side file,
 /// generated warehouse).
 GridMap fromOccupancyGrid(const planning::OccupancyGrid& g);
+/// A planning grid with the map's blocked cells (what a robot agent plans on).
+planning::OccupancyGrid toOccupancyGrid(const GridMap& m);
 
 }  // namespace fleet::sim

@@ -1,0 +1,280 @@
+#include "agent_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <thread>
+
+#include "fleet/core/ids.hpp"
+#include "fleet/core/logging.hpp"
+#include "fleet/site/wall_segments.hpp"
+#include "fleet/site/zone_costs.hpp"
+#include "fleet/validation/sample_checks.hpp"
+#include "risk_lookup_of.hpp"
+
+namespace fleet::agent {
+
+Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const Settings& s) {
+  MapFacts facts;
+  // Robots plan on the map with the site's no-go zones blocked; the walls the localizer matches its
+  // scan lines against come from the map itself (a zone is no wall).
+  std::shared_ptr<const planning::OccupancyGrid> raw = world.map;
+  planning::CostLayers zoneLayers;
+  std::function<double(Vec2)> speedLimit;
+  if (world.site) {
+    const auto& noGo = world.site->layers.noGo;
+    if (std::any_of(noGo.begin(), noGo.end(), [](std::uint8_t c) { return c != 0; })) {
+      raw = std::make_shared<const planning::OccupancyGrid>(world.site->drivable());
+    }
+    zoneLayers = site::zoneCostLayers(world.site, 0.8);
+    const auto& limits = world.site->layers.speedLimit;
+    if (std::any_of(limits.begin(), limits.end(), [](float v) { return std::isfinite(v); })) {
+      speedLimit = [st = world.site](Vec2 p) { return st->speedLimitAt(p); };
+    }
+    facts.siteName = world.site->name;
+    facts.zones = world.site->zones.size();
+    facts.zoneLayers = zoneLayers.size();
+    facts.speedLimits = static_cast<bool>(speedLimit);
+  }
+  std::shared_ptr<const planning::LaneMap> lanes;
+  if (s.useLanes) {
+    lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
+    facts.oneWayCells = lanes->oneWayCells();
+  }
+  // The walls every localizer matches its scan lines against: faces of 0.5 m and more (the line
+  // extractor keeps nothing shorter).
+  auto walls = std::make_shared<std::vector<estimation::MapSegment>>();
+  for (const auto& w : site::wallSegments(*world.map, agentLineExtraction().minLength)) {
+    walls->push_back({w.a, w.b, w.normal});
+  }
+  facts.wallFaces = walls->size();
+
+  std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
+  std::vector<std::unique_ptr<Agent>> agents;
+  for (const auto& r : world.robots) {
+    if (!s.only.empty() && std::find(s.only.begin(), s.only.end(), r.id) == s.only.end()) {
+      continue;
+    }
+    auto& grid = inflatedByRadius[r.radius];
+    if (!grid) {
+      // Plan with a margin beyond the footprint so paths keep to the middle of aisles.
+      grid = inflate(*raw, r.radius + 0.2);
+    }
+    AgentParams p;
+    p.id = r.id;
+    p.start = r.start;
+    p.radius = r.radius;
+    p.wheelBase = r.wheelBase;
+    p.vMax = std::min(0.8, r.limits.vMax);
+    p.wMax = r.limits.omegaMax;
+    p.localPlanner = s.localPlanner;
+    p.dwa = s.dwa;
+    p.riskStepping = s.riskStepping;
+    p.safety = s.safety;
+    p.globalPlanner = s.globalPlanner;
+    p.sensorTimeoutS = s.sensorTimeoutS;
+    p.returnHomeS = s.returnHomeS;
+    p.riskWeightGlobal = s.riskWeightGlobal;
+    p.lanes = lanes;
+    p.zoneLayers = zoneLayers;
+    p.speedLimit = speedLimit;
+    p.traffic = s.traffic;
+    p.limits = r.limits;
+    p.limits.vMax = p.vMax;
+    p.landmarks = world.landmarks;
+    p.walls = walls;
+    p.lineUpdates = s.lineUpdates;
+    agents.push_back(std::make_unique<Agent>(p, grid, raw));
+  }
+  if (agents.empty()) {
+    return unexpected("no_robots", "none of the requested robots is in the scenario");
+  }
+  const unsigned threads =
+      std::max(1u, std::min(s.threads == 0 ? std::thread::hardware_concurrency() : s.threads,
+                            static_cast<unsigned>(agents.size())));
+  std::unique_ptr<AgentNode> node(new AgentNode(s, threads));
+  node->facts_ = std::move(facts);
+  node->agents_ = std::move(agents);
+  for (auto& a : node->agents_) {
+    node->byId_[a->id()] = a.get();
+  }
+  node->outs_.resize(node->agents_.size());
+  return node;
+}
+
+Agent* AgentNode::hosted(const std::string& id) {
+  const auto it = byId_.find(id);
+  return it == byId_.end() ? nullptr : it->second;
+}
+
+const Agent* AgentNode::find(const std::string& id) const {
+  const auto it = byId_.find(id);
+  return it == byId_.end() ? nullptr : it->second;
+}
+
+template <class T>
+std::optional<validation::Rejection> AgentNode::refused(T& sample) {
+  validation::Rejection why;
+  if (validation::admit(sample, rejections_, &why)) {
+    return std::nullopt;
+  }
+  refusals_.push_back({why.topic + ":" + why.reason, "refused " + why.topic + ": " + why.detail});
+  return why;
+}
+
+template <class T>
+std::vector<T> AgentNode::admitted(std::vector<T> samples) {
+  std::erase_if(samples, [&](T& s) { return refused(s).has_value(); });
+  return samples;
+}
+
+void AgentNode::onFrames(std::vector<msg::SensorFrame> frames) {
+  for (const auto& f : admitted(std::move(frames))) {
+    if (Agent* a = hosted(f.robot_id)) {
+      a->onFrame(f);
+    }
+  }
+}
+
+void AgentNode::onRobotStates(std::vector<msg::RobotState> states) {
+  for (const auto& s : admitted(std::move(states))) {
+    if (byId_.count(s.robot_id) != 0) {
+      continue;  // hosted here: handed over in-process after the step
+    }
+    for (auto& a : agents_) {
+      a->onOtherRobot(s);
+    }
+  }
+}
+
+void AgentNode::onAssignments(std::vector<msg::TaskAssignment> assignments) {
+  for (auto& a : assignments) {
+    Agent* robot = hosted(a.robot_id);
+    const auto why = refused(a);
+    if (!why) {
+      if (robot != nullptr) {
+        robot->onAssignment(a);
+      }
+    } else if (robot != nullptr && isValidId(a.task_id)) {
+      robot->refuseAssignment(a, why->detail);  // the manager hears why and retries elsewhere
+    }
+  }
+}
+
+void AgentNode::onReleases(std::vector<msg::TrafficRelease> releases) {
+  for (const auto& r : admitted(std::move(releases))) {
+    if (Agent* a = hosted(r.robot_id)) {
+      a->onRelease(r);
+    }
+  }
+}
+
+void AgentNode::onRiskMaps(std::vector<msg::RiskMap> maps) {
+  maps = admitted(std::move(maps));
+  if (maps.empty() || !settings_.useRisk) {
+    return;
+  }
+  if (auto field = riskLookupOf(maps.back())) {
+    for (auto& a : agents_) {
+      a->onRiskMap(*field);
+    }
+  } else {
+    refusals_.push_back({"risk_map", "RiskMap ignored: " + field.error().message});
+  }
+}
+
+const std::vector<AgentOutput>& AgentNode::step(std::int64_t nowNs, double dt) {
+  // Each agent touches only its own state and the const shared maps.
+  pool_.forEach(agents_.size(), [&](std::size_t i) {
+    logging::ScopedField robotField("robot", agents_[i]->id());  // on whatever a step logs
+    outs_[i] = agents_[i]->step(nowNs, dt);
+    outs_[i].command.seq = static_cast<std::uint32_t>(cycles_);
+  });
+  pool_.forEach(agents_.size(), [&](std::size_t j) {
+    for (std::size_t i = 0; i < agents_.size(); ++i) {
+      if (i != j) {
+        agents_[j]->onOtherRobot(outs_[i].state);
+      }
+    }
+  });
+  ++cycles_;
+  return outs_;
+}
+
+std::vector<Refusal> AgentNode::takeRefusals() {
+  std::vector<Refusal> r;
+  r.swap(refusals_);
+  return r;
+}
+
+Agent::Conduct AgentNode::conduct() const {
+  Agent::Conduct c;
+  for (const auto& a : agents_) {
+    c.standoffs += a->conduct().standoffs;
+    c.mutualBlocks += a->conduct().mutualBlocks;
+    c.backoffs += a->conduct().backoffs;
+    c.returns += a->conduct().returns;
+    c.detours += a->conduct().detours;
+    c.plannerRecoveries += a->conduct().plannerRecoveries;
+  }
+  return c;
+}
+
+LineStats AgentNode::lineStats() const {
+  LineStats ls;
+  for (const auto& a : agents_) {
+    const auto& l = a->lineStats();
+    ls.scans += l.scans;
+    ls.scansNoLines += l.scansNoLines;
+    ls.extracted += l.extracted;
+    ls.matched += l.matched;
+    ls.accepted += l.accepted;
+    ls.rejectedByFilter += l.rejectedByFilter;
+    ls.noWallFacing += l.noWallFacing;
+    ls.outsideGate += l.outsideGate;
+    ls.noOverlap += l.noOverlap;
+    ls.ambiguous += l.ambiguous;
+  }
+  return ls;
+}
+
+ReleaseCounts AgentNode::releaseCounts() const {
+  ReleaseCounts rc;
+  for (const auto& a : agents_) {
+    rc.accepted += a->releases().accepted;
+    rc.foreign += a->releases().foreign;
+    rc.stale += a->releases().stale;
+    rc.offNode += a->releases().offNode;
+    rc.malformed += a->releases().malformed;
+  }
+  return rc;
+}
+
+nlohmann::json AgentNode::statsJson() const {
+  // How the robots of this process dealt with each other (docs/algorithms.md, fleet conduct).
+  const auto c = conduct();
+  const auto ls = lineStats();
+  const auto rc = releaseCounts();
+  nlohmann::json m;
+  m["samples"] = rejections_.toJson();
+  m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
+                  {"backoffs", c.backoffs},   {"returns", c.returns},
+                  {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};
+  m["localization"] = {{"line_updates", settings_.lineUpdates},
+                       {"scans", ls.scans},
+                       {"skipped_no_lines", ls.scansNoLines},
+                       {"lines_extracted", ls.extracted},
+                       {"lines_matched", ls.matched},
+                       {"lines_accepted", ls.accepted},
+                       {"lines_rejected_by_filter", ls.rejectedByFilter},
+                       {"unmatched_no_wall_facing", ls.noWallFacing},
+                       {"unmatched_outside_gate", ls.outsideGate},
+                       {"unmatched_no_overlap", ls.noOverlap},
+                       {"unmatched_ambiguous", ls.ambiguous}};
+  m["traffic"] = {{"mode", settings_.traffic},      {"releases_taken", rc.accepted},
+                  {"ignored_foreign", rc.foreign},  {"ignored_stale", rc.stale},
+                  {"ignored_off_node", rc.offNode}, {"ignored_malformed", rc.malformed}};
+  return m;
+}
+
+}  // namespace fleet::agent
