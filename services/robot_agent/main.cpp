@@ -17,6 +17,7 @@
 
 #include "agent.hpp"
 #include "fleet/avoidance/planner_config.hpp"
+#include "fleet/control/cruise.hpp"
 #include "fleet/core/angles.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
@@ -217,7 +218,7 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
     if (std::any_of(noGo.begin(), noGo.end(), [](std::uint8_t c) { return c != 0; })) {
       raw = std::make_shared<const planning::OccupancyGrid>(scn.site->drivable());
     }
-    zoneLayers = site::zoneCostLayers(scn.site, 0.8);
+    zoneLayers = site::zoneCostLayers(scn.site, control::kAgentCruiseSpeed);
     const auto& limits = scn.site->layers.speedLimit;
     if (std::any_of(limits.begin(), limits.end(), [](float v) { return std::isfinite(v); })) {
       speedLimit = [s = scn.site](Vec2 p) { return s->speedLimitAt(p); };
@@ -255,7 +256,7 @@ int run(const World& scn, const Options& opt, const service::OpsSettings& opsSet
     p.start = r.start;
     p.radius = r.radius;
     p.wheelBase = r.wheelBase;
-    p.vMax = std::min(0.8, r.limits.vMax);
+    p.vMax = control::agentCruiseSpeed(r.limits);
     p.wMax = r.limits.omegaMax;
     p.localPlanner = opt.localPlanner;
     p.dwa = opt.dwa;
