@@ -289,6 +289,32 @@ def latency_table(blocks):
     return f"<table>{head}{body}</table>"
 
 
+def bound_html(b):
+    """The fleet against the kinematic bound (fleetctl loadtest's kinematic_bound block)."""
+    if not b:
+        return ""
+    if "error" in b:
+        return f"<h3>Against the kinematic bound</h3><p>not computed: {html.escape(str(b['error']))}</p>"
+    cruise = ", ".join(f"{c:g}" for c in b.get("cruise_m_s", []))
+    rows = [("tasks done with a bound", f"{b.get('tasks', 0)} of {b.get('tasks_done', 0)}"),
+            ("mean task time (last assignment → done)", f"{num(b.get('mean_task_time_s'), '.1f')} s"),
+            ("mean kinematic bound", f"{num(b.get('mean_bound_s'), '.1f')} s"),
+            ("task time ÷ bound", f"<b>{num(b.get('task_time_over_bound'))}×</b>"),
+            ("a lone robot at its bound (3600 ÷ mean bound)", f"{num(b.get('lone_rate_per_h'), '.1f')} tasks/h"),
+            ("the fleet", f"{num(b.get('fleet_rate_per_h'), '.1f')} tasks/h, {num(b.get('per_robot_rate_per_h'))} per robot"),
+            ("η (per robot ÷ the lone robot at its bound)", f"<b>{num(b.get('efficiency'))}</b>")]
+    table = "".join(f"<tr><td>{html.escape(k)}</td><td class=\"r\">{v}</td></tr>" for k, v in rows)
+    unbounded = "".join(f"<li>{html.escape(str(u.get('id')))}: {html.escape(str(u.get('reason')))}</li>"
+                        for u in b.get("unbounded", []))
+    ratios = [t["ratio"] for t in b.get("per_task", []) if t.get("ratio") is not None]
+    return f"""<h3>Against the kinematic bound</h3><div class="grid"><div><table>{table}</table>
+<p class="note">The bound of a task: the shortest way for the robot's disc on the free map (not the roadmap) from where it
+was when the task was last assigned to the pickup and on to the drop-off, at the agent's cruise ({html.escape(cruise)} m/s),
+plus the load and unload dwell. A ratio of 1 is a robot that never slows, turns or waits.</p>
+{f'<p>Without a bound:</p><ul>{unbounded}</ul>' if unbounded else ''}</div>
+<div>{svg_hist(ratios, xlabel='task time ÷ its bound', why='no task with a bound', color='#8c564b')}</div></div>"""
+
+
 def loadtest_html(lt):
     if not lt:
         return ""
@@ -322,6 +348,7 @@ def loadtest_html(lt):
               f"{agent_rows}</table>") if agent_rows else ""
     lat = latency_table([("assignment", "submitted → first assigned", a.get("assignment_latency_s", {})),
                          ("end to end", "submitted → done", a.get("end_to_end_latency_s", {}))])
+    bound = bound_html(lt.get("kinematic_bound"))
     return f"""<h2 id="loadtest">Load test</h2>{verdict}
 <p>{lt.get('robots')} robots in {lt.get('agent_processes')} agent process(es), {lt.get('humans')} humans,
 {lt.get('sim_time_s', 0):.0f} s simulated in {lt.get('wall_time_s', 0):.0f} s wall
@@ -332,6 +359,7 @@ Arrival rate {lt.get('rate_per_min', 0):g} tasks per simulated minute. Fault pla
 <div><h3>Latency of acknowledged tasks (s, simulated)</h3>{lat}
 <h3>Faults injected</h3>{faults}</div>
 <div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)', why='no progress samples', diagonal='1× real time')}</div></div>
+{bound}
 {agents}"""
 
 
@@ -405,6 +433,8 @@ def main(run):
         summary["loadtest"] = {k: lt.get(k) for k in ("accounting", "throughput", "real_time_factor", "wall_time_s",
                                                      "agent_processes", "fault_plan", "faults", "tasks",
                                                      "wall_limited", "interrupted")}
+        summary["loadtest"]["kinematic_bound"] = {k: v for k, v in (lt.get("kinematic_bound") or {}).items()
+                                                  if k != "per_task"}
     json.dump(summary, open(os.path.join(run, "summary.json"), "w"), indent=2)
     risk = risk_levels_over_time(run)
     viewer = embedded_viewer(run)

@@ -30,6 +30,7 @@
 #include "fleet/core/config.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
+#include "run_bounds.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
 #include "supervisor.hpp"
@@ -998,6 +999,12 @@ int Run::run() {
   for (const auto& f : faults) {
     report["fault_plan"].push_back(describe(f));
   }
+  // On the wall clock the manager stamps with epoch time, the replay with the simulator's own: the
+  // robot's pose at an assignment cannot be looked up.
+  report["kinematic_bound"] =
+      o.wallClock
+          ? json{{"error", "not in wall-clock runs (the manager's stamps are not the replay's clock)"}}
+          : runBounds(out, report["throughput"]["done_per_sim_hour"].get<double>(), robots.size());
   writeFile(out / "loadtest.json", report.dump(2));
   char line[256];
   std::snprintf(
@@ -1032,6 +1039,7 @@ int Run::run() {
       say(line);
     }
   }
+  say(boundLine(report["kinematic_bound"]));
   if (!contents.error.empty()) {
     say("task database: " + contents.error);
     code = code == 0 ? 1 : code;

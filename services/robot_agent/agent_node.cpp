@@ -5,6 +5,7 @@
 #include <functional>
 #include <thread>
 
+#include "fleet/control/cruise.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/site/wall_segments.hpp"
@@ -26,7 +27,7 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     if (std::any_of(noGo.begin(), noGo.end(), [](std::uint8_t c) { return c != 0; })) {
       raw = std::make_shared<const planning::OccupancyGrid>(world.site->drivable());
     }
-    zoneLayers = site::zoneCostLayers(world.site, 0.8);
+    zoneLayers = site::zoneCostLayers(world.site, control::kAgentCruiseSpeed);
     const auto& limits = world.site->layers.speedLimit;
     if (std::any_of(limits.begin(), limits.end(), [](float v) { return std::isfinite(v); })) {
       speedLimit = [st = world.site](Vec2 p) { return st->speedLimitAt(p); };
@@ -65,7 +66,7 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     p.start = r.start;
     p.radius = r.radius;
     p.wheelBase = r.wheelBase;
-    p.vMax = std::min(0.8, r.limits.vMax);
+    p.vMax = control::agentCruiseSpeed(r.limits);
     p.wMax = r.limits.omegaMax;
     p.localPlanner = s.localPlanner;
     p.dwa = s.dwa;

@@ -33,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "fleet/control/cruise.hpp"
 #include "fleet/core/vec2.hpp"
 #include "fleet/site/site.hpp"
 #include "fleet/traffic/graph.hpp"
@@ -45,7 +46,7 @@ struct RoadmapOptions {
   double targetSpacing = 0.5;  ///< m
   bool diagonals = true;       ///< 8-connected lattice (4-connected when false)
   double radius = 0.0;         ///< m; 0: the site's robot
-  double cruiseSpeed = 0.8;    ///< m/s: the robot agent's cruise speed
+  double cruiseSpeed = control::kAgentCruiseSpeed;  ///< m/s: the robot agent's cruise speed
   /// Free space (m) the motion gate needs ahead of a driving robot not to hold it: its stop gap
   /// (0.35 m) plus 1 s of headway at the 0.05 m/s below which it counts as held.
   double stopGap = 0.40;
