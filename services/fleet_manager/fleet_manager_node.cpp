@@ -154,14 +154,17 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
   if (!rec) {
     return unexpected(rec.error());
   }
-  n->publish(std::move(*rec), nowNs, n->recovered_);
   for (const auto& [id, r] : n->dispatcher_->openTasks()) {
     // The previous incarnation's events are gone with its writer. The revision counts the task's
     // transitions, as the event seq did, so an adapter that kept running sees no step back.
     const auto seq = static_cast<std::uint32_t>(r.revision);
     n->eventSeq_[id] = seq;
-    n->recovered_.events.push_back({id, toMsg(r.state), r.robotId, r.reason.substr(0, 255), nowNs, seq});
+    n->recovered_.events.push_back({id, toMsg(r.state), r.robotId, r.reason.substr(0, 255), nowNs, seq,
+                                    r.stationChosen ? r.task.station : std::string()});
   }
+  // After the announcements: an order that cannot be rebuilt (its station left the site) fails
+  // its task, and that event must follow the task's state with the next seq.
+  n->publish(std::move(*rec), nowNs, n->recovered_);
   return n;
 }
 
@@ -172,18 +175,23 @@ std::uint32_t FleetManagerNode::nextRevision(const std::string& robot, std::int6
   return rev;
 }
 
-msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std::int64_t nowNs) {
+Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrder& o, std::int64_t nowNs) {
   msg::TaskAssignment a;
   a.robot_id = o.robotId;
   a.task_id = o.task.id;
-  a.revision = nextRevision(o.robotId, nowNs);
   a.stamp_ns = nowNs;
   a.paused = o.paused;
+  std::string missing;
   auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
     const Station* s = dispatcher_->stations().find(name);
+    if (s == nullptr) {
+      // Never a goal at a made-up pose: the robot would drive to (0, 0) and report it reached.
+      missing = name;
+      return;
+    }
     msg::Goal g;
     g.station = name;
-    g.pose = s != nullptr ? s->pose : Pose2{};
+    g.pose = s->pose;
     g.action = action;
     g.duration_s = duration;
     a.goals.push_back(g);
@@ -191,7 +199,9 @@ msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std
   switch (o.task.kind) {
     case TaskKind::Transport:
       goal(o.task.pickup, msg::GoalAction::Load, nsToSec(o.task.loadNs));
-      goal(o.task.dropoff, msg::GoalAction::Unload, nsToSec(o.task.unloadNs));
+      if (missing.empty()) {
+        goal(o.task.dropoff, msg::GoalAction::Unload, nsToSec(o.task.unloadNs));
+      }
       break;
     case TaskKind::Goto:
       goal(o.task.station, msg::GoalAction::None, 0);
@@ -204,15 +214,26 @@ msg::TaskAssignment FleetManagerNode::toAssignment(const AssignmentOrder& o, std
       goal(o.task.station, msg::GoalAction::Park, 0);
       break;
   }
+  if (a.goals.empty() || !missing.empty()) {
+    return unexpected(errc::kInternal,
+                      "internal error: task '" + o.task.id + "' has " +
+                          (missing.empty() ? std::string("no station")
+                                           : "station '" + missing + "', which is not on this site") +
+                          "; no order sent to robot " + o.robotId);
+  }
+  a.revision = nextRevision(o.robotId, nowNs);
   return a;
 }
 
 void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out) {
   for (const auto& e : r.events) {
     auto& seq = eventSeq_[e.taskId];
-    out.events.push_back({e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq});
+    out.events.push_back(
+        {e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq, e.station});
     if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
-      queuedAt_[e.taskId] = e.stampNs;
+      // Kept from the first event: a waiting task's later events (paused, why it waits) do not
+      // restart its wait.
+      queuedAt_.try_emplace(e.taskId, e.stampNs);
     } else if (e.state == TaskState::Assigned) {
       auto it = queuedAt_.find(e.taskId);
       if (it != queuedAt_.end()) {
@@ -226,8 +247,23 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
     }
   }
   for (const auto& o : r.assignments) {
-    out.assignments.push_back(toAssignment(o, nowNs));
-    ++metrics_.assignments;
+    auto a = toAssignment(o, nowNs);
+    if (a) {
+      out.assignments.push_back(std::move(*a));
+      ++metrics_.assignments;
+      continue;
+    }
+    // The order cannot be built: the task fails with the reason (and its robot is released)
+    // rather than the robot being sent somewhere the task never meant.
+    ++metrics_.badOrders;
+    auto failed = dispatcher_->fail(o.task.id, a.error().message, nowNs);
+    DispatchResult stop;
+    if (failed) {
+      stop = std::move(*failed);
+    } else {
+      stop.revoked.push_back(o.robotId);  // not stored as failed (storage): at least stop the robot
+    }
+    publish(std::move(stop), nowNs, out);
   }
   for (const auto& robot : r.revoked) {
     msg::TaskAssignment a;
@@ -337,6 +373,9 @@ msg::TaskAck FleetManagerNode::query(const msg::Task& req, std::int64_t nowNs) {
                       {"updated_ns", r->updatedNs},
                       {"revision", r->revision},
                       {"task", toJson(r->task)}};
+  if (r->stationChosen) {
+    d["station_chosen"] = true;  // task.station was chosen by the dispatcher, not sent
+  }
   const auto replace = nlohmann::json::error_handler_t::replace;
   std::string detail = d.dump(-1, ' ', false, replace);
   if (detail.size() > 1023) {
@@ -406,6 +445,7 @@ nlohmann::json FleetManagerNode::metricsJson() const {
           {"duplicates", metrics_.duplicates},
           {"rejected", metrics_.rejected},
           {"assignments", metrics_.assignments},
+          {"bad_orders", metrics_.badOrders},
           {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.count}}}};
 }
 

@@ -68,6 +68,7 @@ struct Metrics {
   std::int64_t duplicates = 0;
   std::int64_t rejected = 0;
   std::int64_t assignments = 0;
+  std::int64_t badOrders = 0;  ///< orders that could not be built (a station not on the site): task failed
 };
 
 class FleetManagerNode {
@@ -105,7 +106,8 @@ class FleetManagerNode {
   void publish(DispatchResult r, std::int64_t nowNs, Outbox& out);
   /// The answer to a TC_QUERY request: the stored state, robot, reason and body (JSON in detail).
   msg::TaskAck query(const msg::Task& req, std::int64_t nowNs);
-  msg::TaskAssignment toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
+  /// The robot's order; error "internal" when a station of the task is not on the site.
+  Expected<msg::TaskAssignment> toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
   std::uint32_t nextRevision(const std::string& robot, std::int64_t nowNs);
 
   Settings settings_;

@@ -27,6 +27,7 @@ void FleetView::onEvent(const msg::TaskEvent& e) {
       v.reason = e.reason;
       v.updatedNs = e.stamp_ns;
       v.seq = e.seq;
+      v.station = e.station;
     }
     events_.push_back(e);
     ++eventCount_;
@@ -83,6 +84,9 @@ void FleetView::onStored(const msg::TaskAck& a, std::int64_t nowNs) {
     v.seq = d.value("revision", 0U);
     if (d.contains("task")) {
       v.body = d["task"].dump();
+      if (d.value("station_chosen", false) && d["task"].is_object()) {
+        v.station = d["task"].value("station", "");
+      }
     }
   }
 }

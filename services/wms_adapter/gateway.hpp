@@ -29,6 +29,8 @@ struct TaskView {
   std::int64_t updatedNs = 0;
   std::uint32_t seq = 0;
   std::string body;  // the task JSON, when this adapter submitted it
+  /// The station the manager chose for a charge / park task sent without one (TaskEvent.station).
+  std::string station;
 };
 
 class TaskGateway {

@@ -49,6 +49,14 @@ json viewJson(const TaskView& v) {
   if (!v.body.empty()) {
     j["task"] = json::parse(v.body, nullptr, false);
   }
+  if (!v.station.empty()) {
+    // Chosen by the manager for a charge / park task sent without a station.
+    j["station"] = v.station;
+    j["station_chosen"] = true;
+    if (j.contains("task") && j["task"].is_object()) {
+      j["task"]["station"] = v.station;
+    }
+  }
   return j;
 }
 
@@ -339,7 +347,8 @@ void HttpApi::routes() {
                                {"robot", e.robot_id},
                                {"reason", e.reason},
                                {"stamp_ns", e.stamp_ns},
-                               {"seq", e.seq}}) +
+                               {"seq", e.seq},
+                               {"station", e.station}}) +
                      "\n\n";
           }
           return chunk;

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
        "task_cancel");
   seed(1, msg::TaskAck{"req-1", "T-1", msg::AckResult::Stored, msg::TaskState::Queued, "stored", 5},
        "task_ack");
-  seed(2, msg::TaskEvent{"T-1", msg::TaskState::Unloading, "r-7", "Kệ hàng Ω-7 → dock ✓", 99, 4},
+  seed(2, msg::TaskEvent{"T-1", msg::TaskState::Unloading, "r-7", "Kệ hàng Ω-7 → dock ✓", 99, 4, "D-3"},
        "task_event");
   msg::TaskAssignment a{"r-1", "T-1", 3, {}, false, 10};
   a.goals.push_back({{1.0, 2.0, 0.5}, "P-1", msg::GoalAction::Load, 2.0});

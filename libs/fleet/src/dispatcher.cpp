@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
+#include <memory>
+#include <set>
 #include <tuple>
 #include <unordered_map>
 
@@ -74,7 +77,8 @@ std::size_t Dispatcher::activeCount() const {
 }
 
 void Dispatcher::applied(const TaskRecord& r, DispatchResult& out) {
-  out.events.push_back({r.task.id, r.state, r.robotId, r.reason, r.updatedNs});
+  out.events.push_back({r.task.id, r.state, r.robotId, r.reason, r.updatedNs,
+                        r.stationChosen ? r.task.station : std::string()});
   switch (r.state) {
     case TaskState::Assigned:
       ++counters_.assigned;
@@ -241,7 +245,7 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   std::vector<TransitionRequest> steps;
   for (auto s = from + 1; s <= to; ++s) {
     steps.push_back(
-        {taskId, *s, robotId, s == to ? reason : std::string("implied by a later report"), nowNs});
+        {taskId, *s, robotId, s == to ? reason : std::string("implied by a later report"), nowNs, {}});
   }
   auto results = store_.transitionBatch(steps);
   for (auto& r : results) {
@@ -275,6 +279,16 @@ Expected<std::map<std::string, TaskRecord, std::less<>>::iterator> Dispatcher::f
 
 Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std::string& reason,
                                             std::int64_t nowNs) {
+  return close(taskId, TaskState::Cancelled, reason, nowNs);
+}
+
+Expected<DispatchResult> Dispatcher::fail(const std::string& taskId, const std::string& reason,
+                                          std::int64_t nowNs) {
+  return close(taskId, TaskState::Failed, reason, nowNs);
+}
+
+Expected<DispatchResult> Dispatcher::close(const std::string& taskId, TaskState to, const std::string& reason,
+                                           std::int64_t nowNs) {
   auto found = findOpen(taskId);
   if (!found) {
     return unexpected(found.error());
@@ -282,7 +296,7 @@ Expected<DispatchResult> Dispatcher::cancel(const std::string& taskId, const std
   const auto it = *found;
   const std::string robot = it->second.robotId;
   const bool active = isActive(it->second.state);
-  auto res = store_.transition(taskId, TaskState::Cancelled, "", reason, nowNs);
+  auto res = store_.transition(taskId, to, "", reason, nowNs);
   if (!res) {
     return unexpected(res.error());
   }
@@ -314,7 +328,8 @@ Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool p
   }
   if (changed) {
     out.events.push_back({taskId, it->second.state, it->second.robotId,
-                          paused ? "paused by request" : "resumed by request", nowNs});
+                          paused ? "paused by request" : "resumed by request", nowNs,
+                          it->second.stationChosen ? it->second.task.station : std::string()});
   }
   return out;
 }
@@ -358,7 +373,7 @@ void Dispatcher::completeCharged(std::int64_t nowNs, DispatchResult& out) {
       char why[64];
       std::snprintf(why, sizeof why, "charged to %.2f", info->battery);
       steps.push_back(
-          {id, *s, r.robotId, *s == TaskState::Done ? std::string(why) : "implied by the charge", nowNs});
+          {id, *s, r.robotId, *s == TaskState::Done ? std::string(why) : "implied by the charge", nowNs, {}});
     }
     robotOf.emplace(id, r.robotId);
   }
@@ -398,17 +413,15 @@ void Dispatcher::chargeLowRobots(std::int64_t nowNs, DispatchResult& out) {
     t.id = chargeTaskId(r.id, nowNs);
     t.kind = TaskKind::Charge;
     t.robot = r.id;
-    double best = kInfeasible;
-    for (const Station* s : chargers) {
+    // No station: the charger is chosen when the task is assigned (in this tick, the task being
+    // the robot's own): the nearest free one, so that low robots do not queue at one charger while
+    // another stands free, and none is sent to a charger another robot is already on its way to.
+    const bool reachable = std::any_of(chargers.begin(), chargers.end(), [&](const Station* s) {
       Task cand = t;
       cand.station = s->name;
-      const double d = travel_(cand)(r);
-      if (std::isfinite(d) && d < best) {
-        best = d;
-        t.station = s->name;
-      }
-    }
-    if (t.station.empty()) {
+      return std::isfinite(travel_(cand)(r));
+    });
+    if (!reachable) {
       out.errors.push_back(
           Error{errc::kNotFound, "robot " + r.id + " is low but no charging station is reachable"});
       continue;
@@ -469,11 +482,33 @@ void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
 
 void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   std::vector<Task> waiting;
+  bool choosing = false;
   for (const auto& [id, r] : open_) {
     if (isWaiting(r.state) && !r.paused) {
       waiting.push_back(r.task);
+      choosing = choosing || needsStation(r.task);
     }
   }
+  if (!choosing) {
+    assignWaiting(std::move(waiting), nullptr, nowNs, out);
+    return;
+  }
+  std::set<std::string, std::less<>> targeted;
+  for (const auto& [id, r] : open_) {
+    if (isActive(r.state)) {
+      for (const std::string* s : stationsOf(r.task)) {
+        targeted.insert(*s);
+      }
+    }
+  }
+  const auto robots = registry_.all();
+  StationChooser chooser(stations_, std::move(targeted), robots, cfg_.standReach);
+  assignWaiting(std::move(waiting), &chooser, nowNs, out);
+  noteStationWaits(chooser, nowNs, out);
+}
+
+void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* chooser, std::int64_t nowNs,
+                               DispatchResult& out) {
   auto idle = registry_.idleRobots();
   std::erase_if(idle, [&](const RobotInfo& r) {
     const auto it = failStreak_.find(r.id);
@@ -504,23 +539,70 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
                                ? static_cast<const Allocator&>(greedy_)
                                : static_cast<const Allocator&>(hungarian_);
   TravelModel travel = travel_;
+  if (chooser != nullptr) {
+    // A task without a station costs what the trip to the station the robot would get costs;
+    // with no free station it can reach, the robot cannot take it.
+    travel = [this, chooser](const Task& t) -> RobotTravel {
+      if (!needsStation(t)) {
+        return travel_(t);
+      }
+      auto options = std::make_shared<const StationChooser::Options>(chooser->options(t, travel_));
+      return [options, chooser](const RobotInfo& r) { return chooser->best(*options, r).travelS; };
+    };
+  }
   if (!failedBy_.empty() && idle.size() > 1) {
     // A retry goes to another robot: whatever held the last one (boxed in, a bad pose estimate)
     // is likely to hold it again. With a single idle robot it may take the task back.
-    travel = [this](const Task& t) -> RobotTravel {
-      RobotTravel base = travel_(t);
+    travel = [this, base = std::move(travel)](const Task& t) -> RobotTravel {
+      RobotTravel inner = base(t);
       const auto it = failedBy_.find(t.id);
       if (it == failedBy_.end()) {
-        return base;
+        return inner;
       }
-      return [base, who = it->second](const RobotInfo& r) { return r.id == who ? kInfeasible : base(r); };
+      return [inner, who = it->second](const RobotInfo& r) { return r.id == who ? kInfeasible : inner(r); };
     };
   }
   const auto assignments = alloc.assign(waiting, idle, travel, nowNs);
+  // The stations of the assigned tasks that need one. Two such tasks may have been costed against
+  // the same station: the robot nearest to its best one chooses first, and each choice is taken at
+  // once. A task left without a station stays in the queue.
+  std::vector<std::string> chosen(assignments.size());
+  std::vector<bool> dropped(assignments.size(), false);
+  if (chooser != nullptr) {
+    std::vector<StationChooser::Options> options(assignments.size());
+    std::vector<std::tuple<bool, double, std::size_t>> order;
+    for (std::size_t k = 0; k < assignments.size(); ++k) {
+      const Task& t = waiting[assignments[k].task];
+      if (needsStation(t)) {
+        options[k] = chooser->options(t, travel_);
+        const auto pick = chooser->best(options[k], idle[assignments[k].robot]);
+        order.emplace_back(pick.blocked, pick.travelS, k);
+      }
+    }
+    std::sort(order.begin(), order.end());
+    for (const auto& [blocked, travelS, k] : order) {
+      const auto pick = chooser->best(options[k], idle[assignments[k].robot]);
+      if (pick.station == nullptr) {
+        dropped[k] = true;
+        continue;
+      }
+      chosen[k] = pick.station->name;
+      chooser->take(pick.station->name);
+    }
+  }
   std::vector<TransitionRequest> reqs;
   reqs.reserve(assignments.size());
-  for (const auto& a : assignments) {
-    reqs.push_back({waiting[a.task].id, TaskState::Assigned, idle[a.robot].id, "allocated", nowNs});
+  for (std::size_t k = 0; k < assignments.size(); ++k) {
+    if (dropped[k]) {
+      continue;
+    }
+    const Task& t = waiting[assignments[k].task];
+    std::string why = "allocated";
+    if (!chosen[k].empty()) {
+      why += " to the nearest free " + std::string(toString(targetKind(t.kind))) + " station " + chosen[k];
+    }
+    reqs.push_back(
+        {t.id, TaskState::Assigned, idle[assignments[k].robot].id, std::move(why), nowNs, chosen[k]});
   }
   auto results = store_.transitionBatch(reqs);
   for (std::size_t k = 0; k < results.size(); ++k) {
@@ -531,6 +613,42 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
     registry_.setTask(reqs[k].robotId, reqs[k].taskId);
     out.assignments.push_back({reqs[k].robotId, results[k]->task, results[k]->revision});
     applied(*results[k], out);
+  }
+}
+
+void Dispatcher::noteStationWaits(const StationChooser& chooser, std::int64_t nowNs, DispatchResult& out) {
+  static constexpr std::string_view kWaiting = "waiting for a free ";
+  std::map<StationKind, std::size_t> freeOf;
+  for (auto& [id, r] : open_) {
+    if (!isWaiting(r.state) || r.paused || !needsStation(r.task)) {
+      continue;
+    }
+    const StationKind kind = targetKind(r.task.kind);
+    auto [free, fresh] = freeOf.try_emplace(kind, 0);
+    if (fresh) {
+      free->second = chooser.freeOfKind(kind);
+    }
+    const std::string what(toString(kind));
+    std::string why;
+    if (free->second == 0) {
+      const std::size_t n = chooser.countOfKind(kind);
+      why = std::string(kWaiting) + what +
+            " station: " + (n == 1 ? std::string("the only one is") : "all " + std::to_string(n) + " are") +
+            " taken by other tasks";
+    } else if (r.reason.starts_with(kWaiting)) {
+      why = "a " + what + " station is free again; waiting for a robot";
+    }
+    if (why.empty() || why == r.reason) {
+      continue;
+    }
+    auto res = store_.setWaitReason(id, why, nowNs);
+    if (!res) {
+      out.errors.push_back(res.error());
+      continue;
+    }
+    r.reason = res->reason;
+    r.updatedNs = res->updatedNs;
+    out.events.push_back({id, r.state, "", r.reason, nowNs, ""});
   }
 }
 

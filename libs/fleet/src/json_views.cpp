@@ -7,10 +7,14 @@ namespace fleet {
 nlohmann::json toJson(const TaskRecord& r) {
   auto task = toJson(r.task);
   task["created_ns"] = r.task.createdNs;  // always present here, even when 0
-  return {{"task", std::move(task)}, {"state", std::string(toString(r.state))},
-          {"robot", r.robotId},      {"attempts", r.attempts},
-          {"reason", r.reason},      {"updated_ns", r.updatedNs},
-          {"revision", r.revision},  {"paused", r.paused}};
+  nlohmann::json j = {{"task", std::move(task)}, {"state", std::string(toString(r.state))},
+                      {"robot", r.robotId},      {"attempts", r.attempts},
+                      {"reason", r.reason},      {"updated_ns", r.updatedNs},
+                      {"revision", r.revision},  {"paused", r.paused}};
+  if (r.stationChosen) {
+    j["station_chosen"] = true;
+  }
+  return j;
 }
 
 nlohmann::json toJson(const TransitionRecord& t) {

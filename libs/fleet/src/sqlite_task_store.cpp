@@ -5,6 +5,7 @@
 #include <array>
 #include <limits>
 
+#include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
 #include "fleet/validation/utf8.hpp"
 
@@ -72,7 +73,8 @@ CREATE TABLE IF NOT EXISTS tasks(
   created_ns INTEGER NOT NULL,
   updated_ns INTEGER NOT NULL,
   revision INTEGER NOT NULL,
-  paused INTEGER NOT NULL DEFAULT 0
+  paused INTEGER NOT NULL DEFAULT 0,
+  station TEXT NOT NULL DEFAULT ''
 ) WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS tasks_by_state ON tasks(state, id);
 CREATE TABLE IF NOT EXISTS transitions(
@@ -87,17 +89,19 @@ CREATE TABLE IF NOT EXISTS transitions(
 CREATE INDEX IF NOT EXISTS transitions_by_task ON transitions(task_id, seq);
 )sql";
 
-/// Schema version 2 added tasks.paused; a version-1 database gets the column on open.
-constexpr int kSchemaVersion = 2;
+/// Schema version 2 added tasks.paused, version 3 tasks.station (the station the dispatcher chose
+/// for a charge or park task submitted without one; the body stays as submitted, so a retry of the
+/// request is still the same request). An older database gets the columns on open.
+constexpr int kSchemaVersion = 3;
 
 constexpr const char* kRecordColumns =
-    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused";
+    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station";
 
 }  // namespace
 
 struct SqliteTaskStore::Impl {
   sqlite3* db = nullptr;
-  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open, pause;
+  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open, pause, waitReason;
 
   ~Impl() {
     // close_v2 defers the close until the statements (members, destroyed after this body) are
@@ -149,6 +153,10 @@ struct SqliteTaskStore::Impl {
     r.updatedNs = s.integer(7);
     r.revision = s.integer(8);
     r.paused = s.integer(9) != 0;
+    if (std::string chosen = s.text(10); !chosen.empty()) {
+      r.task.station = std::move(chosen);
+      r.stationChosen = true;
+    }
     return r;
   }
 
@@ -189,7 +197,11 @@ struct SqliteTaskStore::Impl {
     const std::string body = canonicalBody(t);
     auto existing = load(t.id);
     if (existing) {
-      if (canonicalBody(existing->task) != body) {
+      Task asSubmitted = existing->task;
+      if (existing->stationChosen) {
+        asSubmitted.station.clear();
+      }
+      if (canonicalBody(asSubmitted) != body) {
         return unexpected(errc::kConflict, "task '" + t.id + "' already exists with a different body");
       }
       return SubmitResult{std::move(existing).value(), false};
@@ -235,14 +247,19 @@ struct SqliteTaskStore::Impl {
       return {};
     }
     Stmt cols;
-    if (!cols.prepare(db, "SELECT COUNT(*) FROM pragma_table_info('tasks') WHERE name = 'paused'")) {
+    if (!cols.prepare(db, "SELECT COUNT(*) FROM pragma_table_info('tasks') WHERE name = ?1")) {
       return storageError(db, "read the tasks table's columns");
     }
-    const bool hasPaused = cols.step() == SQLITE_ROW && cols.integer(0) > 0;
-    cols.reset();
-    if (!hasPaused) {
-      if (auto ok = exec("ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0"); !ok) {
-        return ok;
+    for (const auto& [name, ddl] :
+         {std::pair{"paused", "ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0"},
+          std::pair{"station", "ALTER TABLE tasks ADD COLUMN station TEXT NOT NULL DEFAULT ''"}}) {
+      cols.bind(1, std::string_view(name));
+      const bool has = cols.step() == SQLITE_ROW && cols.integer(0) > 0;
+      cols.reset();
+      if (!has) {
+        if (auto ok = exec(ddl); !ok) {
+          return ok;
+        }
       }
     }
     return exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
@@ -271,6 +288,27 @@ struct SqliteTaskStore::Impl {
       return unexpected(errc::kWrongRobot,
                         "task '" + q.taskId + "' is not held by robot '" + q.robotId + "'");
     }
+    if (!q.station.empty()) {
+      if (q.to != TaskState::Assigned) {
+        return unexpected(errc::kInvalid, "task '" + q.taskId + "': a station is chosen only when assigning");
+      }
+      if (r.task.kind != TaskKind::Charge && r.task.kind != TaskKind::Park) {
+        return unexpected(errc::kInvalid,
+                          "task '" + q.taskId + "': only charge and park tasks get a chosen station");
+      }
+      if (!r.task.station.empty() && !r.stationChosen) {
+        return unexpected(errc::kInvalid, "task '" + q.taskId + "' names its station");
+      }
+      if (!isValidId(q.station)) {
+        return unexpected(errc::kInvalid, "task '" + q.taskId + "': not a valid station id");
+      }
+      r.task.station = q.station;
+      r.stationChosen = true;
+    } else if (isWaiting(q.to) && r.stationChosen) {
+      // Back in the queue: the next robot gets the station nearest to it.
+      r.task.station.clear();
+      r.stationChosen = false;
+    }
     const std::optional<TaskState> from = r.state;
     const std::string holder = r.robotId;
     r.state = q.to;
@@ -288,6 +326,7 @@ struct SqliteTaskStore::Impl {
     update.bind(5, r.updatedNs);
     update.bind(6, r.revision);
     update.bind(7, q.taskId);
+    update.bind(8, r.stationChosen ? std::string_view(r.task.station) : std::string_view());
     if (auto ok = stepDone(update, "update task"); !ok) {
       return unexpected(ok.error());
     }
@@ -357,7 +396,7 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
     return unexpected(ok.error());
   }
   const std::string sel = std::string("SELECT ") + kRecordColumns + " FROM tasks";
-  const std::array<std::pair<Stmt*, std::string>, 11> stmts = {{
+  const std::array<std::pair<Stmt*, std::string>, 12> stmts = {{
       {&impl->begin, "BEGIN IMMEDIATE"},
       {&impl->commit, "COMMIT"},
       {&impl->rollback, "ROLLBACK"},
@@ -366,8 +405,8 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
        "INSERT INTO tasks(id, kind, body, state, robot, attempts, reason, created_ns, updated_ns, revision) "
        "VALUES (?1, ?2, ?3, ?4, '', 0, ?5, ?6, ?7, 1)"},
       {&impl->update,
-       "UPDATE tasks SET state = ?1, robot = ?2, attempts = ?3, reason = ?4, updated_ns = ?5, revision = ?6 "
-       "WHERE id = ?7"},
+       "UPDATE tasks SET state = ?1, robot = ?2, attempts = ?3, reason = ?4, updated_ns = ?5, revision = ?6, "
+       "station = ?8 WHERE id = ?7"},
       {&impl->log,
        "INSERT INTO transitions(task_id, from_state, to_state, robot, reason, stamp_ns) VALUES (?1, ?2, ?3, "
        "?4, ?5, "
@@ -378,6 +417,7 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
        "ORDER BY seq"},
       {&impl->counts, "SELECT state, COUNT(*) FROM tasks GROUP BY state"},
       {&impl->pause, "UPDATE tasks SET paused = ?1, updated_ns = ?2 WHERE id = ?3"},
+      {&impl->waitReason, "UPDATE tasks SET reason = ?1, updated_ns = ?2 WHERE id = ?3"},
       {&impl->open, sel + " WHERE state NOT IN ('done', 'failed', 'cancelled') ORDER BY created_ns, id"},
   }};
   for (const auto& [stmt, sql] : stmts) {
@@ -455,6 +495,31 @@ Expected<TaskRecord> SqliteTaskStore::setPaused(std::string_view id, bool paused
     return unexpected(ok.error());
   }
   cur->paused = paused;
+  cur->updatedNs = stampNs;
+  return cur;
+}
+
+Expected<TaskRecord> SqliteTaskStore::setWaitReason(std::string_view id, std::string_view reason,
+                                                    std::int64_t stampNs) {
+  std::lock_guard lock(mu_);
+  auto cur = impl_->load(id);
+  if (!cur) {
+    return cur;
+  }
+  if (!isWaiting(cur->state)) {
+    return unexpected(errc::kIllegalTransition, "task '" + std::string(id) + "' is " +
+                                                    std::string(toString(cur->state)) + ", not waiting");
+  }
+  if (cur->reason == reason) {
+    return cur;  // idempotent: nothing to write
+  }
+  impl_->waitReason.bind(1, reason);
+  impl_->waitReason.bind(2, stampNs);
+  impl_->waitReason.bind(3, id);
+  if (auto ok = impl_->stepDone(impl_->waitReason, "set the reason of a waiting task"); !ok) {
+    return unexpected(ok.error());
+  }
+  cur->reason = std::string(reason);
   cur->updatedNs = stampNs;
   return cur;
 }

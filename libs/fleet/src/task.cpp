@@ -106,6 +106,14 @@ std::vector<FieldError> validateTask(const Task& t, const StationMap* stations, 
     if (t.station.empty()) {
       if (t.kind == TaskKind::Goto) {
         out.push_back({join(prefix, "station"), "required for a goto task"});
+      } else if (stations != nullptr) {
+        // The dispatcher picks the station at assignment; with none of the kind it never could,
+        // and the task would wait for ever.
+        const StationKind need = t.kind == TaskKind::Charge ? StationKind::Charging : StationKind::Parking;
+        if (stations->ofKind(need).empty()) {
+          out.push_back({join(prefix, "station"),
+                         "no " + std::string(toString(need)) + " station on this site to choose from"});
+        }
       }
     } else if (t.kind == TaskKind::Goto) {
       // Any station is a valid go-to target; only existence is checked.

@@ -134,11 +134,13 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   putStr(out.reason, in.reason, "TaskEvent.reason");
   out.stamp_ns = in.stamp_ns;
   out.seq = in.seq;
+  putStr(out.station, in.station, "TaskEvent.station");
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
   return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
           getStr(in.robot_id), getStr(in.reason),
-          in.stamp_ns,         in.seq};
+          in.stamp_ns,         in.seq,
+          getStr(in.station)};
 }
 
 // ---- TaskAssignment

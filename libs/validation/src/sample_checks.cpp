@@ -135,7 +135,7 @@ std::optional<Rejection> check(const msg::TaskAck& m) {
 
 std::optional<Rejection> check(const msg::TaskEvent& m) {
   Checker c("TaskEvent");
-  c.id(m.task_id, "task_id").optionalId(m.robot_id, "robot_id");
+  c.id(m.task_id, "task_id").optionalId(m.robot_id, "robot_id").optionalId(m.station, "station");
   c.known(m.state, msg::TaskState::Rejected, "state");
   return c.text(m.reason, "reason").done();
 }

@@ -122,8 +122,10 @@ TEST_F(RoundTrip, TaskAck) {
 }
 
 TEST_F(RoundTrip, TaskEvent) {
-  expectRoundTrip<msg::TaskEvent>({{"t-1", msg::TaskState::Unloading, "r-7", kNonAscii, 99, 4},
-                                   {"t-2", msg::TaskState::Rejected, "", std::string(255, 'x'), -1, 0}});
+  expectRoundTrip<msg::TaskEvent>(
+      {{"t-1", msg::TaskState::Unloading, "r-7", kNonAscii, 99, 4, ""},
+       {"t-2", msg::TaskState::Rejected, "", std::string(255, 'x'), -1, 0, maxId()},
+       {"t-3", msg::TaskState::Assigned, "r-1", "allocated", 7, 2, "PARK-3"}});
 }
 
 TEST_F(RoundTrip, TaskAssignment) {

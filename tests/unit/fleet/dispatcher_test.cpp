@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "fleet/fleet/errors.hpp"
@@ -472,6 +473,230 @@ TEST_F(DispatcherTest, RecoverRebuildsOpenStateAfterRestart) {
   auto later = dispatcher->tick(12 * kSec);
   EXPECT_EQ(stateOf(held), S::Requeued);
   EXPECT_TRUE(later.assignments.empty());
+}
+
+// Charge and park tasks without a station: the dispatcher chooses one when it assigns the task.
+class StationChoiceTest : public DispatcherTest {
+ protected:
+  void SetUp() override {
+    // Three parking places in a row at y = 10 (none at the origin), two chargers far apart.
+    map = StationMap();
+    for (const auto& [name, x] : {std::pair{"K-1", 10.0}, std::pair{"K-2", 20.0}, std::pair{"K-3", 30.0}}) {
+      EXPECT_TRUE(map.add({name, {x, 10, 0}, static_cast<std::uint8_t>(StationKind::Parking)}));
+    }
+    EXPECT_TRUE(map.add({"C-1", {5, -10, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+    EXPECT_TRUE(map.add({"C-2", {40, -10, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+    EXPECT_TRUE(map.add({"P-1", {0, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+    EXPECT_TRUE(map.add({"D-1", {50, 0, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
+    reopen();
+  }
+  static Task stationless(std::string id, TaskKind kind) {
+    Task t;
+    t.id = std::move(id);
+    t.kind = kind;
+    return t;
+  }
+  /// Robot `robot` near x = 29 takes the stationless park task `park-1` and is given K-3.
+  void parkAtK3(const std::string& robot) {
+    robotAt(robot, 29, 0, 0.9, 0);
+    dispatcher->submit({stationless("park-1", TaskKind::Park)}, 0);
+    const auto out = dispatcher->tick(1);
+    ASSERT_EQ(out.assignments.size(), 1u);
+    ASSERT_EQ(out.assignments[0].task.station, "K-3");
+  }
+  /// Every order names a station of the site; none is at the origin.
+  void expectRealStations(const DispatchResult& out) {
+    for (const auto& a : out.assignments) {
+      const Station* s = map.find(a.task.station);
+      ASSERT_NE(s, nullptr) << a.task.id << " goes to '" << a.task.station << "'";
+      EXPECT_FALSE(s->pose.x == 0 && s->pose.y == 0) << a.task.id;
+    }
+  }
+};
+
+TEST_F(StationChoiceTest, AParkTaskWithoutAStationGetsTheNearestFreeParking) {
+  robotAt("r", 19, 0, 0.9, 0);  // K-2 is 10 m away, K-1 and K-3 about 14 m
+  auto rs = dispatcher->submit({stationless("park-1", TaskKind::Park)}, 0);
+  ASSERT_TRUE(rs[0]) << rs[0].error().message;
+  EXPECT_TRUE(rs[0]->record.task.station.empty()) << "chosen at assignment, not at submission";
+  auto out = dispatcher->tick(1);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "r");
+  EXPECT_EQ(out.assignments[0].task.station, "K-2");
+  const auto rec = store->get("park-1");
+  ASSERT_TRUE(rec);
+  EXPECT_EQ(rec->task.station, "K-2");
+  EXPECT_TRUE(rec->stationChosen);
+  EXPECT_EQ(rec->reason, "allocated to the nearest free parking station K-2");
+  ASSERT_FALSE(out.events.empty());
+  EXPECT_EQ(out.events.back().state, S::Assigned);
+  EXPECT_EQ(out.events.back().station, "K-2") << "the event names the chosen station";
+}
+
+TEST_F(StationChoiceTest, TwoParkTasksWithoutAStationGetDifferentStations) {
+  robotAt("a", 19, 0, 0.9, 0);
+  robotAt("b", 21, 0, 0.9, 0);  // both nearest to K-2
+  dispatcher->submit({stationless("park-a", TaskKind::Park), stationless("park-b", TaskKind::Park)}, 0);
+  auto out = dispatcher->tick(1);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 2u);
+  std::set<std::string> chosen;
+  for (const auto& a : out.assignments) {
+    chosen.insert(a.task.station);
+  }
+  EXPECT_EQ(chosen.size(), 2u) << "two robots sent to one parking place";
+  EXPECT_TRUE(chosen.contains("K-2"));
+  // A third one, later, does not get a station an active task targets either.
+  robotAt("c", 20, 0, 0.9, 2);
+  dispatcher->submit({stationless("park-c", TaskKind::Park)}, 2);
+  out = dispatcher->tick(3);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_FALSE(chosen.contains(out.assignments[0].task.station));
+}
+
+TEST_F(StationChoiceTest, AStationARobotStandsOnIsChosenOnlyWhenNoOtherIsFree) {
+  // A robot in fault mode stands on K-2 (it takes no task, but it is in the way).
+  dispatcher->onRobotState({"stuck-2", {20, 10.2, 0}, 0.9, 0, true});
+  robotAt("r", 20, 0, 0.9, 0);
+  dispatcher->submit({stationless("park-1", TaskKind::Park)}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "r");
+  EXPECT_NE(out.assignments[0].task.station, "K-2") << "sent onto a robot standing there";
+  // With a robot on every free parking place, the nearest of them is still better than none.
+  dispatcher->onRobotState({"stuck-1", {10, 10, 0}, 0.9, 2, true});
+  dispatcher->onRobotState({"stuck-3", {30, 10, 0}, 0.9, 2, true});
+  robotAt("q", 21, 0, 0.9, 2);
+  dispatcher->submit({stationless("park-2", TaskKind::Park)}, 2);
+  out = dispatcher->tick(3);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "q");
+  EXPECT_EQ(out.assignments[0].task.station, "K-2");
+}
+
+TEST_F(StationChoiceTest, AChargeTaskWithoutAStationGetsAFreeCharger) {
+  robotAt("a", 10, -10, 0.9, 0);
+  robotAt("b", 12, -10, 0.9, 0);  // both nearest to C-1
+  dispatcher->submit({stationless("charge-a", TaskKind::Charge), stationless("charge-b", TaskKind::Charge)},
+                     0);
+  auto out = dispatcher->tick(1);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 2u);
+  std::map<std::string, std::string> chargerOf;
+  for (const auto& a : out.assignments) {
+    chargerOf[a.robotId] = a.task.station;
+  }
+  EXPECT_EQ(chargerOf["a"], "C-1") << "the nearer robot keeps the nearer charger";
+  EXPECT_EQ(chargerOf["b"], "C-2");
+}
+
+TEST_F(StationChoiceTest, ALowRobotIsSentToAFreeChargerNotToOneInUse) {
+  robotAt("a", 5, -9, 0.9, 0);
+  dispatcher->submit({stationless("charge-a", TaskKind::Charge)}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  ASSERT_EQ(out.assignments[0].task.station, "C-1");
+  robotAt("low", 6, -9, 0.1, 2);  // right next to C-1, which a is charging at
+  out = dispatcher->tick(3);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "low");
+  EXPECT_EQ(out.assignments[0].task.kind, TaskKind::Charge);
+  EXPECT_EQ(out.assignments[0].task.station, "C-2");
+}
+
+TEST_F(StationChoiceTest, WhenEveryStationIsTakenTheTaskWaitsAndSaysWhy) {
+  robotAt("a", 5, -8, 0.9, 0);
+  robotAt("b", 40, -8, 0.9, 0);
+  dispatcher->submit({stationless("charge-a", TaskKind::Charge), stationless("charge-b", TaskKind::Charge)},
+                     0);
+  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 2u);
+  robotAt("c", 20, -9, 0.9, 2);
+  dispatcher->submit({stationless("charge-c", TaskKind::Charge)}, 2);
+  auto out = dispatcher->tick(3);
+  EXPECT_TRUE(out.assignments.empty()) << "sent to a charger in use (or to nowhere)";
+  EXPECT_EQ(stateOf("charge-c"), S::Queued);
+  const std::string why = "waiting for a free charging station: all 2 are taken by other tasks";
+  EXPECT_EQ(store->get("charge-c")->reason, why) << "durable";
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].reason, why);
+  EXPECT_TRUE(dispatcher->tick(4).events.empty()) << "said once";
+  // A charger frees up: the waiting task gets it.
+  ASSERT_TRUE(dispatcher->onTaskStatus("b", "charge-b", S::Done, "", 5));
+  out = dispatcher->tick(6);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "charge-c");
+  EXPECT_EQ(out.assignments[0].task.station, "C-2");
+}
+
+TEST_F(StationChoiceTest, ASiteWithoutParkingRefusesAStationlessParkTaskAtSubmission) {
+  map = StationMap();
+  EXPECT_TRUE(map.add({"P-1", {0, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  EXPECT_TRUE(map.add({"C-1", {5, 5, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+  reopen();
+  std::vector<std::vector<FieldError>> fields;
+  auto rs =
+      dispatcher->submit({stationless("park-1", TaskKind::Park), stationless("charge-1", TaskKind::Charge)},
+                         0, nullptr, &fields);
+  ASSERT_FALSE(rs[0]);
+  EXPECT_EQ(rs[0].error().code, errc::kInvalid);
+  EXPECT_EQ(fields[0],
+            (std::vector<FieldError>{{"station", "no parking station on this site to choose from"}}));
+  EXPECT_TRUE(rs[1]) << "a charger exists";
+  EXPECT_FALSE(store->get("park-1")) << "nothing stored";
+}
+
+TEST_F(StationChoiceTest, TheChosenStationSurvivesARestartAndARetryIsStillTheSameRequest) {
+  parkAtK3("r");
+  reopen();  // the manager restarts
+  auto rec = dispatcher->recover(10 * kSec);
+  ASSERT_TRUE(rec) << rec.error().message;
+  ASSERT_EQ(rec->assignments.size(), 1u);
+  EXPECT_EQ(rec->assignments[0].task.station, "K-3") << "re-published with the station chosen before";
+  expectRealStations(*rec);
+  const auto stored = store->get("park-1");
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->task.station, "K-3");
+  EXPECT_TRUE(stored->stationChosen);
+  EXPECT_EQ(toJson(*stored)["station_chosen"], true);
+  // The WMS retries its original request (no station): the same request, not a conflict.
+  auto retry = dispatcher->submit({stationless("park-1", TaskKind::Park)}, 11 * kSec);
+  ASSERT_TRUE(retry[0]) << retry[0].error().message;
+  EXPECT_FALSE(retry[0]->created);
+  Task other = stationless("park-1", TaskKind::Park);
+  other.station = "K-1";
+  auto conflict = dispatcher->submit({other}, 11 * kSec);
+  ASSERT_FALSE(conflict[0]);
+  EXPECT_EQ(conflict[0].error().code, errc::kConflict);
+}
+
+TEST_F(StationChoiceTest, ARequeuedTaskGetsAStationForItsNextRobot) {
+  parkAtK3("a");
+  // a is lost; b, near K-1, takes the task over and parks there, not at a's choice.
+  auto out = dispatcher->onRobotLost("a", 2);
+  EXPECT_EQ(stateOf("park-1"), S::Requeued);
+  EXPECT_TRUE(store->get("park-1")->task.station.empty()) << "back in the queue, the choice is dropped";
+  robotAt("b", 9, 0, 0.9, 3);
+  out = dispatcher->tick(4);
+  expectRealStations(out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].robotId, "b");
+  EXPECT_EQ(out.assignments[0].task.station, "K-1");
+}
+
+TEST_F(StationChoiceTest, ATaskNamingItsStationKeepsIt) {
+  robotAt("r", 9, 0, 0.9, 0);
+  Task t = stationless("park-1", TaskKind::Park);
+  t.station = "K-3";
+  dispatcher->submit({t}, 0);
+  auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.station, "K-3");
+  EXPECT_FALSE(store->get("park-1")->stationChosen);
+  EXPECT_EQ(out.events.back().station, "") << "nothing chosen";
 }
 
 }  // namespace

@@ -30,6 +30,23 @@ std::string numbered(std::string prefix, int i) {
   return prefix;
 }
 
+/// The tables of schema version 1 (before `paused`).
+constexpr const char* kSchemaV1 = R"sql(
+CREATE TABLE tasks(id TEXT PRIMARY KEY, kind TEXT NOT NULL, body TEXT NOT NULL, state TEXT NOT NULL,
+  robot TEXT NOT NULL DEFAULT '', attempts INTEGER NOT NULL DEFAULT 0, reason TEXT NOT NULL DEFAULT '',
+  created_ns INTEGER NOT NULL, updated_ns INTEGER NOT NULL, revision INTEGER NOT NULL) WITHOUT ROWID;
+CREATE TABLE transitions(seq INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, from_state TEXT,
+  to_state TEXT NOT NULL, robot TEXT NOT NULL DEFAULT '', reason TEXT NOT NULL DEFAULT '', stamp_ns INTEGER NOT NULL);
+)sql";
+
+/// A database file as an older manager left it: `sql` run on a fresh file.
+void writeDatabase(const std::string& path, const std::string& sql) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  sqlite3_close(db);
+}
+
 std::unique_ptr<SqliteTaskStore> openStore(const std::string& path) {
   auto s = SqliteTaskStore::open({path});
   EXPECT_TRUE(s) << s.error().message;
@@ -65,19 +82,10 @@ TEST(SqliteTaskStore, OpensAVersionOneDatabaseAddingThePausedColumn) {
   // The schema before `paused` (user_version 1), with one task in it.
   test::TempDir dir;
   const std::string path = dir.file("v1.db");
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
-  const char* v1 = R"sql(
-CREATE TABLE tasks(id TEXT PRIMARY KEY, kind TEXT NOT NULL, body TEXT NOT NULL, state TEXT NOT NULL,
-  robot TEXT NOT NULL DEFAULT '', attempts INTEGER NOT NULL DEFAULT 0, reason TEXT NOT NULL DEFAULT '',
-  created_ns INTEGER NOT NULL, updated_ns INTEGER NOT NULL, revision INTEGER NOT NULL) WITHOUT ROWID;
-CREATE TABLE transitions(seq INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, from_state TEXT,
-  to_state TEXT NOT NULL, robot TEXT NOT NULL DEFAULT '', reason TEXT NOT NULL DEFAULT '', stamp_ns INTEGER NOT NULL);
+  writeDatabase(path, std::string(kSchemaV1) + R"sql(
 INSERT INTO tasks VALUES('old', 'goto', '{"id":"old","kind":"goto","station":"D-1"}', 'queued', '', 0, '', 5, 5, 1);
 PRAGMA user_version = 1;
-)sql";
-  ASSERT_EQ(sqlite3_exec(db, v1, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
-  sqlite3_close(db);
+)sql");
   auto store = openStore(path);
   auto old = store->get("old");
   ASSERT_TRUE(old) << old.error().message;
@@ -85,6 +93,69 @@ PRAGMA user_version = 1;
   ASSERT_TRUE(store->setPaused("old", true, 6));
   store.reset();
   EXPECT_TRUE(openStore(path)->get("old")->paused) << "migrated once, then used as version 2";
+}
+
+TEST(SqliteTaskStore, AChosenStationIsStoredWithTheAssignmentAndDroppedOnRequeue) {
+  test::TempDir dir;
+  Task park;
+  park.id = "park-1";
+  park.kind = TaskKind::Park;
+  {
+    auto store = openStore(dir.file("tasks.db"));
+    ASSERT_TRUE(store->submit(park, 1));
+    ASSERT_TRUE(store->submit(transport("t1"), 1));
+    auto a = store->transition({"park-1", S::Assigned, "r1", "allocated", 2, "K-2"});
+    ASSERT_TRUE(a) << a.error().message;
+    EXPECT_EQ(a->task.station, "K-2");
+    EXPECT_TRUE(a->stationChosen);
+    EXPECT_EQ(store->transition({"t1", S::Assigned, "r2", "", 2, "K-2"}).error().code, errc::kInvalid)
+        << "only charge and park tasks get a station chosen";
+  }
+  auto store = openStore(dir.file("tasks.db"));  // a restart
+  const auto got = store->get("park-1");
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->task.station, "K-2");
+  EXPECT_TRUE(got->stationChosen);
+  EXPECT_EQ(store->openTasks()->front().task.station, "K-2");
+  const auto retry = store->submit(park, 3);
+  ASSERT_TRUE(retry) << retry.error().message;
+  EXPECT_FALSE(retry->created) << "the request as sent is the same request";
+  // Back in the queue: the choice goes; the next assignment chooses again.
+  auto rq = store->transition("park-1", S::Requeued, "", "robot r1 lost", 4);
+  ASSERT_TRUE(rq);
+  EXPECT_TRUE(rq->task.station.empty());
+  EXPECT_FALSE(rq->stationChosen);
+  EXPECT_TRUE(store->get("park-1")->task.station.empty());
+  // Why it waits is stored without a transition, and only for a waiting task.
+  auto w = store->setWaitReason("park-1", "waiting for a free parking station", 5);
+  ASSERT_TRUE(w) << w.error().message;
+  EXPECT_EQ(store->get("park-1")->reason, "waiting for a free parking station");
+  EXPECT_EQ(store->history("park-1")->size(), 3u) << "not a transition";
+  ASSERT_TRUE(store->transition({"park-1", S::Assigned, "r3", "allocated", 6, "K-1"}));
+  EXPECT_EQ(store->setWaitReason("park-1", "x", 7).error().code, errc::kIllegalTransition);
+  ASSERT_TRUE(store->transition("park-1", S::EnRoute, "r3", "", 8));
+  ASSERT_TRUE(store->transition("park-1", S::Done, "r3", "", 9));
+  EXPECT_EQ(store->get("park-1")->task.station, "K-1") << "a finished task keeps where it went";
+}
+
+TEST(SqliteTaskStore, OpensAVersionTwoDatabaseAddingTheStationColumn) {
+  test::TempDir dir;
+  const std::string path = dir.file("v2.db");
+  // Version 2 as the migration left it: version 1 plus `paused`.
+  writeDatabase(path, std::string(kSchemaV1) + R"sql(
+ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0;
+INSERT INTO tasks VALUES('old', 'park', '{"id":"old","kind":"park"}', 'queued', '', 0, '', 5, 5, 1, 1);
+PRAGMA user_version = 2;
+)sql");
+  {
+    auto store = openStore(path);
+    const auto old = store->get("old");
+    ASSERT_TRUE(old) << old.error().message;
+    EXPECT_TRUE(old->paused);
+    EXPECT_FALSE(old->stationChosen);
+    ASSERT_TRUE(store->transition({"old", S::Assigned, "r1", "", 6, "K-1"}));
+  }
+  EXPECT_EQ(openStore(path)->get("old")->task.station, "K-1") << "migrated once, then used as version 3";
 }
 
 TEST(SqliteTaskStore, SubmitIsIdempotentAndDetectsConflicts) {
@@ -207,10 +278,10 @@ TEST(SqliteTaskStore, BatchesAreIndependentItemsInOneCommit) {
   EXPECT_TRUE(rs[3] && !rs[3]->created) << "a repeat inside the batch is a retry of the first";
   EXPECT_TRUE(rs[4] && rs[4]->created);
 
-  auto ts = store->transitionBatch({{"a", S::Assigned, "r1", "", 11},
-                                    {"a", S::EnRoute, "r1", "", 12},
-                                    {"b", S::EnRoute, "r1", "", 12},
-                                    {"b", S::Cancelled, "", "operator", 13}});
+  auto ts = store->transitionBatch({{"a", S::Assigned, "r1", "", 11, {}},
+                                    {"a", S::EnRoute, "r1", "", 12, {}},
+                                    {"b", S::EnRoute, "r1", "", 12, {}},
+                                    {"b", S::Cancelled, "", "operator", 13, {}}});
   ASSERT_EQ(ts.size(), 4u);
   EXPECT_TRUE(ts[0]);
   EXPECT_TRUE(ts[1]) << "checked against the state the previous item left";

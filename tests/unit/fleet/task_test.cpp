@@ -173,6 +173,24 @@ TEST(Task, BatchPathsNameTheElement) {
   EXPECT_EQ(bad.error().fields.at(0).path, "[0].pickup");
 }
 
+TEST(Task, AChargeOrParkTaskWithoutAStationNeedsOneOfItsKindOnTheSite) {
+  auto st = testStations();
+  EXPECT_TRUE(parseTask(nlohmann::json::parse(R"({"id": "a", "kind": "park"})"), &st));
+  EXPECT_TRUE(parseTask(nlohmann::json::parse(R"({"id": "a", "kind": "charge"})"), &st));
+  StationMap noParking;
+  ASSERT_TRUE(noParking.add({"P-1", {1, 1, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  EXPECT_EQ(errorsOf(R"({"id": "a", "kind": "park"})", &noParking),
+            (std::vector<FieldError>{{"station", "no parking station on this site to choose from"}}));
+  auto batch = parseTasks(nlohmann::json::parse(R"([{"id": "a", "kind": "charge"}])"), &noParking);
+  ASSERT_FALSE(batch);
+  EXPECT_EQ(batch.error().fields,
+            (std::vector<FieldError>{{"[0].station", "no charging station on this site to choose from"}}));
+  // Naming a station still works the same; without a site only the syntax is checked.
+  EXPECT_EQ(errorsOf(R"({"id": "a", "kind": "park", "station": "P-1"})", &noParking),
+            (std::vector<FieldError>{{"station", "station 'P-1' is not a parking station"}}));
+  EXPECT_TRUE(parseTask(nlohmann::json::parse(R"({"id": "a", "kind": "park"})")));
+}
+
 TEST(StationMapTest, AcceptsTheSimulatorScenarioForm) {
   auto m = StationMap::fromJson(nlohmann::json::parse(R"({"name": "x", "map": {}, "stations": [
     {"name": "PARK-1", "kind": "parking", "pose": [4.0, 1.25, 1.5708]},

@@ -62,8 +62,9 @@ class Node : public ::testing::Test {
     settings_.stationsFile = "unused";
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::unique_ptr<manager::FleetManagerNode> open(std::int64_t now) {
-    auto n = manager::FleetManagerNode::create(settings_, stations(), now);
+  std::unique_ptr<manager::FleetManagerNode> open(std::int64_t now) { return open(now, stations()); }
+  std::unique_ptr<manager::FleetManagerNode> open(std::int64_t now, StationMap site) {
+    auto n = manager::FleetManagerNode::create(settings_, std::move(site), now);
     EXPECT_TRUE(n) << (n ? "" : n.error().message);
     return std::move(*n);
   }
@@ -435,4 +436,149 @@ TEST_F(Node, HoldingABusyRobotPausesItsTaskAndReleasingResumesIt) {
   ASSERT_EQ(out.assignments.size(), 1u);
   EXPECT_EQ(out.assignments[0].task_id, "t1");
   EXPECT_FALSE(out.assignments[0].paused);
+}
+
+namespace {
+/// Parking places K-1..K-3 along y = 10 and one charger; nothing at the origin.
+StationMap parkingSite(bool withK3 = true) {
+  StationMap m;
+  EXPECT_TRUE(m.add({"P-1", {1, 1, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  EXPECT_TRUE(m.add({"D-1", {5, 1, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
+  EXPECT_TRUE(m.add({"K-1", {10, 10, 0}, static_cast<std::uint8_t>(StationKind::Parking)}));
+  EXPECT_TRUE(m.add({"K-2", {20, 10, 0}, static_cast<std::uint8_t>(StationKind::Parking)}));
+  if (withK3) {
+    EXPECT_TRUE(m.add({"K-3", {30, 10, 0}, static_cast<std::uint8_t>(StationKind::Parking)}));
+  }
+  EXPECT_TRUE(m.add({"C-1", {15, -10, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+  return m;
+}
+
+msg::RobotState idleAt(const std::string& id, double x, double y, std::int64_t t, float battery = 0.9f) {
+  return {id, t, {x, y, 0}, {}, 0, 0, msg::RobotMode::Idle, battery, "", 0.3f};
+}
+
+void expectNoGoalAtTheOrigin(const manager::Outbox& out) {
+  for (const auto& a : out.assignments) {
+    for (const auto& g : a.goals) {
+      EXPECT_FALSE(g.pose.x == 0 && g.pose.y == 0) << a.task_id << " sends " << a.robot_id << " to (0, 0)";
+      EXPECT_FALSE(g.station.empty()) << a.task_id;
+    }
+  }
+}
+}  // namespace
+
+TEST_F(Node, ParkAndChargeTasksWithoutAStationGoToTheNearestFreeOneAndKeepItAcrossARestart) {
+  settings_.travelCost = "straight";
+  std::string park1Station;
+  {
+    auto node = open(0, parkingSite());
+    manager::Outbox out;
+    node->onRobotState(idleAt("r1", 19, 0, 0), 0);
+    node->onRobotState(idleAt("r2", 21, 0, 0), 0);
+    node->onRobotState(idleAt("r3", 15, -7, 0), 0);
+    node->onRequests({request("park-1", R"({"id": "park-1", "kind": "park"})"),
+                      request("park-2", R"({"id": "park-2", "kind": "park"})"),
+                      request("charge-1", R"({"id": "charge-1", "kind": "charge"})")},
+                     1'000, out);
+    ASSERT_EQ(out.acks.size(), 3u);
+    for (const auto& a : out.acks) {
+      EXPECT_EQ(a.result, msg::AckResult::Stored) << a.detail;
+    }
+    out = {};
+    node->tick(2'000, out);
+    expectNoGoalAtTheOrigin(out);
+    ASSERT_EQ(out.assignments.size(), 3u);
+    std::map<std::string, msg::Goal> goalOf;
+    for (const auto& a : out.assignments) {
+      ASSERT_EQ(a.goals.size(), 1u);
+      goalOf[a.task_id] = a.goals[0];
+    }
+    EXPECT_EQ(goalOf["charge-1"].station, "C-1");
+    EXPECT_EQ(goalOf["charge-1"].action, msg::GoalAction::Charge);
+    EXPECT_NE(goalOf["park-1"].station, goalOf["park-2"].station) << "two robots sent to one place";
+    EXPECT_TRUE(goalOf["park-1"].station == "K-2" || goalOf["park-2"].station == "K-2");
+    EXPECT_EQ(goalOf["park-1"].action, msg::GoalAction::Park);
+    EXPECT_DOUBLE_EQ(goalOf["park-1"].pose.y, 10.0);
+    park1Station = goalOf["park-1"].station;
+    // The assigned events name the chosen station.
+    std::map<std::string, std::string> eventStation;
+    for (const auto& e : out.events) {
+      if (e.state == msg::TaskState::Assigned) {
+        eventStation[e.task_id] = e.station;
+      }
+    }
+    EXPECT_EQ(eventStation["park-1"], park1Station);
+    EXPECT_EQ(eventStation["charge-1"], "C-1");
+  }
+  auto node = open(10'000, parkingSite());  // the manager restarts
+  expectNoGoalAtTheOrigin(node->recovered());
+  std::map<std::string, std::string> recovered;
+  for (const auto& a : node->recovered().assignments) {
+    ASSERT_EQ(a.goals.size(), 1u);
+    recovered[a.task_id] = a.goals[0].station;
+  }
+  EXPECT_EQ(recovered["park-1"], park1Station) << "the choice is durable";
+  EXPECT_EQ(recovered["charge-1"], "C-1");
+  for (const auto& e : node->recovered().events) {
+    if (e.task_id == "park-1") {
+      EXPECT_EQ(e.station, park1Station);
+    }
+  }
+  // GET /v1/tasks/park-1 through the adapter asks the manager: the stored task shows the station.
+  msg::Task q;
+  q.task_id = "park-1";
+  q.request_id = "q-park";
+  q.control = msg::TaskControl::Query;
+  manager::Outbox out;
+  node->onRequests({q}, 11'000, out);
+  ASSERT_EQ(out.acks.size(), 1u);
+  const auto d = nlohmann::json::parse(out.acks[0].detail);
+  EXPECT_EQ(d["task"]["station"], park1Station);
+  EXPECT_EQ(d["station_chosen"], true);
+}
+
+TEST_F(Node, AStationlessParkTaskIsRefusedOnASiteWithoutParking) {
+  auto node = open(0, [] {
+    StationMap m;
+    EXPECT_TRUE(m.add({"P-1", {1, 1, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+    EXPECT_TRUE(m.add({"C-1", {3, 3, 0}, static_cast<std::uint8_t>(StationKind::Charging)}));
+    return m;
+  }());
+  manager::Outbox out;
+  node->onRequests({request("park-1", R"({"id": "park-1", "kind": "park"})")}, 0, out);
+  ASSERT_EQ(out.acks.size(), 1u);
+  EXPECT_EQ(out.acks[0].result, msg::AckResult::Invalid);
+  EXPECT_THAT(out.acks[0].detail, HasSubstr(R"("path":"station")"));
+  EXPECT_THAT(out.acks[0].detail, HasSubstr("no parking station on this site to choose from"));
+  EXPECT_TRUE(out.events.empty()) << "nothing stored";
+}
+
+// A station that is not on the site (a stored task's station removed from the site before a
+// restart) must never become a goal at (0, 0): the task fails with the reason, the robot is freed.
+TEST_F(Node, AnOrderWhoseStationIsNotOnTheSiteFailsTheTaskInsteadOfDrivingToTheOrigin) {
+  settings_.travelCost = "straight";
+  {
+    auto node = open(0, parkingSite());
+    manager::Outbox out;
+    node->onRobotState(idleAt("r1", 29, 0, 0), 0);
+    node->onRequests({request("park-1", R"({"id": "park-1", "kind": "park", "station": "K-3"})")}, 1'000,
+                     out);
+    node->tick(2'000, out);
+    ASSERT_EQ(out.assignments.size(), 1u);
+    ASSERT_EQ(out.assignments[0].goals.at(0).station, "K-3");
+  }
+  auto node = open(10'000, parkingSite(false));  // K-3 is gone from the site
+  const auto& rec = node->recovered();
+  expectNoGoalAtTheOrigin(rec);
+  ASSERT_EQ(rec.assignments.size(), 1u);
+  EXPECT_EQ(rec.assignments[0].robot_id, "r1");
+  EXPECT_TRUE(rec.assignments[0].task_id.empty()) << "the robot gets an empty order, not (0, 0)";
+  ASSERT_FALSE(rec.events.empty());
+  const auto& last = rec.events.back();
+  EXPECT_EQ(last.task_id, "park-1");
+  EXPECT_EQ(last.state, msg::TaskState::Failed);
+  EXPECT_THAT(last.reason, HasSubstr("station 'K-3', which is not on this site"));
+  EXPECT_EQ(last.seq, rec.events.front().seq + 1) << "the failure follows the announced state";
+  EXPECT_TRUE(node->dispatcher().openTasks().empty());
+  EXPECT_EQ(node->metricsJson()["bad_orders"], 1);
 }

@@ -90,7 +90,7 @@ TEST(SampleChecks, FreeTextIsRepairedAndCounted) {
   EXPECT_EQ(s.error, "bad \xEF\xBF\xBD\xEF\xBF\xBD byte");
   EXPECT_EQ(counters.repairedCount("TaskStatus"), 1u);
   EXPECT_EQ(counters.total(), 0u);
-  msg::TaskEvent e{"t1", msg::TaskState::Failed, "r1", "\xC0", 0, 1};
+  msg::TaskEvent e{"t1", msg::TaskState::Failed, "r1", "\xC0", 0, 1, ""};
   EXPECT_TRUE(admit(e, counters));
   EXPECT_EQ(e.reason, "\xEF\xBF\xBD");
 }

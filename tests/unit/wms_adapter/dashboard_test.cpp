@@ -291,7 +291,7 @@ TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
   std::thread feeder([this] {
     std::this_thread::sleep_for(std::chrono::milliseconds(400));
     view_.onRobot(robot("r2", 8.0, 2.0, 2));
-    view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1});
+    view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1, ""});
     msg::RiskMap m;
     m.width = 4;
     m.height = 2;

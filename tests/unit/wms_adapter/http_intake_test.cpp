@@ -121,7 +121,7 @@ TEST_F(Intake, OpenEventStreamsDoNotBlockSubmissions) {
   auto r = post(kTask);
   ASSERT_TRUE(r) << "POST /v1/tasks did not answer with event streams open";
   EXPECT_EQ(r->status, 201);
-  view_.onEvent({"t-1", msg::TaskState::Assigned, "r1", "", 1, 1});
+  view_.onEvent({"t-1", msg::TaskState::Assigned, "r1", "", 1, 1, ""});
   EXPECT_THAT(streams.front()->receive("assigned"), HasSubstr("\"state\":\"assigned\""));
   EXPECT_THAT(streams.back()->receive("assigned"), HasSubstr("\"state\":\"assigned\""));
 }

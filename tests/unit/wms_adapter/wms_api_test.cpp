@@ -160,8 +160,8 @@ TEST_F(Api, EventsStreamAndMetrics) {
     });
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  view_.onEvent({"t-5", msg::TaskState::Assigned, "r1", "", 1, 1});
-  view_.onEvent({"t-5", msg::TaskState::Done, "r1", "", 2, 2});
+  view_.onEvent({"t-5", msg::TaskState::Assigned, "r1", "", 1, 1, ""});
+  view_.onEvent({"t-5", msg::TaskState::Done, "r1", "", 2, 2, ""});
   reader.join();
   EXPECT_THAT(received, HasSubstr("event: task"));
   EXPECT_THAT(received, HasSubstr("\"state\":\"assigned\""));
@@ -203,8 +203,8 @@ TEST_F(Api, TextThatIsNotUtf8NeitherStopsTheStreamNorBreaksTheList) {
     });
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  view_.onEvent({"t-7", msg::TaskState::Failed, "r1", "motor \xFF\xFE fault", 1, 1});
-  view_.onEvent({"t-8", msg::TaskState::Done, "r1", "", 2, 1});
+  view_.onEvent({"t-7", msg::TaskState::Failed, "r1", "motor \xFF\xFE fault", 1, 1, ""});
+  view_.onEvent({"t-8", msg::TaskState::Done, "r1", "", 2, 1, ""});
   reader.join();
   EXPECT_THAT(received, HasSubstr("motor \xEF\xBF\xBD\xEF\xBF\xBD fault"));
   auto r = client_->Get("/v1/tasks");
@@ -238,4 +238,35 @@ TEST_F(Api, TaskMissingFromTheViewIsAskedOfTheManager) {
   EXPECT_EQ(c.Get("/v1/tasks/t-404")->status, 404);
   second.stop();
   serving.join();
+}
+
+// A park or charge task may leave its station out: the manager chooses one when it assigns the
+// task. On a site without such a station that could never happen, so the task is refused at once.
+TEST_F(Api, AStationlessParkTaskIsRefusedOnASiteWithoutParking) {
+  start();
+  auto r = post(R"({"id": "park-1", "kind": "park"})");
+  ASSERT_EQ(r->status, 400);
+  const auto body = json::parse(r->body);
+  EXPECT_EQ(body["fields"][0]["path"], "station");
+  EXPECT_EQ(body["fields"][0]["reason"], "no parking station on this site to choose from");
+  EXPECT_TRUE(gateway_.bodies.empty());
+}
+
+// The station the manager chose arrives with the task's events; GET shows it until the task goes
+// back to the queue (where the next robot gets its own choice).
+TEST_F(Api, TheStationTheManagerChoseIsShownWithTheTask) {
+  start();
+  view_.onAccepted("park-2", R"({"id": "park-2", "kind": "park"})", msg::TaskState::Queued, 1);
+  view_.onEvent({"park-2", msg::TaskState::Assigned, "r1",
+                 "allocated to the nearest free parking station K-2", 2, 2, "K-2"});
+  auto r = client_->Get("/v1/tasks/park-2");
+  ASSERT_EQ(r->status, 200);
+  auto body = json::parse(r->body);
+  EXPECT_EQ(body["task"]["station"], "K-2");
+  EXPECT_EQ(body["station"], "K-2");
+  EXPECT_EQ(body["station_chosen"], true);
+  view_.onEvent({"park-2", msg::TaskState::Requeued, "", "robot r1 lost", 3, 3, ""});
+  body = json::parse(client_->Get("/v1/tasks/park-2")->body);
+  EXPECT_FALSE(body.contains("station"));
+  EXPECT_FALSE(body["task"].contains("station"));
 }

@@ -10,6 +10,7 @@
 #include "fleet/core/expected.hpp"
 #include "fleet/fleet/allocator.hpp"
 #include "fleet/fleet/robot_registry.hpp"
+#include "fleet/fleet/station_choice.hpp"
 #include "fleet/fleet/station_map.hpp"
 #include "fleet/fleet/task_store.hpp"
 
@@ -40,6 +41,9 @@ struct DispatcherConfig {
   /// robot released below the threshold would be sent straight back.
   double chargeUntil = 0.9;
   double chargeReach = 0.5;
+  /// A robot within this distance (m) of a station stands on it. A charge or park task without a
+  /// station is given a free one nobody stands on when there is one (StationChooser).
+  double standReach = 0.5;
 };
 
 /// A state change to publish as `TaskEvent`.
@@ -49,6 +53,7 @@ struct TaskEvent {
   std::string robotId;
   std::string reason;
   std::int64_t stampNs = 0;
+  std::string station;  ///< the station the dispatcher chose for the task (TaskRecord::stationChosen)
 };
 
 /// A task a robot must now execute (publish as `TaskAssignment`, key robot_id).
@@ -115,6 +120,9 @@ class Dispatcher {
                                         TaskState state, const std::string& reason, std::int64_t nowNs);
   /// Operator cancel; an active task is withdrawn from its robot.
   Expected<DispatchResult> cancel(const std::string& taskId, const std::string& reason, std::int64_t nowNs);
+  /// Fails an open task for good, whatever its attempts (an internal error: the service cannot
+  /// build the task's order); an active task is withdrawn from its robot. Errors as cancel.
+  Expected<DispatchResult> fail(const std::string& taskId, const std::string& reason, std::int64_t nowNs);
   /// Operator pause / resume (durable): a paused waiting task is not dispatched; an active one is
   /// re-sent to its robot with `paused` set, and the robot stands still with it until resumed.
   /// Errors as cancel (not_found, illegal_transition for a finished task).
@@ -127,7 +135,9 @@ class Dispatcher {
 
   /// Periodic work: expire leases (requeue the lost robots' tasks), complete the charge tasks whose
   /// robot is charged (releasing it), send low robots to charge, and assign waiting tasks to idle
-  /// robots.
+  /// robots. A charge or park task without a station is given the nearest free station of its kind
+  /// for its robot with the assignment (stored with it); while every such station is taken it waits,
+  /// and its reason says so.
   DispatchResult tick(std::int64_t nowNs);
 
   [[nodiscard]] const RobotRegistry& robots() const { return registry_; }
@@ -147,6 +157,15 @@ class Dispatcher {
   void completeCharged(std::int64_t nowNs, DispatchResult& out);
   void chargeLowRobots(std::int64_t nowNs, DispatchResult& out);
   void allocate(std::int64_t nowNs, DispatchResult& out);
+  /// The assignment itself; `chooser` is set when a waiting task needs a station chosen.
+  void assignWaiting(std::vector<Task> waiting, StationChooser* chooser, std::int64_t nowNs,
+                     DispatchResult& out);
+  /// Cancel or fail (`to`) an open task; an active one's robot is revoked.
+  Expected<DispatchResult> close(const std::string& taskId, TaskState to, const std::string& reason,
+                                 std::int64_t nowNs);
+  /// Says in their reason why charge / park tasks without a station still wait (every station of
+  /// their kind taken), and takes it back once one is free again.
+  void noteStationWaits(const StationChooser& chooser, std::int64_t nowNs, DispatchResult& out);
   /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig).
   void admitByStationCapacity(std::vector<Task>& waiting) const;
 

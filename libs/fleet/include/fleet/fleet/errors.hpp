@@ -11,5 +11,7 @@ inline constexpr const char* kConflict = "conflict";
 inline constexpr const char* kIllegalTransition = "illegal_transition";
 inline constexpr const char* kStorage = "storage";
 inline constexpr const char* kWrongRobot = "wrong_robot";
+/// A fault of the service itself, not of the request (an order that cannot be built).
+inline constexpr const char* kInternal = "internal";
 
 }  // namespace fleet::errc

@@ -33,6 +33,8 @@ class SqliteTaskStore final : public TaskStore {
   Expected<TaskRecord> transition(const TransitionRequest& r) override;
   std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) override;
   Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) override;
+  Expected<TaskRecord> setWaitReason(std::string_view id, std::string_view reason,
+                                     std::int64_t stampNs) override;
   Expected<TaskRecord> get(std::string_view id) override;
   Expected<std::vector<TaskRecord>> list(std::optional<TaskState> state, std::size_t limit,
                                          std::string_view afterId = {}) override;

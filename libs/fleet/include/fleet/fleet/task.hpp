@@ -19,7 +19,8 @@ inline constexpr std::int32_t kMaxPriority = 1000;
 inline constexpr std::int64_t kMaxHandlingNs = 3600LL * 1'000'000'000LL;
 
 /// A unit of work. Transport: pickup → dropoff. Goto: drive to `station`. Charge / park: go to
-/// `station`, or when it is empty to the charging / parking station the dispatcher picks.
+/// `station`, or when it is empty to the charging / parking station the dispatcher picks when it
+/// assigns the task (the nearest free one for that robot; the store keeps the choice).
 struct Task {
   std::string id;
   TaskKind kind = TaskKind::Transport;
@@ -52,7 +53,8 @@ struct ValidationError {
 };
 
 /// Semantic checks on a task (ids, which fields each kind allows, ranges, and — when `stations` is
-/// given — that every station exists and serves the purpose). Paths are prefixed with `prefix`.
+/// given — that every station exists and serves the purpose, and that a charge / park task without
+/// a station has a station of its kind to be given). Paths are prefixed with `prefix`.
 std::vector<FieldError> validateTask(const Task& t, const StationMap* stations = nullptr,
                                      std::string_view prefix = "");
 

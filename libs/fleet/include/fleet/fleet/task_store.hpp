@@ -25,6 +25,10 @@ struct TaskRecord {
   /// Held by an operator: a waiting task is not dispatched, an active one's robot stands still
   /// with it. Not a state: the task keeps its state and transitions while paused.
   bool paused = false;
+  /// `task.station` was chosen by the dispatcher when it assigned the task (a charge or park task
+  /// submitted without one). Kept while the task is active and after it ended; cleared when the
+  /// task goes back to the queue, as its next robot gets its own choice.
+  bool stationChosen = false;
 };
 
 /// One row of the append-only transition log. `from` is empty for the submission itself.
@@ -39,7 +43,8 @@ struct TransitionRecord {
 };
 
 /// `{"task": {…toJson(task)…, "created_ns": …}, "state": "en_route", "robot": "r1", "attempts": 1,
-/// "reason": "…", "updated_ns": …, "revision": 3}` — the body of `GET /v1/tasks/{id}`.
+/// "reason": "…", "updated_ns": …, "revision": 3, "paused": false}` — the body of
+/// `GET /v1/tasks/{id}`; `"station_chosen": true` is added when the dispatcher chose task.station.
 nlohmann::json toJson(const TaskRecord& r);
 /// `{"seq": …, "task_id": …, "from": "queued" | null, "to": …, "robot": …, "reason": …, "stamp_ns": …}`
 nlohmann::json toJson(const TransitionRecord& t);
@@ -58,6 +63,10 @@ struct TransitionRequest {
   std::string robotId;
   std::string reason;
   std::int64_t stampNs = 0;
+  /// `assigned` only: the station the dispatcher chose for a charge or park task submitted without
+  /// one, stored with the assignment in the same commit. Error "invalid" for another kind of task
+  /// or one that names its station.
+  std::string station;
 };
 
 /// Durable tasks: a current-state table and an append-only transition log. Every call that
@@ -81,7 +90,7 @@ class TaskStore {
   Expected<TaskRecord> transition(std::string_view taskId, TaskState to, std::string_view robotId,
                                   std::string_view reason, std::int64_t stampNs) {
     return transition(
-        TransitionRequest{std::string(taskId), to, std::string(robotId), std::string(reason), stampNs});
+        TransitionRequest{std::string(taskId), to, std::string(robotId), std::string(reason), stampNs, {}});
   }
   /// Several transitions in one commit; each is checked against the state left by the ones before.
   virtual std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) = 0;
@@ -89,6 +98,10 @@ class TaskStore {
   /// Sets the task's `paused` flag durably (not a transition: the log is unchanged). Errors:
   /// not_found; illegal_transition for a task already done, failed or cancelled.
   virtual Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) = 0;
+  /// Sets the reason of a waiting task (why it still waits) durably, without a transition.
+  /// Errors: not_found; illegal_transition for a task that is not queued or requeued.
+  virtual Expected<TaskRecord> setWaitReason(std::string_view id, std::string_view reason,
+                                             std::int64_t stampNs) = 0;
 
   virtual Expected<TaskRecord> get(std::string_view id) = 0;
   /// Tasks in `state` (all when empty) ordered by id, at most `limit`, with ids after `afterId`.

@@ -68,6 +68,7 @@ struct TaskEvent {
   std::string reason;
   std::int64_t stamp_ns = 0;
   std::uint32_t seq = 0;
+  std::string station;  ///< chosen by the manager for a charge/park task sent without one
   bool operator==(const TaskEvent&) const = default;
 };
 
