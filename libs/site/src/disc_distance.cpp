@@ -75,7 +75,7 @@ Expected<DiscDistance::Snapped> DiscDistance::snap(Vec2 p, const char* what) con
         continue;
       }
       const double d = (grid_->cellCenter(c) - p).norm();
-      if (d <= kSnapM && (!best || d < best->stub)) {
+      if (d <= kSnapM && (!best || d < best->leg)) {
         best = Snapped{c, d};
       }
     }
@@ -105,7 +105,7 @@ const DiscDistance::Field& DiscDistance::field(Vec2 goal, const Snapped& at) {
   }
   auto f = std::make_unique<Field>();
   f->goal = goal;
-  f->root = at.stub == 0.0 ? goal : grid_->cellCenter(at.cell);
+  f->root = at.leg == 0.0 ? goal : grid_->cellCenter(at.cell);
   const std::size_t n = grid_->size();
   const double inf = std::numeric_limits<double>::infinity();
   f->g.assign(n, inf);
@@ -182,8 +182,8 @@ Expected<double> DiscDistance::length(Vec2 from, Vec2 to) {
     return unexpected("unreachable", std::string("no way for a disc of radius ") + r + " m from " +
                                          where(from) + " to " + where(to));
   }
-  if (a->stub > 0.0) {
-    return a->stub + f.g[at] + b->stub;
+  if (a->leg > 0.0) {
+    return a->leg + f.g[at] + b->leg;
   }
   // From the point itself: straight to where its cell's way heads when that is in sight.
   const Vec2 pp = parentPoint(f, f.parent[at]);
@@ -191,7 +191,7 @@ Expected<double> DiscDistance::length(Vec2 from, Vec2 to) {
   const double direct = planning::segmentFree(*grid_, from, pp)
                             ? gp + (pp - from).norm()
                             : f.g[at] + (grid_->cellCenter(a->cell) - from).norm();
-  return direct + b->stub;
+  return direct + b->leg;
 }
 
 }  // namespace fleet::site

@@ -35,7 +35,7 @@ class DiscDistance {
   /// Length [m] of the shortest way for the disc from `from` to `to`; calls toward one goal share
   /// its field, so ask them together. A point whose refined cell the disc does not fit on (a robot
   /// pressed against a shelf, a station on a cell edge) joins the nearest free cell within `kSnapM`
-  /// by a straight stub. Errors: "off_map" (a point outside the map or not finite), "no_room" (the
+  /// by a straight leg. Errors: "off_map" (a point outside the map or not finite), "no_room" (the
   /// disc fits nowhere within kSnapM of a point), "unreachable" (the disc cannot get from one to
   /// the other).
   [[nodiscard]] Expected<double> length(Vec2 from, Vec2 to);
@@ -48,7 +48,7 @@ class DiscDistance {
  private:
   struct Snapped {
     planning::Cell cell;
-    double stub = 0.0;  ///< straight distance from the point to the cell centre (0: its own cell)
+    double leg = 0.0;  ///< straight distance from the point to the cell centre (0: its own cell)
   };
   /// Distances to one goal point: per cell, the length to it and the cell whose centre the way
   /// first heads for (kRoot: the goal point itself).
