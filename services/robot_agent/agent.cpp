@@ -240,7 +240,12 @@ control::Twist Agent::planLocal(bool& blocked) {
 }
 
 GateView Agent::gateView() const {
-  return {localizer_.perception(), others_, *raw_, {v_, w_}, docking_};
+  return {localizer_.perception(),
+          others_,
+          *raw_,
+          {v_, w_},
+          docking_,
+          gateRoute_.empty() ? nullptr : &gateRoute_};
 }
 
 double Agent::clearSpeed(double v, Blocker& blocker) {

@@ -287,11 +287,13 @@ class Agent {
 
   // Reserved traffic.
   bool reserved_ = false;
-  ReleaseTracker releases_;                           // what may be driven, the last node reached
-  std::uint64_t followedRevision_ = 0;                // the release the follower's path was built from
-  std::vector<Vec2> basePath_;                        // ... that path (from where the robot was then)
-  bool baseAhead_ = false;                            // driving along the base this cycle (progress watch)
-  bool dockingLeg_ = false;                           // on the base's last leg onto the goal
+  ReleaseTracker releases_;             // what may be driven, the last node reached
+  std::uint64_t followedRevision_ = 0;  // the release the follower's path was built from
+  std::vector<Vec2> basePath_;          // ... that path (from where the robot was then)
+  std::vector<Vec2>
+      gateRoute_;            // the base ahead, for the gate's stop rule (empty: reactive, straight corridor)
+  bool baseAhead_ = false;   // driving along the base this cycle (progress watch)
+  bool dockingLeg_ = false;  // on the base's last leg onto the goal
   std::int64_t heldSinceNs_ = -1;                     // the gate has held the robot since (a person, ...)
   Vec2 heldAt_;                                       // ... here
   bool blocked_ = false;                              // ... for more than a second

@@ -57,6 +57,10 @@ constexpr double kCornerApproach = 0.8;
 /// ... until it is this close [m] (then it turns to the next leg).
 constexpr double kOnCorner = 0.05;
 
+/// The gate's stop rule looks this far along the base [m] (more than the stopping distance plus
+/// the gap at cruise).
+constexpr double kGateRoute = 3.0;
+
 /// The stretch of the polyline `pts` from arc length `from` on, `length` long.
 std::vector<Vec2> stretch(const std::vector<Vec2>& pts, double from, double length) {
   std::vector<Vec2> out;
@@ -266,6 +270,12 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     v = cap;
   }
   mode = msg::RobotMode::Moving;
+  // The gate keeps its gap along the base, which the roadmap keeps clear of shelves (see GateView).
+  gateRoute_ = stretch(basePath_, r->progress, kGateRoute);
+  struct Forget {
+    std::vector<Vec2>& route;
+    ~Forget() { route.clear(); }
+  } forget{gateRoute_};
   Blocker blocker;
   const double wanted = v;
   bool held = heldUp(v, w, blocker) && wanted > (planning ? 0.02 : 0.1);

@@ -7,6 +7,22 @@
 #include "map_faces.hpp"
 
 namespace fleet::agent {
+namespace {
+
+/// Distance from `p` to the polyline `route`.
+double distanceToRoute(const std::vector<Vec2>& route, Vec2 p) {
+  double best = route.empty() ? std::numeric_limits<double>::infinity() : distance(route.front(), p);
+  for (std::size_t i = 0; i + 1 < route.size(); ++i) {
+    const Vec2 a = route[i];
+    const Vec2 ab = route[i + 1] - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 1e-18 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, distance(a + ab * t, p));
+  }
+  return best;
+}
+
+}  // namespace
 
 MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blocker& blocker) const {
   Clearance c;
@@ -50,12 +66,17 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
       }
     }
   }
-  // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed.
+  // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed
+  // (with a route: the corridor along the route, the gap measured straight to the point).
+  const double corridor = p_.radius + 0.05;
   for (const auto& ray : view.seen.scan) {
     const double ahead = ray.local.x;
-    if (ahead > 0.0 && std::abs(ray.local.y) < p_.radius + 0.05) {
+    const bool straight = std::abs(ray.local.y) < corridor;
+    const bool counts =
+        ahead > 0.0 && (view.route ? distanceToRoute(*view.route, ray.map) < corridor : straight);
+    if (counts) {
       const double before = allowed;
-      limit(ahead - p_.radius, staticGap);
+      limit((straight ? ahead : ray.local.norm()) - p_.radius, staticGap);
       if (allowed < before) {
         c.blockPoint = ray.map;
       }

@@ -36,6 +36,12 @@ struct GateView {
   const planning::OccupancyGrid& map;     ///< the raw map (its obstacle faces near the robot)
   control::Twist current;                 ///< the command of the previous cycle
   bool docking = false;                   ///< on the final approach to a goal: static points may come closer
+  /// The route the robot follows from where it is (map frame; null: none). With one, the stop
+  /// rule keeps its gap to static points on the route, not in the straight corridor ahead: a
+  /// roadmap route passes a shelf corner 0.1 m clear of the disc while the corner is still in the
+  /// straight corridor (the robot heading past it), which held a robot for good at its first
+  /// release. What really sweeps past the corner is left to the cross-traffic check.
+  const std::vector<Vec2>* route = nullptr;
 };
 
 /// What holds the robot up: a robot (its id, or "robot" when it cannot be named), "human", or

@@ -82,6 +82,32 @@ TEST(MotionGate, APointAheadLimitsTheSpeedToKeepTheGap) {
   EXPECT_NEAR(gate.clearSpeed({close, others, emptyMap(), {}, true}, 0.8, b).speed, 0.07, 1e-12);
 }
 
+TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
+  const MotionGate gate(params());
+  const std::vector<OtherRobot> others;
+  // The route bends right after 0.3 m. A shelf corner 0.67 m ahead and 0.2 m left is in the
+  // straight corridor but 0.42 m from the route; a point 0.55 m ahead and 0.5 m right is outside
+  // the straight corridor but on the route.
+  const std::vector<Vec2> route{{2.0, 2.0}, {2.3, 2.0}, {2.6, 1.4}};
+  const Perception corner = perception({{0.67, 0.2}});
+  Blocker b;
+  EXPECT_NEAR(gate.clearSpeed({corner, others, emptyMap(), {}, false}, 0.8, b).speed, 0.02, 1e-9)
+      << "straight corridor: held by the corner";
+  EXPECT_EQ(gate.clearSpeed({corner, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8)
+      << "the route passes clear of the corner";
+  const Perception onRoute = perception({{0.55, -0.5}});
+  EXPECT_EQ(gate.clearSpeed({onRoute, others, emptyMap(), {}, false}, 0.8, b).speed, 0.8);
+  EXPECT_NEAR(gate.clearSpeed({onRoute, others, emptyMap(), {}, false, &route}, 0.8, b).speed,
+              std::hypot(0.55, 0.5) - 0.3 - 0.35, 1e-9)
+      << "on the route: the gap straight to the point";
+  // Behind the robot, the route's start does not count; and a straight-ahead point on the route
+  // still keeps the straight gap.
+  const Perception both = perception({{-0.2, 0.0}, {0.5, 0.0}});
+  EXPECT_NEAR(gate.clearSpeed({both, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.0, 1e-12);
+  const Perception behind = perception({{-0.2, 0.0}});
+  EXPECT_EQ(gate.clearSpeed({behind, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8);
+}
+
 TEST(MotionGate, ARobotInTheWayIsNamedByTheNearestKnownRobot) {
   const MotionGate gate(params());
   const Perception seen = perception({}, {{SeenKind::kRobot, {0.8, 0.1}, 0.3, {}}});
