@@ -4,6 +4,7 @@
 
 #include "fleet/vda5050/header.hpp"
 #include "fleet/vda5050/instant_actions.hpp"
+#include "fleet/vda5050/order_rejection.hpp"
 
 namespace fleet::vdabridge {
 
@@ -59,8 +60,11 @@ void BridgeNode::instant(Vehicle& v, const std::string& type, std::int64_t nowNs
        vda5050::toJson(ia).dump(), 0, false});
 }
 
-void BridgeNode::sendOrder(Vehicle& v, const vda5050::Order& o, BridgeOutbox& out) {
+void BridgeNode::sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out) {
   registry_.ordered(v.entry.robot_id, o);
+  v.awaiting = true;
+  v.sent_update = o.orderUpdateId;
+  v.sent_ns = nowNs;
   out.mqtt.push_back(
       {vda5050::topicName(settings_.interface_name, v.entry.manufacturer, v.entry.serial, "order"),
        vda5050::toJson(o).dump(), 0, false});
@@ -83,6 +87,7 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     }
     v.task_id = a.task_id;
     v.goal = 0;
+    freshChance(v);
     v.reported = msg::TaskState::Queued;
   }
   v.revision = a.revision;
@@ -96,9 +101,97 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
 
 void BridgeNode::onRelease(const msg::TrafficRelease& r) {
   auto it = vehicles_.find(r.robot_id);
-  if (it != vehicles_.end()) {
-    it->second.release = r;
+  if (it == vehicles_.end()) {
+    return;
   }
+  auto& v = it->second;
+  if (!v.release || v.release->base != r.base) {
+    freshChance(v);
+  }
+  v.release = r;
+  // Consecutive nodes of a release are joined by a roadmap edge in that direction: enough to start
+  // an order at the vehicle's last node before the traffic manager's roadmap has arrived.
+  const msg::RouteNode* prev = nullptr;
+  for (const auto* part : {&r.base, &r.horizon}) {
+    for (const auto& n : *part) {
+      roadmap_.addNode({n.node, n.x, n.y});
+      if (prev != nullptr) {
+        roadmap_.addEdge(prev->node, n.node);
+      }
+      prev = &n;
+    }
+  }
+}
+
+void BridgeNode::onRoadmap(const msg::Roadmap& m) {
+  roadmap_.clear();
+  for (const auto& n : m.nodes) {
+    roadmap_.addNode({n.node, n.x, n.y});
+  }
+  for (const auto& e : m.edges) {
+    if (e.open) {
+      roadmap_.addEdge(e.from, e.to);
+    }
+  }
+}
+
+void BridgeNode::freshChance(Vehicle& v) {
+  // Something changed that may let an order through: what the vehicle refused before does not count.
+  if (v.gave_up) {
+    v.gave_up = false;
+    v.failures = 0;
+    v.retry_ns = 0;
+  }
+}
+
+void BridgeNode::orderFailed(Vehicle& v, const std::string& why, std::int64_t nowNs, BridgeOutbox& out) {
+  ++v.failures;
+  if (v.failures > settings_.order_retries) {
+    v.gave_up = true;
+    ++counters_.gave_up;
+    out.warnings.push_back(v.entry.robot_id + ": no order taken after " + std::to_string(v.failures) +
+                           " attempts (last: " + why +
+                           "); reported blocked to the traffic manager until its release or task changes");
+    return;
+  }
+  const double wait = settings_.retry_backoff_s * static_cast<double>(1 << std::min(v.failures - 1, 20));
+  v.retry_ns = nowNs + static_cast<std::int64_t>(wait * 1e9);
+}
+
+void BridgeNode::watchOrder(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out) {
+  if (!v.has_order) {
+    v.awaiting = false;  // cancelled: what was in flight does not matter any more
+  }
+  if (!v.awaiting) {
+    return;
+  }
+  const auto& id = v.builder.orderId();
+  if (s.orderId == id && s.orderUpdateId >= v.sent_update) {
+    v.awaiting = false;
+    v.failures = 0;
+    return;
+  }
+  std::string why;
+  if (const auto r = vda5050::findOrderRejection(s, id, v.sent_update)) {
+    why = r->errorType + ": " + r->description;
+  } else if (static_cast<double>(nowNs - v.sent_ns) * 1e-9 > settings_.order_ack_timeout_s) {
+    why = "neither taken nor rejected in " + std::to_string(static_cast<int>(settings_.order_ack_timeout_s)) +
+          " s";
+  } else {
+    return;
+  }
+  v.awaiting = false;
+  ++counters_.rejected;
+  const bool update = s.orderId == id && v.builder.rollbackTo(s.orderUpdateId);
+  out.warnings.push_back(
+      v.entry.robot_id + ": order " + id + " update " + std::to_string(v.sent_update) + " rejected (" + why +
+      "); " +
+      (update ? "the next update starts at the base end of update " + std::to_string(s.orderUpdateId)
+              : std::string("a new order starts from its latest state")));
+  if (!update) {
+    v.has_order = false;  // the next order is a new one, built from where the vehicle then is
+  }
+  orderFailed(v, why, nowNs, out);
 }
 
 void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
@@ -124,7 +217,8 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
 
 void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
                                BridgeOutbox& out) {
-  if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline) {
+  if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline || v.gave_up ||
+      nowNs < v.retry_ns) {
     return;
   }
   const auto& r = *v.release;
@@ -157,13 +251,14 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
       }
       return;
     }
-    // A new order starts where the vehicle stands: drop the release's nodes it has passed.
-    const int at = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
-    const auto here =
-        std::find_if(in.base.begin(), in.base.end(), [&](const auto& n) { return n.node == at; });
-    if (here != in.base.end()) {
-      in.base.erase(in.base.begin(), here);
+    // A new order starts where the vehicle stands, or the vehicle rejects it (noRouteError).
+    auto from = vda5050::startAtVehicle(in, s.lastNodeId, roadmap_);
+    if (!from) {
+      out.warnings.push_back(v.entry.robot_id + ": no new order: " + from.error().message);
+      orderFailed(v, from.error().message, nowNs, out);
+      return;
     }
+    in = std::move(*from);
     if (in.base.size() < 2 && in.actions.empty()) {
       return;  // holding on the node it stands on: nothing to drive
     }
@@ -176,7 +271,7 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
     }
     v.has_order = true;
     v.cancel_sent = false;
-    sendOrder(v, *o, out);
+    sendOrder(v, *o, nowNs, out);
     return;
   }
   if (s.orderId != v.builder.orderId()) {
@@ -200,7 +295,7 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
     return;
   }
   if (up->has_value()) {
-    sendOrder(v, **up, out);
+    sendOrder(v, **up, nowNs, out);
   }
 }
 
@@ -247,6 +342,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     const auto& s = *view->state;
     const bool online = view->health == VehicleHealth::kOnline;
     if (online) {
+      watchOrder(v, s, nowNs, out);
       trackGoals(v, *view);
       followRelease(v, *view, nowNs, out);
       reportTask(v, nowNs, out);
@@ -292,7 +388,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       p.goal = *v.home;
     }
     p.holding = !online || acting || s.paused.value_or(false);
-    p.blocked = s.safetyState.fieldViolation;
+    p.blocked = s.safetyState.fieldViolation || v.gave_up;
     p.follows = online;
     p.stamp_ns = nowNs;
     out.progress.push_back(std::move(p));

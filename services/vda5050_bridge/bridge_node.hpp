@@ -12,6 +12,13 @@
 //    vehicle stands on the goal's node with nothing left of its order.
 //  - Idle: without a task the vehicle's goal is where it was first seen (its parking place), so the
 //    traffic manager takes it home and out of the way, as robot agents return home.
+//  - New orders start where the vehicle's latest state says it is (vda5050::startAtVehicle): at its
+//    last node, put in front of the release when the release begins at a neighbour of it.
+//  - Rejections (vda5050::findOrderRejection): an order or update the vehicle rejects, or does not
+//    take within order_ack_timeout_s, is logged with the vehicle's reason and built again from its
+//    latest state (a new order from its last node; an update from the base end of the update it
+//    has), after a back-off that doubles. After order_retries failed retries the robot is reported
+//    blocked to the traffic manager until a changed release or task gives it a new chance.
 //  - Health (vda5050::VehicleRegistry): a vehicle that is not online (MANUAL, a FATAL error, a
 //    message that fails the checks, its last will) publishes no RobotState, so the fleet manager
 //    loses it and re-queues its task as for our robots, and its TrafficProgress says it does not
@@ -25,6 +32,7 @@
 
 #include "fleet/messages/messages.hpp"
 #include "fleet/vda5050/order_builder.hpp"
+#include "fleet/vda5050/order_start.hpp"
 #include "fleet/vda5050/vehicle_registry.hpp"
 
 namespace fleet::vdabridge {
@@ -34,6 +42,9 @@ struct BridgeSettings {
   std::string map_id;
   std::vector<vda5050::VehicleEntry> vehicles;
   double allowed_deviation = 0.2;  // m, the orders' allowedDeviationXY
+  int order_retries = 3;           // re-sends of an order the vehicle rejected before it is reported blocked
+  double retry_backoff_s = 1.0;    // wait before the first re-send; doubles with each
+  double order_ack_timeout_s = 10.0;  // an order neither taken nor rejected by then counts as rejected
 };
 
 struct MqttMessage {
@@ -57,6 +68,8 @@ struct BridgeCounters {
   std::uint64_t cancels = 0;
   std::uint64_t refused_messages = 0;
   std::uint64_t cannot_stitch = 0;
+  std::uint64_t rejected = 0;  // orders and updates the vehicle rejected or did not take
+  std::uint64_t gave_up = 0;   // times a vehicle was reported blocked after its retries
 };
 
 class BridgeNode {
@@ -66,6 +79,8 @@ class BridgeNode {
   void onMqtt(const std::string& topic, const std::string& payload, BridgeOutbox& out);
   void onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, BridgeOutbox& out);
   void onRelease(const msg::TrafficRelease& r);
+  /// The traffic manager's roadmap: where a new order may put the vehicle's last node in front.
+  void onRoadmap(const msg::Roadmap& m);
   /// Orders for new releases, RobotState and TrafficProgress of every vehicle, task progress.
   void tick(std::int64_t nowNs, BridgeOutbox& out);
 
@@ -90,9 +105,19 @@ class BridgeNode {
     bool cancel_sent = false;
     std::uint32_t instant_header = 0;
     std::optional<Pose2> home;  // where it was first seen: it parks there when it has no task
+    // The order or update last sent, until the vehicle's state shows it taken or rejected.
+    bool awaiting = false;
+    std::uint32_t sent_update = 0;
+    std::int64_t sent_ns = 0;
+    int failures = 0;  // orders in a row it rejected (or none could be built)
+    std::int64_t retry_ns = 0;
+    bool gave_up = false;  // retries spent: reported blocked
   };
 
-  void sendOrder(Vehicle& v, const vda5050::Order& o, BridgeOutbox& out);
+  void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);
+  void watchOrder(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
+  void orderFailed(Vehicle& v, const std::string& why, std::int64_t nowNs, BridgeOutbox& out);
+  void freshChance(Vehicle& v);
   void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out);
   void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
   void trackGoals(Vehicle& v, const vda5050::VehicleView& view);
@@ -102,6 +127,7 @@ class BridgeNode {
   BridgeSettings settings_;
   vda5050::VehicleRegistry registry_;
   std::map<std::string, Vehicle> vehicles_;  // by robot id
+  vda5050::KnownRoadmap roadmap_;
   BridgeCounters counters_;
 };
 

@@ -1,5 +1,5 @@
 // vda5050_bridge: puts VDA 5050 vehicles under the fleet manager and the traffic manager. Reads
-// TaskAssignment and TrafficRelease (DDS) and the vehicles' state, connection and factsheet (MQTT);
+// TaskAssignment, TrafficRelease and Roadmap (DDS) and the vehicles' state, connection and factsheet (MQTT);
 // writes orders and instant actions (MQTT) and RobotState, TrafficProgress, TaskStatus (DDS).
 // See docs/operator-guide.md#vda-5050-vehicles for the configuration.
 
@@ -87,6 +87,7 @@ int run(const Settings& settings) {
   transport::Participant p;
   transport::Reader<msg::TaskAssignment> assignments(p);
   transport::Reader<msg::TrafficRelease> releases(p);
+  transport::Reader<msg::Roadmap> roadmaps(p);
   transport::Writer<msg::RobotState> states(p);
   transport::Writer<msg::TaskStatus> statuses(p);
   transport::Writer<msg::TrafficProgress> progress(p);
@@ -114,6 +115,9 @@ int run(const Settings& settings) {
     }
     for (const auto& a : assignments.take()) {
       node.onAssignment(a, now, out);
+    }
+    for (const auto& m : roadmaps.take()) {
+      node.onRoadmap(m);
     }
     for (const auto& r : releases.take()) {
       node.onRelease(r);
@@ -147,8 +151,9 @@ int run(const Settings& settings) {
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
       const auto& c = node.counters();
       spdlog::info(
-          "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched",
-          c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch);
+          "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched, "
+          "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries",
+          c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up);
       lastStats = std::chrono::steady_clock::now();
     }
   };

@@ -73,7 +73,20 @@ Expected<Order> OrderBuilder::start(const std::string& order_id, const ReleaseIn
     nodes.push_back(makeNode(n, seq, false, release));
     seq += 2;
   }
+  sent_ = {{update_id_, base_.size(), sent_actions_.size()}};
   return assemble(std::move(nodes), stamp_ns);
+}
+
+bool OrderBuilder::rollbackTo(std::uint32_t update_id) {
+  const auto it =
+      std::find_if(sent_.begin(), sent_.end(), [&](const Sent& s) { return s.update_id == update_id; });
+  if (it == sent_.end()) {
+    return false;
+  }
+  base_.resize(it->base_size);
+  sent_actions_.resize(it->actions_size);
+  sent_.erase(it + 1, sent_.end());
+  return true;
 }
 
 Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
@@ -90,30 +103,42 @@ Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
                                                   ", beyond the base sent");
   }
   const auto sent = static_cast<std::size_t>(base_.end() - from);
-  // The release starts at the node last reported to the traffic layer, which may lag behind the
-  // vehicle: find the sent base (from the vehicle's last node on) inside the release's base.
+  // The release starts at the node last reported to the traffic layer. That node usually lags
+  // behind the vehicle: the release passes the vehicle's last node (at k). It can be ahead of it
+  // too, at a later node of the sent base (at j): a new order that began at the vehicle's last node
+  // put in front of the release (startAtVehicle) runs through the release's first node.
+  const auto sentNode = [&](std::size_t i) { return from[static_cast<std::ptrdiff_t>(i)]; };
   const int first = roadmapNode(from->nodeId);
   std::size_t k = 0;
   while (k < release.base.size() && release.base[k].node != first) {
     ++k;
   }
+  std::size_t j = 0;
   if (k == release.base.size()) {
-    return unexpected("vda5050.cannot_stitch", "release for '" + options_.serial + "' does not pass node " +
-                                                   from->nodeId +
-                                                   " where the vehicle is: cancel and start a new order");
+    k = 0;
+    j = 1;
+    while (j < sent && roadmapNode(sentNode(j).nodeId) != release.base.front().node) {
+      ++j;
+    }
+    if (j == sent) {
+      return unexpected("vda5050.cannot_stitch", "release for '" + options_.serial + "' does not pass node " +
+                                                     from->nodeId +
+                                                     " where the vehicle is: cancel and start a new order");
+    }
   }
-  if (release.base.size() - k < sent) {
+  const std::size_t overlap = sent - j;  // the sent nodes the release must repeat
+  if (release.base.size() - k < overlap) {
     return std::optional<Order>{};  // the release is behind what was sent: nothing new
   }
-  for (std::size_t i = 0; i < sent; ++i) {
-    if (release.base[k + i].node != roadmapNode(from[static_cast<std::ptrdiff_t>(i)].nodeId)) {
+  for (std::size_t i = 0; i < overlap; ++i) {
+    if (release.base[k + i].node != roadmapNode(sentNode(j + i).nodeId)) {
       return unexpected("vda5050.cannot_stitch",
                         "release for '" + options_.serial + "' leaves the sent base at node " +
-                            from[static_cast<std::ptrdiff_t>(i)].nodeId + " (release has n" +
+                            sentNode(j + i).nodeId + " (release has n" +
                             std::to_string(release.base[k + i].node) + "): cancel and start a new order");
     }
   }
-  if (release.base.size() - k == sent) {
+  if (release.base.size() - k == overlap) {
     return std::optional<Order>{};  // the base did not grow; a horizon change alone is not worth an update
   }
   ++update_id_;
@@ -122,7 +147,7 @@ Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
   stitch.actions.clear();  // sent already with the node
   nodes.push_back(stitch);
   std::uint32_t seq = stitch.sequenceId + 2;
-  for (std::size_t i = k + sent; i < release.base.size(); ++i) {
+  for (std::size_t i = k + overlap; i < release.base.size(); ++i) {
     nodes.push_back(makeNode(release.base[i], seq, true, release));
     base_.push_back(nodes.back());
     seq += 2;
@@ -131,6 +156,7 @@ Expected<std::optional<Order>> OrderBuilder::extend(const ReleaseInput& release,
     nodes.push_back(makeNode(n, seq, false, release));
     seq += 2;
   }
+  sent_.push_back({update_id_, base_.size(), sent_actions_.size()});
   return std::optional<Order>(assemble(std::move(nodes), stamp_ns));
 }
 

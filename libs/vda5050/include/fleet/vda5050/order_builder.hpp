@@ -50,6 +50,12 @@ class OrderBuilder {
   Expected<std::optional<Order>> extend(const ReleaseInput& release, std::uint32_t last_sequence_id,
                                         std::int64_t stamp_ns);
 
+  /// The vehicle rejected the updates after `update_id` (it drives on with that one): forget what
+  /// they added, so that the next extend starts again at that update's base end. orderUpdateIds
+  /// keep counting up, so the next update cannot be taken for one the vehicle rejected. False
+  /// when `update_id` was not sent in this order.
+  bool rollbackTo(std::uint32_t update_id);
+
   [[nodiscard]] const std::string& orderId() const { return order_id_; }
   [[nodiscard]] std::uint32_t orderUpdateId() const { return update_id_; }
   /// The roadmap node of an order nodeId ("n12" -> 12), or -1 when it is not one of ours.
@@ -65,6 +71,12 @@ class OrderBuilder {
   std::uint32_t header_id_ = 0;
   std::vector<Node> base_;                 // every base node sent in this order, in sequence
   std::vector<std::string> sent_actions_;  // action ids sent in this order (each goes once)
+  struct Sent {
+    std::uint32_t update_id;
+    std::size_t base_size;
+    std::size_t actions_size;
+  };
+  std::vector<Sent> sent_;  // what base_ and sent_actions_ held after each update sent
 };
 
 }  // namespace fleet::vda5050

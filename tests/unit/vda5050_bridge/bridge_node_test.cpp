@@ -1,0 +1,288 @@
+// The bridge's order handling against the simulated VDA 5050 vehicle, which takes or rejects
+// orders by the specification's rules: where new orders start, and what happens when the vehicle
+// says no.
+
+#include "bridge_node.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "fleet/vda5050/instant_actions.hpp"
+#include "vehicle_rig.hpp"
+
+namespace fleet::vdabridge {
+namespace {
+
+const std::string kTopic = "uagv/v2/fleet-sim/AGV-1/";
+
+BridgeSettings settings() {
+  return {"uagv", "small", {{"fleet-sim", "AGV-1", "r1"}}, 0.2};
+}
+
+/// Roadmap nodes 0..9 at (k, 0), joined both ways.
+msg::Roadmap lineRoadmap() {
+  msg::Roadmap m;
+  for (int k = 0; k < 10; ++k) {
+    m.nodes.push_back({k, static_cast<double>(k), 0.0});
+    if (k > 0) {
+      m.edges.push_back({k - 1, k, 1.0F, true});
+      m.edges.push_back({k, k - 1, 1.0F, true});
+    }
+  }
+  return m;
+}
+
+msg::TrafficRelease release(std::vector<int> base, std::vector<int> horizon = {}) {
+  msg::TrafficRelease r;
+  r.robot_id = "r1";
+  r.epoch = 1;
+  for (int k : base) {
+    r.base.push_back({k, static_cast<double>(k), 0.0});
+  }
+  for (int k : horizon) {
+    r.horizon.push_back({k, static_cast<double>(k), 0.0});
+  }
+  return r;
+}
+
+/// The bridge and one simulated vehicle, the vehicle stepped at 10 Hz and the bridge cycling after
+/// each step with the vehicle's latest state, its orders and instant actions carried to the vehicle.
+struct Loop {
+  BridgeNode bridge;
+  sim::test::Rig rig;  // "fleet-sim"/"AGV-1" on map "small", at (0, 0) facing +x
+  std::int64_t now = 0;
+  bool deliver = true;  // false: orders are lost on the way
+  std::vector<vda5050::Order> orders;
+  std::vector<std::string> instants;
+  std::vector<std::string> warnings;
+  msg::TrafficProgress progress;
+
+  explicit Loop(BridgeSettings s = settings()) : bridge(std::move(s)) {
+    bridge.onRoadmap(lineRoadmap());
+    cycle();
+  }
+
+  void cycle() {
+    BridgeOutbox out;
+    bridge.onMqtt(kTopic + "state", vda5050::toJson(rig.vehicle.takeState(rig.t, now)).dump(), out);
+    bridge.tick(now, out);
+    for (const auto& m : out.mqtt) {
+      if (m.topic == kTopic + "order") {
+        auto o = vda5050::parseOrder(m.payload);
+        ASSERT_TRUE(o) << o.error().message;
+        orders.push_back(*o);
+        if (deliver) {
+          (void)rig.vehicle.onOrder(*o);
+        }
+      } else if (m.topic == kTopic + "instantActions") {
+        auto ia = vda5050::parseInstantActions(m.payload);
+        ASSERT_TRUE(ia) << ia.error().message;
+        for (const auto& a : ia->actions) {
+          instants.push_back(a.actionType);
+        }
+        rig.vehicle.onInstantActions(*ia);
+      }
+    }
+    warnings.insert(warnings.end(), out.warnings.begin(), out.warnings.end());
+    if (!out.progress.empty()) {
+      progress = out.progress.back();
+    }
+  }
+  void run(double seconds) {
+    for (int k = 0; k < static_cast<int>(seconds * 10 + 0.5); ++k) {
+      rig.run(0.1);
+      now = static_cast<std::int64_t>(rig.t * 1e9);
+      cycle();
+    }
+  }
+  /// Runs until the vehicle's last node is `node` (at most `seconds`).
+  bool runUntilAt(const std::string& node, double seconds) {
+    for (int k = 0; k < static_cast<int>(seconds * 10); ++k) {
+      if (rig.vehicle.lastNodeId() == node) {
+        return true;
+      }
+      run(0.1);
+    }
+    return rig.vehicle.lastNodeId() == node;
+  }
+  void assign(const std::string& task, double goal_x) {
+    msg::TaskAssignment a;
+    a.robot_id = "r1";
+    a.task_id = task;
+    a.goals = {{{goal_x, 0.0, 0.0}, "", msg::GoalAction::None, 0.0}};
+    BridgeOutbox out;
+    bridge.onAssignment(a, now, out);
+  }
+  /// Task `task`, driven by a first order n0, n1 to stand at n1 with it done.
+  void standAtN1(const std::string& task, double goal_x) {
+    assign(task, goal_x);
+    bridge.onRelease(release({0, 1}));
+    run(0.1);
+    ASSERT_TRUE(runUntilAt("n1", 20.0));
+    run(1.0);
+  }
+  [[nodiscard]] bool warned(const std::string& part) const {
+    return std::any_of(warnings.begin(), warnings.end(),
+                       [&](const std::string& w) { return w.find(part) != std::string::npos; });
+  }
+  vda5050::State state() { return rig.vehicle.takeState(rig.t, now); }
+};
+
+TEST(Vda5050BridgeNode, ANewOrderAfterACancelStartsAtTheVehiclesLastNode) {
+  Loop l;
+  l.assign("t1", 5.0);
+  l.bridge.onRelease(release({0, 1}, {2}));
+  l.run(0.1);
+  ASSERT_EQ(l.orders.size(), 1U);
+  EXPECT_EQ(l.orders[0].nodes.front().nodeId, "n0");
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(1.0);  // standing at its base end n1
+  // The traffic manager has it at n2 (a report it took while the vehicle's own last node is n1):
+  // the release does not pass n1, so the order is cancelled and a new one starts.
+  l.bridge.onRelease(release({2, 3, 4}));
+  l.run(1.0);
+  ASSERT_NE(std::find(l.instants.begin(), l.instants.end(), "cancelOrder"), l.instants.end());
+  ASSERT_EQ(l.orders.size(), 2U);
+  const auto& o = l.orders[1];
+  EXPECT_EQ(o.orderId, "t1-2");
+  ASSERT_EQ(o.nodes.size(), 4U);
+  EXPECT_EQ(o.nodes[0].nodeId, "n1") << "where the vehicle's state says it is, not the release's n2";
+  EXPECT_EQ(o.nodes[1].nodeId, "n2");
+  auto s = l.state();
+  EXPECT_EQ(s.orderId, "t1-2") << "the vehicle took it";
+  EXPECT_TRUE(s.errors.empty());
+  EXPECT_TRUE(l.runUntilAt("n4", 30.0));
+  EXPECT_EQ(l.bridge.counters().rejected, 0U);
+}
+
+TEST(Vda5050BridgeNode, ARejectedOrderIsLoggedAndSentAgainFromTheVehiclesLatestState) {
+  Loop l;
+  l.standAtN1("t1", 3.0);
+  // In SEMIAUTOMATIC mode the vehicle stays online to the fleet but takes no order (orderError).
+  l.rig.vehicle.setOperatingMode("SEMIAUTOMATIC");
+  // The traffic manager has it at n2: the order is done, so a new one starts (from n1).
+  l.bridge.onRelease(release({2, 3}));
+  l.run(0.3);
+  ASSERT_EQ(l.orders.size(), 2U);
+  EXPECT_EQ(l.orders[1].orderId, "t1-2");
+  EXPECT_TRUE(l.warned("order t1-2 update 0 rejected (orderError: the vehicle is in SEMIAUTOMATIC mode)"));
+  EXPECT_EQ(l.bridge.counters().rejected, 1U);
+  l.rig.vehicle.setOperatingMode("AUTOMATIC");
+  l.run(0.5);
+  EXPECT_EQ(l.orders.size(), 2U) << "no re-send before the back-off";
+  l.run(1.0);
+  ASSERT_EQ(l.orders.size(), 3U);
+  EXPECT_EQ(l.orders[2].orderId, "t1-3") << "a new orderId: the rejected one never became the vehicle's";
+  EXPECT_EQ(l.orders[2].nodes.front().nodeId, "n1");
+  EXPECT_EQ(l.state().orderId, "t1-3");
+  EXPECT_TRUE(l.runUntilAt("n3", 20.0));
+  EXPECT_FALSE(l.progress.blocked);
+}
+
+TEST(Vda5050BridgeNode, ARejectedUpdateIsSentAgainFromTheBaseEndTheVehicleHas) {
+  Loop l;
+  l.assign("t1", 4.0);
+  l.bridge.onRelease(release({0, 1}, {2}));
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.rig.vehicle.setOperatingMode("SEMIAUTOMATIC");
+  l.bridge.onRelease(release({1, 2, 3}, {4}));
+  l.run(0.3);
+  ASSERT_EQ(l.orders.size(), 2U);
+  EXPECT_EQ(l.orders[1].orderUpdateId, 1U);
+  EXPECT_TRUE(l.warned("order t1-1 update 1 rejected (orderError"));
+  l.rig.vehicle.setOperatingMode("AUTOMATIC");
+  l.run(1.5);
+  ASSERT_EQ(l.orders.size(), 3U);
+  const auto& u = l.orders[2];
+  EXPECT_EQ(u.orderId, "t1-1");
+  EXPECT_EQ(u.orderUpdateId, 2U);
+  EXPECT_EQ(u.nodes.front().nodeId, "n1") << "the base end of update 0, which the vehicle has";
+  EXPECT_EQ(u.nodes.front().sequenceId, 2U);
+  const auto s = l.state();
+  EXPECT_EQ(s.orderUpdateId, 2U);
+  EXPECT_TRUE(s.errors.empty());
+  EXPECT_TRUE(l.runUntilAt("n3", 20.0));
+}
+
+TEST(Vda5050BridgeNode, BoundedRetriesEndInALoggedRefusalAndABlockedReport) {
+  Loop l;
+  l.rig.vehicle.setOperatingMode("SEMIAUTOMATIC");
+  l.assign("t1", 3.0);
+  l.bridge.onRelease(release({0, 1, 2}));
+  l.run(30.0);
+  EXPECT_EQ(l.orders.size(), 4U) << "the first order and 3 retries";
+  EXPECT_EQ(l.bridge.counters().rejected, 4U);
+  EXPECT_EQ(l.bridge.counters().gave_up, 1U);
+  EXPECT_TRUE(l.warned("r1: no order taken after 4 attempts (last: orderError"));
+  EXPECT_TRUE(l.progress.blocked) << "the traffic manager hears it cannot follow";
+  l.run(30.0);
+  EXPECT_EQ(l.orders.size(), 4U) << "silent from then on, not sending for ever";
+  // A changed release is a new chance.
+  l.rig.vehicle.setOperatingMode("AUTOMATIC");
+  l.bridge.onRelease(release({0, 1, 2, 3}));
+  l.run(0.3);
+  ASSERT_EQ(l.orders.size(), 5U);
+  EXPECT_EQ(l.state().orderId, l.orders.back().orderId);
+  EXPECT_FALSE(l.progress.blocked);
+}
+
+TEST(Vda5050BridgeNode, AnOrderLostOnTheWayIsSentAgain) {
+  Loop l;
+  l.deliver = false;
+  l.assign("t1", 2.0);
+  l.bridge.onRelease(release({0, 1, 2}));
+  l.run(5.0);
+  EXPECT_EQ(l.orders.size(), 1U);
+  l.deliver = true;
+  l.run(7.0);  // 10 s without an answer, then the back-off
+  ASSERT_EQ(l.orders.size(), 2U);
+  EXPECT_TRUE(l.warned("order t1-1 update 0 rejected (neither taken nor rejected in 10 s)"));
+  EXPECT_EQ(l.state().orderId, "t1-2");
+}
+
+TEST(Vda5050BridgeNode, ANewOrderTheVehicleCouldNotTakeIsNotSent) {
+  // The vehicle's last node n1 is not next to n5, where the release starts.
+  Loop l;
+  l.standAtN1("t1", 1.0);
+  l.bridge.onRelease(release({5, 6}));
+  l.run(30.0);
+  EXPECT_EQ(l.orders.size(), 1U);
+  EXPECT_TRUE(l.warned("r1: no new order: the release starts at n5, the vehicle's last node is n1"));
+  EXPECT_TRUE(l.progress.blocked);
+}
+
+TEST(Vda5050BridgeNode, ErrorsWithMissingFieldsDoNotUpsetTheBridge) {
+  Loop l;
+  l.assign("t1", 2.0);
+  l.deliver = false;
+  l.bridge.onRelease(release({0, 1, 2}));
+  l.run(0.1);
+  ASSERT_EQ(l.orders.size(), 1U);
+  auto j = vda5050::toJson(l.state());
+  BridgeOutbox out;
+  // Without references or description: it names no order, so it is not taken as a rejection.
+  j["errors"] = nlohmann::json::array({{{"errorType", "noRouteError"}, {"errorLevel", "WARNING"}}});
+  l.bridge.onMqtt(kTopic + "state", j.dump(), out);
+  l.bridge.tick(l.now, out);
+  EXPECT_EQ(l.bridge.counters().rejected, 0U);
+  // Required fields missing: the message is refused with a reason.
+  nlohmann::json no_value = {{"errorType", "orderError"}, {"errorLevel", "WARNING"}};
+  no_value["errorReferences"] = nlohmann::json::array({nlohmann::json{{"referenceKey", "orderId"}}});
+  for (const auto& bad :
+       {nlohmann::json{{"errorType", "orderError"}}, no_value, nlohmann::json{{"errorLevel", "WARNING"}}}) {
+    j["errors"] = nlohmann::json::array({bad});
+    const auto before = l.bridge.counters().refused_messages;
+    l.bridge.onMqtt(kTopic + "state", j.dump(), out);
+    l.bridge.tick(l.now, out);
+    EXPECT_EQ(l.bridge.counters().refused_messages, before + 1) << bad.dump();
+  }
+  EXPECT_EQ(l.bridge.counters().rejected, 0U);
+  l.deliver = true;
+  l.run(15.0);  // back to the vehicle's own states; the lost order is sent again
+  EXPECT_EQ(l.state().orderId, l.orders.back().orderId);
+}
+
+}  // namespace
+}  // namespace fleet::vdabridge
