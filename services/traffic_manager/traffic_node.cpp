@@ -267,6 +267,10 @@ std::vector<std::string> TrafficNode::stalled(std::int64_t nowNs, double minS) c
        << static_cast<int>(still) << " s: " << control_->explain(static_cast<std::size_t>(r.index));
     if (r.last.blocked)
       os << "; it reports itself blocked";
+    if (r.last.holding)
+      os << "; it reports itself holding (docking, dwelling, paused or lost)";
+    if (static_cast<double>(nowNs - r.heardNs) * 1e-9 > settings_.robotTimeoutS)
+      os << "; not heard from for " << static_cast<int>(static_cast<double>(nowNs - r.heardNs) * 1e-9) << " s";
     if (!r.last.follows)
       os << "; it does not follow releases";
     out.push_back(os.str());

@@ -251,7 +251,11 @@ TrafficControl::Need TrafficControl::needsPlanning() const {
     if (evadeUntil_[r] >= 0)
       return Need::Now;
     const NodeId t = target_[r];
-    if (t != kNoNode && execution_.plannedEnd(r) != t && execution_.pendingNodes(r) < 2) {
+    // (A plan that brings the robot back to the node it stands on counts as nothing ahead: after
+    // a change of goal the plan starts again from the released end, and a robot released one node
+    // on, then planned back, stood for good on a base [A, B, A] that ends where it is.)
+    const bool back = execution_.plannedEnd(r) == execution_.at(r);
+    if (t != kNoNode && execution_.plannedEnd(r) != t && (execution_.pendingNodes(r) < 2 || back)) {
       if (stall_[r] < options_.standingSteps)
         return Need::Now;
       need = Need::Later;

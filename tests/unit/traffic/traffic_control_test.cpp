@@ -101,6 +101,43 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   }
 }
 
+/// A lone robot released one node on (its goal was there), then given a goal behind it: the plan
+/// starts again from the released end and comes back over the node the robot stands on. That plan
+/// was two nodes long, so it was not planned further, and the robot stood for good on a base that
+/// ended where it was (seen in the full stack when a task preempted a trip home).
+TEST(TrafficControl, APlanThatComesBackToTheRobotsNodeIsPlannedOn) {
+  // A corridor 0 - 1 - ... - 6, 0.5 m apart; the robot on 3.
+  Graph g;
+  for (int i = 0; i <= 6; ++i)
+    g.addNode({0.5 * i, 0.0});
+  for (NodeId i = 0; i < 6; ++i) {
+    g.addEdge(i, i + 1);
+    g.addEdge(i + 1, i);
+  }
+  const std::vector<NodeId> starts{3};
+  TrafficControl tc(g, starts);
+  ASSERT_TRUE(tc.setGoal(0, 4));
+  tc.update();
+  auto rel = tc.release(0);
+  ASSERT_EQ(rel.base, (std::vector<NodeId>{3, 4}));
+  ASSERT_TRUE(tc.setGoal(0, 0));  // before the robot reports 4
+  for (int t = 0; t < 5; ++t)
+    tc.update();
+  rel = tc.release(0);
+  ASSERT_GE(rel.base.size(), 4U) << tc.explain(0);
+  EXPECT_EQ(rel.base[1], 4);
+  EXPECT_NE(rel.base.back(), 3) << "the base must lead somewhere, not back to where the robot stands";
+  // Reporting the end of every base gets it there.
+  for (int t = 0; t < 100 && !tc.arrived(0); ++t) {
+    tc.update();
+    rel = tc.release(0);
+    if (rel.base.size() > 1) {
+      EXPECT_EQ(tc.reached(0, rel.base.back()), Report::Accepted);
+    }
+  }
+  EXPECT_TRUE(tc.arrived(0));
+}
+
 TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   Roadmap map = smallWarehouse();
   const auto* d1 = map.station("D-1");
