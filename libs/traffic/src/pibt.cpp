@@ -673,7 +673,11 @@ void Pibt::escapeDeadlocks() {
       continue;
     }
     const std::span<const std::int32_t> knot(chain_.data() + first, chain_.size() - first);
-    if (options_.untangleGroup >= 2 &&
+    // On a plain grid a node excludes only itself, so the agent in the escalated one's way can
+    // always clear it in one move if it can move at all: escalation is enough there, and the
+    // search's one-move-at-a-time ways out cost throughput (1,000 agents on
+    // warehouse-10-20-10-2-1: 5.36 goals per step against 5.44).
+    if (!grid_ && options_.untangleGroup >= 2 &&
         knot.size() <=
             std::min<std::size_t>(kMaxUntangleGroup, static_cast<std::size_t>(options_.untangleGroup)) &&
         untangleKnot(knot)) {
