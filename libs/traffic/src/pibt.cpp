@@ -1,5 +1,7 @@
 #include "fleet/traffic/pibt.hpp"
 
+#include "fleet/traffic/untangle.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -41,6 +43,9 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   detourFrom_.assign(n, 0.0F);
   tries_.assign(n, 0);
   visited_.assign(n, 0);
+  forced_.assign(n, {});
+  forcedAt_.assign(n, 0);
+  forcedGroup_.assign(n, -1);
   epsilon_.resize(n);
   for (auto& e : epsilon_) {
     e = static_cast<double>(random() >> 11) * 0x1.0p-53;
@@ -137,6 +142,7 @@ void Pibt::setControlled(std::size_t agent, bool controlled) {
     cover(now_[agent], controlled ? -1 : 1);
   }
   controlled_[agent] = controlled ? 1 : 0;
+  dropForced(forcedGroup_[agent]);
   dropDetour(agent);
   escalatedAt_[agent] = -1;
   stalled_[agent] = 0;
@@ -164,6 +170,7 @@ bool Pibt::setPosition(std::size_t agent, NodeId v) {
     cover(now_[agent], -1);
     cover(v, 1);
   }
+  dropForced(forcedGroup_[agent]);
   agentAt_[idx(now_[agent])] = -1;
   now_[agent] = v;
   agentAt_[idx(v)] = static_cast<std::int32_t>(agent);
@@ -223,6 +230,9 @@ void Pibt::reset(std::span<const NodeId> positions) {
     detourFrom_.resize(n, 0.0F);
     tries_.resize(n, 0);
     visited_.resize(n, 0);
+    forced_.resize(n);
+    forcedAt_.resize(n, 0);
+    forcedGroup_.resize(n, -1);
     for (std::size_t i = old; i < n; ++i)
       epsilon_.push_back(static_cast<double>(random() >> 11) * 0x1.0p-53);
   }
@@ -231,6 +241,31 @@ void Pibt::reset(std::span<const NodeId> positions) {
       // Where it was planned to be is gone: its progress is measured afresh.
       best_[i] = DistanceTable::kUnreachable;
       stalled_[i] = 0;
+    }
+  }
+  // A way out of a knot goes on from where the new positions are on it (the robots were released
+  // part of it), else it is given up.
+  for (std::size_t i = 0; i < old; ++i) {
+    const std::int32_t g = forcedGroup_[i];
+    if (g < 0)
+      continue;  // (each member of a group finds the same place: done again, no harm)
+    std::size_t place = forced_[i].size();
+    for (std::size_t k = forced_[i].size(); k-- > 0;) {
+      bool all = true;
+      for (std::size_t j = 0; j < old && all; ++j)
+        all = forcedGroup_[j] != g || forced_[j][k] == positions[j];
+      if (all) {
+        place = k;
+        break;
+      }
+    }
+    if (place + 1 >= forced_[i].size()) {
+      dropForced(g);  // not on it, or at its end
+      continue;
+    }
+    for (std::size_t j = 0; j < old; ++j) {
+      if (forcedGroup_[j] == g)
+        forcedAt_[j] = place;
     }
   }
   now_.assign(positions.begin(), positions.end());
@@ -392,6 +427,11 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
       add(e.to);
     }
   }
+  if (forcedGroup_[a] >= 0) {
+    // On a way out of a knot: its move this step is fixed (staying, if it cannot be made).
+    c[0] = Candidate{forced_[a][forcedAt_[a] + 1], 0.0F, 0};
+    m = 1;
+  }
   for (std::size_t i = 1; i < m; ++i) {
     const Candidate x = c[i];
     std::size_t j = i;
@@ -473,7 +513,12 @@ const std::vector<NodeId>& Pibt::step() {
       reservedBy_[idx(now_[i])] = static_cast<std::int32_t>(i);
     }
   }
-  std::sort(order_.begin(), order_.end(), [this](std::int32_t a, std::int32_t b) { return before(a, b); });
+  // Agents on a way out of a knot first: their moves were found with everyone else standing.
+  std::sort(order_.begin(), order_.end(), [this](std::int32_t a, std::int32_t b) {
+    const bool fa = forcedGroup_[idx(a)] >= 0;
+    const bool fb = forcedGroup_[idx(b)] >= 0;
+    return fa != fb ? fa : before(a, b);
+  });
   for (const std::int32_t i : order_) {
     if (next_[idx(i)] == kNoNode) {
       plan(i, -1, 0);
@@ -494,6 +539,7 @@ const std::vector<NodeId>& Pibt::step() {
     agentAt_[idx(now_[i])] = static_cast<std::int32_t>(i);
     updateProgress(i);
   }
+  advanceForced();
   if (options_.escapeAfter > 0) {
     escapeDeadlocks();
   }
@@ -580,7 +626,9 @@ void Pibt::escapeDeadlocks() {
   ++stamp_;
   const std::uint32_t seen = stamp_;
   for (std::size_t s = 0; s < n; ++s) {
-    if (still_[s] < options_.escapeAfter || stalled_[s] < options_.escapeAfter || escalatedAt_[s] >= 0 ||
+    // Standing still, not "no closer": a robot sent out of another's way gets a new goal every few
+    // steps (TrafficControl's evasion), which restarts its progress but not its standing.
+    if (still_[s] < options_.escapeAfter || escalatedAt_[s] >= 0 || forcedGroup_[s] >= 0 ||
         visited_[s] == seen) {
       continue;
     }
@@ -614,7 +662,7 @@ void Pibt::escapeDeadlocks() {
     bool standing = true;
     for (std::size_t k = first; k < chain_.size(); ++k) {
       const std::int32_t m = chain_[k];
-      anyEscalated = anyEscalated || escalatedAt_[idx(m)] >= 0;
+      anyEscalated = anyEscalated || escalatedAt_[idx(m)] >= 0 || forcedGroup_[idx(m)] >= 0;
       standing = standing && still_[idx(m)] >= options_.escapeAfter;
       if (pick < 0 || tries_[idx(m)] < tries_[idx(pick)] ||
           (tries_[idx(m)] == tries_[idx(pick)] && before(pick, m))) {
@@ -624,13 +672,131 @@ void Pibt::escapeDeadlocks() {
     if (anyEscalated || !standing) {
       continue;
     }
-    const auto p = idx(pick);
-    escalatedAt_[p] = static_cast<std::int64_t>(stats_.steps);
-    escalationDraw_[p] = random();
-    escalationDistance_[p] = table_[p][idx(now_[p])];
-    escalationIdle_[p] = 0;
-    ++tries_[p];
-    ++stats_.escalations;
+    const std::span<const std::int32_t> knot(chain_.data() + first, chain_.size() - first);
+    // On a plain grid a node excludes only itself, so the agent in the escalated one's way can
+    // always clear it in one move if it can move at all: escalation is enough there, and the
+    // search's one-move-at-a-time ways out cost throughput (1,000 agents on
+    // warehouse-10-20-10-2-1: 5.36 goals per step against 5.44).
+    if (!grid_ && options_.untangleGroup >= 2 &&
+        knot.size() <=
+            std::min<std::size_t>(kMaxUntangleGroup, static_cast<std::size_t>(options_.untangleGroup)) &&
+        untangleKnot(knot)) {
+      continue;
+    }
+    escalate(idx(pick));
+  }
+}
+
+void Pibt::escalate(std::size_t p) {
+  escalatedAt_[p] = static_cast<std::int64_t>(stats_.steps);
+  escalationDraw_[p] = random();
+  escalationDistance_[p] = table_[p][idx(now_[p])];
+  escalationIdle_[p] = 0;
+  ++tries_[p];
+  ++stats_.escalations;
+}
+
+bool Pibt::untangleKnot(std::span<const std::int32_t> knot) {
+  // Escalating one member of the knot makes it plan first, but on a roadmap the one in its way may
+  // have no single move that clears what it needs (every neighbour of a lane node in front of a
+  // dock is still excluded by the dock's exit): search a few steps of the knot's agents instead,
+  // and if that finds nothing, of the agents standing in their way too.
+  const std::size_t limit =
+      std::min<std::size_t>(kMaxUntangleGroup, static_cast<std::size_t>(options_.untangleGroup));
+  std::vector<std::int32_t> group(knot.begin(), knot.end());
+  const auto inGroup = [&](std::int32_t o) {
+    return std::find(group.begin(), group.end(), o) != group.end();
+  };
+  for (int round = 0; round < 2; ++round) {
+    UntangleProblem problem;
+    for (const std::int32_t a : group) {
+      problem.starts.push_back(now_[idx(a)]);
+      problem.tables.push_back(table_[idx(a)]);
+      problem.counts.push_back(std::find(knot.begin(), knot.end(), a) != knot.end() ? 1 : 0);
+    }
+    problem.clearOfOthers = [&](NodeId v) {
+      const auto other = [&](NodeId w) {
+        const std::int32_t o = agentAt_[idx(w)];
+        return o >= 0 && !inGroup(o);
+      };
+      if (other(v))
+        return false;
+      for (const NodeId w : graph_.conflicts(v)) {
+        if (other(w))
+          return false;
+      }
+      return true;
+    };
+    problem.maxSteps = options_.untangleSteps;
+    problem.maxConfigurations = options_.untangleConfigurations;
+    if (const auto way = untangle(graph_, problem)) {
+      const std::int32_t id = nextGroup_++;
+      for (std::size_t j = 0; j < group.size(); ++j) {
+        const auto a = idx(group[j]);
+        forced_[a].clear();
+        for (const auto& config : way->steps)
+          forced_[a].push_back(config[j]);
+        forcedAt_[a] = 0;
+        forcedGroup_[a] = id;
+      }
+      // The member the way out brings closer keeps the lead once it is out.
+      escalate(idx(group[way->improved]));
+      ++stats_.untangles;
+      return true;
+    }
+    // Pull in the agents standing where the knot's members could move: they may make room.
+    const std::size_t pulled = group.size();
+    for (const std::int32_t m : knot) {
+      for (const Edge& e : graph_.edges(now_[idx(m)])) {
+        if (!e.open || !graph_.isOpen(e.to))
+          continue;
+        const auto pull = [&](NodeId w) {
+          const std::int32_t o = agentAt_[idx(w)];
+          if (o >= 0 && group.size() < limit && !inGroup(o) && controlled_[idx(o)] != 0 &&
+              forcedGroup_[idx(o)] < 0)
+            group.push_back(o);
+        };
+        pull(e.to);
+        for (const NodeId w : graph_.conflicts(e.to))
+          pull(w);
+      }
+    }
+    if (group.size() == pulled)
+      break;
+  }
+  ++stats_.untangleFailures;
+  return false;
+}
+
+void Pibt::advanceForced() {
+  // A move of a way out that could not be made (someone from outside the knot got in the way since
+  // it was found): the way out is given up, and the knot is found again if it still holds.
+  const std::size_t n = now_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t g = forcedGroup_[i];
+    if (g < 0)
+      continue;
+    if (now_[i] != forced_[i][forcedAt_[i] + 1]) {
+      ++stats_.untangleAborts;
+      dropForced(g);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (forcedGroup_[i] >= 0 && ++forcedAt_[i] + 1 >= forced_[i].size()) {
+      forced_[i].clear();
+      forcedGroup_[i] = -1;
+    }
+  }
+}
+
+void Pibt::dropForced(std::int32_t group) {
+  if (group < 0)
+    return;
+  for (std::size_t i = 0; i < now_.size(); ++i) {
+    if (forcedGroup_[i] == group) {
+      forced_[i].clear();
+      forcedGroup_[i] = -1;
+    }
   }
 }
 

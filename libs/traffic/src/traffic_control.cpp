@@ -357,9 +357,21 @@ void TrafficControl::clearWayFor(std::size_t robot) {
   auto blocks = [&](NodeId w) {
     return std::any_of(path.begin(), path.end(), [&](NodeId p) { return graph_.conflicting(p, w); });
   };
+  // How many robots stand on or exclude each node: a robot is sent only where it can drive now, not
+  // through or into what another robot excludes (a refuge behind a robot parked in its dock is no
+  // refuge: the robot sent there stood still, and the one it was to make room for with it).
+  std::vector<int> cover(graph_.size(), 0);
+  const auto footprint = [&](NodeId at, int delta) {
+    cover[static_cast<std::size_t>(at)] += delta;
+    for (const NodeId w : graph_.conflicts(at))
+      cover[static_cast<std::size_t>(w)] += delta;
+  };
+  for (std::size_t q = 0; q < robots(); ++q)
+    footprint(pos[q], 1);
   for (std::size_t q = 0; q < robots(); ++q) {
     if (q == robot || held_[q] != 0 || evadeUntil_[q] >= 0 || !blocks(pos[q]))
       continue;
+    footprint(pos[q], -1);  // its own footprint is no obstacle to it
     // The nearest node (in edges) clear of that path, away from the stalled robot.
     std::vector<NodeId> frontier{pos[q]};
     std::vector<std::uint8_t> seen(graph_.size(), 0);
@@ -373,8 +385,8 @@ void TrafficControl::clearWayFor(std::size_t robot) {
           if (!graph_.passable(u, e) || seen[w] != 0)
             continue;
           seen[w] = 1;
-          if (graph_.conflicting(e.to, pos[robot]))
-            continue;  // not through the stalled robot
+          if (cover[w] > 0)
+            continue;  // not through the stalled robot or any other
           if (!blocks(e.to) && e.to != goal && refuge == kNoNode)
             refuge = e.to;
           next.push_back(e.to);
@@ -382,6 +394,7 @@ void TrafficControl::clearWayFor(std::size_t robot) {
       }
       frontier = std::move(next);
     }
+    footprint(pos[q], 1);
     if (refuge == kNoNode)
       continue;
     planner_->setGoal(q, refuge);

@@ -219,6 +219,90 @@ TEST(Pibt, StationSpurWithAQueueServesEveryoneOnlyWithEscape) {
   }
 }
 
+/// A parking place off a one-line lane, as the small warehouse's parking row: the dock D, its
+/// approach A (the only way out, joined to the three lane nodes in front), lane nodes 0.5 m apart
+/// that exclude the lane within 1 m. A robot standing in the dock excludes the lane nodes in front
+/// of it and the approach; a robot on the approach excludes the lane within 1.25 m.
+struct DockOffALane {
+  Graph graph;
+  std::vector<NodeId> lane;   // x = 0, 0.5, ..., 5 at y = 1.75
+  NodeId dock = kNoNode;      // (3, 0.9)
+  NodeId approach = kNoNode;  // (3, 1.9)
+};
+
+DockOffALane dockOffALane() {
+  DockOffALane d;
+  Graph& g = d.graph;
+  for (int i = 0; i <= 10; ++i)
+    d.lane.push_back(g.addNode({0.5 * i, 1.75}));
+  d.dock = g.addNode({3.0, 0.9});
+  d.approach = g.addNode({3.0, 1.9});
+  const double step = 0.625;  // 0.5 m at 0.8 m/s
+  for (std::size_t i = 0; i + 1 < d.lane.size(); ++i) {
+    g.addEdge(d.lane[i], d.lane[i + 1], step);
+    g.addEdge(d.lane[i + 1], d.lane[i], step);
+  }
+  g.addEdge(d.dock, d.approach, step);
+  g.addEdge(d.approach, d.dock, step);
+  for (const std::size_t i : {5U, 6U, 7U}) {
+    g.addEdge(d.approach, d.lane[i], step);
+    g.addEdge(d.lane[i], d.approach, step);
+  }
+  for (std::size_t i = 0; i < d.lane.size(); ++i) {
+    for (std::size_t j = i + 1; j < d.lane.size() && j <= i + 2; ++j)
+      g.addConflict(d.lane[i], d.lane[j]);
+  }
+  for (std::size_t i = 4; i <= 8; ++i)
+    g.addConflict(d.approach, d.lane[i]);
+  g.addConflict(d.dock, d.approach);
+  g.addConflict(d.dock, d.lane[6]);
+  g.addConflict(d.dock, d.lane[7]);
+  return d;
+}
+
+// The knot of the virtual fleet's parking row (20 robots, seed 1: four such pairs stood for the
+// whole 600 s). Robot 0 is parked in the dock and wants east along the lane; robot 1 stands on the
+// lane just west of the dock's front and wants east too. Robot 1's way east is excluded by the
+// parked robot, the parked robot's only way out (the approach) by robot 1. Each waits for the
+// other: a cycle, so the escape escalates one of them, but that does not help either way: robot 1's
+// every single move (one node west, or east) is still excluded by the approach, and the parked
+// robot cannot move while robot 1 stands where it does. Only two moves west of robot 1 and then the
+// parked robot's way out untie it, which a search over a few steps of both finds.
+TEST(Pibt, ARobotParkedBehindOneOnTheLaneGetsOutOnlyByUntangling) {
+  const DockOffALane d = dockOffALane();
+  const Graph& g = d.graph;
+  const std::vector<NodeId> starts{d.dock, d.lane[5]};
+  ASSERT_TRUE(g.conflicting(d.approach, d.lane[5]));  // robot 1 shuts the way out
+  ASSERT_TRUE(g.conflicting(d.dock, d.lane[6]));      // the parked robot shuts robot 1's way east
+  for (const NodeId v : {d.lane[4], d.lane[6]})
+    ASSERT_TRUE(g.conflicting(d.approach, v));  // no single move of robot 1 clears the way out
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    for (const bool untangling : {false, true}) {
+      PibtOptions o;
+      o.seed = seed;
+      if (!untangling)
+        o.untangleGroup = 0;  // PIBT with its escape (escalation) only: the planner before the search
+      Pibt p(g, starts, o);
+      p.setGoal(0, d.lane[10]);
+      p.setGoal(1, d.lane[7]);
+      std::vector<std::vector<NodeId>> plan;
+      const int t = stepsUntilAllReached(p, 400, &plan);
+      EXPECT_TRUE(checkPlan(g, plan).empty()) << firstViolations(checkPlan(g, plan));
+      if (!untangling) {
+        EXPECT_EQ(t, -1) << "seed " << seed;
+        EXPECT_EQ(p.positions(), starts) << "seed " << seed << ": escalation alone moves neither";
+        EXPECT_GE(p.stats().escalations, 1U);
+      } else {
+        // 16 steps of standing still tell the knot from a wait; then 3 moves out and ~8 east.
+        EXPECT_GT(t, 0) << "seed " << seed;
+        EXPECT_LT(t, 60) << "seed " << seed;
+        EXPECT_GE(p.stats().untangles, 1U);
+        EXPECT_EQ(p.stats().untangleAborts, 0U);
+      }
+    }
+  }
+}
+
 TEST(Pibt, FixedAgentsAreObstaclesThatNeverMove) {
   const GridMap m = gridOf({
       "........",

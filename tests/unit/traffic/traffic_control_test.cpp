@@ -62,16 +62,18 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   const std::vector<NodeId> starts{park, front};
   const NodeId goal0 = map.station("P-4")->dock, goal1 = map.station("P-1")->dock;
   // Evasion alone gets it off the dock, detours alone get both robots to their goals (the robot in
-  // front goes round the parked one's exit instead of waiting on it), and so do both together (the
-  // default); neither: both stay for ever. (Evasion alone no longer gets both to their goals here
-  // since steps for robots the plan keeps standing are paced: they swap places back and forth.)
-  enum class Way { Neither, Evasion, Detour, Both };
-  for (Way way : {Way::Neither, Way::Evasion, Way::Detour, Way::Both}) {
+  // front goes round the parked one's exit instead of waiting on it), so does the planner's
+  // untangling alone (a search over a few steps of both robots), and so do all together (the
+  // default); none of them: both stay for ever. (Evasion alone no longer gets both to their goals
+  // here since steps for robots the plan keeps standing are paced: they swap places back and forth.)
+  enum class Way { Neither, Evasion, Detour, Untangle, All };
+  for (Way way : {Way::Neither, Way::Evasion, Way::Detour, Way::Untangle, Way::All}) {
     const bool evade = way != Way::Neither;
     TrafficOptions opt;
-    if (way != Way::Both) {
+    if (way != Way::All) {
       opt.evadeAfter = way == Way::Evasion ? 6 : 1000000;
       opt.pibt.detourAfter = way == Way::Detour ? 4 : 0;
+      opt.pibt.untangleGroup = way == Way::Untangle ? 4 : 0;
     }
     TrafficControl tc(map.graph, starts, opt);
     tc.setGoal(0, goal0);
@@ -88,7 +90,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
       left = left || tc.at(0) != park;
     }
     EXPECT_EQ(left, evade) << "way " << static_cast<int>(way);
-    if (way == Way::Detour || way == Way::Both) {
+    if (way == Way::Detour || way == Way::Untangle || way == Way::All) {
       EXPECT_TRUE(tc.arrived(0)) << "way " << static_cast<int>(way);
       EXPECT_TRUE(tc.arrived(1)) << "way " << static_cast<int>(way);
     }
@@ -97,6 +99,9 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
     }
     if (way == Way::Detour) {
       EXPECT_GE(tc.plannerStats().detours, 1U);
+    }
+    if (way == Way::Untangle) {
+      EXPECT_GE(tc.plannerStats().untangles, 1U);
     }
   }
 }

@@ -25,6 +25,12 @@
 //   is escalated above every other priority until it has gained `escapeProgress` on where it was
 //   escalated or reached its goal; if it stays stuck for another `escapeAfter` steps it drops back
 //   and the next member gets its turn.
+// - Untangling: a knot escalation cannot untie because on a roadmap no single move of the agent in
+//   the way clears what the other needs (a robot on the lane in front of a parked robot's only way
+//   out) is searched for: a few steps of the cycle's agents (and of agents in their way, up to
+//   untangleGroup), one move at a time, everyone else standing (untangle.hpp). The moves found are
+//   planned before everyone else's; the member they bring closer to its goal is then escalated.
+//   Escalation alone is the fallback when the search finds nothing.
 // - Fixed agents' nodes are taken out of the routes (DistanceTable::setBlocked), since PIBT only
 //   moves greedily and would otherwise wait behind a stopped robot for ever.
 //
@@ -55,6 +61,12 @@ struct PibtOptions {
   /// Distance an escalated agent gains on where it was escalated before it drops back (cells on a
   /// unit grid, the edges' duration unit on a roadmap).
   double escapeProgress = 16.0;
+  /// Agents a search for a way out of a knot may move together (untangle.hpp; at most 4); below 2:
+  /// never search, escalate only.
+  int untangleGroup = 4;
+  /// Single moves a way out of a knot may take at most, and configurations it may look at.
+  int untangleSteps = 12;
+  std::size_t untangleConfigurations = 20000;
   /// Steps an agent stands without coming closer to its goal before it is routed round the agents
   /// that have stood still that long too (a detour table: entering what such an agent excludes
   /// costs `detourPenalty` more). PIBT ranks moves by distance alone, so an agent whose shortest way
@@ -74,6 +86,9 @@ struct PibtStats {
   std::uint64_t escalations = 0;
   std::uint64_t escalationRequeues = 0;  ///< escalated agents that stayed stuck and dropped back
   std::uint64_t detours = 0;             ///< detour tables computed
+  std::uint64_t untangles = 0;           ///< knots a search found a way out of
+  std::uint64_t untangleFailures = 0;    ///< knots it found none for (escalated instead)
+  std::uint64_t untangleAborts = 0;      ///< ways out given up half way (a move could not be made)
 };
 
 class Pibt {
@@ -107,6 +122,8 @@ class Pibt {
   const std::vector<NodeId>& step();
 
   [[nodiscard]] bool escalated(std::size_t agent) const { return escalatedAt_[agent] >= 0; }
+  /// Whether the agent is on a way out of a knot (its next moves are fixed).
+  [[nodiscard]] bool untangling(std::size_t agent) const { return forcedGroup_[agent] >= 0; }
   /// Steps since the agent last reached its goal (its PIBT priority).
   [[nodiscard]] int elapsed(std::size_t agent) const { return elapsed_[agent]; }
   [[nodiscard]] const PibtStats& stats() const { return stats_; }
@@ -130,6 +147,10 @@ class Pibt {
   void updateProgress(std::size_t agent);
   [[nodiscard]] std::int32_t blocker(std::size_t agent) const;
   void escapeDeadlocks();
+  [[nodiscard]] bool untangleKnot(std::span<const std::int32_t> knot);
+  void escalate(std::size_t agent);
+  void advanceForced();
+  void dropForced(std::int32_t group);
   void planDetours();
   void dropDetour(std::size_t agent);
   void resizeForGraph();
@@ -161,14 +182,18 @@ class Pibt {
   std::vector<std::int64_t> escalatedAt_;  ///< step of (re-)escalation, -1 when not escalated
   std::vector<std::uint64_t> escalationDraw_;
   std::vector<float> escalationDistance_;
-  std::vector<int> escalationIdle_;         ///< steps escalated without coming closer
-  std::vector<int> still_;                  ///< steps since it last moved
-  std::vector<int> tries_;                  ///< escalations since it last came closer to its goal
-  std::vector<std::uint32_t> visited_;      ///< stamps for the cycle search
-  std::vector<std::vector<float>> detour_;  ///< detour table to its goal, empty when none
-  std::vector<float> detourFrom_;           ///< regular distance when the detour was taken
-  std::vector<float> extra_;                ///< per node scratch: detour penalties
-  std::vector<int> standCover_;             ///< per node scratch: standing agents excluding it
+  std::vector<int> escalationIdle_;          ///< steps escalated without coming closer
+  std::vector<int> still_;                   ///< steps since it last moved
+  std::vector<int> tries_;                   ///< escalations since it last came closer to its goal
+  std::vector<std::uint32_t> visited_;       ///< stamps for the cycle search
+  std::vector<std::vector<float>> detour_;   ///< detour table to its goal, empty when none
+  std::vector<float> detourFrom_;            ///< regular distance when the detour was taken
+  std::vector<float> extra_;                 ///< per node scratch: detour penalties
+  std::vector<int> standCover_;              ///< per node scratch: standing agents excluding it
+  std::vector<std::vector<NodeId>> forced_;  ///< way out of a knot: its node per step, from now
+  std::vector<std::size_t> forcedAt_;        ///< index in forced_ of where it stands
+  std::vector<std::int32_t> forcedGroup_;    ///< the knot it is untangling with, -1
+  std::int32_t nextGroup_ = 0;
   std::uint32_t stamp_ = 0;
 
   // Per node.
