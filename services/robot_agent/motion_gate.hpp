@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fleet/avoidance/safety_layer.hpp"
@@ -27,6 +28,9 @@ struct GateParams {
   control::VelocityLimits limits;
   /// The site's speed limit at a map point [m/s] (+inf: none); empty: no zones.
   std::function<double(Vec2)> speedLimit;
+  /// The cross-traffic check's slow-down zone counts walls and shelves too (see
+  /// avoidance::SafetyParams::slowForStatic; false in reserved traffic).
+  bool slowForStatic = true;
 };
 
 /// What the gate looks at in one cycle (non-owning: the caller keeps it alive for the call).
@@ -53,7 +57,7 @@ struct Blocker {
 
 class MotionGate {
  public:
-  explicit MotionGate(GateParams params) : p_(params) {}
+  explicit MotionGate(GateParams params) : p_(std::move(params)), safety_(safetyOf(p_)) {}
 
   struct Clearance {
     double speed = 0.0;              ///< largest forward speed that keeps the stop gap
@@ -82,6 +86,11 @@ class MotionGate {
   Hold heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const;
 
  private:
+  static avoidance::SafetyParams safetyOf(const GateParams& p) {
+    avoidance::SafetyParams s;
+    s.slowForStatic = p.slowForStatic;
+    return s;
+  }
   GateParams p_;
   /// The library's default zones, not AgentParams::safety (those are the local planner's).
   avoidance::SafetyLayer safety_;

@@ -92,7 +92,9 @@ SafetyParams safetyParams(Config& cfg) {
   p.slowTime = cfg.number("slow_time", p.slowTime, kNonNegative);
   p.slowRatio = cfg.number("slow_ratio", p.slowRatio, {0.0, 1.0, true});
   p.sampleStep = cfg.number("sample_step", p.sampleStep, {0.001, 1.0});
-  cfg.rejectUnknownKeys({"stop_margin", "slow_margin", "slow_time", "slow_ratio", "sample_step"});
+  p.slowForStatic = cfg.boolean("slow_for_static", p.slowForStatic);
+  cfg.rejectUnknownKeys(
+      {"stop_margin", "slow_margin", "slow_time", "slow_ratio", "sample_step", "slow_for_static"});
   if (p.slowMargin < p.stopMargin)
     cfg.problem("slow_margin", "must be >= stop_margin (" + std::to_string(p.stopMargin) + ")");
   return p;

@@ -16,12 +16,14 @@ double approach(double from, double to, double max_step) {
   return from + std::clamp(to - from, -max_step, max_step);
 }
 
-// Surface clearance of the robot at p to everything, discs advanced to time tau.
-double clearanceAt(const LocalView& view, Vec2 p, double tau) {
+// Surface clearance of the robot at p to everything (or the discs only), discs advanced to time tau.
+double clearanceAt(const LocalView& view, Vec2 p, double tau, bool withScan = true) {
   double best = std::numeric_limits<double>::infinity();
   const double r = view.robot.radius;
-  for (const Vec2& q : view.scan)
-    best = std::min(best, (p - q).squaredNorm());
+  if (withScan) {
+    for (const Vec2& q : view.scan)
+      best = std::min(best, (p - q).squaredNorm());
+  }
   best = std::sqrt(best) - r;
   for (const MovingDisc& d : view.discs) {
     best = std::min(best, fastDistance(p, d.position + d.velocity * tau) - r - d.radius);
@@ -110,7 +112,7 @@ SafetyResult SafetyLayer::filter(const LocalView& view, Twist request) const {
       double min_c = std::numeric_limits<double>::infinity();
       for (double t = params_.sampleStep; t <= params_.slowTime + 1e-12; t += params_.sampleStep) {
         const Pose2 p = control::DiffDriveKinematics::integrateExact(view.robot.pose, out.twist, t);
-        min_c = std::min(min_c, clearanceAt(view, p.position(), t));
+        min_c = std::min(min_c, clearanceAt(view, p.position(), t, params_.slowForStatic));
       }
       if (min_c < params_.slowMargin) {
         out.twist.v = std::copysign(cap, out.twist.v);

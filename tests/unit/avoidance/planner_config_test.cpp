@@ -73,7 +73,11 @@ TEST(PlannerConfig, SafetyZonesAndTheirOrder) {
   EXPECT_DOUBLE_EQ(p.stopMargin, 0.1);
   EXPECT_DOUBLE_EQ(p.slowMargin, 0.5);
   EXPECT_DOUBLE_EQ(p.slowRatio, 0.4);
+  EXPECT_TRUE(p.slowForStatic);
   EXPECT_TRUE(p.validate().has_value());
+  Config off = Config::fromText(R"({"slow_for_static": false})", "s.json");
+  EXPECT_FALSE(safetyParams(off).slowForStatic);
+  EXPECT_TRUE(off.ok());
 
   Config bad = Config::fromText(R"({"stop_margin": 0.4, "slow_margin": 0.2, "slow_ratio": 0})", "s.json");
   (void)safetyParams(bad);

@@ -130,6 +130,28 @@ TEST(SafetyLayer, SlowDownZoneCapsSpeedNearObstacles) {
   EXPECT_NEAR(r.twist.v, 0.5 * 0.45, 1e-12);
 }
 
+TEST(SafetyLayer, WithoutStaticSlowingOnlyDiscsSlowTheRobot) {
+  LocalView v;
+  v.robot.pose = {0, 0, 0};
+  v.robot.twist = {0.45, 0.0};
+  v.robot.radius = 0.3;
+  const auto scan = test::wall({0.0, 0.5}, {3.0, 0.5});  // as above: 0.2 m beside the surface
+  v.scan = scan;
+  SafetyParams p;
+  p.slowForStatic = false;
+  const SafetyLayer layer(p);
+  const auto r = layer.filter(v, {0.45, 0.0});
+  EXPECT_FALSE(r.slowed);
+  EXPECT_EQ(r.twist.v, 0.45);
+  // A person 0.2 m beside the path still slows it, and the wall still stops it when driven at.
+  const std::vector<MovingDisc> person{{{0.5, -0.75}, {}, 0.25}};
+  v.discs = person;
+  EXPECT_TRUE(layer.filter(v, {0.45, 0.0}).slowed);
+  v.discs = {};
+  v.robot.pose = {0, 0.1, 1.5707963};  // facing the wall, 0.1 m off it
+  EXPECT_LT(layer.filter(v, {0.45, 0.0}).twist.v, 0.45);
+}
+
 TEST(Dwa, SamplesStayInsideTheDynamicWindow) {
   DynamicWindowPlanner dwa;
   LocalView v;

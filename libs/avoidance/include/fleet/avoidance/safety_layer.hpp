@@ -12,6 +12,11 @@ struct SafetyParams {
   double slowTime = 1.0;     ///< look-ahead of the slow-down zone [s]
   double slowRatio = 0.5;    ///< |v| cap in the slow-down zone, as a fraction of vMax
   double sampleStep = 0.05;  ///< time step of the profile check [s]
+  /// The slow-down zone counts the scan (walls, shelves) as well as the discs. False: only discs
+  /// (people, robots), for a robot on a route known to keep clear of the static map (a roadmap
+  /// base keeps 0.1 m, inside slowMargin: every aisle was a slow zone). The stop zone always
+  /// counts everything.
+  bool slowForStatic = true;
 
   [[nodiscard]] Expected<void> validate() const;
 };
