@@ -90,19 +90,17 @@ class FusionEngine {
     TimeBase alignedFor{};
     bool hasAligned = false;
   };
-  struct StepDisc {
-    Disc disc;
-    std::uint32_t source;  // index into the current entry order
-    SourceKind kind;
-    double reach;
-  };
-
   FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model);
   void noteChanged(const AlignedSource& aligned);
   void markDirtyTiles(double maxReach);
   void recompute(bool full);
-  void paintDisc(const Disc& d, double p, std::uint8_t level);
-  void buildHash(const std::vector<StepDisc>& discs);
+  int windowLength() const;
+  void scanWindow(int k0, int k1);
+  void visitPair(std::uint32_t qa, std::uint32_t qb, int k);
+  void scorePair(std::uint32_t qa, std::uint32_t qb, double d, double inter);
+  void rowSpans(const Disc& d);
+  void writeSpan(int j, int a, int b, double p, std::uint8_t level);
+  void paintSource(std::uint32_t s);
 
   FusionConfig config_;
   std::shared_ptr<const RiskModel> model_;
@@ -115,45 +113,52 @@ class FusionEngine {
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
-  struct Paint {  // what painting reads of a disc (not its uncertainty), and the score
-    double x, y, r;
-    double p;
-  };
   struct RowSpan {
     int j, a, b;  // row j, cells a..b inside the disc
   };
-  // scratch, kept between calls to avoid reallocation
-  std::vector<Paint> paints_;
+  // Scratch, kept between calls to avoid reallocation. Per-disc arrays are indexed source-major,
+  // q = source · steps + step, over the sources in id order.
+  std::vector<const Entry*> entries_;
+  std::vector<const Disc*> disc_;         // nullptr when the source has no disc at that step
+  std::vector<double> qx_, qy_, qreach_;  // centre (NaN when absent, so no distance test passes) and reach
+  std::vector<double> discMax_;           // the largest score of the disc's pairs
+  std::vector<std::uint8_t> active_;      // the disc touches a tile being recomputed
+  std::vector<double> interSum_;          // Σ∩ per step, for the scene index
   std::vector<RowSpan> rowSpans_;
-  std::vector<std::uint32_t> bucketFill_;
-  std::vector<std::uint32_t> paintTile_;
+  std::vector<double> cellX_;           // cell-centre x of every column
+  std::vector<int> coverLo_, coverHi_;  // per row of the source being painted: cells it already holds
+  struct PaintDisc {
+    double p;
+    std::uint32_t q;
+  };
+  std::vector<PaintDisc> sourcePaints_;
+  std::vector<std::uint32_t> paintOrder_;
   std::vector<std::uint32_t> tileStart_;
-  std::vector<Paint> sortedPaints_;
-  std::vector<double> cellX_;  // cell-centre x of every column
-  std::vector<std::vector<StepDisc>> stepDiscs_;
-  std::vector<double> discMax_;
-  std::vector<std::uint8_t> active_;
-  std::vector<std::uint32_t> bucketStart_;
-  std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> bucketOf_;
+  std::vector<std::uint32_t> sourceTile_;
+  // The spatial hash over the sources' bounding circles of one window of steps.
   struct HashEntry {
     double x, y, reach;
     bool wide;  // reach above half a bucket: searched from its own side
   };
-  std::vector<HashEntry> sorted_;  // the discs in bucket order
+  std::vector<HashEntry> items_;  // per source present in the window
+  std::vector<std::uint32_t> itemSource_;
+  std::vector<HashEntry> sorted_;  // the items in bucket order
+  std::vector<std::uint32_t> bucketStart_;
+  std::vector<std::uint32_t> bucketFill_;
+  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> bucketOf_;
+  std::vector<std::uint32_t> wide_;
+  std::vector<double> reachScratch_;
   struct DeferredPair {
-    std::uint32_t i, j;
+    std::uint32_t qa, qb;
     double d;
   };
   std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
-  std::vector<std::uint32_t> wide_;
-  std::vector<double> reachScratch_;
   double maxReachInHash_ = 0.0;
-  double bucketMinX_ = 0.0;
-  double bucketMinY_ = 0.0;
   double bucketSize_ = 1.0;
   int bucketsX_ = 0;
   int bucketsY_ = 0;
+  void buildHash();
 };
 
 }  // namespace fleet::risk
