@@ -52,6 +52,10 @@ FusionEngine::FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel>
   for (int i = 0; i < g.width; ++i) {
     cellX_[static_cast<std::size_t>(i)] = g.cellCentreX(i);  // the same doubles, looked up on the paint path
   }
+  cellY_.resize(static_cast<std::size_t>(g.height));
+  for (int j = 0; j < g.height; ++j) {
+    cellY_[static_cast<std::size_t>(j)] = g.cellCentreY(j);
+  }
   result_.probability = ProbabilityGrid{g, std::vector<double>(g.cellCount(), 0.0)};
   result_.levels = LevelGrid{g, config_.levels, std::vector<std::uint8_t>(g.cellCount(), 0)};
   result_.time = TimeBase{0, config_.dt, config_.steps};
@@ -169,6 +173,17 @@ const FusionResult& FusionEngine::fuse(std::int64_t tRefNs) {
   return result_;
 }
 
+namespace {
+// Conservative row bounds of a disc whose rows span the row coordinates [lo, hi]: floor(lo) − 1 and
+// at least ceil(hi) + 1, by truncation of clamped values (cheaper than floor/ceil without SSE4.1).
+int firstRow(double lo) {
+  return static_cast<int>(std::clamp(lo, 1.0, 2e9)) - 1;
+}
+int lastRow(double hi) {
+  return static_cast<int>(std::clamp(hi + 2.0, 0.0, 2e9));
+}
+}  // namespace
+
 void FusionEngine::buildHash() {
   // Uniform buckets over the bounding box of the centres, filled by counting sort. Their side is twice
   // the 90th percentile of the reaches rather than of the largest: a few very uncertain discs (people
@@ -229,15 +244,15 @@ void FusionEngine::buildHash() {
   }
 }
 
-void FusionEngine::rowSpans(const Disc& d) {
-  // The cell interval of every row the disc covers (independent rows, so their square roots overlap in
-  // the pipeline); the writes follow separately.
+void FusionEngine::rowSpans(const Disc& d, int rowLo, int rowHi) {
+  // The cell interval of every row the disc covers within rowLo..rowHi (independent rows, so their
+  // square roots overlap in the pipeline); the writes follow separately.
   const GridSpec& g = config_.grid;
   const double invRes = 1.0 / g.resolution;            // estimates only; the exact test settles the ends
   const double fy = (d.y - g.originY) * invRes - 0.5;  // row coordinate of the centre
   const double fr = d.r * invRes;
-  const int j0 = std::max(0, static_cast<int>(std::floor(fy - fr)) - 1);
-  const int j1 = std::min(g.height - 1, static_cast<int>(std::ceil(fy + fr)) + 1);
+  const int j0 = std::max(rowLo, firstRow(fy - fr));
+  const int j1 = std::min(rowHi, lastRow(fy + fr));
   const double fx = (d.x - g.originX) * invRes - 0.5;
   rowSpans_.clear();
   const double* cx = cellX_.data();
@@ -245,8 +260,11 @@ void FusionEngine::rowSpans(const Disc& d) {
   // (the rounding of r² − dy² then moves the ends by < 1e-8 cells when half > 1e-3); else always test.
   const bool spansByEstimate =
       fr < 100.0 && (std::abs(d.x) + std::abs(g.originX) + g.width * g.resolution) * invRes < 1e6;
+  // Every row's ends inside the grid with a cell of margin: no clamping, floor by truncation.
+  const bool interior = spansByEstimate && fx - fr > 1.0 && fx + fr < g.width - 2.0;
+  const double* cyOf = cellY_.data();
   for (int j = j0; j <= j1; ++j) {
-    const double cy = g.cellCentreY(j);
+    const double cy = cyOf[j];
     const double dy = cy - d.y;
     const double rem = d.r * d.r - dy * dy;
     if (rem < -1e-9 * d.r * d.r) {
@@ -255,6 +273,22 @@ void FusionEngine::rowSpans(const Disc& d) {
     // The cells of a row inside the disc form one interval (dx² grows monotonically away from the
     // centre); estimate its ends with sqrt, then settle them with the exact test the reference uses.
     const double half = std::sqrt(std::max(rem, 0.0)) * invRes;
+    if (interior) {
+      // The common case of the general path below, without its branches: both ends clear of cell
+      // centres (non-short-circuit &, so the test is one predictable branch).
+      const double lo = fx - half;
+      const double hi = fx + half;
+      const int fa = static_cast<int>(lo);
+      const int fb = static_cast<int>(hi);
+      const double ra = lo - static_cast<double>(fa);
+      const double rb = hi - static_cast<double>(fb);
+      if ((half > 1e-3) & (ra > 1e-6) & (ra < 1.0 - 1e-6) & (rb > 1e-6) & (rb < 1.0 - 1e-6)) {
+        if (fa < fb) {
+          rowSpans_.push_back(RowSpan{j, fa + 1, fb});
+        }
+        continue;
+      }
+    }
     // Cell i's centre is at column coordinate i, so the row's cells are those in [lo, hi]. When both
     // ends are more than 1e-6 cells from a cell centre (and the row is not a near-tangent sliver), the
     // floating-point error of either computation (~1e-12 cells) cannot change which cells are inside,
@@ -331,73 +365,137 @@ void FusionEngine::writeSpan(int j, int a, int b, double p, std::uint8_t level) 
   }
 }
 
-void FusionEngine::paintSource(std::uint32_t s) {
+void FusionEngine::paintSourceRows(const SourcePaint& sp, int rowLo, int rowHi) {
   // The discs of one source overlap heavily from step to step (it moves a fraction of its radius per
   // step). Painted in decreasing score, a disc only needs to write the cells of each row that the
   // source's higher-scored discs have not written yet: per row the cells written so far are kept as
   // one interval (the union of overlapping spans; of two disjoint ones the longer), and anything
   // outside it is written with max as before, so the grid is the same whatever the shapes.
-  const int steps = config_.steps;
-  sourcePaints_.clear();
-  for (int k = 0; k < steps; ++k) {
-    const std::uint32_t q = s * static_cast<std::uint32_t>(steps) + static_cast<std::uint32_t>(k);
-    if (active_[q] != 0 && discMax_[q] > 0.0) {
-      sourcePaints_.push_back(PaintDisc{discMax_[q], q});
-    }
-  }
-  if (sourcePaints_.empty()) {
-    return;
-  }
-  std::sort(sourcePaints_.begin(), sourcePaints_.end(),
-            [](const PaintDisc& a, const PaintDisc& b) { return a.p > b.p; });
-  const GridSpec& g = config_.grid;
-  const double invRes = 1.0 / g.resolution;
-  int rowMin = g.height;
-  int rowMax = -1;
-  for (const PaintDisc& pd : sourcePaints_) {
-    const Disc& d = *disc_[pd.q];
-    const double fy = (d.y - g.originY) * invRes - 0.5;
-    const double fr = d.r * invRes;
-    rowMin = std::min(rowMin, std::max(0, static_cast<int>(std::floor(fy - fr)) - 1));
-    rowMax = std::max(rowMax, std::min(g.height - 1, static_cast<int>(std::ceil(fy + fr)) + 1));
-  }
-  result_.stats.discsPainted += sourcePaints_.size();
-  if (rowMin > rowMax) {
-    return;
-  }
-  const auto rows = static_cast<std::size_t>(rowMax - rowMin + 1);
+  const auto rows = static_cast<std::size_t>(rowHi - rowLo + 1);
   coverLo_.assign(rows, 1);
   coverHi_.assign(rows, 0);  // lo > hi: nothing written in the row yet
+  const GridSpec& g = config_.grid;
   const int K = config_.levels;
-  for (const PaintDisc& pd : sourcePaints_) {
+  double* P = result_.probability.p.data();
+  std::uint8_t* L = result_.levels.level.data();
+  for (std::uint32_t n = sp.begin; n < sp.end; ++n) {
+    const PaintDisc pd = paintList_[n];
     // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
     // level with max gives the classified grid without a pass over the cells.
     const auto level = static_cast<std::uint8_t>(isoLevel(pd.p, K));
-    rowSpans(*disc_[pd.q]);
+    rowSpans(*disc_[pd.q], rowLo, rowHi);
+    auto write = [&](int j, int a, int b) {
+      if (!allDirty_) {
+        writeSpan(j, a, b, pd.p, level);
+        return;
+      }
+      double* row = P + g.index(0, j);
+      std::uint8_t* lrow = L + g.index(0, j);
+      for (int i = a; i <= b; ++i) {
+        row[i] = std::max(row[i], pd.p);
+      }
+      for (int i = a; i <= b; ++i) {
+        lrow[i] = std::max(lrow[i], level);
+      }
+      result_.stats.cellsVisited += static_cast<std::size_t>(b - a + 1);
+    };
     for (const RowSpan& span : rowSpans_) {
-      const auto r = static_cast<std::size_t>(span.j - rowMin);
+      const auto r = static_cast<std::size_t>(span.j - rowLo);
       int& lo = coverLo_[r];
       int& hi = coverHi_[r];
       if (lo > hi) {
-        writeSpan(span.j, span.a, span.b, pd.p, level);
+        write(span.j, span.a, span.b);
         lo = span.a;
         hi = span.b;
       } else if (span.b < lo - 1 || span.a > hi + 1) {
-        writeSpan(span.j, span.a, span.b, pd.p, level);
+        write(span.j, span.a, span.b);
         if (span.b - span.a > hi - lo) {
           lo = span.a;
           hi = span.b;
         }
       } else {
         if (span.a < lo) {
-          writeSpan(span.j, span.a, lo - 1, pd.p, level);
+          write(span.j, span.a, lo - 1);
           lo = span.a;
         }
         if (span.b > hi) {
-          writeSpan(span.j, hi + 1, span.b, pd.p, level);
+          write(span.j, hi + 1, span.b);
           hi = span.b;
         }
       }
+    }
+  }
+}
+
+void FusionEngine::paint(bool full) {
+  // The grid (megabytes) is painted band by band of rows, each band small enough to stay in the
+  // cache while every source crossing it paints its rows there; a full recompute clears each band
+  // just before painting it rather than the whole grid up front.
+  const GridSpec& g = config_.grid;
+  const auto steps = static_cast<std::size_t>(config_.steps);
+  const double invRes = 1.0 / g.resolution;
+  paintList_.clear();
+  sourcePaints_.clear();
+  for (std::size_t s = 0; s < entries_.size(); ++s) {
+    const auto begin = static_cast<std::uint32_t>(paintList_.size());
+    int rowMin = g.height;
+    int rowMax = -1;
+    for (std::size_t k = 0; k < steps; ++k) {
+      const std::size_t q = s * steps + k;
+      if (active_[q] != 0 && discMax_[q] > 0.0) {
+        paintList_.push_back(PaintDisc{discMax_[q], static_cast<std::uint32_t>(q)});
+        const Disc& d = *disc_[q];
+        const double fy = (d.y - g.originY) * invRes - 0.5;
+        const double fr = d.r * invRes;
+        rowMin = std::min(rowMin, firstRow(fy - fr));
+        rowMax = std::max(rowMax, std::min(g.height - 1, lastRow(fy + fr)));
+      }
+    }
+    const auto end = static_cast<std::uint32_t>(paintList_.size());
+    if (end == begin) {
+      continue;
+    }
+    std::sort(paintList_.begin() + begin, paintList_.begin() + end,
+              [](const PaintDisc& a, const PaintDisc& b) { return a.p > b.p; });
+    if (rowMin <= rowMax) {
+      sourcePaints_.push_back(SourcePaint{begin, end, rowMin, rowMax});
+    }
+  }
+  result_.stats.discsPainted = paintList_.size();
+  // ~256 KiB of grid per band.
+  const std::size_t rowBytes = static_cast<std::size_t>(g.width) * (sizeof(double) + 1);
+  const int band = static_cast<int>(std::clamp<std::size_t>((256u << 10) / rowBytes, 1, g.height));
+  const int bands = (g.height + band - 1) / band;
+  bandStart_.assign(static_cast<std::size_t>(bands) + 1, 0);
+  for (const SourcePaint& sp : sourcePaints_) {
+    for (int b = sp.rowMin / band; b <= sp.rowMax / band; ++b) {
+      ++bandStart_[static_cast<std::size_t>(b) + 1];
+    }
+  }
+  for (int b = 0; b < bands; ++b) {
+    bandStart_[static_cast<std::size_t>(b) + 1] += bandStart_[static_cast<std::size_t>(b)];
+  }
+  bandItems_.resize(bandStart_.back());
+  bandFill_.assign(bandStart_.begin(), bandStart_.end() - 1);
+  for (std::uint32_t n = 0; n < sourcePaints_.size(); ++n) {
+    for (int b = sourcePaints_[n].rowMin / band; b <= sourcePaints_[n].rowMax / band; ++b) {
+      bandItems_[bandFill_[static_cast<std::size_t>(b)]++] = n;
+    }
+  }
+  for (int b = 0; b < bands; ++b) {
+    const int lo = b * band;
+    const int hi = std::min(g.height, lo + band) - 1;
+    if (full) {
+      std::fill(result_.probability.p.begin() + static_cast<std::ptrdiff_t>(g.index(0, lo)),
+                result_.probability.p.begin() + static_cast<std::ptrdiff_t>(g.index(0, hi + 1)), 0.0);
+      std::fill(result_.levels.level.begin() + static_cast<std::ptrdiff_t>(g.index(0, lo)),
+                result_.levels.level.begin() + static_cast<std::ptrdiff_t>(g.index(0, hi + 1)),
+                std::uint8_t{0});
+    }
+    for (std::uint32_t n = bandStart_[static_cast<std::size_t>(b)];
+         n < bandStart_[static_cast<std::size_t>(b) + 1]; ++n) {
+      const SourcePaint& sp = sourcePaints_[bandItems_[n]];
+      paintSourceRows(sp, std::max(lo, sp.rowMin), std::min(hi, sp.rowMax));
     }
   }
 }
@@ -659,9 +757,7 @@ void FusionEngine::recompute(bool full) {
   allDirty_ = full;
   if (full) {
     std::fill(dirtyTiles_.begin(), dirtyTiles_.end(), 1);
-    pendingDirty_.clear();
-    std::fill(result_.probability.p.begin(), result_.probability.p.end(), 0.0);
-    std::fill(result_.levels.level.begin(), result_.levels.level.end(), std::uint8_t{0});
+    pendingDirty_.clear();  // the grid is cleared band by band as it is painted
   } else {
     markDirtyTiles(maxReach);
     const int ts = config_.tileSize;
@@ -739,41 +835,7 @@ void FusionEngine::recompute(bool full) {
     result_.sceneIndexPerStep[k] = den > 0.0 ? std::clamp(interSum_[k] / den, 0.0, 1.0) : 0.0;
   }
 
-  // Sources are painted in the tile order of their first painted disc, so that nearby sources reuse
-  // the same cache lines of the grid (megabytes; the sources are scattered in id order).
-  {
-    const double inv = 1.0 / tileM;
-    const std::size_t tiles = static_cast<std::size_t>(tilesX_) * static_cast<std::size_t>(tilesY_);
-    const auto none = static_cast<std::uint32_t>(tiles);
-    sourceTile_.assign(entries_.size(), none);
-    tileStart_.assign(tiles + 2, 0);
-    for (std::size_t s = 0; s < entries_.size(); ++s) {
-      for (std::size_t k = 0; k < K; ++k) {
-        const std::size_t q = s * K + k;
-        if (active_[q] != 0 && discMax_[q] > 0.0) {
-          const auto tx = static_cast<std::size_t>(
-              std::clamp((qx_[q] - g.originX) * inv, 0.0, static_cast<double>(tilesX_ - 1)));
-          const auto ty = static_cast<std::size_t>(
-              std::clamp((qy_[q] - g.originY) * inv, 0.0, static_cast<double>(tilesY_ - 1)));
-          sourceTile_[s] = static_cast<std::uint32_t>(ty * static_cast<std::size_t>(tilesX_) + tx);
-          break;
-        }
-      }
-      ++tileStart_[sourceTile_[s] + 1];
-    }
-    for (std::size_t t = 0; t < tiles; ++t) {
-      tileStart_[t + 1] += tileStart_[t];
-    }
-    paintOrder_.resize(tileStart_[tiles]);  // sources with nothing to paint are left out
-    for (std::size_t s = 0; s < entries_.size(); ++s) {
-      if (sourceTile_[s] != none) {
-        paintOrder_[tileStart_[sourceTile_[s]]++] = static_cast<std::uint32_t>(s);
-      }
-    }
-    for (const std::uint32_t s : paintOrder_) {
-      paintSource(s);
-    }
-  }
+  paint(full);
   result_.sceneIndex = 0.0;
   for (double s : result_.sceneIndexPerStep) {
     result_.sceneIndex = std::max(result_.sceneIndex, s);

@@ -98,9 +98,14 @@ class FusionEngine {
   void scanWindow(int k0, int k1);
   void visitPair(std::uint32_t qa, std::uint32_t qb, int k);
   void scorePair(std::uint32_t qa, std::uint32_t qb, double d, double inter);
-  void rowSpans(const Disc& d);
+  void rowSpans(const Disc& d, int rowLo, int rowHi);
   void writeSpan(int j, int a, int b, double p, std::uint8_t level);
-  void paintSource(std::uint32_t s);
+  struct SourcePaint {
+    std::uint32_t begin, end;  // its discs in paintList_
+    int rowMin, rowMax;        // rows they may cover
+  };
+  void paintSourceRows(const SourcePaint& sp, int rowLo, int rowHi);
+  void paint(bool full);
 
   FusionConfig config_;
   std::shared_ptr<const RiskModel> model_;
@@ -126,15 +131,15 @@ class FusionEngine {
   std::vector<double> interSum_;          // Σ∩ per step, for the scene index
   std::vector<RowSpan> rowSpans_;
   std::vector<double> cellX_;           // cell-centre x of every column
+  std::vector<double> cellY_;           // and y of every row
   std::vector<int> coverLo_, coverHi_;  // per row of the source being painted: cells it already holds
   struct PaintDisc {
     double p;
     std::uint32_t q;
   };
-  std::vector<PaintDisc> sourcePaints_;
-  std::vector<std::uint32_t> paintOrder_;
-  std::vector<std::uint32_t> tileStart_;
-  std::vector<std::uint32_t> sourceTile_;
+  std::vector<PaintDisc> paintList_;  // per source, in decreasing score
+  std::vector<SourcePaint> sourcePaints_;
+  std::vector<std::uint32_t> bandStart_, bandFill_, bandItems_;  // sources by band of rows
   // The spatial hash over the sources' bounding circles of one window of steps.
   struct HashEntry {
     double x, y, reach;
