@@ -377,6 +377,11 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
 
 double Gaussian::pairAbove(const Disc& a, const Disc& b, double d, double /*intersectionArea*/,
                            double known) const {
+  // The cull first (a square root): many of the engine's candidates within reach(a) + reach(b) lie
+  // beyond it, and for them the exp of the bound below would be wasted.
+  if (d >= cullDistance(a, b)) {
+    return 0.0;
+  }
   const double gap = d - (a.r + b.r);
   if (known > 0.0 && gap > 0.0) {
     const double sa = a.sigmaMax();
@@ -385,18 +390,22 @@ double Gaussian::pairAbove(const Disc& a, const Disc& b, double d, double /*inte
       return 0.0;  // P <= the bound < known: this pair cannot raise the maximum
     }
   }
-  return pairAt(a, b, d);
+  return pairWithin(a, b, d);
 }
 
 double Gaussian::pairAt(const Disc& a, const Disc& b, double d) const {
   if (d >= cullDistance(a, b)) {
     return 0.0;
   }
+  return pairWithin(a, b, d);
+}
+
+double Gaussian::pairWithin(const Disc& a, const Disc& b, double d) const {
   if (a.anisotropic() || b.anisotropic()) {
     // Independent errors: the relative position's covariance is the sum of the two. The quadrature is
     // not bitwise even in the mean, so the pair is put in one order to keep pair(a, b) == pair(b, a).
     if (a.x > b.x || (a.x == b.x && a.y > b.y)) {
-      return pairAt(b, a, d);
+      return pairWithin(b, a, d);
     }
     const Cov2 ca = a.covariance();
     const Cov2 cb = b.covariance();

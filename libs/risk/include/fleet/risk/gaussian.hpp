@@ -84,6 +84,7 @@ class Gaussian final : public RiskModel {
 
  private:
   [[nodiscard]] double pairAt(const Disc& a, const Disc& b, double d) const;
+  [[nodiscard]] double pairWithin(const Disc& a, const Disc& b, double d) const;  // d below the cull
   double floor_;
   double tailSigmas_;  // sqrt(2 ln(1/floor)), slightly padded
   GaussianEvaluation evaluation_;
