@@ -375,15 +375,12 @@ void FusionEngine::paintSourceRows(const SourcePaint& sp, int rowLo, int rowHi) 
   coverLo_.assign(rows, 1);
   coverHi_.assign(rows, 0);  // lo > hi: nothing written in the row yet
   const GridSpec& g = config_.grid;
-  const int K = config_.levels;
   double* P = result_.probability.p.data();
   std::uint8_t* L = result_.levels.level.data();
   for (std::uint32_t n = sp.begin; n < sp.end; ++n) {
     const PaintDisc pd = paintList_[n];
-    // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
-    // level with max gives the classified grid without a pass over the cells.
-    const auto level = static_cast<std::uint8_t>(isoLevel(pd.p, K));
-    rowSpans(*disc_[pd.q], rowLo, rowHi);
+    const std::uint8_t level = pd.level;
+    rowSpans(Disc{pd.x, pd.y, pd.r}, rowLo, rowHi);
     auto write = [&](int j, int a, int b) {
       if (!allDirty_) {
         writeSpan(j, a, b, pd.p, level);
@@ -443,8 +440,11 @@ void FusionEngine::paint(bool full) {
     for (std::size_t k = 0; k < steps; ++k) {
       const std::size_t q = s * steps + k;
       if (active_[q] != 0 && discMax_[q] > 0.0) {
-        paintList_.push_back(PaintDisc{discMax_[q], static_cast<std::uint32_t>(q)});
         const Disc& d = *disc_[q];
+        // The level of a cell is that of its maximum, and isoLevel is monotone, so painting each disc's
+        // level with max gives the classified grid without a pass over the cells.
+        paintList_.push_back(PaintDisc{d.x, d.y, d.r, discMax_[q],
+                                       static_cast<std::uint8_t>(isoLevel(discMax_[q], config_.levels))});
         const double fy = (d.y - g.originY) * invRes - 0.5;
         const double fr = d.r * invRes;
         rowMin = std::min(rowMin, firstRow(fy - fr));

@@ -133,9 +133,9 @@ class FusionEngine {
   std::vector<double> cellX_;           // cell-centre x of every column
   std::vector<double> cellY_;           // and y of every row
   std::vector<int> coverLo_, coverHi_;  // per row of the source being painted: cells it already holds
-  struct PaintDisc {
-    double p;
-    std::uint32_t q;
+  struct PaintDisc {  // what painting reads of a disc (copied: the discs are scattered), its score and level
+    double x, y, r, p;
+    std::uint8_t level;
   };
   std::vector<PaintDisc> paintList_;  // per source, in decreasing score
   std::vector<SourcePaint> sourcePaints_;
