@@ -521,15 +521,20 @@ void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   const Disc& b = *disc_[qb];
   const double d = centreDistance(a, b);
   // Most pairs of the Gaussian model's reach do not touch: no call for their zero area.
-  const bool touching = d < a.r + b.r;
-  const double inter = touching ? discIntersectionArea(a.r, b.r, d) : 0.0;
-  interSum_[static_cast<std::size_t>(k)] += inter;
-  if (active_[qa] == 0 && active_[qb] == 0) {
+  const double R = a.r + b.r;
+  if (d < R) {
+    const double inter = discIntersectionArea(a.r, b.r, d);
+    interSum_[static_cast<std::size_t>(k)] += inter;
+    if (active_[qa] != 0 || active_[qb] != 0) {
+      scorePair(qa, qb, d, inter);  // touching pairs score highest: first, so more of the others skip
+    }
     return;
   }
-  if (touching) {
-    scorePair(qa, qb, d, inter);  // touching pairs score highest: first, so more of the others skip
-  } else {
+  // Beyond the model's cull (tighter than the reaches: for the Gaussian √(σa² + σb²) instead of
+  // σa + σb) the pair scores 0; a third of the Gaussian's candidates end here.
+  const double ta = qtail_[qa];
+  const double tb = qtail_[qb];
+  if ((active_[qa] != 0 || active_[qb] != 0) && d < R + std::sqrt(ta * ta + tb * tb)) {
     deferred_.push_back(DeferredPair{qa, qb, d});
   }
 }
@@ -716,6 +721,7 @@ void FusionEngine::recompute(bool full) {
   qx_.resize(nq);
   qy_.resize(nq);
   qreach_.resize(nq);
+  qtail_.resize(nq);
   std::vector<double> areaAll(K, 0.0), areaHumans(K, 0.0);
   std::vector<std::size_t> count(K, 0), humans(K, 0);
   double maxReach = 0.0;
@@ -737,6 +743,7 @@ void FusionEngine::recompute(bool full) {
       qx_[q] = d.x;
       qy_[q] = d.y;
       qreach_[q] = model_->reach(d);
+      qtail_[q] = model_->tail(d);
       maxReach = std::max(maxReach, qreach_[q]);
       const double a = std::numbers::pi * d.r * d.r;
       areaAll[k] += a;

@@ -432,6 +432,10 @@ double Gaussian::cullDistance(const Disc& a, const Disc& b) const {
   return a.r + b.r + std::sqrt(sa * sa + sb * sb) * tailSigmas_;
 }
 
+double Gaussian::tail(const Disc& a) const {
+  return a.sigmaMax() * tailSigmas_;
+}
+
 double Gaussian::reach(const Disc& a) const {
   return a.r + a.sigmaMax() * tailSigmas_;
 }
