@@ -517,13 +517,17 @@ void FusionEngine::scorePair(std::uint32_t qa, std::uint32_t qb, double d, doubl
 void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   // Called for two discs of one step within reach of each other, of sources the policy pairs.
   ++result_.stats.pairsTested;
-  const Disc& a = *disc_[qa];
-  const Disc& b = *disc_[qb];
-  const double d = centreDistance(a, b);
+  // From the contiguous copies rather than the discs (scattered over the sources' records); the same
+  // doubles, so d is centreDistance(a, b) exactly.
+  const double dx = qx_[qa] - qx_[qb];
+  const double dy = qy_[qa] - qy_[qb];
+  const double d = std::sqrt(dx * dx + dy * dy);
+  const double ra = qr_[qa];
+  const double rb = qr_[qb];
   // Most pairs of the Gaussian model's reach do not touch: no call for their zero area.
-  const double R = a.r + b.r;
+  const double R = ra + rb;
   if (d < R) {
-    const double inter = discIntersectionArea(a.r, b.r, d);
+    const double inter = discIntersectionArea(ra, rb, d);
     interSum_[static_cast<std::size_t>(k)] += inter;
     if (active_[qa] != 0 || active_[qb] != 0) {
       scorePair(qa, qb, d, inter);  // touching pairs score highest: first, so more of the others skip
@@ -624,7 +628,7 @@ void FusionEngine::scanWindow(int k0, int k1) {
   auto sourcePair = [&](std::uint32_t ia, std::uint32_t ib) {
     const std::uint32_t sa = itemSource_[ia];
     const std::uint32_t sb = itemSource_[ib];
-    if (!pairAllowed(entries_[sa]->source.kind, entries_[sb]->source.kind, policy)) {
+    if (!pairAllowed(kind_[sa], kind_[sb], policy)) {
       return;
     }
     const std::size_t ba = sa * steps;
@@ -722,13 +726,16 @@ void FusionEngine::recompute(bool full) {
   qy_.resize(nq);
   qreach_.resize(nq);
   qtail_.resize(nq);
+  qr_.resize(nq);
+  kind_.resize(entries_.size());
   std::vector<double> areaAll(K, 0.0), areaHumans(K, 0.0);
   std::vector<std::size_t> count(K, 0), humans(K, 0);
   double maxReach = 0.0;
   constexpr double kAbsent = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t s = 0; s < entries_.size(); ++s) {
     const auto& aligned = entries_[s]->aligned.steps;
-    const bool human = entries_[s]->source.kind == SourceKind::kHuman;
+    kind_[s] = entries_[s]->source.kind;
+    const bool human = kind_[s] == SourceKind::kHuman;
     for (std::size_t k = 0; k < K; ++k) {
       const std::size_t q = s * K + k;
       const auto& slot = aligned[k];
@@ -744,6 +751,7 @@ void FusionEngine::recompute(bool full) {
       qy_[q] = d.y;
       qreach_[q] = model_->reach(d);
       qtail_[q] = model_->tail(d);
+      qr_[q] = d.r;
       maxReach = std::max(maxReach, qreach_[q]);
       const double a = std::numbers::pi * d.r * d.r;
       areaAll[k] += a;

@@ -127,6 +127,8 @@ class FusionEngine {
   std::vector<const Disc*> disc_;         // nullptr when the source has no disc at that step
   std::vector<double> qx_, qy_, qreach_;  // centre (NaN when absent, so no distance test passes) and reach
   std::vector<double> qtail_;             // RiskModel::tail
+  std::vector<double> qr_;                // radius
+  std::vector<SourceKind> kind_;          // per source
   std::vector<double> discMax_;           // the largest score of the disc's pairs
   std::vector<std::uint8_t> active_;      // the disc touches a tile being recomputed
   std::vector<double> interSum_;          // Σ∩ per step, for the scene index
