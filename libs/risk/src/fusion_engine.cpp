@@ -176,6 +176,8 @@ const FusionResult& FusionEngine::fuse(std::int64_t tRefNs) {
 namespace {
 // Conservative row bounds of a disc whose rows span the row coordinates [lo, hi]: floor(lo) − 1 and
 // at least ceil(hi) + 1, by truncation of clamped values (cheaper than floor/ceil without SSE4.1).
+constexpr double kDeferredBins = 32.0;
+
 int firstRow(double lo) {
   return static_cast<int>(std::clamp(lo, 1.0, 2e9)) - 1;
 }
@@ -538,8 +540,15 @@ void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   // σa + σb) the pair scores 0; a third of the Gaussian's candidates end here.
   const double ta = qtail_[qa];
   const double tb = qtail_[qb];
-  if ((active_[qa] != 0 || active_[qb] != 0) && d < R + std::sqrt(ta * ta + tb * tb)) {
-    deferred_.push_back(DeferredPair{qa, qb, d});
+  const double t2 = ta * ta + tb * tb;
+  if ((active_[qa] != 0 || active_[qb] != 0) && d < R + std::sqrt(t2)) {
+    // Scored later in kDeferredBins bins of (gap / √(ta² + tb²))² ∈ [0, 1): for the Gaussian a
+    // decreasing order of the tail bound, so a disc's best partners come first and set the maxima
+    // that let the model skip the rest.
+    const double gap = d - R;
+    const auto bin = static_cast<std::uint8_t>(
+        std::min(kDeferredBins - 1.0, t2 > 0.0 ? gap * gap / t2 * kDeferredBins : 0.0));
+    deferred_.push_back(DeferredPair{qa, qb, d, bin});
   }
 }
 
@@ -830,7 +839,18 @@ void FusionEngine::recompute(bool full) {
   for (int k0 = 0; k0 < steps; k0 += w) {
     scanWindow(k0, std::min(steps, k0 + w));
   }
+  deferredStart_.assign(static_cast<std::size_t>(kDeferredBins) + 1, 0);
   for (const DeferredPair& q : deferred_) {
+    ++deferredStart_[q.bin + 1u];
+  }
+  for (std::size_t b = 0; b < static_cast<std::size_t>(kDeferredBins); ++b) {
+    deferredStart_[b + 1] += deferredStart_[b];
+  }
+  deferredSorted_.resize(deferred_.size());
+  for (const DeferredPair& q : deferred_) {
+    deferredSorted_[deferredStart_[q.bin]++] = q;
+  }
+  for (const DeferredPair& q : deferredSorted_) {
     scorePair(q.qa, q.qb, q.d, 0.0);
   }
 

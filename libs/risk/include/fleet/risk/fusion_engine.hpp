@@ -160,8 +160,11 @@ class FusionEngine {
   struct DeferredPair {
     std::uint32_t qa, qb;
     double d;
+    std::uint8_t bin;  // of the gap relative to the tails
   };
   std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
+  std::vector<DeferredPair> deferredSorted_;
+  std::vector<std::uint32_t> deferredStart_;
   double maxReachInHash_ = 0.0;
   double bucketSize_ = 1.0;
   int bucketsX_ = 0;
