@@ -850,7 +850,17 @@ void FusionEngine::recompute(bool full) {
   for (const DeferredPair& q : deferred_) {
     deferredSorted_[deferredStart_[q.bin]++] = q;
   }
-  for (const DeferredPair& q : deferredSorted_) {
+  // In bin order the pairs' discs are scattered: their loads are issued a few pairs ahead.
+  constexpr std::size_t kAhead = 8;
+  for (std::size_t n = 0; n < deferredSorted_.size(); ++n) {
+    if (n + kAhead < deferredSorted_.size()) {
+      const DeferredPair& f = deferredSorted_[n + kAhead];
+      __builtin_prefetch(disc_[f.qa]);
+      __builtin_prefetch(disc_[f.qb]);
+      __builtin_prefetch(&discMax_[f.qa]);
+      __builtin_prefetch(&discMax_[f.qb]);
+    }
+    const DeferredPair& q = deferredSorted_[n];
     scorePair(q.qa, q.qb, q.d, 0.0);
   }
 
