@@ -521,11 +521,11 @@ void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   ++result_.stats.pairsTested;
   // From the contiguous copies rather than the discs (scattered over the sources' records); the same
   // doubles, so d is centreDistance(a, b) exactly.
-  const double dx = qx_[qa] - qx_[qb];
-  const double dy = qy_[qa] - qy_[qb];
+  const double dx = qd_[qa].x - qd_[qb].x;
+  const double dy = qd_[qa].y - qd_[qb].y;
   const double d = std::sqrt(dx * dx + dy * dy);
-  const double ra = qr_[qa];
-  const double rb = qr_[qb];
+  const double ra = qd_[qa].r;
+  const double rb = qd_[qb].r;
   // Most pairs of the Gaussian model's reach do not touch: no call for their zero area.
   const double R = ra + rb;
   if (d < R) {
@@ -538,8 +538,8 @@ void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   }
   // Beyond the model's cull (tighter than the reaches: for the Gaussian √(σa² + σb²) instead of
   // σa + σb) the pair scores 0; a third of the Gaussian's candidates end here.
-  const double ta = qtail_[qa];
-  const double tb = qtail_[qb];
+  const double ta = qd_[qa].tail;
+  const double tb = qd_[qb].tail;
   const double t2 = ta * ta + tb * tb;
   if ((active_[qa] != 0 || active_[qb] != 0) && d < R + std::sqrt(t2)) {
     // Scored later in kDeferredBins bins of (gap / √(ta² + tb²))² ∈ [0, 1): for the Gaussian a
@@ -569,8 +569,8 @@ int FusionEngine::windowLength() const {
     for (int k = 0; k + 1 < steps; k += 4) {
       const std::size_t q = s * static_cast<std::size_t>(steps) + static_cast<std::size_t>(k);
       if (disc_[q] != nullptr && disc_[q + 1] != nullptr) {
-        reach.push_back(qreach_[q]);
-        move.push_back(std::hypot(qx_[q + 1] - qx_[q], qy_[q + 1] - qy_[q]));
+        reach.push_back(qd_[q].reach);
+        move.push_back(std::hypot(qd_[q + 1].x - qd_[q].x, qd_[q + 1].y - qd_[q].y));
       }
     }
   }
@@ -600,14 +600,14 @@ void FusionEngine::scanWindow(int k0, int k1) {
         continue;
       }
       if (!any) {
-        minX = maxX = qx_[q];
-        minY = maxY = qy_[q];
+        minX = maxX = qd_[q].x;
+        minY = maxY = qd_[q].y;
         any = true;
       } else {
-        minX = std::min(minX, qx_[q]);
-        maxX = std::max(maxX, qx_[q]);
-        minY = std::min(minY, qy_[q]);
-        maxY = std::max(maxY, qy_[q]);
+        minX = std::min(minX, qd_[q].x);
+        maxX = std::max(maxX, qd_[q].x);
+        minY = std::min(minY, qd_[q].y);
+        maxY = std::max(maxY, qd_[q].y);
       }
     }
     if (!any) {
@@ -619,7 +619,7 @@ void FusionEngine::scanWindow(int k0, int k1) {
     for (int k = k0; k < k1; ++k) {
       const std::size_t q = base + static_cast<std::size_t>(k);
       if (disc_[q] != nullptr) {
-        rho = std::max(rho, std::hypot(qx_[q] - cx, qy_[q] - cy) + qreach_[q]);
+        rho = std::max(rho, std::hypot(qd_[q].x - cx, qd_[q].y - cy) + qd_[q].reach);
       }
     }
     // |a_k − b_k| < reach_a + reach_b implies |c_a − c_b| < ρ_a + ρ_b by the triangle inequality; the
@@ -645,9 +645,9 @@ void FusionEngine::scanWindow(int k0, int k1) {
     for (int k = k0; k < k1; ++k) {
       const std::size_t qa = ba + static_cast<std::size_t>(k);
       const std::size_t qb = bb + static_cast<std::size_t>(k);
-      const double dx = qx_[qa] - qx_[qb];  // NaN when either is absent: the test below fails
-      const double dy = qy_[qa] - qy_[qb];
-      const double reachSum = qreach_[qa] + qreach_[qb];
+      const double dx = qd_[qa].x - qd_[qb].x;  // NaN when either is absent: the test below fails
+      const double dy = qd_[qa].y - qd_[qb].y;
+      const double reachSum = qd_[qa].reach + qd_[qb].reach;
       if (dx * dx + dy * dy < reachSum * reachSum) {
         visitPair(static_cast<std::uint32_t>(qa), static_cast<std::uint32_t>(qb), k);
       }
@@ -731,11 +731,7 @@ void FusionEngine::recompute(bool full) {
   // Source-major arrays of every disc, and the per-step sums of eq. (3.7) in the same order as before.
   const std::size_t nq = entries_.size() * K;
   disc_.assign(nq, nullptr);
-  qx_.resize(nq);
-  qy_.resize(nq);
-  qreach_.resize(nq);
-  qtail_.resize(nq);
-  qr_.resize(nq);
+  qd_.resize(nq);
   kind_.resize(entries_.size());
   std::vector<double> areaAll(K, 0.0), areaHumans(K, 0.0);
   std::vector<std::size_t> count(K, 0), humans(K, 0);
@@ -749,19 +745,13 @@ void FusionEngine::recompute(bool full) {
       const std::size_t q = s * K + k;
       const auto& slot = aligned[k];
       if (!slot.has_value()) {
-        qx_[q] = kAbsent;
-        qy_[q] = kAbsent;
-        qreach_[q] = 0.0;
+        qd_[q] = PairDisc{kAbsent, kAbsent, 0.0, 0.0, 0.0};
         continue;
       }
       const Disc& d = *slot;
       disc_[q] = &d;
-      qx_[q] = d.x;
-      qy_[q] = d.y;
-      qreach_[q] = model_->reach(d);
-      qtail_[q] = model_->tail(d);
-      qr_[q] = d.r;
-      maxReach = std::max(maxReach, qreach_[q]);
+      qd_[q] = PairDisc{d.x, d.y, model_->reach(d), d.r, model_->tail(d)};
+      maxReach = std::max(maxReach, qd_[q].reach);
       const double a = std::numbers::pi * d.r * d.r;
       areaAll[k] += a;
       ++count[k];

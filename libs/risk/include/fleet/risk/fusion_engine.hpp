@@ -124,14 +124,17 @@ class FusionEngine {
   // Scratch, kept between calls to avoid reallocation. Per-disc arrays are indexed source-major,
   // q = source · steps + step, over the sources in id order.
   std::vector<const Entry*> entries_;
-  std::vector<const Disc*> disc_;         // nullptr when the source has no disc at that step
-  std::vector<double> qx_, qy_, qreach_;  // centre (NaN when absent, so no distance test passes) and reach
-  std::vector<double> qtail_;             // RiskModel::tail
-  std::vector<double> qr_;                // radius
-  std::vector<SourceKind> kind_;          // per source
-  std::vector<double> discMax_;           // the largest score of the disc's pairs
-  std::vector<std::uint8_t> active_;      // the disc touches a tile being recomputed
-  std::vector<double> interSum_;          // Σ∩ per step, for the scene index
+  std::vector<const Disc*> disc_;  // nullptr when the source has no disc at that step
+  struct PairDisc {                // what the pair search reads of a disc, together
+    double x, y;                   // centre; NaN when absent, so no distance test passes
+    double reach, r;               // RiskModel::reach, radius
+    double tail;                   // RiskModel::tail
+  };
+  std::vector<PairDisc> qd_;
+  std::vector<SourceKind> kind_;      // per source
+  std::vector<double> discMax_;       // the largest score of the disc's pairs
+  std::vector<std::uint8_t> active_;  // the disc touches a tile being recomputed
+  std::vector<double> interSum_;      // Σ∩ per step, for the scene index
   std::vector<RowSpan> rowSpans_;
   std::vector<double> cellX_;           // cell-centre x of every column
   std::vector<double> cellY_;           // and y of every row
