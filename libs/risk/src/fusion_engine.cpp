@@ -619,7 +619,10 @@ void FusionEngine::scanWindow(int k0, int k1) {
     for (int k = k0; k < k1; ++k) {
       const std::size_t q = base + static_cast<std::size_t>(k);
       if (disc_[q] != nullptr) {
-        rho = std::max(rho, std::hypot(qd_[q].x - cx, qd_[q].y - cy) + qd_[q].reach);
+        // sqrt rather than hypot (coordinates are validated); the padding below covers its rounding.
+        const double dx = qd_[q].x - cx;
+        const double dy = qd_[q].y - cy;
+        rho = std::max(rho, std::sqrt(dx * dx + dy * dy) + qd_[q].reach);
       }
     }
     // |a_k − b_k| < reach_a + reach_b implies |c_a − c_b| < ρ_a + ρ_b by the triangle inequality; the
