@@ -377,26 +377,49 @@ double Gaussian::pair(const Disc& a, const Disc& b) const {
 
 double Gaussian::pairAbove(const Disc& a, const Disc& b, double d, double /*intersectionArea*/,
                            double known) const {
+  // The cull first (a square root): many of the engine's candidates within reach(a) + reach(b) lie
+  // beyond it, and for them the exp of the bound below would be wasted.
+  if (d >= cullDistance(a, b)) {
+    return 0.0;
+  }
   const double gap = d - (a.r + b.r);
   if (known > 0.0 && gap > 0.0) {
-    const double sa = a.sigmaMax();
-    const double sb = b.sigmaMax();
-    if (std::exp(-0.5 * gap * gap / (sa * sa + sb * sb)) < known) {
+    // The disc ‖x‖ <= R lies in the half-plane u·x <= R (u the unit vector of the mean), and u·x is
+    // normal with mean d and variance s² = uᵀ(Ca + Cb)u, so P <= Φ(−t) with t = gap/s, and Φ(−t) <=
+    // min(1/2, 1/(t√(2π)))·e^{−t²/2}. Tighter than the Rayleigh bound e^{−gap²/2(λa + λb)} of the cull,
+    // by 2× and more for isotropic discs and by far across an anisotropic disc's narrow axis.
+    double s2 = 0.0;
+    if (!a.anisotropic() && !b.anisotropic()) {
+      s2 = a.sigma * a.sigma + b.sigma * b.sigma;
+    } else {
+      const Cov2 ca = a.covariance();
+      const Cov2 cb = b.covariance();
+      const double ux = (b.x - a.x) / d;
+      const double uy = (b.y - a.y) / d;
+      s2 = ux * ux * (ca.xx + cb.xx) + 2.0 * ux * uy * (ca.xy + cb.xy) + uy * uy * (ca.yy + cb.yy);
+    }
+    const double t2 = gap * gap / std::max(s2, 0.0);
+    const double bound = std::exp(-0.5 * t2) * std::min(0.5, 1.0 / std::sqrt(2.0 * kPi * t2));
+    if (bound * (1.0 + 1e-9) < known) {
       return 0.0;  // P <= the bound < known: this pair cannot raise the maximum
     }
   }
-  return pairAt(a, b, d);
+  return pairWithin(a, b, d);
 }
 
 double Gaussian::pairAt(const Disc& a, const Disc& b, double d) const {
   if (d >= cullDistance(a, b)) {
     return 0.0;
   }
+  return pairWithin(a, b, d);
+}
+
+double Gaussian::pairWithin(const Disc& a, const Disc& b, double d) const {
   if (a.anisotropic() || b.anisotropic()) {
     // Independent errors: the relative position's covariance is the sum of the two. The quadrature is
     // not bitwise even in the mean, so the pair is put in one order to keep pair(a, b) == pair(b, a).
     if (a.x > b.x || (a.x == b.x && a.y > b.y)) {
-      return pairAt(b, a, d);
+      return pairWithin(b, a, d);
     }
     const Cov2 ca = a.covariance();
     const Cov2 cb = b.covariance();
@@ -421,6 +444,10 @@ double Gaussian::cullDistance(const Disc& a, const Disc& b) const {
   const double sa = a.sigmaMax();
   const double sb = b.sigmaMax();
   return a.r + b.r + std::sqrt(sa * sa + sb * sb) * tailSigmas_;
+}
+
+double Gaussian::tail(const Disc& a) const {
+  return a.sigmaMax() * tailSigmas_;
 }
 
 double Gaussian::reach(const Disc& a) const {

@@ -7,6 +7,7 @@
 
 #include "fleet/risk/fusion_engine.hpp"
 #include "fleet/risk/gaussian.hpp"
+#include "fleet/risk/overlap_ratio.hpp"
 
 namespace fleet::risk {
 namespace {
@@ -62,6 +63,46 @@ TEST(AnisotropicDiscs, CullAndReachBoundTheAnisotropicPair) {
         1e-4);
     EXPECT_EQ(m.pair(a, far), 0.0);
   }
+}
+
+// The fusion engine drops a pair at or beyond a.r + b.r + √(tail(a)² + tail(b)²) without asking the
+// model: the pair must score exactly 0 there (isotropic and anisotropic, fast and exact evaluation).
+TEST(AnisotropicDiscs, PairsAtOrBeyondTheTailDistanceScoreZero) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const auto eval : {GaussianEvaluation::kExact, GaussianEvaluation::kFast}) {
+    const Gaussian m(1e-4, eval);
+    for (int i = 0; i < 2000; ++i) {
+      Disc a{0, 0, 0.2 + 0.4 * u(rng), 0.02 + 0.9 * u(rng)};
+      if (i % 2 == 0) {
+        a.cov = covAlong(6.283 * u(rng), 0.05 + 0.8 * u(rng), 0.01 + 0.2 * u(rng));
+        a.sigma = a.sigmaMax();
+      }
+      const double rb = 0.2 + 0.4 * u(rng), sb = 0.02 + 0.9 * u(rng);
+      const double ta = m.tail(a), tb = m.tail(Disc{0, 0, rb, sb});
+      const double t = a.r + rb + std::sqrt(ta * ta + tb * tb), th = 6.283 * u(rng);
+      ASSERT_LE(std::abs(t - m.cullDistance(a, Disc{0, 0, rb, sb})), 1e-12 * t) << i;
+      for (const double scale : {1.0, 1.0 + 1e-12, 1.01}) {
+        const Disc b{t * scale * std::cos(th), t * scale * std::sin(th), rb, sb};
+        ASSERT_GE(centreDistance(a, b), t * (1.0 - 1e-15));
+        EXPECT_EQ(m.pair(a, b), 0.0) << i << " " << scale;
+      }
+    }
+  }
+  // The overlap ratio's tail is 0 (touching is the cull), and the default for other models follows from
+  // the reaches.
+  const OverlapRatio o;
+  EXPECT_EQ(o.tail(Disc{0, 0, 0.4, 0.3}), 0.0);
+  struct ReachOnly final : RiskModel {
+    double pair(const Disc& a, const Disc& b) const override {
+      return centreDistance(a, b) < 1.0 ? 1.0 : 0.0;
+    }
+    double cullDistance(const Disc&, const Disc&) const override { return 1.0; }
+    double reach(const Disc&) const override { return 0.5; }
+    std::string_view name() const override { return "reach_only"; }
+  } r;
+  const Disc z{0, 0, 0.1, 0};
+  EXPECT_GE(z.r + z.r + std::sqrt(2.0) * r.tail(z), r.cullDistance(z, z));
 }
 
 TEST(AnisotropicDiscs, ValidationRefusesNonFiniteAndIndefiniteCovariances) {

@@ -90,19 +90,22 @@ class FusionEngine {
     TimeBase alignedFor{};
     bool hasAligned = false;
   };
-  struct StepDisc {
-    Disc disc;
-    std::uint32_t source;  // index into the current entry order
-    SourceKind kind;
-    double reach;
-  };
-
   FusionEngine(FusionConfig config, std::shared_ptr<const RiskModel> model);
   void noteChanged(const AlignedSource& aligned);
   void markDirtyTiles(double maxReach);
   void recompute(bool full);
-  void paintDisc(const Disc& d, double p, std::uint8_t level);
-  void buildHash(const std::vector<StepDisc>& discs);
+  int windowLength() const;
+  void scanWindow(int k0, int k1);
+  void visitPair(std::uint32_t qa, std::uint32_t qb, int k);
+  void scorePair(std::uint32_t qa, std::uint32_t qb, double d, double inter);
+  void rowSpans(const Disc& d, int rowLo, int rowHi);
+  void writeSpan(int j, int a, int b, double p, std::uint8_t level);
+  struct SourcePaint {
+    std::uint32_t begin, end;  // its discs in paintList_
+    int rowMin, rowMax;        // rows they may cover
+  };
+  void paintSourceRows(const SourcePaint& sp, int rowLo, int rowHi);
+  void paint(bool full);
 
   FusionConfig config_;
   std::shared_ptr<const RiskModel> model_;
@@ -115,45 +118,61 @@ class FusionEngine {
   int tileShift_ = 0;
   int tilesX_ = 0;
   int tilesY_ = 0;
-  struct Paint {  // what painting reads of a disc (not its uncertainty), and the score
-    double x, y, r;
-    double p;
-  };
   struct RowSpan {
     int j, a, b;  // row j, cells a..b inside the disc
   };
-  // scratch, kept between calls to avoid reallocation
-  std::vector<Paint> paints_;
+  // Scratch, kept between calls to avoid reallocation. Per-disc arrays are indexed source-major,
+  // q = source · steps + step, over the sources in id order.
+  std::vector<const Entry*> entries_;
+  std::vector<const Disc*> disc_;  // nullptr when the source has no disc at that step
+  struct PairDisc {                // what the pair search reads of a disc, together
+    double x, y;                   // centre; NaN when absent, so no distance test passes
+    double reach, r;               // RiskModel::reach, radius
+    double tail;                   // RiskModel::tail
+  };
+  std::vector<PairDisc> qd_;
+  std::vector<SourceKind> kind_;      // per source
+  std::vector<double> discMax_;       // the largest score of the disc's pairs
+  std::vector<std::uint8_t> active_;  // the disc touches a tile being recomputed
+  std::vector<double> interSum_;      // Σ∩ per step, for the scene index
   std::vector<RowSpan> rowSpans_;
-  std::vector<std::uint32_t> bucketFill_;
-  std::vector<std::uint32_t> paintTile_;
-  std::vector<std::uint32_t> tileStart_;
-  std::vector<Paint> sortedPaints_;
-  std::vector<double> cellX_;  // cell-centre x of every column
-  std::vector<std::vector<StepDisc>> stepDiscs_;
-  std::vector<double> discMax_;
-  std::vector<std::uint8_t> active_;
-  std::vector<std::uint32_t> bucketStart_;
-  std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> bucketOf_;
+  std::vector<double> cellX_;           // cell-centre x of every column
+  std::vector<double> cellY_;           // and y of every row
+  std::vector<int> coverLo_, coverHi_;  // per row of the source being painted: cells it already holds
+  struct PaintDisc {  // what painting reads of a disc (copied: the discs are scattered), its score and level
+    double x, y, r, p;
+    std::uint8_t level;
+  };
+  std::vector<PaintDisc> paintList_;  // per source, in decreasing score
+  std::vector<SourcePaint> sourcePaints_;
+  std::vector<std::uint32_t> bandStart_, bandFill_, bandItems_;  // sources by band of rows
+  // The spatial hash over the sources' bounding circles of one window of steps.
   struct HashEntry {
     double x, y, reach;
     bool wide;  // reach above half a bucket: searched from its own side
   };
-  std::vector<HashEntry> sorted_;  // the discs in bucket order
-  struct DeferredPair {
-    std::uint32_t i, j;
-    double d;
-  };
-  std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
+  std::vector<HashEntry> items_;  // per source present in the window
+  std::vector<std::uint32_t> itemSource_;
+  std::vector<HashEntry> sorted_;  // the items in bucket order
+  std::vector<std::uint32_t> bucketStart_;
+  std::vector<std::uint32_t> bucketFill_;
+  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> bucketOf_;
   std::vector<std::uint32_t> wide_;
   std::vector<double> reachScratch_;
+  struct DeferredPair {
+    std::uint32_t qa, qb;
+    double d;
+    std::uint8_t bin;  // of the gap relative to the tails
+  };
+  std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
+  std::vector<DeferredPair> deferredSorted_;
+  std::vector<std::uint32_t> deferredStart_;
   double maxReachInHash_ = 0.0;
-  double bucketMinX_ = 0.0;
-  double bucketMinY_ = 0.0;
   double bucketSize_ = 1.0;
   int bucketsX_ = 0;
   int bucketsY_ = 0;
+  void buildHash();
 };
 
 }  // namespace fleet::risk

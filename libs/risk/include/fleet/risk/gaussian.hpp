@@ -79,11 +79,16 @@ class Gaussian final : public RiskModel {
                                  double known) const override;
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double reach(const Disc& a) const override;
+  /// σmax(a)·√(2 ln(1/floor)) (padded): a.r + b.r + √(tail(a)² + tail(b)²) is cullDistance(a, b) up to
+  /// rounding, and the padding puts the probability there below the floor, so a pair at or beyond it
+  /// is 0 either way.
+  [[nodiscard]] double tail(const Disc& a) const override;
   [[nodiscard]] std::string_view name() const override { return "gaussian"; }
   [[nodiscard]] double floor() const { return floor_; }
 
  private:
   [[nodiscard]] double pairAt(const Disc& a, const Disc& b, double d) const;
+  [[nodiscard]] double pairWithin(const Disc& a, const Disc& b, double d) const;  // d below the cull
   double floor_;
   double tailSigmas_;  // sqrt(2 ln(1/floor)), slightly padded
   GaussianEvaluation evaluation_;

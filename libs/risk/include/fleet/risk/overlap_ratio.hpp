@@ -32,6 +32,8 @@ class OverlapRatio final : public RiskModel {
   [[nodiscard]] double pair(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double cullDistance(const Disc& a, const Disc& b) const override;
   [[nodiscard]] double reach(const Disc& a) const override;
+  /// 0: discs that do not touch score 0.
+  [[nodiscard]] double tail(const Disc& /*a*/) const override { return 0.0; }
   [[nodiscard]] std::string_view name() const override { return "overlap_ratio"; }
   [[nodiscard]] double pairWithIntersection(const Disc& a, const Disc& b, double d,
                                             double intersectionArea) const override;

@@ -22,6 +22,11 @@ class RiskModel {
   /// can find all candidate partners of a disc without knowing them first.
   [[nodiscard]] virtual double reach(const Disc& a) const = 0;
 
+  /// Per-disc part of the cull distance beyond the radii, for a tighter test than reach(a) + reach(b):
+  /// pair(a, b) is 0 whenever the centre distance is at least a.r + b.r + √(tail(a)² + tail(b)²). The
+  /// default √2·reach(a) follows from the reach contract (√(2·ra² + 2·rb²) >= ra + rb) for any model.
+  [[nodiscard]] virtual double tail(const Disc& a) const { return 1.4142135623730951 * reach(a); }
+
   [[nodiscard]] virtual std::string_view name() const = 0;
   /// pair(a, b) for a caller that already has the centre distance d and the area of intersection of the
   /// two discs (the fusion engine needs it for the scene index); must equal pair(a, b) exactly.
