@@ -357,8 +357,10 @@ bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, 
   const double ahead = c * dx + s * dy;
   const double side = -s * dx + c * dy;
   const double front = config_.length / 2.0;
-  return ahead + radius >= 0.0 && ahead - radius <= front + config_.protectiveField &&
-         std::abs(side) - radius <= config_.width / 2.0;
+  const double v = std::abs(last_command_.v);
+  const double reach = config_.protectiveField + v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
+  return ahead + radius >= 0.0 && ahead - radius <= front + reach &&
+         std::abs(side) - radius <= config_.width / 2.0 + config_.fieldSideMargin;
 }
 
 }  // namespace fleet::sim

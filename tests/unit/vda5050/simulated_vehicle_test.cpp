@@ -112,12 +112,23 @@ TEST(Vda5050Vehicle, APersonInTheProtectiveFieldStopsIt) {
   r.run(10.0);
   EXPECT_GT(r.pose.x, x + 1.0);
 
-  // The field is ahead, not behind, and as wide as the vehicle.
+  // The field is ahead, not behind, a little wider than the vehicle (standing: 0.3 + 1 m ahead of
+  // the centre, 0.3 + 0.3 m to each side).
   const Pose2 p{0.0, 0.0, 0.0};
   EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.0, 0.0, 0.25));
   EXPECT_FALSE(r.vehicle.inProtectiveField(p, -1.5, 0.0, 0.25));
   EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.0, 1.5, 0.25));
-  EXPECT_FALSE(r.vehicle.inProtectiveField(p, 3.0, 0.0, 0.25));
+  EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.0, 0.8, 0.25)) << "beside the vehicle's width";
+  EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25));
+}
+
+TEST(Vda5050Vehicle, ItsProtectiveFieldGrowsWithItsSpeed) {
+  Rig r;
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);
+  const Pose2 p{0.0, 0.0, 0.0};
+  EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25)) << "standing";
+  r.run(2.0);  // up to speed along the line
+  EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25)) << "driving: its braking distance too";
 }
 
 TEST(Vda5050Vehicle, PauseResumeAndCancel) {
