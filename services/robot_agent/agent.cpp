@@ -63,6 +63,9 @@ SensorReading readingOf(const msg::SensorFrame& f) {
 }
 
 constexpr double kLookahead = 0.5;
+/// In reserved traffic DWA's rollout at cruise ends this fraction of the way to its carrot (see
+/// the constructor).
+constexpr double kRolloutToCarrot = 0.8;
 constexpr double kQueueDistance = 2.0;     // m from a station where a robot waits while it is taken
 constexpr double kTrailStep = 0.25;        // m between trail points
 constexpr double kUndockDistance = 1.0;    // m the follower drives off a station before the planner
@@ -182,9 +185,12 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       // which peaks where the rollout ends on the carrot: 0.8 m over 1.7 s is 0.47 m/s, and a lone
       // robot drove 72 % of its time at 0.4-0.6 m/s. A longer carrot cut shelf corners off the
       // base (a robot stood at one for good), so the rollout is shortened instead: at cruise it
-      // ends on the carrot. (Reactive traffic keeps both; the clearance term looks 2 m ahead
-      // either way.)
-      dwa.simTime = std::min(dwa.simTime, dwa.lookahead / p_.vMax);
+      // ends a fifth short of the carrot. (Ending exactly on it, the heading term's bearing from
+      // the rollout's end to the carrot swung sideways for a centimetre off the base, and a lone
+      // robot drove 0.6-0.75 m/s for 40 % of its time: 1.39-1.42x its kinematic bound, 1.23-1.26x
+      // with this and faster docking, docs/benchmarks.md. Reactive traffic keeps both; the
+      // clearance term looks 2 m ahead either way.)
+      dwa.simTime = std::min(dwa.simTime, kRolloutToCarrot * dwa.lookahead / p_.vMax);
     }
     auto inner = p_.localPlanner == "dwa" ? PlannerPtr(std::make_unique<avoidance::DynamicWindowPlanner>(dwa))
                  : stepping ? PlannerPtr(std::make_unique<avoidance::RiskSteppingPlanner>(steppingParams))

@@ -294,9 +294,12 @@ class Agent {
       gateRoute_;            // the base ahead, for the gate's stop rule (empty: reactive, straight corridor)
   bool baseAhead_ = false;   // driving along the base this cycle (progress watch)
   bool dockingLeg_ = false;  // on the base's last leg onto the goal
-  std::int64_t heldSinceNs_ = -1;                     // the gate has held the robot since (a person, ...)
-  Vec2 heldAt_;                                       // ... here
-  bool blocked_ = false;                              // ... for more than a second
+  bool aligning_ = false;    // turning on the spot to face the next base node
+  std::optional<Vec2> alignedTo_;  // ... done for this next node (once per node: see kMisaligned)
+  std::optional<Vec2> cornerAt_;   // the corner node it drove onto last (where it aligns)
+  std::int64_t heldSinceNs_ = -1;  // the gate has held the robot since (a person, ...)
+  Vec2 heldAt_;                    // ... here
+  bool blocked_ = false;           // ... for more than a second
   std::optional<msg::TrafficProgress> lastProgress_;  // the last report sent
 };
 

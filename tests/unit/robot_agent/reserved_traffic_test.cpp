@@ -3,8 +3,8 @@
 // synthetic releases in place of a traffic manager: it drives what is released and stops at its
 // end, keeps going when the base is extended in time, reports every node it reaches, ignores
 // releases it must not follow, docks when the base ends at its goal, waits (and fails nothing)
-// without releases, reports itself blocked by a person, and keeps to the released nodes round
-// corners.
+// without releases, reports itself blocked by a person, keeps to the released nodes round
+// corners, and drives off a corner node only once it faces the next node.
 //
 // RESERVED_TRACE=1 prints the robot's pose, command, speed, mode and node every cycle.
 
@@ -20,6 +20,7 @@
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
 #include "fleet/control/velocity_limits.hpp"
+#include "fleet/core/angles.hpp"
 
 using namespace fleet;
 
@@ -352,6 +353,31 @@ TEST_P(ReservedPlanner, FollowsABaseRoundCornersAndStaysOnIt) {
   EXPECT_GE(sim.truth.x, 2.0 - 0.05) << "overshot the end of the base";
   EXPECT_EQ(sim.lastNode(), 204);
   EXPECT_EQ(sim.twist.v, 0.0);
+}
+
+TEST_P(ReservedPlanner, DrivesOffACornerNodeOnlyOnceItFacesTheNextNode) {
+  // Along the lane, then a sharp turn (135°) up and back along a diagonal: standing on the corner
+  // node the robot turns on the spot until it faces the next node, then drives (an arc driven off
+  // a corner at speed swung it off a diagonal leg towards the shelf corner the leg passes).
+  Sim sim(GetParam());
+  std::vector<msg::RouteNode> base = lane(0, 6);  // to (4, 5)
+  for (int k = 1; k <= 4; ++k) {
+    base.push_back({100 + k, 4.0 - kSpacing * k, kY + kSpacing * k});  // to (2, 7)
+  }
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, base));
+  const Vec2 corner{4.0, kY};
+  const double leg = 0.75 * M_PI;
+  double worst = 0.0;  // the largest heading error off the leg while driving off the corner
+  while (sim.now() < 30.0) {
+    (void)sim.step();
+    if (sim.twist.v > 0.05 && distance(sim.truth.position(), corner) < 0.5 && sim.truth.y > kY + 0.02) {
+      worst = std::max(worst, std::abs(angleDiff(leg, sim.truth.theta)));
+    }
+  }
+  EXPECT_LT(worst, 0.15) << "drove off the corner still turning";
+  EXPECT_LT(distance(sim.truth.position(), {2.0, kY + 2.0}), 0.15);
+  EXPECT_EQ(sim.lastNode(), 104);
 }
 
 INSTANTIATE_TEST_SUITE_P(Reserved, ReservedPlanner, ::testing::Values("dwa", "follow"));
