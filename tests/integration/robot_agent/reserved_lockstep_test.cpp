@@ -96,7 +96,11 @@ TEST(AgentLockstepReserved, DrivesItsBaseRoundACornerAndStopsAtItsEnd) {
   ASSERT_FALSE(nodes.empty());
   EXPECT_EQ(nodes.back(), 1010);
   EXPECT_TRUE(std::is_sorted(nodes.begin(), nodes.end())) << "nodes reported out of order";
-  EXPECT_GE(nodes.size(), 8u) << "nodes skipped";
+  // (The topic keeps each robot's latest report (history 1) and this reader polls it every 100 ms
+  // of wall time while the lockstep runs faster, so a report can be overwritten before it is read;
+  // the contract allows that: reaching a node implies passing the ones before it. Requiring 8 of
+  // the 9 failed about 1 run in 5 on a loaded machine.)
+  EXPECT_GE(nodes.size(), 5u) << "most nodes never reported";
   const auto summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
   EXPECT_EQ(summary["contacts"]["robot_shelf"], 0);
   EXPECT_EQ(summary["lockstep_step_timeouts"], 0);
