@@ -269,8 +269,9 @@ std::vector<std::string> TrafficNode::stalled(std::int64_t nowNs, double minS) c
       os << "; it reports itself blocked";
     if (r.last.holding)
       os << "; it reports itself holding (docking, dwelling, paused or lost)";
-    if (static_cast<double>(nowNs - r.heardNs) * 1e-9 > settings_.robotTimeoutS)
-      os << "; not heard from for " << static_cast<int>(static_cast<double>(nowNs - r.heardNs) * 1e-9) << " s";
+    if (const double silentS = static_cast<double>(nowNs - r.heardNs) * 1e-9;
+        silentS > settings_.robotTimeoutS)
+      os << "; not heard from for " << static_cast<int>(silentS) << " s";
     if (!r.last.follows)
       os << "; it does not follow releases";
     out.push_back(os.str());

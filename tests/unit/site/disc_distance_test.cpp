@@ -24,14 +24,20 @@ TEST(DiscDistance, AClearDiagonalIsItsEuclideanLengthNotTheOctileOne) {
   EXPECT_NEAR(d.grid().resolution(), 0.1, 1e-12);
 }
 
-TEST(DiscDistance, BendsRoundABlockAtTheDiscsClearance) {
-  // A 2 m x 2 m block in the middle of a 10 m x 10 m hall, between start and goal.
+/// A 10 m x 10 m hall of 0.5 m cells with the square block of cells [from, to) x [from, to).
+OccupancyGrid hallWithBlock(int from, int to) {
   OccupancyGrid g(20, 20, 0.5);
-  for (int y = 8; y < 12; ++y) {
-    for (int x = 8; x < 12; ++x) {
+  for (int y = from; y < to; ++y) {
+    for (int x = from; x < to; ++x) {
       g.setBlocked({x, y});
     }
   }
+  return g;
+}
+
+TEST(DiscDistance, BendsRoundABlockAtTheDiscsClearance) {
+  // A 2 m x 2 m block in the middle of a 10 m x 10 m hall, between start and goal.
+  const OccupancyGrid g = hallWithBlock(8, 12);
   DiscDistance d(g, 0.3);
   const auto len = d.length({1.0, 5.0}, {9.0, 5.0});
   ASSERT_TRUE(len) << len.error().message;
@@ -42,12 +48,7 @@ TEST(DiscDistance, BendsRoundABlockAtTheDiscsClearance) {
 }
 
 TEST(DiscDistance, PlacesTheDiscCannotBeAreErrors) {
-  OccupancyGrid g(20, 20, 0.5);
-  for (int y = 4; y < 16; ++y) {
-    for (int x = 4; x < 16; ++x) {
-      g.setBlocked({x, y});
-    }
-  }
+  const OccupancyGrid g = hallWithBlock(4, 16);
   DiscDistance d(g, 0.3);
   const auto inside = d.length({5.0, 5.0}, {1.0, 1.0});
   ASSERT_FALSE(inside);
