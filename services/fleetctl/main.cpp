@@ -269,6 +269,16 @@ int main(int argc, char** argv) {
                    "roadmap's)")
       ->check(CLI::Range(0.0, 5.0));
   trafficSim
+      ->add_option("--max-lag", ts.maxLag,
+                   "planner steps a robot may fall behind the plan before everyone's unreleased plan is "
+                   "dropped and planned again (default: the traffic layer's)")
+      ->check(CLI::Range(1, 100000));
+  trafficSim
+      ->add_option("--prefer-straight", ts.straight,
+                   "1: among equally short moves the planner takes the one that turns least; 0: at random "
+                   "(default: the traffic layer's)")
+      ->check(CLI::Range(0, 1));
+  trafficSim
       ->add_option("--detour-after", ts.detourAfter,
                    "planner steps a robot stands short of its goal before it is routed round "
                    "robots standing in its way (0: never; default: the traffic layer's)")

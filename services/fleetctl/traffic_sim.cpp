@@ -48,6 +48,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.duration = o.duration;
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
+    if (o.maxLag > 0)
+      v.traffic.maxLag = o.maxLag;
+    if (o.straight >= 0)
+      v.traffic.pibt.preferStraight = o.straight != 0;
     if (o.detourAfter >= 0)
       v.traffic.pibt.detourAfter = o.detourAfter;
     if (o.detourPenalty >= 0.0)
@@ -86,8 +90,16 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"hold_violations", r.holdViolations},
                      {"longest_wait_s", r.longestWait},
                      {"replans", r.replans},
+                     {"evasions", r.evasions},
+                     {"detours", r.detours},
+                     {"escalations", r.escalations},
+                     {"untangles", r.untangles},
                      {"update_p99_ms", r.updateP99Ms},
                      {"density", r.density},
+                     {"time_driving", r.driving},
+                     {"time_dwelling", r.dwelling},
+                     {"time_waiting_on_others", r.waitingOnOthers},
+                     {"time_planned_to_stand", r.standingPlanned},
                      {"stalls", r.stalls}});
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";

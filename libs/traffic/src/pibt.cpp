@@ -3,6 +3,7 @@
 #include "fleet/traffic/untangle.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,7 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   const std::size_t n = starts.size();
   now_.assign(starts.begin(), starts.end());
   next_.assign(n, kNoNode);
+  prev_.assign(n, kNoNode);
   goal_.assign(n, kNoNode);
   table_.assign(n, nullptr);
   task_.assign(n, 0);
@@ -172,6 +174,8 @@ bool Pibt::setPosition(std::size_t agent, NodeId v) {
   }
   dropForced(forcedGroup_[agent]);
   agentAt_[idx(now_[agent])] = -1;
+  if (now_[agent] != v)
+    prev_[agent] = kNoNode;
   now_[agent] = v;
   agentAt_[idx(v)] = static_cast<std::int32_t>(agent);
   best_[agent] = DistanceTable::kUnreachable;
@@ -226,6 +230,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
     escalationDistance_.resize(n, 0.0F);
     escalationIdle_.resize(n, 0);
     still_.resize(n, 0);
+    prev_.resize(n, kNoNode);
     detour_.resize(n);
     detourFrom_.resize(n, 0.0F);
     tries_.resize(n, 0);
@@ -241,6 +246,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
       // Where it was planned to be is gone: its progress is measured afresh.
       best_[i] = DistanceTable::kUnreachable;
       stalled_[i] = 0;
+      prev_[i] = kNoNode;
     }
   }
   // A way out of a knot goes on from where the new positions are on it (the robots were released
@@ -413,12 +419,26 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
   Candidate* c = candidates_.data() + depth * stride_;
   std::size_t m = 0;
   const float* table = table_[a];
+  const NodeId back = prev_[a];
+  const bool straight = options_.preferStraight && back != kNoNode;
+  const Vec2 heading = straight ? graph_.position(from) - graph_.position(back) : Vec2{};
   const auto add = [&](NodeId v) {
     const float d = table != nullptr ? table[idx(v)] : (v == from ? 0.0F : 1.0F);
     const std::int32_t o = agentAt_[idx(v)];
     const auto occupied = static_cast<std::uint32_t>(o >= 0 && o != agent);
-    // Ties go to free nodes first, then at random (the seed makes the random part repeatable).
-    c[m++] = Candidate{v, d, (occupied << 31) | static_cast<std::uint32_t>(random() >> 33)};
+    // Ties go to free nodes first, then (if asked) to the smallest turn, then at random (the seed
+    // makes the random part repeatable).
+    std::uint32_t turn = 0;
+    if (straight && v != from) {
+      const Vec2 step = graph_.position(v) - graph_.position(from);
+      const double cosine = heading.dot(step) / std::max(1e-9, heading.norm() * step.norm());
+      turn = static_cast<std::uint32_t>(
+          std::lround(std::acos(std::clamp(cosine, -1.0, 1.0)) * 4.0 / 3.14159266));
+    }
+    const auto draw = static_cast<std::uint32_t>(random() >> 33);
+    c[m++] = Candidate{
+        v, d,
+        options_.preferStraight ? (occupied << 31) | (turn << 28) | (draw >> 3) : (occupied << 31) | draw};
   };
   add(from);
   for (const Edge& e : graph_.edges(from)) {
@@ -435,8 +455,9 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
   for (std::size_t i = 1; i < m; ++i) {
     const Candidate x = c[i];
     std::size_t j = i;
-    while (j > 0 && (x.distance < c[j - 1].distance ||
-                     (x.distance == c[j - 1].distance && x.tieBreak < c[j - 1].tieBreak))) {
+    const float tol = options_.tieTolerance;
+    while (j > 0 && (x.distance < c[j - 1].distance - tol ||
+                     (x.distance <= c[j - 1].distance + tol && x.tieBreak < c[j - 1].tieBreak))) {
       c[j] = c[j - 1];
       --j;
     }
@@ -535,6 +556,8 @@ const std::vector<NodeId>& Pibt::step() {
   }
   for (std::size_t i = 0; i < n; ++i) {
     still_[i] = next_[i] == now_[i] ? still_[i] + 1 : 0;
+    if (next_[i] != now_[i])
+      prev_[i] = now_[i];
     now_[i] = next_[i];
     agentAt_[idx(now_[i])] = static_cast<std::int32_t>(i);
     updateProgress(i);

@@ -103,6 +103,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   const double contact = roadmap.separation.contact - roadmap.separation.margin;
   std::vector<Vec2> where(o.robots);
   double nextFrame = 0.0;
+  double tDrive = 0.0, tDwell = 0.0, tWait = 0.0, tStand = 0.0;
 
   for (double now = 0.0; now < o.duration; now += o.dt) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -148,6 +149,14 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           traffic.setHeld(r, true);
         }
       }
+      if (b.dwellLeft > 0.0)
+        tDwell += o.dt;
+      else if (b.to != kNoNode)
+        tDrive += o.dt;
+      else if (traffic.execution().pendingNodes(r) > 0)
+        tWait += o.dt;
+      else
+        tStand += o.dt;
       if (b.to != kNoNode) {
         b.left -= o.dt;
         if (b.left <= 0.0) {
@@ -224,6 +233,12 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     res.stalls.push_back(os.str());
   }
   res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / o.duration;
+  if (const double total = tDrive + tDwell + tWait + tStand; total > 0.0) {
+    res.driving = tDrive / total;
+    res.dwelling = tDwell / total;
+    res.waitingOnOthers = tWait / total;
+    res.standingPlanned = tStand / total;
+  }
   double sum = 0.0;
   for (double t : taskTimes)
     sum += t;
@@ -231,6 +246,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.plannerSteps = traffic.stats().steps;
   res.replans = traffic.stats().replans;
   res.refusedReports = traffic.stats().refusedReports;
+  res.evasions = traffic.stats().evasions;
+  res.detours = traffic.plannerStats().detours;
+  res.escalations = traffic.plannerStats().escalations;
+  res.untangles = traffic.plannerStats().untangles;
   res.updateP50Ms = percentile(updateMs, 0.5);
   res.updateP99Ms = percentile(updateMs, 0.99);
   if (o.robots < 2)
@@ -248,10 +267,15 @@ std::string formatResult(const VirtualFleetResult& r) {
   os << r.minSeparation << " m, contacts " << r.contacts << ", hold violations " << r.holdViolations
      << ", longest wait ";
   os.precision(1);
-  os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans
-     << ", update p50/p99 ";
+  os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans << ", evasions "
+     << r.evasions << ", detours " << r.detours << ", escalations " << r.escalations << ", untangles "
+     << r.untangles << ", update p50/p99 ";
   os.precision(3);
   os << r.updateP50Ms << "/" << r.updateP99Ms << " ms, density " << r.density;
+  os.precision(0);
+  os << "; time: driving " << 100.0 * r.driving << " %, dwelling " << 100.0 * r.dwelling
+     << " %, waiting on others " << 100.0 * r.waitingOnOthers << " %, planned to stand "
+     << 100.0 * r.standingPlanned << " %";
   return os.str();
 }
 

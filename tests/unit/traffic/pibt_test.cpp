@@ -83,6 +83,44 @@ TEST(Pibt, ALoneAgentDrivesAShortestPath) {
   EXPECT_EQ(p.elapsed(0), 0);
 }
 
+/// On an open grid a goal 5 across and 5 up has 252 shortest ways. Picking among them at random
+/// zigzags (a real robot stops to turn at each zig); preferring the straightest takes one turn.
+TEST(Pibt, AmongEquallyShortMovesTheStraightestIsTakenWhenAsked) {
+  const GridMap m = gridOf({
+      "......",
+      "......",
+      "......",
+      "......",
+      "......",
+      "......",
+  });
+  auto turns = [&](bool straight, std::uint64_t seed) {
+    PibtOptions o;
+    o.preferStraight = straight;
+    o.tieTolerance = 1e-3F;
+    o.seed = seed;
+    const std::vector<NodeId> start = {m.node(0, 5)};
+    Pibt p(m.graph, start, o);
+    p.setGoal(0, m.node(5, 0));
+    std::vector<Vec2> path{m.graph.position(start[0])};
+    for (int k = 0; k < 20 && p.positions()[0] != m.node(5, 0); ++k)
+      path.push_back(m.graph.position(p.step()[0]));
+    EXPECT_EQ(path.size(), 11U) << "a shortest way either way";
+    int n = 0;
+    for (std::size_t i = 2; i < path.size(); ++i) {
+      const Vec2 a = path[i - 1] - path[i - 2], b = path[i] - path[i - 1];
+      n += a.dot(b) < a.norm() * b.norm() - 1e-9 ? 1 : 0;
+    }
+    return n;
+  };
+  int randomTurns = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    EXPECT_EQ(turns(true, seed), 1) << "seed " << seed;
+    randomTurns += turns(false, seed);
+  }
+  EXPECT_GT(randomTurns, 8 * 2) << "at random it zigzags (the reference behaviour, kept by default)";
+}
+
 TEST(Pibt, TaskPriorityDecidesWhoCrossesFirst) {
   const GridMap m = gridOf({
       "@.@",

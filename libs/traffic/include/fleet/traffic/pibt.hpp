@@ -78,6 +78,13 @@ struct PibtOptions {
   /// Detour tables computed per step at most (each is one search of the whole graph).
   int maxDetoursPerStep = 4;
   std::size_t distanceCacheBytes = std::size_t{256} << 20;
+  /// Moves whose distances to the goal differ by at most this much count as equally good (0: exact;
+  /// sums of edge durations along equally long ways differ in the last bits).
+  float tieTolerance = 0.0F;
+  /// Among equally good moves, prefer the one that turns least from the agent's last move. On a
+  /// lattice with diagonals many shortest ways exist; picking among them at random zigzags, and a
+  /// real robot stops to turn at every zig (the plan counts each edge as one step whatever the turn).
+  bool preferStraight = false;
 };
 
 struct PibtStats {
@@ -170,6 +177,7 @@ class Pibt {
   // Per agent.
   std::vector<NodeId> now_;
   std::vector<NodeId> next_;
+  std::vector<NodeId> prev_;  ///< the node it last moved from (its heading), kNoNode: unknown
   std::vector<NodeId> goal_;
   std::vector<const float*> table_;
   std::vector<int> task_;

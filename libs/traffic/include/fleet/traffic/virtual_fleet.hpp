@@ -65,9 +65,20 @@ struct VirtualFleetResult {
   std::uint64_t plannerSteps = 0;
   std::uint64_t replans = 0;
   std::uint64_t refusedReports = 0;
-  double updateP50Ms = 0.0;  ///< wall time of one traffic update (planning and releases)
+  std::uint64_t evasions = 0;     ///< robots sent out of another's way (TrafficStats)
+  std::uint64_t detours = 0;      ///< detour tables the planner computed (PibtStats)
+  std::uint64_t escalations = 0;  ///< agents the planner escalated out of a wait cycle
+  std::uint64_t untangles = 0;    ///< knots the planner searched a way out of
+  double updateP50Ms = 0.0;       ///< wall time of one traffic update (planning and releases)
   double updateP99Ms = 0.0;
   double density = 0.0;  ///< robots ÷ roadmap nodes
+  /// Where the robots' time went, fractions of robot-time summing to 1: driving an edge, dwelling at
+  /// a station, standing with planned nodes not released yet (waiting on other robots' progress),
+  /// and standing with nothing planned ahead (the plan keeps it there, or it has arrived).
+  double driving = 0.0;
+  double dwelling = 0.0;
+  double waitingOnOthers = 0.0;
+  double standingPlanned = 0.0;
   /// Robots waiting longer than a minute at the end: where, for what, behind whom.
   std::vector<std::string> stalls;
   std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0
