@@ -190,7 +190,8 @@ export class FleetModel {
     const open = this.openTasks();
     const px = this.proximity;
     const clearance = (v) => (v === null || v === undefined ? '—' : `${v.toFixed(2)} m`);
-    const seen = this.peopleSeen().length;
+    const seen = this.peopleSeen();
+    const seers = new Set(seen.map((p) => p.robot)).size;
     return {
       robots: `${this.robots.size - stale} live` + (stale ? `, ${stale} not heard of` : '') +
         (newest && now - newest > STALE_MS ? ` — no update for ${Math.round((now - newest) / 1000)} s` : ''),
@@ -199,7 +200,8 @@ export class FleetModel {
       'tasks done': String(this.doneStamps.length),
       'done per hour': spanS > 30 ? (doneHour * 3600 / spanS).toFixed(1) : '—',
       'assignment latency': median === null ? '—' : `median ${median.toFixed(2)} s (${sorted.length} tasks)`,
-      'people seen': String(seen),
+      // Sightings, not people: two robots that see one person both report it (no identities).
+      'people seen': seen.length ? `${seen.length} sightings by ${seers} robot${seers === 1 ? '' : 's'}` : 'none',
       contacts: px ? `${px.robot_robot.contacts} robot–robot, ${px.robot_person.contacts} robot–person` : '—',
       'near misses': px
         ? `${px.robot_robot.near_misses} robot–robot, ${px.robot_person.near_misses} robot–person (< ${px.near_miss_margin_m} m)`
