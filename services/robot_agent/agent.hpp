@@ -115,6 +115,8 @@ struct AgentOutput {
   /// Reserved traffic only: on every node reached, on a change of goal, holding or blocked, and at
   /// least once a second.
   std::optional<msg::TrafficProgress> traffic;
+  /// The people the robot sees, a few times a second (AgentNode, PeopleReport); never set by Agent.
+  std::optional<msg::PeopleSeen> people;
 };
 
 class Agent {
@@ -153,6 +155,8 @@ class Agent {
   [[nodiscard]] bool homing() const { return tasks_.homing(); }
   [[nodiscard]] std::uint64_t framesRejected() const { return localizer_.rejected(); }
   [[nodiscard]] const LineStats& lineStats() const { return localizer_.lineStats(); }
+  /// What the sensors saw as of the last reading (pose, scan, detections, people).
+  [[nodiscard]] const Perception& perception() const { return localizer_.perception(); }
   /// Follows the traffic manager's releases (AgentParams::traffic "reserved").
   [[nodiscard]] bool reserved() const { return reserved_; }
   /// Releases taken and ignored (cumulative).

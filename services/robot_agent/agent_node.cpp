@@ -100,6 +100,11 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     node->byId_[a->id()] = a.get();
   }
   node->outs_.resize(node->agents_.size());
+  for (std::size_t i = 0; i < node->agents_.size(); ++i) {
+    const auto n = static_cast<std::int64_t>(node->agents_.size());
+    node->peopleReports_.emplace_back(kPeopleSeenPeriodNs,
+                                      kPeopleSeenPeriodNs * static_cast<std::int64_t>(i) / n);
+  }
   return node;
 }
 
@@ -190,6 +195,8 @@ const std::vector<AgentOutput>& AgentNode::step(std::int64_t nowNs, double dt) {
     logging::ScopedField robotField("robot", agents_[i]->id());  // on whatever a step logs
     outs_[i] = agents_[i]->step(nowNs, dt);
     outs_[i].command.seq = static_cast<std::uint32_t>(cycles_);
+    outs_[i].people =
+        peopleReports_[i].due(agents_[i]->id(), nowNs, agents_[i]->perception(), agents_[i]->sensorLost());
   });
   pool_.forEach(agents_.size(), [&](std::size_t j) {
     for (std::size_t i = 0; i < agents_.size(); ++i) {

@@ -24,6 +24,7 @@
 #include "fleet/core/expected.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
+#include "people_report.hpp"
 #include "worker_pool.hpp"
 
 namespace fleet::agent {
@@ -66,7 +67,8 @@ class AgentNode {
   /// `useRisk` off (the samples are still checked).
   void onRiskMaps(std::vector<msg::RiskMap> maps);
 
-  /// Steps every agent at `nowNs` (in parallel), numbers the commands by cycle, and hands each
+  /// Steps every agent at `nowNs` (in parallel), numbers the commands by cycle, adds each robot's
+  /// people seen when its report is due (AgentOutput::people, PeopleReport), and hands each
   /// robot's new state to the others of this process (exactly one cycle later for them: over DDS a
   /// state came one or two cycles late depending on timing, and lockstep replays differed).
   const std::vector<AgentOutput>& step(std::int64_t nowNs, double dt);
@@ -110,6 +112,7 @@ class AgentNode {
   std::map<std::string, Agent*> byId_;
   WorkerPool pool_;
   std::vector<AgentOutput> outs_;
+  std::vector<PeopleReport> peopleReports_;  // one per agent, phases spread over the period
   std::uint64_t cycles_ = 0;
   validation::Rejections rejections_;
   std::vector<Refusal> refusals_;

@@ -185,8 +185,10 @@ void Localizer::track(const SensorReading& f) {
     if (d.kind != SeenKind::kHuman || !std::isfinite(d.x) || !std::isfinite(d.y)) {
       continue;
     }
-    Person p{
-        pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}), {}, static_cast<double>(d.r)};
+    Person p{pose.transform({static_cast<double>(d.x), static_cast<double>(d.y)}),
+             {},
+             static_cast<double>(d.r),
+             false};
     const Person* prev = nullptr;
     for (const auto& q : seen_.people) {
       if (distance(q.pos, p.pos) < 0.5 &&
@@ -197,6 +199,7 @@ void Localizer::track(const SensorReading& f) {
     if (prev != nullptr && dtFrame > 0.0 && dtFrame < 1.0) {
       // Smoothed: detections jitter by a few centimetres per frame.
       p.velocity = prev->velocity * 0.5 + ((p.pos - prev->pos) / dtFrame) * 0.5;
+      p.tracked = true;
     }
     seen.push_back(p);
   }

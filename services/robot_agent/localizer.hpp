@@ -65,6 +65,7 @@ struct Person {
   Vec2 pos;
   Vec2 velocity;
   double radius = 0.25;
+  bool tracked = false;  ///< seen in the reading before too: `velocity` is measured (else zero)
 };
 
 /// What the robot knows as of the latest reading.

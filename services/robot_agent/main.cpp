@@ -93,6 +93,14 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     releases.emplace(part);
     trafficProgress.emplace(part);
   }
+  // For operators (the dashboard): optional, as DDS permissions made before the topic existed do
+  // not let an agent write it; the robots drive the same without it.
+  std::optional<transport::Writer<msg::PeopleSeen>> peopleSeen;
+  try {
+    peopleSeen.emplace(part);
+  } catch (const std::exception& e) {
+    spdlog::warn("robot agent {}: not publishing the people seen ({})", proc.id, e.what());
+  }
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
@@ -167,6 +175,9 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
       }
       if (out.traffic && trafficProgress) {
         trafficProgress->write(*out.traffic);
+      }
+      if (out.people && peopleSeen) {
+        peopleSeen->write(*out.people);
       }
     }
     cyclesTotal.inc();

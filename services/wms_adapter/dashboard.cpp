@@ -58,10 +58,23 @@ const Station* nearest(const StationMap& stations, StationKind kind, Vec2 p) {
 
 }  // namespace
 
-json robotJson(const msg::RobotState& r) {
+json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people) {
   // One number for how well the pose is known: the position's standard deviation (largest axis
   // bound by the trace). A huge one means the robot does not know where it is.
   const double var = r.covariance[0] + r.covariance[4];
+  json seen = json::array();
+  if (people != nullptr) {
+    // To the centimetre: the page draws them, nobody steers by them.
+    auto cm = [](float v) { return std::round(static_cast<double>(v) * 100.0) / 100.0; };
+    for (const auto& p : people->people) {
+      seen.push_back({{"x", cm(p.x)},
+                      {"y", cm(p.y)},
+                      {"vx", cm(p.vx)},
+                      {"vy", cm(p.vy)},
+                      {"radius", cm(p.r)},
+                      {"velocity_known", p.velocity_known}});
+    }
+  }
   return {{"id", r.robot_id},
           {"pose", {{"x", r.pose.x}, {"y", r.pose.y}, {"theta", r.pose.theta}}},
           {"heading_deg", r.pose.theta * 180.0 / M_PI},
@@ -74,7 +87,23 @@ json robotJson(const msg::RobotState& r) {
           {"task", r.task_id},
           {"radius", r.radius},
           {"position_sigma", std::isfinite(var) && var >= 0 ? std::sqrt(var) : -1.0},
-          {"stamp_ns", r.stamp_ns}};
+          {"stamp_ns", r.stamp_ns},
+          {"people_seen", seen},
+          {"people_seen_stamp_ns", people != nullptr ? json(people->stamp_ns) : json()}};
+}
+
+json proximityJson(const FleetView::Proximity& p) {
+  auto counts = [](const ProximityCounts& c) {
+    return json{{"contacts", c.contacts},
+                {"near_misses", c.nearMisses},
+                {"in_contact_now", c.inContact},
+                {"close_now", c.close},
+                {"min_clearance_m", std::isfinite(c.minClearance) ? json(c.minClearance) : json()}};
+  };
+  return {{"robot_robot", counts(p.robotRobot)},
+          {"robot_person", counts(p.robotPerson)},
+          {"near_miss_margin_m", p.params.nearMissMargin},
+          {"hysteresis_m", p.params.hysteresis}};
 }
 
 json riskJson(const msg::RiskMap& m) {
@@ -276,7 +305,8 @@ void Dashboard::routes(HttpServer& server) {
     const std::string id = req.matches[1];
     for (const auto& r : d_.view.robots()) {
       if (r.robot_id == id) {
-        send(res, 200, robotJson(r));
+        const auto people = d_.view.peopleSeen(id, steadyNowNs());
+        send(res, 200, robotJson(r, people ? &*people : nullptr));
         return;
       }
     }
@@ -474,7 +504,9 @@ EventSource Dashboard::stream() {
     std::uint64_t releases = 0;  // the view's release count when they were last looked at
     FleetView::Releases releasesSent;
     std::chrono::steady_clock::time_point releasesSentAt;
-    std::string queues;  // the queues event's data sent last
+    std::string queues;           // the queues event's data sent last
+    std::uint64_t proximity = 0;  // the proximity figures' version sent last
+    std::chrono::steady_clock::time_point proximitySentAt;
   };
   auto cur = std::make_shared<Cursor>();
   cur->events = d_.view.eventCursor();
@@ -482,11 +514,13 @@ EventSource Dashboard::stream() {
     const auto now = std::chrono::steady_clock::now();
     auto robotsJson = [&](bool all) {
       json items = json::array();
+      const auto people = d_.view.allPeopleSeen(steadyNowNs());
       for (const auto& r : d_.view.robots()) {
         auto& last = cur->sent[r.robot_id];
         if (all || r.stamp_ns != last) {
           last = r.stamp_ns;
-          items.push_back(robotJson(r));
+          const auto p = people.find(r.robot_id);
+          items.push_back(robotJson(r, p != people.end() ? &p->second : nullptr));
         }
       }
       cur->robotsSentAt = now;
@@ -549,6 +583,19 @@ EventSource Dashboard::stream() {
                  -1, ' ', false, json::error_handler_t::replace) +
              "\n\n";
     };
+    // Contacts and near misses whenever a figure changed, at most every streamPeriodMs.
+    auto proximityEvent = [&](bool force) -> std::string {
+      if (!force && now - cur->proximitySentAt < std::chrono::milliseconds(d_.streamPeriodMs)) {
+        return {};
+      }
+      const auto p = d_.view.proximity();
+      if (!force && p.version == cur->proximity) {
+        return {};
+      }
+      cur->proximity = p.version;
+      cur->proximitySentAt = now;
+      return "event: proximity\ndata: " + proximityJson(p).dump() + "\n\n";
+    };
     auto queuesEvent = [&]() -> std::string {
       std::string q = queuesText();
       if (q.empty() || q == cur->queues) {
@@ -577,6 +624,7 @@ EventSource Dashboard::stream() {
       snapshot += roadmapEvent();
       snapshot += releasesEvent(true);
       snapshot += queuesEvent();
+      snapshot += proximityEvent(true);
       return snapshot + riskEvent(true);
     }
     std::string chunk;
@@ -602,6 +650,7 @@ EventSource Dashboard::stream() {
     chunk += roadmapEvent();
     chunk += releasesEvent(false);
     chunk += queuesEvent();
+    chunk += proximityEvent(false);
     return chunk + riskEvent(false);
   };
 }

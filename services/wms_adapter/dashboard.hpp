@@ -23,8 +23,12 @@
 
 namespace fleet::wms {
 
-/// A robot as the API shows it (GET /v1/robots, /v1/robots/{id}, the stream).
-nlohmann::json robotJson(const msg::RobotState& r);
+/// A robot as the API shows it (GET /v1/robots, /v1/robots/{id}, the stream), with the people it
+/// sees (`people_seen`: empty when it sees nobody or its list is stale or missing).
+nlohmann::json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people = nullptr);
+
+/// Contacts and near misses as /v1/metrics and the stream's `proximity` event show them.
+nlohmann::json proximityJson(const FleetView::Proximity& p);
 
 /// A risk map for the page: grid, K and the level runs flattened ([level, count, level, count, ...],
 /// row-major from the origin); null for a map too large to send (over 500,000 runs).

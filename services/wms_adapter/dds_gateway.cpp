@@ -31,6 +31,7 @@ DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
   optionalReader(p, ws_, risk_, "risk map");
   optionalReader(p, ws_, roadmap_, "roadmap");
   optionalReader(p, ws_, releases_, "traffic releases");
+  optionalReader(p, ws_, people_, "people seen");
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -45,6 +46,9 @@ bool DdsGateway::managerOnline() const {
 }
 
 void DdsGateway::loop() {
+  // Contacts and near misses are looked for at most this often (the loop wakes with every sample).
+  constexpr auto kProximityPeriod = std::chrono::milliseconds(50);
+  auto proximityAt = std::chrono::steady_clock::now() - kProximityPeriod;
   while (!stop_) {
     ws_.wait(std::chrono::milliseconds(200));
     auto acks = acks_.take();
@@ -70,6 +74,16 @@ void DdsGateway::loop() {
       if (validation::admit(r, view_.rejections())) {
         view_.onRobot(r);
       }
+    }
+    // After the states: the first list of a robot whose first state came with it is not refused.
+    for (auto& p : people_ ? people_->take() : std::vector<msg::PeopleSeen>{}) {
+      if (validation::admit(p, view_.rejections())) {
+        view_.onPeopleSeen(std::move(p), steadyNowNs());
+      }
+    }
+    if (const auto now = std::chrono::steady_clock::now(); now - proximityAt >= kProximityPeriod) {
+      proximityAt = now;
+      view_.updateProximity(steadyNowNs());
     }
     auto maps = risk_ ? risk_->take() : std::vector<msg::RiskMap>{};
     if (!maps.empty() && validation::admit(maps.back(), view_.rejections())) {

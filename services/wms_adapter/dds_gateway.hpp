@@ -38,6 +38,8 @@ class DdsGateway final : public TaskGateway {
   // The traffic layer (roadmap, releases), likewise optional; only read, never written.
   std::unique_ptr<transport::Reader<msg::Roadmap>> roadmap_;
   std::unique_ptr<transport::Reader<msg::TrafficRelease>> releases_;
+  // The people the robots see (robot agents publish them), likewise optional.
+  std::unique_ptr<transport::Reader<msg::PeopleSeen>> people_;
   transport::WaitSet ws_;
   std::mutex writeMutex_;
   std::mutex m_;

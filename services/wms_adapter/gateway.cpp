@@ -1,5 +1,7 @@
 #include "gateway.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 namespace fleet::wms {
@@ -94,6 +96,81 @@ void FleetView::onStored(const msg::TaskAck& a, std::int64_t nowNs) {
 void FleetView::onRobot(const msg::RobotState& s) {
   std::lock_guard lock(m_);
   robots_[s.robot_id] = s;
+}
+
+bool FleetView::onPeopleSeen(msg::PeopleSeen p, std::int64_t receivedNs) {
+  std::lock_guard lock(m_);
+  if (!robots_.contains(p.robot_id)) {
+    rejections_.count({"PeopleSeen", "unknown_robot",
+                       "robot_id \"" + p.robot_id + "\" is no robot this adapter has a state of"});
+    return false;
+  }
+  auto& s = people_[p.robot_id];
+  if (s.people.stamp_ns > p.stamp_ns && s.receivedNs + kPeopleSeenMaxAgeNs > receivedNs) {
+    return true;  // older than the list kept (delivered late): keep the newer one
+  }
+  s = {std::move(p), receivedNs};
+  return true;
+}
+
+bool FleetView::fresh(const Seen& s, std::int64_t nowNs) const {
+  if (nowNs - s.receivedNs > kPeopleSeenMaxAgeNs) {
+    return false;
+  }
+  const auto r = robots_.find(s.people.robot_id);
+  return r != robots_.end() && r->second.stamp_ns - s.people.stamp_ns <= kPeopleSeenMaxAgeNs;
+}
+
+std::optional<msg::PeopleSeen> FleetView::peopleSeen(const std::string& robot, std::int64_t nowNs) const {
+  std::lock_guard lock(m_);
+  const auto it = people_.find(robot);
+  if (it == people_.end() || !fresh(it->second, nowNs)) {
+    return std::nullopt;
+  }
+  return it->second.people;
+}
+
+std::map<std::string, msg::PeopleSeen> FleetView::allPeopleSeen(std::int64_t nowNs) const {
+  std::lock_guard lock(m_);
+  std::map<std::string, msg::PeopleSeen> out;
+  for (const auto& [robot, s] : people_) {
+    if (fresh(s, nowNs)) {
+      out.emplace(robot, s.people);
+    }
+  }
+  return out;
+}
+
+void FleetView::updateProximity(std::int64_t nowNs) {
+  std::vector<ProximityDisc> robots;
+  std::vector<ProximityDisc> people;
+  {
+    std::lock_guard lock(m_);
+    std::int64_t newest = std::numeric_limits<std::int64_t>::min();
+    for (const auto& [id, r] : robots_) {
+      newest = std::max(newest, r.stamp_ns);
+    }
+    for (const auto& [id, r] : robots_) {
+      if (newest - r.stamp_ns <= kLiveRobotNs) {
+        robots.push_back({id, r.pose.position(), static_cast<double>(r.radius)});
+      }
+    }
+    for (const auto& [robot, s] : people_) {
+      if (fresh(s, nowNs)) {
+        for (const auto& p : s.people.people) {
+          people.push_back(
+              {"", {static_cast<double>(p.x), static_cast<double>(p.y)}, static_cast<double>(p.r)});
+        }
+      }
+    }
+  }
+  std::lock_guard lock(proximityMutex_);
+  proximity_.update(robots, people);
+}
+
+FleetView::Proximity FleetView::proximity() const {
+  std::lock_guard lock(proximityMutex_);
+  return {proximity_.robotRobot(), proximity_.robotPerson(), proximity_.params(), proximity_.version()};
 }
 
 void FleetView::onRisk(msg::RiskMap m) {

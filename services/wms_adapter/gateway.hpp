@@ -17,6 +17,7 @@
 
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
+#include "proximity_counter.hpp"
 
 namespace fleet::wms {
 
@@ -53,6 +54,13 @@ class TaskGateway {
   [[nodiscard]] virtual bool managerOnline() const = 0;
 };
 
+/// The clock people-seen lists are aged by (receipt and lookup): steady, in ns.
+inline std::int64_t steadyNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 /// Task and robot views and the event stream, fed from DDS (or by tests). Thread-safe.
 class FleetView {
  public:
@@ -69,6 +77,28 @@ class FleetView {
   /// robot beyond the first kMaxReleaseRobots.
   void onRelease(const msg::TrafficRelease& r);
   static constexpr std::size_t kMaxReleaseRobots = 10'000;
+  /// The people robot `p.robot_id` sees, received at `receivedNs` (a steady clock's ns). Refused,
+  /// and counted as PeopleSeen:unknown_robot, for a robot the view has no state of (false then);
+  /// the caller has checked the sample itself (validation::check).
+  bool onPeopleSeen(msg::PeopleSeen p, std::int64_t receivedNs);
+  /// Robot `robot`'s latest people seen, unless stale at `nowNs` (same clock as receivedNs): older
+  /// than kPeopleSeenMaxAgeNs by the time it came, or by the stamp of the robot's latest state.
+  [[nodiscard]] std::optional<msg::PeopleSeen> peopleSeen(const std::string& robot, std::int64_t nowNs) const;
+  /// Every robot's people seen that is not stale at `nowNs`, by robot.
+  [[nodiscard]] std::map<std::string, msg::PeopleSeen> allPeopleSeen(std::int64_t nowNs) const;
+  static constexpr std::int64_t kPeopleSeenMaxAgeNs = 2'000'000'000;
+  /// Contacts and near misses: one look at the robots' latest states (those heard of within
+  /// kLiveRobotNs of the newest, by stamp: a vanished robot's last pose is not an obstacle) and the
+  /// people seen now. The caller decides how often (the DDS gateway: at most 20 times a second).
+  void updateProximity(std::int64_t nowNs);
+  static constexpr std::int64_t kLiveRobotNs = 5'000'000'000;
+  struct Proximity {
+    ProximityCounts robotRobot;
+    ProximityCounts robotPerson;
+    ProximityParams params;
+    std::uint64_t version = 0;  ///< grows whenever a figure changes
+  };
+  [[nodiscard]] Proximity proximity() const;
   /// A task as the manager's store has it (the answer to a query), for a task the view lacked.
   void onStored(const msg::TaskAck& a, std::int64_t nowNs);
   /// Samples refused (or repaired) on their way into the view, for /v1/metrics.
@@ -100,6 +130,14 @@ class FleetView {
   std::map<std::string, TaskView> tasks_;
   std::deque<std::string> insertion_;
   std::map<std::string, msg::RobotState> robots_;
+  struct Seen {
+    msg::PeopleSeen people;
+    std::int64_t receivedNs = 0;
+  };
+  std::map<std::string, Seen> people_;                                // by robot; only robots in robots_
+  [[nodiscard]] bool fresh(const Seen& s, std::int64_t nowNs) const;  // m_ held
+  mutable std::mutex proximityMutex_;                                 // the counter runs outside m_
+  ProximityCounter proximity_;
   std::shared_ptr<const msg::RiskMap> risk_;
   std::uint64_t riskCount_ = 0;
   std::shared_ptr<const msg::Roadmap> roadmap_;

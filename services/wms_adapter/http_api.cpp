@@ -285,8 +285,10 @@ void HttpApi::routes() {
   });
   server_.route("GET", "/v1/robots", Scope::Read, [this](const Request&, Response& res) {
     json items = json::array();
+    const auto people = view_.allPeopleSeen(steadyNowNs());
     for (const auto& r : view_.robots()) {
-      items.push_back(robotJson(r));
+      const auto p = people.find(r.robot_id);
+      items.push_back(robotJson(r, p != people.end() ? &p->second : nullptr));
     }
     reply(res, 200, {{"robots", items}, {"count", items.size()}});
   });
@@ -312,6 +314,7 @@ void HttpApi::routes() {
            {"tasks_duplicate", counters_.tasksDuplicate.load()},
            {"tasks_by_state", view_.countByState()},
            {"robots", view_.robots().size()},
+           {"proximity", proximityJson(view_.proximity())},
            {"fleet_manager_online", gateway_.managerOnline()},
            {"samples", view_.rejections().toJson()},
            {"http",

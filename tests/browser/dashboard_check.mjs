@@ -199,6 +199,43 @@ try {
   check(seen.length === want && worst < 0.3,
         `${seen.length} robots on the page, ${want} in the simulator; farthest ${worst.toFixed(3)} m from ground truth`);
   await shot('2-live.png');
+
+  // 2a. The people the robots see (the agents publish them; no ground truth in a deployment), drawn
+  // as pink diamonds where the simulator has its person, and the contacts and near misses counted
+  // from what the fleet reports.
+  const people = await until('the page shows the people the robots see', () => model(() => {
+    const seen = window.fleetDashboard.model.peopleSeen();
+    return seen.length ? seen : null;
+  }), 20000);
+  if (people) {
+    const h = Object.values(truth().humans || {});
+    const off = Math.min(...people.map((p) => Math.min(...h.map((t) => Math.hypot(t[0] - p.x, t[1] - p.y)))));
+    check(h.length > 0 && off < 0.6,
+          `${people.length} people seen (by ${[...new Set(people.map((p) => p.robot))].join(', ')}), ${off.toFixed(2)} m from the simulator's person`);
+    const pink = await model(() => {
+      const { view: v, model: m } = window.fleetDashboard;
+      const p = m.peopleSeen()[0];
+      const [px, py] = v.toCanvas(p.x, p.y);
+      const rgb = [...v.canvas.getContext('2d').getImageData(Math.round(px), Math.round(py), 1, 1).data].slice(0, 3);
+      return rgb[0] > 170 && rgb[1] < 120 && rgb[2] > 70 && rgb[2] < 170 ? rgb : null;
+    });
+    check(!!pink, `a person seen is drawn as a pink diamond (${JSON.stringify(pink)})`);
+  }
+  const figures = await until('the contacts and near-miss figures are shown', () => page.evaluate(() => {
+    const f = {};
+    const dl = document.getElementById('figure-list');
+    for (const dt of dl.querySelectorAll('dt')) {
+      f[dt.textContent] = dt.nextElementSibling ? dt.nextElementSibling.textContent : '';
+    }
+    return f.contacts && f.contacts.includes('robot–person') && f['near misses'].includes('robot–robot') ? f : null;
+  }), 10000);
+  if (figures) {
+    const metrics = await page.evaluate(async () => (await fetch('/v1/metrics')).json());
+    const px = metrics.proximity;
+    check(px && figures.contacts.startsWith(`${px.robot_robot.contacts} robot–robot`),
+          `contacts: ${figures.contacts}; near misses: ${figures['near misses']}; closest: ${figures.closest}; people seen: ${figures['people seen']}`);
+  }
+  await shot('2a-people-seen.png');
   const operatorActions = await page.evaluate(() =>
     [...document.querySelectorAll('[data-robot-action]')].filter((b) => !b.disabled).length);
   check(operatorActions === 4, `the operator is offered the robot's four actions (${operatorActions} enabled)`);

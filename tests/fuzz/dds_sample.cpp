@@ -69,7 +69,8 @@ constexpr Receive kTopics[] = {receive<msg::Task>,           receive<msg::TaskAc
                                receive<msg::SensorFrame>,    receive<msg::VelocityCommand>,
                                receive<msg::Clock>,          receive<msg::StepDone>,
                                receive<msg::GroundTruth>,    receive<msg::Roadmap>,
-                               receive<msg::TrafficRelease>, receive<msg::TrafficProgress>};
+                               receive<msg::TrafficRelease>, receive<msg::TrafficProgress>,
+                               receive<msg::PeopleSeen>};
 constexpr std::size_t kTopicCount = sizeof(kTopics) / sizeof(kTopics[0]);
 
 }  // namespace

@@ -113,5 +113,8 @@ int main(int argc, char** argv) {
   p.robot_id = "r-1";
   p.epoch = 3;
   seed(15, p, "traffic_progress");
+  msg::PeopleSeen people{
+      "r-1", 7, {{1.0f, 2.0f, 0.5f, -0.5f, 0.25f, true}, {3.0f, 1.0f, 0.0f, 0.0f, 0.3f, false}}};
+  seed(16, people, "people_seen");
   return 0;
 }

@@ -218,6 +218,25 @@ msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   return m;
 }
 
+// ---- PeopleSeen
+void Traits<msg::PeopleSeen>::toC(const msg::PeopleSeen& in, C& out, Arena& arena) {
+  putStr(out.robot_id, in.robot_id, "PeopleSeen.robot_id");
+  out.stamp_ns = in.stamp_ns;
+  putSeq(out.people, in.people, msg::kMaxPeopleSeen, arena, "PeopleSeen.people",
+         [](const msg::SeenPerson& p, fleet_SeenPerson& c) {
+           c = {p.x, p.y, p.vx, p.vy, p.r, p.velocity_known};
+         });
+}
+msg::PeopleSeen Traits<msg::PeopleSeen>::fromC(const C& in) {
+  msg::PeopleSeen m;
+  m.robot_id = getStr(in.robot_id);
+  m.stamp_ns = in.stamp_ns;
+  m.people = getSeq(in.people, [](const fleet_SeenPerson& c) {
+    return msg::SeenPerson{c.x, c.y, c.vx, c.vy, c.r, c.velocity_known};
+  });
+  return m;
+}
+
 // ---- PredictedDiscs
 void Traits<msg::PredictedDiscs>::toC(const msg::PredictedDiscs& in, C& out, Arena& arena) {
   putStr(out.source_id, in.source_id, "PredictedDiscs.source_id");

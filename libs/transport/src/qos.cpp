@@ -47,6 +47,9 @@ QosProfile robotState() {
 QosProfile predictedDiscs() {
   return {false, false, 1, 0, 0};
 }
+QosProfile peopleSeen() {
+  return {false, false, 1, 0, 0};
+}
 QosProfile riskMap() {
   return {true, true, 1, 0, 100};
 }
@@ -106,6 +109,8 @@ bool byName(std::string_view name, QosProfile& out) {
     out = trafficRelease();
   else if (n == "traffic_progress")
     out = trafficProgress();
+  else if (n == "people_seen")
+    out = peopleSeen();
   else
     return false;
   return true;

@@ -189,6 +189,17 @@ std::optional<Rejection> check(const msg::PredictedDiscs& m) {
   return c.done();
 }
 
+std::optional<Rejection> check(const msg::PeopleSeen& m) {
+  Checker c("PeopleSeen");
+  c.id(m.robot_id, "robot_id").size(m.people.size(), msg::kMaxPeopleSeen, "people");
+  for (const auto& p : m.people) {
+    c.position(p.x, p.y, "people[]").within(p.r, 0.0, kMaxRadius, "people[].r");
+    c.within(p.vx, -kMaxSpeed, kMaxSpeed, "people[].vx").within(p.vy, -kMaxSpeed, kMaxSpeed, "people[].vy");
+    c.require(p.r > 0.0F, "implausible", "people[].r must be > 0");
+  }
+  return c.done();
+}
+
 std::optional<Rejection> check(const msg::RiskMap& m) {
   Checker c("RiskMap");
   c.position(m.origin_x, m.origin_y, "origin").within(m.resolution, 1e-6, 1e3, "resolution");

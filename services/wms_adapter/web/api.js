@@ -3,7 +3,7 @@
 // messages, and the SSE stream with reconnects.
 
 /** What GET /v1/stream sends (docs/openapi.yaml). */
-export const STREAM_EVENTS = ['snapshot', 'robots', 'task', 'risk', 'roadmap', 'releases', 'queues'];
+export const STREAM_EVENTS = ['snapshot', 'robots', 'task', 'risk', 'roadmap', 'releases', 'queues', 'proximity'];
 
 export class ApiError extends Error {
   constructor(status, message) {

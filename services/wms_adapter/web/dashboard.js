@@ -65,6 +65,8 @@ function onMessage(name, data) {
     model.releasesUpdate(data);
   } else if (name === 'queues') {
     model.setQueues(data);
+  } else if (name === 'proximity') {
+    model.setProximity(data);
   }
 }
 
@@ -89,7 +91,14 @@ function frame(t) {
     lastDrawVersion = model.version;
     lastDrawAt = now;
     const robots = new Map([...model.robots].map(([id, r]) => [id, { ...r, pose: drawnPose(r, now) }]));
-    view.draw({ robots, risk: model.risk, roadmap: model.roadmap, releases: model.releases, queues: model.queues }, t);
+    view.draw({
+      robots,
+      people: model.peopleSeen(),
+      risk: model.risk,
+      roadmap: model.roadmap,
+      releases: model.releases,
+      queues: model.queues,
+    }, t);
     panels.update(now);
   }
   requestAnimationFrame(frame);
@@ -212,6 +221,11 @@ for (const [mode, colour] of Object.entries(MODE_COLOURS)) {
   span.append(dot, mode);
   legend.append(span);
 }
+const personKey = document.createElement('span');
+const personMark = document.createElement('i');
+personMark.className = 'person';
+personKey.append(personMark, 'person seen (by a robot)');
+legend.append(personKey);
 const riskKey = document.createElement('span');
 riskKey.textContent = '· risk iso-levels: yellow (low) to red (high)';
 legend.append(riskKey);

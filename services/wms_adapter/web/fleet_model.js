@@ -1,6 +1,6 @@
-// What the page knows of the fleet, fed by the stream: robots (with when each was last heard of),
-// tasks, recent events, the traffic layer (roadmap, releases, station queues), and the live
-// figures computed from them.
+// What the page knows of the fleet, fed by the stream: robots (with when each was last heard of and
+// the people each sees), tasks, recent events, the traffic layer (roadmap, releases, station
+// queues), contacts and near misses (counted by the adapter), and the live figures.
 
 const TERMINAL = new Set(['done', 'failed', 'cancelled', 'rejected']);
 export const STALE_MS = 5000; // a robot not heard of for this long is drawn as lost
@@ -37,6 +37,7 @@ export class FleetModel {
     this.roadmap = null; // the traffic manager's roadmap (`roadmap`); null: none (reactive traffic)
     this.releases = new Map(); // robot -> its release (`releases`): base and horizon
     this.queues = []; // per station queue: {station, at, waiting: [robot, ...], length}
+    this.proximity = null; // contacts and near misses (`proximity`), as /v1/metrics has them
     this.version = 0; // grows with every change, so views redraw only when needed
   }
 
@@ -78,6 +79,26 @@ export class FleetModel {
       this.releases.delete(id);
     }
     this.version++;
+  }
+
+  setProximity(data) {
+    this.proximity = data;
+    this.version++;
+  }
+
+  /** The people the live robots see: [{x, y, vx, vy, radius, velocity_known, robot}]. */
+  peopleSeen() {
+    const out = [];
+    const newest = newestUpdate(this.robots);
+    for (const r of this.robots.values()) {
+      if (isStale(r, newest)) {
+        continue; // its list is as old as the robot's news
+      }
+      for (const p of r.people_seen || []) {
+        out.push({ ...p, robot: r.id });
+      }
+    }
+    return out;
   }
 
   setQueues(data) {
@@ -167,6 +188,10 @@ export class FleetModel {
     const sorted = [...this.latencies].sort((a, b) => a - b);
     const median = sorted.length ? sorted[Math.floor(sorted.length / 2)] : null;
     const open = this.openTasks();
+    const px = this.proximity;
+    const clearance = (v) => (v === null || v === undefined ? '—' : `${v.toFixed(2)} m`);
+    const seen = this.peopleSeen();
+    const seers = new Set(seen.map((p) => p.robot)).size;
     return {
       robots: `${this.robots.size - stale} live` + (stale ? `, ${stale} not heard of` : '') +
         (newest && now - newest > STALE_MS ? ` — no update for ${Math.round((now - newest) / 1000)} s` : ''),
@@ -175,6 +200,13 @@ export class FleetModel {
       'tasks done': String(this.doneStamps.length),
       'done per hour': spanS > 30 ? (doneHour * 3600 / spanS).toFixed(1) : '—',
       'assignment latency': median === null ? '—' : `median ${median.toFixed(2)} s (${sorted.length} tasks)`,
+      // Sightings, not people: two robots that see one person both report it (no identities).
+      'people seen': seen.length ? `${seen.length} sightings by ${seers} robot${seers === 1 ? '' : 's'}` : 'none',
+      contacts: px ? `${px.robot_robot.contacts} robot–robot, ${px.robot_person.contacts} robot–person` : '—',
+      'near misses': px
+        ? `${px.robot_robot.near_misses} robot–robot, ${px.robot_person.near_misses} robot–person (< ${px.near_miss_margin_m} m)`
+        : '—',
+      closest: px ? `${clearance(px.robot_robot.min_clearance_m)} robot–robot, ${clearance(px.robot_person.min_clearance_m)} robot–person` : '—',
       'fleet manager': this.managerOnline ? 'online' : 'unreachable',
     };
   }

@@ -4,7 +4,8 @@
 // are hollow. Layers, each of which the page can switch off: the risk map's iso-levels, the
 // roadmap (faint, drawn once into a canvas of its own), each robot's route (its released base
 // solid, the planned horizon dashed, in the robot's own colour, which also rings the robot) and
-// the station queues (how many wait).
+// the station queues (how many wait), and the people the robots see (pink diamonds with a line
+// along their velocity when it is known: what the robots' sensors report, not a simulator's truth).
 
 import { isStale, newestUpdate } from './fleet_model.js';
 
@@ -24,7 +25,10 @@ export const LAYERS = {
   roadmap: 'roadmap',
   routes: 'routes (released solid, planned dashed)',
   queues: 'station queues',
+  people: 'people seen',
 };
+
+export const PERSON_COLOUR = '#d6336c';
 
 /** A colour of the robot's own, the same on every page and visit (from its id). */
 export function robotColour(id) {
@@ -174,6 +178,9 @@ export class MapView {
     }
     if (roadmap && this.layers.queues && model.queues) {
       this.drawQueues(roadmap, model.queues);
+    }
+    if (this.layers.people && model.people && model.people.length) {
+      this.drawPeople(model.people);
     }
     const newest = newestUpdate(model.robots);
     const labels = this.scale > 14 * this.dpr;
@@ -332,6 +339,33 @@ export class MapView {
     g.globalAlpha = 1;
     g.lineCap = 'butt';
     g.lineJoin = 'miter';
+  }
+
+  /** People seen: a diamond of the person's size, a line to where they walk in the next second. */
+  drawPeople(people) {
+    const g = this.ctx;
+    g.fillStyle = PERSON_COLOUR;
+    g.strokeStyle = PERSON_COLOUR;
+    g.lineWidth = 1.5 * this.dpr;
+    g.globalAlpha = 0.85;
+    for (const p of people) {
+      const [x, y] = this.toCanvas(p.x, p.y);
+      const s = Math.max(3.5 * this.dpr, (p.radius || 0.25) * this.scale);
+      g.beginPath();
+      g.moveTo(x, y - s);
+      g.lineTo(x + s, y);
+      g.lineTo(x, y + s);
+      g.lineTo(x - s, y);
+      g.closePath();
+      g.fill();
+      if (p.velocity_known && (p.vx || p.vy)) {
+        g.beginPath();
+        g.moveTo(x, y);
+        g.lineTo(x + p.vx * this.scale, y - p.vy * this.scale);
+        g.stroke();
+      }
+    }
+    g.globalAlpha = 1;
   }
 
   /** A purple count beside each station with robots waiting in its queue. */

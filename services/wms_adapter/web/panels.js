@@ -140,6 +140,7 @@ export class Panels {
       position: `${r.pose.x.toFixed(2)}, ${r.pose.y.toFixed(2)} m`,
       heading: `${Math.round(r.heading_deg)}°`,
       speed: `${r.v.toFixed(2)} m/s`,
+      'people seen': String((r.people_seen || []).length),
       'pose σ': r.position_sigma < 0 || r.position_sigma > 100 ? 'unknown' : `${(r.position_sigma * 100).toFixed(1)} cm`,
       heard: age < 2 ? 'now' : `${age.toFixed(0)} s ago`,
     });

@@ -8,7 +8,8 @@
 // agent drives reactively and follows none), the layer switches, a task submitted from the page
 // reaching done, pause from the page stopping the robot (ground truth again) and the page catching
 // up after an adapter restart (asked for through restart.request; this test restarts the adapter
-// on the same port). Screenshots go to <build>/reports/dashboard/.
+// on the same port), the people the robots see drawn where the simulator has its one person, and
+// the contacts and near-miss figures. Screenshots go to <build>/reports/dashboard/.
 
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -39,7 +40,9 @@ namespace {
 
 using fleet::test::freePort;
 
-/// one_robot.json with three robots at parking places 1, 4 and 7, its site by absolute path.
+/// one_robot.json with three robots at parking places 1, 4 and 7, its site by absolute path, and a
+/// person pacing slowly by the west wall, in sight of r1 and out of every robot's way (the robots
+/// publish the people they see; the page draws those).
 std::string writeScenario(const fs::path& dir) {
   const std::string src = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
   json s = json::parse(std::ifstream(src));
@@ -47,6 +50,12 @@ std::string writeScenario(const fs::path& dir) {
   s["robots"] = json::array({{{"id", "r1"}, {"start_station", "PARK-1"}},
                              {{"id", "r2"}, {"start_station", "PARK-4"}},
                              {{"id", "r3"}, {"start_station", "PARK-7"}}});
+  s["humans"] = {
+      {"count", 0},
+      {"list", json::array({{{"id", "h1"},
+                             {"start", {2.0, 2.6}},
+                             {"route", json::array({json::array({2.0, 3.2}), json::array({2.0, 2.6})})},
+                             {"speed", 0.3}}})}};
   const auto path = dir / "scenario.json";
   std::ofstream(path) << s.dump(1);
   return path.string();
@@ -163,13 +172,18 @@ TEST(DashboardBrowser, LoginRobotsTaskPauseAndRestartInChromium) {
           }
         }
         json robots = json::object();
+        json humans = json::object();
         for (const auto& b : g.bodies) {
           if (b.kind == msg::SourceKind::Robot) {
             robots[b.id] = {b.pose.x, b.pose.y, b.pose.theta, b.v};
+          } else {
+            humans[b.id] = {b.pose.x, b.pose.y};
           }
         }
-        std::ofstream(dir / "truth.json.tmp")
-            << json{{"t", static_cast<double>(g.sim_time_ns) / 1e9}, {"robots", robots}}.dump();
+        std::ofstream(dir / "truth.json.tmp") << json{
+            {"t", static_cast<double>(g.sim_time_ns) / 1e9},
+            {"robots", robots},
+            {"humans", humans}}.dump();
         fs::rename(dir / "truth.json.tmp", dir / "truth.json");
       }
       if (fs::exists(dir / "restart.request")) {

@@ -152,6 +152,16 @@ TEST_F(RoundTrip, RobotState) {
   expectRoundTrip<msg::RobotState>({s});
 }
 
+TEST_F(RoundTrip, PeopleSeen) {
+  msg::PeopleSeen none{"r-1", 5, {}};
+  msg::PeopleSeen full{maxId(), -7, {}};
+  for (std::size_t i = 0; i < msg::kMaxPeopleSeen; ++i) {
+    const float f = static_cast<float>(i);
+    full.people.push_back({f, -f, 0.5f * f, -0.25f, 0.2f + 0.01f * f, i % 2 == 0});
+  }
+  expectRoundTrip<msg::PeopleSeen>({none, full});
+}
+
 TEST_F(RoundTrip, PredictedDiscs) {
   msg::PredictedDiscs a{"h-1", msg::SourceKind::Human, 100, 0.1f, {}};
   msg::PredictedDiscs b{"r-1", msg::SourceKind::Robot, 200, 0.2f, {}};

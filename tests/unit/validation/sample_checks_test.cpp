@@ -213,3 +213,25 @@ TEST(SampleChecks, RoadmapAndReleasesNameNodesThatExist) {
   longBase.base.assign(65, {0, 1.0, 1.0});
   EXPECT_EQ(reasonOf(check(longBase)), "too_large");
 }
+
+TEST(SampleChecks, PeopleSeenMustBeFiniteBoundedAndNamed) {
+  msg::PeopleSeen p;
+  p.robot_id = "r1";
+  EXPECT_FALSE(check(p)) << "a robot that sees nobody says so";
+  p.people = {{2.0F, 3.0F, 0.5F, -0.2F, 0.25F, true}, {4.0F, 1.0F, 0.0F, 0.0F, 0.3F, false}};
+  EXPECT_FALSE(check(p));
+  auto bad = [&](auto edit) {
+    msg::PeopleSeen q = p;
+    edit(q);
+    return reasonOf(check(q));
+  };
+  EXPECT_EQ(bad([](auto& q) { q.people[1].x = std::numeric_limits<float>::quiet_NaN(); }), "non_finite");
+  EXPECT_EQ(bad([](auto& q) { q.people[0].vy = std::numeric_limits<float>::infinity(); }), "non_finite");
+  EXPECT_EQ(bad([](auto& q) { q.people[0].y = 5e6F; }), "implausible");
+  EXPECT_EQ(bad([](auto& q) { q.people[0].vx = 1000.0F; }), "implausible");
+  EXPECT_EQ(bad([](auto& q) { q.people[0].r = -0.25F; }), "implausible");
+  EXPECT_EQ(bad([](auto& q) { q.people[0].r = 0.0F; }), "implausible");
+  EXPECT_EQ(bad([](auto& q) { q.robot_id = "r 1"; }), "id");
+  EXPECT_EQ(bad([](auto& q) { q.people.resize(msg::kMaxPeopleSeen + 1, q.people[0]); }), "too_large");
+  EXPECT_EQ(bad([](auto& q) { q.people.resize(msg::kMaxPeopleSeen, q.people[0]); }), "accepted");
+}

@@ -600,3 +600,75 @@ TEST_F(Dash, WithoutAuthenticationThePageMayDoEverything) {
   EXPECT_EQ(s["auth"], "off");
   EXPECT_EQ(s["scopes"], json::array({"read", "submit", "operate"}));
 }
+
+namespace {
+msg::PeopleSeen peopleOf(const std::string& robot, std::int64_t stamp, std::vector<msg::SeenPerson> people) {
+  return {robot, stamp, std::move(people)};
+}
+}  // namespace
+
+TEST_F(Dash, ThePeopleEachRobotSeesAreInTheRobotApiUntilTheirListIsStale) {
+  start("");
+  const auto now = steadyNowNs();
+  ASSERT_TRUE(view_.onPeopleSeen(peopleOf("r1", 1, {{2.004F, 3.0F, 0.5F, 0.0F, 0.25F, true}}), now));
+  EXPECT_TRUE(view_.onPeopleSeen(peopleOf("r2", 1, {}), now)) << "seeing nobody is a list too";
+  EXPECT_FALSE(view_.onPeopleSeen(peopleOf("r9", 1, {{1, 1, 0, 0, 0.25F, false}}), now));
+  EXPECT_EQ(view_.rejections().count("PeopleSeen", "unknown_robot"), 1U);
+
+  const json one = json::parse(client_->Get("/v1/robots/r1")->body);
+  ASSERT_EQ(one["people_seen"].size(), 1U);
+  EXPECT_DOUBLE_EQ(one["people_seen"][0]["x"].get<double>(), 2.0) << "to the centimetre";
+  EXPECT_DOUBLE_EQ(one["people_seen"][0]["vx"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(one["people_seen"][0]["radius"].get<double>(), 0.25);
+  EXPECT_TRUE(one["people_seen"][0]["velocity_known"].get<bool>());
+  EXPECT_EQ(one["people_seen_stamp_ns"], 1);
+  const json all = json::parse(client_->Get("/v1/robots")->body);
+  ASSERT_EQ(all["robots"].size(), 2U);
+  EXPECT_EQ(all["robots"][0]["people_seen"].size(), 1U);
+  EXPECT_TRUE(all["robots"][1]["people_seen"].empty());
+  EXPECT_FALSE(all["robots"][1]["people_seen_stamp_ns"].is_null());
+  const json metrics = json::parse(client_->Get("/v1/metrics")->body);
+  EXPECT_EQ(metrics["samples"]["rejected"]["PeopleSeen"]["unknown_robot"], 1);
+
+  // Stale: received too long ago (the robot stopped sending), or far behind the robot's own state.
+  ASSERT_TRUE(view_.onPeopleSeen(peopleOf("r1", 1, {{2, 3, 0, 0, 0.25F, false}}),
+                                 now - FleetView::kPeopleSeenMaxAgeNs - 1'000'000));
+  EXPECT_TRUE(json::parse(client_->Get("/v1/robots/r1")->body)["people_seen"].empty());
+  EXPECT_TRUE(json::parse(client_->Get("/v1/robots/r1")->body)["people_seen_stamp_ns"].is_null());
+  ASSERT_TRUE(view_.onPeopleSeen(peopleOf("r1", 1, {{2, 3, 0, 0, 0.25F, false}}), steadyNowNs()));
+  EXPECT_EQ(json::parse(client_->Get("/v1/robots/r1")->body)["people_seen"].size(), 1U);
+  view_.onRobot(robot("r1", 1.0, 1.0, 1 + FleetView::kPeopleSeenMaxAgeNs + 1));
+  EXPECT_TRUE(json::parse(client_->Get("/v1/robots/r1")->body)["people_seen"].empty());
+}
+
+TEST_F(Dash, ContactsAndNearMissesAreCountedFromTheReportsAndShownInMetricsAndTheStream) {
+  start("");
+  view_.onRobot(robot("r3", 1.7, 1.0, 1));  // 0.1 m clear of r1: a near miss
+  ASSERT_TRUE(view_.onPeopleSeen(peopleOf("r1", 1, {{9.4F, 1.0F, 0, 0, 0.25F, false}}), steadyNowNs()));
+  view_.updateProximity(steadyNowNs());  // the person overlaps r2: a contact
+  view_.updateProximity(steadyNowNs());
+  const json m = json::parse(client_->Get("/v1/metrics")->body)["proximity"];
+  EXPECT_EQ(m["robot_robot"]["near_misses"], 1);
+  EXPECT_EQ(m["robot_robot"]["contacts"], 0);
+  EXPECT_EQ(m["robot_robot"]["close_now"], 1);
+  EXPECT_NEAR(m["robot_robot"]["min_clearance_m"].get<double>(), 0.1, 1e-6);
+  EXPECT_EQ(m["robot_person"]["contacts"], 1);
+  EXPECT_EQ(m["robot_person"]["near_misses"], 1);
+  EXPECT_NEAR(m["robot_person"]["min_clearance_m"].get<double>(), -0.15, 1e-6);
+  EXPECT_DOUBLE_EQ(m["near_miss_margin_m"].get<double>(), 0.2);
+
+  // A robot not heard of for a while (by the fleet's clock) is no obstacle.
+  view_.onRobot(robot("r1", 1.0, 1.0, 1 + FleetView::kLiveRobotNs + 1));
+  view_.onRobot(robot("r2", 9.0, 1.0, 1 + FleetView::kLiveRobotNs + 1));
+  view_.updateProximity(steadyNowNs());
+  EXPECT_EQ(view_.proximity().robotRobot.close, 0U);
+
+  std::string got;
+  auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
+    got.append(data, n);
+    return got.find("event: proximity") == std::string::npos;
+  });
+  const auto events = eventsNamed(got, "proximity");
+  ASSERT_FALSE(events.empty()) << "sent with the snapshot";
+  EXPECT_EQ(events[0]["robot_person"]["contacts"], 1);
+}

@@ -137,6 +137,25 @@ struct PredictedDiscs {
   bool operator==(const PredictedDiscs&) const = default;
 };
 
+struct SeenPerson {
+  float x = 0;
+  float y = 0;
+  float vx = 0;
+  float vy = 0;
+  float r = 0;
+  bool velocity_known = false;
+  bool operator==(const SeenPerson&) const = default;
+};
+
+/// The people one robot sees (idl/fleet.idl), at most kMaxPeopleSeen.
+struct PeopleSeen {
+  std::string robot_id;
+  std::int64_t stamp_ns = 0;
+  std::vector<SeenPerson> people;
+  bool operator==(const PeopleSeen&) const = default;
+};
+inline constexpr std::size_t kMaxPeopleSeen = 64;
+
 struct LevelRun {
   std::uint8_t level = 0;
   std::uint32_t count = 0;

@@ -28,6 +28,7 @@ QosProfile assignment();            // TaskAssignment: reliable, transient-local
 QosProfile taskStatus();            // TaskStatus: reliable, keep-last 16
 QosProfile robotState();            // RobotState: best-effort, keep-last 1, liveliness lease 1 s
 QosProfile predictedDiscs();        // best-effort, keep-last 1
+QosProfile peopleSeen();            // PeopleSeen: best-effort, keep-last 1 per robot
 QosProfile riskMap();               // reliable, transient-local, keep-last 1
 QosProfile sensor(bool lockstep);   // SensorFrame: best-effort, reliable in lockstep
 QosProfile command(bool lockstep);  // VelocityCommand: likewise

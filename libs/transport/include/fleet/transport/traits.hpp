@@ -51,6 +51,7 @@ FLEET_DECLARE_TRAITS(TaskAssignment, fleet_TaskAssignment, "TaskAssignment", qos
 FLEET_DECLARE_TRAITS(TaskStatus, fleet_TaskStatus, "TaskStatus", qos::taskStatus())
 FLEET_DECLARE_TRAITS(RobotState, fleet_RobotState, "RobotState", qos::robotState())
 FLEET_DECLARE_TRAITS(PredictedDiscs, fleet_PredictedDiscs, "PredictedDiscs", qos::predictedDiscs())
+FLEET_DECLARE_TRAITS(PeopleSeen, fleet_PeopleSeen, "PeopleSeen", qos::peopleSeen())
 FLEET_DECLARE_TRAITS(RiskMap, fleet_RiskMap, "RiskMap", qos::riskMap())
 FLEET_DECLARE_TRAITS(SensorFrame, fleet_SensorFrame, "SensorFrame", qos::sensor(false))
 FLEET_DECLARE_TRAITS(VelocityCommand, fleet_VelocityCommand, "VelocityCommand", qos::command(false))

@@ -48,6 +48,9 @@ std::optional<Rejection> check(const msg::TaskAssignment& m);
 std::optional<Rejection> check(const msg::TaskStatus& m);
 std::optional<Rejection> check(const msg::RobotState& m);
 std::optional<Rejection> check(const msg::PredictedDiscs& m);
+/// Every person's position, velocity and radius finite and plausible, at most msg::kMaxPeopleSeen.
+/// Whether the robot is one the reader knows is the reader's to judge.
+std::optional<Rejection> check(const msg::PeopleSeen& m);
 std::optional<Rejection> check(const msg::RiskMap& m);
 std::optional<Rejection> check(const msg::SensorFrame& m);
 std::optional<Rejection> check(const msg::VelocityCommand& m);
