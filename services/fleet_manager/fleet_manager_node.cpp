@@ -44,8 +44,9 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
-                         "robot_fail_limit", "robot_hold_s", "battery_threshold", "charge_until",
-                         "charge_max_s", "nominal_speed", "clock", "metrics_file", "map", "travel_cost"});
+                         "station_load", "robot_fail_limit", "robot_hold_s", "battery_threshold",
+                         "charge_until", "charge_max_s", "nominal_speed", "clock", "metrics_file", "map",
+                         "travel_cost"});
   s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight"});
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
@@ -62,6 +63,8 @@ Settings readSettings(Config& cfg) {
   s.robotFailLimit = static_cast<int>(cfg.integer("robot_fail_limit", s.robotFailLimit, {0, 1000}));
   s.robotHoldS = cfg.number("robot_hold_s", s.robotHoldS, {0.0, 86400.0});
   s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
+  s.stationLoadByPhase =
+      cfg.string("station_load", s.stationLoadByPhase ? "phase" : "task", {"task", "phase"}) == "phase";
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
   s.chargeUntil = cfg.number("charge_until", s.chargeUntil, {0.0, 1.0});
   if (s.chargeUntil <= s.batteryThreshold) {
@@ -130,6 +133,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
   DispatcherConfig dc;
   dc.maxAttempts = s.maxAttempts;
   dc.stationCapacity = static_cast<std::size_t>(s.stationCapacity);
+  dc.stationLoadByPhase = s.stationLoadByPhase;
   dc.robotFailLimit = s.robotFailLimit;
   dc.robotHoldNs = secToNs(s.robotHoldS);
   dc.leaseNs = secToNs(s.leaseS);

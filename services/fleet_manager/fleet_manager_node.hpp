@@ -26,6 +26,9 @@ struct Settings {
   int maxAttempts = 3;
   /// Active tasks per station at most (0: no limit); see DispatcherConfig::stationCapacity.
   int stationCapacity = 2;
+  /// "phase": a task loads its pickup until it has loaded, then its drop-off; "task" (false): both
+  /// for the whole task. See DispatcherConfig::stationLoadByPhase.
+  bool stationLoadByPhase = false;
   int robotFailLimit = 3;    ///< failures in a row before a robot is held back (0: never)
   double robotHoldS = 60.0;  ///< ... for this long
   double batteryThreshold = 0.2;

@@ -607,6 +607,7 @@ int Run::run() {
                                        {"clock", "sim"},
                                        {"lease_s", 3.0},
                                        {"station_capacity", o.stationCapacity},
+                                       {"station_load", o.stationLoad},
                                        {"travel_cost", o.travelCost},
                                        {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
                                       .dump(1));

@@ -125,6 +125,12 @@ int main(int argc, char** argv) {
   loadtest->add_flag("--until-done", lt.untilDone,
                      "with --tasks or a task list: stop as soon as every task is done, failed or cancelled");
   loadtest->add_flag("--lanes", lt.lanes, "robot agents plan on one-way lanes (default: plain A*)");
+  loadtest
+      ->add_option("--station-load", lt.stationLoad,
+                   "how a task loads its stations: task (pickup and drop-off for the whole task) or phase "
+                   "(the pickup until loaded, then the drop-off)")
+      ->check(CLI::IsMember({"task", "phase"}))
+      ->capture_default_str();
   loadtest->add_option("--station-capacity", lt.stationCapacity, "active tasks per station (0 = no limit)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();

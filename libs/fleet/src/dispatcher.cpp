@@ -447,13 +447,26 @@ std::vector<const std::string*> stationsOf(const Task& t) {
   }
   return s;
 }
+
+// The stations an active task loads now when load is counted by phase: where its robot is going.
+std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) {
+  const bool delivering = state == TaskState::Delivering || state == TaskState::Unloading;
+  std::vector<const std::string*> s;
+  for (const std::string* n : {delivering ? &t.dropoff : &t.pickup, &t.station}) {
+    if (!n->empty()) {
+      s.push_back(n);
+    }
+  }
+  return s;
+}
 }  // namespace
 
 void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
   std::unordered_map<std::string, std::size_t> load;
   for (const auto& [id, r] : open_) {
     if (isActive(r.state)) {
-      for (const std::string* s : stationsOf(r.task)) {
+      for (const std::string* s :
+           cfg_.stationLoadByPhase ? phaseStationsOf(r.task, r.state) : stationsOf(r.task)) {
         ++load[*s];
       }
     }
@@ -465,7 +478,7 @@ void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
   });
   std::vector<Task> admitted;
   for (auto& t : waiting) {
-    const auto stations = stationsOf(t);
+    const auto stations = cfg_.stationLoadByPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
     // A robot's own charge task is never held back: its battery does not wait for the queue.
     const bool full = t.robot.empty() &&
                       std::any_of(stations.begin(), stations.end(),

@@ -117,6 +117,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     for (std::size_t r = 0; r < o.robots; ++r) {
       Bot& b = bots[r];
       if (b.dwellLeft > 0.0) {
+        tDwell += o.dt;
         b.dwellLeft -= o.dt;
         if (b.dwellLeft > 0.0)
           continue;
@@ -149,9 +150,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           traffic.setHeld(r, true);
         }
       }
-      if (b.dwellLeft > 0.0)
-        tDwell += o.dt;
-      else if (b.to != kNoNode)
+      if (b.to != kNoNode)
         tDrive += o.dt;
       else if (traffic.execution().pendingNodes(r) > 0)
         tWait += o.dt;

@@ -341,6 +341,40 @@ TEST_F(DispatcherTest, StationCapacityHoldsTasksBackOldestFirst) {
   EXPECT_EQ(next.assignments[0].task.id, "t3");
 }
 
+/// Counted by phase, a task loads its pickup until it has loaded and then its drop-off: a robot
+/// delivering elsewhere no longer holds a place at the pickup it has left.
+TEST_F(DispatcherTest, StationLoadByPhaseFreesThePickupOnceLoaded) {
+  cfg.stationCapacity = 1;
+  cfg.stationLoadByPhase = true;
+  reopen();
+  for (int i = 0; i < 3; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  dispatcher->submit({transport("t1"), transport("t2")}, 0);
+  const auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u) << "one robot per pickup";
+  EXPECT_EQ(out.assignments[0].task.id, "t1");
+  const std::string holder = out.assignments[0].robotId;
+  EXPECT_TRUE(dispatcher->tick(2).assignments.empty()) << "P-1 is taken until t1 has loaded";
+  ASSERT_TRUE(dispatcher->onTaskStatus(holder, "t1", S::Delivering, "", 3));
+  const auto next = dispatcher->tick(4);
+  ASSERT_EQ(next.assignments.size(), 1u) << "t1 left P-1 for its drop-off: t2 goes";
+  EXPECT_EQ(next.assignments[0].task.id, "t2");
+}
+
+TEST_F(DispatcherTest, StationLoadByTaskHoldsThePickupUntilTheTaskEnds) {
+  cfg.stationCapacity = 1;
+  reopen();
+  for (int i = 0; i < 3; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  dispatcher->submit({transport("t1"), transport("t2")}, 0);
+  const auto first = dispatcher->tick(1);
+  ASSERT_EQ(first.assignments.size(), 1u);
+  ASSERT_TRUE(dispatcher->onTaskStatus(first.assignments[0].robotId, "t1", S::Delivering, "", 3));
+  EXPECT_TRUE(dispatcher->tick(4).assignments.empty());
+}
+
 TEST_F(DispatcherTest, ARobotThatFailsEveryTaskIsHeldBackForAWhile) {
   robot("broken", 1, 0.9, 0);
   robot("far", 30, 0.9, 0);

@@ -30,6 +30,12 @@ struct DispatcherConfig {
   /// task whose station is full waits in the queue (oldest first) instead of sending another robot
   /// to crowd the station. 0: no limit.
   std::size_t stationCapacity = 0;
+  /// How an active task loads its stations. Whole task (false): its pickup and its drop-off from
+  /// assignment to the end, so with 9 stations and a capacity of 2 at most ~8 tasks are active
+  /// while 20 robots wait. By phase (true): its pickup until it has loaded, then its drop-off,
+  /// which is where the robot is going; admission checks the pickup. With reserved traffic the
+  /// stations' lines (dock and queue nodes) take the robots that arrive while a station is busy.
+  bool stationLoadByPhase = false;
   /// A robot that fails this many tasks in a row gets no task for robotHoldNs: an agent that fails
   /// every order at once (a pose estimate inside a shelf after a restart) would otherwise burn
   /// through the queue, each task failing its attempts on it. 0: never held.
