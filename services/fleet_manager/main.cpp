@@ -169,6 +169,7 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   ops.watchMatchedWriters("Task", [&] { return tasks.matchedWriters(); });
   ops.watchMatchedWriters("TaskStatus", [&] { return statuses.matchedWriters(); });
   ops.watchMatchedWriters("RobotState", [&] { return states.matchedWriters(); });
+  ops.watchForeign([&] { return states.foreign() + statuses.foreign(); });
   ops.watchMatchedReaders("TaskAck", [&] { return acks.matchedReaders(); });
   ops.watchMatchedReaders("TaskEvent", [&] { return events.matchedReaders(); });
   ops.watchMatchedReaders("TaskAssignment", [&] { return assignments.matchedReaders(); });

@@ -538,13 +538,12 @@ int Run::run() {
   // DDS Security: each process joins as its identity of the folder (scripts/dds-security).
   const auto identityOf = [](const std::string& process) -> std::string {
     if (process.rfind("agent-", 0) == 0) {
-      return "agents";
+      return process;  // made for this run with its robots (below)
     }
-    static const std::map<std::string, std::string> kIdentity = {{"fleet_manager", "fleet-manager"},
-                                                                 {"wms_adapter", "wms-adapter"},
-                                                                 {"risk_map", "risk-map"},
-                                                                 {"traffic_manager", "traffic-manager"},
-                                                                 {"fleet-sim", "simulator"}};
+    static const std::map<std::string, std::string> kIdentity = {
+        {"fleet_manager", "fleet-manager"},     {"vda5050_bridge", "vda5050-bridge"},
+        {"wms_adapter", "wms-adapter"},         {"risk_map", "risk-map"},
+        {"traffic_manager", "traffic-manager"}, {"fleet-sim", "simulator"}};
     const auto it = kIdentity.find(process);
     return it == kIdentity.end() ? process : it->second;
   };
@@ -555,11 +554,13 @@ int Run::run() {
       return 2;
     }
     std::vector<std::string> missing;
-    for (const char* id :
-         {"fleet-manager", "wms-adapter", "risk-map", "traffic-manager", "simulator", "agents"}) {
+    for (const char* id : {"fleet-manager", "wms-adapter", "risk-map", "traffic-manager", "simulator"}) {
       if (!fs::exists(fs::path(o.ddsSecurity) / id / "cyclonedds.xml")) {
         missing.emplace_back(id);
       }
+    }
+    if (!fs::exists(fs::path(o.ddsSecurity) / "ca.key")) {
+      missing.emplace_back("the agent processes (the site CA's key ca.key is not there to make them)");
     }
     if (!missing.empty()) {
       std::string names;
@@ -697,7 +698,12 @@ int Run::run() {
     agentOfRobot[r] = "agent-" + std::to_string(next % groups.size());
     ++next;
   }
+  std::map<std::string, std::vector<std::string>> robotsOfProcess;  // DDS Security identities
+  if (!vdaRobots.empty()) {
+    robotsOfProcess["vda5050_bridge"].assign(vdaRobots.begin(), vdaRobots.end());
+  }
   auto agentSpec = [&](const std::string& name, const std::vector<std::string>& ids) {
+    robotsOfProcess[name] = ids;
     fs::remove(out / (name + "_metrics.json"), ec);  // not a previous run's
     std::string list;
     for (const auto& r : ids) {
@@ -777,6 +783,23 @@ int Run::run() {
   }
   for (const auto& f : faults) {
     say("fault planned: " + describe(f));
+  }
+  if (!o.ddsSecurity.empty()) {
+    // One identity per agent process (and the bridge) granting exactly its robots' partitions.
+    for (const auto& [process, ids] : robotsOfProcess) {
+      std::string list;
+      for (const auto& r : ids) {
+        list += (list.empty() ? "" : ",") + r;
+      }
+      const std::string role = process == "vda5050_bridge" ? "vda5050-bridge" : "robot-agent";
+      const std::string cmd = "'" + o.securityScript + "' identity '" + fs::absolute(o.ddsSecurity).string() +
+                              "' '" + identityOf(process) + "' " + role + " --robots '" + list +
+                              "' >/dev/null";
+      if (std::system(cmd.c_str()) != 0) {
+        say("cannot make the DDS Security identity of " + process + ": " + cmd);
+        return 2;
+      }
+    }
   }
   for (auto& s : specs) {
     secure(s);

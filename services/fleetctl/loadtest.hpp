@@ -42,10 +42,13 @@ struct LoadtestOptions {
   double returnHomeS = 5.0;         // robot agents' --return-home (negative: stay where a task ends)
   /// "reactive" or "reserved" (a traffic_manager process plans every robot; the agents follow it).
   std::string traffic = "reactive";
-  /// A folder made by scripts/dds-security ("deployment DIR agents"): every process joins with its
-  /// identity (fleet-manager, wms-adapter, risk-map, traffic-manager, simulator; every agent
-  /// process as "agents"). Empty: no DDS Security.
+  /// A folder made by scripts/dds-security ("deployment DIR"): every process joins with its
+  /// identity (fleet-manager, wms-adapter, risk-map, traffic-manager, simulator). Each agent
+  /// process (and the VDA 5050 bridge) gets an identity of its own made for the run with
+  /// `securityScript`, granting only its robots' partitions ("agent-0" ...; needs DIR/ca.key).
+  /// Empty: no DDS Security.
   std::string ddsSecurity;
+  std::string securityScript;  // scripts/dds-security
   int stepTimeoutMs = 300;
   /// Every service on the wall clock, as in production: the simulator runs at 1x, robot agents
   /// at their configured rate (their achieved rate is reported), and nothing waits for anyone.

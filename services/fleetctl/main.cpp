@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
   fleet::ctl::LoadtestOptions lt;
   lt.templ = FLEETCTL_SOURCE_DIR "/sim/scenarios/small_warehouse.json";
   lt.reportScript = FLEETCTL_SOURCE_DIR "/scripts/report.py";
+  lt.securityScript = FLEETCTL_SOURCE_DIR "/scripts/dds-security";
   lt.binDir = FLEETCTL_BINARY_DIR;
   lt.out = "reports/loadtest";
   loadtest->add_option("--scenario", lt.scenario, "run this scenario file as is (else one is generated)");
@@ -150,7 +151,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   loadtest->add_option("--dds-security", lt.ddsSecurity,
                        "run every process with its DDS Security identity from this folder (made by "
-                       "scripts/dds-security deployment DIR)");
+                       "scripts/dds-security deployment DIR; each agent process gets an identity of its "
+                       "own for its robots, made in the folder for the run)");
   loadtest->add_option("--duration", lt.durationS, "simulated seconds")
       ->check(CLI::Range(1.0, 86400.0))
       ->capture_default_str();

@@ -55,6 +55,7 @@ int run(const riskmap::Settings& settings, const std::string& id, const service:
   validation::Rejections rejections;  // refused at the edge, before the fusion engine's own checks
   badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
   ops.watchMatchedWriters("PredictedDiscs", [&] { return discs.matchedWriters(); });
+  ops.watchForeign([&] { return discs.foreign(); });
   ops.watchMatchedReaders("RiskMap", [&] { return out.matchedReaders(); });
   WallClock wall;
   const bool simClock = settings.clock == "sim";

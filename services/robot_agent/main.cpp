@@ -84,7 +84,6 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   transport::Writer<msg::RobotState> states(part);
   transport::Writer<msg::PredictedDiscs> discs(part);
   transport::Writer<msg::TaskStatus> statuses(part);
-  transport::Writer<msg::StepDone> stepDone(part);
   // Reserved traffic only: a reactive agent neither reads releases nor tells the traffic manager
   // anything (it counts as a robot that does not follow).
   std::optional<transport::Reader<msg::TrafficRelease>> releases;
@@ -101,6 +100,25 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   } catch (const std::exception& e) {
     spdlog::warn("robot agent {}: not publishing the people seen ({})", proc.id, e.what());
   }
+  {
+    // A writer per hosted robot and topic, each in the robot's partition (transport/
+    // robot_partition.hpp), made now: readers match them during start-up, and DDS Security refuses
+    // here, with the robot named, a robot this process's permissions do not grant.
+    std::vector<std::string> robots;
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      robots.push_back(node.agent(i).id());
+    }
+    states.forRobots(robots);
+    discs.forRobots(robots);
+    statuses.forRobots(robots);
+    if (trafficProgress) {
+      trafficProgress->forRobots(robots);
+    }
+  }
+  // Made after the robots' writers: discovery announces a participant's writers in the order they
+  // are made, so a simulator that hears this process's lockstep registration has matched its
+  // command writers already (a command of the first step is not lost).
+  transport::Writer<msg::StepDone> stepDone(part);
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
@@ -117,6 +135,7 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   ops.watchMatchedReaders("VelocityCommand", [&] { return commands.matchedReaders(); });
   ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
   ops.watchMatchedReaders("TaskStatus", [&] { return statuses.matchedReaders(); });
+  ops.watchForeign([&] { return others.foreign(); });
   std::map<std::string, metrics::Gauge*> byMode;
   // Robots by mode, counted from the last cycle's states once a second (and readiness: a robot
   // agent can do its job once a sensor source, simulator or driver, is matched).

@@ -61,6 +61,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   validation::Rejections rejections;  // refused at the edge, before the node's roadmap checks
   badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
   ops.watchMatchedWriters("TrafficProgress", [&] { return progress.matchedWriters(); });
+  ops.watchForeign([&] { return progress.foreign(); });
   ops.watchMatchedReaders("TrafficRelease", [&] { return releases.matchedReaders(); });
   // The roadmap is built (the node exists): what this service needs to do its job.
   ops.health().setReady("roadmap", node.roadmap().graph.size() > 0);

@@ -93,6 +93,16 @@ int run(const Settings& settings) {
   transport::Writer<msg::TrafficProgress> progress(p);
   transport::Reader<msg::Clock> clockIn(p);
   transport::Writer<msg::StepDone> stepDone(p);
+  // One writer per vehicle's robot, each in its robot's partition, made now so that the fleet
+  // manager has matched them before the first report (and so that DDS Security refuses, at start,
+  // a vehicle this bridge's permissions do not name).
+  std::vector<std::string> robots;
+  for (const auto& v : settings.bridge.vehicles) {
+    robots.push_back(v.robot_id);
+  }
+  states.forRobots(robots);
+  statuses.forRobots(robots);
+  progress.forRobots(robots);
   std::int64_t simNow = -1;
   service::RateLimitedLog log;
   spdlog::info("vda5050 bridge: {} vehicle(s), broker {}:{}{}, map '{}'", settings.bridge.vehicles.size(),

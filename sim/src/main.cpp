@@ -274,6 +274,8 @@ class Simulator {
     ops_.watchMatchedReaders("SensorFrame", [this] { return sensorW_.matchedReaders(); });
     ops_.watchMatchedReaders("Clock", [this] { return clockW_.matchedReaders(); });
     ops_.watchMatchedWriters("VelocityCommand", [this] { return cmdR_.matchedWriters(); });
+    ops_.watchForeign([this] { return stateR_.foreign(); });
+    discsW_.forRobots({""});  // people's discs: the default partition (not a robot's)
     ops_.watchMatchedWriters("StepDone", [this] { return doneR_.matchedWriters(); });
   }
 

@@ -115,18 +115,41 @@ dds_entity_t createTopic(const Participant& p, const dds_topic_descriptor_t* des
                ("dds_create_topic " + name).c_str());
 }
 
-dds_entity_t createWriter(const Participant& p, dds_entity_t topic, const QosProfile& q) {
+namespace {
+dds_qos_t* makeQos(const QosProfile& q, const std::vector<std::string>& partitions) {
   dds_qos_t* qos = q.make();
-  const dds_entity_t w = dds_create_writer(p.handle(), topic, qos, nullptr);
+  if (!partitions.empty()) {
+    std::vector<const char*> names;
+    for (const auto& p : partitions) {
+      names.push_back(p.c_str());
+    }
+    dds_qset_partition(qos, static_cast<uint32_t>(names.size()), names.data());
+  }
+  return qos;
+}
+std::string inPartitions(const char* call, const std::vector<std::string>& partitions) {
+  std::string s = call;
+  for (std::size_t i = 0; i < partitions.size(); ++i) {
+    s += (i == 0 ? " (partition \"" : ", \"") + partitions[i] + "\"";
+  }
+  return partitions.empty() ? s : s + ")";
+}
+}  // namespace
+
+dds_entity_t createWriter(dds_entity_t participant, dds_entity_t topic, const QosProfile& q,
+                          const std::vector<std::string>& partitions) {
+  dds_qos_t* qos = makeQos(q, partitions);
+  const dds_entity_t w = dds_create_writer(participant, topic, qos, nullptr);
   dds_delete_qos(qos);
-  return check(w, "dds_create_writer");
+  return check(w, inPartitions("dds_create_writer", partitions).c_str());
 }
 
-dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q) {
-  dds_qos_t* qos = q.make();
-  const dds_entity_t r = dds_create_reader(p.handle(), topic, qos, nullptr);
+dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q,
+                          const std::vector<std::string>& partitions, const dds_listener_t* listener) {
+  dds_qos_t* qos = makeQos(q, partitions);
+  const dds_entity_t r = dds_create_reader(p.handle(), topic, qos, listener);
   dds_delete_qos(qos);
-  return check(r, "dds_create_reader");
+  return check(r, inPartitions("dds_create_reader", partitions).c_str());
 }
 
 std::uint32_t matched(dds_entity_t e, bool publication) {

@@ -49,6 +49,11 @@ void ServiceOps::watchMatchedWriters(const std::string& topic, std::function<std
        std::move(count)});
 }
 
+void ServiceOps::watchForeign(std::function<std::uint64_t()> total) {
+  rejected("foreign_robot");  // listed at 0 from the start
+  foreign_.push_back({std::move(total), 0});
+}
+
 bool ServiceOps::refresh() {
   health_.beat();
   const auto now = std::chrono::steady_clock::now();
@@ -58,6 +63,13 @@ bool ServiceOps::refresh() {
   lastRefresh_ = now;
   for (auto& w : watched_) {
     w.gauge->set(static_cast<double>(w.count()));
+  }
+  for (auto& f : foreign_) {
+    const std::uint64_t total = f.total();
+    if (total > f.counted) {
+      rejected("foreign_robot").inc(total - f.counted);
+      f.counted = total;
+    }
   }
   return true;
 }

@@ -44,6 +44,16 @@ msg::RobotState sample(std::uint32_t i) {
   return s;
 }
 
+/// The robots of sample(): RobotState is a per-robot topic, one writer per robot (made up front so
+/// that the match is complete before timing starts).
+std::vector<std::string> sampleRobots() {
+  std::vector<std::string> ids;
+  for (std::uint32_t i = 0; i < 16; ++i) {
+    ids.push_back(sample(i).robot_id);
+  }
+  return ids;
+}
+
 template <class W, class R>
 void waitMatched(const W& w, const R& r) {
   const auto end = Clk::now() + 20s;
@@ -56,6 +66,7 @@ int runPong() {
   Participant p;
   Reader<msg::RobotState> in(p, kPingQos, "BenchPing");
   Writer<msg::RobotState> out(p, kPingQos, "BenchPong");
+  out.forRobots(sampleRobots());
   auto last = Clk::now();
   while (!gStop && Clk::now() - last < 5s) {
     if (in.waitForData(100ms)) {
@@ -74,6 +85,7 @@ int runPongRaw() {
   Participant p;
   Reader<msg::RobotState> in(p, kPingQos, "BenchPing");
   Writer<msg::RobotState> out(p, kPingQos, "BenchPong");
+  out.forRobots(sampleRobots());
   auto last = Clk::now();
   while (!gStop && Clk::now() - last < 5s) {
     if (in.waitForData(100ms)) {
@@ -82,7 +94,9 @@ int runPongRaw() {
       const int n = dds_take(in.handle(), samples, infos, 16, 16);
       for (int i = 0; i < n; ++i) {
         if (infos[i].valid_data) {
-          check(dds_write(out.handle(), samples[i]), "dds_write");
+          msg::RobotState key;
+          key.robot_id = static_cast<const fleet_RobotState*>(samples[i])->robot_id;
+          check(dds_write(out.handleFor(key), samples[i]), "dds_write");
         }
       }
       if (n > 0) {
@@ -143,6 +157,7 @@ void BM_PingPongOneWay(benchmark::State& state) {
   test::ChildProcess pong(self, {raw ? "--pong-raw" : "--pong"});
   Participant p;
   Writer<msg::RobotState> out(p, kPingQos, "BenchPing");
+  out.forRobots(sampleRobots());
   Reader<msg::RobotState> in(p, kPingQos, "BenchPong");
   waitMatched(out, in);
   fleet_RobotState c{};
@@ -167,7 +182,7 @@ void BM_PingPongOneWay(benchmark::State& state) {
       }
       return false;
     }
-    check(dds_write(out.handle(), &c), "dds_write");
+    check(dds_write(out.handleFor(rawSample), &c), "dds_write");
     while (Clk::now() < giveUp) {
       in.waitForData(100ms);
       void* samples[4] = {nullptr};
@@ -220,6 +235,7 @@ void BM_Throughput(benchmark::State& state) {
                           {{"FLEET_DDS_DOMAIN", std::to_string(domain)}});
   Participant p(domain, ParticipantOptions{.writeBatching = batching});
   Writer<msg::RobotState> out(p, kStreamQos, "BenchStream");
+  out.forRobots(sampleRobots());
   Writer<msg::StepDone> ctl(p, kPingQos, "BenchCtl");
   Reader<msg::StepDone> reply(p, kPingQos, "BenchReply");
   waitMatched(out, reply);
@@ -270,6 +286,7 @@ void BM_Throughput(benchmark::State& state) {
 void BM_WriteWrapper(benchmark::State& state) {
   Participant p;
   Writer<msg::RobotState> w(p, kStreamQos, "BenchLocal");
+  w.forRobots(sampleRobots());
   Reader<msg::RobotState> r(p, kStreamQos, "BenchLocal");
   const auto s = sample(1);
   std::int64_t n = 0;
@@ -286,13 +303,14 @@ void BM_WriteWrapper(benchmark::State& state) {
 void BM_WriteRawC(benchmark::State& state) {
   Participant p;
   Writer<msg::RobotState> w(p, kStreamQos, "BenchLocal");
+  w.forRobots(sampleRobots());
   Reader<msg::RobotState> r(p, kStreamQos, "BenchLocal");
   fleet_RobotState c{};
   Arena arena;
   Traits<msg::RobotState>::toC(sample(1), c, arena);
   std::int64_t n = 0;
   for (auto _ : state) {
-    check(dds_write(w.handle(), &c), "dds_write");
+    check(dds_write(w.handleFor(sample(1)), &c), "dds_write");
     if (++n % 256 == 0) {
       state.PauseTiming();
       (void)r.take();

@@ -101,6 +101,8 @@ struct FakeRobots {
     for (int i = 0; i < n; ++i) {
       ids.push_back("r" + std::to_string(i));
     }
+    states.forRobots(ids);  // as an agent does at start: its writers match before the first report
+    statuses.forRobots(ids);
   }
   void publishStates() {
     WallClock c;

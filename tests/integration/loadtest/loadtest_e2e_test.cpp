@@ -576,6 +576,13 @@ TEST(LoadtestE2E, AFleetRunsUnderDdsSecurity) {
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
   EXPECT_EQ(r["accounting"]["done"], 2) << r["accounting"].dump();
   EXPECT_EQ(r["accounting"]["lost"], 0);
+  // The agent process ran as an identity of its own that publishes only in its robot's partition.
+  std::stringstream perms;
+  perms << std::ifstream(ids / "agent-0" / "permissions.xml").rdbuf();
+  EXPECT_NE(perms.str().find("<partition>robot/r1</partition>"), std::string::npos) << perms.str();
+  EXPECT_EQ(perms.str().find("<partition>robot/*</partition>"),
+            perms.str().rfind("<partition>robot/*</partition>"))
+      << "robot/* only once: in what it reads";
   // A missing identity is named before anything starts.
   fs::remove_all(ids / "risk-map");
   fleet::test::ChildProcess bad(kFleetctl, args);

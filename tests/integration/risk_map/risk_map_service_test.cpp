@@ -29,6 +29,7 @@ TEST(RiskMapService, PublishedMapMatchesLibraryFusion) {
 
   transport::Participant p;
   transport::Writer<msg::PredictedDiscs> out(p);
+  out.forRobots({"src-0", "src-1", ""});  // two robots' partitions and the default one (the human)
   transport::Reader<msg::RiskMap> in(p);
   const auto deadline = std::chrono::steady_clock::now() + 20s;
   while ((out.matchedReaders() == 0 || in.matchedWriters() == 0) &&

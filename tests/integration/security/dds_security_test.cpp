@@ -40,7 +40,8 @@ class DdsSecurity : public ::testing::Test {
     domain_ = std::to_string(test::uniqueDomain());
     dir_ = std::filesystem::temp_directory_path() / ("fleet_dds_security_" + domain_);
     std::filesystem::remove_all(dir_);
-    ASSERT_EQ(sh(kScript + " deployment " + (dir_ / "site").string() + " agents"), 0);
+    // "agents" may speak for robot r1 only.
+    ASSERT_EQ(sh(kScript + " deployment " + (dir_ / "site").string() + " agents=r1"), 0);
     // The same names under another site's CA: valid certificates, but not this site's.
     ASSERT_EQ(sh(kScript + " init " + (dir_ / "other").string()), 0);
     ASSERT_EQ(sh(kScript + " identity " + (dir_ / "other").string() + " wms-adapter wms-adapter"), 0);
@@ -97,4 +98,41 @@ TEST_F(DdsSecurity, AReadOnlyObserverCannotWrite) {
   const auto got = dir_ / "observer.txt";
   test::ChildProcess reader(kProbe, {"read", "2", got.string()}, as("site", "observer"));
   EXPECT_EQ(reader.wait(40s), 0) << "but it may read Task";
+}
+
+TEST_F(DdsSecurity, AnAgentSpeaksOnlyForItsOwnRobots) {
+  // The fleet manager's view of RobotState and TaskStatus, through the same readers it uses.
+  const auto got = dir_ / "manager_states.txt";
+  test::ChildProcess manager(kProbe, {"states", "16", got.string()}, as("site", "fleet-manager"));
+  std::this_thread::sleep_for(1s);
+  test::ChildProcess own(kProbe, {"speak", "12", "r1", "r1"}, as("site", "agents"));
+  test::ChildProcess theirs(kProbe, {"speak", "12", "r2", "r2"}, as("site", "agents"));
+  test::ChildProcess disguised(kProbe, {"speak", "12", "r3", "r1"}, as("site", "agents"));
+  EXPECT_EQ(own.wait(40s), 0);
+  EXPECT_EQ(theirs.wait(40s), 3) << "r2's partition is not in the agents' permissions: writer refused";
+  EXPECT_EQ(disguised.wait(40s), 0) << "its own partition is granted";
+  ASSERT_EQ(manager.wait(40s), 0);
+  const auto m = counts(got);
+  EXPECT_GT(m.count("state:r1") ? m.at("state:r1") : 0, 20) << "the agent's own robot is heard";
+  EXPECT_GT(m.count("status:r1") ? m.at("status:r1") : 0, 20);
+  EXPECT_EQ(m.count("state:r2") + m.count("status:r2"), 0u);
+  EXPECT_EQ(m.count("state:r3") + m.count("status:r3"), 0u) << "r3's samples in r1's partition are dropped";
+  EXPECT_GT(m.count("foreign") ? m.at("foreign") : 0, 20) << "and counted";
+}
+
+TEST_F(DdsSecurity, WithoutSecurityTheReceiverStillDropsARobotSpeakingForAnother) {
+  // Loopback development: partitions are the same, nothing refuses the writer, the readers' check
+  // still holds.
+  const auto got = dir_ / "plain_states.txt";
+  test::ChildProcess manager(kProbe, {"states", "10", got.string()}, as("", ""));
+  std::this_thread::sleep_for(1s);
+  test::ChildProcess own(kProbe, {"speak", "6", "r1", "r1"}, as("", ""));
+  test::ChildProcess disguised(kProbe, {"speak", "6", "r3", "r1"}, as("", ""));
+  EXPECT_EQ(own.wait(40s), 0);
+  EXPECT_EQ(disguised.wait(40s), 0);
+  ASSERT_EQ(manager.wait(40s), 0);
+  const auto m = counts(got);
+  EXPECT_GT(m.count("state:r1") ? m.at("state:r1") : 0, 10);
+  EXPECT_EQ(m.count("state:r3") + m.count("status:r3"), 0u);
+  EXPECT_GT(m.count("foreign") ? m.at("foreign") : 0, 10);
 }

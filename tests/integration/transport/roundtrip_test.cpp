@@ -35,12 +35,21 @@ class RoundTrip : public ::testing::Test {
   template <class T>
   std::vector<T> roundTrip(const std::vector<T>& samples) {
     Writer<T> w(*participant_, kAll);
+    if constexpr (RobotOf<T>::kPerRobot) {
+      std::vector<std::string> robots;  // one writer per robot, in its partition
+      for (const auto& s : samples) {
+        robots.push_back(RobotOf<T>::of(s));
+      }
+      w.forRobots(robots);
+    }
     Reader<T> r(*participant_, kAll, std::string(Traits<T>::kTopic) + "_echo");
     // Generous limits, taken separately for discovery and for the echo: under a full parallel
     // test run on 2 cores one echo of a 40 kB RiskMap missed a shared 15 s (CI, 2026-11-25).
     // A passing run takes well under a second either way.
     const auto matchDeadline = std::chrono::steady_clock::now() + 30s;
-    while ((w.matchedReaders() == 0 || r.matchedWriters() == 0) &&
+    // On a per-robot topic the peer makes its echo writer of a robot at that robot's first sample
+    // (transient-local: it reaches this reader whenever they match), so only this side can wait.
+    while ((w.matchedReaders() == 0 || (!RobotOf<T>::kPerRobot && r.matchedWriters() == 0)) &&
            std::chrono::steady_clock::now() < matchDeadline) {
       std::this_thread::sleep_for(10ms);
     }

@@ -74,6 +74,16 @@ TEST(ServiceOps, RejectedSamplesAreCountedByReasonWithoutTheSender) {
   EXPECT_EQ(ops.rejected("progress").value(), 2u);
 }
 
+TEST(ServiceOps, SamplesFromAWriterOutsideTheRobotsPartitionAreCountedAsForeign) {
+  service::ServiceOps ops("unit_test");
+  std::uint64_t dropped = 0;
+  ops.watchForeign([&] { return dropped; });
+  EXPECT_EQ(ops.rejected("foreign_robot").value(), 0u) << "listed from the start";
+  dropped = 3;                 // what the readers' foreign() say
+  ASSERT_TRUE(ops.refresh());  // the first refresh does the once-a-second part
+  EXPECT_EQ(ops.rejected("foreign_robot").value(), 3u);
+}
+
 TEST(CommandLine, UsageErrorsExitTwoAndVersionZero) {
   auto run = [](std::vector<std::string> args) {
     CLI::App app{"t"};

@@ -107,6 +107,77 @@ TEST_F(Transport, AcknowledgedMeansTheLateJoinerAlreadyHoldsTheData) {
   EXPECT_EQ(r.take().size(), 2u);  // no waiting for data: acknowledged means delivered
 }
 
+// Per-robot topics (robot_partition.hpp): a sample counts only when it comes from a writer in the
+// partition of the robot it names; a human's discs only from the default partition.
+TEST_F(Transport, ASampleCountsOnlyFromItsRobotsPartition) {
+  Participant p;
+  const QosProfile q{true, true, 0, 0, 1000};  // reliable keep-all: nothing is lost in the test
+  Reader<msg::RobotState> r(p, q);
+  Writer<msg::RobotState> w(p, q);
+  w.forRobots({"r1"});
+  // A writer in r1's partition made by hand, as a process speaking for r2 would.
+  using Tr = Traits<msg::RobotState>;
+  const dds_entity_t r1sWriter = detail::createWriter(
+      p.handle(), detail::createTopic(p, Tr::descriptor(), Tr::kTopic), q, {robotPartition("r1")});
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (r.matchedWriters() < 2 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(r.matchedWriters(), 2u);
+  msg::RobotState mine;
+  mine.robot_id = "r1";
+  w.write(mine);
+  msg::RobotState other;
+  other.robot_id = "r2";
+  fleet_RobotState c{};
+  Arena arena;
+  Tr::toC(other, c, arena);
+  ASSERT_EQ(dds_write(r1sWriter, &c), DDS_RETCODE_OK);
+  std::vector<msg::RobotState> got;
+  while (got.size() + r.foreign() < 2 && std::chrono::steady_clock::now() < end) {
+    for (auto& m : r.take()) {
+      got.push_back(std::move(m));
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].robot_id, "r1");
+  EXPECT_EQ(r.foreign(), 1u);
+
+  Reader<msg::PredictedDiscs> rd(p, q);
+  Writer<msg::PredictedDiscs> wd(p, q);
+  msg::PredictedDiscs human;
+  human.source_id = "h1";
+  human.kind = msg::SourceKind::Human;
+  msg::PredictedDiscs robot;
+  robot.source_id = "r1";
+  wd.forRobots({"", "r1"});  // the default partition (humans) and r1's
+  while (rd.matchedWriters() < 2 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(5ms);
+  }
+  wd.write(human);
+  wd.write(robot);
+  msg::PredictedDiscs robotAsHuman = robot;  // a robot's discs in the default partition
+  using Td = Traits<msg::PredictedDiscs>;
+  const dds_entity_t plain =
+      detail::createWriter(p.handle(), detail::createTopic(p, Td::descriptor(), Td::kTopic), q);
+  fleet_PredictedDiscs cd{};
+  Td::toC(robotAsHuman, cd, arena);
+  while (rd.matchedWriters() < 3 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(dds_write(plain, &cd), DDS_RETCODE_OK);
+  std::vector<msg::PredictedDiscs> discs;
+  while (discs.size() + rd.foreign() < 3 && std::chrono::steady_clock::now() < end) {
+    for (auto& m : rd.take()) {
+      discs.push_back(std::move(m));
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_EQ(discs.size(), 2u);
+  EXPECT_EQ(rd.foreign(), 1u);
+}
+
 TEST_F(Transport, WaitSetWakesOnGuard) {
   Participant p;
   WaitSet ws(p);

@@ -110,7 +110,7 @@ TEST(PeopleSeenOverDds, ReachTheRobotApiAndMalformedSamplesAreRefusedAndCounted)
   raw.people._buffer = crowd.data();
   raw.people._length = raw.people._maximum = static_cast<std::uint32_t>(crowd.size());
   raw.stamp_ns = 4;
-  const dds_return_t rawWritten = dds_write(people.handle(), &raw);
+  const dds_return_t rawWritten = dds_write(people.handleFor(msg::PeopleSeen{"r1", 4, {}}), &raw);
   std::this_thread::sleep_for(300ms);
   EXPECT_NE(robotJson("r1")["people_seen"].size(), crowd.size())
       << "dds_write returned " << rawWritten << "; refused as too_large " << rejected("too_large")

@@ -6,12 +6,16 @@
 
 #include <chrono>
 #include <functional>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "fleet/transport/errors.hpp"
+#include "fleet/transport/robot_partition.hpp"
 #include "fleet/transport/traits.hpp"
+#include "fleet/transport/writer_partitions.hpp"
 
 namespace fleet::transport {
 
@@ -69,64 +73,144 @@ class Participant {
 
 namespace detail {
 dds_entity_t createTopic(const Participant& p, const dds_topic_descriptor_t* desc, const std::string& name);
-dds_entity_t createWriter(const Participant& p, dds_entity_t topic, const QosProfile& q);
-dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q);
+/// `partitions` empty: the default partition.
+dds_entity_t createWriter(dds_entity_t participant, dds_entity_t topic, const QosProfile& q,
+                          const std::vector<std::string>& partitions = {});
+dds_entity_t createReader(const Participant& p, dds_entity_t topic, const QosProfile& q,
+                          const std::vector<std::string>& partitions = {},
+                          const dds_listener_t* listener = nullptr);
 std::uint32_t matched(dds_entity_t e, bool publication);
 }  // namespace detail
 
+/// Writes one topic. On a per-robot topic (robot_partition.hpp) it is one DDS writer per robot, each
+/// in the robot's partition, made by forRobots() or at the robot's first sample.
 template <class T>
 class Writer {
  public:
   using Tr = Traits<T>;
+  static constexpr bool kPerRobot = RobotOf<T>::kPerRobot;
   explicit Writer(const Participant& p, std::optional<QosProfile> q = std::nullopt,
                   const std::string& topic = Tr::kTopic)
-      : topic_(detail::createTopic(p, Tr::descriptor(), topic)),
-        w_(detail::createWriter(p, topic_, q.value_or(Tr::qos()))),
+      : participant_(p.handle()),
+        topic_(detail::createTopic(p, Tr::descriptor(), topic)),
+        qos_(q.value_or(Tr::qos())),
+        w_(kPerRobot ? 0 : detail::createWriter(participant_, topic_, qos_)),
         batching_(p.writeBatching()) {}
+
+  /// Per-robot topics: makes the writers of these robots now (at start-up, so that readers have
+  /// matched them before the first sample). Under DDS Security this throws DdsError for a robot
+  /// whose partition the process's permissions do not grant.
+  Writer& forRobots(const std::vector<std::string>& robots) {
+    if constexpr (kPerRobot) {
+      for (const auto& r : robots) {
+        writerOf(r);
+      }
+    }
+    return *this;
+  }
 
   /// Copies `m` into a C sample and writes it; it is on its way when this returns (also on a
   /// write-batching participant). Throws MessageError (bounds) or DdsError.
   void write(const T& m) {
-    queue(m);
+    const dds_entity_t w = put(m);
     if (batching_) {
-      flush();
+      dds_write_flush(w);
     }
   }
   /// Like write(), but on a write-batching participant the sample may wait in the writer's
   /// datagram until it is full or flush() is called: write a burst with queue(), then flush().
-  void queue(const T& m) {
-    typename Tr::C c{};
-    arena_.clear();
-    Tr::toC(m, c, arena_);
-    check(dds_write(w_, &c), "dds_write");
+  void queue(const T& m) { put(m); }
+  /// Sends what queue() left in the writers' datagrams (nothing to do without write batching).
+  /// Batches are per DDS writer: on a per-robot topic only one robot's samples share a datagram.
+  void flush() {
+    if constexpr (kPerRobot) {
+      for (const auto& [robot, w] : byRobot_) {
+        dds_write_flush(w);
+      }
+    } else {
+      dds_write_flush(w_);
+    }
   }
-  /// Sends what queue() left in the writer's datagram (nothing to do without write batching).
-  void flush() { dds_write_flush(w_); }
   /// Disposes the instance with m's key (readers see it not-alive).
   void dispose(const T& m) {
     typename Tr::C c{};
     arena_.clear();
     Tr::toC(m, c, arena_);
-    check(dds_dispose(w_, &c), "dds_dispose");
+    check(dds_dispose(writerFor(m), &c), "dds_dispose");
   }
   /// Tells readers this writer has nothing more for m's key and lets it forget the instance.
   void unregister(const T& m) {
     typename Tr::C c{};
     arena_.clear();
     Tr::toC(m, c, arena_);
-    check(dds_unregister_instance(w_, &c), "dds_unregister_instance");
+    check(dds_unregister_instance(writerFor(m), &c), "dds_unregister_instance");
   }
-  [[nodiscard]] std::uint32_t matchedReaders() const { return detail::matched(w_, true); }
+  /// Readers matched; on a per-robot topic the fewest any of its robots' writers has (0 before
+  /// the first robot).
+  [[nodiscard]] std::uint32_t matchedReaders() const {
+    if constexpr (kPerRobot) {
+      if (byRobot_.empty()) {
+        return 0;
+      }
+      std::uint32_t least = UINT32_MAX;
+      for (const auto& [robot, w] : byRobot_) {
+        least = std::min(least, detail::matched(w, true));
+      }
+      return least;
+    } else {
+      return detail::matched(w_, true);
+    }
+  }
   /// True once every matched reliable reader has acknowledged everything this writer holds (for
   /// transient-local data: the late joiner has it), false when `timeout` passes first.
   [[nodiscard]] bool waitForAcks(std::chrono::nanoseconds timeout) const {
-    return dds_wait_for_acks(w_, static_cast<dds_duration_t>(timeout.count())) == DDS_RETCODE_OK;
+    if constexpr (kPerRobot) {
+      for (const auto& [robot, w] : byRobot_) {
+        if (dds_wait_for_acks(w, static_cast<dds_duration_t>(timeout.count())) != DDS_RETCODE_OK) {
+          return false;
+        }
+      }
+      return true;
+    } else {
+      return dds_wait_for_acks(w_, static_cast<dds_duration_t>(timeout.count())) == DDS_RETCODE_OK;
+    }
   }
-  [[nodiscard]] dds_entity_t handle() const { return w_; }
+
+  /// The DDS writer m goes through (on a per-robot topic, its robot's; made if new).
+  [[nodiscard]] dds_entity_t handleFor(const T& m) { return writerFor(m); }
 
  private:
+  /// Converts first: a sample that breaks a bound makes no writer for its robot.
+  dds_entity_t put(const T& m) {
+    typename Tr::C c{};
+    arena_.clear();
+    Tr::toC(m, c, arena_);
+    const dds_entity_t w = writerFor(m);
+    check(dds_write(w, &c), "dds_write");
+    return w;
+  }
+  dds_entity_t writerFor(const T& m) {
+    if constexpr (kPerRobot) {
+      return writerOf(RobotOf<T>::of(m));
+    } else {
+      return w_;
+    }
+  }
+  dds_entity_t writerOf(const std::string& robot) {
+    auto it = byRobot_.find(robot);
+    if (it == byRobot_.end()) {
+      const std::vector<std::string> partitions =
+          robot.empty() ? std::vector<std::string>{} : std::vector<std::string>{robotPartition(robot)};
+      it = byRobot_.emplace(robot, detail::createWriter(participant_, topic_, qos_, partitions)).first;
+    }
+    return it->second;
+  }
+
+  dds_entity_t participant_;
   dds_entity_t topic_;
-  dds_entity_t w_;  // children of the participant: deleted with it
+  QosProfile qos_;
+  dds_entity_t w_;                               // children of the participant: deleted with it
+  std::map<std::string, dds_entity_t> byRobot_;  // per-robot topics: robot id -> its writer
   bool batching_;
   Arena arena_;
 };
@@ -135,10 +219,21 @@ template <class T>
 class Reader {
  public:
   using Tr = Traits<T>;
+  static constexpr bool kPerRobot = RobotOf<T>::kPerRobot;
   explicit Reader(const Participant& p, std::optional<QosProfile> q = std::nullopt,
                   const std::string& topic = Tr::kTopic)
       : topic_(detail::createTopic(p, Tr::descriptor(), topic)),
-        r_(detail::createReader(p, topic_, q.value_or(Tr::qos()))) {}
+        writers_(kPerRobot ? std::make_unique<WriterPartitions>() : nullptr),
+        r_(detail::createReader(p, topic_, q.value_or(Tr::qos()), partitions(),
+                                writers_ ? writers_->listener() : nullptr)) {}
+  Reader(const Reader&) = delete;
+  Reader& operator=(const Reader&) = delete;
+  /// The reader itself goes with its participant; its listener must not outlive writers_.
+  ~Reader() {
+    if (writers_) {
+      dds_set_listener(r_, nullptr);
+    }
+  }
 
   /// Takes every available sample (removing it from the reader). Loans are returned before return.
   std::vector<T> take(std::size_t max = 1u << 20) { return collect(max, true); }
@@ -166,7 +261,7 @@ class Reader {
       for (int i = 0; i < n; ++i) {
         const auto& c = *static_cast<const typename Tr::C*>(samples[i]);
         if (infos[i].valid_data) {
-          out.push_back(Tr::fromC(c));
+          admit(Tr::fromC(c), infos[i], out);
         } else if (infos[i].instance_state != DDS_IST_ALIVE) {
           gone.push_back(Tr::fromC(c));
         }
@@ -184,8 +279,32 @@ class Reader {
   bool waitForData(std::chrono::milliseconds timeout);
   [[nodiscard]] std::uint32_t matchedWriters() const { return detail::matched(r_, false); }
   [[nodiscard]] dds_entity_t handle() const { return r_; }
+  /// Per-robot topics: samples dropped because their writer is not in the partition of the robot
+  /// they name (a writer speaking for another robot; robot_partition.hpp). Services count them.
+  [[nodiscard]] std::uint64_t foreign() const { return foreign_; }
 
  private:
+  static std::vector<std::string> partitions() {
+    if constexpr (kPerRobot) {
+      if constexpr (RobotOf<T>::kAlsoDefault) {
+        return {kAnyRobotPartition, ""};
+      } else {
+        return {kAnyRobotPartition};
+      }
+    } else {
+      return {};
+    }
+  }
+  void admit(T&& m, const dds_sample_info_t& info, std::vector<T>& out) {
+    if constexpr (kPerRobot) {
+      if (!writers_->speaksFor(r_, info.publication_handle, RobotOf<T>::of(m))) {
+        ++foreign_;
+        return;
+      }
+    }
+    out.push_back(std::move(m));
+  }
+
   std::vector<T> collect(std::size_t max, bool takeIt) {
     constexpr std::size_t kBatch = 256;
     // Most calls find one or a few samples: a small first request keeps Cyclone's per-call loan
@@ -202,7 +321,7 @@ class Reader {
       check(n, takeIt ? "dds_take" : "dds_read");
       for (int i = 0; i < n; ++i) {
         if (infos[i].valid_data) {
-          out.push_back(Tr::fromC(*static_cast<const typename Tr::C*>(samples[i])));
+          admit(Tr::fromC(*static_cast<const typename Tr::C*>(samples[i])), infos[i], out);
         }
       }
       if (n > 0) {
@@ -216,8 +335,10 @@ class Reader {
   }
 
   dds_entity_t topic_;
+  std::unique_ptr<WriterPartitions> writers_;  // per-robot topics; before r_: its listener is r_'s
   dds_entity_t r_;
   Entity waitset_;
+  std::uint64_t foreign_ = 0;
 };
 
 /// Waits on several readers at once; wake() interrupts a wait from another thread (shutdown).

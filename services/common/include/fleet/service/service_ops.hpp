@@ -38,6 +38,10 @@ class ServiceOps {
   /// the thread calling refresh() (the service's loop), never by the scrape.
   void watchMatchedReaders(const std::string& topic, std::function<std::uint32_t()> count);
   void watchMatchedWriters(const std::string& topic, std::function<std::uint32_t()> count);
+  /// A per-robot topic's reader whose samples from a writer outside the named robot's partition are
+  /// dropped (transport::Reader::foreign()): refresh() adds them to
+  /// `<service>_rejected_samples_total{reason="foreign_robot"}`.
+  void watchForeign(std::function<std::uint64_t()> total);
   /// Beats the liveness and, at most once a second, updates the matched gauges. Returns true when
   /// it did the once-a-second part (so a loop can hang its own slow gauges on it).
   bool refresh();
@@ -52,6 +56,11 @@ class ServiceOps {
   Health health_;
   OpsServer server_;
   std::vector<Watched> watched_;
+  struct Foreign {
+    std::function<std::uint64_t()> total;
+    std::uint64_t counted = 0;
+  };
+  std::vector<Foreign> foreign_;
   std::chrono::steady_clock::time_point lastRefresh_{};
 };
 
