@@ -1010,13 +1010,14 @@ void Agent::watchProgress(std::int64_t nowNs) {
 }
 
 void Agent::onStall(std::int64_t nowNs) {
-  ++conduct_.plannerRecoveries;
   if (drove_.driver == Driver::kPlanner) {
-    return;  // the progress watch hands the drive to the follower for a while
+    ++conduct_.plannerRecoveries;  // the progress watch hands the drive to the follower for a while
+    return;
   }
   if (reserved_) {
     return;  // the follower keeps to the released base; re-planning it is the traffic manager's
   }
+  ++conduct_.plannerRecoveries;
   if (tasks_.phase() == Phase::Returning) {
     endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
   } else if (tasks_.phase() == Phase::Driving) {

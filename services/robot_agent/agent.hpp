@@ -170,8 +170,9 @@ class Agent {
     std::uint64_t backoffs = 0;      ///< it yielded by backing off a little
     std::uint64_t returns = 0;       ///< it yielded by backing out of a narrow passage (return path)
     std::uint64_t detours = 0;       ///< plans around what blocked it
-    /// The local planner kept the robot on one spot while nothing held it (a sampling planner's
-    /// local minimum, turning in place at a corner): the path follower drove for a while instead.
+    /// Whoever drove kept the robot on one spot while nothing held it (the progress watch's stall)
+    /// and it recovered: after a sampling planner's local minimum (turning in place at a corner) the
+    /// path follower drove for a while; a stalled return ended; a stalled follower re-planned.
     std::uint64_t plannerRecoveries = 0;
   };
   [[nodiscard]] const Conduct& conduct() const { return conduct_; }
