@@ -584,8 +584,11 @@ int Run::run() {
     env.emplace_back("CYCLONEDDS_URI", "file://" + fs::absolute(out / "cyclonedds.xml").string());
   }
   auto [wM, hM] = mapExtent(scenario);
-  if (scenario.contains("site")) {
-    auto site = service::loadSiteFile(scenario["site"].get<std::string>());
+  // The site every other service reads; the risk map lays its grid over the same site's map.
+  const std::string siteFile =
+      scenario.contains("site") && scenario["site"].is_string() ? scenario["site"].get<std::string>() : "";
+  if (!siteFile.empty()) {
+    auto site = service::loadSiteFile(siteFile);
     if (!site) {
       std::cerr << "fleetctl loadtest: " << site.error().message << "\n";
       return 2;
@@ -612,14 +615,18 @@ int Run::run() {
                                        {"travel_cost", o.travelCost},
                                        {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
                                       .dump(1));
-  writeFile(out / "risk_map.json", json{{"grid",
-                                         {{"width", static_cast<int>(wM / res)},
-                                          {"height", static_cast<int>(hM / res)},
-                                          {"resolution", res}}},
-                                        {"clock", "sim"},
-                                        {"lockstep", !o.wallClock},
-                                        {"rate_hz", 2}}
-                                       .dump(1));
+  {
+    json riskMap = {{"clock", "sim"}, {"lockstep", !o.wallClock}, {"rate_hz", 2}};
+    if (!siteFile.empty()) {
+      // The site gives the grid's origin and extent (a ROS map's origin need not be 0, 0).
+      riskMap["site"] = siteFile;
+      riskMap["grid"] = {{"resolution", res}};
+    } else {
+      riskMap["grid"] = {
+          {"width", static_cast<int>(wM / res)}, {"height", static_cast<int>(hM / res)}, {"resolution", res}};
+    }
+    writeFile(out / "risk_map.json", riskMap.dump(1));
+  }
   const std::string scn = fs::absolute(scenarioPath).string();
   auto log = [&](const std::string& name) { return fs::absolute(out / (name + ".log")).string(); };
   managerSpec = {"fleet_manager",
@@ -636,7 +643,8 @@ int Run::run() {
        log("wms_adapter")},
       {"risk_map",
        bin("services/risk_map/risk_map"),
-       {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "warn"},
+       // At info: its one start-up line names the site and the grid laid over it.
+       {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "info"},
        env,
        log("risk_map")}};
   if (o.traffic == "reserved") {

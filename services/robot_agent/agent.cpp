@@ -164,7 +164,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       gate_(
           GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit, p_.traffic != "reserved"}),
       standsAt_(p_.start),
-      progress_(ProgressLimits{p_.blockedFailS, p_.blockedBackoffS}),
+      progress_(p_.progress),
       arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}),
       route_(RouteOptions{p_.globalPlanner, p_.lanes, p_.riskWeightGlobal, p_.radius, p_.zoneLayers}, grid_,
              raw_) {
@@ -541,7 +541,7 @@ void Agent::finishTask(TaskStage final, const std::string& reason, std::int64_t 
   tasks_.finish(final, reason, nowNs);
   idleSinceNs_ = nowNs;
   holdSinceNs_ = -1;
-  progress_.taskEnded(nowNs);
+  progress_.taskEnded();
 }
 
 void Agent::followerTwist(const control::PathFollowerOutput& r, double& v, double& w) const {
@@ -708,7 +708,7 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
     if (blockedSinceNs_ >= 0) {
       blockedSinceNs_ += c.outageNs;
     }
-    progress_.afterSensorOutage(c.outageNs);
+    progress_.afterOutage(c.outageNs);
     if (planner_) {
       planner_->reset();
     }
@@ -748,6 +748,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
 
 AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
   AgentOutput out;
+  drove_ = {};
   if (tasks_.paused()) {
     // Held by the operator: stand still with the task; the hold is no time blocked or dwelling.
     if (pausedSinceNs_ < 0) {
@@ -769,7 +770,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       }
     }
     tasks_.shiftClock(held);
-    progress_.afterPause(held);
+    progress_.afterOutage(held);
     if (planner_) {
       planner_->reset();
     }
@@ -860,10 +861,10 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       mode = msg::RobotMode::Moving;
       Blocker blocker;
       const double wanted = v;
-      // A sampling planner accelerates from standstill within its dynamic window (a·dt = 0.1 m/s
-      // per cycle), so any forward wish of it counts; the follower always asks for cruise.
-      bool held = heldUp(v, w, blocker) && wanted > (planning ? 0.02 : 0.1);
-      if (!held && planning && std::abs(wanted) < 0.02 && std::abs(w) < 0.1) {
+      // Held: the stop rule cut a command that wanted to move (one threshold whoever drives; see
+      // ProgressParams::wantSpeed).
+      bool held = heldUp(v, w, blocker) && progress_.wantsToMove(wanted);
+      if (!held && planning && !progress_.wantsToMove(std::abs(wanted)) && std::abs(w) < 0.1) {
         // The planner stops the robot in front of something (every rollout ends in the stop
         // gap): as blocked as when the stop rule holds it. Counted only while the stop rule held
         // it, a homing robot facing one on an order in the wide top band alternated a second
@@ -896,9 +897,7 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       } else {
         blockedSinceNs_ = -1;
       }
-      if (progress_.watchPlanner(nowNs, localizer_.pose().position(), planning && !held)) {
-        ++conduct_.plannerRecoveries;
-      }
+      drove_ = {planning ? Driver::kPlanner : Driver::kFollower, held, false};
     }
   } else if (tasks_.phase() == Phase::Returning) {
     mode = msg::RobotMode::Waiting;  // yielding: nobody should wait on this robot's progress
@@ -911,13 +910,15 @@ AgentOutput Agent::drive(std::int64_t nowNs, double dt) {
       docking_ = false;
       followerTwist(*r, v, w);
       const double wanted = v;
-      if (heldUp(v, w, blocker) && wanted > 0.1) {
+      const bool held = heldUp(v, w, blocker) && progress_.wantsToMove(wanted);
+      if (held) {
         if (blockedSinceNs_ < 0) {
           blockedSinceNs_ = nowNs;
         }
       } else {
         blockedSinceNs_ = -1;
       }
+      drove_ = {Driver::kFollower, held, false};
     }
     // At the wide place (or stuck on the way back for a while): replan around what blocked it.
     if (arrived || (blockedSinceNs_ >= 0 && nsToSec(nowNs - blockedSinceNs_) > p_.blockedBackoffS)) {
@@ -980,7 +981,6 @@ void Agent::watchProgress(std::int64_t nowNs) {
   sample.here = localizer_.pose().position();
   sample.travelling = tasks_.phase() == Phase::Driving || tasks_.phase() == Phase::Returning ||
                       tasks_.phase() == Phase::BackingOff;
-  sample.returning = tasks_.phase() == Phase::Returning;
   if (tasks_.hasGoal()) {
     sample.goal = tasks_.goal().pose.position();
   }
@@ -991,6 +991,9 @@ void Agent::watchProgress(std::int64_t nowNs) {
     sample.goal = releases_.next();
   }
   sample.hasOrder = tasks_.hasOrder();
+  sample.driver = drove_.driver;
+  sample.held = drove_.held;
+  sample.waiting = drove_.waiting;
   switch (progress_.check(sample)) {
     case ProgressVerdict::kFailTask:
       finishTask(TaskStage::Failed,
@@ -998,11 +1001,27 @@ void Agent::watchProgress(std::int64_t nowNs) {
                      std::to_string(progress_.failAfterS()) + " s",
                  nowNs);
       break;
-    case ProgressVerdict::kEndReturn:
-      endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
+    case ProgressVerdict::kStalled:
+      onStall(nowNs);
       break;
     case ProgressVerdict::kNone:
       break;
+  }
+}
+
+void Agent::onStall(std::int64_t nowNs) {
+  if (drove_.driver == Driver::kPlanner) {
+    ++conduct_.plannerRecoveries;  // the progress watch hands the drive to the follower for a while
+    return;
+  }
+  if (reserved_) {
+    return;  // the follower keeps to the released base; re-planning it is the traffic manager's
+  }
+  ++conduct_.plannerRecoveries;
+  if (tasks_.phase() == Phase::Returning) {
+    endYield(nowNs);  // the way back is held up too (and not by the stop rule): plan from here
+  } else if (tasks_.phase() == Phase::Driving) {
+    startGoal(nowNs);  // the follower is stuck on this path: a new one from where the robot is
   }
 }
 

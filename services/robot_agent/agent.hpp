@@ -66,7 +66,10 @@ struct AgentParams {
   double stopGap = 0.35;         // m of free space kept ahead at standstill
   double headway = 1.0;          // s: the stop distance grows with speed
   double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
-  double blockedFailS = 60.0;    // a task that cannot progress this long fails
+  double blockedFailS = 60.0;    // a task held in a standoff this long fails
+  /// One notion of "wants to progress and cannot" for every local planner (robot_agent --config,
+  /// "progress"; docs/algorithms.md, "Progress watch").
+  ProgressParams progress;
   /// Idle this long [s] away from its start pose (its parking place): drive back there, so a
   /// finished robot does not stay on a drop-off station or in a lane. A new order preempts the
   /// trip. Negative: stay where the last task ended.
@@ -171,8 +174,9 @@ class Agent {
     std::uint64_t backoffs = 0;      ///< it yielded by backing off a little
     std::uint64_t returns = 0;       ///< it yielded by backing out of a narrow passage (return path)
     std::uint64_t detours = 0;       ///< plans around what blocked it
-    /// The local planner kept the robot on one spot while nothing held it (a sampling planner's
-    /// local minimum, turning in place at a corner): the path follower drove for a while instead.
+    /// Whoever drove kept the robot on one spot while nothing held it (the progress watch's stall)
+    /// and it recovered: after a sampling planner's local minimum (turning in place at a corner) the
+    /// path follower drove for a while; a stalled return ended; a stalled follower re-planned.
     std::uint64_t plannerRecoveries = 0;
   };
   [[nodiscard]] const Conduct& conduct() const { return conduct_; }
@@ -282,8 +286,17 @@ class Agent {
   /// Whether the robot gets anywhere, and the planner's recoveries (see conduct().plannerRecoveries).
   ProgressWatch progress_;
   /// Acts on the progress watch: a task that comes no closer to its goal fails (whatever held it:
-  /// a planner that outputs nothing, a return that cannot finish); a return that stands still ends.
+  /// a planner that outputs nothing, a return that cannot finish); a stalled driver recovers.
   void watchProgress(std::int64_t nowNs);
+  /// A stalled driver: the planner hands over to the follower (inside the watch); a stalled return
+  /// ends; a stalled follower on the way to a goal plans anew from where the robot is.
+  void onStall(std::int64_t nowNs);
+  /// Who drove this cycle and whether something held the robot (reset at the start of a cycle).
+  struct Drove {
+    Driver driver = Driver::kNone;
+    bool held = false;
+    bool waiting = false;  // reserved traffic: on a robot the plan knows about, or on a person
+  } drove_;
   std::vector<Vec2> trail_;  // where the robot drove, a point every kTrailStep (newest last)
   StandoffArbiter arbiter_;  // what to do about a hold: wait, yield, detour, fail
   Conduct conduct_;

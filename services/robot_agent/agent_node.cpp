@@ -85,6 +85,7 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     p.landmarks = world.landmarks;
     p.walls = walls;
     p.lineUpdates = s.lineUpdates;
+    p.progress = s.progress;
     agents.push_back(std::make_unique<Agent>(p, grid, raw));
   }
   if (agents.empty()) {

@@ -34,9 +34,8 @@ constexpr double kLeaveDistance = 1.0;
 /// walk past was held by the traffic manager, and a held robot on an approach node shuts the
 /// approach nodes beside it: the parking row froze one robot at a time. 3 s: 15.0 tasks in 600 s
 /// against 10.8, mean of seeds 1-3, 7, 8, docs/benchmarks.md.)
+/// (The hold lasts until the robot has moved the progress watch's movedM from where it began.)
 constexpr double kBlockedAfterS = 3.0;
-/// ... until it has moved this far [m] from where the hold began.
-constexpr double kHoldOver = 0.1;
 /// A progress report at least this often [s], whatever changed.
 constexpr double kHeartbeatS = 1.0;
 /// The local planner sees this much of the base ahead [m]. Given the whole base, a sampling
@@ -318,8 +317,8 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   } forget{gateRoute_};
   Blocker blocker;
   const double wanted = v;
-  bool held = heldUp(v, w, blocker) && wanted > (planning ? 0.02 : 0.1);
-  if (!held && planning && std::abs(wanted) < 0.02 && std::abs(w) < 0.1 && cap > 0.1) {
+  bool held = heldUp(v, w, blocker) && progress_.wantsToMove(wanted);
+  if (!held && planning && !progress_.wantsToMove(std::abs(wanted)) && std::abs(w) < 0.1 && cap > 0.1) {
     // The planner stops in front of something (every rollout ends in the stop gap): held as well.
     Blocker any;
     localBlocked = clearSpeed(0.5, any) < 0.5;
@@ -346,7 +345,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   // A hold lasts until the robot has got on: a sampling planner turning this way and that in front
   // of a person is not held every cycle, and a blocked flag that flapped with it would have the
   // traffic manager re-plan on every report.
-  if (heldSinceNs_ >= 0 && distance(here, heldAt_) > kHoldOver) {
+  if (heldSinceNs_ >= 0 && distance(here, heldAt_) > progress_.params().movedM) {
     heldSinceNs_ = -1;
   }
   if (held && !byKnownRobot && heldSinceNs_ < 0) {
@@ -354,9 +353,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     heldAt_ = here;
   }
   blocked_ = heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS;
-  if (progress_.watchPlanner(nowNs, here, planning && !held)) {
-    ++conduct_.plannerRecoveries;
-  }
+  // Waiting on a dependency or a person runs no failure timer: the traffic manager re-plans.
+  drove_ = {planning ? Driver::kPlanner : Driver::kFollower, held,
+            held && (byKnownRobot || (!blocker.robot && blocker.id == "human"))};
 }
 
 std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {

@@ -18,8 +18,17 @@ void readSettings(Config& cfg, Settings& s, SetOnCommandLine cli) {
   Config localization = cfg.child("localization");
   s.lineUpdates = localization.boolean("lines", s.lineUpdates);
   localization.rejectUnknownKeys({"lines"});
-  cfg.rejectUnknownKeys(
-      {"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety", "localization"});
+  Config progress = cfg.child("progress");
+  auto& watch = s.progress;
+  watch.wantSpeed = progress.number("want_speed", watch.wantSpeed, {0.0, 1.0});
+  watch.movedM = progress.number("moved_m", watch.movedM, {0.0, 5.0, true});
+  watch.stallS = progress.number("stall_s", watch.stallS, {0.0, 600.0, true});
+  watch.recoverS = progress.number("recover_s", watch.recoverS, {0.0, 600.0, true});
+  watch.closerM = progress.number("closer_m", watch.closerM, {0.0, 5.0, true});
+  watch.failS = progress.number("fail_s", watch.failS, {0.0, 86400.0, true});
+  progress.rejectUnknownKeys({"want_speed", "moved_m", "stall_s", "recover_s", "closer_m", "fail_s"});
+  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety",
+                         "localization", "progress"});
   if (!cli.localPlanner) {
     s.localPlanner = local;
   }

@@ -23,6 +23,7 @@ struct Settings {
   avoidance::RiskSteppingParams riskStepping;
   avoidance::SafetyParams safety;
   bool lineUpdates = true;  // localization.lines: laser lines matched to the site's walls
+  ProgressParams progress;  // "progress": one notion of stalled for every local planner
 
   // Command line only.
   std::vector<std::string> only;  // robots to host (empty: every robot of the world)

@@ -11,46 +11,46 @@ ProgressVerdict ProgressWatch::check(const ProgressSample& s) {
   // 0.1 m" watch).
   if (s.goal) {
     const double toGoal = distance(s.here, *s.goal);
-    if (!s.travelling || closerNs_ < 0 || toGoal < bestToGoal_ - 0.25) {
+    if (!s.travelling || s.waiting || closerNs_ < 0 || toGoal < bestToGoal_ - p_.closerM) {
       bestToGoal_ = toGoal;
       closerNs_ = s.nowNs;
     }
   }
-  if (!s.travelling || movedNs_ < 0 || distance(s.here, movedFrom_) > 0.1) {
-    movedFrom_ = s.here;
-    movedNs_ = s.nowNs;
-  }
+  const ProgressVerdict stalled = stall(s);
   // A last resort behind the standoff rules (whose timer restarts whenever the robot inches on):
   // three times their limit, so a robot in a long queue is not failed for queueing.
-  if (closerNs_ >= 0 && nsToSec(s.nowNs - closerNs_) > 3.0 * limits_.blockedFailS && s.hasOrder) {
+  if (closerNs_ >= 0 && nsToSec(s.nowNs - closerNs_) > p_.failS && s.hasOrder) {
     return ProgressVerdict::kFailTask;
   }
-  if (s.returning && nsToSec(s.nowNs - movedNs_) > 2.0 * limits_.blockedBackoffS) {
-    return ProgressVerdict::kEndReturn;  // the way back is held up too (and not by the stop rule)
-  }
-  return ProgressVerdict::kNone;
+  return stalled;
 }
 
-std::optional<std::int64_t> ProgressWatch::watchPlanner(std::int64_t nowNs, Vec2 here, bool planning) {
-  // A sampling planner can sit in a local minimum that nothing else notices: the robot turns in
-  // place at an aisle corner, never held by the stop rule, never blocked (a 1.25 m passage turning
-  // into a corridor did that for minutes). After kStallS on one spot the follower, which tracks the
-  // path itself, drives for kRecoverS (Nav2 would run a recovery behaviour here).
-  constexpr double kStallS = 6.0;
-  constexpr double kRecoverS = 8.0;
-  if (!planning) {
+ProgressVerdict ProgressWatch::stall(const ProgressSample& s) {
+  // Standing with a way to drive and nothing holding it: a sampling planner in a local minimum
+  // (turning in place at an aisle corner, never held by the stop rule: a 1.25 m passage turning
+  // into a corridor did that for minutes), or the follower on its way back stuck where the stop
+  // rule does not see why. What holds the robot is the standoff rules' or the traffic manager's
+  // business, so a hold stops the clock; so does a change of driver.
+  if (s.driver == Driver::kNone || s.held || s.waiting) {
     stallNs_ = -1;
-    return std::nullopt;
+    return ProgressVerdict::kNone;
   }
-  if (stallNs_ < 0 || distance(here, stallFrom_) > 0.1) {
-    stallFrom_ = here;
-    stallNs_ = nowNs;
-  } else if (nsToSec(nowNs - stallNs_) > kStallS) {
-    followUntilNs_ = nowNs + static_cast<std::int64_t>(kRecoverS * 1e9);
-    stallNs_ = -1;
-    return followUntilNs_;
+  if (stallNs_ < 0 || s.driver != stallDriver_ || distance(s.here, stallFrom_) > p_.movedM) {
+    stallDriver_ = s.driver;
+    stallFrom_ = s.here;
+    stallNs_ = s.nowNs;
+    return ProgressVerdict::kNone;
   }
-  return std::nullopt;
+  if (nsToSec(s.nowNs - stallNs_) <= p_.stallS) {
+    return ProgressVerdict::kNone;
+  }
+  stallNs_ = -1;
+  if (s.driver == Driver::kPlanner) {
+    // The follower, which tracks the path itself, drives for a while (Nav2 would run a recovery
+    // behaviour here).
+    followUntilNs_ = s.nowNs + static_cast<std::int64_t>(p_.recoverS * 1e9);
+  }
+  return ProgressVerdict::kStalled;
 }
 
 }  // namespace fleet::agent

@@ -56,7 +56,7 @@ scenario=$SRC/sim/scenarios/one_robot.json
 cat >"$dir/manager.json" <<JSON
 {"stations": "$scenario", "db": "$dir/fleet.db", "clock": "sim", "lease_s": 3.0}
 JSON
-echo '{"grid": {"width": 300, "height": 200, "resolution": 0.1}, "clock": "sim", "lockstep": true, "rate_hz": 2}' \
+echo "{\"site\": \"$scenario\", \"grid\": {\"resolution\": 0.1}, \"clock\": \"sim\", \"lockstep\": true, \"rate_hz\": 2}" \
   >"$dir/risk_map.json"
 printf 'id,kind,pickup,dropoff,load_s,unload_s\njob-1,transport,P-2,D-1,2,2\n' >"$dir/tasks.csv"
 

@@ -296,10 +296,16 @@ TEST(LoadtestE2E, AFleetRunsOnASiteWithAROSMap) {
   EXPECT_GE(r["accounting"]["done"], 1) << r["accounting"].dump();
   EXPECT_EQ(r["accounting"]["lost"], 0);
   EXPECT_EQ(r["safety"]["contacts"]["robot_shelf"], 0);
-  // The run's risk map covers the site: 30 m x 20 m at 0.1 m.
+  // The risk map reads the same site as every other service and lays its grid over the site's
+  // map: 30 m x 20 m at 0.1 m.
   const json risk = json::parse(std::ifstream(out / "risk_map.json"));
-  EXPECT_NEAR(risk["grid"]["width"].get<double>(), 300, 1);
-  EXPECT_NEAR(risk["grid"]["height"].get<double>(), 200, 1);
+  const json scenario = json::parse(std::ifstream(out / "scenario.json"));
+  EXPECT_EQ(risk["site"], scenario["site"]) << risk.dump();
+  EXPECT_FALSE(risk["grid"].contains("width")) << "the grid's extent comes from the site";
+  std::stringstream log;
+  log << std::ifstream(out / "risk_map.log").rdbuf();
+  EXPECT_NE(log.str().find("risk map: grid 300 x 200 cells of 0.1 m over site"), std::string::npos)
+      << log.str();
 }
 
 // With FLEET_WMS_TOKEN set in the operator's shell, the adapter the load test starts asks for that

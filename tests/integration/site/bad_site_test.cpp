@@ -66,6 +66,17 @@ TEST_F(BadSite, EveryServiceRefusesItWithExitCode2AndEveryProblemNamed) {
                 "fleet-sim");
 }
 
+// The load test hands the risk map the run's site (its "site" key); a path that names no file
+// stops it at start with the path in the message, as every other service.
+TEST_F(BadSite, TheRiskMapRefusesASiteThatIsNotThereNamingTheFile) {
+  const std::string missing = (dir_ / "no-such.site.json").string();
+  std::ofstream(dir_ / "risk_map.json") << R"({"site": ")" + missing + R"(", "grid": {"resolution": 0.1}})";
+  const auto r = run(std::string(FLEET_BINARY_DIR) + "/services/risk_map/risk_map --config " +
+                     (dir_ / "risk_map.json").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find(missing + ": cannot open the file"), std::string::npos) << r.output;
+}
+
 TEST_F(BadSite, AStationInTheWallIsReportedOnceTheFileParses) {
   auto site = nlohmann::json::parse(std::ifstream(dir_ / "bad.site.json"));
   site.erase("colour");

@@ -240,3 +240,31 @@ TEST(AgentSettings, TheFileSetsWhatTheCommandLineLeftAndNamesAnUnknownPlanner) {
     EXPECT_NE(what.find("speed"), std::string::npos) << what;
   }
 }
+
+TEST(AgentSettings, TheProgressWatchTakesOneSetOfParametersFromTheFile) {
+  agent::Settings s;
+  Config cfg = Config::fromJson(
+      {{"progress",
+        {{"want_speed", 0.05}, {"moved_m", 0.2}, {"stall_s", 4.0}, {"recover_s", 5.0}, {"fail_s", 90.0}}}},
+      "agent.json");
+  agent::readSettings(cfg, s);
+  cfg.finish();
+  EXPECT_EQ(s.progress.wantSpeed, 0.05);
+  EXPECT_EQ(s.progress.movedM, 0.2);
+  EXPECT_EQ(s.progress.stallS, 4.0);
+  EXPECT_EQ(s.progress.recoverS, 5.0);
+  EXPECT_EQ(s.progress.closerM, 0.25) << "the default";
+  EXPECT_EQ(s.progress.failS, 90.0);
+
+  agent::Settings t;
+  Config bad = Config::fromJson({{"progress", {{"stall_s", -1.0}, {"stall_seconds", 3}}}}, "agent.json");
+  agent::readSettings(bad, t);
+  try {
+    bad.finish();
+    FAIL() << "accepted";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("progress.stall_s"), std::string::npos) << what;
+    EXPECT_NE(what.find("progress.stall_seconds"), std::string::npos) << what;
+  }
+}

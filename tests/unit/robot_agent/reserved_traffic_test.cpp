@@ -75,6 +75,7 @@ struct Sim {
                double blockedFailS = 60.0) {
     params.id = "r1";
     params.blockedFailS = blockedFailS;
+    params.progress.failS = 3.0 * blockedFailS;
     params.start = {1.0, kY, 0.0};
     params.wheelBase = 0.4;
     params.localPlanner = localPlanner;
