@@ -50,8 +50,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.stopChance = o.stopChance;
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
-    if (o.straight >= 0)
+    if (o.straight >= 0) {
       v.traffic.pibt.preferStraight = o.straight != 0;
+      v.traffic.pibt.tieTolerance = o.straight != 0 ? 1e-3F : 0.0F;
+    }
     if (o.detourAfter >= 0)
       v.traffic.pibt.detourAfter = o.detourAfter;
     if (o.detourPenalty >= 0.0)

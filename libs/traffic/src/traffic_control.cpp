@@ -247,19 +247,11 @@ TrafficControl::Need TrafficControl::needsPlanning() const {
   for (std::size_t r = 0; r < robots(); ++r) {
     if (held_[r] != 0)
       continue;
-    // An evasion lasts a number of planned steps. The evading robot is planned like any other on
-    // its way to its refuge; once there (or kept standing on the way), steps come paced, so the
-    // evasion ends. (Planning at once
-    // until it was over ran everyone's plan up to `evadeSteps` past their robots, past `maxLag`,
-    // and re-planned the fleet every second: 20 robots, seed 4: 15,766 steps and 628 re-plans in
-    // 600 s where about 1,000 steps are driven.)
-    if (evadeUntil_[r] >= 0) {
-      const bool there = execution_.plannedEnd(r) == planner_->goal(r);
-      if (!there && execution_.pendingNodes(r) < 2 && stall_[r] < options_.standingSteps)
-        return Need::Now;
-      need = Need::Later;
-      continue;
-    }
+    // An evasion lasts a number of planned steps: keep planning until it is over. (Planning it at
+    // the fleet's pace instead ended the re-planning churn this causes in crowds, but left a robot
+    // and a vendor's vehicle standing for good in the mixed-fleet test: docs/algorithms.md.)
+    if (evadeUntil_[r] >= 0)
+      return Need::Now;
     const NodeId t = target_[r];
     // (A plan that brings the robot back to the node it stands on counts as nothing ahead: after
     // a change of goal the plan starts again from the released end, and a robot released one node

@@ -106,45 +106,6 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   }
 }
 
-/// An evasion lasts `evadeSteps` planner steps. Planning them at once ran everyone's plan that far
-/// past their robots, past `maxLag`, and re-planned the whole fleet over and over (20 robots, seed
-/// 4: 15,766 planner steps and 628 re-plans in 600 s, where about 1,000 steps are driven). The
-/// evading robot is planned like any other: a step when it is short of nodes ahead.
-TEST(TrafficControl, AnEvasionIsPlannedAtTheFleetsPaceNotAtOnce) {
-  Roadmap map = smallWarehouse();
-  const NodeId park = map.station("PARK-1")->dock;
-  const NodeId front = map.nearest({3.25, 1.75});
-  const std::vector<NodeId> starts{park, front};
-  TrafficOptions opt;
-  opt.pibt.detourAfter = 0;
-  opt.pibt.untangleGroup = 0;
-  TrafficControl tc(map.graph, starts, opt);
-  tc.setGoal(0, map.station("P-4")->dock);
-  tc.setGoal(1, map.station("P-1")->dock);
-  int most = 0;
-  for (int t = 0; t < 300; ++t) {
-    const int steps = tc.update();
-    if (t > 0)
-      most = std::max(most, steps);
-    for (std::size_t r = 0; r < 2; ++r) {
-      const auto rel = tc.release(r);
-      if (rel.base.size() > 1) {
-        EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
-      }
-    }
-  }
-  ASSERT_GE(tc.stats().evasions, 1U);
-  EXPECT_LE(most, 4) << "steps planned in one update while a robot evades (11 before)";
-
-  VirtualFleetOptions o;
-  o.robots = 20;
-  o.seed = 4;
-  const auto r = runVirtualFleet(map, o);
-  SCOPED_TRACE(formatResult(r));
-  EXPECT_LT(r.plannerSteps, 3000U);
-  EXPECT_LT(r.replans, 150U);
-}
-
 /// A lone robot released one node on (its goal was there), then given a goal behind it: the plan
 /// starts again from the released end and comes back over the node the robot stands on. That plan
 /// was two nodes long, so it was not planned further, and the robot stood for good on a base that

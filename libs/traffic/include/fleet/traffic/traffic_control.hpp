@@ -41,7 +41,7 @@ struct TrafficOptions {
   ReleaseOptions release;
   /// Detours on: on a roadmap robots wait in line at stations and stand at docks, and an agent
   /// whose shortest way passes one would otherwise wait beside a free way round (docs/algorithms.md).
-  PibtOptions pibt{.detourAfter = 4, .tieTolerance = 1e-3F, .preferStraight = true};
+  PibtOptions pibt{.detourAfter = 4};
 };
 
 /// A station robots dock at one at a time: its dock node and the nodes to wait on in line,
