@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -433,7 +434,7 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
       const Vec2 step = graph_.position(v) - graph_.position(from);
       const double cosine = heading.dot(step) / std::max(1e-9, heading.norm() * step.norm());
       turn = static_cast<std::uint32_t>(
-          std::lround(std::acos(std::clamp(cosine, -1.0, 1.0)) * 4.0 / 3.14159266));
+          std::lround(std::acos(std::clamp(cosine, -1.0, 1.0)) * 4.0 / std::numbers::pi));
     }
     const auto draw = static_cast<std::uint32_t>(random() >> 33);
     c[m++] = Candidate{
