@@ -652,11 +652,13 @@ int Run::run() {
       std::cerr << "fleetctl loadtest: --traffic reserved needs a scenario with a site (its roadmap)\n";
       return 2;
     }
-    writeFile(out / "traffic_manager.json", json{{"site", scenario["site"].get<std::string>()},
-                                                 {"clock", "sim"},
-                                                 {"lockstep", !o.wallClock},
-                                                 {"seed", o.seed}}
-                                                .dump(1));
+    json tm{{"site", scenario["site"].get<std::string>()},
+            {"clock", "sim"},
+            {"lockstep", !o.wallClock},
+            {"seed", o.seed}};
+    if (o.letPass >= 0)
+      tm["let_pass"] = o.letPass;
+    writeFile(out / "traffic_manager.json", tm.dump(1));
     specs.push_back({"traffic_manager",
                      bin("services/traffic_manager/traffic_manager"),
                      {"--config", fs::absolute(out / "traffic_manager.json").string(), "--id",

@@ -36,10 +36,11 @@ struct LoadtestOptions {
   std::string globalPlanner = "astar";  // robot agents' --global-planner
   std::string agentConfig;              // robot agents' --config (a JSON file; empty: none)
   bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
-  std::string stationLoad = "task";     // the fleet manager's station_load (task or phase)
-  int stationCapacity = 2;              // the fleet manager's station_capacity (0: no limit)
-  std::string travelCost = "path";      // the fleet manager's travel_cost (path | straight)
-  double returnHomeS = 5.0;             // robot agents' --return-home (negative: stay where a task ends)
+  int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
+  std::string stationLoad = "task";  // the fleet manager's station_load (task or phase)
+  int stationCapacity = 2;           // the fleet manager's station_capacity (0: no limit)
+  std::string travelCost = "path";   // the fleet manager's travel_cost (path | straight)
+  double returnHomeS = 5.0;          // robot agents' --return-home (negative: stay where a task ends)
   /// "reactive" or "reserved" (a traffic_manager process plans every robot; the agents follow it).
   std::string traffic = "reactive";
   /// A folder made by scripts/dds-security ("deployment DIR"): every process joins with its

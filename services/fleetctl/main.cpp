@@ -132,6 +132,12 @@ int main(int argc, char** argv) {
                    "(the pickup until loaded, then the drop-off)")
       ->check(CLI::IsMember({"task", "phase"}))
       ->capture_default_str();
+  loadtest
+      ->add_option(
+          "--let-pass", lt.letPass,
+          "reserved traffic: route nodes a robot must be short of a conflict before one waiting on it "
+          "there may go first (switchable dependencies); 0: never (default: the traffic manager's)")
+      ->check(CLI::Range(0, 1000));
   loadtest->add_option("--station-capacity", lt.stationCapacity, "active tasks per station (0 = no limit)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
@@ -276,6 +282,11 @@ int main(int argc, char** argv) {
                    "m of free space the robot's motion gate needs ahead of a driving robot (default: the "
                    "roadmap's)")
       ->check(CLI::Range(0.0, 5.0));
+  trafficSim
+      ->add_option("--let-pass", ts.letPass,
+                   "route nodes a robot must be short of a conflict before a robot waiting on it there may "
+                   "go first (switchable dependencies); 0: never (default: the traffic layer's)")
+      ->check(CLI::Range(0, 1000));
   trafficSim
       ->add_option("--max-lag", ts.maxLag,
                    "planner steps a robot may fall behind the plan before everyone's unreleased plan is "

@@ -50,6 +50,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.stopChance = o.stopChance;
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
+    if (o.letPass >= 0)
+      v.traffic.letPassBehind = o.letPass;
     if (o.straight >= 0) {
       v.traffic.pibt.preferStraight = o.straight != 0;
       v.traffic.pibt.tieTolerance = o.straight != 0 ? 1e-3F : 0.0F;
@@ -96,6 +98,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"detours", r.detours},
                      {"escalations", r.escalations},
                      {"untangles", r.untangles},
+                     {"passes", r.passes},
                      {"update_p99_ms", r.updateP99Ms},
                      {"density", r.density},
                      {"time_driving", r.driving},

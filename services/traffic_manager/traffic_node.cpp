@@ -13,7 +13,7 @@ Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
                          "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
-                         "detour_after", "detour_penalty", "station_lines", "roadmap"});
+                         "detour_after", "detour_penalty", "station_lines", "let_pass", "roadmap"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -25,6 +25,7 @@ Settings readSettings(Config& cfg) {
   if (s.lockstep && s.clock != "sim")
     cfg.problem("lockstep", "requires \"clock\": \"sim\"");
   s.traffic.maxLag = cfg.integer("max_lag", s.traffic.maxLag, {1, 100000});
+  s.traffic.letPassBehind = cfg.integer("let_pass", s.traffic.letPassBehind, {0, 100000});
   s.traffic.release.baseAhead = cfg.number("base_ahead", s.traffic.release.baseAhead, {0.0, 100.0});
   s.traffic.release.maxBaseNodes = static_cast<std::size_t>(
       cfg.integer("max_base_nodes", static_cast<std::int64_t>(s.traffic.release.maxBaseNodes), {1, 63}));

@@ -1,6 +1,7 @@
 #include "fleet/traffic/execution.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 
 namespace fleet::traffic {
@@ -34,7 +35,7 @@ Execution::Execution(const Graph& graph, std::span<const NodeId> starts, Release
                             std::to_string(starts[r]));
       }
     }
-    routes_[r].entries.push_back(Entry{starts[r], 0, 0.0, {}});
+    routes_[r].entries.push_back(Entry{starts[r], 0, 0.0, {}, 0});
     lastVisit_[static_cast<std::size_t>(starts[r])] = Visit{static_cast<std::int32_t>(r), 0};
   }
 }
@@ -94,8 +95,9 @@ void Execution::append(std::span<const NodeId> next) {
   for (std::size_t r : movers) {
     auto& route = routes_[r];
     const NodeId from = route.entries.back().node;
+    const std::int64_t order = std::max(step * kOrderPerStep, route.entries.back().order + 1);
     route.entries.push_back(
-        Entry{next[r], step, (graph_.position(next[r]) - graph_.position(from)).norm(), {}});
+        Entry{next[r], step, (graph_.position(next[r]) - graph_.position(from)).norm(), {}, order});
   }
   auto undo = [&] {
     for (std::size_t r : movers)
@@ -115,6 +117,9 @@ void Execution::append(std::span<const NodeId> next) {
         return;
       const auto q = static_cast<std::size_t>(lv.robot);
       const Route& qr = routes_[q];
+      // After letPass() a visitor may stand later in the order than this step: stay behind it.
+      if (lv.index >= qr.first)
+        entry.order = std::max(entry.order, qr[lv.index].order + 1);
       std::int64_t i = std::max(lv.index + 1, qr.first);
       while (i <= qr.last() && graph_.conflicting(qr[i].node, v))
         ++i;
@@ -161,6 +166,23 @@ void Execution::append(std::span<const NodeId> next) {
       os << " each enter what the next one leaves (a cycle cannot be executed)";
       fail(os.str());
     }
+  }
+  // A robot entering what another leaves in this same step comes after that move in the order
+  // (the same-step dependencies are acyclic, so this settles within one pass per mover).
+  for (std::size_t pass = 0; pass < movers.size(); ++pass) {
+    bool changed = false;
+    for (std::size_t r : movers) {
+      auto& order = routes_[r].entries.back().order;
+      for (std::size_t q : sameStep[r]) {
+        const auto after = routes_[q].entries.back().order + 1;
+        if (order < after) {
+          order = after;
+          changed = true;
+        }
+      }
+    }
+    if (!changed)
+      break;
   }
   for (std::size_t r : movers) {
     const auto& route = routes_[r];
@@ -257,6 +279,21 @@ std::int64_t Execution::nextUnreleasedStep(std::size_t robot) const {
   return route.released < route.last() ? route[route.released + 1].step : -1;
 }
 
+std::string Execution::describe(std::size_t robot) const {
+  std::ostringstream os;
+  const auto& route = routes_.at(robot);
+  for (std::int64_t i = route.progress; i <= route.released; ++i)
+    os << (i > route.progress ? " " : "") << route[i].node;
+  if (route.released < route.last()) {
+    const Entry& e = route[route.released + 1];
+    os << " | " << e.node << " (needs";
+    for (const auto& d : e.deps)
+      os << " " << d.robot << ":" << d.index << "/" << routes_[d.robot].progress;
+    os << ")";
+  }
+  return os.str();
+}
+
 std::size_t Execution::pendingNodes(std::size_t robot) const {
   const auto& route = routes_.at(robot);
   return static_cast<std::size_t>(route.last() - route.progress);
@@ -277,10 +314,183 @@ std::size_t Execution::addRobot(NodeId start) {
     }
   }
   Route route;
-  route.entries.push_back(Entry{start, step_, 0.0, {}});
+  route.entries.push_back(Entry{start, step_, 0.0, {}, step_ * kOrderPerStep});
   routes_.push_back(std::move(route));
   lastVisit_[static_cast<std::size_t>(start)] = Visit{static_cast<std::int32_t>(routes_.size() - 1), 0};
   return routes_.size() - 1;
+}
+
+bool Execution::letPass(std::size_t robot, std::int64_t minBehind) {
+  if (robot >= routes_.size())
+    return false;
+  const Route& mine = routes_[robot];
+  if (mine.released >= mine.last())
+    return false;
+  std::vector<std::size_t> late;
+  for (const auto& d : mine[mine.released + 1].deps) {
+    const auto progress = routes_[d.robot].progress;
+    if (progress < d.index && d.index - progress >= minBehind)
+      late.push_back(d.robot);
+  }
+  if (late.empty())
+    return false;
+  auto saved = routes_;
+  for (const std::size_t b : late) {
+    Route& other = routes_[b];
+    if (other.released >= other.last())
+      continue;
+    const std::int64_t horizon = other[other.last()].order;
+    std::int64_t firstOther = -1;
+    std::int64_t latestMine = std::numeric_limits<std::int64_t>::min();
+    for (std::int64_t j = other.released + 1; j <= other.last(); ++j) {
+      for (std::int64_t i = mine.released + 1; i <= mine.last(); ++i) {
+        // Where this robot comes by again after the late one's route ends, no order is needed yet.
+        if (mine[i].order > horizon || !graph_.conflicting(mine[i].node, other[j].node))
+          continue;
+        if (firstOther < 0)
+          firstOther = j;
+        latestMine = std::max(latestMine, mine[i].order);
+      }
+    }
+    if (firstOther < 0)
+      continue;
+    const std::int64_t shift = latestMine + 1 - other[firstOther].order;
+    if (shift <= 0)
+      continue;
+    for (std::int64_t j = firstOther; j <= other.last(); ++j)
+      other.entries[static_cast<std::size_t>(j - other.first)].order += shift;
+  }
+  if (!rederive() || !satisfied(routes_[robot][routes_[robot].released + 1])) {
+    routes_ = std::move(saved);
+    return false;
+  }
+  rebuildVisitors();
+  return true;
+}
+
+namespace {
+/// The order robots take conflicting nodes in: ties (after letPass() shifts) go to the lower index,
+/// so two entries are never unordered.
+bool before(std::int64_t order, std::size_t robot, std::int64_t otherOrder, std::size_t other) {
+  return order != otherOrder ? order < otherOrder : robot < other;
+}
+}  // namespace
+
+bool Execution::rederive() {
+  struct At {
+    NodeId node;
+    std::uint32_t robot;
+    std::int64_t index;
+    bool operator<(const At& o) const { return node < o.node; }
+  };
+  std::vector<At> at;
+  for (std::size_t r = 0; r < routes_.size(); ++r) {
+    const Route& route = routes_[r];
+    for (std::int64_t i = route.first; i <= route.last(); ++i)
+      at.push_back(At{route[i].node, static_cast<std::uint32_t>(r), i});
+  }
+  std::sort(at.begin(), at.end());
+  std::vector<std::int64_t> lastBefore(routes_.size(), -1);
+  std::vector<std::size_t> touched;
+  for (std::size_t r = 0; r < routes_.size(); ++r) {
+    Route& route = routes_[r];
+    for (std::int64_t i = route.released + 1; i <= route.last(); ++i) {
+      Entry& e = route.entries[static_cast<std::size_t>(i - route.first)];
+      e.deps.clear();
+      auto visits = [&](NodeId x) {
+        const auto [lo, hi] = std::equal_range(at.begin(), at.end(), At{x, 0, 0});
+        for (auto it = lo; it != hi; ++it) {
+          if (it->robot == r)
+            continue;
+          const Route& q = routes_[it->robot];
+          // A released entry was ordered when it was released: before everything unreleased.
+          if (it->index > q.released && !before(q[it->index].order, it->robot, e.order, r))
+            continue;
+          auto& last = lastBefore[it->robot];
+          if (last < 0)
+            touched.push_back(it->robot);
+          last = std::max(last, it->index);
+        }
+      };
+      visits(e.node);
+      for (NodeId x : graph_.conflicts(e.node))
+        visits(x);
+      bool ok = true;
+      for (const std::size_t q : touched) {
+        const Route& qr = routes_[q];
+        std::int64_t need = lastBefore[q] + 1;
+        while (need <= qr.last() && graph_.conflicting(qr[need].node, e.node))
+          ++need;
+        if (need > qr.last())
+          ok = false;  // q would have to drive beyond what is planned for it
+        else if (qr.progress < need)
+          e.deps.push_back(Dependency{static_cast<std::uint32_t>(q), need});
+        lastBefore[q] = -1;
+      }
+      touched.clear();
+      if (!ok)
+        return false;
+    }
+  }
+  return acyclic();
+}
+
+bool Execution::acyclic() const {
+  // Vertices: unreleased entries (released ones only wait on what was already reached). Entering
+  // entry i needs entry i - 1 reached and every dependency's entry reached.
+  std::vector<std::size_t> offset(routes_.size() + 1, 0);
+  for (std::size_t r = 0; r < routes_.size(); ++r)
+    offset[r + 1] = offset[r] + static_cast<std::size_t>(routes_[r].last() - routes_[r].released);
+  auto id = [&](std::size_t r, std::int64_t i) {
+    return offset[r] + static_cast<std::size_t>(i - routes_[r].released - 1);
+  };
+  std::vector<std::uint8_t> mark(offset.back(), 0);  // 0 new, 1 on the stack, 2 done
+  struct Frame {
+    std::size_t robot;
+    std::int64_t index;
+    std::size_t next;  ///< 0: the previous entry, then deps
+  };
+  std::vector<Frame> stack;
+  for (std::size_t r = 0; r < routes_.size(); ++r) {
+    for (std::int64_t i = routes_[r].released + 1; i <= routes_[r].last(); ++i) {
+      if (mark[id(r, i)] != 0)
+        continue;
+      mark[id(r, i)] = 1;
+      stack.push_back(Frame{r, i, 0});
+      while (!stack.empty()) {
+        Frame& f = stack.back();
+        const Route& route = routes_[f.robot];
+        const auto& deps = route[f.index].deps;
+        std::size_t q = 0;
+        std::int64_t j = 0;
+        bool edge = false;
+        while (!edge && f.next <= deps.size()) {
+          if (f.next == 0) {
+            q = f.robot;
+            j = f.index - 1;
+          } else {
+            q = deps[f.next - 1].robot;
+            j = deps[f.next - 1].index;
+          }
+          ++f.next;
+          edge = j > routes_[q].released;
+        }
+        if (!edge) {
+          mark[id(f.robot, f.index)] = 2;
+          stack.pop_back();
+          continue;
+        }
+        const auto v = id(q, j);
+        if (mark[v] == 1)
+          return false;
+        if (mark[v] == 0) {
+          mark[v] = 1;
+          stack.push_back(Frame{q, j, 0});
+        }
+      }
+    }
+  }
+  return true;
 }
 
 void Execution::retract(std::size_t robot) {
@@ -299,8 +509,11 @@ std::vector<NodeId> Execution::truncateToReleased() {
 }
 
 void Execution::rebuildVisitors() {
+  // Released entries were ordered among themselves when they were released and come before every
+  // unreleased one (rederive()); unreleased ones follow their order.
   struct Item {
-    std::int64_t step;
+    bool unreleased;
+    std::int64_t order;
     std::int32_t robot;
     std::int64_t index;
     NodeId node;
@@ -309,10 +522,17 @@ void Execution::rebuildVisitors() {
   for (std::size_t r = 0; r < routes_.size(); ++r) {
     const auto& route = routes_[r];
     for (std::int64_t i = route.first; i <= route.last(); ++i) {
-      items.push_back(Item{route[i].step, static_cast<std::int32_t>(r), i, route[i].node});
+      items.push_back(
+          Item{i > route.released, route[i].order, static_cast<std::int32_t>(r), i, route[i].node});
     }
   }
-  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.step < b.step; });
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    if (a.unreleased != b.unreleased)
+      return b.unreleased;
+    if (a.order != b.order)
+      return a.order < b.order;
+    return a.robot != b.robot ? a.robot < b.robot : a.index < b.index;
+  });
   std::fill(lastVisit_.begin(), lastVisit_.end(), Visit{});
   for (const auto& it : items)
     lastVisit_[static_cast<std::size_t>(it.node)] = Visit{it.robot, it.index};

@@ -289,6 +289,12 @@ int TrafficControl::update() {
     sinceStep_ = 0;
   }
   stats_.steps += static_cast<std::uint64_t>(steps);
+  if (options_.letPassBehind > 0) {
+    for (std::size_t r = 0; r < robots(); ++r) {
+      if (held_[r] == 0 && !execution_.waitingOn(r).empty() && execution_.letPass(r, options_.letPassBehind))
+        ++stats_.passes;
+    }
+  }
   return steps;
 }
 
@@ -423,7 +429,7 @@ std::string TrafficControl::explain(std::size_t robot) const {
     os << " (" << graph_.position(at).x << ", " << graph_.position(at).y << ")";
   os << ", goal " << goal_.at(robot) << ", target " << target_.at(robot) << (held(robot) ? ", held" : "")
      << ", planned " << execution_.pendingNodes(robot) << " nodes ahead, released to "
-     << execution_.releasedEnd(robot) << ", waiting on";
+     << execution_.releasedEnd(robot) << " [" << execution_.describe(robot) << "], waiting on";
   const auto waits = waitingOn(robot);
   if (waits.empty())
     os << " nobody";

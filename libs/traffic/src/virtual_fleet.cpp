@@ -249,6 +249,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.detours = traffic.plannerStats().detours;
   res.escalations = traffic.plannerStats().escalations;
   res.untangles = traffic.plannerStats().untangles;
+  res.passes = traffic.stats().passes;
   res.updateP50Ms = percentile(updateMs, 0.5);
   res.updateP99Ms = percentile(updateMs, 0.99);
   if (o.robots < 2)
@@ -268,7 +269,7 @@ std::string formatResult(const VirtualFleetResult& r) {
   os.precision(1);
   os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans << ", evasions "
      << r.evasions << ", detours " << r.detours << ", escalations " << r.escalations << ", untangles "
-     << r.untangles << ", update p50/p99 ";
+     << r.untangles << ", passes " << r.passes << ", update p50/p99 ";
   os.precision(3);
   os << r.updateP50Ms << "/" << r.updateP99Ms << " ms, density " << r.density;
   os.precision(0);

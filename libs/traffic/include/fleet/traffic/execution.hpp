@@ -94,6 +94,9 @@ class Execution {
   [[nodiscard]] std::int64_t progressStep(std::size_t robot) const;
   /// Plan step of the robot's first planned node not released yet, -1 when everything is released.
   [[nodiscard]] std::int64_t nextUnreleasedStep(std::size_t robot) const;
+  /// The route from the last reported node to the next unreleased one, for stall reports:
+  /// "n1 n2 | n3 (waits q:index ...)", released nodes before the bar.
+  [[nodiscard]] std::string describe(std::size_t robot) const;
   /// Route nodes planned but not yet reported (including released ones).
   [[nodiscard]] std::size_t pendingNodes(std::size_t robot) const;
 
@@ -106,6 +109,16 @@ class Execution {
   /// holds or is released a node conflicting with it; call truncateToReleased() first so planned
   /// but unreleased nodes do not count. Returns the new robot's index.
   std::size_t addRobot(NodeId start);
+
+  /// Switchable dependencies (after Berndt et al.'s switchable action dependency graphs): `robot`'s
+  /// next node waits on robots that are at least `minBehind` route nodes short of what it waits
+  /// for. Those robots, not yet released into the conflict, are put behind `robot` there: their
+  /// remaining route from the first node that conflicts with `robot`'s unreleased route is
+  /// ordered after `robot`'s nodes it conflicts with, every unreleased dependency is derived
+  /// again from that order, and the change is kept only when the dependencies stay acyclic (no
+  /// deadlock), every robot needed is planned far enough, and `robot`'s next node is then free to
+  /// release. Returns whether it was kept; nothing changes otherwise.
+  bool letPass(std::size_t robot, std::int64_t minBehind);
 
   /// A robot that stops following its route (faulted, held by a person, taken over): cuts what was
   /// released to it back to the node it may be driving into (its next one after the last reported),
@@ -123,6 +136,9 @@ class Execution {
     std::int64_t step;
     double distance;  ///< m from the previous route node
     std::vector<Dependency> deps;
+    /// Where the entry stands in the order robots take conflicting nodes: the plan step scaled,
+    /// until letPass() puts a late robot's entries behind another's.
+    std::int64_t order = 0;
   };
   struct Route {
     std::vector<Entry> entries;  ///< entries_[i] is route index first + i
@@ -142,12 +158,18 @@ class Execution {
   [[nodiscard]] bool satisfied(const Entry& e) const;
   void prune(std::size_t robot);
   void rebuildVisitors();
+  /// Derives every unreleased entry's dependencies from `order` (released entries come first);
+  /// false when a robot would have to go beyond its planned route or the dependencies form a
+  /// cycle.
+  bool rederive();
+  [[nodiscard]] bool acyclic() const;
 
   const Graph& graph_;
   ReleaseOptions options_;
   std::vector<Route> routes_;
   std::vector<Visit> lastVisit_;  ///< per node: the robot that entered it last in the plan
   std::int64_t step_ = 0;
+  static constexpr std::int64_t kOrderPerStep = 1024;
 };
 
 }  // namespace fleet::traffic

@@ -39,6 +39,10 @@ struct TrafficOptions {
   int evadeSteps = 10;
   int evadeLookahead = 3;
   ReleaseOptions release;
+  /// Switchable dependencies: a robot whose next node waits on a robot at least this many route
+  /// nodes short of the conflict goes first there when that keeps the execution free of deadlock
+  /// (Execution::letPass); 0: the plan's order always holds.
+  std::int64_t letPassBehind = 1;
   /// Detours on: on a roadmap robots wait in line at stations and stand at docks, and an agent
   /// whose shortest way passes one would otherwise wait beside a free way round (docs/algorithms.md).
   PibtOptions pibt{.detourAfter = 4};
@@ -64,6 +68,7 @@ struct TrafficStats {
   std::uint64_t replans = 0;  ///< unreleased plan dropped and planned again
   std::uint64_t refusedReports = 0;
   std::uint64_t evasions = 0;  ///< robots sent out of another's way
+  std::uint64_t passes = 0;    ///< robots let past late ones (switched dependencies)
 };
 
 class TrafficControl {
