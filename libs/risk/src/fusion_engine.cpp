@@ -176,7 +176,6 @@ const FusionResult& FusionEngine::fuse(std::int64_t tRefNs) {
 namespace {
 // Conservative row bounds of a disc whose rows span the row coordinates [lo, hi]: floor(lo) − 1 and
 // at least ceil(hi) + 1, by truncation of clamped values (cheaper than floor/ceil without SSE4.1).
-constexpr double kDeferredBins = 32.0;
 
 int firstRow(double lo) {
   return static_cast<int>(std::clamp(lo, 1.0, 2e9)) - 1;
@@ -541,13 +540,14 @@ void FusionEngine::visitPair(std::uint32_t qa, std::uint32_t qb, int k) {
   const double ta = qd_[qa].tail;
   const double tb = qd_[qb].tail;
   const double t2 = ta * ta + tb * tb;
-  if ((active_[qa] != 0 || active_[qb] != 0) && d < R + std::sqrt(t2)) {
+  const double gap = d - R;
+  if ((active_[qa] != 0 || active_[qb] != 0) && gap * gap < t2) {
     // Scored later in kDeferredBins bins of (gap / √(ta² + tb²))² ∈ [0, 1): for the Gaussian a
     // decreasing order of the tail bound, so a disc's best partners come first and set the maxima
     // that let the model skip the rest.
-    const double gap = d - R;
     const auto bin = static_cast<std::uint8_t>(
-        std::min(kDeferredBins - 1.0, t2 > 0.0 ? gap * gap / t2 * kDeferredBins : 0.0));
+        std::min(static_cast<double>(kDeferredBins) - 1.0,
+                 t2 > 0.0 ? gap * gap / t2 * static_cast<double>(kDeferredBins) : 0.0));
     deferred_.push_back(DeferredPair{qa, qb, d, bin});
   }
 }
@@ -714,6 +714,39 @@ void FusionEngine::scanWindow(int k0, int k1) {
   }
 }
 
+void FusionEngine::scoreDeferred() {
+  deferredStart_.assign(kDeferredBins + 1, 0);
+  for (const DeferredPair& q : deferred_) {
+    ++deferredStart_[q.bin + 1u];
+  }
+  for (std::size_t b = 0; b < kDeferredBins; ++b) {
+    deferredStart_[b + 1] += deferredStart_[b];
+  }
+  deferredSorted_.resize(deferred_.size());
+  for (const DeferredPair& q : deferred_) {
+    deferredSorted_[deferredStart_[q.bin]++] = q;
+  }
+  constexpr double kNone = 2.0;
+  // In bin order the pairs' discs are scattered: their loads are issued a few pairs ahead.
+  constexpr std::size_t kAhead = 8;
+  for (std::size_t n = 0; n < deferredSorted_.size(); ++n) {
+    if (n + kAhead < deferredSorted_.size()) {
+      const DeferredPair& f = deferredSorted_[n + kAhead];
+      __builtin_prefetch(disc_[f.qa]);
+      __builtin_prefetch(disc_[f.qb]);
+      __builtin_prefetch(&discMax_[f.qa]);
+      __builtin_prefetch(&discMax_[f.qb]);
+    }
+    const DeferredPair& q = deferredSorted_[n];
+    const double known =
+        std::min(active_[q.qa] != 0 ? discMax_[q.qa] : kNone, active_[q.qb] != 0 ? discMax_[q.qb] : kNone);
+    if (binBound_[q.bin] < known) {
+      continue;
+    }
+    scorePair(q.qa, q.qb, q.d, 0.0);
+  }
+}
+
 void FusionEngine::recompute(bool full) {
   const GridSpec& g = config_.grid;
   const int steps = config_.steps;
@@ -825,36 +858,22 @@ void FusionEngine::recompute(bool full) {
   }
 
   // Candidate pairs per window of steps; touching pairs are scored as found, the others (which
-  // score lower) after all of them, so that more of those fall below both discs' maxima.
+  // score lower) after all of them, so that more of those fall below both discs' maxima. A disc's
+  // pairs are all at its own step, so every one of them is known once its window is scanned: the
+  // window's deferred pairs are scored then, while its discs are still in the cache.
   interSum_.assign(K, 0.0);
-  deferred_.clear();
+  // One bound per bin (the model's, for the bin's smallest gap ratio): a pair whose bin bound is
+  // below both discs' maxima cannot raise either, and is passed over without asking the model —
+  // which would skip it too, its own bound for the pair being no larger.
+  for (std::size_t b = 0; b < kDeferredBins; ++b) {
+    binBound_[b] =
+        model_->tailRatioBound(static_cast<double>(b) / static_cast<double>(kDeferredBins)) * (1.0 + 1e-9);
+  }
   const int w = windowLength();
   for (int k0 = 0; k0 < steps; k0 += w) {
+    deferred_.clear();
     scanWindow(k0, std::min(steps, k0 + w));
-  }
-  deferredStart_.assign(static_cast<std::size_t>(kDeferredBins) + 1, 0);
-  for (const DeferredPair& q : deferred_) {
-    ++deferredStart_[q.bin + 1u];
-  }
-  for (std::size_t b = 0; b < static_cast<std::size_t>(kDeferredBins); ++b) {
-    deferredStart_[b + 1] += deferredStart_[b];
-  }
-  deferredSorted_.resize(deferred_.size());
-  for (const DeferredPair& q : deferred_) {
-    deferredSorted_[deferredStart_[q.bin]++] = q;
-  }
-  // In bin order the pairs' discs are scattered: their loads are issued a few pairs ahead.
-  constexpr std::size_t kAhead = 8;
-  for (std::size_t n = 0; n < deferredSorted_.size(); ++n) {
-    if (n + kAhead < deferredSorted_.size()) {
-      const DeferredPair& f = deferredSorted_[n + kAhead];
-      __builtin_prefetch(disc_[f.qa]);
-      __builtin_prefetch(disc_[f.qb]);
-      __builtin_prefetch(&discMax_[f.qa]);
-      __builtin_prefetch(&discMax_[f.qb]);
-    }
-    const DeferredPair& q = deferredSorted_[n];
-    scorePair(q.qa, q.qb, q.d, 0.0);
+    scoreDeferred();
   }
 
   // Eq. (3.7) over the allowed unordered pairs: Σ∪ = Σ_pairs (A_i + A_j) − Σ∩, and Σ_pairs (A_i + A_j)

@@ -450,6 +450,17 @@ double Gaussian::tail(const Disc& a) const {
   return a.sigmaMax() * tailSigmas_;
 }
 
+double Gaussian::tailRatioBound(double x) const {
+  // g² >= x·(tail(a)² + tail(b)²) = x·T²·(σmax(a)² + σmax(b)²) >= x·T²·s², s² <= λmax(Ca) + λmax(Cb)
+  // the variance along the centre line, so t = g/s has t² >= x·T² and pairAbove's bound applies there
+  // (it falls with t). The 1e-6 covers the rounding of the tails, of s² and of the caller's ratio.
+  const double t2 = x * tailSigmas_ * tailSigmas_ * (1.0 - 1e-6);
+  if (!(t2 > 0.0)) {
+    return 1.0;
+  }
+  return std::exp(-0.5 * t2) * std::min(0.5, 1.0 / std::sqrt(2.0 * kPi * t2));
+}
+
 double Gaussian::reach(const Disc& a) const {
   return a.r + a.sigmaMax() * tailSigmas_;
 }

@@ -105,6 +105,46 @@ TEST(AnisotropicDiscs, PairsAtOrBeyondTheTailDistanceScoreZero) {
   EXPECT_GE(z.r + z.r + std::sqrt(2.0) * r.tail(z), r.cullDistance(z, z));
 }
 
+// The engine passes over a deferred pair when the bound of its bin, tailRatioBound(x) with x the bin's
+// smallest gap² / (tail(a)² + tail(b)²), is below both discs' maxima: that bound must hold for every
+// pair of the class, isotropic and anisotropic, exact and fast, down to pairs exactly at a bin's edge.
+TEST(AnisotropicDiscs, TailRatioBoundHoldsForEveryPairOfItsClass) {
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  constexpr int kBins = 32;
+  for (const auto eval : {GaussianEvaluation::kExact, GaussianEvaluation::kFast}) {
+    const Gaussian m(1e-4, eval);
+    EXPECT_EQ(m.tailRatioBound(0.0), 1.0);
+    for (int i = 0; i < 4000; ++i) {
+      Disc a{0, 0, 0.2 + 0.4 * u(rng), 0.02 + 0.9 * u(rng)};
+      Disc b{0, 0, 0.2 + 0.4 * u(rng), 0.02 + 0.9 * u(rng)};
+      if (i % 2 == 0) {
+        a.cov = covAlong(6.283 * u(rng), 0.05 + 0.8 * u(rng), 0.01 + 0.2 * u(rng));
+        a.sigma = a.sigmaMax();
+      }
+      if (i % 4 == 0) {
+        b.cov = covAlong(6.283 * u(rng), 0.05 + 0.8 * u(rng), 0.01 + 0.2 * u(rng));
+        b.sigma = b.sigmaMax();
+      }
+      const double ta = m.tail(a), tb = m.tail(b);
+      // Half the pairs exactly at a bin's edge, the others anywhere in [0, 1).
+      const int bin = static_cast<int>(u(rng) * kBins);
+      const double x = i % 2 == 0 ? static_cast<double>(bin) / kBins : u(rng);
+      const double gap = std::sqrt(x * (ta * ta + tb * tb));
+      const double th = 6.283 * u(rng);
+      b.x = (a.r + b.r + gap) * std::cos(th);
+      b.y = (a.r + b.r + gap) * std::sin(th);
+      const double g = centreDistance(a, b) - a.r - b.r;
+      const double xr = g * g / (ta * ta + tb * tb);
+      const int cls = std::min(kBins - 1, static_cast<int>(xr * kBins));
+      const double p = m.pair(a, b);
+      EXPECT_LE(p, m.tailRatioBound(static_cast<double>(cls) / kBins)) << i << " x " << xr;
+      EXPECT_LE(p, m.tailRatioBound(xr)) << i << " x " << xr;
+    }
+  }
+  EXPECT_EQ(OverlapRatio().tailRatioBound(0.5), 1.0);  // the default bounds nothing
+}
+
 TEST(AnisotropicDiscs, ValidationRefusesNonFiniteAndIndefiniteCovariances) {
   const SourceLimits lim;
   const Source good{"r1", SourceKind::kRobot, 0, 0.1, {{1, 1, 0.4, 0.3, Cov2{0.09, 0.01, 0.01}}}};

@@ -133,6 +133,45 @@ TEST(FusionEngine, LatticeAlignedDiscsMatchReferenceCellForCell) {
   expectEqualsReference(*engine, engine->fuse(0));
 }
 
+// The fast Gaussian (the service's default) on dense scenes: many pairs that do not touch, scored
+// or passed over by the bounds of their bins, and pairs placed at the cut-off distance a.r + b.r +
+// √(tail(a)² + tail(b)²) (and within rounding of it, either side). Cell for cell the thesis loop's grid.
+TEST(FusionEngine, DenseGaussianScenesAndPairsAtTheCutOffMatchReference) {
+  const auto model = std::make_shared<Gaussian>(1e-4, GaussianEvaluation::kFast);
+  for (int seed = 0; seed < 4; ++seed) {
+    std::mt19937_64 rng(2000 + seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto cfg = smallConfig(10.0, 8.0, 6);
+    cfg.policy.humanHuman = seed % 2 == 0;
+    auto engine = FusionEngine::create(cfg, model);
+    ASSERT_TRUE(engine.has_value());
+    for (int s = 0; s < 40; ++s) {
+      ASSERT_TRUE(engine->upsert(randomSource(rng, idOf("s", s), 10.0, 8.0, 8, 0.4)));
+    }
+    // Pairs of static discs at the cut-off: one apart by exactly it, one by it·(1 ± 1e-15).
+    for (int c = 0; c < 12; ++c) {
+      const Disc a{1.0 + 0.7 * c, 1.0 + 0.5 * (c % 10), 0.2 + 0.2 * u(rng), 0.05 + 0.3 * u(rng)};
+      Disc b{0.0, 0.0, 0.2 + 0.2 * u(rng), 0.05 + 0.3 * u(rng)};
+      const double ta = model->tail(a), tb = model->tail(b);
+      const double scale = c % 3 == 0 ? 1.0 : (c % 3 == 1 ? 1.0 - 1e-15 : 1.0 + 1e-15);
+      const double cut = (a.r + b.r + std::sqrt(ta * ta + tb * tb)) * scale, th = 6.283 * u(rng);
+      b.x = a.x + cut * std::cos(th);
+      b.y = a.y + cut * std::sin(th);
+      for (const auto& [name, disc] : {std::pair{idOf("ca", c), a}, std::pair{idOf("cb", c), b}}) {
+        Source s;
+        s.id = name;
+        s.kind = SourceKind::kRobot;
+        s.dt = 0.1;
+        s.discs.assign(8, disc);
+        ASSERT_TRUE(engine->upsert(s));
+      }
+    }
+    const auto& r = engine->fuse(0);
+    EXPECT_GT(r.stats.pairsTested, r.stats.pairsPositive);  // pairs were passed over
+    expectEqualsReference(*engine, r);
+  }
+}
+
 TEST(FusionEngine, IncrementalUpdateTouchesOnlyNearbyTiles) {
   auto cfg = smallConfig(20.0, 20.0, 5);
   auto engine = FusionEngine::create(cfg, std::make_shared<OverlapRatio>());

@@ -98,6 +98,7 @@ class FusionEngine {
   void scanWindow(int k0, int k1);
   void visitPair(std::uint32_t qa, std::uint32_t qb, int k);
   void scorePair(std::uint32_t qa, std::uint32_t qb, double d, double inter);
+  void scoreDeferred();
   void rowSpans(const Disc& d, int rowLo, int rowHi);
   void writeSpan(int j, int a, int b, double p, std::uint8_t level);
   struct SourcePaint {
@@ -166,6 +167,8 @@ class FusionEngine {
     std::uint8_t bin;  // of the gap relative to the tails
   };
   std::vector<DeferredPair> deferred_;  // near pairs that do not touch, scored after the touching ones
+  static constexpr std::size_t kDeferredBins = 32;
+  double binBound_[kDeferredBins] = {};  // RiskModel::tailRatioBound of each bin's smallest ratio
   std::vector<DeferredPair> deferredSorted_;
   std::vector<std::uint32_t> deferredStart_;
   double maxReachInHash_ = 0.0;

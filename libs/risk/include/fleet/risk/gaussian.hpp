@@ -83,6 +83,8 @@ class Gaussian final : public RiskModel {
   /// rounding, and the padding puts the probability there below the floor, so a pair at or beyond it
   /// is 0 either way.
   [[nodiscard]] double tail(const Disc& a) const override;
+  /// The half-plane bound of pairAbove at the smallest t the class allows (t² >= x·2 ln(1/floor)).
+  [[nodiscard]] double tailRatioBound(double x) const override;
   [[nodiscard]] std::string_view name() const override { return "gaussian"; }
   [[nodiscard]] double floor() const { return floor_; }
 

@@ -41,6 +41,11 @@ class RiskModel {
                                          double /*known*/) const {
     return pairWithIntersection(a, b, d, intersectionArea);
   }
+  /// An upper bound on pair(a, b) over every pair whose gap g = d − a.r − b.r is positive with
+  /// g² >= x·(tail(a)² + tail(b)²), x in [0, 1): one bound for a whole class of pairs, which lets the
+  /// engine pass over pairs that cannot raise a known maximum without asking for each. The default
+  /// bounds nothing.
+  [[nodiscard]] virtual double tailRatioBound(double /*x*/) const { return 1.0; }
 };
 
 }  // namespace fleet::risk
