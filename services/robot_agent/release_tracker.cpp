@@ -80,7 +80,9 @@ bool ReleaseTracker::advance(Vec2 here) {
     return false;
   }
   const std::size_t n = base_.size();
+  const double nextArc = arc_[std::min(reached_ + 1, n - 1)];
   double bestD2 = std::numeric_limits<double>::infinity();
+  double bestScore = std::numeric_limits<double>::infinity();
   double bestS = progress_;
   double bestPerp = 0.0;
   double bestBeyond = 0.0;
@@ -104,7 +106,12 @@ bool ReleaseTracker::advance(Vec2 here) {
       t = progress_ - arc_[j];
     }
     const double d2 = (here - (a + u * t)).squaredNorm();
-    if (d2 < bestD2) {
+    // The nearest point, but the earlier one where a base loops back near itself: a robot just off
+    // its node on [A, B, C, A] was nearer the leg back into A than to A's own leg, took the base
+    // as driven and stood for good while the traffic manager waited for B.
+    const double score = std::sqrt(d2) + p_.arcPenalty * std::max(0.0, arc_[j] + t - nextArc);
+    if (score < bestScore) {
+      bestScore = score;
       bestD2 = d2;
       bestS = arc_[j] + t;
       const Vec2 off = here - a;

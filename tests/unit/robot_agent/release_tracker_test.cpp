@@ -126,7 +126,8 @@ TEST(ReleaseTracker, AStationSpurIsDrivenInAndOutNotSkipped) {
 TEST(ReleaseTracker, ARobotOffTheBaseIsLedBackOntoItBeforeTheNextNode) {
   ReleaseTracker t;
   // A diagonal leg past a shelf corner at (0.75, 0.0): node 0 at (0.5, 0.5), node 1 at (1, 0).
-  ASSERT_EQ(t.offer(release(1, 1, {{0, {0.5, 0.5}}, {1, {1.0, 0.0}}}), {0.5, 0.5}), ReleaseVerdict::kAccepted);
+  ASSERT_EQ(t.offer(release(1, 1, {{0, {0.5, 0.5}}, {1, {1.0, 0.0}}}), {0.5, 0.5}),
+            ReleaseVerdict::kAccepted);
   // The robot stands 0.3 m below node 0, nearer the corner than the base passes it.
   const Vec2 here{0.47, 0.2};
   (void)t.advance(here);

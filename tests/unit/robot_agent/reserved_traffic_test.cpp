@@ -381,6 +381,72 @@ TEST_P(ReservedPlanner, DrivesOffACornerNodeOnlyOnceItFacesTheNextNode) {
   EXPECT_EQ(sim.lastNode(), 104);
 }
 
+TEST_P(ReservedPlanner, DrivesABaseThatStepsAsideAndComesBackThroughItsOwnNode) {
+  // The planner moves a robot aside for another and back: [A, B, A, C] with the robot on A. A robot
+  // in the full stack stood 447 s on such a base, the traffic manager waiting for it to report B.
+  Sim sim(GetParam());
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, {lane(0), lane(-1), lane(0), lane(1)}));
+  std::vector<std::int32_t> nodes;
+  while (sim.now() < 30.0) {
+    (void)sim.step();
+    if (nodes.empty() || nodes.back() != sim.lastNode()) {
+      nodes.push_back(sim.lastNode());
+    }
+  }
+  EXPECT_EQ(nodes, (std::vector<std::int32_t>{0, -1, 0, 1})) << "the nodes reported in order";
+  EXPECT_LT(distance(sim.truth.position(), {lane(1).x, lane(1).y}), 0.15);
+  EXPECT_LT(sim.truth.x, lane(1).x + 0.1);
+}
+
+TEST_P(ReservedPlanner, DrivesABaseThatEndsOnTheNodeItStandsOn) {
+  // [A, B, C, A] and [A, B, C, B] (released as far as the base reaches; more to come): the robot
+  // drives out and back and reports each node, though the base ends where it stands or behind it.
+  for (const auto& base : {std::vector<msg::RouteNode>{lane(0), lane(1), lane(2), lane(0)},
+                           std::vector<msg::RouteNode>{lane(0), lane(1), lane(2), lane(1)}}) {
+    Sim sim(GetParam());
+    sim.agent->onAssignment(order(kFarPickup));
+    sim.agent->onRelease(release(1, base));
+    std::vector<std::int32_t> nodes;
+    while (sim.now() < 40.0) {
+      (void)sim.step();
+      if (sim.lastNode() >= 0 && (nodes.empty() || nodes.back() != sim.lastNode())) {
+        nodes.push_back(sim.lastNode());
+      }
+    }
+    std::vector<std::int32_t> want;
+    for (const auto& n : base) {
+      want.push_back(n.node);
+    }
+    EXPECT_EQ(nodes, want) << "the nodes reported in order, ending on " << base.back().node;
+    EXPECT_LT(distance(sim.truth.position(), {base.back().x, base.back().y}), 0.15);
+  }
+}
+
+TEST_P(ReservedPlanner, DrivesALoopBackToItsNodeFacingAway) {
+  // As a robot stood 579 s in the full stack (seed 2): a little off its node, facing away from the
+  // base [A, B, C, A] where C is beside B and the last leg a diagonal back to A.
+  Sim sim(GetParam());
+  sim.params.start = {1.03, kY + 0.07, -2.77};
+  sim.truth = sim.params.start;
+  sim.agent = std::make_unique<agent::Agent>(
+      sim.params, std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}),
+      std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}));
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, {lane(0)}));
+  sim.run(5.0);
+  const msg::RouteNode up{100, lane(1).x, kY + kSpacing};
+  sim.agent->onRelease(release(2, {lane(0), lane(1), up, lane(0)}));
+  std::vector<std::int32_t> nodes;
+  while (sim.now() < 45.0) {
+    (void)sim.step();
+    if (sim.lastNode() >= 0 && (nodes.empty() || nodes.back() != sim.lastNode())) {
+      nodes.push_back(sim.lastNode());
+    }
+  }
+  EXPECT_EQ(nodes, (std::vector<std::int32_t>{0, 1, 100, 0}));
+}
+
 INSTANTIATE_TEST_SUITE_P(Reserved, ReservedPlanner, ::testing::Values("dwa", "follow"));
 
 TEST(Reserved, IgnoresForeignStaleAndOutOfOrderReleases) {
