@@ -80,7 +80,9 @@ bool ReleaseTracker::advance(Vec2 here) {
     return false;
   }
   const std::size_t n = base_.size();
-  const double nextArc = arc_[std::min(reached_ + 1, n - 1)];
+  // (From the node after next: round a corner the robot cuts, the projection must move on to the
+  // next leg, or the corner would stay ahead and the robot be turned back towards it.)
+  const double nextArc = arc_[std::min(reached_ + 2, n - 1)];
   double bestD2 = std::numeric_limits<double>::infinity();
   double bestScore = std::numeric_limits<double>::infinity();
   double bestS = progress_;

@@ -96,7 +96,7 @@ Expected<PathFollowerOutput> PathFollower::step(const Pose2& estimate) {
   // jumps back to a part of the path already driven.
   double best_d2 = std::numeric_limits<double>::infinity();
   double best_score = std::numeric_limits<double>::infinity();
-  const double segmentEnd = cumulative_[std::min(segment_ + 1, cumulative_.size() - 1)];
+  const double segmentEnd = cumulative_[std::min(segment_ + 2, cumulative_.size() - 1)];
   double best_s = progress_;
   std::size_t best_seg = segment_;
   if (points_.size() == 1) {

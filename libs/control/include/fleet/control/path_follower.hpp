@@ -17,7 +17,8 @@ struct PathFollowerParams {
   /// Projection search window [m] past the current progress; keeps a path that crosses itself from
   /// snapping to a later pass.
   double searchWindow = 2.0;
-  /// Each metre the projection would jump past the end of the segment it is on counts like this
+  /// Each metre the projection would jump past the end of the segment after the one it is on
+  /// counts like this
   /// many metres off the path (0: the nearest point in the window wins). Where a path comes back
   /// near itself within the window (a released route that steps aside and returns), the nearest
   /// point can lie on the way back and the robot would take the path as driven.
