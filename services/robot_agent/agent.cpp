@@ -92,11 +92,9 @@ OtherRobot::Mode modeOf(msg::RobotMode m) {
   return OtherRobot::Mode::kBlocked;  // (and a value off the enum: none of the modes the rules look at)
 }
 
-control::PathFollowerParams followerParams(bool reserved) {
+control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
   fp.lookahead = kLookahead;
-  // Released routes may step aside and come back through the robot's node (see ReleaseParams).
-  fp.arcPenalty = reserved ? 0.2 : 0.0;
   fp.goalToleranceXy = 0.15;
   fp.goalToleranceTheta = 0.25;
   return fp;
@@ -162,7 +160,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
       lastPlausiblePose_(p_.start),
-      follower_(followerParams(p_.traffic == "reserved")),
+      follower_(followerParams()),
       gate_(
           GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit, p_.traffic != "reserved"}),
       standsAt_(p_.start),

@@ -80,11 +80,7 @@ bool ReleaseTracker::advance(Vec2 here) {
     return false;
   }
   const std::size_t n = base_.size();
-  // (From the node after next: round a corner the robot cuts, the projection must move on to the
-  // next leg, or the corner would stay ahead and the robot be turned back towards it.)
-  const double nextArc = arc_[std::min(reached_ + 2, n - 1)];
   double bestD2 = std::numeric_limits<double>::infinity();
-  double bestScore = std::numeric_limits<double>::infinity();
   double bestS = progress_;
   double bestPerp = 0.0;
   double bestBeyond = 0.0;
@@ -108,12 +104,7 @@ bool ReleaseTracker::advance(Vec2 here) {
       t = progress_ - arc_[j];
     }
     const double d2 = (here - (a + u * t)).squaredNorm();
-    // The nearest point, but the earlier one where a base loops back near itself: a robot just off
-    // its node on [A, B, C, A] was nearer the leg back into A than to A's own leg, took the base
-    // as driven and stood for good while the traffic manager waited for B.
-    const double score = std::sqrt(d2) + p_.arcPenalty * std::max(0.0, arc_[j] + t - nextArc);
-    if (score < bestScore) {
-      bestScore = score;
+    if (d2 < bestD2) {
       bestD2 = d2;
       bestS = arc_[j] + t;
       const Vec2 off = here - a;
@@ -181,27 +172,7 @@ std::optional<ReleaseTracker::Turn> ReleaseTracker::nextTurn(double angle) const
 
 std::vector<Vec2> ReleaseTracker::ahead(Vec2 here) const {
   std::vector<Vec2> pts{here};
-  // A robot off the base (a local planner cut a corner, or it stopped short beside a node) goes
-  // back onto it first: straight to the next node it would sweep past what the roadmap keeps it
-  // clear of (a shelf corner 0.05 m from the disc held one for good at the stop rule).
-  if (base_.size() >= 2) {
-    Vec2 onBase = base_.back().at;
-    for (std::size_t j = 0; j + 1 < base_.size(); ++j) {
-      if (arc_[j + 1] >= progress_) {
-        const double len = arc_[j + 1] - arc_[j];
-        const double t = len > 1e-9 ? std::clamp((progress_ - arc_[j]) / len, 0.0, 1.0) : 0.0;
-        onBase = base_[j].at + (base_[j + 1].at - base_[j].at) * t;
-        break;
-      }
-    }
-    if (distance(here, onBase) > p_.rejoinOffset) {
-      pts.push_back(onBase);
-    }
-  }
   for (std::size_t k = reached_ + 1; k < base_.size(); ++k) {
-    if (distance(pts.back(), base_[k].at) < 1e-6) {
-      continue;
-    }
     // Nodes the projection has already passed are left out (the path would turn back to them);
     // the last one always stays: it is where the robot has to stop.
     if (arc_[k] > progress_ + 0.05 || k + 1 == base_.size()) {

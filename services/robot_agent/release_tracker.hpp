@@ -42,12 +42,6 @@ struct ReleaseParams {
   /// The projection on the base looks this far past the robot's progress [m], so a base that comes
   /// back past where it went (into a station spur and out) does not skip the spur.
   double searchWindow = 1.0;
-  /// The projection weighs each metre past the node after next like this many metres of distance off
-  /// the base, so where the base comes back near itself the robot is placed on the earlier part.
-  double arcPenalty = 0.2;
-  /// Farther than this from the base [m], the way ahead leads back onto it (through the robot's
-  /// projection) before going on to the next node.
-  double rejoinOffset = 0.1;
 };
 
 enum class ReleaseVerdict {

@@ -95,8 +95,6 @@ Expected<PathFollowerOutput> PathFollower::step(const Pose2& estimate) {
   // Project onto the segments within the search window ahead; progress is monotone so the carrot never
   // jumps back to a part of the path already driven.
   double best_d2 = std::numeric_limits<double>::infinity();
-  double best_score = std::numeric_limits<double>::infinity();
-  const double segmentEnd = cumulative_[std::min(segment_ + 2, cumulative_.size() - 1)];
   double best_s = progress_;
   std::size_t best_seg = segment_;
   if (points_.size() == 1) {
@@ -117,9 +115,7 @@ Expected<PathFollowerOutput> PathFollower::step(const Pose2& estimate) {
       t = (s - cumulative_[i]) / std::sqrt(len2);
     }
     const double d2 = (p - (a + ab * t)).squaredNorm();
-    const double score = std::sqrt(d2) + params_.arcPenalty * std::max(0.0, s - segmentEnd);
-    if (score < best_score) {
-      best_score = score;
+    if (d2 < best_d2) {
       best_d2 = d2;
       best_s = s;
       best_seg = i;

@@ -104,24 +104,3 @@ TEST(PathFollower, Errors) {
   EXPECT_FALSE(p.validate().has_value());
   EXPECT_TRUE(PathFollowerParams{}.validate().has_value());
 }
-
-TEST(PathFollower, WithAnArcPenaltyARouteThatComesBackNearTheRobotIsNotTakenAsDriven) {
-  // Out 1 m, up 0.5 m and back diagonally to just beside the start: the robot at the start is nearer
-  // the way back than the first leg.
-  const std::vector<Vec2> path{{0.0, 0.0}, {1.0, 0.0}, {1.0, 0.5}, {0.03, 0.03}};
-  const Pose2 robot{0.02, 0.025, 0.0};
-  for (const double penalty : {0.0, 0.2}) {
-    PathFollowerParams p;
-    p.arcPenalty = penalty;
-    PathFollower f(p);
-    ASSERT_TRUE(f.setPath(path, 0.0).has_value());
-    const auto r = f.step(robot);
-    ASSERT_TRUE(r.has_value());
-    if (penalty == 0.0) {
-      EXPECT_GT(r->progress, 2.0) << "the nearest point is on the way back";
-    } else {
-      EXPECT_LT(r->progress, 0.1) << "placed on the first leg";
-      EXPECT_LT(r->crossTrack, 0.03);
-    }
-  }
-}

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 
 using namespace fleet;
@@ -121,31 +120,6 @@ TEST(ReleaseTracker, AStationSpurIsDrivenInAndOutNotSkipped) {
   EXPECT_TRUE(t.advance({0.0, 0.1}));
   EXPECT_EQ(t.node(), 0);
   EXPECT_FALSE(t.nodesAhead());
-}
-
-TEST(ReleaseTracker, ARobotOffTheBaseIsLedBackOntoItBeforeTheNextNode) {
-  ReleaseTracker t;
-  // A diagonal leg past a shelf corner at (0.75, 0.0): node 0 at (0.5, 0.5), node 1 at (1, 0).
-  ASSERT_EQ(t.offer(release(1, 1, {{0, {0.5, 0.5}}, {1, {1.0, 0.0}}}), {0.5, 0.5}),
-            ReleaseVerdict::kAccepted);
-  // The robot stands 0.3 m below node 0, nearer the corner than the base passes it.
-  const Vec2 here{0.47, 0.2};
-  (void)t.advance(here);
-  const auto way = t.ahead(here);
-  ASSERT_EQ(way.size(), 3u);
-  EXPECT_EQ(way[0], here);
-  EXPECT_EQ(way[2], (Vec2{1.0, 0.0}));
-  // Through its projection on the base: the way stays as far from the corner as the base does.
-  EXPECT_NEAR(way[1].x + way[1].y, 1.0, 1e-9);
-  auto gap = [](Vec2 a, Vec2 b, Vec2 p) {
-    const Vec2 ab = b - a;
-    const double s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
-    return distance(a + ab * s, p);
-  };
-  const Vec2 corner{0.75, 0.0};
-  EXPECT_GE(std::min(gap(way[0], way[1], corner), gap(way[1], way[2], corner)),
-            gap({0.5, 0.5}, {1.0, 0.0}, corner) - 1e-9);
-  EXPECT_LT(gap(here, {1.0, 0.0}, corner), gap({0.5, 0.5}, {1.0, 0.0}, corner));  // straight would cut it
 }
 
 TEST(ReleaseTracker, RemainingAndTheWayAheadFollowTheRobot) {

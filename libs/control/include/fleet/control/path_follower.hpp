@@ -17,12 +17,6 @@ struct PathFollowerParams {
   /// Projection search window [m] past the current progress; keeps a path that crosses itself from
   /// snapping to a later pass.
   double searchWindow = 2.0;
-  /// Each metre the projection would jump past the end of the segment after the one it is on
-  /// counts like this
-  /// many metres off the path (0: the nearest point in the window wins). Where a path comes back
-  /// near itself within the window (a released route that steps aside and returns), the nearest
-  /// point can lie on the way back and the robot would take the path as driven.
-  double arcPenalty = 0.0;
   /// Final-pose controller (the two-region law by default). Tracking uses the same gains with the
   /// single far-field law and no reversing, since the carrot always lies ahead on the path.
   LyapunovParams controller;
