@@ -92,22 +92,26 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     releases.emplace(part);
     trafficProgress.emplace(part);
   }
-  // For operators (the dashboard): optional, as DDS permissions made before the topic existed do
-  // not let an agent write it; the robots drive the same without it.
+  // A writer per hosted robot and topic, each in the robot's partition (transport/
+  // robot_partition.hpp), made now: readers match them during start-up, and DDS Security refuses
+  // here, with the robot named, a robot this process's permissions do not grant.
+  std::vector<std::string> robots;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    robots.push_back(node.agent(i).id());
+  }
+  // For operators (the dashboard): optional, as DDS permissions made before the topic existed (or
+  // before it moved to the robots' partitions) do not let an agent write it; the robots drive the
+  // same without it.
   std::optional<transport::Writer<msg::PeopleSeen>> peopleSeen;
   try {
     peopleSeen.emplace(part);
+    peopleSeen->forRobots(robots);
   } catch (const std::exception& e) {
+    peopleSeen.reset();
     spdlog::warn("robot agent {}: not publishing the people seen ({})", proc.id, e.what());
   }
   {
-    // A writer per hosted robot and topic, each in the robot's partition (transport/
-    // robot_partition.hpp), made now: readers match them during start-up, and DDS Security refuses
-    // here, with the robot named, a robot this process's permissions do not grant.
-    std::vector<std::string> robots;
-    for (std::size_t i = 0; i < node.size(); ++i) {
-      robots.push_back(node.agent(i).id());
-    }
+    commands.forRobots(robots);
     states.forRobots(robots);
     discs.forRobots(robots);
     statuses.forRobots(robots);
@@ -115,9 +119,6 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
       trafficProgress->forRobots(robots);
     }
   }
-  // Made after the robots' writers: discovery announces a participant's writers in the order they
-  // are made, so a simulator that hears this process's lockstep registration has matched its
-  // command writers already (a command of the first step is not lost).
   transport::Writer<msg::StepDone> stepDone(part);
   transport::WaitSet ws(part);
   ws.attach(clockIn);
@@ -231,7 +232,12 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   std::uint64_t rateCycles = 0;
   while (!service::stopRequested()) {
     if (lockstep) {
-      if (!haveClock && std::chrono::steady_clock::now() - lastRegister > 100ms) {
+      // Registers only once every robot's command writer has matched the simulator's reader: a
+      // volatile writer keeps a command only for the readers it knows, so one written before that
+      // would never arrive, and the simulator would wait for it (StepDone names it) until the step
+      // timeout.
+      if (!haveClock && std::chrono::steady_clock::now() - lastRegister > 100ms &&
+          commands.matchedReaders() > 0) {
         stepDone.write({id, msg::StepDone::kRegister});
         lastRegister = std::chrono::steady_clock::now();
       }
@@ -241,7 +247,12 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
         haveClock = true;
         dt = nsToSec(c.dt_ns);
         cycle(c.sim_time_ns);
-        stepDone.write({id, c.step});
+        // The commands just written, one per robot: the simulator applies the step once they are in.
+        msg::StepDone done{id, c.step, {}};
+        for (const auto& out : node.outputs()) {
+          done.commands.push_back({out.command.robot_id, out.command.seq});
+        }
+        stepDone.write(done);
         if (!firstCycle) {
           firstCycle = std::chrono::steady_clock::now();
         }

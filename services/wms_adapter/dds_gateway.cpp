@@ -21,6 +21,15 @@ void optionalReader(transport::Participant& p, transport::WaitSet& ws,
   }
 }
 
+/// Counts the samples a per-robot reader dropped since the last call (a writer outside the
+/// partition of the robot they name: robot_partition.hpp) as `topic`:foreign_robot.
+void countForeign(validation::Rejections& into, const char* topic, std::uint64_t total,
+                  std::uint64_t& counted) {
+  for (; counted < total; ++counted) {
+    into.count({topic, "foreign_robot", "a writer outside the partition of the robot the sample names"});
+  }
+}
+
 }  // namespace
 
 DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
@@ -75,11 +84,15 @@ void DdsGateway::loop() {
         view_.onRobot(r);
       }
     }
+    countForeign(view_.rejections(), "RobotState", robots_.foreign(), foreignStates_);
     // After the states: the first list of a robot whose first state came with it is not refused.
     for (auto& p : people_ ? people_->take() : std::vector<msg::PeopleSeen>{}) {
       if (validation::admit(p, view_.rejections())) {
         view_.onPeopleSeen(std::move(p), steadyNowNs());
       }
+    }
+    if (people_) {
+      countForeign(view_.rejections(), "PeopleSeen", people_->foreign(), foreignPeople_);
     }
     if (const auto now = std::chrono::steady_clock::now(); now - proximityAt >= kProximityPeriod) {
       proximityAt = now;

@@ -40,6 +40,8 @@ class DdsGateway final : public TaskGateway {
   std::unique_ptr<transport::Reader<msg::TrafficRelease>> releases_;
   // The people the robots see (robot agents publish them), likewise optional.
   std::unique_ptr<transport::Reader<msg::PeopleSeen>> people_;
+  std::uint64_t foreignStates_ = 0;  // robots_/people_ foreign samples counted so far (loop thread)
+  std::uint64_t foreignPeople_ = 0;
   transport::WaitSet ws_;
   std::mutex writeMutex_;
   std::mutex m_;

@@ -264,7 +264,10 @@ class Simulator {
         doneR_(p_),
         stateR_(p_),
         riskR_(p_),
+        stepWs_(p_),
         errors_(1.0, o.hiddenLandmarks) {
+    stepWs_.attach(doneR_);
+    stepWs_.attach(cmdR_);
     ops_.registry()
         .gauge("fleet_sim_bodies", "Bodies in the world", {{"kind", "robot"}})
         .set(static_cast<double>(w_.robots().size()));
@@ -275,6 +278,7 @@ class Simulator {
     ops_.watchMatchedReaders("Clock", [this] { return clockW_.matchedReaders(); });
     ops_.watchMatchedWriters("VelocityCommand", [this] { return cmdR_.matchedWriters(); });
     ops_.watchForeign([this] { return stateR_.foreign(); });
+    ops_.watchForeign([this] { return cmdR_.foreign(); });
     discsW_.forRobots({""});  // people's discs: the default partition (not a robot's)
     ops_.watchMatchedWriters("StepDone", [this] { return doneR_.matchedWriters(); });
   }
@@ -372,8 +376,15 @@ class Simulator {
   }
 
   void pollStepDone() {
-    for (const auto& d : doneR_.take()) {
-      if (!barrier_.onStepDone(d.participant_id, d.step)) {
+    for (auto& d : doneR_.take()) {
+      // Commands for robots the world does not have are ignored when applied: not waited for.
+      sim::LockstepBarrier::Marks marks;
+      for (auto& c : d.commands) {
+        if (w_.robotIndex(c.robot_id) >= 0) {
+          marks.emplace_back(std::move(c.robot_id), c.seq);
+        }
+      }
+      if (!barrier_.onStepDone(d.participant_id, d.step, std::move(marks))) {
         spdlog::debug("StepDone({}) from unregistered '{}' ignored", d.step, d.participant_id);
       } else if (d.step < 0) {
         spdlog::info("lockstep: '{}' {}", d.participant_id, d.step == -1 ? "registered" : "left");
@@ -381,9 +392,21 @@ class Simulator {
     }
   }
 
+  /// Takes the commands that have arrived; they wait in pending_ until the step is applied.
+  void pollCommands() {
+    for (auto& c : cmdR_.take()) {
+      if (w_.robotIndex(c.robot_id) >= 0) {
+        barrier_.onCommand(c.robot_id, c.seq);
+      }
+      pending_.push_back(std::move(c));
+    }
+    w_.counters().foreignCommands = cmdR_.foreign();
+  }
+
   void awaitStep(std::int64_t k) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(o_.stepTimeoutMs);
     pollStepDone();
+    pollCommands();
     while (!barrier_.complete(k) && !gStop) {
       if (std::chrono::steady_clock::now() > deadline) {
         ++w_.counters().stepTimeouts;
@@ -399,14 +422,20 @@ class Simulator {
         }
         return;
       }
-      doneR_.waitForData(5ms);
+      stepWs_.wait(5ms);
       ops_.health().beat();
       pollStepDone();
+      pollCommands();
     }
   }
 
   void applyCommands() {
-    for (const auto& c : cmdR_.take()) {
+    pollCommands();
+    // In arrival order: a robot's commands come from one writer, in the order written; which
+    // robot's come first does not matter.
+    std::vector<msg::VelocityCommand> commands;
+    commands.swap(pending_);
+    for (const auto& c : commands) {
       if (w_.command(c.robot_id, c.v, c.w) == sim::CommandOutcome::Ignored) {
         ops_.rejected(w_.robotIndex(c.robot_id) < 0 ? "velocity_command_unknown_robot"
                                                     : "velocity_command_not_finite")
@@ -597,6 +626,8 @@ class Simulator {
   transport::Reader<msg::StepDone> doneR_;
   transport::Reader<msg::RobotState> stateR_;
   transport::Reader<msg::RiskMap> riskR_;
+  transport::WaitSet stepWs_;                  // lockstep: StepDone or a command arrived
+  std::vector<msg::VelocityCommand> pending_;  // arrived, not yet applied
   sim::LockstepBarrier barrier_;
   std::optional<sim::ReplayWriter> replay_;
   sim::LocalizationErrorLog errors_;

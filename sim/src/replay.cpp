@@ -102,6 +102,7 @@ nlohmann::json summary(const World& w) {
   j["commands"] = {{"nan_ignored", c.nanCommands},
                    {"clamped", c.clampedCommands},
                    {"unknown_robot", c.unknownRobot},
+                   {"foreign_robot", c.foreignCommands},
                    {"timeouts", c.timeouts}};
   j["lockstep_step_timeouts"] = c.stepTimeouts;
   j["wall_overruns"] = c.wallOverruns;

@@ -387,12 +387,23 @@ msg::Clock Traits<msg::Clock>::fromC(const C& in) {
   return {in.step, in.sim_time_ns, in.dt_ns, in.lockstep};
 }
 
-void Traits<msg::StepDone>::toC(const msg::StepDone& in, C& out, Arena&) {
+void Traits<msg::StepDone>::toC(const msg::StepDone& in, C& out, Arena& arena) {
   putStr(out.participant_id, in.participant_id, "StepDone.participant_id");
   out.step = in.step;
+  putSeq(out.commands, in.commands, msg::kMaxStepDoneCommands, arena, "StepDone.commands",
+         [](const msg::CommandMark& m, fleet_CommandMark& c) {
+           putStr(c.robot_id, m.robot_id, "StepDone.commands.robot_id");
+           c.seq = m.seq;
+         });
 }
 msg::StepDone Traits<msg::StepDone>::fromC(const C& in) {
-  return {getStr(in.participant_id), in.step};
+  msg::StepDone m;
+  m.participant_id = getStr(in.participant_id);
+  m.step = in.step;
+  m.commands = getSeq(in.commands, [](const fleet_CommandMark& c) {
+    return msg::CommandMark{getStr(c.robot_id), c.seq};
+  });
+  return m;
 }
 
 // ---- GroundTruth

@@ -10,6 +10,9 @@
 //   dds_probe states SECONDS OUTFILE  reads RobotState and TaskStatus as the services do (robot/*,
 //                                     the partition check), writes "state:ROBOT N", "status:ROBOT N"
 //                                     and "foreign N" (samples dropped by the check) to OUTFILE
+//   dds_probe command SECONDS ROBOT IN
+//                                     writes a VelocityCommand (0.4 m/s ahead) for robot ROBOT
+//                                     every 100 ms, in partition robot/IN (made by hand, likewise)
 //
 // Exit 0 when it ran, 3 when security refused its writer or reader, 4 when it refused the
 // participant (e.g. no valid certificate), 2 on bad usage.
@@ -116,6 +119,27 @@ int main(int argc, char** argv) {
       fleet_TaskStatus ct{};
       transport::Traits<msg::TaskStatus>::toC(ts, ct, arena);
       transport::check(dds_write(statusW, &ct), "dds_write");
+      std::this_thread::sleep_for(100ms);
+    }
+    return 0;
+  }
+  if (mode == "command" && argc == 5) {
+    dds_entity_t w = 0;
+    try {
+      using CW = transport::Traits<msg::VelocityCommand>;
+      w = transport::detail::createWriter(
+          p->handle(), transport::detail::createTopic(*p, CW::descriptor(), CW::kTopic),
+          transport::qos::command(false), {transport::robotPartition(argv[4])});
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "dds_probe: writer refused: %s\n", e.what());
+      return 3;
+    }
+    for (std::uint32_t k = 0; std::chrono::steady_clock::now() < until; ++k) {
+      const msg::VelocityCommand m{argv[3], 0.4, 0.0, 0, k};
+      transport::Arena arena;
+      fleet_VelocityCommand c{};
+      transport::Traits<msg::VelocityCommand>::toC(m, c, arena);
+      transport::check(dds_write(w, &c), "dds_write");
       std::this_thread::sleep_for(100ms);
     }
     return 0;

@@ -9,6 +9,9 @@
 #include <map>
 #include <string>
 
+#include <nlohmann/json.hpp>
+#include <sstream>
+
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -18,6 +21,8 @@ namespace {
 
 const std::string kProbe = FLEET_BINARY_DIR "/tests/integration/security/dds_probe";
 const std::string kScript = FLEET_SOURCE_DIR "/scripts/dds-security";
+const std::string kSim = FLEET_BINARY_DIR "/sim/src/fleet-sim";
+const std::string kCircle = FLEET_SOURCE_DIR "/sim/scenarios/circle_swap.json";
 
 int sh(const std::string& cmd) {
   return std::system((cmd + " >/dev/null 2>&1").c_str());
@@ -58,6 +63,33 @@ class DdsSecurity : public ::testing::Test {
     env.emplace_back("CYCLONEDDS_URI",
                      site.empty() ? "" : "file://" + (dir_ / site / identity / "cyclonedds.xml").string());
     return env;
+  }
+  /// The simulator (wall clock, circle_swap: robots r1..r8, no people) driven for a while by an
+  /// agent's commands for r1 and by commands for r3 written in r1's partition, and, where `theirs`
+  /// is set, for r2 in r2's partition; returns the simulator's summary.
+  nlohmann::json commandRun(const std::string& site, int* theirsExit) {
+    const auto summary = dir_ / (site.empty() ? "plain_summary.json" : "summary.json");
+    test::ChildProcess sim(kSim,
+                           {"--scenario", kCircle, "--clock", "wall", "--duration", "14", "--summary",
+                            summary.string(), "--log-level", "warn"},
+                           as(site, "simulator"));
+    std::this_thread::sleep_for(1s);
+    test::ChildProcess own(kProbe, {"command", "10", "r1", "r1"}, as(site, "agents"));
+    test::ChildProcess disguised(kProbe, {"command", "10", "r3", "r1"}, as(site, "agents"));
+    std::optional<test::ChildProcess> theirs;
+    if (theirsExit != nullptr) {
+      theirs.emplace(kProbe, std::vector<std::string>{"command", "10", "r2", "r2"}, as(site, "agents"));
+    }
+    EXPECT_EQ(own.wait(40s), 0);
+    EXPECT_EQ(disguised.wait(40s), 0) << "its own partition is granted";
+    if (theirs) {
+      *theirsExit = theirs->wait(40s);
+    }
+    EXPECT_EQ(sim.wait(40s), 0);
+    std::ifstream in(summary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return nlohmann::json::parse(ss.str(), nullptr, false);
   }
   std::string domain_;
   std::filesystem::path dir_;
@@ -135,4 +167,55 @@ TEST_F(DdsSecurity, WithoutSecurityTheReceiverStillDropsARobotSpeakingForAnother
   EXPECT_GT(m.count("state:r1") ? m.at("state:r1") : 0, 10);
   EXPECT_EQ(m.count("state:r3") + m.count("status:r3"), 0u);
   EXPECT_GT(m.count("foreign") ? m.at("foreign") : 0, 10);
+}
+
+TEST_F(DdsSecurity, AnAgentCommandsOnlyItsOwnRobots) {
+  int theirs = -1;
+  const auto s = commandRun("site", &theirs);
+  EXPECT_EQ(theirs, 3) << "r2's partition is not in the agents' permissions: command writer refused";
+  ASSERT_TRUE(s.is_object()) << "the simulator wrote its summary";
+  EXPECT_GT(s["per_robot"]["r1"]["distance_m"].get<double>(), 0.5) << "the agent drives its own robot";
+  EXPECT_EQ(s["per_robot"]["r2"]["distance_m"].get<double>(), 0.0);
+  EXPECT_EQ(s["per_robot"]["r3"]["distance_m"].get<double>(), 0.0)
+      << "r3's commands in r1's partition are dropped";
+  EXPECT_GT(s["commands"]["foreign_robot"].get<int>(), 20) << "and counted";
+}
+
+TEST_F(DdsSecurity, WithoutSecurityTheSimulatorStillDropsACommandForAnotherRobot) {
+  const auto s = commandRun("", nullptr);
+  ASSERT_TRUE(s.is_object()) << "the simulator wrote its summary";
+  EXPECT_GT(s["per_robot"]["r1"]["distance_m"].get<double>(), 0.5);
+  EXPECT_EQ(s["per_robot"]["r3"]["distance_m"].get<double>(), 0.0);
+  EXPECT_GT(s["commands"]["foreign_robot"].get<int>(), 20);
+}
+
+TEST_F(DdsSecurity, ARevokedIdentityIsRefused) {
+  const auto site = dir_ / "site";
+  ASSERT_EQ(sh(kScript + " identity " + site.string() + " old-adapter wms-adapter"), 0);
+  ASSERT_EQ(sh(kScript + " revoke " + site.string() + " old-adapter"), 0);
+  // Whoever holds the revoked key is not bound to the site's config: the same without the list.
+  {
+    std::ifstream in(site / "old-adapter" / "cyclonedds.xml");
+    std::ofstream out(site / "old-adapter" / "nocrl.xml");
+    for (std::string line; std::getline(in, line);) {
+      if (line.find("<CRL>") == std::string::npos) {
+        out << line << "\n";
+      }
+    }
+  }
+  const auto got = dir_ / "manager.txt";
+  test::ChildProcess manager(kProbe, {"read", "16", got.string()}, as("site", "fleet-manager"));
+  std::this_thread::sleep_for(1s);
+  test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
+  test::ChildProcess revoked(kProbe, {"write", "12", "revoked"}, as("site", "old-adapter"));
+  auto env = as("site", "old-adapter");
+  env.back().second = "file://" + (site / "old-adapter" / "nocrl.xml").string();
+  test::ChildProcess stolen(kProbe, {"write", "12", "stolen"}, env);
+  EXPECT_EQ(revoked.wait(40s), 4) << "its own config names the list: its participant is refused";
+  EXPECT_EQ(stolen.wait(40s), 0) << "without the list it starts, alone";
+  EXPECT_EQ(adapter.wait(40s), 0);
+  ASSERT_EQ(manager.wait(40s), 0);
+  const auto m = counts(got);
+  EXPECT_GT(m.count("adapter") ? m.at("adapter") : 0, 50) << "the valid adapter's tasks arrive";
+  EXPECT_EQ(m.count("stolen") + m.count("revoked"), 0u) << "the revoked certificate is not authenticated";
 }

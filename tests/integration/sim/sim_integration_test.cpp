@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -57,14 +58,29 @@ struct AgentRun {
   int exitCode = -1;
 };
 
-// The agent side of the lockstep protocol: register with StepDone(-1) until the first Clock, then
-// for each Clock(k): read the frames of step k, command every robot, acknowledge with StepDone(k).
+// The agent side of the lockstep protocol, as robot_agent speaks it: a command writer per robot
+// (each in its robot's partition), matched before registering with StepDone(-1) until the first
+// Clock; then for each Clock(k): read the frames of step k, command every robot, acknowledge with
+// StepDone(k) naming the last command written for each robot.
 AgentRun runLockstep(const std::string& scenario, double duration, const std::string& replay,
                      const std::string& summary, double v) {
   setenv("FLEET_DDS_DOMAIN", domain().c_str(), 1);
+  std::vector<std::string> robots;
+  const auto scenarioJson = nlohmann::json::parse(slurp(kScenarios + scenario));
+  for (const auto& r : scenarioJson["robots"]) {
+    robots.push_back(r["id"].get<std::string>());
+  }
   Participant p;
   Writer<msg::StepDone> done(p);
   Writer<msg::VelocityCommand> cmd(p, qos::command(true));
+  std::vector<std::string> commanded = robots;
+  commanded.push_back("no-such-robot");  // its writer, too, before registering
+  cmd.forRobots(commanded);
+  std::map<std::string, std::uint32_t> seq;  // per robot: the last command's
+  auto command = [&](msg::VelocityCommand c) {
+    c.seq = ++seq[c.robot_id];
+    cmd.write(c);
+  };
   Reader<msg::Clock> clock(p);
   Reader<msg::SensorFrame> frames(p, qos::sensor(true));
   Reader<msg::GroundTruth> truth(p);
@@ -77,9 +93,8 @@ AgentRun runLockstep(const std::string& scenario, double duration, const std::st
   const auto total = static_cast<std::int64_t>(std::llround(duration / 0.1));
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   bool registered = false;
-  std::vector<std::string> robots;
   while (run.lastStep < total && std::chrono::steady_clock::now() < deadline) {
-    if (!registered) {
+    if (!registered && cmd.matchedReaders() > 0) {
       done.write({"agent", msg::StepDone::kRegister});
     }
     clock.waitForData(registered ? 1000ms : 100ms);
@@ -105,26 +120,23 @@ AgentRun runLockstep(const std::string& scenario, double duration, const std::st
             run.finalY = b.pose.y;
           }
         }
-        if (robots.empty()) {
-          for (const auto& b : g.bodies) {
-            if (b.kind == msg::SourceKind::Robot) {
-              robots.push_back(b.id);
-            }
-          }
-        }
       }
       for (std::size_t i = 0; i < robots.size(); ++i) {
         // Deterministic commands: a function of the step and the robot only.
-        cmd.write({robots[i], v, 0.3 * std::sin(0.2 * static_cast<double>(c.step) + static_cast<double>(i)),
-                   c.sim_time_ns, static_cast<std::uint32_t>(c.step)});
+        command({robots[i], v, 0.3 * std::sin(0.2 * static_cast<double>(c.step) + static_cast<double>(i)),
+                 c.sim_time_ns, 0});
       }
       if (c.step == 5 && robots.size() > 2) {
         // Bad input over the wire: NaN is ignored, an over-limit speed clamped, both counted.
-        cmd.write({robots[1], std::nan(""), 0.0, c.sim_time_ns, 5});
-        cmd.write({robots[2], 50.0, 0.0, c.sim_time_ns, 5});
-        cmd.write({"no-such-robot", 0.1, 0.0, c.sim_time_ns, 5});
+        command({robots[1], std::nan(""), 0.0, c.sim_time_ns, 0});
+        command({robots[2], 50.0, 0.0, c.sim_time_ns, 0});
+        command({"no-such-robot", 0.1, 0.0, c.sim_time_ns, 0});
       }
-      done.write({"agent", c.step});
+      msg::StepDone d{"agent", c.step, {}};
+      for (const auto& [robot, last] : seq) {
+        d.commands.push_back({robot, last});
+      }
+      done.write(d);
     }
   }
   run.exitCode = sim.wait(30s);

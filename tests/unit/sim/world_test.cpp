@@ -203,6 +203,35 @@ TEST(Lockstep, BarrierWaitsForEveryRegisteredParticipant) {
   EXPECT_EQ(b.missing(6), (std::vector<std::string>{"b", "late"}));
 }
 
+TEST(Lockstep, AStepWaitsForTheCommandsItsAcknowledgementNames) {
+  LockstepBarrier b;
+  b.onStepDone("agents", LockstepBarrier::kRegister);
+  b.onStepDone("risk", LockstepBarrier::kRegister);
+  b.onStepDone("risk", 0);
+  // The acknowledgement overtook the commands written before it (another writer's).
+  b.onStepDone("agents", 0, {{"r1", 7}, {"r2", 7}});
+  EXPECT_FALSE(b.complete(0));
+  EXPECT_EQ(b.missing(0), (std::vector<std::string>{"agents (command 7 of r1)", "agents (command 7 of r2)"}));
+  b.onCommand("r1", 7);
+  EXPECT_FALSE(b.complete(0));
+  b.onCommand("r2", 6);  // the previous step's, late: not this one
+  EXPECT_FALSE(b.complete(0));
+  b.onCommand("r2", 7);
+  EXPECT_TRUE(b.complete(0));
+  // The next step's marks replace these; an agent restarted with seq 0 is waited for too.
+  b.onStepDone("agents", 1, {{"r1", 0}});
+  b.onStepDone("risk", 1);
+  EXPECT_FALSE(b.complete(1));
+  b.onCommand("r1", 0);
+  EXPECT_TRUE(b.complete(1));
+  // A participant that leaves takes its marks along.
+  b.onStepDone("agents", 2, {{"r1", 1}});
+  b.onStepDone("risk", 2);
+  EXPECT_FALSE(b.complete(2));
+  b.onStepDone("agents", LockstepBarrier::kLeave);
+  EXPECT_TRUE(b.complete(2));
+}
+
 TEST(World, MinimumSeparationIsTheExactSurfaceGap) {
   auto j = test::room(40, 10);
   j["robots"] = {{{"id", "a"}, {"start", {5.0, 1.2, 0.0}}}, {{"id", "b"}, {"start", {6.0, 1.2, 0.0}}}};

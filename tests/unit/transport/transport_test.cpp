@@ -52,6 +52,7 @@ TEST_F(Transport, OversizedFieldsAreRefusedWithTheFieldName) {
 TEST_F(Transport, InProcessPublishSubscribe) {
   Participant p;
   Writer<msg::VelocityCommand> w(p, qos::command(true));
+  w.forRobots({"r0", "r1", "r2"});  // a writer per robot, in its partition
   Reader<msg::VelocityCommand> r(p, qos::command(true));
   waitMatched(w, r);
   for (std::uint32_t i = 0; i < 3; ++i) {

@@ -124,6 +124,16 @@ TEST(PeopleSeenOverDds, ReachTheRobotApiAndMalformedSamplesAreRefusedAndCounted)
     people.write({"r1", 6, {{4.0F, 4.0F, 0.0F, 0.0F, 0.25F, false}, {5.0F, 5.0F, 0.0F, 0.0F, 0.25F, false}}});
     return robotJson("r1")["people_seen"].size() == 2;
   }));
+  // A list naming r1 from r2's writer (partition robot/r2): dropped and counted, r1's list stays.
+  const dds_entity_t r2Writer = people.handleFor(msg::PeopleSeen{"r2", 7, {}});
+  ASSERT_TRUE(eventually([&] {
+    fleet_PeopleSeen disguised{};
+    std::snprintf(disguised.robot_id, sizeof disguised.robot_id, "%s", "r1");
+    disguised.stamp_ns = 7;
+    (void)dds_write(r2Writer, &disguised);
+    return rejected("foreign_robot") > 0;
+  }));
+  EXPECT_EQ(robotJson("r1")["people_seen"].size(), 2U);
   api.stop();
   server.join();
 }

@@ -61,6 +61,7 @@ struct Counters {
   std::uint64_t nanCommands = 0;      // NaN/inf commands ignored
   std::uint64_t clampedCommands = 0;  // commands beyond the robot's speed limits (clamped)
   std::uint64_t unknownRobot = 0;     // commands for robots not in the scenario (ignored)
+  std::uint64_t foreignCommands = 0;  // commands from a writer outside the robot's partition (dropped)
   std::uint64_t timeouts = 0;         // robots stopped by the command timeout (rising edges)
   std::uint64_t stepTimeouts = 0;     // lockstep steps that advanced without every StepDone
   std::uint64_t wallOverruns = 0;     // wall-clock steps that took longer than dt (the run fell behind)

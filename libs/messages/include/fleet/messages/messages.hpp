@@ -240,11 +240,24 @@ struct Clock {
   bool operator==(const Clock&) const = default;
 };
 
+/// The last VelocityCommand a lockstep participant wrote for `robot_id` in a step.
+struct CommandMark {
+  std::string robot_id;
+  std::uint32_t seq = 0;
+  bool operator==(const CommandMark&) const = default;
+};
+
+/// At most this many robots' commands in one StepDone (the IDL bound).
+inline constexpr std::size_t kMaxStepDoneCommands = 4096;
+
 struct StepDone {
   static constexpr std::int64_t kRegister = -1;
   static constexpr std::int64_t kLeave = -2;
   std::string participant_id;
   std::int64_t step = 0;
+  /// Step k: the robots commanded and the seq of each one's last command; the simulator waits for
+  /// them before it applies the step.
+  std::vector<CommandMark> commands{};
   bool operator==(const StepDone&) const = default;
 };
 

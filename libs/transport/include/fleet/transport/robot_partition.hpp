@@ -1,16 +1,19 @@
 #pragma once
 
-// Per-robot topics: what a robot says (its state, task status, traffic progress, predicted discs)
-// travels in a DDS partition of its own, "robot/<id>". Under DDS
+// Per-robot topics: what a robot says (its state, task status, traffic progress, predicted discs,
+// the people it sees) and the velocity commands it is given travel in a DDS partition of its own,
+// "robot/<id>". Under DDS
 // Security an agent's permissions name only its robots' partitions, so its certificate cannot
 // create a writer in another robot's partition; readers subscribe to "robot/*" and drop a sample
 // whose robot id is not the partition its writer is in, so a writer in its own partition cannot
 // speak for another robot either. Without security the same partitions are used: one code path,
 // tested by every multi-process test. docs/operator-guide.md ("Security: DDS") has the table.
 //
-// VelocityCommand is not per robot (yet): with one command writer per robot, Cyclone 0.10.2 did not
-// deliver every command of a lockstep step before the StepDone written after them (from another
-// writer), and SimLockstep.SameSeedGivesByteIdenticalReplays differed run to run.
+// DDS orders samples per writer only: a command from a robot's writer may arrive after the StepDone
+// written after it from another writer (a reader matched with a writer it has just discovered holds
+// that writer's first samples until a heartbeat; a lost datagram is resent later). So in lockstep a
+// StepDone names the last command it covers for each robot and the simulator waits for those
+// (sim/lockstep.hpp), and an agent registers only once its command writers have matched a reader.
 
 #include <string>
 #include <string_view>
@@ -39,7 +42,8 @@ template <class T>
 requires requires(const T& m) {
   { m.robot_id } -> std::convertible_to<std::string>;
 } &&(std::same_as<T, msg::RobotState> || std::same_as<T, msg::TaskStatus> ||
-     std::same_as<T, msg::TrafficProgress>)struct RobotOf<T> {
+     std::same_as<T, msg::TrafficProgress> || std::same_as<T, msg::VelocityCommand> ||
+     std::same_as<T, msg::PeopleSeen>)struct RobotOf<T> {
   static constexpr bool kPerRobot = true;
   /// Samples without a robot travel in the default partition too (never for these types).
   static constexpr bool kAlsoDefault = false;
