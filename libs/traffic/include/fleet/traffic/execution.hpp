@@ -95,7 +95,7 @@ class Execution {
   /// Plan step of the robot's first planned node not released yet, -1 when everything is released.
   [[nodiscard]] std::int64_t nextUnreleasedStep(std::size_t robot) const;
   /// The route from the last reported node to the next unreleased one, for stall reports:
-  /// "n1 n2 | n3 (waits q:index ...)", released nodes before the bar.
+  /// "n1 n2 | n3 (needs q:index/progress ...)", released nodes before the bar.
   [[nodiscard]] std::string describe(std::size_t robot) const;
   /// Route nodes planned but not yet reported (including released ones).
   [[nodiscard]] std::size_t pendingNodes(std::size_t robot) const;
