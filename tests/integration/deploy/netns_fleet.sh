@@ -5,10 +5,16 @@
 # process uses the LAN profile deploy/cyclonedds-lan.xml (unicast discovery to the three hosts'
 # addresses, no multicast, pinned to the host's veth). A task posted to the WMS adapter's HTTP API
 # in host C must reach `done`. Namespaces and processes are removed on every exit. Exit 77 (ctest
-# skip) only when `ip netns add` is not permitted. Usage: netns_fleet.sh SOURCE_DIR BUILD_DIR
+# skip) only when `ip netns add` is not permitted.
+# With "secure", DDS Security is on: `scripts/dds-security deployment` makes the identities and each
+# process adds its own security.xml to the LAN profile; a process in host C without a certificate
+# then writes Tasks for 3 s, and none of them may reach the manager.
+# Usage: netns_fleet.sh SOURCE_DIR BUILD_DIR [secure]
 set -uo pipefail
 SRC=$1
 B=$2
+SECURE=0
+[[ ${3:-} == secure ]] && SECURE=1
 cd "$SRC"
 t0=$SECONDS
 fail() { echo "FAIL: $*"; exit 1; }
@@ -60,10 +66,17 @@ echo "{\"site\": \"$scenario\", \"grid\": {\"resolution\": 0.1}, \"clock\": \"si
   >"$dir/risk_map.json"
 printf 'id,kind,pickup,dropoff,load_s,unload_s\njob-1,transport,P-2,D-1,2,2\n' >"$dir/tasks.csv"
 
+if ((SECURE)); then
+  scripts/dds-security deployment "$dir/dds" >"$dir/dds-security.log" 2>&1 ||
+    { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
+fi
+declare -A identity=([fleet_manager]=fleet-manager [wms_adapter]=wms-adapter [risk_map]=risk-map
+  [robot_agent]=agents [fleet-sim]=simulator)
 on() {  # on HOST NAME CMD...: a service in that host's namespace with the LAN profile
-  local h=$1 name=$2
+  local h=$1 name=$2 uri="file://$SRC/deploy/cyclonedds-lan.xml"
   shift 2
-  ip netns exec "fleet-$h-$ID" env FLEET_DDS_DOMAIN=0 CYCLONEDDS_URI="file://$SRC/deploy/cyclonedds-lan.xml" \
+  ((SECURE)) && [[ -n ${identity[$name]:-} ]] && uri+=",file://$dir/dds/${identity[$name]}/security.xml"
+  ip netns exec "fleet-$h-$ID" env FLEET_DDS_DOMAIN=0 CYCLONEDDS_URI="$uri" \
     FLEET_DDS_INTERFACE="veth$h" FLEET_DDS_PEER1="${addr[A]}" FLEET_DDS_PEER2="${addr[B]}" \
     FLEET_DDS_PEER3="${addr[C]}" "$@" >"$dir/$name.log" 2>&1 &
   pids+=($!)
@@ -91,6 +104,23 @@ for _ in $(seq 180); do
 done
 echo "task job-1: $state after $((SECONDS - t0)) s (manager in host A, simulator and agent in B, WMS adapter in C)"
 [[ $state == done ]] || fail "the task did not reach done across the namespaces (last state '$state')"
+# A participant without a certificate in host C writes Tasks straight onto the domain, past the
+# adapter. Without security they reach the manager (the check below can fail); with it, none may.
+on C rogue "$B/tests/integration/security/dds_probe" write 3 rogue
+wait "${pids[-1]}"
+echo "uncertified writer: exit $? $(tail -n 1 "$dir/rogue.log")"
+reached=0
+for _ in $(seq 10); do
+  ctl task rogue-0 2>/dev/null | grep -q '"state"' && { reached=1; break; }
+  sleep 0.5
+done
+if ((SECURE)); then
+  ((reached == 0)) || fail "a Task written without a certificate reached the manager"
+  echo "secure: the fleet ran with DDS Security; no Task of the uncertified writer reached the manager"
+else
+  ((reached == 1)) || fail "without security the probe's Task should reach the manager (is the check broken?)"
+  echo "without security the uncertified writer's Task reached the manager, as expected"
+fi
 for p in "${pids[@]:0:4}"; do kill -0 "$p" 2>/dev/null || fail "a service exited early (pid $p)"; done
 ok=1
-echo "PASS: fleet across network namespaces in $((SECONDS - t0)) s"
+echo "PASS: fleet across network namespaces$( ((SECURE)) && echo " with DDS Security") in $((SECONDS - t0)) s"
