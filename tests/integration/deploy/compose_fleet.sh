@@ -6,10 +6,17 @@
 # containers), that every service is healthy, that no container joined a multicast group, and that
 # fleetctl in the network reaches the adapter by its service name. Everything the run created
 # (containers, network, files) is removed, also on failure. Exit 77 (ctest skip) only when podman
-# cannot run containers here at all. Usage: compose_fleet.sh SOURCE_DIR BUILD_DIR
+# cannot run containers here at all.
+# With "secure", deploy/compose.secure.yaml is added: DDS Security with an identity per service
+# (scripts/dds-security deployment). In both modes a container on the network without a
+# certificate then writes Tasks straight onto the domain: they must reach the manager without
+# security (so the check can fail) and must not with it.
+# Usage: compose_fleet.sh SOURCE_DIR BUILD_DIR [secure]
 set -uo pipefail
 SRC=$1
 export BUILD_DIR=$2
+SECURE=0
+[[ ${3:-} == secure ]] && SECURE=1
 cd "$SRC" || exit 1
 t0=$SECONDS
 fail() { echo "FAIL: $*"; exit 1; }
@@ -33,7 +40,9 @@ P=fleet-compose-$$
 NET=${P}_fleet
 SERVICES=(fleet-manager wms-adapter risk-map robot-agent fleet-sim)
 dir=$(mktemp -d /tmp/fleet-compose.XXXXXX)
-compose() { timeout 120 podman-compose -p "$P" -f deploy/compose.yaml "$@"; }
+files=(-f deploy/compose.yaml)
+((SECURE)) && files+=(-f deploy/compose.secure.yaml)
+compose() { timeout 120 podman-compose -p "$P" "${files[@]}" "$@"; }
 cleanup() {
   if [[ ${ok:-0} != 1 ]]; then
     for s in "${SERVICES[@]}"; do
@@ -63,6 +72,12 @@ done
 
 scripts/containers files "$dir" sim/scenarios/one_robot.json 150 1 >/dev/null || fail "writing the mounted files failed"
 export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
+if ((SECURE)); then
+  scripts/dds-security deployment "$dir/dds" >"$dir/dds-security.log" 2>&1 ||
+    { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
+  chown -R 65532:65532 "$dir/dds"  # the images' user reads its key (0600)
+  export FLEET_DDS_SECURITY_DIR=$dir/dds
+fi
 # fleetctl is left out: podman-compose 1.0.3 ignores `profiles: [cli]`.
 compose up -d "${SERVICES[@]}" >"$dir/up.log" 2>&1 || { tail -n 30 "$dir/up.log"; fail "podman-compose up failed"; }
 echo "podman-compose up after $((SECONDS - t0)) s"
@@ -111,9 +126,29 @@ done
 sim=$(podman inspect --format '{{.State.Status}} {{.State.ExitCode}}' "${P}_fleet-sim_1")
 [[ $sim == "running 0" || $sim == "exited 0" ]] || fail "the simulator ended badly ($sim)"
 
+# A container on the network with no certificate writes Tasks onto the domain, past the adapter.
+probe=$BUILD_DIR/tests/integration/security/dds_probe
+[[ -x $probe ]] || fail "$probe is not built"
+podman run --rm --network "$NET" --user 65532 -e FLEET_DDS_DOMAIN=0 -e RES_OPTIONS=no-tld-query \
+  -e CYCLONEDDS_URI=file:///usr/share/fleet/cyclonedds-compose.xml -v "$probe:/usr/local/bin/dds_probe:ro" \
+  --entrypoint /usr/local/bin/dds_probe localhost/fleet-fleet-manager:latest write 4 rogue >"$dir/rogue.log" 2>&1
+echo "uncertified container: exit $? $(tail -n 1 "$dir/rogue.log")"
+reached=0
+for _ in $(seq 10); do
+  ctl task rogue-0 2>/dev/null | grep -q '"state"' && { reached=1; break; }
+  sleep 0.5
+done
+if ((SECURE)); then
+  ((reached == 0)) || fail "a Task written without a certificate reached the manager"
+  echo "secure: the fleet ran with DDS Security; no Task of the uncertified container reached the manager"
+else
+  ((reached == 1)) || fail "without security the probe's Task should reach the manager (is the check broken?)"
+  echo "without security the uncertified container's Task reached the manager, as expected"
+fi
+
 # The compose file's fleetctl: a client in the network, reaching the adapter by service name.
 compose run --rm --no-deps -T fleetctl task job-000 >"$dir/run.log" 2>&1
 grep -q '"state": "done"' "$dir/run.log" || { tail -n 20 "$dir/run.log"; fail "fleetctl in the network did not reach wms-adapter:8080"; }
 echo "fleetctl in the network: job-000 done"
 ok=1
-echo "PASS: compose fleet test in $((SECONDS - t0)) s"
+echo "PASS: compose fleet test$( ((SECURE)) && echo " with DDS Security") in $((SECONDS - t0)) s"
