@@ -307,6 +307,16 @@ int main(int argc, char** argv) {
                    "s added to a route for entering what a standing robot excludes (default: the "
                    "traffic layer's)")
       ->check(CLI::Range(0.0, 1e6));
+  trafficSim
+      ->add_option("--queue-length", ts.queueLength,
+                   "queue nodes generated for a station the site gives none (default: the roadmap's)")
+      ->check(CLI::Range(0, 50));
+  trafficSim
+      ->add_option(
+          "--station-lines", ts.stationLines,
+          "1: robots sent to a station wait in line on its queue nodes; 0: all are planned to the dock")
+      ->check(CLI::Range(0, 1))
+      ->capture_default_str();
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");
   trafficSim->add_option(
       "--html", ts.html,

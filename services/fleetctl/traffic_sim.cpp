@@ -37,6 +37,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
   }
   traffic::RoadmapOptions ro;
   ro.spacing = o.spacing;
+  if (o.queueLength >= 0)
+    ro.queueLength = o.queueLength;
   if (o.stopGap >= 0.0)
     ro.stopGap = o.stopGap;
   auto roadmap = traffic::buildRoadmap(*site, ro);
@@ -48,6 +50,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.duration = o.duration;
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
+    v.stationLines = o.stationLines != 0;
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
     if (o.letPass >= 0)

@@ -1,5 +1,6 @@
 // `fleetctl traffic-sim --html`: the replay page holds the run it shows (every frame, every robot,
-// released nodes on the roadmap), and a page it cannot write is bad input (exit 2).
+// released nodes on the roadmap), and a page it cannot write is bad input (exit 2). Its roadmap
+// options reach the roadmap it drives on (--queue-length).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -80,3 +81,35 @@ TEST(TrafficSimView, APageItCannotWriteIsBadInput) {
 }
 
 }  // namespace
+
+// The roadmap of the page: `--queue-length N` generates N queue nodes per station the site gives
+// none, so the roadmap grows with N; out of range is bad input.
+TEST(TrafficSimView, QueueLengthShapesTheRoadmapAndOutOfRangeIsBadInput) {
+  auto nodesWith = [](const std::string& args) -> long {
+    const fs::path page =
+        fs::temp_directory_path() / ("traffic_sim_queue_" + std::to_string(getpid()) + ".html");
+    const auto r = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                                           " --robots 2 --duration 2 " + args + " --html " + page.string());
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream in(page);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    fs::remove(page);
+    const std::string html = ss.str();
+    const auto at = html.find("const DATA = ");
+    if (at == std::string::npos) {
+      return -1;
+    }
+    const auto end = html.find(";\n", at + 13);
+    return static_cast<long>(nlohmann::json::parse(html.substr(at + 13, end - at - 13))["nodes"].size());
+  };
+  const long none = nodesWith("--queue-length 0");
+  const long one = nodesWith("--queue-length 1 --station-lines 0");
+  const long byDefault = nodesWith("");
+  EXPECT_GT(none, 0);
+  EXPECT_GT(one, none);
+  EXPECT_GT(byDefault, one);
+  const auto r = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite + " --queue-length 51");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--queue-length"), std::string::npos) << r.output;
+}
