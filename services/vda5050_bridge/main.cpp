@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -17,7 +18,10 @@
 #include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/mqtt/client.hpp"
+#include "fleet/service/command_line.hpp"
+#include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
+#include "fleet/service/service_ops.hpp"
 #include "fleet/transport/dds.hpp"
 
 using namespace fleet;
@@ -64,15 +68,64 @@ Settings readSettings(Config& c) {
   return s;
 }
 
-int run(const Settings& settings) {
+int run(const Settings& settings, const service::OpsSettings& opsSettings) {
+  service::ServiceOps ops("vda5050_bridge");
+  if (!ops.start(opsSettings)) {
+    return service::kExitUsage;
+  }
+  auto& cycleSeconds = ops.registry().histogram(
+      "vda5050_bridge_cycle_seconds", "Wall time of one cycle (messages read, orders and reports written)",
+      metrics::exponentialBuckets(1e-5, 2.0, 20));
+  // Counted on the MQTT client's thread: a counter is an atomic add, constant cost per message.
+  auto& mqttReceived = ops.registry().counter("vda5050_bridge_mqtt_messages_received_total",
+                                              "MQTT messages from the vehicles");
+  auto& mqttDropped = ops.registry().counter("vda5050_bridge_mqtt_messages_dropped_total",
+                                             "MQTT messages dropped because 100,000 were already waiting");
+  auto& mqttSent = ops.registry().counter("vda5050_bridge_mqtt_messages_sent_total",
+                                          "Orders and instant actions published to the vehicles");
+  auto& mqttUnsent = ops.registry().counter("vda5050_bridge_mqtt_messages_unsent_total",
+                                            "Orders and instant actions not published (broker unreachable)");
+  struct Count {
+    const char* what;
+    const char* help;
+    std::uint64_t vdabridge::BridgeCounters::*field;
+    metrics::Counter* counter = nullptr;
+    std::uint64_t seen = 0;
+  };
+  std::vector<Count> counts = {
+      {"orders", "New orders sent", &vdabridge::BridgeCounters::orders},
+      {"order_updates", "Order updates sent (more of the route released)",
+       &vdabridge::BridgeCounters::updates},
+      {"cancels", "Orders cancelled", &vdabridge::BridgeCounters::cancels},
+      {"releases_not_stitched", "Releases that did not extend the vehicle's base",
+       &vdabridge::BridgeCounters::cannot_stitch},
+      {"orders_rejected", "Orders and updates the vehicle rejected or did not take",
+       &vdabridge::BridgeCounters::rejected},
+      {"vehicles_given_up", "Times a vehicle was reported blocked after its retries",
+       &vdabridge::BridgeCounters::gave_up},
+  };
+  for (auto& c : counts) {
+    c.counter = &ops.registry().counter(std::string("vda5050_bridge_") + c.what + "_total", c.help);
+  }
+  std::map<std::string, metrics::Gauge*> byHealth;
+  for (auto h :
+       {vda5050::VehicleHealth::kUnknown, vda5050::VehicleHealth::kOnline, vda5050::VehicleHealth::kManual,
+        vda5050::VehicleHealth::kFault, vda5050::VehicleHealth::kOffline}) {
+    byHealth[vda5050::toString(h)] = &ops.registry().gauge("vda5050_bridge_vehicles", "Vehicles by health",
+                                                           {{"health", vda5050::toString(h)}});
+  }
+  std::map<std::string, std::uint64_t> refusalsSeen;
   WallClock wall;
   vdabridge::BridgeNode node(settings.bridge);
   std::mutex mutex;
   std::deque<std::pair<std::string, std::string>> inbox;
   auto client = mqtt::Client::start(settings.broker, [&](const std::string& t, const std::string& p) {
+    mqttReceived.inc();
     std::lock_guard lock(mutex);
     if (inbox.size() < 100000) {  // a flood is dropped rather than eating the memory
       inbox.emplace_back(t, p);
+    } else {
+      mqttDropped.inc();
     }
   });
   if (!client) {
@@ -113,7 +166,37 @@ int run(const Settings& settings) {
   auto next = std::chrono::steady_clock::now();
   auto lastStats = next;
   bool wasConnected = false;
+  ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
+  ops.watchMatchedWriters("TaskAssignment", [&] { return assignments.matchedWriters(); });
+  ops.watchMatchedWriters("TrafficRelease", [&] { return releases.matchedWriters(); });
+  // Ready: it hears the broker (the vehicles' side); the DDS side shows in the matched gauges.
+  ops.health().setReady("broker", false);
+  const auto refreshMetrics = [&] {
+    if (!ops.refresh()) {
+      return;
+    }
+    ops.health().setReady("broker", (*client)->connected());
+    const auto& c = node.counters();
+    for (auto& k : counts) {
+      const std::uint64_t now = c.*(k.field);
+      k.counter->inc(static_cast<double>(now - k.seen));
+      k.seen = now;
+    }
+    for (const auto& [kind, n] : node.registry().refusals()) {
+      auto& seen = refusalsSeen[kind];
+      ops.rejected(kind).inc(static_cast<double>(n - seen));
+      seen = n;
+    }
+    std::map<std::string, double> health;
+    for (const auto& [id, v] : node.registry().vehicles()) {
+      health[vda5050::toString(v.health)] += 1.0;
+    }
+    for (auto& [h, g] : byHealth) {
+      g->set(health[h]);
+    }
+  };
   const auto cycle = [&](std::int64_t now) {
+    const auto t0 = std::chrono::steady_clock::now();
     vdabridge::BridgeOutbox out;
     std::deque<std::pair<std::string, std::string>> batch;
     {
@@ -134,7 +217,10 @@ int run(const Settings& settings) {
     }
     node.tick(now, out);
     for (const auto& m : out.mqtt) {
-      if (!(*client)->publish(m.topic, m.payload, m.qos, m.retain)) {
+      if ((*client)->publish(m.topic, m.payload, m.qos, m.retain)) {
+        mqttSent.inc();
+      } else {
+        mqttUnsent.inc();
         log.warn("mqtt:" + m.topic, "not sent (broker unreachable): " + m.topic);
       }
     }
@@ -158,6 +244,8 @@ int run(const Settings& settings) {
         spdlog::warn("vda5050 bridge: lost the broker; reconnecting");
       }
     }
+    cycleSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    refreshMetrics();
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
       const auto& c = node.counters();
       spdlog::info(
@@ -179,6 +267,7 @@ int run(const Settings& settings) {
         lastRegister = std::chrono::steady_clock::now();
       }
       clockIn.waitForData(100ms);
+      refreshMetrics();  // the liveness beats while no simulated time comes
       for (const auto& c : clockIn.take()) {
         registered = true;
         cycle(c.sim_time_ns);
@@ -209,17 +298,19 @@ int run(const Settings& settings) {
 int main(int argc, char** argv) {
   CLI::App app{"vda5050_bridge: VDA 5050 vehicles (MQTT) as robots of the fleet (DDS)"};
   std::string configPath;
-  std::string level = "info";
+  service::CommonOptions common;
   app.add_option("-c,--config", configPath, "JSON configuration file")->required();
-  app.add_option("--log-level", level, "trace, debug, info, warn, error, critical, off");
-  CLI11_PARSE(app, argc, argv);
+  service::addCommonOptions(app, common);
+  if (auto code = service::parse(app, argc, argv)) {
+    return *code;
+  }
   try {
-    logging::setup("vda5050_bridge", level);
+    service::setupLogging("vda5050_bridge", common);
     Config cfg = Config::fromFile(configPath);
     const auto settings = readSettings(cfg);
     cfg.finish();
     service::installStopHandlers();
-    return run(settings);
+    return run(settings, common.ops);
   } catch (const ConfigError& e) {
     spdlog::critical("{}", e.what());
     return 2;

@@ -294,6 +294,7 @@ TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {
                                          "/services/risk_map/risk_map",
                                          "/services/robot_agent/robot_agent",
                                          "/services/traffic_manager/traffic_manager",
+                                         "/services/vda5050_bridge/vda5050_bridge",
                                          "/sim/src/fleet-sim",
                                          "/services/fleetctl/fleetctl",
                                          "/services/risk_render/risk_render",

@@ -6,15 +6,18 @@
 // fails the checks, an unknown serial, another map) must fault r1 only until its next good state
 // and never stop the bridge; after it, a broker restart must be survived; then the vehicle is
 // killed: its last will must take it out of traffic control (TrafficProgress follows=false) and
-// stop its RobotState.
+// stop its RobotState. Throughout, the bridge's ops port tells the truth: live, ready only while it
+// hears the broker, and metrics (promtool-clean) that count what happened.
 
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <signal.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "fleet/mqtt/client.hpp"
@@ -38,6 +41,31 @@ msg::TrafficRelease release(std::uint32_t seq, const std::vector<std::pair<int, 
   }
   r.ends_at_goal = at_goal;
   return r;
+}
+
+int status(int port, const std::string& path, std::string* body = nullptr) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_connection_timeout(1s);
+  c.set_read_timeout(5s);
+  auto r = c.Get(path);
+  if (!r) {
+    return -1;
+  }
+  if (body != nullptr) {
+    *body = r->body;
+  }
+  return r->status;
+}
+
+/// The value of one sample (`name{labels}` as exposed) in a Prometheus text page; -1 when absent.
+double sample(const std::string& page, const std::string& series) {
+  std::istringstream lines(page);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(series + " ", 0) == 0) {
+      return std::stod(line.substr(series.size() + 1));
+    }
+  }
+  return -1.0;
 }
 
 }  // namespace
@@ -71,8 +99,11 @@ TEST(Vda5050Bridge, AVehicleDoesATransportTaskFromReleasesAndLeavesTrafficContro
   transport::Reader<msg::RobotState> states(p);
   transport::Reader<msg::TrafficProgress> progress(p);
 
+  const int ops = test::freePort();
   test::ChildProcess bridge(FLEET_BINARY_DIR "/services/vda5050_bridge/vda5050_bridge",
-                            {"--config", (dir / "bridge.json").string(), "--log-level", "warn"}, env);
+                            {"--config", (dir / "bridge.json").string(), "--log-level", "warn",
+                             "--metrics-port", std::to_string(ops)},
+                            env);
   auto sim = std::make_unique<test::ChildProcess>(
       FLEET_BINARY_DIR "/sim/src/fleet-sim",
       std::vector<std::string>{"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", "--clock",
@@ -184,9 +215,36 @@ TEST(Vda5050Bridge, AVehicleDoesATransportTaskFromReleasesAndLeavesTrafficContro
                                                 msg::TaskState::Unloading, msg::TaskState::Done};
   EXPECT_EQ(seen, expected);
 
-  // A broker restart: the bridge and the vehicle reconnect, RobotState flows again.
+  // The ops port: live and ready, and the metrics count what happened above.
+  EXPECT_EQ(status(ops, "/livez"), 200);
+  EXPECT_EQ(status(ops, "/readyz"), 200);
+  std::string page;
+  ASSERT_EQ(status(ops, "/metrics", &page), 200);
+  EXPECT_GT(sample(page, "vda5050_bridge_mqtt_messages_received_total"), 10.0) << page;
+  EXPECT_GE(sample(page, "vda5050_bridge_orders_total"), 1.0) << page;
+  EXPECT_GE(sample(page, "vda5050_bridge_order_updates_total"), 1.0) << page;
+  EXPECT_GE(sample(page, "vda5050_bridge_mqtt_messages_sent_total"), 3.0) << page;
+  EXPECT_EQ(sample(page, "vda5050_bridge_vehicles{health=\"online\"}"), 1.0) << page;
+  EXPECT_GE(sample(page, "vda5050_bridge_rejected_samples_total{reason=\"other_map\"}"), 1.0) << page;
+  EXPECT_GE(sample(page, "vda5050_bridge_rejected_samples_total{reason=\"unknown_serial\"}"), 1.0) << page;
+  EXPECT_GT(sample(page, "vda5050_bridge_cycle_seconds_count"), 10.0) << page;
+  {
+    const auto file = dir / "bridge.prom";
+    std::ofstream(file) << page;
+    const auto check =
+        std::system(("promtool check metrics < " + file.string() + " > /dev/null 2>&1").c_str());
+    EXPECT_EQ(check, 0) << "promtool check metrics failed on:\n" << page;
+  }
+
+  // A broker restart: the bridge and the vehicle reconnect, RobotState flows again. While the
+  // broker is away the bridge is live but not ready.
   broker.stop();
+  const auto notReady = [&] { return status(ops, "/readyz") == 503; };
+  EXPECT_TRUE(until(notReady, 10s)) << "ready without a broker";
+  EXPECT_EQ(status(ops, "/livez"), 200);
   broker.start();
+  EXPECT_TRUE(until([&] { return status(ops, "/readyz") == 200; }, 30s))
+      << "not ready again with the broker back";
   robot_states = 0;
   ASSERT_TRUE(until([&] { return robot_states > 3; }, 30s)) << "no RobotState after the broker restart";
   ASSERT_TRUE(follows);
