@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "fleet_stack.hpp"
+#include "mosquitto_broker.hpp"
 #include "test_process.hpp"
 
 using namespace std::chrono_literals;
@@ -80,7 +81,7 @@ bool waitFor(int port, const std::string& path, int status, std::chrono::seconds
   return false;
 }
 
-/// The six services of a small lockstep fleet (one robot), each with its ops port.
+/// The seven services of a small lockstep fleet (one robot, and a VDA 5050 bridge), each with its ops port.
 class Fleet {
  public:
   Fleet() {
@@ -113,6 +114,20 @@ class Fleet {
     start("fleet_sim", "/sim/src/fleet-sim",
           {"--scenario", kScenario, "--clock", "lockstep", "--participants", "2", "--duration", "600",
            "--max-speed", "5"});
+    // The VDA 5050 bridge on a broker of this fleet's own, for a vehicle that never comes: it is
+    // ready once it hears the broker, and its metrics are scraped like the others'.
+    broker_ = std::make_unique<fleet::test::MosquittoBroker>(
+        std::vector<fleet::test::BrokerVehicle>{{"fleet-sim", "v1", "pw-v1"}});
+    std::ofstream(dir_ / "bridge.json")
+        << nlohmann::json{{"broker",
+                           {{"port", broker_->port()},
+                            {"username", fleet::test::MosquittoBroker::kMasterUser},
+                            {"password", fleet::test::MosquittoBroker::kMasterPassword}}},
+                          {"map_id", "small_warehouse"},
+                          {"vehicles", {{{"manufacturer", "fleet-sim"}, {"serial", "v1"}, {"robot", "v1"}}}}}
+               .dump();
+    start("vda5050_bridge", "/services/vda5050_bridge/vda5050_bridge",
+          {"--config", (dir_ / "bridge.json").string()});
   }
   ~Fleet() { fs::remove_all(dir_); }
 
@@ -122,6 +137,7 @@ class Fleet {
  private:
   std::string domain_;
   fs::path dir_;
+  std::unique_ptr<fleet::test::MosquittoBroker> broker_;  // outlives the bridge (procs_ go first)
   std::vector<std::unique_ptr<fleet::test::ChildProcess>> procs_;
 };
 
@@ -136,7 +152,7 @@ std::unique_ptr<Fleet> OpsFleet::fleet_;
 }  // namespace
 
 TEST_F(OpsFleet, EveryServiceIsLiveThenReadyAndItsMetricsPassPromtool) {
-  ASSERT_EQ(fleet_->ports.size(), 6u);
+  ASSERT_EQ(fleet_->ports.size(), 7u);
   for (const auto& [name, port] : fleet_->ports) {
     ASSERT_TRUE(waitFor(port, "/livez", 200, 30s)) << name << " never live";
     EXPECT_TRUE(waitFor(port, "/readyz", 200, 60s))
@@ -250,7 +266,7 @@ TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
   while (std::chrono::steady_clock::now() < end) {
     up = query("count(up == 1)");
     cycles = query("sum(robot_agent_cycles_total)");
-    if (up.is_object() && !up["data"]["result"].empty() && up["data"]["result"][0]["value"][1] == "6" &&
+    if (up.is_object() && !up["data"]["result"].empty() && up["data"]["result"][0]["value"][1] == "7" &&
         cycles.is_object() && !cycles["data"]["result"].empty() &&
         std::stod(cycles["data"]["result"][0]["value"][1].get<std::string>()) > 0) {
       break;
@@ -259,7 +275,7 @@ TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
   }
   ASSERT_TRUE(up.is_object()) << "Prometheus never answered on port " << promPort;
   ASSERT_FALSE(up["data"]["result"].empty()) << up.dump();
-  EXPECT_EQ(up["data"]["result"][0]["value"][1], "6") << up.dump();
+  EXPECT_EQ(up["data"]["result"][0]["value"][1], "7") << up.dump();
   ASSERT_FALSE(cycles["data"]["result"].empty()) << cycles.dump();
   EXPECT_GT(std::stod(cycles["data"]["result"][0]["value"][1].get<std::string>()), 0.0);
   // A histogram query as a dashboard makes it.
