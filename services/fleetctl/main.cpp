@@ -317,6 +317,12 @@ int main(int argc, char** argv) {
           "1: robots sent to a station wait in line on its queue nodes; 0: all are planned to the dock")
       ->check(CLI::Range(0, 1))
       ->capture_default_str();
+  trafficSim
+      ->add_option("--station-cap", ts.stationCap,
+                   "at most this many robots' tasks use one station at once (the fleet manager's "
+                   "station_capacity); a robot with no admissible task waits at a parking place; 0: no limit")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");
   trafficSim->add_option(
       "--html", ts.html,

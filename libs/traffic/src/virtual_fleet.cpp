@@ -23,6 +23,7 @@ struct Bot {
   NodeId dropoff = kNoNode;
   double taskStart = 0.0;
   double lastProgress = 0.0;
+  bool idle = false;  // no admissible task (station cap): sent to a parking place
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -80,10 +81,49 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
   std::vector<Bot> bots(o.robots);
+  // Stations a task may use now: all without a cap, else those fewer than the cap's robots use.
+  auto admissible = [&](const std::vector<NodeId>& stations) {
+    if (o.stationCap == 0)
+      return stations;
+    std::vector<NodeId> out;
+    for (NodeId s : stations) {
+      const auto users = std::count_if(bots.begin(), bots.end(), [&](const Bot& b) {
+        return !b.idle && b.pickup != kNoNode && (b.pickup == s || b.dropoff == s);
+      });
+      if (static_cast<std::size_t>(users) < o.stationCap)
+        out.push_back(s);
+    }
+    return out;
+  };
   auto newTask = [&](std::size_t r, double now) {
     Bot& b = bots[r];
-    b.pickup = pickups[rng() % pickups.size()];
-    b.dropoff = dropoffs[rng() % dropoffs.size()];
+    b.pickup = b.dropoff = kNoNode;
+    const auto ps = admissible(pickups);
+    const auto ds = admissible(dropoffs);
+    if (ps.empty() || ds.empty()) {
+      // Nothing admissible: wait at the nearest parking place nobody else is sent to.
+      if (!b.idle) {
+        NodeId best = kNoNode;
+        double bestD = std::numeric_limits<double>::infinity();
+        for (NodeId v : parking) {
+          const bool taken = std::any_of(bots.begin(), bots.end(), [&](const Bot& q) {
+            return &q != &b &&
+                   ((q.idle && traffic.goal(static_cast<std::size_t>(&q - bots.data())) == v) || q.at == v);
+          });
+          const double d = (g.position(v) - g.position(b.at)).norm();
+          if (!taken && d < bestD) {
+            best = v;
+            bestD = d;
+          }
+        }
+        traffic.setGoal(r, best);
+      }
+      b.idle = true;
+      return;
+    }
+    b.idle = false;
+    b.pickup = ps[rng() % ps.size()];
+    b.dropoff = ds[rng() % ds.size()];
     b.phase = 0;
     b.taskStart = now;
     b.lastProgress = now;
@@ -116,6 +156,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
 
     for (std::size_t r = 0; r < o.robots; ++r) {
       Bot& b = bots[r];
+      if (b.idle && b.dwellLeft <= 0.0) {
+        newTask(r, now);
+        b.lastProgress = now;  // waiting for work is not waiting on traffic
+      }
       if (b.dwellLeft > 0.0) {
         tDwell += o.dt;
         b.dwellLeft -= o.dt;
@@ -145,7 +189,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           if (unit(rng) < o.stopChance)
             d += o.stopMax * unit(rng);
           b.left = b.total = d;
-        } else if (traffic.goal(r) != kNoNode && b.at == traffic.goal(r)) {
+        } else if (!b.idle && traffic.goal(r) != kNoNode && b.at == traffic.goal(r)) {
           b.dwellLeft = o.dwell;
           traffic.setHeld(r, true);
         }

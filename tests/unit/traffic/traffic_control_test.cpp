@@ -230,6 +230,52 @@ TEST(VirtualFleet, FiveRobotsKeepWorkingOnTheSmallWarehouse) {
   }
 }
 
+/// The fleet manager's station cap in the virtual fleet: with one task per station, at most as many
+/// robots have a task as there are drop-offs, no two of them head for one station, and the others
+/// wait at parking places; the promises hold and work gets done.
+TEST(VirtualFleet, AStationCapKeepsTasksApartAndTheRestParked) {
+  Roadmap map = smallWarehouse();
+  std::size_t dropoffs = 0;
+  for (const auto& s : map.stations) {
+    dropoffs += s.kind == site::StationKind::Dropoff && s.dock != kNoNode ? 1 : 0;
+  }
+  VirtualFleetOptions o;
+  o.robots = 10;
+  o.duration = 300.0;
+  o.stationCap = 1;
+  o.recordEvery = 1.0;
+  for (const auto& r : runSeeds(map, o)) {
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_GE(r.tasksDone, 4U);
+    std::size_t most = 0;
+    for (const auto& f : r.frames) {
+      std::vector<NodeId> targets;
+      for (const auto& b : f.robots) {
+        if (b.target != kNoNode) {
+          targets.push_back(b.target);
+        }
+      }
+      most = std::max(most, targets.size());
+      std::sort(targets.begin(), targets.end());
+      EXPECT_EQ(std::adjacent_find(targets.begin(), targets.end()), targets.end())
+          << "two robots head for one station at " << f.time << " s";
+    }
+    EXPECT_LE(most, dropoffs);
+    EXPECT_GE(most, 2U);
+    // The robots without a task end up at parking places.
+    std::size_t parked = 0;
+    for (const auto& b : r.frames.back().robots) {
+      if (b.target == kNoNode) {
+        for (const auto& s : map.stations) {
+          parked +=
+              s.kind == site::StationKind::Parking && (map.graph.position(s.dock) - b.position).norm() < 1e-6;
+        }
+      }
+    }
+    EXPECT_GE(parked, o.robots - dropoffs - 2) << "robots without a task are not at parking places";
+  }
+}
+
 TEST(VirtualFleet, ALoneRobot) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;
