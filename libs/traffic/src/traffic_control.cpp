@@ -269,6 +269,7 @@ TrafficControl::Need TrafficControl::needsPlanning() const {
 int TrafficControl::update() {
   int steps = 0;
   ++sinceStep_;
+  freeDocks();  // robots report between planner steps too
   while (steps < options_.maxStepsPerUpdate) {
     const Need need = needsPlanning();
     if (need == Need::None || (need == Need::Later && (steps > 0 || sinceStep_ < options_.standingEvery)))
@@ -298,19 +299,26 @@ int TrafficControl::update() {
   return steps;
 }
 
-void TrafficControl::afterStep() {
-  const auto now = execution_.plannedSteps();
-  for (std::size_t i = 0; i < stations_.size(); ++i)
-    orderLine(i);
+void TrafficControl::freeDocks() {
+  // A dock is free for the next in line once the robot leaving it has *reported* a node clear of
+  // it, not once the plan has it there: a re-plan drops what was not released and puts the robot
+  // back on the dock in the planner, and a next in line already sent onto the approach (the dock's
+  // only way out) then waits for the dock while the robot on it waits for the approach, for ever.
   for (std::size_t i = 0; i < stations_.size(); ++i) {
     const auto q = leaving_[i];
-    if (q >= 0 &&
-        !graph_.conflicting(planner_->positions()[static_cast<std::size_t>(q)], stations_[i].dock)) {
+    if (q >= 0 && !graph_.conflicting(execution_.at(static_cast<std::size_t>(q)), stations_[i].dock)) {
       leaving_[i] = -1;
       plannerPriority(static_cast<std::size_t>(q));
       updateLine(i);
     }
   }
+}
+
+void TrafficControl::afterStep() {
+  const auto now = execution_.plannedSteps();
+  for (std::size_t i = 0; i < stations_.size(); ++i)
+    orderLine(i);
+  freeDocks();
   for (std::size_t r = 0; r < robots(); ++r) {
     if (evadeUntil_[r] >= 0 && now >= evadeUntil_[r]) {
       evadeUntil_[r] = -1;

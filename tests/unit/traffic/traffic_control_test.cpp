@@ -214,6 +214,43 @@ TEST(TrafficControl, TheNextInLineWaitsClearOfTheWaysOutOfTheApproach) {
   EXPECT_FALSE(shuts(wait));
 }
 
+/// The dock stays the leaving robot's until it has *reported* a node clear of it. The plan runs
+/// ahead of the robots; freeing the dock when the plan had the robot off it let the next in line
+/// onto the approach, and after a re-plan put the leaving robot back on the dock in the planner,
+/// each stood waiting for the other's node for good (virtual fleet, station cap 2, seed 14: 401 s
+/// at D-4 until the run ended).
+TEST(TrafficControl, TheDockIsFreeOnlyOnceTheLeavingRobotReportsItOff) {
+  Roadmap map = smallWarehouse();
+  const auto* d3 = map.station("D-3");
+  ASSERT_NE(d3->approach, kNoNode);
+  const std::vector<NodeId> starts{d3->dock, map.station("PARK-1")->dock};
+  TrafficControl tc(map.graph, starts);
+  tc.setStations({{d3->dock, d3->queue, d3->approach}});
+  tc.setGoal(0, d3->dock);
+  tc.setGoal(1, d3->dock);
+  tc.setGoal(0, map.station("P-1")->dock);  // robot 0 is done and is to drive off
+  // Robot 0 drives on, slowly, but only within what the dock excludes (onto the approach): the plan
+  // runs ahead of it, clear of the dock, yet robot 1 must go on waiting in line.
+  for (int k = 0; k < 30; ++k) {
+    tc.update();
+    const auto base = tc.release(0).base;
+    if (base.size() > 1 && map.graph.conflicting(base[1], d3->dock))
+      tc.reached(0, base[1]);
+    ASSERT_TRUE(map.graph.conflicting(tc.execution().at(0), d3->dock));
+    ASSERT_NE(tc.planner().goal(1), d3->dock) << "update " << k << ": the dock was given away";
+  }
+  // Robot 0 drives what it is released until it reports a node clear of the dock.
+  for (int k = 0; k < 200 && map.graph.conflicting(tc.execution().at(0), d3->dock); ++k) {
+    tc.update();
+    const auto base = tc.release(0).base;
+    if (base.size() > 1)
+      tc.reached(0, base[1]);
+  }
+  ASSERT_FALSE(map.graph.conflicting(tc.execution().at(0), d3->dock)) << "robot 0 never left the dock";
+  tc.update();
+  EXPECT_EQ(tc.planner().goal(1), d3->dock);
+}
+
 /// Five robots chained on random tasks. Before detours, pacing and leaving docks first, three
 /// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
 /// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the

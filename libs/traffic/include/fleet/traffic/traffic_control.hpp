@@ -139,6 +139,7 @@ class TrafficControl {
   void plannerGoal(std::size_t robot, NodeId goal);
   void plannerPriority(std::size_t robot);
   void afterStep();
+  void freeDocks();
   void clearWayFor(std::size_t robot);
   enum class Need : std::uint8_t { None, Later, Now };
   [[nodiscard]] Need needsPlanning() const;
