@@ -116,7 +116,7 @@ TEST_F(Node, TransportTaskIsAssignedWithStationGoalsAndFinishes) {
   out = {};
   node->tick(2'000'000, out);
   ASSERT_EQ(out.assignments.size(), 1u);
-  const auto& a = out.assignments[0];
+  const auto a = out.assignments[0];  // a copy: `out` is cleared below
   EXPECT_EQ(a.robot_id, "r1");
   EXPECT_EQ(a.task_id, "t1");
   ASSERT_EQ(a.goals.size(), 2u);
