@@ -11,6 +11,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "bridge_node.hpp"
@@ -85,28 +86,6 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
                                           "Orders and instant actions published to the vehicles");
   auto& mqttUnsent = ops.registry().counter("vda5050_bridge_mqtt_messages_unsent_total",
                                             "Orders and instant actions not published (broker unreachable)");
-  struct Count {
-    const char* what;
-    const char* help;
-    std::uint64_t vdabridge::BridgeCounters::*field;
-    metrics::Counter* counter = nullptr;
-    std::uint64_t seen = 0;
-  };
-  std::vector<Count> counts = {
-      {"orders", "New orders sent", &vdabridge::BridgeCounters::orders},
-      {"order_updates", "Order updates sent (more of the route released)",
-       &vdabridge::BridgeCounters::updates},
-      {"cancels", "Orders cancelled", &vdabridge::BridgeCounters::cancels},
-      {"releases_not_stitched", "Releases that did not extend the vehicle's base",
-       &vdabridge::BridgeCounters::cannot_stitch},
-      {"orders_rejected", "Orders and updates the vehicle rejected or did not take",
-       &vdabridge::BridgeCounters::rejected},
-      {"vehicles_given_up", "Times a vehicle was reported blocked after its retries",
-       &vdabridge::BridgeCounters::gave_up},
-  };
-  for (auto& c : counts) {
-    c.counter = &ops.registry().counter(std::string("vda5050_bridge_") + c.what + "_total", c.help);
-  }
   std::map<std::string, metrics::Gauge*> byHealth;
   for (auto h :
        {vda5050::VehicleHealth::kUnknown, vda5050::VehicleHealth::kOnline, vda5050::VehicleHealth::kManual,
@@ -114,7 +93,7 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
     byHealth[vda5050::toString(h)] = &ops.registry().gauge("vda5050_bridge_vehicles", "Vehicles by health",
                                                            {{"health", vda5050::toString(h)}});
   }
-  std::map<std::string, std::uint64_t> refusalsSeen;
+  std::set<std::string> refusalKinds;  // watched by ops already
   WallClock wall;
   vdabridge::BridgeNode node(settings.bridge);
   std::mutex mutex;
@@ -166,6 +145,21 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
   auto next = std::chrono::steady_clock::now();
   auto lastStats = next;
   bool wasConnected = false;
+  const auto total = [&](const char* what, const char* help,
+                         std::uint64_t vdabridge::BridgeCounters::*field) {
+    ops.watchTotal(ops.registry().counter(std::string("vda5050_bridge_") + what + "_total", help),
+                   [&node, field] { return node.counters().*field; });
+  };
+  total("orders", "New orders sent", &vdabridge::BridgeCounters::orders);
+  total("order_updates", "Order updates sent (more of the route released)",
+        &vdabridge::BridgeCounters::updates);
+  total("cancels", "Orders cancelled", &vdabridge::BridgeCounters::cancels);
+  total("releases_not_stitched", "Releases that did not extend the vehicle's base",
+        &vdabridge::BridgeCounters::cannot_stitch);
+  total("orders_rejected", "Orders and updates the vehicle rejected or did not take",
+        &vdabridge::BridgeCounters::rejected);
+  total("vehicles_given_up", "Times a vehicle was reported blocked after its retries",
+        &vdabridge::BridgeCounters::gave_up);
   ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
   ops.watchMatchedWriters("TaskAssignment", [&] { return assignments.matchedWriters(); });
   ops.watchMatchedWriters("TrafficRelease", [&] { return releases.matchedWriters(); });
@@ -176,16 +170,11 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
       return;
     }
     ops.health().setReady("broker", (*client)->connected());
-    const auto& c = node.counters();
-    for (auto& k : counts) {
-      const std::uint64_t now = c.*(k.field);
-      k.counter->inc(static_cast<double>(now - k.seen));
-      k.seen = now;
-    }
-    for (const auto& [kind, n] : node.registry().refusals()) {
-      auto& seen = refusalsSeen[kind];
-      ops.rejected(kind).inc(static_cast<double>(n - seen));
-      seen = n;
+    // By kind, as the registry meets them (a kind is listed from its first refusal on).
+    for (const auto& entry : node.registry().refusals()) {
+      if (const std::string& kind = entry.first; refusalKinds.insert(kind).second) {
+        ops.watchTotal(ops.rejected(kind), [&node, kind] { return node.registry().refusals().at(kind); });
+      }
     }
     std::map<std::string, double> health;
     for (const auto& [id, v] : node.registry().vehicles()) {

@@ -50,8 +50,11 @@ void ServiceOps::watchMatchedWriters(const std::string& topic, std::function<std
 }
 
 void ServiceOps::watchForeign(std::function<std::uint64_t()> total) {
-  rejected("foreign_robot");  // listed at 0 from the start
-  foreign_.push_back({std::move(total), 0});
+  watchTotal(rejected("foreign_robot"), std::move(total));  // listed at 0 from the start
+}
+
+void ServiceOps::watchTotal(metrics::Counter& counter, std::function<std::uint64_t()> total) {
+  totals_.push_back({&counter, std::move(total), 0});
 }
 
 bool ServiceOps::refresh() {
@@ -64,11 +67,11 @@ bool ServiceOps::refresh() {
   for (auto& w : watched_) {
     w.gauge->set(static_cast<double>(w.count()));
   }
-  for (auto& f : foreign_) {
-    const std::uint64_t total = f.total();
-    if (total > f.counted) {
-      rejected("foreign_robot").inc(total - f.counted);
-      f.counted = total;
+  for (auto& t : totals_) {
+    const std::uint64_t total = t.total();
+    if (total > t.counted) {
+      t.counter->inc(total - t.counted);
+      t.counted = total;
     }
   }
   return true;

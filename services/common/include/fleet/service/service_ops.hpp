@@ -42,6 +42,9 @@ class ServiceOps {
   /// dropped (transport::Reader::foreign()): refresh() adds them to
   /// `<service>_rejected_samples_total{reason="foreign_robot"}`.
   void watchForeign(std::function<std::uint64_t()> total);
+  /// A running total kept elsewhere (a node's own counters, read on the loop's thread): refresh()
+  /// adds what it grew by to `counter`.
+  void watchTotal(metrics::Counter& counter, std::function<std::uint64_t()> total);
   /// Beats the liveness and, at most once a second, updates the matched gauges. Returns true when
   /// it did the once-a-second part (so a loop can hang its own slow gauges on it).
   bool refresh();
@@ -56,11 +59,12 @@ class ServiceOps {
   Health health_;
   OpsServer server_;
   std::vector<Watched> watched_;
-  struct Foreign {
+  struct Total {
+    metrics::Counter* counter;
     std::function<std::uint64_t()> total;
     std::uint64_t counted = 0;
   };
-  std::vector<Foreign> foreign_;
+  std::vector<Total> totals_;
   std::chrono::steady_clock::time_point lastRefresh_{};
 };
 
