@@ -81,49 +81,52 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
   std::vector<Bot> bots(o.robots);
-  // Stations a task may use now: all without a cap, else those fewer than the cap's robots use.
+  // Robots' tasks using each station (pickup and drop-off, for the whole task), for the cap.
+  std::vector<std::size_t> uses(g.size(), 0);
   auto admissible = [&](const std::vector<NodeId>& stations) {
-    if (o.stationCap == 0)
-      return stations;
     std::vector<NodeId> out;
     for (NodeId s : stations) {
-      const auto users = std::count_if(bots.begin(), bots.end(), [&](const Bot& b) {
-        return !b.idle && b.pickup != kNoNode && (b.pickup == s || b.dropoff == s);
-      });
-      if (static_cast<std::size_t>(users) < o.stationCap)
+      if (o.stationCap == 0 || uses[static_cast<std::size_t>(s)] < o.stationCap)
         out.push_back(s);
     }
     return out;
   };
+  // The parking place nearest to robot r that no robot stands on or is sent to.
+  auto freeParking = [&](std::size_t r) {
+    NodeId best = kNoNode;
+    double bestD = std::numeric_limits<double>::infinity();
+    for (NodeId v : parking) {
+      bool taken = false;
+      for (std::size_t q = 0; q < bots.size() && !taken; ++q)
+        taken = q != r && (bots[q].at == v || (bots[q].idle && traffic.goal(q) == v));
+      const double d = (g.position(v) - g.position(bots[r].at)).norm();
+      if (!taken && d < bestD) {
+        best = v;
+        bestD = d;
+      }
+    }
+    return best;
+  };
   auto newTask = [&](std::size_t r, double now) {
     Bot& b = bots[r];
-    b.pickup = b.dropoff = kNoNode;
+    if (b.pickup != kNoNode) {  // the task just finished frees its stations
+      --uses[static_cast<std::size_t>(b.pickup)];
+      --uses[static_cast<std::size_t>(b.dropoff)];
+      b.pickup = b.dropoff = kNoNode;
+    }
     const auto ps = admissible(pickups);
     const auto ds = admissible(dropoffs);
     if (ps.empty() || ds.empty()) {
-      // Nothing admissible: wait at the nearest parking place nobody else is sent to.
-      if (!b.idle) {
-        NodeId best = kNoNode;
-        double bestD = std::numeric_limits<double>::infinity();
-        for (NodeId v : parking) {
-          const bool taken = std::any_of(bots.begin(), bots.end(), [&](const Bot& q) {
-            return &q != &b &&
-                   ((q.idle && traffic.goal(static_cast<std::size_t>(&q - bots.data())) == v) || q.at == v);
-          });
-          const double d = (g.position(v) - g.position(b.at)).norm();
-          if (!taken && d < bestD) {
-            best = v;
-            bestD = d;
-          }
-        }
-        traffic.setGoal(r, best);
-      }
+      if (!b.idle)  // nothing admissible: wait at a parking place
+        traffic.setGoal(r, freeParking(r));
       b.idle = true;
       return;
     }
     b.idle = false;
     b.pickup = ps[rng() % ps.size()];
     b.dropoff = ds[rng() % ds.size()];
+    ++uses[static_cast<std::size_t>(b.pickup)];
+    ++uses[static_cast<std::size_t>(b.dropoff)];
     b.phase = 0;
     b.taskStart = now;
     b.lastProgress = now;
