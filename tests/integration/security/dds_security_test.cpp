@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -37,6 +38,12 @@ std::map<std::string, int> counts(const std::filesystem::path& file) {
     out[prefix] = n;
   }
   return out;
+}
+
+/// How many samples of `key` a probe counted (0: none).
+int of(const std::map<std::string, int>& counted, const std::string& key) {
+  const auto it = counted.find(key);
+  return it == counted.end() ? 0 : it->second;
 }
 
 class DdsSecurity : public ::testing::Test {
@@ -91,6 +98,16 @@ class DdsSecurity : public ::testing::Test {
     ss << in.rdbuf();
     return nlohmann::json::parse(ss.str(), nullptr, false);
   }
+  /// The Tasks, by prefix, that a probe with the fleet manager's certificate reads while `writers`
+  /// (which starts the writing probes and waits for them) runs.
+  std::map<std::string, int> managerReadsWhile(const std::function<void()>& writers) {
+    const auto got = dir_ / "manager.txt";
+    test::ChildProcess manager(kProbe, {"read", "16", got.string()}, as("site", "fleet-manager"));
+    std::this_thread::sleep_for(1s);
+    writers();
+    EXPECT_EQ(manager.wait(40s), 0);
+    return counts(got);
+  }
   std::string domain_;
   std::filesystem::path dir_;
 };
@@ -98,30 +115,26 @@ class DdsSecurity : public ::testing::Test {
 }  // namespace
 
 TEST_F(DdsSecurity, OnlyTheAdaptersCertificateGetsATaskToTheManager) {
-  const auto got = dir_ / "manager.txt";
   const auto plainGot = dir_ / "plain.txt";
-  test::ChildProcess manager(kProbe, {"read", "16", got.string()}, as("site", "fleet-manager"));
   test::ChildProcess plainReader(kProbe, {"read", "16", plainGot.string()}, as("", ""));
-  std::this_thread::sleep_for(1s);
-  test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
-  test::ChildProcess plain(kProbe, {"write", "12", "plain"}, as("", ""));
-  test::ChildProcess robot(kProbe, {"write", "12", "robot"}, as("site", "agents"));
-  test::ChildProcess foreign(kProbe, {"write", "12", "foreign"}, as("other", "wms-adapter"));
-  EXPECT_EQ(adapter.wait(40s), 0);
-  EXPECT_EQ(plain.wait(40s), 0) << "an unsecured participant runs, alone";
-  EXPECT_EQ(robot.wait(40s), 3) << "a robot's permissions do not include writing Task";
-  EXPECT_EQ(foreign.wait(40s), 0) << "another site's certificate is valid for itself";
-  ASSERT_EQ(manager.wait(40s), 0);
+  const auto m = managerReadsWhile([&] {
+    test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
+    test::ChildProcess plain(kProbe, {"write", "12", "plain"}, as("", ""));
+    test::ChildProcess robot(kProbe, {"write", "12", "robot"}, as("site", "agents"));
+    test::ChildProcess foreign(kProbe, {"write", "12", "foreign"}, as("other", "wms-adapter"));
+    EXPECT_EQ(adapter.wait(40s), 0);
+    EXPECT_EQ(plain.wait(40s), 0) << "an unsecured participant runs, alone";
+    EXPECT_EQ(robot.wait(40s), 3) << "a robot's permissions do not include writing Task";
+    EXPECT_EQ(foreign.wait(40s), 0) << "another site's certificate is valid for itself";
+  });
   ASSERT_EQ(plainReader.wait(40s), 0);
-  const auto m = counts(got);
-  EXPECT_GT(m.count("adapter") ? m.at("adapter") : 0, 50) << "the secured adapter's tasks arrive";
-  EXPECT_EQ(m.count("plain"), 0u) << "no certificate: not admitted";
-  EXPECT_EQ(m.count("foreign"), 0u) << "another site's CA: not authenticated";
-  EXPECT_EQ(m.count("robot"), 0u);
+  EXPECT_GT(of(m, "adapter"), 50) << "the secured adapter's tasks arrive";
+  EXPECT_EQ(of(m, "plain"), 0) << "no certificate: not admitted";
+  EXPECT_EQ(of(m, "foreign"), 0) << "another site's CA: not authenticated";
+  EXPECT_EQ(of(m, "robot"), 0);
   const auto p = counts(plainGot);
-  EXPECT_EQ(p.count("adapter"), 0u) << "an unsecured reader sees nothing of the secured fleet";
-  EXPECT_GT(p.count("plain") ? p.at("plain") : 0, 50)
-      << "(the unsecured pair talks among itself: the probe works)";
+  EXPECT_EQ(of(p, "adapter"), 0) << "an unsecured reader sees nothing of the secured fleet";
+  EXPECT_GT(of(p, "plain"), 50) << "(the unsecured pair talks among itself: the probe works)";
 }
 
 TEST_F(DdsSecurity, AReadOnlyObserverCannotWrite) {
@@ -145,11 +158,11 @@ TEST_F(DdsSecurity, AnAgentSpeaksOnlyForItsOwnRobots) {
   EXPECT_EQ(disguised.wait(40s), 0) << "its own partition is granted";
   ASSERT_EQ(manager.wait(40s), 0);
   const auto m = counts(got);
-  EXPECT_GT(m.count("state:r1") ? m.at("state:r1") : 0, 20) << "the agent's own robot is heard";
-  EXPECT_GT(m.count("status:r1") ? m.at("status:r1") : 0, 20);
-  EXPECT_EQ(m.count("state:r2") + m.count("status:r2"), 0u);
-  EXPECT_EQ(m.count("state:r3") + m.count("status:r3"), 0u) << "r3's samples in r1's partition are dropped";
-  EXPECT_GT(m.count("foreign") ? m.at("foreign") : 0, 20) << "and counted";
+  EXPECT_GT(of(m, "state:r1"), 20) << "the agent's own robot is heard";
+  EXPECT_GT(of(m, "status:r1"), 20);
+  EXPECT_EQ(of(m, "state:r2") + of(m, "status:r2"), 0);
+  EXPECT_EQ(of(m, "state:r3") + of(m, "status:r3"), 0) << "r3's samples in r1's partition are dropped";
+  EXPECT_GT(of(m, "foreign"), 20) << "and counted";
 }
 
 TEST_F(DdsSecurity, WithoutSecurityTheReceiverStillDropsARobotSpeakingForAnother) {
@@ -164,9 +177,9 @@ TEST_F(DdsSecurity, WithoutSecurityTheReceiverStillDropsARobotSpeakingForAnother
   EXPECT_EQ(disguised.wait(40s), 0);
   ASSERT_EQ(manager.wait(40s), 0);
   const auto m = counts(got);
-  EXPECT_GT(m.count("state:r1") ? m.at("state:r1") : 0, 10);
-  EXPECT_EQ(m.count("state:r3") + m.count("status:r3"), 0u);
-  EXPECT_GT(m.count("foreign") ? m.at("foreign") : 0, 10);
+  EXPECT_GT(of(m, "state:r1"), 10);
+  EXPECT_EQ(of(m, "state:r3") + of(m, "status:r3"), 0);
+  EXPECT_GT(of(m, "foreign"), 10);
 }
 
 TEST_F(DdsSecurity, AnAgentCommandsOnlyItsOwnRobots) {
@@ -203,19 +216,16 @@ TEST_F(DdsSecurity, ARevokedIdentityIsRefused) {
       }
     }
   }
-  const auto got = dir_ / "manager.txt";
-  test::ChildProcess manager(kProbe, {"read", "16", got.string()}, as("site", "fleet-manager"));
-  std::this_thread::sleep_for(1s);
-  test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
-  test::ChildProcess revoked(kProbe, {"write", "12", "revoked"}, as("site", "old-adapter"));
-  auto env = as("site", "old-adapter");
-  env.back().second = "file://" + (site / "old-adapter" / "nocrl.xml").string();
-  test::ChildProcess stolen(kProbe, {"write", "12", "stolen"}, env);
-  EXPECT_EQ(revoked.wait(40s), 4) << "its own config names the list: its participant is refused";
-  EXPECT_EQ(stolen.wait(40s), 0) << "without the list it starts, alone";
-  EXPECT_EQ(adapter.wait(40s), 0);
-  ASSERT_EQ(manager.wait(40s), 0);
-  const auto m = counts(got);
-  EXPECT_GT(m.count("adapter") ? m.at("adapter") : 0, 50) << "the valid adapter's tasks arrive";
-  EXPECT_EQ(m.count("stolen") + m.count("revoked"), 0u) << "the revoked certificate is not authenticated";
+  auto stolenEnv = as("site", "old-adapter");
+  stolenEnv.back().second = "file://" + (site / "old-adapter" / "nocrl.xml").string();
+  const auto m = managerReadsWhile([&] {
+    test::ChildProcess adapter(kProbe, {"write", "12", "adapter"}, as("site", "wms-adapter"));
+    test::ChildProcess revoked(kProbe, {"write", "12", "revoked"}, as("site", "old-adapter"));
+    test::ChildProcess stolen(kProbe, {"write", "12", "stolen"}, stolenEnv);
+    EXPECT_EQ(revoked.wait(40s), 4) << "its own config names the list: its participant is refused";
+    EXPECT_EQ(stolen.wait(40s), 0) << "without the list it starts, alone";
+    EXPECT_EQ(adapter.wait(40s), 0);
+  });
+  EXPECT_GT(of(m, "adapter"), 50) << "the valid adapter's tasks arrive";
+  EXPECT_EQ(of(m, "stolen") + of(m, "revoked"), 0) << "the revoked certificate is not authenticated";
 }
