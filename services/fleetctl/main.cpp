@@ -7,6 +7,7 @@
 //   fleetctl health | metrics
 //   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet
 //   fleetctl traffic-bench --map F.map --agents N --steps T   the lifelong planner alone on a grid
+//   fleetctl vda5050-files DIR --robots r3,r4 --map-id M   broker, ACL and bridge files for vehicles
 
 #include <httplib.h>
 
@@ -23,6 +24,7 @@
 #include "traffic_bench.hpp"
 #include "traffic_sim.hpp"
 #include "url.hpp"
+#include "vda5050_setup.hpp"
 
 using nlohmann::json;
 
@@ -327,6 +329,28 @@ int main(int argc, char** argv) {
   trafficSim->add_option(
       "--html", ts.html,
       "write a replay page of the first seed's run (roadmap, robots, releases) to this file");
+  auto* vdaFiles = app.add_subcommand(
+      "vda5050-files",
+      "write a Mosquitto configuration (listener, one password per vehicle, an ACL confining each to "
+      "its topic subtree), the bridge's configuration and fleet-sim's vehicles file, e.g. for "
+      "deploy/compose.vda5050.yaml");
+  fleet::ctl::Vda5050Files vf;
+  std::string vfRobots;
+  std::string vfSeenAt;
+  vdaFiles->add_option("dir", vf.out, "directory to write into (created)")->required();
+  vdaFiles->add_option("--robots", vfRobots, "robot ids that are VDA 5050 vehicles, comma-separated")
+      ->required();
+  vdaFiles->add_option("--map-id", vf.map_id, "the VDA 5050 mapId (the site's name)")->required();
+  vdaFiles
+      ->add_option("--broker-host", vf.broker_host,
+                   "the broker's address as the bridge and vehicles reach it")
+      ->capture_default_str();
+  vdaFiles->add_option("--bind", vf.bind_address, "the broker's listening address")->capture_default_str();
+  vdaFiles->add_option("--port", vf.port, "the broker's port")->required()->check(CLI::Range(1, 65535));
+  vdaFiles->add_option("--seen-at", vfSeenAt,
+                       "the directory's path as the broker reads it (e.g. its mount point in a container); "
+                       "the broker then logs to stderr");
+  vdaFiles->add_flag("!--wall-clock", vf.sim_clock, "the bridge on the wall clock (default: lockstep)");
   // Exit codes as every binary's: 0 after --help/--version, 2 for any usage error.
   if (auto code = fleet::service::parse(app, argc, argv)) {
     return *code;
@@ -339,6 +363,40 @@ int main(int argc, char** argv) {
   }
   if (*trafficSim) {
     return fleet::ctl::runTrafficSim(ts);
+  }
+  if (*vdaFiles) {
+    for (std::size_t at = 0; at <= vfRobots.size();) {
+      const std::size_t comma = std::min(vfRobots.find(',', at), vfRobots.size());
+      if (comma > at) {
+        vf.robots.push_back(vfRobots.substr(at, comma - at));
+      }
+      at = comma + 1;
+    }
+    for (const auto& r : vf.robots) {
+      if (r.find_first_of("/#+ ") != std::string::npos) {
+        std::cerr
+            << "fleetctl vda5050-files: robot id \"" << r
+            << "\" cannot be a VDA 5050 serial number (no '/', '#', '+' or spaces in MQTT topic levels)\n";
+        return 2;
+      }
+    }
+    if (vf.robots.empty()) {
+      std::cerr << "fleetctl vda5050-files: --robots names no robot\n";
+      return 2;
+    }
+    if (!vfSeenAt.empty()) {
+      vf.seen_at = vfSeenAt;
+      vf.log_to_file = false;
+    }
+    std::error_code ec;
+    std::filesystem::create_directories(vf.out, ec);
+    if (auto written = fleet::ctl::writeVda5050Files(vf); !written) {
+      std::cerr << "fleetctl vda5050-files: " << written.error().message << "\n";
+      return 1;
+    }
+    std::cout << "fleetctl vda5050-files: " << vf.robots.size() << " vehicle(s) written to "
+              << vf.out.string() << "\n";
+    return 0;
   }
   if (*siteCheck) {
     return fleet::ctl::siteCheck(siteFile, siteRadius, mapResolution, siteJson, siteSvg);

@@ -328,7 +328,8 @@ int main(int argc, char** argv) {
          "--traffic", settings.traffic,
          "reactive (default: robots keep clear of each other by standoffs, yielding and detours) or "
          "reserved (drive only what the traffic manager releases: TrafficRelease in, TrafficProgress out)")
-      ->check(CLI::IsMember({"reactive", "reserved"}));
+      ->check(CLI::IsMember({"reactive", "reserved"}))
+      ->envname("FLEET_TRAFFIC");
   std::string sitePath;
   std::vector<std::string> robotSpecs;
   auto* scenarioOpt =
@@ -337,7 +338,8 @@ int main(int argc, char** argv) {
       ->excludes(scenarioOpt);
   app.add_option("--robot", robotSpecs,
                  "with --site: a robot and where it stands, ID@STATION or ID@x,y,theta (repeat)");
-  app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)");
+  app.add_option("--robots", robots, "comma-separated robot ids (default: every robot of the scenario)")
+      ->envname("FLEET_AGENT_ROBOTS");
   app.add_option("--clock", clock, "wall or lockstep")->check(CLI::IsMember({"wall", "lockstep"}));
   app.add_option("--id", proc.id, "participant id in lockstep");
   service::CommonOptions common;

@@ -127,6 +127,8 @@ const char* kUsage =
     "                 [--replay OUT.jsonl.gz] [--summary OUT.json] [--html OUT.html] [--no-scan]\n"
     "                 [--vda5050 VEHICLES.json] [--validate] [--log-level LEVEL] [--log-format text|json]\n"
     "                 [--metrics-port PORT] [--metrics-host ADDR]\n"
+    "       (environment, the options win: FLEET_METRICS_PORT, FLEET_METRICS_HOST,\n"
+    "        FLEET_SIM_PARTICIPANTS, FLEET_SIM_VDA5050)\n"
     "       fleet-sim --version\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
 
@@ -137,6 +139,14 @@ bool parseArgs(int argc, char** argv, Options& o) {
   }
   if (const char* host = std::getenv("FLEET_METRICS_HOST")) {
     o.ops.host = host;
+  }
+  // What a deployment overlay sets without rewriting the command (deploy/compose.vda5050.yaml;
+  // compose implementations differ in how they merge an overlay's command list).
+  if (const char* n = std::getenv("FLEET_SIM_PARTICIPANTS"); n != nullptr && *n != '\0') {
+    o.participants = std::stoi(n);
+  }
+  if (const char* v = std::getenv("FLEET_SIM_VDA5050"); v != nullptr && *v != '\0') {
+    o.vda5050 = v;
   }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -565,6 +575,22 @@ class Simulator {
                       {"refused_messages", vda_->counters().refused_messages},
                       {"rejected_orders", vda_->counters().rejected_orders},
                       {"base_starved_stops", vda_->baseStarvedStops()}};
+      // Order-to-motion (issue 20: p99 <= 100 ms through the broker): the bridge stamps an order
+      // when it publishes it, on its clock; on the wall clock that is the simulator's too.
+      auto ms = vda_->orderToMotionNs();
+      std::sort(ms.begin(), ms.end());
+      auto pct = [&](double q) {
+        return ms.empty() ? 0.0
+                          : static_cast<double>(
+                                ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1) + 0.5)]) /
+                                1e6;
+      };
+      s["vda5050"]["order_to_motion"] = {{"clock", lockstep_ ? "simulated" : "wall"},
+                                         {"count", ms.size()},
+                                         {"untimed", vda_->untimedOrders()},
+                                         {"p50_ms", pct(0.5)},
+                                         {"p99_ms", pct(0.99)},
+                                         {"max_ms", ms.empty() ? 0.0 : static_cast<double>(ms.back()) / 1e6}};
       vda_.reset();  // OFFLINE on the connection topic, then a clean disconnect
     }
     if (replay_) {

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "fleet/vda5050/header.hpp"
+
 namespace fleet::sim {
 
 Vda5050FleetConfig readVda5050FleetConfig(Config c) {
@@ -111,6 +113,13 @@ void Vda5050Fleet::step(World& world, double now_s, std::int64_t stamp_ns) {
     }
     const auto cmd = m.vehicle->step(now_s, pose, person);
     world.command(m.robot, cmd.v, cmd.w);
+    if (const auto stamp = m.vehicle->takeMotionStart()) {
+      if (const auto sent = vda5050::parseIsoTimestamp(*stamp)) {
+        order_to_motion_ns_.push_back(stamp_ns - *sent);
+      } else {
+        ++untimed_;
+      }
+    }
     if (m.link->connected()) {
       if (!m.factsheet_sent || m.vehicle->takeFactsheetRequest()) {
         m.factsheet_sent = m.link->publish(m.vehicle->factsheet(stamp_ns));

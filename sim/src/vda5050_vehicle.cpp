@@ -49,6 +49,7 @@ ActionState* Vda5050Vehicle::actionState(const std::string& id) {
 }
 
 OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
+  const bool idle = !driving_ && running_.empty() && !paused_;
   auto verdict = judgeOrder(progress(), order);
   if (!order.nodes.empty() && order.nodes.front().nodePosition &&
       order.nodes.front().nodePosition->mapId != config_.mapId &&
@@ -100,6 +101,17 @@ OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
       event();
       return verdict;
   }
+  // Order-to-motion: timed when the vehicle stood with nothing to do and the order gives it a
+  // released node to drive to (not one it stands on).
+  if (idle) {
+    for (std::size_t k = next_; k < order_->nodes.size() && order_->nodes[k].released; ++k) {
+      const auto& p = order_->nodes[k].nodePosition;
+      if (p && std::hypot(p->x - pose_.x, p->y - pose_.y) > config_.nodeTolerance) {
+        motion_pending_ = order.header.timestamp;
+        break;
+      }
+    }
+  }
   for (const auto& n : order_->nodes) {
     for (const auto& a : n.actions) {
       if (actionState(a.actionId) == nullptr) {
@@ -128,6 +140,7 @@ void Vda5050Vehicle::cancel() {
   }
   running_.clear();
   waiting_for_base_ = false;
+  motion_pending_.reset();
 }
 
 void Vda5050Vehicle::onInstantActions(const InstantActions& message) {
@@ -264,6 +277,9 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     event();
   }
   waiting_for_base_ = at_base_end;
+  if (motion_pending_ && (std::abs(cmd.v) > 1e-3 || std::abs(cmd.w) > 1e-3)) {
+    motion_started_ = std::exchange(motion_pending_, std::nullopt);
+  }
   if (person_in_field) {
     cmd = {};
   }

@@ -17,6 +17,38 @@ std::string vehicleSubtree(const std::string& interface_name, const std::string&
   return topicName(interface_name, manufacturer, serial, "#");
 }
 
+std::optional<std::int64_t> parseIsoTimestamp(const std::string& text) {
+  std::tm tm{};
+  int consumed = 0;
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2dT%2d:%2d:%2d%n", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &consumed) != 6 ||
+      consumed != 19 || tm.tm_mon < 1 || tm.tm_mon > 12 || tm.tm_mday < 1 || tm.tm_mday > 31 ||
+      tm.tm_hour > 23 || tm.tm_min > 59 || tm.tm_sec > 60) {
+    return std::nullopt;
+  }
+  std::size_t i = 19;
+  std::int64_t frac_ns = 0;
+  if (i < text.size() && text[i] == '.') {
+    std::int64_t scale = 100'000'000;
+    ++i;
+    const std::size_t first = i;
+    for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i) {
+      frac_ns += (text[i] - '0') * scale;
+      scale /= 10;
+    }
+    if (i == first) {
+      return std::nullopt;
+    }
+  }
+  if (i + 1 != text.size() || text[i] != 'Z') {
+    return std::nullopt;
+  }
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  const std::time_t secs = timegm(&tm);
+  return static_cast<std::int64_t>(secs) * 1'000'000'000 + frac_ns;
+}
+
 std::string isoTimestamp(std::int64_t ns_since_epoch) {
   const std::time_t secs = static_cast<std::time_t>(ns_since_epoch / 1'000'000'000);
   const auto ms = static_cast<int>((ns_since_epoch % 1'000'000'000) / 1'000'000);

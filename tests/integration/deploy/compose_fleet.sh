@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # CI test of deploy/compose.yaml with podman-compose: builds the images from the host build, starts
-# the five services each in its own container on the project's bridge network (DDS by unicast to
-# the service names, no multicast), posts a transport task from the host to the WMS adapter's API
-# published on 127.0.0.1, and asserts that the task reaches `done` (DDS between all five
-# containers), that every service is healthy, that no container joined a multicast group, and that
-# fleetctl in the network reaches the adapter by its service name. Everything the run created
-# (containers, network, files) is removed, also on failure. Exit 77 (ctest skip) only when podman
-# cannot run containers here at all.
-# With "secure", deploy/compose.secure.yaml is added: DDS Security with an identity per service
+# the services each in its own container on the project's bridge network (DDS by unicast to the
+# service names, no multicast), posts transport tasks from the host to the WMS adapter's API
+# published on 127.0.0.1, and asserts that they reach `done` (DDS between all the containers), that
+# every service is healthy, that no container joined a multicast group, and that fleetctl in the
+# network reaches the adapter by its service name. Everything the run created (containers, network,
+# files) is removed, also on failure. Exit 77 (ctest skip) only when podman cannot run containers
+# here at all.
+# By default deploy/compose.vda5050.yaml is added: reserved traffic (traffic-manager) and a VDA 5050
+# vehicle (robot r2 of two, the simulator's) through the mosquitto container and the
+# vda5050-bridge; both tasks must be done, the bridge must have sent the vehicle orders that it
+# drove, and be ready (it hears the broker). With "secure", compose.yaml alone plus
+# deploy/compose.secure.yaml: one robot agent, DDS Security with an identity per service
 # (scripts/dds-security deployment). In both modes a container on the network without a
 # certificate then writes Tasks straight onto the domain: they must reach the manager without
 # security (so the check can fail) and must not with it.
@@ -43,7 +47,14 @@ NET=${P}_fleet
 SERVICES=(fleet-manager wms-adapter risk-map robot-agent fleet-sim)
 dir=$(mktemp -d /tmp/fleet-compose.XXXXXX)
 files=(-f deploy/compose.yaml)
-((SECURE)) && files+=(-f deploy/compose.secure.yaml)
+if ((SECURE)); then
+  files+=(-f deploy/compose.secure.yaml)
+  scenario=sim/scenarios/one_robot.json ntasks=1
+else
+  files+=(-f deploy/compose.vda5050.yaml)
+  SERVICES+=(traffic-manager mosquitto vda5050-bridge)
+  scenario=sim/scenarios/two_robots.json ntasks=2
+fi
 compose() { timeout 120 podman-compose -p "$P" "${files[@]}" "$@"; }
 cleanup() {
   if [[ ${ok:-0} != 1 ]]; then
@@ -72,8 +83,11 @@ for k in $(seq 0 99); do
 done
 [[ -n $port ]] || fail "no free loopback port for the API"
 
-scripts/containers files "$dir" sim/scenarios/one_robot.json 150 1 >/dev/null || fail "writing the mounted files failed"
+# The broker's port inside the network: not MQTT's 1883, as every test's broker.
+export FLEET_MQTT_PORT=$((18830 + $$ % 1000))
+VDA5050=$((1 - SECURE)) scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null || fail "writing the mounted files failed"
 export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
+((SECURE)) || export FLEET_AGENT_ROBOTS=$(cat "$dir/config/agent_robots")
 if ((SECURE)); then
   scripts/dds-security deployment "$dir/dds" >"$dir/dds-security.log" 2>&1 ||
     { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
@@ -100,20 +114,35 @@ echo "containers: $(for s in "${SERVICES[@]}"; do printf '%s=%s ' "$s" "${ip[$s]
 ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port" "$@"; }
 for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
 ctl submit "$dir/config/tasks.csv" | tee "$dir/submit.txt"
-grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the task"
+grep -q "submitted $ntasks tasks, 0 refused" "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
 touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
 
-state=""
-deadline=$((SECONDS + 120))
-while ((SECONDS < deadline)); do
-  state=$(ctl task job-000 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
-  [[ $state == "done" || $state == "failed" ]] && break
-  sleep 1
+for ((k = 0; k < ntasks; ++k)); do
+  id=$(printf 'job-%03d' "$k") state=""
+  deadline=$((SECONDS + 120))
+  while ((SECONDS < deadline)); do
+    state=$(ctl task "$id" 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
+    [[ $state == "done" || $state == "failed" ]] && break
+    sleep 1
+  done
+  echo "task $id: $state after $((SECONDS - t0)) s"
+  [[ $state == "done" ]] || fail "task $id did not reach done (last state '$state')"
 done
-echo "task job-000: $state after $((SECONDS - t0)) s"
-[[ $state == "done" ]] || fail "the task did not reach done (last state '$state')"
+if ((!SECURE)); then
+  # The vehicle's share: the bridge sent it orders (through the broker container) and it drove.
+  r=1
+  for _ in 1 2 3; do podman exec "${P}_vda5050-bridge_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 && { r=0; break; }; sleep 1; done
+  ((r == 0)) || fail "the vda5050-bridge is not ready (it does not hear the broker)"
+  orders=$(podman exec "${P}_vda5050-bridge_1" /usr/local/bin/fleet-probe /metrics | awk '$1 == "vda5050_bridge_orders_total" {print $2}')
+  for _ in $(seq 30); do [[ -f $dir/data/sim_summary.json ]] && break; sleep 1; done
+  driven=$(python3 -c 'import json,sys; print(int(json.load(open(sys.argv[1]))["per_robot"]["r2"]["distance_m"]))' "$dir/data/sim_summary.json" 2>/dev/null)
+  ((${orders:-0} >= 1 && ${driven:-0} >= 5)) ||
+    fail "the VDA 5050 vehicle r2 took no part: the bridge sent ${orders:-no} orders, r2 drove ${driven:-?} m"
+  echo "the VDA 5050 vehicle r2 drove $driven m on $orders order(s) through the broker container; the bridge is ready"
+fi
 
-for s in fleet-manager wms-adapter risk-map robot-agent; do
+for s in "${SERVICES[@]}"; do
+  [[ $s == fleet-sim ]] && continue
   c=${P}_${s}_1
   [[ $(podman inspect --format '{{.State.Status}}' "$c") == running ]] || fail "$c is no longer running"
   # A probe is a podman exec: on a loaded machine one may time out, so up to three tries.
@@ -142,4 +171,4 @@ compose run --rm --no-deps -T fleetctl task job-000 >"$dir/run.log" 2>&1
 grep -q '"state": "done"' "$dir/run.log" || { tail -n 20 "$dir/run.log"; fail "fleetctl in the network did not reach wms-adapter:8080"; }
 echo "fleetctl in the network: job-000 done"
 ok=1
-echo "PASS: compose fleet test$( ((SECURE)) && echo " with DDS Security") in $((SECONDS - t0)) s"
+echo "PASS: compose fleet test$( ((SECURE)) && echo " with DDS Security" || echo " with reserved traffic and a VDA 5050 vehicle") in $((SECONDS - t0)) s"

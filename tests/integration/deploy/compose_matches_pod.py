@@ -20,6 +20,11 @@ import yaml
 src = sys.argv[1]
 doc = yaml.safe_load(open(f"{src}/deploy/compose.yaml"))
 compose = doc["services"]
+# The overlay's new services (traffic manager, MQTT broker, VDA 5050 bridge) join the same network
+# under the same rules; the services it only adds settings to are compose.yaml's.
+overlay = yaml.safe_load(open(f"{src}/deploy/compose.vda5050.yaml"))["services"]
+added = {n: s for n, s in overlay.items() if n not in compose}
+NOT_DDS = ("fleetctl", "mosquitto")
 pod = {c["name"]: c for c in yaml.safe_load(open(f"{src}/deploy/fleet-pod.yaml"))["spec"]["containers"]}
 problems = []
 PROFILE = "cyclonedds-compose.xml"
@@ -72,8 +77,14 @@ for name, c in pod.items():
 
 # The network: one project bridge network, each service in its own namespace on it.
 check("fleet" in (doc.get("networks") or {}), "no project network `fleet` under networks:")
-dds = [n for n in compose if n != "fleetctl"]
-for name, s in compose.items():
+dds = [n for n in {**compose, **added} if n not in NOT_DDS]
+for name, s in added.items():
+    check(s.get("image", "").startswith("localhost/fleet-"), f"{name}: image {s.get('image')} is not one of ours")
+    check(s.get("read_only") is True, f"{name}: the root filesystem is not read-only")
+    check("no-new-privileges" in s.get("security_opt", []), f"{name}: no security_opt no-new-privileges")
+    check(s.get("cap_drop") == ["ALL"], f"{name}: capabilities not dropped")
+    check(all(v.endswith(":ro") for v in s.get("volumes", []) if "/etc/fleet" in v), f"{name}: /etc/fleet writable")
+for name, s in {**compose, **added}.items():
     check("network_mode" not in s, f"{name}: network_mode {s.get('network_mode')}: every service joins `fleet`")
     check(s.get("networks") == ["fleet"], f"{name}: networks {s.get('networks')} != ['fleet']")
     ports = s.get("ports", [])
@@ -99,5 +110,5 @@ check(any(line.startswith("COPY ") and PROFILE in line and "/usr/share/fleet/" i
 
 for p in problems:
     print("compose.yaml:", p)
-print(f"{len(pod)} services compared, {len(peers)} DDS peers, {len(problems)} problems")
+print(f"{len(pod)} services compared, {len(added)} of the VDA 5050 overlay checked, {len(peers)} DDS peers, {len(problems)} problems")
 sys.exit(1 if problems else 0)

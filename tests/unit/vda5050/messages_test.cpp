@@ -116,5 +116,19 @@ TEST(Vda5050Messages, TopicLayoutAndTimestamp) {
   EXPECT_EQ(isoTimestamp(1'700'000'000'123'000'000), "2023-11-14T22:13:20.123Z");
 }
 
+TEST(Vda5050Messages, TimestampsReadBackAsWritten) {
+  for (const std::int64_t ns :
+       {std::int64_t{0}, std::int64_t{1'700'000'000'123'000'000}, std::int64_t{1'795'000'000'999'000'000}}) {
+    EXPECT_EQ(parseIsoTimestamp(isoTimestamp(ns)), ns) << isoTimestamp(ns);
+  }
+  EXPECT_EQ(parseIsoTimestamp("2023-11-14T22:13:20Z"), 1'700'000'000'000'000'000);
+  EXPECT_EQ(parseIsoTimestamp("2023-11-14T22:13:20.5Z"), 1'700'000'000'500'000'000);
+  for (const char* bad :
+       {"", "2023-11-14", "2023-11-14T22:13:20", "2023-11-14T22:13:20.Z", "2023-11-14T22:13:20+01:00",
+        "2023-13-14T22:13:20Z", "2023-11-14T22:13:20.123Zx", "yesterday"}) {
+    EXPECT_FALSE(parseIsoTimestamp(bad).has_value()) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace fleet::vda5050

@@ -36,6 +36,30 @@ TEST(Vda5050Vehicle, FollowsTheBaseAndStopsAtItsEnd) {
   EXPECT_TRUE(s.edgeStates.empty());
 }
 
+// Order-to-motion is timed from the order that got a standing vehicle going, at the step it
+// starts; an update that reaches it while it drives, or one that releases nothing new, is not.
+TEST(Vda5050Vehicle, SaysOnceWhichOrderGotItMoving) {
+  Rig r;
+  auto first = lineOrder("o1", 0, 0, 6, 3);
+  first.header.timestamp = "2026-11-27T02:00:00.000Z";
+  ASSERT_EQ(r.vehicle.onOrder(first).decision, OrderDecision::kAcceptNew);
+  EXPECT_FALSE(r.vehicle.takeMotionStart().has_value());  // not moved yet
+  r.run(0.1);
+  EXPECT_EQ(r.vehicle.takeMotionStart(), "2026-11-27T02:00:00.000Z");
+  EXPECT_FALSE(r.vehicle.takeMotionStart().has_value());  // once
+  auto moving = lineOrder("o1", 1, 2, 4, 4);
+  moving.header.timestamp = "2026-11-27T02:00:01.000Z";
+  ASSERT_EQ(r.vehicle.onOrder(moving).decision, OrderDecision::kAcceptUpdate);  // still driving
+  r.run(20.0);
+  EXPECT_FALSE(r.vehicle.takeMotionStart().has_value());
+  EXPECT_NEAR(r.pose.x, 5.0, 0.2);  // stands at its base end, n5
+  auto again = lineOrder("o1", 2, 5, 2, 2);
+  again.header.timestamp = "2026-11-27T02:00:30.000Z";
+  ASSERT_EQ(r.vehicle.onOrder(again).decision, OrderDecision::kAcceptUpdate);
+  r.run(0.1);
+  EXPECT_EQ(r.vehicle.takeMotionStart(), "2026-11-27T02:00:30.000Z");
+}
+
 /// An order through `points` (all released), node ids p0, p1, ...
 vda5050::Order pathOrder(const std::vector<Vec2>& points) {
   vda5050::Order o = lineOrder("o1", 0, 0, static_cast<int>(points.size()), static_cast<int>(points.size()));

@@ -58,6 +58,12 @@ class Vda5050Fleet {
 
   [[nodiscard]] const Vda5050FleetCounters& counters() const { return counters_; }
   [[nodiscard]] std::uint64_t baseStarvedStops() const;
+  /// Order-to-motion latencies in ns: from an order's header timestamp to the step at which the
+  /// vehicle it reached, standing idle, started to move on it (stamp_ns of that step). Meaningful
+  /// when the bridge and the simulator share a clock (wall clock runs).
+  [[nodiscard]] const std::vector<std::int64_t>& orderToMotionNs() const { return order_to_motion_ns_; }
+  /// Orders whose timestamp could not be read (not timed).
+  [[nodiscard]] std::uint64_t untimedOrders() const { return untimed_; }
   /// Warnings for the log since the last call (refused messages, rejected orders).
   std::vector<std::string> takeWarnings() { return std::exchange(warnings_, {}); }
 
@@ -71,6 +77,8 @@ class Vda5050Fleet {
   std::vector<Member> members_;
   Vda5050FleetCounters counters_;
   std::vector<std::string> warnings_;
+  std::vector<std::int64_t> order_to_motion_ns_;
+  std::uint64_t untimed_ = 0;
 };
 
 }  // namespace fleet::sim

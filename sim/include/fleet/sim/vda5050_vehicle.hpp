@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fleet/core/pose2.hpp"
@@ -71,6 +72,10 @@ class Vda5050Vehicle {
   [[nodiscard]] std::uint64_t baseStarvedStops() const { return starved_stops_; }
   [[nodiscard]] bool paused() const { return paused_; }
   [[nodiscard]] const std::string& lastNodeId() const { return last_node_id_; }
+  /// Once, at the step where the vehicle starts moving on an order or update that reached it while
+  /// it stood with nothing to do: that order's header timestamp (order-to-motion latency; the
+  /// controller's command counts, before the protective field's stop).
+  std::optional<std::string> takeMotionStart() { return std::exchange(motion_started_, std::nullopt); }
 
   /// Whether a point (a person) is inside the protective field of a vehicle at `pose`: a
   /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin each side, as long as
@@ -107,6 +112,8 @@ class Vda5050Vehicle {
   std::uint64_t starved_stops_ = 0;
   double distance_since_node_ = 0.0;
   VehicleCommand last_command_;
+  std::optional<std::string> motion_pending_;  // header timestamp of the order it should start on
+  std::optional<std::string> motion_started_;
 };
 
 }  // namespace fleet::sim

@@ -6,6 +6,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace fleet::vda5050 {
@@ -30,6 +31,9 @@ std::string vehicleSubtree(const std::string& interface_name, const std::string&
                            const std::string& serial);
 /// ISO 8601 UTC with milliseconds for nanoseconds since the epoch.
 std::string isoTimestamp(std::int64_t ns_since_epoch);
+/// Nanoseconds since the epoch of "YYYY-MM-DDTHH:MM:SS[.fraction]Z" (UTC, as isoTimestamp writes
+/// it); nullopt for anything else (offsets other than Z are not accepted).
+std::optional<std::int64_t> parseIsoTimestamp(const std::string& text);
 
 void writeHeader(nlohmann::json& j, const Header& h);
 
