@@ -128,7 +128,7 @@ const char* kUsage =
     "                 [--vda5050 VEHICLES.json] [--validate] [--log-level LEVEL] [--log-format text|json]\n"
     "                 [--metrics-port PORT] [--metrics-host ADDR]\n"
     "       (environment, the options win: FLEET_METRICS_PORT, FLEET_METRICS_HOST,\n"
-    "        FLEET_SIM_PARTICIPANTS, FLEET_SIM_VDA5050)\n"
+    "        FLEET_SIM_PARTICIPANTS, FLEET_SIM_VDA5050, FLEET_SIM_MAX_SPEED)\n"
     "       fleet-sim --version\n"
     "       fleet-sim --viewer REPLAY.jsonl.gz --html OUT.html\n";
 
@@ -147,6 +147,12 @@ bool parseArgs(int argc, char** argv, Options& o) {
   }
   if (const char* v = std::getenv("FLEET_SIM_VDA5050"); v != nullptr && *v != '\0') {
     o.vda5050 = v;
+  }
+  if (const char* m = std::getenv("FLEET_SIM_MAX_SPEED"); m != nullptr && *m != '\0') {
+    o.maxSpeed = std::stod(m);
+    if (!(o.maxSpeed >= 0.0)) {
+      throw std::invalid_argument("FLEET_SIM_MAX_SPEED must be >= 0 (simulated s per wall s; 0 = no cap)");
+    }
   }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # CI smoke test of the service containers: builds the images from the host build, starts the
 # small-fleet pod (simulator, risk map, fleet manager, WMS adapter, robot agent) with
-# `podman play kube --network none`, posts a transport task over HTTP from inside the pod and
-# asserts that every container started and stays healthy (liveness), ready, with metrics, not as
-# root, and that the task reached `done` (which
-# needs DDS traffic between all five services). Exit 77 (ctest skip) only when podman cannot run
+# `podman play kube --network none`, plus deploy/fleet-pod.vda5050.yaml's traffic manager, MQTT
+# broker and VDA 5050 bridge (VDA5050=1: of two robots, r2 is the simulator's VDA 5050 vehicle),
+# posts two transport tasks over HTTP from inside the pod and asserts that every container started
+# and stays healthy (liveness), ready, with metrics, not as root, that both tasks reached `done`
+# (DDS between all the services, MQTT between the bridge and the vehicle) and that the vehicle
+# drove on the bridge's orders. (The plain pod, reactive traffic: compose_fleet_secure runs the
+# same services from compose.yaml; kube_play the Kubernetes manifests.) Exit 77 (ctest skip) only when podman cannot run
 # containers on this machine at all. Usage: containers_smoke.sh SOURCE_DIR BUILD_DIR
 set -uo pipefail
 SRC=$1
@@ -21,7 +24,7 @@ export POD=fleet-smoke-$$
 dir=$(mktemp -d /tmp/fleet-smoke.XXXXXX)
 cleanup() {
   if [[ ${ok:-0} != 1 ]]; then
-    for c in fleet-manager wms-adapter risk-map robot-agent fleet-sim; do
+    for c in fleet-manager wms-adapter risk-map robot-agent fleet-sim traffic-manager mosquitto vda5050-bridge; do
       echo "--- log of $POD-$c"
       podman logs --tail 30 "$POD-$c" 2>&1
     done
@@ -30,30 +33,43 @@ cleanup() {
   rm -rf "$dir"
 }
 trap cleanup EXIT
-scripts/containers up "$dir" sim/scenarios/one_robot.json 150 1 || fail "podman play kube failed"
+export FLEET_MQTT_PORT=$((18830 + $$ % 1000))  # not MQTT's 1883, as every test's broker
+VDA5050=1 scripts/containers up "$dir" sim/scenarios/two_robots.json 150 2 || fail "podman play kube failed"
 
 ctl() { podman run --rm --pod "$POD" -v "$dir/config:/etc/fleet:ro" localhost/fleet-fleetctl \
   --url http://127.0.0.1:8080 "$@"; }
-services=(fleet-manager wms-adapter risk-map robot-agent fleet-sim)
+services=(fleet-manager wms-adapter risk-map robot-agent fleet-sim traffic-manager mosquitto vda5050-bridge)
 for c in "${services[@]}"; do
   [[ $(podman inspect --format '{{.State.Status}}' "$POD-$c") == running ]] || fail "$POD-$c did not start"
 done
 for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
 ctl submit /etc/fleet/tasks.csv | tee "$dir/submit.txt"
-grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the task"
+grep -q 'submitted 2 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
 touch "$dir/data/start"  # the simulator starts now (deploy/fleet-pod.yaml)
 
-state=""
-deadline=$((SECONDS + 150))
-while ((SECONDS < deadline)); do
-  state=$(ctl task job-000 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
-  [[ $state == done || $state == failed ]] && break
-  sleep 1
+for id in job-000 job-001; do
+  state=""
+  deadline=$((SECONDS + 150))
+  while ((SECONDS < deadline)); do
+    state=$(ctl task "$id" 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
+    [[ $state == done || $state == failed ]] && break
+    sleep 1
+  done
+  echo "task $id: $state after $((SECONDS - t0)) s"
+  [[ $state == done ]] || fail "task $id did not reach done (last state '$state')"
 done
-echo "task job-000: $state after $((SECONDS - t0)) s"
-[[ $state == done ]] || fail "the task did not reach done (last state '$state')"
+orders=$(podman exec "$POD-vda5050-bridge" /usr/local/bin/fleet-probe /metrics | awk '$1 == "vda5050_bridge_orders_total" {print $2}')
+for _ in $(seq 30); do [[ -f $dir/data/sim_summary.json ]] && break; sleep 1; done
+driven=$(python3 -c 'import json,sys; print(int(json.load(open(sys.argv[1]))["per_robot"]["r2"]["distance_m"]))' "$dir/data/sim_summary.json" 2>/dev/null)
+((${orders:-0} >= 1 && ${driven:-0} >= 5)) ||
+  fail "the VDA 5050 vehicle r2 took no part: the bridge sent ${orders:-no} orders, r2 drove ${driven:-?} m"
+echo "the VDA 5050 vehicle r2 drove $driven m on $orders order(s) through the pod's broker"
 
-for c in fleet-manager wms-adapter risk-map robot-agent; do
+h=1
+for _ in 1 2 3; do podman healthcheck run "$POD-mosquitto" >/dev/null && { h=0; break; }; sleep 1; done
+((h == 0)) || fail "$POD-mosquitto is unhealthy"
+[[ $(podman exec "$POD-mosquitto" id -u) == 65532 ]] || fail "$POD-mosquitto runs as root"
+for c in fleet-manager wms-adapter risk-map robot-agent traffic-manager vda5050-bridge; do
   [[ $(podman inspect --format '{{.State.Status}}' "$POD-$c") == running ]] || fail "$POD-$c is no longer running"
   # A probe is a podman exec: on a loaded machine one may time out, so up to three tries.
   h=1
