@@ -60,8 +60,10 @@ TEST_F(Vda5050Files, ForAContainerThePathsAreTheMountsAndTheCredentialsAgree) {
   EXPECT_EQ(conf.find("\nuser "), std::string::npos) << "in a container the broker runs as the image's user";
 
   const std::string acl = slurp(dir_ / "mosquitto.acl");
-  EXPECT_NE(acl.find("user fleet-sim-r2\ntopic readwrite uagv/v2/fleet-sim/r2/#\n"), std::string::npos) << acl;
-  EXPECT_NE(acl.find("user fleet-sim-r3\ntopic readwrite uagv/v2/fleet-sim/r3/#\n"), std::string::npos) << acl;
+  EXPECT_NE(acl.find("user fleet-sim-r2\ntopic readwrite uagv/v2/fleet-sim/r2/#\n"), std::string::npos)
+      << acl;
+  EXPECT_NE(acl.find("user fleet-sim-r3\ntopic readwrite uagv/v2/fleet-sim/r3/#\n"), std::string::npos)
+      << acl;
 
   const auto bridge = json::parse(slurp(dir_ / "vda5050_bridge.json"));
   const auto vehicles = json::parse(slurp(dir_ / "vda5050_vehicles.json"));
@@ -85,8 +87,9 @@ TEST_F(Vda5050Files, ForAContainerThePathsAreTheMountsAndTheCredentialsAgree) {
   }
   EXPECT_EQ(passwd.find(bridge["broker"]["password"].get<std::string>()), std::string::npos);
   EXPECT_NE(vehicles["vehicles"][0]["password"], vehicles["vehicles"][1]["password"]);
-  EXPECT_EQ(fs::status(dir_ / "mosquitto.passwd").permissions() & (fs::perms::group_all | fs::perms::others_all),
-            fs::perms::none);
+  EXPECT_EQ(
+      fs::status(dir_ / "mosquitto.passwd").permissions() & (fs::perms::group_all | fs::perms::others_all),
+      fs::perms::none);
 }
 
 TEST_F(Vda5050Files, OnThisMachineTheBrokerLogsBesideItsFilesOnLoopback) {
@@ -114,7 +117,8 @@ TEST_F(Vda5050Files, AnUnwritableDirectoryIsAnErrorNamingIt) {
   f.port = 18833;
   const auto r = fleet::ctl::writeVda5050Files(f);
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().message.find((dir_ / "missing" / "deeper").string()), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find((dir_ / "missing" / "deeper").string()), std::string::npos)
+      << r.error().message;
 }
 
 }  // namespace
