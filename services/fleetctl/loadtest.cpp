@@ -674,6 +674,14 @@ int Run::run() {
                 << robots.size() << " robots\n";
       return 2;
     }
+    if (!o.wallClock && (o.maxSpeed <= 0.0 || o.maxSpeed > 10.0)) {
+      // MQTT runs on the wall clock: at 100x a millisecond in the broker is a tenth of a simulated
+      // second, and the vehicles wait for their orders (docs/operator-guide.md#pod).
+      say("warning: --max-speed " +
+          (o.maxSpeed <= 0.0 ? std::string("0 (no cap)") : std::to_string(o.maxSpeed)) +
+          " with VDA 5050 vehicles: MQTT runs on the wall clock, so above 10x their orders arrive late in "
+          "simulated time (stops at base ends, rejected updates); 4 (the default) or 10 keep it small");
+    }
     const std::vector<std::string> ids(robots.end() - o.vda5050, robots.end());
     vdaRobots.insert(ids.begin(), ids.end());
     auto site = service::loadSiteFile(scenario["site"].get<std::string>());
