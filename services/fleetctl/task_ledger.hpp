@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "fleet/core/percentiles.hpp"
+
 #include <nlohmann/json.hpp>
 
 namespace fleet::ctl {
@@ -30,13 +32,8 @@ struct TransitionRow {
   std::int64_t stampNs = 0;
 };
 
-struct Percentiles {
-  std::size_t count = 0;
-  double p50 = 0, p90 = 0, p99 = 0, max = 0;
-};
-
-/// Nearest-rank percentiles (the value below which q of the samples lie, one of the samples).
-Percentiles percentiles(std::vector<double> values);
+using fleet::Percentiles;
+using fleet::percentiles;
 
 struct Accounting {
   std::size_t acknowledged = 0;

@@ -18,6 +18,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/core/percentiles.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/sim/localization_error.hpp"
@@ -134,22 +135,34 @@ const char* kUsage =
 
 bool parseArgs(int argc, char** argv, Options& o) {
   // As the other services read them (CLI11 envname): the options below win.
-  if (const char* port = std::getenv("FLEET_METRICS_PORT")) {
-    o.ops.port = std::stoi(port);
+  // A bad value names its variable (std::stoi alone says only "stoi").
+  auto number = [](const char* name, auto parse) -> std::optional<decltype(parse(std::string()))> {
+    const char* v = std::getenv(name);
+    if (v == nullptr || *v == '\0') {
+      return std::nullopt;
+    }
+    try {
+      return parse(std::string(v));
+    } catch (const std::exception&) {
+      throw std::invalid_argument(std::string(name) + "=" + v + " is not a number");
+    }
+  };
+  if (const auto port = number("FLEET_METRICS_PORT", [](const std::string& t) { return std::stoi(t); })) {
+    o.ops.port = *port;
   }
   if (const char* host = std::getenv("FLEET_METRICS_HOST")) {
     o.ops.host = host;
   }
   // What a deployment overlay sets without rewriting the command (deploy/compose.vda5050.yaml;
   // compose implementations differ in how they merge an overlay's command list).
-  if (const char* n = std::getenv("FLEET_SIM_PARTICIPANTS"); n != nullptr && *n != '\0') {
-    o.participants = std::stoi(n);
+  if (const auto n = number("FLEET_SIM_PARTICIPANTS", [](const std::string& t) { return std::stoi(t); })) {
+    o.participants = *n;
   }
   if (const char* v = std::getenv("FLEET_SIM_VDA5050"); v != nullptr && *v != '\0') {
     o.vda5050 = v;
   }
-  if (const char* m = std::getenv("FLEET_SIM_MAX_SPEED"); m != nullptr && *m != '\0') {
-    o.maxSpeed = std::stod(m);
+  if (const auto m = number("FLEET_SIM_MAX_SPEED", [](const std::string& t) { return std::stod(t); })) {
+    o.maxSpeed = *m;
     if (!(o.maxSpeed >= 0.0)) {
       throw std::invalid_argument("FLEET_SIM_MAX_SPEED must be >= 0 (simulated s per wall s; 0 = no cap)");
     }
@@ -583,20 +596,17 @@ class Simulator {
                       {"base_starved_stops", vda_->baseStarvedStops()}};
       // Order-to-motion (issue 20: p99 <= 100 ms through the broker): the bridge stamps an order
       // when it publishes it, on its clock; on the wall clock that is the simulator's too.
-      auto ms = vda_->orderToMotionNs();
-      std::sort(ms.begin(), ms.end());
-      auto pct = [&](double q) {
-        return ms.empty() ? 0.0
-                          : static_cast<double>(
-                                ms[static_cast<std::size_t>(q * static_cast<double>(ms.size() - 1) + 0.5)]) /
-                                1e6;
-      };
+      std::vector<double> ms;
+      for (const std::int64_t ns : vda_->orderToMotionNs()) {
+        ms.push_back(static_cast<double>(ns) / 1e6);
+      }
+      const auto p = fleet::percentiles(std::move(ms));
       s["vda5050"]["order_to_motion"] = {{"clock", lockstep_ ? "simulated" : "wall"},
-                                         {"count", ms.size()},
+                                         {"count", p.count},
                                          {"untimed", vda_->untimedOrders()},
-                                         {"p50_ms", pct(0.5)},
-                                         {"p99_ms", pct(0.99)},
-                                         {"max_ms", ms.empty() ? 0.0 : static_cast<double>(ms.back()) / 1e6}};
+                                         {"p50_ms", p.p50},
+                                         {"p99_ms", p.p99},
+                                         {"max_ms", p.max}};
       vda_.reset();  // OFFLINE on the connection topic, then a clean disconnect
     }
     if (replay_) {

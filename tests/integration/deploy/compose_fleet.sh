@@ -23,6 +23,8 @@ SECURE=0
 [[ ${3:-} == secure ]] && SECURE=1
 # shellcheck source=uncertified_writer.sh
 source "$(dirname "${BASH_SOURCE[0]}")/uncertified_writer.sh"
+# shellcheck source=fleet_checks.sh
+source "$(dirname "${BASH_SOURCE[0]}")/fleet_checks.sh"
 cd "$SRC" || exit 1
 t0=$SECONDS
 fail() { echo "FAIL: $*"; exit 1; }
@@ -117,29 +119,8 @@ ctl submit "$dir/config/tasks.csv" | tee "$dir/submit.txt"
 grep -q "submitted $ntasks tasks, 0 refused" "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
 touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
 
-for ((k = 0; k < ntasks; ++k)); do
-  id=$(printf 'job-%03d' "$k") state=""
-  deadline=$((SECONDS + 120))
-  while ((SECONDS < deadline)); do
-    state=$(ctl task "$id" 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
-    [[ $state == "done" || $state == "failed" ]] && break
-    sleep 1
-  done
-  echo "task $id: $state after $((SECONDS - t0)) s"
-  [[ $state == "done" ]] || fail "task $id did not reach done (last state '$state')"
-done
-if ((!SECURE)); then
-  # The vehicle's share: the bridge sent it orders (through the broker container) and it drove.
-  r=1
-  for _ in 1 2 3; do podman exec "${P}_vda5050-bridge_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 && { r=0; break; }; sleep 1; done
-  ((r == 0)) || fail "the vda5050-bridge is not ready (it does not hear the broker)"
-  orders=$(podman exec "${P}_vda5050-bridge_1" /usr/local/bin/fleet-probe /metrics | awk '$1 == "vda5050_bridge_orders_total" {print $2}')
-  for _ in $(seq 30); do [[ -f $dir/data/sim_summary.json ]] && break; sleep 1; done
-  driven=$(python3 -c 'import json,sys; print(int(json.load(open(sys.argv[1]))["per_robot"]["r2"]["distance_m"]))' "$dir/data/sim_summary.json" 2>/dev/null)
-  ((${orders:-0} >= 1 && ${driven:-0} >= 5)) ||
-    fail "the VDA 5050 vehicle r2 took no part: the bridge sent ${orders:-no} orders, r2 drove ${driven:-?} m"
-  echo "the VDA 5050 vehicle r2 drove $driven m on $orders order(s) through the broker container; the bridge is ready"
-fi
+wait_tasks_done "$ntasks" 120
+((SECURE)) || check_vehicle_took_part "${P}_vda5050-bridge_1" "$dir/data"
 
 for s in "${SERVICES[@]}"; do
   [[ $s == fleet-sim ]] && continue

@@ -16,6 +16,8 @@ cd "$SRC"
 t0=$SECONDS
 fail() { echo "FAIL: $*"; exit 1; }
 
+# shellcheck source=fleet_checks.sh
+source "$(dirname "${BASH_SOURCE[0]}")/fleet_checks.sh"
 # shellcheck source=podman_images.sh
 source "$(dirname "${BASH_SOURCE[0]}")/podman_images.sh"
 echo "images built after $((SECONDS - t0)) s"
@@ -47,23 +49,8 @@ ctl submit /etc/fleet/tasks.csv | tee "$dir/submit.txt"
 grep -q 'submitted 2 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
 touch "$dir/data/start"  # the simulator starts now (deploy/fleet-pod.yaml)
 
-for id in job-000 job-001; do
-  state=""
-  deadline=$((SECONDS + 150))
-  while ((SECONDS < deadline)); do
-    state=$(ctl task "$id" 2>/dev/null | python3 -c 'import json,sys; print(json.load(sys.stdin).get("state",""))' 2>/dev/null)
-    [[ $state == done || $state == failed ]] && break
-    sleep 1
-  done
-  echo "task $id: $state after $((SECONDS - t0)) s"
-  [[ $state == done ]] || fail "task $id did not reach done (last state '$state')"
-done
-orders=$(podman exec "$POD-vda5050-bridge" /usr/local/bin/fleet-probe /metrics | awk '$1 == "vda5050_bridge_orders_total" {print $2}')
-for _ in $(seq 30); do [[ -f $dir/data/sim_summary.json ]] && break; sleep 1; done
-driven=$(python3 -c 'import json,sys; print(int(json.load(open(sys.argv[1]))["per_robot"]["r2"]["distance_m"]))' "$dir/data/sim_summary.json" 2>/dev/null)
-((${orders:-0} >= 1 && ${driven:-0} >= 5)) ||
-  fail "the VDA 5050 vehicle r2 took no part: the bridge sent ${orders:-no} orders, r2 drove ${driven:-?} m"
-echo "the VDA 5050 vehicle r2 drove $driven m on $orders order(s) through the pod's broker"
+wait_tasks_done 2 150
+check_vehicle_took_part "$POD-vda5050-bridge" "$dir/data"
 
 h=1
 for _ in 1 2 3; do podman healthcheck run "$POD-mosquitto" >/dev/null && { h=0; break; }; sleep 1; done
