@@ -6,7 +6,8 @@ wms_adapter.json that scripts/containers writes, which must name the pod's stati
 all addresses of its container), environment, mounts, health check, read-only root filesystem and
 no privilege escalation. Network: every service on the project network `fleet`, none in another's
 namespace; the compose DDS profile (in the images) with multicast off and exactly the DDS services'
-names as unicast peers; only the adapter publishes a port, on 127.0.0.1. Usage:
+names as unicast peers; only the adapter publishes a port, on 127.0.0.1. DDS Security: each DDS
+service has its identity in compose.secure.yaml or compose.secure.vda5050.yaml. Usage:
 compose_matches_pod.py SOURCE_DIR"""
 import json
 import os
@@ -98,6 +99,22 @@ for name, s in {**compose, **added}.items():
               f"{name}: CYCLONEDDS_URI {s.get('environment', {}).get('CYCLONEDDS_URI')} is not the compose profile")
 check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_URL") == "http://wms-adapter:8080",
       "fleetctl: FLEET_WMS_URL is not the adapter's service name")
+
+# DDS Security: every DDS service of the two files gets its own identity from one of the two secure
+# overlays (compose.secure.yaml for compose.yaml's, compose.secure.vda5050.yaml for the overlay's),
+# with the compose profile first and the identity's security.xml from the read-only mount.
+secure = {**yaml.safe_load(open(f"{src}/deploy/compose.secure.yaml"))["services"],
+          **yaml.safe_load(open(f"{src}/deploy/compose.secure.vda5050.yaml"))["services"]}
+IDENTITY = {"robot-agent": "agents", "fleet-sim": "simulator"}
+for name in dds:
+    env = secure.get(name, {}).get("environment", {})
+    ident = IDENTITY.get(name, name)
+    check(env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE},file:///run/fleet-dds/{ident}/security.xml",
+          f"{name}: no DDS Security identity in the secure overlays (CYCLONEDDS_URI {env.get('CYCLONEDDS_URI')})")
+    check(env.get("FLEET_DDS_SECURITY_DIR") == "/run/fleet-dds", f"{name}: FLEET_DDS_SECURITY_DIR is not the mount")
+    check(any(str(v).endswith(":/run/fleet-dds:ro") for v in secure.get(name, {}).get("volumes", [])),
+          f"{name}: the identities are not mounted read-only at /run/fleet-dds")
+check(not set(secure) - set(dds), f"secure overlays name services that are not DDS services: {set(secure) - set(dds)}")
 
 ns = {"c": "https://cdds.io/config"}
 general = ET.parse(f"{src}/deploy/{PROFILE}").getroot().find("c:Domain", ns)
