@@ -294,9 +294,18 @@ try {
   // 4. Pause its robot from the page: click it on the map, Pause, confirm.
   if (robot) {
     await sleep(1500); // let it drive a little
-    const at = await robotOnScreen(robot);
-    await page.mouse.click(at[0], at[1]);
-    await page.waitForFunction((id) => document.getElementById('robot-name').textContent === id, { timeout: 5000 }, robot);
+    // The robot drives on between reading its place and the click (by more than its disc when the
+    // machine is loaded and the page draws late): try again where it is now, up to five times.
+    for (let attempt = 1; ; ++attempt) {
+      const at = await robotOnScreen(robot);
+      await page.mouse.click(at[0], at[1]);
+      try {
+        await page.waitForFunction((id) => document.getElementById('robot-name').textContent === id, { timeout: 3000 }, robot);
+        break;
+      } catch (e) {
+        if (attempt >= 5) throw e;
+      }
+    }
     await page.click('[data-robot-action=pause]');
     await page.waitForSelector('#confirm[open]');
     await page.click('#confirm-ok');
