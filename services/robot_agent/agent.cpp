@@ -161,8 +161,8 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
       localizer_(localizerParams(p_)),
       lastPlausiblePose_(p_.start),
       follower_(followerParams()),
-      gate_(
-          GateParams{p_.radius, p_.stopGap, p_.headway, p_.limits, p_.speedLimit, p_.traffic != "reserved"}),
+      gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.traffic == "reserved" ? p_.robotStopGap : -1.0,
+                       p_.limits, p_.speedLimit, p_.traffic != "reserved"}),
       standsAt_(p_.start),
       progress_(p_.progress),
       arbiter_(StandoffParams{p_.id, p_.radius, p_.blockedBackoffS, p_.blockedFailS}),

@@ -64,6 +64,7 @@ struct AgentParams {
   double vMax = 0.8;             // m/s cruise
   double wMax = 1.5;             // rad/s
   double stopGap = 0.35;         // m of free space kept ahead at standstill
+  double robotStopGap = 0.25;    // the same to another robot, in reserved traffic (GateParams)
   double headway = 1.0;          // s: the stop distance grows with speed
   double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
   double blockedFailS = 60.0;    // a task held in a standoff this long fails

@@ -34,6 +34,22 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
   // Docking at a station next to a shelf or wall: the last few decimetres are driven slowly, so
   // static points may come closer than the cruising stop gap (else the robot stalls short of it).
   const double staticGap = view.docking ? 0.08 : p_.stopGap;
+  const double robotGap = p_.robotStopGap >= 0.0 ? p_.robotStopGap : p_.stopGap;
+  // A range reading on a robot's body (one detected, or one that reports itself there) keeps the
+  // robot gap: the laser sees robots as it sees shelves.
+  auto onRobot = [&](Vec2 at) {
+    for (const auto& d : view.seen.detections) {
+      if (d.kind == SeenKind::kRobot && distance(d.map, at) < d.radius + 0.08) {
+        return true;
+      }
+    }
+    for (const auto& o : view.others) {
+      if (distance(o.pos, at) < p_.radius + 0.08) {
+        return true;
+      }
+    }
+    return false;
+  };
   auto limit = [&](double gap, double keep) {
     allowed = std::min(allowed, std::max(0.0, (gap - keep) / p_.headway));
   };
@@ -46,7 +62,7 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
     }
     const double gap = std::hypot(x, y) - p_.radius - r;
     const double before = allowed;
-    limit(gap, p_.stopGap);
+    limit(gap, d.kind == SeenKind::kRobot ? robotGap : p_.stopGap);
     if (allowed < before) {
       c.blockPoint = d.map;
     }
@@ -76,7 +92,8 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
         ahead > 0.0 && (view.route ? distanceToRoute(*view.route, ray.map) < corridor : straight);
     if (counts) {
       const double before = allowed;
-      limit((straight ? ahead : ray.local.norm()) - p_.radius, staticGap);
+      const double keep = robotGap < staticGap && onRobot(ray.map) ? robotGap : staticGap;
+      limit((straight ? ahead : ray.local.norm()) - p_.radius, keep);
       if (allowed < before) {
         c.blockPoint = ray.map;
       }

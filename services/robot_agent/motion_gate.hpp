@@ -25,6 +25,11 @@ struct GateParams {
   double radius = 0.3;
   double stopGap = 0.35;  ///< m of free space kept ahead at standstill
   double headway = 1.0;   ///< s: the stop distance grows with speed
+  /// The same gap to another robot (detected, or the range readings on its disc); < 0: stopGap.
+  /// Reserved traffic keeps it smaller than the gap to people: the traffic layer plans robots
+  /// one behind another at the roadmap's following distance (libs/traffic RoadmapOptions::stopGap
+  /// is this plus 0.05 m), and a wider gap here turned every planned follow into a halt.
+  double robotStopGap = -1.0;
   control::VelocityLimits limits;
   /// The site's speed limit at a map point [m/s] (+inf: none); empty: no zones.
   std::function<double(Vec2)> speedLimit;

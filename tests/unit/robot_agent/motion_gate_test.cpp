@@ -108,6 +108,38 @@ TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
   EXPECT_EQ(gate.clearSpeed({behind, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8);
 }
 
+// Reserved traffic: the traffic layer plans robots one behind another at its following distance,
+// so the gap to a robot is smaller than to a person or a shelf; the laser's readings on a robot's
+// body keep the robot gap too (the laser sees a robot as it sees a shelf).
+TEST(MotionGate, ARobotKeepsTheRobotGapAPersonAndAShelfTheStopGap) {
+  auto p = params();
+  p.robotStopGap = 0.25;
+  const MotionGate gate(p);
+  const MotionGate plain(params());
+  const std::vector<OtherRobot> none;
+  Blocker b;
+  // Centres 1.0 m apart (the roadmap's following distance): 0.4 m between the discs.
+  const Perception robot = perception({}, {{SeenKind::kRobot, {1.0, 0.0}, 0.3, {}}});
+  EXPECT_NEAR(gate.clearSpeed({robot, none, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.25, 1e-9);
+  EXPECT_NEAR(plain.clearSpeed({robot, none, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.35, 1e-9)
+      << "no robot gap given: the stop gap";
+  const Perception person = perception({}, {{SeenKind::kHuman, {0.95, 0.0}, 0.25, {}}});
+  EXPECT_NEAR(gate.clearSpeed({person, none, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.35, 1e-9);
+  // The laser's reading on the front of that robot: the robot gap when the robot is detected
+  // there or reports itself there, the stop gap for a reading on nothing known (a shelf).
+  const Perception hit = perception({{0.7, 0.0}}, {{SeenKind::kRobot, {1.0, 0.0}, 0.3, {}}});
+  EXPECT_NEAR(gate.clearSpeed({hit, none, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.25, 1e-9);
+  const Perception reading = perception({{0.7, 0.0}});
+  std::vector<OtherRobot> reported(1);
+  reported[0].id = "r2";
+  reported[0].pos = {3.0, 2.0};
+  EXPECT_NEAR(gate.clearSpeed({reading, reported, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.25, 1e-9);
+  EXPECT_NEAR(gate.clearSpeed({reading, none, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.35, 1e-9);
+  reported[0].pos = {3.5, 2.0};
+  EXPECT_NEAR(gate.clearSpeed({reading, reported, emptyMap(), {}, false}, 0.8, b).speed, 0.4 - 0.35, 1e-9)
+      << "a robot 0.8 m beyond the reading is not what the laser hit";
+}
+
 TEST(MotionGate, ARobotInTheWayIsNamedByTheNearestKnownRobot) {
   const MotionGate gate(params());
   const Perception seen = perception({}, {{SeenKind::kRobot, {0.8, 0.1}, 0.3, {}}});

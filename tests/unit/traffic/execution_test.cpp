@@ -68,6 +68,25 @@ TEST(Execution, AFollowerEntersOnlyAfterTheLeaderHasLeft) {
   EXPECT_TRUE(ex.waitingOn(1).empty());
 }
 
+// The planner moves a robot aside and back onto its node ([0 1 4 3 0 1 2]); a base that passes a
+// node twice made the agent take it as driven (its node at both ends) and stand for good.
+TEST(Execution, ABaseNeverPassesANodeTwice) {
+  const Graph g = grid(3, 2);  // 0 1 2 / 3 4 5
+  const std::vector<NodeId> start{0};
+  Execution ex(g, start, ReleaseOptions{10.0, 12, 8});
+  for (const NodeId v : {1, 4, 3, 0, 1, 2})
+    ex.append(std::vector<NodeId>{v});
+  const auto first = ex.release(0);
+  EXPECT_EQ(first.base, (std::vector<NodeId>{0, 1, 4, 3}));
+  EXPECT_TRUE(first.horizon.empty()) << "the horizon stops where it comes back too";
+  // Once the robot has left 0 the way back to it is released, up to 1, which comes again.
+  EXPECT_EQ(ex.reached(0, 1), Report::Accepted);
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{1, 4, 3, 0}));
+  EXPECT_EQ(ex.reached(0, 0), Report::Accepted);
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{0, 1, 2}));
+  EXPECT_EQ(ex.reached(0, 2), Report::Accepted);
+}
+
 TEST(Execution, RefusedStepsNameTheRobotsAndChangeNothing) {
   const Graph g = grid(3, 3);
   Execution ex(g, std::vector<NodeId>{0, 1});
