@@ -95,6 +95,9 @@ struct Builder {
     return static_cast<NodeId>(pos.size() - 1);
   }
   [[nodiscard]] bool fits(Vec2 p) const { return site::discFits(grid, p, opt.radius); }
+  [[nodiscard]] bool latticeFits(Vec2 p) const {
+    return site::discFits(grid, p, opt.radius + opt.nodeClearance);
+  }
   [[nodiscard]] bool sweeps(Vec2 a, Vec2 b) const { return site::segmentFits(grid, a, b, opt.radius); }
   void problem(RoadmapProblem::Severity sev, const std::string& station, Vec2 p, const std::string& what) {
     problems.push_back({sev, station, p, what});
@@ -156,7 +159,7 @@ struct Builder {
     };
     for (int b = 0; b < hh; b += 2) {
       for (int a = 0; a < hw; a += 2) {
-        if (fits(point(a, b))) {
+        if (latticeFits(point(a, b))) {
           id[static_cast<std::size_t>(b * hw + a)] = add(point(a, b), NodeKind::Lane);
         }
       }
@@ -166,10 +169,10 @@ struct Builder {
       for (int a = 0; a < hw; a += 2) {
         const bool right = a + 2 < hw && at(a, b) == kNoNode && at(a + 2, b) == kNoNode;
         const bool up = b + 2 < hh && at(a, b) == kNoNode && at(a, b + 2) == kNoNode;
-        if (right && fits(point(a + 1, b))) {
+        if (right && latticeFits(point(a + 1, b))) {
           filled.emplace_back(a + 1, b);
         }
-        if (up && fits(point(a, b + 1))) {
+        if (up && latticeFits(point(a, b + 1))) {
           filled.emplace_back(a, b + 1);
         }
       }
@@ -435,10 +438,11 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   const auto& in = options;
   if (!(in.cruiseSpeed > 0.0) || in.spacing < 0.0 || (in.spacing > 0.0 && in.spacing < 0.05) ||
       !(in.targetSpacing >= 0.05) || in.radius < 0.0 || in.stopGap < 0.0 || in.corridorSlack < 0.0 ||
-      in.margin < 0.0 || in.queueLength < 0 || in.queueLength > 50 || in.followingDistance < 0.0) {
+      in.nodeClearance < 0.0 || in.margin < 0.0 || in.queueLength < 0 || in.queueLength > 50 ||
+      in.followingDistance < 0.0) {
     throw std::invalid_argument(
         "RoadmapOptions: cruiseSpeed > 0, spacing 0 or >= 0.05 m, targetSpacing >= 0.05 m, radius, stopGap, "
-        "corridorSlack, margin and followingDistance >= 0, queueLength 0..50");
+        "corridorSlack, nodeClearance, margin and followingDistance >= 0, queueLength 0..50");
   }
   Builder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}};
   auto& o = b.opt;

@@ -51,8 +51,12 @@ struct RoadmapOptions {
   /// to another robot in reserved traffic (0.25 m, services/robot_agent GateParams::robotStopGap)
   /// plus 1 s of headway at the 0.05 m/s below which it counts as held.
   double stopGap = 0.30;
-  double corridorSlack = 0.05;     ///< the gate's corridor is 2·radius + this wide, each side
-  double margin = 0.1;             ///< m of tracking error of the two robots together
+  double corridorSlack = 0.05;  ///< the gate's corridor is 2·radius + this wide, each side
+  double margin = 0.1;          ///< m of tracking error of the two robots together
+  /// m of free space a lattice node keeps around the robot's disc (edges need only the disc): a
+  /// robot stops a few centimetres off its node, and one stopped that close to a shelf corner its
+  /// route leads past is held there by the stop rule for good.
+  double nodeClearance = 0.1;
   int queueLength = 3;             ///< generated queue nodes per station (pickup, drop-off, charger)
   double followingDistance = 0.0;  ///< m between generated queue nodes; 0: the `ahead` separation
 };
