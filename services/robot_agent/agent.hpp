@@ -34,6 +34,7 @@
 #include "fleet/avoidance/local_planner.hpp"
 #include "fleet/avoidance/risk_stepping.hpp"
 #include "fleet/avoidance/safety_layer.hpp"
+#include "fleet/control/cruise.hpp"
 #include "fleet/control/path_follower.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/planning/lane_map.hpp"
@@ -61,13 +62,13 @@ struct AgentParams {
   Pose2 start;
   double radius = 0.3;
   double wheelBase = 0.4;
-  double vMax = 0.8;             // m/s cruise
-  double wMax = 1.5;             // rad/s
-  double stopGap = 0.35;         // m of free space kept ahead at standstill
-  double robotStopGap = 0.25;    // the same to another robot, in reserved traffic (GateParams)
-  double headway = 1.0;          // s: the stop distance grows with speed
-  double blockedBackoffS = 4.0;  // standoff time before the larger id backs off
-  double blockedFailS = 60.0;    // a task held in a standoff this long fails
+  double vMax = 0.8;                                  // m/s cruise
+  double wMax = 1.5;                                  // rad/s
+  double stopGap = 0.35;                              // m of free space kept ahead at standstill
+  double robotStopGap = control::kAgentRobotStopGap;  // the same to another robot, in reserved traffic
+  double headway = 1.0;                               // s: the stop distance grows with speed
+  double blockedBackoffS = 4.0;                       // standoff time before the larger id backs off
+  double blockedFailS = 60.0;                         // a task held in a standoff this long fails
   /// One notion of "wants to progress and cannot" for every local planner (robot_agent --config,
   /// "progress"; docs/algorithms.md, "Progress watch").
   ProgressParams progress;

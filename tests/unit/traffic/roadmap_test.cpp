@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -253,6 +254,34 @@ TEST(Roadmap, RosWarehouseLatticeLiesOnItsAisleCentresToo) {
   EXPECT_NEAR(r.options.spacing, 0.5, 1e-9);
   EXPECT_NEAR(std::remainder(r.latticeOrigin.x - 0.25, 0.5), 0.0, 1e-6);
   EXPECT_NEAR(std::remainder(r.latticeOrigin.y - 0.25, 0.5), 0.0, 1e-6);
+}
+
+// Lane nodes keep nodeClearance around the disc: robots stop a few centimetres off their node, and
+// beside a shelf corner (5.4 cm on the small warehouse's diagonals) the stop rule then held them.
+TEST(Roadmap, LaneNodesKeepTheirClearanceFromShelves) {
+  const auto s = shipped("small_warehouse.site.json");
+  const auto g = s.drivable();
+  auto tight = [&](const Roadmap& r) {
+    std::size_t n = 0;
+    for (NodeId v = 0; v < static_cast<NodeId>(r.graph.size()); ++v) {
+      n += r.kind(v) == NodeKind::Lane && !site::discFits(g, r.graph.position(v), 0.3 + 0.1) ? 1 : 0;
+    }
+    return n;
+  };
+  const Roadmap r = buildRoadmap(s);
+  EXPECT_NEAR(r.options.nodeClearance, 0.1, 1e-12);
+  EXPECT_EQ(tight(r), 0U);
+  RoadmapOptions o;
+  o.nodeClearance = 0.0;
+  const Roadmap before = buildRoadmap(s, o);
+  EXPECT_GT(tight(before), 0U) << "without it the lattice has nodes beside shelf corners";
+  EXPECT_LT(r.graph.size(), before.graph.size());
+  EXPECT_TRUE(r.problems.empty() ||
+              std::none_of(r.problems.begin(), r.problems.end(),
+                           [](const auto& p) { return p.severity == RoadmapProblem::Severity::Error; }))
+      << "every station still connected";
+  o.nodeClearance = -0.1;
+  EXPECT_THROW(buildRoadmap(s, o), std::invalid_argument);
 }
 
 TEST(Roadmap, EveryNodeAndEdgeFitsTheRobotsDisc) {

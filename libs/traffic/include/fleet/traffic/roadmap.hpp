@@ -48,9 +48,9 @@ struct RoadmapOptions {
   double radius = 0.0;         ///< m; 0: the site's robot
   double cruiseSpeed = control::kAgentCruiseSpeed;  ///< m/s: the robot agent's cruise speed
   /// Free space (m) the motion gate needs ahead of a driving robot not to hold it: its stop gap
-  /// to another robot in reserved traffic (0.25 m, services/robot_agent GateParams::robotStopGap)
-  /// plus 1 s of headway at the 0.05 m/s below which it counts as held.
-  double stopGap = 0.30;
+  /// to another robot in reserved traffic (control::kAgentRobotStopGap) plus 1 s of headway at the
+  /// 0.05 m/s below which it counts as held.
+  double stopGap = control::kAgentRobotStopGap + 0.05;
   double corridorSlack = 0.05;  ///< the gate's corridor is 2·radius + this wide, each side
   double margin = 0.1;          ///< m of tracking error of the two robots together
   /// m of free space a lattice node keeps around the robot's disc (edges need only the disc): a
