@@ -1074,10 +1074,10 @@ int Run::run() {
       const auto& c = m["conduct"];
       std::snprintf(line, sizeof line,
                     "%s conduct: %d standoffs (%d on a robot itself waiting: wait cycles), %d back-offs, %d "
-                    "returns along the trail, %d detours, %d local-planner recoveries",
+                    "returns along the trail, %d detours, %d local-planner recoveries, %d rejoins of a node",
                     m.value("id", std::string("?")).c_str(), c.value("standoffs", 0),
                     c.value("wait_cycles", 0), c.value("backoffs", 0), c.value("returns", 0),
-                    c.value("detours", 0), c.value("planner_recoveries", 0));
+                    c.value("detours", 0), c.value("planner_recoveries", 0), c.value("rejoins", 0));
       say(line);
     }
   }

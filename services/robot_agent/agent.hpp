@@ -168,6 +168,16 @@ class Agent {
   [[nodiscard]] const ReleaseCounts& releases() const { return releases_.counts(); }
   /// The last roadmap node reached (-1 before any release).
   [[nodiscard]] std::int32_t trafficNode() const { return releases_.node(); }
+  /// Reserved traffic: why the robot stands with a task (what last stopped it), and since when
+  /// [ns] it has not got 0.1 m further; sinceNs < 0: it has nothing to do. For the operator's
+  /// log: a robot that stands for minutes without reporting itself blocked has the traffic manager
+  /// waiting on it, and only the robot knows why.
+  struct Standing {
+    std::string why;
+    std::int64_t sinceNs = -1;
+    std::optional<Vec2> next;  ///< the next base node, if one is released
+  };
+  [[nodiscard]] const Standing& standingStill() const { return standing_; }
 
   /// What the robot did about being blocked (cumulative), for tests and the service's counters.
   struct Conduct {
@@ -180,6 +190,8 @@ class Agent {
     /// and it recovered: after a sampling planner's local minimum (turning in place at a corner) the
     /// path follower drove for a while; a stalled return ended; a stalled follower re-planned.
     std::uint64_t plannerRecoveries = 0;
+    /// Reserved traffic: stuck off its node, it drove back onto it before going on.
+    std::uint64_t rejoins = 0;
   };
   [[nodiscard]] const Conduct& conduct() const { return conduct_; }
 
@@ -306,9 +318,12 @@ class Agent {
 
   // Reserved traffic.
   bool reserved_ = false;
-  ReleaseTracker releases_;             // what may be driven, the last node reached
-  std::uint64_t followedRevision_ = 0;  // the release the follower's path was built from
-  std::vector<Vec2> basePath_;          // ... that path (from where the robot was then)
+  ReleaseTracker releases_;                  // what may be driven, the last node reached
+  std::uint64_t followedRevision_ = 0;       // the release the follower's path was built from
+  std::vector<Vec2> basePath_;               // ... that path (from where the robot was then)
+  std::optional<std::int32_t> turnsBackAt_;  // ... which stops at this node, where the base turns back
+  bool rejoining_ = false;  // ... which leads back onto the node it last reached (off it, stuck)
+  bool rejoined_ = false;   // ... and it is there: the base from there
   std::vector<Vec2>
       gateRoute_;            // the base ahead, for the gate's stop rule (empty: reactive, straight corridor)
   bool baseAhead_ = false;   // driving along the base this cycle (progress watch)
@@ -319,6 +334,9 @@ class Agent {
   std::int64_t heldSinceNs_ = -1;  // the gate has held the robot since (a person, ...)
   Vec2 heldAt_;                    // ... here
   bool blocked_ = false;           // ... for more than a second
+  Standing standing_;
+  Vec2 standAt_;          // where the robot began standing
+  std::string standWhy_;  // this cycle's reason for a zero command (reserved traffic)
   std::optional<msg::TrafficProgress> lastProgress_;  // the last report sent
 };
 

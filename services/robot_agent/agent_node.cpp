@@ -225,6 +225,7 @@ Agent::Conduct AgentNode::conduct() const {
     c.returns += a->conduct().returns;
     c.detours += a->conduct().detours;
     c.plannerRecoveries += a->conduct().plannerRecoveries;
+    c.rejoins += a->conduct().rejoins;
   }
   return c;
 }
@@ -268,7 +269,8 @@ nlohmann::json AgentNode::statsJson() const {
   m["samples"] = rejections_.toJson();
   m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
                   {"backoffs", c.backoffs},   {"returns", c.returns},
-                  {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries}};
+                  {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries},
+                  {"rejoins", c.rejoins}};
   m["localization"] = {{"line_updates", settings_.lineUpdates},
                        {"scans", ls.scans},
                        {"skipped_no_lines", ls.scansNoLines},

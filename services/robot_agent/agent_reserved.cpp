@@ -73,6 +73,25 @@ constexpr double kStanding = 0.05;
 constexpr double kMisaligned = 0.2;
 constexpr double kAligned = 0.05;
 
+/// A base that turns by more than this [rad] at a node (back along the lane beside it, or round a
+/// 135° corner) is followed up to that node, where the robot stops, and on from there once it has
+/// reported it (ReleaseTracker::aheadToTurnBack). Given the whole base, the path follower took the
+/// way back for the way out: in a full-stack run (seed 2, session 22) a robot 0.3 m off its node
+/// got [1144 1143 360 359], out along a queue and back on the lane beside it, took it for driven
+/// and stood for good with the traffic manager waiting for it to report 1143.
+constexpr double kTurnBack = 2.0;
+
+/// Standing this far [m] off the node it last reached (more than the reach tolerance), held by a
+/// static obstacle or by its own planner for kBlockedAfterS, the robot drives back onto the node
+/// before it goes on. Its straight way from there to the next node is no roadmap edge: from 0.28 m
+/// off its node in the gap between two shelves, a robot's way to a parking place's approach
+/// passed a shelf corner 0.29 m off (less than its radius) and the stop rule held it for good
+/// (2,100 s, and five robots behind it; full stack, seed 3, session 22).
+constexpr double kRejoinOff = 0.15;
+constexpr const char* kWhyObstacle = "held by an obstacle";
+constexpr const char* kWhyOwnZero = "driving without getting on";
+constexpr const char* kWhyStand = "commanded to stand";
+
 /// The gate's stop rule looks this far along the base [m] (more than the stopping distance plus
 /// the gap at cruise).
 constexpr double kGateRoute = 3.0;
@@ -173,12 +192,32 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
     return;
   }
   driveBase(nowNs, dt, v, w, mode);
+  // Standing is not getting on (the progress watch's movedM): a planner turning this way and that
+  // in front of a person stands as much as a robot told to.
+  const Vec2 here = localizer_.pose().position();
+  if (!tasks_.busy() || (standing_.sinceNs >= 0 && distance(here, standAt_) > progress_.params().movedM)) {
+    standing_ = {};
+  }
+  if (!tasks_.busy()) {
+    return;
+  }
+  if (standing_.sinceNs < 0) {
+    standing_.sinceNs = nowNs;
+    standAt_ = here;
+  }
+  if (!standWhy_.empty()) {
+    standing_.why = standWhy_;  // the latest (a hold can change hands while the robot stands)
+  } else if (standing_.why.empty()) {
+    standing_.why = std::abs(v) > 1e-9 || std::abs(w) > 1e-9 ? kWhyOwnZero : kWhyStand;
+  }
+  standing_.next = releases_.next();
 }
 
 void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
+  standWhy_.clear();
   const Pose2 pose = localizer_.pose();
   const Vec2 here = pose.position();
-  if (releases_.advance(here)) {
+  if (releases_.advance(here) || (std::abs(v_) < kStanding && releases_.arriveWhereItStands(here))) {
     progress_.newGoal();  // progress is measured to the next node from now on
   }
   const auto goal = trafficGoal();
@@ -191,7 +230,8 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   // Standing (at the end of the base, on the goal, or with nothing released): waiting on the
   // traffic manager, which is waiting on other robots; nothing holds it up.
   mode = !tasks_.busy() ? msg::RobotMode::Idle : msg::RobotMode::Waiting;
-  auto standStill = [&] {
+  auto standStill = [&](const char* why) {
+    standWhy_ = why;
     aligning_ = false;
     v = 0.0;
     w = 0.0;
@@ -199,7 +239,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     blocked_ = false;
   };
   if (toGoal && distance(here, goal->pose.position()) < kAtGoal) {
-    standStill();
+    standStill("on its goal");
     dockingLeg_ = false;
     standsAt_ = goal->pose;
     if (tasks_.busy() && tasks_.phase() == Phase::Driving) {
@@ -207,20 +247,41 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     }
     return;
   }
-  const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath();
+  // On the node where the way it follows turned back: the rest of the base from there.
+  const bool pastTurnBack = turnsBackAt_ && releases_.node() == *turnsBackAt_;
+  // Off its node and standing for nothing the plan knows of (a static obstacle, or its own zero):
+  // back to the node first, then along the roadmap's edge, which clears the shelves.
+  const auto own = releases_.at();
+  const bool rejoin =
+      !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
+      standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kBlockedAfterS &&
+      (standing_.why == kWhyObstacle || standing_.why == kWhyOwnZero || standing_.why == kWhyStand);
+  const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
+                          rejoin || rejoined_;
   if (!releases_.nodesAhead() && newRelease) {
-    standStill();  // nothing released beyond the node it is on
+    standStill("nothing released beyond its node");
     return;
   }
   if (newRelease) {
-    std::vector<Vec2> pts = releases_.ahead(here);
-    if (toGoal) {
+    auto way = releases_.aheadToTurnBack(here, kTurnBack);
+    std::vector<Vec2> pts = std::move(way.points);
+    turnsBackAt_ = way.turnsBackAt;
+    rejoining_ = rejoin;
+    if (rejoined_) {
+      aligning_ = true;  // back on its node: face the next one on the spot, then drive the edge
+    }
+    rejoined_ = false;
+    if (rejoining_) {
+      pts = {here, *own};
+      turnsBackAt_.reset();
+      ++conduct_.rejoins;
+    } else if (toGoal && !turnsBackAt_) {
       pts.back() = goal->pose.position();  // dock on the goal's pose itself
     }
     const Vec2 last = pts.back() - pts[pts.size() - 2];
     const double heading = last.norm() > 1e-6 ? std::atan2(last.y, last.x) : pose.theta;
     if (!follower_.setPath(pts, heading)) {
-      standStill();
+      standStill("the base is no path to follow");
       return;
     }
     basePath_ = pts;
@@ -230,7 +291,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   }
   const auto r = follower_.step(pose);
   if (!r) {
-    standStill();  // a non-finite estimate: nothing sensible to drive
+    standStill("no pose estimate to follow the base with");
     return;
   }
   const double left = follower_.pathLength() - r->progress;
@@ -239,11 +300,15 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   // At the end, or the end no longer ahead of the robot: turning round for the last centimetres
   // would sweep the body over what was not released.
   if (left < kAtEnd || (r->finalApproach && toEnd.norm() < kAtGoal && toEnd.dot(facing) < kAtEnd)) {
-    standStill();
+    if (rejoining_) {
+      rejoining_ = false;
+      rejoined_ = true;  // back on its node: the base from here next cycle
+    }
+    standStill("at the end of its base");
     return;
   }
   baseAhead_ = true;
-  docking_ = dockingLeg_ && r->finalApproach;
+  docking_ = dockingLeg_ && r->finalApproach && !rejoining_;
   if (undockFrom_ && distance(here, *undockFrom_) > kLeaveDistance) {
     undockFrom_.reset();
   }
@@ -341,6 +406,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
                                                          [&](const Other& o) { return o.id == blocker.id; });
   if (held) {
     mode = msg::RobotMode::Waiting;
+    standWhy_ = blocker.robot        ? "held by robot " + blocker.id + (byKnownRobot ? "" : " (unknown)")
+                : blocker.id.empty() ? std::string(kWhyObstacle)
+                                     : "held by " + blocker.id;
   }
   // A hold lasts until the robot has got on: a sampling planner turning this way and that in front
   // of a person is not held every cycle, and a blocked flag that flapped with it would have the

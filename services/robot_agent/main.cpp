@@ -162,6 +162,26 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     }
   };
 
+  // Reserved traffic: a robot standing with its task this long [s] is logged (and again as often),
+  // with why it stands. The traffic manager logs whom it waits on; this is the robot's side.
+  constexpr double kStandingWarnS = 60.0;
+  std::vector<std::int64_t> standWarnedNs(node.size(), -1);
+  auto warnStanding = [&](std::size_t i, std::int64_t now) {
+    const auto& a = node.agent(i);
+    const auto& st = a.standingStill();
+    if (st.sinceNs < 0 || nsToSec(now - st.sinceNs) < kStandingWarnS ||
+        (standWarnedNs[i] >= st.sinceNs && nsToSec(now - standWarnedNs[i]) < kStandingWarnS)) {
+      return;
+    }
+    standWarnedNs[i] = now;
+    const Pose2 pose = a.perception().pose;
+    logging::ScopedField robotField("robot", a.id());
+    spdlog::warn(
+        "{}: standing for {:.0f} s with its task at ({:.2f}, {:.2f}, {:.2f} rad), node {}, next {}: {}",
+        a.id(), nsToSec(now - st.sinceNs), pose.x, pose.y, pose.theta, a.trafficNode(),
+        st.next ? fmt::format("({:.2f}, {:.2f})", st.next->x, st.next->y) : std::string("none"), st.why);
+  };
+
   double dt = world.dt;
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
@@ -195,6 +215,9 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
       }
       if (out.traffic && trafficProgress) {
         trafficProgress->write(*out.traffic);
+      }
+      if (node.agent(i).reserved()) {
+        warnStanding(i, now);
       }
       if (out.people && peopleSeen) {
         peopleSeen->write(*out.people);

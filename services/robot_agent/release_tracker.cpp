@@ -130,6 +130,30 @@ bool ReleaseTracker::advance(Vec2 here) {
   return false;
 }
 
+bool ReleaseTracker::arriveWhereItStands(Vec2 here) {
+  if (!nodesAhead() || distance(here, base_[reached_].at) < p_.reachTolerance) {
+    return false;
+  }
+  for (std::size_t k = base_.size() - 1; k > reached_; --k) {
+    if (base_[k].id != node_ && distance(here, base_[k].at) < p_.reachTolerance) {
+      reached_ = k;
+      node_ = base_[k].id;
+      progress_ = arc_[k];
+      beyondEnd_ = 0.0;
+      ++revision_;  // the way from here is what follows node k
+      return true;
+    }
+  }
+  return false;
+}
+
+std::optional<Vec2> ReleaseTracker::at() const {
+  if (!have_ || base_.empty()) {
+    return std::nullopt;
+  }
+  return base_[reached_].at;
+}
+
 std::optional<Vec2> ReleaseTracker::next() const {
   if (!nodesAhead()) {
     return std::nullopt;
@@ -180,6 +204,30 @@ std::vector<Vec2> ReleaseTracker::ahead(Vec2 here) const {
     }
   }
   return pts;
+}
+
+ReleaseTracker::Way ReleaseTracker::aheadToTurnBack(Vec2 here, double reversal) const {
+  Way way;
+  way.points.push_back(here);
+  std::int32_t lastId = 0;
+  for (std::size_t k = reached_ + 1; k < base_.size(); ++k) {
+    if (arc_[k] > progress_ + 0.05 || k + 1 == base_.size()) {
+      const std::size_t n = way.points.size();
+      if (n >= 2) {
+        // The turn at the last point taken, between the legs into it and out of it.
+        const Vec2 in = way.points[n - 1] - way.points[n - 2];
+        const Vec2 out = base_[k].at - way.points[n - 1];
+        if (in.norm() > 1e-9 && out.norm() > 1e-9 &&
+            std::acos(std::clamp(in.dot(out) / (in.norm() * out.norm()), -1.0, 1.0)) > reversal) {
+          way.turnsBackAt = lastId;
+          return way;
+        }
+      }
+      way.points.push_back(base_[k].at);
+      lastId = base_[k].id;
+    }
+  }
+  return way;
 }
 
 }  // namespace fleet::agent

@@ -76,6 +76,15 @@ class ReleaseTracker {
   /// Marks the base nodes the robot at `here` has reached, in order (reaching a node implies the
   /// ones before it). True when the last reached node changed.
   bool advance(Vec2 here);
+  /// The robot stands on a later base node's spot, off the node it last reported: it was held off
+  /// its node (a person in the way) and the traffic manager, which still places it on that node,
+  /// routed it round a loop back to where it stands. It is there: marks that node (the last such)
+  /// reached. Left to drive the loop, the path follower projected the robot onto the loop's last
+  /// leg and saw the base driven, and the robot stood without reporting the node, the traffic
+  /// manager waiting on a robot that waited on nothing (the whole fleet stood in one run). Not
+  /// on its own node's spot only: a base [A, B, C, A] from A still has to be driven. True when it
+  /// marked a node.
+  bool arriveWhereItStands(Vec2 here);
 
   [[nodiscard]] bool hasRelease() const { return have_; }
   [[nodiscard]] std::uint32_t epoch() const { return epoch_; }
@@ -86,6 +95,8 @@ class ReleaseTracker {
   [[nodiscard]] bool endsAtGoal() const { return endsAtGoal_; }
   /// Base nodes after the last one reached (none: nothing to drive until the next release).
   [[nodiscard]] bool nodesAhead() const { return have_ && reached_ + 1 < base_.size(); }
+  /// Where the last node reached is, if any.
+  [[nodiscard]] std::optional<Vec2> at() const;
   /// The next base node to reach, if any.
   [[nodiscard]] std::optional<Vec2> next() const;
   /// The base's last node, if any.
@@ -103,6 +114,16 @@ class ReleaseTracker {
   [[nodiscard]] std::optional<Turn> nextTurn(double angle) const;
   /// The way to drive: `here`, then the base nodes not yet passed.
   [[nodiscard]] std::vector<Vec2> ahead(Vec2 here) const;
+  struct Way {
+    std::vector<Vec2> points;  ///< `here`, then base nodes
+    std::optional<std::int32_t>
+        turnsBackAt;  ///< the node the way stops at, where the base turns back (none: its end)
+  };
+  /// ahead(), up to the first node where the base turns by more than `reversal` [rad] (that node
+  /// included). A base that turns back runs beside itself (out along a queue and back along the
+  /// lane next to it): a path follower projecting the robot onto the nearest leg within its window
+  /// takes the way back for the way out and the base for driven.
+  [[nodiscard]] Way aheadToTurnBack(Vec2 here, double reversal) const;
   [[nodiscard]] const ReleaseCounts& counts() const { return counts_; }
 
  private:

@@ -109,7 +109,8 @@ std::vector<std::string> untilDoneArgs(const std::string& scenario, const fs::pa
 }
 
 /// An 8-robot, kFaultRunS load test with `faults`; its loadtest.json (empty when the run failed).
-json runWithFaults(const fs::path& out, std::initializer_list<const char*> faults) {
+json runWithFaults(const fs::path& out, std::initializer_list<const char*> faults,
+                   std::initializer_list<const char*> extra = {}) {
   fs::remove_all(out);
   auto args = baseArgs(out, 8, kFaultRunS);
   // 5 % packet loss runs at ~1.3x real time here: room for a slower machine within the ctest timeout.
@@ -118,6 +119,7 @@ json runWithFaults(const fs::path& out, std::initializer_list<const char*> fault
     args.push_back("--fault");
     args.push_back(f);
   }
+  args.insert(args.end(), extra.begin(), extra.end());
   fleet::test::ChildProcess run(kFleetctl, args);
   if (run.wait(std::chrono::seconds(280)) != 0) {
     return json();
@@ -206,6 +208,31 @@ TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
   EXPECT_NE(events.find("SIGCONT"), std::string::npos) << events;
   // Under 5 % packet loss for the whole run, and after the stalled robot went on.
   expectTasksDoneAfter(r, out / "fleet.db", {"SIGCONT"});
+  EXPECT_EQ(processesMentioning(out.string()), 0);
+}
+
+TEST(LoadtestE2E, ReservedTrafficThroughEveryFaultNoTaskLostOrDuplicated) {
+  // The process faults in one run with the traffic manager planning every robot (issue 18, before
+  // reserved traffic can become the default): the manager and an agent process killed and
+  // restarted, robot r3's agent frozen for 5 s. The traffic manager holds the frozen or restarting
+  // robots where they are and plans round them. (With 5 % of the DDS packets dropped as well it
+  // passed too, in 180 s of wall time against ~60: left to the reactive test above.)
+  const fs::path out =
+      fs::path(::testing::TempDir()) / ("loadtest-reserved-faults-" + std::to_string(getpid()));
+  const json r = runWithFaults(out, {"kill-manager@15+1", "kill-agent@30+1:1", "stall:r3@20+5"},
+                               {"--traffic", "reserved"});
+  ASSERT_FALSE(r.is_null()) << "see " << out;
+  EXPECT_EQ(r["db_error"], "");
+  expectEveryTaskAccountedFor(r);
+  const std::string events = faultEvents(r);
+  for (const char* e :
+       {"SIGKILL fleet_manager\n", "SIGKILL agent-1\n", "restarted agent-1", "SIGSTOP", "SIGCONT"}) {
+    EXPECT_NE(events.find(e), std::string::npos) << e << " missing in\n" << events;
+  }
+  expectTasksDoneAfter(r, out / "fleet.db", {"restarted agent-1", "SIGCONT"});
+  const auto& c = r["safety"]["contacts"];
+  EXPECT_EQ(c["robot_robot"].get<int>() + c["robot_human"].get<int>() + c["robot_shelf"].get<int>(), 0)
+      << c.dump();
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
 

@@ -4,7 +4,8 @@
 // end, keeps going when the base is extended in time, reports every node it reaches, ignores
 // releases it must not follow, docks when the base ends at its goal, waits (and fails nothing)
 // without releases, reports itself blocked by a person, keeps to the released nodes round
-// corners, and drives off a corner node only once it faces the next node.
+// corners, drives off a corner node only once it faces the next node, reports the node whose spot
+// it was held on, and drives back onto its node when the straight way on passes a shelf corner.
 //
 // RESERVED_TRACE=1 prints the robot's pose, command, speed, mode and node every cycle.
 
@@ -83,6 +84,16 @@ struct Sim {
     auto grid = std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
     agent = std::make_unique<agent::Agent>(params, grid, grid);
     truth = params.start;
+  }
+
+  /// A new agent standing at `start` (on a free floor, or on `grid`).
+  void restartAt(Pose2 start, std::shared_ptr<const planning::OccupancyGrid> grid = nullptr) {
+    if (!grid) {
+      grid = std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+    }
+    params.start = start;
+    truth = start;
+    agent = std::make_unique<agent::Agent>(params, grid, grid);
   }
 
   [[nodiscard]] double now() const { return k * kDt; }
@@ -296,6 +307,11 @@ TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAf
   EXPECT_FALSE(sim.failed());
   const auto& c = sim.agent->conduct();
   EXPECT_EQ(c.standoffs + c.backoffs + c.returns + c.detours, 0u) << "reactive conduct in reserved traffic";
+  // What the service logs about a robot standing with its task: why, and since when.
+  const auto& standing = sim.agent->standingStill();
+  EXPECT_EQ(standing.why, "held by human");
+  EXPECT_NEAR(static_cast<double>(standing.sinceNs) * 1e-9, *heldAt, 1.0);
+  ASSERT_TRUE(standing.next.has_value());
   // The person walks away: the robot goes on to the end of its base and is no longer blocked.
   sim.people.clear();
   sim.run(25.0);
@@ -307,11 +323,7 @@ TEST_P(ReservedPlanner, FollowsABaseRoundCornersAndStaysOnIt) {
   // Behind the robot first (it turns on the spot), then along the lane, up and back along the lane
   // above: 0.5 m nodes, two right angles.
   Sim sim(GetParam());
-  sim.truth.theta = M_PI;
-  sim.params.start.theta = M_PI;
-  sim.agent = std::make_unique<agent::Agent>(
-      sim.params, std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}),
-      std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}));
+  sim.restartAt({sim.params.start.x, sim.params.start.y, M_PI});
   std::vector<Vec2> route;
   std::vector<msg::RouteNode> base = lane(0, 6);  // to (4, 5)
   for (int k = 1; k <= 4; ++k) {
@@ -423,6 +435,60 @@ TEST_P(ReservedPlanner, DrivesABaseThatEndsOnTheNodeItStandsOn) {
   }
 }
 
+TEST_P(ReservedPlanner, HeldOffItsNodeOnTheSpotItsNewBaseEndsOnItReportsThatNode) {
+  // As the whole fleet stood in a full-stack run (seed 3, session 22): a person stopped the robot
+  // 0.6 m off its node A, on the spot of a queue node Q; the traffic manager, still placing it on
+  // A, released a loop [A, B, C, D, Q] round to Q. The robot reports Q within a few seconds and
+  // stays where it is instead of standing there for good with the traffic manager waiting on it.
+  Sim sim(GetParam());
+  sim.restartAt({lane(0).x - 0.235, kY - 0.56, 2.58});  // as it stood, 6 cm from Q
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, {lane(0)}));
+  sim.run(2.0);
+  const msg::RouteNode q{200, lane(0).x - 0.25, kY - 0.5};
+  sim.agent->onRelease(release(2, {lane(0),
+                                   {101, lane(0).x + 0.5, kY - 0.5},
+                                   {102, lane(0).x + 1.0, kY - 0.5},
+                                   {103, lane(0).x + 0.75, kY - 0.5},
+                                   q}));
+  const Vec2 start = sim.truth.position();
+  double moved = 0.0;
+  while (sim.now() < 8.0) {
+    (void)sim.step();
+    moved = std::max(moved, distance(sim.truth.position(), start));
+  }
+  EXPECT_EQ(sim.lastNode(), 200);
+  EXPECT_LT(moved, 0.1);
+  EXPECT_EQ(sim.agent->standingStill().why, "nothing released beyond its node");
+}
+
+TEST_P(ReservedPlanner, OffItsNodeWithAShelfCornerInTheStraightWayItRejoinsThroughItsNode) {
+  // As r10 stood 2,100 s in a full-stack run (seed 3, session 22): 0.28 m off its node A in the
+  // gap between two shelves, its next node B (a parking place's approach) beyond a shelf corner
+  // that the straight way from where it stands passes 0.29 m off, less than its radius. The
+  // roadmap's edge A-B clears the corner; the robot goes back to A and drives the edge.
+  Sim sim(GetParam());
+  auto grid = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int cx = 4; cx < 16; ++cx) {     // x 1.0 .. 4.0
+    for (int cy = 10; cy < 14; ++cy) {  // y 2.5 .. 3.5
+      grid->setBlocked({cx, cy});
+    }
+  }
+  sim.restartAt({4.47, 2.76, -1.95}, grid);
+  sim.agent->onAssignment(order(kFarPickup));
+  const msg::RouteNode a{131, 4.75, 2.75};
+  const msg::RouteNode b{1075, 4.0, 1.9};
+  sim.agent->onRelease(release(1, {a, b}));
+  double closest = 1e9;  // to the shelf corner
+  while (sim.now() < 30.0 && sim.lastNode() != 1075) {
+    (void)sim.step();
+    closest = std::min(closest, distance(sim.truth.position(), {4.0, 2.5}));
+  }
+  EXPECT_EQ(sim.lastNode(), 1075);
+  EXPECT_GT(closest, sim.params.radius) << "touched the corner";
+  EXPECT_EQ(sim.agent->conduct().rejoins, 1u);
+}
+
 // Known to fail (docs/algorithms.md, "robot agent: reserved traffic", session 16): the release
 // tracker and the path follower project the robot onto the leg back into A and take the base as
 // driven. Projections that prefer the earlier leg fixed it here, but in the full stack robots then
@@ -431,11 +497,7 @@ TEST_P(ReservedPlanner, DISABLED_DrivesALoopBackToItsNodeFacingAway) {
   // As a robot stood 579 s in the full stack (seed 2): a little off its node, facing away from the
   // base [A, B, C, A] where C is beside B and the last leg a diagonal back to A.
   Sim sim(GetParam());
-  sim.params.start = {1.03, kY + 0.07, -2.77};
-  sim.truth = sim.params.start;
-  sim.agent = std::make_unique<agent::Agent>(
-      sim.params, std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}),
-      std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0}));
+  sim.restartAt({1.03, kY + 0.07, -2.77});
   sim.agent->onAssignment(order(kFarPickup));
   sim.agent->onRelease(release(1, {lane(0)}));
   sim.run(5.0);
