@@ -82,12 +82,14 @@ constexpr double kAligned = 0.05;
 constexpr double kTurnBack = 2.0;
 
 /// Standing this far [m] off the node it last reached (more than the reach tolerance), held by a
-/// static obstacle or by its own planner for kBlockedAfterS, the robot drives back onto the node
-/// before it goes on. Its straight way from there to the next node is no roadmap edge: from 0.28 m
-/// off its node in the gap between two shelves, a robot's way to a parking place's approach
-/// passed a shelf corner 0.29 m off (less than its radius) and the stop rule held it for good
-/// (2,100 s, and five robots behind it; full stack, seed 3, session 22).
+/// static obstacle for kRejoinAfterS [s], the robot drives back onto the node before it goes on. Its straight
+/// way from there to the next node is no roadmap edge: from 0.28 m off its node in the gap between two
+/// shelves, a robot's way to a parking place's approach passed a shelf corner 0.29 m off (less than its
+/// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed 3,
+/// session 22). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
+/// the one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
 constexpr double kRejoinOff = 0.15;
+constexpr double kRejoinAfterS = 10.0;
 constexpr const char* kWhyObstacle = "held by an obstacle";
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
@@ -249,13 +251,12 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   }
   // On the node where the way it follows turned back: the rest of the base from there.
   const bool pastTurnBack = turnsBackAt_ && releases_.node() == *turnsBackAt_;
-  // Off its node and standing for nothing the plan knows of (a static obstacle, or its own zero):
-  // back to the node first, then along the roadmap's edge, which clears the shelves.
+  // Off its node and held by a static obstacle: back to the node first, then along the roadmap's
+  // edge, which clears the shelves.
   const auto own = releases_.at();
-  const bool rejoin =
-      !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
-      standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kBlockedAfterS &&
-      (standing_.why == kWhyObstacle || standing_.why == kWhyOwnZero || standing_.why == kWhyStand);
+  const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
+                      standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
+                      standing_.why == kWhyObstacle;
   const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
                           rejoin || rejoined_;
   if (!releases_.nodesAhead() && newRelease) {
