@@ -395,8 +395,10 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   }
   const Vec2 toCarrot = r->target.position() - here;
   const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), pose.theta);
-  if (held && !blocker.robot && blocker.id.empty() && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
-    // A wall ahead while the base bends away: turn towards the carrot on the spot (as reactive).
+  if (held && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
+    // Something ahead while the way bends away from it: turn towards the carrot on the spot, which
+    // sweeps nothing. (Only for walls at first, as reactive: a robot 7 cm off its lane facing 24°
+    // towards a robot parked beside the lane stood 1,200 s, full stack, seed 4, session 22.)
     v = 0.0;
     w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
     held = false;

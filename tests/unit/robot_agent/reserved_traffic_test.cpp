@@ -66,6 +66,7 @@ struct Sim {
   std::uint32_t seq = 0;
   int k = 0;
   std::vector<Vec2> people;  // standing still where they are (map frame)
+  std::vector<Vec2> parked;  // other robots standing idle where they are (map frame), known by state
   std::vector<msg::TrafficProgress> reports;
   std::vector<double> reportX;  // the robot's true x at each report
   std::vector<msg::TaskStatus> statuses;
@@ -120,6 +121,19 @@ struct Sim {
       f.detections.push_back({msg::SourceKind::Human, static_cast<float>(c * rel.x + s * rel.y),
                               static_cast<float>(-s * rel.x + c * rel.y), 0.25f});
       minToPeople = std::min(minToPeople, rel.norm());
+    }
+    for (std::size_t i = 0; i < parked.size(); ++i) {
+      const Vec2 rel = parked[i] - truth.position();
+      const double c = std::cos(truth.theta);
+      const double s = std::sin(truth.theta);
+      f.detections.push_back({msg::SourceKind::Robot, static_cast<float>(c * rel.x + s * rel.y),
+                              static_cast<float>(-s * rel.x + c * rel.y), 0.3f});
+      msg::RobotState o;
+      o.robot_id = "p" + std::to_string(i + 1);
+      o.stamp_ns = static_cast<std::int64_t>(k) * 100'000'000;
+      o.pose = {parked[i].x, parked[i].y, M_PI_2};
+      o.radius = 0.3f;
+      agent->onOtherRobot(o);
     }
     agent->onFrame(f);
     auto out = agent->step(static_cast<std::int64_t>(k) * 100'000'000, kDt);
@@ -487,6 +501,22 @@ TEST_P(ReservedPlanner, OffItsNodeWithAShelfCornerInTheStraightWayItRejoinsThrou
   EXPECT_EQ(sim.lastNode(), 1075);
   EXPECT_GT(closest, sim.params.radius) << "touched the corner";
   EXPECT_EQ(sim.agent->conduct().rejoins, 1u);
+}
+
+TEST_P(ReservedPlanner, HeldByARobotBesideItsWayItTurnsToItsWayAndGoesOn) {
+  // As r8 stood 1,200 s in a full-stack run (seed 4, session 22): on the band in front of the
+  // parking row, 7 cm below its lane and facing 24° down towards a robot parked beside the lane,
+  // which its stop rule's corridor took in. The way on runs along the lane, clear of that robot:
+  // the robot turns on the spot to face its way and drives on.
+  Sim sim(GetParam());
+  sim.restartAt({lane(0).x, kY - 0.07, -0.42});
+  sim.parked = {{lane(0).x + 0.24, kY - 0.85}};
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, lane(0, 4)));
+  while (sim.now() < 20.0 && sim.lastNode() != 4) {
+    (void)sim.step();
+  }
+  EXPECT_EQ(sim.lastNode(), 4);
 }
 
 // Known to fail (docs/algorithms.md, "robot agent: reserved traffic", session 16): the release
