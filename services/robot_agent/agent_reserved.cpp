@@ -73,14 +73,6 @@ constexpr double kStanding = 0.05;
 constexpr double kMisaligned = 0.2;
 constexpr double kAligned = 0.05;
 
-/// A base that turns by more than this [rad] at a node (back along the lane beside it, or round a
-/// 135° corner) is followed up to that node, where the robot stops, and on from there once it has
-/// reported it (ReleaseTracker::aheadToTurnBack). Given the whole base, the path follower took the
-/// way back for the way out: in a full-stack run (seed 2, session 22) a robot 0.3 m off its node
-/// got [1144 1143 360 359], out along a queue and back on the lane beside it, took it for driven
-/// and stood for good with the traffic manager waiting for it to report 1143.
-constexpr double kTurnBack = 2.0;
-
 /// Standing this far [m] off the node it last reached (more than the reach tolerance), held by a
 /// static obstacle for kRejoinAfterS [s], the robot drives back onto the node before it goes on. Its straight
 /// way from there to the next node is no roadmap edge: from 0.28 m off its node in the gap between two
@@ -219,7 +211,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   standWhy_.clear();
   const Pose2 pose = localizer_.pose();
   const Vec2 here = pose.position();
-  if (releases_.advance(here) || (std::abs(v_) < kStanding && releases_.arriveWhereItStands(here))) {
+  if (releases_.advance(here)) {
     progress_.newGoal();  // progress is measured to the next node from now on
   }
   const auto goal = trafficGoal();
@@ -264,7 +256,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     return;
   }
   if (newRelease) {
-    auto way = releases_.aheadToTurnBack(here, kTurnBack);
+    auto way = releases_.aheadToTurnBack(here);
     std::vector<Vec2> pts = std::move(way.points);
     turnsBackAt_ = way.turnsBackAt;
     rejoining_ = rejoin;

@@ -80,11 +80,13 @@ bool ReleaseTracker::advance(Vec2 here) {
     return false;
   }
   const std::size_t n = base_.size();
+  // Not past a node where the base turns back before that node is reached (see turnBack).
+  const std::size_t last = firstTurnBack();
   double bestD2 = std::numeric_limits<double>::infinity();
   double bestS = progress_;
   double bestPerp = 0.0;
   double bestBeyond = 0.0;
-  for (std::size_t j = 0; j + 1 < n; ++j) {
+  for (std::size_t j = 0; j + 1 < n && j < last; ++j) {
     if (arc_[j + 1] < progress_ - 1e-9) {
       continue;  // behind the robot's progress
     }
@@ -109,14 +111,14 @@ bool ReleaseTracker::advance(Vec2 here) {
       bestS = arc_[j] + t;
       const Vec2 off = here - a;
       bestPerp = std::abs(off.x * u.y - off.y * u.x);
-      bestBeyond = j + 2 == n ? std::max(0.0, along - len) : 0.0;
+      bestBeyond = j + 2 == n ? std::max(0.0, along - len) : 0.0;  // (j + 1 == last then)
     }
   }
   progress_ = std::max(progress_, bestS);
   const double lateral = std::sqrt(bestD2);
   beyondEnd_ = bestBeyond;
   // The furthest node reached wins: reports may skip nodes, a skipped one was passed.
-  for (std::size_t k = n - 1; k > reached_; --k) {
+  for (std::size_t k = last; k > reached_; --k) {
     const bool close = distance(here, base_[k].at) < p_.reachTolerance &&
                        arc_[k] <= progress_ + 2.0 * p_.reachTolerance;  // (not a later visit of the spot)
     const bool passed = k + 1 < n ? progress_ > arc_[k] + 1e-6 && lateral < p_.passLateral
@@ -124,23 +126,6 @@ bool ReleaseTracker::advance(Vec2 here) {
     if (close || passed) {
       reached_ = k;
       node_ = base_[k].id;
-      return true;
-    }
-  }
-  return false;
-}
-
-bool ReleaseTracker::arriveWhereItStands(Vec2 here) {
-  if (!nodesAhead() || distance(here, base_[reached_].at) < p_.reachTolerance) {
-    return false;
-  }
-  for (std::size_t k = base_.size() - 1; k > reached_; --k) {
-    if (base_[k].id != node_ && distance(here, base_[k].at) < p_.reachTolerance) {
-      reached_ = k;
-      node_ = base_[k].id;
-      progress_ = arc_[k];
-      beyondEnd_ = 0.0;
-      ++revision_;  // the way from here is what follows node k
       return true;
     }
   }
@@ -206,25 +191,34 @@ std::vector<Vec2> ReleaseTracker::ahead(Vec2 here) const {
   return pts;
 }
 
-ReleaseTracker::Way ReleaseTracker::aheadToTurnBack(Vec2 here, double reversal) const {
-  Way way;
-  way.points.push_back(here);
-  std::int32_t lastId = 0;
-  for (std::size_t k = reached_ + 1; k < base_.size(); ++k) {
-    if (arc_[k] > progress_ + 0.05 || k + 1 == base_.size()) {
-      const std::size_t n = way.points.size();
-      if (n >= 2) {
-        // The turn at the last point taken, between the legs into it and out of it.
-        const Vec2 in = way.points[n - 1] - way.points[n - 2];
-        const Vec2 out = base_[k].at - way.points[n - 1];
-        if (in.norm() > 1e-9 && out.norm() > 1e-9 &&
-            std::acos(std::clamp(in.dot(out) / (in.norm() * out.norm()), -1.0, 1.0)) > reversal) {
-          way.turnsBackAt = lastId;
-          return way;
-        }
+std::size_t ReleaseTracker::firstTurnBack() const {
+  for (std::size_t k = reached_ + 1; k + 1 < base_.size(); ++k) {
+    const Vec2 in = base_[k].at - base_[k - 1].at;
+    const Vec2 out = base_[k + 1].at - base_[k].at;
+    if (in.norm() > 1e-9 && out.norm() > 1e-9 &&
+        std::acos(std::clamp(in.dot(out) / (in.norm() * out.norm()), -1.0, 1.0)) > p_.turnBack) {
+      return k;
+    }
+  }
+  return base_.empty() ? 0 : base_.size() - 1;
+}
+
+ReleaseTracker::Way ReleaseTracker::aheadToTurnBack(Vec2 here) const {
+  Way way{ahead(here), std::nullopt};
+  if (!nodesAhead()) {
+    return way;
+  }
+  const std::size_t stop = firstTurnBack();
+  if (stop + 1 < base_.size()) {
+    // ahead() leaves out nodes already passed; the turn-back node is not passed (advance() stops
+    // there), so it is in the way: cut after it.
+    const Vec2 at = base_[stop].at;
+    for (std::size_t i = 1; i < way.points.size(); ++i) {
+      if (distance(way.points[i], at) < 1e-9) {
+        way.points.resize(i + 1);
+        way.turnsBackAt = base_[stop].id;
+        break;
       }
-      way.points.push_back(base_[k].at);
-      lastId = base_[k].id;
     }
   }
   return way;

@@ -42,6 +42,11 @@ struct ReleaseParams {
   /// The projection on the base looks this far past the robot's progress [m], so a base that comes
   /// back past where it went (into a station spur and out) does not skip the spur.
   double searchWindow = 1.0;
+  /// A node where the base turns by more than this [rad] (back along the lane beside it, or round a
+  /// 135° corner) ends the way to drive (aheadToTurnBack) and the projection until it is reached:
+  /// past it the base runs back beside itself, and the nearest point of a robot on the way out can
+  /// lie on the way back.
+  double turnBack = 2.0;
 };
 
 enum class ReleaseVerdict {
@@ -76,15 +81,6 @@ class ReleaseTracker {
   /// Marks the base nodes the robot at `here` has reached, in order (reaching a node implies the
   /// ones before it). True when the last reached node changed.
   bool advance(Vec2 here);
-  /// The robot stands on a later base node's spot, off the node it last reported: it was held off
-  /// its node (a person in the way) and the traffic manager, which still places it on that node,
-  /// routed it round a loop back to where it stands. It is there: marks that node (the last such)
-  /// reached. Left to drive the loop, the path follower projected the robot onto the loop's last
-  /// leg and saw the base driven, and the robot stood without reporting the node, the traffic
-  /// manager waiting on a robot that waited on nothing (the whole fleet stood in one run). Not
-  /// on its own node's spot only: a base [A, B, C, A] from A still has to be driven. True when it
-  /// marked a node.
-  bool arriveWhereItStands(Vec2 here);
 
   [[nodiscard]] bool hasRelease() const { return have_; }
   [[nodiscard]] std::uint32_t epoch() const { return epoch_; }
@@ -119,15 +115,17 @@ class ReleaseTracker {
     std::optional<std::int32_t>
         turnsBackAt;  ///< the node the way stops at, where the base turns back (none: its end)
   };
-  /// ahead(), up to the first node where the base turns by more than `reversal` [rad] (that node
-  /// included). A base that turns back runs beside itself (out along a queue and back along the
+  /// ahead(), up to the first node where the base turns by more than ReleaseParams::turnBack (that
+  /// node included). A base that turns back runs beside itself (out along a queue and back along the
   /// lane next to it): a path follower projecting the robot onto the nearest leg within its window
   /// takes the way back for the way out and the base for driven.
-  [[nodiscard]] Way aheadToTurnBack(Vec2 here, double reversal) const;
+  [[nodiscard]] Way aheadToTurnBack(Vec2 here) const;
   [[nodiscard]] const ReleaseCounts& counts() const { return counts_; }
 
  private:
   void take(const Release& r);
+  /// The first node after the last one reached where the base turns back (the last node if none).
+  [[nodiscard]] std::size_t firstTurnBack() const;
   /// Cuts the base after the last node reached (an empty base: hold where it is).
   void hold();
 

@@ -122,44 +122,35 @@ TEST(ReleaseTracker, AStationSpurIsDrivenInAndOutNotSkipped) {
   EXPECT_FALSE(t.nodesAhead());
 }
 
-TEST(ReleaseTracker, ARobotStandingOnItsBasesLastNodeHasArrivedUnlessThatIsItsOwnNode) {
-  // Held 0.6 m off node 0 on the spot of node 9, the robot gets a loop [0 1 2 9] round to where it
-  // stands: it is there. On [0 7 0] (the spur) standing on node 0 is not the spur driven.
+TEST(ReleaseTracker, TheWayStopsWhereTheBaseTurnsBack) {
+  // Out along a line and back along the line beside it: [0 1 2 9 8], 2 -> 9 turning back. The way
+  // ends on node 2; once node 2 is reached, the rest.
   ReleaseTracker t;
-  const Vec2 here{0.05, -0.6};
   ASSERT_EQ(
-      t.offer(release(1, 1, {{0, {0.0, 0.0}}, {1, {0.5, -0.5}}, {2, {1.0, -0.5}}, {9, {0.0, -0.55}}}), here),
+      t.offer(
+          release(1, 1,
+                  {{0, {0.0, 0.0}}, {1, {0.5, 0.0}}, {2, {1.0, 0.0}}, {9, {0.5, -0.5}}, {8, {0.0, -0.5}}}),
+          {0.0, 0.0}),
       ReleaseVerdict::kAccepted);
-  EXPECT_FALSE(t.advance(here)) << "the loop's last node is a later visit of the spot";
-  EXPECT_FALSE(t.arriveWhereItStands({0.3, -0.55})) << "0.3 m from it";
-  EXPECT_EQ(t.node(), 0);
-  EXPECT_TRUE(t.arriveWhereItStands(here));
-  EXPECT_EQ(t.node(), 9);
-  EXPECT_FALSE(t.nodesAhead());
-  EXPECT_NEAR(t.remaining(), 0.0, 1e-9);
-  EXPECT_FALSE(t.arriveWhereItStands(here)) << "once";
-
-  // The same spot mid-way along a longer loop [0 1 2 9 8]: node 9, and the way on from there.
-  ReleaseTracker mid;
-  ASSERT_EQ(
-      mid.offer(
-          release(
-              1, 1,
-              {{0, {0.0, 0.0}}, {1, {0.5, -0.5}}, {2, {1.0, -0.5}}, {9, {0.0, -0.55}}, {8, {-0.5, -0.55}}}),
-          here),
-      ReleaseVerdict::kAccepted);
-  const auto before = mid.revision();
-  EXPECT_TRUE(mid.arriveWhereItStands(here));
-  EXPECT_EQ(mid.node(), 9);
-  EXPECT_GT(mid.revision(), before) << "the path to drive is rebuilt";
-  ASSERT_TRUE(mid.next().has_value());
-  EXPECT_NEAR(mid.next()->x, -0.5, 1e-9);
-
-  ReleaseTracker spur;
-  ASSERT_EQ(spur.offer(release(1, 1, {{0, {0.0, 0.0}}, {7, {0.0, 1.0}}, {0, {0.0, 0.0}}}), {0.0, 0.0}),
+  auto way = t.aheadToTurnBack({0.0, 0.0});
+  ASSERT_TRUE(way.turnsBackAt.has_value());
+  EXPECT_EQ(*way.turnsBackAt, 2);
+  ASSERT_EQ(way.points.size(), 3u);
+  EXPECT_NEAR(way.points.back().x, 1.0, 1e-9);
+  EXPECT_TRUE(t.advance({0.6, 0.0}));
+  EXPECT_TRUE(t.advance({1.0, 0.0}));
+  EXPECT_EQ(t.node(), 2);
+  way = t.aheadToTurnBack({1.0, 0.0});
+  EXPECT_FALSE(way.turnsBackAt.has_value());
+  ASSERT_EQ(way.points.size(), 3u);
+  EXPECT_NEAR(way.points.back().x, 0.0, 1e-9);
+  ASSERT_TRUE(t.at().has_value());
+  EXPECT_NEAR(t.at()->x, 1.0, 1e-9);
+  // A right angle is no turning back: the whole base.
+  ReleaseTracker r;
+  ASSERT_EQ(r.offer(release(1, 1, {{0, {0.0, 0.0}}, {1, {0.5, 0.0}}, {2, {0.5, 0.5}}}), {0.0, 0.0}),
             ReleaseVerdict::kAccepted);
-  EXPECT_FALSE(spur.arriveWhereItStands({0.0, 0.0}));
-  EXPECT_TRUE(spur.nodesAhead());
+  EXPECT_FALSE(r.aheadToTurnBack({0.0, 0.0}).turnsBackAt.has_value());
 }
 
 TEST(ReleaseTracker, RemainingAndTheWayAheadFollowTheRobot) {
