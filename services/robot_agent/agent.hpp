@@ -176,6 +176,7 @@ class Agent {
     std::string why;
     std::int64_t sinceNs = -1;
     std::optional<Vec2> next;  ///< the next base node, if one is released
+    bool byObstacle = false;   ///< last held by a static obstacle (what a rejoin is for)
   };
   [[nodiscard]] const Standing& standingStill() const { return standing_; }
 
@@ -335,8 +336,9 @@ class Agent {
   Vec2 heldAt_;                    // ... here
   bool blocked_ = false;           // ... for more than a second
   Standing standing_;
-  Vec2 standAt_;          // where the robot began standing
-  std::string standWhy_;  // this cycle's reason for a zero command (reserved traffic)
+  Vec2 standAt_;                  // where the robot began standing
+  std::string standWhy_;          // this cycle's reason for a zero command (reserved traffic)
+  bool standByObstacle_ = false;  // ... a static obstacle held it
   std::optional<msg::TrafficProgress> lastProgress_;  // the last report sent
 };
 

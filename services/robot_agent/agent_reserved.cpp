@@ -82,7 +82,6 @@ constexpr double kAligned = 0.05;
 /// the one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
 constexpr double kRejoinOff = 0.15;
 constexpr double kRejoinAfterS = 10.0;
-constexpr const char* kWhyObstacle = "held by an obstacle";
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
 
@@ -201,6 +200,7 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
   }
   if (!standWhy_.empty()) {
     standing_.why = standWhy_;  // the latest (a hold can change hands while the robot stands)
+    standing_.byObstacle = standByObstacle_;
   } else if (standing_.why.empty()) {
     standing_.why = std::abs(v) > 1e-9 || std::abs(w) > 1e-9 ? kWhyOwnZero : kWhyStand;
   }
@@ -209,6 +209,7 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
 
 void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
   standWhy_.clear();
+  standByObstacle_ = false;
   const Pose2 pose = localizer_.pose();
   const Vec2 here = pose.position();
   if (releases_.advance(here)) {
@@ -248,7 +249,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   const auto own = releases_.at();
   const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
                       standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-                      standing_.why == kWhyObstacle;
+                      standing_.byObstacle;
   const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
                           rejoin || rejoined_;
   if (!releases_.nodesAhead() && newRelease) {
@@ -401,8 +402,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
                                                          [&](const Other& o) { return o.id == blocker.id; });
   if (held) {
     mode = msg::RobotMode::Waiting;
+    standByObstacle_ = !blocker.robot && blocker.id.empty();
     standWhy_ = blocker.robot        ? "held by robot " + blocker.id + (byKnownRobot ? "" : " (unknown)")
-                : blocker.id.empty() ? std::string(kWhyObstacle)
+                : blocker.id.empty() ? std::string("held by an obstacle")
                                      : "held by " + blocker.id;
   }
   // A hold lasts until the robot has got on: a sampling planner turning this way and that in front

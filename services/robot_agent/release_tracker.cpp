@@ -165,14 +165,7 @@ std::optional<ReleaseTracker::Turn> ReleaseTracker::nextTurn(double angle) const
     if (arc_[k] < progress_) {
       continue;  // passed
     }
-    const Vec2 in = base_[k].at - base_[k - 1].at;
-    const Vec2 out = base_[k + 1].at - base_[k].at;
-    if (in.norm() < 1e-9 || out.norm() < 1e-9) {
-      continue;
-    }
-    const double turn =
-        std::abs(std::remainder(std::atan2(out.y, out.x) - std::atan2(in.y, in.x), 2.0 * M_PI));
-    if (turn > angle) {
+    if (turnAt(k) > angle) {
       return Turn{arc_[k] - progress_, base_[k].at};
     }
   }
@@ -191,12 +184,18 @@ std::vector<Vec2> ReleaseTracker::ahead(Vec2 here) const {
   return pts;
 }
 
+double ReleaseTracker::turnAt(std::size_t k) const {
+  const Vec2 in = base_[k].at - base_[k - 1].at;
+  const Vec2 out = base_[k + 1].at - base_[k].at;
+  if (in.norm() < 1e-9 || out.norm() < 1e-9) {
+    return 0.0;
+  }
+  return std::abs(std::remainder(std::atan2(out.y, out.x) - std::atan2(in.y, in.x), 2.0 * M_PI));
+}
+
 std::size_t ReleaseTracker::firstTurnBack() const {
   for (std::size_t k = reached_ + 1; k + 1 < base_.size(); ++k) {
-    const Vec2 in = base_[k].at - base_[k - 1].at;
-    const Vec2 out = base_[k + 1].at - base_[k].at;
-    if (in.norm() > 1e-9 && out.norm() > 1e-9 &&
-        std::acos(std::clamp(in.dot(out) / (in.norm() * out.norm()), -1.0, 1.0)) > p_.turnBack) {
+    if (turnAt(k) > p_.turnBack) {
       return k;
     }
   }

@@ -124,6 +124,8 @@ class ReleaseTracker {
 
  private:
   void take(const Release& r);
+  /// How far the base turns at node k (0 < k < size - 1) [rad, 0..π].
+  [[nodiscard]] double turnAt(std::size_t k) const;
   /// The first node after the last one reached where the base turns back (the last node if none).
   [[nodiscard]] std::size_t firstTurnBack() const;
   /// Cuts the base after the last node reached (an empty base: hold where it is).
