@@ -177,6 +177,7 @@ class Agent {
     std::int64_t sinceNs = -1;
     std::optional<Vec2> next;  ///< the next base node, if one is released
     bool byObstacle = false;   ///< last held by a static obstacle (what a rejoin is for)
+    bool homing = false;       ///< on its way home with no task
   };
   [[nodiscard]] const Standing& standingStill() const { return standing_; }
 

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "agent.hpp"
+#include "base_end.hpp"
 #include "fleet/core/angles.hpp"
 #include "fleet/core/clock.hpp"
 
@@ -84,6 +85,10 @@ constexpr double kRejoinOff = 0.15;
 constexpr double kRejoinAfterS = 10.0;
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
+
+/// Projected onto the end of the base but further than this from it [m]: it drives onto the end
+/// (see base_end.hpp; below the release tracker's reach tolerance, kAtGoal).
+constexpr double kSettleBeyond = 0.10;
 
 /// The gate's stop rule looks this far along the base [m] (more than the stopping distance plus
 /// the gap at cruise).
@@ -168,6 +173,7 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
     startGoal(nowNs);
   }
   if (tasks_.phase() == Phase::Dwelling) {
+    standing_ = {};  // at work, not standing (a charge lasts longer than the log's minute)
     heldSinceNs_ = -1;
     blocked_ = false;
     baseAhead_ = false;
@@ -186,18 +192,22 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
   }
   driveBase(nowNs, dt, v, w, mode);
   // Standing is not getting on (the progress watch's movedM): a planner turning this way and that
-  // in front of a person stands as much as a robot told to.
+  // in front of a person stands as much as a robot told to. A robot on its way home counts too (one
+  // stood 1,400 s 0.17 m from the end of its base, five robots behind it, and no log said so).
   const Vec2 here = localizer_.pose().position();
-  if (!tasks_.busy() || (standing_.sinceNs >= 0 && distance(here, standAt_) > progress_.params().movedM)) {
+  const auto goal = trafficGoal();
+  const bool onItsWay = tasks_.busy() || (goal && distance(here, goal->pose.position()) >= kAtGoal);
+  if (!onItsWay || (standing_.sinceNs >= 0 && distance(here, standAt_) > progress_.params().movedM)) {
     standing_ = {};
   }
-  if (!tasks_.busy()) {
+  if (!onItsWay) {
     return;
   }
   if (standing_.sinceNs < 0) {
     standing_.sinceNs = nowNs;
     standAt_ = here;
   }
+  standing_.homing = !tasks_.busy();
   if (!standWhy_.empty()) {
     standing_.why = standWhy_;  // the latest (a hold can change hands while the robot stands)
     standing_.byObstacle = standByObstacle_;
@@ -288,12 +298,15 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     standStill("no pose estimate to follow the base with");
     return;
   }
-  const double left = follower_.pathLength() - r->progress;
+  double left = follower_.pathLength() - r->progress;
   const Vec2 toEnd = basePath_.back() - here;
   const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
-  // At the end, or the end no longer ahead of the robot: turning round for the last centimetres
-  // would sweep the body over what was not released.
-  if (left < kAtEnd || (r->finalApproach && toEnd.norm() < kAtGoal && toEnd.dot(facing) < kAtEnd)) {
+  const BaseEnd end = baseEnd(left, toEnd, facing, r->finalApproach, {kAtEnd, kSettleBeyond, kAtGoal});
+  const bool settling = end == BaseEnd::kSettle;
+  if (settling) {
+    left = toEnd.norm();  // what the stop at the end brakes for
+  }
+  if (end == BaseEnd::kStand) {
     if (rejoining_) {
       rejoining_ = false;
       rejoined_ = true;  // back on its node: the base from here next cycle
@@ -307,8 +320,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     undockFrom_.reset();
   }
   const auto turn = releases_.nextTurn(kSharpTurn);
-  const bool cornering = turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;
-  const bool planning = planner_ && !r->finalApproach && !cornering && !undockFrom_ &&
+  const bool cornering =
+      !settling && turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;
+  const bool planning = planner_ && !r->finalApproach && !cornering && !settling && !undockFrom_ &&
                         r->crossTrack < kMaxCrossTrack && !progress_.followerDrives(nowNs);
   bool localBlocked = false;
   if (planning) {
@@ -316,7 +330,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     const auto tw = planLocal(localBlocked);
     v = tw.v;
     w = tw.omega;
-  } else if (r->finalApproach || cornering) {
+  } else if (r->finalApproach || cornering || settling) {
     // Onto the corner, or the last stretch: face it and drive straight there (onto a station:
     // only once it faces it). The pose law's curve could bulge off the base.
     // (Turning on the spot only when far off: told to at speed, the robot slides on while it brakes.)
@@ -326,7 +340,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     const Vec2 to = cornering ? turn->at - here : toEnd;
     const double b = angleDiff(std::atan2(to.y, to.x), pose.theta);
     w = std::clamp(2.0 * b, -p_.wMax, p_.wMax);
-    if (docking_) {
+    if (settling) {
+      v = std::abs(b) > 0.25 ? 0.0 : kTurnSpeed;  // the last centimetres, straight and slow
+    } else if (docking_) {
       // As fast as it can brake onto the station (the cap below; the gate's docking gap still
       // governs what is in front of it).
       v = std::abs(b) > 0.25 ? 0.0 : std::min(kDockSpeed, p_.vMax);

@@ -162,8 +162,8 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     }
   };
 
-  // Reserved traffic: a robot standing with its task this long [s] is logged (and again as often),
-  // with why it stands. The traffic manager logs whom it waits on; this is the robot's side.
+  // Reserved traffic: a robot standing with its task (or on its way home) this long [s] is logged (and again
+  // as often), with why it stands. The traffic manager logs whom it waits on; this is the robot's side.
   constexpr double kStandingWarnS = 60.0;
   std::vector<std::int64_t> standWarnedNs(node.size(), -1);
   auto warnStanding = [&](std::size_t i, std::int64_t now) {
@@ -176,10 +176,11 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     standWarnedNs[i] = now;
     const Pose2 pose = a.perception().pose;
     logging::ScopedField robotField("robot", a.id());
-    spdlog::warn(
-        "{}: standing for {:.0f} s with its task at ({:.2f}, {:.2f}, {:.2f} rad), node {}, next {}: {}",
-        a.id(), nsToSec(now - st.sinceNs), pose.x, pose.y, pose.theta, a.trafficNode(),
-        st.next ? fmt::format("({:.2f}, {:.2f})", st.next->x, st.next->y) : std::string("none"), st.why);
+    spdlog::warn("{}: standing for {:.0f} s {} at ({:.2f}, {:.2f}, {:.2f} rad), node {}, next {}: {}", a.id(),
+                 nsToSec(now - st.sinceNs), st.homing ? "on its way home" : "with its task", pose.x, pose.y,
+                 pose.theta, a.trafficNode(),
+                 st.next ? fmt::format("({:.2f}, {:.2f})", st.next->x, st.next->y) : std::string("none"),
+                 st.why);
   };
 
   double dt = world.dt;
