@@ -678,8 +678,25 @@ void Pibt::escapeDeadlocks() {
         break;
       }
     }
+    // A chain can also end at an agent content where it stands (at its goal, or without one: it
+    // waits for nobody). On a plain grid priority inheritance pushes it off if it can move at all.
+    // With conflict sets it may have no single move clear of the one waiting on it (a robot parked
+    // in a dock whose only way out the robot on the lane in front excludes, that robot wanting
+    // past the dock): the chain stands for ever, a knot like a cycle, and escalating one of its
+    // agents changes nothing. Its tail (the content agent and those waiting on it) is searched;
+    // the content agent does not count, it only makes room. (Full stack, session 22: r7 and r1
+    // head-on in front of the parking row for 830 s, r6 parked across every way west.)
+    const bool untangling = !grid_ && options_.untangleGroup >= 2;
+    const std::size_t limit = std::min<std::size_t>(
+        kMaxUntangleGroup, static_cast<std::size_t>(std::max(options_.untangleGroup, 0)));
     if (!cycle) {
-      continue;
+      const auto end = idx(chain_.back());
+      const bool content =
+          cur < 0 && controlled_[end] != 0 && (goal_[end] == kNoNode || now_[end] == goal_[end]);
+      if (!untangling || !content || chain_.size() < 2) {
+        continue;
+      }
+      first = chain_.size() - std::min(chain_.size(), limit);
     }
     std::int32_t pick = -1;
     bool anyEscalated = false;
@@ -688,8 +705,9 @@ void Pibt::escapeDeadlocks() {
       const std::int32_t m = chain_[k];
       anyEscalated = anyEscalated || escalatedAt_[idx(m)] >= 0 || forcedGroup_[idx(m)] >= 0;
       standing = standing && still_[idx(m)] >= options_.escapeAfter;
-      if (pick < 0 || tries_[idx(m)] < tries_[idx(pick)] ||
-          (tries_[idx(m)] == tries_[idx(pick)] && before(pick, m))) {
+      // (The content end of a chain wants nothing: escalating it would not make it move.)
+      if ((cycle || k + 1 < chain_.size()) && (pick < 0 || tries_[idx(m)] < tries_[idx(pick)] ||
+                                               (tries_[idx(m)] == tries_[idx(pick)] && before(pick, m)))) {
         pick = m;
       }
     }
@@ -701,12 +719,18 @@ void Pibt::escapeDeadlocks() {
     // always clear it in one move if it can move at all: escalation is enough there, and the
     // search's one-move-at-a-time ways out cost throughput (1,000 agents on
     // warehouse-10-20-10-2-1: 5.36 goals per step against 5.44).
-    if (!grid_ && options_.untangleGroup >= 2 &&
-        knot.size() <=
-            std::min<std::size_t>(kMaxUntangleGroup, static_cast<std::size_t>(options_.untangleGroup)) &&
-        untangleKnot(knot)) {
+    //
+    // In a chain only the agent waiting on the content one counts: the search stops when that one
+    // is closer to its goal. An agent further back coming closer proves nothing: counting r1 too,
+    // r7 tucked into the empty dock beside the lane, r1 gained a node, still short of r6's
+    // footprint, and the two swapped places back and forth.
+    const std::span<const std::int32_t> counting =
+        cycle ? knot : std::span<const std::int32_t>(chain_.data() + chain_.size() - 2, 1);
+    if (untangling && knot.size() <= limit && untangleKnot(knot, counting)) {
       continue;
     }
+    // The fallback for a chain too: the one escalated goes first and keeps trying to push, and the
+    // chain counts as handled (no search every step) until it drops back.
     escalate(idx(pick));
   }
 }
@@ -720,7 +744,7 @@ void Pibt::escalate(std::size_t p) {
   ++stats_.escalations;
 }
 
-bool Pibt::untangleKnot(std::span<const std::int32_t> knot) {
+bool Pibt::untangleKnot(std::span<const std::int32_t> knot, std::span<const std::int32_t> counting) {
   // Escalating one member of the knot makes it plan first, but on a roadmap the one in its way may
   // have no single move that clears what it needs (every neighbour of a lane node in front of a
   // dock is still excluded by the dock's exit): search a few steps of the knot's agents instead,
@@ -736,7 +760,7 @@ bool Pibt::untangleKnot(std::span<const std::int32_t> knot) {
     for (const std::int32_t a : group) {
       problem.starts.push_back(now_[idx(a)]);
       problem.tables.push_back(table_[idx(a)]);
-      problem.counts.push_back(std::find(knot.begin(), knot.end(), a) != knot.end() ? 1 : 0);
+      problem.counts.push_back(std::find(counting.begin(), counting.end(), a) != counting.end() ? 1 : 0);
     }
     problem.clearOfOthers = [&](NodeId v) {
       const auto other = [&](NodeId w) {

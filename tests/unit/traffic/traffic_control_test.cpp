@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iostream>
 
 #include "fleet/site/site_loader.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -108,6 +109,132 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
       EXPECT_GE(tc.plannerStats().untangles, 1U);
     }
   }
+}
+
+/// The knot of the full stack's session-22 run (seed 7, fix3-2: r1 and r7 stood for 830 s at the
+/// end of the shift): the robots at their parking places (r10 held docking), r7 on the lane node in
+/// front of PARK-6 on its way to P-2 (north, by the aisle west of it), r1 right behind it on its way
+/// home to PARK-1. Their nodes, goals and the planner's seed are the run's. A robot parked at PARK-6
+/// excludes every node west of r7 (its dock is left by an approach node r7's node excludes), so it
+/// must drive out of the lane for r7 to pass, and it can only once r7 has backed off two nodes,
+/// which needs r1 to back off two first. Nobody in that chain waits for anybody in a cycle: the
+/// parked robot is where it wants to be, so neither the escape nor the untangling saw a knot, and
+/// evasion finds the parked robot no refuge (its only way out is excluded by r7). Once the knot is
+/// untied both get where they are going, and the parked robot back to its place.
+TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
+  Roadmap map = smallWarehouse();
+  // The planner's indices are the robots' names sorted as strings, as in the traffic manager.
+  std::vector<std::string> names;
+  for (int k = 1; k <= 20; ++k)
+    names.push_back("r" + std::to_string(k));
+  std::sort(names.begin(), names.end());
+  const auto index = [&](const std::string& n) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  const auto home = [&](const std::string& n) { return map.station("PARK-" + n.substr(1))->dock; };
+  const NodeId behind = map.nearest({9.25, 1.75});  // r1
+  const NodeId front = map.nearest({8.25, 1.75});   // r7
+  const NodeId park6 = home("r6");
+  const NodeId r10 = map.station("PARK-10")->approach;  // r10 docks there, held
+  // The case: PARK-6 excludes every way west from r7's node, and its way out is excluded by it.
+  for (const Edge& e : map.graph.edges(front)) {
+    if (map.graph.position(e.to).x < map.graph.position(front).x) {
+      ASSERT_TRUE(map.graph.conflicting(e.to, park6)) << e.to;
+    }
+  }
+  ASSERT_EQ(map.graph.edges(park6).size(), 1U);
+  ASSERT_TRUE(map.graph.conflicting(map.graph.edges(park6)[0].to, front));
+  std::vector<NodeId> starts;
+  for (const auto& n : names)
+    starts.push_back(n == "r1" ? behind : n == "r7" ? front : n == "r10" ? r10 : home(n));
+  TrafficOptions options;
+  options.pibt.seed = 2;  // the traffic manager's in that run
+  TrafficControl tc(map.graph, starts, options);
+  tc.setStations(stationLines(map));
+  for (const auto& n : names)
+    tc.setGoal(index(n), n == "r7" ? map.station("P-2")->dock : home(n));
+  tc.setHeld(index("r10"), true);
+  const std::size_t a = index("r1"), b = index("r7");
+  const std::size_t c = index("r6");
+  for (int t = 0; t < 600 && !(tc.arrived(a) && tc.arrived(b) && tc.arrived(c)); ++t) {
+    tc.update();
+    for (std::size_t r = 0; r < tc.robots(); ++r) {
+      const auto rel = tc.release(r);
+      if (!tc.held(r) && rel.base.size() > 1) {
+        EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
+      }
+    }
+  }
+  EXPECT_TRUE(tc.arrived(a)) << "r1 " << tc.explain(a);
+  EXPECT_TRUE(tc.arrived(b)) << "r7 " << tc.explain(b);
+  EXPECT_TRUE(tc.arrived(c)) << "r6 is not back at its place: " << tc.explain(c);
+  EXPECT_GE(tc.plannerStats().untangles, 1U);
+}
+
+/// The stall of the full stack's session-23 run (seed 5, s23-5: r20, r7 and r11 stood from 206 s
+/// to the end at 2,400 s). r7 has loaded at P-5 and leaves for D-1; its dock's only way out, the
+/// approach, is excluded by r20 standing beside it on the lane on its way east to D-4; r11 waits
+/// in P-5's queue for the dock; r6, second in D-4's line, drives back and forth just west of r20.
+/// Everyone else is parked. Their nodes, goals, lines and the planner's seed are the run's.
+TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
+  Roadmap map = smallWarehouse();
+  std::vector<std::string> names;
+  for (int k = 1; k <= 20; ++k)
+    names.push_back("r" + std::to_string(k));
+  std::sort(names.begin(), names.end());
+  const auto index = [&](const std::string& n) {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+  };
+  const auto home = [&](const std::string& n) { return map.station("PARK-" + n.substr(1))->dock; };
+  const auto* p5 = map.station("P-5");
+  const NodeId beside = map.nearest({25.75, 15.75});  // r20
+  const NodeId west = map.nearest({24.75, 15.75});    // r6
+  const NodeId queued = map.nearest({25.5, 13.75});  // r11, in P-5's queue
+  ASSERT_NE(std::find(p5->queue.begin(), p5->queue.end(), queued), p5->queue.end());
+  std::vector<NodeId> starts;
+  for (const auto& n : names) {
+    starts.push_back(n == "r20"   ? beside
+                     : n == "r6"  ? west
+                     : n == "r7"  ? p5->dock
+                     : n == "r11" ? queued
+                                  : home(n));
+  }
+  for (NodeId v : {beside, p5->dock, p5->approach, NodeId{754}, NodeId{738}, NodeId{737}, NodeId{1149}}) {
+    std::cerr << v << " (" << map.graph.position(v).x << "," << map.graph.position(v).y << ") conflicts:";
+    for (NodeId w : map.graph.conflicts(v)) std::cerr << " " << w;
+    std::cerr << "\n";
+  }
+  TrafficOptions options;
+  options.pibt.seed = 5;  // the traffic manager's in that run
+  TrafficControl tc(map.graph, starts, options);
+  tc.setStations(stationLines(map));
+  for (const auto& n : names)
+    tc.setGoal(index(n), home(n));
+  const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
+  const NodeId d4 = map.station("D-4")->dock;
+  // The lines as they were: r7 at P-5's dock with r11 behind, r7 then sent on (it leaves the dock
+  // first); r20 first in D-4's line, r6 after it.
+  tc.setGoal(r7, p5->dock);
+  tc.setGoal(r11, p5->dock);
+  tc.setGoal(r20, d4);
+  tc.setGoal(r6, d4);
+  tc.setGoal(r7, map.station("D-1")->dock);
+  for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t) {
+    tc.update();
+    for (std::size_t r = 0; r < tc.robots(); ++r) {
+      const auto rel = tc.release(r);
+      if (!tc.held(r) && rel.base.size() > 1) {
+        EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
+      }
+    }
+    if (t % 50 == 0 || t < 5) {
+      std::cerr << "t " << t << "\n r20 " << tc.explain(r20) << "\n r7 " << tc.explain(r7) << "\n r6 "
+                << tc.explain(r6) << "\n r11 " << tc.explain(r11) << "\n";
+    }
+  }
+  EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
+  EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
+  EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
 }
 
 /// A lone robot released one node on (its goal was there), then given a goal behind it: the plan

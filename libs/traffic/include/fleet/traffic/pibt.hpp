@@ -30,7 +30,11 @@
 //   out) is searched for: a few steps of the cycle's agents (and of agents in their way, up to
 //   untangleGroup), one move at a time, everyone else standing (untangle.hpp). The moves found are
 //   planned before everyone else's; the member they bring closer to its goal is then escalated.
-//   Escalation alone is the fallback when the search finds nothing.
+//   Escalation alone is the fallback when the search finds nothing. A wait-for chain that ends at
+//   an agent content where it stands (at its goal or without one) is such a knot too when all its
+//   agents have stood still that long (a robot parked in a dock, its way out excluded by the robot
+//   on the lane that wants past it): its tail is searched until the agent waiting on the content
+//   one is closer to its goal.
 // - Fixed agents' nodes are taken out of the routes (DistanceTable::setBlocked), since PIBT only
 //   moves greedily and would otherwise wait behind a stopped robot for ever.
 //
@@ -154,7 +158,9 @@ class Pibt {
   void updateProgress(std::size_t agent);
   [[nodiscard]] std::int32_t blocker(std::size_t agent) const;
   void escapeDeadlocks();
-  [[nodiscard]] bool untangleKnot(std::span<const std::int32_t> knot);
+  /// Searches a way out for the knot's agents (and agents in their way); it ends when one of
+  /// `counting` (members of the knot) is closer to its goal.
+  [[nodiscard]] bool untangleKnot(std::span<const std::int32_t> knot, std::span<const std::int32_t> counting);
   void escalate(std::size_t agent);
   void advanceForced();
   void dropForced(std::int32_t group);
