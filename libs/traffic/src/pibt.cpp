@@ -490,7 +490,13 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
       if (o < 0 || o == agent || next_[idx(o)] != kNoNode) {
         return true;
       }
-      return plan(o, agent, depth + 1);
+      if (plan(o, agent, depth + 1)) {
+        return true;
+      }
+      if (!grid_) {
+        refused_.push_back(o);
+      }
+      return false;
     };
     bool ok = inherit(u);
     if (!grid_) {
@@ -544,6 +550,7 @@ const std::vector<NodeId>& Pibt::step() {
   for (const std::int32_t i : order_) {
     if (next_[idx(i)] == kNoNode) {
       plan(i, -1, 0);
+      reconsiderRefused();
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -569,6 +576,28 @@ const std::vector<NodeId>& Pibt::step() {
   }
   ++stats_.steps;
   return now_;
+}
+
+void Pibt::reconsiderRefused() {
+  // A pushed agent that could not make room was left standing (PIBT's rule), so the pushers tried
+  // their other nodes with it there. On a plain grid that agent has (almost) no move left of its
+  // own: every neighbour was taken or held by one that could not move either. With conflict sets it
+  // only had no move clear of what its pusher wanted, which reaches past its neighbours: every move
+  // of a robot on the lane beside a dock's approach still excludes the approach, yet two of them
+  // take it clear. Kept standing, it never made its own move while the robot leaving the dock, first
+  // by priority, pushed it every step: both stood for good (full stack, session 23, seed 5: r20
+  // beside P-5's approach with free ways on to D-4, r7 on P-5's dock and r11 in its queue, 2,200 s).
+  // Now, once the pusher's search is over, such an agent is undecided again and plans in its own
+  // turn. Nobody relies on its standing: every node reserved since was checked against its node,
+  // and whoever takes what it excludes pushes it first, so it can still stay.
+  for (const std::int32_t o : refused_) {
+    const auto a = idx(o);
+    if (next_[a] == now_[a] && reservedBy_[idx(now_[a])] == o) {
+      reservedBy_[idx(now_[a])] = -1;
+      next_[a] = kNoNode;
+    }
+  }
+  refused_.clear();
 }
 
 void Pibt::updateProgress(std::size_t i) {

@@ -9,8 +9,11 @@
 // reservation is given up and the next node tried (backtracking), staying put last. On a roadmap a
 // reservation of u excludes u and conflicts(u) for everyone else, and a swap is two agents each
 // moving into what the other excludes now. Moving into a node its agent is leaving is allowed (the
-// MAPF convention). Agents outside the planner's control (faulted, paused, a vendor's vehicle) are
-// fixed obstacles on their node.
+// MAPF convention). On a roadmap a pushed agent that cannot make room stands only for the rest of
+// its pusher's search, then plans in its own turn: it had no move clear of what the pusher wanted,
+// which reaches past its neighbours, but may have moves of its own (reconsiderRefused). Agents
+// outside the planner's control (faulted, paused, a vendor's vehicle) are fixed obstacles on their
+// node.
 //
 // Priorities: task priority first, then agents with a goal before those without, then the number
 // of steps since the agent last reached a goal, then a per-agent random number (seeded). Three
@@ -155,6 +158,8 @@ class Pibt {
   [[nodiscard]] bool leavesAncestorsAlone(std::int32_t agent, std::int32_t parent, NodeId u) const;
   [[nodiscard]] bool closesCycle(std::int32_t agent, NodeId u);
   [[nodiscard]] bool before(std::int32_t a, std::int32_t b) const;
+  /// Agents refused as pushed children (roadmaps only) are undecided again after the root's search.
+  void reconsiderRefused();
   void updateProgress(std::size_t agent);
   [[nodiscard]] std::int32_t blocker(std::size_t agent) const;
   void escapeDeadlocks();
@@ -218,8 +223,9 @@ class Pibt {
   std::vector<std::int32_t> order_;
   std::vector<Candidate> candidates_;  ///< (max degree + 1) per recursion depth
   std::size_t stride_ = 1;
-  std::vector<std::int32_t> search_;  ///< cycle search stack
-  std::vector<std::int32_t> chain_;   ///< wait-for chain in escapeDeadlocks()
+  std::vector<std::int32_t> search_;   ///< cycle search stack
+  std::vector<std::int32_t> chain_;    ///< wait-for chain in escapeDeadlocks()
+  std::vector<std::int32_t> refused_;  ///< pushed agents that could not make room, this search
 };
 
 }  // namespace fleet::traffic
