@@ -86,10 +86,6 @@ constexpr double kRejoinAfterS = 10.0;
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
 
-/// Projected onto the end of the base but further than this from it [m]: it drives onto the end
-/// (see base_end.hpp; below the release tracker's reach tolerance, kAtGoal).
-constexpr double kSettleBeyond = 0.10;
-
 /// The gate's stop rule looks this far along the base [m] (more than the stopping distance plus
 /// the gap at cruise).
 constexpr double kGateRoute = 3.0;
@@ -301,7 +297,8 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   double left = follower_.pathLength() - r->progress;
   const Vec2 toEnd = basePath_.back() - here;
   const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
-  const BaseEnd end = baseEnd(left, toEnd, facing, r->finalApproach, {kAtEnd, kSettleBeyond, kAtGoal});
+  const BaseEnd end =
+      baseEnd(left, toEnd, facing, r->finalApproach, {.atEnd = kAtEnd, .behindWithin = kAtGoal});
   const bool settling = end == BaseEnd::kSettle;
   if (settling) {
     left = toEnd.norm();  // what the stop at the end brakes for

@@ -2,6 +2,8 @@
 
 #include "base_end.hpp"
 
+#include "release_tracker.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -32,6 +34,13 @@ TEST(BaseEnd, ProjectedOntoTheEndButBesideItTheRobotDrivesOntoIt) {
   EXPECT_EQ(baseEnd(left, end - here, heading(1.50), true), BaseEnd::kSettle);
   // Facing away from it too (it turns on the spot first, which sweeps nothing for a disc).
   EXPECT_EQ(baseEnd(left, end - here, heading(1.50 + M_PI), true), BaseEnd::kSettle);
+}
+
+TEST(BaseEnd, ItSettlesOnlyWhereTheReleaseTrackerWouldNotCountTheNodeReached) {
+  // Standing within settleBeyond of the end, the robot must be within the tracker's reach of it, or
+  // it stands without reporting the node (the stand this decision is for).
+  EXPECT_LT(agent::BaseEndParams{}.settleBeyond, agent::ReleaseParams{}.reachTolerance);
+  EXPECT_LE(agent::BaseEndParams{}.behindWithin, agent::ReleaseParams{}.reachTolerance);
 }
 
 TEST(BaseEnd, OnTheEndOrJustBesideItTheRobotStands) {

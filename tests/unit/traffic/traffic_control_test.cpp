@@ -17,6 +17,36 @@ Roadmap smallWarehouse(RoadmapOptions options = {}) {
   return buildRoadmap(site, options);
 }
 
+/// The small warehouse's robots r1..r20 as the traffic manager indexes them (names sorted as
+/// strings), for tests that rebuild a full-stack run's state.
+struct TwentyRobots {
+  std::vector<std::string> names;
+  TwentyRobots() {
+    for (int k = 1; k <= 20; ++k)
+      names.push_back("r" + std::to_string(k));
+    std::sort(names.begin(), names.end());
+  }
+  [[nodiscard]] std::size_t index(const std::string& n) const {
+    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
+  }
+  /// rK's parking place (PARK-K), where it starts and goes when idle.
+  [[nodiscard]] static NodeId home(const Roadmap& map, const std::string& n) {
+    return map.station("PARK-" + n.substr(1))->dock;
+  }
+};
+
+/// One planning step with every robot not held reporting its next base node at once (robots on
+/// time): the reports are all accepted.
+void stepOnTime(TrafficControl& tc) {
+  tc.update();
+  for (std::size_t r = 0; r < tc.robots(); ++r) {
+    const auto rel = tc.release(r);
+    if (!tc.held(r) && rel.base.size() > 1) {
+      EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
+    }
+  }
+}
+
 /// Robots follow the releases, late at random. What holds whatever the planner does: no two robots
 /// ever hold conflicting nodes, their centres keep the contact distance, no report is refused.
 /// (How much work they get done is the planner's business: measured in docs/benchmarks.md, where
@@ -84,13 +114,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
     tc.setGoal(1, goal1);
     bool left = false;
     for (int t = 0; t < 600; ++t) {
-      tc.update();
-      for (std::size_t r = 0; r < 2; ++r) {
-        const auto rel = tc.release(r);
-        if (rel.base.size() > 1) {
-          EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
-        }
-      }
+      stepOnTime(tc);
       left = left || tc.at(0) != park;
     }
     EXPECT_EQ(left, evade) << "way " << static_cast<int>(way);
@@ -110,7 +134,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   }
 }
 
-/// The knot of the full stack's session-22 run (seed 7, fix3-2: r1 and r7 stood for 830 s at the
+/// The knot of the full stack's session-22 run (load test seed 2: r1 and r7 stood for 830 s at the
 /// end of the shift): the robots at their parking places (r10 held docking), r7 on the lane node in
 /// front of PARK-6 on its way to P-2 (north, by the aisle west of it), r1 right behind it on its way
 /// home to PARK-1. Their nodes, goals and the planner's seed are the run's. A robot parked at PARK-6
@@ -122,15 +146,9 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
 /// untied both get where they are going, and the parked robot back to its place.
 TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
   Roadmap map = smallWarehouse();
-  // The planner's indices are the robots' names sorted as strings, as in the traffic manager.
-  std::vector<std::string> names;
-  for (int k = 1; k <= 20; ++k)
-    names.push_back("r" + std::to_string(k));
-  std::sort(names.begin(), names.end());
-  const auto index = [&](const std::string& n) {
-    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
-  };
-  const auto home = [&](const std::string& n) { return map.station("PARK-" + n.substr(1))->dock; };
+  const TwentyRobots fleet;
+  const auto index = [&](const std::string& n) { return fleet.index(n); };
+  const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
   const NodeId behind = map.nearest({9.25, 1.75});  // r1
   const NodeId front = map.nearest({8.25, 1.75});   // r7
   const NodeId park6 = home("r6");
@@ -144,26 +162,19 @@ TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
   ASSERT_EQ(map.graph.edges(park6).size(), 1U);
   ASSERT_TRUE(map.graph.conflicting(map.graph.edges(park6)[0].to, front));
   std::vector<NodeId> starts;
-  for (const auto& n : names)
+  for (const auto& n : fleet.names)
     starts.push_back(n == "r1" ? behind : n == "r7" ? front : n == "r10" ? r10 : home(n));
   TrafficOptions options;
   options.pibt.seed = 2;  // the traffic manager's in that run
   TrafficControl tc(map.graph, starts, options);
   tc.setStations(stationLines(map));
-  for (const auto& n : names)
+  for (const auto& n : fleet.names)
     tc.setGoal(index(n), n == "r7" ? map.station("P-2")->dock : home(n));
   tc.setHeld(index("r10"), true);
   const std::size_t a = index("r1"), b = index("r7");
   const std::size_t c = index("r6");
-  for (int t = 0; t < 600 && !(tc.arrived(a) && tc.arrived(b) && tc.arrived(c)); ++t) {
-    tc.update();
-    for (std::size_t r = 0; r < tc.robots(); ++r) {
-      const auto rel = tc.release(r);
-      if (!tc.held(r) && rel.base.size() > 1) {
-        EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
-      }
-    }
-  }
+  for (int t = 0; t < 600 && !(tc.arrived(a) && tc.arrived(b) && tc.arrived(c)); ++t)
+    stepOnTime(tc);
   EXPECT_TRUE(tc.arrived(a)) << "r1 " << tc.explain(a);
   EXPECT_TRUE(tc.arrived(b)) << "r7 " << tc.explain(b);
   EXPECT_TRUE(tc.arrived(c)) << "r6 is not back at its place: " << tc.explain(c);
@@ -182,15 +193,9 @@ TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
 /// to be: neither the escape nor the untangling saw a knot.
 TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
   Roadmap map = smallWarehouse();
-  // The planner's indices are the robots' names sorted as strings, as in the traffic manager.
-  std::vector<std::string> names;
-  for (int k = 1; k <= 20; ++k)
-    names.push_back("r" + std::to_string(k));
-  std::sort(names.begin(), names.end());
-  const auto index = [&](const std::string& n) {
-    return static_cast<std::size_t>(std::find(names.begin(), names.end(), n) - names.begin());
-  };
-  const auto home = [&](const std::string& n) { return map.station("PARK-" + n.substr(1))->dock; };
+  const TwentyRobots fleet;
+  const auto index = [&](const std::string& n) { return fleet.index(n); };
+  const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
   const auto* p5 = map.station("P-5");
   const NodeId beside = map.nearest({25.75, 15.75});  // r20
   const NodeId west = map.nearest({24.75, 15.75});    // r6
@@ -208,7 +213,7 @@ TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
   }
   ASSERT_GE(free, 1);
   std::vector<NodeId> starts;
-  for (const auto& n : names) {
+  for (const auto& n : fleet.names) {
     starts.push_back(n == "r20"   ? beside
                      : n == "r6"  ? west
                      : n == "r7"  ? p5->dock
@@ -219,7 +224,7 @@ TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
   options.pibt.seed = 5;  // the traffic manager's in that run
   TrafficControl tc(map.graph, starts, options);
   tc.setStations(stationLines(map));
-  for (const auto& n : names)
+  for (const auto& n : fleet.names)
     tc.setGoal(index(n), home(n));
   const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
   const NodeId d4 = map.station("D-4")->dock;
@@ -231,15 +236,8 @@ TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
   tc.setGoal(r6, d4);
   tc.setGoal(r7, map.station("D-1")->dock);
   ASSERT_EQ(tc.target(r11), queued);
-  for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t) {
-    tc.update();
-    for (std::size_t r = 0; r < tc.robots(); ++r) {
-      const auto rel = tc.release(r);
-      if (!tc.held(r) && rel.base.size() > 1) {
-        EXPECT_EQ(tc.reached(r, rel.base[1]), Report::Accepted);
-      }
-    }
-  }
+  for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t)
+    stepOnTime(tc);
   EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
   EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
   EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
