@@ -83,13 +83,19 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
     }
   }
   // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed
-  // (with a route: the corridor along the route, the gap measured straight to the point).
+  // (with a route: the corridor along the route, the gap measured straight to the point, and only
+  // a point the route comes nearer to than the robot is now: one it leads away from cannot be run
+  // into. A parking place's approach point 0.035 m beyond the disc from a shelf corner, its route
+  // on along the corner, held a robot there for 595 s; 100 robots, session 23.)
   const double corridor = p_.radius + 0.05;
   for (const auto& ray : view.seen.scan) {
     const double ahead = ray.local.x;
     const bool straight = std::abs(ray.local.y) < corridor;
-    const bool counts =
-        ahead > 0.0 && (view.route ? distanceToRoute(*view.route, ray.map) < corridor : straight);
+    auto alongRoute = [&] {
+      const double d = distanceToRoute(*view.route, ray.map);
+      return d < corridor && d < ray.local.norm() - 0.01;
+    };
+    const bool counts = ahead > 0.0 && (view.route ? alongRoute() : straight);
     if (counts) {
       const double before = allowed;
       const double keep = robotGap < staticGap && onRobot(ray.map) ? robotGap : staticGap;

@@ -99,6 +99,9 @@ struct Builder {
     return site::discFits(grid, p, opt.radius + opt.nodeClearance);
   }
   [[nodiscard]] bool sweeps(Vec2 a, Vec2 b) const { return site::segmentFits(grid, a, b, opt.radius); }
+  [[nodiscard]] bool passes(Vec2 a, Vec2 b) const {
+    return site::segmentFits(grid, a, b, opt.radius + opt.edgeClearance);
+  }
   void problem(RoadmapProblem::Severity sev, const std::string& station, Vec2 p, const std::string& what) {
     problems.push_back({sev, station, p, what});
   }
@@ -186,7 +189,7 @@ struct Builder {
       steps.insert(steps.end(), {{2, 2}, {-2, 2}});
     }
     auto link = [&](NodeId u, NodeId v) {
-      if (sweeps(pos[static_cast<std::size_t>(u)], pos[static_cast<std::size_t>(v)])) {
+      if (passes(pos[static_cast<std::size_t>(u)], pos[static_cast<std::size_t>(v)])) {
         links.push_back({u, v, true, true});
       }
     };
@@ -217,10 +220,11 @@ struct Builder {
 
   enum class Join { Both, Out };
 
-  // Joins `v` to the lattice nodes within one spacing that the disc reaches in a straight line and
-  // that lie within `cone` rad of one of `dirs` (any direction when `dirs` is empty); failing
-  // that, to the nearest two such within three spacings. The number of nodes joined.
-  int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how) {
+  // Joins `v` to the lattice nodes within one spacing that the disc reaches in a straight line
+  // keeping the edge clearance (`wide`; else the disc only) and that lie within `cone` rad of one of
+  // `dirs` (any direction when `dirs` is empty); failing that, to the nearest two such within three
+  // spacings. The number of nodes joined.
+  int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how, bool wide = true) {
     const Vec2 p = pos[static_cast<std::size_t>(v)];
     std::vector<std::pair<double, NodeId>> near;
     const double reach2 = std::pow(3.0 * opt.spacing + 1e-9, 2);
@@ -242,7 +246,7 @@ struct Builder {
       if (d > opt.spacing + 1e-9 && joined >= 2) {
         break;
       }
-      if (sweeps(p, pos[static_cast<std::size_t>(w)])) {
+      if (wide ? passes(p, pos[static_cast<std::size_t>(w)]) : sweeps(p, pos[static_cast<std::size_t>(w)])) {
         links.push_back({v, w, true, how == Join::Both});
         ++joined;
       }
@@ -336,6 +340,12 @@ struct Builder {
       if (joined == 0) {
         joined = joinToLattice(entry, {}, 0.0, Join::Both);
       }
+      if (joined == 0 && sn.approach != kNoNode) {
+        joined = joinToLattice(entry, {st.pose.heading()}, kCone, Join::Both, false);
+      }
+      if (joined == 0) {
+        joined = joinToLattice(entry, {}, 0.0, Join::Both, false);
+      }
       if (joined == 0) {
         std::ostringstream d;
         d << 3.0 * opt.spacing;
@@ -382,9 +392,11 @@ struct Builder {
                     " cannot be driven straight to the one before it");
       }
       const Vec2 back = (queue[q] - nextAt).normalized();
-      joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out);
-      if (q + 1 == queue.size()) {
-        joinToLattice(v, {back}, kPi / 2.0, Join::Both);
+      if (joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out) == 0) {
+        joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out, false);
+      }
+      if (q + 1 == queue.size() && joinToLattice(v, {back}, kPi / 2.0, Join::Both) == 0) {
+        joinToLattice(v, {back}, kPi / 2.0, Join::Both, false);
       }
       sn.queue.push_back(v);
       next = v;
@@ -438,11 +450,11 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   const auto& in = options;
   if (!(in.cruiseSpeed > 0.0) || in.spacing < 0.0 || (in.spacing > 0.0 && in.spacing < 0.05) ||
       !(in.targetSpacing >= 0.05) || in.radius < 0.0 || in.stopGap < 0.0 || in.corridorSlack < 0.0 ||
-      in.nodeClearance < 0.0 || in.margin < 0.0 || in.queueLength < 0 || in.queueLength > 50 ||
-      in.followingDistance < 0.0) {
+      in.nodeClearance < 0.0 || in.edgeClearance < 0.0 || in.margin < 0.0 || in.queueLength < 0 ||
+      in.queueLength > 50 || in.followingDistance < 0.0) {
     throw std::invalid_argument(
         "RoadmapOptions: cruiseSpeed > 0, spacing 0 or >= 0.05 m, targetSpacing >= 0.05 m, radius, stopGap, "
-        "corridorSlack, nodeClearance, margin and followingDistance >= 0, queueLength 0..50");
+        "corridorSlack, nodeClearance, edgeClearance, margin and followingDistance >= 0, queueLength 0..50");
   }
   Builder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}};
   auto& o = b.opt;

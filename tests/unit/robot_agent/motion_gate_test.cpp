@@ -108,6 +108,30 @@ TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
   EXPECT_EQ(gate.clearSpeed({behind, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8);
 }
 
+// 100 robots, session 23: a parking place's approach node 0.335 m from a shelf corner, its route
+// on to the lane leading along the corner, not towards it. The stop rule held the robot there for
+// 595 s (0.035 m of gap where it keeps 0.35 m); a point the route leads away from does not count.
+TEST(MotionGate, APointTheRouteLeadsAwayFromDoesNotHoldTheRobot) {
+  const MotionGate gate(params());
+  const std::vector<OtherRobot> others;
+  // The robot at (2, 2) faces +x, its route straight on; the corner 0.3 m to the right and 0.15 m
+  // behind its front, as at r60's approach node (turned into the robot's frame).
+  const std::vector<Vec2> route{{2.0, 2.0}, {3.0, 2.0}};
+  const Perception beside = perception({{0.01, -0.335}});
+  Blocker b;
+  EXPECT_EQ(gate.clearSpeed({beside, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8)
+      << "the route leads along the corner, not nearer to it";
+  EXPECT_NEAR(gate.clearSpeed({beside, others, emptyMap(), {}, false}, 0.8, b).speed, 0.0, 1e-12)
+      << "the straight corridor (reactive traffic) still counts it";
+  // The same corner once the route bends towards it: held.
+  const std::vector<Vec2> bends{{2.0, 2.0}, {2.1, 2.0}, {2.4, 1.6}};
+  EXPECT_NEAR(gate.clearSpeed({beside, others, emptyMap(), {}, false, &bends}, 0.8, b).speed, 0.0, 1e-12);
+  // A point ahead beside the route, which the robot comes nearer to, still keeps the gap.
+  const Perception ahead = perception({{1.0, -0.32}});
+  EXPECT_NEAR(gate.clearSpeed({ahead, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 1.0 - 0.3 - 0.35,
+              1e-9);
+}
+
 // Reserved traffic: the traffic layer plans robots one behind another at its following distance,
 // so the gap to a robot is smaller than to a person or a shelf; the laser's readings on a robot's
 // body keep the robot gap too (the laser sees a robot as it sees a shelf).

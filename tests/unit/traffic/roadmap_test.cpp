@@ -273,6 +273,7 @@ TEST(Roadmap, LaneNodesKeepTheirClearanceFromShelves) {
   EXPECT_EQ(tight(r), 0U);
   RoadmapOptions o;
   o.nodeClearance = 0.0;
+  o.edgeClearance = 0.0;  // else the nodes beside corners are left without edges and dropped
   const Roadmap before = buildRoadmap(s, o);
   EXPECT_GT(tight(before), 0U) << "without it the lattice has nodes beside shelf corners";
   EXPECT_LT(r.graph.size(), before.graph.size());
@@ -295,6 +296,33 @@ TEST(Roadmap, EveryNodeAndEdgeFitsTheRobotsDisc) {
           << v << "->" << e.to;
     }
   }
+}
+
+// The motion gate keeps its stop gap to static points within 0.05 m of the route, so a lane edge
+// keeps that much (and 0.02 m of tracking error) beyond the disc along its whole length: with
+// lane nodes allowed beside shelf corners (nodeClearance 0), the edges past the corners are left out.
+TEST(Roadmap, LaneEdgesKeepTheGatesCorridorClear) {
+  const auto s = shipped("small_warehouse.site.json");
+  const auto g = s.drivable();
+  RoadmapOptions o;
+  o.nodeClearance = 0.0;
+  auto tight = [&](const Roadmap& r) {
+    std::size_t n = 0;
+    for (NodeId v = 0; v < static_cast<NodeId>(r.graph.size()); ++v) {
+      for (const auto& e : r.graph.edges(v)) {
+        const bool lanes = r.kind(v) == NodeKind::Lane && r.kind(e.to) == NodeKind::Lane;
+        n += lanes && !site::segmentFits(g, r.graph.position(v), r.graph.position(e.to), 0.3 + 0.07) ? 1 : 0;
+      }
+    }
+    return n;
+  };
+  const Roadmap r = buildRoadmap(s, o);
+  EXPECT_NEAR(r.options.edgeClearance, 0.07, 1e-12);
+  EXPECT_EQ(tight(r), 0U);
+  o.edgeClearance = 0.0;
+  EXPECT_GT(tight(buildRoadmap(s, o)), 0U) << "without it, edges pass shelf corners closer";
+  o.edgeClearance = -0.01;
+  EXPECT_THROW(buildRoadmap(s, o), std::invalid_argument);
 }
 
 // ---- zones -------------------------------------------------------------------------------------

@@ -85,6 +85,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   // front of PARK-1 has no way round the exit it excludes: the knot this test needs.
   RoadmapOptions o;
   o.nodeClearance = 0.0;
+  o.edgeClearance = 0.0;
   Roadmap map = smallWarehouse(o);
   const NodeId park = map.station("PARK-1")->dock;
   // The lane node just right of the dock's exit (PARK-1 at (3, 0.9) is left by (3, 1.9)): it

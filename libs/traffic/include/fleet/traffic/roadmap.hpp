@@ -53,10 +53,18 @@ struct RoadmapOptions {
   double stopGap = control::kAgentRobotStopGap + 0.05;
   double corridorSlack = 0.05;  ///< the gate's corridor is 2·radius + this wide, each side
   double margin = 0.1;          ///< m of tracking error of the two robots together
-  /// m of free space a lattice node keeps around the robot's disc (edges need only the disc): a
-  /// robot stops a few centimetres off its node, and one stopped that close to a shelf corner its
-  /// route leads past is held there by the stop rule for good.
+  /// m of free space a lattice node keeps around the robot's disc: a robot stops a few
+  /// centimetres off its node, and one stopped that close to a shelf corner its route leads past
+  /// is held there by the stop rule for good.
   double nodeClearance = 0.1;
+  /// m of free space a lane edge (and an edge joining a station's, queue's or parking place's node
+  /// to the lanes) keeps around the disc along its whole length: the motion gate stops for static
+  /// points within `corridorSlack` of the route, so an edge closer than that to a shelf corner
+  /// holds the robot at its start for good (100 robots, session 23: 0.035 m beyond the disc). This
+  /// is the corridor plus 0.02 m of tracking error. A station whose nodes cannot be joined with it
+  /// is joined by edges that clear the disc only (the dock's own edge always is: docking lets
+  /// static points come closer).
+  double edgeClearance = 0.07;
   int queueLength = 3;             ///< generated queue nodes per station (pickup, drop-off, charger)
   double followingDistance = 0.0;  ///< m between generated queue nodes; 0: the `ahead` separation
 };
