@@ -154,7 +154,7 @@ DbContents readDb(const fs::path& path) {
 }
 
 struct Run {
-  const LoadtestOptions& o;
+  LoadtestOptions o;  // a copy: the traffic mode may fall back to reactive (see LoadtestOptions)
   Supervisor sup;
   fs::path out;
   json scenario;
@@ -647,8 +647,13 @@ int Run::run() {
        {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "info"},
        env,
        log("risk_map")}};
+  const bool hasSite = scenario.contains("site") && scenario["site"].is_string();
+  if (o.traffic == "reserved" && !hasSite && !o.trafficNamed) {
+    say("the scenario has no site, so no roadmap: reactive traffic (robots avoid each other on their own)");
+    o.traffic = "reactive";
+  }
   if (o.traffic == "reserved") {
-    if (!scenario.contains("site") || !scenario["site"].is_string()) {
+    if (!hasSite) {
       std::cerr << "fleetctl loadtest: --traffic reserved needs a scenario with a site (its roadmap)\n";
       return 2;
     }
@@ -778,7 +783,7 @@ int Run::run() {
       " robots, " + std::to_string(scenario.value("humans", json::object()).value("count", 0)) + " humans, " +
       std::to_string(static_cast<int>(o.durationS)) + " s simulated (wall limit " +
       std::to_string(static_cast<int>(o.wallLimitS)) + " s), " + std::to_string(agentNames.size()) +
-      " agent process(es), DDS domain " + std::to_string(domain) +
+      " agent process(es), " + o.traffic + " traffic, DDS domain " + std::to_string(domain) +
       ", WMS API http://127.0.0.1:" + std::to_string(port) + ", run folder " + out.string());
   if (fromList) {
     untilDoneTarget = static_cast<int>(std::count_if(
@@ -1033,6 +1038,7 @@ int Run::run() {
         {"near_misses", summary.value("near_misses", json::object())},
         {"lockstep_step_timeouts", summary.value("lockstep_step_timeouts", json())}}},
       {"clock", o.wallClock ? "wall" : "lockstep"},
+      {"traffic", o.traffic},
       {"agents", agentMetrics},
       {"faults", faultLog},
       {"fault_plan", json::array()},

@@ -41,8 +41,12 @@ struct LoadtestOptions {
   int stationCapacity = 2;           // the fleet manager's station_capacity (0: no limit)
   std::string travelCost = "path";   // the fleet manager's travel_cost (path | straight)
   double returnHomeS = 5.0;          // robot agents' --return-home (negative: stay where a task ends)
-  /// "reactive" or "reserved" (a traffic_manager process plans every robot; the agents follow it).
-  std::string traffic = "reactive";
+  /// "reserved" (a traffic_manager process plans every robot; the agents follow its releases) or
+  /// "reactive" (robots keep clear of each other on their own). Reserved needs the scenario's site
+  /// (its roadmap): without one, and not named (`trafficNamed` false), the run falls back to
+  /// reactive and says so.
+  std::string traffic = "reserved";
+  bool trafficNamed = false;
   /// A folder made by scripts/dds-security ("deployment DIR"): every process joins with its
   /// identity (fleet-manager, wms-adapter, risk-map, traffic-manager, simulator). Each agent
   /// process (and the VDA 5050 bridge) gets an identity of its own made for the run with

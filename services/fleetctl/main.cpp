@@ -151,12 +151,11 @@ int main(int argc, char** argv) {
   loadtest
       ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")
       ->capture_default_str();
-  loadtest
-      ->add_option("--traffic", lt.traffic,
-                   "reactive: robots avoid each other on their own; reserved: a traffic manager plans them "
-                   "all together and releases their routes")
-      ->check(CLI::IsMember({"reactive", "reserved"}))
-      ->capture_default_str();
+  auto* trafficOption =
+      loadtest->add_option("--traffic", lt.traffic,
+                           "reserved: a traffic manager plans every robot together and releases their routes "
+                           "(needs the scenario's site); reactive: robots avoid each other on their own");
+  trafficOption->check(CLI::IsMember({"reactive", "reserved"}))->capture_default_str();
   loadtest->add_option("--dds-security", lt.ddsSecurity,
                        "run every process with its DDS Security identity from this folder (made by "
                        "scripts/dds-security deployment DIR; each agent process gets an identity of its "
@@ -403,6 +402,7 @@ int main(int argc, char** argv) {
   }
   if (*loadtest) {
     lt.generateTasks = lt.generateTasks || rateOpt->count() > 0 || tasksOpt->count() > 0;
+    lt.trafficNamed = trafficOption->count() > 0;
     return fleet::ctl::runLoadtest(lt);
   }
 
