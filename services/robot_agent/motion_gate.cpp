@@ -9,6 +9,10 @@
 namespace fleet::agent {
 namespace {
 
+/// m/s past a static point the route leads away from (see clearSpeed): slow enough for the
+/// cross-traffic check to stop the robot should its arc turn towards the point after all.
+constexpr double kCreepSpeed = 0.15;
+
 /// Distance from `p` to the polyline `route`.
 double distanceToRoute(const std::vector<Vec2>& route, Vec2 p) {
   double best = route.empty() ? std::numeric_limits<double>::infinity() : distance(route.front(), p);
@@ -83,26 +87,35 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
     }
   }
   // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed
-  // (with a route: the corridor along the route, the gap measured straight to the point, and only
-  // a point the route comes nearer to than the robot is now: one it leads away from cannot be run
-  // into. A parking place's approach point 0.035 m beyond the disc from a shelf corner, its route
-  // on along the corner, held a robot there for 595 s; 100 robots, session 23.)
+  // (with a route: the corridor along the route, the gap measured straight to the point). A point
+  // the route leads away from (it comes no nearer to the route than to the robot now) only slows
+  // the robot to a creep while it is within the gap: held, a robot stood 595 s on a parking place's
+  // approach node 0.035 m beyond the disc from a shelf corner, its route on along the corner (100
+  // robots, session 24); not slowed, the arc a local planner drives may still swing into it (a
+  // shelf touched in session 21, docs/algorithms.md "The gate beside a shelf corner").
   const double corridor = p_.radius + 0.05;
   for (const auto& ray : view.seen.scan) {
     const double ahead = ray.local.x;
+    if (ahead <= 0.0) {
+      continue;
+    }
     const bool straight = std::abs(ray.local.y) < corridor;
-    auto alongRoute = [&] {
-      const double d = distanceToRoute(*view.route, ray.map);
-      return d < corridor && d < ray.local.norm() - 0.01;
-    };
-    const bool counts = ahead > 0.0 && (view.route ? alongRoute() : straight);
-    if (counts) {
-      const double before = allowed;
-      const double keep = robotGap < staticGap && onRobot(ray.map) ? robotGap : staticGap;
-      limit((straight ? ahead : ray.local.norm()) - p_.radius, keep);
-      if (allowed < before) {
-        c.blockPoint = ray.map;
+    const double toRoute = view.route ? distanceToRoute(*view.route, ray.map) : 0.0;
+    if (view.route ? toRoute >= corridor : !straight) {
+      continue;
+    }
+    const double before = allowed;
+    const double keep = robotGap < staticGap && onRobot(ray.map) ? robotGap : staticGap;
+    const double gap = (straight ? ahead : ray.local.norm()) - p_.radius;
+    if (view.route && toRoute >= ray.local.norm() - 0.01) {
+      if (gap < keep) {
+        allowed = std::min(allowed, kCreepSpeed);
       }
+    } else {
+      limit(gap, keep);
+    }
+    if (allowed < before) {
+      c.blockPoint = ray.map;
     }
   }
   c.speed = allowed;

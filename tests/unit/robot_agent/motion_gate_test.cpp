@@ -110,7 +110,8 @@ TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
 
 // 100 robots, session 23: a parking place's approach node 0.335 m from a shelf corner, its route
 // on to the lane leading along the corner, not towards it. The stop rule held the robot there for
-// 595 s (0.035 m of gap where it keeps 0.35 m); a point the route leads away from does not count.
+// 595 s (0.035 m of gap where it keeps 0.35 m); a point the route leads away from only slows the
+// robot to a creep (0.15 m/s) while it is within the gap.
 TEST(MotionGate, APointTheRouteLeadsAwayFromDoesNotHoldTheRobot) {
   const MotionGate gate(params());
   const std::vector<OtherRobot> others;
@@ -119,8 +120,12 @@ TEST(MotionGate, APointTheRouteLeadsAwayFromDoesNotHoldTheRobot) {
   const std::vector<Vec2> route{{2.0, 2.0}, {3.0, 2.0}};
   const Perception beside = perception({{0.01, -0.335}});
   Blocker b;
-  EXPECT_EQ(gate.clearSpeed({beside, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8)
-      << "the route leads along the corner, not nearer to it";
+  EXPECT_NEAR(gate.clearSpeed({beside, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.15, 1e-12)
+      << "the route leads along the corner, not nearer to it: a creep";
+  EXPECT_NEAR(gate.clearSpeed({beside, others, emptyMap(), {}, false, &route}, 0.1, b).speed, 0.1, 1e-12);
+  const Perception clear = perception({{0.01, -0.7}, {-0.3, -0.34}});
+  EXPECT_EQ(gate.clearSpeed({clear, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8)
+      << "beyond the gap, or behind: no creep";
   EXPECT_NEAR(gate.clearSpeed({beside, others, emptyMap(), {}, false}, 0.8, b).speed, 0.0, 1e-12)
       << "the straight corridor (reactive traffic) still counts it";
   // The same corner once the route bends towards it: held.
