@@ -402,6 +402,15 @@ void completeSite(Site& s) {
     const Vec2 a = st.pose.position() + st.pose.heading() * kDefaultApproachDistance;
     st.approach = n > 0 && segmentFits(drivable, st.pose.position(), a, s.robot.radius) ? std::optional(a)
                                                                                         : std::nullopt;
+    if (st.approach && !discFits(drivable, a, s.robot.radius + kApproachClearance)) {
+      for (double d = kDefaultApproachDistance - 0.05; d >= kMinApproachDistance - 1e-9; d -= 0.05) {
+        const Vec2 nearer = st.pose.position() + st.pose.heading() * d;
+        if (discFits(drivable, nearer, s.robot.radius + kApproachClearance)) {
+          st.approach = nearer;
+          break;
+        }
+      }
+    }
   }
 }
 

@@ -9,6 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include <unistd.h>
+
 #include "fleet/core/config.hpp"
 #include "fleet/site/reachability.hpp"
 #include "fleet/site/site_loader.hpp"
@@ -55,6 +57,37 @@ TEST(SiteFiles, EveryShippedSiteLoadsAndEveryStationIsReachable) {
     }
   }
   EXPECT_GE(sites, 6);
+}
+
+// A derived approach point keeps 0.1 m of free space beyond the disc, nearer the station if it
+// must: PARK-60 of the generated 100-robot warehouse had its point 1 m out, 0.035 m beyond the
+// disc from a shelf corner, and robots stood there for good.
+TEST(SiteFiles, ADerivedApproachPointKeepsItsClearanceFromAShelfCorner) {
+  const fs::path f =
+      fs::path(::testing::TempDir()) / ("approach-" + std::to_string(::getpid()) + ".site.json");
+  nlohmann::json j = {{"format", "fleet-site/1"},
+                      {"name", "corner"},
+                      {"map",
+                       {{"rows",
+                         {"@@@@@@@@@@@@", "@..........@", "@......@@@@@", "@......@@@@@", "@..........@",
+                          "@..........@", "@..........@", "@..........@", "@..........@", "@@@@@@@@@@@@"}},
+                        {"resolution", 0.5}}},
+                      {"robot", {{"radius", 0.3}, {"wheel_base", 0.4}, {"limits", {{"v_max", 1.0}}}}},
+                      {"stations",
+                       {{{"name", "PARK-1"}, {"kind", "parking"}, {"pose", {3.2, 1.85, 1.5708}}},
+                        {{"name", "PARK-2"}, {"kind", "parking"}, {"pose", {1.5, 1.85, 1.5708}}}}}};
+  std::ofstream(f) << j.dump();
+  const Site s = loadSite(f.string());
+  fs::remove(f);
+  ASSERT_EQ(s.stations.size(), 2u);
+  // The shelf's corner (3.5, 3.0) is 0.335 m from the point 1 m out: in by 0.15 m, 0.424 m from it.
+  ASSERT_TRUE(s.stations[0].approach.has_value());
+  EXPECT_NEAR(s.stations[0].approach->x, 3.2, 1e-4);
+  EXPECT_NEAR(s.stations[0].approach->y, 2.70, 1e-4);
+  EXPECT_TRUE(discFits(s.drivable(), *s.stations[0].approach, 0.3 + kApproachClearance));
+  // In the open: 1 m out as before.
+  ASSERT_TRUE(s.stations[1].approach.has_value());
+  EXPECT_NEAR(s.stations[1].approach->y, 2.85, 1e-4);
 }
 
 TEST(SiteFiles, TheCorpusGoodSiteLoadsWithItsParts) {

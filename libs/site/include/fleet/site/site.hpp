@@ -25,7 +25,11 @@ std::optional<StationKind> stationKindFromString(const std::string& s);
 /// reached from. `approach` is the pre-dock point (VDA 5050's approach pose): the straight last leg
 /// runs from it to the station. When site.json gives none, it is the point
 /// `kDefaultApproachDistance` along the heading if the robot's disc fits along that whole leg, and
-/// there is none otherwise (a station in a narrow row is approached along the row).
+/// there is none otherwise (a station in a narrow row is approached along the row). Where the disc
+/// keeps less than `kApproachClearance` of free space at that point, the nearest point further in
+/// (down to `kMinApproachDistance`) that keeps it is taken instead: a robot stops a few centimetres
+/// off its approach point, and one stopped within reach of a shelf corner that its way on leads
+/// past stood for good (100 robots on the generated warehouse, session 24).
 struct Station {
   std::string name;
   StationKind kind = StationKind::Pickup;
@@ -36,6 +40,8 @@ struct Station {
 };
 
 inline constexpr double kDefaultApproachDistance = 1.0;  // m
+inline constexpr double kMinApproachDistance = 0.6;      // m
+inline constexpr double kApproachClearance = 0.1;        // m beyond the disc (the roadmap's nodeClearance)
 
 struct Landmark {
   std::int32_t id = 0;
