@@ -160,12 +160,14 @@ double ReleaseTracker::remaining() const {
   return arc_.back() - progress_ - beyondEnd_;
 }
 
-std::optional<ReleaseTracker::Turn> ReleaseTracker::nextTurn(double angle) const {
+std::optional<ReleaseTracker::Turn> ReleaseTracker::nextTurn(double angle, double tightAngle,
+                                                             const std::function<bool(Vec2)>& tight) const {
   for (std::size_t k = std::max<std::size_t>(reached_, 1); k + 1 < base_.size(); ++k) {
     if (arc_[k] < progress_) {
       continue;  // passed
     }
-    if (turnAt(k) > angle) {
+    const double bend = turnAt(k);
+    if (bend > angle || (tight && bend > tightAngle && tight(base_[k].at))) {
       return Turn{arc_[k] - progress_, base_[k].at};
     }
   }

@@ -11,6 +11,7 @@
 // and counted: the robot keeps what it had, which never lets it drive further than was released.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -105,9 +106,10 @@ class ReleaseTracker {
     double distance = 0.0;  ///< arc length from the robot's projection [m]
     Vec2 at;                ///< the node
   };
-  /// The next node ahead where the base turns by more than `angle` [rad] (none: it runs straight to
-  /// its end).
-  [[nodiscard]] std::optional<Turn> nextTurn(double angle) const;
+  /// The next node ahead where the base turns by more than `angle` [rad], or by more than
+  /// `tightAngle` at a node `tight` says is tight (none: it runs straight to its end).
+  [[nodiscard]] std::optional<Turn> nextTurn(double angle, double tightAngle = 0.0,
+                                             const std::function<bool(Vec2)>& tight = {}) const;
   /// The way to drive: `here`, then the base nodes not yet passed.
   [[nodiscard]] std::vector<Vec2> ahead(Vec2 here) const;
   struct Way {

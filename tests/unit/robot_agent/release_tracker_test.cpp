@@ -172,6 +172,25 @@ TEST(ReleaseTracker, RemainingAndTheWayAheadFollowTheRobot) {
   EXPECT_EQ(*t.next(), (Vec2{1.0, 1.0}));
 }
 
+// A bend under the sharp-turn angle is rounded, except at a node said to be tight (beside a
+// shelf): there it is a corner too, as a 40-robot run's 39° bend at a parking row's approach node
+// beside a shelf corner needed (session 24).
+TEST(ReleaseTracker, AGentleBendIsACornerWhereTheNodeIsTight) {
+  ReleaseTracker t;
+  // Up from (0, 0) to (0, 0.85), then 39° to the left on to (-0.45, 1.4).
+  ASSERT_EQ(t.offer(release(1, 1, {{0, {0.0, 0.0}}, {1, {0.0, 0.85}}, {2, {-0.45, 1.4}}}), {0.0, 0.0}),
+            ReleaseVerdict::kAccepted);
+  (void)t.advance({0.0, 0.1});
+  EXPECT_FALSE(t.nextTurn(0.9).has_value());
+  const auto near = [](Vec2 at) { return at.norm() > 0.5 && at.norm() < 1.0; };
+  const auto turn = t.nextTurn(0.9, 0.3, near);
+  ASSERT_TRUE(turn.has_value());
+  EXPECT_EQ(turn->at, (Vec2{0.0, 0.85}));
+  EXPECT_NEAR(turn->distance, 0.75, 1e-9);
+  EXPECT_FALSE(t.nextTurn(0.9, 0.3, [](Vec2) { return false; }).has_value()) << "not tight: rounded";
+  EXPECT_FALSE(t.nextTurn(0.9, 0.8, near).has_value()) << "under the tight angle: rounded";
+}
+
 TEST(ReleaseTracker, AnEmptyBaseHoldsTheRobotAtTheLastNodeItReached) {
   ReleaseTracker t;
   ASSERT_EQ(t.offer(release(1, 1, line(0, 8)), {0.0, 0.0}), ReleaseVerdict::kAccepted);
