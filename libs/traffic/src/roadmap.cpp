@@ -221,10 +221,14 @@ struct Builder {
   enum class Join { Both, Out };
 
   // Joins `v` to the lattice nodes within one spacing that the disc reaches in a straight line
-  // keeping the edge clearance (`wide`; else the disc only) and that lie within `cone` rad of one of
-  // `dirs` (any direction when `dirs` is empty); failing that, to the nearest two such within three
-  // spacings. The number of nodes joined.
-  int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how, bool wide = true) {
+  // keeping the edge clearance and that lie within `cone` rad of one of `dirs` (any direction when
+  // `dirs` is empty); failing that, to the nearest two such within three spacings; failing both,
+  // the same with edges that clear the disc only. The number of nodes joined.
+  int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how) {
+    const int joined = joinToLattice(v, dirs, cone, how, true);
+    return joined > 0 ? joined : joinToLattice(v, dirs, cone, how, false);
+  }
+  int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how, bool wide) {
     const Vec2 p = pos[static_cast<std::size_t>(v)];
     std::vector<std::pair<double, NodeId>> near;
     const double reach2 = std::pow(3.0 * opt.spacing + 1e-9, 2);
@@ -340,12 +344,6 @@ struct Builder {
       if (joined == 0) {
         joined = joinToLattice(entry, {}, 0.0, Join::Both);
       }
-      if (joined == 0 && sn.approach != kNoNode) {
-        joined = joinToLattice(entry, {st.pose.heading()}, kCone, Join::Both, false);
-      }
-      if (joined == 0) {
-        joined = joinToLattice(entry, {}, 0.0, Join::Both, false);
-      }
       if (joined == 0) {
         std::ostringstream d;
         d << 3.0 * opt.spacing;
@@ -392,11 +390,9 @@ struct Builder {
                     " cannot be driven straight to the one before it");
       }
       const Vec2 back = (queue[q] - nextAt).normalized();
-      if (joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out) == 0) {
-        joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out, false);
-      }
-      if (q + 1 == queue.size() && joinToLattice(v, {back}, kPi / 2.0, Join::Both) == 0) {
-        joinToLattice(v, {back}, kPi / 2.0, Join::Both, false);
+      joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out);
+      if (q + 1 == queue.size()) {
+        joinToLattice(v, {back}, kPi / 2.0, Join::Both);
       }
       sn.queue.push_back(v);
       next = v;
