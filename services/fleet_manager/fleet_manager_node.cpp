@@ -1,5 +1,6 @@
 #include "fleet_manager_node.hpp"
 
+#include "fleet/service/roadmap_config.hpp"
 #include "fleet/service/task_wire.hpp"
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/fleet/errors.hpp"
 #include "fleet/planning/map_io.hpp"
+#include "fleet/traffic/roadmap_travel.hpp"
 
 namespace fleet::manager {
 namespace {
@@ -46,8 +48,9 @@ Settings readSettings(Config& cfg) {
   cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
                          "station_load", "robot_fail_limit", "robot_hold_s", "battery_threshold",
                          "charge_until", "charge_max_s", "nominal_speed", "clock", "metrics_file", "map",
-                         "travel_cost"});
-  s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight"});
+                         "travel_cost", "roadmap"});
+  s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight", "roadmap"});
+  s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -62,7 +65,12 @@ Settings readSettings(Config& cfg) {
   s.maxAttempts = static_cast<int>(cfg.integer("max_attempts", s.maxAttempts, {1, 100}));
   s.robotFailLimit = static_cast<int>(cfg.integer("robot_fail_limit", s.robotFailLimit, {0, 1000}));
   s.robotHoldS = cfg.number("robot_hold_s", s.robotHoldS, {0.0, 86400.0});
-  s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
+  if (const auto* cap = cfg.find("station_capacity"); cap != nullptr && cap->is_string()) {
+    // "queue": each station takes as many active tasks as its line on the roadmap holds.
+    s.stationCapacityFromLines = cfg.string("station_capacity", "queue", {"queue"}) == "queue";
+  } else {
+    s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
+  }
   s.stationLoadByPhase =
       cfg.string("station_load", s.stationLoadByPhase ? "phase" : "task", {"task", "phase"}) == "phase";
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
@@ -117,9 +125,31 @@ TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning
   };
 }
 
-Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
-    const Settings& s, StationMap stations, std::int64_t nowNs,
-    std::shared_ptr<const planning::OccupancyGrid> siteMap) {
+TravelModel makeRoadmapTravelModel(const StationMap& stations,
+                                   std::shared_ptr<const traffic::RoadmapTravel> roads) {
+  return [stations, roads](const Task& t) -> RobotTravel {
+    std::vector<const std::string*> stops;
+    for (const auto* name : {&t.pickup, &t.dropoff, &t.station}) {
+      if (!name->empty() && stations.find(*name) != nullptr) {
+        stops.push_back(name);
+      }
+    }
+    if (stops.empty()) {
+      return [](const RobotInfo&) { return 0.0; };  // a charge/park task the dispatcher resolves
+    }
+    double rest = 0.0;
+    for (std::size_t i = 1; i < stops.size(); ++i) {
+      rest += roads->between(*stops[i - 1], *stops[i]).value_or(kInfeasible);
+    }
+    return [roads, first = *stops[0], rest](const RobotInfo& r) {
+      return roads->toStation(r.pose.position(), first).value_or(kInfeasible) + rest;
+    };
+  };
+}
+
+Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
+                                                                     std::int64_t nowNs,
+                                                                     std::shared_ptr<const site::Site> site) {
   SqliteTaskStoreOptions opts;
   opts.path = s.db;
   opts.sync = s.syncFull ? SqliteTaskStoreOptions::Sync::Full : SqliteTaskStoreOptions::Sync::Normal;
@@ -133,6 +163,25 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
   DispatcherConfig dc;
   dc.maxAttempts = s.maxAttempts;
   dc.stationCapacity = static_cast<std::size_t>(s.stationCapacity);
+  std::shared_ptr<const traffic::RoadmapTravel> roads;
+  if (s.travelCost == "roadmap" || s.stationCapacityFromLines) {
+    if (!site) {
+      return unexpected(Error{
+          errc::kInvalid,
+          std::string(s.travelCost == "roadmap" ? "travel_cost \"roadmap\"" : "station_capacity \"queue\"") +
+              " needs a site (stations from a site file or a scenario naming one)"});
+    }
+    roads = std::make_shared<const traffic::RoadmapTravel>(
+        std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site, s.roadmap)));
+  }
+  if (s.stationCapacityFromLines) {
+    // Stations without a line (parking places, a dock the disc does not fit) keep stationCapacity.
+    for (const auto& st : roads->roadmap().stations) {
+      if (const std::size_t line = roads->lineCapacity(st.name); line > 0) {
+        dc.stationCapacities[st.name] = line;
+      }
+    }
+  }
   dc.stationLoadByPhase = s.stationLoadByPhase;
   dc.robotFailLimit = s.robotFailLimit;
   dc.robotHoldNs = secToNs(s.robotHoldS);
@@ -149,10 +198,12 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(
     }
     cache = std::make_shared<planning::DistanceFieldCache>(
         std::make_shared<const planning::OccupancyGrid>(std::move(*grid)));
-  } else if (siteMap) {
-    cache = std::make_shared<planning::DistanceFieldCache>(std::move(siteMap));
+  } else if (site && s.travelCost == "path") {
+    cache = std::make_shared<planning::DistanceFieldCache>(
+        std::make_shared<const planning::OccupancyGrid>(site->drivable()));
   }
-  auto travel = makeTravelModel(stations, cache, s.nominalSpeed);
+  auto travel = s.travelCost == "roadmap" ? makeRoadmapTravelModel(stations, roads)
+                                          : makeTravelModel(stations, cache, s.nominalSpeed);
   n->dispatcher_ = std::make_unique<Dispatcher>(*n->store_, std::move(stations), std::move(travel), dc);
   auto rec = n->dispatcher_->recover(nowNs);
   if (!rec) {

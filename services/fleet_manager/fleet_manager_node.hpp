@@ -14,6 +14,9 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/metrics/histogram.hpp"
 #include "fleet/planning/distance_field_cache.hpp"
+#include "fleet/site/site.hpp"
+#include "fleet/traffic/roadmap.hpp"
+#include "fleet/traffic/roadmap_travel.hpp"
 
 namespace fleet::manager {
 
@@ -26,6 +29,9 @@ struct Settings {
   int maxAttempts = 3;
   /// Active tasks per station at most (0: no limit); see DispatcherConfig::stationCapacity.
   int stationCapacity = 2;
+  /// `"station_capacity": "queue"`: each station takes as many active tasks as its line on the
+  /// roadmap holds (dock and queue nodes); stations without one keep stationCapacity.
+  bool stationCapacityFromLines = false;
   /// "phase": a task loads its pickup until it has loaded, then its drop-off; "task" (false): both
   /// for the whole task. See DispatcherConfig::stationLoadByPhase.
   bool stationLoadByPhase = false;
@@ -42,8 +48,12 @@ struct Settings {
   std::string clock = "wall";
   std::string metricsFile;  // written every second when set (JSON)
   /// "path": travel costs along grid distance fields on the site's map (or `mapFile`);
-  /// "straight": straight lines, as before sites (kept to measure one against the other).
+  /// "straight": straight lines, as before sites (kept to measure one against the other);
+  /// "roadmap": free-flow times on the traffic layer's roadmap (what robots drive in reserved
+  /// traffic: one-way aisles, turns, docks), from the site.
   std::string travelCost = "path";
+  /// The roadmap of "roadmap" costs and "queue" capacities: the traffic manager's "roadmap" object.
+  traffic::RoadmapOptions roadmap;
   // Optional map: travel costs from grid distance fields instead of straight lines.
   std::string mapFile;  // MovingAI .map
   double mapResolution = 1.0;
@@ -55,6 +65,11 @@ struct Settings {
 /// distance fields when `cache` is given, else in straight lines.
 TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning::DistanceFieldCache> cache,
                             double speed);
+
+/// Seconds a robot needs for a task along the roadmap (free flow): to its first stop's dock and on
+/// through the task's stops; infeasible where a stop has no dock or no route.
+TravelModel makeRoadmapTravelModel(const StationMap& stations,
+                                   std::shared_ptr<const traffic::RoadmapTravel> roads);
 
 Settings readSettings(Config& cfg);
 
@@ -76,11 +91,11 @@ struct Metrics {
 
 class FleetManagerNode {
  public:
-  /// `siteMap`: the site's drivable map, for travel costs along paths (a "map" file in the
-  /// settings wins; neither: straight lines).
-  static Expected<std::unique_ptr<FleetManagerNode>> create(
-      const Settings& s, StationMap stations, std::int64_t nowNs,
-      std::shared_ptr<const planning::OccupancyGrid> siteMap = nullptr);
+  /// `site`: for travel costs along paths on its drivable map (a "map" file in the settings wins;
+  /// neither: straight lines) or on its roadmap, and for station lines.
+  static Expected<std::unique_ptr<FleetManagerNode>> create(const Settings& s, StationMap stations,
+                                                            std::int64_t nowNs,
+                                                            std::shared_ptr<const site::Site> site = nullptr);
 
   /// A batch of requests taken from the Task topic: stores new tasks in one group commit, answers
   /// each with a TaskAck, publishes the resulting events. Cancels are applied in order.

@@ -11,6 +11,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/errors.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/runtime.hpp"
@@ -128,15 +129,19 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   const bool simClock = settings.clock == "sim";
   const Clock& clock = simClock ? static_cast<const Clock&>(sim) : wall;
 
-  // Travel costs follow paths on the site's map when the stations come from a site.
-  std::shared_ptr<const planning::OccupancyGrid> siteMap;
+  // Travel costs follow paths on the site's map (or its roadmap) when the stations come from a site.
+  std::shared_ptr<const site::Site> site;
   if (loaded->site) {
-    siteMap = std::make_shared<const planning::OccupancyGrid>(loaded->site->drivable());
+    site = std::make_shared<const site::Site>(std::move(*loaded->site));
   }
   auto created =
-      manager::FleetManagerNode::create(settings, std::move(loaded->stations), clock.nowNs(), siteMap);
+      manager::FleetManagerNode::create(settings, std::move(loaded->stations), clock.nowNs(), site);
   if (!created) {
-    spdlog::critical("fleet manager: cannot open task store {}: {}", settings.db, created.error().message);
+    if (created.error().code == errc::kInvalid) {
+      spdlog::critical("fleet manager: {}", created.error().message);  // the settings, not the store
+    } else {
+      spdlog::critical("fleet manager: cannot open task store {}: {}", settings.db, created.error().message);
+    }
     return 2;
   }
   auto& node = **created;

@@ -606,15 +606,17 @@ int Run::run() {
   fs::remove(db, ec);
   fs::remove(out / "fleet.db-wal", ec);
   fs::remove(out / "fleet.db-shm", ec);
-  writeFile(out / "manager.json", json{{"stations", fs::absolute(scenarioPath).string()},
-                                       {"db", fs::absolute(db).string()},
-                                       {"clock", "sim"},
-                                       {"lease_s", 3.0},
-                                       {"station_capacity", o.stationCapacity},
-                                       {"station_load", o.stationLoad},
-                                       {"travel_cost", o.travelCost},
-                                       {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
-                                      .dump(1));
+  writeFile(out / "manager.json",
+            json{{"stations", fs::absolute(scenarioPath).string()},
+                 {"db", fs::absolute(db).string()},
+                 {"clock", "sim"},
+                 {"lease_s", 3.0},
+                 {"station_capacity", o.stationCapacity == "queue" ? json(o.stationCapacity)
+                                                                   : json(std::stoi(o.stationCapacity))},
+                 {"station_load", o.stationLoad},
+                 {"travel_cost", o.travelCost},
+                 {"metrics_file", fs::absolute(out / "manager_metrics.json").string()}}
+                .dump(1));
   {
     json riskMap = {{"clock", "sim"}, {"lockstep", !o.wallClock}, {"rate_hz", 2}};
     if (!siteFile.empty()) {
@@ -651,6 +653,12 @@ int Run::run() {
   if (o.traffic == "reserved" && !hasSite && !o.trafficNamed) {
     say("the scenario has no site, so no roadmap: reactive traffic (robots avoid each other on their own)");
     o.traffic = "reactive";
+  }
+  if ((o.travelCost == "roadmap" || o.stationCapacity == "queue") && !hasSite) {
+    std::cerr << "fleetctl loadtest: "
+              << (o.travelCost == "roadmap" ? "--travel-cost roadmap" : "--station-capacity queue")
+              << " needs a scenario with a site (its roadmap)\n";
+    return 2;
   }
   if (o.traffic == "reserved") {
     if (!hasSite) {

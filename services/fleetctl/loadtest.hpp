@@ -38,9 +38,11 @@ struct LoadtestOptions {
   bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
   int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
   std::string stationLoad = "task";  // the fleet manager's station_load (task or phase)
-  int stationCapacity = 2;           // the fleet manager's station_capacity (0: no limit)
-  std::string travelCost = "path";   // the fleet manager's travel_cost (path | straight)
-  double returnHomeS = 5.0;          // robot agents' --return-home (negative: stay where a task ends)
+  /// The fleet manager's station_capacity: active tasks per station ("0": no limit), or "queue":
+  /// as many as the station's line on the roadmap holds (dock and queue nodes).
+  std::string stationCapacity = "2";
+  std::string travelCost = "path";  // the fleet manager's travel_cost (path | straight | roadmap)
+  double returnHomeS = 5.0;         // robot agents' --return-home (negative: stay where a task ends)
   /// "reserved" (a traffic_manager process plans every robot; the agents follow its releases) or
   /// "reactive" (robots keep clear of each other on their own). Reserved needs the scenario's site
   /// (its roadmap): without one, and not named (`trafficNamed` false), the run falls back to

@@ -140,13 +140,17 @@ int main(int argc, char** argv) {
           "reserved traffic: route nodes a robot must be short of a conflict before one waiting on it "
           "there may go first (switchable dependencies); 0: never (default: the traffic manager's)")
       ->check(CLI::Range(0, 1000));
-  loadtest->add_option("--station-capacity", lt.stationCapacity, "active tasks per station (0 = no limit)")
-      ->check(CLI::Range(0, 1000))
+  loadtest
+      ->add_option("--station-capacity", lt.stationCapacity,
+                   "active tasks per station (0 = no limit), or queue: as many as the station's line on the "
+                   "roadmap holds (its dock and queue nodes)")
+      ->check(CLI::IsMember({"queue"}) | CLI::Range(0, 1000))
       ->capture_default_str();
   loadtest
       ->add_option("--travel-cost", lt.travelCost,
-                   "fleet manager's travel costs: along paths or straight lines")
-      ->check(CLI::IsMember({"path", "straight"}))
+                   "fleet manager's travel costs: along paths on the map, straight lines, or free-flow times "
+                   "on the roadmap (needs the scenario's site)")
+      ->check(CLI::IsMember({"path", "straight", "roadmap"}))
       ->capture_default_str();
   loadtest
       ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")

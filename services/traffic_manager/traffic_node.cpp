@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "fleet/service/roadmap_config.hpp"
+
 namespace fleet::trafficmgr {
 
 using traffic::kNoNode;
@@ -36,13 +38,7 @@ Settings readSettings(Config& cfg) {
       static_cast<int>(cfg.integer("detour_after", s.traffic.pibt.detourAfter, {0, 100000}));
   s.traffic.pibt.detourPenalty =
       static_cast<float>(cfg.number("detour_penalty", s.traffic.pibt.detourPenalty, {0.0, 1e6}));
-  auto r = cfg.child("roadmap");
-  r.rejectUnknownKeys({"spacing", "cruise_speed", "margin", "queue_length", "diagonals"});
-  s.roadmap.spacing = r.number("spacing", 0.0, {0.0, 10.0});
-  s.roadmap.cruiseSpeed = r.number("cruise_speed", s.roadmap.cruiseSpeed, {0.0, 10.0, true});
-  s.roadmap.margin = r.number("margin", s.roadmap.margin, {0.0, 2.0});
-  s.roadmap.queueLength = static_cast<int>(r.integer("queue_length", s.roadmap.queueLength, {0, 50}));
-  s.roadmap.diagonals = r.boolean("diagonals", s.roadmap.diagonals);
+  s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
   return s;
 }
 

@@ -480,9 +480,12 @@ void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
   for (auto& t : waiting) {
     const auto stations = cfg_.stationLoadByPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
     // A robot's own charge task is never held back: its battery does not wait for the queue.
-    const bool full = t.robot.empty() &&
-                      std::any_of(stations.begin(), stations.end(),
-                                  [&](const std::string* s) { return load[*s] >= cfg_.stationCapacity; });
+    const bool full =
+        t.robot.empty() && std::any_of(stations.begin(), stations.end(), [&](const std::string* s) {
+          const auto it = cfg_.stationCapacities.find(*s);
+          const std::size_t cap = it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
+          return cap > 0 && load[*s] >= cap;
+        });
     if (!full) {
       for (const std::string* s : stations) {
         ++load[*s];
@@ -530,7 +533,7 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
   if (waiting.empty() || idle.empty()) {
     return;
   }
-  if (cfg_.stationCapacity > 0) {
+  if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
     admitByStationCapacity(waiting);
     if (waiting.empty()) {
       return;

@@ -341,6 +341,32 @@ TEST_F(DispatcherTest, StationCapacityHoldsTasksBackOldestFirst) {
   EXPECT_EQ(next.assignments[0].task.id, "t3");
 }
 
+/// Per-station capacities (a station's line on the roadmap in reserved traffic) override the
+/// global one, and 0 there means no limit at that station.
+TEST_F(DispatcherTest, AStationsOwnCapacityOverridesTheGlobalOne) {
+  cfg.stationCapacity = 1;
+  cfg.stationCapacities = {{"P-1", 3}, {"D-1", 3}};
+  reopen();
+  for (int i = 0; i < 5; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  dispatcher->submit({transport("t1"), transport("t2"), transport("t3"), transport("t4")}, 0);
+  auto out = dispatcher->tick(1);
+  EXPECT_EQ(out.assignments.size(), 3u) << "P-1 and D-1 each hold three";
+  EXPECT_TRUE(dispatcher->tick(2).assignments.empty());
+}
+
+TEST_F(DispatcherTest, AStationCapacityOfZeroIsNoLimitThere) {
+  cfg.stationCapacity = 1;
+  cfg.stationCapacities = {{"P-1", 0}, {"D-1", 0}};
+  reopen();
+  for (int i = 0; i < 5; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  dispatcher->submit({transport("t1"), transport("t2"), transport("t3"), transport("t4")}, 0);
+  EXPECT_EQ(dispatcher->tick(1).assignments.size(), 4u);
+}
+
 /// Counted by phase, a task loads its pickup until it has loaded and then its drop-off: a robot
 /// delivering elsewhere no longer holds a place at the pickup it has left.
 TEST_F(DispatcherTest, StationLoadByPhaseFreesThePickupOnceLoaded) {

@@ -5,6 +5,8 @@
 #include <fstream>
 
 #include "fleet/planning/map_io.hpp"
+#include "fleet/service/site_stations.hpp"
+#include "fleet/site/site_loader.hpp"
 #include "fleet_manager_node.hpp"
 
 using namespace fleet;
@@ -224,6 +226,97 @@ TEST(TravelModel, GridDistanceGoesAroundWallsStraightLineDoesNot) {
               cache->travelDistance({2.5, 0.5}, {7.5, 0.5}) + cache->travelDistance({7.5, 0.5}, {7.5, 3.5}),
               1e-9);
   std::filesystem::remove(path);
+}
+
+namespace {
+std::shared_ptr<const site::Site> smallWarehouse() {
+  return std::make_shared<const site::Site>(site::loadSite(
+      (std::filesystem::path(FLEET_SOURCE_DIR) / "sim/scenarios/small_warehouse.site.json").string()));
+}
+}  // namespace
+
+// Reserved traffic drives the roadmap: its times (turns, docks' last legs) are the costs.
+TEST(TravelModel, RoadmapTimesAreTheRoadmapsDockToDockTimes) {
+  const auto site = smallWarehouse();
+  const auto roads = std::make_shared<const traffic::RoadmapTravel>(
+      std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site)));
+  const StationMap st = service::stationMapOf(*site);
+  Task t;
+  t.id = "t";
+  t.pickup = "P-1";
+  t.dropoff = "D-2";
+  RobotInfo atPickup;
+  atPickup.pose = site->station("P-1")->pose;
+  const auto model = manager::makeRoadmapTravelModel(st, roads);
+  EXPECT_NEAR(model(t)(atPickup), *roads->between("P-1", "D-2"), 1e-6);
+  RobotInfo atDropoff;
+  atDropoff.pose = site->station("D-2")->pose;
+  EXPECT_NEAR(model(t)(atDropoff), *roads->between("D-2", "P-1") + *roads->between("P-1", "D-2"), 1e-6);
+  // Never below the straight lines at cruise speed: the roadmap is a way through the shelves.
+  const double line = (distance(atDropoff.pose.position(), atPickup.pose.position()) * 2) /
+                      roads->roadmap().options.cruiseSpeed;
+  EXPECT_GT(model(t)(atDropoff), line);
+}
+
+TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
+  settings_.stationCapacityFromLines = true;
+  settings_.travelCost = "roadmap";
+  const auto site = smallWarehouse();
+  auto n = manager::FleetManagerNode::create(settings_, service::stationMapOf(*site), 1'000, site);
+  ASSERT_TRUE(n) << n.error().message;
+  auto& node = **n;
+  const traffic::RoadmapTravel roads(std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site)));
+  const std::size_t line = std::min(roads.lineCapacity("P-1"), roads.lineCapacity("D-1"));
+  ASSERT_GT(line, 2U) << "the small warehouse's pickups and drop-offs have queues";
+  manager::Outbox out;
+  std::vector<msg::Task> reqs;
+  for (int i = 0; i < 8; ++i) {
+    reqs.push_back(request("t" + std::to_string(i), transport("t" + std::to_string(i))));
+  }
+  node.onRequests(reqs, 2'000, out);
+  for (int i = 0; i < 8; ++i) {
+    const auto& park = site->stations[static_cast<std::size_t>(i)];  // parking places, one robot each
+    node.onRobotState({"r" + std::to_string(i),
+                       3'000,
+                       {park.pose.x, park.pose.y, park.pose.theta},
+                       {},
+                       0,
+                       0,
+                       msg::RobotMode::Idle,
+                       0.9f,
+                       "",
+                       0.3f},
+                      3'000);
+  }
+  manager::Outbox assigned;
+  node.tick(4'000, assigned);
+  EXPECT_EQ(assigned.assignments.size(), line) << "P-1 and D-1 each take as many as their lines hold";
+}
+
+TEST(Settings, StationCapacityIsANumberOrQueueAndRoadmapCostsNeedASite) {
+  auto queue = Config::fromText(R"({"stations": "s.json", "station_capacity": "queue",
+                                    "travel_cost": "roadmap", "roadmap": {"queue_length": 2}})",
+                                "manager.json");
+  const auto s = manager::readSettings(queue);
+  queue.finish();
+  EXPECT_TRUE(s.stationCapacityFromLines);
+  EXPECT_EQ(s.travelCost, "roadmap");
+  EXPECT_EQ(s.roadmap.queueLength, 2);
+  auto bad = Config::fromText(
+      R"({"stations": "s.json", "station_capacity": "lots", "roadmap": {"spacin": 1}})", "manager.json");
+  manager::readSettings(bad);
+  ASSERT_EQ(bad.problems().size(), 2U);
+  EXPECT_THAT(bad.problems()[0] + bad.problems()[1], HasSubstr("station_capacity: expected one of"));
+  EXPECT_THAT(bad.problems()[0] + bad.problems()[1], HasSubstr("roadmap.spacin"));
+  // Without a site there is no roadmap: a clear refusal, not straight lines in disguise.
+  auto noSite = manager::Settings{};
+  noSite.travelCost = "roadmap";
+  noSite.db =
+      (std::filesystem::temp_directory_path() / ("fm_nosite_" + std::to_string(getpid()) + ".db")).string();
+  auto n = manager::FleetManagerNode::create(noSite, stations(), 1'000);
+  ASSERT_FALSE(n);
+  EXPECT_THAT(n.error().message, HasSubstr("needs a site"));
+  std::filesystem::remove(noSite.db);
 }
 
 TEST(Settings, ChargeUntilMustExceedTheBatteryThreshold) {

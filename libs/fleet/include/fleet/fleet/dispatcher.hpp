@@ -5,6 +5,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
@@ -30,6 +31,9 @@ struct DispatcherConfig {
   /// task whose station is full waits in the queue (oldest first) instead of sending another robot
   /// to crowd the station. 0: no limit.
   std::size_t stationCapacity = 0;
+  /// Per-station capacities that override stationCapacity (0: no limit at that station). With
+  /// reserved traffic, each station's line on the roadmap (dock and queue nodes) gives its own.
+  std::unordered_map<std::string, std::size_t> stationCapacities;
   /// How an active task loads its stations. Whole task (false): its pickup and its drop-off from
   /// assignment to the end, so with 9 stations and a capacity of 2 at most ~8 tasks are active
   /// while 20 robots wait. By phase (true): its pickup until it has loaded, then its drop-off,

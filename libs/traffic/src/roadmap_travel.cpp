@@ -1,0 +1,56 @@
+#include "fleet/traffic/roadmap_travel.hpp"
+
+#include <limits>
+#include <utility>
+
+#include "fleet/traffic/distance_table.hpp"
+
+namespace fleet::traffic {
+
+RoadmapTravel::RoadmapTravel(std::shared_ptr<const Roadmap> roadmap) : roadmap_(std::move(roadmap)) {
+  DistanceTable tables(roadmap_->graph);
+  for (const auto& st : roadmap_->stations) {
+    StationTable t;
+    t.dock = st.dock;
+    if (st.dock != kNoNode) {
+      t.line = 1 + st.queue.size();
+      const auto d = tables.to(st.dock);
+      t.toDock.assign(d.begin(), d.end());
+    }
+    stations_.emplace(st.name, std::move(t));
+  }
+}
+
+const RoadmapTravel::StationTable* RoadmapTravel::find(const std::string& name) const {
+  const auto it = stations_.find(name);
+  return it == stations_.end() || it->second.dock == kNoNode ? nullptr : &it->second;
+}
+
+std::optional<double> RoadmapTravel::toStation(Vec2 from, const std::string& name) const {
+  const StationTable* t = find(name);
+  if (t == nullptr) {
+    return std::nullopt;
+  }
+  const NodeId start = roadmap_->nearest(from);
+  if (start == kNoNode) {
+    return std::numeric_limits<double>::infinity();
+  }
+  const double leg = distance(from, roadmap_->graph.position(start)) / roadmap_->options.cruiseSpeed;
+  return leg + static_cast<double>(t->toDock[static_cast<std::size_t>(start)]);
+}
+
+std::optional<double> RoadmapTravel::between(const std::string& a, const std::string& b) const {
+  const StationTable* from = find(a);
+  const StationTable* to = find(b);
+  if (from == nullptr || to == nullptr) {
+    return std::nullopt;
+  }
+  return static_cast<double>(to->toDock[static_cast<std::size_t>(from->dock)]);
+}
+
+std::size_t RoadmapTravel::lineCapacity(const std::string& name) const {
+  const StationTable* t = find(name);
+  return t == nullptr ? 0 : t->line;
+}
+
+}  // namespace fleet::traffic

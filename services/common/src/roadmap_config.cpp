@@ -1,0 +1,16 @@
+#include "fleet/service/roadmap_config.hpp"
+
+namespace fleet::service {
+
+traffic::RoadmapOptions readRoadmapOptions(Config r) {
+  traffic::RoadmapOptions o;
+  r.rejectUnknownKeys({"spacing", "cruise_speed", "margin", "queue_length", "diagonals"});
+  o.spacing = r.number("spacing", 0.0, {0.0, 10.0});
+  o.cruiseSpeed = r.number("cruise_speed", o.cruiseSpeed, {0.0, 10.0, true});
+  o.margin = r.number("margin", o.margin, {0.0, 2.0});
+  o.queueLength = static_cast<int>(r.integer("queue_length", o.queueLength, {0, 50}));
+  o.diagonals = r.boolean("diagonals", o.diagonals);
+  return o;
+}
+
+}  // namespace fleet::service
