@@ -8,10 +8,10 @@
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/site/wall_segments.hpp"
 #include "fleet/site/zone_costs.hpp"
 #include "fleet/validation/sample_checks.hpp"
-#include "risk_lookup_of.hpp"
 
 namespace fleet::agent {
 
@@ -181,7 +181,7 @@ void AgentNode::onRiskMaps(std::vector<msg::RiskMap> maps) {
   if (maps.empty() || !settings_.useRisk) {
     return;
   }
-  if (auto field = riskLookupOf(maps.back())) {
+  if (auto field = service::riskLookupOf(maps.back())) {
     for (auto& a : agents_) {
       a->onRiskMap(*field);
     }

@@ -11,6 +11,7 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
@@ -54,6 +55,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   transport::Writer<msg::Roadmap> roadmapOut(p);
   transport::Reader<msg::Clock> clockIn(p);
   transport::Writer<msg::StepDone> stepDone(p);
+  transport::Reader<msg::RiskMap> riskMaps(p);
   transport::WaitSet ws(p);
   ws.attach(progress);
   ws.attach(clockIn);
@@ -78,15 +80,23 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     const auto& c = node.counters();
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
-        "re-plans, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
+        "re-plans, {} risk updates, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
-        c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
+        c.riskUpdates, c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
     // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
     // is slow (a minute of its clock, sim or wall).
     for (const auto& line : node.stalled(now, 60.0))
       spdlog::warn("traffic manager: {}", line);
   };
   auto ingest = [&] {
+    // Only the newest map matters; a map that does not decode is refused as any bad sample.
+    if (auto maps = riskMaps.take(); !maps.empty() && haveClock && settings.riskCostS > 0.0) {
+      if (auto risk = service::riskLookupOf(maps.back())) {
+        node.onRiskMap(**risk, now);
+      } else {
+        badInput.warn("risk_map", "RiskMap ignored: " + risk.error().message);
+      }
+    }
     for (const auto& m : service::admitted(progress.take(), rejections, badInput)) {
       if (!haveClock)
         continue;

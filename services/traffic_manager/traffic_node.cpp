@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "fleet/core/clock.hpp"
 #include "fleet/service/roadmap_config.hpp"
 
 namespace fleet::trafficmgr {
@@ -15,7 +16,8 @@ Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
                          "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
-                         "detour_after", "detour_penalty", "station_lines", "let_pass", "roadmap"});
+                         "detour_after", "detour_penalty", "station_lines", "let_pass", "roadmap",
+                         "risk_cost_s", "risk_period_s"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -38,6 +40,8 @@ Settings readSettings(Config& cfg) {
       static_cast<int>(cfg.integer("detour_after", s.traffic.pibt.detourAfter, {0, 100000}));
   s.traffic.pibt.detourPenalty =
       static_cast<float>(cfg.number("detour_penalty", s.traffic.pibt.detourPenalty, {0.0, 1e6}));
+  s.riskCostS = cfg.number("risk_cost_s", s.riskCostS, {0.0, 3600.0});
+  s.riskPeriodS = cfg.number("risk_period_s", s.riskPeriodS, {0.0, 3600.0});
   s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
   return s;
 }
@@ -50,6 +54,19 @@ TrafficNode::TrafficNode(const site::Site& site, Settings settings, std::uint32_
       std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, settings_.traffic);
   if (settings_.stationLines)
     control_->setStations(traffic::stationLines(roadmap_));
+}
+
+bool TrafficNode::onRiskMap(const risk::RiskLookup& risk, std::int64_t nowNs) {
+  if (settings_.riskCostS <= 0.0 || (riskNs_ >= 0 && nowNs - riskNs_ < secToNs(settings_.riskPeriodS)))
+    return false;
+  riskNs_ = nowNs;
+  riskCost_.resize(roadmap_.graph.size());
+  for (std::size_t v = 0; v < riskCost_.size(); ++v)
+    riskCost_[v] =
+        static_cast<float>(settings_.riskCostS * risk.at(roadmap_.graph.position(static_cast<NodeId>(v))));
+  control_->setNodeCost(riskCost_);
+  ++counters_.riskUpdates;
+  return true;
 }
 
 msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {

@@ -22,6 +22,7 @@
 
 #include "fleet/core/config.hpp"
 #include "fleet/messages/messages.hpp"
+#include "fleet/risk/risk_lookup.hpp"
 #include "fleet/site/site.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
@@ -39,6 +40,13 @@ struct Settings {
   /// Robots sent to a pickup, drop-off or charger wait in line on its queue nodes, one at the dock
   /// (false: they are planned straight to the dock and wait wherever the planner leaves them).
   bool stationLines = true;
+  /// Seconds added to driving into a node where the risk map's collision probability is 1 (in
+  /// proportion below): people-dense space costs more, so routes go round it where that is worth
+  /// it. 0: the risk map is not used.
+  double riskCostS = 1.0;
+  /// At most one risk update per this many seconds: each one recomputes the planner's distance
+  /// tables (one search per robot's goal).
+  double riskPeriodS = 2.0;
   traffic::RoadmapOptions roadmap;
   traffic::TrafficOptions traffic;
 };
@@ -58,6 +66,13 @@ class TrafficNode {
   /// whole, and the robot stays held where it was); nothing otherwise.
   std::optional<std::string> onProgress(const msg::TrafficProgress& p, std::int64_t nowNs);
 
+  /// The collision-probability map: each node's cost becomes riskCostS × the probability at it.
+  /// Returns whether it was applied (not when risk is off or the last one is younger than
+  /// riskPeriodS).
+  bool onRiskMap(const risk::RiskLookup& risk, std::int64_t nowNs);
+  /// Each node's current risk cost (s), empty before the first map.
+  [[nodiscard]] const std::vector<float>& riskCost() const { return riskCost_; }
+
   /// Places robots, plans, and returns the releases that changed since they were last returned.
   std::vector<msg::TrafficRelease> tick(std::int64_t nowNs);
   /// The latest release of every placed robot (to publish again, e.g. after a reconnect).
@@ -69,6 +84,7 @@ class TrafficNode {
     std::uint64_t releases = 0;
     std::uint64_t plannedSteps = 0;
     std::uint64_t replans = 0;
+    std::uint64_t riskUpdates = 0;
     double lastTickMs = 0.0;
     double maxTickMs = 0.0;
   };
@@ -107,6 +123,8 @@ class TrafficNode {
   std::map<std::string, Robot> robots_;
   std::vector<std::string> byIndex_;
   std::int64_t startNs_ = -1;
+  std::int64_t riskNs_ = -1;
+  std::vector<float> riskCost_;
   Counters counters_;
 };
 

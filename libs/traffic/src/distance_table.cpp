@@ -55,6 +55,18 @@ void DistanceTable::setBlocked(NodeId v, bool blocked) {
   }
 }
 
+bool DistanceTable::setNodeCost(std::vector<float> cost) {
+  if (std::all_of(cost.begin(), cost.end(), [](float c) { return c == 0.0F; })) {
+    cost.clear();  // all zero is none: unit grids keep their breadth-first search
+  }
+  if (cost == nodeCost_) {
+    return false;
+  }
+  nodeCost_ = std::move(cost);
+  dirty_ = true;
+  return true;
+}
+
 void DistanceTable::invalidate() {
   dirty_ = false;
   blocked_.resize(graph_.size(), 0);
@@ -152,6 +164,10 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
     return;
   }
   d[static_cast<std::size_t>(goal)] = 0.0F;
+  if (nodeCost_.size() == graph_.size()) {
+    dijkstra(goal, nodeCost_, d);
+    return;
+  }
   if (unit_) {
     queue_.clear();
     queue_.push_back(goal);
@@ -187,6 +203,14 @@ void DistanceTable::withExtraCost(NodeId goal, std::span<const float> extra, std
     return;
   }
   d[static_cast<std::size_t>(goal)] = 0.0F;
+  if (nodeCost_.size() == graph_.size()) {
+    combined_.resize(extra.size());
+    for (std::size_t v = 0; v < extra.size(); ++v) {
+      combined_[v] = extra[v] + nodeCost_[v];
+    }
+    dijkstra(goal, combined_, d);
+    return;
+  }
   dijkstra(goal, extra, d);
 }
 

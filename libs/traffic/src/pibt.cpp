@@ -104,6 +104,10 @@ void Pibt::graphChanged() {
   }
 }
 
+void Pibt::setNodeCost(std::vector<float> cost) {
+  rebaseProgress_ = distances_.setNodeCost(std::move(cost)) || rebaseProgress_;
+}
+
 void Pibt::setGoal(std::size_t agent, NodeId goal) {
   if (goal != kNoNode && !graph_.valid(goal)) {
     throw std::invalid_argument("Pibt::setGoal: invalid node " + std::to_string(goal));
@@ -526,6 +530,12 @@ const std::vector<NodeId>& Pibt::step() {
     } else {
       table_[i] = detour_[i].empty() ? distances_.to(goal_[i]).data() : detour_[i].data();
     }
+    if (rebaseProgress_ && table_[i] != nullptr && detour_[i].empty()) {
+      const float d = table_[i][idx(now_[i])];
+      if (d != DistanceTable::kUnreachable) {
+        best_[i] = d;
+      }
+    }
     if (controlled_[i] != 0) {
       next_[i] = kNoNode;
       order_.push_back(static_cast<std::int32_t>(i));
@@ -534,6 +544,7 @@ const std::vector<NodeId>& Pibt::step() {
       reservedBy_[idx(now_[i])] = static_cast<std::int32_t>(i);
     }
   }
+  rebaseProgress_ = false;
   // Agents on a way out of a knot first: their moves were found with everyone else standing.
   std::sort(order_.begin(), order_.end(), [this](std::int32_t a, std::int32_t b) {
     const bool fa = forcedGroup_[idx(a)] >= 0;

@@ -426,7 +426,12 @@ void TrafficControl::replan() {
 }
 
 void TrafficControl::graphChanged() {
+  planner_->graphChanged();  // its cached distances still route through what was closed
   replan();
+}
+
+void TrafficControl::setNodeCost(std::vector<float> cost) {
+  planner_->setNodeCost(std::move(cost));
 }
 
 std::string TrafficControl::explain(std::size_t robot) const {

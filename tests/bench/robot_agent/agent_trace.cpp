@@ -17,8 +17,8 @@
 
 #include "agent.hpp"
 #include "fleet/risk/rle.hpp"
+#include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/site/site_loader.hpp"
-#include "risk_lookup_of.hpp"
 
 using namespace fleet;
 
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
       for (const auto& r : risk::encodeRle(lv)) {
         m.runs.push_back({r.level, r.length});
       }
-      auto f = agent::riskLookupOf(m);
+      auto f = service::riskLookupOf(m);
       for (auto& a : agents) {
         a->onRiskMap(*f);
       }

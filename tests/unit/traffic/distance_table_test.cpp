@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "pibt_test_support.hpp"
@@ -122,6 +123,59 @@ TEST(DistanceTable, RandomWeightedDirectedGraphsMatchFloydWarshall) {
     }
     t.invalidate();
     expectSameAsAllPairs(g, t);
+  }
+}
+
+// A cost of driving into each node is the same as adding it to every edge into that node, except
+// that arriving at the goal costs nothing: checked against Floyd-Warshall on such a graph.
+TEST(DistanceTable, NodeCostsAreEdgesIntoTheNodeCostingMore) {
+  std::mt19937_64 rng(5);
+  for (int round = 0; round < 10; ++round) {
+    Graph g;
+    Graph costed;
+    const int n = 10 + round;
+    for (int i = 0; i < n; ++i) {
+      g.addNode({static_cast<double>(i), 0.0});
+      costed.addNode({static_cast<double>(i), 0.0});
+    }
+    std::uniform_int_distribution<int> node(0, n - 1);
+    std::uniform_real_distribution<float> cost(0.0F, 2.0F);
+    std::vector<float> c(static_cast<std::size_t>(n));
+    for (auto& x : c) {
+      x = cost(rng);
+    }
+    for (int e = 0; e < n * 3; ++e) {
+      const int a = node(rng);
+      const int b = node(rng);
+      if (a != b) {
+        g.addEdge(a, b, 1.0);  // unit durations: the costs must switch the search to Dijkstra's
+        costed.addEdge(a, b, 1.0 + static_cast<double>(c[static_cast<std::size_t>(b)]));
+      }
+    }
+    DistanceTable t(g);
+    const auto plain = allPairs(g);
+    EXPECT_TRUE(t.setNodeCost(c));
+    EXPECT_FALSE(t.setNodeCost(c)) << "the same costs again change nothing";
+    const auto expected = allPairs(costed);
+    for (int goal = 0; goal < n; ++goal) {
+      const auto d = t.to(goal);
+      for (int from = 0; from < n; ++from) {
+        const double want =
+            from == goal ? 0.0
+                         : expected[from][goal] - static_cast<double>(c[static_cast<std::size_t>(goal)]);
+        if (std::isinf(expected[from][goal])) {
+          EXPECT_EQ(d[from], kInf);
+        } else {
+          EXPECT_NEAR(d[from], want, 1e-4) << from << " -> " << goal;
+          EXPECT_GE(static_cast<double>(d[from]) + 1e-4, plain[from][goal])
+              << "a cost never makes a way shorter";
+        }
+      }
+    }
+    // All zero is no cost at all: the plain tables again.
+    EXPECT_TRUE(t.setNodeCost(std::vector<float>(static_cast<std::size_t>(n), 0.0F)));
+    expectSameAsAllPairs(g, t);
+    EXPECT_TRUE(t.nodeCost().empty());
   }
 }
 

@@ -395,6 +395,37 @@ TEST(Pibt, ClosedNodesAreNotEnteredButCanBeLeft) {
   EXPECT_EQ(p.positions()[0], m.node(2, 0));
 }
 
+// The risk map's weight: a costly band on the short way sends the agent round by the long one;
+// without it the short way is taken.
+TEST(Pibt, AgentsGoRoundCostlyNodesWhenTheDetourIsCheaper) {
+  const GridMap m = gridOf({
+      ".....",
+      ".@@@.",
+      ".....",
+  });
+  auto route = [&](const std::vector<float>& cost) {
+    Pibt p(m.graph, std::vector<NodeId>{m.node(0, 0)});
+    p.setNodeCost(cost);
+    p.setGoal(0, m.node(4, 0));
+    std::vector<NodeId> visited;
+    for (int t = 0; t < 20 && p.positions()[0] != m.node(4, 0); ++t) {
+      p.step();
+      visited.push_back(p.positions()[0]);
+    }
+    EXPECT_EQ(p.positions()[0], m.node(4, 0));
+    return visited;
+  };
+  const auto straight = route({});
+  EXPECT_EQ(straight.size(), 4U) << "the top row, 4 steps";
+  std::vector<float> cost(m.graph.size(), 0.0F);
+  cost[static_cast<std::size_t>(m.node(2, 0))] = 5.0F;  // a person's predicted disc on the top row
+  const auto round = route(cost);
+  EXPECT_EQ(round.size(), 8U) << "down, along the bottom row and up";
+  EXPECT_EQ(std::count(round.begin(), round.end(), m.node(2, 0)), 0);
+  cost[static_cast<std::size_t>(m.node(2, 0))] = 1.0F;  // cheaper than the 4 steps more of the detour
+  EXPECT_EQ(route(cost).size(), 4U);
+}
+
 TEST(Pibt, StartsAndMovesThatConflictAreRefused) {
   const GridMap m = gridOf({"...."});
   const std::vector<NodeId> same = {0, 0};

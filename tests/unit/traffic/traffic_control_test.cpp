@@ -282,6 +282,41 @@ TEST(TrafficControl, APlanThatComesBackToTheRobotsNodeIsPlannedOn) {
   EXPECT_TRUE(tc.arrived(0));
 }
 
+// A node closed on the robot's way after it was planned: told so, the planner forgets the distances
+// that led through it and goes the long way round at once. It used to keep them (the short way
+// still looked shortest) and stand in front of the closed node until its detour search, meant for
+// robots in the way, found the way round: 19 updates here instead of 4.
+TEST(TrafficControl, AClosedNodeOnTheWayIsGoneRoundOnceTheGraphChanged) {
+  // 0 - 1 - 2 short; 0 - 3 - 4 - 5 - 2 long; 1 m apart so nothing excludes anything else.
+  Graph g;
+  for (const Vec2 p : {Vec2{0, 0}, Vec2{1, 0}, Vec2{2, 0}, Vec2{0, -1}, Vec2{1, -2}, Vec2{2, -1}})
+    g.addNode(p);
+  for (const auto& [a, b] : {std::pair{0, 1}, std::pair{1, 2}, std::pair{0, 3}, std::pair{3, 4},
+                             std::pair{4, 5}, std::pair{5, 2}}) {
+    g.addEdge(a, b);
+    g.addEdge(b, a);
+  }
+  const std::vector<NodeId> starts{0};
+  TrafficControl tc(g, starts);
+  ASSERT_TRUE(tc.setGoal(0, 2));
+  tc.update();  // distances to 2 computed through 1
+  g.setOpen(1, false);
+  tc.graphChanged();
+  std::vector<NodeId> reported;
+  int updates = 0;
+  for (; updates < 100 && !tc.arrived(0); ++updates) {
+    tc.update();
+    const auto rel = tc.release(0);
+    if (rel.base.size() > 1) {
+      EXPECT_EQ(tc.reached(0, rel.base[1]), Report::Accepted);
+      reported.push_back(rel.base[1]);
+    }
+  }
+  EXPECT_TRUE(tc.arrived(0)) << tc.explain(0);
+  EXPECT_EQ(reported, (std::vector<NodeId>{3, 4, 5, 2}));
+  EXPECT_LE(updates, 6) << "stood in front of the closed node";
+}
+
 TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   Roadmap map = smallWarehouse();
   const auto* d1 = map.station("D-1");

@@ -66,6 +66,63 @@ TEST(TrafficNode, WaitsForReportsThenPlacesAndReleases) {
   EXPECT_TRUE(node.tick(2 * kS + kS / 10).empty());
 }
 
+// A risk map whose cells left of x = 10 m are at the top level K (probability 1) and the rest at 0.
+std::shared_ptr<const risk::RiskLookup> leftHalfRisky() {
+  risk::EncodedRiskMap e;
+  e.origin = {-1.0, -1.0};
+  e.resolution = 1.0;
+  e.width = 40;
+  e.height = 30;
+  e.levels = 4;
+  for (std::uint32_t y = 0; y < e.height; ++y) {
+    e.runs.push_back({4, 11});  // x from -1 to 10 m
+    e.runs.push_back({0, e.width - 11});
+  }
+  auto r = risk::RiskLookup::decode(e);
+  EXPECT_TRUE(r) << (r ? "" : r.error().message);
+  return *r;
+}
+
+TEST(TrafficNode, TheRiskMapSetsEachNodesCostAtMostEveryPeriod) {
+  Settings s = settings();
+  s.riskCostS = 3.0;
+  s.riskPeriodS = 2.0;
+  TrafficNode node(smallWarehouse(), s, 7);
+  const auto risk = leftHalfRisky();
+  EXPECT_TRUE(node.onRiskMap(*risk, 1 * kS));
+  const auto& g = node.roadmap().graph;
+  ASSERT_EQ(node.riskCost().size(), g.size());
+  std::size_t risky = 0;
+  for (traffic::NodeId v = 0; v < static_cast<traffic::NodeId>(g.size()); ++v) {
+    const double expected = g.position(v).x < 10.0 ? 3.0 : 0.0;
+    EXPECT_NEAR(node.riskCost()[static_cast<std::size_t>(v)], expected, 1e-6) << g.position(v).x;
+    risky += expected > 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(risky, 10U);
+  EXPECT_LT(risky, g.size());
+  EXPECT_FALSE(node.onRiskMap(*risk, 2 * kS)) << "1 s after the last: too soon";
+  EXPECT_TRUE(node.onRiskMap(*risk, 3 * kS));
+  EXPECT_EQ(node.counters().riskUpdates, 2U);
+  EXPECT_EQ(node.control()->planner().distances().nodeCost().size(), g.size()) << "the planner has them";
+
+  s.riskCostS = 0.0;
+  TrafficNode off(smallWarehouse(), s, 7);
+  EXPECT_FALSE(off.onRiskMap(*risk, 1 * kS)) << "risk_cost_s 0: the map is not used";
+  EXPECT_TRUE(off.riskCost().empty());
+}
+
+TEST(TrafficNode, RiskSettingsAreReadAndChecked) {
+  auto cfg = Config::fromText(R"({"risk_cost_s": 2.5, "risk_period_s": 5})", "traffic.json");
+  const auto s = readSettings(cfg);
+  cfg.finish();
+  EXPECT_DOUBLE_EQ(s.riskCostS, 2.5);
+  EXPECT_DOUBLE_EQ(s.riskPeriodS, 5.0);
+  auto bad = Config::fromText(R"({"risk_cost_s": -1})", "traffic.json");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.problems()[0].find("risk_cost_s"), std::string::npos) << bad.problems()[0];
+}
+
 TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {
   TrafficNode node(smallWarehouse(), settings(), 3);
   node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);

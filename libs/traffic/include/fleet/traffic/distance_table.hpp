@@ -44,6 +44,14 @@ class DistanceTable {
   void setBlocked(NodeId v, bool blocked);
   [[nodiscard]] bool blocked(NodeId v) const { return blocked_[static_cast<std::size_t>(v)] != 0; }
 
+  /// A standing cost (s) of driving into each node, on top of the edges' durations, in every table
+  /// from the next query on (the traffic manager's collision-probability map: people-dense space
+  /// costs more). One entry per node, each finite and >= 0; empty: none. Tables are recomputed
+  /// when it changed; searches are then Dijkstra's even on unit grids.
+  /// Returns whether it changed.
+  bool setNodeCost(std::vector<float> cost);
+  [[nodiscard]] std::span<const float> nodeCost() const { return nodeCost_; }
+
   /// Distances to `goal` where driving into node v costs `extra[v]` on top of the edge's duration
   /// (soft obstacles: robots that have stood in the way for a while, which a detour may be worth
   /// going round). Dijkstra, not cached; `extra[goal]` is ignored and closed or blocked nodes are
@@ -86,6 +94,8 @@ class DistanceTable {
   std::size_t used_ = 0;
   std::uint64_t computed_ = 0;
   std::vector<std::uint8_t> blocked_;
+  std::vector<float> nodeCost_;
+  std::vector<float> combined_;  ///< withExtraCost's extra + nodeCost_
   bool dirty_ = false;
   // Search scratch, kept to avoid allocating per table.
   std::vector<NodeId> queue_;

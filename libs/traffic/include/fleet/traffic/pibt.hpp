@@ -145,6 +145,10 @@ class Pibt {
   [[nodiscard]] const DistanceTable& distances() const { return distances_; }
   /// Call after opening or closing nodes or edges (or adding any): drops the cached distances.
   void graphChanged();
+  /// A standing cost (s) of driving into each node (DistanceTable::setNodeCost) from the next step
+  /// on. Each agent's progress is measured afresh on the new distances, without resetting how
+  /// long it has stalled: a cost that changes every few seconds must not hide a livelock.
+  void setNodeCost(std::vector<float> cost);
 
  private:
   struct Candidate {
@@ -196,6 +200,7 @@ class Pibt {
   std::vector<double> epsilon_;
   std::vector<std::uint8_t> controlled_;
   std::vector<std::uint8_t> onStack_;
+  bool rebaseProgress_ = false;            ///< the distances changed: best_ from the new ones
   std::vector<float> best_;                ///< nearest it has been to its goal since the goal was set
   std::vector<int> stalled_;               ///< steps since best_ last improved
   std::vector<std::int64_t> escalatedAt_;  ///< step of (re-)escalation, -1 when not escalated

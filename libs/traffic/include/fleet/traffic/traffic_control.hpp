@@ -123,8 +123,12 @@ class TrafficControl {
   /// out of its node with the robots whose node excludes it. For reports of robots that do not move.
   [[nodiscard]] std::string explain(std::size_t robot) const;
 
-  /// Call after closing or reopening nodes or edges: plans again from the released ends.
+  /// Call after closing or reopening nodes or edges: drops the planner's distances and plans again
+  /// from the released ends.
   void graphChanged();
+  /// A standing cost (s) of driving into each node (Pibt::setNodeCost): the collision-probability
+  /// map's weight on the plan. Plans already released stand; new steps route by it.
+  void setNodeCost(std::vector<float> cost);
 
   [[nodiscard]] const TrafficStats& stats() const { return stats_; }
   [[nodiscard]] const PibtStats& plannerStats() const { return planner_->stats(); }

@@ -1,6 +1,7 @@
 #pragma once
 
-// The RiskMap sample as the agents' risk lookup (libs/risk): the wire form's fields mapped once.
+// The RiskMap sample as a risk lookup (libs/risk) for the agents and the traffic manager: the wire
+// form's fields mapped once.
 
 #include <memory>
 
@@ -8,9 +9,9 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/risk/risk_lookup.hpp"
 
-namespace fleet::agent {
+namespace fleet::service {
 
 /// Errors those of risk::RiskLookup::decode (every field a remote writer could get wrong).
 Expected<std::shared_ptr<const risk::RiskLookup>> riskLookupOf(const msg::RiskMap& m);
 
-}  // namespace fleet::agent
+}  // namespace fleet::service
