@@ -236,6 +236,7 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
   a.task_id = o.task.id;
   a.stamp_ns = nowNs;
   a.paused = o.paused;
+  a.priority = o.task.priority;
   std::string missing;
   auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
     const Station* s = dispatcher_->stations().find(name);

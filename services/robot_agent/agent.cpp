@@ -111,7 +111,7 @@ TaskGoal goalOf(const msg::Goal& g) {
 }
 
 Order orderOf(const msg::TaskAssignment& a) {
-  Order o{a.task_id, a.revision, {}, a.paused, a.stamp_ns};
+  Order o{a.task_id, a.revision, {}, a.paused, a.stamp_ns, a.priority};
   o.goals.reserve(a.goals.size());
   for (const auto& g : a.goals) {
     o.goals.push_back(goalOf(g));

@@ -455,15 +455,15 @@ std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {
     p.goal = g->pose;
     p.goal_station = g->station;
   }
-  p.priority = 0;  // (TaskAssignment carries no priority yet)
+  p.priority = tasks_.priority();
   p.holding = tasks_.phase() == Phase::Dwelling || paused() || localizer_.lost() || dockingLeg_;
   p.blocked = blocked_;
   p.follows = true;
   p.stamp_ns = nowNs;
   const auto& q = lastProgress_;
   const bool changed = !q || q->epoch != p.epoch || q->node != p.node || q->has_goal != p.has_goal ||
-                       !(q->goal == p.goal) || q->goal_station != p.goal_station || q->holding != p.holding ||
-                       q->blocked != p.blocked;
+                       !(q->goal == p.goal) || q->goal_station != p.goal_station ||
+                       q->priority != p.priority || q->holding != p.holding || q->blocked != p.blocked;
   if (!changed && nsToSec(nowNs - q->stamp_ns) < kHeartbeatS) {
     return std::nullopt;
   }

@@ -11,6 +11,7 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
     return OrderChange::kSame;
   }
   revision_ = o.revision;
+  priority_ = o.priority;
   homing_ = false;     // an order (or a cancel) replaces the trip home
   paused_ = o.paused;  // an empty paused order holds the idle robot where it is
   if (o.task.empty()) {

@@ -57,7 +57,8 @@ struct Order {
   std::uint32_t revision = 0;
   std::vector<TaskGoal> goals;
   bool paused = false;
-  std::int64_t stampNs = 0;  ///< when it was issued (a refusal is reported with it)
+  std::int64_t stampNs = 0;   ///< when it was issued (a refusal is reported with it)
+  std::int32_t priority = 0;  ///< the task's (higher first)
 };
 
 enum class Phase : std::uint8_t { Idle, Driving, Dwelling, BackingOff, Returning };
@@ -110,6 +111,8 @@ class TaskRunner {
   /// Held by the operator: with a task (paused), or idle (a robot hold: no trip home either).
   [[nodiscard]] bool paused() const { return paused_; }
   [[nodiscard]] const std::string& task() const { return task_; }
+  /// The running task's priority (0 without a task): reserved traffic lets it go first.
+  [[nodiscard]] std::int32_t priority() const { return busy() ? priority_ : 0; }
   [[nodiscard]] std::uint32_t revision() const { return revision_; }
   [[nodiscard]] std::size_t goalIndex() const { return goal_; }
   [[nodiscard]] bool hasGoal() const { return goal_ < goals_.size(); }
@@ -125,6 +128,7 @@ class TaskRunner {
 
   std::string task_;
   std::uint32_t revision_ = 0;
+  std::int32_t priority_ = 0;
   bool paused_ = false;
   bool homing_ = false;
   std::vector<TaskGoal> goals_;

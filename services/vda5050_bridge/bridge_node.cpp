@@ -91,6 +91,7 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     v.reported = msg::TaskState::Queued;
   }
   v.revision = a.revision;
+  v.priority = a.task_id.empty() ? 0 : a.priority;
   v.goals = a.goals;
   if (a.paused != v.paused) {
     v.paused = a.paused;
@@ -383,6 +384,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       p.has_goal = true;
       p.goal = v.goals[v.goal].pose;
       p.goal_station = v.goals[v.goal].station;
+      p.priority = v.priority;
     } else if (v.home) {
       p.has_goal = true;
       p.goal = *v.home;

@@ -98,6 +98,7 @@ class BridgeNode {
     std::optional<msg::TrafficRelease> release;
     std::string task_id;
     std::uint32_t revision = 0;
+    std::int32_t priority = 0;  ///< the task's, passed to the traffic manager
     std::vector<msg::Goal> goals;
     std::size_t goal = 0;
     bool paused = false;

@@ -156,6 +156,7 @@ void Traits<msg::TaskAssignment>::toC(const msg::TaskAssignment& in, C& out, Are
   });
   out.paused = in.paused;
   out.stamp_ns = in.stamp_ns;
+  out.priority = in.priority;
 }
 msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   msg::TaskAssignment m;
@@ -168,6 +169,7 @@ msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   });
   m.paused = in.paused;
   m.stamp_ns = in.stamp_ns;
+  m.priority = in.priority;
   return m;
 }
 

@@ -110,6 +110,19 @@ TEST_F(Node, RequestsAreAcknowledgedWithTheRightResult) {
   EXPECT_EQ(out.events[0].seq, 1u);
 }
 
+TEST_F(Node, TheAssignmentCarriesTheTasksPriority) {
+  auto node = open(0);
+  manager::Outbox out;
+  const std::string body =
+      R"({"id": "t1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1", "priority": 5})";
+  node->onRequests({request("t1", body)}, 1'000'000, out);
+  node->onRobotState({"r1", 1'000'000, {0, 1, 0}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f}, 1'000'000);
+  out = {};
+  node->tick(2'000'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].priority, 5);
+}
+
 TEST_F(Node, TransportTaskIsAssignedWithStationGoalsAndFinishes) {
   auto node = open(0);
   manager::Outbox out;

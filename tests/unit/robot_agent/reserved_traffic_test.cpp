@@ -677,6 +677,25 @@ TEST(Reserved, PausedOrBlindItReportsHolding) {
   EXPECT_TRUE(sim.reports.back().holding) << "sensor stream lost";
 }
 
+// The task's priority reaches the traffic manager with the robot's progress (issue 18: "task
+// priority is respected"); without a task it is 0.
+TEST(Reserved, ItReportsItsTasksPriority) {
+  Sim sim;
+  auto a = order(kFarPickup);
+  a.priority = 7;
+  sim.agent->onAssignment(a);
+  sim.run(1.0);
+  ASSERT_FALSE(sim.reports.empty());
+  EXPECT_EQ(sim.reports.back().priority, 7);
+  msg::TaskAssignment cancel;
+  cancel.robot_id = "r1";
+  cancel.revision = a.revision + 1;
+  cancel.priority = 7;  // a stale field on a cancel means nothing
+  sim.agent->onAssignment(cancel);
+  sim.run(1.0);
+  EXPECT_EQ(sim.reports.back().priority, 0);
+}
+
 TEST(Reserved, ReactiveModeNeitherFollowsReleasesNorReports) {
   Sim sim("dwa", "reactive");
   EXPECT_FALSE(sim.agent->reserved());

@@ -87,6 +87,7 @@ struct TaskAssignment {
   std::vector<Goal> goals;
   bool paused = false;
   std::int64_t stamp_ns = 0;
+  std::int32_t priority = 0;  ///< the task's (higher first)
   bool operator==(const TaskAssignment&) const = default;
 };
 
