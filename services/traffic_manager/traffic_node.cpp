@@ -49,7 +49,8 @@ Settings readSettings(Config& cfg) {
 TrafficNode::TrafficNode(const site::Site& site, Settings settings, std::uint32_t epoch)
     : settings_(std::move(settings)),
       epoch_(epoch),
-      roadmap_(traffic::buildRoadmap(site, settings_.roadmap)) {
+      roadmap_(traffic::buildRoadmap(site, settings_.roadmap)),
+      reach_(roadmap_.graph, std::size_t{64} << 20) {
   control_ =
       std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, settings_.traffic);
   if (settings_.stationLines)
@@ -97,10 +98,21 @@ std::size_t TrafficNode::robotsPlaced() const {
 NodeId TrafficNode::goalNode(const msg::TrafficProgress& p, std::string& why) const {
   if (!p.has_goal)
     return kNoNode;
+  // A goal the roadmap does not connect to where the robot is: refused and logged, the robot held
+  // where it is, instead of standing with a goal the planner can never bring it to.
+  auto reachable = [&](NodeId goal, const std::string& what) {
+    const NodeId from = placeNode(p);
+    if (from == kNoNode ||
+        reach_.to(goal)[static_cast<std::size_t>(from)] != traffic::DistanceTable::kUnreachable)
+      return goal;
+    why = what + " cannot be reached on the roadmap from node " + std::to_string(from) +
+          " (the roadmap does not connect them: see the traffic manager's roadmap problems at start)";
+    return kNoNode;
+  };
   if (!p.goal_station.empty()) {
     const auto* s = roadmap_.station(p.goal_station);
     if (s != nullptr && s->dock != kNoNode)
-      return s->dock;
+      return reachable(s->dock, "goal station \"" + p.goal_station + "\"");
     if (s == nullptr) {
       why = "goal station \"" + p.goal_station + "\" is not on the site";
     } else {
@@ -117,7 +129,9 @@ NodeId TrafficNode::goalNode(const msg::TrafficProgress& p, std::string& why) co
     why = os.str();
     return kNoNode;
   }
-  return v;
+  std::ostringstream os;
+  os << "goal (" << p.goal.x << ", " << p.goal.y << ")";
+  return reachable(v, os.str());
 }
 
 NodeId TrafficNode::placeNode(const msg::TrafficProgress& p) const {

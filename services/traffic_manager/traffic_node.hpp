@@ -24,6 +24,7 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/risk/risk_lookup.hpp"
 #include "fleet/site/site.hpp"
+#include "fleet/traffic/distance_table.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
 
@@ -123,6 +124,9 @@ class TrafficNode {
   std::map<std::string, Robot> robots_;
   std::vector<std::string> byIndex_;
   std::int64_t startNs_ = -1;
+  /// Free-flow distances to goals, to refuse a goal the roadmap does not connect to the robot
+  /// (the roadmap does not change in the service, so tables stay valid).
+  mutable traffic::DistanceTable reach_;
   std::int64_t riskNs_ = -1;
   std::vector<float> riskCost_;
   Counters counters_;

@@ -123,6 +123,43 @@ TEST(TrafficNode, RiskSettingsAreReadAndChecked) {
   EXPECT_NE(bad.problems()[0].find("risk_cost_s"), std::string::npos) << bad.problems()[0];
 }
 
+// Bad input: a goal the roadmap does not connect (a station walled off from the robot's part of
+// the hall) is refused with a logged reason and the robot gets no route, instead of a goal the
+// planner can never bring it to.
+TEST(TrafficNode, AGoalTheRoadmapDoesNotConnectIsRefused) {
+  std::vector<std::string> rows(10, "@" + std::string(20, '.') + "@");
+  rows.front() = rows.back() = std::string(22, '@');
+  for (auto& r : rows)
+    r[14] = '@';  // a wall at x 7.0..7.5 m from top to bottom
+  const nlohmann::json doc = {{"format", "fleet-site/1"},
+                              {"name", "walled"},
+                              {"map", {{"rows", rows}, {"resolution", 0.5}}},
+                              {"robot", {{"radius", 0.3}}},
+                              {"stations",
+                               {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 2.5, 0.0}}},
+                                {{"name", "C"}, {"kind", "dropoff"}, {"pose", {5.5, 2.5, 0.0}}},
+                                {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 2.5, M_PI}}}}}};
+  const auto site = site::parseSite(doc, "walled.site.json", ".", false);
+  TrafficNode node(site, settings(), 1);
+  ASSERT_FALSE(node.roadmap().problems.empty()) << "the roadmap says B is cut off";
+  const auto refused = node.onProgress(at("r1", {1.5, 2.5, 0.0}, "B"), 0);
+  ASSERT_TRUE(refused);
+  EXPECT_NE(refused->find("goal station \"B\" cannot be reached on the roadmap"), std::string::npos)
+      << *refused;
+  node.tick(0);
+  const auto rel = node.tick(3 * kS);
+  ASSERT_EQ(rel.size(), 1U);
+  EXPECT_EQ(rel[0].base.size(), 1U) << "held where it is";
+  // A goal on its side of the wall is taken.
+  EXPECT_FALSE(node.onProgress(at("r1", {1.5, 2.5, 0.0}, "C", rel[0].base[0].node, 1), 3 * kS));
+  bool moves = false;
+  for (int i = 1; i <= 20 && !moves; ++i) {
+    for (const auto& r : node.tick(3 * kS + i * kS / 10))
+      moves = moves || r.base.size() > 1;
+  }
+  EXPECT_TRUE(moves);
+}
+
 TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {
   TrafficNode node(smallWarehouse(), settings(), 3);
   node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
