@@ -379,4 +379,15 @@ bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, 
          std::abs(side) - radius <= config_.width / 2.0 + config_.fieldSideMargin;
 }
 
+bool Vda5050Vehicle::machineInField(const Pose2& pose, double px, double py, double radius) const {
+  const double c = std::cos(pose.theta);
+  const double s = std::sin(pose.theta);
+  const double ahead = c * (px - pose.x) + s * (py - pose.y);
+  const double side = -s * (px - pose.x) + c * (py - pose.y);
+  const double v = std::abs(last_command_.v);
+  const double reach = kMachineFieldM + v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
+  return ahead + radius >= 0.0 && ahead - radius <= config_.length / 2.0 + reach &&
+         std::abs(side) - radius <= config_.width / 2.0 + kMachineSideM;
+}
+
 }  // namespace fleet::sim

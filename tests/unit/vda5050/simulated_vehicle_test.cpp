@@ -155,6 +155,23 @@ TEST(Vda5050Vehicle, ItsProtectiveFieldGrowsWithItsSpeed) {
   EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25)) << "driving: its braking distance too";
 }
 
+// Its scanner sees machines too, in a shorter field than people's (so vehicles can follow one
+// another on the roadmap): a robot 0.5 m ahead of the front stops it when it drives, not when it
+// stands; one beside or behind does not.
+TEST(Vda5050Vehicle, ItsFieldForMachinesIsShortAndGrowsWithItsSpeed) {
+  Rig r;
+  const Pose2 p{0.0, 0.0, 0.0};
+  // Standing: the front at 0.3 m, the field to 0.45 m, a robot of radius 0.3 whose centre is at x.
+  EXPECT_TRUE(r.vehicle.machineInField(p, 0.7, 0.0, 0.3));
+  EXPECT_FALSE(r.vehicle.machineInField(p, 0.8, 0.0, 0.3)) << "standing: just beyond";
+  EXPECT_FALSE(r.vehicle.machineInField(p, -0.8, 0.0, 0.3)) << "behind";
+  EXPECT_FALSE(r.vehicle.machineInField(p, 0.5, 0.7, 0.3)) << "beside, clear of the width";
+  EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.2, 0.0, 0.3)) << "people are seen farther";
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);
+  r.run(2.0);
+  EXPECT_TRUE(r.vehicle.machineInField(p, 0.8, 0.0, 0.3)) << "driving: its braking distance too";
+}
+
 TEST(Vda5050Vehicle, PauseResumeAndCancel) {
   Rig r;
   ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);

@@ -81,6 +81,13 @@ class Vda5050Vehicle {
   /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin each side, as long as
   /// `protectiveField` plus the braking distance at the last commanded speed.
   [[nodiscard]] bool inProtectiveField(const Pose2& pose, double px, double py, double radius) const;
+  /// Whether another vehicle's body (a disc) is inside the short field a scanner keeps for
+  /// machines: ahead of the front by the braking distance at the last commanded speed plus
+  /// kMachineFieldM, the vehicle's width plus kMachineSideM each side. Shorter than the people's
+  /// field so vehicles can follow one another at the roadmap's following distance.
+  [[nodiscard]] bool machineInField(const Pose2& pose, double px, double py, double radius) const;
+  static constexpr double kMachineFieldM = 0.15;
+  static constexpr double kMachineSideM = 0.05;
 
  private:
   [[nodiscard]] bool actionsRunning() const;
