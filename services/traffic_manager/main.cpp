@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <optional>
+#include <vector>
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
@@ -55,7 +57,16 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   transport::Writer<msg::Roadmap> roadmapOut(p);
   transport::Reader<msg::Clock> clockIn(p);
   transport::Writer<msg::StepDone> stepDone(p);
-  transport::Reader<msg::RiskMap> riskMaps(p);
+  // The risk map is a refinement, not a need: permissions that predate it (DDS Security) leave the
+  // traffic manager planning without it, said once, instead of not starting.
+  std::optional<transport::Reader<msg::RiskMap>> riskMaps;
+  if (settings.riskCostS > 0.0) {
+    try {
+      riskMaps.emplace(p);
+    } catch (const std::exception& e) {
+      spdlog::warn("traffic manager: planning without the risk map (risk_cost_s ignored): {}", e.what());
+    }
+  }
   transport::WaitSet ws(p);
   ws.attach(progress);
   ws.attach(clockIn);
@@ -90,7 +101,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   };
   auto ingest = [&] {
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
-    if (auto maps = riskMaps.take(); !maps.empty() && haveClock && settings.riskCostS > 0.0) {
+    if (auto maps = riskMaps ? riskMaps->take() : std::vector<msg::RiskMap>{}; !maps.empty() && haveClock) {
       if (auto risk = service::riskLookupOf(maps.back())) {
         node.onRiskMap(**risk, now);
       } else {
