@@ -1,5 +1,6 @@
 #include "fault_plan.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -73,9 +74,10 @@ Expected<Fault> parseOne(const std::string& spec) {
   }
   const auto at = spec.find('@');
   if (at == std::string::npos) {
-    return unexpected("invalid",
-                      "expected kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, "
-                      "hide-landmarks@T+D or drop-dds=F");
+    return unexpected(
+        "invalid",
+        "expected kill-agent@T[+D][:K], kill-manager@T[+D], kill-traffic@T[+D], stall:ROBOT@T+D, "
+        "hide-landmarks@T+D, close@T+D:X1,Y1,... or drop-dds=F");
   }
   const std::string head = spec.substr(0, at);
   std::string tail = spec.substr(at + 1);
@@ -95,11 +97,11 @@ Expected<Fault> parseOne(const std::string& spec) {
     std::tie(f.atS, f.downS) = *t;
     return f;
   }
-  if (head == "kill-manager") {
-    f.kind = Fault::Kind::KillManager;
+  if (head == "kill-manager" || head == "kill-traffic") {
+    f.kind = head == "kill-manager" ? Fault::Kind::KillManager : Fault::Kind::KillTraffic;
     auto t = timing(tail, 1.0, false);
     if (!t) {
-      return unexpected("invalid", "kill-manager: " + t.error().message);
+      return unexpected("invalid", head + ": " + t.error().message);
     }
     std::tie(f.atS, f.downS) = *t;
     return f;
@@ -117,6 +119,36 @@ Expected<Fault> parseOne(const std::string& spec) {
     std::tie(f.atS, f.downS) = *t;
     return f;
   }
+  if (head == "close") {
+    f.kind = Fault::Kind::CloseArea;
+    const auto colon = tail.find(':');
+    if (colon == std::string::npos) {
+      return unexpected("invalid",
+                        "close: expected ':X1,Y1,X2,Y2,X3,Y3[,...]' (the area's corners) after T+D");
+    }
+    std::string corners = tail.substr(colon + 1);
+    tail = tail.substr(0, colon);
+    auto t = timing(tail, 0.0, true, 86400, "simulated seconds");
+    if (!t) {
+      return unexpected("invalid", "close: " + t.error().message);
+    }
+    std::tie(f.atS, f.downS) = *t;
+    for (std::size_t pos = 0; pos <= corners.size();) {
+      const auto comma = std::min(corners.find(',', pos), corners.size());
+      const std::string v = corners.substr(pos, comma - pos);
+      double x = 0;
+      const bool negative = !v.empty() && v[0] == '-';
+      if (!number(negative ? v.substr(1) : v, x)) {
+        return unexpected("invalid", "close: expected a coordinate in m, got \"" + v + "\"");
+      }
+      f.area.push_back(negative ? -x : x);
+      pos = comma + 1;
+    }
+    if (f.area.size() < 6 || f.area.size() % 2 != 0) {
+      return unexpected("invalid", "close: the area needs X,Y pairs of at least 3 corners");
+    }
+    return f;
+  }
   if (head == "hide-landmarks") {
     f.kind = Fault::Kind::HideLandmarks;
     auto t = timing(tail, 0.0, true, 86400, "simulated seconds");
@@ -128,7 +160,8 @@ Expected<Fault> parseOne(const std::string& spec) {
   }
   return unexpected("invalid",
                     "unknown fault \"" + head +
-                        "\" (known: kill-agent, kill-manager, stall:ROBOT, hide-landmarks, drop-dds)");
+                        "\" (known: kill-agent, kill-manager, kill-traffic, stall:ROBOT, hide-landmarks, "
+                        "close, drop-dds)");
 }
 
 }  // namespace
@@ -162,14 +195,34 @@ std::string describe(const Fault& f) {
       return "kill-agent@" + fmt(f.atS) + "+" + fmt(f.downS) + ":" + std::to_string(f.agent);
     case Fault::Kind::KillManager:
       return "kill-manager@" + fmt(f.atS) + "+" + fmt(f.downS);
+    case Fault::Kind::KillTraffic:
+      return "kill-traffic@" + fmt(f.atS) + "+" + fmt(f.downS);
     case Fault::Kind::StallRobot:
       return "stall:" + f.robot + "@" + fmt(f.atS) + "+" + fmt(f.downS);
     case Fault::Kind::DropDds:
       return "drop-dds=" + fmt(f.fraction);
     case Fault::Kind::HideLandmarks:
       return "hide-landmarks@" + fmt(f.atS) + "+" + fmt(f.downS);
+    case Fault::Kind::CloseArea: {
+      std::string s = "close@" + fmt(f.atS) + "+" + fmt(f.downS) + ":";
+      for (std::size_t i = 0; i < f.area.size(); ++i) {
+        s += (i > 0 ? "," : "") + fmt(f.area[i]);
+      }
+      return s;
+    }
   }
   return "";
+}
+
+std::string killedService(const Fault& f) {
+  switch (f.kind) {
+    case Fault::Kind::KillManager:
+      return "fleet_manager";
+    case Fault::Kind::KillTraffic:
+      return "traffic_manager";
+    default:
+      return "";
+  }
 }
 
 double dropFraction(const std::vector<Fault>& faults) {

@@ -356,7 +356,27 @@ struct Run {
         }
         continue;
       }
-      const std::string who = f.kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(f);
+      if (f.kind == Fault::Kind::CloseArea) {
+        // Through the API an operator would use; on the simulated clock, as hide-landmarks.
+        const std::string path = "/v1/traffic/closures/fault-" + std::to_string(i);
+        if (!faultStarted[i] && simS >= f.atS) {
+          faultStarted[i] = true;
+          json body = {{"area", json::array()}, {"reason", "load test fault " + describe(f)}};
+          for (std::size_t k = 0; k + 1 < f.area.size(); k += 2) {
+            body["area"].push_back({f.area[k], f.area[k + 1]});
+          }
+          auto r = http->Put(path, body.dump(), "application/json");
+          logFault("closed area fault-" + std::to_string(i) + ": " +
+                   (r ? std::to_string(r->status) + " " + r->body : std::string("adapter unreachable")));
+        } else if (faultStarted[i] && !faultEnded[i] && simS >= f.atS + f.downS) {
+          faultEnded[i] = true;
+          auto r = http->Delete(path);
+          logFault("reopened area fault-" + std::to_string(i) + ": " +
+                   (r ? std::to_string(r->status) : std::string("adapter unreachable")));
+        }
+        continue;
+      }
+      const std::string who = killedService(f).empty() ? agentFor(f) : killedService(f);
       if (!faultStarted[i] && simS >= f.atS) {
         faultStarted[i] = true;
         faultEndAt[i] =
@@ -653,6 +673,13 @@ int Run::run() {
   if (o.traffic == "reserved" && !hasSite && !o.trafficNamed) {
     say("the scenario has no site, so no roadmap: reactive traffic (robots avoid each other on their own)");
     o.traffic = "reactive";
+  }
+  for (const auto& f : faults) {
+    if ((f.kind == Fault::Kind::KillTraffic || f.kind == Fault::Kind::CloseArea) && o.traffic != "reserved") {
+      std::cerr << "fleetctl loadtest: --fault " << describe(f)
+                << ": there is no traffic manager in reactive traffic (give --traffic reserved)\n";
+      return 2;
+    }
   }
   if ((o.travelCost == "roadmap" || o.stationCapacity == "queue") && !hasSite) {
     std::cerr << "fleetctl loadtest: "
@@ -979,11 +1006,11 @@ int Run::run() {
   for (std::size_t i = 0; i < faults.size(); ++i) {
     if (faultStarted[i] && !faultEnded[i]) {
       const std::string who =
-          faults[i].kind == Fault::Kind::KillManager ? "fleet_manager" : agentFor(faults[i]);
+          killedService(faults[i]).empty() ? agentFor(faults[i]) : killedService(faults[i]);
       if (faults[i].kind == Fault::Kind::StallRobot) {
         sup.signal(who, SIGCONT);
         logFault("SIGCONT " + who + " (end of run)");
-      } else if (faults[i].kind == Fault::Kind::KillManager) {
+      } else if (faults[i].kind == Fault::Kind::KillManager || faults[i].kind == Fault::Kind::KillTraffic) {
         sup.restart(who);
         logFault("restarted " + who + " (end of run)");
         std::this_thread::sleep_for(std::chrono::seconds(1));

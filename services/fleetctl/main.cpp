@@ -92,6 +92,22 @@ int main(int argc, char** argv) {
   auto* resume = app.add_subcommand("resume", "let a paused task go on");
   resume->add_option("id", id)->required();
   auto* robots = app.add_subcommand("robots", "list robots");
+  auto* close = app.add_subcommand(
+      "close", "close part of the roadmap to traffic (an area, nodes or lanes): robots are planned round it");
+  close->add_option("id", id, "closure id (closing again under it replaces the closure)")->required();
+  std::vector<double> closeArea;
+  std::vector<int> closeNodes;
+  std::vector<std::string> closeLanes;
+  std::string closeReason;
+  close->add_option("--area", closeArea, "polygon corners X1,Y1,X2,Y2,X3,Y3,... (m, map frame)")
+      ->delimiter(',');
+  close->add_option("--nodes", closeNodes, "roadmap node ids N1,N2,...")->delimiter(',');
+  close->add_option("--lane", closeLanes,
+                    "a directed roadmap edge FROM:TO (repeat; give both ways for both)");
+  close->add_option("--reason", closeReason, "why (shown with the closure and in the traffic manager's log)");
+  auto* reopen = app.add_subcommand("reopen", "reopen a closure");
+  reopen->add_option("id", id)->required();
+  auto* closures = app.add_subcommand("closures", "list the roadmap closures in force");
   auto* follow = app.add_subcommand("follow", "print task events as they happen");
   int count = 0;
   int seconds = 0;
@@ -173,10 +189,11 @@ int main(int argc, char** argv) {
   loadtest->add_option("--agents", lt.agents, "robot agent processes")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
-  loadtest->add_option(
-      "--fault", lt.faults,
-      "kill-agent@T[+D][:K], kill-manager@T[+D], stall:ROBOT@T+D, drop-dds=F (T simulated s, D wall s), "
-      "hide-landmarks@T+D (T and D simulated s)");
+  loadtest->add_option("--fault", lt.faults,
+                       "kill-agent@T[+D][:K], kill-manager@T[+D], kill-traffic@T[+D], stall:ROBOT@T+D, "
+                       "drop-dds=F (T simulated s, "
+                       "D wall s), "
+                       "hide-landmarks@T+D, close@T+D:X1,Y1,X2,Y2,X3,Y3,... (T and D simulated s)");
   loadtest->add_option("--out", lt.out, "run folder (report, logs, database)")->capture_default_str();
   loadtest->add_option("--bin", lt.binDir, "build tree with the services")->capture_default_str();
   loadtest->add_option("--report-script", lt.reportScript, "scripts/report.py ('' = no HTML report)");
@@ -497,6 +514,42 @@ int main(int argc, char** argv) {
   }
   if (*pause || *resume) {
     return show(c.Post("/v1/tasks/" + id + (*pause ? "/pause" : "/resume"), h, "", "application/json"));
+  }
+  if (*close) {
+    json body = json::object();
+    if (!closeArea.empty()) {
+      if (closeArea.size() % 2 != 0 || closeArea.size() < 6) {
+        std::fprintf(stderr, "fleetctl close: --area takes X,Y pairs of at least 3 corners\n");
+        return 2;
+      }
+      body["area"] = json::array();
+      for (std::size_t i = 0; i + 1 < closeArea.size(); i += 2) {
+        body["area"].push_back({closeArea[i], closeArea[i + 1]});
+      }
+    }
+    if (!closeNodes.empty()) {
+      body["nodes"] = closeNodes;
+    }
+    for (const auto& l : closeLanes) {
+      const auto colon = l.find(':');
+      int from = 0;
+      int to = 0;
+      if (colon == std::string::npos || std::sscanf(l.c_str(), "%d:%d", &from, &to) != 2) {
+        std::fprintf(stderr, "fleetctl close: --lane \"%s\": expected FROM:TO (two node ids)\n", l.c_str());
+        return 2;
+      }
+      body["lanes"].push_back({from, to});
+    }
+    if (!closeReason.empty()) {
+      body["reason"] = closeReason;
+    }
+    return show(c.Put("/v1/traffic/closures/" + id, h, body.dump(), "application/json"));
+  }
+  if (*reopen) {
+    return show(c.Delete("/v1/traffic/closures/" + id, h));
+  }
+  if (*closures) {
+    return show(c.Get("/v1/traffic/closures", h));
   }
   if (*robots) {
     auto r = c.Get("/v1/robots", h);

@@ -26,6 +26,13 @@ using namespace std::chrono_literals;
 
 namespace {
 
+std::string cutOffText(const std::vector<std::string>& stations) {
+  std::string out;
+  for (const auto& st : stations)
+    out += (out.empty() ? "; stations cut off: " : ", ") + st;
+  return out;
+}
+
 int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id,
         const service::OpsSettings& opsSettings) {
   service::ServiceOps ops("traffic_manager");
@@ -67,9 +74,19 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
       spdlog::warn("traffic manager: planning without the risk map (risk_cost_s ignored): {}", e.what());
     }
   }
+  // Closures come from operators (the WMS adapter); like the risk map, optional under permissions
+  // that predate them.
+  std::optional<transport::Reader<msg::TrafficClosure>> closuresIn;
+  try {
+    closuresIn.emplace(p);
+  } catch (const std::exception& e) {
+    spdlog::warn("traffic manager: run-time closures cannot be read (none will apply): {}", e.what());
+  }
   transport::WaitSet ws(p);
   ws.attach(progress);
   ws.attach(clockIn);
+  if (closuresIn)
+    ws.attach(*closuresIn);
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // refused at the edge, before the node's roadmap checks
   badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
@@ -99,7 +116,34 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     for (const auto& line : node.stalled(now, 60.0))
       spdlog::warn("traffic manager: {}", line);
   };
+  auto takeClosures = [&] {
+    if (!closuresIn)
+      return;
+    for (const auto& c : service::admitted(closuresIn->take(), rejections, badInput)) {
+      const auto r = node.onClosure(c);
+      if (r.error) {
+        badInput.warn("closure:" + c.closure_id, *r.error);
+        continue;
+      }
+      if (!r.changed) {
+        spdlog::info("traffic manager: closure '{}' reopened: it was not in force", c.closure_id);
+        continue;
+      }
+      roadmapSent = false;  // published again with the new open flags and revision
+      if (c.active) {
+        spdlog::warn(
+            "traffic manager: closure '{}' in force ({}): {} nodes, {} directed edges closed{}; roadmap "
+            "revision {}",
+            c.closure_id, c.reason.empty() ? "no reason given" : c.reason, r.nodes, r.edges,
+            cutOffText(r.cutOff), node.revision());
+      } else {
+        spdlog::info("traffic manager: closure '{}' reopened; roadmap revision {}", c.closure_id,
+                     node.revision());
+      }
+    }
+  };
   auto ingest = [&] {
+    takeClosures();
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
     if (auto maps = riskMaps ? riskMaps->take() : std::vector<msg::RiskMap>{}; !maps.empty() && haveClock) {
       if (auto risk = service::riskLookupOf(maps.back())) {

@@ -1,5 +1,6 @@
 #include "traffic_node.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -70,9 +71,76 @@ bool TrafficNode::onRiskMap(const risk::RiskLookup& risk, std::int64_t nowNs) {
   return true;
 }
 
+TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) {
+  ClosureResult out;
+  const auto& g = roadmap_.graph;
+  // Everything is checked before anything changes: a closure is applied whole or not at all.
+  for (const auto v : c.nodes) {
+    if (!g.valid(v)) {
+      out.error = "closure \"" + c.closure_id + "\": node " + std::to_string(v) +
+                  " is not on the roadmap (0.." + std::to_string(g.size() - 1) + ")";
+      return out;
+    }
+  }
+  std::vector<std::pair<NodeId, NodeId>> lanes;
+  for (const auto& e : c.lanes) {
+    const bool edge = g.valid(e.from) && g.valid(e.to) &&
+                      std::any_of(g.edges(e.from).begin(), g.edges(e.from).end(),
+                                  [&](const traffic::Edge& x) { return x.to == e.to; });
+    if (!edge) {
+      out.error = "closure \"" + c.closure_id + "\": there is no roadmap edge " + std::to_string(e.from) +
+                  " -> " + std::to_string(e.to);
+      return out;
+    }
+    lanes.emplace_back(e.from, e.to);
+  }
+  if (c.active && c.area.empty() && c.nodes.empty() && c.lanes.empty()) {
+    out.error = "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";
+    return out;
+  }
+  if (auto it = closures_.find(c.closure_id); it != closures_.end()) {
+    for (const auto& part : it->second)
+      roadmap_.reopen(part);
+    closures_.erase(it);
+    out.changed = true;
+  }
+  if (c.active) {
+    std::vector<traffic::Closure> parts;
+    if (!c.area.empty())
+      parts.push_back(roadmap_.closeArea(c.area));
+    if (!c.nodes.empty())
+      parts.push_back(roadmap_.closeNodes({c.nodes.begin(), c.nodes.end()}));
+    if (!lanes.empty())
+      parts.push_back(roadmap_.closeEdges(lanes));
+    for (const auto& part : parts) {
+      out.nodes += part.nodes.size();
+      out.edges += part.edges.size();
+      out.cutOff.insert(out.cutOff.end(), part.cutOff.begin(), part.cutOff.end());
+    }
+    std::sort(out.cutOff.begin(), out.cutOff.end());
+    out.cutOff.erase(std::unique(out.cutOff.begin(), out.cutOff.end()), out.cutOff.end());
+    closures_[c.closure_id] = std::move(parts);
+    out.changed = true;
+  }
+  if (out.changed) {
+    ++revision_;
+    reach_.invalidate();
+    control_->graphChanged();
+  }
+  return out;
+}
+
+std::vector<std::string> TrafficNode::closures() const {
+  std::vector<std::string> ids;
+  for (const auto& [id, parts] : closures_)
+    ids.push_back(id);
+  return ids;
+}
+
 msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {
   msg::Roadmap m;
   m.epoch = epoch_;
+  m.revision = revision_;
   m.stamp_ns = nowNs;
   const auto& g = roadmap_.graph;
   for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {

@@ -71,6 +71,24 @@ class TrafficNode {
   /// Returns whether it was applied (not when risk is off or the last one is younger than
   /// riskPeriodS).
   bool onRiskMap(const risk::RiskLookup& risk, std::int64_t nowNs);
+  /// What a TrafficClosure did: nothing when refused (`error` says why; nothing changed).
+  struct ClosureResult {
+    std::optional<std::string> error;
+    bool changed = false;   ///< the roadmap changed: publish it again (roadmapMessage)
+    std::size_t nodes = 0;  ///< nodes and directed edges the closure covers now
+    std::size_t edges = 0;
+    std::vector<std::string> cutOff;  ///< stations it disconnects from the rest
+  };
+  /// Closes (active) or reopens a part of the roadmap by the closure's id. A closure given again
+  /// under the same id replaces the earlier one; reopening an unknown id, or one already open,
+  /// changes nothing. Node ids must be on the roadmap and lanes must be its edges, else the whole
+  /// closure is refused. Robots standing on closed nodes may leave them; nothing is routed through.
+  ClosureResult onClosure(const msg::TrafficClosure& c);
+  /// Closure ids in force.
+  [[nodiscard]] std::vector<std::string> closures() const;
+  /// Grows with every change to what is open (the Roadmap message's revision).
+  [[nodiscard]] std::uint32_t revision() const { return revision_; }
+
   /// Each node's current risk cost (s), empty before the first map.
   [[nodiscard]] const std::vector<float>& riskCost() const { return riskCost_; }
 
@@ -125,8 +143,10 @@ class TrafficNode {
   std::vector<std::string> byIndex_;
   std::int64_t startNs_ = -1;
   /// Free-flow distances to goals, to refuse a goal the roadmap does not connect to the robot
-  /// (the roadmap does not change in the service, so tables stay valid).
+  /// (dropped when closures change what is open).
   mutable traffic::DistanceTable reach_;
+  std::map<std::string, std::vector<traffic::Closure>> closures_;
+  std::uint32_t revision_ = 0;
   std::int64_t riskNs_ = -1;
   std::vector<float> riskCost_;
   Counters counters_;

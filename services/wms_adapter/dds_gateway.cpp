@@ -41,6 +41,12 @@ DdsGateway::DdsGateway(transport::Participant& p, FleetView& view)
   optionalReader(p, ws_, roadmap_, "roadmap");
   optionalReader(p, ws_, releases_, "traffic releases");
   optionalReader(p, ws_, people_, "people seen");
+  optionalReader(p, ws_, closuresIn_, "roadmap closures");
+  try {
+    closuresOut_ = std::make_unique<transport::Writer<msg::TrafficClosure>>(p);
+  } catch (const std::exception& e) {
+    spdlog::warn("wms adapter: roadmap closures cannot be sent ({})", e.what());
+  }
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -52,6 +58,24 @@ DdsGateway::~DdsGateway() {
 
 bool DdsGateway::managerOnline() const {
   return tasks_.matchedReaders() > 0;
+}
+
+std::optional<std::string> DdsGateway::sendClosure(const msg::TrafficClosure& c) {
+  if (!closuresOut_) {
+    return std::string("this adapter may not write TrafficClosure (DDS permissions)");
+  }
+  try {
+    std::lock_guard lock(writeMutex_);
+    closuresOut_->write(c);
+  } catch (const std::exception& e) {
+    return std::string("TrafficClosure not sent: ") + e.what();
+  }
+  view_.onClosure(c);  // at once, not only when the sample comes back
+  return std::nullopt;
+}
+
+bool DdsGateway::trafficManagerOnline() const {
+  return closuresOut_ && closuresOut_->matchedReaders() > 0;
 }
 
 void DdsGateway::loop() {
@@ -105,6 +129,11 @@ void DdsGateway::loop() {
     auto roadmaps = roadmap_ ? roadmap_->take() : std::vector<msg::Roadmap>{};
     if (!roadmaps.empty() && validation::admit(roadmaps.back(), view_.rejections())) {
       view_.onRoadmap(std::move(roadmaps.back()));
+    }
+    for (auto& c : closuresIn_ ? closuresIn_->take() : std::vector<msg::TrafficClosure>{}) {
+      if (validation::admit(c, view_.rejections())) {
+        view_.onClosure(c);
+      }
     }
     for (auto& r : releases_ ? releases_->take() : std::vector<msg::TrafficRelease>{}) {
       if (validation::admit(r, view_.rejections())) {

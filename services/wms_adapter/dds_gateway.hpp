@@ -23,6 +23,8 @@ class DdsGateway final : public TaskGateway {
   std::vector<std::optional<msg::TaskAck>> submit(const std::vector<msg::Task>& requests,
                                                   std::chrono::milliseconds timeout) override;
   [[nodiscard]] bool managerOnline() const override;
+  std::optional<std::string> sendClosure(const msg::TrafficClosure& c) override;
+  [[nodiscard]] bool trafficManagerOnline() const override;
 
  private:
   void loop();
@@ -40,6 +42,10 @@ class DdsGateway final : public TaskGateway {
   std::unique_ptr<transport::Reader<msg::TrafficRelease>> releases_;
   // The people the robots see (robot agents publish them), likewise optional.
   std::unique_ptr<transport::Reader<msg::PeopleSeen>> people_;
+  // Roadmap closures operators make through the API (written) and every adapter's (read, so the
+  // list shows them all); optional as the rest of the traffic layer.
+  std::unique_ptr<transport::Writer<msg::TrafficClosure>> closuresOut_;
+  std::unique_ptr<transport::Reader<msg::TrafficClosure>> closuresIn_;
   std::uint64_t foreignStates_ = 0;  // robots_/people_ foreign samples counted so far (loop thread)
   std::uint64_t foreignPeople_ = 0;
   transport::WaitSet ws_;

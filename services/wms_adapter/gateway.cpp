@@ -194,6 +194,20 @@ void FleetView::onRoadmap(msg::Roadmap m) {
   ++releaseCount_;
 }
 
+void FleetView::onClosure(const msg::TrafficClosure& c) {
+  std::lock_guard lock(m_);
+  if (c.active) {
+    closures_[c.closure_id] = c;
+  } else {
+    closures_.erase(c.closure_id);
+  }
+}
+
+std::map<std::string, msg::TrafficClosure> FleetView::closures() const {
+  std::lock_guard lock(m_);
+  return closures_;
+}
+
 void FleetView::onRelease(const msg::TrafficRelease& r) {
   auto shared = std::make_shared<const msg::TrafficRelease>(r);
   std::lock_guard lock(m_);

@@ -52,6 +52,13 @@ class TaskGateway {
   }
   /// Whether a fleet manager is matched on the Task topic.
   [[nodiscard]] virtual bool managerOnline() const = 0;
+  /// Publishes a roadmap closure (or its reopening) to the traffic manager; what stopped it
+  /// otherwise (no permission for the topic, a transport error).
+  virtual std::optional<std::string> sendClosure(const msg::TrafficClosure&) {
+    return std::string("this adapter cannot send closures");
+  }
+  /// Whether a traffic manager is matched on the TrafficClosure topic.
+  [[nodiscard]] virtual bool trafficManagerOnline() const { return false; }
 };
 
 /// The clock people-seen lists are aged by (receipt and lookup): steady, in ns.
@@ -73,6 +80,10 @@ class FleetView {
   /// The traffic manager's roadmap (the dashboard's traffic layer). One of a new epoch (a
   /// restarted traffic manager) drops the releases of earlier epochs.
   void onRoadmap(msg::Roadmap m);
+  /// A closure in force (active) or reopened (forgotten): the roadmap closures operators made.
+  void onClosure(const msg::TrafficClosure& c);
+  /// Closures in force, by id.
+  [[nodiscard]] std::map<std::string, msg::TrafficClosure> closures() const;
   /// A robot's latest release. One of an epoch before the roadmap's is stale and ignored, as is a
   /// robot beyond the first kMaxReleaseRobots.
   void onRelease(const msg::TrafficRelease& r);
@@ -143,6 +154,7 @@ class FleetView {
   std::shared_ptr<const msg::Roadmap> roadmap_;
   std::uint64_t roadmapCount_ = 0;
   Releases releases_;
+  std::map<std::string, msg::TrafficClosure> closures_;
   std::uint64_t releaseCount_ = 0;
   std::deque<msg::TaskEvent> events_;
   std::uint64_t eventCount_ = 0;

@@ -2,10 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <random>
 
+#include "closure_request.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/task_wire.hpp"
@@ -283,6 +285,30 @@ void HttpApi::routes() {
     }
     reply(res, 200, {{"tasks", items}, {"count", items.size()}});
   });
+  // Roadmap closures: an operator closes part of the roadmap (a spill, maintenance) and reopens
+  // it; the traffic manager plans round it. Accepted (202) once sent: the traffic manager applies
+  // it when it reads it (the Roadmap's revision grows and its open flags show it).
+  server_.route("GET", "/v1/traffic/closures", Scope::Read, [this](const Request&, Response& res) {
+    json items = json::array();
+    for (const auto& [id, c] : view_.closures()) {
+      items.push_back(closureJson(c));
+    }
+    const auto [count, roadmap] = view_.roadmap();
+    json body = {{"closures", items},
+                 {"count", items.size()},
+                 {"traffic_manager_online", gateway_.trafficManagerOnline()}};
+    if (roadmap) {
+      const auto closed =
+          static_cast<std::size_t>(std::count(roadmap->open.begin(), roadmap->open.end(), false));
+      body["roadmap"] = {
+          {"epoch", roadmap->epoch}, {"revision", roadmap->revision}, {"closed_nodes", closed}};
+    }
+    reply(res, 200, body);
+  });
+  server_.route("PUT", R"(/v1/traffic/closures/([^/]+))", Scope::Operate,
+                [this](const Request& req, Response& res) { putClosure(req, res); });
+  server_.route("DELETE", R"(/v1/traffic/closures/([^/]+))", Scope::Operate,
+                [this](const Request& req, Response& res) { deleteClosure(req, res); });
   server_.route("GET", "/v1/robots", Scope::Read, [this](const Request&, Response& res) {
     json items = json::array();
     const auto people = view_.allPeopleSeen(steadyNowNs());
@@ -491,6 +517,53 @@ void HttpApi::controlTask(const Request& req, Response& res, bool pause) {
   } else {
     reply(res, 409, error("conflict", a->detail));
   }
+}
+
+void HttpApi::putClosure(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  res.audit = json{{"closure", id}, {"action", "close"}}.dump();
+  const auto roadmap = view_.roadmap().second;
+  auto parsed = parseClosure(id, req.body, roadmap ? std::optional(roadmap->nodes.size()) : std::nullopt,
+                             clock_.nowNs());
+  if (auto* errors = std::get_if<std::vector<FieldError>>(&parsed)) {
+    reply(res, 400,
+          {{"error", "invalid"}, {"message", "the closure was not sent"}, {"fields", fieldsJson(*errors)}});
+    return;
+  }
+  const auto& c = std::get<msg::TrafficClosure>(parsed);
+  if (auto why = gateway_.sendClosure(c)) {
+    reply(res, 503, error("unavailable", *why + "; the closure was not sent"));
+    return;
+  }
+  json body = closureJson(c);
+  body["traffic_manager_online"] = gateway_.trafficManagerOnline();
+  reply(res, 202, body);
+}
+
+void HttpApi::deleteClosure(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  res.audit = json{{"closure", id}, {"action", "reopen"}}.dump();
+  if (!isValidId(id)) {
+    reply(res, 400,
+          error("invalid", "closure id \"" + id + "\" is not a valid id (1..63 of [A-Za-z0-9_.:-])"));
+    return;
+  }
+  // Sent whether this adapter knows the id or not: a closure made through an adapter that has
+  // since restarted is still in force in the traffic manager, and must be possible to reopen.
+  const bool known = view_.closures().contains(id);
+  msg::TrafficClosure c;
+  c.closure_id = id;
+  c.active = false;
+  c.stamp_ns = clock_.nowNs();
+  if (auto why = gateway_.sendClosure(c)) {
+    reply(res, 503, error("unavailable", *why + "; the reopening was not sent"));
+    return;
+  }
+  reply(res, 202,
+        {{"id", id},
+         {"active", false},
+         {"known", known},
+         {"traffic_manager_online", gateway_.trafficManagerOnline()}});
 }
 
 }  // namespace fleet::wms

@@ -78,6 +78,9 @@ class HttpApi {
   bool admitTaskRequest(const std::string& id, const char* verb, Response& res);
   /// POST /v1/tasks/{id}/pause and /resume.
   void controlTask(const Request& req, Response& res, bool pause);
+  /// PUT and DELETE /v1/traffic/closures/{id}.
+  void putClosure(const Request& req, Response& res);
+  void deleteClosure(const Request& req, Response& res);
   std::string nextRequestId();
 
   ApiSettings settings_;

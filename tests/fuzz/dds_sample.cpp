@@ -70,7 +70,7 @@ constexpr Receive kTopics[] = {receive<msg::Task>,           receive<msg::TaskAc
                                receive<msg::Clock>,          receive<msg::StepDone>,
                                receive<msg::GroundTruth>,    receive<msg::Roadmap>,
                                receive<msg::TrafficRelease>, receive<msg::TrafficProgress>,
-                               receive<msg::PeopleSeen>};
+                               receive<msg::PeopleSeen>,     receive<msg::TrafficClosure>};
 constexpr std::size_t kTopicCount = sizeof(kTopics) / sizeof(kTopics[0]);
 
 }  // namespace

@@ -116,5 +116,7 @@ int main(int argc, char** argv) {
   msg::PeopleSeen people{
       "r-1", 7, {{1.0f, 2.0f, 0.5f, -0.5f, 0.25f, true}, {3.0f, 1.0f, 0.0f, 0.0f, 0.3f, false}}};
   seed(16, people, "people_seen");
+  msg::TrafficClosure closure{"spill-1", true, {{1, 1}, {3, 1}, {3, 2}}, {4, 5}, {{5, 6}}, "a spill", 12};
+  seed(17, closure, "traffic_closure");
   return 0;
 }

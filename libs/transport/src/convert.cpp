@@ -482,6 +482,33 @@ msg::Roadmap Traits<msg::Roadmap>::fromC(const C& in) {
   return m;
 }
 
+void Traits<msg::TrafficClosure>::toC(const msg::TrafficClosure& in, C& out, Arena& arena) {
+  putStr(out.closure_id, in.closure_id, "TrafficClosure.closure_id");
+  out.active = in.active;
+  putSeq(out.area, in.area, 256, arena, "TrafficClosure.area", [](const Vec2& p, fleet_Point2D& q) {
+    q = {p.x, p.y};
+  });
+  putSeq(out.nodes, in.nodes, 4096, arena, "TrafficClosure.nodes",
+         [](std::int32_t v, std::int32_t& c) { c = v; });
+  putSeq(out.lanes, in.lanes, 4096, arena, "TrafficClosure.lanes",
+         [](const msg::NodePair& e, fleet_NodePair& c) {
+           c = fleet_NodePair{e.from, e.to};
+         });
+  putStr(out.reason, in.reason, "TrafficClosure.reason");
+  out.stamp_ns = in.stamp_ns;
+}
+msg::TrafficClosure Traits<msg::TrafficClosure>::fromC(const C& in) {
+  msg::TrafficClosure m;
+  m.closure_id = getStr(in.closure_id);
+  m.active = in.active;
+  m.area = getSeq(in.area, [](const fleet_Point2D& q) { return Vec2{q.x, q.y}; });
+  m.nodes = getSeq(in.nodes, [](std::int32_t v) { return v; });
+  m.lanes = getSeq(in.lanes, [](const fleet_NodePair& c) { return msg::NodePair{c.from, c.to}; });
+  m.reason = getStr(in.reason);
+  m.stamp_ns = in.stamp_ns;
+  return m;
+}
+
 void Traits<msg::TrafficRelease>::toC(const msg::TrafficRelease& in, C& out, Arena& arena) {
   putStr(out.robot_id, in.robot_id, "TrafficRelease.robot_id");
   out.epoch = in.epoch;

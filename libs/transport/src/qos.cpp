@@ -74,6 +74,9 @@ QosProfile trafficRelease() {
 QosProfile trafficProgress() {
   return {true, true, 1, 0, 1000};
 }
+QosProfile trafficClosure() {
+  return {true, true, 1, 0, 1000};
+}
 
 bool byName(std::string_view name, QosProfile& out) {
   const std::string n(name);
@@ -109,6 +112,8 @@ bool byName(std::string_view name, QosProfile& out) {
     out = trafficRelease();
   else if (n == "traffic_progress")
     out = trafficProgress();
+  else if (n == "traffic_closure")
+    out = trafficClosure();
   else if (n == "people_seen")
     out = peopleSeen();
   else

@@ -287,6 +287,27 @@ std::optional<Rejection> check(const msg::TrafficProgress& m) {
   return c.require(m.node >= -1, "implausible", "node must be >= -1").done();
 }
 
+std::optional<Rejection> check(const msg::TrafficClosure& m) {
+  Checker c("TrafficClosure");
+  c.id(m.closure_id, "closure_id").text(m.reason, "reason");
+  c.size(m.area.size(), 256, "area").size(m.nodes.size(), 4096, "nodes").size(m.lanes.size(), 4096, "lanes");
+  for (const auto& p : m.area) {
+    c.position(p.x, p.y, "area[]");
+  }
+  c.require(m.area.empty() || m.area.size() >= 3, "structure", "area needs at least 3 corners (or none)");
+  for (const auto v : m.nodes) {
+    c.require(v >= 0, "implausible", "a node id is negative");
+  }
+  for (const auto& e : m.lanes) {
+    c.require(e.from >= 0 && e.to >= 0, "implausible", "a lane's node id is negative");
+  }
+  // A reopening names only the id; a closure must close something.
+  return c
+      .require(!m.active || !m.area.empty() || !m.nodes.empty() || !m.lanes.empty(), "structure",
+               "an active closure needs an area, nodes or lanes")
+      .done();
+}
+
 std::optional<Rejection> check(const msg::Roadmap& m) {
   Checker c("Roadmap");
   c.size(m.nodes.size(), kMaxRoadmapNodes, "nodes").size(m.edges.size(), kMaxRoadmapEdges, "edges");

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <optional>
@@ -80,4 +81,65 @@ TEST(TrafficManagerService, PlacesReleasesAndComesBackAfterARestart) {
   ASSERT_TRUE(again) << "no release from the restarted traffic manager within 30 s";
   EXPECT_NE(again->epoch, first->epoch);
   EXPECT_EQ(again->base.front().node, n.node);
+}
+
+// Closures over DDS (what the WMS adapter's PUT/DELETE /v1/traffic/closures send): the traffic
+// manager closes the area, publishes the roadmap again with a higher revision and the closed
+// nodes, refuses a closure naming a node off the roadmap (and changes nothing), and reopens.
+TEST(TrafficManagerService, AppliesClosuresAndPublishesTheRoadmapAgain) {
+  const std::string domain = std::to_string(test::uniqueDomain());
+  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
+  const std::vector<std::string> args = {"--site", kSite, "--log-level", "warn"};
+  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain}};
+  test::ChildProcess service(FLEET_BINARY_DIR "/services/traffic_manager/traffic_manager", args, env);
+  transport::Participant p;
+  transport::Writer<msg::TrafficClosure> closures(p);
+  transport::Reader<msg::Roadmap> roadmaps(p);
+  // The roadmap with at least `revision`, within 30 s.
+  auto roadmapAt = [&](std::uint32_t revision) -> std::optional<msg::Roadmap> {
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      roadmaps.waitForData(100ms);
+      for (auto& m : roadmaps.take()) {
+        if (m.revision >= revision)
+          return m;
+      }
+    }
+    return std::nullopt;
+  };
+  const auto first = roadmapAt(0);
+  ASSERT_TRUE(first) << "no roadmap within 30 s";
+  ASSERT_EQ(std::count(first->open.begin(), first->open.end(), false), 0);
+  const auto nodes = static_cast<std::int32_t>(first->nodes.size());
+
+  msg::TrafficClosure bad;
+  bad.closure_id = "bad";
+  bad.nodes = {nodes + 5};
+  closures.write(bad);
+  msg::TrafficClosure c;
+  c.closure_id = "aisle";
+  c.area = {{4.0, 0.0}, {6.0, 0.0}, {6.0, 20.0}, {4.0, 20.0}};
+  c.reason = "test";
+  closures.write(c);
+  const auto closed = roadmapAt(1);
+  ASSERT_TRUE(closed) << "the roadmap was not published again within 30 s";
+  EXPECT_EQ(closed->revision, 1U) << "the bad closure changed nothing";
+  EXPECT_EQ(closed->epoch, first->epoch);
+  std::size_t shut = 0;
+  for (std::size_t v = 0; v < closed->nodes.size(); ++v) {
+    if (!closed->open[v]) {
+      ++shut;
+      EXPECT_GE(closed->nodes[v].x, 4.0 - 1.0) << "node " << v << " is closed far from the area";
+      EXPECT_LE(closed->nodes[v].x, 6.0 + 1.0) << "node " << v << " is closed far from the area";
+    }
+  }
+  EXPECT_GT(shut, 0U);
+
+  c.active = false;
+  c.area.clear();
+  closures.write(c);
+  const auto reopened = roadmapAt(2);
+  ASSERT_TRUE(reopened);
+  EXPECT_EQ(std::count(reopened->open.begin(), reopened->open.end(), false), 0);
+  EXPECT_EQ(service.wait(std::chrono::milliseconds(0)), -1) << "the traffic manager exited";
 }

@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
     echoes.push_back(std::make_unique<EchoOf<msg::Roadmap>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::TrafficRelease>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::TrafficProgress>>(p, ws));
+    echoes.push_back(std::make_unique<EchoOf<msg::TrafficClosure>>(p, ws));
     echoes.push_back(std::make_unique<EchoOf<msg::PeopleSeen>>(p, ws));
     auto lastActivity = std::chrono::steady_clock::now();
     while (std::chrono::steady_clock::now() - lastActivity < std::chrono::seconds(idleSeconds)) {

@@ -256,6 +256,10 @@ TEST_F(RoundTrip, Traffic) {
   msg::TrafficProgress p{"r-1", 2, 17, {1, 2, 0.5}, true, {3, 4, -1}, "P-1", -3, true, false, true, 42};
   msg::TrafficProgress q{kNonAscii, 0, -1, {}, false, {}, "", 0, false, true, false, 0};
   expectRoundTrip<msg::TrafficProgress>({p, q});
+  msg::TrafficClosure c{"spill-1", true, {{1, 1}, {3, 1}, {3, 2}}, {4, 2147483647}, {{5, 6}, {6, 5}},
+                        kNonAscii, 7};
+  msg::TrafficClosure reopen{maxId(), false, {}, {}, {}, "", 0};
+  expectRoundTrip<msg::TrafficClosure>({c, reopen});
 }
 
 TEST(Traffic, OversizedReleasesAreRefusedNamingTheField) {

@@ -52,6 +52,43 @@ TEST(FaultPlan, HideLandmarksTakesSimulatedSecondsAndParsesBack) {
   EXPECT_NE(bad.error().message.find("how many simulated seconds"), std::string::npos) << bad.error().message;
 }
 
+TEST(FaultPlan, KillTrafficNamesTheTrafficManagerAndParsesBack) {
+  auto f = parseFaults({"kill-traffic@45", "kill-traffic@10+3", "kill-manager@5", "kill-agent@5"});
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_EQ((*f)[0].kind, Fault::Kind::KillTraffic);
+  EXPECT_DOUBLE_EQ((*f)[0].downS, 1);  // default restart delay
+  EXPECT_EQ(describe((*f)[1]), "kill-traffic@10+3");
+  EXPECT_EQ(killedService((*f)[0]), "traffic_manager");
+  EXPECT_EQ(killedService((*f)[2]), "fleet_manager");
+  EXPECT_EQ(killedService((*f)[3]), "") << "which agent process depends on the run";
+  auto bad = parseFaults({"kill-traffic@3+0"});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("kill-traffic: expected a duration"), std::string::npos)
+      << bad.error().message;
+}
+
+TEST(FaultPlan, CloseTakesAnAreaAndSimulatedSecondsAndParsesBack) {
+  auto f = parseFaults({"close@40+60:10,4,14,4,14,6,-1.5,6"});
+  ASSERT_TRUE(f) << f.error().message;
+  EXPECT_EQ((*f)[0].kind, Fault::Kind::CloseArea);
+  EXPECT_DOUBLE_EQ((*f)[0].atS, 40);
+  EXPECT_DOUBLE_EQ((*f)[0].downS, 60);
+  EXPECT_EQ((*f)[0].area, (std::vector<double>{10, 4, 14, 4, 14, 6, -1.5, 6}));
+  EXPECT_EQ(describe((*f)[0]), "close@40+60:10,4,14,4,14,6,-1.5,6");
+  EXPECT_EQ(killedService((*f)[0]), "");
+  const std::pair<const char*, const char*> bad[] = {
+      {"close@40+60", "the area's corners"},
+      {"close@40:1,1,2,2,3,3", "expected '+D'"},
+      {"close@40+60:1,1,2,2", "at least 3 corners"},
+      {"close@40+60:1,1,2,x,3,3", "got \"x\""},
+  };
+  for (const auto& [spec, expect] : bad) {
+    auto e = parseFaults({spec});
+    ASSERT_FALSE(e) << spec;
+    EXPECT_NE(e.error().message.find(expect), std::string::npos) << spec << " -> " << e.error().message;
+  }
+}
+
 TEST(FaultPlan, NoDropWithoutDropFault) {
   auto f = parseFaults({"kill-manager@1"});
   ASSERT_TRUE(f);

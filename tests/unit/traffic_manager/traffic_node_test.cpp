@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "fleet/site/site_loader.hpp"
 
@@ -123,23 +124,31 @@ TEST(TrafficNode, RiskSettingsAreReadAndChecked) {
   EXPECT_NE(bad.problems()[0].find("risk_cost_s"), std::string::npos) << bad.problems()[0];
 }
 
-// Bad input: a goal the roadmap does not connect (a station walled off from the robot's part of
-// the hall) is refused with a logged reason and the robot gets no route, instead of a goal the
-// planner can never bring it to.
-TEST(TrafficNode, AGoalTheRoadmapDoesNotConnectIsRefused) {
+/// A 10 m × 5 m room split by a wall at x 7.0..7.5 m, with a 2 m door in it or none; A and C on
+/// the left of the wall, B on the right.
+site::Site wallSite(bool door) {
   std::vector<std::string> rows(10, "@" + std::string(20, '.') + "@");
   rows.front() = rows.back() = std::string(22, '@');
-  for (auto& r : rows)
-    r[14] = '@';  // a wall at x 7.0..7.5 m from top to bottom
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    if (!door || r < 3 || r > 6)
+      rows[r][14] = '@';
+  }
   const nlohmann::json doc = {{"format", "fleet-site/1"},
-                              {"name", "walled"},
+                              {"name", door ? "door" : "walled"},
                               {"map", {{"rows", rows}, {"resolution", 0.5}}},
                               {"robot", {{"radius", 0.3}}},
                               {"stations",
                                {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 2.5, 0.0}}},
-                                {{"name", "C"}, {"kind", "dropoff"}, {"pose", {5.5, 2.5, 0.0}}},
+                                {{"name", "C"}, {"kind", "dropoff"}, {"pose", {4.5, 2.5, 0.0}}},
                                 {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 2.5, M_PI}}}}}};
-  const auto site = site::parseSite(doc, "walled.site.json", ".", false);
+  return site::parseSite(doc, "wall.site.json", ".", false);
+}
+
+// Bad input: a goal the roadmap does not connect (a station walled off from the robot's part of
+// the hall) is refused with a logged reason and the robot gets no route, instead of a goal the
+// planner can never bring it to.
+TEST(TrafficNode, AGoalTheRoadmapDoesNotConnectIsRefused) {
+  const auto site = wallSite(false);
   TrafficNode node(site, settings(), 1);
   ASSERT_FALSE(node.roadmap().problems.empty()) << "the roadmap says B is cut off";
   const auto refused = node.onProgress(at("r1", {1.5, 2.5, 0.0}, "B"), 0);
@@ -158,6 +167,126 @@ TEST(TrafficNode, AGoalTheRoadmapDoesNotConnectIsRefused) {
       moves = moves || r.base.size() > 1;
   }
   EXPECT_TRUE(moves);
+}
+
+msg::TrafficClosure closure(const std::string& id, std::vector<Vec2> area,
+                            std::vector<std::int32_t> nodes = {}, std::vector<msg::NodePair> lanes = {}) {
+  msg::TrafficClosure c;
+  c.closure_id = id;
+  c.area = std::move(area);
+  c.nodes = std::move(nodes);
+  c.lanes = std::move(lanes);
+  c.reason = "test";
+  return c;
+}
+
+/// Ticks `node` for `seconds` from `now` with robot r1 (epoch `epoch`, goal `goal`) reporting
+/// every tick: it drives each release's next node at once. `last` is its latest release (kept across
+/// calls); every node released to it goes into `released`.
+void drive(TrafficNode& node, std::int64_t& now, double seconds, const std::string& goal, std::uint32_t epoch,
+           msg::TrafficRelease& last, std::vector<std::int32_t>& released) {
+  for (const auto end = now + static_cast<std::int64_t>(seconds * kS); now < end; now += kS / 10) {
+    for (const auto& r : node.tick(now))
+      last = r;
+    for (const auto& n : last.base)
+      released.push_back(n.node);
+    if (last.base.size() > 1) {
+      node.onProgress(at("r1", {last.base[1].x, last.base[1].y, 0}, goal, last.base[1].node, epoch), now);
+    } else if (!last.base.empty()) {
+      node.onProgress(at("r1", {last.base[0].x, last.base[0].y, 0}, goal, last.base[0].node, epoch), now);
+    } else {
+      node.onProgress(at("r1", {1.5, 2.5, 0.0}, goal), now);
+    }
+  }
+}
+
+TEST(TrafficNode, AClosedDoorIsNotDrivenThroughUntilItIsReopened) {
+  TrafficNode node(wallSite(true), settings(), 5);
+  ASSERT_TRUE(node.roadmap().problems.empty()) << node.roadmap().problems.front().what;
+  const std::vector<Vec2> door = {{6.6, -1.0}, {7.9, -1.0}, {7.9, 6.0}, {6.6, 6.0}};
+  const auto r = node.onClosure(closure("spill-1", door));
+  ASSERT_FALSE(r.error) << *r.error;
+  EXPECT_TRUE(r.changed);
+  EXPECT_GT(r.nodes, 0U);
+  EXPECT_EQ(r.cutOff, std::vector<std::string>{"B"}) << "the door was the only way to B";
+  EXPECT_EQ(node.revision(), 1U);
+  EXPECT_EQ(node.closures(), std::vector<std::string>{"spill-1"});
+  const auto m = node.roadmapMessage(0);
+  EXPECT_EQ(m.revision, 1U);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(m.open.begin(), m.open.end(), false)), r.nodes);
+  std::set<std::int32_t> closed;
+  for (std::size_t v = 0; v < m.open.size(); ++v) {
+    if (!m.open[v])
+      closed.insert(static_cast<std::int32_t>(v));
+  }
+  // Sent to B while the door is closed: refused (held), never released into the closed nodes.
+  EXPECT_TRUE(node.onProgress(at("r1", {1.5, 2.5, 0.0}, "B"), 0));
+  std::int64_t now = 0;
+  std::vector<std::int32_t> released;
+  msg::TrafficRelease last;
+  drive(node, now, 20.0, "B", 5, last, released);
+  for (const auto v : released)
+    EXPECT_FALSE(closed.contains(v)) << "node " << v << " is closed";
+  // Reopened: it drives through to B.
+  msg::TrafficClosure reopen;
+  reopen.closure_id = "spill-1";
+  reopen.active = false;
+  const auto o = node.onClosure(reopen);
+  EXPECT_TRUE(o.changed);
+  EXPECT_EQ(node.revision(), 2U);
+  EXPECT_TRUE(node.closures().empty());
+  const auto m2 = node.roadmapMessage(now);
+  EXPECT_EQ(std::count(m2.open.begin(), m2.open.end(), false), 0);
+  released.clear();
+  drive(node, now, 60.0, "B", 5, last, released);
+  ASSERT_FALSE(last.base.empty());
+  EXPECT_EQ(last.base.back().node, node.roadmap().station("B")->dock);
+  EXPECT_TRUE(last.ends_at_goal);
+}
+
+TEST(TrafficNode, ClosuresAreCheckedWholeReplacedByIdAndReopenedOnce) {
+  TrafficNode node(wallSite(true), settings(), 5);
+  const auto& g = node.roadmap().graph;
+  const auto n = static_cast<std::int32_t>(g.size());
+  // A node off the roadmap or a lane that is no edge: refused, nothing changed.
+  auto bad = node.onClosure(closure("x", {}, {0, n}));
+  ASSERT_TRUE(bad.error);
+  EXPECT_NE(bad.error->find("node " + std::to_string(n) + " is not on the roadmap"), std::string::npos)
+      << *bad.error;
+  const traffic::NodeId a = node.roadmap().station("A")->dock;
+  const traffic::NodeId b = node.roadmap().station("B")->dock;
+  bad = node.onClosure(closure("x", {}, {}, {{a, b}}));
+  ASSERT_TRUE(bad.error);
+  EXPECT_NE(bad.error->find("no roadmap edge"), std::string::npos) << *bad.error;
+  bad = node.onClosure(closure("x", {}));
+  ASSERT_TRUE(bad.error);
+  EXPECT_NE(bad.error->find("closes nothing"), std::string::npos) << *bad.error;
+  EXPECT_EQ(node.revision(), 0U);
+  EXPECT_TRUE(g.isOpen(0));
+  // The same id again replaces the closure: the first node opens, the second closes.
+  ASSERT_FALSE(node.onClosure(closure("c", {}, {a})).error);
+  EXPECT_FALSE(g.isOpen(a));
+  ASSERT_FALSE(node.onClosure(closure("c", {}, {b})).error);
+  EXPECT_TRUE(g.isOpen(a));
+  EXPECT_FALSE(g.isOpen(b));
+  // A lane closed one way: the edge closes, its nodes stay open.
+  const traffic::NodeId next = g.edges(a).front().to;
+  const auto lane = node.onClosure(closure("lane", {}, {}, {{a, next}}));
+  ASSERT_FALSE(lane.error) << *lane.error;
+  EXPECT_EQ(lane.edges, 1U);
+  EXPECT_FALSE(g.edges(a).front().open);
+  EXPECT_TRUE(g.isOpen(a));
+  EXPECT_EQ(node.closures(), (std::vector<std::string>{"c", "lane"}));
+  // Reopening twice, or an id never closed, changes nothing the second time.
+  msg::TrafficClosure reopen;
+  reopen.closure_id = "c";
+  reopen.active = false;
+  EXPECT_TRUE(node.onClosure(reopen).changed);
+  EXPECT_FALSE(node.onClosure(reopen).changed);
+  reopen.closure_id = "never";
+  EXPECT_FALSE(node.onClosure(reopen).changed);
+  EXPECT_TRUE(g.isOpen(b));
+  EXPECT_EQ(node.revision(), 4U);
 }
 
 TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {

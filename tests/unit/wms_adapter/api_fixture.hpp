@@ -69,6 +69,17 @@ class FakeGateway : public TaskGateway {
     return out;
   }
   [[nodiscard]] bool managerOnline() const override { return online; }
+  std::optional<std::string> sendClosure(const msg::TrafficClosure& c) override {
+    std::lock_guard lock(m_);
+    if (!closureProblem.empty()) {
+      return closureProblem;
+    }
+    closuresSent.push_back(c);
+    return std::nullopt;
+  }
+  [[nodiscard]] bool trafficManagerOnline() const override { return online; }
+  std::vector<msg::TrafficClosure> closuresSent;
+  std::string closureProblem;  // sendClosure fails with this when not empty
   std::map<std::string, std::string> bodies;
   std::vector<msg::TaskControl> controls;
   bool online = true;

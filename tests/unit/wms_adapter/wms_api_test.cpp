@@ -270,3 +270,84 @@ TEST_F(Api, TheStationTheManagerChoseIsShownWithTheTask) {
   EXPECT_FALSE(body.contains("station"));
   EXPECT_FALSE(body["task"].contains("station"));
 }
+
+TEST_F(Api, RoadmapClosuresAreSentListedAndReopened) {
+  start();
+  // Node ids are checked against the roadmap once the adapter has one.
+  msg::Roadmap rm;
+  rm.epoch = 3;
+  for (int i = 0; i < 10; ++i) {
+    rm.nodes.push_back({i, static_cast<double>(i), 0.0});
+    rm.kinds.push_back(0);
+    rm.open.push_back(true);
+  }
+  view_.onRoadmap(rm);
+  const std::string good = R"({"area": [[1, 1], [3, 1], [3, 2]], "nodes": [4], "lanes": [[5, 6], [6, 5]],
+                               "reason": "spill in aisle 3"})";
+  auto r = client_->Put("/v1/traffic/closures/spill-3", good, "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 202) << r->body;
+  auto j = json::parse(r->body);
+  EXPECT_EQ(j["id"], "spill-3");
+  EXPECT_EQ(j["nodes"], json::array({4}));
+  EXPECT_EQ(j["lanes"], json::parse("[[5, 6], [6, 5]]"));
+  ASSERT_EQ(gateway_.closuresSent.size(), 1U);
+  const auto sent = gateway_.closuresSent[0];
+  EXPECT_TRUE(sent.active);
+  EXPECT_EQ(sent.area.size(), 3U);
+  EXPECT_EQ(sent.reason, "spill in aisle 3");
+  view_.onClosure(sent);  // as the DDS gateway does
+  r = client_->Get("/v1/traffic/closures");
+  ASSERT_TRUE(r);
+  j = json::parse(r->body);
+  EXPECT_EQ(j["count"], 1);
+  EXPECT_EQ(j["closures"][0]["id"], "spill-3");
+  EXPECT_EQ(j["roadmap"]["epoch"], 3);
+  // Bad bodies: each wrong field named, nothing sent.
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"nodes": [10]})", "nodes[0]"},
+      {R"({"nodes": [-1]})", "nodes[0]"},
+      {R"({"area": [[0, 0], [1, 1]]})", "area"},
+      {R"({"area": [[0, 0], [1, "x"], [1, 1]]})", "area[1]"},
+      {R"({"lanes": [[1]]})", "lanes[0]"},
+      {R"({"reason": "no target"})", ""},
+      {R"({"nodes": [1], "colour": "red"})", "colour"},
+      {R"([1, 2])", ""},
+  };
+  for (const auto& [body, path] : bad) {
+    r = client_->Put("/v1/traffic/closures/c2", body, "application/json");
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 400) << body;
+    const auto e = json::parse(r->body);
+    bool named = false;
+    for (const auto& f : e["fields"]) {
+      named = named || f["path"] == path;
+    }
+    EXPECT_TRUE(named) << body << " -> " << r->body;
+  }
+  r = client_->Put("/v1/traffic/closures/bad%20id", good, "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400);
+  EXPECT_EQ(gateway_.closuresSent.size(), 1U) << "nothing sent for a bad request";
+  // The transport refusing: 503, said.
+  gateway_.closureProblem = "no permission";
+  r = client_->Put("/v1/traffic/closures/c3", good, "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 503);
+  EXPECT_NE(r->body.find("no permission"), std::string::npos);
+  gateway_.closureProblem.clear();
+  // Reopened: sent inactive, known or not.
+  r = client_->Delete("/v1/traffic/closures/spill-3");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 202);
+  EXPECT_EQ(json::parse(r->body)["known"], true);
+  ASSERT_EQ(gateway_.closuresSent.size(), 2U);
+  EXPECT_FALSE(gateway_.closuresSent[1].active);
+  view_.onClosure(gateway_.closuresSent[1]);
+  r = client_->Delete("/v1/traffic/closures/made-elsewhere");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 202);
+  EXPECT_EQ(json::parse(r->body)["known"], false);
+  r = client_->Get("/v1/traffic/closures");
+  EXPECT_EQ(json::parse(r->body)["count"], 0);
+}

@@ -314,6 +314,24 @@ struct Roadmap {
   bool operator==(const Roadmap&) const = default;
 };
 
+struct NodePair {
+  std::int32_t from = 0;
+  std::int32_t to = 0;
+  bool operator==(const NodePair&) const = default;
+};
+
+/// A part of the roadmap closed at run time (or reopened: active = false); see fleet.idl.
+struct TrafficClosure {
+  std::string closure_id;
+  bool active = true;
+  std::vector<Vec2> area;           ///< polygon, at most 256 corners; empty: none
+  std::vector<std::int32_t> nodes;  ///< at most 4096
+  std::vector<NodePair> lanes;      ///< directed edges, at most 4096
+  std::string reason;
+  std::int64_t stamp_ns = 0;
+  bool operator==(const TrafficClosure&) const = default;
+};
+
 struct TrafficRelease {
   std::string robot_id;
   std::uint32_t epoch = 0;

@@ -37,6 +37,7 @@ QosProfile groundTruth();           // reliable, keep-last 64
 QosProfile roadmap();               // reliable, transient-local, keep-last 1
 QosProfile trafficRelease();        // reliable, transient-local, keep-last 1 per robot
 QosProfile trafficProgress();       // reliable, transient-local, keep-last 1 per robot
+QosProfile trafficClosure();        // reliable, transient-local, keep-last 1 per closure id
 /// Looks a profile up by name (the names above, snake_case); false when unknown.
 bool byName(std::string_view name, QosProfile& out);
 }  // namespace qos

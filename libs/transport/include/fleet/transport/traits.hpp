@@ -61,6 +61,7 @@ FLEET_DECLARE_TRAITS(GroundTruth, fleet_GroundTruth, "GroundTruth", qos::groundT
 FLEET_DECLARE_TRAITS(Roadmap, fleet_Roadmap, "Roadmap", qos::roadmap())
 FLEET_DECLARE_TRAITS(TrafficRelease, fleet_TrafficRelease, "TrafficRelease", qos::trafficRelease())
 FLEET_DECLARE_TRAITS(TrafficProgress, fleet_TrafficProgress, "TrafficProgress", qos::trafficProgress())
+FLEET_DECLARE_TRAITS(TrafficClosure, fleet_TrafficClosure, "TrafficClosure", qos::trafficClosure())
 
 #undef FLEET_DECLARE_TRAITS
 

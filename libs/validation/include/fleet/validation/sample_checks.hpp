@@ -57,6 +57,7 @@ std::optional<Rejection> check(const msg::VelocityCommand& m);
 std::optional<Rejection> check(const msg::GroundTruth& m);
 std::optional<Rejection> check(const msg::TrafficRelease& m);
 std::optional<Rejection> check(const msg::TrafficProgress& m);
+std::optional<Rejection> check(const msg::TrafficClosure& m);
 std::optional<Rejection> check(const msg::Roadmap& m);
 
 /// Replaces invalid UTF-8 in the free-text fields; true when anything changed.
