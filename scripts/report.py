@@ -248,6 +248,74 @@ def risk_levels_over_time(run):
     return [(f"p > {(l - 1) / K:.2g}", pts) for l, pts in sorted(levels.items()) if l in shown]
 
 
+def traffic_over_time(run):
+    """From the replay's traffic layer (reserved traffic): per simulated second, robots standing on a
+    station's queue place (within 0.3 m of a queue node), robots whose release lets them drive (a
+    base beyond the node they are at) and robots held at their node; and each roadmap revision
+    (closures) with its time and closed nodes. None when the replay has no roadmap."""
+    path = os.path.join(run, "replay.jsonl.gz")
+    if not os.path.exists(path):
+        return None
+    header = {}
+    queue_cells = {}  # (ix, iy) of 0.5 m cells -> queue node positions
+    releases = {}
+    waiting, driving, held, revisions = [], [], [], []
+    last_t = -1.0
+    with gzip.open(path, "rt") as f:
+        for line in f:
+            d = json.loads(line)
+            if d.get("type") == "header":
+                header = d
+                continue
+            rm = d.get("roadmap")
+            if rm:
+                n = rm["nodes"]
+                queue_cells = {}
+                for v, k in enumerate(rm["kinds"]):
+                    if k == 3:
+                        x, y = n[2 * v], n[2 * v + 1]
+                        queue_cells.setdefault((int(x // 0.5), int(y // 0.5)), []).append((x, y))
+                revisions.append((d.get("t", 0.0), rm.get("revision", 0), len(rm.get("closed", []))))
+            for rid, rel in (d.get("releases") or {}).items():
+                releases[rid] = rel
+            t = d.get("t", 0.0)
+            if not revisions or t - last_t < 1.0:
+                continue
+            last_t = t
+            ids = [r.get("id") for r in header.get("robots", [])]
+            q = 0
+            for r in d.get("robots", []):
+                cx, cy = int(r[0] // 0.5), int(r[1] // 0.5)
+                near = any((r[0] - x) ** 2 + (r[1] - y) ** 2 <= 0.09
+                           for dx in (-1, 0, 1) for dy in (-1, 0, 1)
+                           for (x, y) in queue_cells.get((cx + dx, cy + dy), ()))
+                q += 1 if near else 0
+            may = sum(1 for i in ids if i in releases and len(releases[i]["b"]) > 1)
+            stay = sum(1 for i in ids if i in releases and len(releases[i]["b"]) <= 1)
+            waiting.append((t, q))
+            driving.append((t, may))
+            held.append((t, stay))
+    if not revisions:
+        return None
+    return {"series": [("may drive", driving), ("held", held), ("in a queue", waiting)], "revisions": revisions}
+
+
+def traffic_html(run):
+    t = traffic_over_time(run)
+    if t is None:
+        return ""
+    rows = "".join(f'<tr><td class="r">{tt:.1f}</td><td class="r">{rev}</td><td class="r">{closed}</td></tr>'
+                   for tt, rev, closed in t["revisions"])
+    return f"""<h2 id="traffic">Traffic layer</h2>
+<div class="grid"><div>{svg_lines(t['series'], w=640, h=260, xlabel='simulated time (s)', ylabel='robots', legend_title='robots', why='no releases in the replay')}</div>
+<div><h3>Roadmap revisions (closures)</h3><table><tr><th>at (s)</th><th>revision</th><th>closed nodes</th></tr>{rows}</table>
+<p class="note">From the traffic manager's Roadmap and TrafficRelease topics as the simulator recorded them: robots whose
+release lets them drive on ("may drive": a base beyond their node), robots held at their node ("held": waiting on a
+dependency, on their goal, docked or idle), and robots standing on a station's queue place ("in a queue"). The replay below draws the roadmap (queue places purple,
+closed nodes red) and each robot's base (solid) and horizon (dashed).</p></div></div>
+"""
+
+
 def embedded_viewer(run):
     """The replay viewer as an iframe whose document travels inside this page (gzip + base64):
     a few lines of script unpack it into srcdoc, so the page needs no other file."""
@@ -466,7 +534,7 @@ iframe{{border:1px solid #aaa;width:100%;max-width:1200px;height:790px}} nav a{{
 <p>{summary['robots']} robots, {summary['humans']} humans, {sim_s:.0f} s of simulated time.
 <b>{done}</b> of {summary['tasks']['submitted']} tasks done ({summary['tasks']['per_hour']:.0f} per simulated hour);
 <b class="{'bad' if sum(v or 0 for k, v in contacts.items() if k != 'steps_with_contact') else ''}">{contacts.get('robot_robot', '—')} robot–robot and {contacts.get('robot_human', '—')} robot–human contacts</b>.</p>
-<nav><a href="#throughput">Throughput &amp; latency</a><a href="#safety">Safety</a><a href="#risk">Risk map</a><a href="#localization">Localization</a>{'<a href="#loadtest">Load test</a>' if lt else ''}<a href="#replay">Replay</a><a href="#raw">Raw summary</a></nav>
+<nav><a href="#throughput">Throughput &amp; latency</a><a href="#safety">Safety</a><a href="#risk">Risk map</a><a href="#traffic">Traffic</a><a href="#localization">Localization</a>{'<a href="#loadtest">Load test</a>' if lt else ''}<a href="#replay">Replay</a><a href="#raw">Raw summary</a></nav>
 <h2 id="throughput">Throughput and latency</h2>
 <p class="note" style="max-width:900px">All times are seconds of simulated time, from the fleet manager's task database (every task it stored).
 Percentiles are nearest-rank; a task restarted before the manager had a clock gives no samples.</p>
@@ -490,8 +558,10 @@ long it stays). A negative gap is an overlap; a gap of "—": no such pair ever 
 <p class="note">Area of the warehouse floor whose collision probability exceeds each iso-level's lower bound, for each risk map
 the simulator recorded. Level l of K holds p in ((l−1)/K, l/K].</p></div>
 {localization_html(run, lt)}
+{traffic_html(run)}
 {loadtest_html(lt)}
-<h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded.
+<h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded;
+in reserved traffic the roadmap, its queue places and closed nodes, and each robot's released base (solid) and horizon (dashed).
 The viewer is embedded in this page; <a href="viewer.html">open it on its own</a> (viewer.html, next to this page in the run folder).</p>
 {viewer}
 <h2 id="raw">Raw summary</h2><details><summary>summary.json</summary><pre>{html.escape(json.dumps(summary, indent=2))}</pre></details>

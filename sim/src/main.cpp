@@ -27,6 +27,7 @@
 #include "fleet/sim/vda5050_fleet.hpp"
 #include "fleet/sim/world.hpp"
 #include "fleet/transport/dds.hpp"
+#include "fleet/validation/sample_checks.hpp"
 
 using namespace fleet;
 using namespace std::chrono_literals;
@@ -297,6 +298,15 @@ class Simulator {
         errors_(1.0, o.hiddenLandmarks) {
     stepWs_.attach(doneR_);
     stepWs_.attach(cmdR_);
+    // The traffic layer for the replay viewer (roadmap, releases); the simulator runs on without
+    // it where its DDS permissions predate it.
+    try {
+      roadmapR_ = std::make_unique<transport::Reader<msg::Roadmap>>(p_);
+      releaseR_ = std::make_unique<transport::Reader<msg::TrafficRelease>>(p_);
+    } catch (const std::exception& e) {
+      roadmapR_.reset();
+      spdlog::warn("fleet-sim: the replay will not show the traffic layer ({})", e.what());
+    }
     ops_.registry()
         .gauge("fleet_sim_bodies", "Bodies in the world", {{"kind", "robot"}})
         .set(static_cast<double>(w_.robots().size()));
@@ -566,9 +576,32 @@ class Simulator {
                         {"levels", m.levels},
                         {"runs", runs}};
       }
+      if (roadmapR_ && releaseR_) {
+        addTraffic(line);
+      }
       (void)replay_->write(line);
     }
     clockW_.write({w_.step(), lockstep_ ? w_.timeNs() : st, secToNs(w_.scenario().dt), lockstep_});
+  }
+
+  /// The traffic layer into the replay step it arrived at: a new roadmap (its open flags change
+  /// with closures) and the releases that changed, for the viewer.
+  void addTraffic(nlohmann::json& line) {
+    auto maps = roadmapR_->take();
+    if (!maps.empty() && !validation::check(maps.back())) {
+      line["roadmap"] = sim::replayRoadmap(maps.back());
+      roadmapEpoch_ = maps.back().epoch;
+    }
+    nlohmann::json rel = nlohmann::json::object();
+    for (const auto& r : releaseR_->take()) {
+      if (validation::check(r) || r.epoch < roadmapEpoch_) {
+        continue;  // malformed, or from a traffic manager before the roadmap's
+      }
+      rel[r.robot_id] = sim::replayRelease(r);
+    }
+    if (!rel.empty()) {
+      line["releases"] = std::move(rel);
+    }
   }
 
   /// Contacts so far, by pair kind (the world counts them; the counters follow).
@@ -668,6 +701,9 @@ class Simulator {
   transport::Reader<msg::StepDone> doneR_;
   transport::Reader<msg::RobotState> stateR_;
   transport::Reader<msg::RiskMap> riskR_;
+  std::unique_ptr<transport::Reader<msg::Roadmap>> roadmapR_;
+  std::unique_ptr<transport::Reader<msg::TrafficRelease>> releaseR_;
+  std::uint32_t roadmapEpoch_ = 0;
   transport::WaitSet stepWs_;                  // lockstep: StepDone or a command arrived
   std::vector<msg::VelocityCommand> pending_;  // arrived, not yet applied
   sim::LockstepBarrier barrier_;

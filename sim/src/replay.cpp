@@ -2,7 +2,9 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 
 namespace fleet::sim {
 
@@ -78,6 +80,44 @@ nlohmann::json replayStep(const World& w) {
   }
   j["contacts"] = contacts;
   return j;
+}
+
+nlohmann::json replayRoadmap(const msg::Roadmap& m) {
+  nlohmann::json nodes = nlohmann::json::array();
+  nlohmann::json closed = nlohmann::json::array();
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    nodes.push_back(std::round(m.nodes[i].x * 100.0) / 100.0);
+    nodes.push_back(std::round(m.nodes[i].y * 100.0) / 100.0);
+    if (i < m.open.size() && !m.open[i]) {
+      closed.push_back(i);
+    }
+  }
+  nlohmann::json lanes = nlohmann::json::array();
+  nlohmann::json closedEdges = nlohmann::json::array();
+  std::set<std::pair<std::int32_t, std::int32_t>> drawn;
+  for (const auto& e : m.edges) {
+    if (!e.open) {
+      closedEdges.push_back(e.from);
+      closedEdges.push_back(e.to);
+    } else if (drawn.insert({std::min(e.from, e.to), std::max(e.from, e.to)}).second) {
+      lanes.push_back(e.from);
+      lanes.push_back(e.to);
+    }
+  }
+  return {{"epoch", m.epoch}, {"revision", m.revision}, {"nodes", nodes},       {"kinds", m.kinds},
+          {"closed", closed}, {"lanes", lanes},         {"closed_edges", closedEdges}};
+}
+
+nlohmann::json replayRelease(const msg::TrafficRelease& r) {
+  nlohmann::json base = nlohmann::json::array();
+  nlohmann::json horizon = nlohmann::json::array();
+  for (const auto& n : r.base) {
+    base.push_back(n.node);
+  }
+  for (const auto& n : r.horizon) {
+    horizon.push_back(n.node);
+  }
+  return {{"b", base}, {"h", horizon}, {"g", r.ends_at_goal}};
 }
 
 nlohmann::json summary(const World& w) {

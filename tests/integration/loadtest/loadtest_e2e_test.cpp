@@ -656,6 +656,8 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
   }
   EXPECT_NE(html.find("Robot agents (wall clock)"), std::string::npos);
   EXPECT_NE(html.find("0 lost, 0 duplicated"), std::string::npos);
+  // Reserved traffic (the default): the report has the traffic layer from the replay.
+  EXPECT_NE(html.find("<h2 id=\"traffic\">Traffic layer</h2>"), std::string::npos);
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
 

@@ -154,6 +154,30 @@ TEST(SimViewer, HeadlessChromiumRendersMapRobotsAndHumans) {
     m.levels = 3;
     m.runs = {{2, 60 * 15}, {0, 60 * 15}};
     risk.write(m);
+    // The traffic layer as the traffic manager would publish it: a lane of 20 nodes along y = 4 m
+    // (nodes 0-9 queue places, 10-19 closed) and a release to r1 of a base and a horizon.
+    fleet::transport::Writer<fleet::msg::Roadmap> roadmap(p);
+    fleet::transport::Writer<fleet::msg::TrafficRelease> release(p);
+    fleet::msg::Roadmap rm;
+    rm.epoch = 1;
+    rm.revision = 1;
+    for (int i = 0; i < 20; ++i) {
+      rm.nodes.push_back({i, 2.0 + 1.2 * i, 4.0});
+      rm.kinds.push_back(i < 10 ? 3 : 0);
+      rm.open.push_back(i < 10);
+      if (i > 0) {
+        rm.edges.push_back({i - 1, i, 1.5f, true});
+        rm.edges.push_back({i, i - 1, 1.5f, true});
+      }
+    }
+    roadmap.write(rm);
+    fleet::msg::TrafficRelease rel;
+    rel.robot_id = "r1";
+    rel.epoch = 1;
+    rel.seq = 1;
+    rel.base = {{0, 2.0, 4.0}, {1, 3.2, 4.0}};
+    rel.horizon = {{2, 4.4, 4.0}};
+    release.write(rel);
     fleet::test::ChildProcess sim(
         FLEET_BINARY_DIR "/sim/src/fleet-sim",
         {"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/aisle_crossing.json", "--clock", "wall", "--duration",
@@ -162,6 +186,9 @@ TEST(SimViewer, HeadlessChromiumRendersMapRobotsAndHumans) {
     ASSERT_EQ(sim.wait(std::chrono::seconds(60)), 0);
   }
   EXPECT_NE(slurp(html).find("\"risk\":{"), std::string::npos) << "risk map not recorded in the replay";
+  EXPECT_NE(slurp(html).find("\"roadmap\":{"), std::string::npos) << "roadmap not recorded in the replay";
+  EXPECT_NE(slurp(html).find("\"releases\":{\"r1\":{\"b\":[0,1]"), std::string::npos)
+      << "r1's release not recorded in the replay";
   const std::string profile = (dir / "profile").string();
   const std::string cmd = std::string("timeout 90 ") + chromium +
                           " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
@@ -182,5 +209,10 @@ TEST(SimViewer, HeadlessChromiumRendersMapRobotsAndHumans) {
   EXPECT_GT(humans, 3 * 50U) << "3 humans not drawn";
   // Level 2 of 3 shaded over white: alpha 0.367 of (150, 0, 190) -> about (216, 161, 231).
   EXPECT_GT(countColour(img, 216, 161, 231, 6), 20000U) << "risk iso-levels not drawn";
+  // The traffic layer: 10 closed nodes (filled red squares), 10 queue places (purple rings).
+  const std::size_t closed = countColour(img, 0xd0, 0x00, 0x00, 8);
+  const std::size_t queue = countColour(img, 0xa0, 0x20, 0xf0, 40);
+  EXPECT_GT(closed, 10 * 10U) << "closed roadmap nodes not drawn";
+  EXPECT_GT(queue, 10 * 15U) << "queue places not drawn";
   std::filesystem::remove_all(dir);
 }
