@@ -104,8 +104,9 @@ nlohmann::json replayRoadmap(const msg::Roadmap& m) {
       lanes.push_back(e.to);
     }
   }
-  return {{"epoch", m.epoch}, {"revision", m.revision}, {"nodes", nodes},       {"kinds", m.kinds},
-          {"closed", closed}, {"lanes", lanes},         {"closed_edges", closedEdges}};
+  return {{"epoch", m.epoch},           {"revision", m.revision}, {"nodes", nodes},
+          {"kinds", m.kinds},           {"closed", closed},       {"lanes", lanes},
+          {"closed_edges", closedEdges}};
 }
 
 nlohmann::json replayRelease(const msg::TrafficRelease& r) {
