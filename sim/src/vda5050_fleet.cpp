@@ -108,8 +108,10 @@ void Vda5050Fleet::step(World& world, double now_s, std::int64_t stamp_ns) {
     }
     const auto& pose = world.robots()[m.robot].pose;
     bool person = false;
+    bool warned = false;
     for (const auto& h : world.humans()) {
       person = person || m.vehicle->inProtectiveField(pose, h.p.x, h.p.y, h.r);
+      warned = warned || m.vehicle->inWarningField(pose, h.p.x, h.p.y, h.r);
     }
     // A safety scanner sees machines too: a vehicle driving into another robot stops as it would
     // for a person (a mixed run had two vehicles overlap by 0.34 m when their orders fell out of
@@ -118,7 +120,7 @@ void Vda5050Fleet::step(World& world, double now_s, std::int64_t stamp_ns) {
       const auto& q = world.robots()[j].pose;
       person = j != m.robot && m.vehicle->machineInField(pose, q.x, q.y, world.scenario().robots[j].radius);
     }
-    const auto cmd = m.vehicle->step(now_s, pose, person);
+    const auto cmd = m.vehicle->step(now_s, pose, person, warned);
     world.command(m.robot, cmd.v, cmd.w);
     if (const auto stamp = m.vehicle->takeMotionStart()) {
       if (const auto sent = vda5050::parseIsoTimestamp(*stamp)) {

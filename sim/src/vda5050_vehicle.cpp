@@ -200,8 +200,12 @@ void Vda5050Vehicle::runNodeActions(double now_s) {
   }
 }
 
-VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person_in_field) {
-  distance_since_node_ += std::hypot(pose.x - pose_.x, pose.y - pose_.y);
+VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person_in_field,
+                                    bool person_in_warning_field) {
+  const double moved = std::hypot(pose.x - pose_.x, pose.y - pose_.y);
+  distance_since_node_ += moved;
+  measured_speed_ = last_step_s_ >= 0.0 && now_s > last_step_s_ ? moved / (now_s - last_step_s_) : 0.0;
+  last_step_s_ = now_s;
   pose_ = pose;
   for (auto it = running_.begin(); it != running_.end();) {
     if (now_s >= it->second) {
@@ -282,6 +286,8 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
   }
   if (person_in_field) {
     cmd = {};
+  } else if (person_in_warning_field) {
+    cmd.v = std::clamp(cmd.v, -config_.warningSpeed, config_.warningSpeed);
   }
   const bool driving = std::abs(cmd.v) > 1e-3 || std::abs(cmd.w) > 1e-3;
   if (driving != driving_) {
@@ -365,29 +371,40 @@ void Vda5050Vehicle::setOperatingMode(std::string mode) {
   }
 }
 
-bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, double radius) const {
-  const double c = std::cos(pose.theta);
-  const double s = std::sin(pose.theta);
-  const double dx = px - pose.x;
-  const double dy = py - pose.y;
-  const double ahead = c * dx + s * dy;
-  const double side = -s * dx + c * dy;
-  const double front = config_.length / 2.0;
-  const double v = std::abs(last_command_.v);
-  const double reach = config_.protectiveField + v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
-  return ahead + radius >= 0.0 && ahead - radius <= front + reach &&
-         std::abs(side) - radius <= config_.width / 2.0 + config_.fieldSideMargin;
-}
+namespace {
 
-bool Vda5050Vehicle::machineInField(const Pose2& pose, double px, double py, double radius) const {
+/// Whether a disc at (px, py) reaches into the rectangle ahead of a vehicle at `pose` from its
+/// centre to `reach` beyond its front, `halfWidth` each side.
+bool inFieldAhead(const Pose2& pose, double px, double py, double radius, double front, double reach,
+                  double halfWidth) {
   const double c = std::cos(pose.theta);
   const double s = std::sin(pose.theta);
   const double ahead = c * (px - pose.x) + s * (py - pose.y);
   const double side = -s * (px - pose.x) + c * (py - pose.y);
-  const double v = std::abs(last_command_.v);
+  return ahead + radius >= 0.0 && ahead - radius <= front + reach && std::abs(side) - radius <= halfWidth;
+}
+
+}  // namespace
+
+bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, double radius) const {
+  const double v = fieldSpeed();
+  const double reach = config_.protectiveField + v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
+  return inFieldAhead(pose, px, py, radius, config_.length / 2.0, reach,
+                      config_.width / 2.0 + config_.fieldSideMargin);
+}
+
+bool Vda5050Vehicle::inWarningField(const Pose2& pose, double px, double py, double radius) const {
+  const double v = fieldSpeed();
+  const double a = std::max(config_.brakeDecel, 1e-3);
+  const double reach = config_.protectiveField + v * v / (2.0 * a) + config_.personApproachSpeed * v / a;
+  return inFieldAhead(pose, px, py, radius, config_.length / 2.0, reach,
+                      config_.width / 2.0 + config_.fieldSideMargin);
+}
+
+bool Vda5050Vehicle::machineInField(const Pose2& pose, double px, double py, double radius) const {
+  const double v = fieldSpeed();
   const double reach = kMachineFieldM + v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
-  return ahead + radius >= 0.0 && ahead - radius <= config_.length / 2.0 + reach &&
-         std::abs(side) - radius <= config_.width / 2.0 + kMachineSideM;
+  return inFieldAhead(pose, px, py, radius, config_.length / 2.0, reach, config_.width / 2.0 + kMachineSideM);
 }
 
 }  // namespace fleet::sim

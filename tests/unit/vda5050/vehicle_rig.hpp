@@ -23,13 +23,14 @@ struct Rig {
   Pose2 pose{0.0, 0.0, 0.0};
   double t = 0.0;
   bool person = false;
-  double accel = 0.0;  ///< m/s² the speed follows the command with (0: at once, as an ideal unicycle)
+  bool warned = false;  ///< a person in the warning field
+  double accel = 0.0;   ///< m/s² the speed follows the command with (0: at once, as an ideal unicycle)
   double v = 0.0;
 
   /// Steps for `seconds`; `after_step` (if any) runs after each step.
   void run(double seconds, const std::function<void()>& after_step = {}) {
     for (int k = 0; k < static_cast<int>(seconds * 10); ++k) {
-      const auto c = vehicle.step(t, pose, person);
+      const auto c = vehicle.step(t, pose, person, warned);
       v = accel > 0.0 ? std::clamp(c.v, v - accel * 0.1, v + accel * 0.1) : c.v;
       pose.x += v * std::cos(pose.theta) * 0.1;
       pose.y += v * std::sin(pose.theta) * 0.1;

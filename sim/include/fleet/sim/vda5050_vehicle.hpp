@@ -6,6 +6,7 @@
 // pause, resume and cancel, and accepts or rejects orders by the specification's rules
 // (vda5050/order_rules.hpp). No MQTT here: the simulator carries the messages.
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -35,6 +36,15 @@ struct Vda5050VehicleConfig {
   /// vehicle at 0.9 m/s (a 3.6 cm contact in a 20-robot mixed run).
   double fieldSideMargin = 0.3;
   double brakeDecel = 1.0;  // m/s²
+  /// The warning field: a person inside it slows the vehicle to `warningSpeed`. It reaches ahead
+  /// of the protective field by the way a person walking towards the vehicle at
+  /// `personApproachSpeed` covers while it brakes from its speed (ISO 13855 sizes safety distances
+  /// for 1.6 m/s). Off by default (0): with 1.6 m/s the mixed 20-robot benchmark did ~80 % of the
+  /// all-agent tasks instead of ~89 % (vehicles crawl behind people in the aisles), and with the
+  /// fields sized on the measured speed (below) it had no contact without it either
+  /// (docs/benchmarks.md, 2026-11-28).
+  double warningSpeed = 0.3;         // m/s
+  double personApproachSpeed = 0.0;  // m/s; 1.6 for ISO 13855's approach speed
   double width = 0.6;
   double length = 0.6;
   double stateInterval = 1.0;   // s between state messages without an event
@@ -54,8 +64,9 @@ class Vda5050Vehicle {
   vda5050::OrderVerdict onOrder(const vda5050::Order& order);
   void onInstantActions(const vda5050::InstantActions& message);
   /// One control step at simulated time `now_s` from the true pose; `person_in_field` is what the
-  /// safety scanner sees.
-  VehicleCommand step(double now_s, const Pose2& pose, bool person_in_field);
+  /// safety scanner sees, `person_in_warning_field` whether it sees one in its warning field.
+  VehicleCommand step(double now_s, const Pose2& pose, bool person_in_field,
+                      bool person_in_warning_field = false);
 
   /// True when a state message is due: the interval passed or something happened.
   [[nodiscard]] bool stateDue(double now_s) const;
@@ -81,6 +92,9 @@ class Vda5050Vehicle {
   /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin each side, as long as
   /// `protectiveField` plus the braking distance at the last commanded speed.
   [[nodiscard]] bool inProtectiveField(const Pose2& pose, double px, double py, double radius) const;
+  /// Whether a person is inside the warning field: as the protective field, longer by
+  /// personApproachSpeed × the time to brake from the last commanded speed.
+  [[nodiscard]] bool inWarningField(const Pose2& pose, double px, double py, double radius) const;
   /// Whether another vehicle's body (a disc) is inside the short field a scanner keeps for
   /// machines: ahead of the front by the braking distance at the last commanded speed plus
   /// kMachineFieldM, the vehicle's width plus kMachineSideM each side. Shorter than the people's
@@ -119,6 +133,11 @@ class Vda5050Vehicle {
   std::uint64_t starved_stops_ = 0;
   double distance_since_node_ = 0.0;
   VehicleCommand last_command_;
+  /// Speed over the last step from the poses it was given: the fields switch on the larger of
+  /// this and the commanded speed (braking, the command drops at once, the vehicle does not).
+  double measured_speed_ = 0.0;
+  double last_step_s_ = -1.0;
+  [[nodiscard]] double fieldSpeed() const { return std::max(std::abs(last_command_.v), measured_speed_); }
   std::optional<std::string> motion_pending_;  // header timestamp of the order it should start on
   std::optional<std::string> motion_started_;
 };
