@@ -698,6 +698,8 @@ int Run::run() {
             {"seed", o.seed}};
     if (o.letPass >= 0)
       tm["let_pass"] = o.letPass;
+    if (o.yieldAfterS >= 0.0)
+      tm["yield_after_s"] = o.yieldAfterS;
     writeFile(out / "traffic_manager.json", tm.dump(1));
     specs.push_back({"traffic_manager",
                      bin("services/traffic_manager/traffic_manager"),

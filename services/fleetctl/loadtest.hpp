@@ -37,6 +37,7 @@ struct LoadtestOptions {
   std::string agentConfig;              // robot agents' --config (a JSON file; empty: none)
   bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
   int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
+  double yieldAfterS = -1.0;         // the traffic manager's yield_after_s (0 off); < 0: its default
   std::string stationLoad = "task";  // the fleet manager's station_load (task or phase)
   /// The fleet manager's station_capacity: active tasks per station ("0": no limit), or "queue":
   /// as many as the station's line on the roadmap holds (dock and queue nodes).

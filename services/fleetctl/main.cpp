@@ -157,6 +157,11 @@ int main(int argc, char** argv) {
           "there may go first (switchable dependencies); 0: never (default: the traffic manager's)")
       ->check(CLI::Range(0, 1000));
   loadtest
+      ->add_option("--yield-after", lt.yieldAfterS,
+                   "reserved traffic: seconds a robot reports itself blocked (a person in front of it) "
+                   "before it is made to yield; 0: never (default: the traffic manager's)")
+      ->check(CLI::Range(0.0, 3600.0));
+  loadtest
       ->add_option("--station-capacity", lt.stationCapacity,
                    "active tasks per station (0 = no limit), or queue: as many as the station's line on the "
                    "roadmap holds (its dock and queue nodes)")

@@ -108,9 +108,9 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     const auto& c = node.counters();
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
-        "re-plans, {} risk updates, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
+        "re-plans, {} risk updates, {} yields, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
-        c.riskUpdates, c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
+        c.riskUpdates, c.yields, c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
     // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
     // is slow (a minute of its clock, sim or wall).
     for (const auto& line : node.stalled(now, 60.0))

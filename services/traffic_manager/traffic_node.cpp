@@ -15,10 +15,11 @@ using traffic::NodeId;
 
 Settings readSettings(Config& cfg) {
   Settings s;
-  cfg.rejectUnknownKeys({"site", "rate_hz", "settle_s", "robot_timeout_s", "place_tolerance", "clock",
-                         "lockstep", "max_lag", "base_ahead", "max_base_nodes", "horizon_nodes", "seed",
-                         "detour_after", "detour_penalty", "station_lines", "let_pass", "roadmap",
-                         "risk_cost_s", "risk_period_s"});
+  cfg.rejectUnknownKeys({"site",          "rate_hz",     "settle_s",     "robot_timeout_s", "place_tolerance",
+                         "clock",         "lockstep",    "max_lag",      "base_ahead",      "max_base_nodes",
+                         "horizon_nodes", "seed",        "detour_after", "detour_penalty",  "station_lines",
+                         "let_pass",      "roadmap",     "risk_cost_s",  "risk_period_s",   "yield_after_s",
+                         "yield_for_s",   "yield_cost_s"});
   s.site = cfg.string("site", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
@@ -43,6 +44,9 @@ Settings readSettings(Config& cfg) {
       static_cast<float>(cfg.number("detour_penalty", s.traffic.pibt.detourPenalty, {0.0, 1e6}));
   s.riskCostS = cfg.number("risk_cost_s", s.riskCostS, {0.0, 3600.0});
   s.riskPeriodS = cfg.number("risk_period_s", s.riskPeriodS, {0.0, 3600.0});
+  s.yieldAfterS = cfg.number("yield_after_s", s.yieldAfterS, {0.0, 3600.0});
+  s.yieldForS = cfg.number("yield_for_s", s.yieldForS, {0.0, 3600.0});
+  s.yieldCostS = cfg.number("yield_cost_s", s.yieldCostS, {0.0, 3600.0});
   s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
   return s;
 }
@@ -66,9 +70,58 @@ bool TrafficNode::onRiskMap(const risk::RiskLookup& risk, std::int64_t nowNs) {
   for (std::size_t v = 0; v < riskCost_.size(); ++v)
     riskCost_[v] =
         static_cast<float>(settings_.riskCostS * risk.at(roadmap_.graph.position(static_cast<NodeId>(v))));
-  control_->setNodeCost(riskCost_);
+  applyNodeCost();
   ++counters_.riskUpdates;
   return true;
+}
+
+void TrafficNode::applyNodeCost() {
+  std::vector<float> cost = riskCost_;
+  for (const auto& [id, r] : robots_) {
+    if (r.yieldNodes.empty())
+      continue;
+    cost.resize(roadmap_.graph.size(), 0.0F);
+    for (const auto v : r.yieldNodes)
+      cost[static_cast<std::size_t>(v)] += static_cast<float>(settings_.yieldCostS);
+  }
+  control_->setNodeCost(std::move(cost));
+}
+
+bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs) {
+  if (!r.last.blocked) {
+    r.blockedSinceNs = -1;
+    r.blockedAhead.clear();
+  } else if (r.blockedSinceNs < 0) {
+    // What holds it stands on the nodes just ahead on its way: taken now, before holding it
+    // retracts its release to where it stands.
+    r.blockedSinceNs = nowNs;
+    r.blockedAhead.clear();
+    const Vec2 at{r.last.pose.x, r.last.pose.y};
+    const NodeId here = control_->at(static_cast<std::size_t>(r.index));
+    for (std::size_t i = 1; i < r.sent.base.size() && r.blockedAhead.size() < 3; ++i) {
+      const auto& n = r.sent.base[i];
+      if (n.node != here && (Vec2{n.x, n.y} - at).norm() <= 1.5)
+        r.blockedAhead.push_back(n.node);
+    }
+  }
+  bool changed = false;
+  if (r.yieldUntilNs >= 0 && nowNs >= r.yieldUntilNs) {
+    r.yieldUntilNs = -1;
+    r.blockedSinceNs = r.last.blocked ? nowNs : -1;  // still blocked: yield again after a while
+    changed = !r.yieldNodes.empty();
+    r.yieldNodes.clear();
+  }
+  if (settings_.yieldAfterS > 0.0 && r.yieldUntilNs < 0 && r.blockedSinceNs >= 0 &&
+      static_cast<double>(nowNs - r.blockedSinceNs) * 1e-9 >= settings_.yieldAfterS) {
+    // Those nodes cost more for a while, so the plan takes it back or round when that is shorter
+    // (and others keep off them meanwhile).
+    r.yieldNodes = r.blockedAhead;
+    control_->retractStanding(static_cast<std::size_t>(r.index));
+    r.yieldUntilNs = nowNs + secToNs(settings_.yieldForS);
+    ++counters_.yields;
+    changed = changed || !r.yieldNodes.empty();
+  }
+  return changed;
 }
 
 TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) {
@@ -263,7 +316,10 @@ std::optional<std::string> TrafficNode::onProgress(const msg::TrafficProgress& p
 void TrafficNode::apply(Robot& r, std::int64_t nowNs) {
   const auto idx = static_cast<std::size_t>(r.index);
   const bool timedOut = static_cast<double>(nowNs - r.heardNs) * 1e-9 > settings_.robotTimeoutS;
-  const bool held = r.last.holding || r.last.blocked || !r.last.follows || timedOut;
+  if (updateYield(r, nowNs))
+    applyNodeCost();
+  const bool yielding = r.yieldUntilNs >= 0;
+  const bool held = r.last.holding || (r.last.blocked && !yielding) || !r.last.follows || timedOut;
   control_->setHeld(idx, held);
   std::string why;
   const NodeId goal = goalNode(r.last, why);

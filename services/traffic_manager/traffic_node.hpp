@@ -48,6 +48,13 @@ struct Settings {
   /// At most one risk update per this many seconds: each one recomputes the planner's distance
   /// tables (one search per robot's goal).
   double riskPeriodS = 2.0;
+  /// A robot that reports itself blocked (a person in front of it) this long is made to yield: the
+  /// nodes just ahead of it on its release cost `yieldCostS` more for `yieldForS`, and it is planned
+  /// again instead of held, so it backs off or goes round when another way is shorter. 0: never
+  /// (the robot waits for the person to leave, and a person whose way lies past it waits too).
+  double yieldAfterS = 0.0;
+  double yieldForS = 20.0;
+  double yieldCostS = 60.0;
   traffic::RoadmapOptions roadmap;
   traffic::TrafficOptions traffic;
 };
@@ -104,6 +111,7 @@ class TrafficNode {
     std::uint64_t plannedSteps = 0;
     std::uint64_t replans = 0;
     std::uint64_t riskUpdates = 0;
+    std::uint64_t yields = 0;  ///< robots made to yield to a person (yieldAfterS)
     double lastTickMs = 0.0;
     double maxTickMs = 0.0;
   };
@@ -127,7 +135,15 @@ class TrafficNode {
     msg::TrafficRelease sent;
     traffic::NodeId lastNode = traffic::kNoNode;
     std::int64_t movedNs = 0;  ///< when it last reported a node other than lastNode
+    std::int64_t blockedSinceNs = -1;
+    std::int64_t yieldUntilNs = -1;             ///< yielding: its blocked report does not hold it until then
+    std::vector<traffic::NodeId> yieldNodes;    ///< the nodes ahead that cost more meanwhile
+    std::vector<traffic::NodeId> blockedAhead;  ///< its way ahead when it said it was blocked
   };
+  /// Starts or ends the robot's yielding (yieldAfterS); true when the node costs changed.
+  bool updateYield(Robot& r, std::int64_t nowNs);
+  /// The risk costs plus the yielding robots' costs, to the planner.
+  void applyNodeCost();
   [[nodiscard]] traffic::NodeId goalNode(const msg::TrafficProgress& p, std::string& why) const;
   [[nodiscard]] traffic::NodeId placeNode(const msg::TrafficProgress& p) const;
   void place(std::int64_t nowNs);

@@ -515,9 +515,9 @@ bool Execution::acyclic() const {
   return true;
 }
 
-void Execution::retract(std::size_t robot) {
+void Execution::retract(std::size_t robot, bool standing) {
   auto& route = routes_.at(robot);
-  route.released = std::min(route.released, route.progress + 1);
+  route.released = std::min(route.released, route.progress + (standing ? 0 : 1));
 }
 
 std::vector<NodeId> Execution::truncateToReleased() {

@@ -227,6 +227,13 @@ void TrafficControl::setHeld(std::size_t robot, bool held) {
   planner_->setControlled(robot, !held);
 }
 
+void TrafficControl::retractStanding(std::size_t robot) {
+  if (robot >= robots())
+    return;
+  execution_.retract(robot, true);
+  replan();
+}
+
 Report TrafficControl::reached(std::size_t robot, NodeId node) {
   const Report r = execution_.reached(robot, node);
   if (r == Report::NotReleased || r == Report::UnknownRobot)

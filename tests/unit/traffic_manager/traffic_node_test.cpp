@@ -124,6 +124,21 @@ TEST(TrafficNode, RiskSettingsAreReadAndChecked) {
   EXPECT_NE(bad.problems()[0].find("risk_cost_s"), std::string::npos) << bad.problems()[0];
 }
 
+TEST(TrafficNode, YieldSettingsAreReadAndChecked) {
+  EXPECT_DOUBLE_EQ(Settings{}.yieldAfterS, 0.0) << "off by default";
+  auto cfg =
+      Config::fromText(R"({"yield_after_s": 10, "yield_for_s": 15, "yield_cost_s": 30})", "traffic.json");
+  const auto s = readSettings(cfg);
+  cfg.finish();
+  EXPECT_DOUBLE_EQ(s.yieldAfterS, 10.0);
+  EXPECT_DOUBLE_EQ(s.yieldForS, 15.0);
+  EXPECT_DOUBLE_EQ(s.yieldCostS, 30.0);
+  auto bad = Config::fromText(R"({"yield_after_s": -2})", "traffic.json");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.problems()[0].find("yield_after_s"), std::string::npos) << bad.problems()[0];
+}
+
 /// A 10 m × 5 m room split by a wall at x 7.0..7.5 m, with a 2 m door in it or none; A and C on
 /// the left of the wall, B on the right.
 site::Site wallSite(bool door) {
@@ -287,6 +302,54 @@ TEST(TrafficNode, ClosuresAreCheckedWholeReplacedByIdAndReopenedOnce) {
   EXPECT_FALSE(node.onClosure(reopen).changed);
   EXPECT_TRUE(g.isOpen(b));
   EXPECT_EQ(node.revision(), 4U);
+}
+
+/// r1 drives from PARK-1 towards P-1 following its releases until it is out on the lanes with a
+/// way ahead, then reports itself blocked where it stands for 10 s (a person in front of it).
+/// Returns whether it was released another way meanwhile (a base[1] other than the one towards
+/// the person) and how many yields the node counted.
+std::pair<bool, std::uint64_t> blockedFor10s(double yieldAfterS) {
+  auto s = settings();
+  s.yieldAfterS = yieldAfterS;
+  TrafficNode node(smallWarehouse(), s, 3);
+  node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
+  msg::TrafficRelease last;
+  std::int64_t now = 2 * kS;
+  for (int i = 0; i < 200 && !(last.base.size() >= 3 && i >= 10); ++i, now += kS / 10) {
+    for (const auto& r : node.tick(now))
+      last = r;
+    if (last.base.size() > 1 && !(last.base.size() >= 3 && i >= 9))
+      node.onProgress(at("r1", {last.base[1].x, last.base[1].y, 0}, "P-1", last.base[1].node, 3), now);
+  }
+  EXPECT_GE(last.base.size(), 3U);
+  if (last.base.size() < 3)
+    return {false, 0};
+  const auto here = last.base[0];
+  const auto ahead = last.base[1].node;
+  auto blocked = at("r1", {here.x, here.y, 0}, "P-1", here.node, 3);
+  blocked.blocked = true;
+  bool otherWay = false;
+  for (int i = 0; i < 100; ++i, now += kS / 10) {
+    node.onProgress(blocked, now);
+    for (const auto& r : node.tick(now)) {
+      if (r.base.size() > 1 && r.base[1].node != ahead)
+        otherWay = true;
+    }
+  }
+  return {otherWay, node.counters().yields};
+}
+
+// A robot held by a person it cannot get by (it reports itself blocked) is made to yield after
+// yield_after_s: the nodes just ahead cost more for a while and it is planned instead of held, so
+// it is released another way (back, or round by another aisle) rather than waiting for ever.
+// Without yielding (0, the default) it is held where it is.
+TEST(TrafficNode, ARobotBlockedByAPersonForLongIsReleasedAnotherWay) {
+  const auto [otherWay, yields] = blockedFor10s(3.0);
+  EXPECT_EQ(yields, 1U);
+  EXPECT_TRUE(otherWay) << "still released only towards the person";
+  const auto [otherWayOff, yieldsOff] = blockedFor10s(0.0);
+  EXPECT_EQ(yieldsOff, 0U);
+  EXPECT_FALSE(otherWayOff) << "held: no new way";
 }
 
 TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {

@@ -122,9 +122,11 @@ class Execution {
 
   /// A robot that stops following its route (faulted, held by a person, taken over): cuts what was
   /// released to it back to the node it may be driving into (its next one after the last reported),
-  /// so the others' routes can be planned around where it really is. Call truncateToReleased()
-  /// after it. Robots must then be sent the shorter release.
-  void retract(std::size_t robot);
+  /// so the others' routes can be planned around where it really is. `standing`: the robot is known
+  /// to stand at its last reported node (held there by a person for a while), so that next node
+  /// goes too and it can be planned another way. Call truncateToReleased() after it. Robots must
+  /// then be sent the shorter release.
+  void retract(std::size_t robot, bool standing = false);
 
  private:
   struct Dependency {

@@ -101,6 +101,11 @@ class TrafficControl {
 
   /// A held robot stands where it is and is planned around (docking, faulted, paused, manual).
   void setHeld(std::size_t robot, bool held);
+  /// The robot stands at its last reported node and will not drive on (held there by a person for
+  /// long): what was released beyond that node is taken back and it is planned from there, so it
+  /// can be sent another way (the traffic manager's yielding). Its agent must get the shorter
+  /// release before the person lets it go on.
+  void retractStanding(std::size_t robot);
   [[nodiscard]] bool held(std::size_t robot) const { return held_.at(robot) != 0; }
 
   /// The robot reports it has arrived at `node`; refused reports leave it held where it was.
