@@ -276,6 +276,8 @@ def traffic_over_time(run):
                         x, y = n[2 * v], n[2 * v + 1]
                         queue_cells.setdefault((int(x // 0.5), int(y // 0.5)), []).append((x, y))
                 revisions.append((d.get("t", 0.0), rm.get("revision", 0), len(rm.get("closed", []))))
+            if d.get("releases_reset"):
+                releases = {}  # a new traffic manager: the earlier releases no longer hold
             for rid, rel in (d.get("releases") or {}).items():
                 releases[rid] = rel
             t = d.get("t", 0.0)

@@ -144,8 +144,8 @@ Expected<Fault> parseOne(const std::string& spec) {
       f.area.push_back(negative ? -x : x);
       pos = comma + 1;
     }
-    if (f.area.size() < 6 || f.area.size() % 2 != 0) {
-      return unexpected("invalid", "close: the area needs X,Y pairs of at least 3 corners");
+    if (f.area.size() < 6 || f.area.size() % 2 != 0 || f.area.size() > 512) {
+      return unexpected("invalid", "close: the area needs X,Y pairs of 3 to 256 corners");
     }
     return f;
   }

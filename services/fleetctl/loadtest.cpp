@@ -361,7 +361,8 @@ struct Run {
         const std::string path = "/v1/traffic/closures/fault-" + std::to_string(i);
         if (!faultStarted[i] && simS >= f.atS) {
           faultStarted[i] = true;
-          json body = {{"area", json::array()}, {"reason", "load test fault " + describe(f)}};
+          json body = {{"area", json::array()},
+                       {"reason", ("load test fault " + describe(f)).substr(0, 255)}};
           for (std::size_t k = 0; k + 1 < f.area.size(); k += 2) {
             body["area"].push_back({f.area[k], f.area[k + 1]});
           }

@@ -87,8 +87,17 @@ void TrafficNode::applyNodeCost() {
   control_->setNodeCost(std::move(cost));
 }
 
-bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs) {
-  if (!r.last.blocked) {
+bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs, bool timedOut) {
+  // Only a robot that follows its releases, is heard from, not docking or paused, and stands on
+  // the node it last reported may yield: taking back its release gives away the node it might
+  // otherwise be driving into.
+  const NodeId reported = control_->at(static_cast<std::size_t>(r.index));
+  constexpr double kOnNodeM = 0.2;  // well short of the next node (lattice spacing 0.5 m)
+  const bool onNode =
+      roadmap_.graph.valid(reported) &&
+      (roadmap_.graph.position(reported) - Vec2{r.last.pose.x, r.last.pose.y}).norm() <= kOnNodeM;
+  const bool mayYield = r.last.follows && !r.last.holding && !timedOut && onNode;
+  if (!r.last.blocked || !mayYield) {
     r.blockedSinceNs = -1;
     r.blockedAhead.clear();
   } else if (r.blockedSinceNs < 0) {
@@ -151,6 +160,15 @@ TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) 
     out.error = "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";
     return out;
   }
+  // The same closure again (a reader that joins late, a repeated sample) changes nothing.
+  if (auto same = closureSamples_.find(c.closure_id);
+      c.active && same != closureSamples_.end() && same->second.area == c.area &&
+      same->second.nodes == c.nodes && same->second.lanes == c.lanes) {
+    return out;
+  }
+  closureSamples_.erase(c.closure_id);
+  if (c.active)
+    closureSamples_[c.closure_id] = c;
   if (auto it = closures_.find(c.closure_id); it != closures_.end()) {
     for (const auto& part : it->second)
       roadmap_.reopen(part);
@@ -316,7 +334,7 @@ std::optional<std::string> TrafficNode::onProgress(const msg::TrafficProgress& p
 void TrafficNode::apply(Robot& r, std::int64_t nowNs) {
   const auto idx = static_cast<std::size_t>(r.index);
   const bool timedOut = static_cast<double>(nowNs - r.heardNs) * 1e-9 > settings_.robotTimeoutS;
-  if (updateYield(r, nowNs))
+  if (updateYield(r, nowNs, timedOut))
     applyNodeCost();
   const bool yielding = r.yieldUntilNs >= 0;
   const bool held = r.last.holding || (r.last.blocked && !yielding) || !r.last.follows || timedOut;

@@ -141,7 +141,7 @@ class TrafficNode {
     std::vector<traffic::NodeId> blockedAhead;  ///< its way ahead when it said it was blocked
   };
   /// Starts or ends the robot's yielding (yieldAfterS); true when the node costs changed.
-  bool updateYield(Robot& r, std::int64_t nowNs);
+  bool updateYield(Robot& r, std::int64_t nowNs, bool timedOut);
   /// The risk costs plus the yielding robots' costs, to the planner.
   void applyNodeCost();
   [[nodiscard]] traffic::NodeId goalNode(const msg::TrafficProgress& p, std::string& why) const;
@@ -162,6 +162,7 @@ class TrafficNode {
   /// (dropped when closures change what is open).
   mutable traffic::DistanceTable reach_;
   std::map<std::string, std::vector<traffic::Closure>> closures_;
+  std::map<std::string, msg::TrafficClosure> closureSamples_;  ///< what each closure in force said
   std::uint32_t revision_ = 0;
   std::int64_t riskNs_ = -1;
   std::vector<float> riskCost_;

@@ -65,12 +65,13 @@ std::optional<std::string> DdsGateway::sendClosure(const msg::TrafficClosure& c)
     return std::string("this adapter may not write TrafficClosure (DDS permissions)");
   }
   try {
+    // Under the lock, so a PUT and a DELETE of one id at once leave the view as the topic has it.
     std::lock_guard lock(writeMutex_);
     closuresOut_->write(c);
+    view_.onClosure(c);  // at once, not only when the sample comes back
   } catch (const std::exception& e) {
     return std::string("TrafficClosure not sent: ") + e.what();
   }
-  view_.onClosure(c);  // at once, not only when the sample comes back
   return std::nullopt;
 }
 

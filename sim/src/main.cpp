@@ -590,6 +590,9 @@ class Simulator {
     auto maps = roadmapR_->take();
     if (!maps.empty() && !validation::check(maps.back())) {
       line["roadmap"] = sim::replayRoadmap(maps.back());
+      if (maps.back().epoch != roadmapEpoch_) {
+        line["releases_reset"] = true;  // a new traffic manager: earlier releases no longer hold
+      }
       roadmapEpoch_ = maps.back().epoch;
     }
     nlohmann::json rel = nlohmann::json::object();

@@ -111,7 +111,8 @@ void Vda5050Fleet::step(World& world, double now_s, std::int64_t stamp_ns) {
     bool warned = false;
     for (const auto& h : world.humans()) {
       person = person || m.vehicle->inProtectiveField(pose, h.p.x, h.p.y, h.r);
-      warned = warned || m.vehicle->inWarningField(pose, h.p.x, h.p.y, h.r);
+      warned = warned || (m.vehicle->config().personApproachSpeed > 0.0 &&
+                          m.vehicle->inWarningField(pose, h.p.x, h.p.y, h.r));
     }
     // A safety scanner sees machines too: a vehicle driving into another robot stops as it would
     // for a person (a mixed run had two vehicles overlap by 0.34 m when their orders fell out of

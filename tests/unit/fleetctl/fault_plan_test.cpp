@@ -79,7 +79,7 @@ TEST(FaultPlan, CloseTakesAnAreaAndSimulatedSecondsAndParsesBack) {
   const std::pair<const char*, const char*> bad[] = {
       {"close@40+60", "the area's corners"},
       {"close@40:1,1,2,2,3,3", "expected '+D'"},
-      {"close@40+60:1,1,2,2", "at least 3 corners"},
+      {"close@40+60:1,1,2,2", "3 to 256 corners"},
       {"close@40+60:1,1,2,x,3,3", "got \"x\""},
   };
   for (const auto& [spec, expect] : bad) {

@@ -90,13 +90,14 @@ class Vda5050Vehicle {
 
   /// Whether a point (a person) is inside the protective field of a vehicle at `pose`: a
   /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin each side, as long as
-  /// `protectiveField` plus the braking distance at the last commanded speed.
+  /// `protectiveField` plus the braking distance at its speed (the larger of the last commanded
+  /// and the measured one).
   [[nodiscard]] bool inProtectiveField(const Pose2& pose, double px, double py, double radius) const;
   /// Whether a person is inside the warning field: as the protective field, longer by
-  /// personApproachSpeed × the time to brake from the last commanded speed.
+  /// personApproachSpeed × the time to brake from its speed.
   [[nodiscard]] bool inWarningField(const Pose2& pose, double px, double py, double radius) const;
   /// Whether another vehicle's body (a disc) is inside the short field a scanner keeps for
-  /// machines: ahead of the front by the braking distance at the last commanded speed plus
+  /// machines: ahead of the front by the braking distance at its speed (as above) plus
   /// kMachineFieldM, the vehicle's width plus kMachineSideM each side. Shorter than the people's
   /// field so vehicles can follow one another at the roadmap's following distance.
   [[nodiscard]] bool machineInField(const Pose2& pose, double px, double py, double radius) const;
