@@ -105,11 +105,9 @@ bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs, bool timedOut) {
     // retracts its release to where it stands.
     r.blockedSinceNs = nowNs;
     r.blockedAhead.clear();
-    const Vec2 at{r.last.pose.x, r.last.pose.y};
-    const NodeId here = control_->at(static_cast<std::size_t>(r.index));
     for (std::size_t i = 1; i < r.sent.base.size() && r.blockedAhead.size() < 3; ++i) {
       const auto& n = r.sent.base[i];
-      if (n.node != here && (Vec2{n.x, n.y} - at).norm() <= 1.5)
+      if (n.node != reported && (Vec2{n.x, n.y} - Vec2{r.last.pose.x, r.last.pose.y}).norm() <= 1.5)
         r.blockedAhead.push_back(n.node);
     }
   }
@@ -160,17 +158,12 @@ TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) 
     out.error = "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";
     return out;
   }
-  // The same closure again (a reader that joins late, a repeated sample) changes nothing.
-  if (auto same = closureSamples_.find(c.closure_id);
-      c.active && same != closureSamples_.end() && same->second.area == c.area &&
-      same->second.nodes == c.nodes && same->second.lanes == c.lanes) {
-    return out;
-  }
-  closureSamples_.erase(c.closure_id);
-  if (c.active)
-    closureSamples_[c.closure_id] = c;
   if (auto it = closures_.find(c.closure_id); it != closures_.end()) {
-    for (const auto& part : it->second)
+    // The same closure again (a reader that joins late, a repeated sample) changes nothing.
+    const auto& said = it->second.said;
+    if (c.active && said.area == c.area && said.nodes == c.nodes && said.lanes == c.lanes)
+      return out;
+    for (const auto& part : it->second.parts)
       roadmap_.reopen(part);
     closures_.erase(it);
     out.changed = true;
@@ -190,7 +183,7 @@ TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) 
     }
     std::sort(out.cutOff.begin(), out.cutOff.end());
     out.cutOff.erase(std::unique(out.cutOff.begin(), out.cutOff.end()), out.cutOff.end());
-    closures_[c.closure_id] = std::move(parts);
+    closures_[c.closure_id] = InForce{c, std::move(parts)};
     out.changed = true;
   }
   if (out.changed) {
@@ -203,7 +196,7 @@ TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) 
 
 std::vector<std::string> TrafficNode::closures() const {
   std::vector<std::string> ids;
-  for (const auto& [id, parts] : closures_)
+  for (const auto& [id, inForce] : closures_)
     ids.push_back(id);
   return ids;
 }

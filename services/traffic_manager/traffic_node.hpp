@@ -161,8 +161,12 @@ class TrafficNode {
   /// Free-flow distances to goals, to refuse a goal the roadmap does not connect to the robot
   /// (dropped when closures change what is open).
   mutable traffic::DistanceTable reach_;
-  std::map<std::string, std::vector<traffic::Closure>> closures_;
-  std::map<std::string, msg::TrafficClosure> closureSamples_;  ///< what each closure in force said
+  /// A closure in force: what it said, and what it closed (one part per area, nodes, lanes).
+  struct InForce {
+    msg::TrafficClosure said;
+    std::vector<traffic::Closure> parts;
+  };
+  std::map<std::string, InForce> closures_;
   std::uint32_t revision_ = 0;
   std::int64_t riskNs_ = -1;
   std::vector<float> riskCost_;

@@ -4,6 +4,7 @@
 #include <variant>
 
 #include "fleet/core/ids.hpp"
+#include "fleet/validation/sample_checks.hpp"
 
 namespace fleet::wms {
 
@@ -13,7 +14,6 @@ namespace {
 
 constexpr std::size_t kMaxArea = 256;  // the TrafficClosure sequence bounds (fleet.idl)
 constexpr std::size_t kMaxNodes = 4096;
-constexpr double kMaxCoordinate = 1e5;  // m; a site is far smaller
 constexpr std::size_t kMaxReason = 255;
 
 /// A non-negative node id below `nodes` (when known); the problem otherwise.
@@ -65,10 +65,10 @@ std::variant<msg::TrafficClosure, std::vector<FieldError>> parseClosure(
         const auto& p = a[i];
         const bool ok = p.is_array() && p.size() == 2 && p[0].is_number() && p[1].is_number() &&
                         std::isfinite(p[0].get<double>()) && std::isfinite(p[1].get<double>()) &&
-                        std::abs(p[0].get<double>()) <= kMaxCoordinate &&
-                        std::abs(p[1].get<double>()) <= kMaxCoordinate;
+                        std::abs(p[0].get<double>()) <= validation::kMaxCoordinate &&
+                        std::abs(p[1].get<double>()) <= validation::kMaxCoordinate;
         if (!ok) {
-          bad("area[" + std::to_string(i) + "]", "must be [x, y] in metres (finite, |v| <= 1e5)");
+          bad("area[" + std::to_string(i) + "]", "must be [x, y] in metres (finite, |v| <= 1e6)");
         } else {
           c.area.push_back({p[0].get<double>(), p[1].get<double>()});
         }
