@@ -89,6 +89,12 @@ constexpr double kAligned = 0.05;
 /// the one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
 constexpr double kRejoinOff = 0.15;
 constexpr double kRejoinAfterS = 10.0;
+/// Held that long by a person between its node and the next (which it holds both of), the robot
+/// backs onto its node and stands there reporting itself blocked for kGiveWayS or until a new
+/// release. The person gets room, and the traffic manager may re-plan it (yield_after_s), which it
+/// does only for a robot on its node: the node ahead can then go to others. (Two robots stood
+/// 0.3 m past their nodes, a person between them, for 2,000 s: 20 robots under load, session 27.)
+constexpr double kGiveWayS = 15.0;
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
 
@@ -213,6 +219,7 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
   if (!standWhy_.empty()) {
     standing_.why = standWhy_;  // the latest (a hold can change hands while the robot stands)
     standing_.byObstacle = standByObstacle_;
+    standing_.byPerson = standByPerson_;
   } else if (standing_.why.empty()) {
     standing_.why = std::abs(v) > 1e-9 || std::abs(w) > 1e-9 ? kWhyOwnZero : kWhyStand;
   }
@@ -222,6 +229,8 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
 void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode) {
   standWhy_.clear();
   standByObstacle_ = false;
+  const bool personInTheWay = standByPerson_;  // (as of the last cycle: gone once the person is)
+  standByPerson_ = false;
   const Pose2 pose = localizer_.pose();
   const Vec2 here = pose.position();
   if (releases_.advance(here)) {
@@ -229,7 +238,12 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   }
   const auto goal = trafficGoal();
   const bool toGoal = baseEndsAtGoal();
-  dockingLeg_ = toGoal && releases_.onLastLeg();
+  // Counted on its goal's node (passed beside it, up to ReleaseParams::passLateral off) but not on
+  // the goal's pose: the traffic manager takes it as arrived and releases nothing more, so it docks
+  // from here, within the node it holds. (Standing there, one robot waited 300 s with a station's
+  // line behind it: dense check, seed 2, session 26.)
+  const bool shortOfGoal = toGoal && !releases_.nodesAhead();
+  dockingLeg_ = toGoal && (releases_.onLastLeg() || shortOfGoal);
   docking_ = false;
   baseAhead_ = false;
   v = 0.0;
@@ -261,23 +275,43 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   const auto own = releases_.at();
   const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
                       standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-                      standing_.byObstacle;
+                      (standing_.byObstacle || (standing_.byPerson && personInTheWay));
+  if (givingWayUntilNs_ >= 0 && (nowNs >= givingWayUntilNs_ || givingWayRevision_ != releases_.revision())) {
+    givingWayUntilNs_ = -1;
+  }
+  if (givingWayUntilNs_ >= 0) {
+    standStill("giving way to a person");
+    blocked_ = true;  // (standStill clears it) the traffic manager may plan it another way
+    return;
+  }
   const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
                           rejoin || rejoined_;
-  if (!releases_.nodesAhead() && newRelease) {
+  if (!releases_.nodesAhead() && newRelease && !shortOfGoal) {
     standStill("nothing released beyond its node");
     return;
   }
   if (newRelease) {
-    auto way = releases_.aheadToTurnBack(here);
+    auto way = shortOfGoal ? ReleaseTracker::Way{{here, goal->pose.position()}, std::nullopt}
+                           : releases_.aheadToTurnBack(here);
     std::vector<Vec2> pts = std::move(way.points);
     turnsBackAt_ = way.turnsBackAt;
     rejoining_ = rejoin;
     if (rejoined_) {
       aligning_ = true;  // back on its node: face the next one on the spot, then drive the edge
     }
+    if (rejoined_ && rejoinForPerson_) {
+      rejoinForPerson_ = false;
+      rejoined_ = false;
+      givingWayUntilNs_ = nowNs + secToNs(kGiveWayS);
+      givingWayRevision_ = releases_.revision();
+      followedRevision_ = 0;  // the base from here afterwards
+      standStill("giving way to a person");
+      blocked_ = true;
+      return;
+    }
     rejoined_ = false;
     if (rejoining_) {
+      rejoinForPerson_ = !standing_.byObstacle;
       pts = {here, *own};
       turnsBackAt_.reset();
       ++conduct_.rejoins;
@@ -315,6 +349,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
       rejoined_ = true;  // back on its node: the base from here next cycle
     }
     standStill("at the end of its base");
+    blocked_ = rejoined_ && rejoinForPerson_;
     return;
   }
   baseAhead_ = true;
@@ -424,6 +459,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   if (held) {
     mode = msg::RobotMode::Waiting;
     standByObstacle_ = !blocker.robot && blocker.id.empty();
+    standByPerson_ = !blocker.robot && blocker.id == "human";
     standWhy_ = blocker.robot        ? "held by robot " + blocker.id + (byKnownRobot ? "" : " (unknown)")
                 : blocker.id.empty() ? std::string("held by an obstacle")
                                      : "held by " + blocker.id;
@@ -438,7 +474,10 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     heldSinceNs_ = nowNs;
     heldAt_ = here;
   }
-  blocked_ = heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS;
+  // (Backing onto its node for a person is still being blocked: a flag that dropped while it
+  // moved would have the traffic manager plan it as free for those seconds.)
+  blocked_ = (heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS) ||
+             (rejoining_ && rejoinForPerson_);
   // Waiting on a dependency or a person runs no failure timer: the traffic manager re-plans.
   drove_ = {planning ? Driver::kPlanner : Driver::kFollower, held,
             held && (byKnownRobot || (!blocker.robot && blocker.id == "human"))};

@@ -197,11 +197,20 @@ double ReleaseTracker::turnAt(std::size_t k) const {
 
 std::size_t ReleaseTracker::firstTurnBack() const {
   for (std::size_t k = reached_ + 1; k + 1 < base_.size(); ++k) {
-    if (turnAt(k) > p_.turnBack) {
+    if (turnAt(k) > p_.turnBack || comesBackTo(k + 1)) {
       return k;
     }
   }
   return base_.empty() ? 0 : base_.size() - 1;
+}
+
+bool ReleaseTracker::comesBackTo(std::size_t j) const {
+  for (std::size_t i = reached_; i < j; ++i) {
+    if (arc_[j] - arc_[i] > 2.0 * p_.comesBack && distance(base_[i].at, base_[j].at) < p_.comesBack) {
+      return true;
+    }
+  }
+  return false;
 }
 
 ReleaseTracker::Way ReleaseTracker::aheadToTurnBack(Vec2 here) const {

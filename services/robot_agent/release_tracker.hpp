@@ -48,6 +48,12 @@ struct ReleaseParams {
   /// past it the base runs back beside itself, and the nearest point of a robot on the way out can
   /// lie on the way back.
   double turnBack = 2.0;
+  /// ... and so does a node after which the base comes back within this distance [m] of a node it
+  /// passed more than twice as far back along the base (a loop round a shelf's end, a U-turn over
+  /// two corners): the projection would take the robot for on the way back and skip the loop
+  /// (one robot stood 300 s 0.14 m from its base's last node, a loop's end, with six robots
+  /// waiting on it: 20-robot scenario under load, session 27).
+  double comesBack = 0.6;
 };
 
 enum class ReleaseVerdict {
@@ -130,6 +136,9 @@ class ReleaseTracker {
   [[nodiscard]] double turnAt(std::size_t k) const;
   /// The first node after the last one reached where the base turns back (the last node if none).
   [[nodiscard]] std::size_t firstTurnBack() const;
+  /// Base node j lies within ReleaseParams::comesBack of a node from the robot's on that is more
+  /// than twice that further back along the base.
+  [[nodiscard]] bool comesBackTo(std::size_t j) const;
   /// Cuts the base after the last node reached (an empty base: hold where it is).
   void hold();
 

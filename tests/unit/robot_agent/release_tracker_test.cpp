@@ -153,6 +153,44 @@ TEST(ReleaseTracker, TheWayStopsWhereTheBaseTurnsBack) {
   EXPECT_FALSE(r.aheadToTurnBack({0.0, 0.0}).turnsBackAt.has_value());
 }
 
+TEST(ReleaseTracker, TheWayStopsBeforeALoopComesBackToTheRobot) {
+  // The loop a robot was released round a block in the 20-robot scenario (session 27): from 649 by
+  // two gentle corners and back to 1137, 0.25 m from where it started. Its last leg passes 0.1 m
+  // from the robot, so a projection on the whole way takes it for nearly there; the way ends on
+  // 1138 instead, and from there on, the rest.
+  ReleaseTracker t;
+  const std::vector<BaseNode> loop{{649, {25.75, 13.75}},
+                                   {632, {25.25, 13.25}},
+                                   {616, {25.25, 12.75}},
+                                   {1138, {25.5, 12.75}},
+                                   {1137, {25.5, 13.75}}};
+  ASSERT_EQ(t.offer(release(1, 1, loop), {25.41, 13.64}), ReleaseVerdict::kAccepted);
+  EXPECT_FALSE(t.advance({25.41, 13.64}));
+  EXPECT_EQ(t.node(), 649);
+  auto way = t.aheadToTurnBack({25.41, 13.64});
+  ASSERT_TRUE(way.turnsBackAt.has_value());
+  EXPECT_EQ(*way.turnsBackAt, 1138);
+  EXPECT_NEAR(way.points.back().x, 25.5, 1e-9);
+  EXPECT_NEAR(way.points.back().y, 12.75, 1e-9);
+  EXPECT_GT(t.remaining(), 1.0) << "the projection does not jump to the loop's end";
+  EXPECT_TRUE(t.advance({25.26, 13.26}));
+  EXPECT_EQ(t.node(), 632);
+  EXPECT_TRUE(t.advance({25.26, 12.76}));
+  EXPECT_TRUE(t.advance({25.5, 12.76}));
+  EXPECT_EQ(t.node(), 1138);
+  way = t.aheadToTurnBack({25.5, 12.76});
+  EXPECT_FALSE(way.turnsBackAt.has_value());
+  EXPECT_NEAR(way.points.back().y, 13.75, 1e-9);
+  // Round one corner the way comes no closer to where it began than the arc allows: no cut.
+  ReleaseTracker r;
+  ASSERT_EQ(
+      r.offer(release(1, 1,
+                      {{0, {0.0, 0.0}}, {1, {0.5, 0.0}}, {2, {1.0, 0.0}}, {3, {1.0, 0.5}}, {4, {1.0, 1.0}}}),
+              {0.0, 0.0}),
+      ReleaseVerdict::kAccepted);
+  EXPECT_FALSE(r.aheadToTurnBack({0.0, 0.0}).turnsBackAt.has_value());
+}
+
 TEST(ReleaseTracker, RemainingAndTheWayAheadFollowTheRobot) {
   ReleaseTracker t;
   // Along x to node 2 at (1, 0), then up to node 3 at (1, 1).

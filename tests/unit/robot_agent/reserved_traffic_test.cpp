@@ -334,6 +334,50 @@ TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAf
   EXPECT_EQ(sim.lastNode(), 16);
 }
 
+TEST_P(ReservedPlanner, HeldByAPersonPastItsNodeItBacksOntoItAndGivesWay) {
+  // The person stands so that the robot stops 0.3 m past node 5 (x = 3.5), holding node 6 too: the
+  // traffic manager re-plans only a robot on its node. After 10 s it backs onto node 5 and stands
+  // there "giving way" (blocked all along, no flapping) for 15 s, then tries again.
+  Sim sim(GetParam());
+  sim.people = {{4.7, kY}};
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, lane(0, 16)));
+  std::optional<double> blockedAt;
+  std::optional<double> backAt;
+  bool unblocked = false;
+  double farthest = 0.0;
+  while (sim.now() < 45.0) {
+    const auto out = sim.step();
+    if (out.traffic && out.traffic->blocked && !blockedAt) {
+      blockedAt = sim.now();
+    }
+    // (Until it tries again, 15 s after it is back.)
+    const bool givingWay = !backAt || sim.now() < *backAt + 14.0;
+    unblocked = unblocked || (blockedAt && givingWay && out.traffic && !out.traffic->blocked);
+    if (blockedAt && !backAt) {
+      farthest = std::max(farthest, sim.truth.x);
+    }
+    if (blockedAt && !backAt && std::abs(sim.truth.x - lane(5).x) < 0.08 &&
+        sim.agent->standingStill().why == "giving way to a person") {
+      backAt = sim.now();
+    }
+  }
+  ASSERT_TRUE(blockedAt);
+  EXPECT_GT(farthest, lane(5).x + 0.2) << "stopped short of where the test wants it";
+  ASSERT_TRUE(backAt) << "never backed onto its node";
+  EXPECT_GT(*backAt - *blockedAt, 5.0);
+  EXPECT_LT(*backAt - *blockedAt, 20.0);
+  EXPECT_FALSE(unblocked) << "the blocked flag dropped while it backed off or gave way";
+  EXPECT_GE(sim.minToPeople, 0.25 + 0.3 + 0.1);
+  EXPECT_EQ(sim.lastNode(), 5);
+  EXPECT_FALSE(sim.failed());
+  // The person leaves: it goes on.
+  sim.people.clear();
+  sim.run(30.0);
+  EXPECT_FALSE(sim.reports.back().blocked);
+  EXPECT_EQ(sim.lastNode(), 16);
+}
+
 TEST_P(ReservedPlanner, FollowsABaseRoundCornersAndStaysOnIt) {
   // Behind the robot first (it turns on the spot), then along the lane, up and back along the lane
   // above: 0.5 m nodes, two right angles.
@@ -448,6 +492,27 @@ TEST_P(ReservedPlanner, DrivesABaseThatEndsOnTheNodeItStandsOn) {
     EXPECT_EQ(nodes, want) << "the nodes reported in order, ending on " << base.back().node;
     EXPECT_LT(distance(sim.truth.position(), {base.back().x, base.back().y}), 0.15);
   }
+}
+
+TEST_P(ReservedPlanner, DrivesALoopRoundABlockWhoseLastNodeIsBesideIt) {
+  // As one robot stood 300 s with six waiting on it (20 robots, session 27): released from its
+  // node A round a block by gentle corners to E, 0.14 m from where it stood. The path follower's
+  // projection took it for at E at once and it stood "at the end of its base"; it drives to D,
+  // where the way comes back, then on to E, and reports every node.
+  Sim sim(GetParam());
+  sim.restartAt({2.89, 4.99, 0.64});  // facing away, as it got the base
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(
+      release(1, {{649, 3.0, 5.0}, {632, 2.5, 4.5}, {616, 2.5, 4.0}, {1138, 2.75, 4.0}, {1137, 2.75, 5.0}}));
+  std::vector<std::int32_t> nodes;
+  while (sim.now() < 30.0) {
+    (void)sim.step();
+    if (sim.lastNode() >= 0 && (nodes.empty() || nodes.back() != sim.lastNode())) {
+      nodes.push_back(sim.lastNode());
+    }
+  }
+  EXPECT_EQ(nodes, (std::vector<std::int32_t>{649, 632, 616, 1138, 1137})) << "every node, in order";
+  EXPECT_LT(distance(sim.truth.position(), {2.75, 5.0}), 0.15);
 }
 
 TEST_P(ReservedPlanner, HeldOffItsNodeItDrivesALoopBackToWhereItStands) {
@@ -610,6 +675,28 @@ TEST(Reserved, DocksOnItsGoalAtTheEndOfTheBaseDwellsAndReportsHolding) {
   EXPECT_TRUE(last.has_goal);
   EXPECT_EQ(last.goal, sim.params.start);
   EXPECT_FALSE(sim.agent->busy());
+}
+
+TEST(Reserved, CountedOnItsGoalsNodeShortOfThePoseItDocksWithoutAnotherRelease) {
+  // It passed beside its dock node (100, P-1 at x = 6) 0.28 m off, so it reported that node; the
+  // traffic manager takes it as arrived and its release is the goal's node alone, from then on.
+  Sim sim;
+  sim.restartAt({5.78, 5.18, 0.63});
+  const msg::Goal p1{{6.0, kY, M_PI_2}, "P-1", msg::GoalAction::Load, 2.0};
+  sim.agent->onAssignment(order(p1));
+  sim.agent->onRelease(release(1, {{100, 6.0, kY}}, true));
+  std::optional<double> loadingAt;
+  while (sim.now() < 20.0 && !loadingAt) {
+    const auto out = sim.step();
+    if (out.status && out.status->state == msg::TaskState::Loading) {
+      loadingAt = sim.now();
+    }
+  }
+  ASSERT_TRUE(loadingAt) << "stood 0.28 m from its dock with nothing more to come";
+  EXPECT_LT(*loadingAt, 10.0);
+  EXPECT_LT(distance(sim.truth.position(), p1.pose.position()), 0.15);
+  EXPECT_EQ(sim.lastNode(), 100);
+  EXPECT_FALSE(sim.failed());
 }
 
 TEST(Reserved, WithoutAReleaseItStandsStillWithItsTaskFor120sAndNothingFails) {
