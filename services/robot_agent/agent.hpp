@@ -177,7 +177,6 @@ class Agent {
     std::int64_t sinceNs = -1;
     std::optional<Vec2> next;  ///< the next base node, if one is released
     bool byObstacle = false;   ///< last held by a static obstacle (what a rejoin is for)
-    bool byPerson = false;     ///< last held by a person (a rejoin gives way)
     bool homing = false;       ///< on its way home with no task
   };
   [[nodiscard]] const Standing& standingStill() const { return standing_; }
@@ -342,9 +341,10 @@ class Agent {
   std::string standWhy_;                 // this cycle's reason for a zero command (reserved traffic)
   bool standByObstacle_ = false;         // ... a static obstacle held it
   bool standByPerson_ = false;           // ... a person held it
-  bool rejoinForPerson_ = false;         // the rejoin under way gives way to a person
+  bool rejoinForPerson_ = false;         // the rejoin under way (or just done) gives way to a person
   std::int64_t givingWayUntilNs_ = -1;   // back on its node for a person: stands there until then
   std::uint64_t givingWayRevision_ = 0;  // ... or a new release comes
+  [[nodiscard]] bool givingWay() const { return rejoinForPerson_ || givingWayUntilNs_ >= 0; }
   std::optional<msg::TrafficProgress> lastProgress_;  // the last report sent
 };
 

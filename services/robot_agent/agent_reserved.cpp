@@ -219,7 +219,6 @@ void Agent::followRelease(std::int64_t nowNs, double dt, double& v, double& w, m
   if (!standWhy_.empty()) {
     standing_.why = standWhy_;  // the latest (a hold can change hands while the robot stands)
     standing_.byObstacle = standByObstacle_;
-    standing_.byPerson = standByPerson_;
   } else if (standing_.why.empty()) {
     standing_.why = std::abs(v) > 1e-9 || std::abs(w) > 1e-9 ? kWhyOwnZero : kWhyStand;
   }
@@ -257,7 +256,9 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     v = 0.0;
     w = 0.0;
     heldSinceNs_ = -1;
-    blocked_ = false;
+    // Backing onto its node for a person and standing there is still being blocked: a flag that
+    // dropped meanwhile would have the traffic manager plan it as free for those seconds.
+    blocked_ = givingWay();
   };
   if (toGoal && distance(here, goal->pose.position()) < kAtGoal) {
     standStill("on its goal");
@@ -271,22 +272,30 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
   // On the node where the way it follows turned back: the rest of the base from there.
   const bool pastTurnBack = turnsBackAt_ && releases_.node() == *turnsBackAt_;
   // Off its node and held by a static obstacle: back to the node first, then along the roadmap's
-  // edge, which clears the shelves.
+  // edge, which clears the shelves. Held by a person: back to the node, and give way (kGiveWayS).
   const auto own = releases_.at();
   const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
                       standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-                      (standing_.byObstacle || (standing_.byPerson && personInTheWay));
+                      (standing_.byObstacle || personInTheWay);
+  if (rejoined_ && rejoinForPerson_) {
+    // Back on its node: it stands there, and the base from there afterwards.
+    rejoinForPerson_ = false;
+    rejoined_ = false;
+    givingWayUntilNs_ = nowNs + secToNs(kGiveWayS);
+    givingWayRevision_ = releases_.revision();
+    followedRevision_ = 0;
+  }
   if (givingWayUntilNs_ >= 0 && (nowNs >= givingWayUntilNs_ || givingWayRevision_ != releases_.revision())) {
     givingWayUntilNs_ = -1;
   }
   if (givingWayUntilNs_ >= 0) {
     standStill("giving way to a person");
-    blocked_ = true;  // (standStill clears it) the traffic manager may plan it another way
     return;
   }
   const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
                           rejoin || rejoined_;
   if (!releases_.nodesAhead() && newRelease && !shortOfGoal) {
+    rejoinForPerson_ = false;  // (nothing to back along: not giving way)
     standStill("nothing released beyond its node");
     return;
   }
@@ -296,22 +305,12 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     std::vector<Vec2> pts = std::move(way.points);
     turnsBackAt_ = way.turnsBackAt;
     rejoining_ = rejoin;
+    rejoinForPerson_ = rejoin && personInTheWay;  // (a new release during a rejoin ends it)
     if (rejoined_) {
       aligning_ = true;  // back on its node: face the next one on the spot, then drive the edge
     }
-    if (rejoined_ && rejoinForPerson_) {
-      rejoinForPerson_ = false;
-      rejoined_ = false;
-      givingWayUntilNs_ = nowNs + secToNs(kGiveWayS);
-      givingWayRevision_ = releases_.revision();
-      followedRevision_ = 0;  // the base from here afterwards
-      standStill("giving way to a person");
-      blocked_ = true;
-      return;
-    }
     rejoined_ = false;
     if (rejoining_) {
-      rejoinForPerson_ = !standing_.byObstacle;
       pts = {here, *own};
       turnsBackAt_.reset();
       ++conduct_.rejoins;
@@ -349,7 +348,6 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
       rejoined_ = true;  // back on its node: the base from here next cycle
     }
     standStill("at the end of its base");
-    blocked_ = rejoined_ && rejoinForPerson_;
     return;
   }
   baseAhead_ = true;
@@ -474,10 +472,7 @@ void Agent::driveBase(std::int64_t nowNs, double dt, double& v, double& w, msg::
     heldSinceNs_ = nowNs;
     heldAt_ = here;
   }
-  // (Backing onto its node for a person is still being blocked: a flag that dropped while it
-  // moved would have the traffic manager plan it as free for those seconds.)
-  blocked_ = (heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS) ||
-             (rejoining_ && rejoinForPerson_);
+  blocked_ = (heldSinceNs_ >= 0 && nsToSec(nowNs - heldSinceNs_) > kBlockedAfterS) || givingWay();
   // Waiting on a dependency or a person runs no failure timer: the traffic manager re-plans.
   drove_ = {planning ? Driver::kPlanner : Driver::kFollower, held,
             held && (byKnownRobot || (!blocker.robot && blocker.id == "human"))};
