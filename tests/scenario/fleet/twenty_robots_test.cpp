@@ -136,7 +136,9 @@ TEST(FleetScenario, TwentyRobotsOneHundredTasksNoContactNoDeadlock) {
             << " s wall), failed " << a["failed"] << ", min separation robot-robot "
             << s["min_separation_m"]["robot_robot"] << " m, robot-human "
             << s["min_separation_m"]["robot_human"] << " m\n";
-  fs::remove_all(out);
+  if (!HasFailure()) {
+    fs::remove_all(out);  // kept on failure: the logs and replay say why (a stall is read there)
+  }
 }
 
 // Thesis 000 §3.2.3's risk stepping drives the fleet too (docs/benchmarks.md has its 100-task
@@ -167,5 +169,7 @@ TEST(FleetScenario, TwentyRobotsDeliverWithRiskSteppingWithoutContact) {
   }
   // 0-4 per 100-task run with risk_stepping (docs/benchmarks.md); a planner that never moves: 291.
   EXPECT_LE(recoveries, 5) << r["agents"].dump();
-  fs::remove_all(out);
+  if (!HasFailure()) {
+    fs::remove_all(out);  // kept on failure: the logs and replay say why (a stall is read there)
+  }
 }
