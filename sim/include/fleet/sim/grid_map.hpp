@@ -26,11 +26,16 @@ struct GridMap {
     return !inside(cx, cy) || cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(width) +
                                     static_cast<std::size_t>(cx)] != 0;
   }
-  [[nodiscard]] int cellX(double x) const {
-    return static_cast<int>(std::floor((x - origin.x) / resolution));
-  }
-  [[nodiscard]] int cellY(double y) const {
-    return static_cast<int>(std::floor((y - origin.y) / resolution));
+  [[nodiscard]] int cellX(double x) const { return toCell((x - origin.x) / resolution); }
+  [[nodiscard]] int cellY(double y) const { return toCell((y - origin.y) / resolution); }
+  /// Far outside any map, or not a number (a scenario's coordinates are input): an index outside
+  /// the map that an int holds, not an out-of-range cast (the scenario fuzzer's 1.3e34).
+  [[nodiscard]] static int toCell(double c) {
+    constexpr double kFar = 1e9;
+    if (!(c > -kFar)) {
+      return -static_cast<int>(kFar);
+    }
+    return c > kFar ? static_cast<int>(kFar) : static_cast<int>(std::floor(c));
   }
   [[nodiscard]] Vec2 cellCenter(int cx, int cy) const {
     return origin + Vec2{(cx + 0.5) * resolution, (cy + 0.5) * resolution};
