@@ -54,11 +54,13 @@ std::uint64_t pairKey(int a, int b) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
 }
 
-constexpr double kChargeReach = 0.5;  // m from a charging station's pose
-constexpr double kStillSpeed = 0.02;  // m/s under which a robot is idle
-constexpr double kArrive = 0.6;       // m: a human reached its goal
-constexpr double kProgressM = 0.5;    // m: moving less than this in kGiveUpS is being stuck
-constexpr double kGiveUpS = 5.0;      // s of being stuck before choosing another goal
+constexpr double kChargeReach = 0.5;     // m from a charging station's pose
+constexpr double kStillSpeed = 0.02;     // m/s under which a robot is idle
+constexpr double kArrive = 0.6;          // m: a human reached its goal
+constexpr double kProgressM = 0.5;       // m: moving less than this in kGiveUpS is being stuck
+constexpr double kGiveUpS = 5.0;         // s of being stuck before choosing another goal
+constexpr double kBlockingRobotM = 1.0;  // m (surface gap): a robot this close can be what blocks someone
+constexpr double kIntoRobotCos = 0.5;    // a way within 60° of a robot's bearing leads into it
 // Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
 // a run whose bodies never come that close reports null.
 constexpr double kSeparationReach = 2.0;
@@ -238,6 +240,48 @@ void World::pickGoal(std::size_t hi) {
   h.field = next;
 }
 
+void World::pickGoalAwayFromRobots(std::size_t hi) {
+  HumanBody& h = humans_[hi];
+  std::vector<Vec2> near;
+  if (h.route.empty()) {
+    const double reach = h.r + maxRadius_ + kBlockingRobotM;
+    hash_.forEachNear(h.p, reach, [&](int j) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (ju < robots_.size() && distance(positions_[ju], h.p) < reach) {
+        near.push_back(positions_[ju]);
+      }
+    });
+  }
+  if (near.empty()) {
+    pickGoal(hi);  // nothing to turn from (or a fixed route): as before
+    return;
+  }
+  // A random goal is usually just as blocked: at the mouth of an aisle most of the site lies beyond
+  // the robot standing in it, and someone re-drawing every kGiveUpS paces in front of it for minutes
+  // while the robot waits for them. Take the first goal, from a random start, whose way leads away.
+  const auto n = randomGoals_.size();
+  const auto start = static_cast<std::size_t>(humanRng_.engine() % n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const int g = randomGoals_[(start + k) % n];
+    if (g == h.field) {
+      continue;
+    }
+    const Vec2 e = fields_[static_cast<std::size_t>(g)].direction(sc_.map, h.p);
+    if (e.squaredNorm() < 1e-12) {
+      continue;  // unreachable from here, or already there
+    }
+    const bool intoRobot = std::any_of(near.begin(), near.end(), [&](Vec2 q) {
+      const Vec2 d = q - h.p;
+      return e.dot(d) > kIntoRobotCos * len(d);
+    });
+    if (!intoRobot) {
+      h.field = g;
+      return;
+    }
+  }
+  pickGoal(hi);  // hemmed in on every side: wait it out as before
+}
+
 CommandOutcome World::command(const std::string& id, double v, double w) {
   const int i = robotIndex(id);
   if (i < 0) {
@@ -377,7 +421,7 @@ void World::stepHumans() {
     } else if (h.field >= 0 && now - h.progressAt > kGiveUpS) {
       h.progressRef = h.p;
       h.progressAt = now;
-      pickGoal(i);
+      pickGoalAwayFromRobots(i);
       continue;
     }
     if (h.field >= 0 && now >= h.stopUntil &&

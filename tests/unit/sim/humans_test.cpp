@@ -237,3 +237,56 @@ TEST(Humans, NeverWalkIntoAStandingRobotUnlessTheKeepDistanceIsOff) {
   EXPECT_GT(contactsOff, 0U) << "the scene must press people into the robot for this test to mean anything";
   EXPECT_LT(sepOff, 0.0);
 }
+
+TEST(Humans, SomeoneWhoseWayIsThroughAStandingRobotTurnsAwayInsteadOfPacingBesideIt) {
+  // A 1.5 m cross corridor (y 10..11.5) crossed by a 1.5 m aisle (x 9..10.5); a robot stands in the
+  // aisle's mouth south of the corridor, facing it. Most goals lie south, beyond the robot: someone
+  // who comes down the aisle from the north cannot pass it. Drawing another goal at random, they
+  // mostly draw another one beyond the robot and pace in front of it (what held robots for minutes
+  // in the dense fleet check); they must turn to a way that leads away.
+  auto nearTime = [](std::uint64_t seed) {
+    auto j = test::room(40, 30);
+    j["seed"] = seed;
+    auto& rows = j["map"]["rows"];
+    for (int r = 1; r < 29; ++r) {
+      std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+      for (int c = 1; c < 39; ++c) {
+        const bool corridor = r >= 7 && r <= 9;
+        const bool aisle = c >= 18 && c <= 20;
+        const bool south = r >= 25;
+        if (!corridor && !aisle && !south) {
+          s[static_cast<std::size_t>(c)] = '@';
+        }
+      }
+      rows[static_cast<std::size_t>(r)] = s;
+    }
+    j["robots"] = {{{"id", "r1"}, {"start", {9.75, 9.75, 1.5708}}}};
+    j["points_of_interest"] = {{2.0, 1.0},  {5.0, 1.0},  {8.0, 1.0},   {11.0, 1.0},
+                               {14.0, 1.0}, {17.0, 1.0}, {2.0, 10.75}, {18.0, 10.75}};
+    j["humans"] = {{"list", {{{"id", "h"}, {"start", {9.75, 14.0}}}}}, {"stop_probability", 0.0}};
+    World w(test::parse(j));
+    const Vec2 robot{9.75, 9.75};
+    double stretch = 0.0;  // the longest time in one go within 1.2 m of the robot
+    double since = -1.0;
+    for (int k = 0; k < 900; ++k) {  // 90 s
+      w.advance();
+      if (distance(w.humans()[0].p, robot) >= 1.2) {
+        since = -1.0;
+      } else if (since < 0.0) {
+        since = w.time();
+      } else {
+        stretch = std::max(stretch, w.time() - since);
+      }
+    }
+    return stretch;
+  };
+  double worst = 0.0;
+  int cameNear = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const double t = nearTime(seed);
+    worst = std::max(worst, t);
+    cameNear += t > 3.0 ? 1 : 0;
+  }
+  EXPECT_GE(cameNear, 5) << "people must come down to the robot for this test to mean anything";
+  EXPECT_LT(worst, 15.0) << "someone stood within 1.2 m of the robot for that many seconds at a time";
+}

@@ -166,6 +166,8 @@ class World {
   void spawnHumans();
   int fieldFor(Vec2 goal);
   void pickGoal(std::size_t h);
+  /// Another goal for someone who could not get on: one whose way does not lead into a robot beside them.
+  void pickGoalAwayFromRobots(std::size_t h);
   void stepRobots();
   void stepHumans();
   void updateContacts();
