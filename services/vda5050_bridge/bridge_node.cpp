@@ -390,7 +390,14 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       p.goal = *v.home;
     }
     p.holding = !online || acting || s.paused.value_or(false);
-    p.blocked = s.safetyState.fieldViolation || v.gave_up;
+    // Reported blocked, a robot is held by the traffic manager, which cuts its release back to its
+    // next node and plans the others over the rest. A vehicle stopped by its protective field
+    // keeps its order's base and drives on by itself once the field is clear: while it holds more
+    // than its next node it is only late, which the dependencies cover (a robot that went on into
+    // nodes the plan had given others stood for good, and one touched a vehicle planned there).
+    const auto baseAhead = std::count_if(s.nodeStates.begin(), s.nodeStates.end(),
+                                         [](const vda5050::NodeState& n) { return n.released; });
+    p.blocked = (s.safetyState.fieldViolation && baseAhead <= 1) || v.gave_up;
     p.follows = online;
     p.stamp_ns = nowNs;
     out.progress.push_back(std::move(p));

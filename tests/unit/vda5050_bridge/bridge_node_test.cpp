@@ -228,6 +228,28 @@ TEST(Vda5050BridgeNode, BoundedRetriesEndInALoggedRefusalAndABlockedReport) {
   EXPECT_FALSE(l.progress.blocked);
 }
 
+TEST(Vda5050BridgeNode, AVehicleStoppedByAPersonIsReportedBlockedOnlyWhenItHoldsNoMoreThanItsNextNode) {
+  // Blocked, the traffic manager cuts the release back to the next node and plans others over the
+  // rest; a vehicle keeps its order's base and drives on once the person has gone.
+  Loop l;
+  l.assign("t1", 9.0);
+  l.bridge.onRelease(release({0, 1, 2, 3, 4}));
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.rig.person = true;
+  l.run(1.0);
+  EXPECT_TRUE(l.state().safetyState.fieldViolation);
+  EXPECT_FALSE(l.progress.blocked) << "it holds n2..n4 and will drive them: only late";
+  l.rig.person = false;
+  ASSERT_TRUE(l.runUntilAt("n3", 20.0));
+  l.rig.person = true;
+  l.run(1.0);
+  EXPECT_TRUE(l.progress.blocked) << "only n4 is left: cutting back to it takes nothing it holds";
+  l.rig.person = false;
+  l.run(0.5);
+  EXPECT_FALSE(l.progress.blocked);
+}
+
 TEST(Vda5050BridgeNode, AnOrderLostOnTheWayIsSentAgain) {
   Loop l;
   l.deliver = false;
