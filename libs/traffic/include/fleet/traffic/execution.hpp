@@ -162,8 +162,9 @@ class Execution {
   void rebuildVisitors();
   /// Derives every unreleased entry's dependencies from `order` (released entries come first);
   /// false when a robot would have to go beyond its planned route or the dependencies form a
-  /// cycle.
-  bool rederive();
+  /// cycle. `only` (per node): derive again only the entries on marked nodes, the others' orders
+  /// having stayed as they were derived from (the whole acyclicity check runs either way).
+  bool rederive(const std::vector<std::uint8_t>* only = nullptr);
   [[nodiscard]] bool acyclic() const;
 
   const Graph& graph_;
