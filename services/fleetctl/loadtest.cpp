@@ -496,7 +496,7 @@ int Run::run() {
         return 2;
       }
     }
-    auto g = generateScenario(*t, {o.robots, o.humans, o.durationS, o.seed});
+    auto g = generateScenario(*t, {o.robots, o.humans, o.durationS, o.seed, o.siteRobots});
     if (!g) {
       std::cerr << "fleetctl loadtest: " << g.error().message << "\n";
       return 2;

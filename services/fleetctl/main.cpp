@@ -128,6 +128,12 @@ int main(int argc, char** argv) {
   loadtest->add_option("--robots", lt.robots, "robots of the generated scenario")
       ->check(CLI::Range(1, 2000))
       ->capture_default_str();
+  loadtest
+      ->add_option("--site-for", lt.siteRobots,
+                   "size the generated warehouse (floor, parking, stations) for this many robots and place "
+                   "--robots of "
+                   "them: fleet sizes compared on one site (0: sized for --robots)")
+      ->check(CLI::Range(0, 2000));
   loadtest->add_option("--humans", lt.humans, "humans of the generated scenario")
       ->check(CLI::Range(0, 5000))
       ->capture_default_str();

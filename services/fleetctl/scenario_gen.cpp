@@ -26,16 +26,21 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   if (size.humans < 0 || size.humans > 5000) {
     return unexpected("invalid", "--humans: expected 0..5000, got " + std::to_string(size.humans));
   }
+  if (size.siteRobots != 0 && (size.siteRobots < size.robots || size.siteRobots > 2000)) {
+    return unexpected("invalid", "--site-for: expected " + std::to_string(size.robots) +
+                                     "..2000 (at least --robots), got " + std::to_string(size.siteRobots));
+  }
   if (!templ.is_object()) {
     return unexpected("invalid", "the scenario template is not a JSON object");
   }
-  const double n = size.robots;
+  const int sized = size.siteRobots > 0 ? size.siteRobots : size.robots;
+  const double n = sized;
   // Floor area from the fleet size, 3:2 aspect; at least the small warehouse (30 m x 20 m).
   const double area = std::max(600.0, kAreaPerRobot * n);
   double widthM = std::max(30.0, std::round(std::sqrt(area * 1.5)));
   // Parking: rows along the bottom margin; the margin grows with the number of rows.
   const int perRow = static_cast<int>(std::floor((widthM - 4.0) / kParkDx)) + 1;
-  const int rows = (size.robots + perRow - 1) / perRow;
+  const int rows = (sized + perRow - 1) / perRow;
   const double marginM = std::max(2.5, std::ceil((1.25 + (rows - 1) * kRowDy + 1.0) / kRes) * kRes);
   double heightM = std::max(20.0, std::round(area / widthM) + 2.0 * (marginM - 2.5));
   const int wCells = static_cast<int>(widthM / kRes);
@@ -47,7 +52,8 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   s.erase("tasks");  // the template's task list names the template's stations
   // The generated map and stations replace the template's site (inlineSiteRobot() keeps its robot).
   s.erase("site");
-  s["name"] = "loadtest-" + std::to_string(size.robots) + "r-" + std::to_string(size.humans) + "h";
+  s["name"] = "loadtest-" + std::to_string(size.robots) + "r-" + std::to_string(size.humans) + "h" +
+              (sized != size.robots ? "-site" + std::to_string(sized) : "");
   s["seed"] = size.seed;
   s["duration_s"] = size.durationS;
   s["map"] = {{"warehouse",
@@ -63,7 +69,7 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   nlohmann::json stations = nlohmann::json::array();
   int k = 0;
   for (int r = 0; r < rows; ++r) {
-    for (int i = 0; i < perRow && k < size.robots; ++i) {
+    for (int i = 0; i < perRow && k < sized; ++i) {
       ++k;
       stations.push_back(
           station("PARK-" + std::to_string(k), "parking", 2.0 + i * kParkDx, 1.25 + r * kRowDy, 1.5708));
@@ -74,9 +80,9 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   const double sideY1 = heightM - marginM - 1.0;
   const int sideRoom = std::max(1, static_cast<int>((sideY1 - sideY0) / kStationGap) + 1);
   const int topRoom = std::max(1, static_cast<int>((widthM - 6.0) / kStationGap) + 1);
-  const int chargers = std::clamp(size.robots / 10, 3, sideRoom);
-  const int pickups = std::clamp(size.robots / 4, 5, topRoom);
-  const int dropoffs = std::clamp(size.robots / 5, 4, sideRoom);
+  const int chargers = std::clamp(sized / 10, 3, sideRoom);
+  const int pickups = std::clamp(sized / 4, 5, topRoom);
+  const int dropoffs = std::clamp(sized / 5, 4, sideRoom);
   auto spread = [](double lo, double hi, int count, int i) {
     return count == 1 ? (lo + hi) / 2 : lo + (hi - lo) * i / (count - 1);
   };

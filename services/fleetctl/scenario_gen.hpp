@@ -17,11 +17,14 @@ struct ScenarioSize {
   int humans = 8;
   double durationS = 180;
   std::uint64_t seed = 7;
+  // Size the warehouse, its parking and stations for this many robots (0: for `robots`) and place
+  // `robots` of them: a sweep over fleet sizes on one site.
+  int siteRobots = 0;
 };
 
 /// Builds the scenario document from a template document (keys other than map, stations, robots,
 /// landmarks and humans.count/spawn_areas are kept). Errors: robots outside [1, 2000], humans
-/// outside [0, 5000].
+/// outside [0, 5000], siteRobots outside [robots, 2000] (when not 0).
 Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const ScenarioSize& size);
 
 /// Extent of a scenario's map in metres (generated warehouse maps only; else 0 x 0).

@@ -69,6 +69,29 @@ TEST(ScenarioGen, BiggerFleetsGetBiggerWarehouses) {
   }
 }
 
+TEST(ScenarioGen, ASiteSizedForMoreRobotsHoldsFewerOfThemAsTheBiggerFleetsSiteIs) {
+  auto big = generateScenario(smallTemplate(), {300, 50, 60, 1});
+  auto few = generateScenario(smallTemplate(), {20, 50, 60, 1, 300});
+  ASSERT_TRUE(big && few);
+  EXPECT_EQ((*few)["map"], (*big)["map"]);
+  EXPECT_EQ((*few)["stations"], (*big)["stations"]);  // parking for all 300, their stations
+  EXPECT_EQ((*few)["landmarks"], (*big)["landmarks"]);
+  ASSERT_EQ((*few)["robots"].size(), 20U);
+  for (std::size_t i = 0; i < 20; ++i) {
+    EXPECT_EQ((*few)["robots"][i], (*big)["robots"][i]);
+  }
+  sim::Scenario s;
+  EXPECT_NO_THROW(s = sim::parseScenario(*few, "generated", "."));
+  EXPECT_EQ(s.robots.size(), 20U);
+  auto same = generateScenario(smallTemplate(), {20, 8, 60, 1, 20});
+  auto plain = generateScenario(smallTemplate(), {20, 8, 60, 1});
+  ASSERT_TRUE(same && plain);
+  EXPECT_EQ(*same, *plain);
+  auto smaller = generateScenario(smallTemplate(), {20, 8, 60, 1, 10});
+  ASSERT_FALSE(smaller);
+  EXPECT_NE(smaller.error().message.find("--site-for"), std::string::npos) << smaller.error().message;
+}
+
 TEST(ScenarioGen, KeepsTheTemplateRobotModel) {
   const auto t = smallTemplate();
   auto doc = generateScenario(t, {50, 10, 90, 1});
