@@ -195,6 +195,36 @@ void BridgeNode::watchOrder(Vehicle& v, const vda5050::State& s, std::int64_t no
   orderFailed(v, why, nowNs, out);
 }
 
+namespace {
+/// Base nodes the vehicle still holds ahead of its last node.
+std::size_t baseAhead(const vda5050::State& s) {
+  return static_cast<std::size_t>(std::count_if(s.nodeStates.begin(), s.nodeStates.end(),
+                                                [](const vda5050::NodeState& n) { return n.released; }));
+}
+}  // namespace
+
+void BridgeNode::cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out) {
+  if (!s.safetyState.fieldViolation) {
+    v.field_since_ns = -1;
+    v.field_cancelled = false;
+    return;
+  }
+  if (v.field_since_ns < 0) {
+    v.field_since_ns = nowNs;
+  }
+  if (static_cast<double>(nowNs - v.field_since_ns) * 1e-9 < settings_.field_cancel_s || baseAhead(s) <= 1 ||
+      !v.has_order || v.cancel_sent) {
+    return;
+  }
+  // The base cannot be shortened by an update (VDA 5050 2.1, 6.6): it ends only with the order.
+  instant(v, "cancelOrder", nowNs, out);
+  ++counters_.cancels;
+  ++counters_.field_cancels;
+  v.cancel_sent = true;
+  v.has_order = false;  // the next order starts from where the vehicle then stands
+  v.field_cancelled = true;
+}
+
 void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
   while (!v.task_id.empty() && v.goal < v.goals.size()) {
     const auto& g = v.goals[v.goal];
@@ -218,8 +248,10 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
 
 void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
                                BridgeOutbox& out) {
+  // Held where it stands (the traffic manager plans round it): an order now would be the release
+  // it had, cancelled again; the next comes once its field is clear, from the release then.
   if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline || v.gave_up ||
-      nowNs < v.retry_ns) {
+      nowNs < v.retry_ns || v.field_cancelled) {
     return;
   }
   const auto& r = *v.release;
@@ -344,6 +376,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     const bool online = view->health == VehicleHealth::kOnline;
     if (online) {
       watchOrder(v, s, nowNs, out);
+      cancelWhenHeld(v, s, nowNs, out);
       trackGoals(v, *view);
       followRelease(v, *view, nowNs, out);
       reportTask(v, nowNs, out);
@@ -391,13 +424,12 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     }
     p.holding = !online || acting || s.paused.value_or(false);
     // Reported blocked, a robot is held by the traffic manager, which cuts its release back to its
-    // next node and plans the others over the rest. A vehicle stopped by its protective field
-    // keeps its order's base and drives on by itself once the field is clear: while it holds more
-    // than its next node it is only late, which the dependencies cover (a robot that went on into
-    // nodes the plan had given others stood for good, and one touched a vehicle planned there).
-    const auto baseAhead = std::count_if(s.nodeStates.begin(), s.nodeStates.end(),
-                                         [](const vda5050::NodeState& n) { return n.released; });
-    p.blocked = (s.safetyState.fieldViolation && baseAhead <= 1) || v.gave_up;
+    // next node and plans the others over the rest. A vehicle stopped by its protective field keeps
+    // its order's base and drives on by itself once the field is clear: while it holds more than
+    // its next node it is only late (the dependencies cover that) until cancelWhenHeld() ends the
+    // order. (Reported at once, a vehicle drove on into nodes the plan had given others: its reports
+    // were refused from then on and it stood for good; once two vehicles touched.)
+    p.blocked = (s.safetyState.fieldViolation && baseAhead(s) <= 1) || v.gave_up;
     p.follows = online;
     p.stamp_ns = nowNs;
     out.progress.push_back(std::move(p));

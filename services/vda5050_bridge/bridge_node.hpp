@@ -45,6 +45,10 @@ struct BridgeSettings {
   int order_retries = 3;           // re-sends of an order the vehicle rejected before it is reported blocked
   double retry_backoff_s = 1.0;    // wait before the first re-send; doubles with each
   double order_ack_timeout_s = 10.0;  // an order neither taken nor rejected by then counts as rejected
+  // A vehicle its protective field has stopped this long, holding base beyond its next node, has
+  // its order cancelled: then it can be reported blocked and planned round (as our robots are
+  // after 3 s held by a person) without driving on into nodes given to others.
+  double field_cancel_s = 3.0;
 };
 
 struct MqttMessage {
@@ -68,8 +72,9 @@ struct BridgeCounters {
   std::uint64_t cancels = 0;
   std::uint64_t refused_messages = 0;
   std::uint64_t cannot_stitch = 0;
-  std::uint64_t rejected = 0;  // orders and updates the vehicle rejected or did not take
-  std::uint64_t gave_up = 0;   // times a vehicle was reported blocked after its retries
+  std::uint64_t rejected = 0;       // orders and updates the vehicle rejected or did not take
+  std::uint64_t gave_up = 0;        // times a vehicle was reported blocked after its retries
+  std::uint64_t field_cancels = 0;  // orders cancelled because the vehicle's field held it (in `cancels` too)
 };
 
 class BridgeNode {
@@ -112,7 +117,9 @@ class BridgeNode {
     std::int64_t sent_ns = 0;
     int failures = 0;  // orders in a row it rejected (or none could be built)
     std::int64_t retry_ns = 0;
-    bool gave_up = false;  // retries spent: reported blocked
+    bool gave_up = false;              // retries spent: reported blocked
+    std::int64_t field_since_ns = -1;  // its protective field has stopped it since then
+    bool field_cancelled = false;      // its order was cancelled for that: no new one until it is clear
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);
@@ -122,6 +129,7 @@ class BridgeNode {
   void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out);
   void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
   void trackGoals(Vehicle& v, const vda5050::VehicleView& view);
+  void cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
   void reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out);
   [[nodiscard]] std::string goalActionId(const Vehicle& v, std::size_t goal) const;
 

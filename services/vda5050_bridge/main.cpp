@@ -160,6 +160,8 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
         &vdabridge::BridgeCounters::rejected);
   total("vehicles_given_up", "Times a vehicle was reported blocked after its retries",
         &vdabridge::BridgeCounters::gave_up);
+  total("field_cancels", "Orders cancelled because the vehicle's protective field held it",
+        &vdabridge::BridgeCounters::field_cancels);
   ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
   ops.watchMatchedWriters("TaskAssignment", [&] { return assignments.matchedWriters(); });
   ops.watchMatchedWriters("TrafficRelease", [&] { return releases.matchedWriters(); });
@@ -239,8 +241,10 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
       const auto& c = node.counters();
       spdlog::info(
           "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched, "
-          "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries",
-          c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up);
+          "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries, {} orders "
+          "cancelled for a vehicle its field held",
+          c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up,
+          c.field_cancels);
       lastStats = std::chrono::steady_clock::now();
     }
   };

@@ -228,9 +228,9 @@ TEST(Vda5050BridgeNode, BoundedRetriesEndInALoggedRefusalAndABlockedReport) {
   EXPECT_FALSE(l.progress.blocked);
 }
 
-TEST(Vda5050BridgeNode, AVehicleStoppedByAPersonIsReportedBlockedOnlyWhenItHoldsNoMoreThanItsNextNode) {
+TEST(Vda5050BridgeNode, AVehicleHeldByAPersonWithBaseAheadHasItsOrderCancelledBeforeItIsReportedBlocked) {
   // Blocked, the traffic manager cuts the release back to the next node and plans others over the
-  // rest; a vehicle keeps its order's base and drives on once the person has gone.
+  // rest; a vehicle would keep its order's base and drive on into them once the person has gone.
   Loop l;
   l.assign("t1", 9.0);
   l.bridge.onRelease(release({0, 1, 2, 3, 4}));
@@ -240,13 +240,34 @@ TEST(Vda5050BridgeNode, AVehicleStoppedByAPersonIsReportedBlockedOnlyWhenItHolds
   l.run(1.0);
   EXPECT_TRUE(l.state().safetyState.fieldViolation);
   EXPECT_FALSE(l.progress.blocked) << "it holds n2..n4 and will drive them: only late";
-  l.rig.person = false;
-  ASSERT_TRUE(l.runUntilAt("n3", 20.0));
-  l.rig.person = true;
-  l.run(1.0);
-  EXPECT_TRUE(l.progress.blocked) << "only n4 is left: cutting back to it takes nothing it holds";
+  EXPECT_EQ(std::count(l.instants.begin(), l.instants.end(), "cancelOrder"), 0);
+  l.run(3.0);
+  EXPECT_EQ(std::count(l.instants.begin(), l.instants.end(), "cancelOrder"), 1);
+  EXPECT_EQ(l.bridge.counters().field_cancels, 1U);
+  EXPECT_TRUE(l.state().nodeStates.empty()) << "the vehicle ended its order";
+  EXPECT_TRUE(l.progress.blocked) << "holding nothing beyond where it is, it can be planned round";
   l.rig.person = false;
   l.run(0.5);
+  EXPECT_FALSE(l.progress.blocked);
+  // The traffic manager releases it again from its node: a new order from where it stands.
+  l.bridge.onRelease(release({1, 2, 3, 4}));
+  EXPECT_TRUE(l.runUntilAt("n4", 30.0));
+  EXPECT_EQ(l.orders.back().nodes.front().nodeId, "n1");
+}
+
+TEST(Vda5050BridgeNode, AVehicleHeldByAPersonBeforeItsLastBaseNodeIsReportedBlockedAtOnce) {
+  Loop l;
+  l.assign("t1", 9.0);
+  l.bridge.onRelease(release({0, 1, 2}));
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.rig.person = true;
+  l.run(1.0);
+  EXPECT_TRUE(l.progress.blocked) << "only n2 is left: cutting back to it takes nothing it holds";
+  l.run(4.0);
+  EXPECT_EQ(std::count(l.instants.begin(), l.instants.end(), "cancelOrder"), 0);
+  l.rig.person = false;
+  EXPECT_TRUE(l.runUntilAt("n2", 10.0));
   EXPECT_FALSE(l.progress.blocked);
 }
 
