@@ -252,7 +252,7 @@ void World::pickGoalAwayFromRobots(std::size_t hi) {
       }
     });
   }
-  if (near.empty()) {
+  if (near.empty() || randomGoals_.empty()) {
     pickGoal(hi);  // nothing to turn from (or a fixed route): as before
     return;
   }
