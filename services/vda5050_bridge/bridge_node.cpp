@@ -223,6 +223,9 @@ void BridgeNode::cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_
   v.cancel_sent = true;
   v.has_order = false;  // the next order starts from where the vehicle then stands
   v.field_cancelled = true;
+  if (v.release) {
+    v.stale_release = std::pair{v.release->epoch, v.release->seq};
+  }
 }
 
 void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
@@ -255,14 +258,21 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
     return;
   }
   const auto& r = *v.release;
+  if (v.stale_release && *v.stale_release != std::pair{r.epoch, r.seq}) {
+    v.stale_release.reset();
+  }
+  // What a held robot keeps of its release: the node it reported last and the next one.
+  const std::size_t keep = v.stale_release ? std::min<std::size_t>(2, r.base.size()) : r.base.size();
   vda5050::ReleaseInput in;
-  for (const auto& n : r.base) {
-    in.base.push_back({n.node, n.x, n.y});
+  for (std::size_t i = 0; i < keep; ++i) {
+    in.base.push_back({r.base[i].node, r.base[i].x, r.base[i].y});
   }
   for (const auto& n : r.horizon) {
-    in.horizon.push_back({n.node, n.x, n.y});
+    if (keep == r.base.size()) {
+      in.horizon.push_back({n.node, n.x, n.y});
+    }
   }
-  if (r.ends_at_goal && !v.task_id.empty() && v.goal < v.goals.size()) {
+  if (keep == r.base.size() && r.ends_at_goal && !v.task_id.empty() && v.goal < v.goals.size()) {
     const auto& g = v.goals[v.goal];
     if (g.action == msg::GoalAction::Load || g.action == msg::GoalAction::Unload) {
       vda5050::Action a{

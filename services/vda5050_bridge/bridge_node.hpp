@@ -28,6 +28,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fleet/messages/messages.hpp"
@@ -120,6 +121,10 @@ class BridgeNode {
     bool gave_up = false;              // retries spent: reported blocked
     std::int64_t field_since_ns = -1;  // its protective field has stopped it since then
     bool field_cancelled = false;      // its order was cancelled for that: no new one until it is clear
+    // The release held when that order was cancelled: the traffic manager may have taken back all
+    // of it but its first two nodes since (it holds a blocked robot there), so until a newer
+    // release arrives an order takes no more than those.
+    std::optional<std::pair<std::uint32_t, std::uint32_t>> stale_release;  // epoch, seq
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);

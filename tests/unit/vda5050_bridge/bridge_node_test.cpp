@@ -246,11 +246,22 @@ TEST(Vda5050BridgeNode, AVehicleHeldByAPersonWithBaseAheadHasItsOrderCancelledBe
   EXPECT_EQ(l.bridge.counters().field_cancels, 1U);
   EXPECT_TRUE(l.state().nodeStates.empty()) << "the vehicle ended its order";
   EXPECT_TRUE(l.progress.blocked) << "holding nothing beyond where it is, it can be planned round";
+  const auto ordersBefore = l.orders.size();
   l.rig.person = false;
-  l.run(0.5);
+  l.run(3.0);
   EXPECT_FALSE(l.progress.blocked);
+  // Until the traffic manager's next release the old one may have been taken back but for its
+  // first two nodes (n0, n1): nothing beyond n1 is ordered, so the vehicle stays there.
+  for (std::size_t k = ordersBefore; k < l.orders.size(); ++k) {
+    for (const auto& n : l.orders[k].nodes) {
+      EXPECT_TRUE(n.nodeId == "n0" || n.nodeId == "n1") << n.nodeId << " ordered from a stale release";
+    }
+  }
+  EXPECT_EQ(l.rig.vehicle.lastNodeId(), "n1");
   // The traffic manager releases it again from its node: a new order from where it stands.
-  l.bridge.onRelease(release({1, 2, 3, 4}));
+  auto again = release({1, 2, 3, 4});
+  again.seq = 2;
+  l.bridge.onRelease(again);
   EXPECT_TRUE(l.runUntilAt("n4", 30.0));
   EXPECT_EQ(l.orders.back().nodes.front().nodeId, "n1");
 }
