@@ -31,6 +31,7 @@
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "run_bounds.hpp"
+#include "saturation.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
 #include "supervisor.hpp"
@@ -1091,6 +1092,8 @@ int Run::run() {
       o.wallClock
           ? json{{"error", "not in wall-clock runs (the manager's stamps are not the replay's clock)"}}
           : runBounds(out, report["throughput"]["done_per_sim_hour"].get<double>(), robots.size());
+  report["saturated"] =
+      saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime), o.loneSaturatedPerH);
   writeFile(out / "loadtest.json", report.dump(2));
   char line[256];
   std::snprintf(
@@ -1126,6 +1129,7 @@ int Run::run() {
     }
   }
   say(boundLine(report["kinematic_bound"]));
+  say(saturatedLine(report["saturated"]));
   if (!contents.error.empty()) {
     say("task database: " + contents.error);
     code = code == 0 ? 1 : code;
