@@ -42,8 +42,9 @@ constexpr const char* kParticipant = "vda5050_bridge";
 
 Settings readSettings(Config& c) {
   Settings s;
-  c.rejectUnknownKeys(
-      {"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "vehicles", "clock", "lockstep"});
+  c.rejectUnknownKeys({"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "order_retries",
+                       "retry_backoff_s", "order_ack_timeout_s", "field_cancel_s", "vehicles", "clock",
+                       "lockstep"});
   s.sim_clock = c.string("clock", "wall", {"wall", "sim"}) == "sim";
   s.lockstep = c.boolean("lockstep", false);
   if (s.lockstep && !s.sim_clock) {
@@ -61,6 +62,10 @@ Settings readSettings(Config& c) {
   s.bridge.map_id = c.requireString("map_id");
   s.rate_hz = c.number("rate_hz", 10.0, {1.0, 100.0});
   s.bridge.allowed_deviation = c.number("allowed_deviation", 0.2, {0.01, 5.0});
+  s.bridge.order_retries = static_cast<int>(c.integer("order_retries", s.bridge.order_retries, {0, 100}));
+  s.bridge.retry_backoff_s = c.number("retry_backoff_s", s.bridge.retry_backoff_s, {0.0, 60.0});
+  s.bridge.order_ack_timeout_s = c.number("order_ack_timeout_s", s.bridge.order_ack_timeout_s, {0.1, 600.0});
+  s.bridge.field_cancel_s = c.number("field_cancel_s", s.bridge.field_cancel_s, {0.0, 600.0});
   for (auto& v : c.array("vehicles", true)) {
     v.rejectUnknownKeys({"manufacturer", "serial", "robot"});
     s.bridge.vehicles.push_back(
@@ -137,9 +142,14 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
   progress.forRobots(robots);
   std::int64_t simNow = -1;
   service::RateLimitedLog log;
-  spdlog::info("vda5050 bridge: {} vehicle(s), broker {}:{}{}, map '{}'", settings.bridge.vehicles.size(),
-               settings.broker.host, settings.broker.port,
-               settings.broker.tls_ca_file.empty() ? "" : " (TLS)", settings.bridge.map_id);
+  const auto& b = settings.bridge;
+  spdlog::info(
+      "vda5050 bridge: {} vehicle(s), broker {}:{}{}, map '{}'; a rejected order re-sent {} times (first "
+      "after "
+      "{} s), unanswered after {} s; a vehicle held by its field cancelled after {} s",
+      b.vehicles.size(), settings.broker.host, settings.broker.port,
+      settings.broker.tls_ca_file.empty() ? "" : " (TLS)", b.map_id, b.order_retries, b.retry_backoff_s,
+      b.order_ack_timeout_s, b.field_cancel_s);
   const auto period = std::chrono::duration_cast<std::chrono::nanoseconds>(
       std::chrono::duration<double>(1.0 / settings.rate_hz));
   auto next = std::chrono::steady_clock::now();

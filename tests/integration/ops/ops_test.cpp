@@ -336,6 +336,34 @@ TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {
   EXPECT_EQ(sim.code, 2) << sim.out;
 }
 
+TEST(OpsCommandLine, TheBridgesTuningIsConfigurableAndOutOfRangeValuesAreRefusedByName) {
+  const auto dir = fs::temp_directory_path() / ("fleet-ops-bridge-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  auto config = [&](const std::string& tuning, int timeoutS = 10) {
+    std::ofstream(dir / "bridge.json")
+        << R"({"broker": {"port": 1, "username": "m", "password": "p"}, "map_id": "m", )" << tuning
+        << R"("vehicles": [{"manufacturer": "a", "serial": "s", "robot": "r1"}]})";
+    // A domain of its own: an accepted configuration starts the bridge's DDS participant.
+    return run("env FLEET_DDS_DOMAIN=" + std::to_string(fleet::test::uniqueDomain()) + " " + kBin +
+                   "/services/vda5050_bridge/vda5050_bridge --config " + (dir / "bridge.json").string(),
+               timeoutS);
+  };
+  const auto bad = config(R"("field_cancel_s": -1, "order_retries": 1000, )");
+  const auto typo = config(R"("field_cancel": 3, )");
+  // Accepted: the bridge starts (and keeps trying the broker, which is not there, until stopped).
+  const auto good = config(R"("field_cancel_s": 5.5, "order_retries": 7, "order_ack_timeout_s": 4, )", 3);
+  fs::remove_all(dir);
+  EXPECT_EQ(good.code, 124) << good.out;
+  EXPECT_NE(good.out.find("re-sent 7 times"), std::string::npos) << good.out;
+  EXPECT_NE(good.out.find("unanswered after 4 s"), std::string::npos) << good.out;
+  EXPECT_NE(good.out.find("cancelled after 5.5 s"), std::string::npos) << good.out;
+  EXPECT_EQ(bad.code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("field_cancel_s"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("order_retries"), std::string::npos) << bad.out;
+  EXPECT_EQ(typo.code, 2) << typo.out;
+  EXPECT_NE(typo.out.find("field_cancel"), std::string::npos) << typo.out;
+}
+
 TEST(OpsLogs, JsonFormatIsOneObjectPerLineWithTimeLevelAndService) {
   // A configuration error logged as JSON: the multi-line problem list stays on one line.
   const auto r =
