@@ -10,6 +10,12 @@ namespace fleet::sim {
 using namespace fleet::vda5050;
 
 namespace {
+
+// A bend in the route up to this is driven through (at kCornerSpeed m/s on the node); a sharper one
+// is stopped at and turned on the spot.
+constexpr double kGentleBend = 0.8;  // rad, 46°
+constexpr double kCornerSpeed = 0.35;
+constexpr double kLookahead = 0.2;  // m along the edge
 bool finished(const ActionState& a) {
   return a.actionStatus == "FINISHED" || a.actionStatus == "FAILED";
 }
@@ -237,6 +243,7 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     // it at speed slid on past it (0.1-0.2 m into a parking place's back wall when the base
     // turned back out of the place, 2026-11-26).
     bool corner = false;
+    bool gentle = false;
     if (!last && order_->nodes[next_ + 1].nodePosition) {
       const auto& m = *order_->nodes[next_ + 1].nodePosition;
       // The way in: from the node before (the pose's bearing swings as the vehicle nears the node).
@@ -245,12 +252,16 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
         from = {order_->nodes[next_ - 1].nodePosition->x, order_->nodes[next_ - 1].nodePosition->y};
       const double in = std::atan2(n.nodePosition->y - from.y, n.nodePosition->x - from.x);
       const double out = std::atan2(m.y - n.nodePosition->y, m.x - n.nodePosition->x);
-      corner = std::abs(angleDiff(out, in)) > 0.1;
+      const double bend = std::abs(angleDiff(out, in));
+      corner = bend > 0.1;
+      // The lattice's straight-to-diagonal bends (45°) are driven through at the corner speed:
+      // stopping at each held the vehicle to ~0.2 m/s on a lattice route.
+      gentle = corner && bend <= kGentleBend;
     }
-    const bool stop_here = last || corner;
-    const double tol =
-        stop_here ? std::min(config_.nodeTolerance, 0.1)
-                  : std::max(config_.nodeTolerance, n.nodePosition->allowedDeviationXY.value_or(0.0));
+    const bool stop_here = last || (corner && !gentle);
+    const double tol = stop_here || gentle ? std::min(config_.nodeTolerance, 0.1)
+                                           : std::max(config_.nodeTolerance,
+                                                      n.nodePosition->allowedDeviationXY.value_or(0.0));
     const double dx = n.nodePosition->x - pose.x;
     const double dy = n.nodePosition->y - pose.y;
     const double dist = std::hypot(dx, dy);
@@ -261,18 +272,46 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
       }
       continue;
     }
-    const double err = angleDiff(std::atan2(dy, dx), pose.theta);
+    // Steer for a point a little ahead on the edge into the node, not for the node itself: out of
+    // a bend driven through, the vehicle is off the line, and steering for the node swung it to
+    // and fro across the edge.
+    Vec2 aim{n.nodePosition->x, n.nodePosition->y};
+    if (next_ > 0 && order_->nodes[next_ - 1].nodePosition) {
+      const Vec2 a{order_->nodes[next_ - 1].nodePosition->x, order_->nodes[next_ - 1].nodePosition->y};
+      const Vec2 ab = aim - a;
+      const double len = ab.norm();
+      if (len > 1e-6) {
+        const double along = std::clamp((Vec2{pose.x, pose.y} - a).dot(ab) / len, 0.0, len) + kLookahead;
+        if (along < len) {
+          aim = a + ab * (along / len);
+        }
+      }
+    }
+    const double err = angleDiff(std::atan2(aim.y - pose.y, aim.x - pose.x), pose.theta);
     double vmax = config_.maxSpeed;
     if (next_ > 0 && next_ - 1 < order_->edges.size() && order_->edges[next_ - 1].maxSpeed) {
       vmax = std::min(vmax, *order_->edges[next_ - 1].maxSpeed);
     }
     if (stop_here) {
       vmax = std::min(vmax, 0.05 + 0.6 * dist);
+    } else if (gentle) {
+      // Braking at half the factsheet's 1 m/s² reaches the node at the corner speed.
+      vmax = std::min(vmax, std::sqrt(kCornerSpeed * kCornerSpeed + 2.0 * 0.5 * dist));
     }
     // Turn on the spot, then drive straight: the roadmap's edges are straight and keep clear of
-    // shelves only along them (driving while turning cut corners into shelves, 2026-11-26).
+    // shelves only along them (driving while turning cut corners into shelves, 2026-11-26). A
+    // vehicle already moving out of a gentle bend turns at the corner speed instead: it began the
+    // turn on the node, so it swings a few centimetres outward, never across the inside.
     cmd.w = std::clamp(2.0 * err, -config_.maxTurnRate, config_.maxTurnRate);
-    cmd.v = std::abs(err) > 0.1 ? 0.0 : vmax;
+    if (std::abs(err) <= 0.1) {
+      cmd.v = vmax;
+    } else if (std::abs(err) <= kGentleBend + 0.1 && measured_speed_ > 0.5 * kCornerSpeed) {
+      // Speed comes back as the heading nears the line.
+      const double aligned = std::clamp(1.0 - (std::abs(err) - 0.1) / 0.3, 0.0, 1.0);
+      cmd.v = std::min(vmax, kCornerSpeed + (vmax - kCornerSpeed) * aligned);
+    } else {
+      cmd.v = 0.0;
+    }
     break;
   }
   const bool at_base_end = order_ && next_ < order_->nodes.size() && !order_->nodes[next_].released;
