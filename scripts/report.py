@@ -385,7 +385,65 @@ plus the load and unload dwell. A ratio of 1 is a robot that never slows, turns 
 <div>{svg_hist(ratios, xlabel='task time ÷ its bound', why='no task with a bound', color='#8c564b')}</div></div>"""
 
 
-def loadtest_html(lt):
+def waiting_series(db):
+    """Tasks waiting (stored, not assigned) over simulated time, as fleetctl's saturated window counts
+    them: the count after the last transition of each stamp."""
+    queued, waiting, out = {}, 0, []
+    rows = db.execute("select task_id, to_state, stamp_ns from transitions order by seq").fetchall()
+    for i, (task, to, stamp) in enumerate(rows):
+        now = to == "queued"
+        waiting += (1 if now and not queued.get(task) else -1 if queued.get(task) and not now else 0)
+        queued[task] = now
+        if i + 1 == len(rows) or rows[i + 1][2] != stamp:
+            out.append((stamp / 1e9, waiting))
+    return out
+
+
+def saturated_html(s, waiting, done_at, end_s, w=640, h=260):
+    """fleetctl's saturated window: tasks waiting against the robot count, the window shaded, and
+    the tasks done over time."""
+    if not s:
+        return ""
+    robots = s.get("robots", 0)
+    if s.get("found"):
+        rows = [("window (at least as many tasks waiting as robots)",
+                 f"{s['from_s']:.0f}–{s['to_s']:.0f} s (held {100 * s.get('held_fraction', 0):.0f} % of it)"),
+                ("tasks done in it", f"{s['done']}"),
+                ("the fleet's rate in it", f"{s['fleet_rate_per_h']:.1f} tasks/h, <b>{s['per_robot_rate_per_h']:.2f}</b> per robot")]
+        if "efficiency" in s:
+            rows.append(("η (÷ a lone robot's saturated rate)",
+                         f"<b>{s['efficiency']:.2f}</b> (lone robot {s['lone_rate_per_h']:.1f}/h)"))
+        table = "<table>" + "".join(f"<tr><td>{html.escape(k)}</td><td class=\"r\">{v}</td></tr>" for k, v in rows) + "</table>"
+    else:
+        table = f"<p>No saturated window: {html.escape(str(s.get('why', '')))} (peak {s.get('peak_waiting', 0)} waiting, {robots} robots).</p>"
+    if not waiting:
+        return f"<h3>Saturated window</h3>{table}"
+    pts = [(0.0, 0)]
+    for t, n in waiting:
+        pts += [(t, pts[-1][1]), (t, n)]
+    pts.append((end_s, pts[-1][1]))
+    done = [(0.0, 0)] + [(t, i + 1) for i, t in enumerate(sorted(done_at))] + [(end_s, len(done_at))]
+    y1 = max(max(n for _, n in pts), len(done_at), robots) or 1
+    sx, sy, frame = svg_frame(w, h, 0.0, end_s or 1.0, y1, "simulated time (s)", "tasks", right=150, integer_y=True)
+    shade = (f'<rect x="{sx(s["from_s"]):.1f}" y="20" width="{max(0.0, sx(s["to_s"]) - sx(s["from_s"])):.1f}" '
+             f'height="{h-60}" fill="#e3eefa"/>' if s.get("found") else "")
+    line = lambda p, c, dash="": (f'<path d="{" ".join(("M" if k == 0 else "L") + f"{sx(x):.1f},{sy(y):.1f}" for k, (x, y) in enumerate(p))}" '
+                                  f'fill="none" stroke="{c}" stroke-width="1.6"{dash}/>')
+    legend = (f'<rect x="{w-142}" y="12" width="12" height="10" fill="#e3eefa"/><text x="{w-126}" y="21">saturated window</text>'
+              f'<line x1="{w-142}" y1="33" x2="{w-128}" y2="33" stroke="#1f77b4" stroke-width="2"/><text x="{w-124}" y="37">tasks waiting</text>'
+              f'<line x1="{w-142}" y1="49" x2="{w-128}" y2="49" stroke="#d62728" stroke-dasharray="4 3" stroke-width="2"/><text x="{w-124}" y="53">robots ({robots})</text>'
+              f'<line x1="{w-142}" y1="65" x2="{w-128}" y2="65" stroke="#2ca02c" stroke-width="2"/><text x="{w-124}" y="69">tasks done</text>')
+    dashed = ' stroke-dasharray="4 3"'
+    svg = (f'{svg_open(w, h)}{shade}{frame}{line(pts, "#1f77b4")}'
+           f'{line([(0.0, robots), (end_s, robots)], "#d62728", dashed)}'
+           f'{line(done, "#2ca02c")}{legend}</svg>')
+    return f"""<h3>Saturated window</h3><div class="grid"><div>{table}
+<p class="note">Issue 18's efficiency is taken while at least as many tasks wait as there are robots: every robot that
+finishes can chain the next task, so the rate there is the fleet's capacity, without the ramp-up from parking or the tail
+after the last task was posted.</p></div><div>{svg}</div></div>"""
+
+
+def loadtest_html(lt, saturated=""):
     if not lt:
         return ""
     a = lt.get("accounting", {})
@@ -430,6 +488,7 @@ Arrival rate {lt.get('rate_per_min', 0):g} tasks per simulated minute. Fault pla
 <h3>Faults injected</h3>{faults}</div>
 <div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)', why='no progress samples', diagonal='1× real time')}</div></div>
 {bound}
+{saturated}
 {agents}"""
 
 
@@ -505,6 +564,8 @@ def main(run):
                                                      "wall_limited", "interrupted")}
         summary["loadtest"]["kinematic_bound"] = {k: v for k, v in (lt.get("kinematic_bound") or {}).items()
                                                   if k != "per_task"}
+        if lt.get("saturated"):
+            summary["loadtest"]["saturated"] = lt["saturated"]
     json.dump(summary, open(os.path.join(run, "summary.json"), "w"), indent=2)
     risk = risk_levels_over_time(run)
     viewer = embedded_viewer(run)
@@ -561,7 +622,7 @@ long it stays). A negative gap is an overlap; a gap of "—": no such pair ever 
 the simulator recorded. Level l of K holds p in ((l−1)/K, l/K].</p></div>
 {localization_html(run, lt)}
 {traffic_html(run)}
-{loadtest_html(lt)}
+{loadtest_html(lt, saturated_html(lt.get("saturated") if lt else None, waiting_series(db), done_at, sim.get("sim_time_s", 0)))}
 <h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded;
 in reserved traffic the roadmap, its queue places and closed nodes, and each robot's released base (solid) and horizon (dashed).
 The viewer is embedded in this page; <a href="viewer.html">open it on its own</a> (viewer.html, next to this page in the run folder).</p>

@@ -423,7 +423,8 @@ TEST(LoadtestE2E, RunsWithTheApiTokenOfItsEnvironment) {
 TEST(LoadtestE2E, TaskTimesAreStatedAgainstTheKinematicBound) {
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-bound-" + std::to_string(getpid()));
   fs::remove_all(out);
-  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 400, 120);
+  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 400, 120,
+                                  {"--lone-saturated-per-h", "40"});
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(180)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
@@ -454,6 +455,18 @@ TEST(LoadtestE2E, TaskTimesAreStatedAgainstTheKinematicBound) {
   EXPECT_NEAR(b["fleet_rate_per_h"].get<double>(), r["throughput"]["done_per_sim_hour"].get<double>(), 0.01);
   EXPECT_GT(b["efficiency"].get<double>(), 0.0);
   EXPECT_LE(b["efficiency"].get<double>(), 1.0) << "a lone robot above the rate of its own bound";
+  // The saturated window (the η) is stated whether or not this run had one.
+  const json& s = r["saturated"];
+  ASSERT_TRUE(s.is_object()) << r.dump();
+  EXPECT_EQ(s["robots"], 1);
+  if (s["found"].get<bool>()) {
+    EXPECT_LT(s["from_s"].get<double>(), s["to_s"].get<double>());
+    EXPECT_NEAR(s["efficiency"].get<double>(), s["per_robot_rate_per_h"].get<double>() / 40.0, 0.001)
+        << s.dump();
+  } else {
+    EXPECT_TRUE(s.contains("why")) << s.dump();
+    EXPECT_FALSE(s.contains("efficiency")) << s.dump();
+  }
 }
 
 // Disabled from 2026-11-25 to 11-26: about 1 run in 4 the robot stood idle after ~25 m while the
@@ -655,6 +668,7 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
     html += line + "\n";
   }
   EXPECT_NE(html.find("Robot agents (wall clock)"), std::string::npos);
+  EXPECT_NE(html.find("<h3>Saturated window</h3>"), std::string::npos);
   EXPECT_NE(html.find("0 lost, 0 duplicated"), std::string::npos);
   // Reserved traffic (the default): the report has the traffic layer from the replay.
   EXPECT_NE(html.find("<h2 id=\"traffic\">Traffic layer</h2>"), std::string::npos);
