@@ -279,7 +279,55 @@ void World::pickGoalAwayFromRobots(std::size_t hi) {
       return;
     }
   }
-  pickGoal(hi);  // hemmed in on every side: wait it out as before
+  // Every way leads into a robot (someone between two robots that face each other, each waiting
+  // for them): step out of the gap first. Drawing a goal here sent them to and fro between the two
+  // for minutes in a mixed-fleet run.
+  if (!stepAside(h, near)) {
+    pickGoal(hi);  // hemmed in on every side: wait it out as before
+  }
+}
+
+bool World::stepAside(HumanBody& h, const std::vector<Vec2>& near) {
+  constexpr int kDirections = 16;
+  constexpr double kSteps[] = {1.5, 1.0};
+  double best = -1.0;
+  for (const double step : kSteps) {
+    for (int k = 0; k < kDirections; ++k) {
+      const double a = 2.0 * kPi * k / kDirections;
+      const Vec2 e{std::cos(a), std::sin(a)};
+      const Vec2 q = h.p + e * step;
+      const bool intoRobot = std::any_of(near.begin(), near.end(), [&](Vec2 r) {
+        const Vec2 d = r - h.p;
+        return e.dot(d) > kIntoRobotCos * len(d);
+      });
+      if (intoRobot) {
+        continue;
+      }
+      bool clear = true;
+      for (double s = 0.1; s <= step + 1e-9 && clear; s += 0.1) {
+        clear = discGridPenetration(sc_.map, h.p + e * s, h.r + 0.05) <= 0.0;
+      }
+      if (!clear) {
+        continue;
+      }
+      double gap = 1e9;
+      for (const Vec2 r : near) {
+        gap = std::min(gap, distance(q, r));
+      }
+      if (gap > best) {
+        best = gap;
+        h.aside = q;
+      }
+    }
+    if (best >= 0.0) {
+      break;  // a full step if one is free
+    }
+  }
+  if (best < 0.0) {
+    return false;
+  }
+  h.asideUntil = time() + kGiveUpS;
+  return true;
 }
 
 CommandOutcome World::command(const std::string& id, double v, double w) {
@@ -424,6 +472,11 @@ void World::stepHumans() {
       pickGoalAwayFromRobots(i);
       continue;
     }
+    if (h.asideUntil >= 0.0 && (now >= h.asideUntil || distance(h.p, h.aside) < kArrive)) {
+      h.asideUntil = -1.0;  // out of the gap: on to a new goal
+      pickGoal(i);
+      continue;
+    }
     if (h.field >= 0 && now >= h.stopUntil &&
         distance(h.p, fields_[static_cast<std::size_t>(h.field)].goal()) < kArrive) {
       if (uniform01(humanRng_) < sc_.crowd.stopProbability) {
@@ -438,7 +491,9 @@ void World::stepHumans() {
   for (std::size_t i = 0; i < humans_.size(); ++i) {
     const HumanBody& h = humans_[i];
     Vec2 e;
-    if (h.field >= 0 && now >= h.stopUntil) {
+    if (h.asideUntil >= 0.0) {
+      e = (h.aside - h.p).normalized();
+    } else if (h.field >= 0 && now >= h.stopUntil) {
       e = fields_[static_cast<std::size_t>(h.field)].direction(sc_.map, h.p);
     }
     Vec2 f = drivingForce(e * h.v0, h.v, sf.tau);

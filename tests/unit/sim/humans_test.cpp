@@ -238,6 +238,54 @@ TEST(Humans, NeverWalkIntoAStandingRobotUnlessTheKeepDistanceIsOff) {
   EXPECT_LT(sepOff, 0.0);
 }
 
+TEST(Humans, SomeoneBetweenTwoStandingRobotsStepsOutOfTheGap) {
+  // A 2.5 m corridor (y 9..11.5) along a shelf; two robots stand by the shelf facing each other 2 m
+  // apart (vehicles whose protective fields a person stopped), the person between them. Every goal
+  // lies along the corridor, so every way leads into one robot or the other and no goal turns away
+  // from both: in a mixed-fleet run such a person stood there for 400 s, and both vehicles with
+  // them. They must step out of the gap (the corridor is free beside it).
+  auto trapped = [](std::uint64_t seed) {
+    auto j = test::room(40, 30);
+    j["seed"] = seed;
+    auto& rows = j["map"]["rows"];
+    for (int r = 1; r < 29; ++r) {
+      std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+      for (int c = 1; c < 39; ++c) {
+        if (r < 7 || r > 11) {
+          s[static_cast<std::size_t>(c)] = '@';
+        }
+      }
+      rows[static_cast<std::size_t>(r)] = s;
+    }
+    j["robots"] = {{{"id", "r1"}, {"start", {8.8, 9.75, 0.0}}},
+                   {{"id", "r2"}, {"start", {10.8, 9.75, 3.1416}}}};
+    j["points_of_interest"] = {{1.5, 9.5}, {18.5, 9.5}, {4.0, 9.5}, {16.0, 9.5}};
+    j["humans"] = {{"list", {{{"id", "h"}, {"start", {9.8, 9.3}}}}}, {"stop_probability", 0.0}};
+    World w(test::parse(j));
+    const Vec2 a{8.8, 9.75}, b{10.8, 9.75};
+    double stretch = 0.0, since = 0.0;
+    for (int k = 0; k < 900; ++k) {  // 90 s
+      w.advance();
+      const Vec2 p = w.humans()[0].p;
+      if (std::min(distance(p, a), distance(p, b)) >= 1.0) {
+        since = -1.0;
+      } else if (since < 0.0) {
+        since = w.time();
+      } else {
+        stretch = std::max(stretch, w.time() - since);
+      }
+    }
+    return stretch;
+  };
+  double worst = 0.0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    worst = std::max(worst, trapped(seed));
+  }
+  // Drawing goals, they went to and fro between the two: 17-27 s at a time within 1 m of one (90 s
+  // within 1.2 m); stepping out of the gap, 6-8 s.
+  EXPECT_LT(worst, 12.0) << "someone stood within 1 m of the robots for that many seconds at a time";
+}
+
 TEST(Humans, SomeoneWhoseWayIsThroughAStandingRobotTurnsAwayInsteadOfPacingBesideIt) {
   // A 1.5 m cross corridor (y 10..11.5) crossed by a 1.5 m aisle (x 9..10.5); a robot stands in the
   // aisle's mouth south of the corridor, facing it. Most goals lie south, beyond the robot: someone

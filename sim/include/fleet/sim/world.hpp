@@ -48,6 +48,8 @@ struct HumanBody {
   int leader = -1;         // group leader's index (self when leading or alone)
   Vec2 progressRef;        // where the human was when it last made progress
   double progressAt = -1;  // sim s of that moment; -1 before the first step
+  Vec2 aside;              // a point to step to out of a gap between robots ...
+  double asideUntil = -1;  // ... until then (sim s); < 0: none
 };
 
 /// A contact between two bodies this step. Indices: robots 0..R-1, humans R..R+H-1, b = -1 is the map.
@@ -168,6 +170,9 @@ class World {
   void pickGoal(std::size_t h);
   /// Another goal for someone who could not get on: one whose way does not lead into a robot beside them.
   void pickGoalAwayFromRobots(std::size_t h);
+  /// A free point a step away whose direction leads into none of `near`, as far from them as
+  /// possible; false if there is none.
+  bool stepAside(HumanBody& h, const std::vector<Vec2>& near);
   void stepRobots();
   void stepHumans();
   void updateContacts();
