@@ -238,6 +238,24 @@ TEST(Humans, NeverWalkIntoAStandingRobotUnlessTheKeepDistanceIsOff) {
   EXPECT_LT(sepOff, 0.0);
 }
 
+/// A 40 x 30 cell room (0.5 m cells) walled inside except where `open(row, column)`.
+template <typename Open>
+nlohmann::json carvedRoom(std::uint64_t seed, Open open) {
+  auto j = test::room(40, 30);
+  j["seed"] = seed;
+  auto& rows = j["map"]["rows"];
+  for (int r = 1; r < 29; ++r) {
+    std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
+    for (int c = 1; c < 39; ++c) {
+      if (!open(r, c)) {
+        s[static_cast<std::size_t>(c)] = '@';
+      }
+    }
+    rows[static_cast<std::size_t>(r)] = s;
+  }
+  return j;
+}
+
 TEST(Humans, SomeoneBetweenTwoStandingRobotsStepsOutOfTheGap) {
   // A 2.5 m corridor (y 9..11.5) along a shelf; two robots stand by the shelf facing each other 2 m
   // apart (vehicles whose protective fields a person stopped), the person between them. Every goal
@@ -245,18 +263,7 @@ TEST(Humans, SomeoneBetweenTwoStandingRobotsStepsOutOfTheGap) {
   // from both: in a mixed-fleet run such a person stood there for 400 s, and both vehicles with
   // them. They must step out of the gap (the corridor is free beside it).
   auto trapped = [](std::uint64_t seed) {
-    auto j = test::room(40, 30);
-    j["seed"] = seed;
-    auto& rows = j["map"]["rows"];
-    for (int r = 1; r < 29; ++r) {
-      std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
-      for (int c = 1; c < 39; ++c) {
-        if (r < 7 || r > 11) {
-          s[static_cast<std::size_t>(c)] = '@';
-        }
-      }
-      rows[static_cast<std::size_t>(r)] = s;
-    }
+    auto j = carvedRoom(seed, [](int r, int) { return r >= 7 && r <= 11; });
     j["robots"] = {{{"id", "r1"}, {"start", {8.8, 9.75, 0.0}}},
                    {{"id", "r2"}, {"start", {10.8, 9.75, 3.1416}}}};
     j["points_of_interest"] = {{1.5, 9.5}, {18.5, 9.5}, {4.0, 9.5}, {16.0, 9.5}};
@@ -293,21 +300,12 @@ TEST(Humans, SomeoneWhoseWayIsThroughAStandingRobotTurnsAwayInsteadOfPacingBesid
   // mostly draw another one beyond the robot and pace in front of it (what held robots for minutes
   // in the dense fleet check); they must turn to a way that leads away.
   auto nearTime = [](std::uint64_t seed) {
-    auto j = test::room(40, 30);
-    j["seed"] = seed;
-    auto& rows = j["map"]["rows"];
-    for (int r = 1; r < 29; ++r) {
-      std::string s = rows[static_cast<std::size_t>(r)].get<std::string>();
-      for (int c = 1; c < 39; ++c) {
-        const bool corridor = r >= 7 && r <= 9;
-        const bool aisle = c >= 18 && c <= 20;
-        const bool south = r >= 25;
-        if (!corridor && !aisle && !south) {
-          s[static_cast<std::size_t>(c)] = '@';
-        }
-      }
-      rows[static_cast<std::size_t>(r)] = s;
-    }
+    auto j = carvedRoom(seed, [](int r, int c) {
+      const bool corridor = r >= 7 && r <= 9;
+      const bool aisle = c >= 18 && c <= 20;
+      const bool south = r >= 25;
+      return corridor || aisle || south;
+    });
     j["robots"] = {{{"id", "r1"}, {"start", {9.75, 9.75, 1.5708}}}};
     j["points_of_interest"] = {{2.0, 1.0},  {5.0, 1.0},  {8.0, 1.0},   {11.0, 1.0},
                                {14.0, 1.0}, {17.0, 1.0}, {2.0, 10.75}, {18.0, 10.75}};
