@@ -622,7 +622,7 @@ long it stays). A negative gap is an overlap; a gap of "—": no such pair ever 
 the simulator recorded. Level l of K holds p in ((l−1)/K, l/K].</p></div>
 {localization_html(run, lt)}
 {traffic_html(run)}
-{loadtest_html(lt, saturated_html(lt.get("saturated") if lt else None, waiting_series(db), done_at, sim.get("sim_time_s", 0)))}
+{loadtest_html(lt, saturated_html(lt.get("saturated") if lt else None, waiting_series(db) if lt and lt.get("clock") != "wall" else [], done_at, sim.get("sim_time_s", 0)))}
 <h2 id="replay">Replay</h2><p>Robots (orange) with task labels, humans (blue), contacts highlighted, risk-map iso-levels shaded;
 in reserved traffic the roadmap, its queue places and closed nodes, and each robot's released base (solid) and horizon (dashed).
 The viewer is embedded in this page; <a href="viewer.html">open it on its own</a> (viewer.html, next to this page in the run folder).</p>

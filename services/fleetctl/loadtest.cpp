@@ -1092,8 +1092,14 @@ int Run::run() {
       o.wallClock
           ? json{{"error", "not in wall-clock runs (the manager's stamps are not the replay's clock)"}}
           : runBounds(out, report["throughput"]["done_per_sim_hour"].get<double>(), robots.size());
+  // As for the bound: on the wall clock the manager's stamps are epoch time, not the run's.
   report["saturated"] =
-      saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime), o.loneSaturatedPerH);
+      o.wallClock
+          ? json{{"found", false},
+                 {"why", "not in wall-clock runs (the manager's stamps are not the run's clock)"},
+                 {"robots", robots.size()},
+                 {"peak_waiting", 0}}
+          : saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime), o.loneSaturatedPerH);
   writeFile(out / "loadtest.json", report.dump(2));
   char line[256];
   std::snprintf(

@@ -459,6 +459,8 @@ void World::stepHumans() {
       const HumanBody& l = humans_[static_cast<std::size_t>(h.leader)];
       h.field = l.field;
       h.stopUntil = l.stopUntil;
+      h.aside = l.aside;  // out of a gap together (each steering for the leader's point)
+      h.asideUntil = l.asideUntil;
       continue;
     }
     // People who cannot get past (a robot waiting in a narrow aisle, a crowd) do not push forever:

@@ -669,6 +669,8 @@ TEST(LoadtestE2E, WallClockRunReportsTheAgentsAchievedControlRate) {
   }
   EXPECT_NE(html.find("Robot agents (wall clock)"), std::string::npos);
   EXPECT_NE(html.find("<h3>Saturated window</h3>"), std::string::npos);
+  EXPECT_FALSE(r["saturated"]["found"].get<bool>()) << "epoch stamps are not a window of the run";
+  EXPECT_NE(r["saturated"]["why"].get<std::string>().find("wall-clock"), std::string::npos);
   EXPECT_NE(html.find("0 lost, 0 duplicated"), std::string::npos);
   // Reserved traffic (the default): the report has the traffic layer from the replay.
   EXPECT_NE(html.find("<h2 id=\"traffic\">Traffic layer</h2>"), std::string::npos);
