@@ -24,6 +24,7 @@ SaturatedWindow saturatedWindow(const std::vector<TransitionRow>& transitions, s
   double heldS = 0.0;
   bool any = false;
   auto settle = [&](double t) {
+    w.peakWaiting = std::max(w.peakWaiting, waiting);
     const bool holds = waiting >= robots;
     if (holds && openedAt < 0.0) {
       openedAt = t;
@@ -47,7 +48,6 @@ SaturatedWindow saturatedWindow(const std::vector<TransitionRow>& transitions, s
       --waiting;
     }
     q = nowQueued;
-    w.peakWaiting = std::max(w.peakWaiting, waiting);
     const double t = static_cast<double>(tr.stampNs) * 1e-9;
     if (i + 1 == transitions.size() || transitions[i + 1].stampNs != tr.stampNs) {
       settle(t);

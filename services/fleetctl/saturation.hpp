@@ -24,8 +24,8 @@ struct SaturatedWindow {
   double heldFraction = 0;  ///< share of [from, to] in which it held (it may dip in between)
   std::size_t done = 0;     ///< tasks first done inside (from, to]
   std::size_t robots = 0;
-  std::size_t peakWaiting = 0;
-  double perRobotPerH = 0.0;  ///< done ÷ robots ÷ window hours
+  std::size_t peakWaiting = 0;  ///< counted as the window is: after each stamp's last transition
+  double perRobotPerH = 0.0;    ///< done ÷ robots ÷ window hours
 };
 
 /// `transitions` in the order the manager stored them (stamps in simulated ns); `endS` the run's

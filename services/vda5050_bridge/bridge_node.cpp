@@ -267,12 +267,13 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
   for (std::size_t i = 0; i < keep; ++i) {
     in.base.push_back({r.base[i].node, r.base[i].x, r.base[i].y});
   }
-  for (const auto& n : r.horizon) {
-    if (keep == r.base.size()) {
+  const bool whole = keep == r.base.size();
+  if (whole) {
+    for (const auto& n : r.horizon) {
       in.horizon.push_back({n.node, n.x, n.y});
     }
   }
-  if (keep == r.base.size() && r.ends_at_goal && !v.task_id.empty() && v.goal < v.goals.size()) {
+  if (whole && r.ends_at_goal && !v.task_id.empty() && v.goal < v.goals.size()) {
     const auto& g = v.goals[v.goal];
     if (g.action == msg::GoalAction::Load || g.action == msg::GoalAction::Unload) {
       vda5050::Action a{

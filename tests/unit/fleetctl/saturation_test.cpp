@@ -60,6 +60,14 @@ TEST(SaturatedWindow, ARequeuedTaskWaitsAgainAndADuplicateDoneCountsOnce) {
   EXPECT_DOUBLE_EQ(w.toS, 30.0);
   EXPECT_NEAR(w.heldFraction, 11.0 / 30.0, 1e-12);
   EXPECT_EQ(w.done, 0u);  // done at 50 s, after the window
+  // With b waiting from 0 s until it is taken at 60 s, one robot is saturated over [0, 60], and
+  // a's two "done" (50 s, 55 s) inside it count once.
+  auto withB = t;
+  withB.insert(withB.begin(), at(0, "b", "queued"));
+  const auto all = saturatedWindow(withB, 1, 100.0);
+  ASSERT_TRUE(all.found);
+  EXPECT_DOUBLE_EQ(all.toS, 60.0);
+  EXPECT_EQ(all.done, 1u);
 }
 
 TEST(SaturatedWindow, NoWindowWhenFewerTasksThanRobotsEverWaitOrOnlyInsideOneBatch) {
@@ -67,7 +75,7 @@ TEST(SaturatedWindow, NoWindowWhenFewerTasksThanRobotsEverWaitOrOnlyInsideOneBat
   const std::vector<TransitionRow> batch = {at(3, "a", "queued"), at(3, "b", "queued"), at(3, "c", "queued"),
                                             at(3, "a", "assigned"), at(3, "b", "assigned")};
   EXPECT_FALSE(saturatedWindow(batch, 2, 10.0).found);
-  EXPECT_EQ(saturatedWindow(batch, 2, 10.0).peakWaiting, 3u);
+  EXPECT_EQ(saturatedWindow(batch, 2, 10.0).peakWaiting, 1u);  // as the window counts it
   EXPECT_FALSE(saturatedWindow(batch, 0, 10.0).found);
   EXPECT_FALSE(saturatedWindow({}, 1, 10.0).found);
   // Reached at the run's very end only: a window of no length.
