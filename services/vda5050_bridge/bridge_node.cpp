@@ -1,6 +1,7 @@
 #include "bridge_node.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fleet/vda5050/header.hpp"
 #include "fleet/vda5050/instant_actions.hpp"
@@ -11,6 +12,10 @@ namespace fleet::vdabridge {
 using vda5050::VehicleHealth;
 
 namespace {
+
+/// A release's last node this close to a goal's pose is the goal's node (station nodes lie on the
+/// station's pose; the traffic manager puts a goal at most this far from its node).
+constexpr double kGoalReach = 0.5;  // m
 
 const vda5050::ActionState* findAction(const vda5050::State& s, const std::string& id) {
   for (const auto& a : s.actionStates) {
@@ -50,11 +55,13 @@ void BridgeNode::onMqtt(const std::string& topic, const std::string& payload, Br
   }
 }
 
-void BridgeNode::instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out) {
+void BridgeNode::instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out,
+                         const std::string& id) {
   vda5050::InstantActions ia;
   ia.header = {v.instant_header++, vda5050::isoTimestamp(nowNs), vda5050::kVersion, v.entry.manufacturer,
                v.entry.serial};
-  ia.actions.push_back({type, type + "-" + std::to_string(ia.header.headerId), "HARD", {}, {}});
+  ia.actions.push_back(
+      {type, id.empty() ? type + "-" + std::to_string(ia.header.headerId) : id, "HARD", {}, {}});
   out.mqtt.push_back(
       {vda5050::topicName(settings_.interface_name, v.entry.manufacturer, v.entry.serial, "instantActions"),
        vda5050::toJson(ia).dump(), 0, false});
@@ -77,7 +84,10 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     return;
   }
   auto& v = it->second;
-  if (a.task_id != v.task_id) {
+  // The same task again in a newer revision after it failed here: the manager re-queued it and
+  // gave it back, so it starts afresh (a charge task at the same charger tries startCharging again).
+  const bool retried = a.task_id == v.task_id && !v.failure.empty() && a.revision != v.revision;
+  if (a.task_id != v.task_id || retried) {
     // A task taken away: stop where it is. A new task simply goes on with the current order: the
     // traffic manager's next releases extend it towards the new goal.
     if (a.task_id.empty() && !v.task_id.empty() && v.has_order) {
@@ -87,6 +97,9 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     }
     v.task_id = a.task_id;
     v.goal = 0;
+    v.charge_action.clear();
+    v.charging_since_ns = -1;
+    v.failure.clear();
     freshChance(v);
     v.reported = msg::TaskState::Queued;
   }
@@ -228,8 +241,9 @@ void BridgeNode::cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_
   }
 }
 
-void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
-  while (!v.task_id.empty() && v.goal < v.goals.size()) {
+void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
+                            BridgeOutbox& out) {
+  while (!v.task_id.empty() && v.goal < v.goals.size() && v.failure.empty()) {
     const auto& g = v.goals[v.goal];
     if (g.action == msg::GoalAction::Load || g.action == msg::GoalAction::Unload) {
       const auto* a = findAction(*view.state, goalActionId(v, v.goal));
@@ -237,11 +251,19 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
         return;
       }
     } else {
+      // The release must end at this goal, not at the last task's (a release that has not caught
+      // up with a new task still ends where the vehicle stands: a charge task began with a
+      // startCharging at the drop-off it came from).
       const bool there =
           v.release && v.release->ends_at_goal && !v.release->base.empty() &&
+          std::hypot(v.release->base.back().x - g.pose.x, v.release->base.back().y - g.pose.y) <=
+              kGoalReach &&
           view.state->nodeStates.empty() &&
           vda5050::OrderBuilder::roadmapNode(view.state->lastNodeId) == v.release->base.back().node;
       if (!there) {
+        return;
+      }
+      if (g.action == msg::GoalAction::Charge && !charged(v, *view.state, nowNs, out)) {
         return;
       }
     }
@@ -249,12 +271,63 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view) {
   }
 }
 
+bool BridgeNode::charged(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out) {
+  if (v.charge_action.empty()) {
+    v.charge_action = goalActionId(v, v.goal);
+    v.charging_since_ns = -1;
+    instant(v, "startCharging", nowNs, out, v.charge_action);
+    ++counters_.charges;
+    return false;
+  }
+  const auto* a = findAction(s, v.charge_action);
+  if (a != nullptr && a->actionStatus == "FAILED") {
+    ++counters_.charge_failures;
+    v.failure = "startCharging failed: " + a->resultDescription.value_or("no reason given");
+    out.warnings.push_back(v.entry.robot_id + ": " + v.failure + " (task " + v.task_id + " failed)");
+    return false;
+  }
+  if (!s.batteryState.charging) {
+    return false;  // not yet started (or the vehicle has not said so)
+  }
+  if (v.charging_since_ns < 0) {
+    v.charging_since_ns = nowNs;
+  }
+  // The fleet manager ends the task once the battery is charged; a charger that does not charge
+  // holds the vehicle no longer than the goal's duration (charge_max_s), as for a robot agent.
+  if (static_cast<double>(nowNs - v.charging_since_ns) * 1e-9 < v.goals[v.goal].duration_s) {
+    return false;
+  }
+  instant(v, "stopCharging", nowNs, out);
+  ++counters_.charge_stops;
+  v.charge_stop_ns = nowNs;
+  v.charge_action.clear();
+  return true;
+}
+
+void BridgeNode::stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int64_t nowNs,
+                                   BridgeOutbox& out) {
+  const bool wanted = !v.charge_action.empty() && v.failure.empty() && !v.task_id.empty() &&
+                      v.goal < v.goals.size() && v.goals[v.goal].action == msg::GoalAction::Charge;
+  if (!s.batteryState.charging || wanted) {
+    return;
+  }
+  // Again after a while: a stopCharging lost on the way (QoS 0) must not hold the vehicle for ever.
+  constexpr double kResendS = 5.0;
+  if (v.charge_stop_ns >= 0 && static_cast<double>(nowNs - v.charge_stop_ns) * 1e-9 < kResendS) {
+    return;
+  }
+  instant(v, "stopCharging", nowNs, out);
+  ++counters_.charge_stops;
+  v.charge_stop_ns = nowNs;
+}
+
 void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
                                BridgeOutbox& out) {
   // Held where it stands (the traffic manager plans round it): an order now would be the release
   // it had, cancelled again; the next comes once its field is clear, from the release then.
+  // Charging, it takes no order (stopCharging first: stopStrayCharging()).
   if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline || v.gave_up ||
-      nowNs < v.retry_ns || v.field_cancelled) {
+      nowNs < v.retry_ns || v.field_cancelled || view.state->batteryState.charging) {
     return;
   }
   const auto& r = *v.release;
@@ -349,7 +422,9 @@ void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
   }
   msg::TaskState st = msg::TaskState::Assigned;
   const auto* view = registry_.find(v.entry.robot_id);
-  if (v.goal >= v.goals.size()) {
+  if (!v.failure.empty()) {
+    st = msg::TaskState::Failed;
+  } else if (v.goal >= v.goals.size()) {
     st = msg::TaskState::Done;
   } else if (view != nullptr && view->state && v.has_order) {
     const auto& g = v.goals[v.goal];
@@ -373,6 +448,7 @@ void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
   ts.revision = v.revision;
   ts.state = st;
   ts.progress = v.goals.empty() ? 1.0F : static_cast<float>(v.goal) / static_cast<float>(v.goals.size());
+  ts.error = v.failure.substr(0, 255);
   ts.stamp_ns = nowNs;
   out.statuses.push_back(std::move(ts));
 }
@@ -388,7 +464,8 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     if (online) {
       watchOrder(v, s, nowNs, out);
       cancelWhenHeld(v, s, nowNs, out);
-      trackGoals(v, *view);
+      trackGoals(v, *view, nowNs, out);
+      stopStrayCharging(v, s, nowNs, out);
       followRelease(v, *view, nowNs, out);
       reportTask(v, nowNs, out);
     }
@@ -408,7 +485,8 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       rs.pose = pose;
       rs.v = s.velocity ? s.velocity->vx : 0.0;
       rs.w = s.velocity ? s.velocity->omega : 0.0;
-      rs.mode = acting                                                           ? msg::RobotMode::Loading
+      rs.mode = s.batteryState.charging                                          ? msg::RobotMode::Charging
+                : acting                                                         ? msg::RobotMode::Loading
                 : (s.paused.value_or(false) || s.newBaseRequest.value_or(false)) ? msg::RobotMode::Waiting
                 : s.driving                                                      ? msg::RobotMode::Moving
                                                                                  : msg::RobotMode::Idle;
@@ -433,7 +511,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       p.has_goal = true;
       p.goal = *v.home;
     }
-    p.holding = !online || acting || s.paused.value_or(false);
+    p.holding = !online || acting || s.paused.value_or(false) || s.batteryState.charging;
     // Reported blocked, a robot is held by the traffic manager, which cuts its release back to its
     // next node and plans the others over the rest. A vehicle stopped by its protective field keeps
     // its order's base and drives on by itself once the field is clear: while it holds more than

@@ -19,6 +19,13 @@
 //    latest state (a new order from its last node; an update from the base end of the update it
 //    has), after a back-off that doubles. After order_retries failed retries the robot is reported
 //    blocked to the traffic manager until a changed release or task gives it a new chance.
+//  - Charging: at a charge goal's node, with nothing left of its order, the vehicle is sent
+//    startCharging; it reports mode Charging and holds its node while its state says charging, until
+//    the fleet manager ends the task (charged to its target) or the goal's duration runs out (then
+//    the bridge ends the goal, as a robot agent does). Whenever the vehicle charges with no charge
+//    goal of its own (the task ended or changed) it is sent stopCharging, and no order goes out
+//    until it reports charging false (VDA 5050 2.1, 6.8.1: stopCharging comes before a new order).
+//    A startCharging that FAILED fails the task with the vehicle's reason.
 //  - Health (vda5050::VehicleRegistry): a vehicle that is not online (MANUAL, a FATAL error, a
 //    message that fails the checks, its last will) publishes no RobotState, so the fleet manager
 //    loses it and re-queues its task as for our robots, and its TrafficProgress says it does not
@@ -76,6 +83,9 @@ struct BridgeCounters {
   std::uint64_t rejected = 0;       // orders and updates the vehicle rejected or did not take
   std::uint64_t gave_up = 0;        // times a vehicle was reported blocked after its retries
   std::uint64_t field_cancels = 0;  // orders cancelled because the vehicle's field held it (in `cancels` too)
+  std::uint64_t charges = 0;        // startCharging sent
+  std::uint64_t charge_failures = 0;  // startCharging the vehicle answered FAILED
+  std::uint64_t charge_stops = 0;     // stopCharging sent
 };
 
 class BridgeNode {
@@ -125,15 +135,26 @@ class BridgeNode {
     // of it but its first two nodes since (it holds a blocked robot there), so until a newer
     // release arrives an order takes no more than those.
     std::optional<std::pair<std::uint32_t, std::uint32_t>> stale_release;  // epoch, seq
+    std::string charge_action;            // the startCharging sent for the current goal; empty: none
+    std::int64_t charging_since_ns = -1;  // its state said charging from then, at that goal
+    std::int64_t charge_stop_ns = -1;     // stopCharging last sent then
+    std::string failure;                  // the task failed for this (reported with the status)
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);
   void watchOrder(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
   void orderFailed(Vehicle& v, const std::string& why, std::int64_t nowNs, BridgeOutbox& out);
   void freshChance(Vehicle& v);
-  void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out);
+  /// Sends one instant action; its id is `id`, or "<type>-<header id>" when empty.
+  void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out,
+               const std::string& id = {});
   void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
-  void trackGoals(Vehicle& v, const vda5050::VehicleView& view);
+  void trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
+  /// A charge goal at its node: start charging, watch it, end the goal when its duration is over.
+  /// False while the goal goes on.
+  bool charged(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
+  /// stopCharging to a vehicle that charges without a charge goal of its own.
+  void stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
   void cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
   void reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out);
   [[nodiscard]] std::string goalActionId(const Vehicle& v, std::size_t goal) const;

@@ -172,6 +172,10 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
         &vdabridge::BridgeCounters::gave_up);
   total("field_cancels", "Orders cancelled because the vehicle's protective field held it",
         &vdabridge::BridgeCounters::field_cancels);
+  total("charges_started", "startCharging sent at a charge goal", &vdabridge::BridgeCounters::charges);
+  total("charge_failures", "startCharging the vehicle answered FAILED (the task failed)",
+        &vdabridge::BridgeCounters::charge_failures);
+  total("charge_stops", "stopCharging sent", &vdabridge::BridgeCounters::charge_stops);
   ops.watchMatchedReaders("RobotState", [&] { return states.matchedReaders(); });
   ops.watchMatchedWriters("TaskAssignment", [&] { return assignments.matchedWriters(); });
   ops.watchMatchedWriters("TrafficRelease", [&] { return releases.matchedWriters(); });
@@ -252,9 +256,9 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
       spdlog::info(
           "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched, "
           "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries, {} orders "
-          "cancelled for a vehicle its field held",
+          "cancelled for a vehicle its field held, {} charges started ({} failed), {} stopped",
           c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up,
-          c.field_cancels);
+          c.field_cancels, c.charges, c.charge_failures, c.charge_stops);
       lastStats = std::chrono::steady_clock::now();
     }
   };

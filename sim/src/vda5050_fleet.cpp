@@ -103,9 +103,11 @@ void Vda5050Fleet::step(World& world, double now_s, std::int64_t stamp_ns) {
                             "): " + verdict.description);
       }
     }
+    m.vehicle->senseBattery(world.robots()[m.robot].battery, world.atCharger(m.robot));
     for (const auto& ia : in.instant_actions) {
       m.vehicle->onInstantActions(ia);
     }
+    world.setChargeSwitch(m.robot, m.vehicle->charging());
     const auto& pose = world.robots()[m.robot].pose;
     bool person = false;
     bool warned = false;

@@ -67,6 +67,13 @@ OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
   if (operating_mode_ != "AUTOMATIC" && verdict.decision != OrderDecision::kReject) {
     verdict = {OrderDecision::kReject, "orderError", "the vehicle is in " + operating_mode_ + " mode"};
   }
+  // VDA 5050 2.1, 6.8.1: charging is stopped "to send a new order"; the vehicle is not ready for
+  // one before (a duplicate is still discarded, it changes nothing).
+  if (charging_ &&
+      (verdict.decision == OrderDecision::kAcceptNew || verdict.decision == OrderDecision::kAcceptUpdate)) {
+    verdict = {OrderDecision::kReject, "orderError",
+               "order '" + order.orderId + "': the vehicle is charging (stopCharging first)"};
+  }
   switch (verdict.decision) {
     case OrderDecision::kAcceptNew: {
       order_ = order;
@@ -165,6 +172,24 @@ void Vda5050Vehicle::onInstantActions(const InstantActions& message) {
       } else {
         cancel();
       }
+    } else if (a.actionType == "startCharging") {
+      // Only standing on a charger with nothing left to drive: charging on the way (a charging
+      // lane) is not something this vehicle does.
+      std::string why;
+      if (!at_charger_) {
+        why = "not on a charging spot";
+      } else if (driving_ || (order_ && next_ < order_->nodes.size())) {
+        why = "the vehicle has an order to drive";
+      }
+      if (why.empty()) {
+        charging_ = true;
+      } else {
+        s.actionStatus = "FAILED";
+        s.resultDescription = why;
+        errors_.push_back({"chargingError", "WARNING", "startCharging: " + why, {{"actionId", a.actionId}}});
+      }
+    } else if (a.actionType == "stopCharging") {
+      charging_ = false;  // idempotent: FINISHED when it was not charging either
     } else if (a.actionType == "factsheetRequest") {
       factsheet_requested_ = true;
     } else if (a.actionType == "stateRequest") {
@@ -180,6 +205,11 @@ void Vda5050Vehicle::onInstantActions(const InstantActions& message) {
     }
   }
   event();
+}
+
+void Vda5050Vehicle::senseBattery(double stateOfCharge, bool atCharger) {
+  battery_ = std::clamp(stateOfCharge, 0.0, 1.0);
+  at_charger_ = atCharger;
 }
 
 void Vda5050Vehicle::reachNode(double now_s) {
@@ -371,7 +401,7 @@ State Vda5050Vehicle::takeState(double now_s, std::int64_t stamp_ns) {
   s.agvPosition = AgvPosition{pose_.x, pose_.y, pose_.theta, config_.mapId, true};
   s.velocity = Velocity{last_command_.v, 0.0, last_command_.w};
   s.actionStates = action_states_;
-  s.batteryState = {100.0, false};
+  s.batteryState = {battery_ * 100.0, charging_};
   s.errors = errors_;
   s.safetyState = {"NONE", field_violation_};
   return s;
@@ -398,8 +428,8 @@ Factsheet Vda5050Vehicle::factsheet(std::int64_t stamp_ns) const {
   f.minOrderInterval = 0.1;
   f.minStateInterval = 0.1;
   f.defaultStateInterval = config_.stateInterval;
-  f.agvActions = {"pick",        "drop", "startPause", "stopPause", "cancelOrder", "factsheetRequest",
-                  "stateRequest"};
+  f.agvActions = {"pick",          "drop",         "startPause",       "stopPause",   "cancelOrder",
+                  "startCharging", "stopCharging", "factsheetRequest", "stateRequest"};
   return f;
 }
 

@@ -360,6 +360,18 @@ void World::setLabel(std::size_t robot, std::string mode, std::string task) {
   robots_[robot].task = std::move(task);
 }
 
+void World::setChargeSwitch(std::size_t robot, bool on) {
+  robots_[robot].switchedCharging = true;
+  robots_[robot].chargeSwitch = on;
+}
+
+bool World::atCharger(std::size_t robot) const {
+  const auto& p = robots_[robot].pose;
+  return std::any_of(sc_.stations.begin(), sc_.stations.end(), [&](const auto& st) {
+    return st.kind == StationKind::Charging && distance(st.pose, p) < kChargeReach;
+  });
+}
+
 void World::advance() {
   stepHumans();  // reads robot poses of the step start; writes humans after robots are done below
   stepRobots();
@@ -430,15 +442,7 @@ void World::stepRobots() {
     if (std::abs(r.twist.v) < kStillSpeed && std::abs(r.twist.omega) < kStillSpeed) {
       r.idleS += dt;
     }
-    r.charging = false;
-    if (std::abs(r.twist.v) < kStillSpeed) {
-      for (const auto& st : sc_.stations) {
-        if (st.kind == StationKind::Charging && distance(st.pose, r.pose) < kChargeReach) {
-          r.charging = true;
-          break;
-        }
-      }
-    }
+    r.charging = std::abs(r.twist.v) < kStillSpeed && (!r.switchedCharging || r.chargeSwitch) && atCharger(i);
     if (r.charging) {
       r.battery = std::min(1.0, r.battery + spec.battery.chargePerS * dt);
     } else {

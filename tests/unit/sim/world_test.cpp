@@ -166,6 +166,33 @@ TEST(World, BatteryDrainsWhenDrivingAndChargesOnStation) {
   EXPECT_NEAR(w.robots()[1].battery, 0.5 - 5.0 * 1e-5 - 0.01 * w.robots()[1].distance, 1e-9);
 }
 
+// A VDA 5050 vehicle charges only once it switched its charging on (startCharging), and stops
+// when it switches it off, however long it stands on the charger.
+TEST(World, ARobotWithAChargeSwitchChargesOnlyWhileItIsOn) {
+  auto j = test::room(40, 10);
+  j["stations"] = {{{"name", "C"}, {"kind", "charging"}, {"pose", {2.0, 2.5, 0.0}}}};
+  j["robots"] = {{{"id", "v"}, {"start", {2.0, 2.5, 0.0}}, {"battery", {{"initial", 0.5}}}},
+                 {{"id", "far"}, {"start", {6.0, 2.5, 0.0}}, {"battery", {{"initial", 0.5}}}}};
+  World w(test::parse(j));
+  EXPECT_TRUE(w.atCharger(0));
+  EXPECT_FALSE(w.atCharger(1));
+  w.setChargeSwitch(0, false);
+  w.setChargeSwitch(1, true);  // on, but not on a charger
+  for (int k = 0; k < 10; ++k) {
+    w.advance();
+  }
+  EXPECT_FALSE(w.robots()[0].charging);
+  EXPECT_LT(w.robots()[0].battery, 0.5);
+  EXPECT_FALSE(w.robots()[1].charging);
+  const double before = w.robots()[0].battery;
+  w.setChargeSwitch(0, true);
+  for (int k = 0; k < 10; ++k) {
+    w.advance();
+  }
+  EXPECT_TRUE(w.robots()[0].charging);
+  EXPECT_NEAR(w.robots()[0].battery, before + 1.0 * 2e-3, 1e-9);
+}
+
 TEST(World, EmptyBatteryImmobilises) {
   auto j = test::room(40, 10);
   j["robots"] = {{{"id", "r"}, {"start", {2.0, 2.5, 0.0}}, {"battery", {{"initial", 0.0}}}}};

@@ -63,6 +63,19 @@ int main() {
   print("instantActions", vda5050::toJson(ia));
   vehicle.onInstantActions(ia);
   run(2.0, false);
+  // Charging: refused off a charger (a chargingError in the state), then on one, then stopped.
+  vehicle.senseBattery(0.35, false);
+  ia.actions = {{"startCharging", "charge.r1-g0", "HARD", {}, {}}};
+  print("instantActions", vda5050::toJson(ia));
+  vehicle.onInstantActions(ia);
+  run(1.0, false);
+  vehicle.senseBattery(0.35, true);
+  vehicle.onInstantActions(ia);
+  run(1.0, false);
+  ia.actions = {{"stopCharging", "stopCharging-7", "HARD", {}, {}}};
+  print("instantActions", vda5050::toJson(ia));
+  vehicle.onInstantActions(ia);
+  run(1.0, false);
   for (const char* s : {"ONLINE", "OFFLINE", "CONNECTIONBROKEN"}) {
     print("connection", vda5050::toJson(vda5050::Connection{ia.header, s}));
   }

@@ -301,6 +301,59 @@ TEST(Vda5050Vehicle, PauseResumeAndCancel) {
   EXPECT_EQ(s.actionStates.back().actionStatus, "FAILED");
 }
 
+// startCharging works only standing on a charger with nothing left to drive (else FAILED with a
+// chargingError saying why); while charging the vehicle takes no order (VDA 5050 2.1, 6.8.1:
+// stopCharging comes first); its state reports the battery and the charging flag.
+TEST(Vda5050Vehicle, ChargesOnAChargerOnlyAndTakesNoOrderWhileCharging) {
+  Rig r;
+  const auto action = [&](const std::string& type, const std::string& id) {
+    vda5050::InstantActions ia;
+    ia.actions.push_back({type, id, "HARD", {}, {}});
+    r.vehicle.onInstantActions(ia);
+    for (const auto& a : r.state().actionStates) {
+      if (a.actionId == id) {
+        return a;
+      }
+    }
+    return vda5050::ActionState{};
+  };
+  r.vehicle.senseBattery(0.4, false);
+  auto a = action("startCharging", "c1");
+  EXPECT_EQ(a.actionStatus, "FAILED");
+  EXPECT_EQ(a.resultDescription.value_or(""), "not on a charging spot");
+  auto s = r.state();
+  ASSERT_FALSE(s.errors.empty());
+  EXPECT_EQ(s.errors.back().errorType, "chargingError");
+  EXPECT_FALSE(s.batteryState.charging);
+  EXPECT_NEAR(s.batteryState.batteryCharge, 40.0, 1e-9);
+
+  // On a charger but with an order to drive: no.
+  r.vehicle.senseBattery(0.4, true);
+  ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 3, 3)).decision, OrderDecision::kAcceptNew);
+  EXPECT_EQ(action("startCharging", "c2").actionStatus, "FAILED");
+  r.run(10.0);  // drives to n2 and stops: the order is done
+  ASSERT_TRUE(r.state().nodeStates.empty());
+
+  EXPECT_EQ(action("startCharging", "c3").actionStatus, "FINISHED");
+  EXPECT_TRUE(r.vehicle.charging());
+  r.vehicle.senseBattery(0.45, true);
+  s = r.state();
+  EXPECT_TRUE(s.batteryState.charging);
+  EXPECT_NEAR(s.batteryState.batteryCharge, 45.0, 1e-9);
+  const auto v = r.vehicle.onOrder(lineOrder("o2", 0, 2, 2, 2));
+  EXPECT_EQ(v.decision, OrderDecision::kReject);
+  EXPECT_EQ(v.errorType, "orderError");
+  EXPECT_NE(v.description.find("charging"), std::string::npos) << v.description;
+
+  EXPECT_EQ(action("stopCharging", "c4").actionStatus, "FINISHED");
+  EXPECT_FALSE(r.vehicle.charging());
+  EXPECT_FALSE(r.state().batteryState.charging);
+  EXPECT_EQ(action("stopCharging", "c5").actionStatus, "FINISHED");  // idempotent
+  EXPECT_EQ(r.vehicle.onOrder(lineOrder("o2", 0, 2, 2, 2)).decision, OrderDecision::kAcceptNew);
+  const auto f = r.vehicle.factsheet(0);
+  EXPECT_NE(std::find(f.agvActions.begin(), f.agvActions.end(), "startCharging"), f.agvActions.end());
+}
+
 TEST(Vda5050Vehicle, PickAtANodeHoldsTheVehicleUntilFinished) {
   Rig r;
   auto o = lineOrder("o1", 0, 0, 3, 3);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "fleet/vda5050/instant_actions.hpp"
 #include "vehicle_rig.hpp"
@@ -57,6 +58,8 @@ struct Loop {
   std::vector<std::string> instants;
   std::vector<std::string> warnings;
   msg::TrafficProgress progress;
+  std::vector<msg::TaskStatus> statuses;
+  std::optional<msg::RobotState> robot;  // the latest RobotState
 
   explicit Loop(BridgeSettings s = settings()) : bridge(std::move(s)) {
     bridge.onRoadmap(lineRoadmap());
@@ -87,6 +90,10 @@ struct Loop {
     warnings.insert(warnings.end(), out.warnings.begin(), out.warnings.end());
     if (!out.progress.empty()) {
       progress = out.progress.back();
+    }
+    statuses.insert(statuses.end(), out.statuses.begin(), out.statuses.end());
+    if (!out.states.empty()) {
+      robot = out.states.back();
     }
   }
   void run(double seconds) {
@@ -128,6 +135,92 @@ struct Loop {
   }
   vda5050::State state() { return rig.vehicle.takeState(rig.t, now); }
 };
+
+/// A charge task: drive to x = 1 (a charger) and charge there, at most `max_s`.
+void chargeAtN1(Loop& l, const std::string& task, double max_s) {
+  msg::TaskAssignment a;
+  a.robot_id = "r1";
+  a.task_id = task;
+  a.goals = {{{1.0, 0.0, 0.0}, "C-1", msg::GoalAction::Charge, max_s}};
+  BridgeOutbox out;
+  l.bridge.onAssignment(a, l.now, out);
+  auto r = release({0, 1});
+  r.ends_at_goal = true;
+  l.bridge.onRelease(r);
+}
+
+std::size_t count(const std::vector<std::string>& v, const std::string& what) {
+  return static_cast<std::size_t>(std::count(v.begin(), v.end(), what));
+}
+
+// At the charge goal the vehicle is sent startCharging and reports Charging, holding its node, for
+// as long as the task lasts (the fleet manager ends it when the battery is charged). The next task
+// begins with stopCharging, and its order goes out only once the vehicle stopped: it takes no
+// order while charging, so none is rejected.
+TEST(Vda5050BridgeNode, ChargesAtTheChargeGoalAndStopsChargingBeforeTheNextOrder) {
+  Loop l;
+  l.rig.vehicle.senseBattery(0.3, true);  // its contacts touch a charger's (x = 1)
+  chargeAtN1(l, "charge.r1", 1800.0);
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(5.0);
+  EXPECT_EQ(count(l.instants, "startCharging"), 1U);
+  EXPECT_TRUE(l.state().batteryState.charging);
+  ASSERT_TRUE(l.robot);
+  EXPECT_EQ(l.robot->mode, msg::RobotMode::Charging);
+  EXPECT_TRUE(l.progress.holding);
+  ASSERT_FALSE(l.statuses.empty());
+  EXPECT_EQ(l.statuses.back().task_id, "charge.r1");
+  EXPECT_EQ(l.statuses.back().state, msg::TaskState::EnRoute) << "not done before the manager says so";
+  EXPECT_EQ(l.bridge.counters().charges, 1U);
+
+  const auto ordersBefore = l.orders.size();
+  l.assign("t2", 3.0);  // the manager ended the charge task (charged) and gives it the next
+  l.bridge.onRelease(release({1, 2, 3}));
+  l.run(0.1);
+  EXPECT_EQ(count(l.instants, "stopCharging"), 1U);
+  EXPECT_FALSE(l.state().batteryState.charging);
+  ASSERT_TRUE(l.runUntilAt("n3", 20.0));
+  EXPECT_GT(l.orders.size(), ordersBefore);
+  EXPECT_EQ(l.bridge.counters().rejected, 0U) << "an order reached the vehicle while it charged";
+  EXPECT_EQ(count(l.instants, "stopCharging"), 1U);
+  EXPECT_NE(l.robot->mode, msg::RobotMode::Charging);
+}
+
+// A charger that does not charge the battery holds the vehicle no longer than the goal's duration
+// (charge_max_s): then the bridge stops the charging and reports the goal done, as an agent does.
+TEST(Vda5050BridgeNode, AChargeGoalEndsAfterItsDuration) {
+  Loop l;
+  l.rig.vehicle.senseBattery(0.3, true);
+  chargeAtN1(l, "charge.r1", 5.0);
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(3.0);
+  EXPECT_TRUE(l.state().batteryState.charging);
+  EXPECT_NE(l.statuses.back().state, msg::TaskState::Done);
+  l.run(4.0);
+  EXPECT_EQ(count(l.instants, "stopCharging"), 1U);
+  EXPECT_FALSE(l.state().batteryState.charging);
+  EXPECT_EQ(l.statuses.back().state, msg::TaskState::Done);
+}
+
+// A vehicle that cannot start charging there (here: no charger under it) fails the task with its
+// reason, logged; nothing else is sent to it.
+TEST(Vda5050BridgeNode, AFailedStartChargingFailsTheTaskWithTheVehiclesReason) {
+  Loop l;
+  l.rig.vehicle.senseBattery(0.3, false);
+  chargeAtN1(l, "charge.r1", 1800.0);
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(2.0);
+  ASSERT_FALSE(l.statuses.empty());
+  EXPECT_EQ(l.statuses.back().state, msg::TaskState::Failed);
+  EXPECT_NE(l.statuses.back().error.find("not on a charging spot"), std::string::npos)
+      << l.statuses.back().error;
+  EXPECT_TRUE(l.warned("startCharging failed"));
+  EXPECT_EQ(l.bridge.counters().charge_failures, 1U);
+  EXPECT_EQ(count(l.instants, "startCharging"), 1U) << "not tried again and again";
+}
 
 TEST(Vda5050BridgeNode, ANewOrderAfterACancelStartsAtTheVehiclesLastNode) {
   Loop l;

@@ -3,8 +3,9 @@
 // A simulated VDA 5050 vehicle: no robot agent, its own simple controller. It follows the released
 // nodes of its order, stops at the last base node until the order is extended, stops for a person
 // in its protective field as a safety scanner would, runs pick and drop actions at nodes, obeys
-// pause, resume and cancel, and accepts or rejects orders by the specification's rules
-// (vda5050/order_rules.hpp). No MQTT here: the simulator carries the messages.
+// pause, resume and cancel, switches its charging on and off (startCharging / stopCharging, on a
+// charger only; no orders while charging), and accepts or rejects orders by the specification's
+// rules (vda5050/order_rules.hpp). No MQTT here: the simulator carries the messages.
 
 #include <algorithm>
 #include <cstdint>
@@ -63,6 +64,11 @@ class Vda5050Vehicle {
   /// Accepts (new, stitched update), discards a duplicate, or rejects with an error in the state.
   vda5050::OrderVerdict onOrder(const vda5050::Order& order);
   void onInstantActions(const vda5050::InstantActions& message);
+  /// What its battery management sees before a step: state of charge 0..1 and whether its
+  /// charging contacts touch a charger's.
+  void senseBattery(double stateOfCharge, bool atCharger);
+  /// Its charging is switched on (startCharging taken, stopCharging not yet).
+  [[nodiscard]] bool charging() const { return charging_; }
   /// One control step at simulated time `now_s` from the true pose; `person_in_field` is what the
   /// safety scanner sees, `person_in_warning_field` whether it sees one in its warning field.
   VehicleCommand step(double now_s, const Pose2& pose, bool person_in_field,
@@ -123,6 +129,9 @@ class Vda5050Vehicle {
   bool driving_ = false;
   bool field_violation_ = false;
   bool waiting_for_base_ = false;
+  bool charging_ = false;
+  bool at_charger_ = false;
+  double battery_ = 1.0;
   std::string operating_mode_ = "AUTOMATIC";
   std::vector<vda5050::ActionState> action_states_;
   std::vector<std::pair<std::string, double>> running_;  // node action id, finish time

@@ -23,6 +23,11 @@ struct RobotBody {
   double commandTime = -std::numeric_limits<double>::infinity();  // sim s
   double battery = 1.0;
   bool charging = false;
+  /// Whether it charges when standing on a charger: always (our robots' chargers switch on by
+  /// contact), or only once the vehicle has switched its charging on (a VDA 5050 vehicle's
+  /// startCharging; setChargeSwitch()).
+  bool switchedCharging = false;
+  bool chargeSwitch = false;
   double odomLeft = 0.0;  // measured wheel distances since the last sensor frame, m
   double odomRight = 0.0;
   double odomLeftTotal = 0.0;  // measured wheel distances since the start, m (what wheel encoders count)
@@ -149,6 +154,10 @@ class World {
   CommandOutcome command(const std::string& id, double v, double w);
   CommandOutcome command(std::size_t robot, double v, double w);
   void setLabel(std::size_t robot, std::string mode, std::string task);
+  /// From now on robot `robot` charges on a charger only while `on` (see RobotBody::chargeSwitch).
+  void setChargeSwitch(std::size_t robot, bool on);
+  /// Whether the robot stands within reach of a charging station's contacts.
+  [[nodiscard]] bool atCharger(std::size_t robot) const;
 
   /// Advances by dt: robots (limits, slip, shelves), humans (social force), contacts, metrics, battery.
   void advance();
