@@ -206,6 +206,7 @@ msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {
   m.epoch = epoch_;
   m.revision = revision_;
   m.stamp_ns = nowNs;
+  m.robot_radius = roadmap_.options.radius;
   const auto& g = roadmap_.graph;
   for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {
     m.nodes.push_back({v, g.position(v).x, g.position(v).y});

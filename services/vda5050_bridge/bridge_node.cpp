@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "fleet/vda5050/header.hpp"
 #include "fleet/vda5050/instant_actions.hpp"
@@ -138,6 +139,7 @@ void BridgeNode::onRelease(const msg::TrafficRelease& r) {
 }
 
 void BridgeNode::onRoadmap(const msg::Roadmap& m) {
+  roadmap_radius_ = m.robot_radius;
   roadmap_.clear();
   for (const auto& n : m.nodes) {
     roadmap_.addNode({n.node, n.x, n.y});
@@ -416,6 +418,63 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
   }
 }
 
+std::string BridgeNode::refusal(const vda5050::VehicleView& view) const {
+  if (!view.factsheet) {
+    return "no factsheet yet (its footprint decides whether the roadmap fits it)";
+  }
+  const auto f = vda5050::footprint(*view.factsheet);
+  // A millimetre of slack: a footprint given as the robot's own disc, rounded in JSON, still fits.
+  constexpr double kSlack = 1e-3;
+  if (roadmap_radius_ > 0.0 && f.radius > roadmap_radius_ + kSlack) {
+    char why[512];
+    std::snprintf(
+        why, sizeof why,
+        "its footprint (a disc of radius %.3f m about its reference point, from its factsheet's %s) "
+        "is larger than the robot the roadmap's conflicts are computed for (radius %.3f m): planned "
+        "as that robot it could touch others; a roadmap for it needs a robot radius of at least "
+        "%.3f m (the site's robot.radius or the traffic manager's roadmap.radius)",
+        f.radius, f.source.c_str(), roadmap_radius_, f.radius);
+    return why;
+  }
+  return {};
+}
+
+bool BridgeNode::admit(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out) {
+  const std::string why = refusal(view);
+  if (why != v.refused) {
+    if (why.empty()) {
+      const auto f = vda5050::footprint(*view.factsheet);
+      char fits[200];
+      if (roadmap_radius_ > 0.0) {
+        std::snprintf(fits, sizeof fits,
+                      "joins the fleet: its footprint (radius %.3f m, %s) fits the roadmap's robot (%.3f m)",
+                      f.radius, f.source.c_str(), roadmap_radius_);
+      } else {
+        std::snprintf(fits, sizeof fits,
+                      "joins the fleet: its footprint (radius %.3f m, %s) not checked (the roadmap states no "
+                      "robot radius)",
+                      f.radius, f.source.c_str());
+      }
+      out.warnings.push_back(v.entry.robot_id + ": " + fits);
+    } else {
+      ++counters_.refused_vehicles;
+      out.warnings.push_back(v.entry.robot_id + ": refused: " + why);
+    }
+    v.refused = why;
+  }
+  if (!view.factsheet && (v.factsheet_asked_ns < 0 || nowNs - v.factsheet_asked_ns > 30'000'000'000)) {
+    instant(v, "factsheetRequest", nowNs, out);
+    v.factsheet_asked_ns = nowNs;
+  }
+  if (!why.empty() && v.has_order && !v.cancel_sent && view.state && !view.state->nodeStates.empty()) {
+    instant(v, "cancelOrder", nowNs, out);  // it may not drive a plan made for a smaller robot
+    ++counters_.cancels;
+    v.cancel_sent = true;
+    v.has_order = false;
+  }
+  return why.empty();
+}
+
 void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
   if (v.task_id.empty()) {
     return;
@@ -460,7 +519,8 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
       continue;
     }
     const auto& s = *view->state;
-    const bool online = view->health == VehicleHealth::kOnline;
+    const bool admitted = admit(v, *view, nowNs, out);
+    const bool online = view->health == VehicleHealth::kOnline && admitted;
     if (online) {
       watchOrder(v, s, nowNs, out);
       cancelWhenHeld(v, s, nowNs, out);
@@ -492,9 +552,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
                                                                                  : msg::RobotMode::Idle;
       rs.battery = static_cast<float>(s.batteryState.batteryCharge / 100.0);
       rs.task_id = v.task_id;
-      rs.radius = view->factsheet
-                      ? static_cast<float>(std::max(view->factsheet->width, view->factsheet->length) / 2.0)
-                      : 0.3F;
+      rs.radius = static_cast<float>(vda5050::footprint(*view->factsheet).radius);
       out.states.push_back(std::move(rs));
     }
     msg::TrafficProgress p;

@@ -26,6 +26,13 @@
 //    goal of its own (the task ended or changed) it is sent stopCharging, and no order goes out
 //    until it reports charging false (VDA 5050 2.1, 6.8.1: stopCharging comes before a new order).
 //    A startCharging that FAILED fails the task with the vehicle's reason.
+//  - Footprint: a vehicle joins the fleet only once its factsheet is known and its footprint
+//    (vda5050::footprint: the disc that holds it at every heading) fits in the robot disc the
+//    traffic manager's roadmap conflicts were computed for (Roadmap.robot_radius): a larger
+//    vehicle would touch others the plan keeps apart. Until then, or when it does not fit, it is
+//    refused with a logged reason: no RobotState (the fleet manager gives it no task), no order,
+//    and TrafficProgress `follows: false` (the traffic manager plans round it as an obstacle).
+//    Without a factsheet the bridge asks for one (factsheetRequest, every 30 s).
 //  - Health (vda5050::VehicleRegistry): a vehicle that is not online (MANUAL, a FATAL error, a
 //    message that fails the checks, its last will) publishes no RobotState, so the fleet manager
 //    loses it and re-queues its task as for our robots, and its TrafficProgress says it does not
@@ -83,9 +90,10 @@ struct BridgeCounters {
   std::uint64_t rejected = 0;       // orders and updates the vehicle rejected or did not take
   std::uint64_t gave_up = 0;        // times a vehicle was reported blocked after its retries
   std::uint64_t field_cancels = 0;  // orders cancelled because the vehicle's field held it (in `cancels` too)
-  std::uint64_t charges = 0;        // startCharging sent
-  std::uint64_t charge_failures = 0;  // startCharging the vehicle answered FAILED
-  std::uint64_t charge_stops = 0;     // stopCharging sent
+  std::uint64_t refused_vehicles = 0;  // times a vehicle was refused (no factsheet, too large)
+  std::uint64_t charges = 0;           // startCharging sent
+  std::uint64_t charge_failures = 0;   // startCharging the vehicle answered FAILED
+  std::uint64_t charge_stops = 0;      // stopCharging sent
 };
 
 class BridgeNode {
@@ -135,10 +143,12 @@ class BridgeNode {
     // of it but its first two nodes since (it holds a blocked robot there), so until a newer
     // release arrives an order takes no more than those.
     std::optional<std::pair<std::uint32_t, std::uint32_t>> stale_release;  // epoch, seq
-    std::string charge_action;            // the startCharging sent for the current goal; empty: none
-    std::int64_t charging_since_ns = -1;  // its state said charging from then, at that goal
-    std::int64_t charge_stop_ns = -1;     // stopCharging last sent then
-    std::string failure;                  // the task failed for this (reported with the status)
+    std::string charge_action;             // the startCharging sent for the current goal; empty: none
+    std::int64_t charging_since_ns = -1;   // its state said charging from then, at that goal
+    std::int64_t charge_stop_ns = -1;      // stopCharging last sent then
+    std::string failure;                   // the task failed for this (reported with the status)
+    std::string refused = "not seen yet";  // why it may not join the fleet now; empty: it may
+    std::int64_t factsheet_asked_ns = -1;  // factsheetRequest last sent then
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);
@@ -158,11 +168,16 @@ class BridgeNode {
   void cancelWhenHeld(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out);
   void reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out);
   [[nodiscard]] std::string goalActionId(const Vehicle& v, std::size_t goal) const;
+  /// Why the vehicle may not join the fleet now; empty when it may.
+  [[nodiscard]] std::string refusal(const vda5050::VehicleView& view) const;
+  /// Refusal changes logged; an order of a refused vehicle cancelled; factsheet asked for.
+  bool admit(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
 
   BridgeSettings settings_;
   vda5050::VehicleRegistry registry_;
   std::map<std::string, Vehicle> vehicles_;  // by robot id
   vda5050::KnownRoadmap roadmap_;
+  double roadmap_radius_ = 0.0;  // m: Roadmap.robot_radius (0: not stated, not checked)
   BridgeCounters counters_;
 };
 

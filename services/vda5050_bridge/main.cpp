@@ -172,6 +172,9 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
         &vdabridge::BridgeCounters::gave_up);
   total("field_cancels", "Orders cancelled because the vehicle's protective field held it",
         &vdabridge::BridgeCounters::field_cancels);
+  total("refused_vehicles",
+        "Times a vehicle was refused (no factsheet yet, or a footprint the roadmap does not fit)",
+        &vdabridge::BridgeCounters::refused_vehicles);
   total("charges_started", "startCharging sent at a charge goal", &vdabridge::BridgeCounters::charges);
   total("charge_failures", "startCharging the vehicle answered FAILED (the task failed)",
         &vdabridge::BridgeCounters::charge_failures);

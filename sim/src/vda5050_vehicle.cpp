@@ -428,6 +428,15 @@ Factsheet Vda5050Vehicle::factsheet(std::int64_t stamp_ns) const {
   f.minOrderInterval = 0.1;
   f.minStateInterval = 0.1;
   f.defaultStateInterval = config_.stateInterval;
+  // Its body is a disc (the simulated world's robots are): the envelope is that disc, as 16 points
+  // on its rim, so the master control sees a footprint of its radius, not the square's diagonal.
+  const double r = std::max(config_.width, config_.length) / 2.0;
+  Envelope2d outline{"default", {}};
+  for (int k = 0; k < 16; ++k) {
+    const double a = 2.0 * kPi * k / 16.0;
+    outline.points.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  f.envelopes2d = {std::move(outline)};
   f.agvActions = {"pick",          "drop",         "startPause",       "stopPause",   "cancelOrder",
                   "startCharging", "stopCharging", "factsheetRequest", "stateRequest"};
   return f;

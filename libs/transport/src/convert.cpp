@@ -466,6 +466,7 @@ void Traits<msg::Roadmap>::toC(const msg::Roadmap& in, C& out, Arena& arena) {
            c = fleet_RoadmapEdge{e.from, e.to, e.duration_s, e.open};
          });
   out.stamp_ns = in.stamp_ns;
+  out.robot_radius = static_cast<float>(in.robot_radius);
 }
 msg::Roadmap Traits<msg::Roadmap>::fromC(const C& in) {
   msg::Roadmap m;
@@ -479,6 +480,7 @@ msg::Roadmap Traits<msg::Roadmap>::fromC(const C& in) {
     return msg::RoadmapEdge{c.from, c.to, c.duration_s, c.open};
   });
   m.stamp_ns = in.stamp_ns;
+  m.robot_radius = static_cast<double>(in.robot_radius);
   return m;
 }
 

@@ -1,5 +1,7 @@
 #include "fleet/vda5050/factsheet.hpp"
 
+#include <cmath>
+
 #include "json_reader.hpp"
 
 namespace fleet::vda5050 {
@@ -49,15 +51,25 @@ nlohmann::json toJson(const Factsheet& m) {
   }
   j["protocolFeatures"] = {{"optionalParameters", nlohmann::json::array()}, {"agvActions", actions}};
   // The footprint as the 2-D envelope around the kinematic centre.
-  const double hx = m.length / 2.0;
-  const double hy = m.width / 2.0;
-  j["agvGeometry"] = {{"envelopes2d",
-                       {{{"set", "default"},
+  auto envelopes = nlohmann::json::array();
+  for (const auto& e : m.envelopes2d) {
+    auto points = nlohmann::json::array();
+    for (const auto& [x, y] : e.points) {
+      points.push_back({{"x", x}, {"y", y}});
+    }
+    envelopes.push_back({{"set", e.set}, {"polygonPoints", points}});
+  }
+  if (m.envelopes2d.empty()) {
+    const double hx = m.length / 2.0;
+    const double hy = m.width / 2.0;
+    envelopes.push_back({{"set", "default"},
                          {"polygonPoints",
                           {{{"x", hx}, {"y", hy}},
                            {{"x", -hx}, {"y", hy}},
                            {{"x", -hx}, {"y", -hy}},
-                           {{"x", hx}, {"y", -hy}}}}}}}};
+                           {{"x", hx}, {"y", -hy}}}}});
+  }
+  j["agvGeometry"] = {{"envelopes2d", envelopes}};
   j["loadSpecification"] = nlohmann::json::object();
   return j;
 }
@@ -95,10 +107,38 @@ Expected<Factsheet> parseFactsheet(const nlohmann::json& j) {
     for (const auto& a : r.object("protocolFeatures").array("agvActions")) {
       m.agvActions.push_back(a.str("actionType"));
     }
-    (void)r.object("agvGeometry");
+    const auto geometry = r.object("agvGeometry");
+    if (geometry.has("envelopes2d")) {
+      for (const auto& e : geometry.array("envelopes2d")) {
+        Envelope2d env{e.str("set"), {}};
+        for (const auto& point : e.array("polygonPoints")) {
+          env.points.emplace_back(point.number("x"), point.number("y"));
+        }
+        if (env.points.size() < 3) {
+          throw detail::BadField(e.path() + ".polygonPoints: a polygon needs at least 3 points");
+        }
+        m.envelopes2d.push_back(std::move(env));
+      }
+    }
     (void)r.object("loadSpecification");
     return m;
   });
+}
+
+Footprint footprint(const Factsheet& f) {
+  Footprint out;
+  for (const auto& e : f.envelopes2d) {
+    for (const auto& [x, y] : e.points) {
+      const double r = std::hypot(x, y);
+      if (r > out.radius) {
+        out = {r, "envelope '" + e.set + "'"};
+      }
+    }
+  }
+  if (f.envelopes2d.empty()) {
+    out = {std::hypot(f.width, f.length) / 2.0, "width x length"};
+  }
+  return out;
 }
 
 Expected<Factsheet> parseFactsheet(const std::string& text) {

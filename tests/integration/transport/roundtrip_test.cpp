@@ -237,7 +237,7 @@ TEST_F(RoundTrip, GroundTruth) {
 }
 
 TEST_F(RoundTrip, Traffic) {
-  msg::Roadmap m{"small-warehouse", 3, 7, {}, {}, {}, {}, 99};
+  msg::Roadmap m{"small-warehouse", 3, 7, {}, {}, {}, {}, 99, 0.375};  // a radius a float holds exactly
   for (int i = 0; i < 3000; ++i) {
     m.nodes.push_back({i, i * 0.5, -i * 0.25});
     m.kinds.push_back(static_cast<std::uint8_t>(i % 6));

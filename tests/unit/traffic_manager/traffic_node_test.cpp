@@ -124,6 +124,23 @@ TEST(TrafficNode, RiskSettingsAreReadAndChecked) {
   EXPECT_NE(bad.problems()[0].find("risk_cost_s"), std::string::npos) << bad.problems()[0];
 }
 
+// The Roadmap message says which robot disc its conflicts keep apart (a VDA 5050 bridge refuses
+// vehicles that do not fit it): the site's robot, or roadmap.radius when set.
+TEST(TrafficNode, TheRoadmapMessageStatesTheRobotRadiusItWasBuiltFor) {
+  const TrafficNode site(smallWarehouse(), settings(), 7);
+  EXPECT_DOUBLE_EQ(site.roadmapMessage(0).robot_radius, smallWarehouse().robot.radius);
+  auto cfg = Config::fromText(R"({"roadmap": {"radius": 0.42}})", "traffic.json");
+  auto s = readSettings(cfg);
+  cfg.finish();
+  ASSERT_TRUE(cfg.ok()) << cfg.problems()[0];
+  const TrafficNode larger(smallWarehouse(), s, 7);
+  EXPECT_DOUBLE_EQ(larger.roadmapMessage(0).robot_radius, 0.42);
+  auto bad = Config::fromText(R"({"roadmap": {"radius": -1}})", "traffic.json");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.problems()[0].find("radius"), std::string::npos) << bad.problems()[0];
+}
+
 TEST(TrafficNode, YieldSettingsAreReadAndChecked) {
   EXPECT_DOUBLE_EQ(Settings{}.yieldAfterS, 0.0) << "off by default";
   auto cfg =

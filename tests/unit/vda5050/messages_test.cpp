@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "fleet/vda5050/connection.hpp"
 #include "fleet/vda5050/factsheet.hpp"
 #include "fleet/vda5050/instant_actions.hpp"
@@ -73,6 +75,44 @@ TEST(Vda5050Messages, InstantActionsConnectionAndFactsheetRoundTrip) {
   ASSERT_TRUE(f2) << f2.error().message;
   EXPECT_DOUBLE_EQ(f2->length, 0.8);
   EXPECT_EQ(f2->agvActions, f.agvActions);
+}
+
+// The footprint is the disc about the reference point that holds the vehicle at every heading:
+// the farthest envelope point of any set, or half the diagonal of width x length without one.
+TEST(Vda5050Messages, TheFactsheetsFootprintIsItsFarthestEnvelopePoint) {
+  Factsheet f;
+  f.header = {1, "2026-11-26T03:00:00.000Z", kVersion, "acme", "AGV-1"};
+  f.seriesName = "sim";
+  f.width = 0.6;
+  f.length = 0.8;
+  auto fp = footprint(f);
+  EXPECT_DOUBLE_EQ(fp.radius, 0.5);  // 0.3, 0.4: a 3-4-5 triangle
+  EXPECT_EQ(fp.source, "width x length");
+  // A written factsheet without envelopes carries the rectangle, read back as an envelope.
+  auto back = parseFactsheet(toJson(f).dump());
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->envelopes2d.size(), 1U);
+  EXPECT_DOUBLE_EQ(footprint(*back).radius, 0.5);
+
+  // A forklift: its reference point between the fork roots, its body behind, forks ahead.
+  f.envelopes2d = {{"unloaded", {{-1.2, 0.4}, {-1.2, -0.4}, {0.0, -0.4}, {0.0, 0.4}}},
+                   {"forks", {{0.0, 0.3}, {1.1, 0.3}, {1.1, -0.3}, {0.0, -0.3}}}};
+  back = parseFactsheet(toJson(f).dump());
+  ASSERT_TRUE(back) << back.error().message;
+  ASSERT_EQ(back->envelopes2d.size(), 2U);
+  EXPECT_EQ(back->envelopes2d[1].set, "forks");
+  fp = footprint(*back);
+  EXPECT_NEAR(fp.radius, std::hypot(1.2, 0.4), 1e-12);
+  EXPECT_EQ(fp.source, "envelope 'unloaded'");
+
+  auto j = toJson(f);
+  j["agvGeometry"]["envelopes2d"][1]["polygonPoints"].erase(2);
+  j["agvGeometry"]["envelopes2d"][1]["polygonPoints"].erase(1);
+  const auto bad = parseFactsheet(j);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("envelopes2d[1].polygonPoints: a polygon needs at least 3 points"),
+            std::string::npos)
+      << bad.error().message;
 }
 
 TEST(Vda5050Messages, RefusalNamesTheBadKey) {

@@ -97,6 +97,7 @@ int main() {
   sim::test::Rig fresh;
   auto st = fresh.vehicle.takeState(0.0, 0);
   st.header.manufacturer = "fleet-sim";
+  bridge.onMqtt("uagv/v2/fleet-sim/AGV-1/factsheet", vda5050::toJson(fresh.vehicle.factsheet(0)).dump(), out);
   bridge.onMqtt("uagv/v2/fleet-sim/AGV-1/state", vda5050::toJson(st).dump(), out);
   msg::TaskAssignment assignment;
   assignment.robot_id = "r1";

@@ -61,9 +61,16 @@ struct Loop {
   std::vector<msg::TaskStatus> statuses;
   std::optional<msg::RobotState> robot;  // the latest RobotState
 
-  explicit Loop(BridgeSettings s = settings()) : bridge(std::move(s)) {
+  explicit Loop(BridgeSettings s = settings(), bool factsheet = true) : bridge(std::move(s)) {
     bridge.onRoadmap(lineRoadmap());
+    if (factsheet) {
+      sendFactsheet();
+    }
     cycle();
+  }
+  void sendFactsheet() {
+    BridgeOutbox out;
+    bridge.onMqtt(kTopic + "factsheet", vda5050::toJson(rig.vehicle.factsheet(0)).dump(), out);
   }
 
   void cycle() {
@@ -220,6 +227,64 @@ TEST(Vda5050BridgeNode, AFailedStartChargingFailsTheTaskWithTheVehiclesReason) {
   EXPECT_TRUE(l.warned("startCharging failed"));
   EXPECT_EQ(l.bridge.counters().charge_failures, 1U);
   EXPECT_EQ(count(l.instants, "startCharging"), 1U) << "not tried again and again";
+}
+
+// Until its factsheet is known a vehicle is not in the fleet: no RobotState (no task for it), no
+// order, and the traffic manager told it does not follow releases; the bridge asks for the
+// factsheet and says why. With the factsheet it joins.
+TEST(Vda5050BridgeNode, AVehicleJoinsTheFleetOnlyWithItsFactsheet) {
+  Loop l(settings(), false);
+  l.assign("t1", 2.0);
+  l.bridge.onRelease(release({0, 1, 2}));
+  l.run(1.0);
+  EXPECT_TRUE(l.orders.empty());
+  EXPECT_FALSE(l.robot.has_value());
+  EXPECT_FALSE(l.progress.follows);
+  EXPECT_TRUE(l.warned("r1: refused: no factsheet yet"));
+  EXPECT_EQ(count(l.instants, "factsheetRequest"), 1U);
+  l.sendFactsheet();
+  l.run(1.0);
+  EXPECT_TRUE(l.warned("r1: joins the fleet: its footprint (radius 0.300 m, envelope 'default')"));
+  EXPECT_EQ(l.orders.size(), 1U);
+  ASSERT_TRUE(l.robot.has_value());
+  EXPECT_FLOAT_EQ(l.robot->radius, 0.3F);
+  EXPECT_TRUE(l.progress.follows);
+}
+
+// A vehicle larger than the robot the roadmap's conflicts were computed for is refused with the
+// two sizes named; an order it was driving is cancelled. A roadmap for its size lets it in.
+TEST(Vda5050BridgeNode, AVehicleLargerThanTheRoadmapsRobotIsRefusedSayingWhy) {
+  Loop l;
+  l.assign("t1", 5.0);
+  l.bridge.onRelease(release({0, 1, 2, 3, 4, 5}));
+  l.run(1.0);
+  ASSERT_EQ(l.orders.size(), 1U);
+  EXPECT_TRUE(l.state().driving);
+  auto small = lineRoadmap();
+  small.robot_radius = 0.25;
+  l.bridge.onRoadmap(small);
+  l.run(3.0);
+  EXPECT_TRUE(
+      l.warned("r1: refused: its footprint (a disc of radius 0.300 m about its reference point, from "
+               "its factsheet's envelope 'default') is larger than the robot the roadmap's conflicts "
+               "are computed for (radius 0.250 m)"));
+  EXPECT_EQ(count(l.instants, "cancelOrder"), 1U);
+  EXPECT_FALSE(l.state().driving);
+  EXPECT_FALSE(l.progress.follows);
+  EXPECT_EQ(l.bridge.counters().refused_vehicles, 1U);
+  const auto orders = l.orders.size();
+  const auto states = l.robot->stamp_ns;
+  l.run(2.0);
+  EXPECT_EQ(l.orders.size(), orders) << "no order for a refused vehicle";
+  EXPECT_EQ(l.robot->stamp_ns, states) << "no RobotState for a refused vehicle";
+  auto fits = lineRoadmap();
+  fits.robot_radius = 0.3;
+  l.bridge.onRoadmap(fits);
+  l.run(2.0);
+  EXPECT_TRUE(l.warned("joins the fleet"));
+  EXPECT_TRUE(l.progress.follows);
+  EXPECT_GT(l.orders.size(), orders);
+  EXPECT_TRUE(l.runUntilAt("n5", 20.0));
 }
 
 TEST(Vda5050BridgeNode, ANewOrderAfterACancelStartsAtTheVehiclesLastNode) {

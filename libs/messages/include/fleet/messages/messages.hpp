@@ -311,6 +311,8 @@ struct Roadmap {
   std::vector<bool> open;
   std::vector<RoadmapEdge> edges;
   std::int64_t stamp_ns = 0;
+  /// m: the robot disc its conflicts were computed for; a robot must fit in it (0: not stated).
+  double robot_radius = 0;
   bool operator==(const Roadmap&) const = default;
 };
 

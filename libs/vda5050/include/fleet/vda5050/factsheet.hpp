@@ -1,17 +1,26 @@
 #pragma once
 
 // The factsheet: what a vehicle is (kinematics, size, speeds) and what of the protocol it supports
-// (specification 2.1, section 6.15). The bridge reads the footprint from width and length.
+// (specification 2.1, section 6.15). The bridge reads the footprint from the 2-D envelopes, or
+// from width and length when there are none (footprint()).
 
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
 #include "fleet/vda5050/header.hpp"
 
 namespace fleet::vda5050 {
+
+/// One of agvGeometry.envelopes2d: a polygon in the vehicle's frame (x ahead, y left, m) about its
+/// reference point, e.g. its outline unloaded or loaded.
+struct Envelope2d {
+  std::string set;
+  std::vector<std::pair<double, double>> points;  // x, y
+};
 
 struct Factsheet {
   Header header;
@@ -32,7 +41,18 @@ struct Factsheet {
   double minStateInterval = 0.0;
   double defaultStateInterval = 1.0;
   std::vector<std::string> agvActions;  // action types the vehicle runs
+  /// Written as given, or as the width × length rectangle about the centre when empty.
+  std::vector<Envelope2d> envelopes2d;
 };
+
+/// The disc about the vehicle's reference point that holds it at every heading (it turns on the
+/// spot): its radius is the farthest point of any 2-D envelope, or half the diagonal of width ×
+/// length when it gives none. `source` says which, for messages.
+struct Footprint {
+  double radius = 0.0;
+  std::string source;
+};
+Footprint footprint(const Factsheet& f);
 
 nlohmann::json toJson(const Factsheet& m);
 Expected<Factsheet> parseFactsheet(const nlohmann::json& j);
