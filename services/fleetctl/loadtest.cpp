@@ -26,6 +26,7 @@
 #include <thread>
 #include <tuple>
 
+#include "base_ends.hpp"
 #include "fault_plan.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/service/site_stations.hpp"
@@ -702,6 +703,7 @@ int Run::run() {
       tm["let_pass"] = o.letPass;
     if (o.yieldAfterS >= 0.0)
       tm["yield_after_s"] = o.yieldAfterS;
+    tm["summary_file"] = fs::absolute(out / "traffic_manager_summary.json").string();
     writeFile(out / "traffic_manager.json", tm.dump(1));
     specs.push_back({"traffic_manager",
                      bin("services/traffic_manager/traffic_manager"),
@@ -1100,6 +1102,9 @@ int Run::run() {
                  {"robots", robots.size()},
                  {"peak_waiting", 0}}
           : saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime), o.loneSaturatedPerH);
+  if (auto tm = readJson(out / "traffic_manager_summary.json")) {
+    report["traffic_manager"] = trafficSummaryJson(*tm, vdaRobots);
+  }
   writeFile(out / "loadtest.json", report.dump(2));
   char line[256];
   std::snprintf(
@@ -1136,6 +1141,9 @@ int Run::run() {
   }
   say(boundLine(report["kinematic_bound"]));
   say(saturatedLine(report["saturated"]));
+  if (report.contains("traffic_manager")) {
+    say(baseEndsLine(report["traffic_manager"]));
+  }
   if (!contents.error.empty()) {
     say("task database: " + contents.error);
     code = code == 0 ? 1 : code;

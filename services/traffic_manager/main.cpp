@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <fstream>
 #include <optional>
 #include <vector>
 
@@ -106,11 +107,16 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
 
   auto logStats = [&] {
     const auto& c = node.counters();
+    traffic::BaseEnds ends;
+    for (const auto& [robot, b] : node.baseEnds())
+      ends += b;
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
-        "re-plans, {} risk updates, {} yields, tick {:.2f} ms (max {:.2f}), refused at the edge: {}",
+        "re-plans, {} risk updates, {} yields, tick {:.2f} ms (max {:.2f}), base ends reached short of the "
+        "target: {} held by others, {} at the plan's end, {} with more free (late), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
-        c.riskUpdates, c.yields, c.lastTickMs, c.maxTickMs, rejections.toJson().dump());
+        c.riskUpdates, c.yields, c.lastTickMs, c.maxTickMs, ends.held, ends.planEnd, ends.limit,
+        rejections.toJson().dump());
     // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
     // is slow (a minute of its clock, sim or wall).
     for (const auto& line : node.stalled(now, 60.0))
@@ -224,6 +230,29 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   if (settings.lockstep)
     stepDone.write({id, msg::StepDone::kLeave});
   logStats();
+  if (!settings.summaryFile.empty()) {
+    const auto& c = node.counters();
+    nlohmann::json ends = nlohmann::json::object();
+    traffic::BaseEnds all;
+    for (const auto& [robot, b] : node.baseEnds()) {
+      ends[robot] = {{"held", b.held}, {"plan_end", b.planEnd}, {"limit", b.limit}};
+      all += b;
+    }
+    const nlohmann::json summary = {
+        {"reports", c.reports},
+        {"refused_reports", c.refused},
+        {"releases", c.releases},
+        {"planned_steps", c.plannedSteps},
+        {"replans", c.replans},
+        {"yields", c.yields},
+        {"max_tick_ms", c.maxTickMs},
+        {"base_ends", {{"held", all.held}, {"plan_end", all.planEnd}, {"limit", all.limit}}},
+        {"base_ends_by_robot", ends}};
+    std::ofstream f(settings.summaryFile);
+    f << summary.dump(1) << '\n';
+    if (!f)
+      spdlog::error("traffic manager: could not write the summary to {}", settings.summaryFile);
+  }
   spdlog::info("traffic manager: stopped");
   return 0;
 }

@@ -15,12 +15,14 @@ using traffic::NodeId;
 
 Settings readSettings(Config& cfg) {
   Settings s;
-  cfg.rejectUnknownKeys({"site",          "rate_hz",     "settle_s",     "robot_timeout_s", "place_tolerance",
-                         "clock",         "lockstep",    "max_lag",      "base_ahead",      "max_base_nodes",
-                         "horizon_nodes", "seed",        "detour_after", "detour_penalty",  "station_lines",
-                         "let_pass",      "roadmap",     "risk_cost_s",  "risk_period_s",   "yield_after_s",
-                         "yield_for_s",   "yield_cost_s"});
+  cfg.rejectUnknownKeys(
+      {"site",          "rate_hz",      "settle_s",     "robot_timeout_s", "place_tolerance",
+       "clock",         "lockstep",     "max_lag",      "base_ahead",      "max_base_nodes",
+       "horizon_nodes", "seed",         "detour_after", "detour_penalty",  "station_lines",
+       "let_pass",      "roadmap",      "risk_cost_s",  "risk_period_s",   "yield_after_s",
+       "yield_for_s",   "yield_cost_s", "summary_file"});
   s.site = cfg.string("site", "");
+  s.summaryFile = cfg.string("summary_file", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
   s.settleS = cfg.number("settle_s", 3.0, {0.0, 600.0});
   s.robotTimeoutS = cfg.number("robot_timeout_s", 5.0, {0.0, 3600.0, true});
@@ -217,6 +219,15 @@ msg::Roadmap TrafficNode::roadmapMessage(std::int64_t nowNs) const {
     }
   }
   return m;
+}
+
+std::map<std::string, traffic::BaseEnds> TrafficNode::baseEnds() const {
+  std::map<std::string, traffic::BaseEnds> out;
+  for (const auto& [id, r] : robots_) {
+    if (r.index >= 0 && control_ && static_cast<std::size_t>(r.index) < control_->robots())
+      out[id] = control_->baseEnds(static_cast<std::size_t>(r.index));
+  }
+  return out;
 }
 
 int TrafficNode::indexOf(const std::string& robot) const {

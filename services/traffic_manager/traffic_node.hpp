@@ -57,6 +57,8 @@ struct Settings {
   double yieldCostS = 60.0;
   traffic::RoadmapOptions roadmap;
   traffic::TrafficOptions traffic;
+  /// Written when the traffic manager stops: its counters and each robot's base ends (load tests).
+  std::string summaryFile;
 };
 
 /// Reads the settings; every problem is recorded in `cfg` (call cfg.finish() after).
@@ -116,6 +118,9 @@ class TrafficNode {
     double maxTickMs = 0.0;
   };
   [[nodiscard]] const Counters& counters() const { return counters_; }
+  /// Per robot placed: the ends of its base it reached short of its target, by why they were
+  /// there (traffic::BaseEnds).
+  [[nodiscard]] std::map<std::string, traffic::BaseEnds> baseEnds() const;
   [[nodiscard]] std::size_t robotsKnown() const { return robots_.size(); }
   [[nodiscard]] std::size_t robotsPlaced() const;
   /// Robot's index in the planner, -1 when not placed.

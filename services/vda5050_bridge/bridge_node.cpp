@@ -521,6 +521,17 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     const auto& s = *view->state;
     const bool admitted = admit(v, *view, nowNs, out);
     const bool online = view->health == VehicleHealth::kOnline && admitted;
+    const bool atBaseEnd = online && s.newBaseRequest.value_or(false);
+    if (atBaseEnd && !v.at_base_end && v.release) {
+      const auto& base = v.release->base;
+      const int at = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
+      const auto it =
+          std::find_if(base.begin(), base.end(), [&](const msg::RouteNode& n) { return n.node == at; });
+      if (it != base.end() && it + 1 != base.end()) {
+        ++counters_.late_updates;
+      }
+    }
+    v.at_base_end = atBaseEnd;
     if (online) {
       watchOrder(v, s, nowNs, out);
       cancelWhenHeld(v, s, nowNs, out);

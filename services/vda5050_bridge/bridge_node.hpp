@@ -94,6 +94,10 @@ struct BridgeCounters {
   std::uint64_t charges = 0;           // startCharging sent
   std::uint64_t charge_failures = 0;   // startCharging the vehicle answered FAILED
   std::uint64_t charge_stops = 0;      // stopCharging sent
+  /// Times a vehicle stopped at the end of its order's base (newBaseRequest) although its release
+  /// from the traffic manager went further: an update that had not reached it (bridge or broker
+  /// latency). The traffic manager counts the stops its own releases cause (base ends).
+  std::uint64_t late_updates = 0;
 };
 
 class BridgeNode {
@@ -149,6 +153,7 @@ class BridgeNode {
     std::string failure;                   // the task failed for this (reported with the status)
     std::string refused = "not seen yet";  // why it may not join the fleet now; empty: it may
     std::int64_t factsheet_asked_ns = -1;  // factsheetRequest last sent then
+    bool at_base_end = false;              // its last state said newBaseRequest
   };
 
   void sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t nowNs, BridgeOutbox& out);

@@ -175,6 +175,8 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
   total("refused_vehicles",
         "Times a vehicle was refused (no factsheet yet, or a footprint the roadmap does not fit)",
         &vdabridge::BridgeCounters::refused_vehicles);
+  total("late_updates", "Stops of a vehicle at its base end while its release went further (update latency)",
+        &vdabridge::BridgeCounters::late_updates);
   total("charges_started", "startCharging sent at a charge goal", &vdabridge::BridgeCounters::charges);
   total("charge_failures", "startCharging the vehicle answered FAILED (the task failed)",
         &vdabridge::BridgeCounters::charge_failures);
@@ -184,6 +186,17 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
   ops.watchMatchedWriters("TrafficRelease", [&] { return releases.matchedWriters(); });
   // Ready: it hears the broker (the vehicles' side); the DDS side shows in the matched gauges.
   ops.health().setReady("broker", false);
+  const auto logStats = [&] {
+    const auto& c = node.counters();
+    spdlog::info(
+        "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched, "
+        "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries, {} orders "
+        "cancelled for a vehicle its field held, {} charges started ({} failed), {} stopped, {} stops at a "
+        "base end "
+        "an update had not reached",
+        c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up,
+        c.field_cancels, c.charges, c.charge_failures, c.charge_stops, c.late_updates);
+  };
   const auto refreshMetrics = [&] {
     if (!ops.refresh()) {
       return;
@@ -242,7 +255,11 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
       progress.write(s);
     }
     for (const auto& w : out.warnings) {
-      log.warn(w.substr(0, w.find(':')), w);
+      // Rate-limited per vehicle and kind ("r3: refused", "r3: online"): one kind does not hide
+      // another (a vehicle's refusal came right after its "online" and was swallowed).
+      const auto colon = w.find(':');
+      const auto word = colon == std::string::npos ? colon : w.find_first_of(" (:", colon + 2);
+      log.warn(w.substr(0, word), w);
     }
     if ((*client)->connected() != wasConnected) {
       wasConnected = !wasConnected;
@@ -255,13 +272,7 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
     cycleSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     refreshMetrics();
     if (std::chrono::steady_clock::now() - lastStats > 10s) {
-      const auto& c = node.counters();
-      spdlog::info(
-          "vda5050 bridge: {} orders, {} updates, {} cancels, {} refused messages, {} releases not stitched, "
-          "{} orders rejected by vehicles, {} times a vehicle reported blocked after its retries, {} orders "
-          "cancelled for a vehicle its field held, {} charges started ({} failed), {} stopped",
-          c.orders, c.updates, c.cancels, c.refused_messages, c.cannot_stitch, c.rejected, c.gave_up,
-          c.field_cancels, c.charges, c.charge_failures, c.charge_stops);
+      logStats();
       lastStats = std::chrono::steady_clock::now();
     }
   };
@@ -299,6 +310,7 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
     }
     cycle(settings.sim_clock ? simNow : wall.nowNs());
   }
+  logStats();  // the final counts
   spdlog::info("vda5050 bridge: stopped");
   return 0;
 }

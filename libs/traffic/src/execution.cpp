@@ -197,6 +197,18 @@ bool Execution::satisfied(const Entry& e) const {
                      [&](const Dependency& d) { return routes_[d.robot].progress >= d.index; });
 }
 
+const char* toString(BaseCut c) {
+  switch (c) {
+    case BaseCut::PlanEnd:
+      return "plan_end";
+    case BaseCut::Held:
+      return "held";
+    case BaseCut::Limit:
+      return "limit";
+  }
+  return "?";
+}
+
 Report Execution::reached(std::size_t robot, NodeId node) {
   if (robot >= routes_.size())
     return Report::UnknownRobot;
@@ -248,14 +260,19 @@ Release Execution::release(std::size_t robot) {
   double ahead = 0.0;
   for (std::int64_t i = route.progress + 1; i <= route.released; ++i)
     ahead += route[i].distance;
+  route.cut = BaseCut::Limit;
   while (route.released < route.last() && ahead < options_.baseAhead &&
          static_cast<std::size_t>(route.released - route.progress) < options_.maxBaseNodes) {
     const Entry& e = route[route.released + 1];
-    if (!satisfied(e) || releasedAgain(route, e.node))
+    if (!satisfied(e) || releasedAgain(route, e.node)) {
+      route.cut = BaseCut::Held;
       break;
+    }
     ++route.released;
     ahead += e.distance;
   }
+  if (route.released >= route.last())
+    route.cut = BaseCut::PlanEnd;
   for (std::int64_t i = route.progress; i <= route.released; ++i)
     out.base.push_back(route[i].node);
   const std::int64_t end =

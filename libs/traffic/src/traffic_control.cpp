@@ -39,7 +39,8 @@ TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> start
       target_(starts.size(), kNoNode),
       stall_(starts.size(), 0),
       lastEnd_(starts.begin(), starts.end()),
-      evadeUntil_(starts.size(), -1) {}
+      evadeUntil_(starts.size(), -1),
+      baseEnds_(starts.size()) {}
 
 void TrafficControl::setStations(std::vector<StationLine> stations) {
   for (std::size_t r = 0; r < robots(); ++r)
@@ -187,6 +188,7 @@ std::size_t TrafficControl::addRobot(NodeId start) {
   stall_.push_back(0);
   lastEnd_.push_back(start);
   evadeUntil_.push_back(-1);
+  baseEnds_.emplace_back();
   replan();
   return r;
 }
@@ -238,6 +240,22 @@ Report TrafficControl::reached(std::size_t robot, NodeId node) {
   const Report r = execution_.reached(robot, node);
   if (r == Report::NotReleased || r == Report::UnknownRobot)
     ++stats_.refusedReports;
+  // At the end of its base short of where it is being taken: say why the base ended there.
+  if (r == Report::Accepted && node == execution_.releasedEnd(robot) && node != target_[robot] &&
+      node != goal_[robot]) {
+    auto& b = baseEnds_[robot];
+    switch (execution_.baseCut(robot)) {
+      case BaseCut::Held:
+        ++b.held;
+        break;
+      case BaseCut::PlanEnd:
+        ++b.planEnd;
+        break;
+      case BaseCut::Limit:
+        ++b.limit;
+        break;
+    }
+  }
   return r;
 }
 

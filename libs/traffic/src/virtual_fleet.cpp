@@ -297,6 +297,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.escalations = traffic.plannerStats().escalations;
   res.untangles = traffic.plannerStats().untangles;
   res.passes = traffic.stats().passes;
+  for (std::size_t r = 0; r < traffic.robots(); ++r)
+    res.baseEnds += traffic.baseEnds(r);
   res.updateP50Ms = percentile(updateMs, 0.5);
   res.updateP99Ms = percentile(updateMs, 0.99);
   if (o.robots < 2)

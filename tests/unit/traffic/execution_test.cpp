@@ -70,6 +70,28 @@ TEST(Execution, AFollowerEntersOnlyAfterTheLeaderHasLeft) {
 
 // The planner moves a robot aside and back onto its node ([0 1 4 3 0 1 2]); a base that passes a
 // node twice made the agent take it as driven (its node at both ends) and stand for good.
+// Each release says why its base ends where it does: a dependency, the plan's end, or the base
+// is long enough (more was free).
+TEST(Execution, EachReleaseSaysWhyItsBaseEndsThere) {
+  const Graph g = grid(8, 1);
+  const std::vector<NodeId> start{1, 0};
+  ReleaseOptions o;
+  o.baseAhead = 2.0;  // two unit edges
+  Execution ex(g, start, o);
+  for (NodeId k = 2; k <= 6; ++k)
+    ex.append(std::vector<NodeId>{k, static_cast<NodeId>(k - 1)});
+  ex.release(1);
+  EXPECT_EQ(ex.baseCut(1), BaseCut::Held) << "its next node waits for robot 0 to leave it";
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{1, 2, 3}));
+  EXPECT_EQ(ex.baseCut(0), BaseCut::Limit) << "more was free: the base is long enough";
+  ASSERT_EQ(ex.reached(0, 3), Report::Accepted);
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{3, 4, 5}));
+  EXPECT_EQ(ex.reached(0, 5), Report::Accepted);
+  EXPECT_EQ(ex.release(0).base, (std::vector<NodeId>{5, 6}));
+  EXPECT_EQ(ex.baseCut(0), BaseCut::PlanEnd);
+  EXPECT_STREQ(toString(BaseCut::Limit), "limit");
+}
+
 TEST(Execution, ABaseNeverPassesANodeTwice) {
   const Graph g = grid(3, 2);  // 0 1 2 / 3 4 5
   const std::vector<NodeId> start{0};

@@ -429,6 +429,21 @@ TEST(TrafficControl, TheDockIsFreeOnlyOnceTheLeavingRobotReportsItOff) {
 /// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
 /// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the
 /// robot waiting for it). A lone robot does 6 or 7.
+// Robots that follow their releases at once (no latency) reach the end of their base short of
+// their target only where the plan holds them (a dependency) or has not gone on yet, never because
+// a longer base was free but late: the release keeps ahead of a robot on time.
+TEST(VirtualFleet, ARobotOnTimeNeverReachesABaseEndThatMoreWasFreeBeyond) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  for (const auto& r : runSeeds(map, o)) {
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_GT(r.baseEnds.held, 0U) << "20 robots on the small warehouse wait on each other";
+    EXPECT_EQ(r.baseEnds.limit, 0U);
+  }
+}
+
 TEST(VirtualFleet, FiveRobotsKeepWorkingOnTheSmallWarehouse) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;

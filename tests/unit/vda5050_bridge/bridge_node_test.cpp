@@ -287,6 +287,26 @@ TEST(Vda5050BridgeNode, AVehicleLargerThanTheRoadmapsRobotIsRefusedSayingWhy) {
   EXPECT_TRUE(l.runUntilAt("n5", 20.0));
 }
 
+// A stop at the end of the order's base counts as late when the release went further (the update
+// had not reached the vehicle), not when the traffic manager's release ended there too.
+TEST(Vda5050BridgeNode, AStopAtABaseEndTheReleaseWentBeyondIsCountedLate) {
+  Loop l;
+  l.assign("t1", 5.0);
+  l.bridge.onRelease(release({0, 1}, {2}));
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(2.0);
+  EXPECT_TRUE(l.state().newBaseRequest.value_or(false));
+  EXPECT_EQ(l.bridge.counters().late_updates, 0U) << "the release ended at n1 too";
+  l.bridge.onRelease(release({1, 2}, {3}));
+  l.run(0.1);
+  l.deliver = false;  // the next update is lost on the way
+  l.bridge.onRelease(release({1, 2, 3, 4}, {5}));
+  ASSERT_TRUE(l.runUntilAt("n2", 20.0));
+  l.run(1.0);
+  ASSERT_EQ(l.rig.vehicle.lastNodeId(), "n2");
+  EXPECT_EQ(l.bridge.counters().late_updates, 1U);
+}
+
 TEST(Vda5050BridgeNode, ANewOrderAfterACancelStartsAtTheVehiclesLastNode) {
   Loop l;
   l.assign("t1", 5.0);

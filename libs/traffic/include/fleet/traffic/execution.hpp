@@ -52,6 +52,14 @@ struct Release {
   std::int64_t baseEndStep = 0;  ///< plan step at which the base's last node is reached
 };
 
+/// Why a robot's base ended where it did when it was last released.
+enum class BaseCut : std::uint8_t {
+  PlanEnd,  ///< the planned route ends there (its goal or target, or the planner has not gone on)
+  Held,     ///< its next node waits on robots planned before it there (a dependency)
+  Limit,    ///< far enough ahead (ReleaseOptions::baseAhead, maxBaseNodes): more was free
+};
+const char* toString(BaseCut c);
+
 enum class Report {
   Accepted,     ///< progress moved on
   Duplicate,    ///< the node it already reported
@@ -85,6 +93,9 @@ class Execution {
   /// The robots whose progress the next unreleased node of `robot` waits for (empty: nothing, or
   /// the route ends).
   [[nodiscard]] std::vector<std::size_t> waitingOn(std::size_t robot) const;
+
+  /// Why the robot's base ends where it does (set by release()).
+  [[nodiscard]] BaseCut baseCut(std::size_t robot) const { return routes_.at(robot).cut; }
 
   /// Last reported node, last released node, last planned node of a robot.
   [[nodiscard]] NodeId at(std::size_t robot) const;
@@ -147,6 +158,7 @@ class Execution {
     std::int64_t first = 0;      ///< route index of entries.front()
     std::int64_t progress = 0;   ///< last reported route index
     std::int64_t released = 0;   ///< last released route index
+    BaseCut cut = BaseCut::PlanEnd;
     [[nodiscard]] std::int64_t last() const { return first + static_cast<std::int64_t>(entries.size()) - 1; }
     [[nodiscard]] const Entry& operator[](std::int64_t i) const {
       return entries[static_cast<std::size_t>(i - first)];

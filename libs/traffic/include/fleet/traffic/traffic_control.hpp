@@ -71,6 +71,24 @@ struct TrafficStats {
   std::uint64_t passes = 0;    ///< robots let past late ones (switched dependencies)
 };
 
+/// Times a robot reported the last node of its base short of where it was being taken, by why the
+/// base ended there (Execution::baseCut). `held`: a dependency (a robot planned before it there
+/// had not left): a stop the plan asks for. `planEnd`: the planner had not planned it further.
+/// `limit`: more was free to release, the robot got there before a longer base reached it (release
+/// latency): what a robot on time should never see.
+struct BaseEnds {
+  std::uint64_t held = 0;
+  std::uint64_t planEnd = 0;
+  std::uint64_t limit = 0;
+  [[nodiscard]] std::uint64_t total() const { return held + planEnd + limit; }
+  BaseEnds& operator+=(const BaseEnds& o) {
+    held += o.held;
+    planEnd += o.planEnd;
+    limit += o.limit;
+    return *this;
+  }
+};
+
 class TrafficControl {
  public:
   /// Robots start on `starts` (valid, free of conflicts: std::invalid_argument otherwise).
@@ -136,6 +154,7 @@ class TrafficControl {
   void setNodeCost(std::vector<float> cost);
 
   [[nodiscard]] const TrafficStats& stats() const { return stats_; }
+  [[nodiscard]] const BaseEnds& baseEnds(std::size_t robot) const { return baseEnds_.at(robot); }
   [[nodiscard]] const PibtStats& plannerStats() const { return planner_->stats(); }
   [[nodiscard]] const Execution& execution() const { return execution_; }
   [[nodiscard]] const Pibt& planner() const { return *planner_; }
@@ -170,6 +189,7 @@ class TrafficControl {
   std::vector<int> stall_;                       ///< planned steps standing short of its target
   std::vector<NodeId> lastEnd_;                  ///< planned end after the previous step
   std::vector<std::int64_t> evadeUntil_;         ///< step its evasion ends, -1
+  std::vector<BaseEnds> baseEnds_;
   TrafficStats stats_;
   int sinceStep_ = 0;  ///< update() calls since the last planned step
 };

@@ -75,6 +75,7 @@ struct VirtualFleetResult {
   std::uint64_t escalations = 0;  ///< agents the planner escalated out of a wait cycle
   std::uint64_t untangles = 0;    ///< knots the planner searched a way out of
   std::uint64_t passes = 0;       ///< robots let past late ones (TrafficStats)
+  BaseEnds baseEnds;              ///< the robots' base ends reached short of their target, summed
   double updateP50Ms = 0.0;       ///< wall time of one traffic update (planning and releases)
   double updateP99Ms = 0.0;
   double density = 0.0;  ///< robots ÷ roadmap nodes
