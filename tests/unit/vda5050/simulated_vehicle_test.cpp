@@ -188,6 +188,35 @@ TEST(Vda5050Vehicle, APersonInTheProtectiveFieldStopsIt) {
   EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25));
 }
 
+// A vehicle its field stops may still turn on the spot when it stands (its body is a disc): one
+// that had to turn towards its next node with a neighbour diagonally ahead in its field stood
+// there for good. It drives only once the field is clear.
+TEST(Vda5050Vehicle, StoppedByItsFieldItStillTurnsOnTheSpot) {
+  Rig r;
+  auto o = pathOrder({{0.0, 0.0}, {0.0, 2.0}});  // its next node lies 90 degrees to the left
+  ASSERT_EQ(r.vehicle.onOrder(o).decision, OrderDecision::kAcceptNew);
+  r.person = true;  // something in its field along its present heading
+  r.run(3.0);
+  EXPECT_NEAR(r.pose.x, 0.0, 1e-9);
+  EXPECT_NEAR(r.pose.y, 0.0, 1e-9);
+  EXPECT_NEAR(r.pose.theta, M_PI / 2.0, 0.1) << "turned towards its next node";
+  r.person = false;
+  r.run(6.0);
+  EXPECT_NEAR(r.pose.y, 2.0, 0.15);
+
+  // Driving, a field violation stops it, turning included.
+  Rig d;
+  ASSERT_EQ(d.vehicle.onOrder(pathOrder({{0.0, 0.0}, {3.0, 0.0}, {3.5, 0.5}})).decision,
+            OrderDecision::kAcceptNew);
+  d.accel = 1.0;
+  d.run(2.5);
+  ASSERT_GT(d.v, 0.3);
+  d.person = true;
+  const auto c = d.vehicle.step(d.t, d.pose, true);
+  EXPECT_EQ(c.v, 0.0);
+  EXPECT_EQ(c.w, 0.0);
+}
+
 TEST(Vda5050Vehicle, ItsProtectiveFieldGrowsWithItsSpeed) {
   Rig r;
   ASSERT_EQ(r.vehicle.onOrder(lineOrder("o1", 0, 0, 6, 6)).decision, OrderDecision::kAcceptNew);
