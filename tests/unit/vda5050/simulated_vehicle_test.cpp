@@ -224,6 +224,10 @@ TEST(Vda5050Vehicle, ItsProtectiveFieldGrowsWithItsSpeed) {
   EXPECT_FALSE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25)) << "standing";
   r.run(2.0);  // up to speed along the line
   EXPECT_TRUE(r.vehicle.inProtectiveField(p, 1.8, 0.0, 0.25)) << "driving: its braking distance too";
+  // And wider by it: a person 0.9 m off its side, 0.8 m ahead (standing, 0.6 m beside the body).
+  EXPECT_TRUE(r.vehicle.inProtectiveField(p, 0.8, -1.1, 0.25)) << "driving: wider by its braking distance";
+  Rig still;
+  EXPECT_FALSE(still.vehicle.inProtectiveField(p, 0.8, -1.1, 0.25)) << "standing";
   // Braking, the command drops at once and the vehicle does not: the field stays sized for the
   // speed it drives at (sized for the command, it shrank under a vehicle still at 1 m/s).
   r.accel = 1.0;

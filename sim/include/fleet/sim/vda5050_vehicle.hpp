@@ -31,8 +31,9 @@ struct Vda5050VehicleConfig {
   double maxTurnRate = 1.5;      // rad/s
   double nodeTolerance = 0.15;   // m; a node's allowedDeviationXY wins when larger
   double protectiveField = 1.0;  // m ahead of the front at standstill; a person inside stops the vehicle
-  /// The field reaches this much beyond each side [m], and grows ahead by the braking distance at
-  /// the commanded speed (v² / 2·brakeDecel), as a safety scanner's speed-switched fields do. A
+  /// The field reaches this much beyond each side [m], and grows ahead and to each side by the
+  /// braking distance at its speed (v² / 2·brakeDecel), as a safety scanner's speed-switched
+  /// fields do. A
   /// field only as wide as the vehicle and 1 m long let a person walking in from the side reach a
   /// vehicle at 0.9 m/s (a 3.6 cm contact in a 20-robot mixed run).
   double fieldSideMargin = 0.3;
@@ -95,7 +96,8 @@ class Vda5050Vehicle {
   std::optional<std::string> takeMotionStart() { return std::exchange(motion_started_, std::nullopt); }
 
   /// Whether a point (a person) is inside the protective field of a vehicle at `pose`: a
-  /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin each side, as long as
+  /// rectangle ahead of its front, the vehicle's width plus fieldSideMargin plus the braking
+  /// distance at its speed each side, as long as
   /// `protectiveField` plus the braking distance at its speed (the larger of the last commanded
   /// and the measured one).
   [[nodiscard]] bool inProtectiveField(const Pose2& pose, double px, double py, double radius) const;
