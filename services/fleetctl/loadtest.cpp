@@ -629,6 +629,7 @@ int Run::run() {
   fs::remove(db, ec);
   fs::remove(out / "fleet.db-wal", ec);
   fs::remove(out / "fleet.db-shm", ec);
+  fs::remove(out / "traffic_manager_summary.json", ec);  // not a previous run's
   writeFile(out / "manager.json",
             json{{"stations", fs::absolute(scenarioPath).string()},
                  {"db", fs::absolute(db).string()},

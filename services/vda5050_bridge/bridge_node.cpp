@@ -99,7 +99,8 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     v.task_id = a.task_id;
     v.goal = 0;
     v.charge_action.clear();
-    v.charging_since_ns = -1;
+    v.charge_arrived_ns = -1;
+    v.charge_attempts = 0;
     v.failure.clear();
     freshChance(v);
     v.reported = msg::TaskState::Queued;
@@ -265,8 +266,12 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::i
       if (!there) {
         return;
       }
-      if (g.action == msg::GoalAction::Charge && !charged(v, *view.state, nowNs, out)) {
-        return;
+      if (g.action == msg::GoalAction::Charge) {
+        if (!charged(v, *view.state, nowNs, out)) {
+          return;
+        }
+        v.charge_arrived_ns = -1;
+        v.charge_attempts = 0;
       }
     }
     ++v.goal;
@@ -274,36 +279,51 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::i
 }
 
 bool BridgeNode::charged(Vehicle& v, const vda5050::State& s, std::int64_t nowNs, BridgeOutbox& out) {
-  if (v.charge_action.empty()) {
-    v.charge_action = goalActionId(v, v.goal);
-    v.charging_since_ns = -1;
-    instant(v, "startCharging", nowNs, out, v.charge_action);
-    ++counters_.charges;
+  constexpr double kAnswerS = 5.0;  // a startCharging without charging by then is sent again
+  constexpr int kAttempts = 3;      // startCharging sent at most this often at one goal
+  if (v.charge_arrived_ns < 0) {
+    v.charge_arrived_ns = nowNs;
+  }
+  const auto since = [&](std::int64_t t) { return static_cast<double>(nowNs - t) * 1e-9; };
+  // The fleet manager ends the task once the battery is charged; a charger that does not charge
+  // (or a vehicle that does not start) holds it no longer than the goal's duration
+  // (charge_max_s) from its arrival, as for a robot agent.
+  if (since(v.charge_arrived_ns) >= v.goals[v.goal].duration_s) {
+    if (s.batteryState.charging) {
+      instant(v, "stopCharging", nowNs, out);
+      ++counters_.charge_stops;
+      v.charge_stop_ns = nowNs;
+    }
+    v.charge_action.clear();
+    return true;
+  }
+  if (s.batteryState.charging) {
     return false;
   }
-  const auto* a = findAction(s, v.charge_action);
-  if (a != nullptr && a->actionStatus == "FAILED") {
+  const auto* a = v.charge_action.empty() ? nullptr : findAction(s, v.charge_action);
+  const bool failed = a != nullptr && a->actionStatus == "FAILED";
+  const bool unanswered = !v.charge_action.empty() && !failed && since(v.charge_sent_ns) >= kAnswerS;
+  if (!v.charge_action.empty() && !failed && !unanswered) {
+    return false;  // sent, not answered yet
+  }
+  if (failed) {
     ++counters_.charge_failures;
-    v.failure = "startCharging failed: " + a->resultDescription.value_or("no reason given");
+  }
+  if (v.charge_attempts >= kAttempts) {
+    v.failure = failed ? "startCharging failed: " + a->resultDescription.value_or("no reason given")
+                       : "startCharging " + std::to_string(kAttempts) + " times, the vehicle never charged";
     out.warnings.push_back(v.entry.robot_id + ": " + v.failure + " (task " + v.task_id + " failed)");
     return false;
   }
-  if (!s.batteryState.charging) {
-    return false;  // not yet started (or the vehicle has not said so)
+  if (s.driving) {
+    return false;  // still settling on the node: a vehicle on the move does not start charging
   }
-  if (v.charging_since_ns < 0) {
-    v.charging_since_ns = nowNs;
-  }
-  // The fleet manager ends the task once the battery is charged; a charger that does not charge
-  // holds the vehicle no longer than the goal's duration (charge_max_s), as for a robot agent.
-  if (static_cast<double>(nowNs - v.charging_since_ns) * 1e-9 < v.goals[v.goal].duration_s) {
-    return false;
-  }
-  instant(v, "stopCharging", nowNs, out);
-  ++counters_.charge_stops;
-  v.charge_stop_ns = nowNs;
-  v.charge_action.clear();
-  return true;
+  // A fresh id each time: the vehicle's state may still list the last attempt's FAILED.
+  v.charge_action = goalActionId(v, v.goal) + "-c" + std::to_string(++v.charge_attempts);
+  v.charge_sent_ns = nowNs;
+  instant(v, "startCharging", nowNs, out, v.charge_action);
+  ++counters_.charges;
+  return false;
 }
 
 void BridgeNode::stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int64_t nowNs,
@@ -311,6 +331,7 @@ void BridgeNode::stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int
   const bool wanted = !v.charge_action.empty() && v.failure.empty() && !v.task_id.empty() &&
                       v.goal < v.goals.size() && v.goals[v.goal].action == msg::GoalAction::Charge;
   if (!s.batteryState.charging || wanted) {
+    v.stray_stops = 0;
     return;
   }
   // Again after a while: a stopCharging lost on the way (QoS 0) must not hold the vehicle for ever.
@@ -321,6 +342,11 @@ void BridgeNode::stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int
   instant(v, "stopCharging", nowNs, out);
   ++counters_.charge_stops;
   v.charge_stop_ns = nowNs;
+  if (++v.stray_stops == 3) {
+    out.warnings.push_back(v.entry.robot_id +
+                           ": still charging after 3 stopCharging; no order goes to it while it charges "
+                           "(it is reported holding, so traffic is planned round it)");
+  }
 }
 
 void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
@@ -422,10 +448,13 @@ std::string BridgeNode::refusal(const vda5050::VehicleView& view) const {
   if (!view.factsheet) {
     return "no factsheet yet (its footprint decides whether the roadmap fits it)";
   }
+  if (!roadmap_radius_) {
+    return "no roadmap from the traffic manager yet (its robot radius decides whether the vehicle fits)";
+  }
   const auto f = vda5050::footprint(*view.factsheet);
   // A millimetre of slack: a footprint given as the robot's own disc, rounded in JSON, still fits.
   constexpr double kSlack = 1e-3;
-  if (roadmap_radius_ > 0.0 && f.radius > roadmap_radius_ + kSlack) {
+  if (*roadmap_radius_ > 0.0 && f.radius > *roadmap_radius_ + kSlack) {
     char why[512];
     std::snprintf(
         why, sizeof why,
@@ -433,7 +462,7 @@ std::string BridgeNode::refusal(const vda5050::VehicleView& view) const {
         "is larger than the robot the roadmap's conflicts are computed for (radius %.3f m): planned "
         "as that robot it could touch others; a roadmap for it needs a robot radius of at least "
         "%.3f m (the site's robot.radius or the traffic manager's roadmap.radius)",
-        f.radius, f.source.c_str(), roadmap_radius_, f.radius);
+        f.radius, f.source.c_str(), *roadmap_radius_, f.radius);
     return why;
   }
   return {};
@@ -445,20 +474,20 @@ bool BridgeNode::admit(Vehicle& v, const vda5050::VehicleView& view, std::int64_
     if (why.empty()) {
       const auto f = vda5050::footprint(*view.factsheet);
       char fits[200];
-      if (roadmap_radius_ > 0.0) {
+      if (*roadmap_radius_ > 0.0) {
         std::snprintf(fits, sizeof fits,
                       "joins the fleet: its footprint (radius %.3f m, %s) fits the roadmap's robot (%.3f m)",
-                      f.radius, f.source.c_str(), roadmap_radius_);
+                      f.radius, f.source.c_str(), *roadmap_radius_);
       } else {
         std::snprintf(fits, sizeof fits,
                       "joins the fleet: its footprint (radius %.3f m, %s) not checked (the roadmap states no "
                       "robot radius)",
                       f.radius, f.source.c_str());
       }
-      out.warnings.push_back(v.entry.robot_id + ": " + fits);
+      out.notices.push_back(v.entry.robot_id + ": " + fits);
     } else {
       ++counters_.refused_vehicles;
-      out.warnings.push_back(v.entry.robot_id + ": refused: " + why);
+      out.notices.push_back(v.entry.robot_id + ": not in the fleet: " + why);
     }
     v.refused = why;
   }
@@ -466,7 +495,7 @@ bool BridgeNode::admit(Vehicle& v, const vda5050::VehicleView& view, std::int64_
     instant(v, "factsheetRequest", nowNs, out);
     v.factsheet_asked_ns = nowNs;
   }
-  if (!why.empty() && v.has_order && !v.cancel_sent && view.state && !view.state->nodeStates.empty()) {
+  if (!why.empty() && !v.cancel_sent && view.state && !view.state->nodeStates.empty()) {
     instant(v, "cancelOrder", nowNs, out);  // it may not drive a plan made for a smaller robot
     ++counters_.cancels;
     v.cancel_sent = true;
@@ -571,7 +600,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     p.epoch = v.release ? v.release->epoch : 0;
     p.node = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
     p.pose = pose;
-    if (!v.task_id.empty() && v.goal < v.goals.size()) {
+    if (!v.task_id.empty() && v.goal < v.goals.size() && v.failure.empty()) {
       p.has_goal = true;
       p.goal = v.goals[v.goal].pose;
       p.goal_station = v.goals[v.goal].station;

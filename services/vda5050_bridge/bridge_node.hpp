@@ -20,13 +20,15 @@
 //    has), after a back-off that doubles. After order_retries failed retries the robot is reported
 //    blocked to the traffic manager until a changed release or task gives it a new chance.
 //  - Charging: at a charge goal's node, with nothing left of its order, the vehicle is sent
-//    startCharging; it reports mode Charging and holds its node while its state says charging, until
-//    the fleet manager ends the task (charged to its target) or the goal's duration runs out (then
-//    the bridge ends the goal, as a robot agent does). Whenever the vehicle charges with no charge
+//    startCharging (again, with a fresh action id, when it does not charge within 5 s or answers
+//    FAILED; after three the task fails with its reason); it reports mode Charging and holds its
+//    node while its state says charging, until the fleet manager ends the task (charged to its
+//    target) or the goal's duration from its arrival runs out (then the bridge ends the goal, as a
+//    robot agent does). Whenever the vehicle charges with no charge
 //    goal of its own (the task ended or changed) it is sent stopCharging, and no order goes out
 //    until it reports charging false (VDA 5050 2.1, 6.8.1: stopCharging comes before a new order).
 //    A startCharging that FAILED fails the task with the vehicle's reason.
-//  - Footprint: a vehicle joins the fleet only once its factsheet is known and its footprint
+//  - Footprint: a vehicle joins the fleet only once its factsheet and the roadmap are known and its footprint
 //    (vda5050::footprint: the disc that holds it at every heading) fits in the robot disc the
 //    traffic manager's roadmap conflicts were computed for (Roadmap.robot_radius): a larger
 //    vehicle would touch others the plan keeps apart. Until then, or when it does not fit, it is
@@ -79,6 +81,8 @@ struct BridgeOutbox {
   std::vector<msg::TrafficProgress> progress;
   std::vector<msg::TaskStatus> statuses;
   std::vector<std::string> warnings;
+  /// Rare and each worth reading (a vehicle joins or is refused): logged without rate limit.
+  std::vector<std::string> notices;
 };
 
 struct BridgeCounters {
@@ -148,7 +152,10 @@ class BridgeNode {
     // release arrives an order takes no more than those.
     std::optional<std::pair<std::uint32_t, std::uint32_t>> stale_release;  // epoch, seq
     std::string charge_action;             // the startCharging sent for the current goal; empty: none
-    std::int64_t charging_since_ns = -1;   // its state said charging from then, at that goal
+    std::int64_t charge_arrived_ns = -1;   // it stood at its charge goal from then
+    std::int64_t charge_sent_ns = 0;       // the last startCharging went out then
+    int charge_attempts = 0;               // startCharging sent at this goal
+    int stray_stops = 0;                   // stopCharging sent while it charged on without a charge goal
     std::int64_t charge_stop_ns = -1;      // stopCharging last sent then
     std::string failure;                   // the task failed for this (reported with the status)
     std::string refused = "not seen yet";  // why it may not join the fleet now; empty: it may
@@ -182,7 +189,7 @@ class BridgeNode {
   vda5050::VehicleRegistry registry_;
   std::map<std::string, Vehicle> vehicles_;  // by robot id
   vda5050::KnownRoadmap roadmap_;
-  double roadmap_radius_ = 0.0;  // m: Roadmap.robot_radius (0: not stated, not checked)
+  std::optional<double> roadmap_radius_;  // m: Roadmap.robot_radius (none yet; 0: not stated, not checked)
   BridgeCounters counters_;
 };
 

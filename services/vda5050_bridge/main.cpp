@@ -254,6 +254,9 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
     for (const auto& s : out.progress) {
       progress.write(s);
     }
+    for (const auto& n : out.notices) {
+      spdlog::warn("{}", n);
+    }
     for (const auto& w : out.warnings) {
       // Rate-limited per vehicle and kind ("r3: refused", "r3: online"): one kind does not hide
       // another (a vehicle's refusal came right after its "online" and was swallowed).

@@ -484,9 +484,12 @@ bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, 
 bool Vda5050Vehicle::inWarningField(const Pose2& pose, double px, double py, double radius) const {
   const double v = fieldSpeed();
   const double a = std::max(config_.brakeDecel, 1e-3);
-  const double reach = config_.protectiveField + v * v / (2.0 * a) + config_.personApproachSpeed * v / a;
+  const double braking = v * v / (2.0 * a);
+  // It holds the protective field: as wide, longer by the way an approaching person covers while
+  // the vehicle brakes.
+  const double reach = config_.protectiveField + braking + config_.personApproachSpeed * v / a;
   return inFieldAhead(pose, px, py, radius, config_.length / 2.0, reach,
-                      config_.width / 2.0 + config_.fieldSideMargin);
+                      config_.width / 2.0 + config_.fieldSideMargin + braking);
 }
 
 bool Vda5050Vehicle::machineInField(const Pose2& pose, double px, double py, double radius) const {

@@ -555,6 +555,7 @@ bool Execution::acyclic() const {
 void Execution::retract(std::size_t robot, bool standing) {
   auto& route = routes_.at(robot);
   route.released = std::min(route.released, route.progress + (standing ? 0 : 1));
+  route.cut = BaseCut::Held;  // held back (faulted, by a person), not late
 }
 
 std::vector<NodeId> Execution::truncateToReleased() {

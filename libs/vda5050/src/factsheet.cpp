@@ -114,10 +114,11 @@ Expected<Factsheet> parseFactsheet(const nlohmann::json& j) {
         for (const auto& point : e.array("polygonPoints")) {
           env.points.emplace_back(point.number("x"), point.number("y"));
         }
-        if (env.points.size() < 3) {
-          throw detail::BadField(e.path() + ".polygonPoints: a polygon needs at least 3 points");
+        // A polygon of fewer than 3 points outlines nothing: skipped rather than refusing the
+        // whole factsheet (the vehicle could never join for one bad envelope).
+        if (env.points.size() >= 3) {
+          m.envelopes2d.push_back(std::move(env));
         }
-        m.envelopes2d.push_back(std::move(env));
       }
     }
     (void)r.object("loadSpecification");

@@ -95,6 +95,13 @@ TEST(Vda5050Bridge, AVehicleDoesATransportTaskFromReleasesAndLeavesTrafficContro
   transport::Participant p;
   transport::Writer<msg::TaskAssignment> assign(p);
   transport::Writer<msg::TrafficRelease> releases(p);
+  // What a traffic manager publishes first (transient-local): the bridge admits a vehicle only
+  // once it knows the robot the roadmap was built for.
+  transport::Writer<msg::Roadmap> roadmap(p);
+  msg::Roadmap rm;
+  rm.site = "one_robot";
+  rm.robot_radius = 0.3;
+  roadmap.write(rm);
   transport::Reader<msg::TaskStatus> statuses(p);
   transport::Reader<msg::RobotState> states(p);
   transport::Reader<msg::TrafficProgress> progress(p);

@@ -108,11 +108,9 @@ TEST(Vda5050Messages, TheFactsheetsFootprintIsItsFarthestEnvelopePoint) {
   auto j = toJson(f);
   j["agvGeometry"]["envelopes2d"][1]["polygonPoints"].erase(2);
   j["agvGeometry"]["envelopes2d"][1]["polygonPoints"].erase(1);
-  const auto bad = parseFactsheet(j);
-  ASSERT_FALSE(bad);
-  EXPECT_NE(bad.error().message.find("envelopes2d[1].polygonPoints: a polygon needs at least 3 points"),
-            std::string::npos)
-      << bad.error().message;
+  const auto skipped = parseFactsheet(j);  // a polygon of 1 point outlines nothing: skipped
+  ASSERT_TRUE(skipped) << skipped.error().message;
+  EXPECT_EQ(skipped->envelopes2d.size(), 1U);
 }
 
 TEST(Vda5050Messages, RefusalNamesTheBadKey) {

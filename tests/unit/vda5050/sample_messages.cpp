@@ -97,6 +97,9 @@ int main() {
   sim::test::Rig fresh;
   auto st = fresh.vehicle.takeState(0.0, 0);
   st.header.manufacturer = "fleet-sim";
+  msg::Roadmap roadmap;
+  roadmap.robot_radius = 0.3;
+  bridge.onRoadmap(roadmap);
   bridge.onMqtt("uagv/v2/fleet-sim/AGV-1/factsheet", vda5050::toJson(fresh.vehicle.factsheet(0)).dump(), out);
   bridge.onMqtt("uagv/v2/fleet-sim/AGV-1/state", vda5050::toJson(st).dump(), out);
   msg::TaskAssignment assignment;

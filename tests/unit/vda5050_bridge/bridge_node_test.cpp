@@ -53,7 +53,8 @@ struct Loop {
   BridgeNode bridge;
   sim::test::Rig rig;  // "fleet-sim"/"AGV-1" on map "small", at (0, 0) facing +x
   std::int64_t now = 0;
-  bool deliver = true;  // false: orders are lost on the way
+  bool deliver = true;          // false: orders are lost on the way
+  bool deliverInstants = true;  // false: instant actions are lost on the way
   std::vector<vda5050::Order> orders;
   std::vector<std::string> instants;
   std::vector<std::string> warnings;
@@ -91,10 +92,13 @@ struct Loop {
         for (const auto& a : ia->actions) {
           instants.push_back(a.actionType);
         }
-        rig.vehicle.onInstantActions(*ia);
+        if (deliverInstants) {
+          rig.vehicle.onInstantActions(*ia);
+        }
       }
     }
     warnings.insert(warnings.end(), out.warnings.begin(), out.warnings.end());
+    warnings.insert(warnings.end(), out.notices.begin(), out.notices.end());
     if (!out.progress.empty()) {
       progress = out.progress.back();
     }
@@ -211,8 +215,9 @@ TEST(Vda5050BridgeNode, AChargeGoalEndsAfterItsDuration) {
   EXPECT_EQ(l.statuses.back().state, msg::TaskState::Done);
 }
 
-// A vehicle that cannot start charging there (here: no charger under it) fails the task with its
-// reason, logged; nothing else is sent to it.
+// A vehicle that cannot start charging there (here: no charger under it) is asked again (a fresh
+// action id each time: its state still lists the last FAILED), three times in all; then the task
+// fails with its reason, logged.
 TEST(Vda5050BridgeNode, AFailedStartChargingFailsTheTaskWithTheVehiclesReason) {
   Loop l;
   l.rig.vehicle.senseBattery(0.3, false);
@@ -225,13 +230,32 @@ TEST(Vda5050BridgeNode, AFailedStartChargingFailsTheTaskWithTheVehiclesReason) {
   EXPECT_NE(l.statuses.back().error.find("not on a charging spot"), std::string::npos)
       << l.statuses.back().error;
   EXPECT_TRUE(l.warned("startCharging failed"));
-  EXPECT_EQ(l.bridge.counters().charge_failures, 1U);
-  EXPECT_EQ(count(l.instants, "startCharging"), 1U) << "not tried again and again";
+  EXPECT_EQ(count(l.instants, "startCharging"), 3U);
+  EXPECT_EQ(l.bridge.counters().charge_failures, 3U);
+  l.run(5.0);
+  EXPECT_EQ(count(l.instants, "startCharging"), 3U) << "not tried again and again";
 }
 
-// Until its factsheet is known a vehicle is not in the fleet: no RobotState (no task for it), no
-// order, and the traffic manager told it does not follow releases; the bridge asks for the
-// factsheet and says why. With the factsheet it joins.
+// A startCharging lost on the way (or one the vehicle never acts on) is sent again after 5 s; after
+// three the task fails, and the goal never holds the vehicle past its duration from its arrival.
+TEST(Vda5050BridgeNode, AStartChargingWithoutAnAnswerIsSentAgainThenTheTaskFails) {
+  Loop l;
+  l.rig.vehicle.senseBattery(0.3, true);
+  chargeAtN1(l, "charge.r1", 1800.0);
+  l.deliverInstants = false;
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  l.run(1.0);
+  EXPECT_EQ(count(l.instants, "startCharging"), 1U);
+  l.run(5.0);
+  EXPECT_EQ(count(l.instants, "startCharging"), 2U);
+  l.run(10.0);
+  EXPECT_EQ(count(l.instants, "startCharging"), 3U);
+  EXPECT_EQ(l.statuses.back().state, msg::TaskState::Failed);
+  EXPECT_TRUE(l.warned("the vehicle never charged"));
+  EXPECT_FALSE(l.progress.has_goal && l.progress.goal.x == 1.0) << "a failed task no longer steers it";
+}
+
 TEST(Vda5050BridgeNode, AVehicleJoinsTheFleetOnlyWithItsFactsheet) {
   Loop l(settings(), false);
   l.assign("t1", 2.0);
@@ -240,7 +264,7 @@ TEST(Vda5050BridgeNode, AVehicleJoinsTheFleetOnlyWithItsFactsheet) {
   EXPECT_TRUE(l.orders.empty());
   EXPECT_FALSE(l.robot.has_value());
   EXPECT_FALSE(l.progress.follows);
-  EXPECT_TRUE(l.warned("r1: refused: no factsheet yet"));
+  EXPECT_TRUE(l.warned("r1: not in the fleet: no factsheet yet"));
   EXPECT_EQ(count(l.instants, "factsheetRequest"), 1U);
   l.sendFactsheet();
   l.run(1.0);
@@ -264,10 +288,10 @@ TEST(Vda5050BridgeNode, AVehicleLargerThanTheRoadmapsRobotIsRefusedSayingWhy) {
   small.robot_radius = 0.25;
   l.bridge.onRoadmap(small);
   l.run(3.0);
-  EXPECT_TRUE(
-      l.warned("r1: refused: its footprint (a disc of radius 0.300 m about its reference point, from "
-               "its factsheet's envelope 'default') is larger than the robot the roadmap's conflicts "
-               "are computed for (radius 0.250 m)"));
+  EXPECT_TRUE(l.warned(
+      "r1: not in the fleet: its footprint (a disc of radius 0.300 m about its reference point, from "
+      "its factsheet's envelope 'default') is larger than the robot the roadmap's conflicts "
+      "are computed for (radius 0.250 m)"));
   EXPECT_EQ(count(l.instants, "cancelOrder"), 1U);
   EXPECT_FALSE(l.state().driving);
   EXPECT_FALSE(l.progress.follows);
