@@ -1,5 +1,6 @@
 #include "fleet/vda5050/factsheet.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "json_reader.hpp"
@@ -138,6 +139,10 @@ Footprint footprint(const Factsheet& f) {
   }
   if (f.envelopes2d.empty()) {
     out = {std::hypot(f.width, f.length) / 2.0, "width x length"};
+  }
+  // However the envelopes are drawn, the vehicle is at least as wide and as long as it says.
+  if (const double half = std::max(f.width, f.length) / 2.0; half > out.radius) {
+    out = {half, "width and length"};
   }
   return out;
 }

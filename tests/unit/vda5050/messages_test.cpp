@@ -111,6 +111,11 @@ TEST(Vda5050Messages, TheFactsheetsFootprintIsItsFarthestEnvelopePoint) {
   const auto skipped = parseFactsheet(j);  // a polygon of 1 point outlines nothing: skipped
   ASSERT_TRUE(skipped) << skipped.error().message;
   EXPECT_EQ(skipped->envelopes2d.size(), 1U);
+  // An envelope that outlines less than the vehicle's own width and length does not shrink it.
+  f.envelopes2d = {{"dot", {{0.0, 0.0}, {0.01, 0.0}, {0.0, 0.01}}}};
+  fp = footprint(f);
+  EXPECT_DOUBLE_EQ(fp.radius, 0.4);
+  EXPECT_EQ(fp.source, "width and length");
 }
 
 TEST(Vda5050Messages, RefusalNamesTheBadKey) {

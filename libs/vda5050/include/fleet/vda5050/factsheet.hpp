@@ -47,7 +47,8 @@ struct Factsheet {
 
 /// The disc about the vehicle's reference point that holds it at every heading (it turns on the
 /// spot): its radius is the farthest point of any 2-D envelope, or half the diagonal of width ×
-/// length when it gives none. `source` says which, for messages.
+/// length when it gives none, and never less than half the larger of width and length. `source`
+/// says which, for messages.
 struct Footprint {
   double radius = 0.0;
   std::string source;
