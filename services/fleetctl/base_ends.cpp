@@ -28,9 +28,15 @@ nlohmann::json trafficSummaryJson(const nlohmann::json& summary, const std::set<
   auto vdas = zero();
   if (summary.contains("base_ends_by_robot") && summary["base_ends_by_robot"].is_object()) {
     for (const auto& [robot, b] : summary["base_ends_by_robot"].items()) {
+      if (!b.is_object()) {
+        continue;  // not what the traffic manager writes: left out rather than failing the report
+      }
       auto& into = vehicles.count(robot) != 0 ? vdas : agents;
       for (const char* k : kKinds) {
-        into[k] = into[k].get<std::uint64_t>() + b.value(k, std::uint64_t{0});
+        const auto n = b.find(k);
+        if (n != b.end() && n->is_number_integer() && n->get<std::int64_t>() >= 0) {
+          into[k] = into[k].get<std::uint64_t>() + n->get<std::uint64_t>();
+        }
       }
     }
   }

@@ -349,13 +349,18 @@ void BridgeNode::stopStrayCharging(Vehicle& v, const vda5050::State& s, std::int
   }
 }
 
-void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
-                               BridgeOutbox& out) {
+bool BridgeNode::holdsOrdersBack(const Vehicle& v, const vda5050::VehicleView& view,
+                                 std::int64_t nowNs) const {
   // Held where it stands (the traffic manager plans round it): an order now would be the release
   // it had, cancelled again; the next comes once its field is clear, from the release then.
   // Charging, it takes no order (stopCharging first: stopStrayCharging()).
-  if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline || v.gave_up ||
-      nowNs < v.retry_ns || v.field_cancelled || view.state->batteryState.charging) {
+  return v.gave_up || nowNs < v.retry_ns || v.field_cancelled || view.state->batteryState.charging;
+}
+
+void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs,
+                               BridgeOutbox& out) {
+  if (!v.release || v.release->base.empty() || view.health != VehicleHealth::kOnline ||
+      holdsOrdersBack(v, view, nowNs)) {
     return;
   }
   const auto& r = *v.release;
@@ -551,7 +556,7 @@ void BridgeNode::tick(std::int64_t nowNs, BridgeOutbox& out) {
     const bool admitted = admit(v, *view, nowNs, out);
     const bool online = view->health == VehicleHealth::kOnline && admitted;
     const bool atBaseEnd = online && s.newBaseRequest.value_or(false);
-    if (atBaseEnd && !v.at_base_end && v.release) {
+    if (atBaseEnd && !v.at_base_end && v.release && !v.stale_release && !holdsOrdersBack(v, *view, nowNs)) {
       const auto& base = v.release->base;
       const int at = vda5050::OrderBuilder::roadmapNode(s.lastNodeId);
       const auto it =

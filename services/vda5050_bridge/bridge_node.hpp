@@ -171,6 +171,11 @@ class BridgeNode {
   void instant(Vehicle& v, const std::string& type, std::int64_t nowNs, BridgeOutbox& out,
                const std::string& id = {});
   void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
+  /// The bridge itself holds the vehicle's next order back (retries spent or backing off, its field
+  /// held it, charging, or capped to a held robot's two nodes): then a stop at its base end is
+  /// the bridge's doing, not an update that came late.
+  [[nodiscard]] bool holdsOrdersBack(const Vehicle& v, const vda5050::VehicleView& view,
+                                     std::int64_t nowNs) const;
   void trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
   /// A charge goal at its node: start charging, watch it, end the goal when its duration is over.
   /// False while the goal goes on.

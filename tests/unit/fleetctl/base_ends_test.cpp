@@ -25,6 +25,10 @@ TEST(BaseEnds, CountsAreSplitBetweenAgentsAndVehicles) {
   const auto agentsOnly = trafficSummaryJson({{"releases", 1}}, {});
   EXPECT_FALSE(agentsOnly.contains("base_ends_vehicles"));
   EXPECT_EQ(agentsOnly["base_ends_agents"]["held"], 0);
+  // A summary of unexpected shape (an edited file) leaves the odd entries out instead of throwing.
+  const auto odd =
+      trafficSummaryJson({{"base_ends_by_robot", {{"r1", 7}, {"r2", {{"held", "x"}, {"limit", 2}}}}}}, {});
+  EXPECT_EQ(odd["base_ends_agents"], (nlohmann::json{{"held", 0}, {"plan_end", 0}, {"limit", 2}}));
 }
 
 }  // namespace
