@@ -34,6 +34,13 @@ std::string cutOffText(const std::vector<std::string>& stations) {
   return out;
 }
 
+traffic::BaseEnds fleetBaseEnds(const std::map<std::string, traffic::BaseEnds>& byRobot) {
+  traffic::BaseEnds all;
+  for (const auto& [robot, b] : byRobot)
+    all += b;
+  return all;
+}
+
 int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id,
         const service::OpsSettings& opsSettings) {
   service::ServiceOps ops("traffic_manager");
@@ -107,9 +114,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
 
   auto logStats = [&] {
     const auto& c = node.counters();
-    traffic::BaseEnds ends;
-    for (const auto& [robot, b] : node.baseEnds())
-      ends += b;
+    const traffic::BaseEnds ends = fleetBaseEnds(node.baseEnds());
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
         "re-plans, {} risk updates, {} yields, tick {:.2f} ms (max {:.2f}), base ends reached short of the "
@@ -232,12 +237,11 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   logStats();
   if (!settings.summaryFile.empty()) {
     const auto& c = node.counters();
+    const auto byRobot = node.baseEnds();
     nlohmann::json ends = nlohmann::json::object();
-    traffic::BaseEnds all;
-    for (const auto& [robot, b] : node.baseEnds()) {
+    for (const auto& [robot, b] : byRobot)
       ends[robot] = {{"held", b.held}, {"plan_end", b.planEnd}, {"limit", b.limit}};
-      all += b;
-    }
+    const traffic::BaseEnds all = fleetBaseEnds(byRobot);
     const nlohmann::json summary = {
         {"reports", c.reports},
         {"refused_reports", c.refused},
