@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
 
 #include "fleet/control/diff_drive_kinematics.hpp"
 #include "fleet/control/velocity_limits.hpp"
@@ -61,6 +63,30 @@ constexpr double kProgressM = 0.5;       // m: moving less than this in kGiveUpS
 constexpr double kGiveUpS = 5.0;         // s of being stuck before choosing another goal
 constexpr double kBlockingRobotM = 1.0;  // m (surface gap): a robot this close can be what blocks someone
 constexpr double kIntoRobotCos = 0.5;    // a way within 60° of a robot's bearing leads into it
+
+// A person wedged against a shelf corner at the keep distance of a robot beside it: the step they
+// want, and both slides along the axes, each bring them nearer to one of the two, and the free way
+// out can be a wedge of 15° between them (a CI run: 1,400 s frozen there, the robot waiting for
+// them). The nearest turned direction that neither penetrates nor crowds more is taken instead.
+template <typename Ok>
+std::optional<std::pair<Vec2, Vec2>> turnedStep(Vec2 p, Vec2 v, double dt, const Ok& ok) {
+  constexpr int kTurns = 18;  // 10° apart on each side
+  const double speed = len(v);
+  if (speed < 1e-9) {
+    return std::nullopt;
+  }
+  const double a0 = std::atan2(v.y, v.x);
+  for (int k = 1; k <= kTurns; ++k) {
+    for (const int side : {1, -1}) {
+      const double a = a0 + side * k * kPi / kTurns;
+      const Vec2 w{speed * std::cos(a), speed * std::sin(a)};
+      if (ok(p + w * dt)) {
+        return std::pair{p + w * dt, w};
+      }
+    }
+  }
+  return std::nullopt;
+}
 // Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
 // a run whose bodies never come that close reports null.
 constexpr double kSeparationReach = 2.0;
@@ -566,6 +592,9 @@ void World::stepHumans() {
     } else if (const Vec2 py{h.p.x, newP[i].y}; ok(py)) {
       h.p = py;
       h.v = {0.0, newV[i].y};
+    } else if (const auto turned = turnedStep(h.p, newV[i], dt, ok)) {
+      h.p = turned->first;
+      h.v = turned->second;
     } else {
       h.v = {};
     }

@@ -333,3 +333,31 @@ TEST(Humans, SomeoneWhoseWayIsThroughAStandingRobotTurnsAwayInsteadOfPacingBesid
   EXPECT_GE(cameNear, 5) << "people must come down to the robot for this test to mean anything";
   EXPECT_LT(worst, 15.0) << "someone stood within 1.2 m of the robot for that many seconds at a time";
 }
+
+TEST(Humans, SomeoneWedgedBetweenAShelfCornerAndARobotGetsOut) {
+  // A shelf row across the room (y 5..6) with a 1.5 m gap (x 6.5..8); a robot stands at the gap's
+  // mouth, the person at the gap's west corner at the robot's keep distance, every goal south
+  // through the gap. Their step, and both slides along the axes, each bring them nearer to the
+  // corner or to the robot: in a CI run such a person stood frozen 1,400 s and the robot with them.
+  auto moved = [](std::uint64_t seed) {
+    auto j = carvedRoom(seed, [](int r, int c) {
+      const bool shelf = (r == 18 || r == 19) && !(c >= 13 && c <= 15);
+      return !shelf;
+    });
+    j["robots"] = {{{"id", "r1"}, {"start", {7.17, 6.51, -1.5}}}};
+    j["points_of_interest"] = {{3.0, 2.0}, {10.0, 2.0}, {16.0, 2.0}, {7.0, 1.0}};
+    j["humans"] = {{"list", {{{"id", "h"}, {"start", {6.67, 6.19}}}}}, {"stop_probability", 0.0}};
+    World w(test::parse(j));
+    const Vec2 start = w.humans()[0].p;
+    double farthest = 0.0;
+    for (int k = 0; k < 300; ++k) {  // 30 s
+      w.advance();
+      farthest = std::max(farthest, distance(w.humans()[0].p, start));
+    }
+    EXPECT_EQ(w.metrics().robotHumanContacts, 0U);
+    return farthest;
+  };
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    EXPECT_GT(moved(seed), 0.5) << "seed " << seed << ": the person stayed wedged where they stood";
+  }
+}
