@@ -172,8 +172,9 @@ class BridgeNode {
                const std::string& id = {});
   void followRelease(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);
   /// The bridge itself holds the vehicle's next order back (retries spent or backing off, its field
-  /// held it, charging, or capped to a held robot's two nodes): then a stop at its base end is
-  /// the bridge's doing, not an update that came late.
+  /// held it, charging): then a stop at its base end is the bridge's doing, not an update that came
+  /// late. (A stale release, capped to a held robot's two nodes, is left out at the call site: it
+  /// still sends orders.)
   [[nodiscard]] bool holdsOrdersBack(const Vehicle& v, const vda5050::VehicleView& view,
                                      std::int64_t nowNs) const;
   void trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::int64_t nowNs, BridgeOutbox& out);

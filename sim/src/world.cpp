@@ -64,6 +64,10 @@ constexpr double kGiveUpS = 5.0;         // s of being stuck before choosing ano
 constexpr double kBlockingRobotM = 1.0;  // m (surface gap): a robot this close can be what blocks someone
 constexpr double kIntoRobotCos = 0.5;    // a way within 60° of a robot's bearing leads into it
 
+// Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
+// a run whose bodies never come that close reports null.
+constexpr double kSeparationReach = 2.0;
+
 // A person wedged against a shelf corner at the keep distance of a robot beside it: the step they
 // want, and both slides along the axes, each bring them nearer to one of the two, and the free way
 // out can be a wedge of 15° between them (a CI run: 1,400 s frozen there, the robot waiting for
@@ -87,9 +91,6 @@ std::optional<std::pair<Vec2, Vec2>> turnedStep(Vec2 p, Vec2 v, double dt, const
   }
   return std::nullopt;
 }
-// Minimum separations are tracked for pairs with a surface gap under this (or near_miss_m if larger);
-// a run whose bodies never come that close reports null.
-constexpr double kSeparationReach = 2.0;
 
 }  // namespace
 

@@ -42,6 +42,12 @@ class TaskTimes(unittest.TestCase):
         path = db_with([("a", None, "queued", 0), ("a", "queued", "assigned", 1), ("a", "assigned", "done", 11)])
         self.assertEqual(ff.task_times(path), ([10.0], 0))
 
+    def test_done_within_counts_from_the_first_task_posted(self):
+        path = db_with([("a", None, "queued", 10), ("a", "queued", "assigned", 11), ("a", "assigned", "done", 600),
+                        ("b", None, "queued", 20), ("b", "queued", "assigned", 21), ("b", "assigned", "done", 611)])
+        self.assertEqual(ff.done_within(path, 600.0), 1)
+        self.assertEqual(ff.done_within(path, 601.0), 2)
+
 
 if __name__ == "__main__":
     unittest.main()
