@@ -109,7 +109,7 @@ struct AgentParams {
   std::function<double(Vec2)> speedLimit;
   /// "reactive": robots keep clear of each other by the standoff conduct (the default for now);
   /// "reserved": the route comes from the traffic manager's releases (see onRelease).
-  std::string traffic = "reactive";
+  std::string traffic = "reserved";
 };
 
 struct AgentOutput {

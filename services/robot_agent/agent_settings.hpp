@@ -18,7 +18,7 @@ struct Settings {
   // Keys of the --config file (and command-line options, except the parameter blocks).
   std::string localPlanner = "dwa";
   std::string globalPlanner = "astar";
-  std::string traffic = "reactive";  // or "reserved": follow the traffic manager's releases
+  std::string traffic = "reserved";  // or "reactive" (being retired)
   avoidance::DwaParams dwa = agentDwaDefaults();
   avoidance::RiskSteppingParams riskStepping;
   avoidance::SafetyParams safety;
