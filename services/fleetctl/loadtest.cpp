@@ -156,7 +156,7 @@ DbContents readDb(const fs::path& path) {
 }
 
 struct Run {
-  LoadtestOptions o;  // a copy: the traffic mode may fall back to reactive (see LoadtestOptions)
+  LoadtestOptions o;  // a copy
   Supervisor sup;
   fs::path out;
   json scenario;
@@ -674,28 +674,13 @@ int Run::run() {
        env,
        log("risk_map")}};
   const bool hasSite = scenario.contains("site") && scenario["site"].is_string();
-  if (o.traffic == "reserved" && !hasSite && !o.trafficNamed) {
-    say("the scenario has no site, so no roadmap: reactive traffic (robots avoid each other on their own)");
-    o.traffic = "reactive";
-  }
-  for (const auto& f : faults) {
-    if ((f.kind == Fault::Kind::KillTraffic || f.kind == Fault::Kind::CloseArea) && o.traffic != "reserved") {
-      std::cerr << "fleetctl loadtest: --fault " << describe(f)
-                << ": there is no traffic manager in reactive traffic (give --traffic reserved)\n";
-      return 2;
-    }
-  }
-  if ((o.travelCost == "roadmap" || o.stationCapacity == "queue") && !hasSite) {
-    std::cerr << "fleetctl loadtest: "
-              << (o.travelCost == "roadmap" ? "--travel-cost roadmap" : "--station-capacity queue")
-              << " needs a scenario with a site (its roadmap)\n";
+  if (!hasSite) {
+    // Every robot drives what the traffic manager releases, on the roadmap it builds from the site.
+    std::cerr << "fleetctl loadtest: the scenario names no site (\"site\"): the traffic manager needs one "
+                 "for its roadmap\n";
     return 2;
   }
-  if (o.traffic == "reserved") {
-    if (!hasSite) {
-      std::cerr << "fleetctl loadtest: --traffic reserved needs a scenario with a site (its roadmap)\n";
-      return 2;
-    }
+  {
     json tm{{"site", scenario["site"].get<std::string>()},
             {"clock", "sim"},
             {"lockstep", !o.wallClock},
@@ -716,9 +701,9 @@ int Run::run() {
   // VDA 5050 vehicles: the last N robots, with a broker and the bridge of their own.
   std::set<std::string> vdaRobots;
   if (o.vda5050 > 0) {
-    if (o.traffic != "reserved" || o.vda5050 > static_cast<int>(robots.size())) {
-      std::cerr << "fleetctl loadtest: --vda5050 " << o.vda5050 << " needs --traffic reserved and at most "
-                << robots.size() << " robots\n";
+    if (o.vda5050 > static_cast<int>(robots.size())) {
+      std::cerr << "fleetctl loadtest: --vda5050 " << o.vda5050 << " needs at most " << robots.size()
+                << " robots\n";
       return 2;
     }
     if (!o.wallClock && (o.maxSpeed <= 0.0 || o.maxSpeed > 10.0)) {
@@ -786,17 +771,10 @@ int Run::run() {
                                      list,
                                      "--local-planner",
                                      o.localPlanner,
-                                     "--global-planner",
-                                     o.globalPlanner,
                                      "--return-home",
                                      std::to_string(o.returnHomeS),
-                                     "--traffic",
-                                     o.traffic,
                                      "--log-level",
                                      "warn"};
-    if (o.lanes) {
-      args.emplace_back("--lanes");
-    }
     if (!o.agentConfig.empty()) {
       args.emplace_back("--config");
       args.push_back(fs::absolute(o.agentConfig).string());
@@ -825,7 +803,7 @@ int Run::run() {
       " robots, " + std::to_string(scenario.value("humans", json::object()).value("count", 0)) + " humans, " +
       std::to_string(static_cast<int>(o.durationS)) + " s simulated (wall limit " +
       std::to_string(static_cast<int>(o.wallLimitS)) + " s), " + std::to_string(agentNames.size()) +
-      " agent process(es), " + o.traffic + " traffic, DDS domain " + std::to_string(domain) +
+      " agent process(es), DDS domain " + std::to_string(domain) +
       ", WMS API http://127.0.0.1:" + std::to_string(port) + ", run folder " + out.string());
   if (fromList) {
     untilDoneTarget = static_cast<int>(std::count_if(
@@ -907,10 +885,10 @@ int Run::run() {
     return gSignal ? 130 : 1;
   }
   say("live dashboard: http://127.0.0.1:" + std::to_string(port) + "/dashboard/ (open it in a browser)");
-  // The risk map, the agents and, in reserved traffic, the traffic manager: the simulator starts
-  // only when all have registered (a traffic manager it does not wait for falls behind the robots).
-  const int participants = 1 + static_cast<int>(agentNames.size()) + (o.traffic == "reserved" ? 1 : 0) +
-                           (vdaVehiclesFile.empty() ? 0 : 1);  // the VDA 5050 bridge
+  // The risk map, the agents and the traffic manager: the simulator starts only when all have
+  // registered (a traffic manager it does not wait for falls behind the robots).
+  const int participants =
+      1 + static_cast<int>(agentNames.size()) + 1 + (vdaVehiclesFile.empty() ? 0 : 1);  // the VDA 5050 bridge
   std::vector<std::string> simArgs = {"--scenario",     scn,
                                       "--duration",     std::to_string(o.durationS),
                                       "--replay",       fs::absolute(out / "replay.jsonl.gz").string(),
@@ -1080,7 +1058,6 @@ int Run::run() {
         {"near_misses", summary.value("near_misses", json::object())},
         {"lockstep_step_timeouts", summary.value("lockstep_step_timeouts", json())}}},
       {"clock", o.wallClock ? "wall" : "lockstep"},
-      {"traffic", o.traffic},
       {"agents", agentMetrics},
       {"faults", faultLog},
       {"fault_plan", json::array()},
@@ -1131,12 +1108,9 @@ int Run::run() {
     say(line);
     if (m.contains("conduct")) {
       const auto& c = m["conduct"];
-      std::snprintf(line, sizeof line,
-                    "%s conduct: %d standoffs (%d on a robot itself waiting: wait cycles), %d back-offs, %d "
-                    "returns along the trail, %d detours, %d local-planner recoveries, %d rejoins of a node",
-                    m.value("id", std::string("?")).c_str(), c.value("standoffs", 0),
-                    c.value("wait_cycles", 0), c.value("backoffs", 0), c.value("returns", 0),
-                    c.value("detours", 0), c.value("planner_recoveries", 0), c.value("rejoins", 0));
+      std::snprintf(line, sizeof line, "%s conduct: %d local-planner recoveries, %d rejoins of a node",
+                    m.value("id", std::string("?")).c_str(), c.value("planner_recoveries", 0),
+                    c.value("rejoins", 0));
       say(line);
     }
   }

@@ -35,9 +35,7 @@ struct LoadtestOptions {
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
   std::string localPlanner = "dwa";
-  std::string globalPlanner = "astar";  // robot agents' --global-planner
-  std::string agentConfig;              // robot agents' --config (a JSON file; empty: none)
-  bool lanes = false;                   // robot agents plan on the one-way lanes (their --lanes)
+  std::string agentConfig;           // robot agents' --config (a JSON file; empty: none)
   int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
   double yieldAfterS = -1.0;         // the traffic manager's yield_after_s (0 off); < 0: its default
   std::string stationLoad = "task";  // the fleet manager's station_load (task or phase)
@@ -46,12 +44,6 @@ struct LoadtestOptions {
   std::string stationCapacity = "2";
   std::string travelCost = "path";  // the fleet manager's travel_cost (path | straight | roadmap)
   double returnHomeS = 5.0;         // robot agents' --return-home (negative: stay where a task ends)
-  /// "reserved" (a traffic_manager process plans every robot; the agents follow its releases) or
-  /// "reactive" (robots keep clear of each other on their own). Reserved needs the scenario's site
-  /// (its roadmap): without one, and not named (`trafficNamed` false), the run falls back to
-  /// reactive and says so.
-  std::string traffic = "reserved";
-  bool trafficNamed = false;
   /// A folder made by scripts/dds-security ("deployment DIR"): every process joins with its
   /// identity (fleet-manager, wms-adapter, risk-map, traffic-manager, simulator). Each agent
   /// process (and the VDA 5050 bridge) gets an identity of its own made for the run with

@@ -155,7 +155,6 @@ int main(int argc, char** argv) {
                      "generate tasks even if the scenario has a task list (implied by --rate and --tasks)");
   loadtest->add_flag("--until-done", lt.untilDone,
                      "with --tasks or a task list: stop as soon as every task is done, failed or cancelled");
-  loadtest->add_flag("--lanes", lt.lanes, "robot agents plan on one-way lanes (default: plain A*)");
   loadtest
       ->add_option("--station-load", lt.stationLoad,
                    "how a task loads its stations: task (pickup and drop-off for the whole task) or phase "
@@ -188,11 +187,6 @@ int main(int argc, char** argv) {
   loadtest
       ->add_option("--return-home", lt.returnHomeS, "idle seconds before a robot drives home (< 0: never)")
       ->capture_default_str();
-  auto* trafficOption =
-      loadtest->add_option("--traffic", lt.traffic,
-                           "reserved: a traffic manager plans every robot together and releases their routes "
-                           "(needs the scenario's site); reactive: robots avoid each other on their own");
-  trafficOption->check(CLI::IsMember({"reactive", "reserved"}))->capture_default_str();
   loadtest->add_option("--dds-security", lt.ddsSecurity,
                        "run every process with its DDS Security identity from this folder (made by "
                        "scripts/dds-security deployment DIR; each agent process gets an identity of its "
@@ -225,9 +219,6 @@ int main(int argc, char** argv) {
           "--agent-config", lt.agentConfig,
           "robot agents' --config: JSON with local_planner, dwa {...}, safety {...} (see robot_agent --help)")
       ->check(CLI::ExistingFile);
-  loadtest->add_option("--global-planner", lt.globalPlanner, "robot agents' global planner")
-      ->check(CLI::IsMember({"astar", "wavefront", "ompl"}))
-      ->capture_default_str();
   loadtest
       ->add_option("--max-speed", lt.maxSpeed,
                    "at most this many simulated s per wall s (0 = as fast as the fleet steps)")
@@ -239,7 +230,7 @@ int main(int argc, char** argv) {
       ->add_option(
           "--vda5050", lt.vda5050,
           "the last N robots are VDA 5050 vehicles (simulated, over a Mosquitto broker of the run's own, "
-          "behind vda5050_bridge); needs --traffic reserved")
+          "behind vda5050_bridge)")
       ->check(CLI::NonNegativeNumber);
   loadtest->add_flag("--wall-clock", lt.wallClock,
                      "run every service on the wall clock at 1x, as in production (default: lockstep); "
@@ -440,7 +431,6 @@ int main(int argc, char** argv) {
   }
   if (*loadtest) {
     lt.generateTasks = lt.generateTasks || rateOpt->count() > 0 || tasksOpt->count() > 0;
-    lt.trafficNamed = trafficOption->count() > 0;
     return fleet::ctl::runLoadtest(lt);
   }
 

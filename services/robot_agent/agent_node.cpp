@@ -10,37 +10,28 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/site/wall_segments.hpp"
-#include "fleet/site/zone_costs.hpp"
 #include "fleet/validation/sample_checks.hpp"
 
 namespace fleet::agent {
 
 Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const Settings& s) {
   MapFacts facts;
-  // Robots plan on the map with the site's no-go zones blocked; the walls the localizer matches its
-  // scan lines against come from the map itself (a zone is no wall).
+  // Robots keep clear of the map with the site's no-go zones blocked; the walls the localizer
+  // matches its scan lines against come from the map itself (a zone is no wall).
   std::shared_ptr<const planning::OccupancyGrid> raw = world.map;
-  planning::CostLayers zoneLayers;
   std::function<double(Vec2)> speedLimit;
   if (world.site) {
     const auto& noGo = world.site->layers.noGo;
     if (std::any_of(noGo.begin(), noGo.end(), [](std::uint8_t c) { return c != 0; })) {
       raw = std::make_shared<const planning::OccupancyGrid>(world.site->drivable());
     }
-    zoneLayers = site::zoneCostLayers(world.site, control::kAgentCruiseSpeed);
     const auto& limits = world.site->layers.speedLimit;
     if (std::any_of(limits.begin(), limits.end(), [](float v) { return std::isfinite(v); })) {
       speedLimit = [st = world.site](Vec2 p) { return st->speedLimitAt(p); };
     }
     facts.siteName = world.site->name;
     facts.zones = world.site->zones.size();
-    facts.zoneLayers = zoneLayers.size();
     facts.speedLimits = static_cast<bool>(speedLimit);
-  }
-  std::shared_ptr<const planning::LaneMap> lanes;
-  if (s.useLanes) {
-    lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
-    facts.oneWayCells = lanes->oneWayCells();
   }
   // The walls every localizer matches its scan lines against: faces of 0.5 m and more (the line
   // extractor keeps nothing shorter).
@@ -50,16 +41,10 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
   }
   facts.wallFaces = walls->size();
 
-  std::map<double, std::shared_ptr<const planning::OccupancyGrid>> inflatedByRadius;
   std::vector<std::unique_ptr<Agent>> agents;
   for (const auto& r : world.robots) {
     if (!s.only.empty() && std::find(s.only.begin(), s.only.end(), r.id) == s.only.end()) {
       continue;
-    }
-    auto& grid = inflatedByRadius[r.radius];
-    if (!grid) {
-      // Plan with a margin beyond the footprint so paths keep to the middle of aisles.
-      grid = inflate(*raw, r.radius + 0.2);
     }
     AgentParams p;
     p.id = r.id;
@@ -72,21 +57,16 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     p.dwa = s.dwa;
     p.riskStepping = s.riskStepping;
     p.safety = s.safety;
-    p.globalPlanner = s.globalPlanner;
     p.sensorTimeoutS = s.sensorTimeoutS;
     p.returnHomeS = s.returnHomeS;
-    p.riskWeightGlobal = s.riskWeightGlobal;
-    p.lanes = lanes;
-    p.zoneLayers = zoneLayers;
     p.speedLimit = speedLimit;
-    p.traffic = s.traffic;
     p.limits = r.limits;
     p.limits.vMax = p.vMax;
     p.landmarks = world.landmarks;
     p.walls = walls;
     p.lineUpdates = s.lineUpdates;
     p.progress = s.progress;
-    agents.push_back(std::make_unique<Agent>(p, grid, raw));
+    agents.push_back(std::make_unique<Agent>(p, raw));
   }
   if (agents.empty()) {
     return unexpected("no_robots", "none of the requested robots is in the scenario");
@@ -219,11 +199,6 @@ std::vector<Refusal> AgentNode::takeRefusals() {
 Agent::Conduct AgentNode::conduct() const {
   Agent::Conduct c;
   for (const auto& a : agents_) {
-    c.standoffs += a->conduct().standoffs;
-    c.mutualBlocks += a->conduct().mutualBlocks;
-    c.backoffs += a->conduct().backoffs;
-    c.returns += a->conduct().returns;
-    c.detours += a->conduct().detours;
     c.plannerRecoveries += a->conduct().plannerRecoveries;
     c.rejoins += a->conduct().rejoins;
   }
@@ -261,16 +236,12 @@ ReleaseCounts AgentNode::releaseCounts() const {
 }
 
 nlohmann::json AgentNode::statsJson() const {
-  // How the robots of this process dealt with each other (docs/algorithms.md, fleet conduct).
   const auto c = conduct();
   const auto ls = lineStats();
   const auto rc = releaseCounts();
   nlohmann::json m;
   m["samples"] = rejections_.toJson();
-  m["conduct"] = {{"standoffs", c.standoffs}, {"wait_cycles", c.mutualBlocks},
-                  {"backoffs", c.backoffs},   {"returns", c.returns},
-                  {"detours", c.detours},     {"planner_recoveries", c.plannerRecoveries},
-                  {"rejoins", c.rejoins}};
+  m["conduct"] = {{"planner_recoveries", c.plannerRecoveries}, {"rejoins", c.rejoins}};
   m["localization"] = {{"line_updates", settings_.lineUpdates},
                        {"scans", ls.scans},
                        {"skipped_no_lines", ls.scansNoLines},
@@ -282,9 +253,11 @@ nlohmann::json AgentNode::statsJson() const {
                        {"unmatched_outside_gate", ls.outsideGate},
                        {"unmatched_no_overlap", ls.noOverlap},
                        {"unmatched_ambiguous", ls.ambiguous}};
-  m["traffic"] = {{"mode", settings_.traffic},      {"releases_taken", rc.accepted},
-                  {"ignored_foreign", rc.foreign},  {"ignored_stale", rc.stale},
-                  {"ignored_off_node", rc.offNode}, {"ignored_malformed", rc.malformed}};
+  m["traffic"] = {{"releases_taken", rc.accepted},
+                  {"ignored_foreign", rc.foreign},
+                  {"ignored_stale", rc.stale},
+                  {"ignored_off_node", rc.offNode},
+                  {"ignored_malformed", rc.malformed}};
   return m;
 }
 

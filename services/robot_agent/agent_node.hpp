@@ -40,10 +40,8 @@ struct Refusal {
 struct MapFacts {
   std::optional<std::string> siteName;  ///< none: no site (a scenario with its map inline)
   std::size_t zones = 0;
-  std::size_t zoneLayers = 0;              ///< cost layers from the site's zones
-  bool speedLimits = false;                ///< the site has speed-limit zones the motion gate enforces
-  std::optional<std::size_t> oneWayCells;  ///< with lanes: the one-way aisle cells of the lane map
-  std::size_t wallFaces = 0;               ///< walls the localizers match their scan lines against
+  bool speedLimits = false;   ///< the site has speed-limit zones the motion gate enforces
+  std::size_t wallFaces = 0;  ///< walls the localizers match their scan lines against
 };
 
 class AgentNode {

@@ -7,8 +7,6 @@ namespace fleet::agent {
 
 void readSettings(Config& cfg, Settings& s, SetOnCommandLine cli) {
   const std::string local = cfg.string("local_planner", s.localPlanner);
-  const std::string global = cfg.string("global_planner", s.globalPlanner, {"astar", "wavefront", "ompl"});
-  const std::string traffic = cfg.string("traffic", s.traffic, {"reactive", "reserved"});
   Config dwa = cfg.child("dwa");
   Config stepping = cfg.child("risk_stepping");
   Config safety = cfg.child("safety");
@@ -27,16 +25,9 @@ void readSettings(Config& cfg, Settings& s, SetOnCommandLine cli) {
   watch.closerM = progress.number("closer_m", watch.closerM, {0.0, 5.0, true});
   watch.failS = progress.number("fail_s", watch.failS, {0.0, 86400.0, true});
   progress.rejectUnknownKeys({"want_speed", "moved_m", "stall_s", "recover_s", "closer_m", "fail_s"});
-  cfg.rejectUnknownKeys({"local_planner", "global_planner", "traffic", "dwa", "risk_stepping", "safety",
-                         "localization", "progress"});
+  cfg.rejectUnknownKeys({"local_planner", "dwa", "risk_stepping", "safety", "localization", "progress"});
   if (!cli.localPlanner) {
     s.localPlanner = local;
-  }
-  if (!cli.globalPlanner) {
-    s.globalPlanner = global;
-  }
-  if (!cli.traffic) {
-    s.traffic = traffic;
   }
   if (s.localPlanner != "follow") {
     if (auto p = avoidance::makePlanner(s.localPlanner); !p) {

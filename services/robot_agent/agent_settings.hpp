@@ -1,7 +1,7 @@
 #pragma once
 
-// How the agents of one robot_agent process run: the planners, the traffic mode and their
-// parameters, from the command line and the --config file (docs/operator-guide.md, robot agent).
+// How the agents of one robot_agent process run: the local planner and its parameters, from the
+// command line and the --config file (docs/operator-guide.md, robot agent).
 
 #include <string>
 #include <vector>
@@ -17,8 +17,6 @@ namespace fleet::agent {
 struct Settings {
   // Keys of the --config file (and command-line options, except the parameter blocks).
   std::string localPlanner = "dwa";
-  std::string globalPlanner = "astar";
-  std::string traffic = "reserved";  // or "reactive" (being retired)
   avoidance::DwaParams dwa = agentDwaDefaults();
   avoidance::RiskSteppingParams riskStepping;
   avoidance::SafetyParams safety;
@@ -29,17 +27,13 @@ struct Settings {
   std::vector<std::string> only;  // robots to host (empty: every robot of the world)
   unsigned threads = 0;           // 0: hardware concurrency
   double sensorTimeoutS = 0.5;
-  double riskWeightGlobal = 1.0;
   double returnHomeS = 5.0;
   bool useRisk = true;
-  bool useLanes = false;
 };
 
 /// The options of `Settings` that were given on the command line: they win over the file.
 struct SetOnCommandLine {
   bool localPlanner = false;
-  bool globalPlanner = false;
-  bool traffic = false;
 };
 
 /// Reads the --config file's keys into `s`, leaving what the command line set. Every problem is

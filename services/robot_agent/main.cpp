@@ -41,11 +41,8 @@ struct Process {
 
 void logMapFacts(const agent::MapFacts& f, bool lineUpdates) {
   if (f.siteName) {
-    spdlog::info("robot agent: site '{}': {} zones, {} cost layers{}", *f.siteName, f.zones, f.zoneLayers,
+    spdlog::info("robot agent: site '{}': {} zones{}", *f.siteName, f.zones,
                  f.speedLimits ? ", speed limits enforced" : "");
-  }
-  if (f.oneWayCells) {
-    spdlog::info("robot agent: {} one-way aisle cells", *f.oneWayCells);
   }
   spdlog::info("robot agent: {} wall faces for the line updates ({})", f.wallFaces,
                lineUpdates ? "on" : "off: localization.lines is false");
@@ -84,14 +81,8 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   transport::Writer<msg::RobotState> states(part);
   transport::Writer<msg::PredictedDiscs> discs(part);
   transport::Writer<msg::TaskStatus> statuses(part);
-  // Reserved traffic only: a reactive agent neither reads releases nor tells the traffic manager
-  // anything (it counts as a robot that does not follow).
-  std::optional<transport::Reader<msg::TrafficRelease>> releases;
-  std::optional<transport::Writer<msg::TrafficProgress>> trafficProgress;
-  if (settings.traffic == "reserved") {
-    releases.emplace(part);
-    trafficProgress.emplace(part);
-  }
+  transport::Reader<msg::TrafficRelease> releases(part);
+  transport::Writer<msg::TrafficProgress> trafficProgress(part);
   // A writer per hosted robot and topic, each in the robot's partition (transport/
   // robot_partition.hpp), made now: readers match them during start-up, and DDS Security refuses
   // here, with the robot named, a robot this process's permissions do not grant.
@@ -115,17 +106,15 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     states.forRobots(robots);
     discs.forRobots(robots);
     statuses.forRobots(robots);
-    if (trafficProgress) {
-      trafficProgress->forRobots(robots);
-    }
+    trafficProgress.forRobots(robots);
   }
   transport::Writer<msg::StepDone> stepDone(part);
   transport::WaitSet ws(part);
   ws.attach(clockIn);
   ws.attach(frames);
-  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}, {} traffic", id,
-               node.size(), lockstep ? "lockstep" : "wall", node.threads(), settings.localPlanner,
-               settings.useRisk ? "on" : "off", settings.traffic);
+  spdlog::info("robot agent {}: {} robots, {} mode, {} threads, local planner {}, risk {}", id, node.size(),
+               lockstep ? "lockstep" : "wall", node.threads(), settings.localPlanner,
+               settings.useRisk ? "on" : "off");
   service::RateLimitedLog badInput;
   badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
   if (node.size() == 1) {
@@ -162,7 +151,7 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     }
   };
 
-  // Reserved traffic: a robot standing with its task (or on its way home) this long [s] is logged (and again
+  // A robot standing with its task (or on its way home) this long [s] is logged (and again
   // as often), with why it stands. The traffic manager logs whom it waits on; this is the robot's side.
   constexpr double kStandingWarnS = 60.0;
   std::vector<std::int64_t> standWarnedNs(node.size(), -1);
@@ -190,9 +179,7 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     node.onFrames(frames.take());
     node.onRobotStates(others.take());
     node.onAssignments(assignments.take());
-    if (releases) {
-      node.onReleases(releases->take());
-    }
+    node.onReleases(releases.take());
     node.onRiskMaps(riskMaps.take());
     const auto& outs = node.step(now, dt);
     for (const auto& r : node.takeRefusals()) {
@@ -214,12 +201,10 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
         logging::ScopedField taskField("task", out.status->task_id);
         spdlog::debug("{}: task {} {}", robot, out.status->task_id, msg::toString(out.status->state));
       }
-      if (out.traffic && trafficProgress) {
-        trafficProgress->write(*out.traffic);
+      if (out.traffic) {
+        trafficProgress.write(*out.traffic);
       }
-      if (node.agent(i).reserved()) {
-        warnStanding(i, now);
-      }
+      warnStanding(i, now);
       if (out.people && peopleSeen) {
         peopleSeen->write(*out.people);
       }
@@ -314,17 +299,15 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"robot_agent: the local stack of one or many robots"};
+  CLI::App app{
+      "robot_agent: the local stack of one or many robots; each drives what the traffic manager releases "
+      "to it (TrafficRelease in, TrafficProgress out)"};
   std::string scenario;
   std::string robots;
   std::string clock = "wall";
   agent::Settings settings;
   Process proc;
   bool noRisk = false;
-  app.add_option(
-         "--global-planner", settings.globalPlanner,
-         "astar (default; the risk map as cell cost), wavefront, or ompl (Informed RRT*, 50 ms per plan)")
-      ->check(CLI::IsMember({"astar", "wavefront", "ompl"}));
   app.add_option("--local-planner", settings.localPlanner,
                  "dwa (default; with the risk map's term), risk_stepping (thesis 000 §3.2.3), "
                  "risk_stepping_weighted, vo, potential_field, ... (a libs/avoidance planner behind "
@@ -335,25 +318,11 @@ int main(int argc, char** argv) {
   app.add_option("--sensor-timeout", settings.sensorTimeoutS,
                  "s without a SensorFrame (agent clock) before a robot stops and reports RM_FAULT")
       ->check(CLI::Range(0.05, 60.0));
-  app.add_option("--risk-weight", settings.riskWeightGlobal,
-                 "global planner: cell cost = length x (1 + w p); paths stay within (1 + w) x the shortest")
-      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--return-home", settings.returnHomeS,
-                 "s idle before a robot drives back to its start (parking) pose; negative: stay put")
+                 "negative: an idle robot stays where its last task ended instead of going back to its "
+                 "start (parking) pose")
       ->check(CLI::Range(-1.0, 3600.0));
   app.add_flag("--no-risk", noRisk, "ignore RiskMap (planners without the risk term)");
-  bool lanes = false;
-  bool noLanes = false;
-  app.add_flag("--lanes", lanes,
-               "plan on the lane map (one-way narrow aisles, keep-right bands) instead of plain A*; "
-               "off by default: 20 robots finish ~15 % fewer tasks with it (docs/benchmarks.md)");
-  app.add_flag("--no-lanes", noLanes, "plain A* (the default; wins over --lanes)");
-  app.add_option(
-         "--traffic", settings.traffic,
-         "reactive (default: robots keep clear of each other by standoffs, yielding and detours) or "
-         "reserved (drive only what the traffic manager releases: TrafficRelease in, TrafficProgress out)")
-      ->check(CLI::IsMember({"reactive", "reserved"}))
-      ->envname("FLEET_TRAFFIC");
   std::string sitePath;
   std::vector<std::string> robotSpecs;
   auto* scenarioOpt =
@@ -373,7 +342,7 @@ int main(int argc, char** argv) {
                  "10 s in wall mode and at exit");
   std::string configFile;
   app.add_option("-c,--config", configFile,
-                 "JSON file: local_planner, global_planner, traffic, dwa {weights, samples, horizon...}, "
+                 "JSON file: local_planner, dwa {weights, samples, horizon...}, "
                  "risk_stepping {rule: iso_level | weighted, levels, ...}, "
                  "safety {zones}, localization {lines} (docs/operator-guide.md); options given on the "
                  "command line win");
@@ -384,9 +353,7 @@ int main(int argc, char** argv) {
     service::setupLogging("robot_agent", common);
     if (!configFile.empty()) {
       Config cfg = Config::fromFile(configFile);
-      agent::readSettings(
-          cfg, settings,
-          {app.count("--local-planner") > 0, app.count("--global-planner") > 0, app.count("--traffic") > 0});
+      agent::readSettings(cfg, settings, {app.count("--local-planner") > 0});
       cfg.finish();
     }
     agent::World world;
@@ -414,7 +381,6 @@ int main(int argc, char** argv) {
     }
     proc.lockstep = clock == "lockstep";
     settings.useRisk = !noRisk;
-    settings.useLanes = lanes && !noLanes;
     service::installStopHandlers();
     return run(world, settings, proc, common.ops);
   } catch (const ConfigError& e) {

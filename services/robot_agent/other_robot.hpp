@@ -19,12 +19,7 @@ struct OtherRobot {
   bool hasTask = false;
   Vec2 velocity;
   double theta = 0.0;
-  std::int64_t waitingSinceNs = -1;  // stamp of its first state of the current wait (-1: not waiting)
-  std::int64_t stampNs = 0;          // stamp of its latest state
+  std::int64_t stampNs = 0;  // stamp of its latest state
 };
-
-/// It will most likely stand where it is for a while (loading, charging, parked, faulted, or
-/// waiting for long): plans go around it rather than queue behind it.
-bool standing(const OtherRobot& o);
 
 }  // namespace fleet::agent

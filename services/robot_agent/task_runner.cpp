@@ -12,7 +12,6 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
   }
   revision_ = o.revision;
   priority_ = o.priority;
-  homing_ = false;     // an order (or a cancel) replaces the trip home
   paused_ = o.paused;  // an empty paused order holds the idle robot where it is
   if (o.task.empty()) {
     task_.clear();
@@ -42,7 +41,6 @@ void TaskRunner::refuse(const Order& o, const std::string& why) {
     return;
   }
   revision_ = o.revision;
-  homing_ = false;
   task_.clear();
   goals_.clear();
   paused_ = false;
@@ -99,32 +97,29 @@ bool TaskRunner::dwellOver(std::int64_t nowNs) const {
   return nsToSec(nowNs - phaseStartNs_) >= goals_[goal_].dwellS;
 }
 
-bool TaskRunner::nextGoal() {
+TaskTick TaskRunner::tick(std::int64_t nowNs) {
+  if (phase_ == Phase::Idle && busy()) {
+    leg(nowNs);
+    return TaskTick::kLegBegan;
+  }
+  if (phase_ != Phase::Dwelling || !dwellOver(nowNs)) {
+    return TaskTick::kNone;
+  }
   ++goal_;
-  return goal_ < goals_.size();
-}
-
-void TaskRunner::yieldBy(Phase how, std::int64_t nowNs) {
-  phase_ = how;
-  phaseStartNs_ = nowNs;
+  if (goal_ < goals_.size()) {
+    leg(nowNs);
+    return TaskTick::kLegBegan;
+  }
+  finish(TaskStage::Done, "", nowNs);
+  return TaskTick::kDone;
 }
 
 void TaskRunner::finish(TaskStage final, const std::string& reason, std::int64_t nowNs) {
-  if (homing_) {
-    homing_ = false;  // the trip home is no order of the manager's: nothing to report
-  } else {
-    pending_ = TaskReport{
-        task_, revision_, final, final == TaskStage::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
-  }
+  pending_ = TaskReport{
+      task_, revision_, final, final == TaskStage::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;
-}
-
-void TaskRunner::goHome(const TaskGoal& home) {
-  homing_ = true;
-  goals_ = {home};
-  goal_ = 0;
 }
 
 void TaskRunner::notice(const std::string& reason, std::int64_t nowNs) {
@@ -140,8 +135,8 @@ void TaskRunner::shiftClock(std::int64_t heldNs) {
 }
 
 std::optional<TaskReport> TaskRunner::takeReport() {
-  if (pending_ && (homing_ || pending_->task.empty())) {
-    pending_.reset();  // the trip home is not a task
+  if (pending_ && pending_->task.empty()) {
+    pending_.reset();
   }
   return std::exchange(pending_, std::nullopt);
 }

@@ -2,15 +2,14 @@
 
 // The robot's task state machine: the order it carries (goals with their actions and dwell
 // times), where it is in it, and the task states it reports. It is the only part that changes
-// phase; the agent asks it what to do and tells it what happened (a leg begins, the robot arrived,
-// the dwell is over, it yields, the task ends). Its types are its own: the agent maps the wire's.
+// phase: the agent tells it what happened (an order came, the robot arrived at its goal, the task
+// failed) and calls tick() once a cycle, which begins the first leg of a new order and ends each
+// dwell (on to the next goal, or the task is done). Its types are its own: the agent maps the wire's.
 //
-//   Idle ──leg()──► Driving ──arrive()──► Dwelling ──nextGoal()──► Driving ... ──finish()──► Idle
-//                   Driving ──yieldBy()──► BackingOff / Returning ──stop()──► Idle ──leg()──► ...
+//   Idle ──tick()──► Driving ──arrive()──► Dwelling ──tick(): dwell over──► Driving ... ──► Idle
 //
 // Reports follow the task: Assigned on a new order, EnRoute / Delivering when a leg begins (once
-// per change), Loading / Unloading on arriving at such a goal, Done / Failed / Cancelled at the
-// end; the trip home is an order of the robot's own and is never reported.
+// per change), Loading / Unloading on arriving at such a goal, Done / Failed at the end.
 
 #include <cstdint>
 #include <optional>
@@ -61,7 +60,14 @@ struct Order {
   std::int32_t priority = 0;  ///< the task's (higher first)
 };
 
-enum class Phase : std::uint8_t { Idle, Driving, Dwelling, BackingOff, Returning };
+enum class Phase : std::uint8_t { Idle, Driving, Dwelling };
+
+/// What tick() did.
+enum class TaskTick : std::uint8_t {
+  kNone,      ///< nothing changed
+  kLegBegan,  ///< a leg began: the first of a new order, or the next goal's after a dwell
+  kDone,      ///< the last dwell ended: the task is done (reported)
+};
 
 class TaskRunner {
  public:
@@ -79,21 +85,14 @@ class TaskRunner {
   /// the current order and reports task `o.task` failed with "refused: <why>".
   void refuse(const Order& o, const std::string& why);
 
-  /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
-  void leg(std::int64_t nowNs);
-  /// At the current goal: Dwelling; reports Loading / Unloading for such goals.
+  /// Once a cycle: a new order's first leg begins (Idle with a task), and a dwell that is over
+  /// ends, once: the next goal's leg begins, or, after the last goal, the task is done.
+  TaskTick tick(std::int64_t nowNs);
+  /// At the current goal while driving to it: Dwelling; reports Loading / Unloading for such goals.
   void arrive(std::int64_t nowNs);
   [[nodiscard]] bool dwellOver(std::int64_t nowNs) const;
-  /// The dwell is done: on to the next goal; false when there is none (the task is then done).
-  bool nextGoal();
-  /// Yielding to someone: BackingOff (a little, straight back) or Returning (along the trail).
-  void yieldBy(Phase how, std::int64_t nowNs);
-  /// Standing without a leg (after yielding, or to re-plan on the next step).
-  void stop() { phase_ = Phase::Idle; }
-  /// The task (or the trip home) ends: reports `final` with `reason` unless homing; Idle.
+  /// The task ends: reports `final` with `reason`; Idle.
   void finish(TaskStage final, const std::string& reason, std::int64_t nowNs);
-  /// The robot's own order: drive to `home` and park, never reported.
-  void goHome(const TaskGoal& home);
   /// A notice about the task in its current stage (e.g. sensor loss), if there is a task.
   void notice(const std::string& reason, std::int64_t nowNs);
   /// The operator's hold lasted `heldNs`: the phase's clock starts that much later.
@@ -103,12 +102,9 @@ class TaskRunner {
 
   [[nodiscard]] Phase phase() const { return phase_; }
   [[nodiscard]] std::int64_t phaseStartNs() const { return phaseStartNs_; }
-  /// Carries a task of the manager's (not the trip home).
+  /// Carries a task of the manager's.
   [[nodiscard]] bool busy() const { return !task_.empty(); }
-  [[nodiscard]] bool homing() const { return homing_; }
-  /// Has somewhere to go: a task or the trip home.
-  [[nodiscard]] bool hasOrder() const { return busy() || homing_; }
-  /// Held by the operator: with a task (paused), or idle (a robot hold: no trip home either).
+  /// Held by the operator: with a task (paused), or idle (a robot hold: it stays where it is).
   [[nodiscard]] bool paused() const { return paused_; }
   [[nodiscard]] const std::string& task() const { return task_; }
   /// The running task's priority (0 without a task): reserved traffic lets it go first.
@@ -125,12 +121,13 @@ class TaskRunner {
   [[nodiscard]] TaskStage stageFor(std::size_t index, bool dwelling) const;
   [[nodiscard]] float progress() const;
   void reportStage(TaskStage st, std::int64_t nowNs);
+  /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
+  void leg(std::int64_t nowNs);
 
   std::string task_;
   std::uint32_t revision_ = 0;
   std::int32_t priority_ = 0;
   bool paused_ = false;
-  bool homing_ = false;
   std::vector<TaskGoal> goals_;
   std::size_t goal_ = 0;
   Phase phase_ = Phase::Idle;

@@ -1,7 +1,8 @@
-// Agent cycle cost with many agents in one process: N Agent objects (the robot_agent stack: EKF, A*,
-// DWA with the risk term, task execution) on a warehouse map, fed synthetic frames from an exact
-// kinematic world (odometry, compass, a 181-beam scan with nothing in range), each with an endless
-// series of pickup → drop-off tasks. Per-agent step time is thread CPU time; the cycle (all N agents
+// Agent cycle cost with many agents in one process: N Agent objects (the robot_agent stack: EKF,
+// release following, DWA with the risk term, task execution) on a warehouse map, fed synthetic frames
+// from an exact kinematic world (odometry, compass, a 181-beam scan with nothing in range), each with
+// an endless series of pickup → drop-off tasks and its route released by the traffic manager's node
+// in-process (its tick is not timed). Per-agent step time is thread CPU time; the cycle (all N agents
 // through the worker pool) is wall time, from which the achievable control rate follows.
 
 #include <benchmark/benchmark.h>
@@ -15,6 +16,7 @@
 #include "fleet/control/diff_drive_kinematics.hpp"
 #include "fleet/sim/grid_map.hpp"
 #include "fleet/sim/scenario.hpp"
+#include "traffic_node.hpp"
 #include "worker_pool.hpp"
 
 using namespace fleet;
@@ -37,6 +39,7 @@ double percentile(std::vector<double> v, double q) {
 }
 
 struct Fleet {
+  std::unique_ptr<trafficmgr::TrafficNode> traffic;
   std::vector<std::unique_ptr<agent::Agent>> agents;
   std::vector<Pose2> truth;
   std::vector<msg::VelocityCommand> last;
@@ -61,9 +64,11 @@ struct Fleet {
 Fleet makeFleet(const std::string& scenario, int n, const std::string& planner) {
   const auto scn = sim::loadScenario(std::string(FLEET_SOURCE_DIR) + "/sim/scenarios/" + scenario);
   auto raw = std::make_shared<const planning::OccupancyGrid>(sim::toOccupancyGrid(scn.map));
-  const double radius = scn.robots.front().radius;
-  auto grid = agent::inflate(*raw, radius + 0.2);
   Fleet f;
+  trafficmgr::Settings ts;
+  ts.clock = "sim";
+  ts.lockstep = true;
+  f.traffic = std::make_unique<trafficmgr::TrafficNode>(*scn.site, ts, 1);
   for (const auto& s : scn.stations) {
     (s.kind == sim::StationKind::Pickup ? f.pickups : f.drops).push_back(s);
   }
@@ -81,7 +86,7 @@ Fleet makeFleet(const std::string& scenario, int n, const std::string& planner) 
     p.limits = r.limits;
     p.limits.vMax = p.vMax = std::min(0.8, r.limits.vMax);
     f.wheelBase = r.wheelBase;
-    f.agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
+    f.agents.push_back(std::make_unique<agent::Agent>(p, raw));
     f.truth.push_back(r.start);
     f.last.push_back({});
     f.tasks.push_back(0);
@@ -140,6 +145,16 @@ void BM_AgentCycle(benchmark::State& state, const std::string& scenario, const s
       }
       if (!f.agents[i]->busy()) {
         f.agents[i]->onAssignment(f.order(i));
+      }
+      if (outs[i].traffic) {
+        (void)f.traffic->onProgress(*outs[i].traffic, now);
+      }
+    }
+    for (const auto& r : f.traffic->tick(now)) {
+      for (auto& a : f.agents) {
+        if (a->id() == r.robot_id) {
+          a->onRelease(r);
+        }
       }
     }
     now += 100'000'000;

@@ -1,10 +1,11 @@
 // Equivalence check for refactors of the robot agent: steps 20 agents in-process on the small
-// warehouse with ideal kinematics, the other robots' states, a risk map that moves with the robots
+// warehouse with ideal kinematics, the other robots' states, a risk map that moves with the robots,
+// the traffic manager's node in-process (their releases from their progress reports, as over DDS)
 // and a few operator actions (pause, resume, cancel, a second order), and prints a hash of every
 // output. Built from two commits, equal hashes mean the agent computed the same thing (how the
 // agent's parts were shown to be pure moves: docs/architecture.md).
 //
-//   agent_trace [LOCAL_PLANNER [lanes|plain [STEPS]]]     default: dwa plain 3000
+//   agent_trace [LOCAL_PLANNER [STEPS]]     default: dwa 3000
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +20,7 @@
 #include "fleet/risk/rle.hpp"
 #include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/site/site_loader.hpp"
+#include "traffic_node.hpp"
 
 using namespace fleet;
 
@@ -35,15 +37,13 @@ static void mixd(double d) {
 
 int main(int argc, char** argv) {
   const std::string planner = argc > 1 ? argv[1] : "dwa";
-  const bool lanesOn = argc > 2 && std::string(argv[2]) == "lanes";
-  const int steps = argc > 3 ? std::atoi(argv[3]) : 3000;
+  const int steps = argc > 2 ? std::atoi(argv[2]) : 3000;
   const auto st = site::loadSite(FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse.site.json");
   auto raw = std::make_shared<const planning::OccupancyGrid>(st.map);
-  auto grid = agent::inflate(*raw, 0.3 + 0.2);
-  std::shared_ptr<const planning::LaneMap> lanes;
-  if (lanesOn) {
-    lanes = std::make_shared<const planning::LaneMap>(planning::LaneMap::derive(*raw));
-  }
+  trafficmgr::Settings ts;
+  ts.clock = "sim";
+  ts.lockstep = true;
+  trafficmgr::TrafficNode traffic(st, ts, 1);
   std::vector<std::unique_ptr<agent::Agent>> agents;
   std::vector<Pose2> truth;
   const auto pickups = st.ofKind(site::StationKind::Pickup);
@@ -54,9 +54,8 @@ int main(int argc, char** argv) {
     p.id = "r" + std::to_string(i + 1);
     p.start = park->pose;
     p.localPlanner = planner;
-    p.lanes = lanes;
     p.lineUpdates = false;
-    agents.push_back(std::make_unique<agent::Agent>(p, grid, raw));
+    agents.push_back(std::make_unique<agent::Agent>(p, raw));
     truth.push_back(park->pose);
     msg::TaskAssignment a;
     a.robot_id = p.id;
@@ -101,6 +100,7 @@ int main(int argc, char** argv) {
       for (auto& a : agents) {
         a->onRiskMap(*f);
       }
+      (void)traffic.onRiskMap(**f, m.stamp_ns);
     }
     // Operator actions: pause r3 at 50 s and resume at 80 s, cancel r5 at 60 s, a second order for
     // r7 at 200 s.
@@ -159,6 +159,9 @@ int main(int argc, char** argv) {
         mixd(d.x);
         mixd(d.y);
       }
+      if (o.traffic) {
+        (void)traffic.onProgress(*o.traffic, k * 100'000'000LL);
+      }
       if (o.status) {
         ++plansDone;
         mix(o.status->task_id.data(), o.status->task_id.size());
@@ -166,14 +169,23 @@ int main(int argc, char** argv) {
         mix(o.status->error.data(), o.status->error.size());
       }
     }
+    for (const auto& r : traffic.tick(k * 100'000'000LL)) {
+      for (auto& a : agents) {
+        if (a->id() == r.robot_id) {
+          a->onRelease(r);
+        }
+      }
+      for (const auto& n : r.base) {
+        mix(&n.node, sizeof n.node);
+      }
+    }
   }
-  std::printf("planner=%s lanes=%d steps=%d statuses=%d hash=%016llx\n", planner.c_str(), lanesOn ? 1 : 0,
-              steps, plansDone, static_cast<unsigned long long>(h));
+  std::printf("planner=%s steps=%d statuses=%d hash=%016llx\n", planner.c_str(), steps, plansDone,
+              static_cast<unsigned long long>(h));
   for (std::size_t i = 0; i < agents.size(); i += 5) {
-    std::printf("  %s at (%.3f, %.3f) busy=%d standoffs=%llu detours=%llu\n", agents[i]->id().c_str(),
-                agents[i]->pose().x, agents[i]->pose().y, agents[i]->busy() ? 1 : 0,
-                static_cast<unsigned long long>(agents[i]->conduct().standoffs),
-                static_cast<unsigned long long>(agents[i]->conduct().detours));
+    std::printf("  %s at (%.3f, %.3f) busy=%d node=%d rejoins=%llu\n", agents[i]->id().c_str(),
+                agents[i]->pose().x, agents[i]->pose().y, agents[i]->busy() ? 1 : 0, agents[i]->trafficNode(),
+                static_cast<unsigned long long>(agents[i]->conduct().rejoins));
   }
   return 0;
 }

@@ -63,11 +63,9 @@ msg::TaskAssignment order(const std::string& robot, const std::string& task) {
   return a;
 }
 
-/// A robot in reserved traffic on the open floor at (1, 5), its first node there.
+/// A robot on the open floor at (1, 5), its first node there.
 std::unique_ptr<agent::AgentNode> reservedNode() {
-  agent::Settings s;
-  s.traffic = "reserved";
-  return nodeOn(floorWith({{"r1", {1.0, 5.0, 0.0}}}), s);
+  return nodeOn(floorWith({{"r1", {1.0, 5.0, 0.0}}}), agent::Settings{});
 }
 
 msg::TrafficRelease release(const std::string& robot, std::vector<msg::RouteNode> base) {
@@ -204,32 +202,34 @@ TEST(AgentNode, HostsOnlyTheRobotsAskedForAndRefusesToStartWithNone) {
   EXPECT_NE(none.error().message.find("none of the requested robots"), std::string::npos);
 }
 
-TEST(AgentNode, StatsNameTheTrafficModeAndTheLineUpdates) {
+TEST(AgentNode, StatsCountReleasesAndNameTheLineUpdates) {
   agent::Settings s;
   s.lineUpdates = false;
   auto node = nodeOn(floorWith({{"r1", {1.0, 1.0, 0.0}}}), s);
   (void)run(*node, "r1", 2);
   const auto j = node->statsJson();
-  EXPECT_EQ(j["traffic"]["mode"], "reactive");
+  EXPECT_EQ(j["traffic"]["releases_taken"], 0);
+  EXPECT_FALSE(j["traffic"].contains("mode")) << "one way to drive";
   EXPECT_EQ(j["localization"]["line_updates"], false);
-  EXPECT_EQ(j["conduct"]["standoffs"], 0);
+  EXPECT_EQ(j["conduct"]["rejoins"], 0);
   EXPECT_EQ(j["samples"]["rejected_total"], 0);
 }
 
 TEST(AgentSettings, TheFileSetsWhatTheCommandLineLeftAndNamesAnUnknownPlanner) {
   agent::Settings s;
   s.localPlanner = "vo";  // as given on the command line
-  Config cfg = Config::fromJson(
-      {{"local_planner", "follow"}, {"global_planner", "wavefront"}, {"localization", {{"lines", false}}}},
-      "agent.json");
+  Config cfg =
+      Config::fromJson({{"local_planner", "follow"}, {"localization", {{"lines", false}}}}, "agent.json");
   agent::readSettings(cfg, s, {.localPlanner = true});
   cfg.finish();
   EXPECT_EQ(s.localPlanner, "vo");
-  EXPECT_EQ(s.globalPlanner, "wavefront");
   EXPECT_FALSE(s.lineUpdates);
 
   agent::Settings t;
-  Config bad = Config::fromJson({{"local_planner", "teleport"}, {"speed", 3}}, "agent.json");
+  // The keys of the retired reactive conduct are unknown keys now, named like any other.
+  Config bad = Config::fromJson(
+      {{"local_planner", "teleport"}, {"speed", 3}, {"traffic", "reactive"}, {"global_planner", "astar"}},
+      "agent.json");
   agent::readSettings(bad, t);
   try {
     bad.finish();
@@ -238,6 +238,8 @@ TEST(AgentSettings, TheFileSetsWhatTheCommandLineLeftAndNamesAnUnknownPlanner) {
     const std::string what = e.what();
     EXPECT_NE(what.find("teleport"), std::string::npos) << what;
     EXPECT_NE(what.find("speed"), std::string::npos) << what;
+    EXPECT_NE(what.find("traffic"), std::string::npos) << what;
+    EXPECT_NE(what.find("global_planner"), std::string::npos) << what;
   }
 }
 

@@ -14,6 +14,7 @@ using agent::Phase;
 using agent::TaskGoal;
 using agent::TaskRunner;
 using agent::TaskStage;
+using agent::TaskTick;
 
 namespace {
 
@@ -43,7 +44,7 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
   EXPECT_TRUE(r.busy());
   EXPECT_EQ(r.phase(), Phase::Idle) << "started on the next step";
   EXPECT_FALSE(r.takeReport()) << "Assigned is the manager's to say";
-  r.leg(1 * kSec);
+  EXPECT_EQ(r.tick(1 * kSec), TaskTick::kLegBegan);
   auto rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->stage, TaskStage::EnRoute);
@@ -51,24 +52,25 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
   EXPECT_EQ(rep->revision, 1u);
   EXPECT_EQ(rep->progress, 0.0f);
   EXPECT_EQ(rep->stampNs, 1 * kSec);
-  r.leg(2 * kSec);  // a re-plan: same stage, nothing new to say
+  EXPECT_EQ(r.tick(2 * kSec), TaskTick::kNone) << "driving: nothing changes";
   EXPECT_FALSE(r.takeReport());
   r.arrive(3 * kSec);
   EXPECT_EQ(r.phase(), Phase::Dwelling);
   EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Loading});
-  EXPECT_FALSE(r.dwellOver(4 * kSec));
-  EXPECT_TRUE(r.dwellOver(5 * kSec));
-  EXPECT_TRUE(r.nextGoal());
+  EXPECT_EQ(r.tick(4 * kSec), TaskTick::kNone) << "dwelling 2 s";
+  EXPECT_EQ(r.phase(), Phase::Dwelling);
+  EXPECT_EQ(r.tick(5 * kSec), TaskTick::kLegBegan) << "the dwell is over: on to the next goal";
+  EXPECT_EQ(r.phase(), Phase::Driving);
   EXPECT_EQ(r.goal().station, "D-1");
-  r.leg(5 * kSec);
   rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->stage, TaskStage::Delivering);
   EXPECT_EQ(rep->progress, 0.5f);
   r.arrive(9 * kSec);
   EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Unloading});
-  EXPECT_FALSE(r.nextGoal());
-  r.finish(TaskStage::Done, "", 10 * kSec);
+  EXPECT_EQ(r.tick(9 * kSec + kSec / 2), TaskTick::kNone);
+  EXPECT_EQ(r.tick(10 * kSec), TaskTick::kDone) << "the last dwell is over";
+  EXPECT_EQ(r.tick(11 * kSec), TaskTick::kNone) << "ended once";
   rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->stage, TaskStage::Done);
@@ -80,7 +82,7 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
 TEST(TaskRunner, RepeatsPausesAndCancels) {
   TaskRunner r;
   ASSERT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kNewTask);
-  r.leg(0);
+  (void)r.tick(0);
   (void)r.takeReport();
   EXPECT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kSame) << "transient-local re-delivery";
   EXPECT_EQ(r.accept(transport(2, true)), TaskRunner::OrderChange::kPause);
@@ -98,31 +100,14 @@ TEST(TaskRunner, RepeatsPausesAndCancels) {
   EXPECT_FALSE(r.takeReport()) << "a cancel is the manager's own";
 }
 
-TEST(TaskRunner, AnEmptyPausedOrderHoldsTheIdleRobotAndReplacesTheTripHome) {
+TEST(TaskRunner, AnEmptyPausedOrderHoldsTheIdleRobot) {
   TaskRunner r;
-  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
   EXPECT_EQ(r.accept(Order{"", 1, {}, true}), TaskRunner::OrderChange::kCancel);
   EXPECT_TRUE(r.paused()) << "a robot held by the operator while idle";
-  EXPECT_FALSE(r.hasOrder()) << "the trip home is given up";
+  EXPECT_FALSE(r.busy());
+  EXPECT_EQ(r.tick(0), TaskTick::kNone) << "nothing to start";
   EXPECT_EQ(r.accept(Order{"", 2, {}, false}), TaskRunner::OrderChange::kCancel);
   EXPECT_FALSE(r.paused());
-}
-
-TEST(TaskRunner, TheTripHomeIsNeverReportedAndAnOrderReplacesIt) {
-  TaskRunner r;
-  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
-  EXPECT_TRUE(r.homing());
-  EXPECT_TRUE(r.hasOrder());
-  EXPECT_FALSE(r.busy());
-  r.leg(0);
-  EXPECT_FALSE(r.takeReport());
-  r.finish(TaskStage::Failed, "no path", kSec);
-  EXPECT_FALSE(r.takeReport());
-  EXPECT_FALSE(r.homing());
-  r.goHome(TaskGoal{{1.0, 1.0, 0.0}, "home", GoalAction::Park, 0.0});
-  EXPECT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
-  EXPECT_FALSE(r.homing());
-  EXPECT_EQ(r.goal().station, "P-1");
 }
 
 TEST(TaskRunner, NoticesNeedATaskAndFailuresKeepAtMost255BytesOfReason) {
@@ -130,7 +115,7 @@ TEST(TaskRunner, NoticesNeedATaskAndFailuresKeepAtMost255BytesOfReason) {
   r.notice("sensor stream lost", 0);
   EXPECT_FALSE(r.takeReport());
   ASSERT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
-  r.leg(0);
+  (void)r.tick(0);
   (void)r.takeReport();
   r.notice("sensor stream lost", kSec);
   auto rep = r.takeReport();
@@ -147,21 +132,19 @@ TEST(TaskRunner, NoticesNeedATaskAndFailuresKeepAtMost255BytesOfReason) {
 TEST(TaskRunner, AnOperatorHoldMovesTheDwellClock) {
   TaskRunner r;
   ASSERT_EQ(r.accept(transport()), TaskRunner::OrderChange::kNewTask);
+  (void)r.tick(0);
   r.arrive(10 * kSec);  // dwell 2 s
   r.shiftClock(5 * kSec);
   EXPECT_FALSE(r.dwellOver(16 * kSec));
+  EXPECT_EQ(r.tick(16 * kSec), TaskTick::kNone);
   EXPECT_TRUE(r.dwellOver(17 * kSec));
-  r.yieldBy(Phase::BackingOff, 20 * kSec);
-  EXPECT_EQ(r.phase(), Phase::BackingOff);
-  EXPECT_EQ(r.phaseStartNs(), 20 * kSec);
-  r.stop();
-  EXPECT_EQ(r.phase(), Phase::Idle);
+  EXPECT_EQ(r.tick(17 * kSec), TaskTick::kLegBegan);
 }
 
 TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailed) {
   TaskRunner r;
   ASSERT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kNewTask);
-  r.leg(0);
+  (void)r.tick(0);
   (void)r.takeReport();
   Order empty{"t9", 2, {}, false, 5 * kSec};
   EXPECT_EQ(r.accept(empty), TaskRunner::OrderChange::kRefused);
