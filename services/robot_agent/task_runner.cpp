@@ -10,6 +10,12 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
   if (o.revision == revision_ && o.task == task_) {
     return OrderChange::kSame;
   }
+  if (!o.task.empty() && o.goals.empty()) {
+    // Nowhere to go: every phase of an order assumes a first goal (the process's edge refuses such
+    // orders before; this keeps the runner safe alone). Refused before anything of it is taken.
+    refuse(o, "assignment has no goals");
+    return OrderChange::kRefused;
+  }
   revision_ = o.revision;
   priority_ = o.priority;
   paused_ = o.paused;  // an empty paused order holds the idle robot where it is
@@ -21,12 +27,6 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
   }
   if (o.task == task_ && o.goals == goals_) {
     return OrderChange::kPause;
-  }
-  if (o.goals.empty()) {
-    // Nowhere to go: every phase of an order assumes a first goal (the process's edge refuses such
-    // orders before; this keeps the runner safe alone).
-    refuse(o, "assignment has no goals");
-    return OrderChange::kRefused;
   }
   task_ = o.task;
   goals_ = o.goals;
@@ -40,13 +40,19 @@ void TaskRunner::refuse(const Order& o, const std::string& why) {
   if (o.task.empty()) {
     return;
   }
-  revision_ = o.revision;
-  task_.clear();
-  goals_.clear();
-  paused_ = false;
-  phase_ = Phase::Idle;
-  pending_ =
-      TaskReport{o.task, o.revision, TaskStage::Failed, 0.0f, ("refused: " + why).substr(0, 255), o.stampNs};
+  if (o.task == task_) {
+    // Its own task, in a form it cannot carry out: dropped, and reported failed below.
+    revision_ = o.revision;
+    task_.clear();
+    goals_.clear();
+    paused_ = false;
+    phase_ = Phase::Idle;
+    pending_.reset();
+  }
+  // Another task's order leaves the current task as it was: the robot goes on with it and still
+  // reports it (RobotState, TaskStatus), so the fleet manager sees both.
+  refusals_.push_back(
+      TaskReport{o.task, o.revision, TaskStage::Failed, 0.0f, ("refused: " + why).substr(0, 255), o.stampNs});
 }
 
 TaskStage TaskRunner::stageFor(std::size_t index, bool dwelling) const {
@@ -135,6 +141,11 @@ void TaskRunner::shiftClock(std::int64_t heldNs) {
 }
 
 std::optional<TaskReport> TaskRunner::takeReport() {
+  if (!refusals_.empty()) {
+    TaskReport r = std::move(refusals_.front());
+    refusals_.erase(refusals_.begin());
+    return r;
+  }
   if (pending_ && pending_->task.empty()) {
     pending_.reset();
   }

@@ -76,13 +76,14 @@ class TaskRunner {
     kCancel,   ///< no task any more
     kPause,    ///< the same task, held or resumed (or re-published after a manager restart)
     kNewTask,  ///< a new task (or new goals): starts on the next step
-    kRefused,  ///< a task with no goals: refused (reported failed), the robot drops what it had
+    kRefused,  ///< a task with no goals: refused (reported failed); another task it had goes on
   };
   /// A new revision replaces the current order, and any order replaces the trip home.
   OrderChange accept(const Order& o);
 
-  /// An order that cannot be carried out (refused at the process's edge, or without goals): drops
-  /// the current order and reports task `o.task` failed with "refused: <why>".
+  /// An order that cannot be carried out (refused at the process's edge, or without goals): reports
+  /// task `o.task` failed with "refused: <why>". Only an order for the current task drops it; one
+  /// for another task leaves the current task as it was.
   void refuse(const Order& o, const std::string& why);
 
   /// Once a cycle: a new order's first leg begins (Idle with a task), and a dwell that is over
@@ -97,7 +98,7 @@ class TaskRunner {
   void notice(const std::string& reason, std::int64_t nowNs);
   /// The operator's hold lasted `heldNs`: the phase's clock starts that much later.
   void shiftClock(std::int64_t heldNs);
-  /// The report due, if any (taken once).
+  /// The report due, if any (taken once; refusals first).
   std::optional<TaskReport> takeReport();
 
   [[nodiscard]] Phase phase() const { return phase_; }
@@ -134,6 +135,7 @@ class TaskRunner {
   std::int64_t phaseStartNs_ = 0;
   TaskStage reported_ = TaskStage::Queued;
   std::optional<TaskReport> pending_;
+  std::vector<TaskReport> refusals_;  // orders refused, reported before the task's own (oldest first)
 };
 
 }  // namespace fleet::agent

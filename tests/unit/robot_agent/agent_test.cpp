@@ -444,6 +444,41 @@ TEST(Agent, AssignmentWithATaskAndNoGoalsIsRefusedNotFollowed) {
   EXPECT_TRUE(run.a.busy());
 }
 
+// A refused order for another task once made the agent drop its current task without a word: the
+// robot reported idle with no task while the fleet manager kept the task en route. The refusal is
+// reported and the current task goes on to the end.
+TEST(Agent, ARefusedOrderForAnotherTaskIsReportedAndTheCurrentTaskGoesOn) {
+  auto p = params();
+  p.returnHomeS = -1.0;
+  AgentRun run(p);
+  run.a.onAssignment(transport());
+  run.until(30, [] { return false; });
+  ASSERT_TRUE(run.a.busy());
+  msg::TaskAssignment empty;
+  empty.robot_id = "r1";
+  empty.task_id = "t-other";
+  empty.revision = 8;
+  run.a.onAssignment(empty);  // no goals
+  msg::TaskAssignment bad = transport();
+  bad.task_id = "t-bad";
+  bad.revision = 9;
+  run.a.refuseAssignment(bad, "goal pose is not finite");  // refused at the process's edge
+  EXPECT_TRUE(run.a.busy());
+  const auto out = run.step();
+  EXPECT_EQ(out.state.task_id, "t1") << "still reported as its task";
+  run.until(1500, [&] { return run.reported(msg::TaskState::Done); });
+  std::vector<std::string> failed;
+  for (const auto& s : run.statuses) {
+    if (s.state == msg::TaskState::Failed) {
+      failed.push_back(s.task_id);
+    }
+  }
+  EXPECT_EQ(failed, (std::vector<std::string>{"t-other", "t-bad"}));
+  ASSERT_FALSE(run.statuses.empty());
+  EXPECT_EQ(run.statuses.back().task_id, "t1");
+  EXPECT_EQ(run.statuses.back().state, msg::TaskState::Done);
+}
+
 // One frame with finite but absurd wheel totals once made the pose NaN for good while the robot
 // reported idle. The edge refuses such a frame; an Agent that is fed one anyway reports a fault and
 // gives its task back.

@@ -141,15 +141,19 @@ TEST(TaskRunner, AnOperatorHoldMovesTheDwellClock) {
   EXPECT_EQ(r.tick(17 * kSec), TaskTick::kLegBegan);
 }
 
-TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailed) {
+TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailedAndTheCurrentTaskGoesOn) {
   TaskRunner r;
   ASSERT_EQ(r.accept(transport(1)), TaskRunner::OrderChange::kNewTask);
   (void)r.tick(0);
   (void)r.takeReport();
-  Order empty{"t9", 2, {}, false, 5 * kSec};
+  Order empty{"t9", 2, {}, true, 5 * kSec, 9};
   EXPECT_EQ(r.accept(empty), TaskRunner::OrderChange::kRefused);
-  EXPECT_FALSE(r.busy()) << "the robot drops what it had";
-  EXPECT_EQ(r.phase(), Phase::Idle);
+  EXPECT_TRUE(r.busy()) << "another task's order leaves the current one alone";
+  EXPECT_EQ(r.task(), "t1");
+  EXPECT_EQ(r.revision(), 1u);
+  EXPECT_FALSE(r.paused()) << "nothing of the refused order is taken";
+  EXPECT_EQ(r.priority(), 0);
+  EXPECT_EQ(r.phase(), Phase::Driving);
   auto rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->task, "t9");
@@ -157,11 +161,24 @@ TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailed) {
   EXPECT_EQ(rep->stage, TaskStage::Failed);
   EXPECT_EQ(rep->reason, "refused: assignment has no goals");
   EXPECT_EQ(rep->stampNs, 5 * kSec);
-  // Refused at the process's edge (whatever the order holds), and nothing for an empty task id.
-  r.refuse(transport(3), "bad pose");
+  // The current task's own reports are not lost behind a refusal: both come, the refusal first.
+  r.arrive(6 * kSec);
+  r.refuse(Order{"t8", 1, {}, false, 6 * kSec}, "bad pose");
+  EXPECT_EQ(r.takeReport()->task, "t8");
   rep = r.takeReport();
   ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->task, "t1");
+  EXPECT_EQ(rep->stage, TaskStage::Loading);
+  // Its own task refused (at the process's edge, whatever the order holds): dropped and reported.
+  r.refuse(transport(3), "bad pose");
+  EXPECT_FALSE(r.busy());
+  EXPECT_EQ(r.phase(), Phase::Idle);
+  rep = r.takeReport();
+  ASSERT_TRUE(rep);
+  EXPECT_EQ(rep->task, "t1");
   EXPECT_EQ(rep->reason, "refused: bad pose");
+  EXPECT_FALSE(r.takeReport());
+  // Nothing for an empty task id.
   r.refuse(Order{"", 4, {}, false, 0}, "x");
   EXPECT_FALSE(r.takeReport());
 }
