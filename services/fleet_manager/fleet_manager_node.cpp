@@ -45,10 +45,26 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 
 Settings readSettings(Config& cfg) {
   Settings s;
-  cfg.rejectUnknownKeys({"db", "stations", "sync", "tick_s", "lease_s", "max_attempts", "station_capacity",
-                         "station_load", "robot_fail_limit", "robot_hold_s", "battery_threshold",
-                         "charge_until", "charge_max_s", "nominal_speed", "clock", "metrics_file", "map",
-                         "travel_cost", "roadmap"});
+  cfg.rejectUnknownKeys({"db",
+                         "stations",
+                         "sync",
+                         "tick_s",
+                         "lease_s",
+                         "reconcile_s",
+                         "max_attempts",
+                         "station_capacity",
+                         "station_load",
+                         "robot_fail_limit",
+                         "robot_hold_s",
+                         "battery_threshold",
+                         "charge_until",
+                         "charge_max_s",
+                         "nominal_speed",
+                         "clock",
+                         "metrics_file",
+                         "map",
+                         "travel_cost",
+                         "roadmap"});
   s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight", "roadmap"});
   s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
   auto map = cfg.child("map");
@@ -62,6 +78,7 @@ Settings readSettings(Config& cfg) {
   s.syncFull = cfg.string("sync", "full", {"full", "normal"}) == "full";
   s.tickS = cfg.number("tick_s", s.tickS, {0.0, 60.0, true});
   s.leaseS = cfg.number("lease_s", s.leaseS, {0.0, 3600.0, true});
+  s.reconcileS = cfg.number("reconcile_s", s.reconcileS, {0.0, 3600.0});
   s.maxAttempts = static_cast<int>(cfg.integer("max_attempts", s.maxAttempts, {1, 100}));
   s.robotFailLimit = static_cast<int>(cfg.integer("robot_fail_limit", s.robotFailLimit, {0, 1000}));
   s.robotHoldS = cfg.number("robot_hold_s", s.robotHoldS, {0.0, 86400.0});
@@ -159,6 +176,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   }
   std::unique_ptr<FleetManagerNode> n(new FleetManagerNode());
   n->settings_ = s;
+  n->reconciler_ = TaskReconciler(secToNs(s.reconcileS));
   n->store_ = std::move(*store);
   DispatcherConfig dc;
   dc.maxAttempts = s.maxAttempts;
@@ -466,15 +484,23 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
 }
 
 void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs) {
-  dispatcher_->onRobotState(
+  const auto update = dispatcher_->onRobotState(
       {s.robot_id, s.pose, static_cast<double>(s.battery), nowNs, s.mode == msg::RobotMode::Fault});
+  if (update == RobotRegistry::Update::Stale || settings_.reconcileS <= 0) {
+    return;
+  }
+  const RobotInfo* info = dispatcher_->robots().find(s.robot_id);
+  reconciler_.observe(s.robot_id, s.task_id, info != nullptr ? info->taskId : std::string(), nowNs);
 }
 
 void FleetManagerNode::onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out) {
+  reconciler_.forget(robotId);
   publish(dispatcher_->onRobotLost(robotId, nowNs), nowNs, out);
 }
 
 void FleetManagerNode::tick(std::int64_t nowNs, Outbox& out) {
+  // First: a requeued task is assigned again in the same tick.
+  reconcile(nowNs, out);
   publish(dispatcher_->tick(nowNs), nowNs, out);
 }
 
@@ -488,6 +514,8 @@ nlohmann::json FleetManagerNode::metricsJson() const {
   // bounds double, so within a factor of two of the true value, linear inside the bucket).
   const auto lat = assignLatency_->snapshot();
   auto pct = [&](double q) { return lat.quantile(q) * 1e3; };
+  const nlohmann::json reconciled = {{"requeued", metrics_.reconciledRequeued},
+                                     {"stale_report", metrics_.reconciledStale}};
   return {{"queued", dispatcher_->waitingCount()},
           {"active", dispatcher_->activeCount()},
           {"submitted", c.submitted},
@@ -502,6 +530,7 @@ nlohmann::json FleetManagerNode::metricsJson() const {
           {"rejected", metrics_.rejected},
           {"assignments", metrics_.assignments},
           {"bad_orders", metrics_.badOrders},
+          {"reconciled", reconciled},
           {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.count}}}};
 }
 

@@ -11,6 +11,7 @@
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
+#include "fleet/fleet/task_reconciler.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/metrics/histogram.hpp"
 #include "fleet/planning/distance_field_cache.hpp"
@@ -26,6 +27,9 @@ struct Settings {
   bool syncFull = true;      // SQLite synchronous=FULL (survives power loss) or NORMAL (process crash)
   double tickS = 0.2;        // periodic assignment
   double leaseS = 1.0;       // a robot silent this long is lost
+  /// A robot whose RobotState shows no task (or another) this long while the store has it carry
+  /// a task in an active state gets that task requeued (0: never). See TaskReconciler.
+  double reconcileS = 5.0;
   int maxAttempts = 3;
   /// Active tasks per station at most (0: no limit); see DispatcherConfig::stationCapacity.
   int stationCapacity = 2;
@@ -73,11 +77,23 @@ TravelModel makeRoadmapTravelModel(const StationMap& stations,
 
 Settings readSettings(Config& cfg);
 
-/// Everything a call produced that must go on the wire, in order.
+/// A disagreement between a robot's reports and the store that outlasted `reconcile_s`, and what
+/// the manager did about it; the service logs it as a warning.
+struct Reconciled {
+  std::string action;  ///< "requeued" (the robot dropped its task) or "stale_report" (logged only)
+  std::string robot;
+  std::string task;          ///< requeued: the task requeued; stale_report: the task the robot reports
+  std::string reported;      ///< what the robot reports ("" no task)
+  std::int64_t sinceNs = 0;  ///< since when (manager's clock)
+  std::string message;
+};
+
+/// Everything a call produced that must go on the wire, in order (and `reconciled`, for the log).
 struct Outbox {
   std::vector<msg::TaskAck> acks;
   std::vector<msg::TaskEvent> events;
   std::vector<msg::TaskAssignment> assignments;
+  std::vector<Reconciled> reconciled;
 };
 
 struct Metrics {
@@ -87,6 +103,8 @@ struct Metrics {
   std::int64_t rejected = 0;
   std::int64_t assignments = 0;
   std::int64_t badOrders = 0;  ///< orders that could not be built (a station not on the site): task failed
+  std::int64_t reconciledRequeued = 0;  ///< tasks requeued: their robot reported no task, or another
+  std::int64_t reconciledStale = 0;     ///< robots that reported a task finished or not theirs
 };
 
 class FleetManagerNode {
@@ -103,8 +121,10 @@ class FleetManagerNode {
   void onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out);
   /// A robot's state, received at `nowNs` on the manager's clock: the lease runs on the receiver's
   /// clock, so a robot whose clock is off (or stamps INT64_MAX) is neither lost nor kept for ever.
+  /// Its task_id is compared with the task the store has it carry (reconciled in tick).
   void onRobotState(const msg::RobotState& s, std::int64_t nowNs);
   void onRobotLost(const std::string& robotId, std::int64_t nowNs, Outbox& out);
+  /// Reconciles the robots' reported tasks with the store (reconcile_s), then the dispatcher's tick.
   void tick(std::int64_t nowNs, Outbox& out);
   /// Assignments to re-publish after a restart (from the store), and each open task's state as a
   /// TaskEvent, so an adapter that starts later learns every stored open task from the history.
@@ -127,6 +147,9 @@ class FleetManagerNode {
   /// The robot's order; error "internal" when a station of the task is not on the site.
   Expected<msg::TaskAssignment> toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
   std::uint32_t nextRevision(const std::string& robot, std::int64_t nowNs);
+  /// Acts on the disagreements between robots' reports and the store that outlasted the grace
+  /// (fleet_manager_reconcile.cpp).
+  void reconcile(std::int64_t nowNs, Outbox& out);
 
   Settings settings_;
   std::unique_ptr<SqliteTaskStore> store_;
@@ -134,6 +157,7 @@ class FleetManagerNode {
   std::map<std::string, std::uint32_t> eventSeq_;
   std::map<std::string, std::uint32_t> revisions_;
   std::map<std::string, std::int64_t> queuedAt_;
+  TaskReconciler reconciler_{0};
   Outbox recovered_;
   Metrics metrics_;
   metrics::Histogram ownAssignLatency_{assignLatencyBuckets()};

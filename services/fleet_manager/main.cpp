@@ -49,6 +49,13 @@ class ManagerMetrics {
       requests_.push_back({&r_.counter("fleet_manager_task_requests_total",
                                        "Task requests received over DDS, by result", {{"result", result}})});
     }
+    for (const char* action : {"requeued", "stale_report"}) {
+      reconciled_.push_back({&r_.counter(
+          "fleet_manager_reconciled_total",
+          "Robots whose reported task disagreed with the store for reconcile_s: their task requeued, or "
+          "a stale report logged",
+          {{"action", action}})});
+    }
     for (const char* state : {"queued", "active"}) {
       tasks_.push_back(
           &r_.gauge("fleet_manager_tasks", "Open tasks: queued (waiting) or active", {{"state", state}}));
@@ -78,6 +85,8 @@ class ManagerMetrics {
     requests_[0].to(m.stored);
     requests_[1].to(m.duplicates);
     requests_[2].to(m.rejected);
+    reconciled_[0].to(m.reconciledRequeued);
+    reconciled_[1].to(m.reconciledStale);
     tasks_[0]->set(static_cast<double>(node.dispatcher().waitingCount()));
     tasks_[1]->set(static_cast<double>(node.dispatcher().activeCount()));
     double idle = 0;
@@ -108,6 +117,7 @@ class ManagerMetrics {
   metrics::Registry& r_;
   std::vector<Mirrored> outcomes_;
   std::vector<Mirrored> requests_;
+  std::vector<Mirrored> reconciled_;
   std::vector<metrics::Gauge*> tasks_;
   std::vector<metrics::Gauge*> robots_;
 };
@@ -193,6 +203,11 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     for (const auto& a : out.assignments) {
       assignments.write(a);
     }
+    for (const auto& r : out.reconciled) {
+      logging::ScopedField taskField("task", r.task);
+      logging::ScopedField robotField("robot", r.robot);
+      spdlog::warn("{}", r.message);
+    }
     out = {};
   };
   {
@@ -201,8 +216,9 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
                  node.dispatcher().openTasks().size(), settings.db, rec.assignments.size());
     send(rec);
   }
-  spdlog::info("fleet manager: {} stations, tick {} s, lease {} s, clock {}",
-               node.dispatcher().stations().size(), settings.tickS, settings.leaseS, settings.clock);
+  spdlog::info("fleet manager: {} stations, tick {} s, lease {} s, reconcile {} s, clock {}",
+               node.dispatcher().stations().size(), settings.tickS, settings.leaseS, settings.reconcileS,
+               settings.clock);
 
   const std::int64_t tickNs = secToNs(settings.tickS);
   std::int64_t nextTick = 0;

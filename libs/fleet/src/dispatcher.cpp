@@ -171,8 +171,8 @@ std::vector<Expected<SubmitResult>> Dispatcher::submit(const std::vector<Task>& 
   return results;
 }
 
-void Dispatcher::onRobotState(const RobotObservation& o) {
-  registry_.observe(o);
+RobotRegistry::Update Dispatcher::onRobotState(const RobotObservation& o) {
+  return registry_.observe(o);
 }
 
 void Dispatcher::requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason,
@@ -260,6 +260,24 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   if (state == TaskState::Done) {
     failStreak_[robotId].count = 0;
   }
+  return out;
+}
+
+Expected<DispatchResult> Dispatcher::requeueDropped(const std::string& robotId, const std::string& taskId,
+                                                    const std::string& reason, std::int64_t nowNs) {
+  auto it = open_.find(taskId);
+  if (it == open_.end()) {
+    return unexpected(errc::kNotFound, "no open task '" + taskId + "'");
+  }
+  if (!isActive(it->second.state) || it->second.robotId != robotId) {
+    return unexpected(errc::kWrongRobot, "task '" + taskId + "' is not held by robot '" + robotId + "'");
+  }
+  DispatchResult out;
+  requeueOrFail(it->second, false, reason, nowNs, out);
+  if (!out.errors.empty()) {
+    return unexpected(out.errors.front());
+  }
+  failedBy_[taskId] = robotId;  // whatever made the robot drop it may do so again
   return out;
 }
 

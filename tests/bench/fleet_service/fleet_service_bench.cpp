@@ -87,10 +87,14 @@ struct Fleet {
     transport::Reader<msg::TaskAssignment> orders(p);
     WallClock wall;
     auto lastStates = Clk::now() - 1s;
+    // What each robot reports it carries: the manager requeues a task its robot does not report
+    // for reconcile_s.
+    std::map<std::string, std::string> carrying;
     while (!stop) {
       if (orders.waitForData(5ms)) {
         const auto now = Clk::now();
         for (const auto& a : orders.take()) {
+          carrying[a.robot_id] = finish ? std::string() : a.task_id;
           if (a.task_id.empty()) {
             continue;
           }
@@ -112,6 +116,7 @@ struct Fleet {
           s.stamp_ns = wall.nowNs();
           s.pose = {0.2 * i, 0, 0};
           s.battery = 0.9f;
+          s.task_id = carrying[s.robot_id];
           states.write(s);
         }
         lastStates = Clk::now();

@@ -120,7 +120,8 @@ class Dispatcher {
                                              DispatchResult* out = nullptr,
                                              std::vector<std::vector<FieldError>>* fields = nullptr);
 
-  void onRobotState(const RobotObservation& o);
+  /// Stale: a sample older than the newest one of the robot, ignored.
+  RobotRegistry::Update onRobotState(const RobotObservation& o);
   /// DDS liveliness lost: the robot's task is requeued at once.
   DispatchResult onRobotLost(const std::string& robotId, std::int64_t nowNs);
   /// A robot's report on its task. Intermediate happy-path steps it skipped are filled in; failed
@@ -128,6 +129,12 @@ class Dispatcher {
   /// wrong_robot (the robot does not hold it; the service should revoke), illegal_transition.
   Expected<DispatchResult> onTaskStatus(const std::string& robotId, const std::string& taskId,
                                         TaskState state, const std::string& reason, std::int64_t nowNs);
+  /// The robot does not carry the task it holds here (its states have shown no task, or another,
+  /// for longer than the manager's reconcile grace): the task is requeued with `reason` (no
+  /// attempt counted; the retry goes to another idle robot if there is one) and the robot is free
+  /// for new work. Errors as onTaskStatus: not_found, wrong_robot.
+  Expected<DispatchResult> requeueDropped(const std::string& robotId, const std::string& taskId,
+                                          const std::string& reason, std::int64_t nowNs);
   /// Operator cancel; an active task is withdrawn from its robot.
   Expected<DispatchResult> cancel(const std::string& taskId, const std::string& reason, std::int64_t nowNs);
   /// Fails an open task for good, whatever its attempts (an internal error: the service cannot
