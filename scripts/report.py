@@ -4,6 +4,7 @@ in its folder: the simulator's summary and replay viewer, the fleet manager's ta
 metrics. index.html is one self-contained file: the replay viewer travels inside it (gzip +
 base64, unpacked by the browser), so it can be copied or mailed on its own; viewer.html stays
 next to it for opening the viewer by itself. Usage: scripts/report.py RUN_DIR"""
+import report_ledger
 import base64
 import gzip
 import html
@@ -369,10 +370,7 @@ def bound_html(b):
     rows = [("tasks done with a bound", f"{b.get('tasks', 0)} of {b.get('tasks_done', 0)}"),
             ("mean task time (last assignment → done)", f"{num(b.get('mean_task_time_s'), '.1f')} s"),
             ("mean kinematic bound", f"{num(b.get('mean_bound_s'), '.1f')} s"),
-            ("task time ÷ bound", f"<b>{num(b.get('task_time_over_bound'))}×</b>"),
-            ("a lone robot at its bound (3600 ÷ mean bound)", f"{num(b.get('lone_rate_per_h'), '.1f')} tasks/h"),
-            ("the fleet", f"{num(b.get('fleet_rate_per_h'), '.1f')} tasks/h, {num(b.get('per_robot_rate_per_h'))} per robot"),
-            ("η (per robot ÷ the lone robot at its bound)", f"<b>{num(b.get('efficiency'))}</b>")]
+            ("task time ÷ bound", f"<b>{num(b.get('task_time_over_bound'))}×</b>")]
     table = "".join(f"<tr><td>{html.escape(k)}</td><td class=\"r\">{v}</td></tr>" for k, v in rows)
     unbounded = "".join(f"<li>{html.escape(str(u.get('id')))}: {html.escape(str(u.get('reason')))}</li>"
                         for u in b.get("unbounded", []))
@@ -410,9 +408,6 @@ def saturated_html(s, waiting, done_at, end_s, w=640, h=260):
                  f"{s['from_s']:.0f}–{s['to_s']:.0f} s (held {100 * s.get('held_fraction', 0):.0f} % of it)"),
                 ("tasks done in it", f"{s['done']}"),
                 ("the fleet's rate in it", f"{s['fleet_rate_per_h']:.1f} tasks/h, <b>{s['per_robot_rate_per_h']:.2f}</b> per robot")]
-        if "efficiency" in s:
-            rows.append(("η (÷ a lone robot's saturated rate)",
-                         f"<b>{s['efficiency']:.2f}</b> (lone robot {s['lone_rate_per_h']:.1f}/h)"))
         table = "<table>" + "".join(f"<tr><td>{html.escape(k)}</td><td class=\"r\">{v}</td></tr>" for k, v in rows) + "</table>"
     else:
         table = f"<p>No saturated window: {html.escape(str(s.get('why', '')))} (peak {s.get('peak_waiting', 0)} waiting, {robots} robots).</p>"
@@ -476,7 +471,8 @@ def loadtest_html(lt, saturated=""):
               f"{agent_rows}</table>") if agent_rows else ""
     lat = latency_table([("assignment", "submitted → first assigned", a.get("assignment_latency_s", {})),
                          ("end to end", "submitted → done", a.get("end_to_end_latency_s", {}))])
-    bound = bound_html(lt.get("kinematic_bound"))
+    bound = (report_ledger.fleet_bound_html(lt.get("fleet_bound")) + bound_html(lt.get("kinematic_bound"))
+             + report_ledger.robot_time_html(lt.get("robot_time")) + report_ledger.stations_html(lt.get("stations")))
     return f"""<h2 id="loadtest">Load test</h2>{verdict}
 <p>{lt.get('robots')} robots in {lt.get('agent_processes')} agent process(es), {lt.get('humans')} humans,
 {lt.get('sim_time_s', 0):.0f} s simulated in {lt.get('wall_time_s', 0):.0f} s wall
@@ -566,6 +562,9 @@ def main(run):
                                                   if k != "per_task"}
         if lt.get("saturated"):
             summary["loadtest"]["saturated"] = lt["saturated"]
+        for k in ("fleet_bound", "robot_time", "stations"):
+            if lt.get(k) is not None:
+                summary["loadtest"][k] = lt[k]
     json.dump(summary, open(os.path.join(run, "summary.json"), "w"), indent=2)
     risk = risk_levels_over_time(run)
     viewer = embedded_viewer(run)

@@ -81,11 +81,9 @@ std::vector<Expected<KinematicBound>> kinematicBounds(const planning::OccupancyG
   return out;
 }
 
-BoundFigures boundFigures(const std::vector<double>& taskS, const std::vector<double>& boundS,
-                          double fleetRatePerH, std::size_t robots) {
+BoundFigures boundFigures(const std::vector<double>& taskS, const std::vector<double>& boundS) {
   BoundFigures f;
   f.tasks = std::min(taskS.size(), boundS.size());
-  f.fleetRatePerH = fleetRatePerH;
   if (f.tasks == 0) {
     return f;
   }
@@ -95,11 +93,6 @@ BoundFigures boundFigures(const std::vector<double>& taskS, const std::vector<do
       std::accumulate(boundS.begin(), boundS.begin() + static_cast<std::ptrdiff_t>(f.tasks), 0.0) / n;
   if (f.meanBoundS > 0.0) {
     f.timeOverBound = f.meanTaskS / f.meanBoundS;
-    f.loneRatePerH = 3600.0 / f.meanBoundS;
-  }
-  if (robots > 0) {
-    f.perRobotRatePerH = fleetRatePerH / static_cast<double>(robots);
-    f.efficiency = f.loneRatePerH > 0.0 ? f.perRobotRatePerH / f.loneRatePerH : 0.0;
   }
   return f;
 }

@@ -41,21 +41,16 @@ struct KinematicBound {
 std::vector<Expected<KinematicBound>> kinematicBounds(const planning::OccupancyGrid& freeMap,
                                                       const std::vector<BoundTask>& tasks);
 
-/// The fleet against the bound: mean task time ÷ mean bound, the lone robot's ideal rate and η.
+/// Task times against their bounds: mean task time ÷ mean bound.
 struct BoundFigures {
   std::size_t tasks = 0;  ///< tasks with both a time and a bound
   double meanTaskS = 0.0;
   double meanBoundS = 0.0;
   double timeOverBound = 0.0;  ///< mean task time ÷ mean bound
-  double loneRatePerH = 0.0;   ///< 3,600 ÷ mean bound
-  double fleetRatePerH = 0.0;
-  double perRobotRatePerH = 0.0;
-  double efficiency = 0.0;  ///< η = per-robot rate ÷ the lone robot's ideal rate
 };
 
 /// `taskS` and `boundS` pair up (tasks without a bound are left out by the caller); zeros when there
-/// is nothing to average or no robot.
-BoundFigures boundFigures(const std::vector<double>& taskS, const std::vector<double>& boundS,
-                          double fleetRatePerH, std::size_t robots);
+/// is nothing to average.
+BoundFigures boundFigures(const std::vector<double>& taskS, const std::vector<double>& boundS);
 
 }  // namespace fleet::ctl

@@ -32,6 +32,7 @@
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "run_bounds.hpp"
+#include "run_figures.hpp"
 #include "saturation.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
@@ -1071,15 +1072,15 @@ int Run::run() {
   report["kinematic_bound"] =
       o.wallClock
           ? json{{"error", "not in wall-clock runs (the manager's stamps are not the replay's clock)"}}
-          : runBounds(out, report["throughput"]["done_per_sim_hour"].get<double>(), robots.size());
+          : runBounds(out);
   // As for the bound: on the wall clock the manager's stamps are epoch time, not the run's.
   report["saturated"] =
-      o.wallClock
-          ? json{{"found", false},
-                 {"why", "not in wall-clock runs (the manager's stamps are not the run's clock)"},
-                 {"robots", robots.size()},
-                 {"peak_waiting", 0}}
-          : saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime), o.loneSaturatedPerH);
+      o.wallClock ? json{{"found", false},
+                         {"why", "not in wall-clock runs (the manager's stamps are not the run's clock)"},
+                         {"robots", robots.size()},
+                         {"peak_waiting", 0}}
+                  : saturatedJson(saturatedWindow(contents.transitions, robots.size(), simTime));
+  addRunFigures(report, out, o.wallClock);
   if (auto tm = readJson(out / "traffic_manager_summary.json")) {
     report["traffic_manager"] = trafficSummaryJson(*tm, vdaRobots);
   }
@@ -1116,6 +1117,9 @@ int Run::run() {
   }
   say(boundLine(report["kinematic_bound"]));
   say(saturatedLine(report["saturated"]));
+  for (const auto& l : runFigureLines(report)) {
+    say(l);
+  }
   if (report.contains("traffic_manager")) {
     say(baseEndsLine(report["traffic_manager"]));
   }

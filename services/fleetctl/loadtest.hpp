@@ -12,11 +12,10 @@
 namespace fleet::ctl {
 
 struct LoadtestOptions {
-  std::string scenario;            // a scenario file to run as is; empty: generate one
-  std::string templ;               // template for generated scenarios
-  int robots = 20;                 // generated scenarios
-  int siteRobots = 0;              // generated scenarios: size the site for this many robots (0: robots)
-  double loneSaturatedPerH = 0.0;  // a saturated lone robot's tasks/h: η over the saturated window (0: none)
+  std::string scenario;  // a scenario file to run as is; empty: generate one
+  std::string templ;     // template for generated scenarios
+  int robots = 20;       // generated scenarios
+  int siteRobots = 0;    // generated scenarios: size the site for this many robots (0: robots)
   int humans = 8;
   double ratePerMin = 0;   // tasks per simulated minute; 0: 0.75 per robot
   int maxTasks = 0;        // 0: no cap besides the duration

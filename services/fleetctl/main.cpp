@@ -134,12 +134,6 @@ int main(int argc, char** argv) {
                    "--robots of "
                    "them: fleet sizes compared on one site (0: sized for --robots)")
       ->check(CLI::Range(0, 2000));
-  loadtest
-      ->add_option(
-          "--lone-saturated-per-h", lt.loneSaturatedPerH,
-          "tasks/h of a lone robot kept busy on the same site and people (its run's saturated window): "
-          "the report gives the fleet's efficiency eta over its own saturated window against it")
-      ->check(CLI::Range(0.0, 1e6));
   loadtest->add_option("--humans", lt.humans, "humans of the generated scenario")
       ->check(CLI::Range(0, 5000))
       ->capture_default_str();

@@ -163,7 +163,7 @@ std::optional<std::string> positionsAt(const fs::path& replay,
 
 }  // namespace
 
-json runBounds(const fs::path& runDir, double fleetRatePerH, std::size_t robotCount) {
+json runBounds(const fs::path& runDir) {
   try {
     std::vector<DoneTask> done;
     if (auto e = readDoneTasks(runDir / "fleet.db", done)) {
@@ -255,7 +255,7 @@ json runBounds(const fs::path& runDir, double fleetRatePerH, std::size_t robotCo
                          {"task_time_s", round3(time)},
                          {"ratio", b.seconds() > 0.0 ? round3(time / b.seconds()) : 0.0}});
     }
-    const BoundFigures f = boundFigures(taskS, boundS, fleetRatePerH, robotCount);
+    const BoundFigures f = boundFigures(taskS, boundS);
     return {
         {"method",
          "shortest way for the robot's disc on the free map (0.1 m cells, any-angle: Lazy Theta*) from where "
@@ -268,10 +268,6 @@ json runBounds(const fs::path& runDir, double fleetRatePerH, std::size_t robotCo
         {"mean_task_time_s", round3(f.meanTaskS)},
         {"mean_bound_s", round3(f.meanBoundS)},
         {"task_time_over_bound", round3(f.timeOverBound)},
-        {"lone_rate_per_h", round3(f.loneRatePerH)},
-        {"fleet_rate_per_h", round3(f.fleetRatePerH)},
-        {"per_robot_rate_per_h", round3(f.perRobotRatePerH)},
-        {"efficiency", round3(f.efficiency)},
         {"per_task", perTask},
         {"unbounded", unbounded}};
   } catch (const ConfigError& e) {
@@ -294,12 +290,10 @@ std::string boundLine(const json& b) {
   std::snprintf(
       buf, sizeof buf,
       "kinematic bound: task time mean %.1f s = %.2fx the bound (mean %.1f s: the disc's shortest way at "
-      "%g m/s plus dwell) over %zu of %zu done tasks; a lone robot at its bound: %.1f tasks/h; the fleet: "
-      "%.1f tasks/h = %.2f per robot, eta %.2f",
+      "%g m/s plus dwell, from where the robot was at its assignment) over %zu of %zu done tasks",
       b.value("mean_task_time_s", 0.0), b.value("task_time_over_bound", 0.0), b.value("mean_bound_s", 0.0),
       b["cruise_m_s"].empty() ? 0.0 : b["cruise_m_s"].back().get<double>(), n,
-      b.value("tasks_done", std::size_t{0}), b.value("lone_rate_per_h", 0.0),
-      b.value("fleet_rate_per_h", 0.0), b.value("per_robot_rate_per_h", 0.0), b.value("efficiency", 0.0));
+      b.value("tasks_done", std::size_t{0}));
   return buf;
 }
 

@@ -14,10 +14,10 @@
 namespace fleet::ctl {
 
 /// `loadtest.json`'s "kinematic_bound" block: per done task its bound and task time (last
-/// assignment → first done), tasks without a bound with the reason, and the fleet figures
-/// (boundFigures) for `fleetRatePerH` over `robots`. On a folder it cannot read it returns
-/// {"error": why}; it never throws.
-nlohmann::json runBounds(const std::filesystem::path& runDir, double fleetRatePerH, std::size_t robots);
+/// assignment → first done), tasks without a bound with the reason, and the mean task time against
+/// the mean bound (boundFigures). On a folder it cannot read it returns {"error": why}; it never
+/// throws. The fleet's rate is stated against the fleet bound (run_fleet_bound.hpp).
+nlohmann::json runBounds(const std::filesystem::path& runDir);
 
 /// That block as the line the run prints.
 std::string boundLine(const nlohmann::json& block);

@@ -80,7 +80,7 @@ double round3(double v) {
 }
 }  // namespace
 
-nlohmann::json saturatedJson(const SaturatedWindow& w, double loneSaturatedPerH) {
+nlohmann::json saturatedJson(const SaturatedWindow& w) {
   nlohmann::json j = {{"found", w.found},
                       {"definition",
                        "from the first to the last instant at which at least as many tasks waited "
@@ -97,10 +97,6 @@ nlohmann::json saturatedJson(const SaturatedWindow& w, double loneSaturatedPerH)
   j["done"] = w.done;
   j["fleet_rate_per_h"] = round3(w.perRobotPerH * static_cast<double>(w.robots));
   j["per_robot_rate_per_h"] = round3(w.perRobotPerH);
-  if (loneSaturatedPerH > 0.0) {
-    j["lone_rate_per_h"] = loneSaturatedPerH;
-    j["efficiency"] = round3(w.perRobotPerH / loneSaturatedPerH);
-  }
   return j;
 }
 
@@ -116,13 +112,7 @@ std::string saturatedLine(const nlohmann::json& s) {
       "saturated window %.0f-%.0f s (held %.0f %% of it): %d done, %.1f tasks/h, %.2f per robot-hour",
       s.value("from_s", 0.0), s.value("to_s", 0.0), 100.0 * s.value("held_fraction", 0.0), s.value("done", 0),
       s.value("fleet_rate_per_h", 0.0), s.value("per_robot_rate_per_h", 0.0));
-  std::string out = line;
-  if (s.contains("efficiency")) {
-    std::snprintf(line, sizeof line, "; eta %.2f against a lone robot's %.2f/h", s.value("efficiency", 0.0),
-                  s.value("lone_rate_per_h", 0.0));
-    out += line;
-  }
-  return out;
+  return line;
 }
 
 }  // namespace fleet::ctl

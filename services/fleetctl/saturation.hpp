@@ -4,8 +4,8 @@
 // which at least as many tasks wait (stored, not yet assigned) as there are robots, so that every
 // robot that finishes a task can chain the next without a trip home. The rate inside that window
 // is the fleet's capacity; the rate over a whole run mixes in the ramp-up from parking and the
-// tail after the last task was posted. η = this per-robot rate ÷ a lone robot's, measured the same
-// way (a saturated lone run: at least one task waiting).
+// tail after the last task was posted. The fleet's rate is stated against the fleet bound
+// (fleet_bound.hpp), not against a lone robot's run.
 
 #include <cstddef>
 #include <string>
@@ -34,9 +34,8 @@ struct SaturatedWindow {
 [[nodiscard]] SaturatedWindow saturatedWindow(const std::vector<TransitionRow>& transitions,
                                               std::size_t robots, double endS);
 
-/// loadtest.json's "saturated": the window, its rates and, when a lone robot's saturated rate is
-/// given (> 0), the efficiency η against it; {"found": false, "why": ...} without a window.
-[[nodiscard]] nlohmann::json saturatedJson(const SaturatedWindow& w, double loneSaturatedPerH);
+/// loadtest.json's "saturated": the window and its rates; {"found": false, "why": ...} without one.
+[[nodiscard]] nlohmann::json saturatedJson(const SaturatedWindow& w);
 
 /// One line for the run's summary.
 [[nodiscard]] std::string saturatedLine(const nlohmann::json& saturated);

@@ -1,17 +1,81 @@
 #include "traffic_sim.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "fleet/core/config.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/virtual_fleet.hpp"
+#include "run_fleet_bound.hpp"
 #include "traffic_sim_view.hpp"
 
 namespace fleet::ctl {
+
+namespace {
+
+/// The fleet bound of a virtual-fleet run: its drawn tasks in order, its robots' starts, the
+/// roadmap's stations (dock, approach and first queue node as it built them), disc and cruise, the
+/// virtual fleet's dwell at pickup and drop-off.
+nlohmann::json virtualFleetBound(const site::Site& site, const traffic::Roadmap& roadmap,
+                                 const traffic::VirtualFleetResult& r, double dwell) {
+  const auto& g = roadmap.graph;
+  FleetBoundInput in;
+  std::map<traffic::NodeId, std::string> names;
+  for (const auto& s : roadmap.stations) {
+    if (s.dock == traffic::kNoNode)
+      continue;
+    names[s.dock] = s.name;
+    DockGeometry geo{g.position(s.dock), std::nullopt, {}};
+    if (s.approach != traffic::kNoNode)
+      geo.approach = g.position(s.approach);
+    if (!s.queue.empty())
+      geo.queue.push_back(g.position(s.queue.front()));
+    in.stations.push_back({s.name, geo});
+  }
+  for (const auto& t : r.tasks)
+    in.tasks.push_back({names[t.pickup], names[t.dropoff], dwell, dwell});
+  for (const auto v : r.starts)
+    in.starts.push_back(g.position(v));
+  in.radius = roadmap.options.radius;
+  in.cruise = roadmap.options.cruiseSpeed;
+  const auto b = fleetBound(site.drivable(), in);
+  if (!b)
+    return {{"error", b.error().code + ": " + b.error().message}};
+  return fleetBoundJson(*b, r.tasksPerHour, in.cruise, in.radius);
+}
+
+nlohmann::json robotTimeJson(const traffic::VirtualFleetResult& r) {
+  ActivityLedger fleet;
+  nlohmann::json per = nlohmann::json::array();
+  for (const auto& l : r.robotTime) {
+    fleet.add(l);
+    nlohmann::json one = nlohmann::json::object();
+    for (const auto c : kLedgerActivities)
+      one[toString(c)] = std::round(l.share(c) * 1000.0) / 1000.0;
+    per.push_back(one);
+  }
+  nlohmann::json all = nlohmann::json::object();
+  for (const auto c : kLedgerActivities)
+    all[toString(c)] = std::round(fleet.share(c) * 1000.0) / 1000.0;
+  return {{"fleet", all}, {"per_robot", per}};
+}
+
+std::string robotTimeLine(const nlohmann::json& rt) {
+  std::string line = "  robot time:";
+  char buf[80];
+  for (const auto c : kLedgerActivities) {
+    std::snprintf(buf, sizeof buf, " %s %.0f %%", toString(c), 100.0 * rt["fleet"].value(toString(c), 0.0));
+    line += buf;
+  }
+  return line;
+}
+
+}  // namespace
 
 int runTrafficSim(const TrafficSimOptions& o) {
   const auto site = service::loadSiteFile(o.site);
@@ -86,8 +150,12 @@ int runTrafficSim(const TrafficSimOptions& o) {
         return 2;
       }
     }
+    const nlohmann::json bound = virtualFleetBound(*site, roadmap, r, v.dwell);
+    const nlohmann::json robotTime = robotTimeJson(r);
     if (o.json) {
       all.push_back({{"seed", seed},
+                     {"fleet_bound", bound},
+                     {"robot_time", robotTime},
                      {"robots", r.robots},
                      {"duration_s", r.duration},
                      {"tasks_done", r.tasksDone},
@@ -112,6 +180,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"stalls", r.stalls}});
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";
+      std::cout << "  " << fleetBoundLine(bound) << "\n" << robotTimeLine(robotTime) << "\n";
       for (const auto& s : r.stalls)
         std::cout << "  stalled: " << s << "\n";
     }

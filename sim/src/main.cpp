@@ -488,7 +488,9 @@ class Simulator {
     for (const auto& s : stateR_.take()) {
       const int i = w_.robotIndex(s.robot_id);
       if (i >= 0) {
-        w_.setLabel(static_cast<std::size_t>(i), msg::toString(s.mode), s.task_id);
+        w_.setLabel(
+            static_cast<std::size_t>(i), msg::toString(s.mode), s.task_id,
+            s.activity == msg::RobotActivity::Unset ? std::string() : std::string(toString(s.activity)));
         if (lockstep_) {  // stamps are simulated time only in lockstep
           errors_.estimate(static_cast<std::size_t>(i), s.stamp_ns, s.pose);
         }

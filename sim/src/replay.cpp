@@ -67,6 +67,9 @@ nlohmann::json replayStep(const World& w) {
   for (const auto& r : w.robots()) {
     robots.push_back({mm(r.pose.x), mm(r.pose.y), mm(r.pose.theta), mm(r.twist.v), mm(r.battery),
                       r.charging ? 1 : 0, r.mode, r.task});
+    if (!r.activity.empty()) {
+      robots.back().push_back(r.activity);  // the agent's RobotState.activity, when it says one
+    }
   }
   j["robots"] = robots;
   nlohmann::json humans = nlohmann::json::array();

@@ -382,9 +382,10 @@ CommandOutcome World::command(std::size_t i, double v, double w) {
   return CommandOutcome::Accepted;
 }
 
-void World::setLabel(std::size_t robot, std::string mode, std::string task) {
+void World::setLabel(std::size_t robot, std::string mode, std::string task, std::string activity) {
   robots_[robot].mode = std::move(mode);
   robots_[robot].task = std::move(task);
+  robots_[robot].activity = std::move(activity);
 }
 
 void World::setChargeSwitch(std::size_t robot, bool on) {

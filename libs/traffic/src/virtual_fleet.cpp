@@ -18,6 +18,9 @@ struct Bot {
   double left = 0.0;       // s to go on the current edge
   double total = 0.0;      // s the current edge takes
   double dwellLeft = 0.0;  // s of dwell left at a station
+  double stopLeft = 0.0;   // s of a stop (a person in the aisle) left before the edge goes on
+  double turnLeft = 0.0;   // s of the edge's turn left (spent first)
+  bool dockEdge = false;   // the edge leads into or out of a station's dock or approach node
   int phase = 0;           // 0: to the pickup, 1: to the drop-off
   NodeId pickup = kNoNode;
   NodeId dropoff = kNoNode;
@@ -73,6 +76,9 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
                                 " do)");
   }
 
+  VirtualFleetResult res;
+  res.starts = starts;
+  res.robotTime.resize(o.robots);
   std::mt19937_64 rng(o.seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   TrafficOptions topt = o.traffic;
@@ -125,6 +131,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     b.idle = false;
     b.pickup = ps[rng() % ps.size()];
     b.dropoff = ds[rng() % ds.size()];
+    res.tasks.push_back({b.pickup, b.dropoff});
     ++uses[static_cast<std::size_t>(b.pickup)];
     ++uses[static_cast<std::size_t>(b.dropoff)];
     b.phase = 0;
@@ -137,7 +144,6 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     newTask(r, 0.0);
   }
 
-  VirtualFleetResult res;
   res.robots = o.robots;
   res.duration = o.duration;
   res.minSeparation = std::numeric_limits<double>::infinity();
@@ -165,6 +171,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       }
       if (b.dwellLeft > 0.0) {
         tDwell += o.dt;
+        res.robotTime[r].add(RobotActivity::Dwelling, o.dt);
         b.dwellLeft -= o.dt;
         if (b.dwellLeft > 0.0)
           continue;
@@ -186,11 +193,15 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           b.to = rel[r].base[1];
           const Edge* e = g.edge(b.at, b.to);
           double d = e != nullptr ? e->duration : 1.0;
-          if (b.prev != kNoNode)
-            d += roadmap.extraTurn(b.prev, b.at, b.to);
-          d *= 1.0 + o.jitter * unit(rng);
-          if (unit(rng) < o.stopChance)
-            d += o.stopMax * unit(rng);
+          const double turn = b.prev != kNoNode ? roadmap.extraTurn(b.prev, b.at, b.to) : 0.0;
+          const double stretch = 1.0 + o.jitter * unit(rng);
+          d = (d + turn) * stretch;
+          b.turnLeft = turn * stretch;
+          b.stopLeft = unit(rng) < o.stopChance ? o.stopMax * unit(rng) : 0.0;
+          const auto docky = [&](NodeId v) {
+            return roadmap.kind(v) == NodeKind::Station || roadmap.kind(v) == NodeKind::Approach;
+          };
+          b.dockEdge = docky(b.at) && docky(b.to);
           b.left = b.total = d;
         } else if (!b.idle && traffic.goal(r) != kNoNode && b.at == traffic.goal(r)) {
           b.dwellLeft = o.dwell;
@@ -203,7 +214,23 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         tWait += o.dt;
       else
         tStand += o.dt;
-      if (b.to != kNoNode) {
+      if (b.idle) {
+        res.robotTime[r].add(RobotActivity::NoTask, o.dt);  // standing or driving to a parking place
+        if (b.to != kNoNode && b.stopLeft > 0.0)
+          b.stopLeft -= o.dt;
+      } else if (b.to != kNoNode && b.stopLeft > 0.0) {
+        res.robotTime[r].add(RobotActivity::HeldByPerson, o.dt);
+        b.stopLeft -= o.dt;  // the edge goes on once the person has passed
+      } else if (b.to != kNoNode) {
+        const bool turning = b.turnLeft > 0.0;
+        b.turnLeft -= o.dt;
+        res.robotTime[r].add(turning || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving,
+                             o.dt);
+      } else {
+        res.robotTime[r].add(RobotActivity::WaitingOnRobot, o.dt);
+      }
+      if (b.to != kNoNode && b.stopLeft <= 0.0) {
+        b.turnLeft -= b.idle ? o.dt : 0.0;
         b.left -= o.dt;
         if (b.left <= 0.0) {
           b.prev = b.at;

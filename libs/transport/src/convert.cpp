@@ -203,6 +203,7 @@ void Traits<msg::RobotState>::toC(const msg::RobotState& in, C& out, Arena&) {
   putStr(out.task_id, in.task_id, "RobotState.task_id");
   out.radius = in.radius;
   out.paused = in.paused;
+  out.activity = static_cast<fleet_RobotActivity>(in.activity);
 }
 msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   msg::RobotState m;
@@ -217,6 +218,11 @@ msg::RobotState Traits<msg::RobotState>::fromC(const C& in) {
   m.task_id = getStr(in.task_id);
   m.radius = in.radius;
   m.paused = in.paused;
+  // A value from a newer peer is not guessed at: Unset, so the reader derives it from `mode`.
+  const auto act = static_cast<int>(in.activity);
+  m.activity = act < 0 || act > static_cast<int>(msg::RobotActivity::Faulted)
+                   ? msg::RobotActivity::Unset
+                   : static_cast<msg::RobotActivity>(act);
   return m;
 }
 

@@ -171,6 +171,7 @@ std::optional<Rejection> check(const msg::RobotState& m) {
   }
   c.within(m.v, -kMaxSpeed, kMaxSpeed, "v").within(m.w, -kMaxSpeed, kMaxSpeed, "w");
   c.within(m.battery, 0.0, 1.0, "battery").within(m.radius, 0.0, kMaxRadius, "radius");
+  c.known(m.activity, msg::RobotActivity::Faulted, "activity");
   return c.known(m.mode, msg::RobotMode::Fault, "mode").done();
 }
 

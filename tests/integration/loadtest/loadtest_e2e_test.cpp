@@ -419,12 +419,12 @@ TEST(LoadtestE2E, RunsWithTheApiTokenOfItsEnvironment) {
 }
 
 // Issue 18: every done task is stated against its kinematic bound (the disc's shortest way on the
-// free map at the agent's cruise, plus dwell), and the fleet's rate against a lone robot's at it.
+// free map at the agent's cruise, plus dwell), the fleet's rate against the fleet bound of its task
+// list, and the robot-time and station ledgers are written.
 TEST(LoadtestE2E, TaskTimesAreStatedAgainstTheKinematicBound) {
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-bound-" + std::to_string(getpid()));
   fs::remove_all(out);
-  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 400, 120,
-                                  {"--lone-saturated-per-h", "40"});
+  const auto args = untilDoneArgs(FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", out, 400, 120);
   fleet::test::ChildProcess run(kFleetctl, args);
   ASSERT_EQ(run.wait(std::chrono::seconds(180)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));
@@ -451,21 +451,32 @@ TEST(LoadtestE2E, TaskTimesAreStatedAgainstTheKinematicBound) {
   }
   EXPECT_NEAR(b["mean_bound_s"].get<double>(), boundSum / 2.0, 0.01);
   EXPECT_GE(b["task_time_over_bound"].get<double>(), 1.0);
-  EXPECT_NEAR(b["lone_rate_per_h"].get<double>(), 3600.0 / b["mean_bound_s"].get<double>(), 0.01);
-  EXPECT_NEAR(b["fleet_rate_per_h"].get<double>(), r["throughput"]["done_per_sim_hour"].get<double>(), 0.01);
-  EXPECT_GT(b["efficiency"].get<double>(), 0.0);
-  EXPECT_LE(b["efficiency"].get<double>(), 1.0) << "a lone robot above the rate of its own bound";
-  // The saturated window (the issue's η) is stated whether or not this run had one.
+  const json& fb = r["fleet_bound"];
+  ASSERT_FALSE(fb.contains("error")) << fb.dump();
+  EXPECT_EQ(fb["robots"], 1);
+  EXPECT_EQ(fb["tasks"], 2);
+  EXPECT_NEAR(fb["fleet_rate_per_h"].get<double>(), r["throughput"]["done_per_sim_hour"].get<double>(), 0.01);
+  EXPECT_GT(fb["fraction_of_bound"].get<double>(), 0.0);
+  EXPECT_LE(fb["fraction_of_bound"].get<double>(), 1.0) << "a lone robot above its own bound: " << fb.dump();
+  const json& rt = r["robot_time"];
+  ASSERT_TRUE(rt.contains("per_robot")) << rt.dump();
+  for (const auto& [robot, shares] : rt["per_robot"].items()) {
+    double sum = 0.0;
+    for (const auto& [cat, share] : shares["share"].items()) {
+      sum += share.get<double>();
+    }
+    EXPECT_NEAR(sum, 1.0, 0.01) << robot << ": " << shares.dump();
+  }
+  EXPECT_TRUE(r["stations"].is_array()) << r.dump();
+  // The saturated window is stated whether or not this run had one (no lone-robot η any more).
   const json& s = r["saturated"];
   ASSERT_TRUE(s.is_object()) << r.dump();
   EXPECT_EQ(s["robots"], 1);
+  EXPECT_FALSE(s.contains("efficiency")) << s.dump();
   if (s["found"].get<bool>()) {
     EXPECT_LT(s["from_s"].get<double>(), s["to_s"].get<double>());
-    EXPECT_NEAR(s["efficiency"].get<double>(), s["per_robot_rate_per_h"].get<double>() / 40.0, 0.001)
-        << s.dump();
   } else {
     EXPECT_TRUE(s.contains("why")) << s.dump();
-    EXPECT_FALSE(s.contains("efficiency")) << s.dump();
   }
 }
 

@@ -126,20 +126,15 @@ TEST(KinematicBound, AnUnreachableStationIsReportedNotCrashedOn) {
 }
 
 TEST(KinematicBound, FleetFiguresAgainstTheBound) {
-  // Two tasks of 60 and 100 s against bounds of 40 s: 2x the bound; a lone robot at its bound does
-  // 90 tasks/h, a fleet of 2 doing 90/h does 45 each: eta 0.5.
-  const BoundFigures f = boundFigures({60.0, 100.0}, {40.0, 40.0}, 90.0, 2);
+  // Two tasks of 60 and 100 s against bounds of 40 s: 2x the bound.
+  const BoundFigures f = boundFigures({60.0, 100.0}, {40.0, 40.0});
   EXPECT_EQ(f.tasks, 2u);
   EXPECT_DOUBLE_EQ(f.meanTaskS, 80.0);
   EXPECT_DOUBLE_EQ(f.meanBoundS, 40.0);
   EXPECT_DOUBLE_EQ(f.timeOverBound, 2.0);
-  EXPECT_DOUBLE_EQ(f.loneRatePerH, 90.0);
-  EXPECT_DOUBLE_EQ(f.perRobotRatePerH, 45.0);
-  EXPECT_DOUBLE_EQ(f.efficiency, 0.5);
-  const BoundFigures empty = boundFigures({}, {}, 90.0, 2);
+  const BoundFigures empty = boundFigures({}, {});
   EXPECT_EQ(empty.tasks, 0u);
-  EXPECT_EQ(empty.efficiency, 0.0);
-  EXPECT_EQ(boundFigures({60.0}, {40.0}, 90.0, 0).efficiency, 0.0);
+  EXPECT_EQ(empty.timeOverBound, 0.0);
 }
 
 }  // namespace

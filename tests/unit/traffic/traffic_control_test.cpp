@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <algorithm>
 
 #include "fleet/site/site_loader.hpp"
@@ -61,6 +63,13 @@ std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
     EXPECT_EQ(r.holdViolations, 0U);
     EXPECT_EQ(r.contacts, 0U);
     EXPECT_EQ(r.refusedReports, 0U);
+    // The robot-time ledger: every robot's nine categories add up to the run, tick by tick.
+    EXPECT_EQ(r.robotTime.size(), o.robots);
+    for (const auto& l : r.robotTime) {
+      EXPECT_NEAR(l.total(), o.duration, o.dt + 1e-6);  // whole ticks of dt
+      EXPECT_EQ(l.seconds(RobotActivity::Unset), 0.0);
+    }
+    EXPECT_GE(r.tasks.size(), r.tasksDone);
     if (o.robots > 1) {
       EXPECT_GE(r.minSeparation, map.separation.contact - map.separation.margin);
     }

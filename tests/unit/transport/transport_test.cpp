@@ -234,3 +234,18 @@ TEST(MessageNames, RoundTrip) {
   EXPECT_EQ(k, msg::TaskKind::GoTo);
   EXPECT_FALSE(msg::parse("teleport", k));
 }
+
+// RobotState.activity (appended 2026-12-02) crosses the C struct both ways; a value this build does
+// not know (a newer peer's) reads as Unset, so the reader derives the activity from the mode.
+TEST(TransportConvert, RobotActivityRoundTripsAndAnUnknownOneReadsAsUnset) {
+  using Tr = Traits<msg::RobotState>;
+  msg::RobotState s;
+  s.robot_id = "r1";
+  s.activity = msg::RobotActivity::HeldByPerson;
+  fleet_RobotState c{};
+  Arena arena;
+  Tr::toC(s, c, arena);
+  EXPECT_EQ(Tr::fromC(c).activity, msg::RobotActivity::HeldByPerson);
+  c.activity = static_cast<fleet_RobotActivity>(42);
+  EXPECT_EQ(Tr::fromC(c).activity, msg::RobotActivity::Unset);
+}

@@ -147,6 +147,11 @@ TEST(SampleChecks, RobotStateAndDiscsMustBeFiniteAndPlausible) {
   s.covariance[4] = 0;
   s.battery = 7.0F;
   EXPECT_EQ(reasonOf(check(s)), "implausible");
+  s.battery = 0.5F;
+  s.activity = msg::RobotActivity::Faulted;
+  EXPECT_FALSE(check(s));
+  s.activity = static_cast<msg::RobotActivity>(10);  // one past RA_FAULTED
+  EXPECT_EQ(reasonOf(check(s)), "enum");
 
   msg::PredictedDiscs d;
   d.source_id = "r1";

@@ -38,6 +38,7 @@ struct RobotBody {
   int bumps = 0;     // steps a shelf stopped the robot
   std::string mode;  // label from outside (agent's RobotState), replay only
   std::string task;
+  std::string activity;  // RobotState.activity's text name; empty when the agent does not say it
 };
 
 struct HumanBody {
@@ -153,7 +154,7 @@ class World {
   /// outside the speed limits: clamped (by the kinematic limiter) and counted.
   CommandOutcome command(const std::string& id, double v, double w);
   CommandOutcome command(std::size_t robot, double v, double w);
-  void setLabel(std::size_t robot, std::string mode, std::string task);
+  void setLabel(std::size_t robot, std::string mode, std::string task, std::string activity = {});
   /// From now on robot `robot` charges on a charger only while `on` (see RobotBody::chargeSwitch).
   void setChargeSwitch(std::size_t robot, bool on);
   /// Whether the robot stands within reach of a charging station's contacts.

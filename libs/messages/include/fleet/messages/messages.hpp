@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fleet/core/pose2.hpp"
+#include "fleet/core/robot_activity.hpp"
 
 namespace fleet::msg {
 
@@ -30,6 +31,8 @@ enum class TaskState : std::uint8_t {
 enum class RobotMode : std::uint8_t { Idle, Moving, Waiting, Loading, Charging, Blocked, Fault };
 enum class SourceKind : std::uint8_t { Robot, Human };
 enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
+/// IDL RobotActivity (RA_UNSET ... RA_FAULTED), in the same order: fleet/core/robot_activity.hpp.
+using RobotActivity = fleet::RobotActivity;
 
 struct Task {
   std::string task_id;
@@ -114,6 +117,8 @@ struct RobotState {
   std::string task_id;
   float radius = 0;
   bool paused = false;  ///< held by the operator
+  /// What it is doing (the robot-time ledger); Unset from an agent that does not say.
+  RobotActivity activity = RobotActivity::Unset;
   bool operator==(const RobotState&) const = default;
 };
 

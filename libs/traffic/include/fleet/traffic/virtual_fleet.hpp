@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/core/robot_activity.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
 
@@ -86,6 +87,21 @@ struct VirtualFleetResult {
   double dwelling = 0.0;
   double waitingOnOthers = 0.0;
   double standingPlanned = 0.0;
+  /// Each robot's time in the nine ledger categories (fleet/core/robot_activity.hpp), classified per
+  /// tick: dwelling at a station; no task (no admissible one: the station cap); held by a person
+  /// (a random stop on an edge); turning and docking (an edge's turn time, and edges into or out of
+  /// a station's dock or approach node); driving (any other edge); waiting on another robot
+  /// (standing with a task, whether nodes ahead are not released yet or the plan keeps it there).
+  /// Charging, faulted and held by safety do not happen here. Each adds up to `duration`.
+  std::vector<ActivityLedger> robotTime;
+  /// The tasks in the order they were drawn (the list the fleet bound is computed on), and where
+  /// each robot started.
+  struct DrawnTask {
+    NodeId pickup = kNoNode;
+    NodeId dropoff = kNoNode;
+  };
+  std::vector<DrawnTask> tasks;
+  std::vector<NodeId> starts;
   /// Robots waiting longer than a minute at the end: where, for what, behind whom.
   std::vector<std::string> stalls;
   std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0

@@ -1,0 +1,167 @@
+#include "fleet_bound.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <utility>
+
+#include "fleet/site/disc_distance.hpp"
+
+namespace fleet::ctl {
+
+namespace {
+
+bool finiteNonNegative(double x) {
+  return std::isfinite(x) && x >= 0.0;
+}
+
+std::optional<std::string> badInput(const FleetBoundInput& in) {
+  if (in.starts.empty()) {
+    return "no robot";
+  }
+  if (in.tasks.empty()) {
+    return "no task";
+  }
+  if (!std::isfinite(in.cruise) || in.cruise <= 0.0 || !finiteNonNegative(in.radius)) {
+    return "cruise must be > 0 and radius >= 0, both finite";
+  }
+  for (const auto& s : in.starts) {
+    if (!s.isFinite()) {
+      return "a robot start is not finite";
+    }
+  }
+  for (const auto& t : in.tasks) {
+    if (!finiteNonNegative(t.loadS) || !finiteNonNegative(t.unloadS)) {
+      return "a task's load or unload time is negative or not finite";
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Expected<FleetBound> fleetBound(const planning::OccupancyGrid& freeMap, const FleetBoundInput& in) {
+  if (auto why = badInput(in)) {
+    return unexpected("bad_input", *why);
+  }
+  if (freeMap.size() == 0) {
+    return unexpected("bad_input", "the map is empty");
+  }
+  std::map<std::string, const BoundStation*> byName;
+  for (const auto& s : in.stations) {
+    byName[s.name] = &s;
+  }
+  for (const auto& t : in.tasks) {
+    for (const auto* name : {&t.pickup, &t.dropoff}) {
+      if (!byName.count(*name)) {
+        return unexpected("unknown_station", "station '" + *name + "' is not on the site");
+      }
+    }
+  }
+  // Every leg of the chain, grouped by its goal so that each station's field is built once.
+  std::map<std::string, std::vector<Vec2>> froms;  // goal station → from points
+  auto dock = [&](const std::string& name) { return byName.at(name)->geometry.dock; };
+  for (const auto& s : in.starts) {
+    froms[in.tasks.front().pickup].push_back(s);
+  }
+  for (std::size_t i = 0; i < in.tasks.size(); ++i) {
+    froms[in.tasks[i].dropoff].push_back(dock(in.tasks[i].pickup));
+    if (i > 0) {
+      froms[in.tasks[i].pickup].push_back(dock(in.tasks[i - 1].dropoff));
+    }
+  }
+  std::map<std::pair<std::string, std::pair<double, double>>, double> length;
+  try {
+    site::DiscDistance free(freeMap, in.radius, 2);
+    for (const auto& [goal, points] : froms) {
+      for (const Vec2& from : points) {
+        const auto key = std::make_pair(goal, std::make_pair(from.x, from.y));
+        if (length.count(key)) {
+          continue;
+        }
+        auto d = free.length(from, dock(goal));
+        if (!d) {
+          return unexpected(d.error().code, "to " + goal + " from (" + std::to_string(from.x) + ", " +
+                                                std::to_string(from.y) + "): " + d.error().message);
+        }
+        length[key] = *d;
+      }
+    }
+  } catch (const std::invalid_argument& e) {
+    return unexpected("bad_input", e.what());
+  }
+  auto way = [&](Vec2 from, const std::string& goal) {
+    return length.at(std::make_pair(goal, std::make_pair(from.x, from.y)));
+  };
+
+  FleetBound b;
+  b.robots = in.starts.size();
+  b.tasks = in.tasks.size();
+  double first = way(in.starts.front(), in.tasks.front().pickup);
+  for (const auto& s : in.starts) {
+    first = std::min(first, way(s, in.tasks.front().pickup));  // the best start: the bound stays one
+  }
+  double dwell = 0.0;
+  b.chainDriveM = first;
+  for (std::size_t i = 0; i < in.tasks.size(); ++i) {
+    const auto& t = in.tasks[i];
+    if (i > 0) {
+      b.chainDriveM += way(dock(in.tasks[i - 1].dropoff), t.pickup);
+    }
+    b.chainDriveM += way(dock(t.pickup), t.dropoff);
+    dwell += t.loadS + t.unloadS;
+  }
+  b.chainS = b.chainDriveM / in.cruise + dwell;
+  const auto n = static_cast<double>(b.tasks);
+  b.lonePerH = b.chainS > 0.0 ? 3600.0 * n / b.chainS : 0.0;
+  b.robotPerH = static_cast<double>(b.robots) * b.lonePerH;
+
+  // Station loads: visits and the dwell they bring.
+  std::map<std::string, std::pair<std::size_t, double>> visits;  // name → (visits, dwell sum)
+  for (const auto& t : in.tasks) {
+    auto& p = visits[t.pickup];
+    ++p.first;
+    p.second += t.loadS;
+    auto& d = visits[t.dropoff];
+    ++d.first;
+    d.second += t.unloadS;
+  }
+  for (const auto& [name, v] : visits) {
+    StationLoad s;
+    s.name = name;
+    s.visits = v.first;
+    s.share = static_cast<double>(v.first) / n;
+    s.moveS = dockMoveSeconds(byName.at(name)->geometry, in.radius, in.cruise);
+    s.cycleS = s.moveS + v.second / static_cast<double>(v.first);
+    s.boundPerH = s.cycleS > 0.0 ? 3600.0 / (s.cycleS * s.share) : 0.0;
+    b.stations.push_back(s);
+  }
+  // A station whose cycle takes no time bounds nothing (boundPerH 0): it sorts last.
+  std::stable_sort(b.stations.begin(), b.stations.end(), [](const StationLoad& x, const StationLoad& y) {
+    return y.boundPerH <= 0.0 ? x.boundPerH > 0.0 : (x.boundPerH > 0.0 && x.boundPerH < y.boundPerH);
+  });
+  if (!b.stations.empty() && b.stations.front().boundPerH > 0.0) {
+    b.stationPerH = b.stations.front().boundPerH;
+    b.bindingStation = b.stations.front().name;
+  } else {
+    b.stationPerH = b.robotPerH;  // no station time: the robots bind
+  }
+  return b;
+}
+
+}  // namespace fleet::ctl
+
+#include "fleet/site/site.hpp"
+
+namespace fleet::ctl {
+
+std::vector<BoundStation> boundStations(const site::Site& site) {
+  std::vector<BoundStation> out;
+  for (const auto& s : site.stations) {
+    out.push_back({s.name, {s.pose.position(), s.approach, s.queue}});
+  }
+  return out;
+}
+
+}  // namespace fleet::ctl

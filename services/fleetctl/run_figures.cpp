@@ -1,0 +1,141 @@
+#include "run_figures.hpp"
+
+#include <sqlite3.h>
+#include <zlib.h>
+
+#include <map>
+
+#include "fleet/core/config.hpp"
+#include "fleet/sim/scenario.hpp"
+#include "run_fleet_bound.hpp"
+#include "run_ledger.hpp"
+
+namespace fleet::ctl {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+bool readLine(gzFile f, std::string& line) {
+  line.clear();
+  char buf[1 << 16];
+  while (gzgets(f, buf, sizeof buf) != nullptr) {
+    line += buf;
+    if (line.back() == '\n') {
+      return true;
+    }
+  }
+  return !line.empty();
+}
+
+std::map<std::string, LedgerTask> taskStations(const fs::path& dbPath) {
+  std::map<std::string, LedgerTask> out;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(dbPath.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) == SQLITE_OK) {
+    sqlite3_stmt* s = nullptr;
+    if (sqlite3_prepare_v2(db, "SELECT id, body FROM tasks", -1, &s, nullptr) == SQLITE_OK) {
+      while (sqlite3_step(s) == SQLITE_ROW) {
+        const auto* id = sqlite3_column_text(s, 0);
+        const auto* body = sqlite3_column_text(s, 1);
+        const json b = json::parse(body ? reinterpret_cast<const char*>(body) : "", nullptr, false);
+        if (id != nullptr && b.is_object()) {
+          out[reinterpret_cast<const char*>(id)] = {b.value("pickup", ""), b.value("dropoff", "")};
+        }
+      }
+    }
+    sqlite3_finalize(s);
+  }
+  sqlite3_close(db);
+  return out;
+}
+
+/// Both ledgers over the replay: {"robot_time": ..., "stations": ...} or {"error": ...}.
+json ledgers(const fs::path& runDir) {
+  const sim::Scenario scn = sim::loadScenario((runDir / "scenario.json").string());
+  std::vector<LedgerStation> stations;
+  for (const auto& s : scn.stations) {
+    if (s.kind == site::StationKind::Pickup || s.kind == site::StationKind::Dropoff) {
+      stations.push_back({s.name, s.pose.position()});
+    }
+  }
+  std::vector<std::string> robots;
+  for (const auto& r : scn.robots) {
+    robots.push_back(r.id);
+  }
+  RunLedger ledger(robots, stations, taskStations(runDir / "fleet.db"));
+  const fs::path replay = runDir / "replay.jsonl.gz";
+  gzFile f = gzopen(replay.c_str(), "rb");
+  if (f == nullptr) {
+    return {{"error", "cannot open " + replay.string()}};
+  }
+  std::string line;
+  std::vector<RobotSample> samples(robots.size());
+  while (readLine(f, line)) {
+    const json step = json::parse(line, nullptr, false);
+    if (!step.is_object() || !step.contains("robots") || !step.contains("t")) {
+      continue;  // the header, or a line cut short
+    }
+    const auto& rs = step["robots"];
+    if (!rs.is_array() || rs.size() != robots.size()) {
+      continue;
+    }
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+      const auto& r = rs[i];
+      RobotSample& x = samples[i];
+      // [x, y, theta, v, battery, charging, mode, task(, activity)] (sim/src/replay.cpp)
+      if (!r.is_array() || r.size() < 8) {
+        x = {};
+        continue;
+      }
+      x.position = {r[0].get<double>(), r[1].get<double>()};
+      x.charging = r[5].is_number() && r[5].get<double>() != 0.0;
+      x.mode = r[6].is_string() ? r[6].get<std::string>() : "";
+      x.task = r[7].is_string() ? r[7].get<std::string>() : "";
+      x.activity = r.size() > 8 && r[8].is_string() ? r[8].get<std::string>() : "";
+    }
+    ledger.step(step["t"].get<double>(), samples);
+  }
+  gzclose(f);
+  return {{"robot_time", ledger.robotTimeJson()}, {"stations", ledger.stationsJson()}};
+}
+
+}  // namespace
+
+void addRunFigures(json& report, const fs::path& runDir, bool wallClock) {
+  const double rate = report["throughput"].value("done_per_sim_hour", 0.0);
+  report["fleet_bound"] = runFleetBound(runDir, rate);
+  if (wallClock && !report["fleet_bound"].contains("error")) {
+    report["fleet_bound"]["note"] = "wall-clock run: the rate is per simulated hour of a 1x simulator";
+  }
+  try {
+    json l = ledgers(runDir);
+    if (l.contains("error")) {
+      report["robot_time"] = l;
+      report["stations"] = json::array();
+    } else {
+      report["robot_time"] = std::move(l["robot_time"]);
+      report["stations"] = std::move(l["stations"]);
+    }
+  } catch (const std::exception& e) {
+    report["robot_time"] = {{"error", e.what()}};
+    report["stations"] = json::array();
+  }
+}
+
+std::vector<std::string> runFigureLines(const json& report) {
+  std::vector<std::string> out;
+  if (report.contains("fleet_bound")) {
+    out.push_back(fleetBoundLine(report["fleet_bound"]));
+  }
+  const json& rt = report.contains("robot_time") ? report["robot_time"] : json();
+  if (rt.is_object() && rt.contains("error")) {
+    out.push_back("robot time: not computed: " + rt["error"].get<std::string>());
+  }
+  for (auto& l : ledgerLines(rt, report.contains("stations") ? report["stations"] : json::array())) {
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+}  // namespace fleet::ctl

@@ -1,0 +1,19 @@
+#include "station_cycle.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fleet::ctl {
+
+double dockMoveSeconds(const DockGeometry& g, double radius, double cruise) {
+  if (!(cruise > 0.0) || !std::isfinite(cruise) || !std::isfinite(radius) || radius < 0.0) {
+    return 0.0;
+  }
+  const Vec2 a = g.approach.value_or(g.dock);
+  const double leg = (g.dock - a).norm();
+  const double wait = g.queue.empty() ? 2.0 * radius : std::max((g.queue.front() - a).norm(), 2.0 * radius);
+  const double s = (2.0 * leg + wait) / cruise;
+  return std::isfinite(s) ? s : 0.0;
+}
+
+}  // namespace fleet::ctl

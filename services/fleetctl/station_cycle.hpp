@@ -1,0 +1,35 @@
+#pragma once
+
+// A station's least dock cycle with ideal motion (docs/algorithms.md, "Fleet bound"): the least
+// time from one robot's arrival at the dock to the next robot's arrival there. The dock is a dead
+// end: robots enter and leave it along its straight last leg (dock ← approach point), on which two
+// robots cannot pass, so the next robot waits at the queue head (the nearest waiting point) until
+// the one docked has dwelt and backed out along the leg to the approach point. From then on both
+// move at once: the leaving robot drives off clear of the next one's way while the next drives
+// from the queue head to the approach point and along the leg in. The next robot's disc cannot
+// reach the approach point before the leaving one is a diameter (2r) past it, so
+//
+//   c = dwell + (|dock − approach| + max(|queueHead − approach|, 2r) + |approach − dock|) / cruise
+//
+// with straight lines (the leg is straight by construction; a straight line is the least way) and
+// no turns (ideal). Without an approach point the leg has no length (approach = dock); without a
+// queue the next robot waits a diameter away.
+
+#include <optional>
+#include <vector>
+
+#include "fleet/core/vec2.hpp"
+
+namespace fleet::ctl {
+
+struct DockGeometry {
+  Vec2 dock;
+  std::optional<Vec2> approach;  ///< start of the straight last leg
+  std::vector<Vec2> queue;       ///< waiting points, nearest first
+};
+
+/// The motion part of the cycle (the dwell comes from each visit's task): the sum in parentheses
+/// above over the cruise. 0 for a cruise ≤ 0 or anything not finite (the caller checks its inputs).
+[[nodiscard]] double dockMoveSeconds(const DockGeometry& g, double radius, double cruise);
+
+}  // namespace fleet::ctl
