@@ -10,6 +10,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/geometry/polygon.hpp"
 #include "fleet/planning/map_io.hpp"
+#include "fleet/planning/map_limits.hpp"
 #include "fleet/site/reachability.hpp"
 #include "fleet/site/ros_map.hpp"
 
@@ -321,7 +322,11 @@ planning::OccupancyGrid readMapSection(Config c, const std::string& baseDir) {
     l.shelfHeight = static_cast<int>(w.integer("shelf_height", 2, {1, 10000}));
     l.aisleX = static_cast<int>(w.integer("aisle_x", 3, {1, 10000}));
     l.aisleY = static_cast<int>(w.integer("aisle_y", 3, {1, 10000}));
-    grid = planning::makeWarehouseGrid(l);
+    if (auto ok = planning::checkMapSize(l.width, l.height, res, origin, "", "width x height"); !ok) {
+      grid = unexpected(ok.error());
+    } else {
+      grid = planning::makeWarehouseGrid(l);
+    }
   } else {
     key = "rows";
     const nlohmann::json* rows = c.find("rows");
