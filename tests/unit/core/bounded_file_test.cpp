@@ -54,7 +54,8 @@ TEST_F(BoundedFile, RefusesASparseThreeGigabyteFileWithoutReadingIt) {
   fs::resize_file(path("sparse.pgm"), std::uintmax_t{3} << 30);  // no blocks: a hole
   const auto r = readBoundedFile(path("sparse.pgm"), kMapFileLimit, "map_image");
   ASSERT_FALSE(r);
-  EXPECT_THAT(r.error().message, HasSubstr(path("sparse.pgm") + ": is 3221225472 bytes, more than the limit"));
+  EXPECT_THAT(r.error().message,
+              HasSubstr(path("sparse.pgm") + ": is 3221225472 bytes, more than the limit"));
 }
 
 TEST_F(BoundedFile, RefusesAFifoWithoutWaitingForAWriter) {
