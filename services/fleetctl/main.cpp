@@ -14,9 +14,9 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
 
+#include "fleet/core/bounded_file.hpp"
 #include "fleet/service/command_line.hpp"
 #include "loadtest.hpp"
 #include "site_check.hpp"
@@ -436,9 +436,16 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (!tokenFile.empty()) {
-    std::ifstream in(tokenFile);
-    if (!in || !std::getline(in, t.token)) {
-      return fail("cannot read a token from " + tokenFile);
+    auto text = fleet::readBoundedFile(tokenFile, fleet::kTokenFileLimit, "token_file");
+    if (!text) {
+      return fail("cannot read a token: " + text.error().message);
+    }
+    t.token = text->substr(0, text->find('\n'));
+    if (!t.token.empty() && t.token.back() == '\r') {
+      t.token.pop_back();
+    }
+    if (t.token.empty()) {
+      return fail("cannot read a token from " + tokenFile + ": the first line is empty");
     }
   } else if (const char* env = std::getenv("FLEET_WMS_TOKEN")) {
     t.token = env;

@@ -2,11 +2,11 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
 
+#include "fleet/core/bounded_file.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/ids.hpp"
 
@@ -36,10 +36,13 @@ nlohmann::json resolveScenarioSite(nlohmann::json scenario, const std::string& o
     p = std::filesystem::absolute(std::filesystem::path(origin).parent_path() / p).lexically_normal();
   }
   scenario["site"] = p.string();
-  std::ifstream in(p);
-  auto site = nlohmann::json::parse(in, nullptr, false);
-  if (!in || site.is_discarded() || !site.is_object()) {
-    throw ConfigError({origin + ": site: cannot read the site file " + p.string()});
+  const auto text = readBoundedFile(p.string(), kConfigFileLimit, "invalid");
+  if (!text) {
+    throw ConfigError({origin + ": site: cannot read the site file: " + text.error().message});
+  }
+  auto site = nlohmann::json::parse(*text, nullptr, false);
+  if (site.is_discarded() || !site.is_object()) {
+    throw ConfigError({origin + ": site: cannot read the site file " + p.string() + " (not a JSON object)"});
   }
   scenario["site_stations"] = site.value("stations", nlohmann::json::array());
   return scenario;
@@ -50,8 +53,9 @@ nlohmann::json inlineSiteRobot(nlohmann::json scenario, const std::string& origi
   if (!scenario.contains("site")) {
     return scenario;
   }
-  std::ifstream in(scenario["site"].get<std::string>());
-  const auto site = nlohmann::json::parse(in, nullptr, false);
+  // resolveScenarioSite read it already, so it is a bounded regular file holding a JSON object.
+  const auto text = readBoundedFile(scenario["site"].get<std::string>(), kConfigFileLimit, "invalid");
+  const auto site = text ? nlohmann::json::parse(*text, nullptr, false) : nlohmann::json::object();
   auto& defaults = scenario["robot_defaults"];
   if (!defaults.is_object()) {
     defaults = nlohmann::json::object();

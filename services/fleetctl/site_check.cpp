@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "fleet/core/config.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/site/site_report.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -122,7 +123,15 @@ int siteCheck(const std::string& file, double radius, double mapResolution, bool
   traffic::RoadmapOptions options;
   options.radius = report.radius;
   const auto t0 = std::chrono::steady_clock::now();
-  const traffic::Roadmap roadmap = traffic::buildRoadmap(*site, options);
+  traffic::Roadmap roadmap;
+  try {
+    roadmap = traffic::buildRoadmap(*site, options);
+  } catch (const ConfigError& e) {  // a site too large for the lattice
+    for (const auto& p : e.problems()) {
+      std::cerr << site->origin << ": " << p << "\n";
+    }
+    return 2;
+  }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const auto summary = summarise(roadmap, ms);
   if (asJson) {

@@ -1,9 +1,10 @@
 #include "task_file.hpp"
 
 #include <charconv>
-#include <fstream>
 #include <set>
 #include <sstream>
+
+#include "fleet/core/bounded_file.hpp"
 
 namespace fleet::ctl {
 namespace {
@@ -127,13 +128,11 @@ Expected<nlohmann::json> csvToTasks(const std::string& textIn, const std::string
 }
 
 Expected<nlohmann::json> loadTaskFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    return unexpected("invalid", path + ": cannot open file");
+  auto raw = readBoundedFile(path, kConfigFileLimit, "invalid");
+  if (!raw) {
+    return unexpected(raw.error());
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = withoutBom(ss.str());
+  const std::string text = withoutBom(*raw);
   if (path.size() >= 4 && path.substr(path.size() - 4) == ".csv") {
     return csvToTasks(text, path);
   }

@@ -76,8 +76,11 @@ void Localizer::onReading(const SensorReading& f) {
   }
   const bool motionKnown = totals && haveTotals_;
   haveTotals_ = totals;
-  if (!motionKnown && seen_.valid && nsToSec(f.stampNs - lastStampNs_) > p_.sensorTimeoutS) {
-    const double t = std::min(nsToSec(f.stampNs - lastStampNs_), p_.sensorTimeoutS);
+  // The stamps are the driver's (any value, backwards or far ahead): the gap in double cannot
+  // overflow as the int64 difference could, and the widening counts at most the timeout.
+  const double gapS = (static_cast<double>(f.stampNs) - static_cast<double>(lastStampNs_)) * 1e-9;
+  if (!motionKnown && seen_.valid && gapS > p_.sensorTimeoutS) {
+    const double t = std::min(gapS, p_.sensorTimeoutS);
     const double d = p_.vMax * t + p_.vMax * p_.vMax / (2.0 * p_.accelMax);
     const double a = p_.wMax * t + p_.wMax * p_.wMax / (2.0 * p_.alphaMax);
     Eigen::Matrix3d widened = ekf_.covariance();

@@ -1,5 +1,5 @@
 // The map files a site names, as bytes: the first byte picks the reader, the rest is the file.
-//   0: ROS map_server side file (YAML)      -> parseRosMapYaml
+//   0: ROS map_server side file (YAML)      -> parseRosMapYaml, then over a 16 x 12 image (map limits)
 //   1: map image (PGM P2/P5 or PNG)         -> decodeImage, then rosMapFromImage + toOccupancyGrid
 //   2: MovingAI .map text                   -> parseMovingAiMap
 // Every reader reports bad input as an error value (its documented codes) and never throws.
@@ -8,8 +8,10 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "fleet/planning/map_io.hpp"
+#include "fleet/planning/map_limits.hpp"
 #include "fleet/site/ros_map.hpp"
 #include "fuzz_check.hpp"
 
@@ -26,6 +28,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (info) {
         require(info->resolution > 0.0, "a parsed side file has a positive resolution");
         require(info->freeThresh < info->occupiedThresh, "free_thresh < occupied_thresh");
+        // The side file over a small image: a resolution or origin beyond the map limits is an
+        // error, never a grid of billions of cells or kilometres.
+        fleet::site::Image image{16, 12, 1, std::vector<std::uint8_t>(16 * 12, 254)};
+        const auto map = fleet::site::rosMapFromImage(image, *info, "fuzz.yaml");
+        if (map) {
+          const auto grid = fleet::site::toOccupancyGrid(*map);
+          require(static_cast<double>(grid.size()) <= fleet::planning::kMaxMapCells,
+                  "a map within the cell limit");
+          require(grid.width() * grid.resolution() <= fleet::planning::kMaxMapSideM + 1e-6 &&
+                      grid.height() * grid.resolution() <= fleet::planning::kMaxMapSideM + 1e-6,
+                  "a map within the side limit");
+        } else {
+          require(map.error().code == "map_size" || map.error().code == "map_yaml",
+                  "a side file beyond the limits is map_size");
+        }
       } else {
         require(info.error().code == "map_yaml", "side file errors are map_yaml");
       }

@@ -1,8 +1,9 @@
 #include "fleet/core/config.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
+
+#include "fleet/core/bounded_file.hpp"
 
 namespace fleet {
 namespace {
@@ -99,13 +100,11 @@ Config Config::fromText(std::string_view text, std::string origin) {
 }
 
 Config Config::fromFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw ConfigError({path + ": cannot open file"});
+  auto text = readBoundedFile(path, kConfigFileLimit, "config");
+  if (!text) {
+    throw ConfigError({text.error().message});
   }
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return fromText(ss.str(), path);
+  return fromText(*text, path);
 }
 
 std::string Config::keyPath(std::string_view path) const {

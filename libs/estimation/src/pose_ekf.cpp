@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "fleet/core/angles.hpp"
@@ -42,11 +43,49 @@ Expected<void> EkfParams::validate() const {
       minLineDistance < 0.0) {
     return fleet::unexpected("invalid_ekf_params", "gates must be > 0 and min_line_distance >= 0");
   }
+  if (!positiveFinite(maxWheelIncrement) || !positiveFinite(maxPositionVariance) ||
+      !positiveFinite(maxHeadingVariance)) {
+    return fleet::unexpected("invalid_ekf_params",
+                             "max_wheel_increment and the covariance ceilings must be finite and > 0");
+  }
   return {};
 }
 
 PoseEkf::PoseEkf(const EkfParams& params, const Pose2& initial, const Eigen::Matrix3d& P0)
-    : params_(params), x_(initial.x, initial.y, wrapAngle(initial.theta)), P_(P0) {}
+    : params_(params), x_(initial.x, initial.y, wrapAngle(initial.theta)), P_(P0) {
+  boundCovariance();
+}
+
+void PoseEkf::boundCovariance() {
+  const Eigen::Vector3d ceiling(params_.maxPositionVariance, params_.maxPositionVariance,
+                                params_.maxHeadingVariance);
+  if (!P_.allFinite()) {
+    P_ = ceiling.asDiagonal();  // nothing is known any more
+    return;
+  }
+  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: transpose aliases P_
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(P_);
+  if (eig.info() != Eigen::Success) {
+    P_ = ceiling.asDiagonal();
+    return;
+  }
+  if (eig.eigenvalues().minCoeff() < 0.0) {
+    const Eigen::Vector3d clamped = eig.eigenvalues().cwiseMax(0.0);
+    P_ = eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+    P_ = (0.5 * (P_ + P_.transpose())).eval();
+  }
+  for (int i = 0; i < 3; ++i) {
+    const double v = P_(i, i);
+    if (v > ceiling(i)) {
+      const double s = std::sqrt(ceiling(i) / v);
+      P_.row(i) *= s;
+      P_.col(i) *= s;
+      P_(i, i) = ceiling(i);  // exactly, not within rounding
+    } else if (v < 0.0) {
+      P_(i, i) = 0.0;  // rounding after the clamp above
+    }
+  }
+}
 
 Expected<PoseEkf> PoseEkf::create(const EkfParams& params, const Pose2& initial, const Eigen::Matrix3d& P0) {
   if (auto ok = params.validate(); !ok) {
@@ -70,6 +109,7 @@ Expected<void> PoseEkf::reset(const Pose2& pose, const Eigen::Matrix3d& P0) {
   }
   x_ = Eigen::Vector3d(pose.x, pose.y, wrapAngle(pose.theta));
   P_ = P0;
+  boundCovariance();
   return {};
 }
 
@@ -78,11 +118,19 @@ UpdateStatus PoseEkf::predict(double ds_left, double ds_right) {
     ++stats_.odometry.rejectedNonFinite;
     return UpdateStatus::kRejectedNonFinite;
   }
+  if (std::abs(ds_left) > params_.maxWheelIncrement || std::abs(ds_right) > params_.maxWheelIncrement) {
+    ++stats_.odometry.rejectedImplausible;
+    return UpdateStatus::kRejectedImplausible;
+  }
   const OdometryModel m = odometryModel(pose(), ds_left, ds_right, params_.wheelBase);
   const Eigen::Matrix2d Q = odometryNoise(ds_left, ds_right, params_.delta);
+  if (!m.pose.isFinite()) {  // a pose already at the edge of the doubles
+    ++stats_.odometry.rejectedNonFinite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
   x_ << m.pose.x, m.pose.y, m.pose.theta;
   P_ = m.A * P_ * m.A.transpose() + m.W * Q * m.W.transpose();
-  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: transpose aliases P_
+  boundCovariance();
   ++stats_.odometry.accepted;
   return UpdateStatus::kAccepted;
 }
@@ -107,9 +155,15 @@ UpdateStatus PoseEkf::correct(const Eigen::Matrix<double, M, 1>& innovation,
   const Eigen::Matrix<double, 3, M> K = llt.solve(H * P_).transpose();
   const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * H;
   // Joseph form stays positive semi-definite under rounding, unlike (I − KH)P.
-  P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
-  P_ = (0.5 * (P_ + P_.transpose())).eval();  // eval: transpose aliases P_
-  x_ += K * innovation;
+  const Eigen::Matrix3d P = IKH * P_ * IKH.transpose() + K * R * K.transpose();
+  const Eigen::Vector3d x = x_ + K * innovation;
+  if (!P.allFinite() || !x.allFinite()) {  // overflow in extreme readings: keep what we had
+    ++stats.rejectedNonFinite;
+    return UpdateStatus::kRejectedNonFinite;
+  }
+  P_ = P;
+  boundCovariance();
+  x_ = x;
   x_(2) = wrapAngle(x_(2));
   ++stats.accepted;
   return UpdateStatus::kAccepted;

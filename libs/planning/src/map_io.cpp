@@ -8,6 +8,9 @@
 #include <sstream>
 #include <vector>
 
+#include "fleet/core/bounded_file.hpp"
+#include "fleet/planning/map_limits.hpp"
+
 namespace fleet::planning {
 
 namespace {
@@ -47,16 +50,6 @@ std::vector<std::string> splitLines(std::string_view text) {
 bool parseInt(const std::string& s, int& out) {
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
   return ec == std::errc{} && ptr == s.data() + s.size();
-}
-
-Expected<std::string> readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return unexpected("map_io", path + ": cannot open file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 }  // namespace
@@ -108,6 +101,9 @@ Expected<OccupancyGrid> parseMovingAiMap(std::string_view text, const std::strin
   if (!(resolution > 0.0) || !std::isfinite(resolution)) {
     return unexpected("map_format", source + ": resolution must be positive");
   }
+  if (auto ok = checkMapSize(width, height, resolution, origin, source, "width x height"); !ok) {
+    return unexpected(ok.error());
+  }
   const std::size_t firstRow = k + 1;
   if (lines.size() - firstRow < static_cast<std::size_t>(height)) {
     return formatError(source, static_cast<int>(lines.size()),
@@ -153,7 +149,7 @@ Expected<OccupancyGrid> parseMovingAiMap(std::string_view text, const std::strin
 }
 
 Expected<OccupancyGrid> loadMovingAiMap(const std::string& path, double resolution, Vec2 origin) {
-  auto text = readFile(path);
+  auto text = readBoundedFile(path, kMapFileLimit, "map_io");
   if (!text) {
     return unexpected(text.error());
   }
@@ -218,6 +214,9 @@ Expected<OccupancyGrid> parsePgm(std::string_view bytes, const ImageMapInfo& inf
   if (!(info.resolution > 0.0)) {
     return formatError(source, 0, "resolution must be positive");
   }
+  if (auto ok = checkMapSize(w, h, info.resolution, info.origin, source, "image"); !ok) {
+    return unexpected(ok.error());
+  }
   const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
   std::vector<int> pixels;
   pixels.reserve(n);
@@ -264,7 +263,7 @@ Expected<OccupancyGrid> parsePgm(std::string_view bytes, const ImageMapInfo& inf
 }
 
 Expected<OccupancyGrid> loadImageMap(const std::string& sideFilePath) {
-  auto text = readFile(sideFilePath);
+  auto text = readBoundedFile(sideFilePath, kSideFileLimit, "map_io");
   if (!text) {
     return unexpected(text.error());
   }
@@ -324,7 +323,7 @@ Expected<OccupancyGrid> loadImageMap(const std::string& sideFilePath) {
   if (imgPath.is_relative()) {
     imgPath = std::filesystem::path(sideFilePath).parent_path() / imgPath;
   }
-  auto bytes = readFile(imgPath.string());
+  auto bytes = readBoundedFile(imgPath.string(), kMapFileLimit, "map_io");
   if (!bytes) {
     return unexpected(bytes.error());
   }

@@ -3,8 +3,8 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+
+#include "fleet/core/bounded_file.hpp"
 
 namespace fleet::planning {
 
@@ -155,13 +155,11 @@ Expected<ScenFile> parseMovingAiScen(std::string_view text, const std::string& s
 
 Expected<ScenFile> loadMovingAiScen(const std::string& path, const OccupancyGrid* grid,
                                     std::string_view mapName) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return unexpected("scen_io", path + ": cannot open file");
+  auto text = readBoundedFile(path, kMapFileLimit, "scen_io");
+  if (!text) {
+    return unexpected(text.error());
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parseMovingAiScen(ss.str(), path, grid, mapName);
+  return parseMovingAiScen(*text, path, grid, mapName);
 }
 
 }  // namespace fleet::planning

@@ -10,14 +10,16 @@
 #include <cstdio>
 #include <cstring>
 
+#include "fleet/planning/map_limits.hpp"
 #include "fleet/site/ros_map.hpp"
 
 namespace fleet::site {
 
 namespace {
 
-// Anything larger is a corrupt header, not a site: 100 M pixels is 5 km x 5 km at 0.5 m.
-constexpr std::uint64_t kMaxPixels = 100'000'000;
+// A map has at most planning::kMaxMapCells cells (2^26), so an image of more pixels is refused
+// before its pixels are allocated.
+constexpr auto kMaxPixels = static_cast<std::uint64_t>(planning::kMaxMapCells);
 
 Unexpected<Error> imageError(const std::string& source, const std::string& what) {
   return unexpected("map_image", source + ": " + what);
@@ -64,7 +66,7 @@ Expected<Image> decodePgm(std::string_view b, const std::string& source) {
   }
   if (w * h > kMaxPixels) {
     return imageError(source, "PGM header claims " + std::to_string(w) + " x " + std::to_string(h) +
-                                  " pixels (more than 100 million)");
+                                  " pixels (more than the limit of 67108864 = 2^26)");
   }
   if (maxval == 0 || maxval > 65535) {
     return imageError(source, "PGM maxval " + std::to_string(maxval) + " is outside 1..65535");
@@ -222,7 +224,7 @@ Expected<Image> decodePng(std::string_view b, const std::string& source) {
   const std::uint64_t n = std::uint64_t{layout.width} * layout.height;
   if (n == 0 || n > kMaxPixels) {
     return imageError(source, "PNG header claims " + std::to_string(layout.width) + " x " +
-                                  std::to_string(layout.height) + " pixels (expected 1 to 100 million)");
+                                  std::to_string(layout.height) + " pixels (expected 1 to 67108864 = 2^26)");
   }
   // Deflate expands at most ~1032:1; a header promising more than that is lying, and we would rather
   // not allocate gigabytes to find out.

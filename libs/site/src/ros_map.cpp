@@ -6,10 +6,11 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <set>
-#include <sstream>
+
+#include "fleet/core/bounded_file.hpp"
+#include "fleet/planning/map_limits.hpp"
 
 namespace fleet::site {
 
@@ -92,24 +93,46 @@ struct MapFrame {
   }
 };
 
+// The axis-aligned planning grid toOccupancyGrid makes of a width x height image: the image
+// itself at yaw 0, else the rotated image's bounding box. Cell counts as doubles: they are checked
+// against the limits before anything is allocated.
+struct GridBox {
+  Vec2 lo;
+  double cellsX = 0.0;
+  double cellsY = 0.0;
+};
+
+GridBox gridBox(const RosMapInfo& info, double width, double height) {
+  const double res = info.resolution;
+  if (info.origin.theta == 0.0) {
+    return {info.origin.position(), width, height};
+  }
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Vec2 lo{kInf, kInf};
+  Vec2 hi{-kInf, -kInf};
+  for (const Vec2 corner :
+       {Vec2{0, 0}, Vec2{width * res, 0}, Vec2{0, height * res}, Vec2{width * res, height * res}}) {
+    const Vec2 p = info.origin.transform(corner);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+  }
+  // The tolerance keeps a quarter turn from growing a sliver column out of cos(pi/2) ~ 6e-17.
+  auto cells = [&](double extent) { return std::max(1.0, std::ceil(extent / res - 1e-6)); };
+  return {lo, cells(hi.x - lo.x), cells(hi.y - lo.y)};
+}
+
+// The map's size limits (planning::checkMapSize) on the grid it will become.
+Expected<void> checkExtent(const RosMapInfo& info, int width, int height, const std::string& source,
+                           const std::string& sizeKey) {
+  const GridBox b = gridBox(info, width, height);
+  return planning::checkMapSize(b.cellsX, b.cellsY, info.resolution, b.lo, source, sizeKey);
+}
+
 bool isFree(std::int8_t v, const RosMapInfo& info) {
   if (info.mode == MapMode::Raw) {
     return v >= 0 && v < 100.0 * info.freeThresh;
   }
   return v == 0;
-}
-
-Expected<std::string> readFile(const std::string& path, const char* code) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return unexpected(code, path + ": cannot open file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) {
-    return unexpected(code, path + ": read failed");
-  }
-  return ss.str();
 }
 
 }  // namespace
@@ -207,7 +230,7 @@ Expected<RosMapInfo> parseRosMapYaml(std::string_view text, const std::string& s
 }
 
 Expected<RosMap> loadRosMap(const std::string& yamlPath) {
-  auto text = readFile(yamlPath, "map_yaml");
+  auto text = readBoundedFile(yamlPath, kSideFileLimit, "map_yaml");
   if (!text) {
     return unexpected(text.error());
   }
@@ -219,13 +242,18 @@ Expected<RosMap> loadRosMap(const std::string& yamlPath) {
   if (imagePath.is_relative()) {
     imagePath = std::filesystem::path(yamlPath).parent_path() / imagePath;
   }
-  auto bytes = readFile(imagePath.string(), "map_image");
+  auto bytes = readBoundedFile(imagePath.string(), kMapFileLimit, "map_image");
   if (!bytes) {
     return unexpected("map_image", bytes.error().message + " (image of " + yamlPath + ")");
   }
   auto image = decodeImage(*bytes, imagePath.string());
   if (!image) {
     return unexpected(image.error());
+  }
+  if (auto ok = checkExtent(*info, image->width, image->height, yamlPath,
+                            "image (" + imagePath.filename().string() + ") of");
+      !ok) {
+    return unexpected(ok.error());
   }
   return rosMapFromImage(*image, *info, imagePath.string());
 }
@@ -239,6 +267,9 @@ Expected<RosMap> rosMapFromImage(const Image& image, const RosMapInfo& info, con
       image.pixels.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) *
                                  static_cast<std::size_t>(ch)) {
     return unexpected("map_image", source + ": image size and pixel buffer disagree");
+  }
+  if (auto ok = checkExtent(info, image.width, image.height, source, "image"); !ok) {
+    return unexpected(ok.error());
   }
   const bool colour = ch >= 3;
   const bool alpha = ch == 2 || ch == 4;
@@ -289,18 +320,8 @@ planning::OccupancyGrid toOccupancyGrid(const RosMap& m) {
     }
     return g;
   }
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  Vec2 lo{kInf, kInf};
-  Vec2 hi{-kInf, -kInf};
-  for (const Vec2 corner :
-       {Vec2{0, 0}, Vec2{m.width * res, 0}, Vec2{0, m.height * res}, Vec2{m.width * res, m.height * res}}) {
-    const Vec2 p = m.info.origin.transform(corner);
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
-  }
-  // The tolerance keeps a quarter turn from growing a sliver column out of cos(pi/2) ~ 6e-17.
-  auto cells = [&](double extent) { return std::max(1, static_cast<int>(std::ceil(extent / res - 1e-6))); };
-  planning::OccupancyGrid g(cells(hi.x - lo.x), cells(hi.y - lo.y), res, lo);
+  const GridBox b = gridBox(m.info, m.width, m.height);
+  planning::OccupancyGrid g(static_cast<int>(b.cellsX), static_cast<int>(b.cellsY), res, b.lo);
   const MapFrame frame{m};
   for (std::size_t k = 0; k < g.size(); ++k) {
     const planning::Cell c = g.cellOf(k);

@@ -8,7 +8,9 @@
 
 #include "fleet/core/angles.hpp"
 #include "fleet/core/ids.hpp"
+#include "fleet/geometry/polygon.hpp"
 #include "fleet/planning/map_io.hpp"
+#include "fleet/planning/map_limits.hpp"
 #include "fleet/site/reachability.hpp"
 #include "fleet/site/ros_map.hpp"
 
@@ -43,19 +45,6 @@ std::string mapExtent(const planning::OccupancyGrid& g) {
   return "x " + fmt(lo.x) + ".." + fmt(hi.x) + ", y " + fmt(lo.y) + ".." + fmt(hi.y) + " m";
 }
 
-// Even-odd rule.
-bool inPolygon(const std::vector<Vec2>& poly, Vec2 p) {
-  bool in = false;
-  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2 a = poly[i];
-    const Vec2 b = poly[j];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
 double signedArea(const std::vector<Vec2>& poly) {
   double a = 0.0;
   for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
@@ -71,7 +60,7 @@ std::vector<std::size_t> polygonCells(const planning::OccupancyGrid& g, const st
   }
   for (int y = 0; y < g.height(); ++y) {
     for (int x = 0; x < g.width(); ++x) {
-      if (inPolygon(poly, g.cellCenter({x, y}))) {
+      if (geometry::insidePolygon(g.cellCenter({x, y}), poly)) {
         out.push_back(g.index({x, y}));
       }
     }
@@ -333,7 +322,11 @@ planning::OccupancyGrid readMapSection(Config c, const std::string& baseDir) {
     l.shelfHeight = static_cast<int>(w.integer("shelf_height", 2, {1, 10000}));
     l.aisleX = static_cast<int>(w.integer("aisle_x", 3, {1, 10000}));
     l.aisleY = static_cast<int>(w.integer("aisle_y", 3, {1, 10000}));
-    grid = planning::makeWarehouseGrid(l);
+    if (auto ok = planning::checkMapSize(l.width, l.height, res, origin, "", "width x height"); !ok) {
+      grid = unexpected(ok.error());
+    } else {
+      grid = planning::makeWarehouseGrid(l);
+    }
   } else {
     key = "rows";
     const nlohmann::json* rows = c.find("rows");

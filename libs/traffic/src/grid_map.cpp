@@ -1,23 +1,11 @@
 #include "fleet/traffic/grid_map.hpp"
 
-#include <fstream>
-#include <sstream>
-
+#include "fleet/core/bounded_file.hpp"
 #include "fleet/planning/map_io.hpp"
 
 namespace fleet::traffic {
 
 namespace {
-
-Expected<std::string> readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return unexpected("map_io", path + ": cannot open file");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 Unexpected<Error> pdError(const std::string& source, std::size_t line, const std::string& what) {
   return unexpected("map_format", source + ":" + std::to_string(line) + ": " + what);
@@ -63,7 +51,7 @@ Expected<GridMap> parseGridMap(std::string_view text, const std::string& source)
 }
 
 Expected<GridMap> loadGridMap(const std::string& path) {
-  auto text = readText(path);
+  auto text = readBoundedFile(path, kMapFileLimit, "map_io");
   if (!text) {
     return unexpected(text.error());
   }
@@ -144,7 +132,7 @@ Expected<PickupDelivery> parsePickupDelivery(std::string_view text, const GridMa
 }
 
 Expected<PickupDelivery> loadPickupDelivery(const std::string& path, const GridMap& map) {
-  auto text = readText(path);
+  auto text = readBoundedFile(path, kMapFileLimit, "map_io");
   if (!text) {
     return unexpected(text.error());
   }

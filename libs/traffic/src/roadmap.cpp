@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fleet/core/config.hpp"
 #include "fleet/site/reachability.hpp"
 
 namespace fleet::traffic {
@@ -148,8 +149,17 @@ struct Builder {
     const int k = std::abs(cells - std::round(cells)) < 1e-6 ? static_cast<int>(std::round(cells)) : 1;
     latticeOrigin = chooseLatticeOrigin(k);
     const Vec2 hi = grid.origin() + Vec2{grid.width() * res, grid.height() * res};
-    const int lw = std::max(0, static_cast<int>(std::floor((hi.x - latticeOrigin.x) / opt.spacing)) + 1);
-    const int lh = std::max(0, static_cast<int>(std::floor((hi.y - latticeOrigin.y) / opt.spacing)) + 1);
+    const double lwd = std::max(0.0, std::floor((hi.x - latticeOrigin.x) / opt.spacing) + 1.0);
+    const double lhd = std::max(0.0, std::floor((hi.y - latticeOrigin.y) / opt.spacing) + 1.0);
+    if (!(lwd * lhd <= static_cast<double>(kMaxLatticePoints))) {
+      std::ostringstream os;
+      os << "roadmap: a lattice " << opt.spacing << " m apart over the map's " << grid.width() * res << " x "
+         << grid.height() * res << " m has " << lwd * lhd << " points, more than the limit of "
+         << static_cast<long long>(kMaxLatticePoints) << "; give the roadmap a larger spacing";
+      throw ConfigError({os.str()});
+    }
+    const int lw = static_cast<int>(lwd);
+    const int lh = static_cast<int>(lhd);
     // Half-spacing grid: lattice points at even (a, b), the half-offset ones at one odd coordinate.
     const int hw = 2 * lw;
     const int hh = 2 * lh;
@@ -584,7 +594,6 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   addGeometricConflicts(r.graph, sep, waiting);
 
   // Nearest-node lookup.
-  r.bucketSize_ = std::max(o.spacing, 0.25);
   if (r.graph.size() > 0) {
     Vec2 lo = r.graph.position(0);
     Vec2 hi = lo;
@@ -593,6 +602,8 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
       lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
       hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
     }
+    // At most kMaxBucketsPerSide buckets a side, however large the site.
+    r.bucketSize_ = std::max({o.spacing, 0.25, std::max(hi.x - lo.x, hi.y - lo.y) / kMaxBucketsPerSide});
     r.bucketOrigin_ = lo;
     r.bucketW_ = static_cast<int>((hi.x - lo.x) / r.bucketSize_) + 1;
     r.bucketH_ = static_cast<int>((hi.y - lo.y) / r.bucketSize_) + 1;

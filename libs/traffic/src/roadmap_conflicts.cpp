@@ -79,6 +79,8 @@ class Buckets {
       hi_.x = std::max(hi_.x, p.x);
       hi_.y = std::max(hi_.y, p.y);
     }
+    // Coarser buckets on a large site: at most kMaxBucketsPerSide a side.
+    cell_ = std::max(cell_, std::max(hi_.x - lo_.x, hi_.y - lo_.y) / kMaxBucketsPerSide);
     w_ = static_cast<int>((hi_.x - lo_.x) / cell_) + 1;
     h_ = static_cast<int>((hi_.y - lo_.y) / cell_) + 1;
     cells_.resize(static_cast<std::size_t>(w_) * static_cast<std::size_t>(h_));

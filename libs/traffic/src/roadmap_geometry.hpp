@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fleet/core/vec2.hpp"
+#include "fleet/geometry/polygon.hpp"
 
 namespace fleet::traffic::detail {
 
@@ -41,25 +42,12 @@ inline double segmentDistance(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
                    pointSegmentDistance(c, a, b), pointSegmentDistance(d, a, b)});
 }
 
-/// Even-odd rule; either orientation.
-inline bool insidePolygon(Vec2 p, const std::vector<Vec2>& poly) {
-  bool in = false;
-  for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
-    const Vec2 a = poly[i];
-    const Vec2 b = poly[j];
-    if ((a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
 /// Distance from segment ab to the polygon's area (0 when they touch or overlap).
 inline double segmentPolygonDistance(Vec2 a, Vec2 b, const std::vector<Vec2>& poly) {
   if (poly.empty()) {
     return 1e300;
   }
-  if (insidePolygon(a, poly) || insidePolygon(b, poly)) {
+  if (geometry::insidePolygon(a, poly) || geometry::insidePolygon(b, poly)) {
     return 0.0;
   }
   double d = 1e300;

@@ -1,9 +1,9 @@
 #include "fleet/service/site_stations.hpp"
 
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "fleet/core/bounded_file.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/site/site_loader.hpp"
 
@@ -20,11 +20,11 @@ std::string joined(const std::vector<std::string>& problems) {
 }
 
 Expected<nlohmann::json> readJson(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
-    return unexpected("invalid", path + ": cannot open the file");
+  auto text = readBoundedFile(path, kConfigFileLimit, "invalid");
+  if (!text) {
+    return unexpected(text.error());
   }
-  auto doc = nlohmann::json::parse(in, nullptr, false);
+  auto doc = nlohmann::json::parse(*text, nullptr, false);
   if (doc.is_discarded()) {
     return unexpected("invalid", path + ": not valid JSON");
   }

@@ -61,7 +61,7 @@ TEST(Config, SyntaxErrorAndMissingFile) {
   const auto path = writeTemp("fleet_cfg_syntax.json", "{\"a\": 1,,}");
   EXPECT_THAT(messageOf([&] { (void)Config::fromFile(path); }), HasSubstr(path + ": not valid JSON"));
   EXPECT_THAT(messageOf([&] { (void)Config::fromFile("/nonexistent/x.json"); }),
-              HasSubstr("/nonexistent/x.json: cannot open file"));
+              HasSubstr("/nonexistent/x.json: cannot open the file"));
   EXPECT_THAT(messageOf([&] { Config::fromText("[1,2]", "arr").finish(); }),
               HasSubstr("arr: (top level): expected a JSON object"));
 }

@@ -205,3 +205,41 @@ TEST(PoseEkf, IndependentUpdatesCommuteToFirstOrder) {
   EXPECT_LT((a.state() - b.state()).cwiseAbs().maxCoeff(), 1e-3);
   EXPECT_LT((a.covariance() - b.covariance()).cwiseAbs().maxCoeff(), 1e-5);
 }
+
+TEST(PoseEkf, AnAbsurdWheelIncrementIsRefusedWithoutTouchingState) {
+  PoseEkf ekf = makeEkf(Pose2{1.0, 1.0, 0.5}, Eigen::Matrix3d::Identity() * 1e-3);
+  const Eigen::Matrix3d P0 = ekf.covariance();
+  EXPECT_EQ(ekf.predict(1e6, 1e6), UpdateStatus::kRejectedImplausible);
+  EXPECT_EQ(ekf.predict(0.1, -11.0), UpdateStatus::kRejectedImplausible);
+  EXPECT_EQ(ekf.pose(), (Pose2{1.0, 1.0, 0.5}));
+  EXPECT_EQ(ekf.covariance(), P0);
+  EXPECT_EQ(ekf.stats().odometry.rejectedImplausible, 2u);
+  EXPECT_EQ(ekf.stats().odometry.rejected(), 2u);
+  EXPECT_EQ(ekf.predict(9.0, 9.0), UpdateStatus::kAccepted);  // a long gap with wheel totals
+}
+
+// Predictions without any correction: the covariance grows to its ceilings and stops there,
+// symmetric and positive semi-definite, with its correlations kept.
+TEST(PoseEkf, TheCovarianceStopsAtItsCeilings) {
+  EkfParams params;
+  params.delta = 0.5;  // noisy wheels, so the ceiling is reached in a few thousand steps
+  PoseEkf ekf = PoseEkf::create(params, Pose2{}, Eigen::Matrix3d::Identity() * 1e-3).value();
+  for (int k = 0; k < 20000; ++k) {
+    ASSERT_EQ(ekf.predict(9.5, 9.0 + 0.001 * (k % 7)), UpdateStatus::kAccepted);
+    const Eigen::Matrix3d& P = ekf.covariance();
+    ASSERT_TRUE(P.allFinite()) << k;
+    ASSERT_EQ(P, P.transpose()) << k;
+    ASSERT_LE(P(0, 0), params.maxPositionVariance) << k;
+    ASSERT_LE(P(1, 1), params.maxPositionVariance) << k;
+    ASSERT_LE(P(2, 2), params.maxHeadingVariance) << k;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(ekf.covariance());
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-9 * params.maxPositionVariance);
+  // It did grow that far (the heading turns uncertainty between x and y).
+  EXPECT_GT(ekf.covariance()(0, 0) + ekf.covariance()(1, 1), params.maxPositionVariance);
+  EXPECT_TRUE(ekf.pose().isFinite());
+  // A reset over the ceilings is scaled down to them.
+  ASSERT_TRUE(ekf.reset(Pose2{}, Eigen::Matrix3d::Identity() * 1e9));
+  EXPECT_DOUBLE_EQ(ekf.covariance()(1, 1), params.maxPositionVariance);
+  EXPECT_DOUBLE_EQ(ekf.covariance()(2, 2), params.maxHeadingVariance);
+}

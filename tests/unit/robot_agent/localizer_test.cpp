@@ -5,9 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
+#include <random>
 
 #include "fleet/core/angles.hpp"
 
@@ -260,4 +264,114 @@ TEST(LocalizerLines, AScanWithoutLinesAndWallsThatMatchNothingAreSkippedWithARea
   EXPECT_EQ(s.matched, 0u);
   EXPECT_EQ(s.outsideGate + s.noOverlap + s.ambiguous + s.noWallFacing, s.extracted);
   EXPECT_EQ(shifted.pose(), truth);
+}
+
+namespace {
+
+// One malformed reading: stamps anywhere (backwards, huge jumps, the int64 extremes), wheel
+// increments and totals from small to absurd to NaN/inf, the compass present or not and possibly
+// garbage, bearings to unknown ids or NaN, scans of garbage ranges.
+SensorReading malformed(std::mt19937_64& rng, std::int64_t& stamp) {
+  auto pick = [&](int n) { return static_cast<int>(rng() % static_cast<std::uint64_t>(n)); };
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  auto value = [&](double scale) {
+    switch (pick(8)) {
+      case 0:
+        return nan;
+      case 1:
+        return pick(2) ? inf : -inf;
+      case 2:
+        return unit(rng) * 1e300;
+      case 3:
+        return unit(rng) * 1e6;
+      default:
+        return unit(rng) * scale;
+    }
+  };
+  switch (pick(6)) {
+    case 0:
+      stamp -= static_cast<std::int64_t>(rng() % 10'000'000'000ULL);  // backwards
+      break;
+    case 1:
+      stamp += static_cast<std::int64_t>(rng() % 100'000'000'000ULL);  // a jump of up to 100 s
+      break;
+    case 2:
+      stamp = pick(2) ? std::numeric_limits<std::int64_t>::max() : std::numeric_limits<std::int64_t>::min();
+      break;
+    default:
+      stamp += kTick;
+  }
+  SensorReading r;
+  r.stampNs = stamp;
+  r.dsLeft = value(0.1);
+  r.dsRight = value(0.1);
+  r.wheelTotalsValid = pick(3) == 0;
+  r.wheelLeftTotal = value(100.0);
+  r.wheelRightTotal = value(100.0);
+  r.compassValid = pick(2) == 0;
+  r.compass = value(kPi);
+  for (int k = pick(3); k > 0; --k) {
+    r.bearings.emplace_back(pick(4), static_cast<float>(value(kPi)));
+  }
+  if (pick(2) == 0) {
+    r.angleMin = static_cast<float>(-kPi);
+    r.angleIncrement = static_cast<float>(2.0 * kPi / 72.0);
+    r.rangeMax = 8.0f;
+    for (int i = 0; i < 72; ++i) {
+      r.ranges.push_back(static_cast<float>(pick(4) == 0 ? value(8.0) : 2.0 + std::abs(unit(rng))));
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+// Property: whatever the readings, the covariance stays finite, symmetric, positive semi-definite
+// and under the EKF's ceilings, and the pose stays finite. (Once, after mixed malformed samples, a
+// robot's position sigma reached 2,889 m and its pose left the map.)
+TEST(LocalizerProperty, MalformedReadingsKeepTheCovarianceBoundedAndThePoseFinite) {
+  const estimation::EkfParams ceilings;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    auto p = withWalls({3.0, 2.0, 0.3});
+    p.landmarks = {{1, {0.0, 0.0}}, {2, {6.0, 4.0}}};
+    Localizer loc(p);
+    std::int64_t stamp = 0;
+    for (int k = 0; k < 500; ++k) {
+      loc.onReading(malformed(rng, stamp));
+      const Eigen::Matrix3d& P = loc.covariance();
+      ASSERT_TRUE(P.allFinite()) << "reading " << k;
+      ASSERT_TRUE(P.isApprox(P.transpose(), 1e-12) || (P - P.transpose()).cwiseAbs().maxCoeff() < 1e-9)
+          << "reading " << k;
+      ASSERT_LE(P(0, 0), ceilings.maxPositionVariance) << "reading " << k;
+      ASSERT_LE(P(1, 1), ceilings.maxPositionVariance) << "reading " << k;
+      ASSERT_LE(P(2, 2), ceilings.maxHeadingVariance) << "reading " << k;
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(P);
+      ASSERT_GE(eig.eigenvalues().minCoeff(), -1e-9 * std::max(1.0, P.diagonal().maxCoeff()))
+          << "reading " << k;
+      ASSERT_TRUE(loc.pose().isFinite()) << "reading " << k;
+    }
+  }
+}
+
+// The path of the 2,889 m sigma: absurd wheel increments (a driver reporting its odometer, a
+// total that jumped) were accepted, each adding ds² of heading uncertainty to the position.
+TEST(LocalizerProperty, AbsurdWheelIncrementsAreRefusedAndRepeatedGapsStopAtTheCeiling) {
+  Localizer loc(params());
+  auto r = straight(kTick, 0.0);
+  r.dsLeft = 1e6;
+  r.dsRight = -1e6;
+  loc.onReading(r);
+  EXPECT_EQ(loc.rejected(), 1u);
+  EXPECT_NEAR(loc.pose().x, 1.0, 1e-12);
+  EXPECT_LT(loc.covariance()(0, 0), 0.02);
+  // Readings 10 s apart without wheel totals: each widens by the timeout's worth, up to the ceiling.
+  for (int k = 2; k < 20000; ++k) {
+    loc.onReading(straight(k * 100 * kTick, 0.0));
+  }
+  EXPECT_LE(loc.covariance()(0, 0), estimation::EkfParams{}.maxPositionVariance);
+  EXPECT_LE(loc.covariance()(2, 2), estimation::EkfParams{}.maxHeadingVariance);
 }

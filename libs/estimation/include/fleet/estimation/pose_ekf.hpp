@@ -22,15 +22,26 @@ struct EkfParams {
   double gate1dof = 10.83;            ///< χ²(1) 99.9 % Mahalanobis gate
   double gate2dof = 13.82;            ///< χ²(2) 99.9 % gate (one line = (r, ψ))
   double minLineDistance = 0.05;      ///< reject a line closer than this: its ψ is undefined on the line
+  /// A wheel increment larger than this (m, either wheel, one prediction) is no motion a robot makes
+  /// between two readings: refused (kRejectedImplausible), since it would swing the estimate and
+  /// blow the covariance up by its square.
+  double maxWheelIncrement = 10.0;
+  /// Ceilings of the covariance's diagonal: beyond them the filter knows nothing anyway, and a
+  /// covariance growing without bound (a stream of predictions without corrections, widened gaps)
+  /// ends in overflow. A diagonal entry over its ceiling is scaled down with its row and column
+  /// (P ← D P D, which keeps P positive semi-definite and the correlations as they were).
+  double maxPositionVariance = 1e4;  ///< m² (σ = 100 m)
+  double maxHeadingVariance = 10.0;  ///< rad² (σ ≈ π: the heading is unknown)
 
   [[nodiscard]] Expected<void> validate() const;
 };
 
 enum class UpdateStatus {
   kAccepted,
-  kRejectedNonFinite,  ///< NaN/inf reading or variance, or a variance <= 0
-  kRejectedGate,       ///< Mahalanobis distance over the χ² gate (outlier)
-  kRejectedGeometry,   ///< the model is singular here (landmark on the robot, robot on the line)
+  kRejectedNonFinite,    ///< NaN/inf reading or variance, or a variance <= 0
+  kRejectedGate,         ///< Mahalanobis distance over the χ² gate (outlier)
+  kRejectedGeometry,     ///< the model is singular here (landmark on the robot, robot on the line)
+  kRejectedImplausible,  ///< a reading no robot produces (a wheel increment over maxWheelIncrement)
 };
 
 struct SensorStats {
@@ -38,7 +49,10 @@ struct SensorStats {
   std::size_t rejectedNonFinite = 0;
   std::size_t rejectedGate = 0;
   std::size_t rejectedGeometry = 0;
-  [[nodiscard]] std::size_t rejected() const { return rejectedNonFinite + rejectedGate + rejectedGeometry; }
+  std::size_t rejectedImplausible = 0;
+  [[nodiscard]] std::size_t rejected() const {
+    return rejectedNonFinite + rejectedGate + rejectedGeometry + rejectedImplausible;
+  }
 };
 
 struct EkfStats {
@@ -69,7 +83,9 @@ struct LineBatchResult {
 /// landmark-bearing and laser-line corrections, each applied whenever its sensor delivers (no fixed
 /// schedule). Every correction is gated and uses the Joseph form followed by symmetrisation, so the
 /// covariance stays symmetric positive-definite; a rejected reading leaves state and covariance
-/// untouched and is counted in stats().
+/// untouched and is counted in stats(). After every step (and reset) the covariance is kept
+/// finite, symmetric, positive semi-definite (negative eigenvalues from rounding clamped to 0) and
+/// under the ceilings of EkfParams, whatever the readings were.
 class PoseEkf {
  public:
   static Expected<PoseEkf> create(const EkfParams& params, const Pose2& initial, const Eigen::Matrix3d& P0);
@@ -98,7 +114,8 @@ class PoseEkf {
   [[nodiscard]] const EkfStats& stats() const { return stats_; }
   [[nodiscard]] const EkfParams& params() const { return params_; }
 
-  /// Re-initialise (e.g. after a relocalisation); stats are kept.
+  /// Re-initialise (e.g. after a relocalisation); stats are kept. A P0 over the ceilings is scaled
+  /// down to them.
   Expected<void> reset(const Pose2& pose, const Eigen::Matrix3d& P0);
 
  private:
@@ -107,6 +124,9 @@ class PoseEkf {
   template <int M>
   UpdateStatus correct(const Eigen::Matrix<double, M, 1>& innovation, const Eigen::Matrix<double, M, 3>& H,
                        const Eigen::Matrix<double, M, M>& R, double gate, SensorStats& stats);
+
+  // Keeps P_ finite, symmetric, positive semi-definite and under the ceilings.
+  void boundCovariance();
 
   EkfParams params_;
   Eigen::Vector3d x_;

@@ -42,8 +42,9 @@ struct Image {
 /// PGM (P2 or P5, maxval up to 65535, 16-bit big endian) or PNG (through libpng: grey, grey + alpha,
 /// RGB, RGBA, palette (expanded to RGB, or RGBA with a tRNS chunk), any bit depth, interlaced or not),
 /// chosen by the file's magic bytes, not its name. Errors (code "map_image") name `source` and what is
-/// wrong: unknown magic, zero or more than 100 M pixels, data shorter than the header says, samples
-/// above maxval, bad CRC of a critical chunk, truncated or corrupt compressed data, missing IEND.
+/// wrong: unknown magic, zero or more than 2^26 pixels (planning::kMaxMapCells), data shorter than the header
+/// says, samples above maxval, bad CRC of a critical chunk, truncated or corrupt compressed data, missing
+/// IEND.
 Expected<Image> decodeImage(std::string_view bytes, const std::string& source);
 
 /// The map as nav_msgs/OccupancyGrid holds it: one value per pixel, 0..100 occupancy or -1

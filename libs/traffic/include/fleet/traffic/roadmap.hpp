@@ -41,6 +41,10 @@
 
 namespace fleet::traffic {
 
+/// At most 2^22 (4,194,304) lattice points: 2 km x 2 km at 1 m spacing. A larger lattice (a huge
+/// site, a tiny spacing) is refused before anything is allocated for it.
+inline constexpr double kMaxLatticePoints = 4194304.0;
+
 struct RoadmapOptions {
   double spacing = 0.0;        ///< m between lattice nodes; 0: `targetSpacing` snapped to whole cells
   double targetSpacing = 0.5;  ///< m
@@ -148,7 +152,8 @@ class Roadmap {
 
 /// Builds the roadmap of `site` (its map with no-go zones blocked, its stations and zones). What
 /// the site does not allow (a station the disc does not fit at, one that cannot be joined or is
-/// cut off) is in `problems`; options out of range throw std::invalid_argument.
+/// cut off) is in `problems`; options out of range throw std::invalid_argument, a lattice of more
+/// than kMaxLatticePoints throws ConfigError (the site is too large for the spacing).
 Roadmap buildRoadmap(const site::Site& site, const RoadmapOptions& options = {});
 
 /// Connectivity over the open graph: stations (docks) outside the strongly connected component

@@ -31,6 +31,10 @@
 
 namespace fleet::traffic {
 
+/// The nearest-node and conflict lookups bucket nodes on a square grid of at most this many buckets
+/// a side (larger buckets on a larger site).
+inline constexpr double kMaxBucketsPerSide = 1024.0;
+
 /// Centre-to-centre distances two robots keep (m). contact < corridor < ahead.
 struct Separation {
   double contact = 0.7;    ///< any direction: 2·radius + margin
