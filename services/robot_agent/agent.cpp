@@ -408,6 +408,7 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
   out.state.task_id = tasks_.task();
   out.state.radius = static_cast<float>(p_.radius);
   out.state.paused = tasks_.paused();
+  out.state.activity = activity(mode);
 
   // Predicted discs: the current command held over the horizon, the EKF's covariance grown along it.
   out.discs.source_id = p_.id;
@@ -426,6 +427,20 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
         msg::TaskStatus{p_.id, r->task, r->revision, wireState(r->stage), r->progress, r->reason, r->stampNs};
   }
   out.traffic = trafficProgress(nowNs);
+}
+
+RobotActivity Agent::activity(msg::RobotMode mode) const {
+  if (mode == msg::RobotMode::Fault || tasks_.paused()) {
+    return RobotActivity::Faulted;  // blind, lost, or held by the operator: not available for work
+  }
+  if (tasks_.phase() == Phase::Dwelling || mode == msg::RobotMode::Loading ||
+      mode == msg::RobotMode::Charging) {
+    return mode == msg::RobotMode::Charging ? RobotActivity::Charging : RobotActivity::Dwelling;
+  }
+  if (!tasks_.busy()) {
+    return RobotActivity::NoTask;  // parked, or on its way home
+  }
+  return drove_.doing;
 }
 
 std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {

@@ -158,6 +158,8 @@ class Agent : private DriveStack {
   void followRelease(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode);
   /// Where the robot is going (the task's goal; idle, its home), if anywhere.
   [[nodiscard]] std::optional<TaskGoal> trafficGoal() const;
+  /// What the robot-time ledger files this cycle under (RobotState.activity).
+  [[nodiscard]] RobotActivity activity(msg::RobotMode mode) const;
   /// The progress report for this cycle, if one is due.
   std::optional<msg::TrafficProgress> trafficProgress(std::int64_t nowNs);
   /// Acts on the progress watch: a task that comes no closer to its next node fails; a stalled

@@ -221,8 +221,9 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   // Standing (at the end of the base, on the goal, or with nothing released): waiting on the
   // traffic manager, which is waiting on other robots; nothing holds it up.
   mode = !c.busy ? msg::RobotMode::Idle : msg::RobotMode::Waiting;
-  auto standStill = [&](const char* why) {
+  auto standStill = [&](const char* why, RobotActivity doing) {
     standWhy_ = why;
+    cmd.doing = doing;
     aligning_ = false;
     v = 0.0;
     w = 0.0;
@@ -232,7 +233,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
     blocked_ = givingWay();
   };
   if (toGoal && distance(here, goal->pose.position()) < kAtGoal) {
-    standStill("on its goal");
+    standStill("on its goal", RobotActivity::TurningDocking);
     dockingLeg_ = false;
     cmd.onGoal = true;
     return cmd;
@@ -257,14 +258,14 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
     givingWayUntilNs_ = -1;
   }
   if (givingWayUntilNs_ >= 0) {
-    standStill("giving way to a person");
+    standStill("giving way to a person", RobotActivity::HeldByPerson);
     return cmd;
   }
   const bool newRelease = followedRevision_ != releases_.revision() || !follower_.hasPath() || pastTurnBack ||
                           rejoin || rejoined_;
   if (!releases_.nodesAhead() && newRelease && !shortOfGoal) {
     rejoinForPerson_ = false;  // (nothing to back along: not giving way)
-    standStill("nothing released beyond its node");
+    standStill("nothing released beyond its node", RobotActivity::WaitingOnRobot);
     return cmd;
   }
   if (newRelease) {
@@ -288,7 +289,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
     const Vec2 last = pts.back() - pts[pts.size() - 2];
     const double heading = last.norm() > 1e-6 ? std::atan2(last.y, last.x) : pose.theta;
     if (!follower_.setPath(pts, heading)) {
-      standStill("the base is no path to follow");
+      standStill("the base is no path to follow", RobotActivity::HeldBySafety);
       return cmd;
     }
     basePath_ = pts;
@@ -298,7 +299,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   }
   const auto r = follower_.step(pose);
   if (!r) {
-    standStill("no pose estimate to follow the base with");
+    standStill("no pose estimate to follow the base with", RobotActivity::HeldBySafety);
     return cmd;
   }
   double left = follower_.pathLength() - r->progress;
@@ -315,7 +316,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
       rejoining_ = false;
       rejoined_ = true;  // back on its node: the base from here next cycle
     }
-    standStill("at the end of its base");
+    standStill("at the end of its base", RobotActivity::WaitingOnRobot);
     return cmd;
   }
   baseAhead_ = true;
@@ -438,6 +439,17 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   // Waiting on a dependency or a person runs no failure timer: the traffic manager re-plans.
   cmd.driver = planning ? Driver::kPlanner : Driver::kFollower;
   cmd.held = held;
+  // What the robot-time ledger files the cycle under.
+  if (held) {
+    cmd.doing = byKnownRobot                              ? RobotActivity::WaitingOnRobot
+                : !blocker.robot && blocker.id == "human" ? RobotActivity::HeldByPerson
+                                                          : RobotActivity::HeldBySafety;
+  } else if (aligning_ || cornering || settling || docking || undockFrom_ ||
+             (std::abs(v) < 1e-9 && w != 0.0)) {
+    cmd.doing = RobotActivity::TurningDocking;  // on the spot, at a corner, or on a station's leg
+  } else {
+    cmd.doing = RobotActivity::Driving;
+  }
   cmd.waiting = held && (byKnownRobot || (!blocker.robot && blocker.id == "human"));
   return cmd;
 }

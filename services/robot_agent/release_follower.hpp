@@ -20,6 +20,7 @@
 #include "fleet/control/twist.hpp"
 #include "fleet/control/velocity_limits.hpp"
 #include "fleet/core/pose2.hpp"
+#include "fleet/core/robot_activity.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
 #include "motion_gate.hpp"
@@ -73,6 +74,10 @@ struct FollowCommand {
   Driver driver = Driver::kNone;
   bool held = false;     ///< the gate cut a command that wanted to move
   bool waiting = false;  ///< ... on a robot the plan knows about, or on a person
+  /// For the robot-time ledger: driving, turning and docking, waiting on a robot (one it knows, or
+  /// the traffic manager holding it at the end of its base), held by a person or by its own safety
+  /// layer (an obstacle, a robot it cannot name).
+  RobotActivity doing = RobotActivity::WaitingOnRobot;
 };
 
 /// Why the robot stands with a task (what last stopped it), and since when [ns] it has not got

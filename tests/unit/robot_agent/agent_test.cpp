@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -99,6 +100,7 @@ struct AgentRun {
     if (out.status) {
       statuses.push_back(*out.status);
     }
+    ++activities[static_cast<std::size_t>(out.state.activity)];
     return out;
   }
   /// Steps until `until` holds or `steps` have run.
@@ -120,6 +122,7 @@ struct AgentRun {
   double v = 0.0;
   double w = 0.0;
   std::vector<msg::TaskStatus> statuses;
+  std::array<int, kRobotActivities> activities{};  // cycles per RobotState.activity
 };
 
 }  // namespace
@@ -141,6 +144,11 @@ TEST(Agent, DeliversATransportTaskReportingEveryState) {
                                                 msg::TaskState::Done};
   EXPECT_EQ(states, expected);
   EXPECT_EQ(run.releases.releases(), 2) << "one base to each goal";
+  // What it said it did, cycle by cycle, for the robot-time ledger.
+  for (const auto a : {RobotActivity::Driving, RobotActivity::TurningDocking, RobotActivity::Dwelling}) {
+    EXPECT_GT(run.activities[static_cast<std::size_t>(a)], 0) << toString(a);
+  }
+  EXPECT_EQ(run.activities[static_cast<std::size_t>(RobotActivity::Unset)], 0);
   EXPECT_LT(distance(run.world.truth, Pose2{5.0, 6.0, 0}), 0.2);
   EXPECT_LT(distance(run.a.pose(), run.world.truth), 0.05) << "odometry + compass keep the estimate close";
   EXPECT_FALSE(run.a.busy());
@@ -214,6 +222,7 @@ TEST(Agent, ACancelledRobotDrivesNoFurtherThanReleasedAndIgnoresOthersOrders) {
   EXPECT_LT(run.world.truth.x, 5.0 + 0.05);
   EXPECT_EQ(out.command.v, 0.0);
   EXPECT_EQ(out.state.mode, msg::RobotMode::Idle);
+  EXPECT_EQ(out.state.activity, RobotActivity::NoTask);
   EXPECT_EQ(run.releases.releases(), 1) << "nothing more asked for";
   EXPECT_TRUE(run.statuses.size() == 1 && run.statuses[0].state == msg::TaskState::EnRoute)
       << "a cancel is the manager's own: nothing reported";

@@ -19,6 +19,7 @@ using agent::DriveStack;
 using agent::FollowCommand;
 using agent::FollowCycle;
 using agent::ReleaseFollower;
+using fleet::RobotActivity;
 
 namespace {
 
@@ -101,6 +102,7 @@ TEST(ReleaseFollower, WithNothingReleasedItStandsAndSaysWhy) {
     EXPECT_EQ(cmd.v, 0.0);
     EXPECT_EQ(cmd.mode, msg::RobotMode::Waiting) << "with a task, waiting on the traffic manager";
     EXPECT_FALSE(cmd.held);
+    EXPECT_EQ(cmd.doing, RobotActivity::WaitingOnRobot);
   }
   EXPECT_EQ(d.follow.standing().why, "nothing released beyond its node");
   EXPECT_EQ(d.follow.standing().sinceNs, 0);
@@ -111,12 +113,17 @@ TEST(ReleaseFollower, DrivesAReleaseToItsEndAndStopsThere) {
   Drive d;
   d.release(0, 3, false);  // to x = 2.5, short of the goal at x = 4
   bool moved = false;
+  FollowCommand cmd;
   for (int i = 0; i < 150; ++i) {
-    const auto cmd = d.step();
-    moved = moved || cmd.v > 0.3;
+    cmd = d.step();
+    if (cmd.v > 0.3) {
+      moved = true;
+      EXPECT_EQ(cmd.doing, RobotActivity::Driving);
+    }
     EXPECT_FALSE(cmd.onGoal);
   }
   EXPECT_TRUE(moved);
+  EXPECT_EQ(cmd.doing, RobotActivity::WaitingOnRobot) << "held at its base's end for the others";
   EXPECT_NEAR(d.pose.x, 2.5, 0.06) << "stopped at the base's end";
   EXPECT_NEAR(d.pose.y, 5.0, 0.05);
   EXPECT_EQ(d.follow.releases().node(), 3) << "every node reached, the last one last";
@@ -148,6 +155,7 @@ TEST(ReleaseFollower, HeldByAPersonItIsReportedBlockedAfterThreeSecondsButNeverB
   }
   EXPECT_TRUE(cmd.held);
   EXPECT_TRUE(cmd.waiting) << "on a person: no progress clock runs";
+  EXPECT_EQ(cmd.doing, RobotActivity::HeldByPerson);
   EXPECT_FALSE(d.follow.blocked()) << "2.5 s: not yet";
   for (int i = 0; i < 10; ++i) {
     cmd = d.step();
@@ -165,6 +173,7 @@ TEST(ReleaseFollower, HeldByAPersonItIsReportedBlockedAfterThreeSecondsButNeverB
     cmd = e.step();
   }
   EXPECT_TRUE(cmd.waiting) << "a dependency the plan knows";
+  EXPECT_EQ(cmd.doing, RobotActivity::WaitingOnRobot);
   EXPECT_FALSE(e.follow.blocked()) << "a robot the traffic manager plans is no block";
   EXPECT_EQ(e.follow.standing().why, "held by robot r2");
   e.stack.knownRobot.clear();
@@ -173,6 +182,7 @@ TEST(ReleaseFollower, HeldByAPersonItIsReportedBlockedAfterThreeSecondsButNeverB
   }
   EXPECT_FALSE(cmd.waiting);
   EXPECT_TRUE(e.follow.blocked()) << "a robot nobody reports is something the plan does not know";
+  EXPECT_EQ(cmd.doing, RobotActivity::HeldBySafety);
 }
 
 TEST(ReleaseFollower, AtWorkItIsNeitherStandingNorBlocked) {
