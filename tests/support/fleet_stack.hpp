@@ -1,5 +1,7 @@
-// The lockstep fleet of the scenario tests: the fleet manager's config and a task submitted over DDS
-// as the WMS adapter does it. Header-only; the tests that include it link fleet::transport.
+// The lockstep fleet of the scenario tests: the fleet manager's config, the traffic manager the
+// agents follow (reserved traffic: an agent with no traffic manager stands still) and a task
+// submitted over DDS as the WMS adapter does it. Header-only; the tests that include it link
+// fleet::transport.
 #pragma once
 
 #include <chrono>
@@ -9,6 +11,8 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "fleet/transport/dds.hpp"
 #include "test_process.hpp"
@@ -44,9 +48,41 @@ inline std::filesystem::path writeManagerConfig(const std::filesystem::path& dir
   return dir / "manager.json";
 }
 
-/// fleet_manager (config from writeManagerConfig with `managerExtra`) and robot_agent (`agentArgs`
-/// after --scenario) as processes on `domain`; both die with the test. `env` is for the simulator.
+/// The site file of `scenario` (its "site", relative to the scenario's folder).
+inline std::string siteOf(const std::string& scenario) {
+  const auto s = nlohmann::json::parse(std::ifstream(scenario));
+  const std::filesystem::path site = s.at("site").get<std::string>();
+  return site.is_absolute()
+             ? site.string()
+             : (std::filesystem::path(scenario).parent_path() / site).lexically_normal().string();
+}
+
+/// dir/traffic_manager.json: the site of `scenario`, the simulator's clock (the Clock topic, also on
+/// the wall clock) and, with `lockstep`, a lockstep participant (fleet-sim's --participants counts
+/// it), plus `extra` keys. Returns the traffic_manager arguments that use it, with `id` as its
+/// lockstep id.
+inline std::vector<std::string> trafficManagerArgs(const std::filesystem::path& dir,
+                                                   const std::string& scenario, bool lockstep,
+                                                   const nlohmann::json& extra = nlohmann::json::object(),
+                                                   const std::string& id = "traffic_manager") {
+  nlohmann::json cfg{{"site", siteOf(scenario)}, {"clock", "sim"}, {"lockstep", lockstep}};
+  cfg.update(extra);
+  const auto path = dir / (id + ".json");
+  std::ofstream(path) << cfg.dump();
+  return {"--config", path.string(), "--id", id, "--log-level", "warn"};
+}
+
+inline constexpr const char* kTrafficManagerBinary =
+    FLEET_BINARY_DIR "/services/traffic_manager/traffic_manager";
+
+/// fleet_manager (config from writeManagerConfig with `managerExtra`), traffic_manager (on the
+/// scenario's site; a lockstep participant when the agent is, `agentArgs` having "--clock
+/// lockstep") and robot_agent (`agentArgs` after --scenario) as processes on `domain`; all die with
+/// the test. `env` is for the simulator, whose --participants is kLockstepParticipants.
 struct ManagerAndAgent {
+  /// The agent process and the traffic manager.
+  static constexpr const char* kLockstepParticipants = "2";
+
   ManagerAndAgent(const std::filesystem::path& dir, const std::string& scenario, const std::string& domain,
                   std::vector<std::string> agentArgs,
                   const nlohmann::json& managerExtra = nlohmann::json::object())
@@ -54,14 +90,23 @@ struct ManagerAndAgent {
         manager(FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
                 {"--config", writeManagerConfig(dir, scenario, managerExtra).string(), "--log-level", "warn"},
                 env),
+        traffic(kTrafficManagerBinary, trafficManagerArgs(dir, scenario, inLockstep(agentArgs)), env),
         agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
               withScenario(scenario, std::move(agentArgs)), env) {}
 
   std::vector<std::pair<std::string, std::string>> env;
   ChildProcess manager;
+  ChildProcess traffic;
   ChildProcess agent;
 
  private:
+  static bool inLockstep(const std::vector<std::string>& args) {
+    for (std::size_t i = 0; i + 1 < args.size(); ++i) {
+      if (args[i] == "--clock" && args[i + 1] == "lockstep")
+        return true;
+    }
+    return false;
+  }
   static std::vector<std::string> withScenario(const std::string& scenario, std::vector<std::string> args) {
     args.insert(args.begin(), {"--scenario", scenario, "--log-level", "warn"});
     return args;

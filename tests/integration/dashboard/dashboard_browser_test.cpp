@@ -4,12 +4,13 @@
 // operator token). The script checks the login prompt on a wrong token, that a read-only session
 // is offered no action, the robots on the page against the simulator's ground truth (which this
 // test writes to truth.json from the GroundTruth topic), the traffic manager's roadmap and station
-// queues on the map and a robot's release in its colour (this test publishes one over DDS: the
-// agent drives reactively and follows none), the layer switches, a task submitted from the page
-// reaching done, pause from the page stopping the robot (ground truth again) and the page catching
-// up after an adapter restart (asked for through restart.request; this test restarts the adapter
-// on the same port), the people the robots see drawn where the simulator has its one person, and
-// the contacts and near-miss figures. Screenshots go to <build>/reports/dashboard/.
+// queues on the map and a release in its robot's colour (this test publishes one over DDS for r9, a
+// robot no agent drives, so the traffic manager never replaces it and nothing follows it), the
+// layer switches, a task submitted from the page reaching done, pause from the page stopping the
+// robot (ground truth again) and the page catching up after an adapter restart (asked for through
+// restart.request; this test restarts the adapter on the same port), the people the robots see
+// drawn where the simulator has its one person, and the contacts and near-miss figures.
+// Screenshots go to <build>/reports/dashboard/.
 
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -37,6 +38,10 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 namespace {
+
+/// The robot of the test's own release: none of the scenario's (r1 to r3, which the traffic manager
+/// releases to), so its route stays as published and no robot drives it.
+const std::string kReleasedTo = "r9";
 
 using fleet::test::freePort;
 
@@ -135,16 +140,12 @@ TEST(DashboardBrowser, LoginRobotsTaskPauseAndRestartInChromium) {
                                                 "--stations",  scenario,
                                                 "--port",      std::to_string(port),
                                                 "--log-level", "warn"};
-  // On the wall clock: it publishes its roadmap at once and, with no robot reporting progress
-  // (the agent drives reactively), releases nothing of its own.
-  const std::string site = json::parse(std::ifstream(scenario))["site"].get<std::string>();
-  test::ChildProcess traffic(FLEET_BINARY_DIR "/services/traffic_manager/traffic_manager",
-                             {"--site", site, "--log-level", "warn"}, fleet.env);
   auto adapter = std::make_unique<test::ChildProcess>(FLEET_BINARY_DIR "/services/wms_adapter/wms_adapter",
                                                       adapterArgs, adapterEnv);
   test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
-                         {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",
-                          "400", "--max-speed", "5", "--log-level", "warn"},
+                         {"--scenario", scenario, "--clock", "lockstep", "--participants",
+                          test::ManagerAndAgent::kLockstepParticipants, "--duration", "400", "--max-speed",
+                          "5", "--log-level", "warn"},
                          fleet.env);
 
   // The simulator's ground truth for the script, and adapter restarts when it asks for one.
@@ -166,8 +167,8 @@ TEST(DashboardBrowser, LoginRobotsTaskPauseAndRestartInChromium) {
       if (!samples.empty()) {
         const auto& g = samples.back();
         for (const auto& b : g.bodies) {
-          if (roadmap && !released && b.id == "r3") {
-            releases.write(releaseNear(*roadmap, b.id, b.pose.x, b.pose.y));
+          if (roadmap && !released && b.id == "r3") {  // drawn from where r3 stands
+            releases.write(releaseNear(*roadmap, kReleasedTo, b.pose.x, b.pose.y));
             released = true;
           }
         }
@@ -205,8 +206,8 @@ TEST(DashboardBrowser, LoginRobotsTaskPauseAndRestartInChromium) {
   const std::string cmd =
       "cd " + browserDir.string() + " && DASH_URL=http://127.0.0.1:" + std::to_string(port) +
       "/dashboard/ DASH_TOKEN=" + token + " DASH_DIR=" + dir.string() + " DASH_SHOTS=" + shots.string() +
-      " DASH_VIEWER_TOKEN=" + viewerToken + " DASH_RELEASED=r3 timeout 240 node dashboard_check.mjs > " +
-      (dir / "browser.log").string() + " 2>&1";
+      " DASH_VIEWER_TOKEN=" + viewerToken + " DASH_RELEASED=" + kReleasedTo +
+      " timeout 240 node dashboard_check.mjs > " + (dir / "browser.log").string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   stop = true;
   helper.join();

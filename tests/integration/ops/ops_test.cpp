@@ -95,7 +95,10 @@ class Fleet {
         {"clock", "sim"}}.dump();
     std::ofstream(dir_ / "risk_map.json")
         << nlohmann::json{{"clock", "sim"}, {"lockstep", true}, {"rate_hz", 2}, {"site", kSite}}.dump();
-    std::ofstream(dir_ / "traffic.json") << nlohmann::json{{"site", kSite}, {"clock", "sim"}}.dump();
+    // The agent drives what the traffic manager releases; both are lockstep participants, as the
+    // risk map is.
+    std::ofstream(dir_ / "traffic.json")
+        << nlohmann::json{{"site", kSite}, {"clock", "sim"}, {"lockstep", true}}.dump();
     const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain_}};
     auto start = [&](const std::string& name, const std::string& exe, std::vector<std::string> args) {
       ports[name] = freePort();
@@ -112,7 +115,7 @@ class Fleet {
     start("robot_agent", "/services/robot_agent/robot_agent",
           {"--scenario", kScenario, "--clock", "lockstep"});
     start("fleet_sim", "/sim/src/fleet-sim",
-          {"--scenario", kScenario, "--clock", "lockstep", "--participants", "2", "--duration", "600",
+          {"--scenario", kScenario, "--clock", "lockstep", "--participants", "3", "--duration", "600",
            "--max-speed", "5"});
     // The VDA 5050 bridge on a broker of this fleet's own, for a vehicle that never comes: it is
     // ready once it hears the broker, and its metrics are scraped like the others'.

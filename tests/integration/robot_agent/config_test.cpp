@@ -70,23 +70,6 @@ TEST(RobotAgentConfig, GoodFileRunsTheConfiguredPlanner) {
   EXPECT_NE(r.output.find("dwa"), std::string::npos) << r.output;
 }
 
-TEST(RobotAgentConfig, TheTrafficModeComesFromTheFileUnlessTheCommandLineSaysOtherwise) {
-  const AgentRun bad = agentWith(R"({"traffic": "negotiated"})", 20);
-  EXPECT_EQ(bad.code, 2) << bad.output;
-  EXPECT_NE(bad.output.find("traffic"), std::string::npos) << bad.output;
-  EXPECT_NE(bad.output.find("negotiated"), std::string::npos) << bad.output;
-  const AgentRun reserved = agentWith(R"({"traffic": "reserved"})", 3);
-  EXPECT_EQ(reserved.code, 0) << reserved.output;
-  EXPECT_NE(reserved.output.find("reserved traffic"), std::string::npos) << reserved.output;
-  const AgentRun fromCli = runAgent(
-      "--scenario " FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json --clock wall --traffic reactive", 3);
-  EXPECT_EQ(fromCli.code, 0) << fromCli.output;
-  EXPECT_NE(fromCli.output.find("reactive traffic"), std::string::npos) << fromCli.output;
-  const AgentRun badCli = runAgent(
-      "--scenario " FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json --clock wall --traffic fast", 20);
-  EXPECT_NE(badCli.code, 0) << badCli.output;
-}
-
 TEST(RobotAgentConfig, LineUpdatesAreOnByDefaultAndTheFileCanTurnThemOff) {
   const AgentRun on = agentWith(R"({})", 3);
   EXPECT_EQ(on.code, 0) << on.output;

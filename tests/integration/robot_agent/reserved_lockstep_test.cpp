@@ -42,10 +42,9 @@ TEST(AgentLockstepReserved, DrivesItsBaseRoundACornerAndStopsAtItsEnd) {
   }
   releases.write(r);
 
-  test::ChildProcess agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
-                           {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--traffic",
-                            "reserved", "--log-level", "warn"},
-                           env);
+  test::ChildProcess agent(
+      FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
+      {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--log-level", "warn"}, env);
   const auto until = std::chrono::steady_clock::now() + 30s;
   while (releases.matchedReaders() == 0 && std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(20ms);

@@ -1,7 +1,8 @@
-// robot_agent as a real process (wall clock), with this test playing the robot's driver over DDS:
-// while frames flow and a task is assigned the robot drives; when the SensorFrame stream stops it
-// commands zero, reports RM_FAULT in RobotState and a TaskStatus naming the reason; when frames come
-// back it clears the fault and drives again.
+// robot_agent as a real process (wall clock) beside a traffic manager (reserved traffic: it
+// releases the route), with this test playing the robot's driver over DDS: while frames flow and a
+// task is assigned the robot drives; when the SensorFrame stream stops it commands zero, reports
+// RM_FAULT in RobotState and a TaskStatus naming the reason; when frames come back it clears the
+// fault and drives again.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/transport/dds.hpp"
+#include "fleet_stack.hpp"
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -31,6 +33,13 @@ struct Seen {
 TEST(RobotAgentSensorLoss, StopsReportsFaultAndResumes) {
   const std::string domain = std::to_string(test::uniqueDomain());
   setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
+  const auto dir = std::filesystem::temp_directory_path() / ("agent_sensor_loss_" + domain);
+  std::filesystem::create_directories(dir);
+  // On the wall clock: no simulator publishes a Clock here.
+  test::ChildProcess traffic(test::kTrafficManagerBinary,
+                             test::trafficManagerArgs(dir, FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json",
+                                                      false, {{"clock", "wall"}}),
+                             {{"FLEET_DDS_DOMAIN", domain}});
   test::ChildProcess agent(
       FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
       {"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", "--robots", "r1", "--clock", "wall",
@@ -127,4 +136,5 @@ TEST(RobotAgentSensorLoss, StopsReportsFaultAndResumes) {
   ASSERT_TRUE(until(true, 10s, [&] {
     return seen.state && seen.state->mode != msg::RobotMode::Fault && moving();
   })) << "the robot did not resume";
+  std::filesystem::remove_all(dir);
 }

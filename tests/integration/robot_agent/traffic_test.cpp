@@ -1,8 +1,7 @@
-// robot_agent --traffic as a process over DDS, with this test playing the traffic manager (and the
-// robot's driver): in reserved traffic the agent reports TrafficProgress (at least once a second,
-// before any release with node -1), takes a TrafficRelease for its robot from the node next to it
-// and reports that node and the release's epoch; a release for another robot changes nothing. In
-// reactive traffic it reports nothing.
+// robot_agent as a process over DDS in reserved traffic, with this test playing the traffic manager
+// (and the robot's driver): the agent reports TrafficProgress (at least once a second, before any
+// release with node -1), takes a TrafficRelease for its robot from the node next to it and reports
+// that node and the release's epoch; a release for another robot changes nothing.
 
 #include <gtest/gtest.h>
 
@@ -63,10 +62,10 @@ struct Driver {
   }
 };
 
-test::ChildProcess startAgent(const std::string& domain, const std::string& traffic) {
+test::ChildProcess startAgent(const std::string& domain) {
   return test::ChildProcess(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
                             {"--scenario", FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json", "--robots", "r1",
-                             "--clock", "wall", "--traffic", traffic, "--log-level", "warn"},
+                             "--clock", "wall", "--log-level", "warn"},
                             {{"FLEET_DDS_DOMAIN", domain}});
 }
 
@@ -75,7 +74,7 @@ test::ChildProcess startAgent(const std::string& domain, const std::string& traf
 TEST(RobotAgentTraffic, ReservedReportsProgressAndTakesItsReleases) {
   const std::string domain = std::to_string(test::uniqueDomain());
   setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  auto agent = startAgent(domain, "reserved");
+  auto agent = startAgent(domain);
   Driver d;
   ASSERT_TRUE(d.until(20s, [&] { return d.state && !d.reports.empty(); })) << "no TrafficProgress";
   const msg::TrafficProgress first = d.reports.back();
@@ -106,14 +105,4 @@ TEST(RobotAgentTraffic, ReservedReportsProgressAndTakesItsReleases) {
     EXPECT_NE(r.node, 55) << "took another robot's release";
   }
   EXPECT_EQ(d.reports.back().epoch, 4u);
-}
-
-TEST(RobotAgentTraffic, ReactiveReportsNoProgress) {
-  const std::string domain = std::to_string(test::uniqueDomain());
-  setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
-  auto agent = startAgent(domain, "reactive");
-  Driver d;
-  ASSERT_TRUE(d.until(20s, [&] { return d.state.has_value(); })) << "no RobotState from the agent";
-  d.until(3s, [] { return false; });
-  EXPECT_TRUE(d.reports.empty()) << "a reactive agent does not follow releases";
 }

@@ -25,8 +25,6 @@ TEST(Vda5050MixedFleet, AgentsAndVda5050VehiclesShareTheTasks) {
                                  "4",
                                  "--humans",
                                  "0",
-                                 "--traffic",
-                                 "reserved",
                                  "--vda5050",
                                  "2",
                                  "--tasks",

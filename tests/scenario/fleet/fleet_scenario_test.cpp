@@ -34,8 +34,9 @@ TEST(FleetScenario, OneRobotDeliversATransportTaskWithoutContact) {
       << ack->detail;
 
   test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
-                         {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",
-                          "200", "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
+                         {"--scenario", scenario, "--clock", "lockstep", "--participants",
+                          test::ManagerAndAgent::kLockstepParticipants, "--duration", "200", "--summary",
+                          (dir / "summary.json").string(), "--log-level", "warn"},
                          env);
   std::vector<msg::TaskState> seen;
   while (std::chrono::steady_clock::now() < deadline + 200s &&

@@ -71,11 +71,11 @@ TEST(FleetCharging, LowRobotFinishesItsTaskThenChargesToTheTargetWithoutContact)
       << ack->detail;
 
   const auto replayPath = (dir / "replay.jsonl.gz").string();
-  test::ChildProcess sim(
-      FLEET_BINARY_DIR "/sim/src/fleet-sim",
-      {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration", "260", "--replay",
-       replayPath, "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
-      env);
+  test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
+                         {"--scenario", scenario, "--clock", "lockstep", "--participants",
+                          test::ManagerAndAgent::kLockstepParticipants, "--duration", "260", "--replay",
+                          replayPath, "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
+                         env);
   std::map<std::string, Seen> seen;
   while (std::chrono::steady_clock::now() < deadline + 120s) {
     events.waitForData(100ms);

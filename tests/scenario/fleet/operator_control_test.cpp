@@ -50,11 +50,12 @@ TEST(FleetScenario, PauseHoldsTheRobotResumeDrivesOnCancelEndsTheTask) {
   ASSERT_TRUE(stored) << "no acknowledgement from the fleet manager";
 
   const auto replayPath = (dir / "replay.jsonl.gz").string();
-  test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
-                         {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",
-                          "150", "--max-speed", "5", "--replay", replayPath, "--summary",
-                          (dir / "summary.json").string(), "--log-level", "warn"},
-                         fleet.env);
+  test::ChildProcess sim(
+      FLEET_BINARY_DIR "/sim/src/fleet-sim",
+      {"--scenario", scenario, "--clock", "lockstep", "--participants",
+       test::ManagerAndAgent::kLockstepParticipants, "--duration", "150", "--max-speed", "5", "--replay",
+       replayPath, "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
+      fleet.env);
   std::set<msg::TaskState> seen;
   auto watchFor = [&](msg::TaskState state, std::chrono::seconds wait) {
     const auto until = std::chrono::steady_clock::now() + wait;

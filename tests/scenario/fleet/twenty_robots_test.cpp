@@ -147,10 +147,8 @@ TEST(FleetScenario, TwentyRobotsDeliverWithRiskSteppingWithoutContact) {
   const fs::path out = fs::temp_directory_path() / ("fleet_twenty_rs_" + std::to_string(getpid()));
   fs::remove_all(out);
   auto args = loadtestArgs(out, 20, 900.0, 300);
-  // Reactive traffic, named: risk stepping's fleet figures (docs/benchmarks.md) are reactive's.
-  // Under reserved traffic (the default since 2026-11-27) one robot of this run stood en route for
-  // 500 s in session 24's CI check (19 of 20 done; it passed on the rerun): not diagnosed yet.
-  args.insert(args.end(), {"--local-planner", "risk_stepping", "--traffic", "reactive"});
+  // In reserved traffic (the traffic manager plans, risk stepping drives each released base).
+  args.insert(args.end(), {"--local-planner", "risk_stepping"});
   fleet::test::ChildProcess run(FLEET_BINARY_DIR "/services/fleetctl/fleetctl", args);
   ASSERT_EQ(run.wait(std::chrono::seconds(350)), 0) << "see " << out;
   const json r = json::parse(std::ifstream(out / "loadtest.json"));

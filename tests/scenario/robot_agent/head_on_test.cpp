@@ -1,6 +1,7 @@
 // Two robots meet head-on in a passage one robot wide (sim/scenarios/passage_head_on.json: two rooms
 // joined by a 1.5 m passage and, further round, by a second one). In lockstep with the real
-// simulator and robot agent: both must reach the far room, without contact, well within the run.
+// simulator, robot agent and traffic manager (reserved traffic): both must reach the far room,
+// without contact, well within the run.
 
 #include <gtest/gtest.h>
 
@@ -12,6 +13,7 @@
 #include <thread>
 
 #include "fleet/transport/dds.hpp"
+#include "fleet_stack.hpp"
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -40,6 +42,7 @@ TEST(AgentLockstep, HeadOnInAPassageOneRobotWideResolves) {
     a.goals.push_back(goal);
     orders.write(a);
   }
+  test::ChildProcess traffic(test::kTrafficManagerBinary, test::trafficManagerArgs(dir, scenario, true), env);
   test::ChildProcess agent(
       FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
       {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--log-level", "warn"}, env);
@@ -49,9 +52,10 @@ TEST(AgentLockstep, HeadOnInAPassageOneRobotWideResolves) {
   }
   // The agent holds both orders before the first step (a fixed wait is not enough under load).
   ASSERT_TRUE(orders.waitForAcks(30s)) << "the agent did not acknowledge its orders";
+  // Two lockstep participants: the agent process and the traffic manager.
   test::ChildProcess sim(
       FLEET_BINARY_DIR "/sim/src/fleet-sim",
-      {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration", "120", "--summary",
+      {"--scenario", scenario, "--clock", "lockstep", "--participants", "2", "--duration", "120", "--summary",
        (dir / "summary.json").string(), "--step-timeout-ms", "5000", "--log-level", "warn"},
       env);
   std::map<std::string, msg::TaskState> last;

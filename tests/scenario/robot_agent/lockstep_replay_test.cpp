@@ -1,8 +1,8 @@
-// Lockstep determinism with the real robot agent: fleet-sim and robot_agent (12 robots stepped by a
-// 2-thread worker pool, DWA local planner, plain A*: with lanes r4 is boxed in by the parked robots
-// of its lane, a known gap this test is not about) run the same seeded scenario twice with the same orders;
-// the two replays and summaries are byte-identical, so neither thread timing nor DDS write order
-// leaks into what the robots do.
+// Lockstep determinism with the real robot agent in reserved traffic: fleet-sim, traffic_manager
+// and robot_agent (the scenario's robots stepped by a 2-thread worker pool, DWA local planner, no
+// lanes) run the same seeded scenario twice with the same orders; the two replays and summaries are
+// byte-identical, so neither thread timing nor DDS write order (between the agent's progress reports
+// and the traffic manager's releases too) leaks into what the robots do.
 
 #include <gtest/gtest.h>
 
@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "fleet/transport/dds.hpp"
+#include "fleet_stack.hpp"
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -43,6 +44,7 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
   // Orders for four robots, transient-local: each run's agent process receives the same ones.
   transport::Participant p;
   transport::Writer<msg::TaskAssignment> orders(p);
+  transport::Reader<msg::TrafficRelease> releases(p);
   const std::vector<std::pair<std::string, msg::Goal>> plan = {
       {"r1", {{3.5, 17.0, -1.5708}, "P-1", msg::GoalAction::Load, 1.0}},
       {"r2", {{9.0, 17.0, -1.5708}, "P-2", msg::GoalAction::Load, 1.0}},
@@ -65,6 +67,13 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
       std::this_thread::sleep_for(20ms);
     }
     EXPECT_EQ(orders.matchedReaders(), 0u) << "the previous run's agent is still matched";
+    // Nor may the previous run's traffic manager be heard: its releases are transient-local.
+    while (releases.matchedWriters() > 0 && std::chrono::steady_clock::now() < gone) {
+      std::this_thread::sleep_for(20ms);
+    }
+    EXPECT_EQ(releases.matchedWriters(), 0u) << "the previous run's traffic manager is still matched";
+    test::ChildProcess traffic(test::kTrafficManagerBinary, test::trafficManagerArgs(dir, scenario, true),
+                               env);
     test::ChildProcess agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
                              {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--threads",
                               "2", "--local-planner", "dwa", "--no-lanes", "--log-level", "warn"},
@@ -76,15 +85,18 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
       std::this_thread::sleep_for(20ms);
     }
     EXPECT_TRUE(orders.waitForAcks(30s)) << "the agent did not acknowledge its orders";
+    // Two lockstep participants: the agent process and the traffic manager.
     test::ChildProcess sim(
         FLEET_BINARY_DIR "/sim/src/fleet-sim",
-        {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration", "20", "--replay",
+        {"--scenario", scenario, "--clock", "lockstep", "--participants", "2", "--duration", "20", "--replay",
          (dir / (tag + ".jsonl.gz")).string(), "--summary", (dir / (tag + ".json")).string(),
          "--step-timeout-ms", "10000", "--log-level", "warn"},
         env);
     const int rc = sim.wait(120s);
     agent.kill(SIGTERM);  // a clean exit unregisters its reader at once (SIGKILL: a lease later)
     (void)agent.wait(20s);
+    traffic.kill(SIGTERM);
+    (void)traffic.wait(20s);
     return rc;
   };
   ASSERT_EQ(runOnce("a"), 0);

@@ -44,11 +44,12 @@ TEST(AgentLockstep, ARobotWhoseSensorStreamStopsStopsReportsItAndResumes) {
   ASSERT_TRUE(ack) << "no acknowledgement from the fleet manager";
 
   const auto replayPath = (dir / "replay.jsonl.gz").string();
-  test::ChildProcess sim(FLEET_BINARY_DIR "/sim/src/fleet-sim",
-                         {"--scenario", scenario, "--clock", "lockstep", "--participants", "1", "--duration",
-                          "200", "--sensor-outage", "r1@4+6", "--replay", replayPath, "--summary",
-                          (dir / "summary.json").string(), "--log-level", "warn"},
-                         fleet.env);
+  test::ChildProcess sim(
+      FLEET_BINARY_DIR "/sim/src/fleet-sim",
+      {"--scenario", scenario, "--clock", "lockstep", "--participants",
+       test::ManagerAndAgent::kLockstepParticipants, "--duration", "200", "--sensor-outage", "r1@4+6",
+       "--replay", replayPath, "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
+      fleet.env);
   std::string faultReport;
   bool clearedAfterFault = false;
   bool delivered = false;
