@@ -31,7 +31,8 @@ const vda5050::ActionState* findAction(const vda5050::State& s, const std::strin
 
 BridgeNode::BridgeNode(BridgeSettings settings)
     : settings_(std::move(settings)),
-      registry_(settings_.interface_name, settings_.map_id, settings_.vehicles) {
+      registry_(settings_.interface_name, settings_.map_id, settings_.vehicles,
+                vda5050::RegistryLimits{.maxMessageBytes = settings_.max_message_bytes}) {
   for (const auto& e : settings_.vehicles) {
     vehicles_.emplace(e.robot_id,
                       Vehicle(e, vda5050::OrderBuilder({e.manufacturer, e.serial, settings_.map_id,
@@ -142,8 +143,22 @@ void BridgeNode::onRelease(const msg::TrafficRelease& r) {
 void BridgeNode::onRoadmap(const msg::Roadmap& m) {
   roadmap_radius_ = m.robot_radius;
   roadmap_.clear();
-  for (const auto& n : m.nodes) {
+  double minX = 0;
+  double minY = 0;
+  double maxX = 0;
+  double maxY = 0;
+  for (std::size_t i = 0; i < m.nodes.size(); ++i) {
+    const auto& n = m.nodes[i];
     roadmap_.addNode({n.node, n.x, n.y});
+    minX = i == 0 ? n.x : std::min(minX, n.x);
+    minY = i == 0 ? n.y : std::min(minY, n.y);
+    maxX = i == 0 ? n.x : std::max(maxX, n.x);
+    maxY = i == 0 ? n.y : std::max(maxY, n.y);
+  }
+  if (!m.nodes.empty()) {
+    // A vehicle is on the site: within the roadmap's extent and a margin (stations off the lanes).
+    const double g = settings_.site_margin;
+    registry_.setSiteBounds(minX - g, minY - g, maxX + g, maxY + g);
   }
   for (const auto& e : m.edges) {
     if (e.open) {

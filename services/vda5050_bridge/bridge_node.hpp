@@ -66,6 +66,12 @@ struct BridgeSettings {
   // its order cancelled: then it can be reported blocked and planned round (as our robots are
   // after 3 s held by a person) without driving on into nodes given to others.
   double field_cancel_s = 3.0;
+  /// Refused at the edge, counted by kind: messages larger than this (the broker's
+  /// message_size_limit by default), JSON nested or sized past the message limits, a state of a
+  /// protocol version other than 2.0/2.1, an agvPosition off the site (the roadmap's extent and
+  /// `site_margin` m), a batteryCharge outside 0..100.
+  std::size_t max_message_bytes = 256 * 1024;
+  double site_margin = 50.0;
 };
 
 struct MqttMessage {

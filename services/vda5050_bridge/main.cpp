@@ -44,7 +44,7 @@ Settings readSettings(Config& c) {
   Settings s;
   c.rejectUnknownKeys({"broker", "interface", "map_id", "rate_hz", "allowed_deviation", "order_retries",
                        "retry_backoff_s", "order_ack_timeout_s", "field_cancel_s", "vehicles", "clock",
-                       "lockstep"});
+                       "lockstep", "max_message_bytes", "site_margin"});
   s.sim_clock = c.string("clock", "wall", {"wall", "sim"}) == "sim";
   s.lockstep = c.boolean("lockstep", false);
   if (s.lockstep && !s.sim_clock) {
@@ -71,6 +71,12 @@ Settings readSettings(Config& c) {
     s.bridge.vehicles.push_back(
         {v.requireString("manufacturer"), v.requireString("serial"), v.requireString("robot")});
   }
+  for (const auto& problem : vda5050::vehicleEntryProblems(s.bridge.vehicles)) {
+    c.problem(problem.substr(0, problem.find(':')), problem.substr(problem.find(':') + 2));
+  }
+  s.bridge.max_message_bytes = static_cast<std::size_t>(c.integer(
+      "max_message_bytes", static_cast<std::int64_t>(s.bridge.max_message_bytes), {1024, 64 << 20}));
+  s.bridge.site_margin = c.number("site_margin", s.bridge.site_margin, {0.0, 10000.0});
   return s;
 }
 

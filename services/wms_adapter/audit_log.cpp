@@ -5,8 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <nlohmann/json.hpp>
+
+#include "fleet/core/config.hpp"
 
 namespace fleet::wms {
 namespace {
@@ -38,7 +42,8 @@ AuditLog::AuditLog(std::string path) : path_(std::move(path)) {
   std::lock_guard lock(m_);
   openLocked();
   if (!path_.empty() && fd_ < 0) {
-    throw std::runtime_error("http.audit_log: cannot open \"" + path_ + "\" for appending");
+    const int err = errno;
+    throw ConfigError({"http.audit_log: cannot open \"" + path_ + "\" for appending: " + std::strerror(err)});
   }
 }
 

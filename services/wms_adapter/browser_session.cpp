@@ -4,6 +4,7 @@
 #include <openssl/hmac.h>
 #include <openssl/rand.h>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <stdexcept>
@@ -35,11 +36,15 @@ std::string mac(const TokenStore::Digest& key, std::string_view what) {
 
 }  // namespace
 
-BrowserSessions::BrowserSessions(const TokenStore& tokens, bool secure, std::int64_t lifetimeS)
-    : tokens_(tokens), secure_(secure), lifetimeS_(lifetimeS) {}
+BrowserSessions::BrowserSessions(const TokenStore& tokens, bool secure, std::int64_t lifetimeS,
+                                 std::size_t maxSessions)
+    : tokens_(tokens),
+      secure_(secure),
+      lifetimeS_(lifetimeS),
+      maxSessions_(std::max<std::size_t>(1, maxSessions)) {}
 
 // The cookie is "<expiry>.<nonce>.<mac>.<name>": the name last, as it may hold dots itself.
-std::optional<std::string> BrowserSessions::issue(const std::string& name, std::int64_t nowS) const {
+std::optional<std::string> BrowserSessions::issue(const std::string& name, std::int64_t nowS) {
   const auto entry = tokens_.named(name);
   if (!entry) {
     return std::nullopt;
@@ -48,7 +53,19 @@ std::optional<std::string> BrowserSessions::issue(const std::string& name, std::
   if (RAND_bytes(nonce.data(), static_cast<int>(nonce.size())) != 1) {
     throw std::runtime_error("no random bytes for a session");
   }
-  const std::string body = std::to_string(nowS + lifetimeS_) + "." + hex(nonce.data(), nonce.size());
+  const std::string nonceHex = hex(nonce.data(), nonce.size());
+  {
+    std::lock_guard lock(m_);
+    if (live_.size() >= maxSessions_) {
+      std::erase_if(live_, [&](const auto& kv) { return kv.second < nowS; });
+    }
+    if (live_.size() >= maxSessions_) {
+      live_.erase(std::min_element(live_.begin(), live_.end(),
+                                   [](const auto& a, const auto& b) { return a.second < b.second; }));
+    }
+    live_[nonceHex] = nowS + lifetimeS_;
+  }
+  const std::string body = std::to_string(nowS + lifetimeS_) + "." + nonceHex;
   return body + "." + mac(entry->digest, "session." + body + "." + name) + "." + name;
 }
 
@@ -57,8 +74,8 @@ std::optional<Principal> BrowserSessions::principal(std::string_view name) const
   return entry ? std::optional<Principal>(std::move(entry->who)) : std::nullopt;
 }
 
-std::optional<BrowserSessions::Session> BrowserSessions::check(std::string_view cookie,
-                                                               std::int64_t nowS) const {
+std::optional<std::string> BrowserSessions::verifiedNonce(std::string_view cookie, std::int64_t nowS,
+                                                          std::optional<Session>* session) const {
   if (cookie.size() > 512) {
     return std::nullopt;
   }
@@ -80,7 +97,39 @@ std::optional<BrowserSessions::Session> BrowserSessions::check(std::string_view 
   if (ec != std::errc{} || end != cookie.data() + dot1 || expires < nowS) {
     return std::nullopt;
   }
-  return Session{entry->who, mac(entry->digest, "csrf." + body + "." + name)};
+  if (session != nullptr) {
+    *session = Session{entry->who, mac(entry->digest, "csrf." + body + "." + name)};
+  }
+  return std::string(cookie.substr(dot1 + 1, dot2 - dot1 - 1));
+}
+
+std::optional<BrowserSessions::Session> BrowserSessions::check(std::string_view cookie,
+                                                               std::int64_t nowS) const {
+  std::optional<Session> session;
+  const auto nonce = verifiedNonce(cookie, nowS, &session);
+  if (!nonce) {
+    return std::nullopt;
+  }
+  std::lock_guard lock(m_);
+  const auto it = live_.find(*nonce);
+  if (it == live_.end() || it->second < nowS) {
+    return std::nullopt;  // logged out, pushed out of the table, or made before a restart
+  }
+  return session;
+}
+
+bool BrowserSessions::revoke(std::string_view cookie, std::int64_t nowS) {
+  const auto nonce = verifiedNonce(cookie, nowS, nullptr);
+  if (!nonce) {
+    return false;
+  }
+  std::lock_guard lock(m_);
+  return live_.erase(*nonce) > 0;
+}
+
+std::size_t BrowserSessions::liveSessions() const {
+  std::lock_guard lock(m_);
+  return live_.size();
 }
 
 std::string BrowserSessions::setCookie(const std::string& value) const {

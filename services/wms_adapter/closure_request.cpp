@@ -3,6 +3,7 @@
 #include <cmath>
 #include <variant>
 
+#include "fleet/core/bounded_json.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/validation/sample_checks.hpp"
 
@@ -42,8 +43,15 @@ std::variant<msg::TrafficClosure, std::vector<FieldError>> parseClosure(
   if (!isValidId(id)) {
     bad("id", "is not a valid id (1..63 of [A-Za-z0-9_.:-])");
   }
-  const json j = json::parse(body, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) {
+  // An area is a polygon of a few points, nodes and lanes short lists: bounded before parsing.
+  const auto parsed = parseBoundedJson(body, {.maxBytes = 64 * 1024, .maxDepth = 8, .maxElements = 20'000});
+  if (!parsed) {
+    bad("",
+        parsed.error().code == "json.invalid" ? "the body must be a JSON object" : parsed.error().message);
+    return errors;
+  }
+  const json& j = *parsed;
+  if (!j.is_object()) {
     bad("", "the body must be a JSON object");
     return errors;
   }

@@ -8,6 +8,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "fleet/core/bounded_json.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/site_stations.hpp"
@@ -313,6 +314,7 @@ void Dashboard::routes(HttpServer& server) {
     send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
   });
   // Commanding a robot is an operator's: the same scope as pausing a task.
+  server.limitBody("POST", R"(/v1/robots/([^/]+)/([^/]+))", 4096, "the robot action route's fixed limit");
   server.route("POST", R"(/v1/robots/([^/]+)/([^/]+))", Scope::Operate,
                [this](const Request& req, Response& res) { robotAction(req, res); });
   server.route(
@@ -345,6 +347,8 @@ void Dashboard::session(const Request& req, Response& res) {
   }
   if (req.method == "DELETE") {
     res.audit = json{{"session", "logout"}}.dump();
+    // Ended on the server too: the old cookie is refused from now on, wherever a copy of it is.
+    d_.sessions.revoke(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
     res.set_header("Set-Cookie", d_.sessions.clearCookie());
     send(res, 200, {{"auth", "none"}});
     return;
@@ -433,7 +437,8 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
   const bool home = action == "home";
   std::string station;
   if (!req.body.empty()) {
-    const json body = json::parse(req.body, nullptr, false);
+    const auto parsed = parseBoundedJson(req.body, {.maxBytes = 4096, .maxDepth = 4, .maxElements = 64});
+    const json body = parsed ? *parsed : json();
     if (!body.is_object() || (body.contains("station") && !body["station"].is_string())) {
       send(res, 400, invalidField("station", "expected a JSON object with an optional string \"station\""));
       return;

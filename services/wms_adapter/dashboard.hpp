@@ -39,7 +39,7 @@ nlohmann::json riskJson(const msg::RiskMap& m);
 nlohmann::json sitePictureOf(const std::string& path);
 
 struct DashboardDeps {
-  const BrowserSessions& sessions;  // the API's (AccessControl admits their cookies)
+  BrowserSessions& sessions;  // the API's (AccessControl admits their cookies)
   const StationMap& stations;
   TaskGateway& gateway;
   FleetView& view;

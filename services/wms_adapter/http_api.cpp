@@ -1,5 +1,6 @@
 #include "http_api.hpp"
 
+#include <arpa/inet.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -8,7 +9,9 @@
 #include <random>
 
 #include "closure_request.hpp"
+#include "fleet/core/bounded_json.hpp"
 #include "fleet/core/ids.hpp"
+#include "fleet/core/log_text.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/task_wire.hpp"
 
@@ -103,13 +106,15 @@ ApiSettings readApiSettings(Config& cfg) {
   auto& l = s.limits;
   auto h = cfg.child("http");
   h.rejectUnknownKeys({"host", "port", "token_file", "audit_log", "tls_certificate", "tls_key",
-                       "max_body_bytes", "max_batch", "ack_timeout_ms", "max_in_flight", "threads",
-                       "max_connections", "max_streams", "backlog", "request_timeout_ms", "rate_per_client",
-                       "rate_burst"});
+                       "max_body_bytes", "max_task_body_bytes", "max_batch", "ack_timeout_ms",
+                       "max_in_flight", "threads", "max_connections", "max_streams", "backlog",
+                       "request_timeout_ms", "rate_per_client", "rate_burst", "allow_unauthenticated"});
   s.host = h.string("host", s.host);
   s.port = static_cast<int>(h.integer("port", s.port, {0, 65535}));
   l.maxBodyBytes = static_cast<std::size_t>(
       h.integer("max_body_bytes", static_cast<std::int64_t>(l.maxBodyBytes), {1024, 256.0 * 1024 * 1024}));
+  s.maxTaskBodyBytes = static_cast<std::size_t>(h.integer(
+      "max_task_body_bytes", static_cast<std::int64_t>(s.maxTaskBodyBytes), {1024, 256.0 * 1024 * 1024}));
   s.maxBatch =
       static_cast<std::size_t>(h.integer("max_batch", static_cast<std::int64_t>(s.maxBatch), {1, 100000}));
   s.ackTimeoutMs = static_cast<int>(h.integer("ack_timeout_ms", s.ackTimeoutMs, {1, 600000}));
@@ -136,7 +141,22 @@ ApiSettings readApiSettings(Config& cfg) {
   } else if (const char* env = std::getenv("FLEET_WMS_TOKEN"); env != nullptr) {
     s.token = env;
   }
+  s.allowUnauthenticated = h.boolean("allow_unauthenticated", false);
+  if (s.tokenFile.empty() && s.token.empty() && !isLoopbackHost(s.host) && !s.allowUnauthenticated) {
+    h.problem("host", "\"" + s.host +
+                          "\" is reachable from other machines and no token is configured (token_file or "
+                          "FLEET_WMS_TOKEN): anyone could submit tasks. Configure tokens, listen on "
+                          "127.0.0.1, or set \"allow_unauthenticated\": true");
+  }
   return s;
+}
+
+bool isLoopbackHost(const std::string& host) {
+  if (host == "localhost" || host == "::1") {
+    return true;
+  }
+  in_addr a{};
+  return inet_pton(AF_INET, host.c_str(), &a) == 1 && (ntohl(a.s_addr) >> 24) == 127;
 }
 
 namespace {
@@ -199,10 +219,11 @@ void HttpApi::observe(const Request& req, const Response& res, double seconds) {
         .inc();
     requestSeconds_->observe(seconds);
     // The access log: client, who, method, path (no query string: short lines, nothing a client
-    // put there by mistake), status, body bytes, time. Never the Authorization header.
+    // put there by mistake), status, body bytes, time. Never the Authorization header. What the
+    // client chose is escaped as in the audit log: a decoded %0d%0a cannot start a forged line.
     spdlog::info("access {} {} {} {} {} {} {:.6f}s", req.remote_addr,
-                 req.principal.empty() ? "-" : req.principal, req.method, req.path, res.status,
-                 res.body.size(), seconds);
+                 req.principal.empty() ? "-" : escapeForLog(req.principal), escapeForLog(req.method),
+                 escapeForLog(req.path), res.status, res.body.size(), seconds);
   }
   audit_.record(req, res,
                 std::chrono::duration_cast<std::chrono::nanoseconds>(
@@ -225,6 +246,7 @@ void HttpApi::routes() {
   dashboard_ = std::make_unique<Dashboard>(
       server_, DashboardDeps{sessions_, stations_, gateway_, view_, clock_,
                              [this] { return nextRequestId(); }, settings_.ackTimeoutMs});
+  server_.limitBody("POST", "/v1/tasks", settings_.maxTaskBodyBytes, "http.max_task_body_bytes");
   server_.route("POST", "/v1/tasks", Scope::Submit,
                 [this](const Request& req, Response& res) { postTasks(req, res); });
   server_.route("DELETE", R"(/v1/tasks/([^/]+))", Scope::Submit,
@@ -305,6 +327,7 @@ void HttpApi::routes() {
     }
     reply(res, 200, body);
   });
+  server_.limitBody("PUT", R"(/v1/traffic/closures/([^/]+))", 64 * 1024, "the closure route's fixed limit");
   server_.route("PUT", R"(/v1/traffic/closures/([^/]+))", Scope::Operate,
                 [this](const Request& req, Response& res) { putClosure(req, res); });
   server_.route("DELETE", R"(/v1/traffic/closures/([^/]+))", Scope::Operate,
@@ -387,11 +410,18 @@ void HttpApi::routes() {
 }
 
 void HttpApi::postTasks(const Request& req, Response& res) {
-  json body = json::parse(req.body, nullptr, false);
-  if (body.is_discarded()) {
-    reply(res, 400, {{"error", "invalid_json"}, {"message", "the body is not valid JSON"}});
+  // Bounded before any document is built: a task is a handful of values, nested a few levels.
+  auto parsed_json = parseBoundedJson(
+      req.body,
+      {.maxBytes = settings_.maxTaskBodyBytes, .maxDepth = 16, .maxElements = 64 * settings_.maxBatch + 64});
+  if (!parsed_json) {
+    const bool invalid = parsed_json.error().code == "json.invalid";
+    reply(res, invalid ? 400 : 413,
+          {{"error", invalid ? "invalid_json" : parsed_json.error().code.substr(5)},
+           {"message", "the body is not acceptable: " + parsed_json.error().message}});
     return;
   }
+  json& body = *parsed_json;
   const bool batch = body.is_array() || (body.is_object() && body.contains("tasks"));
   const std::size_t n =
       body.is_array() ? body.size() : (batch && body["tasks"].is_array() ? body["tasks"].size() : 1);

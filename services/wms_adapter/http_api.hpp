@@ -28,14 +28,19 @@ struct ApiSettings {
   std::string tokenFile;  // tokens with names and scopes, re-read when it changes
   std::string token;      // one token with every scope (FLEET_WMS_TOKEN); neither = no authentication
   std::string auditLog;   // empty: audit lines go to the service log
+  bool allowUnauthenticated = false;  // a non-loopback host without tokens starts only with this
   TlsFiles tls;
   ServerLimits limits;
   std::size_t maxBatch = 1000;
+  std::size_t maxTaskBodyBytes = 256 * 1024;  // POST /v1/tasks (a batch of max_batch small tasks fits)
   int ackTimeoutMs = 5000;
 };
 
-/// Reads `http.*` keys; without `token_file`, the token comes from FLEET_WMS_TOKEN.
+/// Reads `http.*` keys; without `token_file`, the token comes from FLEET_WMS_TOKEN. A host other
+/// than loopback with no token is a problem unless `allow_unauthenticated` is true.
 ApiSettings readApiSettings(Config& cfg);
+/// True for 127.0.0.0/8, ::1 and "localhost": only this machine can connect.
+bool isLoopbackHost(const std::string& host);
 
 struct ApiCounters {
   std::atomic<std::int64_t> requests{0};

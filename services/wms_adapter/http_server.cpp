@@ -1,5 +1,8 @@
 #include "http_server.hpp"
 
+#include "fleet/core/config.hpp"
+#include "request_parse.hpp"
+
 #include <openssl/ssl.h>
 
 #include <boost/asio.hpp>
@@ -38,64 +41,19 @@ bool sameName(std::string_view a, std::string_view b) {
          });
 }
 
-int hexValue(char c) {
-  if (c >= '0' && c <= '9') {
-    return c - '0';
-  }
-  if (c >= 'a' && c <= 'f') {
-    return c - 'a' + 10;
-  }
-  if (c >= 'A' && c <= 'F') {
-    return c - 'A' + 10;
-  }
-  return -1;
-}
-
-/// %XX decoded (a malformed escape stays as it is); in a query, '+' is a space.
-std::string percentDecode(std::string_view s, bool plusIsSpace) {
-  std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '%' && i + 2 < s.size() && hexValue(s[i + 1]) >= 0 && hexValue(s[i + 2]) >= 0) {
-      out.push_back(static_cast<char>(hexValue(s[i + 1]) * 16 + hexValue(s[i + 2])));
-      i += 2;
-    } else if (plusIsSpace && s[i] == '+') {
-      out.push_back(' ');
-    } else {
-      out.push_back(s[i]);
-    }
-  }
-  return out;
-}
-
-void parseTarget(std::string_view target, Request& req) {
-  const auto q = target.find('?');
-  req.path = percentDecode(target.substr(0, q), false);
-  if (q == std::string_view::npos) {
-    return;
-  }
-  std::string_view rest = target.substr(q + 1);
-  while (!rest.empty()) {
-    const auto amp = rest.find('&');
-    const std::string_view pair = rest.substr(0, amp);
-    if (!pair.empty()) {
-      const auto eq = pair.find('=');
-      req.params.emplace(percentDecode(pair.substr(0, eq), true),
-                         eq == std::string_view::npos ? "" : percentDecode(pair.substr(eq + 1), true));
-    }
-    if (amp == std::string_view::npos) {
-      break;
-    }
-    rest = rest.substr(amp + 1);
-  }
-}
-
 Response errorResponse(int status, const std::string& code, const std::string& message) {
   Response r;
   r.status = status;
   r.set_content(nlohmann::json{{"error", code}, {"message", message}}.dump(), "application/json");
   return r;
 }
+
+struct BodyLimit {
+  std::string method;
+  std::regex pattern;
+  std::size_t bytes;
+  std::string configKey;
+};
 
 struct Route {
   std::string method;
@@ -149,6 +107,7 @@ struct HttpServer::Impl {
 
   ServerLimits limits;
   std::vector<Route> routes;
+  std::vector<BodyLimit> bodyLimits;
   Gate gate;
   Observer observer;
   ServerStats stats;
@@ -175,6 +134,16 @@ struct HttpServer::Impl {
   tcp::acceptor acceptor{io};
   net::steady_timer acceptRetry{io};
 
+  /// The body limit of a request (the route's, else the server's) and the setting that says so.
+  [[nodiscard]] std::pair<std::size_t, std::string> bodyLimitFor(const std::string& method,
+                                                                 const std::string& path) const {
+    for (const auto& l : bodyLimits) {
+      if (l.method == method && std::regex_match(path, l.pattern)) {
+        return {std::min(l.bytes, limits.maxBodyBytes), l.configKey};
+      }
+    }
+    return {limits.maxBodyBytes, "http.max_body_bytes"};
+  }
   void accept();
   void startSession(tcp::socket socket);
   void dispatch(const std::shared_ptr<Request>& req, std::function<void(Response)> done);
@@ -344,9 +313,31 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
     // (slowloris) is cut off, however often it sends.
     tcp().expires_after(milliseconds(refuse_ ? std::min(2000, server_.limits.requestTimeoutMs)
                                              : server_.limits.requestTimeoutMs));
+    bodyLimit_ = {server_.limits.maxBodyBytes, "http.max_body_bytes"};
+    // The head first: the route's own body limit applies to its body.
+    bhttp::async_read_header(
+        stream_, buffer_, *parser_,
+        [self = this->shared_from_this()](beast::error_code ec, std::size_t) { self->onHeader(ec); });
+  }
+
+  void onHeader(beast::error_code ec) {
+    if (ec) {
+      onRead(ec);
+      return;
+    }
+    Request target;
+    const auto t = parser_->get().target();
+    parseTarget(std::string_view(t.data(), t.size()), target);
+    bodyLimit_ = server_.bodyLimitFor(std::string(parser_->get().method_string()), target.path);
+    // A declared length was checked against the server's limit with the head: check the route's.
+    if (const auto declared = parser_->content_length(); declared && *declared > bodyLimit_.first) {
+      onRead(bhttp::error::body_limit);
+      return;
+    }
+    parser_->body_limit(bodyLimit_.first);
     bhttp::async_read(
         stream_, buffer_, *parser_,
-        [self = this->shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+        [self = this->shared_from_this()](beast::error_code e, std::size_t) { self->onRead(e); });
   }
 
   /// The request as far as it was read (the head may be all there is).
@@ -384,9 +375,9 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
       const bool body = ec == bhttp::error::body_limit;
       finish(req,
              errorResponse(body ? 413 : 431, "too_large",
-                           body ? "the body is larger than the limit of " +
-                                      std::to_string(server_.limits.maxBodyBytes) +
-                                      " bytes (http.max_body_bytes)"
+                           body ? "the body is larger than the limit of " + std::to_string(bodyLimit_.first) +
+                                      " bytes for " + req->method + " " + req->path + " (" +
+                                      bodyLimit_.second + ")"
                                 : "the request head is larger than " +
                                       std::to_string(server_.limits.maxHeaderBytes) + " bytes"),
              true);
@@ -566,6 +557,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   std::string remote_;
   beast::flat_buffer buffer_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+  std::pair<std::size_t, std::string> bodyLimit_;  // of the request being read, and its setting
   unsigned version_ = 11;
   bool keepAlive_ = true;
   SteadyClock::time_point started_ = SteadyClock::now();
@@ -726,15 +718,20 @@ HttpServer::HttpServer(ServerLimits limits, TlsFiles tls) : impl_(std::make_uniq
   ctx.set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
                   ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 | ssl::context::single_dh_use);
   SSL_CTX_set_min_proto_version(ctx.native_handle(), TLS1_2_VERSION);
+  // A configuration error (exit 2), naming the key and the file.
   try {
     ctx.use_certificate_chain_file(tls.certificateFile);
   } catch (const std::exception& e) {
-    throw std::runtime_error("http.tls_certificate: cannot use \"" + tls.certificateFile + "\": " + e.what());
+    throw ConfigError({"http.tls_certificate: cannot use \"" + tls.certificateFile + "\": " + e.what()});
   }
   try {
     ctx.use_private_key_file(tls.privateKeyFile, ssl::context::pem);
   } catch (const std::exception& e) {
-    throw std::runtime_error("http.tls_key: cannot use \"" + tls.privateKeyFile + "\": " + e.what());
+    throw ConfigError({"http.tls_key: cannot use \"" + tls.privateKeyFile + "\": " + e.what()});
+  }
+  if (SSL_CTX_check_private_key(ctx.native_handle()) != 1) {
+    throw ConfigError({"http.tls_key: \"" + tls.privateKeyFile + "\" is not the key of the certificate \"" +
+                       tls.certificateFile + "\" (http.tls_certificate)"});
   }
 }
 
@@ -743,6 +740,11 @@ HttpServer::~HttpServer() = default;
 void HttpServer::route(const std::string& method, const std::string& pattern, Scope scope, Handler handler,
                        Run run) {
   impl_->routes.push_back({method, std::regex(pattern), scope, std::move(handler), run});
+}
+
+void HttpServer::limitBody(const std::string& method, const std::string& pattern, std::size_t bytes,
+                           std::string configKey) {
+  impl_->bodyLimits.push_back({method, std::regex(pattern), bytes, std::move(configKey)});
 }
 
 void HttpServer::setGate(Gate gate) {

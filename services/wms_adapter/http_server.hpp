@@ -9,7 +9,8 @@
 // - hold a thread by being slow: sockets are read and written asynchronously on one I/O thread, and
 //   a request (head and body) must arrive within `requestTimeoutMs` of the connection waiting for
 //   it, else the connection is closed;
-// - send an unbounded body: Beast's parser stops at `maxBodyBytes` whether the body comes with a
+// - send an unbounded body: Beast's parser stops at `maxBodyBytes` (or the route's limitBody) whether the
+// body comes with a
 //   Content-Length (refused before it is read) or chunked (refused at the chunk that crosses it): 413;
 // - fill the worker threads: handlers run on `threads` workers; beyond `maxInFlight` requests
 //   being handled, a request gets 429 with Retry-After at once instead of waiting;
@@ -148,6 +149,11 @@ class HttpServer {
   /// `pattern` is an ECMAScript regex matched against the whole decoded path. Call before serve().
   void route(const std::string& method, const std::string& pattern, Scope scope, Handler handler,
              Run run = Run::Worker);
+  /// Bodies of requests to `method` on paths matching `pattern` are limited to `bytes` (at most
+  /// maxBodyBytes): a larger one is refused 413 (as soon as its length or a chunk says so), the
+  /// message naming `configKey`, the setting that raises it. Call before serve().
+  void limitBody(const std::string& method, const std::string& pattern, std::size_t bytes,
+                 std::string configKey);
   void setGate(Gate gate);
   void setObserver(Observer observer);
 

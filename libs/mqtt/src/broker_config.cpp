@@ -15,6 +15,7 @@ std::string mosquittoConf(const BrokerConfig& config) {
   s += "password_file " + config.password_file + "\n";
   s += "acl_file " + config.acl_file + "\n";
   s += "persistence false\n";
+  s += "message_size_limit " + std::to_string(config.message_size_limit) + "\n";
   s += config.log_file.empty() ? std::string("log_dest stderr\n") : "log_dest file " + config.log_file + "\n";
   if (!config.run_as_user.empty()) {
     s += "user " + config.run_as_user + "\n";

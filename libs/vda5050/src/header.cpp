@@ -1,5 +1,6 @@
 #include "fleet/vda5050/header.hpp"
 
+#include <cstdio>
 #include <ctime>
 #include <nlohmann/json.hpp>
 
@@ -10,6 +11,17 @@ namespace fleet::vda5050 {
 std::string topicName(const std::string& interface_name, const std::string& manufacturer,
                       const std::string& serial, const std::string& topic) {
   return interface_name + "/" + kMajorVersion + "/" + manufacturer + "/" + serial + "/" + topic;
+}
+
+bool speaksVersion(const std::string& version) {
+  int major = -1;
+  int minor = -1;
+  int consumed = 0;
+  if (std::sscanf(version.c_str(), "%3d.%3d%n", &major, &minor, &consumed) != 2) {
+    return false;
+  }
+  const char next = version.c_str()[consumed];
+  return major == 2 && minor >= 0 && minor <= 1 && (next == '\0' || next == '.');
 }
 
 std::string vehicleSubtree(const std::string& interface_name, const std::string& manufacturer,

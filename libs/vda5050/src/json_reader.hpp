@@ -12,7 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "fleet/core/bounded_json.hpp"
+
 namespace fleet::vda5050::detail {
+
+/// No message of the standard nests deeper or holds more values (a state with a long order is a
+/// few thousand); the registry's byte limit (RegistryLimits) comes first.
+inline constexpr JsonLimits kMessageJsonLimits{.maxBytes = 1 << 20, .maxDepth = 16, .maxElements = 100'000};
 
 class BadField : public std::runtime_error {
  public:
@@ -135,13 +141,17 @@ Expected<T> parseAs(const nlohmann::json& j, const char* what, F&& read) {
   }
 }
 
-/// The JSON of a message's text, or an error saying the text is not JSON.
+/// The JSON of a message's text, parsed within kMessageJsonLimits (no message of the standard
+/// nests deeper or holds more values), or an error saying the text is not JSON or which limit it
+/// crossed (code "vda5050.json.too_large", ".too_deep", ".too_many_elements").
 inline Expected<nlohmann::json> jsonOf(const std::string& text, const char* what) {
-  auto j = nlohmann::json::parse(text, nullptr, false);
-  if (j.is_discarded()) {
-    return unexpected("vda5050.bad_json", std::string(what) + ": not valid JSON");
+  auto j = parseBoundedJson(text, kMessageJsonLimits);
+  if (!j) {
+    const bool invalid = j.error().code == "json.invalid";
+    return unexpected(invalid ? "vda5050.bad_json" : "vda5050." + j.error().code,
+                      std::string(what) + ": " + (invalid ? "not valid JSON" : j.error().message));
   }
-  return j;
+  return std::move(*j);
 }
 
 /// parse(json of text), or the error saying the text is not JSON.

@@ -3,7 +3,8 @@
 read-only root filesystem and no capabilities, requests and limits, liveness on /livez and readiness
 on /readyz at the port the service serves them (FLEET_METRICS_PORT), images tagged with the project
 version; the fleet manager one replica, strategy Recreate, its database on the PersistentVolumeClaim;
-every ConfigMap, Secret, claim and config file referenced exists; every DDS peer is a headless
+every ConfigMap, Secret, claim and config file referenced exists; a NetworkPolicy admits the ops
+ports from monitoring pods and the nodes only, and liveness probes survive a busy node; every DDS peer is a headless
 Service selecting a Deployment; the shipped site passes `fleetctl site check`. Then the closest to
 running them that this machine offers: each Deployment's binary from BUILD_DIR started with the
 manifest's arguments and the ConfigMap's and Secret's files (paths moved to a temporary folder, DDS
@@ -77,6 +78,10 @@ for name, dep in deployments.items():
         for probe, path in (("livenessProbe", "/livez"), ("readinessProbe", "/readyz")):
             g = c.get(probe, {}).get("httpGet", {})
             check(g.get("path") == path and g.get("port") in ("ops", ports.get("ops")), f"{where}: {probe} not {path} on ops")
+        live = c.get("livenessProbe", {})
+        # A busy node answers late: a restart only after a minute of probes failing, each given 10 s.
+        check(live.get("timeoutSeconds", 1) >= 10 and live.get("timeoutSeconds", 1) * live.get("failureThreshold", 3) >= 60,
+              f"{where}: livenessProbe restarts a merely busy pod (timeoutSeconds x failureThreshold < 60 s)")
         mounts = {m["mountPath"]: m for m in c.get("volumeMounts", [])}
         for m in mounts.values():
             check(m["name"] in vols, f"{where}: mount of unknown volume {m['name']}")
@@ -94,6 +99,28 @@ for name, dep in deployments.items():
             db = args[args.index("--db") + 1]
             m = mounts.get(os.path.dirname(db))
             check(m is not None and "persistentVolumeClaim" in vols[m["name"]], "fleet-manager: database not on the claim")
+
+# The ops ports (no authentication) reachable only by monitoring pods and the nodes (kubelet probes).
+policies = by_kind.get("NetworkPolicy", {})
+ops_ports = {p["containerPort"] for d in deployments.values() for c in d["spec"]["template"]["spec"]["containers"]
+             for p in c.get("ports", []) if p["name"] == "ops"}
+guarded = set()
+for name, pol in policies.items():
+    spec = pol["spec"]
+    check("Ingress" in spec.get("policyTypes", []), f"NetworkPolicy {name}: no Ingress policy type")
+    if spec.get("podSelector", {}).get("matchLabels", {}).items() <= {"app": "fleet"}.items():
+        for rule in spec.get("ingress", []):
+            ports = {p.get("port") for p in rule.get("ports", [])}
+            if ports & ops_ports:
+                sources = rule.get("from", [])
+                check(sources and all("ipBlock" in f or f.get("podSelector", {}).get("matchLabels", {}).get(
+                    "fleet.io/monitoring") == "true" for f in sources),
+                      f"NetworkPolicy {name}: the ops ports open to more than monitoring pods and the nodes")
+                guarded |= ports & ops_ports
+            elif not rule.get("ports") or any(p.get("port") is None and p.get("protocol", "TCP") == "TCP"
+                                              for p in rule["ports"]):
+                problems.append(f"NetworkPolicy {name}: a rule admits every TCP port (the ops ports too)")
+check(guarded == ops_ports, f"no NetworkPolicy limits the ops ports {sorted(ops_ports - guarded)} to monitoring")
 
 # DDS peers: headless Services that select a Deployment's pods.
 dds = configmaps["fleet-config"]["data"]["cyclonedds.xml"]

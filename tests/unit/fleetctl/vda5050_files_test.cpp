@@ -102,6 +102,8 @@ TEST_F(Vda5050Files, OnThisMachineTheBrokerLogsBesideItsFilesOnLoopback) {
   ASSERT_TRUE(fleet::ctl::writeVda5050Files(f));
   const std::string conf = slurp(dir_ / "mosquitto.conf");
   EXPECT_NE(conf.find("listener 18832 127.0.0.1\n"), std::string::npos) << conf;
+  // A vehicle (or anyone with its credentials) cannot make the broker carry huge messages.
+  EXPECT_NE(conf.find("message_size_limit 262144\n"), std::string::npos) << conf;
   EXPECT_NE(conf.find("log_dest file " + (dir_ / "mosquitto.log").string()), std::string::npos) << conf;
   const auto bridge = json::parse(slurp(dir_ / "vda5050_bridge.json"));
   EXPECT_FALSE(bridge["broker"].contains("host"));  // the bridge's default, 127.0.0.1

@@ -6,7 +6,14 @@
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <thread>
+#include <vector>
 
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/ops_server.hpp"
@@ -65,6 +72,99 @@ TEST(OpsServer, ServesMetricsAndProbesAndRefusesATakenPort) {
   ASSERT_TRUE(err.has_value());
   EXPECT_NE(err->find("cannot listen on 127.0.0.1:" + std::to_string(ops.port())), std::string::npos) << *err;
   EXPECT_TRUE(second.start({"127.0.0.1", 70000}).has_value());
+}
+
+namespace {
+
+/// A client that sends a request line, then one header byte every 50 ms, and connects again
+/// whenever the server closes it: it never finishes its head.
+int slowConnect(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  const std::string line = "GET /livez HTTP/1.1\r\nHost: x\r\n";
+  ::send(fd, line.data(), line.size(), MSG_NOSIGNAL);
+  return fd;
+}
+
+}  // namespace
+
+TEST(OpsServer, SlowClientsTricklingTheirHeadsNeverKeepLivezWaiting) {
+  service::Health h;
+  metrics::Registry reg;
+  service::OpsServer server(reg, h);
+  ASSERT_FALSE(server.start({"127.0.0.1", 0}).has_value());
+  constexpr int kSlow = 12;  // three times the worker threads the ops port used to have
+  std::atomic<bool> stop{false};
+  std::vector<std::thread> slow;
+  for (int i = 0; i < kSlow; ++i) {
+    slow.emplace_back([&, port = server.port()] {
+      int fd = slowConnect(port);
+      while (!stop) {
+        std::this_thread::sleep_for(50ms);
+        if (fd < 0 || ::send(fd, "X", 1, MSG_NOSIGNAL) != 1) {
+          if (fd >= 0) {
+            ::close(fd);
+          }
+          fd = slowConnect(port);
+        }
+      }
+      if (fd >= 0) {
+        ::close(fd);
+      }
+    });
+  }
+  std::this_thread::sleep_for(300ms);  // every slow client connected and trickling
+  // Probes through the trickle, past the header timeout (the slow ones are cut off and come back).
+  httplib::Client c("127.0.0.1", server.port());
+  c.set_connection_timeout(3);
+  c.set_read_timeout(3);
+  int answered = 0;
+  for (int i = 0; i < 6; ++i) {
+    auto r = c.Get("/livez");
+    answered += r && r->status == 200 ? 1 : 0;
+    std::this_thread::sleep_for(400ms);
+  }
+  stop = true;
+  for (auto& t : slow) {
+    t.join();
+  }
+  EXPECT_EQ(answered, 6);
+  EXPECT_GE(server.timedOut(), kSlow) << "every slow client was cut off at the header timeout";
+  // A connection table full of slow ones makes room for the newest.
+  service::OpsServer small(reg, h, {.headerTimeoutMs = 60000, .maxConnections = 4});
+  ASSERT_FALSE(small.start({"127.0.0.1", 0}).has_value());
+  std::vector<int> held;
+  for (int i = 0; i < 8; ++i) {
+    held.push_back(slowConnect(small.port()));
+  }
+  httplib::Client c2("127.0.0.1", small.port());
+  c2.set_read_timeout(3);
+  auto r = c2.Get("/livez");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_GE(small.evicted(), 4);
+  for (int fd : held) {
+    ::close(fd);
+  }
+}
+
+TEST(OpsServer, AnswersOtherMethodsPathsAndLargeHeadsWithoutServingThem) {
+  service::Health h;
+  metrics::Registry reg;
+  service::OpsServer server(reg, h);
+  ASSERT_FALSE(server.start({"127.0.0.1", 0}).has_value());
+  httplib::Client c("127.0.0.1", server.port());
+  EXPECT_EQ(c.Get("/nothing")->status, 404);
+  EXPECT_EQ(c.Post("/livez", "x", "text/plain")->status, 405);
+  httplib::Headers big{{"X-Big", std::string(10000, 'a')}};
+  EXPECT_EQ(c.Get("/livez", big)->status, 431);
 }
 
 TEST(ServiceOps, RejectedSamplesAreCountedByReasonWithoutTheSender) {

@@ -220,3 +220,69 @@ TEST(ApiConfig, AnUnusableTokenFileOrHalfATlsPairIsAConfigError) {
   }
   fs::remove_all(dir);
 }
+
+TEST(ApiConfig, AnOpenHostWithoutTokensIsRefusedUnlessAllowedOutright) {
+  ::unsetenv("FLEET_WMS_TOKEN");
+  auto open = Config::fromJson(json{{"http", {{"host", "0.0.0.0"}}}}, "wms.json");
+  readApiSettings(open);
+  try {
+    open.finish();
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("http.host"));
+    EXPECT_THAT(e.what(), HasSubstr("allow_unauthenticated"));
+  }
+  auto allowed =
+      Config::fromJson(json{{"http", {{"host", "10.1.2.3"}, {"allow_unauthenticated", true}}}}, "wms.json");
+  EXPECT_TRUE(readApiSettings(allowed).allowUnauthenticated);
+  EXPECT_NO_THROW(allowed.finish());
+  for (const char* host : {"127.0.0.1", "127.0.0.53", "::1", "localhost"}) {
+    auto local = Config::fromJson(json{{"http", {{"host", host}}}}, "wms.json");
+    readApiSettings(local);
+    EXPECT_NO_THROW(local.finish()) << host;
+  }
+}
+
+TEST(ApiConfig, AMissingCertificateAMismatchedKeyOrAnUnwritableAuditLogIsAConfigErrorNamingIt) {
+  const auto dir = fs::temp_directory_path() / ("wms-tls-" + std::to_string(std::random_device{}()));
+  fs::create_directories(dir);
+  const std::string cmd = std::string(FLEET_SOURCE_DIR) + "/scripts/dds-security https " +
+                          (dir / "site").string() +
+                          " wms-adapter > /dev/null && openssl genpkey -algorithm EC -pkeyopt "
+                          "ec_paramgen_curve:P-256 -out " +
+                          (dir / "other.pem").string() + " 2> /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const StationMap st = stations();
+  FakeGateway gateway;
+  FleetView view;
+  WallClock clock;
+  auto problemOf = [&](const ApiSettings& s) -> std::string {
+    try {
+      HttpApi api(s, st, gateway, view, clock);
+      return "";
+    } catch (const ConfigError& e) {  // main() exits 2 on a ConfigError
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("not a ConfigError: ") + e.what();
+    }
+  };
+  ApiSettings s;
+  s.tls.certificateFile = (dir / "missing.pem").string();
+  s.tls.privateKeyFile = (dir / "site/https/wms-adapter/key.pem").string();
+  EXPECT_THAT(problemOf(s),
+              ::testing::StartsWith("invalid configuration: http.tls_certificate: cannot use \"" +
+                                    s.tls.certificateFile));
+  s.tls.certificateFile = (dir / "site/https/wms-adapter/cert.pem").string();
+  s.tls.privateKeyFile = (dir / "other.pem").string();
+  const auto mismatch = problemOf(s);
+  EXPECT_THAT(mismatch, ::testing::StartsWith("invalid configuration: http.tls_key: "));
+  EXPECT_THAT(mismatch, HasSubstr(s.tls.privateKeyFile));
+  EXPECT_THAT(mismatch, HasSubstr("mismatch"));
+  s.tls.privateKeyFile = (dir / "site/https/wms-adapter/key.pem").string();
+  EXPECT_EQ(problemOf(s), "") << "the matching pair";
+  ApiSettings a;
+  a.auditLog = (dir / "no-such-dir/audit.log").string();
+  EXPECT_THAT(problemOf(a),
+              ::testing::StartsWith("invalid configuration: http.audit_log: cannot open \"" + a.auditLog));
+  fs::remove_all(dir);
+}

@@ -5,6 +5,7 @@
 // bridge) may use the whole interface. Text only; writing files and hashing passwords
 // (mosquitto_passwd) is the caller's business.
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -30,10 +31,13 @@ struct BrokerConfig {
   /// mosquitto started as root drops to the user "mosquitto" unless told otherwise; set this to
   /// "root" when the files it reads belong to root and are private.
   std::string run_as_user;
+  /// Bytes of the largest message the broker takes (larger ones are dropped there): the bridge's
+  /// own limit (vda5050_bridge max_message_bytes) is the same by default.
+  std::size_t message_size_limit = 256 * 1024;
   std::vector<BrokerUser> users;
 };
 
-/// mosquitto.conf text (listener, password and ACL file, no persistence).
+/// mosquitto.conf text (listener, password and ACL file, message size limit, no persistence).
 std::string mosquittoConf(const BrokerConfig& config);
 /// ACL file text: one "user" block per user with its topic filters.
 std::string aclText(const BrokerConfig& config);

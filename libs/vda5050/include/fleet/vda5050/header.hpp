@@ -23,6 +23,10 @@ struct Header {
   std::string serialNumber;
 };
 
+/// True when a message of protocol version `version` ("2.1.0") is one this master control speaks:
+/// major 2, minor 0 or 1 (the minor versions it knows; a later one may mean what it cannot read).
+bool speaksVersion(const std::string& version);
+
 /// "uagv/v2/<manufacturer>/<serialNumber>/<topic>".
 std::string topicName(const std::string& interface_name, const std::string& manufacturer,
                       const std::string& serial, const std::string& topic);

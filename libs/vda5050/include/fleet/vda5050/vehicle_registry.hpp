@@ -40,6 +40,22 @@ struct VehicleView {
   std::string map_id;
 };
 
+/// What the registry refuses at its edge before a message's content counts.
+struct RegistryLimits {
+  std::size_t maxMessageBytes = 256 * 1024;  // the broker's message_size_limit by default
+  /// Where a vehicle can plausibly be (m): the site's extent and a margin. Until the roadmap is
+  /// known, a coarse bound of +-1e5 m; a position outside it (or not finite) is refused.
+  double minX = -1e5;
+  double minY = -1e5;
+  double maxX = 1e5;
+  double maxY = 1e5;
+};
+
+/// Problems with a configured vehicle list, each naming the key ("vehicles[1].serial: ..."):
+/// MQTT wildcards ('#', '+') or '/' in a manufacturer or serial (its topics would be others'),
+/// empty names, and two vehicles with one identity or one robot id.
+std::vector<std::string> vehicleEntryProblems(const std::vector<VehicleEntry>& vehicles);
+
 struct RegistryOutcome {
   bool accepted = false;
   std::string robot_id;  // empty when the message matched no vehicle
@@ -49,7 +65,10 @@ struct RegistryOutcome {
 
 class VehicleRegistry {
  public:
-  VehicleRegistry(std::string interface_name, std::string map_id, std::vector<VehicleEntry> vehicles);
+  VehicleRegistry(std::string interface_name, std::string map_id, std::vector<VehicleEntry> vehicles,
+                  RegistryLimits limits = {});
+  /// The site's extent (from the roadmap) with a margin: where a state's agvPosition may be.
+  void setSiteBounds(double minX, double minY, double maxX, double maxY);
 
   /// One message from the broker.
   RegistryOutcome onMessage(const std::string& topic, const std::string& payload);
@@ -59,15 +78,21 @@ class VehicleRegistry {
   [[nodiscard]] const VehicleView* find(const std::string& robot_id) const;
   [[nodiscard]] const std::map<std::string, VehicleView>& vehicles() const { return vehicles_; }
   /// Refusals by kind: "unknown_serial", "bad_message", "wrong_serial", "other_map",
-  /// "node_never_ordered", "unknown_topic".
+  /// "node_never_ordered", "unknown_topic", "too_large" (bytes or JSON shape past the limits),
+  /// "unsupported_version", "implausible_position", "implausible_battery".
   [[nodiscard]] const std::map<std::string, std::uint64_t>& refusals() const { return refusals_; }
 
  private:
   RegistryOutcome refuse(const std::string& kind, VehicleView* v, std::string reason);
+  /// A parse failure: "too_large" when a limit was crossed, else "bad_message".
+  RegistryOutcome refuseUnread(VehicleView* v, const Error& e);
+  /// Why a parsed state is not plausible (version, position, battery), with its kind; nothing if it is.
+  [[nodiscard]] std::optional<std::pair<std::string, std::string>> implausible(const State& s) const;
   bool setHealth(VehicleView& v, VehicleHealth h, std::string reason);
 
   std::string interface_;
   std::string map_id_;
+  RegistryLimits limits_;
   std::map<std::string, VehicleView> vehicles_;         // by robot id
   std::map<std::string, std::string> by_topic_prefix_;  // "uagv/v2/m/s/" -> robot id
   std::map<std::string, std::uint64_t> refusals_;
