@@ -173,13 +173,33 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   };
 
   double dt = world.dt;
+  // In lockstep a release is acted on in the step after the one it was made in (stamped before
+  // this step's time), whatever DDS delivered first: the traffic manager writes its StepDone only
+  // once every agent has its releases, so they are all here by then, and a release of this step
+  // that came early waits. (Lockstep runs are then byte-identical with a traffic manager in them.)
+  std::vector<msg::TrafficRelease> laterReleases;
+  auto releasesFor = [&](std::int64_t now) {
+    auto in = releases.take();
+    if (!lockstep) {
+      return in;
+    }
+    laterReleases.insert(laterReleases.end(), std::make_move_iterator(in.begin()),
+                         std::make_move_iterator(in.end()));
+    std::vector<msg::TrafficRelease> due;
+    std::vector<msg::TrafficRelease> later;
+    for (auto& r : laterReleases) {
+      (r.stamp_ns < now ? due : later).push_back(std::move(r));
+    }
+    laterReleases = std::move(later);
+    return due;
+  };
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
     // Taken and handed over topic by topic, in the node's order.
     node.onFrames(frames.take());
     node.onRobotStates(others.take());
     node.onAssignments(assignments.take());
-    node.onReleases(releases.take());
+    node.onReleases(releasesFor(now));
     node.onRiskMaps(riskMaps.take());
     const auto& outs = node.step(now, dt);
     for (const auto& r : node.takeRefusals()) {
@@ -260,6 +280,10 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
         msg::StepDone done{id, c.step, {}};
         for (const auto& out : node.outputs()) {
           done.commands.push_back({out.command.robot_id, out.command.seq});
+        }
+        // The traffic manager has this step's progress reports before the next step begins.
+        if (!trafficProgress.waitForAcks(std::chrono::seconds(2))) {
+          badInput.warn("traffic_progress", "TrafficProgress not acknowledged within 2 s of a lockstep step");
         }
         stepDone.write(done);
         if (!firstCycle) {

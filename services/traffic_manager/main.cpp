@@ -57,8 +57,12 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   auto& robotsPlaced =
       ops.registry().gauge("traffic_manager_robots", "Robots by state in the planner", {{"state", "placed"}});
   WallClock wall;
-  // The incarnation: robots tell a restarted manager's releases from the previous one's.
-  const auto epoch = static_cast<std::uint32_t>((wall.nowNs() / 1'000'000) & 0x7fffffff) | 1U;
+  // The incarnation: robots tell a restarted manager's releases from the previous one's. In
+  // lockstep it comes from the seed, so that two runs are byte-identical; a restarted one takes the
+  // next after the robots' (TrafficNode::onProgress, before its first release).
+  const auto epoch = settings.lockstep
+                         ? static_cast<std::uint32_t>((settings.traffic.pibt.seed % 0x3fffffffULL) * 2 + 1)
+                         : static_cast<std::uint32_t>((wall.nowNs() / 1'000'000) & 0x7fffffff) | 1U;
   trafficmgr::TrafficNode node(site, settings, epoch);
   const auto& rm = node.roadmap();
   spdlog::info("traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}", site.name,
@@ -153,6 +157,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
       }
     }
   };
+  std::vector<msg::TrafficProgress> laterProgress;
   auto ingest = [&] {
     takeClosures();
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
@@ -163,13 +168,25 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         badInput.warn("risk_map", "RiskMap ignored: " + risk.error().message);
       }
     }
-    for (const auto& m : service::admitted(progress.take(), rejections, badInput)) {
+    // In lockstep a report counts from the step after the one it was made in (stamped before this
+    // step's time), whatever DDS delivered first: each agent writes its StepDone only once the
+    // traffic manager has its reports, so they are all here by then.
+    auto in = service::admitted(progress.take(), rejections, badInput);
+    laterProgress.insert(laterProgress.end(), std::make_move_iterator(in.begin()),
+                         std::make_move_iterator(in.end()));
+    std::vector<msg::TrafficProgress> later;
+    for (auto& m : laterProgress) {
       if (!haveClock)
         continue;
+      if (settings.lockstep && m.stamp_ns >= now) {
+        later.push_back(std::move(m));
+        continue;
+      }
       if (auto problem = node.onProgress(m, now)) {
         badInput.warn("progress:" + m.robot_id, *problem);
       }
     }
+    laterProgress = std::move(later);
   };
   auto cycle = [&] {
     if (!roadmapSent) {
@@ -211,8 +228,13 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
           cycle();
           nextTick += period * std::max<std::int64_t>(1, (now - nextTick) / period + 1);
         }
-        if (settings.lockstep && c.lockstep)
+        if (settings.lockstep && c.lockstep) {
+          // The agents have this step's releases before the next step begins.
+          if (!releases.waitForAcks(2s)) {
+            badInput.warn("release", "TrafficRelease not acknowledged within 2 s of a lockstep step");
+          }
           stepDone.write({id, c.step});
+        }
       }
       ingest();
     } else {

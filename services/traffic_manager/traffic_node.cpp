@@ -308,6 +308,9 @@ std::optional<std::string> TrafficNode::onProgress(const msg::TrafficProgress& p
     return refuse("node " + std::to_string(p.node) + " is not on the roadmap (0.." +
                   std::to_string(g.size() - 1) + ")");
   }
+  if (counters_.releases == 0 && p.epoch >= epoch_) {
+    epoch_ = p.epoch + 1;  // a robot follows a later incarnation's releases (a seeded epoch restarted)
+  }
   Robot& r = robots_[p.robot_id];
   r.last = p;
   r.heardNs = nowNs;
