@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Multi-host test: three network namespaces ("hosts" of this test's own making) joined by veth
-# pairs to a bridge in a fourth, on the private subnet 10.200.$NET.0/24. The fleet manager runs in
-# host A, the simulator, robot agent and risk map in host B, the WMS adapter in host C; every
-# process uses the LAN profile deploy/cyclonedds-lan.xml (unicast discovery to the three hosts'
-# addresses, no multicast, pinned to the host's veth). A task posted to the WMS adapter's HTTP API
-# in host C must reach `done`. Namespaces and processes are removed on every exit. Exit 77 (ctest
-# skip) only when `ip netns add` is not permitted.
+# pairs to a bridge in a fourth, on the private subnet 10.200.$NET.0/24. The fleet manager and the
+# traffic manager run in host A, the simulator, robot agent and risk map in host B, the WMS adapter
+# in host C; every process uses the LAN profile deploy/cyclonedds-lan.xml (unicast discovery to the
+# three hosts' addresses, no multicast, pinned to the host's veth). A task posted to the WMS
+# adapter's HTTP API in host C must reach `done`, the robot driving the traffic manager's releases
+# across the hosts. Namespaces and processes are removed on every exit. Exit 77 (ctest skip) only
+# when `ip netns add` is not permitted.
 # With "secure", DDS Security is on: `scripts/dds-security deployment` makes the identities and each
 # process adds its own security.xml to the LAN profile; a process in host C without a certificate
 # then writes Tasks for 3 s, and none of them may reach the manager.
@@ -66,6 +67,7 @@ cat >"$dir/manager.json" <<JSON
 JSON
 echo "{\"site\": \"$scenario\", \"grid\": {\"resolution\": 0.1}, \"clock\": \"sim\", \"lockstep\": true, \"rate_hz\": 2}" \
   >"$dir/risk_map.json"
+echo "{\"site\": \"$scenario\", \"clock\": \"sim\", \"lockstep\": true}" >"$dir/traffic_manager.json"
 printf 'id,kind,pickup,dropoff,load_s,unload_s\njob-1,transport,P-2,D-1,2,2\n' >"$dir/tasks.csv"
 
 if ((SECURE)); then
@@ -73,7 +75,7 @@ if ((SECURE)); then
     { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
 fi
 declare -A identity=([fleet_manager]=fleet-manager [wms_adapter]=wms-adapter [risk_map]=risk-map
-  [robot_agent]=agents [fleet-sim]=simulator)
+  [traffic_manager]=traffic-manager [robot_agent]=agents [fleet-sim]=simulator)
 on() {  # on HOST NAME CMD...: a service in that host's namespace with the LAN profile
   local h=$1 name=$2 uri="file://$SRC/deploy/cyclonedds-lan.xml"
   shift 2
@@ -84,6 +86,8 @@ on() {  # on HOST NAME CMD...: a service in that host's namespace with the LAN p
   pids+=($!)
 }
 on A fleet_manager "$B/services/fleet_manager/fleet_manager" --config "$dir/manager.json" --log-level info
+on A traffic_manager "$B/services/traffic_manager/traffic_manager" --config "$dir/traffic_manager.json" \
+  --id traffic_manager --log-level info
 on C wms_adapter "$B/services/wms_adapter/wms_adapter" --stations "$scenario" --port 8080 --log-level info
 on B risk_map "$B/services/risk_map/risk_map" --config "$dir/risk_map.json" --id risk_map --log-level info
 on B robot_agent "$B/services/robot_agent/robot_agent" --scenario "$scenario" --clock lockstep --id agents \
@@ -95,7 +99,7 @@ grep -q 'submitted 1 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapte
 # The manager runs on the wall clock and learns the robot only once the simulator steps, while
 # lockstep runs ~250x real time: the assignment can land ~90 s into the simulation (it did once,
 # and 150 s then left the robot 56 s for a ~75 s task). 600 s leaves room and takes ~2 s of wall time.
-on B fleet-sim "$B/sim/src/fleet-sim" --scenario "$scenario" --clock lockstep --participants 2 --duration 600 \
+on B fleet-sim "$B/sim/src/fleet-sim" --scenario "$scenario" --clock lockstep --participants 3 --duration 600 \
   --summary "$dir/summary.json" --log-level info
 
 state=""
@@ -104,7 +108,7 @@ for _ in $(seq 180); do
   [[ $state == done || $state == failed ]] && break
   sleep 1
 done
-echo "task job-1: $state after $((SECONDS - t0)) s (manager in host A, simulator and agent in B, WMS adapter in C)"
+echo "task job-1: $state after $((SECONDS - t0)) s (managers in host A, simulator and agent in B, WMS adapter in C)"
 [[ $state == done ]] || fail "the task did not reach done across the namespaces (last state '$state')"
 # A participant without a certificate in host C writes Tasks straight onto the domain, past the
 # adapter. Without security they reach the manager (the check below can fail); with it, none may.
@@ -112,6 +116,6 @@ on C rogue "$B/tests/integration/security/dds_probe" write 3 rogue
 wait "${pids[-1]}"
 echo "uncertified writer: exit $? $(tail -n 1 "$dir/rogue.log")"
 check_uncertified_writer writer
-for p in "${pids[@]:0:4}"; do kill -0 "$p" 2>/dev/null || fail "a service exited early (pid $p)"; done
+for p in "${pids[@]:0:5}"; do kill -0 "$p" 2>/dev/null || fail "a service exited early (pid $p)"; done
 ok=1
 echo "PASS: fleet across network namespaces$( ((SECURE)) && echo " with DDS Security") in $((SECONDS - t0)) s"
