@@ -5,20 +5,22 @@ Each Deployment is played as its own pod on a DNS-enabled podman network made fo
 name of the headless Service that selects it as the pod's network alias, so the DDS peers of the
 ConfigMap's cyclonedds.xml resolve as in a cluster. podman 4.3 cannot play a StatefulSet: each of its
 replicas is played as the Pod the StatefulSet controller would make (name <set>-<ordinal>, its
-template, the aliases <set>-<ordinal>.<serviceName> and <serviceName>). What podman 4.3 (Debian 12) needs beyond the
-manifest is done to a copy here and nowhere else: the Secret's token (a placeholder in the manifest)
-replaced by one of this run, in a form podman 4.3 writes into the file as sent; every name prefixed
-with this run's (pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose pod is not up yet is looked up only in
-the network's own DNS, never on the host's resolvers. The manifests have no simulator (robots bring
-their sensors); a simulator pod, added by this test, gives the robot agents their sensors: the robots
-of the ConfigMap fleet-robots, at their stations.
+template, the aliases <set>-<ordinal>.<serviceName> and <serviceName>). What podman 4.3 (Debian 12)
+needs beyond the manifest is done to a copy here and nowhere else: the Secret's token (a placeholder
+in the manifest) replaced by one of this run, in a form podman 4.3 writes into the file as sent; no
+`ports` (podman 4.3 would publish each on the host's 0.0.0.0); every name prefixed with this run's
+(pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose
+pod is not up yet is looked up only in the network's own DNS, never on the host's resolvers. The
+manifests have no simulator (robots bring their sensors); a simulator pod, added by this test, gives
+the robot agents their sensors: the robots of the ConfigMap fleet-robots, at their stations.
 
 Asserts: every pod and container runs; every service is live, and ready (the WMS adapter's readiness
-needs the fleet manager over DDS between the pods); each agent pod drives its ordinal's robots; the
-API refuses a request without the Secret's token and accepts one with it; a posted task is stored,
-assigned to one of fleet-robots' robots and reaches `done` (DDS from adapter to manager to robot
-agent and back, the robot driving the traffic manager's releases, which must have been sent). Exit 77 (ctest skip) only when podman cannot
-run containers here. Usage: kube_play.py SOURCE_DIR BUILD_DIR"""
+needs the fleet manager over DDS between the pods); the API refuses a request without the Secret's
+token and accepts one with it; a posted task is stored, assigned to one of fleet-robots' robots and
+reaches `done` on the wall clock (DDS from adapter to manager to robot agent and back, the robot
+driving the traffic manager's releases, which must have been sent); each agent pod drove its
+ordinal's robots. Exit 77 (ctest skip) only when podman cannot run containers here.
+Usage: kube_play.py SOURCE_DIR BUILD_DIR"""
 import copy
 import json
 import os
@@ -104,7 +106,8 @@ def renamed(name):
 def part_for(dep):
     """The documents podman needs to play one Deployment or Pod, adapted as the docstring says."""
     out = []
-    claims = {v["persistentVolumeClaim"]["claimName"] for v in dep["spec"]["template"]["spec"].get("volumes", [])
+    pod_spec = dep["spec"]["template"]["spec"] if dep["kind"] != "Pod" else dep["spec"]
+    claims = {v["persistentVolumeClaim"]["claimName"] for v in pod_spec.get("volumes", [])
               if "persistentVolumeClaim" in v}
     # A claim in a second play would be made again: podman refuses an existing volume.
     for d in kinds.get("ConfigMap", []) + kinds.get("Secret", []) + [
@@ -130,6 +133,14 @@ def part_for(dep):
             v["persistentVolumeClaim"]["claimName"] = renamed(v["persistentVolumeClaim"]["claimName"])
     for c in pod["containers"]:
         c.setdefault("env", []).append({"name": "RES_OPTIONS", "value": "no-tld-query"})
+        # podman 4.3 publishes every containerPort on the host's 0.0.0.0 (as if hostPort were set):
+        # the two agent pods would collide on 9104, and nothing of a test may listen outside
+        # loopback. The pods are reached at their own addresses; the probes keep their numbers.
+        ports = {p["name"]: p["containerPort"] for p in c.pop("ports", []) if "name" in p}
+        for probe in ("livenessProbe", "readinessProbe"):
+            g = c.get(probe, {}).get("httpGet")
+            if g and g.get("port") in ports:
+                g["port"] = ports[g["port"]]
     return out + [dep]
 
 
@@ -240,15 +251,6 @@ try:
         fail(f"not live or not ready after 60 s: {pending}")
     print(f"every service live and ready after {time.time() - t0:.0f} s")
 
-    # Each agent pod drives its ordinal's robots (a single robot is a field of its every log line).
-    for key in sorted(robot_sets):
-        ids = [r.split("@")[0] for r in robot_sets[key].split()]
-        c = f"{renamed(agent['metadata']['name'])}-{key.split('-')[-1]}-robot-agent"
-        text = logs(c, 1000)
-        if f": {len(ids)} robots," not in text or (len(ids) == 1 and f'"robot":"{ids[0]}"' not in text):
-            fail(f"{c} does not drive {', '.join(ids)} (fleet-robots {key}): {text[-300:]}")
-        print(f"{c}: drives {', '.join(ids)}")
-
     adapter = next(p for p, cs in pods if "wms-adapter" in cs)
     base = f"http://{pod_ip(adapter)}:8080"
     stored = subprocess.run(["podman", "exec", f"{adapter}-wms-adapter", "cat", "/run/secrets/fleet/wms-token"],
@@ -272,7 +274,7 @@ try:
     while time.time() < deadline:
         status, view = http(f"{base}/v1/tasks/kube-1", token)
         if status == 200:
-            robot, state = view.get("robot"), view.get("state")
+            robot, state = view.get("robot") or robot, view.get("state")  # a done task names no robot
             if not seen or seen[-1] != state:
                 seen.append(state)
             if state in ("done", "failed", "cancelled"):
@@ -288,6 +290,16 @@ try:
     if releases < 1:
         fail("the traffic manager sent no releases")
     print(f"the traffic manager sent {releases:.0f} releases")
+
+    # Each agent pod drove its ordinal's robots (a single robot is a field of its log lines, of its
+    # statistics every 10 s).
+    for key in sorted(robot_sets):
+        ids = [r.split("@")[0] for r in robot_sets[key].split()]
+        c = f"{renamed(agent['metadata']['name'])}-{key.split('-')[-1]}-robot-agent"
+        text = logs(c, 1000)
+        if f": {len(ids)} robots," not in text or (len(ids) == 1 and f'"robot":"{ids[0]}"' not in text):
+            fail(f"{c} does not drive {', '.join(ids)} (fleet-robots {key}): {text[-300:]}")
+        print(f"{c}: drives {', '.join(ids)}")
     ok = True
     print(f"PASS: podman kube play of deploy/kube/fleet.yaml in {time.time() - t0:.0f} s")
 finally:
