@@ -7,11 +7,12 @@
 # network reaches the adapter by its service name. Everything the run created (containers, network,
 # files) is removed, also on failure. Exit 77 (ctest skip) only when podman cannot run containers
 # here at all.
-# deploy/compose.vda5050.yaml is always added: reserved traffic (traffic-manager) and a VDA 5050
-# vehicle (robot r2 of two, the simulator's) through the mosquitto container and the
-# vda5050-bridge; both tasks must be done, the bridge must have sent the vehicle orders that it
-# drove, and be ready (it hears the broker). With "secure", deploy/compose.secure.yaml and
-# deploy/compose.secure.vda5050.yaml too: DDS Security with an identity per service
+# Plain: deploy/compose.yaml alone, as deployed (two robots, both the robot agent's): both tasks
+# must be done through compose.yaml's traffic manager, which must have released routes. With
+# "secure", deploy/compose.vda5050.yaml, deploy/compose.secure.yaml and
+# deploy/compose.secure.vda5050.yaml too: a VDA 5050 vehicle (robot r2 of two, the simulator's)
+# through the mosquitto container and the vda5050-bridge, which must have sent the vehicle orders
+# that it drove and be ready (it hears the broker), and DDS Security with an identity per service
 # (scripts/dds-security deployment), the traffic manager and the bridge included. In both modes a
 # container on the network without a certificate then writes Tasks straight onto the domain: they
 # must reach the manager without security (so the check can fail) and must not with it.
@@ -46,10 +47,13 @@ done
 
 P=fleet-compose-$$
 NET=${P}_fleet
-SERVICES=(fleet-manager wms-adapter risk-map robot-agent fleet-sim traffic-manager mosquitto vda5050-bridge)
+SERVICES=(fleet-manager wms-adapter risk-map traffic-manager robot-agent fleet-sim)
 dir=$(mktemp -d /tmp/fleet-compose.XXXXXX)
-files=(-f deploy/compose.yaml -f deploy/compose.vda5050.yaml)
-((SECURE)) && files+=(-f deploy/compose.secure.yaml -f deploy/compose.secure.vda5050.yaml)
+files=(-f deploy/compose.yaml)
+if ((SECURE)); then
+  SERVICES+=(mosquitto vda5050-bridge)
+  files+=(-f deploy/compose.vda5050.yaml -f deploy/compose.secure.yaml -f deploy/compose.secure.vda5050.yaml)
+fi
 scenario=sim/scenarios/two_robots.json ntasks=2
 compose() { timeout 120 podman-compose -p "$P" "${files[@]}" "$@"; }
 cleanup() {
@@ -81,10 +85,11 @@ done
 
 # The broker's port inside the network: not MQTT's 1883, as every test's broker.
 export FLEET_MQTT_PORT=$((18830 + $$ % 1000))
-VDA5050=1 scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null || fail "writing the mounted files failed"
+VDA5050=$SECURE scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null || fail "writing the mounted files failed"
 export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
-export FLEET_AGENT_ROBOTS=$(cat "$dir/config/agent_robots")
 if ((SECURE)); then
+  FLEET_AGENT_ROBOTS=$(cat "$dir/config/agent_robots")
+  export FLEET_AGENT_ROBOTS
   scripts/dds-security deployment "$dir/dds" >"$dir/dds-security.log" 2>&1 ||
     { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
   chown -R 65532:65532 "$dir/dds"  # the images' user reads its key (0600)
@@ -114,7 +119,8 @@ grep -q "submitted $ntasks tasks, 0 refused" "$dir/submit.txt" || fail "the WMS 
 touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
 
 wait_tasks_done "$ntasks" 120
-check_vehicle_took_part "${P}_vda5050-bridge_1" "$dir/data"
+check_traffic_manager_released "${P}_traffic-manager_1"
+((SECURE)) && check_vehicle_took_part "${P}_vda5050-bridge_1" "$dir/data"
 
 for s in "${SERVICES[@]}"; do
   [[ $s == fleet-sim ]] && continue
@@ -146,4 +152,4 @@ compose run --rm --no-deps -T fleetctl task job-000 >"$dir/run.log" 2>&1
 grep -q '"state": "done"' "$dir/run.log" || { tail -n 20 "$dir/run.log"; fail "fleetctl in the network did not reach wms-adapter:8080"; }
 echo "fleetctl in the network: job-000 done"
 ok=1
-echo "PASS: compose fleet test with reserved traffic and a VDA 5050 vehicle$( ((SECURE)) && echo ", DDS Security on") in $((SECONDS - t0)) s"
+echo "PASS: compose fleet test through the traffic manager$( ((SECURE)) && echo ", a VDA 5050 vehicle and DDS Security on") in $((SECONDS - t0)) s"

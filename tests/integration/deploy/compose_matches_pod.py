@@ -21,7 +21,7 @@ import yaml
 src = sys.argv[1]
 doc = yaml.safe_load(open(f"{src}/deploy/compose.yaml"))
 compose = doc["services"]
-# The overlay's new services (traffic manager, MQTT broker, VDA 5050 bridge) join the same network
+# The overlay's new services (MQTT broker, VDA 5050 bridge) join the same network
 # under the same rules; the services it only adds settings to are compose.yaml's.
 overlay = yaml.safe_load(open(f"{src}/deploy/compose.vda5050.yaml"))["services"]
 added = {n: s for n, s in overlay.items() if n not in compose}
@@ -41,6 +41,9 @@ with tempfile.TemporaryDirectory() as t:
     adapter_cfg = json.load(open(f"{t}/config/wms_adapter.json"))
 
 check(set(pod) <= set(compose), f"services missing in compose.yaml: {sorted(set(pod) - set(compose))}")
+# Every robot agent drives only what the traffic manager releases: both files run one.
+check("traffic-manager" in pod and "traffic-manager" in compose, "no traffic-manager in the pod or compose.yaml")
+check("traffic-manager" not in overlay, "compose.vda5050.yaml redefines compose.yaml's traffic-manager")
 for name, c in pod.items():
     s = compose.get(name)
     if s is None:

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # CI smoke test of the service containers: builds the images from the host build, starts the
-# small-fleet pod (simulator, risk map, fleet manager, WMS adapter, robot agent) with
-# `podman play kube --network none`, plus deploy/fleet-pod.vda5050.yaml's traffic manager, MQTT
-# broker and VDA 5050 bridge (VDA5050=1: of two robots, r2 is the simulator's VDA 5050 vehicle),
-# posts two transport tasks over HTTP from inside the pod and asserts that every container started
-# and stays healthy (liveness), ready, with metrics, not as root, that both tasks reached `done`
-# (DDS between all the services, MQTT between the bridge and the vehicle) and that the vehicle
-# drove on the bridge's orders. (The plain pod, reactive traffic: compose_fleet_secure runs the
-# same services from compose.yaml; kube_play the Kubernetes manifests.) Exit 77 (ctest skip) only when podman cannot run
+# small-fleet pod (simulator, risk map, fleet manager, WMS adapter, traffic manager, robot agent)
+# with `podman play kube --network none`, plus deploy/fleet-pod.vda5050.yaml's MQTT broker and VDA
+# 5050 bridge (VDA5050=1: of two robots, r2 is the simulator's VDA 5050 vehicle), posts two
+# transport tasks over HTTP from inside the pod and asserts that every container started and stays
+# healthy (liveness), ready, with metrics, not as root, that both tasks reached `done` (DDS between
+# all the services, MQTT between the bridge and the vehicle) through the traffic manager's
+# releases, and that the vehicle drove on the bridge's orders. (The plain pod's services without the
+# overlay: compose_fleet runs them from compose.yaml, which compose_matches_pod holds equal to the
+# pod; kube_play the Kubernetes manifests.) Exit 77 (ctest skip) only when podman cannot run
 # containers on this machine at all. Usage: containers_smoke.sh SOURCE_DIR BUILD_DIR
 set -uo pipefail
 SRC=$1
@@ -50,6 +51,7 @@ grep -q 'submitted 2 tasks, 0 refused' "$dir/submit.txt" || fail "the WMS adapte
 touch "$dir/data/start"  # the simulator starts now (deploy/fleet-pod.yaml)
 
 wait_tasks_done 2 150
+check_traffic_manager_released "$POD-traffic-manager"
 check_vehicle_took_part "$POD-vda5050-bridge" "$dir/data"
 
 h=1

@@ -31,3 +31,13 @@ check_vehicle_took_part() {
     fail "the VDA 5050 vehicle r2 took no part: the bridge sent ${orders:-no} orders, r2 drove ${driven:-?} m"
   echo "the VDA 5050 vehicle r2 drove $driven m on $orders order(s) through the broker; the bridge is ready"
 }
+
+# check_traffic_manager_released CONTAINER: the traffic manager in CONTAINER sent releases (every
+# robot drives only what it releases: without them no robot moves).
+check_traffic_manager_released() {
+  local c=$1 releases
+  releases=$(podman exec "$c" /usr/local/bin/fleet-probe /metrics 2>/dev/null |
+    awk '$1 == "traffic_manager_releases_total" {print int($2)}')
+  ((${releases:-0} >= 1)) || fail "the traffic manager $c sent no releases (${releases:-no metric})"
+  echo "the traffic manager sent $releases releases"
+}

@@ -1,14 +1,19 @@
 #!/usr/bin/env python3
-"""Checks deploy/kube/fleet.yaml without a cluster (none runs here): every Deployment non-root with a
-read-only root filesystem and no capabilities, requests and limits, liveness on /livez and readiness
-on /readyz at the port the service serves them (FLEET_METRICS_PORT), images tagged with the project
-version; the fleet manager one replica, strategy Recreate, its database on the PersistentVolumeClaim;
-every ConfigMap, Secret, claim and config file referenced exists; a NetworkPolicy admits the ops
-ports from monitoring pods and the nodes only, and liveness probes survive a busy node; every DDS peer is a headless
-Service selecting a Deployment; the shipped site passes `fleetctl site check`. Then the closest to
-running them that this machine offers: each Deployment's binary from BUILD_DIR started with the
-manifest's arguments and the ConfigMap's and Secret's files (paths moved to a temporary folder, DDS
-on loopback), which must come up live, and the fleet manager ready.
+"""Checks deploy/kube/fleet.yaml without a cluster (none runs here): every Deployment and StatefulSet
+non-root with a read-only root filesystem and no capabilities, requests and limits, liveness on
+/livez and readiness on /readyz at the port the service serves them (FLEET_METRICS_PORT), images
+tagged with the project version; the fleet manager one replica, strategy Recreate, its database on
+the PersistentVolumeClaim; a traffic manager (one replica, the ConfigMap's site): every robot agent
+drives only what it releases; the robot agents one StatefulSet whose pods take their robots from the
+ConfigMap fleet-robots by their ordinal (an entry per replica, each robot once, at a station of the
+site; no --robot in the manifest's arguments); every ConfigMap, Secret, claim and config file
+referenced exists; every DDS peer is a headless Service selecting a workload or an agent pod's name;
+a NetworkPolicy admits the ops ports from monitoring pods and the nodes only, and liveness probes
+survive a busy node; the shipped site passes `fleetctl site check`. Then the closest to running them that this machine
+offers: each Deployment's binary from BUILD_DIR, and the StatefulSet's command for each ordinal,
+started with the manifest's arguments and the ConfigMaps' and Secret's files (paths moved to a
+temporary folder, DDS on loopback), which must come up live (the fleet manager and the traffic
+manager ready), each agent driving its ordinal's robot; an ordinal without an entry exits 2.
 Usage: kube_manifests_check.py SOURCE_DIR BUILD_DIR"""
 import json
 import os
@@ -26,7 +31,8 @@ import yaml
 src, build = sys.argv[1], sys.argv[2]
 fleetctl = os.path.join(build, "services/fleetctl/fleetctl")
 binaries = {"fleet-manager": "services/fleet_manager/fleet_manager", "wms-adapter": "services/wms_adapter/wms_adapter",
-            "risk-map": "services/risk_map/risk_map", "robot-agent": "services/robot_agent/robot_agent"}
+            "risk-map": "services/risk_map/risk_map", "robot-agent": "services/robot_agent/robot_agent",
+            "traffic-manager": "services/traffic_manager/traffic_manager"}
 docs = [d for d in yaml.safe_load_all(open(os.path.join(src, "deploy/kube/fleet.yaml"))) if d]
 version = re.search(r"project\(fleet VERSION ([0-9.]+)", open(os.path.join(src, "CMakeLists.txt")).read()).group(1)
 problems = []
@@ -45,9 +51,13 @@ secrets = by_kind.get("Secret", {})
 claims = by_kind.get("PersistentVolumeClaim", {})
 services = by_kind.get("Service", {})
 deployments = by_kind.get("Deployment", {})
-check(set(deployments) >= {"fleet-manager", "wms-adapter", "risk-map", "robot-agent"}, f"deployments: {sorted(deployments)}")
+statefulsets = by_kind.get("StatefulSet", {})
+workloads = {**deployments, **statefulsets}
+check(set(deployments) >= {"fleet-manager", "wms-adapter", "risk-map", "traffic-manager"}, f"deployments: {sorted(deployments)}")
+check(set(statefulsets) == {"robot-agent"} and "robot-agent" not in deployments,
+      f"the robot agents are not the one StatefulSet robot-agent: StatefulSets {sorted(statefulsets)}")
 
-for name, dep in deployments.items():
+for name, dep in workloads.items():
     spec = dep["spec"]
     pod = spec["template"]["spec"]
     labels = spec["template"]["metadata"]["labels"]
@@ -73,6 +83,7 @@ for name, dep in deployments.items():
         check(c["image"].endswith(":" + version), f"{where}: image {c['image']} not tagged {version}")
         env = {e["name"]: e.get("value") for e in c.get("env", [])}
         ports = {p["name"]: p["containerPort"] for p in c.get("ports", [])}
+        check(c.get("image", "").split(":")[0] == f"localhost/fleet-{name}", f"{where}: image {c.get('image')}")
         check(str(ports.get("ops")) == env.get("FLEET_METRICS_PORT"), f"{where}: ops port != FLEET_METRICS_PORT")
         check(env.get("FLEET_METRICS_HOST") == "0.0.0.0", f"{where}: ops port only on loopback (the kubelet probes the pod IP)")
         for probe, path in (("livenessProbe", "/livez"), ("readinessProbe", "/readyz")):
@@ -99,6 +110,52 @@ for name, dep in deployments.items():
             db = args[args.index("--db") + 1]
             m = mounts.get(os.path.dirname(db))
             check(m is not None and "persistentVolumeClaim" in vols[m["name"]], "fleet-manager: database not on the claim")
+        if name == "traffic-manager":
+            check(spec.get("replicas") == 1, "traffic-manager: not one replica (two would release the same roadmap)")
+            cfg = args[args.index("--config") + 1] if "--config" in args else ""
+            tm = json.loads(configmaps["fleet-config"]["data"].get(os.path.basename(cfg), "{}"))
+            check(tm.get("site") == "/etc/fleet/site.json", f"traffic-manager: {cfg} names site {tm.get('site')}, "
+                  "not the ConfigMap's site.json")
+
+# The robot agents: one StatefulSet; pod robot-agent-N runs the robots of fleet-robots' agent-N.
+agents = statefulsets.get("robot-agent")
+robot_sets = {}
+site = json.loads(configmaps["fleet-config"]["data"]["site.json"])
+stations = {s["name"] for s in site["stations"]}
+if agents:
+    spec = agents["spec"]
+    replicas = spec.get("replicas", 1)
+    c = spec["template"]["spec"]["containers"][0]
+    check("--robot" not in c.get("args", []) and "--robots" not in c.get("args", []),
+          "robot-agent: robots in the manifest's arguments, not from the ordinal")
+    env = {e["name"]: e for e in c.get("env", [])}
+    check(env.get("FLEET_POD_NAME", {}).get("valueFrom", {}).get("fieldRef", {}).get("fieldPath") == "metadata.name",
+          "robot-agent: FLEET_POD_NAME is not the pod's name (downward API)")
+    script = " ".join(c.get("command", []))
+    check("FLEET_POD_NAME" in script and "/etc/fleet-robots/agent-" in script and "exec /usr/local/bin/robot_agent" in script,
+          "robot-agent: the command does not pick the robots by the pod's ordinal")
+    vols = {v["name"]: v for v in spec["template"]["spec"].get("volumes", [])}
+    mounts = {m["mountPath"]: m["name"] for m in c.get("volumeMounts", [])}
+    check(vols.get(mounts.get("/etc/fleet-robots"), {}).get("configMap", {}).get("name") == "fleet-robots",
+          "robot-agent: ConfigMap fleet-robots not mounted at /etc/fleet-robots")
+    check(spec.get("selector", {}).get("matchLabels", {}).items() <= spec["template"]["metadata"]["labels"].items(),
+          "robot-agent: selector does not match its pods")
+    svc = services.get(spec.get("serviceName", ""))
+    check(svc is not None and svc["spec"].get("clusterIP") == "None",
+          f"robot-agent: serviceName {spec.get('serviceName')} is not a headless Service (the pods' DNS names)")
+    entries = configmaps.get("fleet-robots", {}).get("data", {})
+    check(set(entries) == {f"agent-{i}" for i in range(replicas)},
+          f"fleet-robots: entries {sorted(entries)} for {replicas} replicas (agent-0 .. agent-{replicas - 1})")
+    seen = set()
+    for key, text in entries.items():
+        specs = text.split()
+        check(specs, f"fleet-robots {key}: no robots")
+        for r in specs:
+            rid, _, station = r.partition("@")
+            check(rid and station in stations, f"fleet-robots {key}: {r} is not ID@STATION with a station of site.json")
+            check(rid not in seen, f"fleet-robots {key}: robot {rid} in two entries")
+            seen.add(rid)
+        robot_sets[key] = [r.split("@")[0] for r in specs]
 
 # The ops ports (no authentication) reachable only by monitoring pods and the nodes (kubelet probes).
 policies = by_kind.get("NetworkPolicy", {})
@@ -125,14 +182,23 @@ check(guarded == ops_ports, f"no NetworkPolicy limits the ops ports {sorted(ops_
 # DDS peers: headless Services that select a Deployment's pods.
 dds = configmaps["fleet-config"]["data"]["cyclonedds.xml"]
 peers = re.findall(r'<Peer address="([^"]+)"', dds)
-check(len(peers) >= 4, f"only {len(peers)} DDS peers")
+check(len(peers) >= 5, f"only {len(peers)} DDS peers")
 check("<AllowMulticast>false</AllowMulticast>" in dds, "DDS multicast not off")
+# A headless Service's name resolves to one of its pods only: the agents are named pod by pod
+# (<statefulset>-<ordinal>.<serviceName>, each pod's stable DNS name).
+pod_names = {f"{n}-{i}.{ss['spec'].get('serviceName')}": n for n, ss in statefulsets.items()
+             for i in range(ss["spec"].get("replicas", 1))}
+for p in pod_names:
+    check(p in peers, f"DDS peer {p} missing: that agent pod is found by no one")
 for p in peers:
+    if p in pod_names:
+        continue
     s = services.get(p)
-    check(s is not None and s["spec"].get("clusterIP") == "None", f"DDS peer {p} is not a headless Service")
+    check(s is not None and s["spec"].get("clusterIP") == "None", f"DDS peer {p} is not a headless Service or an agent pod")
     if s:
         check(any(s["spec"]["selector"].items() <= d["spec"]["template"]["metadata"]["labels"].items()
                   for d in deployments.values()), f"Service {p} selects no Deployment")
+check("traffic-manager-dds" in peers, "the traffic manager is no DDS peer")
 # Each JSON config parses; the site passes fleetctl's check.
 for key, text in configmaps["fleet-config"]["data"].items():
     if key.endswith(".json"):
@@ -168,35 +234,54 @@ with tempfile.TemporaryDirectory() as t:
     etc, var, run = os.path.join(t, "etc"), os.path.join(t, "var"), os.path.join(t, "secrets")
     for d in (etc, var, run):
         os.makedirs(d)
-    move = lambda text: text.replace("/etc/fleet", etc).replace("/var/lib/fleet", var).replace("/run/secrets/fleet", run)
+    robots_dir = os.path.join(t, "robots")
+    os.makedirs(robots_dir)
+    move = lambda text: (text.replace("/etc/fleet-robots", robots_dir).replace("/etc/fleet", etc)
+                         .replace("/var/lib/fleet", var).replace("/run/secrets/fleet", run)
+                         .replace("/usr/local/bin/robot_agent", os.path.join(build, binaries["robot-agent"])))
     for key, text in configmaps["fleet-config"]["data"].items():
         open(os.path.join(etc, key), "w").write(move(text))
+    for key, text in configmaps.get("fleet-robots", {}).get("data", {}).items():
+        open(os.path.join(robots_dir, key), "w").write(text)
     for key, text in secrets["fleet-secrets"]["stringData"].items():
         open(os.path.join(run, key), "w").write(text)
     domain = str(210 + os.getpid() % 19)  # 210..228: away from the tests. 10..209
     procs = {}
+
+    def start(name, c, env, command):
+        """One pod's container as a process: its env and arguments with the paths moved."""
+        env = {e["name"]: e["value"] for e in c.get("env", []) if "value" in e} | env
+        port = free_port()
+        env.update(FLEET_METRICS_PORT=str(port), FLEET_METRICS_HOST="127.0.0.1", FLEET_DDS_DOMAIN=domain)
+        env.pop("CYCLONEDDS_URI")  # loopback here; the cluster profile names the Services
+        log = open(os.path.join(t, f"{name}.log"), "w+")
+        proc = subprocess.Popen(command + [move(a) for a in c.get("args", [])], env={**os.environ, **env},
+                                stdout=log, stderr=subprocess.STDOUT, text=True)
+        return proc, port, log
+
     try:
         for name, dep in deployments.items():
             c = dep["spec"]["template"]["spec"]["containers"][0]
-            env = {e["name"]: e["value"] for e in c.get("env", [])}
-            port = free_port()
-            env.update(FLEET_METRICS_PORT=str(port), FLEET_METRICS_HOST="127.0.0.1", FLEET_DDS_DOMAIN=domain)
-            env.pop("CYCLONEDDS_URI")  # loopback here; the cluster profile names the Services
-            args = [move(a) for a in c.get("args", [])]
             if name == "wms-adapter":  # the API port too: 8080 may be taken on this machine
                 cfg = os.path.join(etc, "wms_adapter.json")
                 j = json.load(open(cfg))
                 j["http"].update(host="127.0.0.1", port=free_port())
                 json.dump(j, open(cfg, "w"))
-            procs[name] = (subprocess.Popen([os.path.join(build, binaries[name])] + args, env={**os.environ, **env},
-                                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True), port)
+            procs[name] = start(name, c, {}, [os.path.join(build, binaries[name])])
+        # The StatefulSet's pods: its command (the ordinal picks the robots) as a pod of that name runs it.
+        for name, ss in statefulsets.items():
+            c = ss["spec"]["template"]["spec"]["containers"][0]
+            for i in range(ss["spec"].get("replicas", 1)):
+                procs[f"{name}-{i}"] = start(f"{name}-{i}", c, {"FLEET_POD_NAME": f"{name}-{i}"},
+                                             [move(a) for a in c["command"]])
         deadline = time.time() + 30
-        pending = {n: ("/readyz" if n == "fleet-manager" else "/livez") for n in procs}
+        pending = {n: ("/readyz" if n in ("fleet-manager", "traffic-manager") else "/livez") for n in procs}
         while pending and time.time() < deadline:
             for n, path in list(pending.items()):
                 if procs[n][0].poll() is not None:
+                    procs[n][2].seek(0)
                     problems.append(f"{n} exited {procs[n][0].returncode} with the manifest's arguments: "
-                                    f"{procs[n][0].stdout.read()[-400:]}")
+                                    f"{procs[n][2].read()[-400:]}")
                     del pending[n]
                 elif answer(procs[n][1], path) == 200:
                     print(f"{n}: {path} 200 with the manifest's arguments and files")
@@ -204,16 +289,47 @@ with tempfile.TemporaryDirectory() as t:
             time.sleep(0.2)
         for n, path in pending.items():
             problems.append(f"{n}: {path} not 200 within 30 s")
+        # A pod whose ordinal has no entry (replicas raised without one) says so and exits 2.
+        for name, ss in statefulsets.items():
+            c = ss["spec"]["template"]["spec"]["containers"][0]
+            extra = f"{name}-{ss['spec'].get('replicas', 1)}"
+            proc, _, log = start(extra, c, {"FLEET_POD_NAME": extra}, [move(a) for a in c["command"]])
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+            log.seek(0)
+            out = log.read()
+            check(proc.returncode == 2 and "has no robots" in out,
+                  f"{extra} (no entry in fleet-robots) did not exit 2 naming the cause: exit {proc.returncode} {out[-300:]}")
+            print(f"{extra}: exit {proc.returncode}: {out.strip()}")
     finally:
-        for p, _ in procs.values():
+        for p, _, _ in procs.values():
             p.terminate()
-        for p, _ in procs.values():
+        for p, _, _ in procs.values():
             try:
                 p.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 p.kill()
 
+    # Each agent pod drove its ordinal's robots (named in its start line; a single robot is a field
+    # of its log lines, the last one written when it stops).
+    for key, ids in sorted(robot_sets.items()):
+        n = key.split("-")[-1]
+        proc, port, log = procs.get(f"robot-agent-{n}", (None, None, None))
+        if log is None:
+            continue
+        log.seek(0)
+        text = log.read()
+        check(f"robot agent robot-agent-{n}: {len(ids)} robots," in text,
+              f"robot-agent-{n}: does not drive {len(ids)} robots as robot-agent-{n}: {text[-300:]}")
+        if len(ids) == 1:
+            check(f'"robot":"{ids[0]}"' in text, f"robot-agent-{n}: its log names no robot {ids[0]}: {text[-300:]}")
+        print(f"robot-agent-{n}: drove {', '.join(ids)} (fleet-robots {key})")
+
 for p in problems:
     print("deploy/kube/fleet.yaml:", p)
-print(f"{len(deployments)} deployments, {len(services)} services checked, {len(problems)} problems")
+print(f"{len(deployments)} deployments, {len(statefulsets)} StatefulSets, {len(services)} services checked, "
+      f"{len(problems)} problems")
 sys.exit(1 if problems else 0)

@@ -3,18 +3,24 @@
 
 Each Deployment is played as its own pod on a DNS-enabled podman network made for this run, with the
 name of the headless Service that selects it as the pod's network alias, so the DDS peers of the
-ConfigMap's cyclonedds.xml resolve as in a cluster. What podman 4.3 (Debian 12) needs beyond the
-manifest is done to a copy here and nowhere else: the Secret's token (a placeholder in the manifest)
-replaced by one of this run, in a form podman 4.3 writes into the file as sent; every name prefixed
-with this run's (pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose pod is not up yet is looked up only in
-the network's own DNS, never on the host's resolvers. The manifests have no simulator (robots bring
-their sensors); a simulator pod, added by this test, gives the robot agent its sensors.
+ConfigMap's cyclonedds.xml resolve as in a cluster. podman 4.3 cannot play a StatefulSet: each of its
+replicas is played as the Pod the StatefulSet controller would make (name <set>-<ordinal>, its
+template, the aliases <set>-<ordinal>.<serviceName> and <serviceName>). What podman 4.3 (Debian 12)
+needs beyond the manifest is done to a copy here and nowhere else: the Secret's token (a placeholder
+in the manifest) replaced by one of this run, in a form podman 4.3 writes into the file as sent; no
+`ports` (podman 4.3 would publish each on the host's 0.0.0.0); every name prefixed with this run's
+(pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose
+pod is not up yet is looked up only in the network's own DNS, never on the host's resolvers. The
+manifests have no simulator (robots bring their sensors); a simulator pod, added by this test, gives
+the robot agents their sensors: the robots of the ConfigMap fleet-robots, at their stations.
 
 Asserts: every pod and container runs; every service is live, and ready (the WMS adapter's readiness
 needs the fleet manager over DDS between the pods); the API refuses a request without the Secret's
-token and accepts one with it; a posted task is stored, assigned to the manifest's robot and under way
-(DDS from adapter to manager to robot agent and back). Exit 77 (ctest skip) only when podman cannot
-run containers here. Usage: kube_play.py SOURCE_DIR BUILD_DIR"""
+token and accepts one with it; a posted task is stored, assigned to one of fleet-robots' robots and
+reaches `done` on the wall clock (DDS from adapter to manager to robot agent and back, the robot
+driving the traffic manager's releases, which must have been sent); each agent pod drove its
+ordinal's robots. Exit 77 (ctest skip) only when podman cannot run containers here.
+Usage: kube_play.py SOURCE_DIR BUILD_DIR"""
 import copy
 import json
 import os
@@ -88,7 +94,9 @@ kinds = {}
 for d in docs:
     kinds.setdefault(d["kind"], []).append(d)
 deployments = kinds["Deployment"]
+statefulsets = kinds.get("StatefulSet", [])
 configmap = next(d for d in kinds["ConfigMap"] if d["metadata"]["name"] == "fleet-config")["data"]
+robot_sets = next(d for d in kinds["ConfigMap"] if d["metadata"]["name"] == "fleet-robots")["data"]
 
 
 def renamed(name):
@@ -96,9 +104,10 @@ def renamed(name):
 
 
 def part_for(dep):
-    """The documents podman needs to play one Deployment, adapted as the docstring says."""
+    """The documents podman needs to play one Deployment or Pod, adapted as the docstring says."""
     out = []
-    claims = {v["persistentVolumeClaim"]["claimName"] for v in dep["spec"]["template"]["spec"].get("volumes", [])
+    pod_spec = dep["spec"]["template"]["spec"] if dep["kind"] != "Pod" else dep["spec"]
+    claims = {v["persistentVolumeClaim"]["claimName"] for v in pod_spec.get("volumes", [])
               if "persistentVolumeClaim" in v}
     # A claim in a second play would be made again: podman refuses an existing volume.
     for d in kinds.get("ConfigMap", []) + kinds.get("Secret", []) + [
@@ -114,7 +123,7 @@ def part_for(dep):
         out.append(d)
     dep = copy.deepcopy(dep)
     dep["metadata"]["name"] = renamed(dep["metadata"]["name"])
-    pod = dep["spec"]["template"]["spec"]
+    pod = dep["spec"]["template"]["spec"] if dep["kind"] != "Pod" else dep["spec"]
     for v in pod.get("volumes", []):
         if "configMap" in v:
             v["configMap"]["name"] = renamed(v["configMap"]["name"])
@@ -124,6 +133,14 @@ def part_for(dep):
             v["persistentVolumeClaim"]["claimName"] = renamed(v["persistentVolumeClaim"]["claimName"])
     for c in pod["containers"]:
         c.setdefault("env", []).append({"name": "RES_OPTIONS", "value": "no-tld-query"})
+        # podman 4.3 publishes every containerPort on the host's 0.0.0.0 (as if hostPort were set):
+        # the two agent pods would collide on 9104, and nothing of a test may listen outside
+        # loopback. The pods are reached at their own addresses; the probes keep their numbers.
+        ports = {p["name"]: p["containerPort"] for p in c.pop("ports", []) if "name" in p}
+        for probe in ("livenessProbe", "readinessProbe"):
+            g = c.get(probe, {}).get("httpGet")
+            if g and g.get("port") in ports:
+                g["port"] = ports[g["port"]]
     return out + [dep]
 
 
@@ -131,6 +148,18 @@ def aliases_of(dep):
     labels = dep["spec"]["template"]["metadata"]["labels"]
     return [s["metadata"]["name"] for s in kinds.get("Service", [])
             if s["spec"].get("clusterIP") == "None" and s["spec"]["selector"].items() <= labels.items()]
+
+
+def pods_of(ss):
+    """The Pods the StatefulSet controller makes: <name>-<ordinal>, with hostname and subdomain."""
+    out = []
+    for i in range(ss["spec"].get("replicas", 1)):
+        name = f"{ss['metadata']['name']}-{i}"
+        spec = copy.deepcopy(ss["spec"]["template"]["spec"])
+        spec.update(hostname=name, subdomain=ss["spec"]["serviceName"])
+        out.append({"apiVersion": "v1", "kind": "Pod",
+                    "metadata": {"name": name, "labels": ss["spec"]["template"]["metadata"]["labels"]}, "spec": spec})
+    return out
 
 
 def pod_ip(pod):
@@ -160,20 +189,27 @@ try:
     if podman("network", "inspect", "--format", "{{.DNSEnabled}}", net) != "true":
         fail(f"network {net} has no DNS: the Services' names do not resolve (podman's CNI backend needs "
              "golang-github-containernetworking-plugin-dnsname; scripts/setup installs it)")
-    for dep in deployments:  # manifest order: the fleet manager first
-        name = dep["metadata"]["name"]
-        path = os.path.join(tmp, f"{name}.yaml")
-        yaml.safe_dump_all(part_for(dep), open(path, "w"))
-        alias = ",".join(f"alias={a}" for a in aliases_of(dep))
+    def play(doc, aliases, pod):
+        path = os.path.join(tmp, f"{doc['metadata']['name']}.yaml")
+        yaml.safe_dump_all(part_for(doc), open(path, "w"))
+        alias = ",".join(f"alias={a}" for a in aliases)
         podman("kube", "play", "--network", f"{net}:{alias}" if alias else net, path)
-        pods.append((renamed(name) + "-pod-0", [c["name"] for c in dep["spec"]["template"]["spec"]["containers"]]))
-    print(f"{len(pods)} Deployments played after {time.time() - t0:.0f} s")
+        spec = doc["spec"]["template"]["spec"] if doc["kind"] != "Pod" else doc["spec"]
+        pods.append((pod, [c["name"] for c in spec["containers"]]))
 
-    # The simulator, with the ConfigMap's site and the robots the robot agent's --robot arguments name.
-    agent = next(d for d in deployments if d["metadata"]["name"] == "robot-agent")
-    args = agent["spec"]["template"]["spec"]["containers"][0]["args"]
-    robots = [{"id": a.split("@")[0], "start_station": a.split("@")[1]}
-              for flag, a in zip(args, args[1:]) if flag == "--robot"]
+    for dep in deployments:  # manifest order: the fleet manager first
+        play(dep, aliases_of(dep), renamed(dep["metadata"]["name"]) + "-pod-0")
+    for ss in statefulsets:
+        for p in pods_of(ss):
+            play(p, aliases_of(ss) + [f"{p['metadata']['name']}.{ss['spec']['serviceName']}"],
+                 renamed(p["metadata"]["name"]))
+    print(f"{len(pods)} pods of {len(deployments)} Deployments and {len(statefulsets)} StatefulSets played "
+          f"after {time.time() - t0:.0f} s")
+
+    # The simulator, with the ConfigMap's site and the robots of fleet-robots at their stations.
+    agent = statefulsets[0]
+    robots = [{"id": r.split("@")[0], "start_station": r.split("@")[1]}
+              for key in sorted(robot_sets) for r in robot_sets[key].split()]
     simdir = os.path.join(tmp, "sim")
     os.makedirs(simdir)
     for key in ("site.json", "cyclonedds.xml"):
@@ -228,21 +264,42 @@ try:
     pickup = next(s["name"] for s in site["stations"] if s["kind"] == "pickup")
     dropoff = next(s["name"] for s in site["stations"] if s["kind"] == "dropoff")
     status, body = http(f"{base}/v1/tasks", token, {"id": "kube-1", "kind": "transport", "pickup": pickup,
-                                                    "dropoff": dropoff})
+                                                    "dropoff": dropoff, "load_duration_ns": 1000000000,
+                                                    "unload_duration_ns": 1000000000})
     if status != 201:
         fail(f"POST /v1/tasks with the Secret's token answered {status} {body}")
-    robot, state = None, None
-    deadline = time.time() + 60
+    # The wall clock, as deployed: the robot drives some 45 m (about 60 s).
+    robot, state, seen = None, None, []
+    deadline = time.time() + 180
     while time.time() < deadline:
         status, view = http(f"{base}/v1/tasks/kube-1", token)
         if status == 200:
-            robot, state = view.get("robot"), view.get("state")
-            if state not in ("queued", "assigned", "requeued"):
+            robot, state = view.get("robot") or robot, view.get("state")  # a done task names no robot
+            if not seen or seen[-1] != state:
+                seen.append(state)
+            if state in ("done", "failed", "cancelled"):
                 break
         time.sleep(1)
-    print(f"task kube-1: {state} by {robot} after {time.time() - t0:.0f} s")
-    if state in (None, "queued", "assigned", "requeued", "failed", "cancelled") or robot != robots[0]["id"]:
-        fail(f"the task is not under way with {robots[0]['id']} (state {state}, robot {robot})")
+    print(f"task kube-1: {' -> '.join(map(str, seen))} by {robot} after {time.time() - t0:.0f} s")
+    if state != "done" or robot not in [r["id"] for r in robots]:
+        fail(f"the task did not reach done with a robot of fleet-robots (state {state}, robot {robot})")
+    traffic = next(p for p, cs in pods if "traffic-manager" in cs)
+    metrics = podman("exec", f"{traffic}-traffic-manager", "/usr/local/bin/fleet-probe", "/metrics")
+    releases = next((float(line.split()[1]) for line in metrics.splitlines()
+                     if line.startswith("traffic_manager_releases_total ")), 0)
+    if releases < 1:
+        fail("the traffic manager sent no releases")
+    print(f"the traffic manager sent {releases:.0f} releases")
+
+    # Each agent pod drove its ordinal's robots (a single robot is a field of its log lines, of its
+    # statistics every 10 s).
+    for key in sorted(robot_sets):
+        ids = [r.split("@")[0] for r in robot_sets[key].split()]
+        c = f"{renamed(agent['metadata']['name'])}-{key.split('-')[-1]}-robot-agent"
+        text = logs(c, 1000)
+        if f": {len(ids)} robots," not in text or (len(ids) == 1 and f'"robot":"{ids[0]}"' not in text):
+            fail(f"{c} does not drive {', '.join(ids)} (fleet-robots {key}): {text[-300:]}")
+        print(f"{c}: drives {', '.join(ids)}")
     ok = True
     print(f"PASS: podman kube play of deploy/kube/fleet.yaml in {time.time() - t0:.0f} s")
 finally:

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Multi-host test: three network namespaces ("hosts" of this test's own making) joined by veth
-# pairs to a bridge in a fourth, on the private subnet 10.200.$NET.0/24. The fleet manager runs in
-# host A, the simulator, robot agent, traffic manager and risk map in host B, the WMS adapter in
-# host C; every process uses the LAN profile deploy/cyclonedds-lan.xml (unicast discovery to the
+# pairs to a bridge in a fourth, on the private subnet 10.200.$NET.0/24. The fleet manager and the
+# traffic manager run in host A, the simulator, robot agent and risk map in host B, the WMS adapter
+# in host C; every process uses the LAN profile deploy/cyclonedds-lan.xml (unicast discovery to the
 # three hosts' addresses, no multicast, pinned to the host's veth). A task posted to the WMS
-# adapter's HTTP API in host C must reach `done`. Namespaces and processes are removed on every
-# exit. Exit 77 (ctest skip) only when `ip netns add` is not permitted.
+# adapter's HTTP API in host C must reach `done`, the robot driving the traffic manager's releases
+# across the hosts. Namespaces and processes are removed on every exit. Exit 77 (ctest skip) only
+# when `ip netns add` is not permitted.
 # With "secure", DDS Security is on: `scripts/dds-security deployment` makes the identities and each
 # process adds its own security.xml to the LAN profile; a process in host C without a certificate
 # then writes Tasks for 3 s, and none of them may reach the manager.
@@ -66,9 +67,7 @@ cat >"$dir/manager.json" <<JSON
 JSON
 echo "{\"site\": \"$scenario\", \"grid\": {\"resolution\": 0.1}, \"clock\": \"sim\", \"lockstep\": true, \"rate_hz\": 2}" \
   >"$dir/risk_map.json"
-# The agent drives only what the traffic manager releases (reserved traffic).
-echo "{\"site\": \"$SRC/sim/scenarios/small_warehouse_12_parking.site.json\", \"clock\": \"sim\", \"lockstep\": true}" \
-  >"$dir/traffic_manager.json"
+echo "{\"site\": \"$scenario\", \"clock\": \"sim\", \"lockstep\": true}" >"$dir/traffic_manager.json"
 printf 'id,kind,pickup,dropoff,load_s,unload_s\njob-1,transport,P-2,D-1,2,2\n' >"$dir/tasks.csv"
 
 if ((SECURE)); then
@@ -87,10 +86,10 @@ on() {  # on HOST NAME CMD...: a service in that host's namespace with the LAN p
   pids+=($!)
 }
 on A fleet_manager "$B/services/fleet_manager/fleet_manager" --config "$dir/manager.json" --log-level info
+on A traffic_manager "$B/services/traffic_manager/traffic_manager" --config "$dir/traffic_manager.json" \
+  --id traffic_manager --log-level info
 on C wms_adapter "$B/services/wms_adapter/wms_adapter" --stations "$scenario" --port 8080 --log-level info
 on B risk_map "$B/services/risk_map/risk_map" --config "$dir/risk_map.json" --id risk_map --log-level info
-on B traffic_manager "$B/services/traffic_manager/traffic_manager" --config "$dir/traffic_manager.json" \
-  --id traffic_manager --log-level info
 on B robot_agent "$B/services/robot_agent/robot_agent" --scenario "$scenario" --clock lockstep --id agents \
   --log-level info
 ctl() { ip netns exec "fleet-C-$ID" "$B/services/fleetctl/fleetctl" --url http://127.0.0.1:8080 "$@"; }
@@ -109,7 +108,7 @@ for _ in $(seq 180); do
   [[ $state == done || $state == failed ]] && break
   sleep 1
 done
-echo "task job-1: $state after $((SECONDS - t0)) s (manager in host A, simulator, agent and traffic manager in B, WMS adapter in C)"
+echo "task job-1: $state after $((SECONDS - t0)) s (managers in host A, simulator and agent in B, WMS adapter in C)"
 [[ $state == done ]] || fail "the task did not reach done across the namespaces (last state '$state')"
 # A participant without a certificate in host C writes Tasks straight onto the domain, past the
 # adapter. Without security they reach the manager (the check below can fail); with it, none may.
