@@ -81,7 +81,11 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   transport::Writer<msg::RobotState> states(part);
   transport::Writer<msg::PredictedDiscs> discs(part);
   transport::Writer<msg::TaskStatus> statuses(part);
-  transport::Reader<msg::TrafficRelease> releases(part);
+  // In lockstep the reader keeps every release of a robot until it is taken (one of the next step
+  // may arrive before this one is taken; keeping the last only, it would replace this one).
+  auto releaseQos = transport::qos::trafficRelease();
+  releaseQos.depth = lockstep ? 16 : releaseQos.depth;
+  transport::Reader<msg::TrafficRelease> releases(part, releaseQos);
   transport::Writer<msg::TrafficProgress> trafficProgress(part);
   // A writer per hosted robot and topic, each in the robot's partition (transport/
   // robot_partition.hpp), made now: readers match them during start-up, and DDS Security refuses

@@ -71,7 +71,11 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     spdlog::warn("traffic manager: roadmap: {}", p.what);
   }
   transport::Participant p;
-  transport::Reader<msg::TrafficProgress> progress(p);
+  // In lockstep the reader keeps every report of a robot until it is taken (a report of the next step
+  // may arrive before this one is taken; keeping the last only, it would replace this one).
+  auto progressQos = transport::qos::trafficProgress();
+  progressQos.depth = settings.lockstep ? 16 : progressQos.depth;
+  transport::Reader<msg::TrafficProgress> progress(p, progressQos);
   transport::Writer<msg::TrafficRelease> releases(p);
   transport::Writer<msg::Roadmap> roadmapOut(p);
   transport::Reader<msg::Clock> clockIn(p);

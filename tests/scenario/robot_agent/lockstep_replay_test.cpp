@@ -76,7 +76,7 @@ TEST(AgentLockstep, SameSeedAndOrdersGiveByteIdenticalReplays) {
                                env);
     test::ChildProcess agent(FLEET_BINARY_DIR "/services/robot_agent/robot_agent",
                              {"--scenario", scenario, "--clock", "lockstep", "--id", "agents", "--threads",
-                              "2", "--local-planner", "dwa", "--no-lanes", "--log-level", "warn"},
+                              "2", "--local-planner", "dwa", "--log-level", "warn"},
                              env);
     // The agent must hold the orders before the first step, or the two runs start differently (a
     // fixed wait after the match was not enough under CI load: r4's order came 4 steps late once).
