@@ -489,26 +489,26 @@ TEST(Agent, ARefusedOrderForAnotherTaskIsReportedAndTheCurrentTaskGoesOn) {
 }
 
 // One frame with finite but absurd wheel totals once made the pose NaN for good while the robot
-// reported idle. The edge refuses such a frame; an Agent that is fed one anyway reports a fault and
-// gives its task back.
-TEST(Agent, ImplausibleEstimateReportsAFaultAndFailsTheTask) {
+// reported idle. The localizer refuses a wheel increment no robot could drive (more than 10 m in a
+// frame): the estimate stays plausible and finite, and the task goes on.
+TEST(Agent, AbsurdWheelTotalsAreRefusedAndTheTaskGoesOn) {
   AgentRun run;
   run.world.wheelTotals = true;
   run.a.onAssignment(transport());
   run.until(5, [] { return false; });
+  const auto before = run.a.framesRejected();
   auto bad = run.world.frame(0, 0, 0.1);
   bad.wheel_left_total = 1e308;
   bad.wheel_right_total = -1e308;
   run.a.onFrame(bad);
+  EXPECT_GT(run.a.framesRejected(), before);
   msg::RobotState last;
   for (int i = 0; i < 15; ++i) {
-    const auto out = i == 0 ? run.stepBlind() : run.step();
-    last = out.state;
-    EXPECT_EQ(out.command.v, 0.0);
+    last = run.step().state;
   }
-  EXPECT_EQ(last.mode, msg::RobotMode::Fault);
-  EXPECT_TRUE(last.pose.isFinite()) << "the last plausible pose is reported, so the fault stays visible";
-  ASSERT_FALSE(run.statuses.empty());
-  EXPECT_EQ(run.statuses.back().state, msg::TaskState::Failed);
-  EXPECT_FALSE(run.a.busy());
+  EXPECT_NE(last.mode, msg::RobotMode::Fault);
+  EXPECT_TRUE(last.pose.isFinite());
+  EXPECT_LT(distance(last.pose, run.world.truth), 0.2);
+  EXPECT_TRUE(run.a.busy());
+  EXPECT_FALSE(run.reported(msg::TaskState::Failed));
 }
