@@ -433,7 +433,7 @@ def saturated_html(s, waiting, done_at, end_s, w=640, h=260):
            f'{line([(0.0, robots), (end_s, robots)], "#d62728", dashed)}'
            f'{line(done, "#2ca02c")}{legend}</svg>')
     return f"""<h3>Saturated window</h3><div class="grid"><div>{table}
-<p class="note">Issue 18's efficiency is taken while at least as many tasks wait as there are robots: every robot that
+<p class="note">The per-robot efficiency is taken while at least as many tasks wait as there are robots: every robot that
 finishes can chain the next task, so the rate there is the fleet's capacity, without the ramp-up from parking or the tail
 after the last task was posted.</p></div><div>{svg}</div></div>"""
 

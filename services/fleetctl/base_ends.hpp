@@ -5,8 +5,8 @@
 // short of its target brakes there; the traffic manager says why the base ended there: `held` (a
 // robot planned before it on the next node had not left: a stop the plan asks for), `plan_end`
 // (the planner had not planned it further yet) or `limit` (more was free: a longer base came too
-// late, the release latency). Issue 20 asks for 0 stops of a vehicle on time, i.e. none but `held`;
-// the load test splits the counts between robot agents and VDA 5050 vehicles.
+// late, the release latency). The target is 0 stops of a vehicle on time, i.e. none but `held`;
+// The load test splits the counts between robot agents and VDA 5050 vehicles.
 
 #include <set>
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
 
-// The kinematic bound of a transport task (issue 18): the least time any robot of that size could
+// The kinematic bound of a transport task: the least time any robot of that size could
 // take for it — the shortest way for its disc on the free map from where it was when the task was
 // assigned to the pickup, and from the pickup to the drop-off, at the agent's cruise speed, plus the
 // load and unload dwell. Fleet figures are stated against it: mean task time ÷ mean bound ("× the

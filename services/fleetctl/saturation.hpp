@@ -1,6 +1,6 @@
 #pragma once
 
-// Issue 18's per-robot efficiency is measured while the fleet is saturated: over the window in
+// The per-robot efficiency is measured while the fleet is saturated: over the window in
 // which at least as many tasks wait (stored, not yet assigned) as there are robots, so that every
 // robot that finishes a task can chain the next without a trip home. The rate inside that window
 // is the fleet's capacity; the rate over a whole run mixes in the ramp-up from parking and the
@@ -30,7 +30,7 @@ struct SaturatedWindow {
 
 /// `transitions` in the order the manager stored them (stamps in simulated ns); `endS` the run's
 /// simulated end, which closes a window still open then. No window (found = false) for 0 robots,
-/// a run in which fewer tasks than robots ever waited, or one that reached it only for an instant.
+/// A run in which fewer tasks than robots ever waited, or one that reached it only for an instant.
 [[nodiscard]] SaturatedWindow saturatedWindow(const std::vector<TransitionRow>& transitions,
                                               std::size_t robots, double endS);
 

@@ -4,8 +4,8 @@
 // straight onto the end, or stand there. The path follower measures what is left by projecting the
 // robot onto the way; the release tracker counts a node reached within its reach tolerance. The two
 // disagree when the robot comes at the end from the side: projected onto the end, 0.17 m beside it,
-// the robot stood and never reported the node, and the traffic manager waited on it for good (a
-// robot going home, full stack, seed 2, session 22: 1,400 s, five robots behind it).
+// The robot stood and never reported the node, and the traffic manager waited on it for good (a
+// robot going home, full stack, seed 2: 1,400 s, five robots behind it).
 
 #include "fleet/core/vec2.hpp"
 

@@ -88,11 +88,11 @@ MotionGate::Clearance MotionGate::clearSpeed(const GateView& view, double v, Blo
   }
   // Range readings: every point that lies in the corridor the robot sweeps ahead limits the speed
   // (with a route: the corridor along the route, the gap measured straight to the point). A point
-  // the route leads away from (it comes no nearer to the route than to the robot now) only slows
-  // the robot to a creep while it is within the gap: held, a robot stood 595 s on a parking place's
+  // The route leads away from (it comes no nearer to the route than to the robot now) only slows
+  // The robot to a creep while it is within the gap: held, a robot stood 595 s on a parking place's
   // approach node 0.035 m beyond the disc from a shelf corner, its route on along the corner (100
-  // robots, session 24); not slowed, the arc a local planner drives may still swing into it (a
-  // shelf touched in session 21, docs/algorithms.md "The gate beside a shelf corner").
+  // robots); not slowed, the arc a local planner drives may still swing into it (a
+  // shelf touched in an earlier run, docs/algorithms.md "The gate beside a shelf corner").
   const double corridor = p_.radius + 0.05;
   for (const auto& ray : view.seen.scan) {
     const double ahead = ray.local.x;
@@ -149,7 +149,7 @@ bool MotionGate::crossTrafficSafe(const GateView& view, double& v, double& w, st
   // Only what is ahead or beside: whoever comes from behind keeps the distance (its own stop rule
   // does); counting it here froze whole queues, each robot held by the one closing in behind it.
   // (Driving backwards, "ahead" is behind: a robot reversing onto its parking place backed into
-  // a person standing behind it, whom this check ignored.)
+  // A person standing behind it, whom this check ignored.)
   const Vec2 heading = Vec2{std::cos(pose.theta), std::sin(pose.theta)} * (v < 0.0 ? -1.0 : 1.0);
   auto relevant = [&](Vec2 at) {
     const Vec2 rel = at - pose.position();
@@ -237,7 +237,7 @@ MotionGate::Hold MotionGate::heldUp(const GateView& view, double& v, double& w, 
   const double allowed = clear.speed;
   if (allowed < v - 1e-9) {
     // Keep the curvature while slowing, so the robot stays on its path. Not while docking: there
-    // the turn toward the station is what frees the robot from the wall that limits its speed.
+    // The turn toward the station is what frees the robot from the wall that limits its speed.
     if (std::abs(v) > 1e-9 && !view.docking) {
       w *= allowed / v;
     }

@@ -25,7 +25,7 @@ constexpr double kAtEnd = 0.02;
 /// The local planner drives while the robot is this close to the base [m]; further off, the
 /// follower steers it back. The roadmap keeps robots apart only near their nodes: a sampling
 /// planner swerving round a person would leave them (the stop rule holds the robot instead, and
-/// the traffic manager re-plans around the person).
+/// The traffic manager re-plans around the person).
 constexpr double kMaxCrossTrack = 0.25;
 /// The follower drives the first metre off a station or parking place (the roadmap's straight
 /// leg from a dock to its approach node), as in reactive traffic.
@@ -51,7 +51,7 @@ constexpr double kPlannerWindow = 2.0;
 constexpr double kSharpTurn = 0.9;
 /// So are bends of more than this [rad] at a node where the disc keeps less than
 /// `kTightClearance` of free space: rounded, the outside of the bend swings towards the shelf (a
-/// robot leaving a parking row came within 0.003 m of a corner, 40 robots, session 24).
+/// robot leaving a parking row came within 0.003 m of a corner, 40 robots).
 constexpr double kTightTurn = 0.3;
 constexpr double kTightClearance = 0.2;  // m beyond the disc
 /// ... coming onto the node at most this fast [m/s] (it slides a centimetre while it brakes) ...
@@ -62,13 +62,13 @@ constexpr double kCornerApproach = 0.8;
 constexpr double kOnCorner = 0.05;
 
 /// The fastest docking [m/s] on the base's last leg; the stop at the end of the base brakes it onto
-/// the goal and the gate's docking gap governs what stands in front of it. (At reactive docking's
+/// The goal and the gate's docking gap governs what stands in front of it. (At reactive docking's
 /// 0.3 m/s a lone robot drove 5 % of its time at 0.2-0.35 m/s.)
 constexpr double kDockSpeed = 0.8;
 
 /// Standing [m/s] (the last command) on a corner node and facing more than kMisaligned [rad] away
 /// from the next base node, the robot turns on the spot until it faces it within kAligned. Left to
-/// the rotation shim (1 rad/s, done at 0.2 rad off a point 1 m on) or the follower (done at
+/// The rotation shim (1 rad/s, done at 0.2 rad off a point 1 m on) or the follower (done at
 /// 0.7 rad), it drove off still turning; with DWA at cruise the arc took it to 2 mm of a shelf
 /// corner (robot-shelf minimum separation in one of three runs; 0.033-0.05 m in four with the
 /// turn, the base build's 0.043-0.098 m). Once per next node and only on a corner: turning to the
@@ -82,22 +82,22 @@ constexpr double kAligned = 0.05;
 /// static obstacle for kRejoinAfterS [s], the robot drives back onto the node before it goes on. Its straight
 /// way from there to the next node is no roadmap edge: from 0.28 m off its node in the gap between two
 /// shelves, a robot's way to a parking place's approach passed a shelf corner 0.29 m off (less than its
-/// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed 3,
-/// session 22). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
-/// the one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
+/// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed
+/// 3). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
+/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
 constexpr double kRejoinOff = 0.15;
 constexpr double kRejoinAfterS = 10.0;
 /// Held that long by a person between its node and the next (which it holds both of), the robot
 /// backs onto its node and stands there reporting itself blocked for kGiveWayS or until a new
 /// release. The person gets room, and the traffic manager may re-plan it (yield_after_s), which it
 /// does only for a robot on its node: the node ahead can then go to others. (Two robots stood
-/// 0.3 m past their nodes, a person between them, for 2,000 s: 20 robots under load, session 27.)
+/// 0.3 m past their nodes, a person between them, for 2,000 s: 20 robots under load.)
 constexpr double kGiveWayS = 15.0;
 constexpr const char* kWhyOwnZero = "driving without getting on";
 constexpr const char* kWhyStand = "commanded to stand";
 
 /// The gate's stop rule looks this far along the base [m] (more than the stopping distance plus
-/// the gap at cruise).
+/// The gap at cruise).
 constexpr double kGateRoute = 3.0;
 
 /// The stretch of the polyline `pts` from arc length `from` on, `length` long.
@@ -209,9 +209,9 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const auto& goal = c.goal;
   const bool toGoal = baseEndsAtGoal(goal);
   // Counted on its goal's node (passed beside it, up to ReleaseParams::passLateral off) but not on
-  // the goal's pose: the traffic manager takes it as arrived and releases nothing more, so it docks
+  // The goal's pose: the traffic manager takes it as arrived and releases nothing more, so it docks
   // from here, within the node it holds. (Standing there, one robot waited 300 s with a station's
-  // line behind it: dense check, seed 2, session 26.)
+  // line behind it: dense check, seed 2.)
   const bool shortOfGoal = toGoal && !releases_.nodesAhead();
   dockingLeg_ = toGoal && (releases_.onLastLeg() || shortOfGoal);
   bool docking = false;
@@ -384,7 +384,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   double cap = stoppingSpeed(left, p_.limits.accelMax, c.dt);
   if (turn) {
     // Down to the turning speed by the time it is on the corner (kOnCorner, with as much again for
-    // the braking's lag behind the command).
+    // The braking's lag behind the command).
     cap = std::min(
         cap, std::max(kTurnSpeed, stoppingSpeed(turn->distance - 2.0 * kOnCorner, p_.limits.accelMax, c.dt)));
   }
@@ -412,7 +412,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   if (held && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
     // Something ahead while the way bends away from it: turn towards the carrot on the spot, which
     // sweeps nothing. (Only for walls at first, as reactive: a robot 7 cm off its lane facing 24°
-    // towards a robot parked beside the lane stood 1,200 s, full stack, seed 4, session 22.)
+    // towards a robot parked beside the lane stood 1,200 s, full stack, seed 4.)
     v = 0.0;
     w = std::clamp(2.0 * bearing, -p_.wMax, p_.wMax);
     held = false;

@@ -7,7 +7,7 @@
 //
 // A release is taken when it is newer than the last one of its epoch and starts at the node the
 // robot last reported; a new epoch (a restarted traffic manager) when it starts at that node or at
-// a node next to the robot (the restarted manager places it by its pose). Anything else is ignored
+// A node next to the robot (the restarted manager places it by its pose). Anything else is ignored
 // and counted: the robot keeps what it had, which never lets it drive further than was released.
 
 #include <cstdint>
@@ -52,7 +52,7 @@ struct ReleaseParams {
   /// passed more than twice as far back along the base (a loop round a shelf's end, a U-turn over
   /// two corners): the projection would take the robot for on the way back and skip the loop
   /// (one robot stood 300 s 0.14 m from its base's last node, a loop's end, with six robots
-  /// waiting on it: 20-robot scenario under load, session 27).
+  /// waiting on it: 20-robot scenario under load).
   double comesBack = 0.6;
 };
 

@@ -430,7 +430,7 @@ class Simulator {
                       {"refused_messages", vda_->counters().refused_messages},
                       {"rejected_orders", vda_->counters().rejected_orders},
                       {"base_starved_stops", vda_->baseStarvedStops()}};
-      // Order-to-motion (issue 20: p99 <= 100 ms through the broker): the bridge stamps an order
+      // Order-to-motion (p99 <= 100 ms through the broker): the bridge stamps an order
       // when it publishes it, on its clock; on the wall clock that is the simulator's too.
       std::vector<double> ms;
       for (const std::int64_t ns : vda_->orderToMotionNs()) {

@@ -84,7 +84,7 @@ OrderVerdict Vda5050Vehicle::onOrder(const Order& order) {
       errors_.clear();
       waiting_for_base_ = false;
       // The first node is where the vehicle stands (the rules checked it): its state says so from
-      // the first message on (the next step reaches it and runs its actions).
+      // The first message on (the next step reaches it and runs its actions).
       if (!order_->nodes.empty() && !last_node_id_.empty() && order_->nodes.front().nodeId == last_node_id_) {
         last_node_seq_ = order_->nodes.front().sequenceId;
       }
@@ -304,7 +304,7 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
       continue;
     }
     // Steer for a point a little ahead on the edge into the node, not for the node itself: out of
-    // a bend driven through, the vehicle is off the line, and steering for the node swung it to
+    // A bend driven through, the vehicle is off the line, and steering for the node swung it to
     // and fro across the edge.
     Vec2 aim{n.nodePosition->x, n.nodePosition->y};
     if (next_ > 0 && order_->nodes[next_ - 1].nodePosition) {
@@ -358,7 +358,7 @@ VehicleCommand Vda5050Vehicle::step(double now_s, const Pose2& pose, bool person
     // It stops driving. Standing, it may still turn on the spot: its body is a disc, so turning
     // brings it no nearer anyone, and a vehicle that could not turn stood for good beside a
     // neighbour parked diagonally ahead of it on its way into its own parking place (mixed-fleet
-    // runs, session 30: 5-8 minutes in most seeds).
+    // runs: 5-8 minutes in most seeds).
     cmd.v = 0.0;
     if (measured_speed_ > kStandingSpeed) {
       cmd.w = 0.0;
@@ -476,7 +476,7 @@ bool Vda5050Vehicle::inProtectiveField(const Pose2& pose, double px, double py, 
   const double v = fieldSpeed();
   const double braking = v * v / (2.0 * std::max(config_.brakeDecel, 1e-3));
   // Wider too with speed: a person walking in from the side at an angle reached a vehicle that
-  // braked from 1 m/s once it saw them 0.5 m off its side (a 2 cm contact, mixed fleet, session 30).
+  // braked from 1 m/s once it saw them 0.5 m off its side (a 2 cm contact, mixed fleet).
   return inFieldAhead(pose, px, py, radius, config_.length / 2.0, config_.protectiveField + braking,
                       config_.width / 2.0 + config_.fieldSideMargin + braking);
 }
@@ -486,7 +486,7 @@ bool Vda5050Vehicle::inWarningField(const Pose2& pose, double px, double py, dou
   const double a = std::max(config_.brakeDecel, 1e-3);
   const double braking = v * v / (2.0 * a);
   // It holds the protective field: as wide, longer by the way an approaching person covers while
-  // the vehicle brakes.
+  // The vehicle brakes.
   const double reach = config_.protectiveField + braking + config_.personApproachSpeed * v / a;
   return inFieldAhead(pose, px, py, radius, config_.length / 2.0, reach,
                       config_.width / 2.0 + config_.fieldSideMargin + braking);

@@ -104,7 +104,7 @@ void Execution::append(std::span<const NodeId> next) {
       routes_[r].entries.pop_back();
   };
   // Dependencies: wait until the last visitor of every node excluding the target has moved on to
-  // the first node of its route that no longer conflicts with the target.
+  // The first node of its route that no longer conflicts with the target.
   std::vector<std::int64_t> need(n, -1);
   std::vector<std::vector<std::size_t>> sameStep(n);
   for (std::size_t r : movers) {
@@ -239,7 +239,7 @@ namespace {
 /// A base never passes a node twice. The planner moves robots aside and back ([A B C A]: out of
 /// another's way and back onto its route); an agent that projects itself onto such a base finds
 /// its own node at both ends, takes the base as driven, and stands while the traffic manager waits
-/// for B (full stack, session 21: three robots stood for good with bases [A B C A], 20 robots,
+/// for B (full stack: three robots stood for good with bases [A B C A], 20 robots,
 /// seed 7, 67 of 100 tasks done). Released up to C, reported there, then [C A ...].
 template <class Route>
 bool releasedAgain(const Route& route, NodeId node) {
@@ -375,7 +375,7 @@ bool Execution::letPass(std::size_t robot, std::int64_t minBehind) {
     return false;
   // Nothing is copied or derived again unless some late robot is really put behind: most calls
   // find none (the late robots' remaining routes do not meet this one's before their own end), and
-  // a whole-fleet rederive() per waiting robot per update was most of the traffic manager's time at
+  // A whole-fleet rederive() per waiting robot per update was most of the traffic manager's time at
   // 300 robots.
   std::optional<std::vector<Route>> saved;
   std::vector<std::uint8_t> touched;  // per node: at or beside an entry whose order changed

@@ -589,7 +589,7 @@ void Pibt::reconsiderRefused() {
   // only had no move clear of what its pusher wanted, which reaches past its neighbours: every move
   // of a robot on the lane beside a dock's approach still excludes the approach, yet two of them
   // take it clear. Kept standing, it never made its own move while the robot leaving the dock, first
-  // by priority, pushed it every step: both stood for good (full stack, session 23, seed 5: r20
+  // by priority, pushed it every step: both stood for good (full stack, seed 5: r20
   // beside P-5's approach with free ways on to D-4, r7 on P-5's dock and r11 in its queue, 2,200 s).
   // Now, once the pusher's search is over, such an agent is undecided again and plans in its own
   // turn. Nobody relies on its standing: every node reserved since was checked against its node,

@@ -1,6 +1,6 @@
 // Pibt's way out of knots PIBT cannot leave on its own: the wait-for graph (blocker), the escape
 // (escalating one agent of a knot), the untangling search over a few steps of a knot's agents, and
-// the forced moves it finds (pibt.hpp: "Escape" and "Untangling" of its three additions).
+// The forced moves it finds (pibt.hpp: "Escape" and "Untangling" of its three additions).
 
 #include <algorithm>
 #include <span>
@@ -98,7 +98,7 @@ void Pibt::escapeDeadlocks() {
     // in a dock whose only way out the robot on the lane in front excludes, that robot wanting
     // past the dock): the chain stands for ever, a knot like a cycle, and escalating one of its
     // agents changes nothing. Its tail (the content agent and those waiting on it) is searched;
-    // the content agent does not count, it only makes room. (Full stack, session 22: r7 and r1
+    // The content agent does not count, it only makes room. (Full stack: r7 and r1
     // head-on in front of the parking row for 830 s, r6 parked across every way west.)
     if (!cycle) {
       const auto end = idx(chain_.back());

@@ -1,4 +1,4 @@
-// Frame rate of the dashboard page under a 500-robot feed (issue 21 item 6; a benchmark, not a test).
+// Frame rate of the dashboard page under a 500-robot feed (a benchmark, not a test).
 //
 //   node tests/bench/dashboard/replay_fps.mjs REPLAY.jsonl.gz [--robots 500] [--hz 2] [--seconds 20]
 //
@@ -8,7 +8,7 @@
 // adapter's /v1/stream sends it (one `event: robots` with every robot's JSON each period) by a small
 // server here that also serves the page's files (services/wms_adapter/web) and a site picture of the
 // tiled map. Headless Debian chromium (puppeteer-core) loads the page; the frame rate is taken from
-// the page's own frame timestamps (requestAnimationFrame, MapView.frameTimes) over --seconds after a
+// The page's own frame timestamps (requestAnimationFrame, MapView.frameTimes) over --seconds after a
 // 3 s warm-up. Prints one JSON line.
 
 import fs from 'node:fs';

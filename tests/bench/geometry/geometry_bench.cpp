@@ -1,4 +1,4 @@
-// Geometry benchmarks (issue 4): BVH vs brute force over 10,000 boxes (both measured in the same
+// Geometry benchmarks: BVH vs brute force over 10,000 boxes (both measured in the same
 // benchmark, ratio reported as a counter), MMS vs the convex cross-check on 10..1000 segments, OBB
 // SAT and grid DDA throughput.
 #include <benchmark/benchmark.h>

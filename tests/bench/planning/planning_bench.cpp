@@ -1,4 +1,4 @@
-// Planning benchmarks (issue 4) on the procedural 340 x 164 warehouse (38,756 free cells, the size
+// Planning benchmarks on the procedural 340 x 164 warehouse (38,756 free cells, the size
 // of MovingAI warehouse-20-40-10-2-2): wavefront distance field, A* random queries (median and
 // tail as counters), cached travel costs, and OMPL planners' time to a path within 1.1x of the
 // grid-optimal (8-connected A*) length.

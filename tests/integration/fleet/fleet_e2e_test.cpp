@@ -329,9 +329,9 @@ TEST_F(FleetE2E, PauseOverHttpHoldsTheRobotAndSurvivesAManagerKill) {
   EXPECT_EQ(getTask("job-p").value("state", ""), "done");
 }
 
-// Issue 19: the Task topic was keyed by task id with history 1, so of two requests on one task at
+// The Task topic was keyed by task id with history 1, so of two requests on one task at
 // once (the same POST twice, pause and resume together) the second could replace the first before
-// the manager took it, and the first was never answered (503 after the ack timeout, ~1 in 20).
+// The manager took it, and the first was never answered (503 after the ack timeout, ~1 in 20).
 // Requests are keyed by request id now. Every one of these concurrent requests must be answered.
 TEST_F(FleetE2E, ConcurrentRequestsOnOneTaskAreAllAnswered) {
   constexpr int kTasks = 40;
@@ -380,8 +380,8 @@ TEST_F(FleetE2E, ConcurrentRequestsOnOneTaskAreAllAnswered) {
   }
 }
 
-// Issue 19 item 5: after a manager restart and then an adapter restart, the adapter found none of
-// the stored tasks that had not moved since (404). The restarted manager announces every open
+// After a manager restart and then an adapter restart, the adapter found none of
+// The stored tasks that had not moved since (404). The restarted manager announces every open
 // task, and the adapter asks the manager for any task its view lacks (finished ones too).
 TEST_F(FleetE2E, AdapterRestartedAfterAManagerRestartFindsEveryStoredTask) {
   std::vector<std::string> ids;

@@ -152,7 +152,7 @@ void expectEveryTaskAccountedFor(const json& r) {
 
 std::map<std::string, double> query(const fs::path& db, const char* sql);
 
-/// Issue 19 item 7: work goes on after each fault, not only nothing lost. For each event (its first
+/// Work goes on after each fault, not only nothing lost. For each event (its first
 /// line in the fault log that contains it), tasks were done after it (by the manager's log, in
 /// simulated seconds).
 void expectTasksDoneAfter(const json& r, const fs::path& db, std::initializer_list<const char*> events) {
@@ -256,7 +256,7 @@ TEST(LoadtestE2E, ReservedTrafficThroughEveryFaultNoTaskLostOrDuplicated) {
   // The process faults in one run with the traffic manager planning every robot: the manager and
   // an agent process killed and restarted, robot r3's agent frozen for 5 s, the traffic manager
   // itself killed and restarted, and an area in the middle of the shelves closed for 40 s through
-  // the WMS adapter. The traffic manager holds the frozen or restarting robots where they are and
+  // The WMS adapter. The traffic manager holds the frozen or restarting robots where they are and
   // plans round them; while it is away every robot stops at the end of its base, and the new one
   // rebuilds its state from their progress reports. (Dropped DDS packets: the test above.)
   const fs::path out =
@@ -337,7 +337,7 @@ TEST(LoadtestE2E, ScenarioTaskListIsPostedExactlyEachAtItsTime) {
   EXPECT_EQ(r["accounting"]["lost"], 0);
   EXPECT_EQ(r["accounting"]["duplicated"], 0);
   // Exactly those ids (the second one's generated after its place in the list), each stored once
-  // the simulated clock had reached its at_s (the manager stamps with the simulated clock).
+  // The simulated clock had reached its at_s (the manager stamps with the simulated clock).
   const auto stored = storedTasks(out / "fleet.db");
   ASSERT_EQ(stored.size(), 3u);
   ASSERT_EQ(stored.count("list-a"), 1u);
@@ -461,7 +461,7 @@ TEST(LoadtestE2E, TaskTimesAreStatedAgainstTheKinematicBound) {
 // leaving robot first (session of 2026-11-26) it passed 18 of 18 runs, 12 of them three at a time
 // beside three other builds; re-enabled. If it comes back, the run folder is kept (see below).
 TEST(LoadtestE2E, ALoneRobotDeliversUnderReservedTraffic) {
-  // The whole chain of issue 18: the traffic manager builds the roadmap from the site, places the
+  // The whole chain: the traffic manager builds the roadmap from the site, places the
   // robot from its first TrafficProgress, plans it and releases its route a few nodes at a time; the
   // agent drives only what it was released and reports the nodes it reaches.
   const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-reserved-" + std::to_string(getpid()));

@@ -1,6 +1,6 @@
 // Every service as a process: /metrics passes `promtool check metrics`, /livez and /readyz answer
 // truthfully, a real Prometheus on loopback scrapes a running lockstep fleet and answers a query;
-// a taken metrics port, a bad option and a bad log level exit 2; --version exits 0; JSON logs are
+// A taken metrics port, a bad option and a bad log level exit 2; --version exits 0; JSON logs are
 // one object per line.
 
 #include <arpa/inet.h>
@@ -437,7 +437,7 @@ TEST(OpsProbes, AnAdapterWithoutManagerIsLiveNotReadyAndLogsEveryRequest) {
 }
 
 TEST(OpsProbes, SamplesTheAdapterRefusesAreCountedInItsMetrics) {
-  // A TaskEvent whose task id is not an id (issue 19's edge checks): refused, and counted where
+  // A TaskEvent whose task id is not an id (the edge checks): refused, and counted where
   // an operations stack looks, as every other service's refusals are.
   const std::string domain = std::to_string(fleet::test::uniqueDomain());
   const auto dir = fs::temp_directory_path() / ("fleet-ops-refused-" + domain);

@@ -1,4 +1,4 @@
-// DDS Security end to end (issue 19 item 1): identities made by scripts/dds-security, Cyclone DDS's
+// DDS Security end to end: identities made by scripts/dds-security, Cyclone DDS's
 // security plugins, and participants that should or should not get a Task to the fleet manager.
 
 #include <gtest/gtest.h>

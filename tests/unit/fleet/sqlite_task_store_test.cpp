@@ -233,7 +233,7 @@ TEST(SqliteTaskStore, TransitionsFollowTheStateMachine) {
   EXPECT_EQ((*h)[3].robotId, "r1") << "the log keeps who held the task";
 }
 
-// Issue 19: a robot's error that was not UTF-8 was stored as it came, and every reader that made
+// A robot's error that was not UTF-8 was stored as it came, and every reader that made
 // JSON of the record threw, across restarts. Reasons are repaired when read back.
 TEST(SqliteTaskStore, ReasonsThatAreNotUtf8AreRepairedWhenRead) {
   test::TempDir dir;

@@ -361,7 +361,7 @@ TEST(Settings, ChargeUntilMustExceedTheBatteryThreshold) {
 }
 
 // The charge goal asks the robot to dwell (charge_max_s at most); the manager ends the task when
-// the robot's RobotState at the charger shows charge_until, and tells the robot with an empty order.
+// The robot's RobotState at the charger shows charge_until, and tells the robot with an empty order.
 TEST_F(Node, ChargeTaskDwellsUntilTheManagerSeesTheTargetBattery) {
   settings_.chargeMaxS = 900.0;
   auto node = open(0);
@@ -409,9 +409,9 @@ TEST(Settings, TravelCostIsPathByDefaultAndStraightOnRequest) {
       << bad.problems()[0];
 }
 
-// Issue 19: leases used the robot's own stamp, so a robot whose clock ran 1.5 s behind was lost
+// Leases used the robot's own stamp, so a robot whose clock ran 1.5 s behind was lost
 // at once and never got a task (and one stamping INT64_MAX was never lost). The lease now runs on
-// the manager's clock, from when the state was received.
+// The manager's clock, from when the state was received.
 TEST_F(Node, LeaseRunsOnTheManagersClockNotTheRobots) {
   settings_.leaseS = 1.0;
   auto node = open(0);
@@ -432,7 +432,7 @@ TEST_F(Node, LeaseRunsOnTheManagersClockNotTheRobots) {
   EXPECT_EQ(node->dispatcher().robots().onlineCount(), 0u);
 }
 
-// Issue 19 item 5: after a restart the manager announces every open task's state, with the seq
+// After a restart the manager announces every open task's state, with the seq
 // going on from the task's stored revision (an adapter that kept running sees no step back).
 TEST_F(Node, RestartAnnouncesEveryOpenTaskAsAnEvent) {
   {
@@ -461,7 +461,7 @@ TEST_F(Node, RestartAnnouncesEveryOpenTaskAsAnEvent) {
   EXPECT_EQ(out.events.back().seq, 3u);
 }
 
-// Issue 19 item 5: the adapter asks for a task its view lacks; the manager answers from the store,
+// The adapter asks for a task its view lacks; the manager answers from the store,
 // finished tasks included.
 TEST_F(Node, QueryAnswersFromTheStore) {
   auto node = open(0);

@@ -21,10 +21,10 @@ Vec2 heading(double theta) {
 }  // namespace
 
 TEST(BaseEnd, ProjectedOntoTheEndButBesideItTheRobotDrivesOntoIt) {
-  // As r6 stood 1,400 s going home (full stack, seed 2, session 22): its way from (25.73, 4.865)
+  // As r6 stood 1,400 s going home (full stack, seed 2): its way from (25.73, 4.865)
   // to node 258 at (26.25, 5.25), the local planner swerved east and the robot came at the node
   // from the side: at (26.34, 5.11) facing 1.50 rad, 0.011 m left by projection, 0.166 m from
-  // the node (the release tracker's reach: 0.15 m). It stood and never reported the node.
+  // The node (the release tracker's reach: 0.15 m). It stood and never reported the node.
   const Vec2 from{25.73, 4.865};
   const Vec2 end{26.25, 5.25};
   const Vec2 here{26.34, 5.11};

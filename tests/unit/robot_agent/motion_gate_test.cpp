@@ -87,7 +87,7 @@ TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
   const std::vector<OtherRobot> others;
   // The route bends right after 0.3 m. A shelf corner 0.67 m ahead and 0.2 m left is in the
   // straight corridor but 0.42 m from the route; a point 0.55 m ahead and 0.5 m right is outside
-  // the straight corridor but on the route.
+  // The straight corridor but on the route.
   const std::vector<Vec2> route{{2.0, 2.0}, {2.3, 2.0}, {2.6, 1.4}};
   const Perception corner = perception({{0.67, 0.2}});
   Blocker b;
@@ -108,7 +108,7 @@ TEST(MotionGate, WithARouteTheGapIsKeptAlongTheRouteNotStraightAhead) {
   EXPECT_EQ(gate.clearSpeed({behind, others, emptyMap(), {}, false, &route}, 0.8, b).speed, 0.8);
 }
 
-// 100 robots, session 23: a parking place's approach node 0.335 m from a shelf corner, its route
+// 100 robots: a parking place's approach node 0.335 m from a shelf corner, its route
 // on to the lane leading along the corner, not towards it. The stop rule held the robot there for
 // 595 s (0.035 m of gap where it keeps 0.35 m); a point the route leads away from only slows the
 // robot to a creep (0.15 m/s) while it is within the gap.

@@ -154,7 +154,7 @@ TEST(ReleaseTracker, TheWayStopsWhereTheBaseTurnsBack) {
 }
 
 TEST(ReleaseTracker, TheWayStopsBeforeALoopComesBackToTheRobot) {
-  // The loop a robot was released round a block in the 20-robot scenario (session 27): from 649 by
+  // The loop a robot was released round a block in the 20-robot scenario: from 649 by
   // two gentle corners and back to 1137, 0.25 m from where it started. Its last leg passes 0.1 m
   // from the robot, so a projection on the whole way takes it for nearly there; the way ends on
   // 1138 instead, and from there on, the rest.
@@ -211,7 +211,7 @@ TEST(ReleaseTracker, RemainingAndTheWayAheadFollowTheRobot) {
 
 // A bend under the sharp-turn angle is rounded, except at a node said to be tight (beside a
 // shelf): there it is a corner too, as a 40-robot run's 39° bend at a parking row's approach node
-// beside a shelf corner needed (session 24).
+// beside a shelf corner needed.
 TEST(ReleaseTracker, AGentleBendIsACornerWhereTheNodeIsTight) {
   ReleaseTracker t;
   // Up from (0, 0) to (0, 0.85), then 39° to the left on to (-0.45, 1.4).

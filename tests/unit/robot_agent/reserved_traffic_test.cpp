@@ -426,7 +426,7 @@ TEST_P(ReservedPlanner, FollowsABaseRoundCornersAndStaysOnIt) {
 TEST_P(ReservedPlanner, DrivesOffACornerNodeOnlyOnceItFacesTheNextNode) {
   // Along the lane, then a sharp turn (135°) up and back along a diagonal: standing on the corner
   // node the robot turns on the spot until it faces the next node, then drives (an arc driven off
-  // a corner at speed swung it off a diagonal leg towards the shelf corner the leg passes).
+  // A corner at speed swung it off a diagonal leg towards the shelf corner the leg passes).
   Sim sim(GetParam());
   std::vector<msg::RouteNode> base = lane(0, 6);  // to (4, 5)
   for (int k = 1; k <= 4; ++k) {
@@ -491,7 +491,7 @@ TEST_P(ReservedPlanner, DrivesABaseThatEndsOnTheNodeItStandsOn) {
 }
 
 TEST_P(ReservedPlanner, DrivesALoopRoundABlockWhoseLastNodeIsBesideIt) {
-  // As one robot stood 300 s with six waiting on it (20 robots, session 27): released from its
+  // As one robot stood 300 s with six waiting on it (20 robots): released from its
   // node A round a block by gentle corners to E, 0.14 m from where it stood. The path follower's
   // projection took it for at E at once and it stood "at the end of its base"; it drives to D,
   // where the way comes back, then on to E, and reports every node.
@@ -512,7 +512,7 @@ TEST_P(ReservedPlanner, DrivesALoopRoundABlockWhoseLastNodeIsBesideIt) {
 }
 
 TEST_P(ReservedPlanner, HeldOffItsNodeItDrivesALoopBackToWhereItStands) {
-  // As the whole fleet stood in a full-stack run (seed 3, session 21): a person stopped the robot
+  // As the whole fleet stood in a full-stack run (seed 3): a person stopped the robot
   // 0.6 m off its node A, on the spot of a queue node Q; the traffic manager, still placing it on
   // A, released a loop [A, B, C, D, Q] out along the lane and back to Q. Given the whole base, the
   // path follower took the way back for the way out and the robot stood for good; it drives the
@@ -540,7 +540,7 @@ TEST_P(ReservedPlanner, HeldOffItsNodeItDrivesALoopBackToWhereItStands) {
 }
 
 TEST_P(ReservedPlanner, OffItsNodeWithAShelfCornerInTheStraightWayItRejoinsThroughItsNode) {
-  // As r10 stood 2,100 s in a full-stack run (seed 3, session 22): 0.28 m off its node A in the
+  // As r10 stood 2,100 s in a full-stack run (seed 3): 0.28 m off its node A in the
   // gap between two shelves, its next node B (a parking place's approach) beyond a shelf corner
   // that the straight way from where it stands passes 0.29 m off, less than its radius. The
   // roadmap's edge A-B clears the corner; the robot goes back to A and drives the edge.
@@ -567,10 +567,10 @@ TEST_P(ReservedPlanner, OffItsNodeWithAShelfCornerInTheStraightWayItRejoinsThrou
 }
 
 TEST_P(ReservedPlanner, HeldByARobotBesideItsWayItTurnsToItsWayAndGoesOn) {
-  // As r8 stood 1,200 s in a full-stack run (seed 4, session 22): on the band in front of the
+  // As r8 stood 1,200 s in a full-stack run (seed 4): on the band in front of the
   // parking row, 7 cm below its lane and facing 24° down towards a robot parked beside the lane,
   // which its stop rule's corridor took in. The way on runs along the lane, clear of that robot:
-  // the robot turns on the spot to face its way and drives on.
+  // The robot turns on the spot to face its way and drives on.
   Sim sim(GetParam());
   sim.restartAt({lane(0).x, kY - 0.07, -0.42});
   sim.parked = {{lane(0).x + 0.24, kY - 0.85}};
@@ -582,7 +582,7 @@ TEST_P(ReservedPlanner, HeldByARobotBesideItsWayItTurnsToItsWayAndGoesOn) {
   EXPECT_EQ(sim.lastNode(), 4);
 }
 
-// Disabled from session 16 to 22 (docs/algorithms.md, "robot agent: reserved traffic"): the release
+// Disabled for a while (docs/algorithms.md, "robot agent: reserved traffic"): the release
 // tracker and the path follower projected the robot onto the leg back into A and took the base as
 // driven. Both now stop at C, where the base turns back (ReleaseParams::turnBack).
 TEST_P(ReservedPlanner, DrivesALoopBackToItsNodeFacingAway) {

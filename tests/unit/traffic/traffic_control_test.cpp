@@ -52,7 +52,7 @@ void stepOnTime(TrafficControl& tc) {
 /// Robots follow the releases, late at random. What holds whatever the planner does: no two robots
 /// ever hold conflicting nodes, their centres keep the contact distance, no report is refused.
 /// (How much work they get done is the planner's business: measured in docs/benchmarks.md, where
-/// the 20-robot fleet still jams; see the issue notes.)
+/// The 20-robot fleet still jams; see the issue notes.)
 /// Seeds 1–3 of the virtual fleet, each checked against every promise; returns the results.
 std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
   std::vector<VirtualFleetResult> out;
@@ -90,7 +90,7 @@ TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
 /// front: PIBT moves one node per step and the robot outside cannot clear the exit in one step, so
 /// plain PIBT leaves both where they are for ever. The stalled robot makes the other drive away.
 TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
-  // The lattice of before session 21 (nodes beside shelf corners too), where the lane node in
+  // The earlier lattice (nodes beside shelf corners too), where the lane node in
   // front of PARK-1 has no way round the exit it excludes: the knot this test needs.
   RoadmapOptions o;
   o.nodeClearance = 0.0;
@@ -368,8 +368,8 @@ TEST(TrafficControl, RobotsStandingInTheQueueGoBeforeRobotsOnTheirWay) {
 
 /// While the robot that was at the dock drives off it, the next in line waits where it leaves the
 /// approach's ways out free, not only the dock's: a robot leaving a drop-off goes on sideways from
-/// the approach, and a robot waiting on the queue's head shut that way (seen in the virtual fleet:
-/// the leaving robot and three waiting ones stood for 220 s at D-3).
+/// The approach, and a robot waiting on the queue's head shut that way (seen in the virtual fleet:
+/// The leaving robot and three waiting ones stood for 220 s at D-3).
 TEST(TrafficControl, TheNextInLineWaitsClearOfTheWaysOutOfTheApproach) {
   Roadmap map = smallWarehouse();
   const auto* d3 = map.station("D-3");
@@ -440,7 +440,7 @@ TEST(TrafficControl, TheDockIsFreeOnlyOnceTheLeavingRobotReportsItOff) {
 /// robot waiting for it). A lone robot does 6 or 7.
 // Robots that follow their releases at once (no latency) reach the end of their base short of
 // their target only where the plan holds them (a dependency) or has not gone on yet, never because
-// a longer base was free but late: the release keeps ahead of a robot on time.
+// A longer base was free but late: the release keeps ahead of a robot on time.
 TEST(VirtualFleet, ARobotOnTimeNeverReachesABaseEndThatMoreWasFreeBeyond) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;

@@ -1,4 +1,4 @@
-// The checks every service applies at its edge (issue 19, item 3), one test per failure listed.
+// The checks every service applies at its edge, one test per failure listed.
 
 #include "fleet/validation/sample_checks.hpp"
 

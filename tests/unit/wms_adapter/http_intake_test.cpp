@@ -1,4 +1,4 @@
-// Issue 19 item 4: HTTP intake that one client cannot stop. Each test is a way a client stopped the
+// HTTP intake that one client cannot stop. Each test is a way a client stopped the
 // cpp-httplib server (slow heads and bodies, open event streams, chunked bodies read whole, a burst
 // of connections against a backlog of 5); the bounds in the tests (client timeouts, receive
 // limits) only keep a broken server from hanging the test. Same-id requests at once are answered

@@ -1,5 +1,5 @@
-// Issue 19 item 2: tokens with names and scopes from a file re-read without a restart, no token in
-// a URL, an audit line per state-changing request, and https with a certificate from
+// Tokens with names and scopes from a file re-read without a restart, no token in
+// A URL, an audit line per state-changing request, and https with a certificate from
 // scripts/dds-security.
 
 #include <gmock/gmock.h>

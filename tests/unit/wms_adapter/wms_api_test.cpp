@@ -188,7 +188,7 @@ TEST_F(Api, PauseAndResumeReachTheManagerAndAnswerWithTheState) {
   EXPECT_THAT(r->body, HasSubstr("nothing was paused"));
 }
 
-// Issue 19: a TaskEvent reason that is not UTF-8 (from a robot's TaskStatus.error) made the adapter
+// A TaskEvent reason that is not UTF-8 (from a robot's TaskStatus.error) made the adapter
 // exit while an event stream was open and made GET /v1/tasks answer 500 for good. Text that gets
 // past the edge unrepaired is now written with U+FFFD; the stream and the list keep working.
 TEST_F(Api, TextThatIsNotUtf8NeitherStopsTheStreamNorBreaksTheList) {
@@ -216,8 +216,8 @@ TEST_F(Api, TextThatIsNotUtf8NeitherStopsTheStreamNorBreaksTheList) {
   EXPECT_EQ(json::parse(r->body)["reason"], "motor \xEF\xBF\xBD\xEF\xBF\xBD fault");
 }
 
-// Issue 19 item 5: a task the view does not hold (an adapter started after its events) is asked of
-// the manager before answering 404.
+// A task the view does not hold (an adapter started after its events) is asked of
+// The manager before answering 404.
 TEST_F(Api, TaskMissingFromTheViewIsAskedOfTheManager) {
   start();
   ASSERT_EQ(post(kTask)->status, 201);

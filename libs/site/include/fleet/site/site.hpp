@@ -29,7 +29,7 @@ std::optional<StationKind> stationKindFromString(const std::string& s);
 /// keeps less than `kApproachClearance` of free space at that point, the nearest point further in
 /// (down to `kMinApproachDistance`) that keeps it is taken instead: a robot stops a few centimetres
 /// off its approach point, and one stopped within reach of a shelf corner that its way on leads
-/// past stood for good (100 robots on the generated warehouse, session 24).
+/// past stood for good (100 robots on the generated warehouse).
 struct Station {
   std::string name;
   StationKind kind = StationKind::Pickup;

@@ -64,7 +64,7 @@ struct RoadmapOptions {
   /// m of free space a lane edge (and an edge joining a station's, queue's or parking place's node
   /// to the lanes) keeps around the disc along its whole length: the motion gate stops for static
   /// points within `corridorSlack` of the route, so an edge closer than that to a shelf corner
-  /// holds the robot at its start for good (100 robots, session 23: 0.035 m beyond the disc). This
+  /// holds the robot at its start for good (100 robots: 0.035 m beyond the disc). This
   /// is the corridor plus 0.02 m of tracking error. A station whose nodes cannot be joined with it
   /// is joined by edges that clear the disc only (the dock's own edge always is: docking lets
   /// static points come closer).
@@ -151,7 +151,7 @@ class Roadmap {
 };
 
 /// Builds the roadmap of `site` (its map with no-go zones blocked, its stations and zones). What
-/// the site does not allow (a station the disc does not fit at, one that cannot be joined or is
+/// The site does not allow (a station the disc does not fit at, one that cannot be joined or is
 /// cut off) is in `problems`; options out of range throw std::invalid_argument, a lattice of more
 /// than kMaxLatticePoints throws ConfigError (the site is too large for the spacing).
 Roadmap buildRoadmap(const site::Site& site, const RoadmapOptions& options = {});
