@@ -28,9 +28,10 @@ using namespace std::chrono_literals;
 using nlohmann::json;
 
 TEST(AgentLockstep, ARobotWhoseSensorStreamStopsStopsReportsItAndResumes) {
-  // The outage, simulated seconds: r1 drives along the parking band at full speed then.
-  constexpr double kFrom = 4.0;
-  constexpr double kTo = 10.0;
+  // The outage, simulated seconds: r1 drives along the parking band at full speed then (it leaves
+  // its parking place once the traffic manager has heard every robot, about 3.5 s in).
+  constexpr double kFrom = 8.0;
+  constexpr double kTo = 14.0;
   constexpr double kSensorTimeout = 0.5;  // robot_agent's default --sensor-timeout
   const auto run = test::freshRun("agent_sensor_loss_");
   const auto& dir = run.dir;
@@ -47,7 +48,7 @@ TEST(AgentLockstep, ARobotWhoseSensorStreamStopsStopsReportsItAndResumes) {
   test::ChildProcess sim(
       FLEET_BINARY_DIR "/sim/src/fleet-sim",
       {"--scenario", scenario, "--clock", "lockstep", "--participants",
-       test::ManagerAndAgent::kLockstepParticipants, "--duration", "200", "--sensor-outage", "r1@4+6",
+       test::ManagerAndAgent::kLockstepParticipants, "--duration", "200", "--sensor-outage", "r1@8+6",
        "--replay", replayPath, "--summary", (dir / "summary.json").string(), "--log-level", "warn"},
       fleet.env);
   std::string faultReport;
