@@ -329,10 +329,16 @@ try {
     }, robot), 20000);
   }
 
-  // 5. The adapter restarts: the page says so, reconnects and catches up.
+  // 5. The adapter restarts: the page says so, reconnects and catches up. Sessions are kept by the
+  // adapter (logging out revokes them), so a restarted adapter knows none: the page asks for the
+  // token again, and once given it is live and catches up.
   fs.writeFileSync(path.join(dir, 'restart.request'), '1');
   await until('the page notices the lost connection', () => page.$eval('#status', (el) => el.textContent.includes('reconnecting') || el.textContent.includes('retrying')), 20000);
   await shot('4-adapter-restarting.png');
+  await until('the page asks for the token again after the restart', async () => (await page.$('#login[open]')) !== null, 30000);
+  await page.$eval('#login-token', (el) => { el.value = ''; });
+  await page.type('#login-token', token);
+  await page.click('#login-submit');
   await until('the page is live again after the restart', () => page.$eval('#status', (el) => el.textContent === 'live'), 30000);
 
   // 6. The task reaches done, as the page tells it.
