@@ -423,7 +423,7 @@ struct Builder {
       if (!c) {
         continue;
       }
-      const float phi = site.layers.oneWay[site.map.index(*c)];
+      const double phi = static_cast<double>(site.layers.oneWay[site.map.index(*c)]);
       if (std::isfinite(phi) && dir.dot({std::cos(phi), std::sin(phi)}) < -1e-9) {
         return false;
       }
