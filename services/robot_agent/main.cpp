@@ -25,6 +25,7 @@
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
+#include "fleet/service/step_order.hpp"
 #include "fleet/transport/dds.hpp"
 
 using namespace fleet;
@@ -177,34 +178,18 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   };
 
   double dt = world.dt;
-  // In lockstep a release is acted on in the step after the one it was made in (stamped before
-  // this step's time), whatever DDS delivered first: one of this step that came early waits.
-  // (With the traffic manager's seeded epoch, lockstep runs are then byte-identical as long as a
-  // release reaches the agents within the simulator's round trip of a step: a loopback sample
-  // takes well under a millisecond. Waiting for acknowledgements instead cost a heartbeat a step.)
-  std::vector<msg::TrafficRelease> laterReleases;
-  auto releasesFor = [&](std::int64_t now) {
-    auto in = releases.take();
-    if (!lockstep) {
-      return in;
-    }
-    laterReleases.insert(laterReleases.end(), std::make_move_iterator(in.begin()),
-                         std::make_move_iterator(in.end()));
-    std::vector<msg::TrafficRelease> due;
-    std::vector<msg::TrafficRelease> later;
-    for (auto& r : laterReleases) {
-      (r.stamp_ns < now ? due : later).push_back(std::move(r));
-    }
-    laterReleases = std::move(later);
-    return due;
-  };
+  // In lockstep a release acts from the step after the one it was made in (StepOrder). (This holds
+  // as long as a release reaches the agents within the simulator's round trip of a step: a loopback
+  // sample takes well under a millisecond. Waiting for acknowledgements instead cost a heartbeat a
+  // step.)
+  service::StepOrder<msg::TrafficRelease> releaseOrder(lockstep);
   auto cycle = [&](std::int64_t now) {
     const auto cycleStart = std::chrono::steady_clock::now();
     // Taken and handed over topic by topic, in the node's order.
     node.onFrames(frames.take());
     node.onRobotStates(others.take());
     node.onAssignments(assignments.take());
-    node.onReleases(releasesFor(now));
+    node.onReleases(releaseOrder.due(releases.take(), now));
     node.onRiskMaps(riskMaps.take());
     const auto& outs = node.step(now, dt);
     for (const auto& r : node.takeRefusals()) {

@@ -19,6 +19,7 @@
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
+#include "fleet/service/step_order.hpp"
 #include "fleet/transport/dds.hpp"
 #include "traffic_node.hpp"
 
@@ -161,7 +162,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
       }
     }
   };
-  std::vector<msg::TrafficProgress> laterProgress;
+  service::StepOrder<msg::TrafficProgress> progressOrder(settings.lockstep);
   auto ingest = [&] {
     takeClosures();
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
@@ -172,24 +173,14 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         badInput.warn("risk_map", "RiskMap ignored: " + risk.error().message);
       }
     }
-    // In lockstep a report counts from the step after the one it was made in (stamped before this
-    // step's time), whatever DDS delivered first: one of this step that came early waits.
-    auto in = service::admitted(progress.take(), rejections, badInput);
-    laterProgress.insert(laterProgress.end(), std::make_move_iterator(in.begin()),
-                         std::make_move_iterator(in.end()));
-    std::vector<msg::TrafficProgress> later;
-    for (auto& m : laterProgress) {
+    // In lockstep a report counts from the step after the one it was made in (StepOrder).
+    for (const auto& m : progressOrder.due(service::admitted(progress.take(), rejections, badInput), now)) {
       if (!haveClock)
         continue;
-      if (settings.lockstep && m.stamp_ns >= now) {
-        later.push_back(std::move(m));
-        continue;
-      }
       if (auto problem = node.onProgress(m, now)) {
         badInput.warn("progress:" + m.robot_id, *problem);
       }
     }
-    laterProgress = std::move(later);
   };
   auto cycle = [&] {
     if (!roadmapSent) {
