@@ -16,6 +16,7 @@
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/sim/scenario.hpp"
+#include "gz_lines.hpp"
 #include "kinematic_bound.hpp"
 
 namespace fleet::ctl {
@@ -100,18 +101,6 @@ std::optional<std::string> readDoneTasks(const fs::path& dbPath, std::vector<Don
   return error;
 }
 
-bool readLine(gzFile f, std::string& line) {
-  line.clear();
-  char buf[1 << 16];
-  while (gzgets(f, buf, sizeof buf) != nullptr) {
-    line += buf;
-    if (line.back() == '\n') {
-      return true;
-    }
-  }
-  return !line.empty();
-}
-
 /// Each robot's position at each asked time: at the first replay step at or after it (the manager
 /// stamps with the simulated clock of the step it last saw). `asks` is (time, robot index).
 std::optional<std::string> positionsAt(const fs::path& replay,
@@ -123,7 +112,7 @@ std::optional<std::string> positionsAt(const fs::path& replay,
     return "cannot open " + replay.string();
   }
   std::string line;
-  if (!readLine(f, line)) {
+  if (!readGzLine(f, line)) {
     gzclose(f);
     return replay.string() + " is empty";
   }
@@ -138,7 +127,7 @@ std::optional<std::string> positionsAt(const fs::path& replay,
   std::vector<std::pair<double, std::size_t>> sorted = asks;
   std::sort(sorted.begin(), sorted.end());
   std::size_t next = 0;
-  while (next < sorted.size() && readLine(f, line)) {
+  while (next < sorted.size() && readGzLine(f, line)) {
     // Keys are written sorted, so "t" is the line's last: read it without parsing the whole step.
     const auto k = line.rfind("\"t\":");
     const double t = k == std::string::npos ? -1.0 : std::strtod(line.c_str() + k + 4, nullptr);

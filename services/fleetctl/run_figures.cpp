@@ -7,6 +7,7 @@
 
 #include "fleet/core/config.hpp"
 #include "fleet/sim/scenario.hpp"
+#include "gz_lines.hpp"
 #include "run_fleet_bound.hpp"
 #include "run_ledger.hpp"
 
@@ -16,18 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-bool readLine(gzFile f, std::string& line) {
-  line.clear();
-  char buf[1 << 16];
-  while (gzgets(f, buf, sizeof buf) != nullptr) {
-    line += buf;
-    if (line.back() == '\n') {
-      return true;
-    }
-  }
-  return !line.empty();
-}
 
 std::map<std::string, LedgerTask> taskStations(const fs::path& dbPath) {
   std::map<std::string, LedgerTask> out;
@@ -71,7 +60,7 @@ json ledgers(const fs::path& runDir) {
   }
   std::string line;
   std::vector<RobotSample> samples(robots.size());
-  while (readLine(f, line)) {
+  while (readGzLine(f, line)) {
     const json step = json::parse(line, nullptr, false);
     if (!step.is_object() || !step.contains("robots") || !step.contains("t")) {
       continue;  // the header, or a line cut short
