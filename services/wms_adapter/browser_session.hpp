@@ -10,11 +10,11 @@
 // actions sent with the cookie must carry in the X-CSRF-Token header.
 
 #include <cstdint>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <map>
 
 #include "token_store.hpp"
 

@@ -74,9 +74,10 @@ int main(int argc, char** argv) {
                                           : "bearer tokens from " + api.tokenFile,
                  api.auditLog.empty() ? "the service log" : api.auditLog);
     if (!http.tokens().enabled() && api.allowUnauthenticated) {
-      spdlog::warn("wms adapter: authentication is OFF on {}:{} (http.allow_unauthenticated): anyone who "
-                   "reaches this port can submit, cancel and pause tasks",
-                   api.host, http.port());
+      spdlog::warn(
+          "wms adapter: authentication is OFF on {}:{} (http.allow_unauthenticated): anyone who "
+          "reaches this port can submit, cancel and pause tasks",
+          api.host, http.port());
     }
     spdlog::info("wms adapter: dashboard at {}://{}:{}/dashboard/", api.tls.enabled() ? "https" : "http",
                  api.host, http.port());
