@@ -342,9 +342,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1))
       ->capture_default_str();
   trafficSim
-      ->add_option("--station-cap", ts.stationCap,
-                   "at most this many robots' tasks use one station at once (the fleet manager's "
-                   "station_capacity); a robot with no admissible task waits at a parking place; 0: no limit")
+      ->add_option(
+          "--admission", ts.admission,
+          "1: a task is given only when its pickup and drop-off each have a free slot (a place in "
+          "their line); a robot with no admissible task waits at a parking place; 0: every task at once")
+      ->check(CLI::Range(0, 1))
+      ->capture_default_str();
+  trafficSim
+      ->add_option("--station-slots", ts.stationSlots,
+                   "slots per station for admission (0: its line, the dock and its queue places)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   trafficSim->add_flag("--json", ts.json, "print the results as JSON");

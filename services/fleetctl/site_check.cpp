@@ -22,7 +22,7 @@ struct RoadmapSummary {
   std::size_t edges = 0;
   std::size_t conflictPairs = 0;
   std::size_t queueNodes = 0;
-  std::array<std::size_t, 6> byKind{};
+  std::array<std::size_t, 7> byKind{};
   std::size_t connected = 0;
   double buildMs = 0.0;
 };
@@ -81,6 +81,7 @@ nlohmann::json roadmapJson(const traffic::Roadmap& r, const RoadmapSummary& s) {
          {"dock", st.dock},
          {"approach", st.approach},
          {"queue", st.queue},
+         {"exit", st.exit},
          {"queue_generated", st.queueGenerated},
          {"connected", std::find(connected.begin(), connected.end(), st.name) != connected.end()}});
   }

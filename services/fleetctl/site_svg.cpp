@@ -13,8 +13,8 @@ namespace {
 using traffic::NodeId;
 using traffic::NodeKind;
 
-constexpr std::array<const char*, 6> kKindColour{"#8fa3b8", "#d62728", "#ff8c00",
-                                                 "#9b30d0", "#1f5fd6", "#1a9e3a"};
+constexpr std::array<const char*, 7> kKindColour{"#8fa3b8", "#d62728", "#ff8c00", "#9b30d0",
+                                                 "#1f5fd6", "#1a9e3a", "#00a6a6"};
 
 const char* colour(NodeKind k) {
   return kKindColour[static_cast<std::size_t>(k)];
@@ -213,7 +213,7 @@ std::string siteSvg(const site::Site& site, const traffic::Roadmap& roadmap) {
   }
 
   // Legend band.
-  std::array<std::size_t, 6> count{};
+  std::array<std::size_t, kKindColour.size()> count{};
   for (const auto k : roadmap.kinds) {
     ++count[static_cast<std::size_t>(k)];
   }

@@ -115,7 +115,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
     v.stationLines = o.stationLines != 0;
-    v.stationCap = static_cast<std::size_t>(o.stationCap);
+    v.admission = o.admission != 0;
+    v.stationCap = static_cast<std::size_t>(o.stationSlots);
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
     if (o.letPass >= 0)

@@ -21,7 +21,8 @@ enum class RoadmapKind : std::uint8_t {
   Approach = 2,
   Queue = 3,
   Parking = 4,
-  Charger = 5
+  Charger = 5,
+  Exit = 6
 };
 
 /// The line robots wait in before a station, read off the roadmap's shape: the queue nodes whose

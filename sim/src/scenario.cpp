@@ -467,7 +467,7 @@ Scenario parseScenario(const nlohmann::json& doc, const std::string& origin, con
       }
     }
     for (const auto& x : s.stations) {
-      st->stations.push_back({x.name, x.kind, x.pose, std::nullopt, false, {}});
+      st->stations.push_back({x.name, x.kind, x.pose, std::nullopt, false, {}, std::nullopt});
     }
     for (const auto& l : s.landmarks) {
       st->landmarks.push_back({l.id, l.position});

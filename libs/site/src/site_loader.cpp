@@ -71,7 +71,7 @@ std::vector<std::size_t> polygonCells(const planning::OccupancyGrid& g, const st
 void readStations(Config& c, Site& s) {
   std::map<std::string, int> seen;
   for (auto& st : c.array("stations")) {
-    st.rejectUnknownKeys({"name", "kind", "pose", "approach", "queue"});
+    st.rejectUnknownKeys({"name", "kind", "pose", "approach", "queue", "exit"});
     Station x;
     x.name = st.requireString("name");
     if (!x.name.empty() && !isValidId(x.name)) {
@@ -88,6 +88,10 @@ void readStations(Config& c, Site& s) {
     if (readPoint(st, "approach", a, false)) {
       x.approach = a;
       x.approachGiven = true;
+    }
+    Vec2 out;
+    if (readPoint(st, "exit", out, false)) {
+      x.exit = out;
     }
     if (const auto* q = st.find("queue")) {
       if (!q->is_array()) {
@@ -448,7 +452,17 @@ std::vector<SiteProblem> checkSite(const Site& s) {
                                             " m cannot drive straight from the approach " + at(*st.approach) +
                                             " to the station"});
     }
+    if (st.exit && !(discFits(g, *st.exit, r) && segmentFits(g, p, *st.exit, r))) {
+      out.push_back({key + ".exit", "station '" + st.name + "': a robot of radius " + fmt(r) +
+                                        " m cannot drive straight from the station to its exit " +
+                                        at(*st.exit)});
+    }
     for (std::size_t q = 0; q < st.queue.size(); ++q) {
+      if (st.exit && distance(st.queue[q], *st.exit) < 2.0 * r + 0.1) {
+        out.push_back({key + ".exit", "station '" + st.name + "': its exit " + at(*st.exit) +
+                                          " leads into its queue (queue point " + std::to_string(q) + " " +
+                                          at(st.queue[q]) + " is within a robot's diameter)"});
+      }
       if (!discFits(g, st.queue[q], r)) {
         out.push_back({key + ".queue[" + std::to_string(q) + "]",
                        "station '" + st.name + "': a robot of radius " + fmt(r) + " m does not fit at " +

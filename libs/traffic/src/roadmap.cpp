@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -228,7 +229,7 @@ struct Builder {
     }
   }
 
-  enum class Join { Both, Out };
+  enum class Join { Both, Out, In };
 
   // Joins `v` to the lattice nodes within one spacing that the disc reaches in a straight line
   // keeping the edge clearance and that lie within `cone` rad of one of `dirs` (any direction when
@@ -261,7 +262,7 @@ struct Builder {
         break;
       }
       if (wide ? passes(p, pos[static_cast<std::size_t>(w)]) : sweeps(p, pos[static_cast<std::size_t>(w)])) {
-        links.push_back({v, w, true, how == Join::Both});
+        links.push_back({v, w, how != Join::In, how != Join::Out});
         ++joined;
       }
     }
@@ -278,17 +279,9 @@ struct Builder {
     return true;
   }
 
-  std::vector<Vec2> generateQueue(const site::Station& st, Vec2 base, bool hasApproach) {
+  // Back from `base` along each of `dirs` in turn while the disc fits; the longest line wins.
+  std::vector<Vec2> generateQueue(Vec2 base, const std::vector<Vec2>& dirs) {
     const double f = opt.followingDistance;
-    const Vec2 h = st.pose.heading();
-    // Back from the approach point along the station's axis first; along the row (either side)
-    // when the axis is blocked or the station has no straight approach.
-    std::vector<Vec2> dirs;
-    if (hasApproach) {
-      dirs.push_back(h);
-    }
-    dirs.push_back(h.perp());
-    dirs.push_back(-h.perp());
     std::vector<Vec2> best;
     for (const Vec2 d : dirs) {
       std::vector<Vec2> pts;
@@ -315,7 +308,56 @@ struct Builder {
     return sn.approach != kNoNode ? sn.approach : sn.dock;
   }
 
-  // Docks and approach points first, so that no queue is generated in front of a station.
+  // Where robots go after this station: the drop-offs after a pickup, the pickups after a
+  // drop-off (their centroid); none for chargers and parking places.
+  [[nodiscard]] std::optional<Vec2> nextPlaces(site::StationKind k) const {
+    const auto want = k == site::StationKind::Pickup    ? site::StationKind::Dropoff
+                      : k == site::StationKind::Dropoff ? site::StationKind::Pickup
+                                                        : site::StationKind::Parking;
+    if (want == site::StationKind::Parking) {
+      return std::nullopt;
+    }
+    Vec2 sum;
+    int n = 0;
+    for (const auto& st : site.stations) {
+      if (st.kind == want) {
+        sum = sum + st.pose.position();
+        ++n;
+      }
+    }
+    return n > 0 ? std::optional(sum * (1.0 / n)) : std::nullopt;
+  }
+
+  // A pickup's or drop-off's way out, apart from its way in (docs/algorithms.md, "Stations as
+  // servers"): approached along the row, the dock is left along the row on the side towards where
+  // robots go next and queued for on the other; approached straight, it is left beside the
+  // approach point, on the side towards where robots go next. The candidate must fit, be reached
+  // from the dock in a straight line and keep a following distance from every station node placed.
+  [[nodiscard]] std::optional<Vec2> placeExit(const site::Station& st, const StationNodes& sn) const {
+    if (st.exit) {
+      return st.exit;
+    }
+    const auto next = nextPlaces(st.kind);
+    if (!next) {
+      return std::nullopt;
+    }
+    const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];
+    const Vec2 base = sn.approach != kNoNode ? pos[static_cast<std::size_t>(sn.approach)] : dockAt;
+    Vec2 side = st.pose.heading().perp();
+    if (side.dot(*next - dockAt) < 0.0) {
+      side = -side;
+    }
+    for (const Vec2 d : {side, -side}) {
+      const Vec2 e = base + d * opt.followingDistance;
+      if (fits(e) && sweeps(dockAt, e) && clearOfStations(e, opt.followingDistance)) {
+        return e;
+      }
+    }
+    return std::nullopt;
+  }
+
+  // Docks and approach points first, then the ways out, then the queues, so that no queue is
+  // generated in front of a station or across its way out.
   void placeStations() {
     constexpr double kCone = kPi / 3.0;
     for (const auto& st : site.stations) {
@@ -339,20 +381,56 @@ struct Builder {
       if (st.approach) {
         if (fits(*st.approach) && sweeps(*st.approach, dockAt) && distance(*st.approach, dockAt) > 1e-6) {
           sn.approach = add(*st.approach, NodeKind::Approach);
-          links.push_back({sn.approach, sn.dock, true, true});
         } else {
           problem(RoadmapProblem::Severity::Error, st.name, *st.approach,
                   "station '" + st.name + "': the robot cannot drive straight from its approach point " +
                       at(*st.approach) + " to the dock " + at(dockAt) + "; joined along the row instead");
         }
       }
+      stations.push_back(sn);
+    }
+    for (std::size_t i = 0; i < site.stations.size(); ++i) {
+      const auto& st = site.stations[i];
+      auto& sn = stations[i];
+      if (sn.dock == kNoNode || st.kind == site::StationKind::Parking) {
+        continue;
+      }
+      if (const auto e = placeExit(st, sn)) {
+        const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];
+        if (fits(*e) && sweeps(dockAt, *e)) {
+          sn.exit = add(*e, NodeKind::Exit);
+          links.push_back({sn.dock, sn.exit, true, false});
+        } else {
+          problem(RoadmapProblem::Severity::Error, st.name, *e,
+                  "station '" + st.name + "': the robot cannot drive straight from the dock " + at(dockAt) +
+                      " to its exit " + at(*e) + "; left by its way in instead");
+        }
+      }
+    }
+    for (std::size_t i = 0; i < site.stations.size(); ++i) {
+      const auto& st = site.stations[i];
+      auto& sn = stations[i];
+      if (sn.dock == kNoNode) {
+        continue;
+      }
+      // With a way out of its own the station is entered only: the approach leg one way in, the
+      // approach point (or a dock on a row: from the queue's side) reached from the lanes.
+      const Join in = sn.exit != kNoNode ? Join::In : Join::Both;
+      const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];
+      std::vector<Vec2> inDirs;
+      if (sn.approach != kNoNode) {
+        links.push_back({sn.approach, sn.dock, true, sn.exit == kNoNode});
+        inDirs = {st.pose.heading()};
+      } else if (sn.exit != kNoNode) {
+        inDirs = {(dockAt - pos[static_cast<std::size_t>(sn.exit)]).normalized()};
+      }
       // An approach point is driven to from the free space in front of it (so robots side by side
       // at neighbouring approach points do not drive at each other); a dock without one from any side.
       const NodeId entry = entryOf(sn);
       const Vec2 ep = pos[static_cast<std::size_t>(entry)];
-      int joined = sn.approach != kNoNode ? joinToLattice(entry, {st.pose.heading()}, kCone, Join::Both) : 0;
+      int joined = inDirs.empty() ? 0 : joinToLattice(entry, inDirs, kCone, in);
       if (joined == 0) {
-        joined = joinToLattice(entry, {}, 0.0, Join::Both);
+        joined = joinToLattice(entry, {}, 0.0, in);
       }
       if (joined == 0) {
         std::ostringstream d;
@@ -362,10 +440,22 @@ struct Builder {
                     (sn.approach != kNoNode ? "approach point " : "dock ") + at(ep) +
                     " that the robot reaches in a straight line: the station is not on the roadmap");
       }
-      stations.push_back(sn);
+      if (sn.exit != kNoNode) {
+        const Vec2 xp = pos[static_cast<std::size_t>(sn.exit)];
+        const Vec2 out = (xp - dockAt).normalized();
+        if (joinToLattice(sn.exit, {out}, kCone, Join::Out) == 0 &&
+            joinToLattice(sn.exit, {}, 0.0, Join::Out) == 0) {
+          problem(RoadmapProblem::Severity::Error, st.name, xp,
+                  "station '" + st.name + "': no lane node near its exit " + at(xp) +
+                      " that the robot reaches in a straight line: robots could not leave the dock");
+        }
+      }
     }
     for (std::size_t i = 0; i < site.stations.size(); ++i) {
       placeQueue(site.stations[i], stations[i]);
+    }
+    for (const auto& sn : stations) {
+      joinQueue(sn);
     }
   }
 
@@ -375,11 +465,26 @@ struct Builder {
     if (sn.dock == kNoNode) {
       return;
     }
-    constexpr double kCone = kPi / 3.0;
     const NodeId entry = entryOf(sn);
     std::vector<Vec2> queue = st.queue;
     if (queue.empty() && st.kind != site::StationKind::Parking && opt.queueLength > 0) {
-      queue = generateQueue(st, pos[static_cast<std::size_t>(entry)], sn.approach != kNoNode);
+      // Back from the approach point along the station's axis first; along the row when the axis
+      // is blocked or the station has no straight approach: on the side away from its way out.
+      const Vec2 h = st.pose.heading();
+      std::vector<Vec2> dirs;
+      if (sn.approach != kNoNode) {
+        dirs.push_back(h);
+      }
+      Vec2 side = h.perp();
+      if (sn.exit != kNoNode &&
+          side.dot(pos[static_cast<std::size_t>(sn.exit)] - pos[static_cast<std::size_t>(sn.dock)]) > 0.0) {
+        side = -side;
+      }
+      dirs.push_back(side);
+      if (sn.exit == kNoNode || sn.approach != kNoNode) {
+        dirs.push_back(-side);
+      }
+      queue = generateQueue(pos[static_cast<std::size_t>(entry)], dirs);
       sn.queueGenerated = !queue.empty();
     }
     NodeId next = entry;
@@ -399,12 +504,22 @@ struct Builder {
                 "station '" + st.name + "': queue point " + std::to_string(q) + " " + at(queue[q]) +
                     " cannot be driven straight to the one before it");
       }
-      const Vec2 back = (queue[q] - nextAt).normalized();
+      sn.queue.push_back(v);
+      next = v;
+    }
+  }
+
+  // A queue is left sideways from any of its places and entered at its tail from behind.
+  void joinQueue(const StationNodes& sn) {
+    constexpr double kCone = kPi / 3.0;
+    NodeId next = sn.dock == kNoNode ? kNoNode : entryOf(sn);
+    for (std::size_t q = 0; q < sn.queue.size(); ++q) {
+      const NodeId v = sn.queue[q];
+      const Vec2 back = (pos[static_cast<std::size_t>(v)] - pos[static_cast<std::size_t>(next)]).normalized();
       joinToLattice(v, {back.perp(), -back.perp()}, kCone, Join::Out);
-      if (q + 1 == queue.size()) {
+      if (q + 1 == sn.queue.size()) {
         joinToLattice(v, {back}, kPi / 2.0, Join::Both);
       }
-      sn.queue.push_back(v);
       next = v;
     }
   }
@@ -448,7 +563,7 @@ struct Builder {
 }  // namespace
 
 const char* toString(NodeKind k) {
-  constexpr const char* kNames[] = {"lane", "station", "approach", "queue", "parking", "charger"};
+  constexpr const char* kNames[] = {"lane", "station", "approach", "queue", "parking", "charger", "exit"};
   return kNames[static_cast<int>(k)];
 }
 
@@ -552,6 +667,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
     auto map = [&](NodeId& v) { v = v == kNoNode ? kNoNode : remap[static_cast<std::size_t>(v)]; };
     map(sn.dock);
     map(sn.approach);
+    map(sn.exit);
     for (auto& q : sn.queue) {
       map(q);
     }

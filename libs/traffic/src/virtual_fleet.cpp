@@ -87,12 +87,21 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
   std::vector<Bot> bots(o.robots);
-  // Robots' tasks using each station (pickup and drop-off, for the whole task), for the cap.
+  // Admission by slots (docs/algorithms.md, "Stations as servers"): a station serves as many robots
+  // at once as its line holds (dock and queue places). A robot counts at its pickup until it has
+  // loaded there, and at its drop-off from the moment it is given the task (it will carry its load
+  // there, and a loaded robot must not find the line full). A task is admitted when both have a
+  // free slot; otherwise the robot waits for one at a parking place.
   std::vector<std::size_t> uses(g.size(), 0);
+  std::vector<std::size_t> slots(g.size(), 0);
+  for (const auto& s : roadmap.stations) {
+    if (s.dock != kNoNode)
+      slots[static_cast<std::size_t>(s.dock)] = o.stationCap > 0 ? o.stationCap : 1 + s.queue.size();
+  }
   auto admissible = [&](const std::vector<NodeId>& stations) {
     std::vector<NodeId> out;
     for (NodeId s : stations) {
-      if (o.stationCap == 0 || uses[static_cast<std::size_t>(s)] < o.stationCap)
+      if (!o.admission || uses[static_cast<std::size_t>(s)] < slots[static_cast<std::size_t>(s)])
         out.push_back(s);
     }
     return out;
@@ -115,8 +124,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   };
   auto newTask = [&](std::size_t r, double now) {
     Bot& b = bots[r];
-    if (b.pickup != kNoNode) {  // the task just finished frees its stations
-      --uses[static_cast<std::size_t>(b.pickup)];
+    if (b.pickup != kNoNode) {  // the task just finished frees its drop-off
       --uses[static_cast<std::size_t>(b.dropoff)];
       b.pickup = b.dropoff = kNoNode;
     }
@@ -178,6 +186,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         traffic.setHeld(r, false);
         if (b.phase == 0) {
           b.phase = 1;
+          --uses[static_cast<std::size_t>(b.pickup)];  // loaded: its pickup slot is free
           traffic.setGoal(r, b.dropoff);
         } else {
           ++res.tasksDone;
@@ -187,26 +196,35 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         b.lastProgress = now;
         continue;
       }
-      if (b.to == kNoNode) {
-        // Standing: take the next released node, if any.
-        if (rel[r].base.size() > 1 && rel[r].base.front() == b.at) {
-          b.to = rel[r].base[1];
-          const Edge* e = g.edge(b.at, b.to);
-          double d = e != nullptr ? e->duration : 1.0;
-          const double turn = b.prev != kNoNode ? roadmap.extraTurn(b.prev, b.at, b.to) : 0.0;
-          const double stretch = 1.0 + o.jitter * unit(rng);
-          d = (d + turn) * stretch;
-          b.turnLeft = turn * stretch;
-          b.stopLeft = unit(rng) < o.stopChance ? o.stopMax * unit(rng) : 0.0;
-          const auto docky = [&](NodeId v) {
-            return roadmap.kind(v) == NodeKind::Station || roadmap.kind(v) == NodeKind::Approach;
-          };
-          b.dockEdge = docky(b.at) && docky(b.to);
-          b.left = b.total = d;
-        } else if (!b.idle && traffic.goal(r) != kNoNode && b.at == traffic.goal(r)) {
-          b.dwellLeft = o.dwell;
-          traffic.setHeld(r, true);
+      // Take the next released node when standing on the release's previous one: at the start
+      // of the tick, or (below) the moment an edge ends within it, so a robot drives its released
+      // nodes without a stop at each (time left over from an edge goes on into the next).
+      const auto takeNext = [&]() {
+        const auto& base = rel[r].base;
+        const auto it = std::find(base.begin(), base.end(), b.at);
+        if (it == base.end() || it + 1 == base.end()) {
+          return false;
         }
+        b.to = *(it + 1);
+        const Edge* e = g.edge(b.at, b.to);
+        double d = e != nullptr ? e->duration : 1.0;
+        const double turn = b.prev != kNoNode ? roadmap.extraTurn(b.prev, b.at, b.to) : 0.0;
+        const double stretch = 1.0 + o.jitter * unit(rng);
+        d = (d + turn) * stretch;
+        b.turnLeft = turn * stretch;
+        b.stopLeft = unit(rng) < o.stopChance ? o.stopMax * unit(rng) : 0.0;
+        const auto docky = [&](NodeId v) {
+          return roadmap.kind(v) == NodeKind::Station || roadmap.kind(v) == NodeKind::Approach ||
+                 roadmap.kind(v) == NodeKind::Exit;
+        };
+        b.dockEdge = docky(b.at) && docky(b.to);
+        b.left = b.total = d;
+        return true;
+      };
+      if (b.to == kNoNode && !takeNext() && !b.idle && traffic.goal(r) != kNoNode &&
+          b.at == traffic.goal(r)) {
+        b.dwellLeft = o.dwell;
+        traffic.setHeld(r, true);
       }
       if (b.to != kNoNode)
         tDrive += o.dt;
@@ -216,29 +234,37 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         tStand += o.dt;
       if (b.idle) {
         res.robotTime[r].add(RobotActivity::NoTask, o.dt);  // standing or driving to a parking place
-        if (b.to != kNoNode && b.stopLeft > 0.0)
-          b.stopLeft -= o.dt;
       } else if (b.to != kNoNode && b.stopLeft > 0.0) {
         res.robotTime[r].add(RobotActivity::HeldByPerson, o.dt);
-        b.stopLeft -= o.dt;  // the edge goes on once the person has passed
       } else if (b.to != kNoNode) {
-        const bool turning = b.turnLeft > 0.0;
-        b.turnLeft -= o.dt;
-        res.robotTime[r].add(turning || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving,
-                             o.dt);
+        res.robotTime[r].add(
+            b.turnLeft > 0.0 || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving, o.dt);
       } else {
         res.robotTime[r].add(RobotActivity::WaitingOnRobot, o.dt);
       }
-      if (b.to != kNoNode && b.stopLeft <= 0.0) {
-        b.turnLeft -= b.idle ? o.dt : 0.0;
-        b.left -= o.dt;
-        if (b.left <= 0.0) {
-          b.prev = b.at;
-          b.at = b.to;
-          b.to = kNoNode;
-          traffic.reached(r, b.at);
-          b.lastProgress = now;
+      // Spend the tick: a stop first (the edge goes on once the person has passed), then the edge,
+      // then the next released edges.
+      double budget = o.dt;
+      while (b.to != kNoNode && budget > 1e-12) {
+        if (b.stopLeft > 0.0) {
+          const double s = std::min(b.stopLeft, budget);
+          b.stopLeft -= s;
+          budget -= s;
+          continue;
         }
+        const double s = std::min(b.left, budget);
+        b.left -= s;
+        b.turnLeft -= s;
+        budget -= s;
+        if (b.left > 1e-12) {
+          break;
+        }
+        b.prev = b.at;
+        b.at = b.to;
+        b.to = kNoNode;
+        traffic.reached(r, b.at);
+        b.lastProgress = now;
+        takeNext();
       }
       res.longestWait = std::max(res.longestWait, now - b.lastProgress);
     }

@@ -434,12 +434,18 @@ TEST(Roadmap, DurationsAreDriveTimeAndTheTurnsANodeForces) {
   const auto* d1 = r.station("D-1");
   ASSERT_NE(d1, nullptr);
   ASSERT_NE(d1->approach, kNoNode);
-  // In along the last leg, out after a 180° turn on the spot (the dock's only way in).
-  const double leg = distance(r.graph.position(d1->dock), r.graph.position(d1->approach));
-  const double turn180 = r.turnTime(kPi);
-  EXPECT_NEAR(turn180, kPi / 1.5 + 1.5 / 3.0, 1e-9);  // the site robot: 1.5 rad/s, 3 rad/s²
-  ASSERT_NE(r.graph.edge(d1->dock, d1->approach), nullptr);
-  EXPECT_NEAR(r.graph.edge(d1->dock, d1->approach)->duration, leg / 0.8 + turn180, 1e-9);
+  ASSERT_NE(d1->exit, kNoNode);
+  // In along the last leg (one way), out to the exit beside the approach point after the turn on
+  // the spot that the dock's only way in forces.
+  EXPECT_EQ(r.graph.edge(d1->dock, d1->approach), nullptr);
+  const Vec2 dock = r.graph.position(d1->dock);
+  const Vec2 in = dock - r.graph.position(d1->approach);
+  const Vec2 out = r.graph.position(d1->exit) - dock;
+  const double turn = std::acos(std::clamp(in.dot(out) / (in.norm() * out.norm()), -1.0, 1.0));
+  EXPECT_NEAR(turn, 3.0 * kPi / 4.0, 1e-6);  // the exit is a following distance beside the approach point
+  EXPECT_NEAR(r.turnTime(kPi), kPi / 1.5 + 1.5 / 3.0, 1e-9);  // the site robot: 1.5 rad/s, 3 rad/s²
+  ASSERT_NE(r.graph.edge(d1->dock, d1->exit), nullptr);
+  EXPECT_NEAR(r.graph.edge(d1->dock, d1->exit)->duration, out.norm() / 0.8 + r.turnTime(turn), 1e-9);
   // A straight lattice step costs its length at cruise; a corner costs its turn on top, which
   // only a planner that knows the previous node can add.
   const NodeId a = r.nearest({10.25, 4.25});
@@ -469,7 +475,9 @@ TEST(Roadmap, StationsHaveDockApproachAndGeneratedQueueInOrder) {
     ++withQueue;
     const auto* st = &station;
     const char* name = st->name.c_str();
-    EXPECT_EQ(st->queue.size(), 3U) << name;
+    // Three places unless a wall (P-1's row ends) or another station's line (P-5's beside D-4) is
+    // in the way.
+    EXPECT_EQ(st->queue.size(), st->name == "P-1" ? 2U : st->name == "D-4" ? 1U : 3U) << name;
     EXPECT_TRUE(st->queueGenerated) << name;
     const NodeId entry = st->approach != kNoNode ? st->approach : st->dock;
     NodeId next = entry;
@@ -503,6 +511,58 @@ TEST(Roadmap, StationsHaveDockApproachAndGeneratedQueueInOrder) {
   // Neighbouring parking places (1 m apart, side by side) do not exclude each other.
   EXPECT_FALSE(r.graph.conflicting(r.station("PARK-3")->dock, r.station("PARK-4")->dock));
   EXPECT_FALSE(r.graph.conflicting(r.station("PARK-3")->approach, r.station("PARK-4")->approach));
+}
+
+TEST(Roadmap, PickupsAndDropOffsAreServersWithAWayOutApartFromTheirQueue) {
+  const Roadmap r = buildRoadmap(shipped("small_warehouse.site.json"));
+  EXPECT_EQ(errors(r), 0U) << describe(r.problems);
+  for (const auto& st : r.stations) {
+    const char* name = st.name.c_str();
+    if (st.kind != site::StationKind::Pickup && st.kind != site::StationKind::Dropoff) {
+      EXPECT_EQ(st.exit, kNoNode) << name;  // chargers and parking places are left the way in
+      continue;
+    }
+    ASSERT_NE(st.exit, kNoNode) << name;
+    EXPECT_EQ(r.kind(st.exit), NodeKind::Exit);
+    // The dock is left only by its exit, entered only from its approach point (or its row).
+    const auto out = r.graph.edges(st.dock);
+    ASSERT_EQ(out.size(), 1U) << name;
+    EXPECT_EQ(out.front().to, st.exit) << name;
+    EXPECT_FALSE(hasEdge(r.graph, st.exit, st.dock)) << name;
+    if (st.approach != kNoNode) {
+      EXPECT_TRUE(hasEdge(r.graph, st.approach, st.dock)) << name;
+    }
+    // The exit leads on to the lanes, and never into the station's own line.
+    EXPECT_FALSE(r.graph.edges(st.exit).empty()) << name;
+    for (const Edge& e : r.graph.edges(st.exit)) {
+      EXPECT_EQ(r.kind(e.to), NodeKind::Lane) << name;
+    }
+    for (const NodeId q : st.queue) {
+      EXPECT_GE(distance(r.graph.position(q), r.graph.position(st.exit)), r.options.followingDistance - 1e-9)
+          << name;
+    }
+  }
+  // Pickups along the top row: queue on the west side, left to the east (towards the drop-offs).
+  for (const char* name : {"P-1", "P-2", "P-3", "P-4"}) {
+    const auto* st = r.station(name);
+    const double x = r.graph.position(st->dock).x;
+    EXPECT_NEAR(r.graph.position(st->exit).x, x + 1.0, 1e-9) << name;
+    for (const NodeId q : st->queue) {
+      EXPECT_LT(r.graph.position(q).x, x) << name;
+    }
+  }
+}
+
+TEST(Roadmap, SiteExitIsUsedAsGiven) {
+  nlohmann::json st = twoStations();
+  st[1]["exit"] = {8.5, 1.5};
+  const Roadmap r = buildRoadmap(rowsSite(hall(), st));
+  EXPECT_EQ(errors(r), 0U) << describe(r.problems);
+  const auto* b = r.station("B");
+  ASSERT_NE(b->exit, kNoNode);
+  EXPECT_NEAR(r.graph.position(b->exit).x, 8.5, 1e-9);
+  EXPECT_NEAR(r.graph.position(b->exit).y, 1.5, 1e-9);
+  EXPECT_EQ(connectedStations(r), (std::vector<std::string>{"A", "B"}));
 }
 
 TEST(Roadmap, SiteQueuePointsAreUsedAsGiven) {
@@ -543,7 +603,7 @@ TEST(Roadmap, OneMetreCorridorOffTheLatticeLinesIsFilledIn) {
 
 TEST(Roadmap, QueuePointsTooCloseToTheStationAreAWarning) {
   nlohmann::json st = twoStations();
-  st[1]["queue"] = {{9.0, 3.0}};
+  st[1]["queue"] = {{9.0, 2.8}};  // 0.58 m from the dock
   const Roadmap r = buildRoadmap(rowsSite(hall(), st));
   ASSERT_EQ(r.problems.size(), 1U) << describe(r.problems);
   EXPECT_EQ(r.problems.front().severity, RoadmapProblem::Severity::Warning);
@@ -627,7 +687,7 @@ TEST(Roadmap, ClosingALaneOneWayMakesADeadEndThatReopenUndoes) {
   // Close the dock's way out only: the station can be reached but not left.
   Roadmap r = buildRoadmap(shipped("small_warehouse.site.json"));
   const auto* d2 = r.station("D-2");
-  const Closure c = r.closeEdges({{d2->dock, d2->approach}});
+  const Closure c = r.closeEdges({{d2->dock, d2->exit}});
   EXPECT_EQ(c.cutOff, std::vector<std::string>{"D-2"});
   const auto problems = checkRoadmap(r);
   ASSERT_EQ(problems.size(), 1U) << describe(problems);

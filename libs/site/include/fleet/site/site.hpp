@@ -37,6 +37,10 @@ struct Station {
   std::optional<Vec2> approach;
   bool approachGiven = false;  ///< false: derived by the loader
   std::vector<Vec2> queue;     ///< waiting points, nearest to the station first
+  /// Where a robot leaves the dock to (a station as a server: it enters from its queue and leaves
+  /// by a way of its own, so the leaving robot never meets the next in line). Given in site.json
+  /// or placed by the roadmap (roadmap.hpp); none for parking places.
+  std::optional<Vec2> exit;
 };
 
 inline constexpr double kDefaultApproachDistance = 1.0;  // m

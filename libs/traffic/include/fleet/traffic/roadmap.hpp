@@ -73,7 +73,7 @@ struct RoadmapOptions {
   double followingDistance = 0.0;  ///< m between generated queue nodes; 0: the `ahead` separation
 };
 
-enum class NodeKind : std::uint8_t { Lane, Station, Approach, Queue, Parking, Charger };
+enum class NodeKind : std::uint8_t { Lane, Station, Approach, Queue, Parking, Charger, Exit };
 const char* toString(NodeKind k);
 
 /// A station's nodes. `dock` is kNoNode when the robot's disc does not fit at the station.
@@ -83,6 +83,7 @@ struct StationNodes {
   NodeId dock = kNoNode;
   NodeId approach = kNoNode;    ///< kNoNode: approached along a row (the dock is joined to the lattice)
   std::vector<NodeId> queue;    ///< nearest to the station first
+  NodeId exit = kNoNode;        ///< the way out (dock → exit one way); kNoNode: left by the way in
   bool queueGenerated = false;  ///< true: generated; false: the site's queue points (or none)
 };
 

@@ -32,10 +32,12 @@ struct VirtualFleetOptions {
   double stopChance = 0.01;  ///< per edge: the robot stops on it for U(0, stopMax) s
   double stopMax = 10.0;
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
-  /// At most this many robots' tasks use one station at once, its pickup and drop-off counted for
-  /// the whole task (the fleet manager's `station_capacity`); 0: no limit. A robot that finishes a
-  /// task when no admissible one is left drives to the nearest parking place no robot is sent to and
-  /// takes the next admissible task from there.
+  /// Admission by slots: a task is given only when its pickup and its drop-off each have a free
+  /// place in their line (dock and queue places; `stationCap` places instead when above 0); a robot
+  /// counts at its pickup until it has loaded and at its drop-off for the whole task. A robot with
+  /// no admissible task drives to the nearest parking place no robot is sent to and takes the next
+  /// admissible task from there. false: every task at once.
+  bool admission = true;
   std::size_t stationCap = 0;
   /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
   double recordEvery = 0.0;

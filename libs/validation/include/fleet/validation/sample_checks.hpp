@@ -37,7 +37,7 @@ inline constexpr std::size_t kMaxContacts = std::size_t{1} << 16;
 inline constexpr std::size_t kMaxRoadmapNodes = std::size_t{1} << 20;
 inline constexpr std::size_t kMaxRoadmapEdges = std::size_t{1} << 22;
 /// A roadmap node's kind: 0 lane, 1 station, 2 approach, 3 queue, 4 parking, 5 charger.
-inline constexpr std::uint8_t kMaxRoadmapNodeKind = 5;
+inline constexpr std::uint8_t kMaxRoadmapNodeKind = 6;
 /// Cells of a risk map (as the agent's RiskField accepts).
 inline constexpr std::size_t kMaxRiskCells = std::size_t{1} << 26;
 
