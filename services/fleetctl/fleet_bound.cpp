@@ -152,14 +152,28 @@ Expected<FleetBound> fleetBound(const planning::OccupancyGrid& freeMap, const Fl
 
 }  // namespace fleet::ctl
 
-#include "fleet/site/site.hpp"
+#include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::ctl {
 
-std::vector<BoundStation> boundStations(const site::Site& site) {
+std::vector<BoundStation> boundStations(const traffic::Roadmap& roadmap) {
+  const auto& g = roadmap.graph;
   std::vector<BoundStation> out;
-  for (const auto& s : site.stations) {
-    out.push_back({s.name, {s.pose.position(), s.approach, s.queue}});
+  for (const auto& s : roadmap.stations) {
+    if (s.dock == traffic::kNoNode) {
+      continue;
+    }
+    DockGeometry geo{g.position(s.dock), std::nullopt, {}, std::nullopt};
+    if (s.approach != traffic::kNoNode) {
+      geo.approach = g.position(s.approach);
+    }
+    if (!s.queue.empty()) {
+      geo.queue.push_back(g.position(s.queue.front()));
+    }
+    if (s.exit != traffic::kNoNode) {
+      geo.exit = g.position(s.exit);
+    }
+    out.push_back({s.name, geo});
   }
   return out;
 }

@@ -74,13 +74,14 @@ struct FleetBound {
 
 }  // namespace fleet::ctl
 
-namespace fleet::site {
-struct Site;
+namespace fleet::traffic {
+class Roadmap;
 }
 
 namespace fleet::ctl {
 
-/// The site's stations as the bound takes them: dock = pose, with the loader's approach and queue.
-[[nodiscard]] std::vector<BoundStation> boundStations(const site::Site& site);
+/// The stations as the bound takes them: the roadmap's dock, approach point, first queue place
+/// and exit (what the traffic manager lays out from the site).
+[[nodiscard]] std::vector<BoundStation> boundStations(const traffic::Roadmap& roadmap);
 
 }  // namespace fleet::ctl

@@ -9,6 +9,7 @@
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/sim/scenario.hpp"
+#include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::ctl {
 
@@ -106,7 +107,8 @@ json runFleetBound(const fs::path& runDir, double fleetRatePerH) {
       return {{"error", "the scenario has no robot"}};
     }
     FleetBoundInput in;
-    in.stations = boundStations(*scn.site);
+    // The stations as the traffic manager's roadmap lays them out (approach, queue and exit).
+    in.stations = boundStations(traffic::buildRoadmap(*scn.site));
     in.tasks = std::move(list);
     // The bound is the best robot's: the smallest disc at the fastest cruise.
     in.radius = scn.robots.front().radius;

@@ -11,6 +11,11 @@ double dockMoveSeconds(const DockGeometry& g, double radius, double cruise) {
   }
   const Vec2 a = g.approach.value_or(g.dock);
   const double leg = (g.dock - a).norm();
+  if (g.exit) {
+    const double wait = g.queue.empty() ? 2.0 * radius : (g.queue.front() - a).norm();
+    const double s = (leg + wait) / cruise;
+    return std::isfinite(s) ? s : 0.0;
+  }
   const double wait = g.queue.empty() ? 2.0 * radius : std::max((g.queue.front() - a).norm(), 2.0 * radius);
   const double s = (2.0 * leg + wait) / cruise;
   return std::isfinite(s) ? s : 0.0;

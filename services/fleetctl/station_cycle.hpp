@@ -14,6 +14,15 @@
 // with straight lines (the leg is straight by construction; a straight line is the least way) and
 // no turns (ideal). Without an approach point the leg has no length (approach = dock); without a
 // queue the next robot waits a diameter away.
+//
+// A station with an exit (a server: left by a way of its own, roadmap.hpp) is not left along the
+// leg: the leaving robot drives off to its exit while the next one comes in, so the least cycle is
+// the next robot's drive from the queue head to the dock,
+//
+//   c = dwell + (|queueHead − approach| + |approach − dock|) / cruise
+//
+// (|queueHead − approach| → 2r without a queue): whatever the exit's geometry, the next robot cannot
+// arrive sooner than that after the last one's dwell.
 
 #include <optional>
 #include <vector>
@@ -26,6 +35,7 @@ struct DockGeometry {
   Vec2 dock;
   std::optional<Vec2> approach;  ///< start of the straight last leg
   std::vector<Vec2> queue;       ///< waiting points, nearest first
+  std::optional<Vec2> exit;      ///< where the docked robot leaves to; none: back along the leg
 };
 
 /// The motion part of the cycle (the dwell comes from each visit's task): the sum in parentheses

@@ -19,24 +19,16 @@ namespace fleet::ctl {
 namespace {
 
 /// The fleet bound of a virtual-fleet run: its drawn tasks in order, its robots' starts, the
-/// roadmap's stations (dock, approach and first queue node as it built them), disc and cruise, the
+/// roadmap's stations (dock, approach, first queue node and exit as it built them), disc and cruise, the
 /// virtual fleet's dwell at pickup and drop-off.
 nlohmann::json virtualFleetBound(const site::Site& site, const traffic::Roadmap& roadmap,
                                  const traffic::VirtualFleetResult& r, double dwell) {
   const auto& g = roadmap.graph;
   FleetBoundInput in;
   std::map<traffic::NodeId, std::string> names;
-  for (const auto& s : roadmap.stations) {
-    if (s.dock == traffic::kNoNode)
-      continue;
+  for (const auto& s : roadmap.stations)
     names[s.dock] = s.name;
-    DockGeometry geo{g.position(s.dock), std::nullopt, {}};
-    if (s.approach != traffic::kNoNode)
-      geo.approach = g.position(s.approach);
-    if (!s.queue.empty())
-      geo.queue.push_back(g.position(s.queue.front()));
-    in.stations.push_back({s.name, geo});
-  }
+  in.stations = boundStations(roadmap);
   for (const auto& t : r.tasks)
     in.tasks.push_back({names[t.pickup], names[t.dropoff], dwell, dwell});
   for (const auto v : r.starts)

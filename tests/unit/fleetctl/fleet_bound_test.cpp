@@ -28,7 +28,8 @@ OccupancyGrid room() {
 // radius 0.2 m (diameter 0.4), cruise 1 m/s, load 1 s, unload 2 s.
 FleetBoundInput twoTasks(std::vector<Vec2> starts) {
   FleetBoundInput in;
-  in.stations = {{"A", {{1.0, 1.0}, Vec2{1.0, 2.0}, {{1.0, 3.0}}}}, {"B", {{4.0, 1.0}, std::nullopt, {}}}};
+  in.stations = {{"A", {{1.0, 1.0}, Vec2{1.0, 2.0}, {{1.0, 3.0}}, std::nullopt}},
+                 {"B", {{4.0, 1.0}, std::nullopt, {}, std::nullopt}}};
   in.tasks = {{"A", "B", 1.0, 2.0}, {"A", "B", 1.0, 2.0}};
   in.starts = std::move(starts);
   in.radius = 0.2;
@@ -38,12 +39,16 @@ FleetBoundInput twoTasks(std::vector<Vec2> starts) {
 
 TEST(StationCycle, LegOutWaitOrDiameterAndLegInAtCruise) {
   // |dock − approach| = 1, |queue head − approach| = 1 > 2r: (1 + 1 + 1) / 1 m/s.
-  EXPECT_DOUBLE_EQ(dockMoveSeconds({{1, 1}, Vec2{1, 2}, {{1, 3}}}, 0.2, 1.0), 3.0);
+  EXPECT_DOUBLE_EQ(dockMoveSeconds({{1, 1}, Vec2{1, 2}, {{1, 3}}, std::nullopt}, 0.2, 1.0), 3.0);
   // A queue head closer than a diameter to the approach point: the diameter counts.
-  EXPECT_DOUBLE_EQ(dockMoveSeconds({{1, 1}, Vec2{1, 2}, {{1, 2.1}}}, 0.2, 1.0), 2.4);
+  EXPECT_DOUBLE_EQ(dockMoveSeconds({{1, 1}, Vec2{1, 2}, {{1, 2.1}}, std::nullopt}, 0.2, 1.0), 2.4);
   // No approach, no queue: a diameter at 0.5 m/s.
-  EXPECT_DOUBLE_EQ(dockMoveSeconds({{4, 1}, std::nullopt, {}}, 0.2, 0.5), 0.8);
-  EXPECT_EQ(dockMoveSeconds({{4, 1}, std::nullopt, {}}, 0.2, 0.0), 0.0);
+  EXPECT_DOUBLE_EQ(dockMoveSeconds({{4, 1}, std::nullopt, {}, std::nullopt}, 0.2, 0.5), 0.8);
+  // A server (an exit of its own): the next robot drives in from the queue head as the last one
+  // leaves, so only its own way in counts: 1 + 1 m at 1 m/s, whatever the exit.
+  EXPECT_DOUBLE_EQ(dockMoveSeconds({{1, 1}, Vec2{1, 2}, {{1, 3}}, Vec2{2, 2}}, 0.2, 1.0), 2.0);
+  EXPECT_DOUBLE_EQ(dockMoveSeconds({{4, 1}, std::nullopt, {}, Vec2{5, 1}}, 0.2, 0.5), 0.8);
+  EXPECT_EQ(dockMoveSeconds({{4, 1}, std::nullopt, {}, std::nullopt}, 0.2, 0.0), 0.0);
 }
 
 TEST(FleetBound, LoneRobotChainsTheListInPostingOrder) {
