@@ -267,25 +267,22 @@ void Dashboard::routes(HttpServer& server) {
       },
       Run::Inline);
   // The page's files carry no data: no login (the page asks for the token itself).
-  server.route(
-      "GET", R"(/dashboard/(.*))", Scope::Public,
-      [](const Request& req, Response& res) {
-        std::string name = req.matches[1];
-        if (name.empty()) {
-          name = "index.html";
-        }
-        const WebFile* f = webFile(name);
-        if (f == nullptr) {
-          send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
-          return;
-        }
-        res.set_header("Cache-Control", "no-cache");
-        res.set_header("X-Content-Type-Options", "nosniff");
-        res.set_header("Content-Security-Policy",
-                       "default-src 'self'; img-src 'self' data:; style-src 'self'; frame-ancestors 'none'");
-        res.set_content(std::string(f->body), std::string(f->type));
-      },
-      Run::Inline);
+  // The page's files are flat: /dashboard/ is index.html, /dashboard/{file} the others.
+  const auto serveFile = [](const Request& req, Response& res) {
+    const std::string name = req.matches.size() > 1 ? req.matches[1] : "index.html";
+    const WebFile* f = webFile(name);
+    if (f == nullptr) {
+      send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
+      return;
+    }
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    res.set_header("Content-Security-Policy",
+                   "default-src 'self'; img-src 'self' data:; style-src 'self'; frame-ancestors 'none'");
+    res.set_content(std::string(f->body), std::string(f->type));
+  };
+  server.route("GET", "/dashboard/", Scope::Public, serveFile, Run::Inline);
+  server.route("GET", R"(/dashboard/([^/]+))", Scope::Public, serveFile, Run::Inline);
   // Any token may make a session (it acts with that token's scopes); logging out with the cookie
   // needs the CSRF token like every other change.
   for (const char* method : {"GET", "POST", "DELETE"}) {
@@ -315,8 +312,10 @@ void Dashboard::routes(HttpServer& server) {
   });
   // Commanding a robot is an operator's: the same scope as pausing a task.
   server.limitBody("POST", R"(/v1/robots/([^/]+)/([^/]+))", 4096, "the robot action route's fixed limit");
-  server.route("POST", R"(/v1/robots/([^/]+)/([^/]+))", Scope::Operate,
-               [this](const Request& req, Response& res) { robotAction(req, res); });
+  for (const std::string action : {"pause", "resume", "home", "charge"}) {
+    server.route("POST", R"(/v1/robots/([^/]+)/)" + action, Scope::Operate,
+                 [this, action](const Request& req, Response& res) { robotAction(req, res, action); });
+  }
   server.route(
       "GET", "/v1/stream", Scope::Read,
       [this](const Request&, Response& res) {
@@ -378,14 +377,9 @@ void Dashboard::session(const Request& req, Response& res) {
         {"scopes", scopesJson(who ? who->scopes : std::set<Scope>{})}});
 }
 
-void Dashboard::robotAction(const Request& req, Response& res) {
+void Dashboard::robotAction(const Request& req, Response& res, const std::string& action) {
   const std::string id = req.matches[1];
-  const std::string action = req.matches[2];
   res.audit = json{{"robot", id}, {"action", action}}.dump(-1, ' ', false, json::error_handler_t::replace);
-  if (action != "pause" && action != "resume" && action != "home" && action != "charge") {
-    send(res, 404, problem("not_found", "no robot action \"" + action + "\" (pause, resume, home, charge)"));
-    return;
-  }
   if (!isValidId(id)) {
     send(res, 400, invalidField("id", "not a valid robot id (1-63 characters of A-Z a-z 0-9 _ . : -)"));
     return;

@@ -62,7 +62,8 @@ class Dashboard {
  private:
   void routes(HttpServer& server);
   void session(const Request& req, Response& res);
-  void robotAction(const Request& req, Response& res);
+  /// POST /v1/robots/{id}/{action}: pause, resume, home or charge.
+  void robotAction(const Request& req, Response& res, const std::string& action);
   void hold(const std::string& robot, bool held, Response& res);
   void sendTo(const msg::RobotState& robot, const std::string& action, const Request& req, Response& res);
   /// The page's event stream; polled by the server from its I/O thread, so it never blocks.

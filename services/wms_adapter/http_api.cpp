@@ -236,6 +236,9 @@ void HttpApi::observe(const Request& req, const Response& res, double seconds) {
   } else {
     ++counters_.status2xx;
   }
+  if (watcher_) {
+    watcher_(req, res);
+  }
 }
 
 void HttpApi::routes() {

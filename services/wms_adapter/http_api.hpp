@@ -5,6 +5,7 @@
 // grants the route's scope (read, submit, operate); https with a certificate configured.
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -70,6 +71,13 @@ class HttpApi {
   /// Counts responses by status code and times requests in `registry` (the ops port's), and
   /// writes one access-log line per request at info level. Call before serve().
   void instrument(metrics::Registry& registry);
+  /// Every route served (the API's and the dashboard's), as registered.
+  [[nodiscard]] std::vector<HttpServer::RouteInfo> routeTable() const { return server_.routeTable(); }
+  /// Called after every response, after the API's own counting and logging (tests check each
+  /// response against docs/openapi.yaml with it). Call before serve().
+  void watchResponses(std::function<void(const Request&, const Response&)> watcher) {
+    watcher_ = std::move(watcher);
+  }
   /// The operator dashboard served with the API (dashboard.hpp).
   [[nodiscard]] Dashboard& dashboard() { return *dashboard_; }
 
@@ -104,6 +112,7 @@ class HttpApi {
   std::unique_ptr<Dashboard> dashboard_;
   metrics::Registry* registry_ = nullptr;
   metrics::Histogram* requestSeconds_ = nullptr;
+  std::function<void(const Request&, const Response&)> watcher_;
 };
 
 }  // namespace fleet::wms

@@ -57,6 +57,7 @@ struct BodyLimit {
 
 struct Route {
   std::string method;
+  std::string source;  // the pattern as given
   std::regex pattern;
   Scope scope;
   HttpServer::Handler handler;
@@ -739,7 +740,15 @@ HttpServer::~HttpServer() = default;
 
 void HttpServer::route(const std::string& method, const std::string& pattern, Scope scope, Handler handler,
                        Run run) {
-  impl_->routes.push_back({method, std::regex(pattern), scope, std::move(handler), run});
+  impl_->routes.push_back({method, pattern, std::regex(pattern), scope, std::move(handler), run});
+}
+
+std::vector<HttpServer::RouteInfo> HttpServer::routeTable() const {
+  std::vector<RouteInfo> out;
+  for (const auto& r : impl_->routes) {
+    out.push_back({r.method, r.source, r.scope});
+  }
+  return out;
 }
 
 void HttpServer::limitBody(const std::string& method, const std::string& pattern, std::size_t bytes,

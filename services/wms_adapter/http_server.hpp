@@ -157,6 +157,16 @@ class HttpServer {
   void setGate(Gate gate);
   void setObserver(Observer observer);
 
+  /// One registered route as route() was given it.
+  struct RouteInfo {
+    std::string method;
+    std::string pattern;
+    Scope scope;
+  };
+  /// Every route in registration order (docs/openapi.yaml must list each; ctest
+  /// ApiContract.EveryRouteIsInTheSpecAndEverySpecPathIsARoute compares them).
+  [[nodiscard]] std::vector<RouteInfo> routeTable() const;
+
   /// Binds and listens; false (and why in lastError()) when the address cannot be bound.
   bool bind(const std::string& host, int port);
   [[nodiscard]] int port() const;

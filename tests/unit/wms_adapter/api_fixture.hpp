@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "http_api.hpp"
+#include "openapi_contract.hpp"
 
 namespace fleet::wms::testing {
 
@@ -90,6 +91,32 @@ class FakeGateway : public TaskGateway {
   std::mutex m_;
 };
 
+/// Checks every response an HttpApi makes against docs/openapi.yaml (OpenApiContract) as it is
+/// made; a test's fixture reports what did not conform when the test ends.
+class SpecWatch {
+ public:
+  void watch(HttpApi& api) {
+    api.watchResponses([this](const Request& req, const Response& res) {
+      auto found = test::OpenApiContract::shipped().checkResponse(req.method, req.path, res.status,
+                                                                  res.contentType, res.body);
+      std::lock_guard lock(m_);  // the server calls from its I/O thread
+      problems_.insert(problems_.end(), found.begin(), found.end());
+    });
+  }
+  /// One test failure per response that did not conform to the document.
+  void report() {
+    std::lock_guard lock(m_);
+    for (const auto& p : problems_) {
+      ADD_FAILURE() << "response does not match docs/openapi.yaml: " << p;
+    }
+    problems_.clear();
+  }
+
+ private:
+  std::mutex m_;
+  std::vector<std::string> problems_;
+};
+
 inline StationMap stations() {
   return *StationMap::fromJson(json::parse(R"({"stations": [
     {"name": "P-1", "x": 1, "y": 1, "kinds": ["pickup"]},
@@ -102,6 +129,7 @@ class Api : public ::testing::Test {
     s.port = 0;
     s.ackTimeoutMs = 200;
     api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
+    spec_.watch(*api_);
     ASSERT_TRUE(api_->bind());
     thread_ = std::thread([this] { api_->serve(); });
     client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
@@ -111,6 +139,7 @@ class Api : public ::testing::Test {
       api_->stop();
       thread_.join();
     }
+    spec_.report();
   }
   httplib::Result post(const std::string& body, const httplib::Headers& h = {}) {
     return client_->Post("/v1/tasks", h, body, "application/json");
@@ -122,6 +151,7 @@ class Api : public ::testing::Test {
   std::unique_ptr<HttpApi> api_;
   std::thread thread_;
   std::unique_ptr<httplib::Client> client_;
+  SpecWatch spec_;
 };
 
 /// A client socket that does exactly what a test says, however rude: partial heads, endless

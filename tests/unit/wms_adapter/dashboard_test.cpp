@@ -124,6 +124,7 @@ class Dash : public ::testing::Test {
     api_ = std::make_unique<HttpApi>(s, stations_, gateway_, view_, clock_);
     api_->dashboard().setSite(
         json{{"name", "test"}, {"stations", json::array()}, {"homes", {{"r1", "PARK-1"}}}});
+    spec_.watch(*api_);
     ASSERT_TRUE(api_->bind());
     thread_ = std::thread([this] { api_->serve(); });
     client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->port());
@@ -135,6 +136,7 @@ class Dash : public ::testing::Test {
       api_->stop();
       thread_.join();
     }
+    spec_.report();
   }
   /// POST /v1/session with the token: the session cookie ("fleet_session=...") and the CSRF token.
   std::pair<std::string, std::string> login(const std::string& token) {
@@ -156,6 +158,7 @@ class Dash : public ::testing::Test {
   std::unique_ptr<HttpApi> api_;
   std::thread thread_;
   std::unique_ptr<httplib::Client> client_;
+  fleet::wms::testing::SpecWatch spec_;
 };
 
 }  // namespace
