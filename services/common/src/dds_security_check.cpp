@@ -86,7 +86,16 @@ void checkSecurityFiles(const std::string& xml, const std::string& origin, const
       }
       const std::string path = value.substr(5);
       std::string why;
-      if (path.find('$') == std::string::npos && !in.readFile(path, why)) {
+      if (path.find('$') != std::string::npos) {
+        continue;
+      }
+      const auto text = in.readFile(path, why);
+      // A systemd unit's SetCredential= placeholder for a key whose LoadCredential= source is missing.
+      const bool placeholder = text && (text->empty() || text->rfind("not loaded:", 0) == 0);
+      if (placeholder) {
+        why = text->empty() ? "the file is empty" : *text;
+      }
+      if (!text || placeholder) {
         problems.push_back("DDS Security: <" + std::string(tag) + "> " + path + " (in " + origin +
                            ") cannot be read: " + why +
                            "; make the site's files with scripts/dds-security deployment DIR "

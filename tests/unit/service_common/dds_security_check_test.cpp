@@ -120,3 +120,23 @@ TEST(DdsSecurityCheck, AnUnknownModeIsRefused) {
   ASSERT_EQ(p.size(), 1u);
   EXPECT_NE(p[0].find("expected required or off"), std::string::npos) << p[0];
 }
+
+TEST(DdsSecurityCheck, AnEmptyKeyOrASystemdPlaceholderIsNamed) {
+  World w;
+  w.env["CYCLONEDDS_URI"] = "file:///s.xml";
+  w.files["/s.xml"] = kSecurity;
+  w.site("/site");
+  w.files["/site/agents/key.pem"] = "";
+  auto p = ddsSecurityProblems(w.inputs());
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_NE(p[0].find("/site/agents/key.pem (in /s.xml) cannot be read: the file is empty"),
+            std::string::npos)
+      << p[0];
+  // The unit's SetCredential= fallback when its LoadCredential= source is missing.
+  w.files["/site/agents/key.pem"] = "not loaded: /etc/fleet/dds/agents/key.pem is missing";
+  p = ddsSecurityProblems(w.inputs());
+  ASSERT_EQ(p.size(), 1u);
+  EXPECT_NE(p[0].find("cannot be read: not loaded: /etc/fleet/dds/agents/key.pem is missing"),
+            std::string::npos)
+      << p[0];
+}
