@@ -14,6 +14,7 @@
 #include "fleet/fleet/errors.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
@@ -311,6 +312,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("fleet_manager", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     nlohmann::json overrides = nlohmann::json::object();
     Config cfg =
         configPath.empty() ? Config::fromJson(overrides, "(command line)") : Config::fromFile(configPath);

@@ -11,6 +11,7 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
@@ -176,6 +177,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("risk_map", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
                                     : Config::fromFile(configPath);
     auto settings = riskmap::readSettings(cfg);

@@ -22,6 +22,7 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
@@ -361,6 +362,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("robot_agent", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     if (!configFile.empty()) {
       Config cfg = Config::fromFile(configFile);
       agent::readSettings(cfg, settings, {app.count("--local-planner") > 0});

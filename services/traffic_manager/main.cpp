@@ -14,6 +14,7 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
@@ -290,6 +291,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("traffic_manager", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(defaults)")
                                     : Config::fromFile(configPath);
     auto settings = trafficmgr::readSettings(cfg);

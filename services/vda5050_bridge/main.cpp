@@ -21,6 +21,7 @@
 #include "fleet/mqtt/client.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/transport/dds.hpp"
@@ -337,6 +338,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("vda5050_bridge", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     Config cfg = Config::fromFile(configPath);
     const auto settings = readSettings(cfg);
     cfg.finish();

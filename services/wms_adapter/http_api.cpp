@@ -133,6 +133,19 @@ ApiSettings readApiSettings(Config& cfg) {
   if (s.tls.certificateFile.empty() != s.tls.privateKeyFile.empty()) {
     h.problem("tls_key", "https needs both tls_certificate and tls_key");
   }
+  // The deployments of deploy/ require https (FLEET_WMS_TLS=required); their dev overlays say off.
+  if (const char* tls = std::getenv("FLEET_WMS_TLS"); tls != nullptr && *tls != '\0') {
+    const std::string mode = tls;
+    if (mode != "required" && mode != "off") {
+      h.problem("tls_certificate", "FLEET_WMS_TLS=\"" + mode + "\": expected required or off");
+    } else if (mode == "required" && s.tls.certificateFile.empty() && s.tls.privateKeyFile.empty()) {
+      h.problem(
+          "tls_certificate",
+          "FLEET_WMS_TLS=required, but no certificate is configured: set tls_certificate and tls_key "
+          "(scripts/dds-security https DIR wms-adapter HOST ..., docs/operator-guide.md#security), or for "
+          "development only set FLEET_WMS_TLS=off (the dev overlays of deploy/)");
+    }
+  }
   s.tokenFile = h.string("token_file", "");
   if (!s.tokenFile.empty()) {
     if (auto t = TokenStore::fromFile(s.tokenFile); !t) {

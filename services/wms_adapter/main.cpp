@@ -12,6 +12,7 @@
 #include "fleet/core/logging.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
+#include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "fleet/service/site_stations.hpp"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   }
   try {
     service::setupLogging("wms_adapter", common);
+    service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(command line)")
                                     : Config::fromFile(configPath);
     cfg.rejectUnknownKeys({"http", "stations"});

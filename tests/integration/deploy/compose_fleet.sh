@@ -7,13 +7,15 @@
 # network reaches the adapter by its service name. Everything the run created (containers, network,
 # files) is removed, also on failure. Exit 77 (ctest skip) only when podman cannot run containers
 # here at all.
-# Plain: deploy/compose.yaml alone, as deployed (two robots, both the robot agent's): both tasks
-# must be done through compose.yaml's traffic manager, which must have released routes. With
-# "secure", deploy/compose.vda5050.yaml, deploy/compose.secure.yaml and
-# deploy/compose.secure.vda5050.yaml too: a VDA 5050 vehicle (robot r2 of two, the simulator's)
-# through the mosquitto container and the vda5050-bridge, which must have sent the vehicle orders
-# that it drove and be ready (it hears the broker), and DDS Security with an identity per service
-# (scripts/dds-security deployment), the traffic manager and the bridge included. In both modes a
+# Plain: deploy/compose.yaml with the development overlay deploy/compose.dev.yaml (two robots, both
+# the robot agent's; no DDS Security, http): both tasks must be done through compose.yaml's traffic
+# manager, which must have released routes. With "secure": the secure default as deployed,
+# deploy/compose.yaml and deploy/compose.vda5050.yaml without the dev overlays, the files of
+# `scripts/dds-security site` (written by scripts/containers files): DDS Security with an identity per
+# service, the traffic manager and the bridge included, https on the API (fleetctl trusts the site
+# CA), and a VDA 5050 vehicle (robot r2 of two, the simulator's) through the mosquitto container and
+# the vda5050-bridge, which must have sent the vehicle orders that it drove and be ready (it hears
+# the broker); a service whose identity file is missing must exit 2 naming it. In both modes a
 # container on the network without a certificate then writes Tasks straight onto the domain: they
 # must reach the manager without security (so the check can fail) and must not with it.
 # Usage: compose_fleet.sh SOURCE_DIR BUILD_DIR [secure]
@@ -52,7 +54,9 @@ dir=$(mktemp -d /tmp/fleet-compose.XXXXXX)
 files=(-f deploy/compose.yaml)
 if ((SECURE)); then
   SERVICES+=(mosquitto vda5050-bridge)
-  files+=(-f deploy/compose.vda5050.yaml -f deploy/compose.secure.yaml -f deploy/compose.secure.vda5050.yaml)
+  files+=(-f deploy/compose.vda5050.yaml)
+else
+  files+=(-f deploy/compose.dev.yaml)
 fi
 scenario=sim/scenarios/two_robots.json ntasks=2
 compose() { timeout 120 podman-compose -p "$P" "${files[@]}" "$@"; }
@@ -85,15 +89,25 @@ done
 
 # The broker's port inside the network: not MQTT's 1883, as every test's broker.
 export FLEET_MQTT_PORT=$((18830 + $$ % 1000))
-VDA5050=$SECURE scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null || fail "writing the mounted files failed"
+# Secure: scripts/containers files makes config/dds with scripts/dds-security site (the images'
+# user owns the files, the CA key stays root's); plain: DEV=1, no dds/ and no https.
+DEV=$((1 - SECURE)) VDA5050=$SECURE scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null ||
+  fail "writing the mounted files failed"
 export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
 if ((SECURE)); then
   FLEET_AGENT_ROBOTS=$(cat "$dir/config/agent_robots")
   export FLEET_AGENT_ROBOTS
-  scripts/dds-security deployment "$dir/dds" >"$dir/dds-security.log" 2>&1 ||
-    { cat "$dir/dds-security.log"; fail "scripts/dds-security deployment failed"; }
-  chown -R 65532:65532 "$dir/dds"  # the images' user reads its key (0600)
-  export FLEET_DDS_SECURITY_DIR=$dir/dds
+  [[ -s $dir/config/dds/fleet-manager/security.xml && -s $dir/config/dds/https/wms-adapter/cert.pem ]] ||
+    fail "scripts/containers files made no DDS identities or https certificate in $dir/config/dds"
+  # A service whose identity is missing refuses to start: exit 2, the file named.
+  podman run --rm --network none --user 65532 -v "$dir/config:/etc/fleet:ro" -e FLEET_DDS_SECURITY=required \
+    -e FLEET_DDS_SECURITY_DIR=/etc/fleet/dds \
+    -e CYCLONEDDS_URI=file:///usr/share/fleet/cyclonedds-compose.xml,file:///etc/fleet/dds/nobody/security.xml \
+    localhost/fleet-risk-map:latest --config /etc/fleet/risk_map.json >"$dir/missing.log" 2>&1
+  rc=$?
+  ((rc == 2)) && grep -q "/etc/fleet/dds/nobody/security.xml" "$dir/missing.log" ||
+    { cat "$dir/missing.log"; fail "a service without its identity file did not exit 2 naming it (exit $rc)"; }
+  echo "a service without its identity file exits 2: $(grep -o 'CYCLONEDDS_URI names [^,]*' "$dir/missing.log")"
 fi
 # fleetctl is left out: podman-compose 1.0.3 ignores `profiles: [cli]`.
 compose up -d "${SERVICES[@]}" >"$dir/up.log" 2>&1 || { tail -n 30 "$dir/up.log"; fail "podman-compose up failed"; }
@@ -112,8 +126,18 @@ echo "containers: $(for s in "${SERVICES[@]}"; do printf '%s=%s ' "$s" "${ip[$s]
 [[ $(podman port "${P}_wms-adapter_1") == "8080/tcp -> 127.0.0.1:$port" ]] ||
   fail "the API is not published on 127.0.0.1:$port only: $(podman port "${P}_wms-adapter_1")"
 
-ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port" "$@"; }
+if ((SECURE)); then
+  ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "https://127.0.0.1:$port" --ca-cert "$dir/config/dds/ca.pem" "$@"; }
+else
+  ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port" "$@"; }
+fi
 for _ in $(seq 60); do ctl health >/dev/null 2>&1 && break; sleep 0.5; done
+if ((SECURE)); then  # https only: plain http on the API's port gets no answer
+  ctl health >/dev/null 2>&1 || fail "the API does not answer https with the site CA's certificate"
+  "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port" health >/dev/null 2>&1 &&
+    fail "the API answered plain http"
+  echo "the API answers https (site CA) and not plain http"
+fi
 ctl submit "$dir/config/tasks.csv" | tee "$dir/submit.txt"
 grep -q "submitted $ntasks tasks, 0 refused" "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
 touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
@@ -152,4 +176,4 @@ compose run --rm --no-deps -T fleetctl task job-000 >"$dir/run.log" 2>&1
 grep -q '"state": "done"' "$dir/run.log" || { tail -n 20 "$dir/run.log"; fail "fleetctl in the network did not reach wms-adapter:8080"; }
 echo "fleetctl in the network: job-000 done"
 ok=1
-echo "PASS: compose fleet test through the traffic manager$( ((SECURE)) && echo ", a VDA 5050 vehicle and DDS Security on") in $((SECONDS - t0)) s"
+echo "PASS: compose fleet test through the traffic manager$( ((SECURE)) && echo ", a VDA 5050 vehicle, DDS Security and https on (the secure default)" || echo " (the dev overlay)") in $((SECONDS - t0)) s"

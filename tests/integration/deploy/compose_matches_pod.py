@@ -6,9 +6,11 @@ wms_adapter.json that scripts/containers writes, which must name the pod's stati
 all addresses of its container), environment, mounts, health check, read-only root filesystem and
 no privilege escalation. Network: every service on the project network `fleet`, none in another's
 namespace; the compose DDS profile (in the images) with multicast off and exactly the DDS services'
-names as unicast peers; only the adapter publishes a port, on 127.0.0.1. DDS Security: each DDS
-service has its identity in compose.secure.yaml or compose.secure.vda5050.yaml. Usage:
-compose_matches_pod.py SOURCE_DIR"""
+names as unicast peers; only the adapter publishes a port, on 127.0.0.1. Secure by default: each
+DDS service of compose.yaml, compose.vda5050.yaml and the Pod requires DDS Security and joins with
+its own identity from /etc/fleet/dds, the adapter requires https; the dev overlays
+(compose.dev.yaml, compose.dev.vda5050.yaml, fleet-pod.dev.yaml) turn both off for every one of
+them and for nothing else. Usage: compose_matches_pod.py SOURCE_DIR"""
 import json
 import os
 import subprocess
@@ -61,7 +63,8 @@ for name, c in pod.items():
     check(s.get("command") == args, f"{name}: command {s.get('command')} != pod's args {args}")
     entry = [a.replace('"$@"', '"$$@"') for a in c.get("command", [])] or None
     check(s.get("entrypoint") == entry, f"{name}: entrypoint {s.get('entrypoint')} != pod's command {entry}")
-    env = {e["name"]: e["value"] for e in c.get("env", [])}
+    # CYCLONEDDS_URI differs (the pod's loopback profile, compose's): checked below.
+    env = {e["name"]: e["value"] for e in c.get("env", []) if e["name"] != "CYCLONEDDS_URI"}
     check(all(s.get("environment", {}).get(k) == v for k, v in env.items()),
           f"{name}: environment {s.get('environment')} lacks the pod's {env}")
     mounts = {m["mountPath"]: m.get("readOnly", False) for m in c.get("volumeMounts", [])}
@@ -97,27 +100,50 @@ for name, s in {**compose, **added}.items():
               f"wms-adapter: ports {ports}: the API only, on the host's loopback")
     else:
         check(not ports, f"{name}: publishes {ports}")
-    if name in dds:
-        check(s.get("environment", {}).get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE}",
-              f"{name}: CYCLONEDDS_URI {s.get('environment', {}).get('CYCLONEDDS_URI')} is not the compose profile")
-check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_URL") == "http://wms-adapter:8080",
-      "fleetctl: FLEET_WMS_URL is not the adapter's service name")
+check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_URL") == "https://wms-adapter:8080",
+      "fleetctl: FLEET_WMS_URL is not https to the adapter's service name")
+check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_CA_CERT") == "/etc/fleet/dds/ca.pem",
+      "fleetctl: FLEET_WMS_CA_CERT is not the site CA")
 
-# DDS Security: every DDS service of the two files gets its own identity from one of the two secure
-# overlays (compose.secure.yaml for compose.yaml's, compose.secure.vda5050.yaml for the overlay's),
-# with the compose profile first and the identity's security.xml from the read-only mount.
-secure = {**yaml.safe_load(open(f"{src}/deploy/compose.secure.yaml"))["services"],
-          **yaml.safe_load(open(f"{src}/deploy/compose.secure.vda5050.yaml"))["services"]}
+# Secure by default: every DDS service of the files (the VDA 5050 overlay's bridge included) and of
+# the Pod requires DDS Security and joins with its own identity, the profile first and the
+# identity's security.xml from the site's files under /etc/fleet/dds; the adapter requires https.
 IDENTITY = {"robot-agent": "agents", "fleet-sim": "simulator"}
-for name in dds:
-    env = secure.get(name, {}).get("environment", {})
+full = {**compose, **overlay}
+for name, s in full.items():
+    env = dict(compose.get(name, {}).get("environment", {}) or {}, **(overlay.get(name, {}).get("environment") or {}))
+    if name not in dds:
+        continue
     ident = IDENTITY.get(name, name)
-    check(env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE},file:///run/fleet-dds/{ident}/security.xml",
-          f"{name}: no DDS Security identity in the secure overlays (CYCLONEDDS_URI {env.get('CYCLONEDDS_URI')})")
-    check(env.get("FLEET_DDS_SECURITY_DIR") == "/run/fleet-dds", f"{name}: FLEET_DDS_SECURITY_DIR is not the mount")
-    check(any(str(v).endswith(":/run/fleet-dds:ro") for v in secure.get(name, {}).get("volumes", [])),
-          f"{name}: the identities are not mounted read-only at /run/fleet-dds")
-check(not set(secure) - set(dds), f"secure overlays name services that are not DDS services: {set(secure) - set(dds)}")
+    check(env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE},file:///etc/fleet/dds/{ident}/security.xml",
+          f"{name}: CYCLONEDDS_URI {env.get('CYCLONEDDS_URI')} is not the compose profile with its identity {ident}")
+    check(env.get("FLEET_DDS_SECURITY") == "required", f"{name}: FLEET_DDS_SECURITY is not required")
+    check(env.get("FLEET_DDS_SECURITY_DIR") == "/etc/fleet/dds", f"{name}: FLEET_DDS_SECURITY_DIR is not /etc/fleet/dds")
+check(compose["wms-adapter"]["environment"].get("FLEET_WMS_TLS") == "required", "wms-adapter: FLEET_WMS_TLS is not required")
+pod_vda = yaml.safe_load(open(f"{src}/deploy/fleet-pod.vda5050.yaml"))
+for c in list(pod.values()) + pod_vda["containers"]:
+    if c["name"] == "mosquitto":
+        continue
+    env = {e["name"]: e["value"] for e in c.get("env", [])}
+    ident = IDENTITY.get(c["name"], c["name"])
+    check(env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/cyclonedds-local.xml,file:///etc/fleet/dds/{ident}/security.xml",
+          f"pod {c['name']}: CYCLONEDDS_URI {env.get('CYCLONEDDS_URI')} is not the loopback profile with its identity")
+    check(env.get("FLEET_DDS_SECURITY") == "required", f"pod {c['name']}: FLEET_DDS_SECURITY is not required")
+check({"name": "FLEET_WMS_TLS", "value": "required"} in pod["wms-adapter"]["env"], "pod wms-adapter: FLEET_WMS_TLS is not required")
+# The dev overlays: off for every DDS service (and https off for the adapter), the plain profile.
+dev = {**yaml.safe_load(open(f"{src}/deploy/compose.dev.yaml"))["services"],
+       **yaml.safe_load(open(f"{src}/deploy/compose.dev.vda5050.yaml"))["services"]}
+pod_dev = yaml.safe_load(open(f"{src}/deploy/fleet-pod.dev.yaml"))["env"]
+for name in dds:
+    env = dev.get(name, {}).get("environment", {})
+    check(env.get("FLEET_DDS_SECURITY") == "off" and env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE}",
+          f"compose dev overlays: {name} keeps DDS Security")
+    penv = {e["name"]: e["value"] for e in pod_dev.get(name, [])}
+    check(penv.get("FLEET_DDS_SECURITY") == "off" and penv.get("CYCLONEDDS_URI") == "file:///usr/share/fleet/cyclonedds-local.xml",
+          f"fleet-pod.dev.yaml: {name} keeps DDS Security")
+check(dev["wms-adapter"]["environment"].get("FLEET_WMS_TLS") == "off", "compose.dev.yaml: the adapter keeps https")
+check({"name": "FLEET_WMS_TLS", "value": "off"} in pod_dev["wms-adapter"], "fleet-pod.dev.yaml: the adapter keeps https")
+check(not set(dev) - set(dds) - {"fleetctl"}, f"compose dev overlays name other services: {set(dev) - set(dds)}")
 
 ns = {"c": "https://cdds.io/config"}
 general = ET.parse(f"{src}/deploy/{PROFILE}").getroot().find("c:Domain", ns)

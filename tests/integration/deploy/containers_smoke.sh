@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CI smoke test of the service containers: builds the images from the host build, starts the
 # small-fleet pod (simulator, risk map, fleet manager, WMS adapter, traffic manager, robot agent)
-# with `podman play kube --network none`, plus deploy/fleet-pod.vda5050.yaml's MQTT broker and VDA
+# with `podman play kube --network none` in its secure default (DDS Security with an identity per
+# service, https on the API; scripts/containers makes the files), plus deploy/fleet-pod.vda5050.yaml's MQTT broker and VDA
 # 5050 bridge (VDA5050=1: of two robots, r2 is the simulator's VDA 5050 vehicle), posts two
 # transport tasks over HTTP from inside the pod and asserts that every container started and stays
 # healthy (liveness), ready, with metrics, not as root, that both tasks reached `done` (DDS between
@@ -39,8 +40,9 @@ trap cleanup EXIT
 export FLEET_MQTT_PORT=$((18830 + $$ % 1000))  # not MQTT's 1883, as every test's broker
 VDA5050=1 scripts/containers up "$dir" sim/scenarios/two_robots.json 150 2 || fail "podman play kube failed"
 
+# The secure default (DDS Security, https): the API trusted through the site CA of config/dds.
 ctl() { podman run --rm --pod "$POD" -v "$dir/config:/etc/fleet:ro" localhost/fleet-fleetctl \
-  --url http://127.0.0.1:8080 "$@"; }
+  --url https://127.0.0.1:8080 --ca-cert /etc/fleet/dds/ca.pem "$@"; }
 services=(fleet-manager wms-adapter risk-map robot-agent fleet-sim traffic-manager mosquitto vda5050-bridge)
 for c in "${services[@]}"; do
   [[ $(podman inspect --format '{{.State.Status}}' "$POD-$c") == running ]] || fail "$POD-$c did not start"

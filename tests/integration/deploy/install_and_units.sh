@@ -45,6 +45,20 @@ for b in "${programs[@]}"; do
     grep -q "^$line" "$u" || fail "$(basename "$u") lacks $line"
   done
 done
+# Secure by default: every unit requires DDS Security with its identity of /etc/fleet/dds, its key a
+# credential; the adapter requires https. The development drop-in turns both off.
+for u in "$units"/*.service; do
+  for line in "Environment=FLEET_DDS_SECURITY=required" "Environment=CYCLONEDDS_URI=.*,file:///etc/fleet/dds/[a-z0-9-]*/security.xml\$" \
+              "LoadCredential=dds-key.pem:/etc/fleet/dds/" "SetCredential=dds-key.pem:not loaded: /etc/fleet/dds/"; do
+    grep -q "^$line" "$u" || fail "$(basename "$u") lacks $line (DDS Security by default)"
+  done
+done
+grep -q "^Environment=FLEET_WMS_TLS=required" "$units/fleet-wms-adapter.service" || fail "fleet-wms-adapter.service: https not required"
+dev=$root/usr/share/fleet/systemd/dev-insecure.conf
+[[ -s $dev ]] || fail "not installed: share/fleet/systemd/dev-insecure.conf"
+grep -q "^Environment=FLEET_DDS_SECURITY=off FLEET_WMS_TLS=off" "$dev" || fail "dev-insecure.conf does not turn security off"
+grep -q "^Environment=CYCLONEDDS_URI=file://$root/usr/share/fleet/cyclonedds-lan.xml$" "$dev" || fail "dev-insecure.conf: paths not filled in"
+echo "install: every unit requires DDS Security (the adapter https); dev-insecure.conf turns them off"
 for u in fleet-robot-agent@.service fleet-vda5050-bridge.service; do
   for dep in After Wants; do
     grep -q "^$dep=.*fleet-traffic-manager.service" "$units/$u" || fail "$u: no $dep=fleet-traffic-manager.service"
@@ -59,6 +73,15 @@ for u in "$units"/*.service; do
   [[ $u == *@.service ]] && continue
   if ! out=$(SYSTEMD_UNIT_PATH="$units:" systemd-analyze verify --man=no "$u" 2>&1) || [[ -n $out ]]; then
     echo "$(basename "$u"): $out"
+    status=1
+  fi
+done
+# The same units with the development drop-in.
+for u in fleet-manager.service fleet-wms-adapter.service; do
+  mkdir -p "$units/$u.d"
+  cp "$dev" "$units/$u.d/"
+  if ! out=$(SYSTEMD_UNIT_PATH="$units:" systemd-analyze verify --man=no "$units/$u" 2>&1) || [[ -n $out ]]; then
+    echo "$u with dev-insecure.conf: $out"
     status=1
   fi
 done

@@ -221,6 +221,33 @@ TEST(ApiConfig, AnUnusableTokenFileOrHalfATlsPairIsAConfigError) {
   fs::remove_all(dir);
 }
 
+TEST(ApiConfig, RequiredTlsRefusesPlainHttp) {
+  ::setenv("FLEET_WMS_TLS", "required", 1);
+  auto plain = Config::fromJson(json{{"http", {{"host", "127.0.0.1"}}}}, "wms.json");
+  readApiSettings(plain);
+  try {
+    plain.finish();
+    ADD_FAILURE() << "no ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("http.tls_certificate"));
+    EXPECT_THAT(e.what(), HasSubstr("FLEET_WMS_TLS=required"));
+  }
+  auto https = Config::fromJson(
+      json{{"http", {{"host", "127.0.0.1"}, {"tls_certificate", "/c.pem"}, {"tls_key", "/k.pem"}}}},
+      "wms.json");
+  EXPECT_TRUE(readApiSettings(https).tls.enabled());
+  EXPECT_NO_THROW(https.finish());  // the files themselves are checked when the server starts
+  ::setenv("FLEET_WMS_TLS", "maybe", 1);
+  auto odd = Config::fromJson(json{{"http", {{"host", "127.0.0.1"}}}}, "wms.json");
+  readApiSettings(odd);
+  EXPECT_THROW(odd.finish(), ConfigError);
+  ::setenv("FLEET_WMS_TLS", "off", 1);
+  auto off = Config::fromJson(json{{"http", {{"host", "127.0.0.1"}}}}, "wms.json");
+  readApiSettings(off);
+  EXPECT_NO_THROW(off.finish());
+  ::unsetenv("FLEET_WMS_TLS");
+}
+
 TEST(ApiConfig, AnOpenHostWithoutTokensIsRefusedUnlessAllowedOutright) {
   ::unsetenv("FLEET_WMS_TOKEN");
   auto open = Config::fromJson(json{{"http", {{"host", "0.0.0.0"}}}}, "wms.json");
