@@ -60,11 +60,12 @@ TEST(TrafficSimView, ThePageReplaysTheRunItReports) {
           ASSERT_LT(v.get<std::size_t>(), nodes.size());
         }
       }
-      // The base starts where the robot last reported: within one edge (≤ 1 m) of its disc.
+      // The base starts where the robot last reported: within one edge of its disc (the longest:
+      // a dead-end dock to its exit beside the approach point, √2 m).
       const auto& base = robot[5];
       ASSERT_FALSE(base.empty());
       const auto& b0 = nodes[base[0].get<std::size_t>()];
-      EXPECT_LE(std::hypot(b0[0].get<double>() - x, b0[1].get<double>() - y), 1.0) << robot.dump();
+      EXPECT_LE(std::hypot(b0[0].get<double>() - x, b0[1].get<double>() - y), 1.5) << robot.dump();
       released = released || base.size() > 1;
     }
   }

@@ -211,17 +211,11 @@ TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
   const NodeId west = map.nearest({24.75, 15.75});    // r6
   const NodeId queued = map.nearest({25.5, 13.75});   // r11, in P-5's queue
   ASSERT_NE(std::find(p5->queue.begin(), p5->queue.end(), queued), p5->queue.end());
-  // The case: the dock is left by its approach only, r20's node excludes it, and so does every
-  // node r20 can move to (none conflicts with the dock itself: r20 can move while r7 stays).
+  // Since stations became servers the dock is left by an exit of its own, not by its approach
+  // (docs/algorithms.md, "Traffic: stations as servers"): r20 beside the approach no longer shuts
+  // the way out. The run's places and lines are kept as a regression: nobody stalls.
   ASSERT_EQ(map.graph.edges(p5->dock).size(), 1U);
-  ASSERT_EQ(map.graph.edges(p5->dock)[0].to, p5->approach);
-  ASSERT_TRUE(map.graph.conflicting(beside, p5->approach));
-  int free = 0;
-  for (const Edge& e : map.graph.edges(beside)) {
-    ASSERT_TRUE(map.graph.conflicting(e.to, p5->approach)) << e.to;
-    free += map.graph.conflicting(e.to, p5->dock) ? 0 : 1;
-  }
-  ASSERT_GE(free, 1);
+  ASSERT_EQ(map.graph.edges(p5->dock)[0].to, p5->exit);
   std::vector<NodeId> starts;
   for (const auto& n : fleet.names) {
     starts.push_back(n == "r20"   ? beside
@@ -367,24 +361,21 @@ TEST(TrafficControl, RobotsStandingInTheQueueGoBeforeRobotsOnTheirWay) {
 }
 
 /// While the robot that was at the dock drives off it, the next in line waits where it leaves the
-/// approach's ways out free, not only the dock's: a robot leaving a drop-off goes on sideways from
-/// The approach, and a robot waiting on the queue's head shut that way (seen in the virtual fleet:
-/// The leaving robot and three waiting ones stood for 220 s at D-3).
-TEST(TrafficControl, TheNextInLineWaitsClearOfTheWaysOutOfTheApproach) {
+/// leaving robot's way free: a robot leaving a drop-off goes on by the dock's exit, and a robot
+/// waiting where it shuts the exit or the exit's ways on would hold it (seen in the virtual fleet
+/// when drop-offs were left sideways from the approach: the leaving robot and three waiting ones
+/// stood for 220 s at D-3).
+TEST(TrafficControl, TheNextInLineWaitsClearOfTheLeavingRobotsWayOut) {
   Roadmap map = smallWarehouse();
   const auto* d3 = map.station("D-3");
-  ASSERT_NE(d3->approach, kNoNode);
+  ASSERT_NE(d3->exit, kNoNode);
   ASSERT_GE(d3->queue.size(), 2U);
-  std::vector<NodeId> exits;
-  for (const Edge& e : map.graph.edges(d3->approach)) {
-    if (e.to != d3->dock && std::find(d3->queue.begin(), d3->queue.end(), e.to) == d3->queue.end())
-      exits.push_back(e.to);
-  }
-  ASSERT_FALSE(exits.empty());
+  std::vector<NodeId> ways{d3->exit};
+  for (const Edge& e : map.graph.edges(d3->exit))
+    ways.push_back(e.to);
   auto shuts = [&](NodeId q) {
-    return std::any_of(exits.begin(), exits.end(), [&](NodeId x) { return map.graph.conflicting(x, q); });
+    return std::any_of(ways.begin(), ways.end(), [&](NodeId x) { return map.graph.conflicting(x, q); });
   };
-  ASSERT_TRUE(shuts(d3->queue[0]));  // the case: the head of the queue is in the way out
   const std::vector<NodeId> starts{d3->dock, map.station("PARK-1")->dock};
   TrafficControl tc(map.graph, starts);
   tc.setStations({{d3->dock, d3->queue, d3->approach}});
