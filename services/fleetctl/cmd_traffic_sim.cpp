@@ -1,0 +1,87 @@
+// fleetctl traffic-sim: the traffic layer driving a virtual fleet on a site (no simulator).
+
+#include <memory>
+
+#include "commands.hpp"
+#include "traffic_sim.hpp"
+
+namespace fleet::ctl {
+
+void addTrafficSimCommand(CLI::App& app, Commands& commands) {
+  auto* trafficSim = app.add_subcommand(
+      "traffic-sim",
+      "the traffic layer driving a virtual fleet on a site (no simulator): tasks/h, stalls, safety");
+  auto o = std::make_shared<TrafficSimOptions>();
+  trafficSim->add_option("--site", o->site, "site.json")->required();
+  trafficSim->add_option("--robots", o->robots, "robots")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  trafficSim->add_option("--duration", o->duration, "simulated seconds")
+      ->check(CLI::Range(1.0, 1e7))
+      ->capture_default_str();
+  trafficSim->add_option("--seeds", o->seeds, "a seed or a range, e.g. 1-8")->capture_default_str();
+  trafficSim->add_option("--spacing", o->spacing, "roadmap lattice spacing in m (0: default)")
+      ->check(CLI::Range(0.0, 10.0));
+  trafficSim->add_option("--stop-chance", o->stopChance, "per edge: chance a robot stops on it up to 10 s")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  trafficSim
+      ->add_option("--stop-gap", o->stopGap,
+                   "m of free space the robot's motion gate needs ahead of a driving robot (default: the "
+                   "roadmap's)")
+      ->check(CLI::Range(0.0, 5.0));
+  trafficSim
+      ->add_option("--let-pass", o->letPass,
+                   "route nodes a robot must be short of a conflict before a robot waiting on it there may "
+                   "go first (switchable dependencies); 0: never (default: the traffic layer's)")
+      ->check(CLI::Range(0, 1000));
+  trafficSim
+      ->add_option("--max-lag", o->maxLag,
+                   "planner steps a robot may fall behind the plan before everyone's unreleased plan is "
+                   "dropped and planned again (default: the traffic layer's)")
+      ->check(CLI::Range(1, 100000));
+  trafficSim
+      ->add_option("--prefer-straight", o->straight,
+                   "1: among equally short moves the planner takes the one that turns least; 0: at random "
+                   "(default: the traffic layer's)")
+      ->check(CLI::Range(0, 1));
+  trafficSim
+      ->add_option("--detour-after", o->detourAfter,
+                   "planner steps a robot stands short of its goal before it is routed round "
+                   "robots standing in its way (0: never; default: the traffic layer's)")
+      ->check(CLI::Range(0, 100000));
+  trafficSim
+      ->add_option("--detour-penalty", o->detourPenalty,
+                   "s added to a route for entering what a standing robot excludes (default: the "
+                   "traffic layer's)")
+      ->check(CLI::Range(0.0, 1e6));
+  trafficSim
+      ->add_option("--queue-length", o->queueLength,
+                   "queue nodes generated for a station the site gives none (default: the roadmap's)")
+      ->check(CLI::Range(0, 50));
+  trafficSim
+      ->add_option(
+          "--station-lines", o->stationLines,
+          "1: robots sent to a station wait in line on its queue nodes; 0: all are planned to the dock")
+      ->check(CLI::Range(0, 1))
+      ->capture_default_str();
+  trafficSim
+      ->add_option(
+          "--admission", o->admission,
+          "1: a task is given only when its pickup and drop-off each have a free slot (a place in "
+          "their line); a robot with no admissible task waits at a parking place; 0: every task at once")
+      ->check(CLI::Range(0, 1))
+      ->capture_default_str();
+  trafficSim
+      ->add_option("--station-slots", o->stationSlots,
+                   "slots per station for admission (0: its line, the dock and its queue places)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  trafficSim->add_flag("--json", o->json, "print the results as JSON");
+  trafficSim->add_option(
+      "--html", o->html,
+      "write a replay page of the first seed's run (roadmap, robots, releases) to this file");
+  commands.push_back({trafficSim, [o] { return runTrafficSim(*o); }});
+}
+
+}  // namespace fleet::ctl
