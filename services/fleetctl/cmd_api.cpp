@@ -202,10 +202,17 @@ int listRobots(const ApiOptions&, httplib::Client& c, const httplib::Headers& h)
     return show(r);
   }
   std::printf("%-12s %8s %8s %7s %-9s %7s %s\n", "ID", "X", "Y", "THETA", "MODE", "BATTERY", "TASK");
-  for (const auto& x : json::parse(r->body)["robots"]) {
-    std::printf("%-12s %8.2f %8.2f %7.2f %-9s %6.0f%% %s\n", x.value("id", "").c_str(),
-                x["pose"].value("x", 0.0), x["pose"].value("y", 0.0), x["pose"].value("theta", 0.0),
-                x.value("mode", "").c_str(), 100.0 * x.value("battery", 0.0), x.value("task", "").c_str());
+  // The parsed body must outlive the loop (a range over a member of a temporary reads freed memory).
+  const auto body = json::parse(r->body, nullptr, false);
+  const auto robots = body.is_object() ? body.value("robots", json::array()) : json::array();
+  for (const auto& x : robots) {
+    if (!x.is_object()) {
+      continue;
+    }
+    const auto pose = x.value("pose", json::object());
+    std::printf("%-12s %8.2f %8.2f %7.2f %-9s %6.0f%% %s\n", x.value("id", "").c_str(), pose.value("x", 0.0),
+                pose.value("y", 0.0), pose.value("theta", 0.0), x.value("mode", "").c_str(),
+                100.0 * x.value("battery", 0.0), x.value("task", "").c_str());
   }
   return 0;
 }
