@@ -25,7 +25,7 @@ with the site's certificate, each agent driving its ordinal's robot; an ordinal 
 exits 2.
 Usage: kube_manifests_check.py SOURCE_DIR BUILD_DIR"""
 import base64
-import http.client
+import http.client as httpclient
 import json
 import os
 import re
@@ -377,7 +377,7 @@ with tempfile.TemporaryDirectory() as t:
         if "wms-adapter" in procs and procs["wms-adapter"][0].poll() is None:
             ctx = ssl.create_default_context(cafile=os.path.join(site_dir, "ca.pem"))
             try:
-                conn = http.client.HTTPSConnection("localhost", api_port, context=ctx, timeout=5)
+                conn = httpclient.HTTPSConnection("localhost", api_port, context=ctx, timeout=5)
                 conn.request("GET", "/v1/health")
                 status = conn.getresponse().status
                 conn.close()
