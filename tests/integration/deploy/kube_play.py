@@ -12,7 +12,7 @@ its Secret by `scripts/dds-security kube-secret`. What podman 4.3 (Debian 12)
 needs beyond the manifest is done to a copy here and nowhere else: the Secret fleet-dds's volume is
 a hostPath folder per pod holding that pod's items of the Secret, laid out by their paths as a
 Secret volume lays them out (owned by the images' user, 0400; podman 4.3 would write each `data`
-value as its base64 text and ignore `items` and `defaultMode`); the Secret's token (a placeholder
+value as its base64 text and not apply `defaultMode`); the Secret's token (a placeholder
 in the manifest) replaced by one of this run, in a form podman 4.3 writes into the file as sent; no
 `ports` (podman 4.3 would publish each on the host's 0.0.0.0); every name prefixed with this run's
 (pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose
