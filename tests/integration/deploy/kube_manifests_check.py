@@ -358,7 +358,7 @@ with tempfile.TemporaryDirectory() as t:
             for i in range(ss["spec"].get("replicas", 1)):
                 procs[f"{name}-{i}"] = start(f"{name}-{i}", name, c, {"FLEET_POD_NAME": f"{name}-{i}"},
                                              [move(a) for a in c["command"]])
-        deadline = time.time() + 30
+        deadline = time.time() + 60  # a busy machine: DDS Security's handshakes take their time
         pending = {n: ("/readyz" if n in ("fleet-manager", "traffic-manager") else "/livez") for n in procs}
         while pending and time.time() < deadline:
             for n, path in list(pending.items()):
@@ -372,17 +372,23 @@ with tempfile.TemporaryDirectory() as t:
                     del pending[n]
             time.sleep(0.2)
         for n, path in pending.items():
-            problems.append(f"{n}: {path} not 200 within 30 s")
+            problems.append(f"{n}: {path} not 200 within 60 s")
         # The API is https with the site's certificate (trusted through the site's CA), not plain http.
         if "wms-adapter" in procs and procs["wms-adapter"][0].poll() is None:
             ctx = ssl.create_default_context(cafile=os.path.join(site_dir, "ca.pem"))
-            try:
-                conn = httpclient.HTTPSConnection("localhost", api_port, context=ctx, timeout=5)
-                conn.request("GET", "/v1/health")
-                status = conn.getresponse().status
-                conn.close()
-            except (OSError, ssl.SSLError) as e:
-                status = f"no answer: {e}"
+            deadline = time.time() + 30  # the API port opens after the ops port: wait for it on a busy machine
+            while True:
+                try:
+                    conn = httpclient.HTTPSConnection("localhost", api_port, context=ctx, timeout=5)
+                    conn.request("GET", "/v1/health")
+                    status = conn.getresponse().status
+                    conn.close()
+                    break
+                except (OSError, ssl.SSLError) as e:
+                    status = f"no answer: {e}"
+                    if isinstance(e, ssl.SSLError) or time.time() > deadline:
+                        break
+                    time.sleep(0.2)
             check(status in (200, 503), f"wms-adapter: https://localhost:{api_port}/v1/health answered {status}")
             plain = answer(api_port, "/v1/health")
             check(plain is None, f"wms-adapter: plain http answered {plain}")
