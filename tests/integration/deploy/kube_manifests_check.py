@@ -9,16 +9,28 @@ ConfigMap fleet-robots by their ordinal (an entry per replica, each robot once, 
 site; no --robot in the manifest's arguments); every ConfigMap, Secret, claim and config file
 referenced exists; every DDS peer is a headless Service selecting a workload or an agent pod's name;
 a NetworkPolicy admits the ops ports from monitoring pods and the nodes only, and liveness probes
-survive a busy node; the shipped site passes `fleetctl site check`. Then the closest to running them that this machine
-offers: each Deployment's binary from BUILD_DIR, and the StatefulSet's command for each ordinal,
-started with the manifest's arguments and the ConfigMaps' and Secret's files (paths moved to a
-temporary folder, DDS on loopback), which must come up live (the fleet manager and the traffic
-manager ready), each agent driving its ordinal's robot; an ordinal without an entry exits 2.
+survive a busy node; the shipped site passes `fleetctl site check`. Secure by default: every
+container requires DDS Security (FLEET_DDS_SECURITY=required, its identity's security.xml after the
+cluster profile, FLEET_DDS_SECURITY_DIR its mount of the Secret fleet-dds, whose items rebuild the
+identity's folder from keys that `scripts/dds-security kube-secret` makes; the Secret itself not in
+the file, which would overwrite the site's), the adapter https (FLEET_WMS_TLS=required, its
+certificate and key among its items); deploy/kube/fleet.dev.yaml is what scripts/kube-dev-variant
+makes of fleet.yaml (development only: no fleet-dds, security off). Then the closest to running
+them that this machine offers: each Deployment's binary from BUILD_DIR, and the StatefulSet's
+command for each ordinal, started with the manifest's arguments and environment, the ConfigMaps'
+and Secret's files and a site made by `scripts/dds-security site`, each pod's items of fleet-dds
+laid out as its mount (paths moved to a temporary folder, DDS on loopback with Security), which
+must come up live (the fleet manager and the traffic manager ready), the adapter answering https
+with the site's certificate, each agent driving its ordinal's robot; an ordinal without an entry
+exits 2.
 Usage: kube_manifests_check.py SOURCE_DIR BUILD_DIR"""
+import base64
+import http.client as httpclient
 import json
 import os
 import re
 import socket
+import ssl
 import subprocess
 import sys
 import tempfile
@@ -34,6 +46,7 @@ binaries = {"fleet-manager": "services/fleet_manager/fleet_manager", "wms-adapte
             "risk-map": "services/risk_map/risk_map", "robot-agent": "services/robot_agent/robot_agent",
             "traffic-manager": "services/traffic_manager/traffic_manager"}
 docs = [d for d in yaml.safe_load_all(open(os.path.join(src, "deploy/kube/fleet.yaml"))) if d]
+DDS_SECRET, DDS_DIR = "fleet-dds", "/run/fleet-dds"
 version = re.search(r"project\(fleet VERSION ([0-9.]+)", open(os.path.join(src, "CMakeLists.txt")).read()).group(1)
 problems = []
 
@@ -56,6 +69,24 @@ workloads = {**deployments, **statefulsets}
 check(set(deployments) >= {"fleet-manager", "wms-adapter", "risk-map", "traffic-manager"}, f"deployments: {sorted(deployments)}")
 check(set(statefulsets) == {"robot-agent"} and "robot-agent" not in deployments,
       f"the robot agents are not the one StatefulSet robot-agent: StatefulSets {sorted(statefulsets)}")
+check(DDS_SECRET not in secrets, f"Secret {DDS_SECRET} in the file: an apply would overwrite the site's "
+      "(scripts/dds-security kube-secret makes it)")
+
+# The keys of the Secret fleet-dds as scripts/dds-security makes them, for a site of its own.
+site_tmp = tempfile.TemporaryDirectory()
+site_dir = os.path.join(site_tmp.name, "dds")
+r = subprocess.run([os.path.join(src, "scripts/dds-security"), "site", site_dir, "wms-adapter.fleet.svc"],
+                   capture_output=True, text=True, timeout=120)
+check(r.returncode == 0, f"scripts/dds-security site failed: {r.stderr[-300:]}")
+r = subprocess.run([os.path.join(src, "scripts/dds-security"), "kube-secret", site_dir], capture_output=True,
+                   text=True, timeout=60)
+check(r.returncode == 0, f"scripts/dds-security kube-secret failed: {r.stderr[-300:]}")
+dds_secret = yaml.safe_load(r.stdout) if r.returncode == 0 else {"metadata": {}, "data": {}}
+check(dds_secret["metadata"].get("name") == DDS_SECRET and dds_secret["metadata"].get("namespace") == "fleet",
+      f"scripts/dds-security kube-secret makes {dds_secret['metadata']}, not {DDS_SECRET} in namespace fleet")
+dds_files = {k: base64.b64decode(v) for k, v in dds_secret.get("data", {}).items()}
+check("ca.key" not in dds_files, "the Secret holds the site CA's key")
+dds_items = {}  # workload -> {path in the mount: key}
 
 for name, dep in workloads.items():
     spec = dep["spec"]
@@ -66,7 +97,14 @@ for name, dep in workloads.items():
     for v in vols.values():
         if "configMap" in v:
             check(v["configMap"]["name"] in configmaps, f"{name}: no ConfigMap {v['configMap']['name']}")
-        if "secret" in v:
+        if "secret" in v and v["secret"]["secretName"] == DDS_SECRET:
+            items = {i["path"]: i["key"] for i in v["secret"].get("items", [])}
+            check(items and all(k in dds_files for k in items.values()),
+                  f"{name}: items of {DDS_SECRET} that scripts/dds-security kube-secret does not make: "
+                  f"{sorted(k for k in items.values() if k not in dds_files)} (or no items: every key would be mounted)")
+            check(v["secret"].get("defaultMode") == 0o400, f"{name}: {DDS_SECRET} not mode 0400")
+            dds_items[name] = items
+        elif "secret" in v:
             check(v["secret"]["secretName"] in secrets, f"{name}: no Secret {v['secret']['secretName']}")
         if "persistentVolumeClaim" in v:
             check(v["persistentVolumeClaim"]["claimName"] in claims, f"{name}: no claim")
@@ -96,8 +134,23 @@ for name, dep in workloads.items():
         mounts = {m["mountPath"]: m for m in c.get("volumeMounts", [])}
         for m in mounts.values():
             check(m["name"] in vols, f"{where}: mount of unknown volume {m['name']}")
-        uri = env.get("CYCLONEDDS_URI", "")
-        check(uri == "file:///etc/fleet/cyclonedds.xml" and "/etc/fleet" in mounts, f"{where}: DDS config not mounted")
+        uri = env.get("CYCLONEDDS_URI", "").split(",")
+        check(uri[0] == "file:///etc/fleet/cyclonedds.xml" and "/etc/fleet" in mounts, f"{where}: DDS config not mounted")
+        # Secure by default: the identity's security.xml after the profile, its folder from fleet-dds.
+        dds = mounts.get(DDS_DIR)
+        items = dds_items.get(name, {}) if dds and vols.get(dds["name"], {}).get("secret") else {}
+        ident = uri[1][len(f"file://{DDS_DIR}/"):-len("/security.xml")] if len(uri) == 2 else ""
+        check(env.get("FLEET_DDS_SECURITY") == "required", f"{where}: FLEET_DDS_SECURITY is not required")
+        check(env.get("FLEET_DDS_SECURITY_DIR") == DDS_DIR and dds is not None and dds.get("readOnly") is True,
+              f"{where}: FLEET_DDS_SECURITY_DIR is not {DDS_DIR}, the read-only mount of {DDS_SECRET}")
+        check(ident != "" and uri[1] == f"file://{DDS_DIR}/{ident}/security.xml",
+              f"{where}: CYCLONEDDS_URI {env.get('CYCLONEDDS_URI')} names no identity's security.xml")
+        need = ["ca.pem", "crl.pem", "governance.p7s"] + [f"{ident}/{f}" for f in
+                                                           ("security.xml", "cert.pem", "key.pem", "permissions.p7s")]
+        check(all(items.get(p) == p.replace("/", ".") for p in need),
+              f"{where}: the items of {DDS_SECRET} do not rebuild {need} (identity {ident})")
+        check(not [k for k in items.values() if k.endswith(".key.pem") and not k.startswith((ident + ".", "https."))],
+              f"{where}: mounts another identity's key")
         args = c.get("args", [])
         for flag in ("--config", "--site"):
             if flag in args:
@@ -116,6 +169,14 @@ for name, dep in workloads.items():
             tm = json.loads(configmaps["fleet-config"]["data"].get(os.path.basename(cfg), "{}"))
             check(tm.get("site") == "/etc/fleet/site.json", f"traffic-manager: {cfg} names site {tm.get('site')}, "
                   "not the ConfigMap's site.json")
+        if name == "wms-adapter":
+            check(env.get("FLEET_WMS_TLS") == "required", "wms-adapter: FLEET_WMS_TLS is not required")
+            cfg = args[args.index("--config") + 1] if "--config" in args else ""
+            h = json.loads(configmaps["fleet-config"]["data"].get(os.path.basename(cfg), "{}")).get("http", {})
+            for key in ("tls_certificate", "tls_key"):
+                f = h.get(key, "")
+                check(f.startswith(DDS_DIR + "/") and f[len(DDS_DIR) + 1:] in items,
+                      f"wms-adapter: http.{key} {f!r} is not an item of its {DDS_SECRET} mount")
 
 # The robot agents: one StatefulSet; pod robot-agent-N runs the robots of fleet-robots' agent-N.
 agents = statefulsets.get("robot-agent")
@@ -206,6 +267,14 @@ for key, text in configmaps["fleet-config"]["data"].items():
             json.loads(text)
         except ValueError as e:
             problems.append(f"ConfigMap {key}: {e}")
+# The development variant: what scripts/kube-dev-variant makes of this file, no security in it.
+r = subprocess.run([sys.executable, os.path.join(src, "scripts/kube-dev-variant"), "--check"], capture_output=True,
+                   text=True, timeout=60)
+check(r.returncode == 0, f"deploy/kube/fleet.dev.yaml: {r.stdout.strip()} {r.stderr.strip()[-300:]}")
+dev_text = open(os.path.join(src, "deploy/kube/fleet.dev.yaml")).read()
+dev_body = json.dumps([d for d in yaml.safe_load_all(dev_text) if d])  # without the comments
+check(dev_text.startswith("# DEVELOPMENT ONLY") and DDS_SECRET not in dev_body and "required" not in dev_body
+      and DDS_DIR not in dev_body, "deploy/kube/fleet.dev.yaml: not marked development-only, or security still in it")
 with tempfile.TemporaryDirectory() as t:
     path = os.path.join(t, "site.json")
     open(path, "w").write(configmaps["fleet-config"]["data"]["site.json"])
@@ -236,7 +305,16 @@ with tempfile.TemporaryDirectory() as t:
         os.makedirs(d)
     robots_dir = os.path.join(t, "robots")
     os.makedirs(robots_dir)
+    # Each workload's mount of fleet-dds: its items of the Secret of the site made above.
+    dds_root = os.path.join(t, "dds")
+    for name, items in dds_items.items():
+        for path, key in items.items():
+            f = os.path.join(dds_root, name, path)
+            os.makedirs(os.path.dirname(f), exist_ok=True)
+            with open(os.open(f, os.O_WRONLY | os.O_CREAT, 0o400), "wb") as out:
+                out.write(dds_files.get(key, b""))
     move = lambda text: (text.replace("/etc/fleet-robots", robots_dir).replace("/etc/fleet", etc)
+                         .replace(DDS_DIR, os.path.join(dds_root, "wms-adapter"))
                          .replace("/var/lib/fleet", var).replace("/run/secrets/fleet", run)
                          .replace("/usr/local/bin/robot_agent", os.path.join(build, binaries["robot-agent"])))
     for key, text in configmaps["fleet-config"]["data"].items():
@@ -248,12 +326,17 @@ with tempfile.TemporaryDirectory() as t:
     domain = str(210 + os.getpid() % 19)  # 210..228: away from the tests. 10..209
     procs = {}
 
-    def start(name, c, env, command):
+    def start(name, workload, c, env, command):
         """One pod's container as a process: its env and arguments with the paths moved."""
         env = {e["name"]: e["value"] for e in c.get("env", []) if "value" in e} | env
         port = free_port()
         env.update(FLEET_METRICS_PORT=str(port), FLEET_METRICS_HOST="127.0.0.1", FLEET_DDS_DOMAIN=domain)
-        env.pop("CYCLONEDDS_URI")  # loopback here; the cluster profile names the Services
+        # Loopback here (the cluster profile names the Services), with the pod's identity after it.
+        mount = os.path.join(dds_root, workload)
+        uri = env["CYCLONEDDS_URI"].split(",")
+        env["CYCLONEDDS_URI"] = ",".join([f"file://{src}/deploy/cyclonedds-local.xml"] +
+                                         [u.replace(DDS_DIR, mount) for u in uri[1:]])
+        env["FLEET_DDS_SECURITY_DIR"] = mount
         log = open(os.path.join(t, f"{name}.log"), "w+")
         proc = subprocess.Popen(command + [move(a) for a in c.get("args", [])], env={**os.environ, **env},
                                 stdout=log, stderr=subprocess.STDOUT, text=True)
@@ -265,16 +348,17 @@ with tempfile.TemporaryDirectory() as t:
             if name == "wms-adapter":  # the API port too: 8080 may be taken on this machine
                 cfg = os.path.join(etc, "wms_adapter.json")
                 j = json.load(open(cfg))
-                j["http"].update(host="127.0.0.1", port=free_port())
+                api_port = free_port()
+                j["http"].update(host="127.0.0.1", port=api_port)
                 json.dump(j, open(cfg, "w"))
-            procs[name] = start(name, c, {}, [os.path.join(build, binaries[name])])
+            procs[name] = start(name, name, c, {}, [os.path.join(build, binaries[name])])
         # The StatefulSet's pods: its command (the ordinal picks the robots) as a pod of that name runs it.
         for name, ss in statefulsets.items():
             c = ss["spec"]["template"]["spec"]["containers"][0]
             for i in range(ss["spec"].get("replicas", 1)):
-                procs[f"{name}-{i}"] = start(f"{name}-{i}", c, {"FLEET_POD_NAME": f"{name}-{i}"},
+                procs[f"{name}-{i}"] = start(f"{name}-{i}", name, c, {"FLEET_POD_NAME": f"{name}-{i}"},
                                              [move(a) for a in c["command"]])
-        deadline = time.time() + 30
+        deadline = time.time() + 60  # a busy machine: DDS Security's handshakes take their time
         pending = {n: ("/readyz" if n in ("fleet-manager", "traffic-manager") else "/livez") for n in procs}
         while pending and time.time() < deadline:
             for n, path in list(pending.items()):
@@ -288,12 +372,32 @@ with tempfile.TemporaryDirectory() as t:
                     del pending[n]
             time.sleep(0.2)
         for n, path in pending.items():
-            problems.append(f"{n}: {path} not 200 within 30 s")
+            problems.append(f"{n}: {path} not 200 within 60 s")
+        # The API is https with the site's certificate (trusted through the site's CA), not plain http.
+        if "wms-adapter" in procs and procs["wms-adapter"][0].poll() is None:
+            ctx = ssl.create_default_context(cafile=os.path.join(site_dir, "ca.pem"))
+            deadline = time.time() + 30  # the API port opens after the ops port: wait for it on a busy machine
+            while True:
+                try:
+                    conn = httpclient.HTTPSConnection("localhost", api_port, context=ctx, timeout=5)
+                    conn.request("GET", "/v1/health")
+                    status = conn.getresponse().status
+                    conn.close()
+                    break
+                except (OSError, ssl.SSLError) as e:
+                    status = f"no answer: {e}"
+                    if isinstance(e, ssl.SSLError) or time.time() > deadline:
+                        break
+                    time.sleep(0.2)
+            check(status in (200, 503), f"wms-adapter: https://localhost:{api_port}/v1/health answered {status}")
+            plain = answer(api_port, "/v1/health")
+            check(plain is None, f"wms-adapter: plain http answered {plain}")
+            print(f"wms-adapter: https with the site's certificate ({status}), plain http refused")
         # A pod whose ordinal has no entry (replicas raised without one) says so and exits 2.
         for name, ss in statefulsets.items():
             c = ss["spec"]["template"]["spec"]["containers"][0]
             extra = f"{name}-{ss['spec'].get('replicas', 1)}"
-            proc, _, log = start(extra, c, {"FLEET_POD_NAME": extra}, [move(a) for a in c["command"]])
+            proc, _, log = start(extra, name, c, {"FLEET_POD_NAME": extra}, [move(a) for a in c["command"]])
             try:
                 proc.wait(timeout=20)
             except subprocess.TimeoutExpired:

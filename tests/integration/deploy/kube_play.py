@@ -1,12 +1,18 @@
 #!/usr/bin/env python3
-"""deploy/kube/fleet.yaml under `podman kube play`, the closest to a cluster that runs here.
+"""deploy/kube/fleet.yaml under `podman kube play`, the closest to a cluster that runs here, in its
+secure default: DDS Security (each pod its identity of the Secret fleet-dds) and https on the API.
 
 Each Deployment is played as its own pod on a DNS-enabled podman network made for this run, with the
 name of the headless Service that selects it as the pod's network alias, so the DDS peers of the
 ConfigMap's cyclonedds.xml resolve as in a cluster. podman 4.3 cannot play a StatefulSet: each of its
 replicas is played as the Pod the StatefulSet controller would make (name <set>-<ordinal>, its
-template, the aliases <set>-<ordinal>.<serviceName> and <serviceName>). What podman 4.3 (Debian 12)
-needs beyond the manifest is done to a copy here and nowhere else: the Secret's token (a placeholder
+template, the aliases <set>-<ordinal>.<serviceName> and <serviceName>). The operator's step is done
+here too: a site made by `scripts/dds-security site` (the adapter's certificate for wms-adapter) and
+its Secret by `scripts/dds-security kube-secret`. What podman 4.3 (Debian 12)
+needs beyond the manifest is done to a copy here and nowhere else: the Secret fleet-dds's volume is
+a hostPath folder per pod holding that pod's items of the Secret, laid out by their paths as a
+Secret volume lays them out (owned by the images' user, 0400; podman 4.3 would write each `data`
+value as its base64 text and not apply `defaultMode`); the Secret's token (a placeholder
 in the manifest) replaced by one of this run, in a form podman 4.3 writes into the file as sent; no
 `ports` (podman 4.3 would publish each on the host's 0.0.0.0); every name prefixed with this run's
 (pods, volumes and secrets are global in podman); and RES_OPTIONS=no-tld-query, so that a peer whose
@@ -15,18 +21,25 @@ manifests have no simulator (robots bring their sensors); a simulator pod, added
 the robot agents their sensors: the robots of the ConfigMap fleet-robots, at their stations.
 
 Asserts: every pod and container runs; every service is live, and ready (the WMS adapter's readiness
-needs the fleet manager over DDS between the pods); the API refuses a request without the Secret's
-token and accepts one with it; a posted task is stored, assigned to one of fleet-robots' robots and
+needs the fleet manager over DDS between the pods); the API answers https with the site's
+certificate (trusted through the site's CA, for the name wms-adapter) and not plain http; it refuses
+a request without the Secret's token and accepts one with it; a container on the pods' network
+without a certificate, writing Tasks onto the domain past the API, gets none to the fleet manager
+(the check of compose_fleet_secure); a posted task is stored, assigned to one of fleet-robots' robots and
 reaches `done` on the wall clock (DDS from adapter to manager to robot agent and back, the robot
 driving the traffic manager's releases, which must have been sent); each agent pod drove its
 ordinal's robots. Exit 77 (ctest skip) only when podman cannot run containers here.
 Usage: kube_play.py SOURCE_DIR BUILD_DIR"""
+import base64
 import copy
+import http.client as httpclient
 import json
 import os
 import re
 import secrets
 import shutil
+import socket
+import ssl
 import subprocess
 import sys
 import tempfile
@@ -73,6 +86,10 @@ if r.returncode != 0:
     print("SKIP: podman cannot start a container here:", r.stderr.strip()[-300:])
     sys.exit(77)
 print(f"images built after {time.time() - t0:.0f} s")
+probe = os.path.join(build, "tests/integration/security/dds_probe")
+if not os.access(probe, os.X_OK):
+    fail(f"{probe} is not built")
+DDS_SECRET, DDS_DIR, USER = "fleet-dds", "/run/fleet-dds", 65532
 
 
 def remove_run(prefix):
@@ -125,6 +142,10 @@ def part_for(dep):
     dep["metadata"]["name"] = renamed(dep["metadata"]["name"])
     pod = dep["spec"]["template"]["spec"] if dep["kind"] != "Pod" else dep["spec"]
     for v in pod.get("volumes", []):
+        if v.get("secret", {}).get("secretName") == DDS_SECRET:
+            items = v.pop("secret").get("items")
+            v["hostPath"] = {"path": dds_folder(dep["metadata"]["name"], items), "type": "Directory"}
+            continue
         if "configMap" in v:
             v["configMap"]["name"] = renamed(v["configMap"]["name"])
         if "secret" in v:
@@ -142,6 +163,22 @@ def part_for(dep):
             if g and g.get("port") in ports:
                 g["port"] = ports[g["port"]]
     return out + [dep]
+
+
+def dds_folder(name, items):
+    """The folder a Secret volume of fleet-dds with these items would be: each item's key of the
+    site's Secret at its path, owned by the images' user, 0400 (every key when no items)."""
+    folder = os.path.join(tmp, "dds-" + name)
+    for item in items or [{"key": k, "path": k} for k in dds_data]:
+        f = os.path.join(folder, item["path"])
+        os.makedirs(os.path.dirname(f), exist_ok=True)
+        with open(os.open(f, os.O_WRONLY | os.O_CREAT, 0o400), "wb") as out:
+            out.write(base64.b64decode(dds_data[item["key"]]))
+    for root, dirs, files in os.walk(folder):
+        for n in dirs + files:
+            os.chown(os.path.join(root, n), USER, USER)
+    os.chmod(folder, 0o755)
+    return folder
 
 
 def aliases_of(dep):
@@ -167,24 +204,63 @@ def pod_ip(pod):
     return podman("inspect", "--format", f'{{{{(index .NetworkSettings.Networks "{net}").IPAddress}}}}', infra)
 
 
+class SiteHttps(httpclient.HTTPSConnection):
+    """https to a pod's address, the certificate checked against the site's CA for the name of the
+    adapter's Service (wms-adapter), as a client in the cluster checks it."""
+
+    def connect(self):
+        sock = socket.create_connection((self.host, self.port), self.timeout)
+        self.sock = self._context.wrap_socket(sock, server_hostname="wms-adapter")
+
+
 def http(url, token=None, body=None):
-    req = urllib.request.Request(url, data=None if body is None else json.dumps(body).encode(),
-                                 headers={"Content-Type": "application/json"})
+    """(status, JSON body) of a request to https://ADDRESS:PORT/PATH; (None, None) without an answer."""
+    hostport, path = url.split("://", 1)[1].split("/", 1)
+    host, port = hostport.rsplit(":", 1)
+    headers = {"Content-Type": "application/json"}
     if token:
-        req.add_header("Authorization", f"Bearer {token}")
+        headers["Authorization"] = f"Bearer {token}"
     try:
-        with urllib.request.urlopen(req, timeout=5) as r:
-            return r.status, json.loads(r.read() or b"null")
-    except urllib.error.HTTPError as e:
-        return e.code, None
-    except OSError:
+        conn = SiteHttps(host, int(port), timeout=5, context=site_tls)
+        conn.request("POST" if body is not None else "GET", "/" + path,
+                     None if body is None else json.dumps(body), headers)
+        r = conn.getresponse()
+        text = r.read()
+        conn.close()
+        return r.status, json.loads(text or b"null") if r.status < 400 else None
+    except (OSError, ssl.SSLError, httpclient.HTTPException, ValueError):
         return None, None
 
 
+def plain_http(url):
+    """The status of a plain-http GET; None when no http answer comes."""
+    try:
+        with urllib.request.urlopen(url, timeout=5) as r:
+            return r.status
+    except urllib.error.HTTPError as e:
+        return e.code
+    except (OSError, httpclient.HTTPException):
+        return None
+
+
 tmp = tempfile.mkdtemp(prefix="fleet-kube-play.")
+os.chmod(tmp, 0o755)
 pods = []
 ok = False
+rogue = None
 try:
+    # The operator's step: the site's files and its Secret fleet-dds.
+    site = os.path.join(tmp, "site-dds")
+    r = subprocess.run([f"{src}/scripts/dds-security", "site", site, "wms-adapter.fleet.svc"], capture_output=True,
+                       text=True, timeout=120)
+    if r.returncode != 0:
+        fail(f"scripts/dds-security site: {r.stderr.strip()[-400:]}")
+    r = subprocess.run([f"{src}/scripts/dds-security", "kube-secret", site], capture_output=True, text=True, timeout=60)
+    if r.returncode != 0:
+        fail(f"scripts/dds-security kube-secret: {r.stderr.strip()[-400:]}")
+    dds_data = yaml.safe_load(r.stdout)["data"]
+    site_tls = ssl.create_default_context(cafile=os.path.join(site, "ca.pem"))
+    print(f"site CA, identities and the Secret {DDS_SECRET} ({len(dds_data)} keys) made after {time.time() - t0:.0f} s")
     podman("network", "create", net)
     if podman("network", "inspect", "--format", "{{.DNSEnabled}}", net) != "true":
         fail(f"network {net} has no DNS: the Services' names do not resolve (podman's CNI backend needs "
@@ -216,18 +292,24 @@ try:
         open(os.path.join(simdir, key), "w").write(configmap[key])
     json.dump({"name": "kube-play", "seed": 1, "dt": 0.1, "clock": "wall", "site": "site.json",
                "robots": robots, "humans": {"count": 0}}, open(os.path.join(simdir, "scenario.json"), "w"))
-    os.chmod(tmp, 0o755)
+    sim_dds = dds_folder("sim", [{"key": k, "path": k.replace(".", "/", 1) if k.startswith("simulator.") else k}
+                                 for k in ("ca.pem", "crl.pem", "governance.p7s", "simulator.security.xml",
+                                           "simulator.cert.pem", "simulator.key.pem", "simulator.permissions.p7s")])
     image = agent["spec"]["template"]["spec"]["containers"][0]["image"].replace("fleet-robot-agent", "fleet-fleet-sim")
     sim = {"apiVersion": "v1", "kind": "Pod", "metadata": {"name": renamed("sim")},
            "spec": {"restartPolicy": "Never",
-                    "volumes": [{"name": "sim", "hostPath": {"path": simdir, "type": "Directory"}}],
+                    "volumes": [{"name": "sim", "hostPath": {"path": simdir, "type": "Directory"}},
+                                {"name": "dds", "hostPath": {"path": sim_dds, "type": "Directory"}}],
                     "containers": [{"name": "fleet-sim", "image": image,
                                     "args": ["--scenario", "/etc/sim/scenario.json", "--clock", "wall",
                                              "--duration", "300", "--log-level", "info"],
-                                    "env": [{"name": "CYCLONEDDS_URI", "value": "file:///etc/sim/cyclonedds.xml"},
+                                    "env": [{"name": "CYCLONEDDS_URI", "value": "file:///etc/sim/cyclonedds.xml,"
+                                             f"file://{DDS_DIR}/simulator/security.xml"},
+                                            {"name": "FLEET_DDS_SECURITY_DIR", "value": DDS_DIR},
                                             {"name": "FLEET_DDS_DOMAIN", "value": "0"},
                                             {"name": "RES_OPTIONS", "value": "no-tld-query"}],
-                                    "volumeMounts": [{"name": "sim", "mountPath": "/etc/sim", "readOnly": True}]}]}}
+                                    "volumeMounts": [{"name": "sim", "mountPath": "/etc/sim", "readOnly": True},
+                                                     {"name": "dds", "mountPath": DDS_DIR, "readOnly": True}]}]}}
     yaml.safe_dump(sim, open(os.path.join(tmp, "sim.yaml"), "w"))
     podman("kube", "play", "--network", net, os.path.join(tmp, "sim.yaml"))
     pods.append((renamed("sim"), ["fleet-sim"]))
@@ -252,7 +334,14 @@ try:
     print(f"every service live and ready after {time.time() - t0:.0f} s")
 
     adapter = next(p for p, cs in pods if "wms-adapter" in cs)
-    base = f"http://{pod_ip(adapter)}:8080"
+    base = f"https://{pod_ip(adapter)}:8080"
+    status, _ = http(f"{base}/v1/health")
+    if status not in (200, 503):
+        fail(f"GET {base}/v1/health with the site's CA answered {status}")
+    plain = plain_http(base.replace("https://", "http://") + "/v1/health")
+    if plain is not None:
+        fail(f"the API answered plain http ({plain}): not https only")
+    print(f"the API answers https with the site's certificate for wms-adapter ({status}), not plain http")
     stored = subprocess.run(["podman", "exec", f"{adapter}-wms-adapter", "cat", "/run/secrets/fleet/wms-token"],
                             capture_output=True, text=True).stdout
     if stored != token:
@@ -268,6 +357,14 @@ try:
                                                     "unload_duration_ns": 1000000000})
     if status != 201:
         fail(f"POST /v1/tasks with the Secret's token answered {status} {body}")
+    # Meanwhile a container on the pods' network without a certificate writes Tasks rogue-<n> onto
+    # the domain (the ConfigMap's DDS profile, no identity): none may reach the manager.
+    rogue = subprocess.Popen(["podman", "run", "--rm", "--name", renamed("rogue"), "--network", net, "--user", str(USER),
+                              "-e", "FLEET_DDS_DOMAIN=0", "-e", "RES_OPTIONS=no-tld-query",
+                              "-e", "CYCLONEDDS_URI=file:///etc/sim/cyclonedds.xml", "-v", f"{simdir}:/etc/sim:ro",
+                              "-v", f"{probe}:/usr/local/bin/dds_probe:ro", "--entrypoint", "/usr/local/bin/dds_probe",
+                              image.replace("fleet-fleet-sim", "fleet-fleet-manager"), "write", "4", "rogue"],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     # The wall clock, as deployed: the robot drives some 45 m (about 60 s).
     robot, state, seen = None, None, []
     deadline = time.time() + 180
@@ -283,6 +380,11 @@ try:
     print(f"task kube-1: {' -> '.join(map(str, seen))} by {robot} after {time.time() - t0:.0f} s")
     if state != "done" or robot not in [r["id"] for r in robots]:
         fail(f"the task did not reach done with a robot of fleet-robots (state {state}, robot {robot})")
+    out = [line for line in rogue.communicate(timeout=60)[0].strip().splitlines() if not line.startswith("time=")]
+    status, _ = http(f"{base}/v1/tasks/rogue-0", token)
+    if status != 404:
+        fail(f"a Task written by a container without a certificate reached the manager (GET rogue-0: {status})")
+    print(f"uncertified container: exit {rogue.returncode} {out[-1] if out else ''}; no Task of it reached the manager")
     traffic = next(p for p, cs in pods if "traffic-manager" in cs)
     metrics = podman("exec", f"{traffic}-traffic-manager", "/usr/local/bin/fleet-probe", "/metrics")
     releases = next((float(line.split()[1]) for line in metrics.splitlines()
@@ -301,12 +403,16 @@ try:
             fail(f"{c} does not drive {', '.join(ids)} (fleet-robots {key}): {text[-300:]}")
         print(f"{c}: drives {', '.join(ids)}")
     ok = True
-    print(f"PASS: podman kube play of deploy/kube/fleet.yaml in {time.time() - t0:.0f} s")
+    print(f"PASS: podman kube play of deploy/kube/fleet.yaml, DDS Security and https on (the secure default), "
+          f"in {time.time() - t0:.0f} s")
 finally:
     if not ok:
         for pod, containers in pods:
             for c in containers:
                 print(f"--- log of {pod}-{c}")
                 print(logs(f"{pod}-{c}", 15))
+    if rogue is not None and rogue.poll() is None:
+        podman("rm", "-f", "-t", "1", renamed("rogue"), check=False)
+        rogue.wait()
     remove_run(run_id)
     shutil.rmtree(tmp, ignore_errors=True)
