@@ -13,6 +13,7 @@
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/service/task_wire.hpp"
+#include "robot_time.hpp"
 #include "web_files.hpp"
 
 namespace fleet::wms {
@@ -82,6 +83,7 @@ json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people) {
           {"v", r.v},
           {"w", r.w},
           {"mode", msg::toString(r.mode)},
+          {"activity", toString(RobotTimeLedger::activityOf(r))},
           {"fault", r.mode == msg::RobotMode::Fault},
           {"paused", r.paused},
           {"battery", r.battery},
@@ -91,6 +93,25 @@ json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people) {
           {"stamp_ns", r.stamp_ns},
           {"people_seen", seen},
           {"people_seen_stamp_ns", people != nullptr ? json(people->stamp_ns) : json()}};
+}
+
+json robotTimeJson(const RobotTimeLedger& ledger) {
+  auto shares = [](const ActivityLedger& l) {
+    json seconds = json::object();
+    json share = json::object();
+    for (const auto a : kLedgerActivities) {
+      seconds[toString(a)] = l.seconds(a);
+      share[toString(a)] = l.share(a);
+    }
+    return json{{"seconds", l.total()}, {"by_activity_s", seconds}, {"shares", share}};
+  };
+  json robots = json::array();
+  for (const auto& [id, l] : ledger.robots()) {
+    json r = shares(l);
+    r["id"] = id;
+    robots.push_back(std::move(r));
+  }
+  return {{"fleet", shares(ledger.fleet())}, {"robots", robots}};
 }
 
 json proximityJson(const FleetView::Proximity& p) {

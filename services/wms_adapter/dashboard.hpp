@@ -29,6 +29,8 @@ nlohmann::json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people
 
 /// Contacts and near misses as /v1/metrics and the stream's `proximity` event show them.
 nlohmann::json proximityJson(const FleetView::Proximity& p);
+/// GET /v1/fleet/robot-time: the fleet's ledger and each robot's, seconds and shares per category.
+nlohmann::json robotTimeJson(const RobotTimeLedger& ledger);
 
 /// A risk map for the page: grid, K and the level runs flattened ([level, count, level, count, ...],
 /// row-major from the origin); null for a map too large to send (over 500,000 runs).

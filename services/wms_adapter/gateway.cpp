@@ -96,6 +96,12 @@ void FleetView::onStored(const msg::TaskAck& a, std::int64_t nowNs) {
 void FleetView::onRobot(const msg::RobotState& s) {
   std::lock_guard lock(m_);
   robots_[s.robot_id] = s;
+  robotTime_.onState(s);
+}
+
+RobotTimeLedger FleetView::robotTime() const {
+  std::lock_guard lock(m_);
+  return robotTime_;
 }
 
 bool FleetView::onPeopleSeen(msg::PeopleSeen p, std::int64_t receivedNs) {

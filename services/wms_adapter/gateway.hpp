@@ -18,6 +18,7 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
 #include "proximity_counter.hpp"
+#include "robot_time.hpp"
 
 namespace fleet::wms {
 
@@ -119,6 +120,8 @@ class FleetView {
   [[nodiscard]] std::optional<TaskView> task(const std::string& id) const;
   [[nodiscard]] std::vector<TaskView> tasks(std::optional<msg::TaskState> state, std::size_t limit) const;
   [[nodiscard]] std::vector<msg::RobotState> robots() const;
+  /// Where the robots' time went since the view started (robot_time.hpp): per robot and the fleet's.
+  [[nodiscard]] RobotTimeLedger robotTime() const;
   /// The latest risk map and a count that grows with every new one (0, nullptr: none yet).
   [[nodiscard]] std::pair<std::uint64_t, std::shared_ptr<const msg::RiskMap>> risk() const;
   /// The latest roadmap and a count that grows with every new one (0, nullptr: none yet).
@@ -141,6 +144,7 @@ class FleetView {
   std::map<std::string, TaskView> tasks_;
   std::deque<std::string> insertion_;
   std::map<std::string, msg::RobotState> robots_;
+  RobotTimeLedger robotTime_;
   struct Seen {
     msg::PeopleSeen people;
     std::int64_t receivedNs = 0;

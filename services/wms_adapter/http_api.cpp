@@ -357,6 +357,8 @@ void HttpApi::routes() {
     }
     reply(res, 200, {{"robots", items}, {"count", items.size()}});
   });
+  server_.route("GET", "/v1/fleet/robot-time", Scope::Read,
+                [this](const Request&, Response& res) { reply(res, 200, robotTimeJson(view_.robotTime())); });
   // Health tells nothing secret and a probe carries no token: public, and answered on the I/O
   // thread so that busy workers never make the adapter look dead.
   server_.route(

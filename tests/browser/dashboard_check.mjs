@@ -171,6 +171,17 @@ try {
   check(gated.submit[0] && gated.submit[1].includes('"submit"'), `nor the task form (${gated.submit[1]})`);
   check(gated.cancels === 0, 'nor cancelling tasks');
   check(gated.note.includes('"viewer"') && gated.who.startsWith('viewer'), `and is told why: ${gated.note}`);
+  // The robot-time card: the fleet's ledger as a stacked bar whose parts add up to the whole.
+  await until('the robot-time bar is drawn', () => page.evaluate(() =>
+    document.querySelectorAll('#robot-time-bar span').length > 0), 15000);
+  const bar = await page.evaluate(() => ({
+    parts: [...document.querySelectorAll('#robot-time-bar span')].map((e) => parseFloat(e.style.width)),
+    keys: document.querySelectorAll('#robot-time-keys li').length,
+    total: document.getElementById('robot-time-total').textContent,
+  }));
+  const whole = bar.parts.reduce((a, b) => a + b, 0);
+  check(Math.abs(whole - 100) < 0.5 && bar.keys === 9 && /robot/.test(bar.total),
+        `the robot-time bar adds up (${whole.toFixed(1)} %, ${bar.keys} categories, ${bar.total})`);
   await shot('1b-read-only.png');
   await page.click('#logout');
   await page.waitForSelector('#login[open]', { timeout: 10000 });

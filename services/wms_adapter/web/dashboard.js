@@ -5,11 +5,13 @@ import { Api, ApiError, STREAM_EVENTS } from './api.js';
 import { FleetModel } from './fleet_model.js';
 import { LAYERS, MapView, MODE_COLOURS, robotColour } from './map_view.js';
 import { Panels } from './panels.js';
+import { RobotTimeCard } from './robot_time.js';
 
 const api = new Api();
 const model = new FleetModel();
 const view = new MapView(document.getElementById('map'));
 const panels = new Panels(model, view, { act, confirmThen });
+const robotTime = new RobotTimeCard(api);
 let closeStream = null;
 let lastDrawVersion = -1;
 let lastDrawAt = 0;
@@ -156,6 +158,7 @@ async function start() {
     document.getElementById('who').textContent =
       session.auth === 'off' ? 'no login (authentication off)' : `${session.name} · ${session.scopes.join(', ')}`;
     panels.setScopes(session.name, session.scopes);
+    robotTime.start();
   } catch (e) {
     if (e.status === 401) {
       showLogin('');

@@ -38,7 +38,7 @@ std::string templateOfSpecPath(const std::string& path) {
 }
 
 const std::string kRobot = R"({"id": "r1", "pose": {"x": 1, "y": 2, "theta": 0}, "heading_deg": 0, "v": 0,
-  "w": 0, "mode": "idle", "fault": false, "paused": false, "battery": 0.5, "task": "", "radius": 0.3,
+  "w": 0, "mode": "idle", "activity": "no_task", "fault": false, "paused": false, "battery": 0.5, "task": "", "radius": 0.3,
   "position_sigma": 0.01, "stamp_ns": 5, "people_seen": [], "people_seen_stamp_ns": null})";
 
 class ApiContract : public Api {};

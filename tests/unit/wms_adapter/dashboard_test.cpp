@@ -676,3 +676,69 @@ TEST_F(Dash, ContactsAndNearMissesAreCountedFromTheReportsAndShownInMetricsAndTh
   ASSERT_FALSE(events.empty()) << "sent with the snapshot";
   EXPECT_EQ(events[0]["robot_person"]["contacts"], 1);
 }
+
+// The live robot-time ledger: each robot's state samples file the time between them under the
+// activity the robot was in; GET /v1/fleet/robot-time answers it (checked against the spec).
+TEST_F(Dash, TheRobotTimeLedgerFilesTheTimeBetweenStatesUnderTheEarlierActivity) {
+  start("secret");
+  auto r1 = robot("r1", 1.0, 1.0, 1);
+  r1.activity = fleet::RobotActivity::Driving;
+  r1.stamp_ns = 10'000'000'000;
+  view_.onRobot(r1);
+  r1.stamp_ns += 1'500'000'000;  // 1.5 s driving
+  r1.activity = fleet::RobotActivity::WaitingOnRobot;
+  view_.onRobot(r1);
+  r1.stamp_ns += 500'000'000;  // 0.5 s waiting
+  r1.activity = fleet::RobotActivity::Dwelling;
+  view_.onRobot(r1);
+  r1.stamp_ns += 60'000'000'000;  // silent for a minute: not filed
+  view_.onRobot(r1);
+  auto res = client_->Get("/v1/fleet/robot-time", {{"Authorization", "Bearer secret"}});
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200) << res->body;
+  const auto body = json::parse(res->body);
+  const json* mine = nullptr;
+  for (const auto& r : body["robots"]) {
+    if (r["id"] == "r1") {
+      mine = &r;
+    }
+  }
+  ASSERT_NE(mine, nullptr) << body.dump();
+  EXPECT_NEAR((*mine)["seconds"].get<double>(), 2.0, 1e-9);
+  EXPECT_NEAR((*mine)["by_activity_s"]["driving"].get<double>(), 1.5, 1e-9);
+  EXPECT_NEAR((*mine)["shares"]["waiting_on_robot"].get<double>(), 0.25, 1e-9);
+  EXPECT_NEAR((*mine)["by_activity_s"]["dwelling"].get<double>(), 0.0, 1e-9);
+  double sum = 0.0;
+  for (const auto& [k, v] : (*mine)["shares"].items()) {
+    sum += v.get<double>();
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-9);  // the shares add up
+  EXPECT_GE(body["fleet"]["seconds"].get<double>(), 2.0);
+  // A robot's own state says what it is doing now.
+  auto one = client_->Get("/v1/robots/r1", {{"Authorization", "Bearer secret"}});
+  ASSERT_TRUE(one && one->status == 200);
+  EXPECT_EQ(json::parse(one->body)["activity"], "dwelling");
+  // Without a token: refused, as every read route.
+  EXPECT_EQ(client_->Get("/v1/fleet/robot-time")->status, 401);
+}
+
+// An agent that does not say its activity is read by its mode and task.
+TEST(RobotTimeLedger, AnUnsetActivityIsReadFromTheModeAndANewerSampleOnly) {
+  fleet::wms::RobotTimeLedger l;
+  msg::RobotState s;
+  s.robot_id = "a";
+  s.mode = msg::RobotMode::Moving;
+  s.task_id = "t1";
+  s.stamp_ns = 1'000'000'000;
+  EXPECT_EQ(fleet::wms::RobotTimeLedger::activityOf(s), fleet::RobotActivity::Driving);
+  l.onState(s);
+  s.stamp_ns = 500'000'000;  // older (delivered late): nothing filed, nothing changed
+  l.onState(s);
+  s.stamp_ns = 2'000'000'000;
+  s.mode = msg::RobotMode::Idle;
+  s.task_id.clear();
+  l.onState(s);
+  EXPECT_NEAR(l.robots().at("a").seconds(fleet::RobotActivity::Driving), 1.0, 1e-9);
+  EXPECT_EQ(fleet::wms::RobotTimeLedger::activityOf(s), fleet::RobotActivity::NoTask);
+  EXPECT_NEAR(l.fleet().total(), 1.0, 1e-9);
+}
