@@ -77,6 +77,10 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
                    "slots per station for admission (0: its line, the dock and its queue places)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  trafficSim
+      ->add_option("--stations", o->stations,
+                   "tasks only between these pickups and drop-offs, comma-separated names (default: all)")
+      ->delimiter(',');
   trafficSim->add_flag("--json", o->json, "print the results as JSON");
   trafficSim->add_option(
       "--html", o->html,

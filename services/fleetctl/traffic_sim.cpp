@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -109,6 +110,16 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.stationLines = o.stationLines != 0;
     v.admission = o.admission != 0;
     v.stationCap = static_cast<std::size_t>(o.stationSlots);
+    v.stations = o.stations;
+    for (const auto& name : o.stations) {
+      const auto* st = roadmap.station(name);
+      if (st == nullptr ||
+          (st->kind != site::StationKind::Pickup && st->kind != site::StationKind::Dropoff)) {
+        std::cerr << "fleetctl traffic-sim: --stations: '" << name << "' is no pickup or drop-off of "
+                  << o.site << "\n";
+        return 2;
+      }
+    }
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
     if (o.letPass >= 0)
@@ -145,10 +156,19 @@ int runTrafficSim(const TrafficSimOptions& o) {
     }
     const nlohmann::json bound = virtualFleetBound(*site, roadmap, r, v.dwell);
     const nlohmann::json robotTime = robotTimeJson(r);
+    nlohmann::json stations = nlohmann::json::array();
+    for (const auto& st : r.stations) {
+      stations.push_back({{"name", st.name},
+                          {"visits", st.visits},
+                          {"dock_cycles", st.cycles},
+                          {"dock_cycle_p50_s", st.cycleP50},
+                          {"dock_cycle_p90_s", st.cycleP90}});
+    }
     if (o.json) {
       all.push_back({{"seed", seed},
                      {"fleet_bound", bound},
                      {"robot_time", robotTime},
+                     {"stations", stations},
                      {"robots", r.robots},
                      {"duration_s", r.duration},
                      {"tasks_done", r.tasksDone},
@@ -174,6 +194,15 @@ int runTrafficSim(const TrafficSimOptions& o) {
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";
       std::cout << "  " << fleetBoundLine(bound) << "\n" << robotTimeLine(robotTime) << "\n";
+      std::cout << "  stations:";
+      for (const auto& st : r.stations) {
+        std::cout << " " << st.name << " " << st.visits << " visits";
+        if (st.cycles > 0)
+          std::cout << ", dock cycle p50 " << std::fixed << std::setprecision(1) << st.cycleP50 << " / p90 "
+                    << st.cycleP90 << " s (" << st.cycles << ")";
+        std::cout << ";";
+      }
+      std::cout << "\n";
       for (const auto& s : r.stalls)
         std::cout << "  stalled: " << s << "\n";
     }

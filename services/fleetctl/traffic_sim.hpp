@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace fleet::ctl {
 
@@ -27,6 +28,7 @@ struct TrafficSimOptions {
   int stationLines = 1;         ///< 1: robots wait in line at stations' queues; 0: all planned to the dock
   int admission = 1;     ///< VirtualFleetOptions::admission
   int stationSlots = 0;  ///< VirtualFleetOptions::stationCap: slots per station (0: its line)
+  std::vector<std::string> stations;  ///< VirtualFleetOptions::stations
   bool json = false;
   std::string html;  ///< write a replay page of the first seed's run here (empty: none)
 };

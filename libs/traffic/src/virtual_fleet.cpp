@@ -43,8 +43,11 @@ double percentile(std::vector<double> v, double p) {
 VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& o) {
   const Graph& g = roadmap.graph;
   std::vector<NodeId> pickups, dropoffs, parking;
+  const auto chosen = [&](const std::string& name) {
+    return o.stations.empty() || std::find(o.stations.begin(), o.stations.end(), name) != o.stations.end();
+  };
   for (const auto& s : roadmap.stations) {
-    if (s.dock == kNoNode)
+    if (s.dock == kNoNode || (s.kind != site::StationKind::Parking && !chosen(s.name)))
       continue;
     if (s.kind == site::StationKind::Pickup)
       pickups.push_back(s.dock);
@@ -54,7 +57,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       parking.push_back(s.dock);
   }
   if (pickups.empty() || dropoffs.empty()) {
-    throw std::invalid_argument("virtual fleet: the roadmap needs a pickup and a drop-off station");
+    throw std::invalid_argument(
+        o.stations.empty()
+            ? "virtual fleet: the roadmap needs a pickup and a drop-off station"
+            : "virtual fleet: the stations chosen hold no pickup or no drop-off on the roadmap");
   }
   // Starts: parking docks, then lane nodes that conflict with nothing taken so far.
   std::vector<NodeId> starts;
@@ -87,6 +93,12 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
   std::vector<Bot> bots(o.robots);
+  // The station ledger: dock arrivals, and the dock cycle from one arrival to the next, counted
+  // when the next robot was already in line as the last one left (station_cycle.hpp's quantity).
+  std::vector<double> lastArrival(g.size(), -1.0);
+  std::vector<std::uint8_t> queuedAtLeave(g.size(), 0);
+  std::vector<std::size_t> visits(g.size(), 0);
+  std::vector<std::vector<double>> cycles(g.size());
   // Admission by slots (docs/algorithms.md, "Stations as servers"): a station serves as many robots
   // at once as its line holds (dock and queue places). A robot counts at its pickup until it has
   // loaded there, and at its drop-off from the moment it is given the task (it will carry its load
@@ -184,6 +196,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         if (b.dwellLeft > 0.0)
           continue;
         traffic.setHeld(r, false);
+        queuedAtLeave[static_cast<std::size_t>(b.at)] = traffic.line(b.at).size() > 1 ? 1 : 0;
         if (b.phase == 0) {
           b.phase = 1;
           --uses[static_cast<std::size_t>(b.pickup)];  // loaded: its pickup slot is free
@@ -225,6 +238,12 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           b.at == traffic.goal(r)) {
         b.dwellLeft = o.dwell;
         traffic.setHeld(r, true);
+        const auto d = static_cast<std::size_t>(b.at);
+        ++visits[d];
+        if (lastArrival[d] >= 0.0 && queuedAtLeave[d] != 0)
+          cycles[d].push_back(now - lastArrival[d]);
+        lastArrival[d] = now;
+        queuedAtLeave[d] = 0;
       }
       if (b.to != kNoNode)
         tDrive += o.dt;
@@ -352,6 +371,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.passes = traffic.stats().passes;
   for (std::size_t r = 0; r < traffic.robots(); ++r)
     res.baseEnds += traffic.baseEnds(r);
+  for (const auto& st : roadmap.stations) {
+    if (st.dock == kNoNode || visits[static_cast<std::size_t>(st.dock)] == 0)
+      continue;
+    const auto& c = cycles[static_cast<std::size_t>(st.dock)];
+    res.stations.push_back({st.name, visits[static_cast<std::size_t>(st.dock)], c.size(), percentile(c, 0.5),
+                            percentile(c, 0.9)});
+  }
   res.updateP50Ms = percentile(updateMs, 0.5);
   res.updateP99Ms = percentile(updateMs, 0.99);
   if (o.robots < 2)

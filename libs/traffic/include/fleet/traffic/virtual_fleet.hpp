@@ -39,6 +39,8 @@ struct VirtualFleetOptions {
   /// admissible task from there. false: every task at once.
   bool admission = true;
   std::size_t stationCap = 0;
+  /// Tasks only between these pickups and drop-offs (by name); empty: all of them.
+  std::vector<std::string> stations;
   /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
   double recordEvery = 0.0;
   TrafficOptions traffic;
@@ -107,6 +109,16 @@ struct VirtualFleetResult {
   /// Robots waiting longer than a minute at the end: where, for what, behind whom.
   std::vector<std::string> stalls;
   std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0
+  /// The station ledger: per visited pickup and drop-off, its dock arrivals and its dock cycle —
+  /// from one arrival to the next, counted when the next robot was in line as the last one left.
+  struct StationLedger {
+    std::string name;
+    std::size_t visits = 0;
+    std::size_t cycles = 0;
+    double cycleP50 = 0.0;  ///< s
+    double cycleP90 = 0.0;
+  };
+  std::vector<StationLedger> stations;
 };
 
 /// Runs the virtual fleet on `roadmap`. Robots start on the parking docks (then on spread-out lane
