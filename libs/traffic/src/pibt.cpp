@@ -42,6 +42,7 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   forced_.assign(n, {});
   forcedAt_.assign(n, 0);
   forcedGroup_.assign(n, -1);
+  line_.assign(n, -1);
   epsilon_.resize(n);
   for (auto& e : epsilon_) {
     e = static_cast<double>(random() >> 11) * 0x1.0p-53;
@@ -181,6 +182,18 @@ bool Pibt::setPosition(std::size_t agent, NodeId v) {
   return true;
 }
 
+void Pibt::setLines(std::vector<std::int32_t> lineOf, std::vector<NodeId> forward) {
+  if (!lineOf.empty() && (lineOf.size() != graph_.size() || forward.size() != graph_.size())) {
+    throw std::invalid_argument("Pibt::setLines: one line and one forward node per graph node");
+  }
+  lineOf_ = std::move(lineOf);
+  lineForward_ = std::move(forward);
+}
+
+void Pibt::setLine(std::size_t agent, std::int32_t line) {
+  line_.at(agent) = line;
+}
+
 void Pibt::reset(std::span<const NodeId> positions) {
   if (positions.size() < now_.size()) {
     throw std::invalid_argument("Pibt::reset: " + std::to_string(positions.size()) + " positions for " +
@@ -236,6 +249,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
     forced_.resize(n);
     forcedAt_.resize(n, 0);
     forcedGroup_.resize(n, -1);
+    line_.resize(n, -1);
     for (std::size_t i = old; i < n; ++i)
       epsilon_.push_back(static_cast<double>(random() >> 11) * 0x1.0p-53);
   }
@@ -439,7 +453,12 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
         options_.preferStraight ? (occupied << 31) | (turn << 28) | (draw >> 3) : (occupied << 31) | draw};
   };
   add(from);
+  // In its line on one of the line's nodes: forward or nowhere.
+  const bool inLine = line_[a] >= 0 && !lineOf_.empty() && lineOf_[idx(from)] == line_[a];
   for (const Edge& e : graph_.edges(from)) {
+    if (inLine && e.to != lineForward_[idx(from)]) {
+      continue;
+    }
     // Leaving a closed node is allowed (a robot stranded on it must get off); entering one is not.
     if (e.open && graph_.isOpen(e.to)) {
       add(e.to);

@@ -47,6 +47,29 @@ void TrafficControl::setStations(std::vector<StationLine> stations) {
     leaveLine(r);
   stations_ = std::move(stations);
   lines_.assign(stations_.size(), {});
+  // The lines as the planner walks them: each queue place leads to the one before it, the head to
+  // the approach (or the dock), the approach to the dock.
+  std::vector<std::int32_t> lineOf(graph_.size(), -1);
+  std::vector<NodeId> forward(graph_.size(), kNoNode);
+  for (std::size_t i = 0; i < stations_.size(); ++i) {
+    const auto& st = stations_[i];
+    if (!graph_.valid(st.dock))
+      continue;
+    const NodeId entry = graph_.valid(st.approach) ? st.approach : st.dock;
+    if (entry != st.dock) {
+      lineOf[static_cast<std::size_t>(entry)] = static_cast<std::int32_t>(i);
+      forward[static_cast<std::size_t>(entry)] = st.dock;
+    }
+    NodeId next = entry;
+    for (const NodeId q : st.queue) {
+      if (graph_.valid(q)) {
+        lineOf[static_cast<std::size_t>(q)] = static_cast<std::int32_t>(i);
+        forward[static_cast<std::size_t>(q)] = next;
+        next = q;
+      }
+    }
+  }
+  planner_->setLines(std::move(lineOf), std::move(forward));
   leaving_.assign(stations_.size(), -1);
   // Robots wait only where they leave the dock's ways in and out free: a queue node next to a dock
   // approached along a row excludes the nodes a robot leaving the dock must drive through.
@@ -128,6 +151,7 @@ void TrafficControl::leaveLine(std::size_t robot) {
   }
   l.erase(std::remove(l.begin(), l.end(), robot), l.end());
   inLine_[robot] = -1;
+  planner_->setLine(robot, -1);
   updateLine(static_cast<std::size_t>(s));
 }
 
@@ -208,6 +232,7 @@ bool TrafficControl::setGoal(std::size_t robot, NodeId goal, int priority) {
   if (s >= 0) {
     lines_[static_cast<std::size_t>(s)].push_back(robot);
     inLine_[robot] = s;
+    planner_->setLine(robot, s);
     updateLine(static_cast<std::size_t>(s));
   } else {
     plannerGoal(robot, goal);

@@ -388,6 +388,35 @@ TEST(TrafficControl, TheNextInLineWaitsClearOfTheLeavingRobotsWayOut) {
   EXPECT_FALSE(shuts(wait));
 }
 
+/// A line is walked forward only: the robots waiting in P-5's queue (a dead-end pickup whose queue
+/// runs into the open floor) are never pushed sideways out of it while the one docked leaves and the
+/// ones behind move up. (Before: the robot behind moving up pushed the head sideways out of its
+/// one-way queue, and it drove round to the tail again, ~24 s with the dock empty; virtual fleet,
+/// P-5 and D-2 shared by 6 robots.)
+TEST(TrafficControl, RobotsWaitingInLineOnlyMoveForward) {
+  Roadmap map = smallWarehouse();
+  const auto* p5 = map.station("P-5");
+  ASSERT_GE(p5->queue.size(), 3U);
+  ASSERT_NE(p5->approach, kNoNode);
+  const std::vector<NodeId> starts{p5->dock, p5->queue[0], p5->queue[2]};
+  TrafficControl tc(map.graph, starts);
+  tc.setStations(stationLines(map));
+  for (std::size_t r = 0; r < 3; ++r)
+    tc.setGoal(r, p5->dock);
+  ASSERT_EQ(tc.line(p5->dock), (std::vector<std::size_t>{0, 1, 2}));
+  tc.setGoal(0, map.station("D-2")->dock);  // the docked robot is done and leaves by the exit
+  std::vector<NodeId> line{p5->dock, p5->approach};
+  line.insert(line.end(), p5->queue.begin(), p5->queue.end());
+  const auto inLine = [&](NodeId v) { return std::find(line.begin(), line.end(), v) != line.end(); };
+  for (int t = 0; t < 200 && !tc.arrived(1); ++t) {
+    stepOnTime(tc);
+    for (const std::size_t r : {1U, 2U})
+      ASSERT_TRUE(inLine(tc.at(r))) << "robot " << r << " left the line at step " << t << ": "
+                                    << tc.explain(r);
+  }
+  EXPECT_TRUE(tc.arrived(1)) << tc.explain(1);
+}
+
 /// The dock stays the leaving robot's until it has *reported* a node clear of it. The plan runs
 /// ahead of the robots; freeing the dock when the plan had the robot off it let the next in line
 /// onto the approach, and after a re-plan put the leaving robot back on the dock in the planner,

@@ -150,6 +150,15 @@ class Pibt {
   /// long it has stalled: a cost that changes every few seconds must not hide a livelock.
   void setNodeCost(std::vector<float> cost);
 
+  /// Station lines (TrafficControl::setStations): per node, the line it belongs to (-1: none) and
+  /// the next node toward the dock (queue place → the one before it → approach → dock). An agent in
+  /// a line (setLine) standing on one of that line's nodes moves only forward or stays: pushed by
+  /// the robot behind it, a robot waiting in a one-way queue would otherwise step sideways out of
+  /// it and have to drive round to the tail (docs/algorithms.md, "Traffic: stations as servers").
+  void setLines(std::vector<std::int32_t> lineOf, std::vector<NodeId> forward);
+  /// The line agent `agent` waits in (-1: none).
+  void setLine(std::size_t agent, std::int32_t line);
+
  private:
   struct Candidate {
     NodeId node;
@@ -217,6 +226,7 @@ class Pibt {
   std::vector<std::vector<NodeId>> forced_;  ///< way out of a knot: its node per step, from now
   std::vector<std::size_t> forcedAt_;        ///< index in forced_ of where it stands
   std::vector<std::int32_t> forcedGroup_;    ///< the knot it is untangling with, -1
+  std::vector<std::int32_t> line_;           ///< the line it waits in, -1
   std::int32_t nextGroup_ = 0;
   std::uint32_t stamp_ = 0;
 
@@ -224,6 +234,8 @@ class Pibt {
   std::vector<std::int32_t> agentAt_;     ///< agent standing there now, -1
   std::vector<std::int32_t> reservedBy_;  ///< agent going there next step, -1
   std::vector<int> fixedCover_;           ///< fixed agents excluding the node (routes avoid it)
+  std::vector<std::int32_t> lineOf_;      ///< the station line the node belongs to, -1 (empty: none)
+  std::vector<NodeId> lineForward_;       ///< the line's next node toward the dock
 
   std::vector<std::int32_t> order_;
   std::vector<Candidate> candidates_;  ///< (max degree + 1) per recursion depth
