@@ -27,7 +27,7 @@ while IFS= read -r -d '' f; do
   [[ " ${programs[*]} " == *" $(basename "$f") "* ]] || fail "$f is built but not installed (install(TARGETS ...))"
 done < <(find "$build/services" "$build/sim/src" -mindepth 1 -maxdepth 2 -path '*/CMakeFiles' -prune -o \
   -type f -perm -u+x -print0)
-for f in share/doc/fleet/LICENSE share/doc/fleet/operator-guide.md share/fleet/grafana-dashboard.json \
+for f in share/doc/fleet/LICENSE share/doc/fleet/operator-guide.md share/fleet/grafana-dashboard.json share/fleet/fleet-alerts.yml \
          share/fleet/cyclonedds-local.xml share/fleet/examples/small_warehouse.site.json; do
   [[ -s $root/usr/$f ]] || fail "not installed: $f"
 done
