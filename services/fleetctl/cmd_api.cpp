@@ -217,28 +217,62 @@ int listRobots(const ApiOptions&, httplib::Client& c, const httplib::Headers& h)
   return 0;
 }
 
+// Exit 0 only when it stopped itself (--count reached, --seconds up); 1 when the adapter cannot be
+// reached, answers other than 200 (401, 403, 503 busy, ...), or the stream breaks or ends.
 int followEvents(const ApiOptions& o, httplib::Client& c, const httplib::Headers& h) {
   int seen = 0;
   const auto start = std::chrono::steady_clock::now();
   std::string buf;
-  auto r = c.Get("/v1/events", h, [&](const char* data, std::size_t n) {
-    buf.append(data, n);
-    std::size_t pos = 0;
-    while ((pos = buf.find("\n\n")) != std::string::npos) {
-      const std::string frame = buf.substr(0, pos);
-      buf.erase(0, pos + 2);
-      const auto d = frame.find("data: ");
-      if (d != std::string::npos) {
-        std::cout << frame.substr(d + 6) << std::endl;
-        ++seen;
-      }
-    }
-    const bool timeUp =
-        o.seconds > 0 && std::chrono::steady_clock::now() - start > std::chrono::seconds(o.seconds);
-    return !(o.count > 0 && seen >= o.count) && !timeUp;
-  });
-  (void)r;
-  return 0;
+  int status = 0;
+  std::string refusal;  // the body of an answer other than 200, bounded
+  bool stopped = false;
+  auto r = c.Get(
+      "/v1/events", h,
+      [&](const httplib::Response& res) {
+        status = res.status;
+        return true;
+      },
+      [&](const char* data, std::size_t n) {
+        if (status != 200) {
+          if (refusal.size() < 4096) {
+            refusal.append(data, std::min(n, 4096 - refusal.size()));
+          }
+          return true;
+        }
+        buf.append(data, n);
+        std::size_t pos = 0;
+        while ((pos = buf.find("\n\n")) != std::string::npos) {
+          const std::string frame = buf.substr(0, pos);
+          buf.erase(0, pos + 2);
+          const auto d = frame.find("data: ");
+          if (d != std::string::npos) {
+            std::cout << frame.substr(d + 6) << std::endl;
+            ++seen;
+          }
+        }
+        const bool timeUp =
+            o.seconds > 0 && std::chrono::steady_clock::now() - start > std::chrono::seconds(o.seconds);
+        stopped = (o.count > 0 && seen >= o.count) || timeUp;
+        return !stopped;
+      });
+  if (stopped) {
+    return 0;
+  }
+  if (status != 0 && status != 200) {
+    const auto j = json::parse(refusal, nullptr, false);
+    const std::string why = j.is_object() && j.contains("message") && j["message"].is_string()
+                                ? j["message"].get<std::string>()
+                                : refusal.substr(0, refusal.find('\n'));
+    return fail("the WMS adapter at " + o.url + " answered " + std::to_string(status) +
+                (why.empty() ? std::string() : ": " + why));
+  }
+  if (status == 0) {
+    return fail("cannot reach the WMS adapter at " + o.url + " (" + httplib::to_string(r.error()) + ")");
+  }
+  if (!r) {
+    return fail("the event stream from " + o.url + " broke (" + httplib::to_string(r.error()) + ")");
+  }
+  return fail("the event stream from " + o.url + " ended (the adapter closed it)");
 }
 
 }  // namespace

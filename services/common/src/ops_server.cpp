@@ -15,6 +15,8 @@
 #include <list>
 #include <vector>
 
+#include "fleet/service/process_metrics.hpp"
+
 namespace fleet::service {
 namespace {
 
@@ -135,7 +137,8 @@ std::string OpsServer::answer(const std::string& head) const {
     return httpAnswer(405, "GET only\n", "text/plain; charset=utf-8");
   }
   if (path == "/metrics") {
-    return httpAnswer(200, registry_.exposition(), "text/plain; version=0.0.4; charset=utf-8");
+    return httpAnswer(200, registry_.exposition() + processMetricsText(),
+                      "text/plain; version=0.0.4; charset=utf-8");
   }
   if (path == "/livez" || path == "/readyz") {
     const auto a = path == "/livez" ? health_.liveness() : health_.readiness();

@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include "fleet/service/command_line.hpp"
+#include "fleet/service/runtime.hpp"
+#include "fleet/service/systemd_notify.hpp"
 
 namespace fleet::service {
 
@@ -13,6 +15,24 @@ ServiceOps::ServiceOps(std::string service) : service_(std::move(service)), serv
       .set(1.0);
   // The family shows (HELP/TYPE) before the first rejection, so dashboards find it.
   rejected("none").inc(0);
+}
+
+ServiceOps::~ServiceOps() {
+  stopping();
+}
+
+void ServiceOps::notify(const char* state) {
+  if (const auto err = notifyServiceManager(state); !err.empty() && !notifyFailed_) {
+    notifyFailed_ = true;  // once: a broken socket would otherwise log every second
+    spdlog::warn("{}: {}", service_, err);
+  }
+}
+
+void ServiceOps::stopping() {
+  if (!stoppingSent_) {
+    stoppingSent_ = true;
+    notify("STOPPING=1");
+  }
 }
 
 bool ServiceOps::start(const OpsSettings& s) {
@@ -59,11 +79,23 @@ void ServiceOps::watchTotal(metrics::Counter& counter, std::function<std::uint64
 
 bool ServiceOps::refresh() {
   health_.beat();
+  if (!readySent_) {
+    // The loop's first turn: everything it needs is set up, so the service serves.
+    readySent_ = true;
+    watchdog_ = watchdogPeriod().has_value();
+    notify("READY=1");
+  }
+  if (stopRequested()) {
+    stopping();
+  }
   const auto now = std::chrono::steady_clock::now();
   if (now - lastRefresh_ < std::chrono::seconds(1)) {
     return false;
   }
   lastRefresh_ = now;
+  if (watchdog_ && !stoppingSent_) {
+    notify("WATCHDOG=1");  // from the loop's own thread: a stalled loop stops it, and systemd restarts
+  }
   for (auto& w : watched_) {
     w.gauge->set(static_cast<double>(w.count()));
   }

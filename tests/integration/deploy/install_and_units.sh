@@ -5,8 +5,9 @@
 # but the tools has a systemd unit that runs it, hardened as the others; the docs, LICENSE and
 # dashboard are there; every unit (paths filled in for that prefix) passes `systemd-analyze
 # verify`; the robot agent's and the VDA 5050 bridge's units start after the traffic manager's and
-# want it (their robots drive only what it releases). Exit 77 (skip) only when systemd-analyze is
-# missing.
+# want it (their robots drive only what it releases). Every service unit is Type=notify with a
+# watchdog (the services send READY=1, WATCHDOG=1, STOPPING=1: systemd_notify.hpp). Exit 77
+# (skip) only when systemd-analyze is missing.
 set -euo pipefail
 src=$1 build=$2
 root=$(mktemp -d)
@@ -27,7 +28,7 @@ while IFS= read -r -d '' f; do
   [[ " ${programs[*]} " == *" $(basename "$f") "* ]] || fail "$f is built but not installed (install(TARGETS ...))"
 done < <(find "$build/services" "$build/sim/src" -mindepth 1 -maxdepth 2 -path '*/CMakeFiles' -prune -o \
   -type f -perm -u+x -print0)
-for f in share/doc/fleet/LICENSE share/doc/fleet/operator-guide.md share/fleet/grafana-dashboard.json \
+for f in share/doc/fleet/LICENSE share/doc/fleet/operator-guide.md share/fleet/grafana-dashboard.json share/fleet/fleet-alerts.yml \
          share/fleet/cyclonedds-local.xml share/fleet/examples/small_warehouse.site.json; do
   [[ -s $root/usr/$f ]] || fail "not installed: $f"
 done
@@ -41,7 +42,8 @@ for b in "${programs[@]}"; do
   u=$(grep -l "^ExecStart=$root/usr/bin/$b " "$units"/*.service) || fail "no unit runs $b"
   for line in DynamicUser=yes NoNewPrivileges=yes CapabilityBoundingSet= ProtectSystem=strict ProtectHome=yes \
               PrivateTmp=yes PrivateDevices=yes RestrictAddressFamilies= MemoryDenyWriteExecute=yes \
-              SystemCallFilter=@system-service RestartPreventExitStatus=2 WantedBy=multi-user.target; do
+              SystemCallFilter=@system-service RestartPreventExitStatus=2 WantedBy=multi-user.target \
+              Type=notify NotifyAccess=main WatchdogSec=; do
     grep -q "^$line" "$u" || fail "$(basename "$u") lacks $line"
   done
 done

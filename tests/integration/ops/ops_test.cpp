@@ -1,7 +1,8 @@
-// Every service as a process: /metrics passes `promtool check metrics`, /livez and /readyz answer
-// truthfully, a real Prometheus on loopback scrapes a running lockstep fleet and answers a query;
-// A taken metrics port, a bad option and a bad log level exit 2; --version exits 0; JSON logs are
-// one object per line.
+// Every service as a process: /metrics (process_* included) passes `promtool check metrics`,
+// /livez and /readyz answer truthfully, a real Prometheus on loopback scrapes a running lockstep
+// fleet, answers a query and evaluates the shipped alert rules without error. A taken metrics
+// port, a bad option and a bad log level exit 2; --version exits 0; JSON logs are one object per
+// line.
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
@@ -165,6 +166,10 @@ TEST_F(OpsFleet, EveryServiceIsLiveThenReadyAndItsMetricsPassPromtool) {
     EXPECT_EQ((*m)->get_header_value("Content-Type"), "text/plain; version=0.0.4; charset=utf-8");
     EXPECT_NE((*m)->body.find("fleet_build_info{service=\"" + name + "\""), std::string::npos) << name;
     EXPECT_NE((*m)->body.find(name + "_rejected_samples_total"), std::string::npos) << name;
+    for (const char* process : {"\nprocess_cpu_seconds_total ", "\nprocess_resident_memory_bytes ",
+                                "\nprocess_open_fds ", "\nprocess_start_time_seconds "}) {
+      EXPECT_NE((*m)->body.find(process), std::string::npos) << name << " lacks" << process;
+    }
     const auto file = fleet_->dir() / (name + ".prom");
     std::ofstream(file) << (*m)->body;
     const auto check = run("promtool check metrics < " + file.string());
@@ -248,7 +253,11 @@ TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
                "\n    static_configs:\n      - targets: ['127.0.0.1:" + std::to_string(port) + "']\n";
   }
   const auto cfg = fleet_->dir() / "prometheus.yml";
-  std::ofstream(cfg) << "global:\n  scrape_interval: 1s\n  scrape_timeout: 1s\nscrape_configs:\n" << targets;
+  // The shipped alert rules too, evaluated every second.
+  std::ofstream(cfg) << "global:\n  scrape_interval: 1s\n  scrape_timeout: 1s\n  evaluation_interval: 1s\n"
+                     << "rule_files:\n  - " FLEET_SOURCE_DIR "/deploy/prometheus/fleet-alerts.yml\n"
+                     << "scrape_configs:\n"
+                     << targets;
   fleet::test::ChildProcess prom(
       "/usr/bin/prometheus",
       {"--config.file=" + cfg.string(), "--storage.tsdb.path=" + (fleet_->dir() / "tsdb").string(),
@@ -305,6 +314,41 @@ TEST_F(OpsFleet, ARealPrometheusScrapesEveryServiceAndAnswersAQuery) {
     }
   }
   EXPECT_GE(queries, 12);
+  // Every alert rule of deploy/prometheus/fleet-alerts.yml loaded and evaluated on the running fleet
+  // without an error (a rule that fails to evaluate never fires), and FleetServiceDown not pending.
+  auto text = [](const nlohmann::json& rule, const char* key) {
+    const auto it = rule.find(key);
+    return it != rule.end() && it->is_string() ? *it->get_ptr<const std::string*>() : std::string();
+  };
+  nlohmann::json rules;
+  for (const auto stop = std::chrono::steady_clock::now() + 20s; std::chrono::steady_clock::now() < stop;
+       std::this_thread::sleep_for(500ms)) {
+    auto r = c.Get("/api/v1/rules");
+    rules = r && r->status == 200 ? nlohmann::json::parse(r->body, nullptr, false) : nullptr;
+    int evaluated = 0;
+    if (rules.is_object() && rules["data"]["groups"].is_array()) {
+      for (const auto& g : rules["data"]["groups"]) {
+        for (const auto& rule : g["rules"]) {
+          evaluated += text(rule, "health") != "unknown" ? 1 : 0;
+        }
+      }
+    }
+    if (evaluated >= 10) {
+      break;
+    }
+  }
+  ASSERT_TRUE(rules.is_object()) << "no /api/v1/rules";
+  int loaded = 0;
+  for (const auto& g : rules["data"]["groups"]) {
+    for (const auto& rule : g["rules"]) {
+      ++loaded;
+      EXPECT_EQ(text(rule, "health"), "ok") << rule.dump();
+      if (text(rule, "name") == "FleetServiceDown") {
+        EXPECT_EQ(text(rule, "state"), "inactive") << rule.dump();
+      }
+    }
+  }
+  EXPECT_GE(loaded, 10) << rules.dump();
 }
 
 TEST(OpsCommandLine, EveryBinaryHasVersionAndExitsTwoOnBadUsage) {

@@ -1,8 +1,9 @@
 #pragma once
 
 // The ops port every service opens when asked (--metrics-port): GET /metrics (Prometheus text
-// 0.0.4), /livez and /readyz (Health). No authentication and nothing secret: it listens on loopback
-// unless --metrics-host says otherwise, and a site exposes it to its scraper only.
+// 0.0.4: the registry, then the process_* metrics of process_metrics.hpp), /livez and /readyz
+// (Health). No authentication and nothing secret: it listens on loopback unless --metrics-host
+// says otherwise, and a site exposes it to its scraper only.
 //
 // One thread serves every connection with poll(2), non-blocking: each answer is a few atomic loads
 // (or the exposition text), so no client waits behind another's handler, and a slow client holds
