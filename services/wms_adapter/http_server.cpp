@@ -10,8 +10,6 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
-#include <boost/beast/websocket.hpp>
-#include <boost/beast/websocket/ssl.hpp>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -28,7 +26,6 @@ namespace {
 
 namespace beast = boost::beast;
 namespace bhttp = beast::http;
-namespace websocket = beast::websocket;
 namespace net = boost::asio;
 namespace ssl = net::ssl;
 using tcp = net::ip::tcp;
@@ -165,100 +162,6 @@ void runHandler(const Route& route, const Request& req, Response& res) {
   }
 }
 
-/// A WebSocket connection after its handshake: pushes what the channel yields, hands over what the
-/// client sends. Counts as an open connection and an open stream; holds no worker.
-template <class Stream>
-class WebSocketSession : public std::enable_shared_from_this<WebSocketSession<Stream>> {
- public:
-  WebSocketSession(HttpServer::Impl& server, Stream stream, WebSocketChannel channel)
-      : server_(server), ws_(std::move(stream)), channel_(std::move(channel)), timer_(server.io) {
-    ++server_.stats.openConnections;
-    ++server_.stats.openStreams;
-  }
-  ~WebSocketSession() {
-    --server_.stats.openConnections;
-    --server_.stats.openStreams;
-  }
-  WebSocketSession(const WebSocketSession&) = delete;
-  WebSocketSession& operator=(const WebSocketSession&) = delete;
-
-  void accept(const bhttp::request<bhttp::string_body>& req) {
-    // The websocket stream keeps its own deadlines: handshake, and idle with pings (a client that
-    // neither answers pings nor reads is closed).
-    beast::get_lowest_layer(ws_).expires_never();
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.read_message_max(server_.limits.maxBodyBytes);
-    ws_.async_accept(req, [self = this->shared_from_this()](beast::error_code ec) {
-      if (ec) {
-        return;
-      }
-      self->read();
-      self->waitForMessages();
-    });
-  }
-
- private:
-  void read() {
-    ws_.async_read(in_, [self = this->shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
-        self->closed_ = true;
-        self->timer_.cancel();
-        return;
-      }
-      if (self->channel_.incoming) {
-        try {
-          self->channel_.incoming(beast::buffers_to_string(self->in_.data()));
-        } catch (...) {
-          // A handler's error closes nothing: the client may send the next message.
-        }
-      }
-      self->in_.consume(self->in_.size());
-      self->read();
-    });
-  }
-
-  void waitForMessages() {
-    timer_.expires_after(milliseconds(server_.limits.streamPollMs));
-    timer_.async_wait([self = this->shared_from_this()](beast::error_code ec) {
-      if (!ec && !self->closed_) {
-        self->pushMessage();
-      }
-    });
-  }
-
-  void pushMessage() {
-    std::optional<std::string> text;
-    try {
-      text = channel_.outgoing();
-    } catch (...) {
-      text.reset();
-    }
-    if (!text) {
-      ws_.async_close(websocket::close_code::normal, [self = this->shared_from_this()](beast::error_code) {});
-      return;
-    }
-    if (text->empty()) {
-      waitForMessages();
-      return;
-    }
-    auto data = std::make_shared<std::string>(std::move(*text));
-    ws_.text(true);
-    ws_.async_write(net::buffer(*data),
-                    [self = this->shared_from_this(), data](beast::error_code ec, std::size_t) {
-                      if (!ec) {
-                        self->waitForMessages();
-                      }
-                    });
-  }
-
-  HttpServer::Impl& server_;
-  websocket::stream<Stream> ws_;
-  WebSocketChannel channel_;
-  net::steady_timer timer_;
-  beast::flat_buffer in_;
-  bool closed_ = false;
-};
-
 /// One connection: reads requests one after the other (no pipelining), hands each to the server,
 /// writes the answer; or streams events. Everything runs on the I/O thread.
 template <class Stream>
@@ -355,7 +258,6 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
       }
       version_ = msg.version();
       keepAlive_ = msg.keep_alive();
-      req->webSocketUpgrade = websocket::is_upgrade(msg);
     }
     return req;
   }
@@ -405,12 +307,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
   }
 
   void finish(const std::shared_ptr<Request>& req, Response res, bool close) {
-    const bool webSocket = static_cast<bool>(res.webSocket.outgoing);
-    if (webSocket && !req->webSocketUpgrade) {
-      res = errorResponse(400, "not_websocket", "this route takes a WebSocket handshake only");
-    }
-    if ((res.events || res.webSocket.outgoing) &&
-        server_.stats.openStreams.load() >= server_.limits.maxStreams) {
+    if (res.events && server_.stats.openStreams.load() >= server_.limits.maxStreams) {
       ++server_.stats.refusedStreams;
       res = errorResponse(503, "busy", "too many open event streams; retry");
       res.set_header("Retry-After", "5");
@@ -418,11 +315,7 @@ class Session : public std::enable_shared_from_this<Session<Stream>> {
     if (server_.observer) {
       server_.observer(*req, res, std::chrono::duration<double>(SteadyClock::now() - started_).count());
     }
-    if (res.webSocket.outgoing) {
-      // The websocket session takes the socket over; this session ends with this function.
-      std::make_shared<WebSocketSession<Stream>>(server_, std::move(stream_), std::move(res.webSocket))
-          ->accept(parser_->get());
-    } else if (res.events) {
+    if (res.events) {
       startStream(std::move(res));
     } else {
       write(std::move(res), close);

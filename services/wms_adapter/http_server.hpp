@@ -17,8 +17,7 @@
 // - hold a thread with an event stream: a stream is polled from the I/O thread (EventSource must
 //   not block) and holds no worker; beyond `maxStreams` open streams, 503 with Retry-After;
 // - make the kernel reset connections: the listen backlog is `backlog`, and beyond `maxConnections`
-//   open connections a new one is read and answered 503 with Retry-After, then closed (WebSocket
-//   connections, like event streams, hold no worker and count against `maxStreams`);
+//   open connections a new one is read and answered 503 with Retry-After, then closed;
 // - send faster than `ratePerClient` (when set) from one address: 429 with Retry-After (public
 //   routes, the health probe, are exempt).
 //
@@ -48,8 +47,7 @@ struct Request {
   std::string body;
   std::vector<std::string> matches;  // the route pattern's groups, [0] = the whole path
   std::string remote_addr;
-  std::string principal;          // who made the request (the token's name), set by the gate
-  bool webSocketUpgrade = false;  // a WebSocket handshake (GET with Upgrade: websocket)
+  std::string principal;  // who made the request (the token's name), set by the gate
 
   [[nodiscard]] std::string get_header_value(const std::string& name) const;
   [[nodiscard]] bool has_header(const std::string& name) const;
@@ -61,22 +59,13 @@ struct Request {
 /// to end the stream. Must not block.
 using EventSource = std::function<std::optional<std::string>()>;
 
-/// A WebSocket connection's two directions: text messages to push (`outgoing`, polled like an
-/// event stream; nothing = close) and a callback for each text message the client sends (may be
-/// empty: push only). Both run on the I/O thread and must not block.
-struct WebSocketChannel {
-  EventSource outgoing;
-  std::function<void(const std::string&)> incoming;
-};
-
 struct Response {
   int status = 200;
   std::string body;
   std::string contentType = "text/plain";
   std::vector<std::pair<std::string, std::string>> headers;
-  EventSource events;          // set: the response is an open-ended stream of this content type
-  WebSocketChannel webSocket;  // outgoing set: accept the WebSocket handshake and run this channel
-  std::string audit;           // what the request changed, for the audit log (JSON text), set by handlers
+  EventSource events;  // set: the response is an open-ended stream of this content type
+  std::string audit;   // what the request changed, for the audit log (JSON text), set by handlers
 
   void set_content(std::string content, std::string type) {
     body = std::move(content);
@@ -89,8 +78,6 @@ struct Response {
     contentType = std::move(type);
     events = std::move(source);
   }
-  /// Accepts the request's WebSocket handshake (a route answering a non-upgrade GET gets 400).
-  void acceptWebSocket(WebSocketChannel channel) { webSocket = std::move(channel); }
 };
 
 struct ServerLimits {
