@@ -9,8 +9,7 @@
 #include <string>
 
 #include "browser_session.hpp"
-#include "http_server.hpp"
-#include "scope.hpp"
+#include "http_names.hpp"
 #include "token_store.hpp"
 
 namespace fleet::wms {
