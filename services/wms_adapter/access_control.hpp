@@ -1,16 +1,15 @@
 #pragma once
 
 // Who may do what on the API: the one check every route goes through (the server's gate runs it
-// with the scope the route was registered with). A route or a WebSocket upgrade that authorizes by
-// itself calls check() with the scope it needs. A browser session cookie (browser_session.hpp)
+// with the scope the route was registered with). A route that authorizes by itself calls check()
+// with the scope it needs. A browser session cookie (browser_session.hpp)
 // stands for the token it was made from; a request with it that changes something also needs the
 // session's CSRF token.
 
 #include <string>
 
 #include "browser_session.hpp"
-#include "http_server.hpp"
-#include "scope.hpp"
+#include "http_names.hpp"
 #include "token_store.hpp"
 
 namespace fleet::wms {

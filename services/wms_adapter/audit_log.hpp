@@ -10,7 +10,7 @@
 #include <mutex>
 #include <string>
 
-#include "http_server.hpp"
+#include "http_names.hpp"
 
 namespace fleet::wms {
 

@@ -18,7 +18,7 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/fleet/station_map.hpp"
 #include "gateway.hpp"
-#include "http_server.hpp"
+#include "http_names.hpp"
 #include "traffic_layer.hpp"
 
 namespace fleet::wms {

@@ -18,7 +18,7 @@
 #include "fleet/fleet/station_map.hpp"
 #include "fleet/metrics/registry.hpp"
 #include "gateway.hpp"
-#include "http_server.hpp"
+#include "http_names.hpp"
 #include "token_store.hpp"
 
 namespace fleet::wms {

@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "fleet/core/expected.hpp"
-#include "scope.hpp"
+#include "http_names.hpp"
 
 namespace fleet::wms {
 

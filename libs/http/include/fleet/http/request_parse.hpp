@@ -9,9 +9,9 @@
 #include <string>
 #include <string_view>
 
-#include "http_server.hpp"
+#include "fleet/http/server.hpp"
 
-namespace fleet::wms {
+namespace fleet::http {
 
 /// %XX decoded (a malformed escape stays as it is); in a query, '+' is a space.
 std::string percentDecode(std::string_view s, bool plusIsSpace);
@@ -28,4 +28,4 @@ struct ParsedRequest {
 /// One request from `bytes` with the limits of `limits` (head, body).
 ParsedRequest parseRequestBytes(std::string_view bytes, const ServerLimits& limits);
 
-}  // namespace fleet::wms
+}  // namespace fleet::http

@@ -1,97 +1,38 @@
 #pragma once
 
-// The WMS adapter's HTTP(S) server, on Boost.Beast (see the commit that brought it: Debian's
-// cpp-httplib 0.11 holds one worker thread per connection for its whole life, has a listen backlog
-// of 5 compiled in, reads a chunked body whole before any limit, and has no in-flight bound that
-// answers instead of queueing).
+// An HTTP(S) server on Boost.Beast, written for the WMS adapter's API; any service may serve with
+// it (see the commit that brought it: Debian's cpp-httplib 0.11 holds one worker thread per
+// connection for its whole life, has a listen backlog of 5 compiled in, reads a chunked body whole
+// before any limit, and has no in-flight bound that answers instead of queueing).
 //
 // What one client cannot do to it:
 // - hold a thread by being slow: sockets are read and written asynchronously on one I/O thread, and
 //   a request (head and body) must arrive within `requestTimeoutMs` of the connection waiting for
 //   it, else the connection is closed;
-// - send an unbounded body: Beast's parser stops at `maxBodyBytes` (or the route's limitBody) whether the
-// body comes with a
-//   Content-Length (refused before it is read) or chunked (refused at the chunk that crosses it): 413;
+// - send an unbounded body: Beast's parser stops at `maxBodyBytes` (or the route's limitBody)
+//   whether the body comes with a Content-Length (refused before it is read) or chunked (refused
+//   at the chunk that crosses it): 413;
 // - fill the worker threads: handlers run on `threads` workers; beyond `maxInFlight` requests
 //   being handled, a request gets 429 with Retry-After at once instead of waiting;
 // - hold a thread with an event stream: a stream is polled from the I/O thread (EventSource must
 //   not block) and holds no worker; beyond `maxStreams` open streams, 503 with Retry-After;
 // - make the kernel reset connections: the listen backlog is `backlog`, and beyond `maxConnections`
-//   open connections a new one is read and answered 503 with Retry-After, then closed (WebSocket
-//   connections, like event streams, hold no worker and count against `maxStreams`);
+//   open connections a new one is read and answered 503 with Retry-After, then closed;
 // - send faster than `ratePerClient` (when set) from one address: 429 with Retry-After (public
 //   routes, the health probe, are exempt).
-//
-// Request and Response carry the few accessors of cpp-httplib's that the handlers use, spelled as
-// there, so a handler written for httplib::Server moves over by changing the two type names.
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
-#include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
-#include "scope.hpp"
+#include "fleet/http/message.hpp"
+#include "fleet/http/scope.hpp"
 
-namespace fleet::wms {
-
-struct Request {
-  std::string method;  // "GET", "POST", ...
-  std::string target;  // as sent (path and query); never logged: a client may put secrets there
-  std::string path;    // percent-decoded path without the query
-  std::multimap<std::string, std::string> params;  // decoded query parameters
-  std::vector<std::pair<std::string, std::string>> headers;
-  std::string body;
-  std::vector<std::string> matches;  // the route pattern's groups, [0] = the whole path
-  std::string remote_addr;
-  std::string principal;          // who made the request (the token's name), set by the gate
-  bool webSocketUpgrade = false;  // a WebSocket handshake (GET with Upgrade: websocket)
-
-  [[nodiscard]] std::string get_header_value(const std::string& name) const;
-  [[nodiscard]] bool has_header(const std::string& name) const;
-  [[nodiscard]] bool has_param(const std::string& name) const { return params.count(name) > 0; }
-  [[nodiscard]] std::string get_param_value(const std::string& name) const;
-};
-
-/// Called on the I/O thread every poll interval: the text to send now (may be empty), or nothing
-/// to end the stream. Must not block.
-using EventSource = std::function<std::optional<std::string>()>;
-
-/// A WebSocket connection's two directions: text messages to push (`outgoing`, polled like an
-/// event stream; nothing = close) and a callback for each text message the client sends (may be
-/// empty: push only). Both run on the I/O thread and must not block.
-struct WebSocketChannel {
-  EventSource outgoing;
-  std::function<void(const std::string&)> incoming;
-};
-
-struct Response {
-  int status = 200;
-  std::string body;
-  std::string contentType = "text/plain";
-  std::vector<std::pair<std::string, std::string>> headers;
-  EventSource events;          // set: the response is an open-ended stream of this content type
-  WebSocketChannel webSocket;  // outgoing set: accept the WebSocket handshake and run this channel
-  std::string audit;           // what the request changed, for the audit log (JSON text), set by handlers
-
-  void set_content(std::string content, std::string type) {
-    body = std::move(content);
-    contentType = std::move(type);
-  }
-  void set_header(const std::string& name, const std::string& value);
-  [[nodiscard]] std::string get_header_value(const std::string& name) const;
-  /// Streams what `source` yields (server-sent events: "text/event-stream").
-  void setEventStream(std::string type, EventSource source) {
-    contentType = std::move(type);
-    events = std::move(source);
-  }
-  /// Accepts the request's WebSocket handshake (a route answering a non-upgrade GET gets 400).
-  void acceptWebSocket(WebSocketChannel channel) { webSocket = std::move(channel); }
-};
+namespace fleet::http {
 
 struct ServerLimits {
   std::size_t maxBodyBytes = 1 << 20;
@@ -182,4 +123,4 @@ class HttpServer {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace fleet::wms
+}  // namespace fleet::http

@@ -1,13 +1,14 @@
 #pragma once
 
-// What a request may do, as a route requires it and a token grants it (docs/operator-guide.md,
-// "Security: HTTP API").
+// What a request may do, as a route requires it and a token grants it (the WMS adapter's tokens:
+// docs/operator-guide.md, "Security: HTTP API"). The server exempts Public routes from the rate
+// limit and hands the route's scope to its gate.
 
 #include <optional>
 #include <string>
 #include <string_view>
 
-namespace fleet::wms {
+namespace fleet::http {
 
 enum class Scope {
   Public,   // no token needed (the health probe)
@@ -44,4 +45,4 @@ inline std::optional<Scope> parseScope(std::string_view s) {
   return std::nullopt;
 }
 
-}  // namespace fleet::wms
+}  // namespace fleet::http

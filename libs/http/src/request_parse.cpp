@@ -1,8 +1,8 @@
-#include "request_parse.hpp"
+#include "fleet/http/request_parse.hpp"
 
 #include <boost/beast/http.hpp>
 
-namespace fleet::wms {
+namespace fleet::http {
 namespace {
 
 int hexValue(char c) {
@@ -99,4 +99,4 @@ ParsedRequest parseRequestBytes(std::string_view bytes, const ServerLimits& limi
   return out;
 }
 
-}  // namespace fleet::wms
+}  // namespace fleet::http
