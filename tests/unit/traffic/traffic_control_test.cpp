@@ -144,7 +144,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   }
 }
 
-/// The knot of a full-stack load test run (2026-11-26, seed 2: r1 and r7 stood for 830 s at the
+/// The knot of a full-stack load test run (2026-11-27, seed 2: r1 and r7 stood for 830 s at the
 /// end of the shift): the robots at their parking places (r10 held docking), r7 on the lane node in
 /// front of PARK-6 on its way to P-2 (north, by the aisle west of it), r1 right behind it on its way
 /// home to PARK-1. Their nodes, goals and the planner's seed are the run's. A robot parked at PARK-6
@@ -191,7 +191,7 @@ TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
   EXPECT_GE(tc.plannerStats().untangles, 1U);
 }
 
-/// The stall of a full-stack load test run (2026-11-26, seed 5: r20, r7 and r11 stood from 206 s
+/// The stall of a full-stack load test run (2026-11-27, seed 5: r20, r7 and r11 stood from 206 s
 /// to the end at 2,400 s). r7 has loaded at P-5 and leaves for D-1 (first by priority while it is
 /// on the dock); the dock's only way out, its approach, is excluded by r20 standing beside it on the
 /// lane on its way east to D-4, and every move of r20 still excludes the approach. r11 waits in
