@@ -45,7 +45,7 @@ void addLoadtestCommand(CLI::App& app, Commands& commands) {
   loadtest
       ->add_option("--station-load", o->stationLoad,
                    "how a task loads its stations: task (pickup and drop-off for the whole task) or phase "
-                   "(the pickup until loaded, then the drop-off)")
+                   "(the pickup until loaded, the drop-off for the whole task)")
       ->check(CLI::IsMember({"task", "phase"}))
       ->capture_default_str();
   loadtest

@@ -37,10 +37,13 @@ struct LoadtestOptions {
   std::string agentConfig;           // robot agents' --config (a JSON file; empty: none)
   int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
   double yieldAfterS = -1.0;         // the traffic manager's yield_after_s (0 off); < 0: its default
-  std::string stationLoad = "task";  // the fleet manager's station_load (task or phase)
-  /// The fleet manager's station_capacity: active tasks per station ("0": no limit), or "queue":
-  /// as many as the station's line on the roadmap holds (dock and queue nodes).
-  std::string stationCapacity = "2";
+  /// The fleet manager's station_load (task or phase) and station_capacity (active tasks per
+  /// station, "0": no limit, or "queue": as many as the station's line on the roadmap holds, dock
+  /// and queue nodes). Default: admission by slots — a task is admitted when its pickup and its
+  /// drop-off each have a place in their line, its pickup counted until it has loaded, its drop-off
+  /// for the whole task (docs/algorithms.md, "Traffic: stations as servers").
+  std::string stationLoad = "phase";
+  std::string stationCapacity = "queue";
   std::string travelCost = "path";  // the fleet manager's travel_cost (path | straight | roadmap)
   double returnHomeS = 5.0;         // robot agents' --return-home (negative: stay where a task ends)
   /// A folder made by scripts/dds-security ("deployment DIR"): every process joins with its

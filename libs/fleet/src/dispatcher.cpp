@@ -468,10 +468,12 @@ std::vector<const std::string*> stationsOf(const Task& t) {
 
 // The stations an active task loads now when load is counted by phase: where its robot is going.
 std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) {
+  // Its pickup until it has loaded there, its drop-off for the whole task: a loaded robot must not
+  // find its drop-off's line full (docs/algorithms.md, "Traffic: stations as servers").
   const bool delivering = state == TaskState::Delivering || state == TaskState::Unloading;
   std::vector<const std::string*> s;
-  for (const std::string* n : {delivering ? &t.dropoff : &t.pickup, &t.station}) {
-    if (!n->empty()) {
+  for (const std::string* n : {&t.pickup, &t.dropoff, &t.station}) {
+    if (!n->empty() && !(delivering && n == &t.pickup)) {
       s.push_back(n);
     }
   }

@@ -367,16 +367,18 @@ TEST_F(DispatcherTest, AStationCapacityOfZeroIsNoLimitThere) {
   EXPECT_EQ(dispatcher->tick(1).assignments.size(), 4u);
 }
 
-/// Counted by phase, a task loads its pickup until it has loaded and then its drop-off: a robot
-/// delivering elsewhere no longer holds a place at the pickup it has left.
+/// Counted by phase, a task loads its pickup until it has loaded and its drop-off for the whole
+/// task: a robot delivering elsewhere no longer holds a place at the pickup it has left, and a task
+/// whose drop-off's line is full waits.
 TEST_F(DispatcherTest, StationLoadByPhaseFreesThePickupOnceLoaded) {
   cfg.stationCapacity = 1;
+  cfg.stationCapacities = {{"D-1", 2}};
   cfg.stationLoadByPhase = true;
   reopen();
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < 4; ++i) {
     robot("r" + std::to_string(i), i, 0.9, 0);
   }
-  dispatcher->submit({transport("t1"), transport("t2")}, 0);
+  dispatcher->submit({transport("t1"), transport("t2"), transport("t3")}, 0);
   const auto out = dispatcher->tick(1);
   ASSERT_EQ(out.assignments.size(), 1u) << "one robot per pickup";
   EXPECT_EQ(out.assignments[0].task.id, "t1");
@@ -386,6 +388,9 @@ TEST_F(DispatcherTest, StationLoadByPhaseFreesThePickupOnceLoaded) {
   const auto next = dispatcher->tick(4);
   ASSERT_EQ(next.assignments.size(), 1u) << "t1 left P-1 for its drop-off: t2 goes";
   EXPECT_EQ(next.assignments[0].task.id, "t2");
+  ASSERT_TRUE(dispatcher->onTaskStatus(next.assignments[0].robotId, "t2", S::Delivering, "", 5));
+  EXPECT_TRUE(dispatcher->tick(6).assignments.empty())
+      << "P-1 is free but D-1's two places are held by t1 and t2 until they are done";
 }
 
 TEST_F(DispatcherTest, StationLoadByTaskHoldsThePickupUntilTheTaskEnds) {

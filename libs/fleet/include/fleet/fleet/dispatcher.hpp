@@ -36,9 +36,10 @@ struct DispatcherConfig {
   std::unordered_map<std::string, std::size_t> stationCapacities;
   /// How an active task loads its stations. Whole task (false): its pickup and its drop-off from
   /// assignment to the end, so with 9 stations and a capacity of 2 at most ~8 tasks are active
-  /// while 20 robots wait. By phase (true): its pickup until it has loaded, then its drop-off,
-  /// which is where the robot is going; admission checks the pickup. With reserved traffic the
-  /// stations' lines (dock and queue nodes) take the robots that arrive while a station is busy.
+  /// while 20 robots wait. By phase (true): its pickup until it has loaded there, its drop-off for
+  /// the whole task (a loaded robot must not find its drop-off's line full); admission checks
+  /// both. With reserved traffic the stations' lines (dock and queue nodes) take the robots that
+  /// arrive while a station is busy.
   bool stationLoadByPhase = false;
   /// A robot that fails this many tasks in a row gets no task for robotHoldNs: an agent that fails
   /// every order at once (a pose estimate inside a shelf after a restart) would otherwise burn
