@@ -34,9 +34,9 @@ struct LoadtestOptions {
   int domain = -1;           // -1: FLEET_DDS_DOMAIN or a random one
   std::uint64_t seed = 7;
   std::string localPlanner = "dwa";
-  std::string agentConfig;           // robot agents' --config (a JSON file; empty: none)
-  int letPass = -1;                  // the traffic manager's let_pass (route nodes; 0 off); -1: its default
-  double yieldAfterS = -1.0;         // the traffic manager's yield_after_s (0 off); < 0: its default
+  std::string agentConfig;    // robot agents' --config (a JSON file; empty: none)
+  int letPass = -1;           // the traffic manager's let_pass (route nodes; 0 off); -1: its default
+  double yieldAfterS = -1.0;  // the traffic manager's yield_after_s (0 off); < 0: its default
   /// The fleet manager's station_load (task or phase) and station_capacity (active tasks per
   /// station, "0": no limit, or "queue": as many as the station's line on the roadmap holds, dock
   /// and queue nodes). Default: admission by slots — a task is admitted when its pickup and its

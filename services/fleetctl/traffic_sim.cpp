@@ -99,6 +99,14 @@ int runTrafficSim(const TrafficSimOptions& o) {
   if (o.stopGap >= 0.0)
     ro.stopGap = o.stopGap;
   auto roadmap = traffic::buildRoadmap(*site, ro);
+  for (const auto& name : o.stations) {
+    const auto* st = roadmap.station(name);
+    if (st == nullptr || (st->kind != site::StationKind::Pickup && st->kind != site::StationKind::Dropoff)) {
+      std::cerr << "fleetctl traffic-sim: --stations: '" << name << "' is no pickup or drop-off of " << o.site
+                << "\n";
+      return 2;
+    }
+  }
   int rc = 0;
   nlohmann::json all = nlohmann::json::array();
   for (int seed = first; seed <= last; ++seed) {
@@ -109,17 +117,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.stopChance = o.stopChance;
     v.stationLines = o.stationLines != 0;
     v.admission = o.admission != 0;
-    v.stationCap = static_cast<std::size_t>(o.stationSlots);
+    v.stationSlots = static_cast<std::size_t>(o.stationSlots);
     v.stations = o.stations;
-    for (const auto& name : o.stations) {
-      const auto* st = roadmap.station(name);
-      if (st == nullptr ||
-          (st->kind != site::StationKind::Pickup && st->kind != site::StationKind::Dropoff)) {
-        std::cerr << "fleetctl traffic-sim: --stations: '" << name << "' is no pickup or drop-off of "
-                  << o.site << "\n";
-        return 2;
-      }
-    }
     if (o.maxLag > 0)
       v.traffic.maxLag = o.maxLag;
     if (o.letPass >= 0)

@@ -27,7 +27,7 @@ struct TrafficSimOptions {
   int queueLength = -1;         ///< generated queue nodes per station; -1: the roadmap's default
   int stationLines = 1;         ///< 1: robots wait in line at stations' queues; 0: all planned to the dock
   int admission = 1;            ///< VirtualFleetOptions::admission
-  int stationSlots = 0;         ///< VirtualFleetOptions::stationCap: slots per station (0: its line)
+  int stationSlots = 0;         ///< VirtualFleetOptions::stationSlots: slots per station (0: its line)
   std::vector<std::string> stations;  ///< VirtualFleetOptions::stations
   bool json = false;
   std::string html;  ///< write a replay page of the first seed's run here (empty: none)

@@ -108,7 +108,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   std::vector<std::size_t> slots(g.size(), 0);
   for (const auto& s : roadmap.stations) {
     if (s.dock != kNoNode)
-      slots[static_cast<std::size_t>(s.dock)] = o.stationCap > 0 ? o.stationCap : 1 + s.queue.size();
+      slots[static_cast<std::size_t>(s.dock)] = o.stationSlots > 0 ? o.stationSlots : 1 + s.queue.size();
   }
   auto admissible = [&](const std::vector<NodeId>& stations) {
     std::vector<NodeId> out;

@@ -497,7 +497,7 @@ TEST(VirtualFleet, AStationCapKeepsTasksApartAndTheRestParked) {
   VirtualFleetOptions o;
   o.robots = 10;
   o.duration = 300.0;
-  o.stationCap = 1;
+  o.stationSlots = 1;
   o.recordEvery = 1.0;
   for (const auto& r : runSeeds(map, o)) {
     SCOPED_TRACE(formatResult(r));

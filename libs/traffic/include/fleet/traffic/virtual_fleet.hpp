@@ -33,12 +33,12 @@ struct VirtualFleetOptions {
   double stopMax = 10.0;
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
   /// Admission by slots: a task is given only when its pickup and its drop-off each have a free
-  /// place in their line (dock and queue places; `stationCap` places instead when above 0); a robot
+  /// place in their line (dock and queue places; `stationSlots` places instead when above 0); a robot
   /// counts at its pickup until it has loaded and at its drop-off for the whole task. A robot with
   /// no admissible task drives to the nearest parking place no robot is sent to and takes the next
   /// admissible task from there. false: every task at once.
   bool admission = true;
-  std::size_t stationCap = 0;
+  std::size_t stationSlots = 0;
   /// Tasks only between these pickups and drop-offs (by name); empty: all of them.
   std::vector<std::string> stations;
   /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
