@@ -9,6 +9,9 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/fleet/errors.hpp"
+#include "fleet/fleet/pg_connection.hpp"
+#include "fleet/fleet/postgres_task_store.hpp"
+#include "fleet/fleet/sqlite_task_store.hpp"
 #include "fleet/planning/map_io.hpp"
 #include "fleet/traffic/roadmap_travel.hpp"
 
@@ -46,6 +49,8 @@ std::string fieldsJson(const std::vector<FieldError>& fields) {
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"db",
+                         "store",
+                         "lease",
                          "stations",
                          "sync",
                          "tick_s",
@@ -74,6 +79,31 @@ Settings readSettings(Config& cfg) {
   s.mapOriginX = map.number("origin_x", 0.0, {-1e6, 1e6});
   s.mapOriginY = map.number("origin_y", 0.0, {-1e6, 1e6});
   s.db = cfg.string("db", s.db);
+  if (cfg.find("store") != nullptr) {
+    if (cfg.find("db") != nullptr) {
+      cfg.problem("store", "give either store or db (db is store \"sqlite:PATH\")");
+    }
+    const std::string store = cfg.string("store", "");
+    if (store.starts_with("sqlite:") && store.size() > 7) {
+      s.db = store.substr(7);
+    } else if (store.starts_with("postgresql://") || store.starts_with("postgres://")) {
+      s.store.backend = StoreSettings::Backend::Postgres;
+      s.store.url = store;
+      if (auto ok = pg::checkUrl(store); !ok) {
+        cfg.problem("store", ok.error().message);
+      }
+    } else {
+      cfg.problem("store", "must be \"sqlite:PATH\" or a \"postgresql://...\" URL");
+    }
+  }
+  auto lease = cfg.child("lease");
+  lease.rejectUnknownKeys({"ttl_s", "renew_s", "name"});
+  s.store.leaseTtlS = lease.number("ttl_s", s.store.leaseTtlS, {0.5, 60.0});
+  s.store.leaseRenewS = lease.number("renew_s", s.store.leaseRenewS, {0.05, 30.0});
+  if (s.store.leaseRenewS * 2 > s.store.leaseTtlS) {
+    lease.problem("renew_s", "must be at most half of ttl_s (a renewal may be late once)");
+  }
+  s.store.leaseName = lease.string("name", s.store.leaseName);
   s.stationsFile = cfg.requireString("stations");
   s.syncFull = cfg.string("sync", "full", {"full", "normal"}) == "full";
   s.tickS = cfg.number("tick_s", s.tickS, {0.0, 60.0, true});
@@ -164,13 +194,29 @@ TravelModel makeRoadmapTravelModel(const StationMap& stations,
   };
 }
 
-Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
-                                                                     std::int64_t nowNs,
-                                                                     std::shared_ptr<const site::Site> site) {
+Expected<std::unique_ptr<TaskStore>> openTaskStore(const Settings& s) {
+  if (s.store.backend == StoreSettings::Backend::Postgres) {
+    auto pgs = PostgresTaskStore::open({s.store.url});
+    if (!pgs) {
+      return unexpected(pgs.error());
+    }
+    return std::unique_ptr<TaskStore>(std::move(*pgs));
+  }
   SqliteTaskStoreOptions opts;
   opts.path = s.db;
   opts.sync = s.syncFull ? SqliteTaskStoreOptions::Sync::Full : SqliteTaskStoreOptions::Sync::Normal;
-  auto store = SqliteTaskStore::open(opts);
+  auto sq = SqliteTaskStore::open(opts);
+  if (!sq) {
+    return unexpected(sq.error());
+  }
+  return std::unique_ptr<TaskStore>(std::move(*sq));
+}
+
+Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Settings& s, StationMap stations,
+                                                                     std::int64_t nowNs,
+                                                                     std::shared_ptr<const site::Site> site,
+                                                                     std::unique_ptr<TaskStore> opened) {
+  auto store = opened ? Expected<std::unique_ptr<TaskStore>>(std::move(opened)) : openTaskStore(s);
   if (!store) {
     return unexpected(store.error());
   }

@@ -10,8 +10,8 @@
 
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
-#include "fleet/fleet/sqlite_task_store.hpp"
 #include "fleet/fleet/task_reconciler.hpp"
+#include "fleet/fleet/task_store.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/metrics/histogram.hpp"
 #include "fleet/planning/distance_field_cache.hpp"
@@ -21,8 +21,22 @@
 
 namespace fleet::manager {
 
+/// Where the tasks live: `"store": "sqlite:PATH"` (the default, `db`'s file) or
+/// `"store": "postgresql://..."` (a libpq URL; several hosts with target_session_attrs=read-write
+/// find the primary). PostgreSQL also holds the managers' lease: one of several managers is active.
+struct StoreSettings {
+  enum class Backend { Sqlite, Postgres } backend = Backend::Sqlite;
+  std::string url;  ///< PostgreSQL's URL (SQLite's file is Settings::db)
+  /// PostgreSQL: the lease's time to live, renewal period and standby poll (seconds).
+  double leaseTtlS = 3.0;
+  double leaseRenewS = 1.0;
+  /// The lease's row in fleet_lease: managers of one fleet share it.
+  std::string leaseName = "fleet_manager";
+};
+
 struct Settings {
-  std::string db = "fleet.db";
+  std::string db = "fleet.db";  ///< the SQLite file (`store: "sqlite:PATH"` sets it too)
+  StoreSettings store;
   std::string stationsFile;  // JSON: {"stations": [...]} (a scenario file works too)
   bool syncFull = true;      // SQLite synchronous=FULL (survives power loss) or NORMAL (process crash)
   double tickS = 0.2;        // periodic assignment
@@ -77,6 +91,9 @@ TravelModel makeRoadmapTravelModel(const StationMap& stations,
 
 Settings readSettings(Config& cfg);
 
+/// Opens the store the settings name (errors as the backends' open).
+Expected<std::unique_ptr<TaskStore>> openTaskStore(const Settings& s);
+
 /// A disagreement between a robot's reports and the store that outlasted `reconcile_s`, and what
 /// the manager did about it; the service logs it as a warning.
 struct Reconciled {
@@ -111,9 +128,11 @@ class FleetManagerNode {
  public:
   /// `site`: for travel costs along paths on its drivable map (a "map" file in the settings wins;
   /// neither: straight lines) or on its roadmap, and for station lines.
+  /// `store`: the opened task store (openTaskStore); null: the node opens the settings' store.
   static Expected<std::unique_ptr<FleetManagerNode>> create(const Settings& s, StationMap stations,
                                                             std::int64_t nowNs,
-                                                            std::shared_ptr<const site::Site> site = nullptr);
+                                                            std::shared_ptr<const site::Site> site = nullptr,
+                                                            std::unique_ptr<TaskStore> store = nullptr);
 
   /// A batch of requests taken from the Task topic: stores new tasks in one group commit, answers
   /// each with a TaskAck, publishes the resulting events. Cancels are applied in order.
@@ -152,7 +171,7 @@ class FleetManagerNode {
   void reconcile(std::int64_t nowNs, Outbox& out);
 
   Settings settings_;
-  std::unique_ptr<SqliteTaskStore> store_;
+  std::unique_ptr<TaskStore> store_;
   std::unique_ptr<Dispatcher> dispatcher_;
   std::map<std::string, std::uint32_t> eventSeq_;
   std::map<std::string, std::uint32_t> revisions_;

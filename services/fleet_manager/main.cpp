@@ -1,5 +1,7 @@
-// fleet_manager: stores tasks durably (SQLite, WAL), assigns them to robots, tracks them to the end
-// and re-assigns work when a robot is lost. Configuration keys: docs/operator-guide.md.
+// fleet_manager: stores tasks durably (SQLite in WAL mode, or PostgreSQL), assigns them to robots,
+// tracks them to the end and re-assigns work when a robot is lost. On PostgreSQL any number of
+// managers run against one database; the one holding the lease (manager_lease.hpp) is active, the
+// others stand by. Configuration keys: docs/operator-guide.md.
 
 #include <spdlog/spdlog.h>
 
@@ -7,11 +9,15 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <optional>
+#include <thread>
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
 #include "fleet/fleet/errors.hpp"
+#include "fleet/fleet/pg_connection.hpp"
+#include "fleet/fleet/postgres_task_store.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
@@ -21,6 +27,7 @@
 #include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
+#include "manager_lease.hpp"
 
 using namespace fleet;
 using namespace std::chrono_literals;
@@ -123,13 +130,87 @@ class ManagerMetrics {
   std::vector<metrics::Gauge*> robots_;
 };
 
+/// Sleeps `d` in short steps; false when a stop was requested meanwhile.
+bool pause(std::chrono::milliseconds d, service::ServiceOps& ops) {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < until) {
+    if (service::stopRequested()) {
+      return false;
+    }
+    ops.refresh();
+    std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(
+        100ms, std::max<std::chrono::steady_clock::duration>(until - std::chrono::steady_clock::now(), 0ms)));
+  }
+  return !service::stopRequested();
+}
+
+/// The task store, opened with retries: an unreachable PostgreSQL is waited for with back-off
+/// (1 s doubling to 10 s; /readyz says task_store not ready). Null when the store cannot be used
+/// (exit 2: a SQLite file that cannot be opened, a schema newer than the binary) or a stop was
+/// requested (`stopped`).
+std::unique_ptr<TaskStore> openStore(const manager::Settings& settings, service::ServiceOps& ops,
+                                     bool& stopped) {
+  const bool pgStore = settings.store.backend == manager::StoreSettings::Backend::Postgres;
+  const std::string where = pgStore ? pg::redacted(settings.store.url) : settings.db;
+  auto backoff = 1000ms;
+  for (;;) {
+    auto s = manager::openTaskStore(settings);
+    if (s) {
+      return std::move(*s);
+    }
+    if (!pgStore || s.error().code != errc::kStorage) {
+      spdlog::critical("fleet manager: cannot open task store {}: {}", where, s.error().message);
+      return nullptr;
+    }
+    spdlog::warn("fleet manager: task store {} unreachable, not ready, retrying in {} s: {}", where,
+                 backoff.count() / 1000.0, s.error().message);
+    if (!pause(backoff, ops)) {
+      stopped = true;
+      return nullptr;
+    }
+    backoff = std::min(backoff * 2, std::chrono::milliseconds(10000));
+  }
+}
+
+/// Stands by until this manager holds the lease; false when a stop was requested.
+bool awaitLease(manager::ManagerLease& lease, const manager::Settings& settings, service::ServiceOps& ops) {
+  const auto poll = std::chrono::milliseconds(static_cast<int>(settings.store.leaseRenewS * 500));
+  bool said = false;
+  std::string lastError;
+  for (;;) {
+    auto got = lease.tryAcquire();
+    if (got && *got) {
+      return true;
+    }
+    if (!got && got.error().message != lastError) {
+      lastError = got.error().message;
+      spdlog::warn("fleet manager: cannot reach the lease: {}", lastError);
+    } else if (got && !said) {
+      said = true;
+      spdlog::info("fleet manager: standing by: lease '{}' held by another manager", lease.options().name);
+    }
+    if (!pause(poll, ops)) {
+      return false;
+    }
+  }
+}
+
 int run(const manager::Settings& settings, const service::OpsSettings& opsSettings) {
   service::ServiceOps ops("fleet_manager");
+  const bool pgStore = settings.store.backend == manager::StoreSettings::Backend::Postgres;
   ops.health().setReady("site", false);
   ops.health().setReady("task_store", false);
+  if (pgStore) {
+    ops.health().setReady("lease", false);
+  }
   if (!ops.start(opsSettings)) {
     return service::kExitUsage;
   }
+  auto& activeGauge = ops.registry().gauge(
+      "fleet_manager_active",
+      "1 on the active manager (the lease holder, or the only one on SQLite), 0 on a standby");
+  auto& epochGauge =
+      ops.registry().gauge("fleet_manager_lease_epoch", "Epoch of the lease this manager holds (0: none)");
   auto loaded = service::loadSiteStations(settings.stationsFile);
   if (!loaded) {
     spdlog::critical("{}", loaded.error().message);
@@ -145,22 +226,14 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   if (loaded->site) {
     site = std::make_shared<const site::Site>(std::move(*loaded->site));
   }
-  auto created =
-      manager::FleetManagerNode::create(settings, std::move(loaded->stations), clock.nowNs(), site);
-  if (!created) {
-    if (created.error().code == errc::kInvalid) {
-      spdlog::critical("fleet manager: {}", created.error().message);  // the settings, not the store
-    } else {
-      spdlog::critical("fleet manager: cannot open task store {}: {}", settings.db, created.error().message);
-    }
-    return 2;
-  }
-  auto& node = **created;
   ops.health().setReady("site", true);
-  ops.health().setReady("task_store", true);
-  ManagerMetrics pm(ops);
-  node.recordAssignLatencyInto(pm.assignLatency());
-  auto& loopSeconds = pm.loopSeconds();
+  std::optional<manager::ManagerLease> lease;
+  if (pgStore) {
+    lease.emplace(manager::ManagerLease::Options{
+        settings.store.url, settings.store.leaseName, {}, settings.store.leaseTtlS});
+    spdlog::info("fleet manager: lease '{}' as {} (ttl {} s, renewed every {} s)", settings.store.leaseName,
+                 lease->options().holder, settings.store.leaseTtlS, settings.store.leaseRenewS);
+  }
 
   transport::Participant p;
   transport::Reader<msg::Task> tasks(p);
@@ -176,8 +249,10 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   ws.attach(states);
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // samples refused at the edge, in the metrics as "samples"
+  std::unique_ptr<manager::FleetManagerNode> active;  // while this manager is active
   auto metrics = [&] {
-    auto j = node.metricsJson();
+    auto j = active ? active->metricsJson() : nlohmann::json::object();
+    j["active"] = active != nullptr;
     j["samples"] = rejections.toJson();
     return j;
   };
@@ -211,81 +286,171 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     }
     out = {};
   };
-  {
-    manager::Outbox rec = node.recovered();
-    spdlog::info("fleet manager: {} open tasks recovered from {}, re-publishing {} assignments",
-                 node.dispatcher().openTasks().size(), settings.db, rec.assignments.size());
-    send(rec);
-  }
-  spdlog::info("fleet manager: {} stations, tick {} s, lease {} s, reconcile {} s, clock {}",
-               node.dispatcher().stations().size(), settings.tickS, settings.leaseS, settings.reconcileS,
-               settings.clock);
-
-  const std::int64_t tickNs = secToNs(settings.tickS);
-  std::int64_t nextTick = 0;
-  auto lastMetrics = std::chrono::steady_clock::now();
-  auto lastLog = lastMetrics;
-  manager::Outbox out;
+  std::optional<ManagerMetrics> pm;
+  bool exitCode2 = false;
   while (!service::stopRequested()) {
-    ws.wait(20ms);
-    const auto turnStart = std::chrono::steady_clock::now();
-    for (const auto& c : clockIn.take()) {
-      sim.set(c.sim_time_ns);
+    // One activation: open the store, (PostgreSQL) wait for the lease, rebuild from the store as a
+    // restarted manager does, run until a stop or until the lease is lost, then stand by again.
+    bool stopped = false;
+    auto store = openStore(settings, ops, stopped);
+    if (!store) {
+      exitCode2 = !stopped;
+      break;
     }
-    const std::int64_t now = clock.nowNs();
-    std::vector<msg::RobotState> gone;
-    for (const auto& s : service::admitted(states.takeWithLifecycle(gone), rejections, badInput)) {
-      node.onRobotState(s, now);
+    ops.health().setReady("task_store", true);
+    if (lease) {
+      if (!awaitLease(*lease, settings, ops)) {
+        break;
+      }
+      static_cast<PostgresTaskStore&>(*store).fenceWith(settings.store.leaseName, lease->epoch());
+      spdlog::info("fleet manager: active: lease '{}' epoch {}", settings.store.leaseName, lease->epoch());
     }
-    // DDS liveliness: a robot whose RobotState writer is gone (agent process ended, lease lost) is
-    // lost now, without waiting for the state lease.
-    for (const auto& g : gone) {
-      if (isValidId(g.robot_id)) {
-        node.onRobotLost(g.robot_id, now, out);
+    auto created =
+        manager::FleetManagerNode::create(settings, loaded->stations, clock.nowNs(), site, std::move(store));
+    if (!created) {
+      if (created.error().code == errc::kInvalid) {
+        spdlog::critical("fleet manager: {}", created.error().message);  // the settings, not the store
+        exitCode2 = true;
+        break;
+      }
+      // The store failed while rebuilding (the database went away): try again.
+      spdlog::error("fleet manager: cannot rebuild from the task store: {}", created.error().message);
+      ops.health().setReady("task_store", false);
+      if (lease) {
+        lease->release();
+      }
+      if (!pause(1000ms, ops)) {
+        break;
+      }
+      continue;
+    }
+    active = std::move(*created);
+    auto& node = *active;
+    ops.health().setReady("lease", true);
+    activeGauge.set(1);
+    epochGauge.set(lease ? static_cast<double>(lease->epoch()) : 0.0);
+    pm.emplace(ops);
+    node.recordAssignLatencyInto(pm->assignLatency());
+    auto& loopSeconds = pm->loopSeconds();
+    bool lost = false;
+    {
+      manager::Outbox rec = node.recovered();
+      if (lease && !lease->held()) {
+        rec = {};  // the lease lapsed while the node rebuilt: nothing published
+      }
+      spdlog::info("fleet manager: {} open tasks recovered from {}, re-publishing {} assignments",
+                   node.dispatcher().openTasks().size(),
+                   pgStore ? pg::redacted(settings.store.url) : settings.db, rec.assignments.size());
+      send(rec);
+    }
+    spdlog::info("fleet manager: {} stations, tick {} s, lease {} s, reconcile {} s, clock {}",
+                 node.dispatcher().stations().size(), settings.tickS, settings.leaseS, settings.reconcileS,
+                 settings.clock);
+
+    const std::int64_t tickNs = secToNs(settings.tickS);
+    std::int64_t nextTick = 0;
+    auto lastMetrics = std::chrono::steady_clock::now();
+    auto lastLog = lastMetrics;
+    manager::Outbox out;
+    auto lastRenew = std::chrono::steady_clock::now();
+    const auto renewEvery = std::chrono::duration<double>(settings.store.leaseRenewS);
+    while (!service::stopRequested()) {
+      ws.wait(20ms);
+      if (lease) {
+        if (std::chrono::steady_clock::now() - lastRenew >= renewEvery) {
+          lastRenew = std::chrono::steady_clock::now();
+          if (auto r = lease->renew(lastRenew); !r) {
+            spdlog::warn("fleet manager: cannot renew the lease: {}", r.error().message);
+          }
+        }
+        if (!lease->held()) {
+          lost = true;
+          break;
+        }
+      }
+      const auto turnStart = std::chrono::steady_clock::now();
+      for (const auto& c : clockIn.take()) {
+        sim.set(c.sim_time_ns);
+      }
+      const std::int64_t now = clock.nowNs();
+      std::vector<msg::RobotState> gone;
+      for (const auto& s : service::admitted(states.takeWithLifecycle(gone), rejections, badInput)) {
+        node.onRobotState(s, now);
+      }
+      // DDS liveliness: a robot whose RobotState writer is gone (agent process ended, lease lost) is
+      // lost now, without waiting for the state lease.
+      for (const auto& g : gone) {
+        if (isValidId(g.robot_id)) {
+          node.onRobotLost(g.robot_id, now, out);
+        }
+      }
+      std::vector<msg::Task> reqs;
+      for (auto& r : tasks.take()) {
+        validation::Rejection why;
+        if (validation::admit(r, rejections, &why)) {
+          reqs.push_back(std::move(r));
+        } else if (isValidId(r.request_id)) {
+          // Answered at once, so the adapter need not wait for a timeout to learn it.
+          const std::string id = isValidId(r.task_id) ? r.task_id : "";
+          const nlohmann::json fields =
+              nlohmann::json::array({{{"path", "request"}, {"reason", why.detail}}});
+          acks.write({r.request_id, id, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                      fields.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), now});
+        } else {
+          badInput.warn("Task:" + why.reason, "refused Task (cannot be answered): " + why.detail);
+        }
+      }
+      bool changed = !reqs.empty();
+      if (!reqs.empty()) {
+        node.onRequests(reqs, now, out);
+      }
+      for (const auto& s : service::admitted(statuses.take(), rejections, badInput)) {
+        node.onStatus(s, now, out);
+        changed = true;
+      }
+      // Event-driven assignment: new tasks or freed robots are matched at once rather than at the
+      // next periodic tick (which still expires leases and handles charging).
+      if (now >= nextTick || changed) {
+        node.tick(now, out);
+        nextTick = now + tickNs;
+      }
+      if (lease && !lease->held()) {
+        // Lost while assigning: nothing of this turn goes out (its store writes were fenced or
+        // are the new holder's to find in the store).
+        lost = true;
+        break;
+      }
+      send(out);
+      loopSeconds.observe(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - turnStart).count());
+      if (ops.refresh()) {
+        pm->update(node);
+      }
+      if (!settings.metricsFile.empty() && std::chrono::steady_clock::now() - lastMetrics > 1s) {
+        writeMetrics(settings.metricsFile, metrics());
+        lastMetrics = std::chrono::steady_clock::now();
+      }
+      if (std::chrono::steady_clock::now() - lastLog > 10s) {
+        spdlog::info("fleet manager: {}", metrics().dump());
+        lastLog = std::chrono::steady_clock::now();
       }
     }
-    std::vector<msg::Task> reqs;
-    for (auto& r : tasks.take()) {
-      validation::Rejection why;
-      if (validation::admit(r, rejections, &why)) {
-        reqs.push_back(std::move(r));
-      } else if (isValidId(r.request_id)) {
-        // Answered at once, so the adapter need not wait for a timeout to learn it.
-        const std::string id = isValidId(r.task_id) ? r.task_id : "";
-        const nlohmann::json fields = nlohmann::json::array({{{"path", "request"}, {"reason", why.detail}}});
-        acks.write({r.request_id, id, msg::AckResult::Invalid, msg::TaskState::Rejected,
-                    fields.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), now});
-      } else {
-        badInput.warn("Task:" + why.reason, "refused Task (cannot be answered): " + why.detail);
-      }
+
+    if (!lost) {
+      break;
     }
-    bool changed = !reqs.empty();
-    if (!reqs.empty()) {
-      node.onRequests(reqs, now, out);
-    }
-    for (const auto& s : service::admitted(statuses.take(), rejections, badInput)) {
-      node.onStatus(s, now, out);
-      changed = true;
-    }
-    // Event-driven assignment: new tasks or freed robots are matched at once rather than at the
-    // next periodic tick (which still expires leases and handles charging).
-    if (now >= nextTick || changed) {
-      node.tick(now, out);
-      nextTick = now + tickNs;
-    }
-    send(out);
-    loopSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - turnStart).count());
-    if (ops.refresh()) {
-      pm.update(node);
-    }
-    if (!settings.metricsFile.empty() && std::chrono::steady_clock::now() - lastMetrics > 1s) {
-      writeMetrics(settings.metricsFile, metrics());
-      lastMetrics = std::chrono::steady_clock::now();
-    }
-    if (std::chrono::steady_clock::now() - lastLog > 10s) {
-      spdlog::info("fleet manager: {}", metrics().dump());
-      lastLog = std::chrono::steady_clock::now();
-    }
+    spdlog::error("fleet manager: lost lease '{}' (epoch {}): stopped publishing, standing by",
+                  settings.store.leaseName, lease->epoch());
+    ops.health().setReady("lease", false);
+    activeGauge.set(0);
+    epochGauge.set(0);
+    active.reset();
+  }
+  if (lease) {
+    lease->release();
+  }
+  if (exitCode2) {
+    return 2;
   }
   if (!settings.metricsFile.empty()) {
     writeMetrics(settings.metricsFile, metrics());
@@ -303,7 +468,10 @@ int main(int argc, char** argv) {
   std::string db;
   std::string stations;
   app.add_option("-c,--config", configPath, "JSON configuration file");
+  std::string store;
   app.add_option("--db", db, "SQLite task database (overrides the config)");
+  app.add_option("--store", store,
+                 "sqlite:PATH or a postgresql:// URL (overrides the config's store and db)");
   app.add_option("--stations", stations,
                  "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   service::addCommonOptions(app, common);
@@ -319,6 +487,11 @@ int main(int argc, char** argv) {
     nlohmann::json merged = cfg.json();
     if (!db.empty()) {
       merged["db"] = db;
+      merged.erase("store");
+    }
+    if (!store.empty()) {
+      merged["store"] = store;
+      merged.erase("db");
     }
     if (!stations.empty()) {
       merged["stations"] = stations;

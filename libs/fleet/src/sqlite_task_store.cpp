@@ -8,6 +8,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
 #include "fleet/validation/utf8.hpp"
+#include "task_store_rules.hpp"
 
 namespace fleet {
 namespace {
@@ -89,10 +90,10 @@ CREATE TABLE IF NOT EXISTS transitions(
 CREATE INDEX IF NOT EXISTS transitions_by_task ON transitions(task_id, seq);
 )sql";
 
-/// Schema version 2 added tasks.paused, version 3 tasks.station (the station the dispatcher chose
-/// for a charge or park task submitted without one; the body stays as submitted, so a retry of the
-/// request is still the same request). An older database gets the columns on open.
-constexpr int kSchemaVersion = 3;
+/// PRAGMA user_version: store_rules::kSchemaVersion (version 2 added tasks.paused, version 3
+/// tasks.station; the body stays as submitted, so a retry of the request is still the same
+/// request). An older database gets the columns on open; a newer one is refused.
+constexpr int kSchemaVersion = store_rules::kSchemaVersion;
 
 constexpr const char* kRecordColumns =
     "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station";
@@ -191,33 +192,21 @@ struct SqliteTaskStore::Impl {
 
   /// Inside a transaction.
   Expected<SubmitResult> submitOne(const Task& t, std::int64_t stamp) {
-    if (auto errs = validateTask(t); !errs.empty()) {
-      return unexpected(errc::kInvalid, makeValidationError(std::move(errs)).message);
+    if (auto ok = store_rules::checkSubmission(t); !ok) {
+      return unexpected(ok.error());
     }
     const std::string body = canonicalBody(t);
     auto existing = load(t.id);
     if (existing) {
-      Task asSubmitted = existing->task;
-      if (existing->stationChosen) {
-        asSubmitted.station.clear();
-      }
-      if (canonicalBody(asSubmitted) != body) {
-        return unexpected(errc::kConflict, "task '" + t.id + "' already exists with a different body");
+      if (auto ok = store_rules::checkResubmission(*existing, body); !ok) {
+        return unexpected(ok.error());
       }
       return SubmitResult{std::move(existing).value(), false};
     }
     if (existing.error().code != errc::kNotFound) {
       return unexpected(existing.error());
     }
-    TaskRecord r;
-    r.task = t;
-    if (r.task.createdNs == 0) {
-      r.task.createdNs = stamp;
-    }
-    r.state = TaskState::Queued;
-    r.reason = "submitted";
-    r.updatedNs = stamp;
-    r.revision = 1;
+    TaskRecord r = store_rules::newRecord(t, stamp);
     insert.bind(1, t.id);
     insert.bind(2, toString(t.kind));
     insert.bind(3, body);
@@ -243,7 +232,10 @@ struct SqliteTaskStore::Impl {
     }
     const int version = v.step() == SQLITE_ROW ? static_cast<int>(v.integer(0)) : 0;
     v.reset();
-    if (version >= kSchemaVersion) {
+    if (version > kSchemaVersion) {
+      return unexpected(store_rules::newerSchema("the task database", version));
+    }
+    if (version == kSchemaVersion) {
       return {};
     }
     Stmt cols;
@@ -270,55 +262,11 @@ struct SqliteTaskStore::Impl {
     if (!cur) {
       return cur;
     }
-    TaskRecord r = std::move(cur).value();
-    if (auto ok = checkTransition(r.state, q.to, r.task.kind); !ok) {
-      return unexpected(errc::kIllegalTransition, "task '" + q.taskId + "': " + ok.error().message);
+    auto applied = store_rules::applyTransition(std::move(cur).value(), q);
+    if (!applied) {
+      return unexpected(applied.error());
     }
-    if (q.to == TaskState::Assigned) {
-      if (q.robotId.empty()) {
-        return unexpected(errc::kInvalid, "task '" + q.taskId + "': assigning needs a robot id");
-      }
-      if (!r.task.robot.empty() && r.task.robot != q.robotId) {
-        return unexpected(errc::kWrongRobot,
-                          "task '" + q.taskId + "' may only be assigned to robot '" + r.task.robot + "'");
-      }
-      r.robotId = q.robotId;
-      ++r.attempts;
-    } else if (!q.robotId.empty() && q.robotId != r.robotId) {
-      return unexpected(errc::kWrongRobot,
-                        "task '" + q.taskId + "' is not held by robot '" + q.robotId + "'");
-    }
-    if (!q.station.empty()) {
-      if (q.to != TaskState::Assigned) {
-        return unexpected(errc::kInvalid, "task '" + q.taskId + "': a station is chosen only when assigning");
-      }
-      if (r.task.kind != TaskKind::Charge && r.task.kind != TaskKind::Park) {
-        return unexpected(errc::kInvalid,
-                          "task '" + q.taskId + "': only charge and park tasks get a chosen station");
-      }
-      if (!r.task.station.empty() && !r.stationChosen) {
-        return unexpected(errc::kInvalid, "task '" + q.taskId + "' names its station");
-      }
-      if (!isValidId(q.station)) {
-        return unexpected(errc::kInvalid, "task '" + q.taskId + "': not a valid station id");
-      }
-      r.task.station = q.station;
-      r.stationChosen = true;
-    } else if (isWaiting(q.to) && r.stationChosen) {
-      // Back in the queue: the next robot gets the station nearest to it.
-      r.task.station.clear();
-      r.stationChosen = false;
-    }
-    const std::optional<TaskState> from = r.state;
-    const std::string holder = r.robotId;
-    r.state = q.to;
-    if (!isActive(q.to)) {
-      // Only an active task has a robot; the log keeps who held it.
-      r.robotId.clear();
-    }
-    r.reason = q.reason;
-    r.updatedNs = q.stampNs;
-    ++r.revision;
+    TaskRecord& r = applied->record;
     update.bind(1, toString(r.state));
     update.bind(2, r.robotId);
     update.bind(3, static_cast<std::int64_t>(r.attempts));
@@ -330,9 +278,7 @@ struct SqliteTaskStore::Impl {
     if (auto ok = stepDone(update, "update task"); !ok) {
       return unexpected(ok.error());
     }
-    if (auto ok = appendLog(q.taskId, from, q.to, q.robotId.empty() ? std::string_view(holder) : q.robotId,
-                            q.reason, q.stampNs);
-        !ok) {
+    if (auto ok = appendLog(q.taskId, applied->from, q.to, applied->logRobot, q.reason, q.stampNs); !ok) {
       return unexpected(ok.error());
     }
     return r;
@@ -481,9 +427,8 @@ Expected<TaskRecord> SqliteTaskStore::setPaused(std::string_view id, bool paused
   if (!cur) {
     return cur;
   }
-  if (isTerminal(cur->state)) {
-    return unexpected(errc::kIllegalTransition,
-                      "task '" + std::string(id) + "' is already " + std::string(toString(cur->state)));
+  if (auto ok = store_rules::checkPause(*cur); !ok) {
+    return unexpected(ok.error());
   }
   if (cur->paused == paused) {
     return cur;  // idempotent: nothing to write
@@ -506,9 +451,8 @@ Expected<TaskRecord> SqliteTaskStore::setWaitReason(std::string_view id, std::st
   if (!cur) {
     return cur;
   }
-  if (!isWaiting(cur->state)) {
-    return unexpected(errc::kIllegalTransition, "task '" + std::string(id) + "' is " +
-                                                    std::string(toString(cur->state)) + ", not waiting");
+  if (auto ok = store_rules::checkWaitReason(*cur); !ok) {
+    return unexpected(ok.error());
   }
   if (cur->reason == reason) {
     return cur;  // idempotent: nothing to write

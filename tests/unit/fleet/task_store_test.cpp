@@ -1,4 +1,6 @@
-#include "fleet/fleet/sqlite_task_store.hpp"
+// Every TaskStore backend passes one suite (TaskStoreTest, parameterised by backend): SQLite in a
+// temporary file, PostgreSQL in a fresh schema on a server the suite starts itself
+// (tests/support/postgres_server.hpp). Backend-specific cases follow the suite.
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -7,6 +9,10 @@
 #include <thread>
 
 #include "fleet/fleet/errors.hpp"
+#include "fleet/fleet/pg_connection.hpp"
+#include "fleet/fleet/postgres_task_store.hpp"
+#include "fleet/fleet/sqlite_task_store.hpp"
+#include "postgres_server.hpp"
 #include "temp_dir.hpp"
 
 namespace fleet {
@@ -53,10 +59,107 @@ std::unique_ptr<SqliteTaskStore> openStore(const std::string& path) {
   return std::move(s).value();
 }
 
-TEST(SqliteTaskStore, PausedFlagIsDurableAndRefusedOnFinishedTasks) {
-  test::TempDir dir;
+enum class Backend { Sqlite, Postgres };
+
+/// One store location per test; open() opens it again (a restart of the manager).
+class TaskStoreTest : public ::testing::TestWithParam<Backend> {
+ public:
+  /// One server for the suite, started by the first PostgreSQL test.
+  static test::PostgresServer& server() {
+    if (!server_) {
+      server_ = std::make_unique<test::PostgresServer>();
+    }
+    return *server_;
+  }
+  static void TearDownTestSuite() { server_.reset(); }
+
+ protected:
+  void SetUp() override {
+    if (GetParam() == Backend::Postgres) {
+      auto& s = server();
+      ASSERT_TRUE(s.ok()) << "the PostgreSQL test server did not start: " << s.error();
+      location_ = s.freshUrl();
+      ASSERT_TRUE(s.ok()) << s.error();
+    } else {
+      location_ = dir_.file("tasks.db");
+    }
+  }
+
+  Expected<std::unique_ptr<TaskStore>> tryOpen() {
+    if (GetParam() == Backend::Postgres) {
+      auto s = PostgresTaskStore::open({location_});
+      if (!s) {
+        return unexpected(s.error());
+      }
+      return std::unique_ptr<TaskStore>(std::move(*s));
+    }
+    auto s = SqliteTaskStore::open({location_});
+    if (!s) {
+      return unexpected(s.error());
+    }
+    return std::unique_ptr<TaskStore>(std::move(*s));
+  }
+  std::unique_ptr<TaskStore> open() {
+    auto s = tryOpen();
+    EXPECT_TRUE(s) << s.error().message;
+    return s ? std::move(s).value() : nullptr;
+  }
+  /// The schema version recorded in the store's database.
+  std::int64_t schemaVersion() {
+    if (GetParam() == Backend::Postgres) {
+      pg::Connection c(location_);
+      auto r = c.exec("read", "SELECT version FROM fleet_schema");
+      return r && r->rows() == 1 ? r->integer(0, 0) : -1;
+    }
+    sqlite3* db = nullptr;
+    sqlite3_open(location_.c_str(), &db);
+    sqlite3_stmt* st = nullptr;
+    sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &st, nullptr);
+    const std::int64_t v = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : -1;
+    sqlite3_finalize(st);
+    sqlite3_close(db);
+    return v;
+  }
+  /// Records `version` as a newer binary would have.
+  void setSchemaVersion(int version) {
+    if (GetParam() == Backend::Postgres) {
+      EXPECT_EQ(server().sql(location_, "UPDATE fleet_schema SET version = " + std::to_string(version)), "");
+      return;
+    }
+    sqlite3* db = nullptr;
+    sqlite3_open(location_.c_str(), &db);
+    EXPECT_EQ(sqlite3_exec(db, ("PRAGMA user_version = " + std::to_string(version)).c_str(), nullptr, nullptr,
+                           nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+  }
+
+  test::TempDir dir_;
+  std::string location_;
+
+ private:
+  static inline std::unique_ptr<test::PostgresServer> server_;
+};
+
+INSTANTIATE_TEST_SUITE_P(Backends, TaskStoreTest, ::testing::Values(Backend::Sqlite, Backend::Postgres),
+                         [](const auto& p) { return p.param == Backend::Sqlite ? "sqlite" : "postgresql"; });
+
+TEST_P(TaskStoreTest, RecordsItsSchemaVersionAndRefusesANewerOne) {
+  ASSERT_TRUE(open());
+  EXPECT_EQ(schemaVersion(), 3);
+  ASSERT_TRUE(open()) << "opened again as it is";
+  setSchemaVersion(9);
+  auto s = tryOpen();
+  ASSERT_FALSE(s) << "a schema newer than the binary";
+  EXPECT_EQ(s.error().code, errc::kSchemaNewer);
+  EXPECT_NE(s.error().message.find("schema version 9"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("version 3"), std::string::npos) << s.error().message;
+  EXPECT_EQ(schemaVersion(), 9) << "left as it was";
+}
+
+TEST_P(TaskStoreTest, PausedFlagIsDurableAndRefusedOnFinishedTasks) {
   {
-    auto store = openStore(dir.file("tasks.db"));
+    auto store = open();
     ASSERT_TRUE(store->submit(transport("t1"), 1));
     ASSERT_TRUE(store->transition("t1", S::Assigned, "r1", "", 2));
     auto p = store->setPaused("t1", true, 3);
@@ -69,7 +172,7 @@ TEST(SqliteTaskStore, PausedFlagIsDurableAndRefusedOnFinishedTasks) {
     EXPECT_TRUE(store->transition("t1", S::EnRoute, "r1", "", 4)->paused);
     EXPECT_EQ(store->setPaused("nope", true, 5).error().code, errc::kNotFound);
   }
-  auto store = openStore(dir.file("tasks.db"));
+  auto store = open();
   EXPECT_TRUE(store->get("t1")->paused);
   EXPECT_TRUE(store->openTasks()->front().paused);
   ASSERT_TRUE(store->setPaused("t1", false, 6));
@@ -95,13 +198,12 @@ PRAGMA user_version = 1;
   EXPECT_TRUE(openStore(path)->get("old")->paused) << "migrated once, then used as version 2";
 }
 
-TEST(SqliteTaskStore, AChosenStationIsStoredWithTheAssignmentAndDroppedOnRequeue) {
-  test::TempDir dir;
+TEST_P(TaskStoreTest, AChosenStationIsStoredWithTheAssignmentAndDroppedOnRequeue) {
   Task park;
   park.id = "park-1";
   park.kind = TaskKind::Park;
   {
-    auto store = openStore(dir.file("tasks.db"));
+    auto store = open();
     ASSERT_TRUE(store->submit(park, 1));
     ASSERT_TRUE(store->submit(transport("t1"), 1));
     auto a = store->transition({"park-1", S::Assigned, "r1", "allocated", 2, "K-2"});
@@ -111,7 +213,7 @@ TEST(SqliteTaskStore, AChosenStationIsStoredWithTheAssignmentAndDroppedOnRequeue
     EXPECT_EQ(store->transition({"t1", S::Assigned, "r2", "", 2, "K-2"}).error().code, errc::kInvalid)
         << "only charge and park tasks get a station chosen";
   }
-  auto store = openStore(dir.file("tasks.db"));  // a restart
+  auto store = open();  // a restart
   const auto got = store->get("park-1");
   ASSERT_TRUE(got);
   EXPECT_EQ(got->task.station, "K-2");
@@ -158,9 +260,8 @@ PRAGMA user_version = 2;
   EXPECT_EQ(openStore(path)->get("old")->task.station, "K-1") << "migrated once, then used as version 3";
 }
 
-TEST(SqliteTaskStore, SubmitIsIdempotentAndDetectsConflicts) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, SubmitIsIdempotentAndDetectsConflicts) {
+  auto store = open();
   auto first = store->submit(transport("t1"), 100);
   ASSERT_TRUE(first) << first.error().message;
   EXPECT_TRUE(first->created);
@@ -190,9 +291,8 @@ TEST(SqliteTaskStore, SubmitIsIdempotentAndDetectsConflicts) {
   EXPECT_EQ(store->get("t 2").error().code, errc::kNotFound);
 }
 
-TEST(SqliteTaskStore, TransitionsFollowTheStateMachine) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, TransitionsFollowTheStateMachine) {
+  auto store = open();
   ASSERT_TRUE(store->submit(transport("t1"), 1));
   EXPECT_EQ(store->transition("t1", S::EnRoute, "r1", "", 2).error().code, errc::kIllegalTransition);
   EXPECT_EQ(store->transition("t1", S::Assigned, "", "", 2).error().code, errc::kInvalid);
@@ -235,24 +335,22 @@ TEST(SqliteTaskStore, TransitionsFollowTheStateMachine) {
 
 // A robot's error that was not UTF-8 was stored as it came, and every reader that made
 // JSON of the record threw, across restarts. Reasons are repaired when read back.
-TEST(SqliteTaskStore, ReasonsThatAreNotUtf8AreRepairedWhenRead) {
-  test::TempDir dir;
+TEST_P(TaskStoreTest, ReasonsThatAreNotUtf8AreRepairedWhenRead) {
   {
-    auto store = openStore(dir.file("tasks.db"));
+    auto store = open();
     ASSERT_TRUE(store->submit(transport("t1"), 1));
     ASSERT_TRUE(store->transition("t1", S::Assigned, "r1", "", 2));
     ASSERT_TRUE(store->transition("t1", S::Requeued, "", "motor \xFF fault", 3));
   }
-  auto store = openStore(dir.file("tasks.db"));
+  auto store = open();
   EXPECT_EQ(store->get("t1")->reason, "motor \xEF\xBF\xBD fault");
   EXPECT_EQ(store->openTasks()->front().reason, "motor \xEF\xBF\xBD fault");
   EXPECT_EQ(store->history("t1")->back().reason, "motor \xEF\xBF\xBD fault");
   EXPECT_NO_THROW((void)toJson(*store->get("t1")).dump());
 }
 
-TEST(SqliteTaskStore, PinnedTaskOnlyForItsRobot) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, PinnedTaskOnlyForItsRobot) {
+  auto store = open();
   Task c;
   c.id = "charge-r1";
   c.kind = TaskKind::Charge;
@@ -264,9 +362,8 @@ TEST(SqliteTaskStore, PinnedTaskOnlyForItsRobot) {
   EXPECT_TRUE(store->transition("charge-r1", S::Done, "r1", "", 4));
 }
 
-TEST(SqliteTaskStore, BatchesAreIndependentItemsInOneCommit) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, BatchesAreIndependentItemsInOneCommit) {
+  auto store = open();
   ASSERT_TRUE(store->submit(transport("old"), 1));
   auto rs = store->submitBatch(
       {transport("a"), transport("old"), transport("old", 3), transport("a"), transport("b")}, 10);
@@ -294,9 +391,8 @@ TEST(SqliteTaskStore, BatchesAreIndependentItemsInOneCommit) {
   EXPECT_EQ((*counts)[S::Cancelled], 1);
 }
 
-TEST(SqliteTaskStore, ListFiltersAndPages) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, ListFiltersAndPages) {
+  auto store = open();
   std::vector<Task> batch;
   for (int i = 0; i < 25; ++i) {
     batch.push_back(transport(numbered("t", 100 + i)));
@@ -327,11 +423,9 @@ TEST(SqliteTaskStore, ListFiltersAndPages) {
   EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), 25u);
 }
 
-TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
-  test::TempDir dir;
-  const auto path = dir.file("tasks.db");
+TEST_P(TaskStoreTest, ReopenRebuildsOpenState) {
   {
-    auto store = openStore(path);
+    auto store = open();
     Task late = transport("late");
     late.deadlineNs = 99;
     late.loadNs = 5;
@@ -341,7 +435,7 @@ TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
     ASSERT_TRUE(store->transition("a", S::Assigned, "r1", "", 4));
     ASSERT_TRUE(store->transition("done", S::Cancelled, "", "", 4));
   }
-  auto store = openStore(path);
+  auto store = open();
   auto open = store->openTasks();
   ASSERT_TRUE(open);
   ASSERT_EQ(open->size(), 2u);
@@ -353,9 +447,8 @@ TEST(SqliteTaskStore, ReopenRebuildsOpenState) {
   EXPECT_EQ((*open)[1].attempts, 1);
 }
 
-TEST(SqliteTaskStore, JsonViewsOfRecordsAndLog) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, JsonViewsOfRecordsAndLog) {
+  auto store = open();
   ASSERT_TRUE(store->submit(transport("t1", 2), 100));
   auto rec = store->transition("t1", S::Assigned, "r1", "allocated", 200);
   ASSERT_TRUE(rec);
@@ -377,9 +470,8 @@ TEST(SqliteTaskStore, JsonViewsOfRecordsAndLog) {
   EXPECT_EQ(toJson(h->back()).at("to"), "assigned");
 }
 
-TEST(SqliteTaskStore, ConcurrentWritersShareOneStore) {
-  test::TempDir dir;
-  auto store = openStore(dir.file("tasks.db"));
+TEST_P(TaskStoreTest, ConcurrentWritersShareOneStore) {
+  auto store = open();
   std::vector<std::thread> threads;
   for (int w = 0; w < 4; ++w) {
     threads.emplace_back([&store, w] {
@@ -407,6 +499,51 @@ TEST(SqliteTaskStore, OpenFailsWithStorageError) {
   auto s = SqliteTaskStore::open({"/nonexistent-dir/x/tasks.db"});
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().code, errc::kStorage);
+}
+
+TEST(PostgresTaskStore, AMalformedUrlIsInvalidAndAnUnreachableServerAStorageError) {
+  auto bad = PostgresTaskStore::open({"postgresql://host:notaport/db"});
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, errc::kInvalid) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("not a PostgreSQL connection URL"), std::string::npos);
+  auto typo = pg::checkUrl("postgresql://db1,db2/fleet?target_session_attr=read-write");
+  ASSERT_FALSE(typo);
+  EXPECT_NE(typo.error().message.find("target_session_attr"), std::string::npos) << typo.error().message;
+  test::TempDir dir;
+  auto gone = PostgresTaskStore::open({"postgresql:///fleet?host=" + dir.file("") + "&connect_timeout=2"});
+  ASSERT_FALSE(gone);
+  EXPECT_EQ(gone.error().code, errc::kStorage) << gone.error().message;
+  EXPECT_NE(gone.error().message.find("cannot connect to PostgreSQL"), std::string::npos)
+      << gone.error().message;
+  EXPECT_EQ(pg::redacted("postgresql://fleet:s3cret@db1,db2/fleet?target_session_attrs=read-write"),
+            "postgresql://fleet:***@db1,db2/fleet?target_session_attrs=read-write");
+  EXPECT_TRUE(pg::checkUrl("postgresql://db1:5432,db2:5432/fleet?target_session_attrs=read-write"));
+}
+
+// Fencing is the PostgreSQL store's (SQLite has one manager): after another manager took the
+// lease, a write of the older epoch stores nothing.
+TEST(PostgresTaskStore, WritesOfAnOlderLeaseEpochAreFenced) {
+  auto& server = TaskStoreTest::server();
+  ASSERT_TRUE(server.ok()) << "the PostgreSQL test server did not start: " << server.error();
+  const std::string url = server.freshUrl();
+  auto store = PostgresTaskStore::open({url});
+  ASSERT_TRUE(store) << store.error().message;
+  ASSERT_EQ(server.sql(url, "INSERT INTO fleet_lease(name, holder, epoch) VALUES ('m', 'a', 4)"), "");
+  (*store)->fenceWith("m", 4);
+  ASSERT_TRUE((*store)->submit(transport("t1"), 1));
+  ASSERT_TRUE((*store)->transition("t1", S::Assigned, "r1", "", 2));
+  ASSERT_EQ(server.sql(url, "UPDATE fleet_lease SET holder = 'b', epoch = 5"), "");
+  auto late = (*store)->transition("t1", S::EnRoute, "r1", "", 3);
+  ASSERT_FALSE(late);
+  EXPECT_EQ(late.error().code, errc::kFenced) << late.error().message;
+  auto batch = (*store)->submitBatch({transport("t2"), transport("t3")}, 4);
+  ASSERT_EQ(batch.size(), 2u);
+  EXPECT_EQ(batch[1].error().code, errc::kFenced);
+  EXPECT_EQ((*store)->get("t2").error().code, errc::kNotFound) << "nothing stored";
+  EXPECT_EQ((*store)->get("t1")->state, S::Assigned);
+  EXPECT_TRUE((*store)->get("t1")) << "reads are not fenced";
+  (*store)->fenceWith("m", 5);
+  EXPECT_TRUE((*store)->transition("t1", S::EnRoute, "r1", "", 5)) << "the new epoch writes";
 }
 
 }  // namespace
