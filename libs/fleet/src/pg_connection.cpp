@@ -102,6 +102,9 @@ Expected<void> Connection::ensure() {
     while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) {
       why.pop_back();
     }
+    for (auto& c : why) {
+      c = c == '\n' || c == '\t' ? ' ' : c;  // one log line
+    }
     return unexpected(errc::kStorage, "cannot connect to PostgreSQL at " + redacted(url_) + ": " + why);
   }
   // Server notices (CREATE TABLE IF NOT EXISTS "already exists, skipping") are not errors: kept
