@@ -8,7 +8,9 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <thread>
 
@@ -172,8 +174,47 @@ std::unique_ptr<TaskStore> openStore(const manager::Settings& settings, service:
   }
 }
 
-/// Stands by until this manager holds the lease; false when a stop was requested.
-bool awaitLease(manager::ManagerLease& lease, const manager::Settings& settings, service::ServiceOps& ops) {
+/// Samples a standby takes off the wire while it waits: its readers' caches must not grow, and the
+/// requests and reports of the last `window` are handed to the manager once it is active (the
+/// takeover gap loses none; requests are idempotent, a report already applied is refused as stale).
+template <class T>
+class Recent {
+ public:
+  explicit Recent(std::chrono::steady_clock::duration window) : window_(window) {}
+  void add(std::vector<T> samples) {
+    const auto now = std::chrono::steady_clock::now();
+    for (auto& s : samples) {
+      held_.emplace_back(now, std::move(s));
+    }
+    while (!held_.empty() && now - held_.front().first > window_) {
+      held_.pop_front();
+    }
+  }
+  /// The held samples, oldest first, followed by `fresh`; nothing is held afterwards.
+  std::vector<T> with(std::vector<T> fresh) {
+    if (held_.empty()) {
+      return fresh;
+    }
+    std::vector<T> out;
+    out.reserve(held_.size() + fresh.size());
+    for (auto& [at, s] : held_) {
+      out.push_back(std::move(s));
+    }
+    held_.clear();
+    std::move(fresh.begin(), fresh.end(), std::back_inserter(out));
+    return out;
+  }
+
+ private:
+  std::chrono::steady_clock::duration window_;
+  std::deque<std::pair<std::chrono::steady_clock::time_point, T>> held_;
+};
+
+/// Stands by until this manager holds the lease, calling `drain` on every poll; false when a stop
+/// was requested.
+template <class Drain>
+bool awaitLease(manager::ManagerLease& lease, const manager::Settings& settings, service::ServiceOps& ops,
+                Drain&& drain) {
   const auto poll = std::chrono::milliseconds(static_cast<int>(settings.store.leaseRenewS * 500));
   bool said = false;
   std::string lastError;
@@ -189,6 +230,7 @@ bool awaitLease(manager::ManagerLease& lease, const manager::Settings& settings,
       said = true;
       spdlog::info("fleet manager: standing by: lease '{}' held by another manager", lease.options().name);
     }
+    drain();
     if (!pause(poll, ops)) {
       return false;
     }
@@ -288,6 +330,11 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   };
   std::optional<ManagerMetrics> pm;
   bool exitCode2 = false;
+  // A lease's ttl and a poll: what arrived since the active manager's last turn, or just before.
+  const auto heldWindow = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(settings.store.leaseTtlS + settings.store.leaseRenewS));
+  Recent<msg::Task> heldTasks(heldWindow);
+  Recent<msg::TaskStatus> heldStatuses(heldWindow);
   while (!service::stopRequested()) {
     // One activation: open the store, (PostgreSQL) wait for the lease, rebuild from the store as a
     // restarted manager does, run until a stop or until the lease is lost, then stand by again.
@@ -299,7 +346,13 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     }
     ops.health().setReady("task_store", true);
     if (lease) {
-      if (!awaitLease(*lease, settings, ops)) {
+      if (!awaitLease(*lease, settings, ops, [&] {
+            heldTasks.add(tasks.take());
+            heldStatuses.add(statuses.take());
+            std::vector<msg::RobotState> gone;
+            (void)states.takeWithLifecycle(gone);  // robots report again at once
+            (void)clockIn.take();
+          })) {
         break;
       }
       static_cast<PostgresTaskStore&>(*store).fenceWith(settings.store.leaseName, lease->epoch());
@@ -385,7 +438,7 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
         }
       }
       std::vector<msg::Task> reqs;
-      for (auto& r : tasks.take()) {
+      for (auto& r : heldTasks.with(tasks.take())) {
         validation::Rejection why;
         if (validation::admit(r, rejections, &why)) {
           reqs.push_back(std::move(r));
@@ -404,7 +457,7 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
       if (!reqs.empty()) {
         node.onRequests(reqs, now, out);
       }
-      for (const auto& s : service::admitted(statuses.take(), rejections, badInput)) {
+      for (const auto& s : service::admitted(heldStatuses.with(statuses.take()), rejections, badInput)) {
         node.onStatus(s, now, out);
         changed = true;
       }
