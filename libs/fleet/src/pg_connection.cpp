@@ -205,6 +205,76 @@ Expected<Result> Connection::exec(std::string_view what, const std::string& sql,
                what);
 }
 
+Expected<std::vector<Result>> Connection::runAll(std::string_view what, const std::string& name,
+                                                 const std::vector<std::vector<Param>>& all) {
+  std::vector<Result> out;
+  out.reserve(all.size());
+  // Chunks keep what is sent before reading bounded (a blocking connection that only writes while
+  // the server's results fill the socket would wait for ever).
+  constexpr std::size_t kChunk = 500;
+  for (std::size_t from = 0; from < all.size(); from += kChunk) {
+    if (auto ok = ensure(); !ok) {
+      return unexpected(ok.error());
+    }
+    if (PQenterPipelineMode(conn_) != 1) {
+      return unexpected(errc::kStorage, "postgresql: " + std::string(what) + ": cannot enter pipeline mode");
+    }
+    const std::size_t to = std::min(all.size(), from + kChunk);
+    for (std::size_t i = from; i < to; ++i) {
+      Params p(all[i]);
+      if (PQsendQueryPrepared(conn_, name.c_str(), static_cast<int>(all[i].size()), p.values.data(), nullptr,
+                              nullptr, 0) != 1) {
+        break;
+      }
+    }
+    PQpipelineSync(conn_);
+    std::optional<Error> failed;
+    for (;;) {
+      PGresult* r = PQgetResult(conn_);
+      if (r == nullptr) {
+        if (PQstatus(conn_) != CONNECTION_OK) {
+          if (!failed) {
+            failed = Error{errc::kStorage, "postgresql: " + std::string(what) + ": " + PQerrorMessage(conn_)};
+          }
+          break;
+        }
+        continue;  // the end of one statement's results
+      }
+      const auto st = PQresultStatus(r);
+      if (st == PGRES_PIPELINE_SYNC) {
+        PQclear(r);
+        break;
+      }
+      if (st == PGRES_PIPELINE_ABORTED) {
+        PQclear(r);
+        continue;  // after the first error: that one is reported
+      }
+      auto one = check(r, what);
+      if (one) {
+        out.push_back(std::move(*one));
+      } else if (!failed) {
+        failed = one.error();
+      }
+    }
+    if (conn_ != nullptr) {
+      PQexitPipelineMode(conn_);
+      if (PQstatus(conn_) != CONNECTION_OK) {
+        close();
+      }
+    }
+    if (failed) {
+      if (inTx_ && !txError_) {
+        txError_ = failed;
+      }
+      return unexpected(std::move(*failed));
+    }
+    if (out.size() != to) {
+      return unexpected(errc::kStorage, "postgresql: " + std::string(what) + ": results missing");
+    }
+  }
+  return out;
+}
+
 Expected<Result> Connection::run(std::string_view what, const std::string& name,
                                  const std::vector<Param>& params) {
   if (auto ok = ensure(); !ok) {

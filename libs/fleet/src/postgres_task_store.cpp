@@ -140,33 +140,6 @@ struct PostgresTaskStore::Impl {
   }
 
   /// Inside a transaction.
-  Expected<SubmitResult> submitOne(const Task& t, std::int64_t stamp) {
-    if (auto ok = store_rules::checkSubmission(t); !ok) {
-      return unexpected(ok.error());
-    }
-    const std::string body = canonicalBody(t);
-    TaskRecord r = store_rules::newRecord(t, stamp);
-    // Inserted with its log row in one round trip; nothing inserted when the id is taken.
-    auto ins = conn.run("insert task", "insert",
-                        {str(t.id), str(toString(t.kind)), str(body), str(toString(r.state)), str(r.reason),
-                         num(r.task.createdNs), num(stamp)});
-    if (!ins) {
-      return unexpected(ins.error());
-    }
-    if (ins->affected() == 1) {
-      return SubmitResult{std::move(r), true};
-    }
-    auto existing = load(t.id, false);
-    if (!existing) {
-      return unexpected(existing.error());
-    }
-    if (auto ok = store_rules::checkResubmission(*existing, body); !ok) {
-      return unexpected(ok.error());
-    }
-    return SubmitResult{std::move(existing).value(), false};
-  }
-
-  /// Inside a transaction.
   Expected<TaskRecord> transitionOne(const TransitionRequest& q) {
     auto cur = load(q.taskId, true);
     if (!cur) {
@@ -342,8 +315,50 @@ Expected<SubmitResult> PostgresTaskStore::submit(const Task& t, std::int64_t sta
 std::vector<Expected<SubmitResult>> PostgresTaskStore::submitBatch(const std::vector<Task>& tasks,
                                                                    std::int64_t stampNs) {
   std::lock_guard lock(mu_);
-  return impl_->batch<SubmitResult>(tasks.size(),
-                                    [&](std::size_t i) { return impl_->submitOne(tasks[i], stampNs); });
+  // Every insert sent at once (one round trip); then, for the ids already taken, the stored record
+  // read back to tell a retry from a conflict.
+  std::vector<Expected<void>> valid;
+  std::vector<std::string> bodies(tasks.size());
+  std::vector<std::vector<Param>> inserts;
+  valid.reserve(tasks.size());
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    valid.push_back(store_rules::checkSubmission(tasks[i]));
+    if (valid.back()) {
+      bodies[i] = canonicalBody(tasks[i]);
+      const TaskRecord r = store_rules::newRecord(tasks[i], stampNs);
+      inserts.push_back({str(tasks[i].id), str(toString(tasks[i].kind)), str(bodies[i]),
+                         str(toString(r.state)), str(r.reason), num(r.task.createdNs), num(stampNs)});
+    }
+  }
+  std::optional<std::vector<pg::Result>> inserted;
+  std::size_t next = 0;
+  return impl_->batch<SubmitResult>(tasks.size(), [&](std::size_t i) -> Expected<SubmitResult> {
+    if (!valid[i]) {
+      return unexpected(valid[i].error());
+    }
+    if (!inserted) {
+      auto all = impl_->conn.runAll("insert tasks", "insert", inserts);
+      if (!all) {
+        inserted.emplace();  // the transaction fails: commit rolls back and fails every item
+        return unexpected(all.error());
+      }
+      inserted = std::move(*all);
+    }
+    if (next >= inserted->size()) {
+      return unexpected(errc::kStorage, "postgresql: insert tasks failed");
+    }
+    if ((*inserted)[next++].affected() == 1) {
+      return SubmitResult{store_rules::newRecord(tasks[i], stampNs), true};
+    }
+    auto existing = impl_->load(tasks[i].id, false);
+    if (!existing) {
+      return unexpected(existing.error());
+    }
+    if (auto ok = store_rules::checkResubmission(*existing, bodies[i]); !ok) {
+      return unexpected(ok.error());
+    }
+    return SubmitResult{std::move(existing).value(), false};
+  });
 }
 
 Expected<TaskRecord> PostgresTaskStore::transition(const TransitionRequest& r) {

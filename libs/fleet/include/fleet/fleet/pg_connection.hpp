@@ -71,6 +71,12 @@ class Connection {
   Expected<void> commit();
   void rollback();
 
+  /// Runs a statement given to addStatement once per parameter list, all sent before the first
+  /// result is read (libpq's pipeline mode): one round trip for the lot. The results in order, or
+  /// the first error.
+  Expected<std::vector<Result>> runAll(std::string_view what, const std::string& name,
+                                       const std::vector<std::vector<Param>>& all);
+
   /// SQLSTATE of the latest failed call ("" when none or unknown).
   [[nodiscard]] const std::string& lastState() const { return lastState_; }
 
