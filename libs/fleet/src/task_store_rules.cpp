@@ -7,8 +7,9 @@ namespace fleet::store_rules {
 
 Error newerSchema(std::string_view where, std::int64_t found) {
   return Error{errc::kSchemaNewer, std::string(where) + " has schema version " + std::to_string(found) +
-                                   ", newer than this binary's version " + std::to_string(kSchemaVersion) +
-                                   ": run a fleet manager of the version that wrote it (or newer)"};
+                                       ", newer than this binary's version " +
+                                       std::to_string(kSchemaVersion) +
+                                       ": run a fleet manager of the version that wrote it (or newer)"};
 }
 
 Expected<void> checkSubmission(const Task& t) {

@@ -332,6 +332,46 @@ TEST(Settings, StationCapacityIsANumberOrQueueAndRoadmapCostsNeedASite) {
   std::filesystem::remove(noSite.db);
 }
 
+TEST(Settings, StoreIsSqliteByDefaultOrAPostgresqlUrl) {
+  auto defaults = Config::fromText(R"({"stations": "s.json"})", "manager.json");
+  auto s = manager::readSettings(defaults);
+  defaults.finish();
+  EXPECT_EQ(s.store.backend, manager::StoreSettings::Backend::Sqlite);
+  EXPECT_EQ(s.db, "fleet.db");
+  auto file =
+      Config::fromText(R"({"stations": "s.json", "store": "sqlite:/var/lib/fleet/tasks.db"})", "m.json");
+  s = manager::readSettings(file);
+  file.finish();
+  EXPECT_EQ(s.store.backend, manager::StoreSettings::Backend::Sqlite);
+  EXPECT_EQ(s.db, "/var/lib/fleet/tasks.db");
+  auto pgc = Config::fromText(R"({"stations": "s.json", "lease": {"ttl_s": 4, "renew_s": 0.5},
+      "store": "postgresql://fleet@db1:5432,db2:5432/fleet?target_session_attrs=read-write"})",
+                              "m.json");
+  s = manager::readSettings(pgc);
+  pgc.finish();
+  EXPECT_EQ(s.store.backend, manager::StoreSettings::Backend::Postgres);
+  EXPECT_EQ(s.store.url, "postgresql://fleet@db1:5432,db2:5432/fleet?target_session_attrs=read-write");
+  EXPECT_DOUBLE_EQ(s.store.leaseTtlS, 4.0);
+  EXPECT_DOUBLE_EQ(s.store.leaseRenewS, 0.5);
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"stations": "s.json", "store": "mysql://db/fleet"})", "store: must be"},
+      {R"({"stations": "s.json", "store": "postgresql://db:port/fleet"})", "port 'port' is not a number"},
+      {R"({"stations": "s.json", "store": "postgresql://db/fleet?target_session_attr=read-write"})",
+       "target_session_attr"},
+      {R"({"stations": "s.json", "store": "sqlite:a.db", "db": "b.db"})", "give either store or db"},
+      {R"({"stations": "s.json", "lease": {"ttl_s": 2, "renew_s": 1.5}})", "at most half of ttl_s"}};
+  for (const auto& [text, why] : bad) {
+    auto c = Config::fromText(text, "m.json");
+    manager::readSettings(c);
+    try {
+      c.finish();
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const ConfigError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(why)) << text;
+    }
+  }
+}
+
 TEST(Settings, ChargeUntilMustExceedTheBatteryThreshold) {
   auto defaults = Config::fromText(R"({"stations": "s.json"})", "manager.json");
   const auto s = manager::readSettings(defaults);
