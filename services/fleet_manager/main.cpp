@@ -85,6 +85,16 @@ class ManagerMetrics {
                         "Wall time of one turn of the manager's loop (work only)",
                         metrics::exponentialBuckets(1e-5, 2.0, 18));
   }
+  /// A manager that stands by again reports no tasks and no robots (sums over managers count the
+  /// active one only).
+  void clear() {
+    for (auto* g : tasks_) {
+      g->set(0);
+    }
+    for (auto* g : robots_) {
+      g->set(0);
+    }
+  }
   void update(const manager::FleetManagerNode& node) {
     const auto& c = node.dispatcher().counters();
     const auto& m = node.metrics();
@@ -495,6 +505,7 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     spdlog::error("fleet manager: lost lease '{}' (epoch {}): stopped publishing, standing by",
                   settings.store.leaseName, lease->epoch());
     ops.health().setReady("lease", false);
+    pm->clear();
     activeGauge.set(0);
     epochGauge.set(0);
     active.reset();
