@@ -117,4 +117,54 @@ TEST(StandbyManager, OneIsActiveAndAStandbyTakesOverWithinFiveSecondsOfAKill) {
   fs::remove_all(dir);
 }
 
+// A hung active manager (SIGSTOP) stops renewing: the standby takes over; once it runs again the
+// old one finds its lease lapsed, publishes nothing, and stands by.
+TEST(StandbyManager, AHungActiveManagerIsReplacedAndStandsByWhenItResumes) {
+  fleet::test::PostgresServer server;
+  ASSERT_TRUE(server.ok()) << "the PostgreSQL test server did not start: " << server.error();
+  const std::string domain = std::to_string(fleet::test::uniqueDomain());
+  const auto dir = fs::temp_directory_path() / ("fleet-standby-hung-" + domain);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "manager.json")
+      << nlohmann::json{{"store", server.url()}, {"stations", kScenario}}.dump();
+  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", domain}};
+  const int ops[2] = {fleet::test::freePort(), fleet::test::freePort()};
+  std::unique_ptr<fleet::test::ChildProcess> managers[2];
+  auto waitUntil = [](auto&& cond, std::chrono::seconds within) {
+    const auto end = std::chrono::steady_clock::now() + within;
+    while (!cond() && std::chrono::steady_clock::now() < end) {
+      std::this_thread::sleep_for(50ms);
+    }
+    return cond();
+  };
+  for (int i = 0; i < 2; ++i) {
+    managers[i] = std::make_unique<fleet::test::ChildProcess>(
+        kBin + "/services/fleet_manager/fleet_manager",
+        std::vector<std::string>{"--config", (dir / "manager.json").string(), "--metrics-port",
+                                 std::to_string(ops[i]), "--log-level", "warn"},
+        env);
+    if (i == 0) {
+      ASSERT_TRUE(waitUntil([&] { return status(ops[0], "/readyz") == 200; }, 30s));
+    }
+  }
+  ASSERT_TRUE(waitUntil([&] { return has(ops[1], "fleet_manager_active 0"); }, 20s));
+  managers[0]->kill(SIGSTOP);
+  const auto stopped = std::chrono::steady_clock::now();
+  EXPECT_TRUE(waitUntil([&] { return status(ops[1], "/readyz") == 200; }, 10s));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - stopped).count(), 5.0);
+  EXPECT_TRUE(has(ops[1], "fleet_manager_lease_epoch 2"));
+  managers[0]->kill(SIGCONT);
+  EXPECT_TRUE(waitUntil([&] { return has(ops[0], "fleet_manager_active 0"); }, 10s))
+      << "the resumed one stands by";
+  EXPECT_EQ(status(ops[0], "/readyz"), 503);
+  EXPECT_TRUE(has(ops[0], "fleet_manager_lease_epoch 0"));
+  EXPECT_TRUE(has(ops[1], "fleet_manager_active 1")) << "exactly one active";
+  for (auto& m : managers) {
+    m->kill(SIGTERM);
+    EXPECT_EQ(m->wait(10s), 0);
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
