@@ -35,7 +35,7 @@ namespace fleet::test {
 class PostgresServer {
  public:
   /// `durable`: fsync and synchronous commit as in production (benchmarks); tests run without.
-  explicit PostgresServer(bool durable = false) {
+  explicit PostgresServer(bool durable = false) : durable_(durable) {
     const char* env = std::getenv("FLEET_PG_BIN");
     bin_ = env != nullptr ? env : "/usr/lib/postgresql/15/bin";
     if (!std::filesystem::exists(bin_ + "/postgres") || !std::filesystem::exists(bin_ + "/initdb")) {
@@ -111,6 +111,12 @@ class PostgresServer {
     pg::Connection c(schemaUrl);
     auto r = c.exec("test setup", statements);
     return r ? std::string() : r.error().message;
+  }
+
+  /// Starts the stopped server again on the same data directory and socket.
+  void restart() {
+    stop();
+    start(durable_);
   }
 
   /// Immediate shutdown (as a crash would: no checkpoint).
@@ -245,6 +251,7 @@ class PostgresServer {
     return ss.str();
   }
 
+  bool durable_ = false;
   std::string bin_;
   std::filesystem::path dir_;
   bool asRoot_ = false;

@@ -546,5 +546,29 @@ TEST(PostgresTaskStore, WritesOfAnOlderLeaseEpochAreFenced) {
   EXPECT_TRUE((*store)->transition("t1", S::EnRoute, "r1", "", 5)) << "the new epoch writes";
 }
 
+// The server goes away (a crash, a fail-over) and comes back: calls fail with "storage" meanwhile
+// and the store connects again by itself, committed work intact. Its own server: it is stopped.
+TEST(PostgresTaskStore, ReconnectsByItselfWhenTheServerIsBack) {
+  test::PostgresServer server(true);  // durable: the test server's asynchronous commits die with it
+  ASSERT_TRUE(server.ok()) << "the PostgreSQL test server did not start: " << server.error();
+  auto store = PostgresTaskStore::open({server.url()});
+  ASSERT_TRUE(store) << store.error().message;
+  ASSERT_TRUE((*store)->submit(transport("t1"), 1));
+  server.stop();
+  auto down = (*store)->submit(transport("t2"), 2);
+  ASSERT_FALSE(down);
+  EXPECT_EQ(down.error().code, errc::kStorage) << down.error().message;
+  EXPECT_EQ((*store)->get("t1").error().code, errc::kStorage);
+  server.restart();
+  ASSERT_TRUE(server.ok()) << server.error();
+  auto t1 = (*store)->get("t1");
+  ASSERT_TRUE(t1) << t1.error().message;
+  EXPECT_EQ(t1->state, S::Queued);
+  auto t2 = (*store)->submit(transport("t2"), 3);
+  ASSERT_TRUE(t2) << t2.error().message;
+  EXPECT_TRUE(t2->created) << "nothing of the failed call was stored";
+  EXPECT_TRUE((*store)->transition("t1", S::Assigned, "r1", "", 4)) << "statements prepared again";
+}
+
 }  // namespace
 }  // namespace fleet
