@@ -546,6 +546,19 @@ TEST(PostgresTaskStore, WritesOfAnOlderLeaseEpochAreFenced) {
   EXPECT_TRUE((*store)->transition("t1", S::EnRoute, "r1", "", 5)) << "the new epoch writes";
 }
 
+// libpq's multi-host form: a host that is down is skipped, and target_session_attrs=read-write
+// takes the primary (here the only server; a read-only replica is skipped the same way).
+TEST(PostgresTaskStore, AMultiHostUrlFindsTheWritableServer) {
+  auto& server = TaskStoreTest::server();
+  ASSERT_TRUE(server.ok()) << "the PostgreSQL test server did not start: " << server.error();
+  test::TempDir nothing;
+  const std::string url = "postgresql:///postgres?host=" + nothing.file("") + "," + server.socketDir() +
+                          "&user=fleet&target_session_attrs=read-write&connect_timeout=2";
+  auto store = PostgresTaskStore::open({url});
+  ASSERT_TRUE(store) << store.error().message;
+  EXPECT_TRUE((*store)->submit(transport("t1"), 1));
+}
+
 // The server goes away (a crash, a fail-over) and comes back: calls fail with "storage" meanwhile
 // and the store connects again by itself, committed work intact. Its own server: it is stopped.
 TEST(PostgresTaskStore, ReconnectsByItselfWhenTheServerIsBack) {
