@@ -174,6 +174,7 @@ std::unique_ptr<TaskStore> openStore(const manager::Settings& settings, service:
       spdlog::critical("fleet manager: cannot open task store {}: {}", where, s.error().message);
       return nullptr;
     }
+    ops.health().setReady("task_store", false);
     spdlog::warn("fleet manager: task store {} unreachable, not ready, retrying in {} s: {}", where,
                  backoff.count() / 1000.0, s.error().message);
     if (!pause(backoff, ops)) {
