@@ -136,6 +136,9 @@ Expected<Result> Connection::check(pg_result* r, std::string_view what) {
   while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) {
     why.pop_back();
   }
+  for (auto& c : why) {
+    c = c == '\n' || c == '\t' ? ' ' : c;  // one log line
+  }
   if (conn_ != nullptr && PQstatus(conn_) != CONNECTION_OK) {
     close();  // opened again by the next call outside a transaction
   }
