@@ -163,8 +163,12 @@ int runTrafficSim(const TrafficSimOptions& o) {
                           {"dock_cycle_p50_s", st.cycleP50},
                           {"dock_cycle_p90_s", st.cycleP90}});
     }
+    nlohmann::json waits = nlohmann::json::array();
+    for (const auto& w : r.waits)
+      waits.push_back({{"place", w.place}, {"robot_s", w.seconds}});
     if (o.json) {
       all.push_back({{"seed", seed},
+                     {"waits", waits},
                      {"fleet_bound", bound},
                      {"robot_time", robotTime},
                      {"stations", stations},
@@ -202,6 +206,16 @@ int runTrafficSim(const TrafficSimOptions& o) {
         std::cout << ";";
       }
       std::cout << "\n";
+      double waited = 0.0;
+      for (const auto& w : r.waits)
+        waited += w.seconds;
+      if (waited > 0.0) {
+        std::cout << "  waiting on robots, where:";
+        for (std::size_t i = 0; i < r.waits.size() && i < 8; ++i)
+          std::cout << " " << r.waits[i].place << " " << std::setprecision(0)
+                    << 100.0 * r.waits[i].seconds / waited << " %;";
+        std::cout << "\n";
+      }
       for (const auto& s : r.stalls)
         std::cout << "  stalled: " << s << "\n";
     }

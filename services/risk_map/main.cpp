@@ -9,6 +9,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/clocked_loop.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
@@ -47,24 +48,16 @@ int run(const riskmap::Settings& settings, const std::string& id, const service:
   transport::Participant p;
   transport::Reader<msg::PredictedDiscs> discs(p);
   transport::Writer<msg::RiskMap> out(p);
-  transport::Reader<msg::Clock> clockIn(p);
-  transport::Writer<msg::StepDone> stepDone(p);
   transport::WaitSet ws(p);
   ws.attach(discs);
-  ws.attach(clockIn);
+  service::ClockedLoop loop(p, ws,
+                            {settings.clock == "sim", settings.lockstep, id, secToNs(1.0 / settings.rateHz)});
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // refused at the edge, before the fusion engine's own checks
   badInput.onEach([&ops](const std::string& reason) { ops.rejected(reason).inc(); });
   ops.watchMatchedWriters("PredictedDiscs", [&] { return discs.matchedWriters(); });
   ops.watchForeign([&] { return discs.foreign(); });
   ops.watchMatchedReaders("RiskMap", [&] { return out.matchedReaders(); });
-  WallClock wall;
-  const bool simClock = settings.clock == "sim";
-  std::int64_t now = simClock ? 0 : wall.nowNs();
-  bool haveClock = !simClock;
-  const std::int64_t period = secToNs(1.0 / settings.rateHz);
-  std::int64_t nextFuse = now;
-  auto lastRegister = std::chrono::steady_clock::now() - 10s;
   auto lastStats = std::chrono::steady_clock::now();
   std::uint64_t published = 0;
   spdlog::info("risk map: {}x{} cells at {} m, K={}, horizon {} x {} s, model {}, {} Hz, clock {}",
@@ -74,10 +67,10 @@ int run(const riskmap::Settings& settings, const std::string& id, const service:
 
   auto ingest = [&] {
     for (const auto& m : service::admitted(discs.take(), rejections, badInput)) {
-      if (!haveClock) {
+      if (!loop.haveClock()) {
         continue;
       }
-      auto ok = node.accept(m, now);
+      auto ok = node.accept(m, loop.now());
       if (ok) {
         samplesAccepted.inc();
       } else {
@@ -89,7 +82,7 @@ int run(const riskmap::Settings& settings, const std::string& id, const service:
   auto publish = [&] {
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      auto map = node.fuse(now);
+      auto map = node.fuse(loop.now());
       fuseSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       out.write(map);
       ++published;
@@ -101,63 +94,27 @@ int run(const riskmap::Settings& settings, const std::string& id, const service:
     }
   };
 
-  while (!service::stopRequested()) {
-    if (settings.lockstep && !haveClock && std::chrono::steady_clock::now() - lastRegister > 1s) {
-      stepDone.write({id, msg::StepDone::kRegister});
-      lastRegister = std::chrono::steady_clock::now();
-    }
-    const auto wait =
-        simClock
-            ? 100ms
-            : std::chrono::milliseconds(std::max<std::int64_t>(0, (nextFuse - wall.nowNs()) / 1'000'000));
-    ws.wait(wait);
-    if (simClock) {
-      for (const auto& c : clockIn.take()) {
-        now = c.sim_time_ns;
-        if (!haveClock) {
-          nextFuse = now;
-          haveClock = true;
-        }
-        ingest();
-        if (now >= nextFuse) {
-          publish();
-          nextFuse += period * std::max<std::int64_t>(1, (now - nextFuse) / period + 1);
-        }
-        if (settings.lockstep && c.lockstep) {
-          stepDone.write({id, c.step});
-        }
-      }
-      ingest();
-    } else {
-      now = wall.nowNs();
-      ingest();
-      if (now >= nextFuse) {
-        publish();
-        nextFuse = std::max(nextFuse + period, now);
-      }
-    }
-    if (ops.refresh()) {
-      sources.set(static_cast<double>(node.sources()));
-    }
-    if (std::chrono::steady_clock::now() - lastStats > 10s) {
-      std::string reasons;
-      for (const auto& [code, n] : node.rejectedByReason()) {
-        reasons += (reasons.empty() ? " (" : ", ") + code + ": " + std::to_string(n);
-      }
-      if (!reasons.empty()) {
-        reasons += ")";
-      }
-      spdlog::info(
-          "risk map: {} sources, {} maps published, {} samples accepted, {} rejected{}, {} stale dropped, "
-          "refused at the edge: {}",
-          node.sources(), published, node.accepted(), node.rejected(), reasons, node.dropped_stale(),
-          rejections.toJson().dump());
-      lastStats = std::chrono::steady_clock::now();
-    }
-  }
-  if (settings.lockstep) {
-    stepDone.write({id, msg::StepDone::kLeave});
-  }
+  loop.run({ingest, publish, [&] {
+              if (ops.refresh()) {
+                sources.set(static_cast<double>(node.sources()));
+              }
+              if (std::chrono::steady_clock::now() - lastStats > 10s) {
+                std::string reasons;
+                for (const auto& [code, n] : node.rejectedByReason()) {
+                  reasons += (reasons.empty() ? " (" : ", ") + code + ": " + std::to_string(n);
+                }
+                if (!reasons.empty()) {
+                  reasons += ")";
+                }
+                spdlog::info(
+                    "risk map: {} sources, {} maps published, {} samples accepted, {} rejected{}, {} stale "
+                    "dropped, "
+                    "refused at the edge: {}",
+                    node.sources(), published, node.accepted(), node.rejected(), reasons,
+                    node.dropped_stale(), rejections.toJson().dump());
+                lastStats = std::chrono::steady_clock::now();
+              }
+            }});
   spdlog::info("risk map: stopped after {} maps", published);
   return 0;
 }

@@ -12,6 +12,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/service/clocked_loop.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
@@ -80,8 +81,6 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   transport::Reader<msg::TrafficProgress> progress(p, progressQos);
   transport::Writer<msg::TrafficRelease> releases(p);
   transport::Writer<msg::Roadmap> roadmapOut(p);
-  transport::Reader<msg::Clock> clockIn(p);
-  transport::Writer<msg::StepDone> stepDone(p);
   // The risk map is a refinement, not a need: permissions that predate it (DDS Security) leave the
   // traffic manager planning without it, said once, instead of not starting.
   std::optional<transport::Reader<msg::RiskMap>> riskMaps;
@@ -102,7 +101,6 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   }
   transport::WaitSet ws(p);
   ws.attach(progress);
-  ws.attach(clockIn);
   if (closuresIn)
     ws.attach(*closuresIn);
   service::RateLimitedLog badInput;
@@ -113,12 +111,8 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   ops.watchMatchedReaders("TrafficRelease", [&] { return releases.matchedReaders(); });
   // The roadmap is built (the node exists): what this service needs to do its job.
   ops.health().setReady("roadmap", node.roadmap().graph.size() > 0);
-  const bool simClock = settings.clock == "sim";
-  std::int64_t now = simClock ? 0 : wall.nowNs();
-  bool haveClock = !simClock;
-  const std::int64_t period = secToNs(1.0 / settings.rateHz);
-  std::int64_t nextTick = now;
-  auto lastRegister = std::chrono::steady_clock::now() - 10s;
+  service::ClockedLoop loop(p, ws,
+                            {settings.clock == "sim", settings.lockstep, id, secToNs(1.0 / settings.rateHz)});
   auto lastStats = std::chrono::steady_clock::now();
   bool roadmapSent = false;
 
@@ -134,7 +128,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         rejections.toJson().dump());
     // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
     // is slow (a minute of its clock, sim or wall).
-    for (const auto& line : node.stalled(now, 60.0))
+    for (const auto& line : node.stalled(loop.now(), 60.0))
       spdlog::warn("traffic manager: {}", line);
   };
   auto takeClosures = [&] {
@@ -167,29 +161,31 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   auto ingest = [&] {
     takeClosures();
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
-    if (auto maps = riskMaps ? riskMaps->take() : std::vector<msg::RiskMap>{}; !maps.empty() && haveClock) {
+    if (auto maps = riskMaps ? riskMaps->take() : std::vector<msg::RiskMap>{};
+        !maps.empty() && loop.haveClock()) {
       if (auto risk = service::riskLookupOf(maps.back())) {
-        node.onRiskMap(**risk, now);
+        node.onRiskMap(**risk, loop.now());
       } else {
         badInput.warn("risk_map", "RiskMap ignored: " + risk.error().message);
       }
     }
     // In lockstep a report counts from the step after the one it was made in (StepOrder).
-    for (const auto& m : progressOrder.due(service::admitted(progress.take(), rejections, badInput), now)) {
-      if (!haveClock)
+    for (const auto& m :
+         progressOrder.due(service::admitted(progress.take(), rejections, badInput), loop.now())) {
+      if (!loop.haveClock())
         continue;
-      if (auto problem = node.onProgress(m, now)) {
+      if (auto problem = node.onProgress(m, loop.now())) {
         badInput.warn("progress:" + m.robot_id, *problem);
       }
     }
   };
   auto cycle = [&] {
     if (!roadmapSent) {
-      roadmapOut.write(node.roadmapMessage(now));
+      roadmapOut.write(node.roadmapMessage(loop.now()));
       roadmapSent = true;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const auto out = node.tick(now);
+    const auto out = node.tick(loop.now());
     tickSeconds.observe(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     for (const auto& r : out) {
       try {
@@ -201,52 +197,16 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     }
   };
 
-  while (!service::stopRequested()) {
-    if (settings.lockstep && !haveClock && std::chrono::steady_clock::now() - lastRegister > 1s) {
-      stepDone.write({id, msg::StepDone::kRegister});
-      lastRegister = std::chrono::steady_clock::now();
-    }
-    const auto wait =
-        simClock
-            ? 100ms
-            : std::chrono::milliseconds(std::max<std::int64_t>(0, (nextTick - wall.nowNs()) / 1'000'000));
-    ws.wait(wait);
-    if (simClock) {
-      for (const auto& c : clockIn.take()) {
-        now = c.sim_time_ns;
-        if (!haveClock) {
-          nextTick = now;
-          haveClock = true;
-        }
-        ingest();
-        if (now >= nextTick) {
-          cycle();
-          nextTick += period * std::max<std::int64_t>(1, (now - nextTick) / period + 1);
-        }
-        if (settings.lockstep && c.lockstep) {
-          stepDone.write({id, c.step});
-        }
-      }
-      ingest();
-    } else {
-      now = wall.nowNs();
-      ingest();
-      if (now >= nextTick) {
-        cycle();
-        nextTick = std::max(nextTick + period, now);
-      }
-    }
-    if (ops.refresh()) {
-      robotsKnown.set(static_cast<double>(node.robotsKnown()));
-      robotsPlaced.set(static_cast<double>(node.robotsPlaced()));
-    }
-    if (std::chrono::steady_clock::now() - lastStats > 10s) {
-      logStats();
-      lastStats = std::chrono::steady_clock::now();
-    }
-  }
-  if (settings.lockstep)
-    stepDone.write({id, msg::StepDone::kLeave});
+  loop.run({ingest, cycle, [&] {
+              if (ops.refresh()) {
+                robotsKnown.set(static_cast<double>(node.robotsKnown()));
+                robotsPlaced.set(static_cast<double>(node.robotsPlaced()));
+              }
+              if (std::chrono::steady_clock::now() - lastStats > 10s) {
+                logStats();
+                lastStats = std::chrono::steady_clock::now();
+              }
+            }});
   logStats();
   if (!settings.summaryFile.empty()) {
     const auto& c = node.counters();

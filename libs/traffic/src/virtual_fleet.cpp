@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -39,6 +40,51 @@ double percentile(std::vector<double> v, double p) {
 }
 
 }  // namespace
+
+std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near) {
+  const Graph& g = roadmap.graph;
+  std::vector<std::string> out(g.size());
+  std::vector<std::pair<Vec2, const std::string*>> docks;
+  for (const auto& s : roadmap.stations) {
+    if (s.dock == kNoNode)
+      continue;
+    const bool served = s.kind == site::StationKind::Pickup || s.kind == site::StationKind::Dropoff;
+    if (served)
+      docks.emplace_back(g.position(s.dock), &s.name);
+    if (s.kind == site::StationKind::Parking) {
+      out[static_cast<std::size_t>(s.dock)] = "parking";
+      continue;
+    }
+    const auto label = [&](NodeId v, const char* what) {
+      if (v != kNoNode && out[static_cast<std::size_t>(v)].empty())
+        out[static_cast<std::size_t>(v)] = s.name + " " + what;
+    };
+    label(s.dock, "dock");
+    label(s.approach, "approach");
+    for (NodeId q : s.queue)
+      label(q, "queue");
+    label(s.exit, "exit");
+  }
+  for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {
+    auto& l = out[static_cast<std::size_t>(v)];
+    if (!l.empty())
+      continue;
+    if (roadmap.kind(v) == NodeKind::Parking) {
+      l = "parking";
+      continue;
+    }
+    const std::string* best = nullptr;
+    double bestD = near;
+    for (const auto& [p, name] : docks) {
+      if (const double d = (p - g.position(v)).norm(); d <= bestD) {
+        bestD = d;
+        best = name;
+      }
+    }
+    l = best != nullptr ? "lane by " + *best : "lane";
+  }
+  return out;
+}
 
 VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& o) {
   const Graph& g = roadmap.graph;
@@ -169,6 +215,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.minSeparation = std::numeric_limits<double>::infinity();
   res.density = static_cast<double>(o.robots) / static_cast<double>(g.size());
   std::vector<double> updateMs, taskTimes;
+  const std::vector<std::string> place = waitPlaces(roadmap);
+  std::vector<double> waitedAt(g.size(), 0.0);
   const double contact = roadmap.separation.contact - roadmap.separation.margin;
   std::vector<Vec2> where(o.robots);
   double nextFrame = 0.0;
@@ -260,6 +308,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
             b.turnLeft > 0.0 || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving, o.dt);
       } else {
         res.robotTime[r].add(RobotActivity::WaitingOnRobot, o.dt);
+        waitedAt[static_cast<std::size_t>(b.at)] += o.dt;
       }
       // Spend the tick: a stop first (the edge goes on once the person has passed), then the edge,
       // then the next released edges.
@@ -378,6 +427,15 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     res.stations.push_back({st.name, visits[static_cast<std::size_t>(st.dock)], c.size(), percentile(c, 0.5),
                             percentile(c, 0.9)});
   }
+  std::map<std::string, double> waits;
+  for (std::size_t v = 0; v < g.size(); ++v) {
+    if (waitedAt[v] > 0.0)
+      waits[place[v]] += waitedAt[v];
+  }
+  for (const auto& [p, sec] : waits)
+    res.waits.push_back({p, sec});
+  std::stable_sort(res.waits.begin(), res.waits.end(),
+                   [](const auto& a, const auto& b) { return a.seconds > b.seconds; });
   res.updateP50Ms = percentile(updateMs, 0.5);
   res.updateP99Ms = percentile(updateMs, 0.99);
   if (o.robots < 2)

@@ -70,6 +70,17 @@ std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
       EXPECT_EQ(l.seconds(RobotActivity::Unset), 0.0);
     }
     EXPECT_GE(r.tasks.size(), r.tasksDone);
+    // The wait ledger splits the fleet's waiting on robots by place, nothing lost or added.
+    double waited = 0.0, waits = 0.0;
+    for (const auto& l : r.robotTime)
+      waited += l.seconds(RobotActivity::WaitingOnRobot);
+    for (const auto& w : r.waits) {
+      EXPECT_GT(w.seconds, 0.0) << w.place;
+      waits += w.seconds;
+    }
+    EXPECT_NEAR(waits, waited, 1e-6 * (1.0 + waited));
+    for (std::size_t i = 1; i < r.waits.size(); ++i)
+      EXPECT_GE(r.waits[i - 1].seconds, r.waits[i].seconds);
     if (o.robots > 1) {
       EXPECT_GE(r.minSeparation, map.separation.contact - map.separation.margin);
     }
@@ -561,6 +572,39 @@ TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
   }
   o.stations = {"P-5"};  // no drop-off among them
   EXPECT_THROW(runVirtualFleet(map, o), std::invalid_argument);
+}
+
+TEST(VirtualFleet, WaitPlacesNameEveryStationsNodesAndTheLanesBesideThem) {
+  Roadmap map = smallWarehouse();
+  const auto place = waitPlaces(map);
+  ASSERT_EQ(place.size(), map.graph.size());
+  const StationNodes* p = map.station("P-5");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(place[static_cast<std::size_t>(p->dock)], "P-5 dock");
+  ASSERT_FALSE(p->queue.empty());
+  EXPECT_EQ(place[static_cast<std::size_t>(p->queue.front())], "P-5 queue");
+  if (p->exit != kNoNode) {
+    EXPECT_EQ(place[static_cast<std::size_t>(p->exit)], "P-5 exit");
+  }
+  EXPECT_EQ(place[static_cast<std::size_t>(map.station("PARK-1")->dock)], "parking");
+  std::size_t lanes = 0, beside = 0;
+  for (NodeId v = 0; static_cast<std::size_t>(v) < map.graph.size(); ++v) {
+    const auto& l = place[static_cast<std::size_t>(v)];
+    EXPECT_FALSE(l.empty()) << v;
+    if (map.kind(v) != NodeKind::Lane)
+      continue;
+    ++lanes;
+    if (l.rfind("lane by ", 0) == 0) {
+      ++beside;
+      const StationNodes* s = map.station(l.substr(8));
+      ASSERT_NE(s, nullptr) << l;
+      EXPECT_LE((map.graph.position(s->dock) - map.graph.position(v)).norm(), 2.0 + 1e-9) << l;
+    } else {
+      EXPECT_EQ(l, "lane");
+    }
+  }
+  EXPECT_GT(beside, 0U);
+  EXPECT_LT(beside, lanes);
 }
 
 TEST(VirtualFleet, ALoneRobot) {

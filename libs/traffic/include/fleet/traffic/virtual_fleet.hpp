@@ -119,7 +119,20 @@ struct VirtualFleetResult {
     double cycleP90 = 0.0;
   };
   std::vector<StationLedger> stations;
+  /// Where the robots waited on other robots: the "waiting on another robot" of `robotTime`, split
+  /// by the place each robot stood (waitPlaces), most first; adds up to the fleet's waiting time.
+  struct WaitPlace {
+    std::string place;
+    double seconds = 0.0;  ///< robot-seconds
+  };
+  std::vector<WaitPlace> waits;
 };
+
+/// Per node, the place a robot standing there is at, as the wait ledger names it: "<station> dock",
+/// "<station> approach", "<station> queue", "<station> exit" for a pickup's, drop-off's or charger's
+/// nodes, "parking", and lane nodes "lane by <station>" within `near` m of the nearest pickup or
+/// drop-off dock, otherwise "lane".
+std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near = 2.0);
 
 /// Runs the virtual fleet on `roadmap`. Robots start on the parking docks (then on spread-out lane
 /// nodes if there are more robots than parking places). Throws std::invalid_argument when the
