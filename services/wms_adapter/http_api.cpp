@@ -14,6 +14,7 @@
 #include "fleet/core/log_text.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/task_wire.hpp"
+#include "status_routes.hpp"
 
 namespace fleet::wms {
 namespace {
@@ -155,6 +156,7 @@ ApiSettings readApiSettings(Config& cfg) {
     s.token = env;
   }
   s.allowUnauthenticated = h.boolean("allow_unauthenticated", false);
+  readStatusSettings(cfg, s.events, s.webhooks);
   if (s.tokenFile.empty() && s.token.empty() && !isLoopbackHost(s.host) && !s.allowUnauthenticated) {
     h.problem("host", "\"" + s.host +
                           "\" is reachable from other machines and no token is configured (token_file or "
@@ -198,7 +200,30 @@ HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& 
       server_(settings_.limits, settings_.tls) {
   std::random_device rd;
   instance_ = std::to_string(rd() % 1'000'000);
+  try {
+    stateDb_ = std::make_shared<SqliteDb>(settings_.events.path);
+    events_ = std::make_unique<EventLog>(settings_.events, stateDb_);
+    webhooks_ = std::make_unique<Webhooks>(settings_.webhooks, stateDb_, *events_);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError({std::string("events.log: ") + e.what()});
+  }
   routes();
+  view_.setEventLog(events_.get());
+}
+
+HttpApi::~HttpApi() {
+  view_.dropEventLog(events_.get());
+  webhooks_->stop();
+}
+
+nlohmann::json HttpApi::eventLogJson() const {
+  const auto hooks = webhooks_->list();
+  const auto failing =
+      std::count_if(hooks.begin(), hooks.end(), [](const auto& w) { return w.state == "failing"; });
+  return {{"last_id", events_->lastId()},       {"pruned_through", events_->prunedThrough()},
+          {"durable", events_->durable()},      {"append_failures", view_.eventLogFailures()},
+          {"problem", view_.eventLogProblem()}, {"webhooks", hooks.size()},
+          {"webhooks_failing", failing}};
 }
 
 std::string HttpApi::nextRequestId() {
@@ -383,6 +408,7 @@ void HttpApi::routes() {
            {"robots", view_.robots().size()},
            {"proximity", proximityJson(view_.proximity())},
            {"fleet_manager_online", gateway_.managerOnline()},
+           {"event_log", eventLogJson()},
            {"samples", view_.rejections().toJson()},
            {"http",
             {{"open_connections", h.openConnections.load()},
@@ -398,33 +424,7 @@ void HttpApi::routes() {
              {"token_file_problem", tokens_.lastProblem()},
              {"audit_write_failures", audit_.writeFailures()}}}});
   });
-  // Server-sent events: every TaskEvent as `event: task` with the JSON of the event. The stream
-  // holds no worker: the server polls it (never blocking) from its I/O thread. It ends when the
-  // client goes away or the server stops.
-  server_.route(
-      "GET", "/v1/events", Scope::Read,
-      [this](const Request&, Response& res) {
-        auto cursor = std::make_shared<std::uint64_t>(view_.eventCursor());
-        res.set_header("Cache-Control", "no-cache");
-        res.setEventStream("text/event-stream", [this, cursor]() -> std::optional<std::string> {
-          std::vector<msg::TaskEvent> evs;
-          *cursor = view_.eventsAfter(*cursor, std::chrono::milliseconds(0), evs);
-          std::string chunk;
-          for (const auto& e : evs) {
-            chunk += "event: task\ndata: " +
-                     dumpJson({{"id", e.task_id},
-                               {"state", msg::toString(e.state)},
-                               {"robot", e.robot_id},
-                               {"reason", e.reason},
-                               {"stamp_ns", e.stamp_ns},
-                               {"seq", e.seq},
-                               {"station", e.station}}) +
-                     "\n\n";
-          }
-          return chunk;
-        });
-      },
-      Run::Inline);
+  addStatusRoutes(server_, *events_, *webhooks_, [this] { return clock_.nowNs(); });
 }
 
 void HttpApi::postTasks(const Request& req, Response& res) {
