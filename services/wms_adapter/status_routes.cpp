@@ -135,7 +135,13 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
                      json{{"missed_after", *cursor}, {"missed_through", pruned}}.dump() + "\n\n";
             *cursor = pruned;
           }
-          for (const auto& e : log.after(*cursor, kEventsPerPoll)) {
+          std::vector<LoggedEvent> events;
+          try {
+            events = log.after(*cursor, kEventsPerPoll);
+          } catch (const std::exception&) {
+            return std::nullopt;  // the log's file cannot be read: end the stream, the client resumes
+          }
+          for (const auto& e : events) {
             chunk += "id: " + std::to_string(e.id) + "\nevent: task\ndata: " +
                      loggedEventJson(e).dump(-1, ' ', false, json::error_handler_t::replace) + "\n\n";
             *cursor = e.id;

@@ -240,6 +240,16 @@ std::optional<std::string> Webhooks::deliver(Sub& sub, std::int64_t eventId, con
   return std::nullopt;
 }
 
+std::vector<LoggedEvent> Webhooks::readAfter(std::int64_t cursor) {
+  try {
+    return log_.after(cursor, 1);
+  } catch (const std::exception&) {
+    // A read error of the log's file (the newest events come from memory): tried again shortly.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    return {};
+  }
+}
+
 void Webhooks::run(const std::shared_ptr<Sub>& sub) {
   std::mt19937 jitter(std::random_device{}());
   std::int64_t cursor = 0;
@@ -259,7 +269,7 @@ void Webhooks::run(const std::shared_ptr<Sub>& sub) {
     if (cursor < pruned) {
       id = pruned;
       body = {{"type", "gap"}, {"event_id", pruned}, {"missed_after", cursor}, {"missed_through", pruned}};
-    } else if (auto next = log_.after(cursor, 1); !next.empty()) {
+    } else if (auto next = readAfter(cursor); !next.empty()) {
       id = next[0].id;
       body = loggedEventJson(next[0]);
       body["type"] = "task";
@@ -294,7 +304,12 @@ void Webhooks::run(const std::shared_ptr<Sub>& sub) {
         }
       }
       if (!sub->removed) {
-        store(*sub);
+        try {
+          store(*sub);
+        } catch (const std::exception& e) {
+          // The cursor stays in memory: delivery goes on, a restart sends from the stored one.
+          st.lastError = std::string("cannot store the cursor: ") + e.what();
+        }
       }
     }
     if (wait.count() > 0) {

@@ -86,7 +86,8 @@ class Webhooks {
   void run(const std::shared_ptr<Sub>& sub);
   /// One POST of `body` for event `eventId`; nothing on a 2xx, else why it failed.
   std::optional<std::string> deliver(Sub& sub, std::int64_t eventId, const std::string& body);
-  void store(const Sub& sub);  // writes the status (cursor, counts, state)
+  void store(const Sub& sub);  // writes the status (cursor, counts, state); throws on a disk error
+  std::vector<LoggedEvent> readAfter(std::int64_t cursor);  // the next event; none on a read error
   void start(const std::shared_ptr<Sub>& sub);
 
   WebhookSettings s_;
