@@ -50,6 +50,11 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
     SqliteStmt q(*db_, "SELECT MIN(id) FROM task_events");
     prunedThrough_ = q.step() && !q.isNull(0) ? q.integer(0) - 1 : lastId_;
   }
+  seen_ = std::make_unique<SqliteStmt>(*db_, "SELECT 1 FROM task_events WHERE task_id = ?1 AND seq = ?2");
+  insert_ =
+      std::make_unique<SqliteStmt>(*db_,
+                                   "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, "
+                                   "station, logged_ns) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
   SqliteStmt q(*db_,
                "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station FROM task_events "
                "WHERE id > ?1 ORDER BY id");
@@ -65,15 +70,15 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
     std::lock_guard dbLock(db_->mutex());
     db_->exec("BEGIN IMMEDIATE");
     try {
-      SqliteStmt seen(*db_, "SELECT 1 FROM task_events WHERE task_id = ?1 AND seq = ?2");
-      SqliteStmt row(*db_,
-                     "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, station, "
-                     "logged_ns) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+      auto& seen = *seen_;
+      auto& row = *insert_;
       for (const auto& e : events) {
         if (e.seq != 0) {
           seen.reset();
           seen.bind(1, e.task_id).bind(2, static_cast<std::int64_t>(e.seq));
-          if (seen.step()) {
+          const bool logged = seen.step();
+          seen.reset();  // no read left open (it would hold the WAL back from checkpoints)
+          if (logged) {
             continue;
           }
         }
@@ -87,6 +92,7 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
             .bind(7, e.station)
             .bind(8, nowNs);
         row.run();
+        row.reset();
         added.push_back({sqlite3_last_insert_rowid(db_->handle()), e});
       }
       // By count when 1 % over (one DELETE per many appends), by age once a second.
@@ -96,6 +102,8 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
       }
       db_->exec("COMMIT");
     } catch (...) {
+      seen_->reset();
+      insert_->reset();
       db_->exec("ROLLBACK");
       throw;
     }

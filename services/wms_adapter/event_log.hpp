@@ -67,6 +67,8 @@ class EventLog {
 
   EventLogSettings s_;
   std::shared_ptr<SqliteDb> db_;
+  std::unique_ptr<SqliteStmt> seen_;  // prepared once: an append is the hot path
+  std::unique_ptr<SqliteStmt> insert_;
   mutable std::mutex m_;  // the tail and the ids below; never held across a disk write
   mutable std::condition_variable cv_;
   std::deque<LoggedEvent> tail_;

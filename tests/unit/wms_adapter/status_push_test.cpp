@@ -244,3 +244,32 @@ TEST_F(StatusPush, EventsAndWebhookSettingsAreReadAndCheckedFromTheConfig) {
   unopenable.events.path = dir_.file("no/such/dir/events.db");
   EXPECT_THROW(HttpApi(unopenable, stations_, gateway_, view_, clock_), ConfigError);
 }
+
+// What logging costs the intake: events appended in the batches the DDS gateway takes (20 here) to
+// a file log. A bound far above the figure (docs/benchmarks.md gives it): the test catches a log
+// that syncs or scans per event, not a slow machine.
+TEST(EventLog, AppendsFarFasterThanTheManagerPublishes) {
+  for (const int batchSize : {20, 1}) {
+    fleet::test::TempDir dir;
+    EventLogSettings s;
+    s.path = dir.file("events.db");
+    s.retainEvents = 2'000;  // pruning by count runs too
+    EventLog log(s, std::make_shared<SqliteDb>(s.path));
+    const int events = batchSize == 1 ? 5'000 : 20'000;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int b = 0; b < events / batchSize; ++b) {
+      std::vector<msg::TaskEvent> batch;
+      for (int i = 0; i < batchSize; ++i) {
+        batch.push_back(ev("t-" + std::to_string(b * batchSize + i), 1));
+      }
+      log.append(batch, 1);
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double rate = events / secs;
+    std::printf("event log: %d events in batches of %d to a file in %.3f s: %.0f events/s\n", events,
+                batchSize, secs, rate);
+    EXPECT_EQ(log.lastId(), events);
+    EXPECT_GE(log.prunedThrough(), events - 2'021);
+    EXPECT_GT(rate, 2000.0) << "batches of " << batchSize;
+  }
+}
