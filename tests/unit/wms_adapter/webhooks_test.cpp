@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <set>
 
 #include "../fleet/temp_dir.hpp"
@@ -330,4 +331,28 @@ TEST_F(Webhook, TheOutboxSurvivesAnAdapterRestart) {
   const auto list = json::parse(client_->Get("/v1/webhooks")->body);
   ASSERT_EQ(list["count"], 1);
   EXPECT_EQ(list["webhooks"][0]["id"], made["id"]);
+}
+
+// Scope-checked as the other routes: a read token lists, only a submit token makes or deletes.
+TEST_F(Webhook, AReadTokenListsButOnlyASubmitTokenMakesOrDeletes) {
+  const std::string tokens = dir_.file("tokens");
+  std::ofstream(tokens) << "# name scopes token\nreader read reader-token-0123456789abcdef\n"
+                           "wms read,submit wms-token-0123456789abcdef0123\n";
+  auto s = settings({"http://127.0.0.1:1/hooks"});
+  s.tokenFile = tokens;
+  start(s);
+  const httplib::Headers reader = {{"Authorization", "Bearer reader-token-0123456789abcdef"}};
+  const httplib::Headers wms = {{"Authorization", "Bearer wms-token-0123456789abcdef0123"}};
+  const std::string body = R"({"url": "http://127.0.0.1:1/hooks"})";
+  EXPECT_EQ(client_->Post("/v1/webhooks", body, "application/json")->status, 401);
+  auto r = client_->Post("/v1/webhooks", reader, body, "application/json");
+  EXPECT_EQ(r->status, 403);
+  EXPECT_THAT(r->body, HasSubstr("submit"));
+  r = client_->Post("/v1/webhooks", wms, body, "application/json");
+  ASSERT_EQ(r->status, 201) << r->body;
+  const std::string id = json::parse(r->body)["id"];
+  EXPECT_EQ(client_->Get("/v1/webhooks", reader)->status, 200);
+  EXPECT_EQ(client_->Get("/v1/webhooks/" + id, reader)->status, 200);
+  EXPECT_EQ(client_->Delete("/v1/webhooks/" + id, reader)->status, 403);
+  EXPECT_EQ(client_->Delete("/v1/webhooks/" + id, wms)->status, 200);
 }
