@@ -35,6 +35,16 @@ LoggedEvent rowOf(const SqliteStmt& q) {
 EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
     : s_(std::move(settings)), db_(std::move(db)) {
   std::lock_guard dbLock(db_->mutex());
+  {
+    // Never written into another program's database (the manager's task store, say).
+    SqliteStmt q(*db_,
+                 "SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT IN "
+                 "('task_events', 'webhooks', 'sqlite_sequence') LIMIT 1");
+    if (q.step()) {
+      throw std::runtime_error("\"" + db_->path() + "\" is not the adapter's event log (it has a table \"" +
+                               q.text(0) + "\"): name a file of its own");
+    }
+  }
   db_->exec(
       "CREATE TABLE IF NOT EXISTS task_events("
       " id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER NOT NULL,"

@@ -243,6 +243,17 @@ TEST_F(StatusPush, EventsAndWebhookSettingsAreReadAndCheckedFromTheConfig) {
   ApiSettings unopenable;
   unopenable.events.path = dir_.file("no/such/dir/events.db");
   EXPECT_THROW(HttpApi(unopenable, stations_, gateway_, view_, clock_), ConfigError);
+  // Another program's database (the manager's task store) is refused, not written into.
+  ApiSettings foreign;
+  foreign.events.path = dir_.file("fleet.db");
+  SqliteDb(foreign.events.path).exec("CREATE TABLE tasks(id TEXT PRIMARY KEY)");
+  try {
+    HttpApi api(foreign, stations_, gateway_, view_, clock_);
+    ADD_FAILURE() << "a foreign database was taken as the event log";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("events.log"), HasSubstr("is not the adapter's event log"),
+                                HasSubstr("\"tasks\"")));
+  }
 }
 
 // What logging costs the intake: events appended in the batches the DDS gateway takes (20 here) to
