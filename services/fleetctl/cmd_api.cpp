@@ -41,6 +41,7 @@ struct ApiOptions {
   std::string closeReason;
   int count = 0;  // follow
   int seconds = 0;
+  std::int64_t since = -1;  // follow: resume after this event id (-1: from the next event)
 };
 
 struct Target {
@@ -218,16 +219,18 @@ int listRobots(const ApiOptions&, httplib::Client& c, const httplib::Headers& h)
 }
 
 // Exit 0 only when it stopped itself (--count reached, --seconds up); 1 when the adapter cannot be
-// reached, answers other than 200 (401, 403, 503 busy, ...), or the stream breaks or ends.
+// reached, answers other than 200 (401, 403, 410 expired, 503 busy, ...), or the stream breaks or
+// ends: then stderr names the --since that resumes after the last event printed.
 int followEvents(const ApiOptions& o, httplib::Client& c, const httplib::Headers& h) {
   int seen = 0;
+  std::int64_t lastId = o.since;  // the newest `id:` printed
   const auto start = std::chrono::steady_clock::now();
   std::string buf;
   int status = 0;
   std::string refusal;  // the body of an answer other than 200, bounded
   bool stopped = false;
   auto r = c.Get(
-      "/v1/events", h,
+      o.since >= 0 ? "/v1/events?since=" + std::to_string(o.since) : std::string("/v1/events"), h,
       [&](const httplib::Response& res) {
         status = res.status;
         return true;
@@ -244,6 +247,10 @@ int followEvents(const ApiOptions& o, httplib::Client& c, const httplib::Headers
         while ((pos = buf.find("\n\n")) != std::string::npos) {
           const std::string frame = buf.substr(0, pos);
           buf.erase(0, pos + 2);
+          if (frame.rfind("id: ", 0) == 0 || frame.find("\nid: ") != std::string::npos) {
+            const auto at = frame.rfind("id: ", 0) == 0 ? 4 : frame.find("\nid: ") + 5;
+            lastId = std::strtoll(frame.c_str() + at, nullptr, 10);
+          }
           const auto d = frame.find("data: ");
           if (d != std::string::npos) {
             std::cout << frame.substr(d + 6) << std::endl;
@@ -258,21 +265,24 @@ int followEvents(const ApiOptions& o, httplib::Client& c, const httplib::Headers
   if (stopped) {
     return 0;
   }
+  const std::string resume =
+      lastId >= 0 ? "; resume with --since " + std::to_string(lastId) + " (nothing after it is missed)" : "";
   if (status != 0 && status != 200) {
     const auto j = json::parse(refusal, nullptr, false);
     const std::string why = j.is_object() && j.contains("message") && j["message"].is_string()
                                 ? j["message"].get<std::string>()
                                 : refusal.substr(0, refusal.find('\n'));
     return fail("the WMS adapter at " + o.url + " answered " + std::to_string(status) +
-                (why.empty() ? std::string() : ": " + why));
+                (why.empty() ? std::string() : ": " + why) + (status == 410 ? std::string() : resume));
   }
   if (status == 0) {
-    return fail("cannot reach the WMS adapter at " + o.url + " (" + httplib::to_string(r.error()) + ")");
+    return fail("cannot reach the WMS adapter at " + o.url + " (" + httplib::to_string(r.error()) + ")" +
+                resume);
   }
   if (!r) {
-    return fail("the event stream from " + o.url + " broke (" + httplib::to_string(r.error()) + ")");
+    return fail("the event stream from " + o.url + " broke (" + httplib::to_string(r.error()) + ")" + resume);
   }
-  return fail("the event stream from " + o.url + " ended (the adapter closed it)");
+  return fail("the event stream from " + o.url + " ended (the adapter closed it)" + resume);
 }
 
 }  // namespace
@@ -317,6 +327,10 @@ void addApiCommands(CLI::App& app, Commands& commands) {
   auto* follow = app.add_subcommand("follow", "print task events as they happen");
   follow->add_option("--count", o->count, "stop after this many events (0 = never)");
   follow->add_option("--seconds", o->seconds, "stop after this long (0 = never)");
+  follow
+      ->add_option("--since", o->since,
+                   "print the events after this event id first (the id a broken follow names), then new ones")
+      ->check(CLI::NonNegativeNumber);
   auto* health = app.add_subcommand("health", "is the adapter up and does it see the manager");
   auto* metrics = app.add_subcommand("metrics", "the adapter's counters");
 

@@ -3,7 +3,7 @@
 //   fleetctl tasks [--state S]       list tasks          fleetctl task ID     one task
 //   fleetctl cancel ID               cancel a task       fleetctl robots      list robots
 //   fleetctl pause ID | resume ID    hold a task (its robot stands still) / let it go on
-//   fleetctl follow [--count N]      print task events as they happen
+//   fleetctl follow [--count N] [--since ID]  print task events as they happen (after event ID)
 //   fleetctl health | metrics
 //   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet
 //   fleetctl traffic-bench --map F.map --agents N --steps T   the lifelong planner alone on a grid

@@ -99,11 +99,13 @@ void DdsGateway::loop() {
       }
       cv_.notify_all();
     }
+    std::vector<msg::TaskEvent> admitted;
     for (auto& e : events_.take()) {
       if (validation::admit(e, view_.rejections())) {
-        view_.onEvent(e);
+        admitted.push_back(std::move(e));
       }
     }
+    view_.onEvents(admitted);
     for (auto& r : robots_.take()) {
       if (validation::admit(r, view_.rejections())) {
         view_.onRobot(r);

@@ -1,5 +1,7 @@
 #include "gateway.hpp"
 
+#include "event_log.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -12,7 +14,47 @@ bool terminal(msg::TaskState s) {
 }
 }  // namespace
 
+void FleetView::setEventLog(EventLog* log) {
+  std::lock_guard lock(logMutex_);
+  log_ = log;
+}
+
+void FleetView::dropEventLog(const EventLog* log) {
+  std::lock_guard lock(logMutex_);
+  if (log_ == log) {
+    log_ = nullptr;
+  }
+}
+
+std::string FleetView::eventLogProblem() const {
+  std::lock_guard lock(logMutex_);
+  return logProblem_;
+}
+
 void FleetView::onEvent(const msg::TaskEvent& e) {
+  onEvents({e});
+}
+
+void FleetView::onEvents(const std::vector<msg::TaskEvent>& events) {
+  for (const auto& e : events) {
+    viewEvent(e);
+  }
+  std::lock_guard lock(logMutex_);
+  if (log_ == nullptr || events.empty()) {
+    return;
+  }
+  try {
+    log_->append(events, std::chrono::duration_cast<std::chrono::nanoseconds>(
+                             std::chrono::system_clock::now().time_since_epoch())
+                             .count());
+  } catch (const std::exception& ex) {
+    // A full or broken disk: the view and the dashboard go on, /v1/metrics shows the count.
+    ++logFailures_;
+    logProblem_ = ex.what();
+  }
+}
+
+void FleetView::viewEvent(const msg::TaskEvent& e) {
   {
     std::lock_guard lock(m_);
     auto [it, inserted] = tasks_.try_emplace(e.task_id);

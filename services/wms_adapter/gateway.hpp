@@ -4,6 +4,7 @@
 // without DDS: send task requests and wait for the manager's acknowledgements, and read the task
 // and robot views kept from TaskEvent / RobotState.
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
@@ -21,6 +22,8 @@
 #include "robot_time.hpp"
 
 namespace fleet::wms {
+
+class EventLog;
 
 /// A task as the API shows it: the latest event plus the task JSON we accepted.
 struct TaskView {
@@ -74,6 +77,16 @@ class FleetView {
  public:
   explicit FleetView(std::size_t maxTasks = 200'000) : maxTasks_(maxTasks) {}
   void onEvent(const msg::TaskEvent& e);
+  /// Several events, logged in one transaction (the DDS gateway's batch).
+  void onEvents(const std::vector<msg::TaskEvent>& events);
+  /// Where task events are also logged, with their event ids (event_log.hpp); nullptr: nowhere.
+  /// The HTTP API sets it for its life.
+  void setEventLog(EventLog* log);
+  /// Stops logging into `log` if it is the one set (another API on the same view keeps its own).
+  void dropEventLog(const EventLog* log);
+  /// Appends the event log refused (a disk error), and the last reason.
+  [[nodiscard]] std::uint64_t eventLogFailures() const { return logFailures_.load(); }
+  [[nodiscard]] std::string eventLogProblem() const;
   void onAccepted(const std::string& id, const std::string& body, msg::TaskState state, std::int64_t nowNs);
   void onRobot(const msg::RobotState& s);
   /// The risk map service's latest map (for the dashboard's iso-level layer).
@@ -162,6 +175,11 @@ class FleetView {
   std::uint64_t releaseCount_ = 0;
   std::deque<msg::TaskEvent> events_;
   std::uint64_t eventCount_ = 0;
+  mutable std::mutex logMutex_;  // the log pointer and its last problem; never under m_
+  EventLog* log_ = nullptr;
+  std::string logProblem_;
+  std::atomic<std::uint64_t> logFailures_{0};
+  void viewEvent(const msg::TaskEvent& e);
   validation::Rejections rejections_;
 };
 

@@ -1,6 +1,5 @@
 #include "http_api.hpp"
 
-#include <arpa/inet.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -14,6 +13,9 @@
 #include "fleet/core/log_text.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/task_wire.hpp"
+#include "rfc3339.hpp"
+#include "status_routes.hpp"
+#include "task_times.hpp"
 
 namespace fleet::wms {
 namespace {
@@ -45,6 +47,9 @@ json fieldsJson(const std::vector<FieldError>& fields) {
 
 json viewJson(const TaskView& v) {
   json j = {{"id", v.id}, {"state", msg::toString(v.state)}, {"updated_ns", v.updatedNs}};
+  if (v.updatedNs > 0) {
+    j["updated"] = toRfc3339(v.updatedNs);
+  }
   if (!v.robot.empty()) {
     j["robot"] = v.robot;
   }
@@ -53,6 +58,9 @@ json viewJson(const TaskView& v) {
   }
   if (!v.body.empty()) {
     j["task"] = json::parse(v.body, nullptr, false);
+  }
+  if (j.contains("task")) {
+    showTaskTimes(j["task"]);
   }
   if (!v.station.empty()) {
     // Chosen by the manager for a charge / park task sent without a station.
@@ -101,77 +109,6 @@ std::pair<int, json> outcome(const Task& t, const std::optional<msg::TaskAck>& a
 
 }  // namespace
 
-ApiSettings readApiSettings(Config& cfg) {
-  ApiSettings s;
-  auto& l = s.limits;
-  auto h = cfg.child("http");
-  h.rejectUnknownKeys({"host", "port", "token_file", "audit_log", "tls_certificate", "tls_key",
-                       "max_body_bytes", "max_task_body_bytes", "max_batch", "ack_timeout_ms",
-                       "max_in_flight", "threads", "max_connections", "max_streams", "backlog",
-                       "request_timeout_ms", "rate_per_client", "rate_burst", "allow_unauthenticated"});
-  s.host = h.string("host", s.host);
-  s.port = static_cast<int>(h.integer("port", s.port, {0, 65535}));
-  l.maxBodyBytes = static_cast<std::size_t>(
-      h.integer("max_body_bytes", static_cast<std::int64_t>(l.maxBodyBytes), {1024, 256.0 * 1024 * 1024}));
-  s.maxTaskBodyBytes = static_cast<std::size_t>(h.integer(
-      "max_task_body_bytes", static_cast<std::int64_t>(s.maxTaskBodyBytes), {1024, 256.0 * 1024 * 1024}));
-  s.maxBatch =
-      static_cast<std::size_t>(h.integer("max_batch", static_cast<std::int64_t>(s.maxBatch), {1, 100000}));
-  s.ackTimeoutMs = static_cast<int>(h.integer("ack_timeout_ms", s.ackTimeoutMs, {1, 600000}));
-  l.threads = static_cast<int>(h.integer("threads", l.threads, {1, 256}));
-  // Beyond the workers a request would only wait: by default it is refused (429) instead.
-  l.maxInFlight = static_cast<int>(h.integer("max_in_flight", l.threads, {1, 100000}));
-  l.maxConnections = static_cast<int>(h.integer("max_connections", l.maxConnections, {1, 100000}));
-  l.maxStreams = static_cast<int>(h.integer("max_streams", l.maxStreams, {0, 100000}));
-  l.backlog = static_cast<int>(h.integer("backlog", l.backlog, {1, 65535}));
-  l.requestTimeoutMs = static_cast<int>(h.integer("request_timeout_ms", l.requestTimeoutMs, {100, 600000}));
-  l.ratePerClient = h.number("rate_per_client", l.ratePerClient, {0, 1e6});
-  l.rateBurst = static_cast<int>(h.integer("rate_burst", l.rateBurst, {1, 1000000}));
-  s.auditLog = h.string("audit_log", "");
-  s.tls.certificateFile = h.string("tls_certificate", "");
-  s.tls.privateKeyFile = h.string("tls_key", "");
-  if (s.tls.certificateFile.empty() != s.tls.privateKeyFile.empty()) {
-    h.problem("tls_key", "https needs both tls_certificate and tls_key");
-  }
-  // The deployments of deploy/ require https (FLEET_WMS_TLS=required); their dev overlays say off.
-  if (const char* tls = std::getenv("FLEET_WMS_TLS"); tls != nullptr && *tls != '\0') {
-    const std::string mode = tls;
-    if (mode != "required" && mode != "off") {
-      h.problem("tls_certificate", "FLEET_WMS_TLS=\"" + mode + "\": expected required or off");
-    } else if (mode == "required" && s.tls.certificateFile.empty() && s.tls.privateKeyFile.empty()) {
-      h.problem(
-          "tls_certificate",
-          "FLEET_WMS_TLS=required, but no certificate is configured: set tls_certificate and tls_key "
-          "(scripts/dds-security https DIR wms-adapter HOST ..., docs/operator-guide.md#security), or for "
-          "development only set FLEET_WMS_TLS=off (the dev overlays of deploy/)");
-    }
-  }
-  s.tokenFile = h.string("token_file", "");
-  if (!s.tokenFile.empty()) {
-    if (auto t = TokenStore::fromFile(s.tokenFile); !t) {
-      h.problem("token_file", t.error().message);
-    }
-  } else if (const char* env = std::getenv("FLEET_WMS_TOKEN"); env != nullptr) {
-    s.token = env;
-  }
-  s.allowUnauthenticated = h.boolean("allow_unauthenticated", false);
-  if (s.tokenFile.empty() && s.token.empty() && !isLoopbackHost(s.host) && !s.allowUnauthenticated) {
-    h.problem("host", "\"" + s.host +
-                          "\" is reachable from other machines and no token is configured (token_file or "
-                          "FLEET_WMS_TOKEN): anyone could submit tasks. Configure tokens, listen on "
-                          "127.0.0.1, or set \"allow_unauthenticated\": true");
-  }
-  return s;
-}
-
-bool isLoopbackHost(const std::string& host) {
-  if (host == "localhost" || host == "::1") {
-    return true;
-  }
-  in_addr a{};
-  return inet_pton(AF_INET, host.c_str(), &a) == 1 && (ntohl(a.s_addr) >> 24) == 127;
-}
-
 namespace {
 TokenStore tokenStoreOf(const ApiSettings& s) {
   if (!s.tokenFile.empty()) {
@@ -198,7 +135,30 @@ HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& 
       server_(settings_.limits, settings_.tls) {
   std::random_device rd;
   instance_ = std::to_string(rd() % 1'000'000);
+  try {
+    stateDb_ = std::make_shared<SqliteDb>(settings_.events.path);
+    events_ = std::make_unique<EventLog>(settings_.events, stateDb_);
+    webhooks_ = std::make_unique<Webhooks>(settings_.webhooks, stateDb_, *events_);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError({std::string("events.log: ") + e.what()});
+  }
   routes();
+  view_.setEventLog(events_.get());
+}
+
+HttpApi::~HttpApi() {
+  view_.dropEventLog(events_.get());
+  webhooks_->stop();
+}
+
+nlohmann::json HttpApi::eventLogJson() const {
+  const auto hooks = webhooks_->list();
+  const auto failing =
+      std::count_if(hooks.begin(), hooks.end(), [](const auto& w) { return w.state == "failing"; });
+  return {{"last_id", events_->lastId()},       {"pruned_through", events_->prunedThrough()},
+          {"durable", events_->durable()},      {"append_failures", view_.eventLogFailures()},
+          {"problem", view_.eventLogProblem()}, {"webhooks", hooks.size()},
+          {"webhooks_failing", failing}};
 }
 
 std::string HttpApi::nextRequestId() {
@@ -383,6 +343,7 @@ void HttpApi::routes() {
            {"robots", view_.robots().size()},
            {"proximity", proximityJson(view_.proximity())},
            {"fleet_manager_online", gateway_.managerOnline()},
+           {"event_log", eventLogJson()},
            {"samples", view_.rejections().toJson()},
            {"http",
             {{"open_connections", h.openConnections.load()},
@@ -398,33 +359,7 @@ void HttpApi::routes() {
              {"token_file_problem", tokens_.lastProblem()},
              {"audit_write_failures", audit_.writeFailures()}}}});
   });
-  // Server-sent events: every TaskEvent as `event: task` with the JSON of the event. The stream
-  // holds no worker: the server polls it (never blocking) from its I/O thread. It ends when the
-  // client goes away or the server stops.
-  server_.route(
-      "GET", "/v1/events", Scope::Read,
-      [this](const Request&, Response& res) {
-        auto cursor = std::make_shared<std::uint64_t>(view_.eventCursor());
-        res.set_header("Cache-Control", "no-cache");
-        res.setEventStream("text/event-stream", [this, cursor]() -> std::optional<std::string> {
-          std::vector<msg::TaskEvent> evs;
-          *cursor = view_.eventsAfter(*cursor, std::chrono::milliseconds(0), evs);
-          std::string chunk;
-          for (const auto& e : evs) {
-            chunk += "event: task\ndata: " +
-                     dumpJson({{"id", e.task_id},
-                               {"state", msg::toString(e.state)},
-                               {"robot", e.robot_id},
-                               {"reason", e.reason},
-                               {"stamp_ns", e.stamp_ns},
-                               {"seq", e.seq},
-                               {"station", e.station}}) +
-                     "\n\n";
-          }
-          return chunk;
-        });
-      },
-      Run::Inline);
+  addStatusRoutes(server_, *events_, *webhooks_, [this] { return clock_.nowNs(); });
 }
 
 void HttpApi::postTasks(const Request& req, Response& res) {
@@ -447,6 +382,11 @@ void HttpApi::postTasks(const Request& req, Response& res) {
     reply(res, 413,
           error("too_large", "batch of " + std::to_string(n) + " tasks, at most " +
                                  std::to_string(settings_.maxBatch) + " allowed"));
+    return;
+  }
+  if (const auto times = acceptTaskTimes(body); !times.empty()) {
+    reply(res, 400,
+          {{"error", "invalid"}, {"message", "a time is not acceptable"}, {"fields", fieldsJson(times)}});
     return;
   }
   auto parsed = parseTasks(body, &stations_);

@@ -13,6 +13,7 @@
 #include "audit_log.hpp"
 #include "browser_session.hpp"
 #include "dashboard.hpp"
+#include "event_log.hpp"
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/station_map.hpp"
@@ -20,6 +21,7 @@
 #include "gateway.hpp"
 #include "http_names.hpp"
 #include "token_store.hpp"
+#include "webhooks.hpp"
 
 namespace fleet::wms {
 
@@ -35,10 +37,13 @@ struct ApiSettings {
   std::size_t maxBatch = 1000;
   std::size_t maxTaskBodyBytes = 256 * 1024;  // POST /v1/tasks (a batch of max_batch small tasks fits)
   int ackTimeoutMs = 5000;
+  EventLogSettings events;   // `events.*`: the durable event log (event_log.hpp)
+  WebhookSettings webhooks;  // `webhooks.*` (webhooks.hpp)
 };
 
-/// Reads `http.*` keys; without `token_file`, the token comes from FLEET_WMS_TOKEN. A host other
-/// than loopback with no token is a problem unless `allow_unauthenticated` is true.
+/// Reads `http.*`, `events.*` and `webhooks.*` keys; without `token_file`, the token comes from
+/// FLEET_WMS_TOKEN. A host other than loopback with no token is a problem unless `allow_unauthenticated` is
+/// true.
 ApiSettings readApiSettings(Config& cfg);
 /// True for 127.0.0.0/8, ::1 and "localhost": only this machine can connect.
 bool isLoopbackHost(const std::string& host);
@@ -54,9 +59,13 @@ struct ApiCounters {
 
 class HttpApi {
  public:
-  /// Throws ConfigError when the token file, the certificate or the audit log cannot be used.
+  /// Throws ConfigError when the token file, the certificate, the audit log or the event log
+  /// cannot be used. Feeds `view`'s task events into the event log until destroyed.
   HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& gateway, FleetView& view,
           const Clock& clock);
+  ~HttpApi();
+  HttpApi(const HttpApi&) = delete;
+  HttpApi& operator=(const HttpApi&) = delete;
   /// Binds the socket; false when the address is taken. port() tells the port bound.
   bool bind();
   [[nodiscard]] int port() const { return server_.port(); }
@@ -80,6 +89,9 @@ class HttpApi {
   }
   /// The operator dashboard served with the API (dashboard.hpp).
   [[nodiscard]] Dashboard& dashboard() { return *dashboard_; }
+  /// The durable log of task transitions the event stream and webhooks serve.
+  [[nodiscard]] EventLog& eventLog() { return *events_; }
+  [[nodiscard]] Webhooks& webhooks() { return *webhooks_; }
 
  private:
   void routes();
@@ -95,6 +107,8 @@ class HttpApi {
   void putClosure(const Request& req, Response& res);
   void deleteClosure(const Request& req, Response& res);
   std::string nextRequestId();
+  /// /v1/metrics' event_log: the log's ids, failures and the webhooks failing.
+  [[nodiscard]] nlohmann::json eventLogJson() const;
 
   ApiSettings settings_;
   const StationMap& stations_;
@@ -109,6 +123,9 @@ class HttpApi {
   std::atomic<std::uint64_t> requestCounter_{0};
   std::string instance_;
   ApiCounters counters_;
+  std::shared_ptr<SqliteDb> stateDb_;  // the event log and the webhook subscriptions
+  std::unique_ptr<EventLog> events_;
+  std::unique_ptr<Webhooks> webhooks_;
   std::unique_ptr<Dashboard> dashboard_;
   metrics::Registry* registry_ = nullptr;
   metrics::Histogram* requestSeconds_ = nullptr;

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     service::checkDdsSecurity();  // exit 2 naming a missing certificate, key or document
     Config cfg = configPath.empty() ? Config::fromJson(nlohmann::json::object(), "(command line)")
                                     : Config::fromFile(configPath);
-    cfg.rejectUnknownKeys({"http", "stations"});
+    cfg.rejectUnknownKeys({"http", "stations", "events", "webhooks"});
     auto api = wms::readApiSettings(cfg);
     if (port >= 0) {
       api.port = port;

@@ -1,0 +1,204 @@
+#include "event_log.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace fleet::wms {
+
+nlohmann::json loggedEventJson(const LoggedEvent& l) {
+  const auto& e = l.event;
+  return {{"event_id", l.id},    {"id", e.task_id},     {"state", msg::toString(e.state)},
+          {"robot", e.robot_id}, {"reason", e.reason},  {"stamp_ns", e.stamp_ns},
+          {"seq", e.seq},        {"station", e.station}};
+}
+
+namespace {
+
+constexpr std::int64_t kPruneEveryNs = 1'000'000'000;
+
+LoggedEvent rowOf(const SqliteStmt& q) {
+  LoggedEvent l;
+  l.id = q.integer(0);
+  l.event.task_id = q.text(1);
+  l.event.seq = static_cast<std::uint32_t>(q.integer(2));
+  msg::TaskState state{};
+  l.event.state = msg::parse(q.text(3), state) ? state : msg::TaskState::Queued;
+  l.event.robot_id = q.text(4);
+  l.event.reason = q.text(5);
+  l.event.stamp_ns = q.integer(6);
+  l.event.station = q.text(7);
+  return l;
+}
+
+}  // namespace
+
+EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
+    : s_(std::move(settings)), db_(std::move(db)) {
+  std::lock_guard dbLock(db_->mutex());
+  {
+    // Never written into another program's database (the manager's task store, say).
+    SqliteStmt q(*db_,
+                 "SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT IN "
+                 "('task_events', 'webhooks', 'sqlite_sequence') LIMIT 1");
+    if (q.step()) {
+      throw std::runtime_error("\"" + db_->path() + "\" is not the adapter's event log (it has a table \"" +
+                               q.text(0) + "\"): name a file of its own");
+    }
+  }
+  db_->exec(
+      "CREATE TABLE IF NOT EXISTS task_events("
+      " id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER NOT NULL,"
+      " state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT NULL,"
+      " station TEXT NOT NULL, logged_ns INTEGER NOT NULL);"
+      "CREATE INDEX IF NOT EXISTS task_events_by_task ON task_events(task_id, seq);"
+      "CREATE INDEX IF NOT EXISTS task_events_by_time ON task_events(logged_ns);");
+  {
+    SqliteStmt q(*db_, "SELECT seq FROM sqlite_sequence WHERE name = 'task_events'");
+    lastId_ = q.step() ? q.integer(0) : 0;
+  }
+  {
+    SqliteStmt q(*db_, "SELECT MIN(id) FROM task_events");
+    prunedThrough_ = q.step() && !q.isNull(0) ? q.integer(0) - 1 : lastId_;
+  }
+  seen_ = std::make_unique<SqliteStmt>(*db_, "SELECT 1 FROM task_events WHERE task_id = ?1 AND seq = ?2");
+  insert_ =
+      std::make_unique<SqliteStmt>(*db_,
+                                   "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, "
+                                   "station, logged_ns) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+  SqliteStmt q(*db_,
+               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station FROM task_events "
+               "WHERE id > ?1 ORDER BY id");
+  q.bind(1, std::max<std::int64_t>(prunedThrough_, lastId_ - static_cast<std::int64_t>(kMemoryTail)));
+  while (q.step()) {
+    tail_.push_back(rowOf(q));
+  }
+}
+
+std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int64_t nowNs) {
+  std::vector<LoggedEvent> added;
+  {
+    std::lock_guard dbLock(db_->mutex());
+    db_->exec("BEGIN IMMEDIATE");
+    try {
+      auto& seen = *seen_;
+      auto& row = *insert_;
+      for (const auto& e : events) {
+        if (e.seq != 0) {
+          seen.reset();
+          seen.bind(1, e.task_id).bind(2, static_cast<std::int64_t>(e.seq));
+          const bool logged = seen.step();
+          seen.reset();  // no read left open (it would hold the WAL back from checkpoints)
+          if (logged) {
+            continue;
+          }
+        }
+        row.reset();
+        row.bind(1, e.task_id)
+            .bind(2, static_cast<std::int64_t>(e.seq))
+            .bind(3, std::string(msg::toString(e.state)))
+            .bind(4, e.robot_id)
+            .bind(5, e.reason)
+            .bind(6, e.stamp_ns)
+            .bind(7, e.station)
+            .bind(8, nowNs);
+        row.run();
+        row.reset();
+        added.push_back({sqlite3_last_insert_rowid(db_->handle()), e});
+      }
+      // By count when 1 % over (one DELETE per many appends), by age once a second.
+      const std::int64_t held = (added.empty() ? lastId() : added.back().id) - prunedThrough();
+      if (nowNs - prunedAtNs_ >= kPruneEveryNs || held > s_.retainEvents + s_.retainEvents / 100) {
+        prune(nowNs);
+      }
+      db_->exec("COMMIT");
+    } catch (...) {
+      seen_->reset();
+      insert_->reset();
+      db_->exec("ROLLBACK");
+      throw;
+    }
+  }
+  if (added.empty()) {
+    return 0;
+  }
+  {
+    std::lock_guard lock(m_);
+    for (auto& a : added) {
+      lastId_ = a.id;
+      tail_.push_back(std::move(a));
+    }
+    while (tail_.size() > kMemoryTail || (!tail_.empty() && tail_.front().id <= prunedThrough_)) {
+      tail_.pop_front();
+    }
+  }
+  cv_.notify_all();
+  return added.size();
+}
+
+void EventLog::prune(std::int64_t nowNs) {
+  prunedAtNs_ = nowNs;
+  SqliteStmt last(*db_, "SELECT seq FROM sqlite_sequence WHERE name = 'task_events'");
+  const std::int64_t newest = last.step() ? last.integer(0) : 0;
+  SqliteStmt byCount(*db_, "DELETE FROM task_events WHERE id <= ?1");
+  byCount.bind(1, newest - s_.retainEvents).run();
+  SqliteStmt byAge(*db_, "DELETE FROM task_events WHERE logged_ns < ?1");
+  byAge.bind(1, nowNs - s_.retainSeconds * 1'000'000'000).run();
+  SqliteStmt first(*db_, "SELECT MIN(id) FROM task_events");
+  const std::int64_t through = first.step() && !first.isNull(0) ? first.integer(0) - 1 : newest;
+  std::lock_guard lock(m_);
+  prunedThrough_ = std::max(prunedThrough_, through);
+}
+
+std::vector<LoggedEvent> EventLog::after(std::int64_t after, std::size_t limit) const {
+  std::vector<LoggedEvent> out;
+  {
+    std::lock_guard lock(m_);
+    after = std::max(after, prunedThrough_);
+    if (after >= lastId_) {
+      return out;
+    }
+    if (!tail_.empty() && after >= tail_.front().id - 1) {
+      auto it = std::lower_bound(tail_.begin(), tail_.end(), after + 1,
+                                 [](const LoggedEvent& l, std::int64_t id) { return l.id < id; });
+      for (; it != tail_.end() && out.size() < limit; ++it) {
+        out.push_back(*it);
+      }
+      return out;
+    }
+  }
+  // Older than the memory holds: a client catching up from far back (bounded by `limit`).
+  std::lock_guard dbLock(db_->mutex());
+  SqliteStmt q(*db_,
+               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station FROM task_events "
+               "WHERE id > ?1 ORDER BY id LIMIT ?2");
+  q.bind(1, after).bind(2, static_cast<std::int64_t>(limit));
+  while (q.step()) {
+    out.push_back(rowOf(q));
+  }
+  return out;
+}
+
+std::int64_t EventLog::lastId() const {
+  std::lock_guard lock(m_);
+  return lastId_;
+}
+
+std::int64_t EventLog::prunedThrough() const {
+  std::lock_guard lock(m_);
+  return prunedThrough_;
+}
+
+bool EventLog::waitAfter(std::int64_t after, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(m_);
+  return cv_.wait_for(lock, timeout, [&] { return lastId_ > after || woken_; }) && lastId_ > after;
+}
+
+void EventLog::wakeAll() {
+  {
+    std::lock_guard lock(m_);
+    woken_ = true;
+  }
+  cv_.notify_all();
+}
+
+}  // namespace fleet::wms
