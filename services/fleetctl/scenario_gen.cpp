@@ -96,7 +96,7 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   }
   for (int i = 0; i < dropoffs; ++i) {
     stations.push_back(station("D-" + std::to_string(i + 1), "dropoff", widthM - 1.5,
-                               spread(sideY0, sideY1, dropoffs, i), 0.0));
+                               spread(sideY0, sideY1, dropoffs, i), 3.1416));
   }
   s["stations"] = stations;
 

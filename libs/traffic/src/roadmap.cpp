@@ -761,6 +761,9 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   for (auto& p : checkRoadmap(r)) {
     r.problems.push_back(std::move(p));
   }
+  for (auto& p : checkQueues(r)) {
+    r.problems.push_back(std::move(p));
+  }
   return r;
 }
 

@@ -1,5 +1,7 @@
 #include "scenario_gen.hpp"
 
+#include "fleet/traffic/roadmap.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -54,6 +56,20 @@ TEST_P(GeneratedScenario, LoadsInTheSimulatorAndFitsTheFleet) {
   const auto [w, h] = mapExtent(*doc);
   EXPECT_GE(w * h, std::max(600.0, 25.0 * n));
   EXPECT_LE(w * h, std::max(1200.0, 60.0 * n));
+}
+
+// The traffic manager's roadmap of the generated site has no errors: every station connected both
+// ways, and no station's full line cuts off another (traffic::checkQueues).
+TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
+  const int n = GetParam();
+  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
+  ASSERT_TRUE(doc) << doc.error().message;
+  const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
+  ASSERT_NE(s.site, nullptr);
+  const traffic::Roadmap r = traffic::buildRoadmap(*s.site);
+  for (const auto& p : r.problems) {
+    EXPECT_NE(p.severity, traffic::RoadmapProblem::Severity::Error) << p.what;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 100, 500));

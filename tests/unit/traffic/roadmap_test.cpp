@@ -601,6 +601,34 @@ TEST(Roadmap, OneMetreCorridorOffTheLatticeLinesIsFilledIn) {
   EXPECT_EQ(inCorridor, 4);  // x = 4.75 … 6.25
 }
 
+TEST(Roadmap, AQueueInTheOnlyCorridorBetweenTwoRoomsIsRefusedByItsKeyPath) {
+  // Two rooms joined by a corridor 1 m wide (x 4.5..6.5 m, y 2..3 m): A in the west room, B and C
+  // in the east one, their lines generated inside their rooms.
+  auto rows = hall();
+  for (std::size_t r = 1; r + 1 < rows.size(); ++r) {
+    if (r != 4 && r != 5) {
+      rows[r].replace(9, 4, "@@@@");
+    }
+  }
+  nlohmann::json st = {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 4.0, kPi / 2}}},
+                       {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 4.0, kPi / 2}}},
+                       {{"name", "C"}, {"kind", "dropoff"}, {"pose", {7.5, 4.0, kPi / 2}}}};
+  const Roadmap fine = buildRoadmap(rowsSite(rows, st));
+  EXPECT_EQ(errors(fine), 0U) << describe(fine.problems);
+  // C docked from the west at the corridor's mouth, its queue points in the corridor: robots waiting
+  // in its full line cut the west room (A) off from B.
+  st[2]["pose"] = {7.5, 2.5, 0.0};
+  st[2]["queue"] = {{6.0, 2.5}, {5.0, 2.5}};
+  const Roadmap r = buildRoadmap(rowsSite(rows, st));
+  ASSERT_EQ(errors(r), 1U) << describe(r.problems);
+  const auto& p = r.problems.front();
+  EXPECT_EQ(p.station, "C");
+  EXPECT_EQ(p.what.rfind("stations[2].queue: ", 0), 0U) << p.what;
+  EXPECT_NE(p.what.find("cut off 1 station: 'B'"), std::string::npos) << p.what;
+  // With the line empty the three are connected: the line, not the layout, cuts the site.
+  EXPECT_EQ(connectedStations(r), (std::vector<std::string>{"A", "B", "C"}));
+}
+
 TEST(Roadmap, QueuePointsTooCloseToTheStationAreAWarning) {
   nlohmann::json st = twoStations();
   st[1]["queue"] = {{9.0, 2.8}};  // 0.58 m from the dock

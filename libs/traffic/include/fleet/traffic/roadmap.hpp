@@ -163,6 +163,12 @@ Roadmap buildRoadmap(const site::Site& site, const RoadmapOptions& options = {})
 /// make (warnings, one per group).
 std::vector<RoadmapProblem> checkRoadmap(const Roadmap& r);
 
+/// Stations whose full line cuts the site: with robots standing on every node of a station's queue,
+/// another station connected before can no longer be reached from the rest or cannot get back
+/// (errors naming `stations[i].queue`; a parking place cut off is a warning: it traps a resting
+/// robot but stops no station; queue_check.cpp). Done once when the roadmap is built.
+std::vector<RoadmapProblem> checkQueues(const Roadmap& r);
+
 /// Names of the stations whose dock is in that main component.
 std::vector<std::string> connectedStations(const Roadmap& r);
 
