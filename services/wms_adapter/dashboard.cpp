@@ -284,7 +284,7 @@ void Dashboard::routes(HttpServer& server) {
       "GET", "/", Scope::Public,
       [](const Request&, Response& res) {
         res.status = 302;
-        res.set_header("Location", "/dashboard/");
+        res.set_header("Location", "dashboard/");  // relative: kept under a proxy's path prefix
       },
       Run::Inline);
   // The page's files carry no data: no login (the page asks for the token itself).

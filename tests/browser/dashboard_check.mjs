@@ -3,15 +3,19 @@
 // writes the simulator's ground truth to $DASH_DIR/truth.json and restarts the adapter when
 // $DASH_DIR/restart.request appears. Exit 0 when every check passed; each check prints one line.
 //
-// Env: DASH_URL (the page), DASH_TOKEN (an operator's token: read, submit, operate),
+// The page is driven through a reverse proxy of our own that serves the adapter under the path
+// prefix /fleet/ (as an ingress would): every request the page makes must stay under it.
+//
+// Env: DASH_URL (the page, served by the adapter itself), DASH_TOKEN (an operator's token: read, submit, operate),
 // DASH_VIEWER_TOKEN (a read-only token), DASH_RELEASED (the robot the test released a route to),
 // DASH_DIR, DASH_SHOTS (folder for the screenshots).
 
 import fs from 'node:fs';
+import http from 'node:http';
 import path from 'node:path';
 import puppeteer from 'puppeteer-core';
 
-const url = process.env.DASH_URL;
+const direct = new URL(process.env.DASH_URL);
 const token = process.env.DASH_TOKEN;
 const viewerToken = process.env.DASH_VIEWER_TOKEN;
 const released = process.env.DASH_RELEASED;
@@ -107,6 +111,40 @@ async function until(what, fn, ms) {
     await sleep(200);
   }
 }
+
+// A reverse proxy on loopback: /fleet/X is the adapter's /X; anything else is counted and refused.
+const kPrefix = '/fleet';
+const outside = [];
+const proxy = http.createServer((req, res) => {
+  if (!req.url.startsWith(kPrefix + '/')) {
+    outside.push(req.url);
+    res.writeHead(404, { 'Content-Type': 'text/plain' });
+    res.end('outside the prefix');
+    return;
+  }
+  const up = http.request({ host: direct.hostname, port: direct.port, method: req.method,
+                            path: req.url.slice(kPrefix.length), headers: req.headers }, (r) => {
+    res.writeHead(r.statusCode, r.headers);
+    r.pipe(res);
+    // The adapter gone mid-response (the stream of a restarted adapter): the page must see it.
+    r.on('close', () => {
+      if (!r.complete) {
+        res.destroy();
+      }
+    });
+  });
+  up.on('error', () => {
+    if (res.headersSent) {
+      res.destroy();
+    } else {
+      res.writeHead(502);
+      res.end();
+    }
+  });
+  req.pipe(up);
+});
+await new Promise((resolve) => proxy.listen(0, '127.0.0.1', resolve));
+const url = `http://127.0.0.1:${proxy.address().port}${kPrefix}${direct.pathname}`;
 
 // Root in CI: chromium's sandbox needs user namespaces it does not get there.
 const browser = await puppeteer.launch({
@@ -241,7 +279,7 @@ try {
     return f.contacts && f.contacts.includes('robot–person') && f['near misses'].includes('robot–robot') ? f : null;
   }), 10000);
   if (figures) {
-    const metrics = await page.evaluate(async () => (await fetch('/v1/metrics')).json());
+    const metrics = await page.evaluate(async () => (await fetch(new URL('../v1/metrics', location.href))).json());
     const px = metrics.proximity;
     check(px && figures.contacts.startsWith(`${px.robot_robot.contacts} robot–robot`),
           `contacts: ${figures.contacts}; near misses: ${figures['near misses']}; closest: ${figures.closest}; people seen: ${figures['people seen']}`);
@@ -360,9 +398,15 @@ try {
   check(true, `task ${taskId} done`);
   await page.mouse.click(5, 5);
   await shot('5-done.png');
+
+  // 7. Under the proxy's prefix the page asked for nothing outside it (no absolute /v1/... URL).
+  check(outside.length === 0, `every request stayed under ${kPrefix}/` +
+                              (outside.length ? ` (outside: ${[...new Set(outside)].join(', ')})` : ''));
 } catch (e) {
   check(false, `no exception: ${e.stack || e}`);
 } finally {
   await browser.close();
+  proxy.closeAllConnections();
+  proxy.close();
 }
 process.exit(failures ? 1 : 0);

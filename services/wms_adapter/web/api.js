@@ -5,6 +5,15 @@
 /** What GET /v1/stream sends (docs/openapi.yaml). */
 export const STREAM_EVENTS = ['snapshot', 'robots', 'task', 'risk', 'roadmap', 'releases', 'queues', 'proximity'];
 
+/**
+ * The URL of an API path ('/v1/...') for this page. The page lives at <prefix>/dashboard/ and the
+ * API at <prefix>/v1/: resolved against the page, so the dashboard works behind a reverse proxy or
+ * an ingress that serves the adapter under a path prefix.
+ */
+export function apiUrl(path) {
+  return new URL('..' + path, window.location.href).href;
+}
+
 export class ApiError extends Error {
   constructor(status, message) {
     super(message);
@@ -31,7 +40,7 @@ export class Api {
 
   /** Makes a session from the token: the token travels once, in a header, never in a URL. */
   async login(token) {
-    const res = await fetch('/v1/session', {
+    const res = await fetch(apiUrl('/v1/session'), {
       method: 'POST',
       headers: { Authorization: 'Bearer ' + token },
       credentials: 'same-origin',
@@ -58,7 +67,7 @@ export class Api {
     }
     let res;
     try {
-      res = await fetch(path, {
+      res = await fetch(apiUrl(path), {
         method,
         headers,
         credentials: 'same-origin',
@@ -84,7 +93,7 @@ export class Api {
     let closed = false;
     let retryTimer = 0;
     const open = () => {
-      es = new EventSource('/v1/stream');
+      es = new EventSource(apiUrl('/v1/stream'));
       es.addEventListener('open', () => handlers.state('live', 'ok'));
       for (const name of STREAM_EVENTS) {
         es.addEventListener(name, (ev) => {
