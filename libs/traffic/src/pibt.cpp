@@ -594,6 +594,9 @@ const std::vector<NodeId>& Pibt::step() {
     updateProgress(i);
   }
   advanceForced();
+  if (options_.detourAfter > 0) {
+    settleDetours();  // the blockers' search reads around where the agents are now
+  }
   if (options_.escapeAfter > 0) {
     escapeDeadlocks();
   }
@@ -702,16 +705,26 @@ void Pibt::planDetours() {
       own(w);
     }
     const float from = distances_.distance(now_[i], goal_[i]);
-    distances_.withExtraCost(goal_[i], extra_, detour_[i]);
+    distances_.startWithExtraCost(goal_[i], extra_, detour_[i]);
     --budget;
     ++stats_.detours;
-    if (detour_[i][idx(now_[i])] == DistanceTable::kUnreachable) {
+    const float there = distances_.settle(detour_[i], now_[i]);
+    if (there == DistanceTable::kUnreachable) {
       detour_[i].clear();
       continue;
     }
     detourFrom_[i] = from;
-    best_[i] = detour_[i][idx(now_[i])];
+    best_[i] = there;
     stalled_[i] = 0;
+  }
+  settleDetours();
+}
+
+void Pibt::settleDetours() {
+  for (std::size_t i = 0; i < detour_.size(); ++i) {
+    if (!detour_[i].empty()) {
+      distances_.settleAround(detour_[i], now_[i], 1);
+    }
   }
 }
 

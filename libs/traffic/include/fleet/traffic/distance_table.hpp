@@ -20,6 +20,25 @@
 
 namespace fleet::traffic {
 
+/// A backward search to one goal kept open (DistanceTable::startWithExtraCost): a distance is
+/// final once its node is settled (DistanceTable::settle), until then an upper bound.
+struct PartialTable {
+  NodeId goal = kNoNode;
+  std::vector<float> dist;                     ///< final where settled, else an upper bound
+  std::vector<float> enter;                    ///< whole cost of entering each node; infinite: never
+  std::vector<std::uint64_t> settled;          ///< one bit per node
+  std::vector<std::pair<float, NodeId>> heap;  ///< the search's frontier
+  std::uint64_t settledCount = 0;
+
+  [[nodiscard]] bool empty() const { return goal == kNoNode; }
+  void clear() { goal = kNoNode; }
+  [[nodiscard]] const float* data() const { return dist.data(); }
+  [[nodiscard]] bool isSettled(NodeId v) const {
+    const auto i = static_cast<std::size_t>(v);
+    return ((settled[i >> 6] >> (i & 63)) & 1U) != 0;
+  }
+};
+
 class DistanceTable {
  public:
   static constexpr float kUnreachable = std::numeric_limits<float>::infinity();
@@ -57,6 +76,16 @@ class DistanceTable {
   /// going round). Dijkstra, not cached; `extra[goal]` is ignored and closed or blocked nodes are
   /// honoured as in to(). `extra` has one entry per node.
   void withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& out);
+  /// The same distances, searched only as far as asked (resumable_dijkstra.cpp): starts the search
+  /// with what is closed, blocked and costs what now, and settle() goes on with that state whatever
+  /// changes later (as a table computed now would). A planner reads a detour table only around its
+  /// robot, a few hundred of a roadmap's nodes, while a whole search visits all of them.
+  void startWithExtraCost(NodeId goal, std::span<const float> extra, PartialTable& out);
+  /// Goes on with `t`'s search until `v` is settled; returns its final distance (kUnreachable when
+  /// there is no route). Valid while the graph's edges stay as they were (graph changes drop tables).
+  float settle(PartialTable& t, NodeId v) const;
+  /// Settles `v` and every node within `hops` edges of it.
+  void settleAround(PartialTable& t, NodeId v, int hops) const;
 
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
   [[nodiscard]] std::size_t cached() const { return used_; }

@@ -183,6 +183,8 @@ class Pibt {
   void advanceForced();
   void dropForced(std::int32_t group);
   void planDetours();
+  /// Settles every detour table at its agent's node and neighbours (all the planner reads of it).
+  void settleDetours();
   void dropDetour(std::size_t agent);
   void resizeForGraph();
   void cover(NodeId v, int delta);
@@ -219,7 +221,7 @@ class Pibt {
   std::vector<int> still_;                   ///< steps since it last moved
   std::vector<int> tries_;                   ///< escalations since it last came closer to its goal
   std::vector<std::uint32_t> visited_;       ///< stamps for the cycle search
-  std::vector<std::vector<float>> detour_;   ///< detour table to its goal, empty when none
+  std::vector<PartialTable> detour_;         ///< detour table to its goal, empty when none
   std::vector<float> detourFrom_;            ///< regular distance when the detour was taken
   std::vector<float> extra_;                 ///< per node scratch: detour penalties
   std::vector<int> standCover_;              ///< per node scratch: standing agents excluding it
