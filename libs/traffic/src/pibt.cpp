@@ -547,7 +547,9 @@ const std::vector<NodeId>& Pibt::step() {
     if (goal_[i] == kNoNode || controlled_[i] == 0) {
       table_[i] = nullptr;
     } else {
-      table_[i] = detour_[i].empty() ? distances_.to(goal_[i]).data() : detour_[i].data();
+      // Searched as far as it is read: here and the next nodes (settleTables).
+      table_[i] = detour_[i].empty() ? distances_.partialTo(goal_[i]) : detour_[i].data();
+      settleTable(i, 1);
     }
     if (rebaseProgress_ && table_[i] != nullptr && detour_[i].empty()) {
       const float d = table_[i][idx(now_[i])];
@@ -594,9 +596,7 @@ const std::vector<NodeId>& Pibt::step() {
     updateProgress(i);
   }
   advanceForced();
-  if (options_.detourAfter > 0) {
-    settleDetours();  // the blockers' search reads around where the agents are now
-  }
+  settleTables();  // the blockers' search reads around where the agents are now
   if (options_.escapeAfter > 0) {
     escapeDeadlocks();
   }
@@ -717,14 +717,23 @@ void Pibt::planDetours() {
     best_[i] = there;
     stalled_[i] = 0;
   }
-  settleDetours();
+  settleTables();
 }
 
-void Pibt::settleDetours() {
-  for (std::size_t i = 0; i < detour_.size(); ++i) {
-    if (!detour_[i].empty()) {
-      distances_.settleAround(detour_[i], now_[i], 1);
-    }
+void Pibt::settleTable(std::size_t i, int hops) {
+  if (controlled_[i] == 0 || goal_[i] == kNoNode) {
+    return;
+  }
+  if (detour_[i].empty()) {
+    distances_.settleAround(goal_[i], now_[i], hops);
+  } else {
+    distances_.settleAround(detour_[i], now_[i], hops);
+  }
+}
+
+void Pibt::settleTables() {
+  for (std::size_t i = 0; i < now_.size(); ++i) {
+    settleTable(i, 1);
   }
 }
 

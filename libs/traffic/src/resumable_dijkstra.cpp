@@ -44,9 +44,21 @@ void DistanceTable::startWithExtraCost(NodeId goal, std::span<const float> extra
 }
 
 float DistanceTable::settle(PartialTable& t, NodeId v) const {
-  const auto want = static_cast<std::size_t>(v);
-  if (t.empty() || t.isSettled(v)) {
-    return t.empty() ? kUnreachable : t.dist[want];
+  return settleIn(t, t.enter, v);
+}
+
+void DistanceTable::settleAround(PartialTable& t, NodeId v, int hops) const {
+  settleAroundIn(t, t.enter, v, hops);
+}
+
+float DistanceTable::settleIn(PartialTable& t, std::span<const float> enterOf, NodeId v) const {
+  // v == kNoNode: to the end of the search.
+  const auto want = v == kNoNode ? graph_.size() : static_cast<std::size_t>(v);
+  if (t.empty()) {
+    return kUnreachable;
+  }
+  if (v != kNoNode && t.isSettled(v)) {
+    return t.dist[want];
   }
   const auto later = std::greater<>{};
   auto& heap = t.heap;
@@ -60,7 +72,7 @@ float DistanceTable::settle(PartialTable& t, NodeId v) const {
     }
     t.settled[u >> 6] |= std::uint64_t{1} << (u & 63);
     ++t.settledCount;
-    const float enter = t.enter[u];
+    const float enter = un == t.goal ? 0.0F : enterOf[u];
     if (enter != kUnreachable) {
       // Driving p→u costs the edge plus entering u (DistanceTable::dijkstra's expression).
       for (std::uint32_t k = revStart_[u]; k < revStart_[u + 1]; ++k) {
@@ -79,21 +91,25 @@ float DistanceTable::settle(PartialTable& t, NodeId v) const {
     }
   }
   // Frontier exhausted: every node left is unreachable (its bound is infinite), hence final.
+  if (v == kNoNode) {
+    return kUnreachable;
+  }
   t.settled[want >> 6] |= std::uint64_t{1} << (want & 63);
   return t.dist[want];
 }
 
-void DistanceTable::settleAround(PartialTable& t, NodeId v, int hops) const {
+void DistanceTable::settleAroundIn(PartialTable& t, std::span<const float> enterOf, NodeId v,
+                                   int hops) const {
   if (t.empty() || !graph_.valid(v)) {
     return;
   }
-  settle(t, v);
+  settleIn(t, enterOf, v);
   if (hops <= 0) {
     return;
   }
   if (hops == 1) {  // every step, for every agent on a detour: no allocation
     for (const Edge& e : graph_.edges(v)) {
-      settle(t, e.to);
+      settleIn(t, enterOf, e.to);
     }
     return;
   }
@@ -106,7 +122,7 @@ void DistanceTable::settleAround(PartialTable& t, NodeId v, int hops) const {
         continue;
       }
       seen.push_back(e.to);
-      settle(t, e.to);
+      settleIn(t, enterOf, e.to);
       if (depth + 1 < hops) {
         todo.emplace_back(e.to, depth + 1);
       }

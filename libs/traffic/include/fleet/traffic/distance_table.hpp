@@ -50,7 +50,13 @@ class DistanceTable {
   /// the goal is closed). The span stays valid until capacity() other goals have been asked for
   /// after it, or invalidate().
   std::span<const float> to(NodeId goal);
-  float distance(NodeId from, NodeId goal) { return to(goal)[static_cast<std::size_t>(from)]; }
+  /// The distance of `from` to `goal`, searching the goal's table only as far as `from`.
+  float distance(NodeId from, NodeId goal);
+  /// The goal's table as far as searched so far: a value is final only where settled by
+  /// distance() or settleAround(goal, ...) (or everywhere after to()). Valid as long as to()'s.
+  const float* partialTo(NodeId goal);
+  /// Settles `v` and every node within `hops` edges of it in the goal's table, if it has one.
+  void settleAround(NodeId goal, NodeId v, int hops);
 
   /// Keep room for at least `tables` goals at once (a planner holding every agent's goal table
   /// through a step needs agents + 1), whatever the byte budget says.
@@ -97,6 +103,10 @@ class DistanceTable {
  private:
   void buildReverse();
   void compute(NodeId goal, std::vector<float>& d);
+  std::size_t acquire(NodeId goal);
+  void start(NodeId goal, PartialTable& t) const;
+  float settleIn(PartialTable& t, std::span<const float> enterOf, NodeId v) const;
+  void settleAroundIn(PartialTable& t, std::span<const float> enterOf, NodeId v, int hops) const;
   /// Dijkstra from `goal` (d[goal] already 0), entering v costing extra[v] more when given.
   void dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d);
   std::size_t acquireSlot();
@@ -115,7 +125,8 @@ class DistanceTable {
   // Cache: slot per goal, slots on an intrusive LRU list (head = most recent).
   std::vector<std::int32_t> slotOfGoal_;
   std::vector<NodeId> goalOfSlot_;
-  std::vector<std::vector<float>> tables_;
+  std::vector<PartialTable> tables_;
+  std::vector<float> baseEnter_;  ///< entering each node in a goal's table (infinite: closed or blocked)
   std::vector<std::int32_t> prev_;
   std::vector<std::int32_t> next_;
   std::int32_t head_ = -1;

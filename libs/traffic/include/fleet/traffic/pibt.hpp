@@ -183,8 +183,11 @@ class Pibt {
   void advanceForced();
   void dropForced(std::int32_t group);
   void planDetours();
-  /// Settles every detour table at its agent's node and neighbours (all the planner reads of it).
-  void settleDetours();
+  /// Settles agent i's table (its goal's or its detour's, both searched only as far as read) at
+  /// its node and within `hops` edges of it.
+  void settleTable(std::size_t i, int hops);
+  /// Every agent's table at its node and neighbours: all a step reads of it but to untangle.
+  void settleTables();
   void dropDetour(std::size_t agent);
   void resizeForGraph();
   void cover(NodeId v, int delta);
