@@ -71,6 +71,12 @@ void DistanceTable::invalidate() {
   dirty_ = false;
   blocked_.resize(graph_.size(), 0);
   buildReverse();
+  // Entering each node in a goal's table: its node cost, never when closed or blocked.
+  baseEnter_.resize(graph_.size());
+  for (std::size_t v = 0; v < graph_.size(); ++v) {
+    const bool open = graph_.isOpen(static_cast<NodeId>(v)) && blocked_[v] == 0;
+    baseEnter_[v] = !open ? kUnreachable : nodeCost_.size() == graph_.size() ? nodeCost_[v] : 0.0F;
+  }
   const std::size_t n = std::max<std::size_t>(graph_.size(), 1);
   const std::size_t byBudget = maxBytes_ / (n * sizeof(float));
   capacity_ = std::max<std::size_t>({byBudget, capacity_, 1});
@@ -137,7 +143,7 @@ std::size_t DistanceTable::acquireSlot() {
   return slot;
 }
 
-std::span<const float> DistanceTable::to(NodeId goal) {
+std::size_t DistanceTable::acquire(NodeId goal) {
   if (dirty_) {
     invalidate();
   }
@@ -145,14 +151,56 @@ std::span<const float> DistanceTable::to(NodeId goal) {
   std::int32_t slot = slotOfGoal_[g];
   if (slot < 0) {
     const std::size_t s = acquireSlot();
-    compute(goal, tables_[s]);
+    start(goal, tables_[s]);
     goalOfSlot_[s] = goal;
     slot = static_cast<std::int32_t>(s);
     slotOfGoal_[g] = slot;
     ++computed_;
   }
   touch(static_cast<std::size_t>(slot));
-  return tables_[static_cast<std::size_t>(slot)];
+  return static_cast<std::size_t>(slot);
+}
+
+std::span<const float> DistanceTable::to(NodeId goal) {
+  PartialTable& t = tables_[acquire(goal)];
+  if (t.settledCount == 0 && unit_ && nodeCost_.empty() && !t.heap.empty()) {
+    compute(goal, t.dist);  // a whole table at once: breadth-first when every edge lasts the same
+    t.heap.clear();
+    std::fill(t.settled.begin(), t.settled.end(), ~std::uint64_t{0});
+    t.settledCount = graph_.size();
+  }
+  settleIn(t, baseEnter_, kNoNode);
+  return t.dist;
+}
+
+const float* DistanceTable::partialTo(NodeId goal) {
+  return tables_[acquire(goal)].data();
+}
+
+float DistanceTable::distance(NodeId from, NodeId goal) {
+  return settleIn(tables_[acquire(goal)], baseEnter_, from);
+}
+
+void DistanceTable::settleAround(NodeId goal, NodeId v, int hops) {
+  const std::int32_t slot = slotOfGoal_[static_cast<std::size_t>(goal)];
+  if (slot >= 0) {
+    settleAroundIn(tables_[static_cast<std::size_t>(slot)], baseEnter_, v, hops);
+  }
+}
+
+void DistanceTable::start(NodeId goal, PartialTable& t) const {
+  const std::size_t n = graph_.size();
+  t.goal = goal;
+  t.dist.assign(n, kUnreachable);
+  t.settled.assign((n + 63) / 64, 0);
+  t.heap.clear();
+  t.settledCount = 0;
+  // A closed goal is not reachable at all (an empty frontier); a blocked one is where the route
+  // leads: the way up to it is what an agent waiting for it needs.
+  if (graph_.isOpen(goal)) {
+    t.dist[static_cast<std::size_t>(goal)] = 0.0F;
+    t.heap.emplace_back(0.0F, goal);
+  }
 }
 
 void DistanceTable::compute(NodeId goal, std::vector<float>& d) {

@@ -547,7 +547,9 @@ const std::vector<NodeId>& Pibt::step() {
     if (goal_[i] == kNoNode || controlled_[i] == 0) {
       table_[i] = nullptr;
     } else {
-      table_[i] = detour_[i].empty() ? distances_.to(goal_[i]).data() : detour_[i].data();
+      // Searched as far as it is read: here and the next nodes (settleTables).
+      table_[i] = detour_[i].empty() ? distances_.partialTo(goal_[i]) : detour_[i].data();
+      settleTable(i, 1);
     }
     if (rebaseProgress_ && table_[i] != nullptr && detour_[i].empty()) {
       const float d = table_[i][idx(now_[i])];
@@ -594,6 +596,7 @@ const std::vector<NodeId>& Pibt::step() {
     updateProgress(i);
   }
   advanceForced();
+  settleTables();  // the blockers' search reads around where the agents are now
   if (options_.escapeAfter > 0) {
     escapeDeadlocks();
   }
@@ -652,66 +655,6 @@ void Pibt::updateProgress(std::size_t i) {
     // Escalated and still stuck: someone else on its cycle has to go first (escapeDeadlocks).
     escalatedAt_[i] = -1;
     ++stats_.escalationRequeues;
-  }
-}
-
-void Pibt::dropDetour(std::size_t agent) {
-  if (!detour_[agent].empty()) {
-    detour_[agent].clear();
-    best_[agent] = DistanceTable::kUnreachable;
-  }
-}
-
-void Pibt::planDetours() {
-  const std::size_t n = now_.size();
-  int budget = options_.maxDetoursPerStep;
-  bool covered = false;
-  std::vector<int>& cover = standCover_;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (controlled_[i] == 0 || goal_[i] == kNoNode || now_[i] == goal_[i]) {
-      dropDetour(i);
-      continue;
-    }
-    if (!detour_[i].empty() && distances_.distance(now_[i], goal_[i]) < detourFrom_[i]) {
-      dropDetour(i);  // past what it went round: the shortest way is its way again
-    }
-    if (budget == 0 || stalled_[i] < options_.detourAfter || still_[i] < options_.detourAfter) {
-      continue;
-    }
-    if (!covered) {
-      // What every agent that has stood still as long excludes, counted per node.
-      cover.assign(graph_.size(), 0);
-      for (std::size_t b = 0; b < n; ++b) {
-        if (controlled_[b] != 0 && still_[b] >= options_.detourAfter) {
-          ++cover[idx(now_[b])];
-          for (const NodeId w : graph_.conflicts(now_[b])) {
-            ++cover[idx(w)];
-          }
-        }
-      }
-      covered = true;
-    }
-    // Its own footprint is no obstacle to it: there only the others standing count.
-    extra_.resize(graph_.size());
-    for (std::size_t v = 0; v < graph_.size(); ++v) {
-      extra_[v] = cover[v] > 0 ? options_.detourPenalty : 0.0F;
-    }
-    const auto own = [&](NodeId w) { extra_[idx(w)] = cover[idx(w)] > 1 ? options_.detourPenalty : 0.0F; };
-    own(now_[i]);
-    for (const NodeId w : graph_.conflicts(now_[i])) {
-      own(w);
-    }
-    const float from = distances_.distance(now_[i], goal_[i]);
-    distances_.withExtraCost(goal_[i], extra_, detour_[i]);
-    --budget;
-    ++stats_.detours;
-    if (detour_[i][idx(now_[i])] == DistanceTable::kUnreachable) {
-      detour_[i].clear();
-      continue;
-    }
-    detourFrom_[i] = from;
-    best_[i] = detour_[i][idx(now_[i])];
-    stalled_[i] = 0;
   }
 }
 

@@ -170,6 +170,7 @@ bool Pibt::untangleKnot(std::span<const std::int32_t> knot, std::span<const std:
     UntangleProblem problem;
     for (const std::int32_t a : group) {
       problem.starts.push_back(now_[idx(a)]);
+      settleTable(idx(a), options_.untangleSteps);  // read up to untangleSteps moves away
       problem.tables.push_back(table_[idx(a)]);
       problem.counts.push_back(std::find(counting.begin(), counting.end(), a) != counting.end() ? 1 : 0);
     }

@@ -20,6 +20,25 @@
 
 namespace fleet::traffic {
 
+/// A backward search to one goal kept open (DistanceTable::startWithExtraCost): a distance is
+/// final once its node is settled (DistanceTable::settle), until then an upper bound.
+struct PartialTable {
+  NodeId goal = kNoNode;
+  std::vector<float> dist;                     ///< final where settled, else an upper bound
+  std::vector<float> enter;                    ///< whole cost of entering each node; infinite: never
+  std::vector<std::uint64_t> settled;          ///< one bit per node
+  std::vector<std::pair<float, NodeId>> heap;  ///< the search's frontier
+  std::uint64_t settledCount = 0;
+
+  [[nodiscard]] bool empty() const { return goal == kNoNode; }
+  void clear() { goal = kNoNode; }
+  [[nodiscard]] const float* data() const { return dist.data(); }
+  [[nodiscard]] bool isSettled(NodeId v) const {
+    const auto i = static_cast<std::size_t>(v);
+    return ((settled[i >> 6] >> (i & 63)) & 1U) != 0;
+  }
+};
+
 class DistanceTable {
  public:
   static constexpr float kUnreachable = std::numeric_limits<float>::infinity();
@@ -31,7 +50,13 @@ class DistanceTable {
   /// the goal is closed). The span stays valid until capacity() other goals have been asked for
   /// after it, or invalidate().
   std::span<const float> to(NodeId goal);
-  float distance(NodeId from, NodeId goal) { return to(goal)[static_cast<std::size_t>(from)]; }
+  /// The distance of `from` to `goal`, searching the goal's table only as far as `from`.
+  float distance(NodeId from, NodeId goal);
+  /// The goal's table as far as searched so far: a value is final only where settled by
+  /// distance() or settleAround(goal, ...) (or everywhere after to()). Valid as long as to()'s.
+  const float* partialTo(NodeId goal);
+  /// Settles `v` and every node within `hops` edges of it in the goal's table, if it has one.
+  void settleAround(NodeId goal, NodeId v, int hops);
 
   /// Keep room for at least `tables` goals at once (a planner holding every agent's goal table
   /// through a step needs agents + 1), whatever the byte budget says.
@@ -57,6 +82,16 @@ class DistanceTable {
   /// going round). Dijkstra, not cached; `extra[goal]` is ignored and closed or blocked nodes are
   /// honoured as in to(). `extra` has one entry per node.
   void withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& out);
+  /// The same distances, searched only as far as asked (resumable_dijkstra.cpp): starts the search
+  /// with what is closed, blocked and costs what now, and settle() goes on with that state whatever
+  /// changes later (as a table computed now would). A planner reads a detour table only around its
+  /// robot, a few hundred of a roadmap's nodes, while a whole search visits all of them.
+  void startWithExtraCost(NodeId goal, std::span<const float> extra, PartialTable& out);
+  /// Goes on with `t`'s search until `v` is settled; returns its final distance (kUnreachable when
+  /// there is no route). Valid while the graph's edges stay as they were (graph changes drop tables).
+  float settle(PartialTable& t, NodeId v) const;
+  /// Settles `v` and every node within `hops` edges of it.
+  void settleAround(PartialTable& t, NodeId v, int hops) const;
 
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
   [[nodiscard]] std::size_t cached() const { return used_; }
@@ -68,6 +103,10 @@ class DistanceTable {
  private:
   void buildReverse();
   void compute(NodeId goal, std::vector<float>& d);
+  std::size_t acquire(NodeId goal);
+  void start(NodeId goal, PartialTable& t) const;
+  float settleIn(PartialTable& t, std::span<const float> enterOf, NodeId v) const;
+  void settleAroundIn(PartialTable& t, std::span<const float> enterOf, NodeId v, int hops) const;
   /// Dijkstra from `goal` (d[goal] already 0), entering v costing extra[v] more when given.
   void dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d);
   std::size_t acquireSlot();
@@ -86,7 +125,8 @@ class DistanceTable {
   // Cache: slot per goal, slots on an intrusive LRU list (head = most recent).
   std::vector<std::int32_t> slotOfGoal_;
   std::vector<NodeId> goalOfSlot_;
-  std::vector<std::vector<float>> tables_;
+  std::vector<PartialTable> tables_;
+  std::vector<float> baseEnter_;  ///< entering each node in a goal's table (infinite: closed or blocked)
   std::vector<std::int32_t> prev_;
   std::vector<std::int32_t> next_;
   std::int32_t head_ = -1;

@@ -183,6 +183,11 @@ class Pibt {
   void advanceForced();
   void dropForced(std::int32_t group);
   void planDetours();
+  /// Settles agent i's table (its goal's or its detour's, both searched only as far as read) at
+  /// its node and within `hops` edges of it.
+  void settleTable(std::size_t i, int hops);
+  /// Every agent's table at its node and neighbours: all a step reads of it but to untangle.
+  void settleTables();
   void dropDetour(std::size_t agent);
   void resizeForGraph();
   void cover(NodeId v, int delta);
@@ -219,7 +224,7 @@ class Pibt {
   std::vector<int> still_;                   ///< steps since it last moved
   std::vector<int> tries_;                   ///< escalations since it last came closer to its goal
   std::vector<std::uint32_t> visited_;       ///< stamps for the cycle search
-  std::vector<std::vector<float>> detour_;   ///< detour table to its goal, empty when none
+  std::vector<PartialTable> detour_;         ///< detour table to its goal, empty when none
   std::vector<float> detourFrom_;            ///< regular distance when the detour was taken
   std::vector<float> extra_;                 ///< per node scratch: detour penalties
   std::vector<int> standCover_;              ///< per node scratch: standing agents excluding it
