@@ -90,20 +90,35 @@ std::vector<RoadmapProblem> checkQueues(const Roadmap& r) {
       if (own != kNoNode)
         blocked[static_cast<std::size_t>(own)] = 0;
     }
-    // One other connected station whose dock the line leaves free is the reference; every other
-    // connected station must reach it and be reached from it.
-    NodeId ref = kNoNode;
+    // The other connected stations must still reach each other both ways. Each is checked against
+    // a reference station: the first whose dock the line leaves free, or, when that one is what the
+    // line traps (it reaches or is reached by few), the next — up to three — keeping the reference
+    // from which most stations remain connected, so the stations named are the ones cut off.
+    std::vector<std::uint8_t> from, to;
+    std::size_t best = 0, tried = 0, others = 0;
+    for (const auto& o : r.stations)
+      others += &o != &s && o.dock != kNoNode && isConnected(o.name) ? 1 : 0;
     for (const auto& o : r.stations) {
-      if (&o != &s && o.dock != kNoNode && isConnected(o.name) &&
-          !blocked[static_cast<std::size_t>(o.dock)]) {
-        ref = o.dock;
+      if (tried == 3 || best == others)
         break;
+      if (&o == &s || o.dock == kNoNode || !isConnected(o.name) || blocked[static_cast<std::size_t>(o.dock)])
+        continue;
+      ++tried;
+      auto f = reachable(g, in, o.dock, blocked, true);
+      auto t = reachable(g, in, o.dock, blocked, false);
+      std::size_t kept = 0;
+      for (const auto& x : r.stations) {
+        if (&x != &s && x.dock != kNoNode && isConnected(x.name))
+          kept += f[static_cast<std::size_t>(x.dock)] && t[static_cast<std::size_t>(x.dock)] ? 1 : 0;
+      }
+      if (kept > best || from.empty()) {
+        best = kept;
+        from = std::move(f);
+        to = std::move(t);
       }
     }
-    if (ref == kNoNode)
+    if (from.empty())
       continue;
-    const auto from = reachable(g, in, ref, blocked, true);
-    const auto to = reachable(g, in, ref, blocked, false);
     // Stations the full line cuts off (an error), and parking places (a warning: it traps a resting
     // robot until the line moves on, but stops no station).
     std::string cut[2];

@@ -171,7 +171,7 @@ site::Site wallSite(bool door) {
                               {"robot", {{"radius", 0.3}}},
                               {"stations",
                                {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 2.5, 0.0}}},
-                                {{"name", "C"}, {"kind", "dropoff"}, {"pose", {4.5, 2.5, 0.0}}},
+                                {{"name", "C"}, {"kind", "dropoff"}, {"pose", {4.5, 4.0, M_PI / 2}}},
                                 {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 2.5, M_PI}}}}}};
   return site::parseSite(doc, "wall.site.json", ".", false);
 }
