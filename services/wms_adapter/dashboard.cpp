@@ -13,6 +13,7 @@
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/site_stations.hpp"
 #include "fleet/service/task_wire.hpp"
+#include "json_reply.hpp"
 #include "robot_time.hpp"
 #include "web_files.hpp"
 
@@ -20,11 +21,6 @@ namespace fleet::wms {
 namespace {
 
 using nlohmann::json;
-
-void send(Response& res, int status, const json& body) {
-  res.status = status;
-  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
-}
 
 json problem(const std::string& code, const std::string& message) {
   return {{"error", code}, {"message", message}};
@@ -293,7 +289,7 @@ void Dashboard::routes(HttpServer& server) {
     const std::string name = req.matches.size() > 1 ? req.matches[1] : "index.html";
     const WebFile* f = webFile(name);
     if (f == nullptr) {
-      send(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
+      replyJson(res, 404, problem("not_found", "no file \"" + name + "\" in the dashboard"));
       return;
     }
     res.set_header("Cache-Control", "no-cache");
@@ -313,23 +309,23 @@ void Dashboard::routes(HttpServer& server) {
   server.route("GET", "/v1/site", Scope::Read, [this](const Request&, Response& res) {
     std::lock_guard lock(siteMutex_);
     if (site_.is_null()) {
-      send(res, 404, problem("not_found", "this adapter has no site picture"));
+      replyJson(res, 404, problem("not_found", "this adapter has no site picture"));
       return;
     }
-    send(res, 200, site_);
+    replyJson(res, 200, site_);
   });
   server.route("GET", "/v1/traffic", Scope::Read,
-               [this](const Request&, Response& res) { send(res, 200, trafficSnapshot()); });
+               [this](const Request&, Response& res) { replyJson(res, 200, trafficSnapshot()); });
   server.route("GET", R"(/v1/robots/([^/]+))", Scope::Read, [this](const Request& req, Response& res) {
     const std::string id = req.matches[1];
     for (const auto& r : d_.view.robots()) {
       if (r.robot_id == id) {
         const auto people = d_.view.peopleSeen(id, steadyNowNs());
-        send(res, 200, robotJson(r, people ? &*people : nullptr));
+        replyJson(res, 200, robotJson(r, people ? &*people : nullptr));
         return;
       }
     }
-    send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
+    replyJson(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
   });
   // Commanding a robot is an operator's: the same scope as pausing a task.
   server.limitBody("POST", R"(/v1/robots/([^/]+)/([^/]+))", 4096, "the robot action route's fixed limit");
@@ -358,11 +354,11 @@ void Dashboard::session(const Request& req, Response& res) {
     return out;
   };
   if (!d_.sessions.enabled()) {
-    send(res, 200,
-         {{"auth", "off"},
-          {"csrf", ""},
-          {"name", req.principal},
-          {"scopes", scopesJson({Scope::Read, Scope::Submit, Scope::Operate})}});
+    replyJson(res, 200,
+              {{"auth", "off"},
+               {"csrf", ""},
+               {"name", req.principal},
+               {"scopes", scopesJson({Scope::Read, Scope::Submit, Scope::Operate})}});
     return;
   }
   if (req.method == "DELETE") {
@@ -370,7 +366,7 @@ void Dashboard::session(const Request& req, Response& res) {
     // Ended on the server too: the old cookie is refused from now on, wherever a copy of it is.
     d_.sessions.revoke(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS());
     res.set_header("Set-Cookie", d_.sessions.clearCookie());
-    send(res, 200, {{"auth", "none"}});
+    replyJson(res, 200, {{"auth", "none"}});
     return;
   }
   if (req.method == "POST") {
@@ -379,11 +375,11 @@ void Dashboard::session(const Request& req, Response& res) {
     const auto cookie = d_.sessions.issue(req.principal, nowS());
     const auto s = cookie ? d_.sessions.check(*cookie, nowS()) : std::nullopt;
     if (!s) {
-      send(res, 401, problem("unauthorized", "the token \"" + req.principal + "\" is no longer valid"));
+      replyJson(res, 401, problem("unauthorized", "the token \"" + req.principal + "\" is no longer valid"));
       return;
     }
     res.set_header("Set-Cookie", d_.sessions.setCookie(*cookie));
-    send(res, 201, {{"auth", "session"}, {"csrf", s->csrf}, {"expires_in_s", d_.sessions.lifetimeS()}});
+    replyJson(res, 201, {{"auth", "session"}, {"csrf", s->csrf}, {"expires_in_s", d_.sessions.lifetimeS()}});
     return;
   }
   // A request with an Authorization header is the bearer token's, whatever cookie it carries.
@@ -391,18 +387,18 @@ void Dashboard::session(const Request& req, Response& res) {
                      ? d_.sessions.check(cookieValue(req.get_header_value("Cookie"), kSessionCookie), nowS())
                      : std::nullopt;
   const auto who = s ? std::optional<Principal>(s->who) : d_.sessions.principal(req.principal);
-  send(res, 200,
-       {{"auth", s ? "session" : "bearer"},
-        {"csrf", s ? s->csrf : ""},
-        {"name", req.principal},
-        {"scopes", scopesJson(who ? who->scopes : std::set<Scope>{})}});
+  replyJson(res, 200,
+            {{"auth", s ? "session" : "bearer"},
+             {"csrf", s ? s->csrf : ""},
+             {"name", req.principal},
+             {"scopes", scopesJson(who ? who->scopes : std::set<Scope>{})}});
 }
 
 void Dashboard::robotAction(const Request& req, Response& res, const std::string& action) {
   const std::string id = req.matches[1];
   res.audit = json{{"robot", id}, {"action", action}}.dump(-1, ' ', false, json::error_handler_t::replace);
   if (!isValidId(id)) {
-    send(res, 400, invalidField("id", "not a valid robot id (1-63 characters of A-Z a-z 0-9 _ . : -)"));
+    replyJson(res, 400, invalidField("id", "not a valid robot id (1-63 characters of A-Z a-z 0-9 _ . : -)"));
     return;
   }
   std::optional<msg::RobotState> robot;
@@ -412,12 +408,12 @@ void Dashboard::robotAction(const Request& req, Response& res, const std::string
     }
   }
   if (!robot) {
-    send(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
+    replyJson(res, 404, problem("not_found", "no robot with id \"" + id + "\""));
     return;
   }
   if (!d_.gateway.managerOnline()) {
     res.set_header("Retry-After", "2");
-    send(res, 503, problem("unavailable", "the fleet manager is unreachable; nothing was sent"));
+    replyJson(res, 503, problem("unavailable", "the fleet manager is unreachable; nothing was sent"));
     return;
   }
   if (action == "pause" || action == "resume") {
@@ -436,14 +432,15 @@ void Dashboard::hold(const std::string& robot, bool held, Response& res) {
   const auto a = d_.gateway.submit({m}, std::chrono::milliseconds(d_.ackTimeoutMs))[0];
   if (!a) {
     res.set_header("Retry-After", "2");
-    send(res, 503,
-         problem("unavailable", "the fleet manager did not acknowledge in time; retry (it is idempotent)"));
+    replyJson(
+        res, 503,
+        problem("unavailable", "the fleet manager did not acknowledge in time; retry (it is idempotent)"));
   } else if (a->result == msg::AckResult::Stored) {
-    send(res, 200, {{"robot", robot}, {"paused", held}, {"task", a->detail}});
+    replyJson(res, 200, {{"robot", robot}, {"paused", held}, {"task", a->detail}});
   } else if (a->result == msg::AckResult::NotFound) {
-    send(res, 404, problem("not_found", "the fleet manager knows no robot \"" + robot + "\""));
+    replyJson(res, 404, problem("not_found", "the fleet manager knows no robot \"" + robot + "\""));
   } else {
-    send(res, 409, problem("conflict", a->detail));
+    replyJson(res, 409, problem("conflict", a->detail));
   }
 }
 
@@ -455,7 +452,8 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
     const auto parsed = parseBoundedJson(req.body, {.maxBytes = 4096, .maxDepth = 4, .maxElements = 64});
     const json body = parsed ? *parsed : json();
     if (!body.is_object() || (body.contains("station") && !body["station"].is_string())) {
-      send(res, 400, invalidField("station", "expected a JSON object with an optional string \"station\""));
+      replyJson(res, 400,
+                invalidField("station", "expected a JSON object with an optional string \"station\""));
       return;
     }
     station = body.value("station", "");
@@ -469,9 +467,9 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
     const Station* s =
         nearest(d_.stations, home ? StationKind::Parking : StationKind::Charging, robot.pose.position());
     if (s == nullptr) {
-      send(res, 409,
-           problem("conflict",
-                   std::string("the site has no ") + (home ? "parking" : "charging") + " station"));
+      replyJson(res, 409,
+                problem("conflict",
+                        std::string("the site has no ") + (home ? "parking" : "charging") + " station"));
       return;
     }
     station = s->name;
@@ -489,22 +487,23 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
     for (const auto& f : task.error().fields) {
       fields.push_back({{"path", f.path}, {"reason", f.reason}});
     }
-    send(res, 400, {{"error", "invalid"}, {"message", task.error().message}, {"fields", fields}});
+    replyJson(res, 400, {{"error", "invalid"}, {"message", task.error().message}, {"fields", fields}});
     return;
   }
   const auto a = d_.gateway.submit({service::toWire(*task, d_.requestId(), now)},
                                    std::chrono::milliseconds(d_.ackTimeoutMs))[0];
   if (!a) {
-    send(res, 503, problem("unavailable", "the fleet manager did not acknowledge the task in time"));
+    replyJson(res, 503, problem("unavailable", "the fleet manager did not acknowledge the task in time"));
     return;
   }
   if (a->result != msg::AckResult::Stored && a->result != msg::AckResult::Duplicate) {
-    send(res, a->result == msg::AckResult::Invalid ? 400 : 409, problem("refused", a->detail));
+    replyJson(res, a->result == msg::AckResult::Invalid ? 400 : 409, problem("refused", a->detail));
     return;
   }
   d_.view.onAccepted(id, toJson(*task).dump(), a->state, now);
-  send(res, 201,
-       {{"robot", robot.robot_id}, {"task", id}, {"station", station}, {"state", msg::toString(a->state)}});
+  replyJson(
+      res, 201,
+      {{"robot", robot.robot_id}, {"task", id}, {"station", station}, {"state", msg::toString(a->state)}});
 }
 
 EventSource Dashboard::stream() {

@@ -13,6 +13,7 @@
 #include "fleet/core/log_text.hpp"
 #include "fleet/fleet/task.hpp"
 #include "fleet/service/task_wire.hpp"
+#include "json_reply.hpp"
 #include "rfc3339.hpp"
 #include "status_routes.hpp"
 #include "task_times.hpp"
@@ -21,17 +22,6 @@ namespace fleet::wms {
 namespace {
 
 using nlohmann::json;
-
-/// JSON text; a string that is not UTF-8 (which the edge repairs, so none should arrive) is
-/// written with U+FFFD instead of making dump() throw.
-std::string dumpJson(const json& j) {
-  return j.dump(-1, ' ', false, json::error_handler_t::replace);
-}
-
-void reply(Response& res, int status, const json& body) {
-  res.status = status;
-  res.set_content(dumpJson(body), "application/json");
-}
 
 json error(const std::string& code, const std::string& message) {
   return {{"error", code}, {"message", message}};
@@ -244,21 +234,22 @@ void HttpApi::routes() {
       }
     }
     if (!v) {
-      reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
+      replyJson(res, 404, error("not_found", "no task with id \"" + id + "\""));
       return;
     }
-    reply(res, 200, viewJson(*v));
+    replyJson(res, 200, viewJson(*v));
   });
   server_.route("GET", "/v1/tasks", Scope::Read, [this](const Request& req, Response& res) {
     std::optional<msg::TaskState> state;
     if (req.has_param("state")) {
       msg::TaskState s{};
       if (!msg::parse(req.get_param_value("state"), s)) {
-        reply(res, 400,
-              {{"error", "invalid"},
-               {"fields",
-                json::array({{{"path", "state"},
-                              {"reason", "unknown task state \"" + req.get_param_value("state") + "\""}}})}});
+        replyJson(
+            res, 400,
+            {{"error", "invalid"},
+             {"fields",
+              json::array({{{"path", "state"},
+                            {"reason", "unknown task state \"" + req.get_param_value("state") + "\""}}})}});
         return;
       }
       state = s;
@@ -269,10 +260,10 @@ void HttpApi::routes() {
       char* end = nullptr;
       const long v = std::strtol(l.c_str(), &end, 10);
       if (l.empty() || *end != '\0' || v < 1 || v > 100000) {
-        reply(res, 400,
-              {{"error", "invalid"},
-               {"fields",
-                json::array({{{"path", "limit"}, {"reason", "expected an integer in [1, 100000]"}}})}});
+        replyJson(res, 400,
+                  {{"error", "invalid"},
+                   {"fields",
+                    json::array({{{"path", "limit"}, {"reason", "expected an integer in [1, 100000]"}}})}});
         return;
       }
       limit = static_cast<std::size_t>(v);
@@ -281,7 +272,7 @@ void HttpApi::routes() {
     for (const auto& v : view_.tasks(state, limit)) {
       items.push_back(viewJson(v));
     }
-    reply(res, 200, {{"tasks", items}, {"count", items.size()}});
+    replyJson(res, 200, {{"tasks", items}, {"count", items.size()}});
   });
   // Roadmap closures: an operator closes part of the roadmap (a spill, maintenance) and reopens
   // it; the traffic manager plans round it. Accepted (202) once sent: the traffic manager applies
@@ -301,7 +292,7 @@ void HttpApi::routes() {
       body["roadmap"] = {
           {"epoch", roadmap->epoch}, {"revision", roadmap->revision}, {"closed_nodes", closed}};
     }
-    reply(res, 200, body);
+    replyJson(res, 200, body);
   });
   server_.limitBody("PUT", R"(/v1/traffic/closures/([^/]+))", 64 * 1024, "the closure route's fixed limit");
   server_.route("PUT", R"(/v1/traffic/closures/([^/]+))", Scope::Operate,
@@ -315,49 +306,50 @@ void HttpApi::routes() {
       const auto p = people.find(r.robot_id);
       items.push_back(robotJson(r, p != people.end() ? &p->second : nullptr));
     }
-    reply(res, 200, {{"robots", items}, {"count", items.size()}});
+    replyJson(res, 200, {{"robots", items}, {"count", items.size()}});
   });
-  server_.route("GET", "/v1/fleet/robot-time", Scope::Read,
-                [this](const Request&, Response& res) { reply(res, 200, robotTimeJson(view_.robotTime())); });
+  server_.route("GET", "/v1/fleet/robot-time", Scope::Read, [this](const Request&, Response& res) {
+    replyJson(res, 200, robotTimeJson(view_.robotTime()));
+  });
   // Health tells nothing secret and a probe carries no token: public, and answered on the I/O
   // thread so that busy workers never make the adapter look dead.
   server_.route(
       "GET", "/v1/health", Scope::Public,
       [this](const Request&, Response& res) {
         const bool up = gateway_.managerOnline();
-        reply(res, up ? 200 : 503,
-              {{"status", up ? "ok" : "degraded"}, {"fleet_manager", up ? "online" : "unreachable"}});
+        replyJson(res, up ? 200 : 503,
+                  {{"status", up ? "ok" : "degraded"}, {"fleet_manager", up ? "online" : "unreachable"}});
       },
       Run::Inline);
   server_.route("GET", "/v1/metrics", Scope::Read, [this](const Request&, Response& res) {
     const auto& h = server_.stats();
-    reply(res, 200,
-          {{"requests", counters_.requests.load()},
-           {"responses",
-            {{"2xx", counters_.status2xx.load()},
-             {"4xx", counters_.status4xx.load()},
-             {"5xx", counters_.status5xx.load()}}},
-           {"tasks_accepted", counters_.tasksAccepted.load()},
-           {"tasks_duplicate", counters_.tasksDuplicate.load()},
-           {"tasks_by_state", view_.countByState()},
-           {"robots", view_.robots().size()},
-           {"proximity", proximityJson(view_.proximity())},
-           {"fleet_manager_online", gateway_.managerOnline()},
-           {"event_log", eventLogJson()},
-           {"samples", view_.rejections().toJson()},
-           {"http",
-            {{"open_connections", h.openConnections.load()},
-             {"open_streams", h.openStreams.load()},
-             {"refused_connections", h.refusedConnections.load()},
-             {"refused_streams", h.refusedStreams.load()},
-             {"busy", h.busy.load()},
-             {"rate_limited", h.rateLimited.load()},
-             {"too_large", h.tooLarge.load()},
-             {"timed_out", h.timedOut.load()},
-             {"tls_failures", h.tlsFailures.load()},
-             {"token_reloads", tokens_.reloads()},
-             {"token_file_problem", tokens_.lastProblem()},
-             {"audit_write_failures", audit_.writeFailures()}}}});
+    replyJson(res, 200,
+              {{"requests", counters_.requests.load()},
+               {"responses",
+                {{"2xx", counters_.status2xx.load()},
+                 {"4xx", counters_.status4xx.load()},
+                 {"5xx", counters_.status5xx.load()}}},
+               {"tasks_accepted", counters_.tasksAccepted.load()},
+               {"tasks_duplicate", counters_.tasksDuplicate.load()},
+               {"tasks_by_state", view_.countByState()},
+               {"robots", view_.robots().size()},
+               {"proximity", proximityJson(view_.proximity())},
+               {"fleet_manager_online", gateway_.managerOnline()},
+               {"event_log", eventLogJson()},
+               {"samples", view_.rejections().toJson()},
+               {"http",
+                {{"open_connections", h.openConnections.load()},
+                 {"open_streams", h.openStreams.load()},
+                 {"refused_connections", h.refusedConnections.load()},
+                 {"refused_streams", h.refusedStreams.load()},
+                 {"busy", h.busy.load()},
+                 {"rate_limited", h.rateLimited.load()},
+                 {"too_large", h.tooLarge.load()},
+                 {"timed_out", h.timedOut.load()},
+                 {"tls_failures", h.tlsFailures.load()},
+                 {"token_reloads", tokens_.reloads()},
+                 {"token_file_problem", tokens_.lastProblem()},
+                 {"audit_write_failures", audit_.writeFailures()}}}});
   });
   addStatusRoutes(server_, *events_, *webhooks_, [this] { return clock_.nowNs(); });
 }
@@ -369,9 +361,9 @@ void HttpApi::postTasks(const Request& req, Response& res) {
       {.maxBytes = settings_.maxTaskBodyBytes, .maxDepth = 16, .maxElements = 64 * settings_.maxBatch + 64});
   if (!parsed_json) {
     const bool invalid = parsed_json.error().code == "json.invalid";
-    reply(res, invalid ? 400 : 413,
-          {{"error", invalid ? "invalid_json" : parsed_json.error().code.substr(5)},
-           {"message", "the body is not acceptable: " + parsed_json.error().message}});
+    replyJson(res, invalid ? 400 : 413,
+              {{"error", invalid ? "invalid_json" : parsed_json.error().code.substr(5)},
+               {"message", "the body is not acceptable: " + parsed_json.error().message}});
     return;
   }
   json& body = *parsed_json;
@@ -379,27 +371,27 @@ void HttpApi::postTasks(const Request& req, Response& res) {
   const std::size_t n =
       body.is_array() ? body.size() : (batch && body["tasks"].is_array() ? body["tasks"].size() : 1);
   if (n > settings_.maxBatch) {
-    reply(res, 413,
-          error("too_large", "batch of " + std::to_string(n) + " tasks, at most " +
-                                 std::to_string(settings_.maxBatch) + " allowed"));
+    replyJson(res, 413,
+              error("too_large", "batch of " + std::to_string(n) + " tasks, at most " +
+                                     std::to_string(settings_.maxBatch) + " allowed"));
     return;
   }
   if (const auto times = acceptTaskTimes(body); !times.empty()) {
-    reply(res, 400,
-          {{"error", "invalid"}, {"message", "a time is not acceptable"}, {"fields", fieldsJson(times)}});
+    replyJson(res, 400,
+              {{"error", "invalid"}, {"message", "a time is not acceptable"}, {"fields", fieldsJson(times)}});
     return;
   }
   auto parsed = parseTasks(body, &stations_);
   if (!parsed) {
-    reply(res, 400,
-          {{"error", "invalid"},
-           {"message", parsed.error().message},
-           {"fields", fieldsJson(parsed.error().fields)}});
+    replyJson(res, 400,
+              {{"error", "invalid"},
+               {"message", parsed.error().message},
+               {"fields", fieldsJson(parsed.error().fields)}});
     return;
   }
   if (!gateway_.managerOnline()) {
     res.set_header("Retry-After", "2");
-    reply(res, 503, error("unavailable", "the fleet manager is unreachable; nothing was stored"));
+    replyJson(res, 503, error("unavailable", "the fleet manager is unreachable; nothing was stored"));
     return;
   }
   std::vector<std::string> ids;
@@ -432,26 +424,26 @@ void HttpApi::postTasks(const Request& req, Response& res) {
     if (first == 503) {
       res.set_header("Retry-After", "2");
     }
-    reply(res, first, results[0]);
+    replyJson(res, first, results[0]);
     return;
   }
   const bool allOk = std::all_of(results.begin(), results.end(),
                                  [](const json& r) { return r["status"] == 200 || r["status"] == 201; });
   int status = same ? first : (allOk ? 200 : 207);
-  reply(res, status, {{"results", results}});
+  replyJson(res, status, {{"results", results}});
 }
 
 bool HttpApi::admitTaskRequest(const std::string& id, const char* verb, Response& res) {
   if (!isValidId(id)) {
-    reply(res, 400,
-          {{"error", "invalid"},
-           {"fields", json::array({{{"path", "id"}, {"reason", "not a valid task id"}}})}});
+    replyJson(res, 400,
+              {{"error", "invalid"},
+               {"fields", json::array({{{"path", "id"}, {"reason", "not a valid task id"}}})}});
     return false;
   }
   if (!gateway_.managerOnline()) {
     res.set_header("Retry-After", "2");
-    reply(res, 503,
-          error("unavailable", std::string("the fleet manager is unreachable; nothing was ") + verb));
+    replyJson(res, 503,
+              error("unavailable", std::string("the fleet manager is unreachable; nothing was ") + verb));
     return false;
   }
   return true;
@@ -470,13 +462,13 @@ void HttpApi::deleteTask(const Request& req, Response& res) {
   const auto acks = gateway_.submit({m}, std::chrono::milliseconds(settings_.ackTimeoutMs));
   const auto& a = acks[0];
   if (!a) {
-    reply(res, 503, error("unavailable", "the fleet manager did not acknowledge the cancel in time"));
+    replyJson(res, 503, error("unavailable", "the fleet manager did not acknowledge the cancel in time"));
   } else if (a->result == msg::AckResult::Stored) {
-    reply(res, 200, {{"id", id}, {"state", "cancelled"}});
+    replyJson(res, 200, {{"id", id}, {"state", "cancelled"}});
   } else if (a->result == msg::AckResult::NotFound) {
-    reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
+    replyJson(res, 404, error("not_found", "no task with id \"" + id + "\""));
   } else {
-    reply(res, 409, error("conflict", a->detail));
+    replyJson(res, 409, error("conflict", a->detail));
   }
 }
 
@@ -494,16 +486,16 @@ void HttpApi::controlTask(const Request& req, Response& res, bool pause) {
   const auto& a = acks[0];
   if (!a) {
     res.set_header("Retry-After", "2");
-    reply(res, 503,
-          error("unavailable",
-                "the fleet manager did not acknowledge in time; retry (pause and resume "
-                "are idempotent)"));
+    replyJson(res, 503,
+              error("unavailable",
+                    "the fleet manager did not acknowledge in time; retry (pause and resume "
+                    "are idempotent)"));
   } else if (a->result == msg::AckResult::Stored) {
-    reply(res, 200, {{"id", id}, {"paused", pause}, {"state", msg::toString(a->state)}});
+    replyJson(res, 200, {{"id", id}, {"paused", pause}, {"state", msg::toString(a->state)}});
   } else if (a->result == msg::AckResult::NotFound) {
-    reply(res, 404, error("not_found", "no task with id \"" + id + "\""));
+    replyJson(res, 404, error("not_found", "no task with id \"" + id + "\""));
   } else {
-    reply(res, 409, error("conflict", a->detail));
+    replyJson(res, 409, error("conflict", a->detail));
   }
 }
 
@@ -514,26 +506,27 @@ void HttpApi::putClosure(const Request& req, Response& res) {
   auto parsed = parseClosure(id, req.body, roadmap ? std::optional(roadmap->nodes.size()) : std::nullopt,
                              clock_.nowNs());
   if (auto* errors = std::get_if<std::vector<FieldError>>(&parsed)) {
-    reply(res, 400,
-          {{"error", "invalid"}, {"message", "the closure was not sent"}, {"fields", fieldsJson(*errors)}});
+    replyJson(
+        res, 400,
+        {{"error", "invalid"}, {"message", "the closure was not sent"}, {"fields", fieldsJson(*errors)}});
     return;
   }
   const auto& c = std::get<msg::TrafficClosure>(parsed);
   if (auto why = gateway_.sendClosure(c)) {
-    reply(res, 503, error("unavailable", *why + "; the closure was not sent"));
+    replyJson(res, 503, error("unavailable", *why + "; the closure was not sent"));
     return;
   }
   json body = closureJson(c);
   body["traffic_manager_online"] = gateway_.trafficManagerOnline();
-  reply(res, 202, body);
+  replyJson(res, 202, body);
 }
 
 void HttpApi::deleteClosure(const Request& req, Response& res) {
   const std::string id = req.matches[1];
   res.audit = json{{"closure", id}, {"action", "reopen"}}.dump();
   if (!isValidId(id)) {
-    reply(res, 400,
-          error("invalid", "closure id \"" + id + "\" is not a valid id (1..63 of [A-Za-z0-9_.:-])"));
+    replyJson(res, 400,
+              error("invalid", "closure id \"" + id + "\" is not a valid id (1..63 of [A-Za-z0-9_.:-])"));
     return;
   }
   // Sent whether this adapter knows the id or not: a closure made through an adapter that has
@@ -544,14 +537,14 @@ void HttpApi::deleteClosure(const Request& req, Response& res) {
   c.active = false;
   c.stamp_ns = clock_.nowNs();
   if (auto why = gateway_.sendClosure(c)) {
-    reply(res, 503, error("unavailable", *why + "; the reopening was not sent"));
+    replyJson(res, 503, error("unavailable", *why + "; the reopening was not sent"));
     return;
   }
-  reply(res, 202,
-        {{"id", id},
-         {"active", false},
-         {"known", known},
-         {"traffic_manager_online", gateway_.trafficManagerOnline()}});
+  replyJson(res, 202,
+            {{"id", id},
+             {"active", false},
+             {"known", known},
+             {"traffic_manager_online", gateway_.trafficManagerOnline()}});
 }
 
 }  // namespace fleet::wms

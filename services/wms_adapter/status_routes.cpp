@@ -3,17 +3,13 @@
 #include <algorithm>
 
 #include "fleet/core/bounded_json.hpp"
+#include "json_reply.hpp"
 #include "webhook_url.hpp"
 
 namespace fleet::wms {
 namespace {
 
 using nlohmann::json;
-
-void sendJson(Response& res, int status, const json& body) {
-  res.status = status;
-  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
-}
 
 json fieldProblem(const std::string& path, const std::string& reason, const std::string& code = "invalid") {
   return {{"error", code},
@@ -80,16 +76,16 @@ std::optional<std::int64_t> resumePoint(const Request& req, const EventLog& log,
   }
   if (text.empty() || text.size() > 18 ||
       !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-    sendJson(res, 400,
-             fieldProblem(field, "\"" + text.substr(0, 40) +
-                                     "\" is not an event id (a whole number from an `id:` line)"));
+    replyJson(res, 400,
+              fieldProblem(field, "\"" + text.substr(0, 40) +
+                                      "\" is not an event id (a whole number from an `id:` line)"));
     return std::nullopt;
   }
   const std::int64_t id = std::stoll(text);
   const std::int64_t last = log.lastId();
   const std::int64_t pruned = log.prunedThrough();
   if (id > last) {
-    sendJson(
+    replyJson(
         res, 400,
         fieldProblem(
             field, "event " + text + " is ahead of this adapter's newest event " + std::to_string(last) +
@@ -100,13 +96,13 @@ std::optional<std::int64_t> resumePoint(const Request& req, const EventLog& log,
     return std::nullopt;
   }
   if (id < pruned) {
-    sendJson(res, 410,
-             fieldProblem(
-                 field,
-                 "the events after " + text + " up to " + std::to_string(pruned) +
-                     " are no longer held (retention: " + retentionText(log.settings()) +
-                     "); reload the tasks (GET /v1/tasks) and resume with since=" + std::to_string(pruned),
-                 "expired"));
+    replyJson(res, 410,
+              fieldProblem(
+                  field,
+                  "the events after " + text + " up to " + std::to_string(pruned) +
+                      " are no longer held (retention: " + retentionText(log.settings()) +
+                      "); reload the tasks (GET /v1/tasks) and resume with since=" + std::to_string(pruned),
+                  "expired"));
     return std::nullopt;
   }
   return id;
@@ -157,18 +153,18 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
     for (const auto& w : webhooks.list()) {
       items.push_back(webhookJson(w, last));
     }
-    sendJson(res, 200, {{"webhooks", items}, {"count", items.size()}, {"last_event_id", last}});
+    replyJson(res, 200, {{"webhooks", items}, {"count", items.size()}, {"last_event_id", last}});
   });
   server.route(
       "GET", R"(/v1/webhooks/([^/]+))", Scope::Read, [&log, &webhooks](const Request& req, Response& res) {
         const std::string id = req.matches[1];
         const auto w = webhooks.find(id);
         if (!w) {
-          sendJson(res, 404,
-                   {{"error", "not_found"}, {"message", "no webhook with id \"" + id.substr(0, 80) + "\""}});
+          replyJson(res, 404,
+                    {{"error", "not_found"}, {"message", "no webhook with id \"" + id.substr(0, 80) + "\""}});
           return;
         }
-        sendJson(res, 200, webhookJson(*w, log.lastId()));
+        replyJson(res, 200, webhookJson(*w, log.lastId()));
       });
   server.limitBody("POST", "/v1/webhooks", 16 * 1024, "the webhook route's fixed limit");
   server.route(
@@ -176,32 +172,32 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
         const auto parsed =
             parseBoundedJson(req.body, {.maxBytes = 16 * 1024, .maxDepth = 4, .maxElements = 64});
         if (!parsed || !parsed->is_object()) {
-          sendJson(res, 400, fieldProblem("body", "expected a JSON object {\"url\": ..., \"secret\": ...}"));
+          replyJson(res, 400, fieldProblem("body", "expected a JSON object {\"url\": ..., \"secret\": ...}"));
           return;
         }
         const json& b = *parsed;
         for (const auto& [key, v] : b.items()) {
           if (key != "url" && key != "secret") {
-            sendJson(res, 400, fieldProblem(key, "unknown field (expected url and an optional secret)"));
+            replyJson(res, 400, fieldProblem(key, "unknown field (expected url and an optional secret)"));
             return;
           }
         }
         if (!b.contains("url") || !b["url"].is_string()) {
-          sendJson(res, 400, fieldProblem("url", "required: the http(s) URL to deliver to"));
+          replyJson(res, 400, fieldProblem("url", "required: the http(s) URL to deliver to"));
           return;
         }
         const std::string url = b["url"];
         res.audit = json{{"webhook", "create"}, {"url", url.substr(0, 200)}}.dump(
             -1, ' ', false, json::error_handler_t::replace);
         if (const auto why = refuseWebhookUrl(url, webhooks.settings().allow)) {
-          sendJson(res, 400, fieldProblem("url", *why));
+          replyJson(res, 400, fieldProblem("url", *why));
           return;
         }
         std::string secret;
         if (b.contains("secret")) {
           if (!b["secret"].is_string() || b["secret"].get<std::string>().size() < 16 ||
               b["secret"].get<std::string>().size() > 256) {
-            sendJson(
+            replyJson(
                 res, 400,
                 fieldProblem("secret", "expected a string of 16 to 256 characters (or none: one is made)"));
             return;
@@ -210,16 +206,16 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
         }
         const auto made = webhooks.create(url, secret, nowNs());
         if (!made) {
-          sendJson(res, 409,
-                   {{"error", "conflict"},
-                    {"message", "already " + std::to_string(webhooks.settings().maxSubscriptions) +
-                                    " webhooks (webhooks.max_subscriptions): delete one first"}});
+          replyJson(res, 409,
+                    {{"error", "conflict"},
+                     {"message", "already " + std::to_string(webhooks.settings().maxSubscriptions) +
+                                     " webhooks (webhooks.max_subscriptions): delete one first"}});
           return;
         }
         json body = webhookJson(made->status, log.lastId());
         body["secret"] = made->secret;
         res.set_header("Location", "/v1/webhooks/" + made->status.id);
-        sendJson(res, 201, body);
+        replyJson(res, 201, body);
       });
   server.route(
       "DELETE", R"(/v1/webhooks/([^/]+))", Scope::Submit, [&webhooks](const Request& req, Response& res) {
@@ -227,11 +223,11 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
         res.audit = json{{"webhook", "delete"}, {"id", id.substr(0, 80)}}.dump(
             -1, ' ', false, json::error_handler_t::replace);
         if (!webhooks.remove(id)) {
-          sendJson(res, 404,
-                   {{"error", "not_found"}, {"message", "no webhook with id \"" + id.substr(0, 80) + "\""}});
+          replyJson(res, 404,
+                    {{"error", "not_found"}, {"message", "no webhook with id \"" + id.substr(0, 80) + "\""}});
           return;
         }
-        sendJson(res, 200, {{"id", id}, {"deleted", true}});
+        replyJson(res, 200, {{"id", id}, {"deleted", true}});
       });
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "fleet/core/clock.hpp"
 #include "webhook_signature.hpp"
 #include "webhook_url.hpp"
 
@@ -20,16 +21,6 @@ struct Webhooks::Sub {
   std::condition_variable cv;
   bool removed = false;
 };
-
-namespace {
-
-std::int64_t wallNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-}  // namespace
 
 nlohmann::json webhookJson(const WebhookStatus& s, std::int64_t lastEventId) {
   return {{"id", s.id},
@@ -282,7 +273,7 @@ void Webhooks::run(const std::shared_ptr<Sub>& sub) {
     {
       std::lock_guard sl(sub->m);
       auto& st = sub->status;
-      st.lastAttemptNs = wallNs();
+      st.lastAttemptNs = WallClock{}.nowNs();
       if (!why) {
         cursor = id;
         st.deliveredThrough = id;

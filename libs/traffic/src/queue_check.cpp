@@ -7,65 +7,20 @@
 // leads there) — and the other stations' docks are checked to stay reachable from each other both
 // ways. A station the full line cuts off is an error naming the queue by its key path in site.json.
 
-#include <deque>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "fleet/traffic/roadmap.hpp"
+#include "graph_reach.hpp"
+#include "roadmap_geometry.hpp"
 
 namespace fleet::traffic {
-namespace {
-
-std::string pointText(Vec2 p) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(2);
-  os << "(" << p.x << ", " << p.y << ")";
-  return os.str();
-}
-
-/// Nodes reachable from `from` (forward) or reaching it (backward), avoiding `blocked`.
-std::vector<std::uint8_t> reachable(const Graph& g, const std::vector<std::vector<NodeId>>& in, NodeId from,
-                                    const std::vector<std::uint8_t>& blocked, bool forward) {
-  std::vector<std::uint8_t> seen(g.size(), 0);
-  std::deque<NodeId> q{from};
-  seen[static_cast<std::size_t>(from)] = 1;
-  const auto visit = [&](NodeId w) {
-    const auto i = static_cast<std::size_t>(w);
-    if (!seen[i] && !blocked[i] && g.isOpen(w)) {
-      seen[i] = 1;
-      q.push_back(w);
-    }
-  };
-  while (!q.empty()) {
-    const NodeId v = q.front();
-    q.pop_front();
-    if (forward) {
-      for (const auto& e : g.edges(v)) {
-        if (g.passable(v, e))
-          visit(e.to);
-      }
-    } else {
-      for (const NodeId w : in[static_cast<std::size_t>(v)])
-        visit(w);
-    }
-  }
-  return seen;
-}
-
-}  // namespace
 
 std::vector<RoadmapProblem> checkQueues(const Roadmap& r) {
   std::vector<RoadmapProblem> out;
   const Graph& g = r.graph;
-  std::vector<std::vector<NodeId>> in(g.size());
-  for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {
-    for (const auto& e : g.edges(v)) {
-      if (g.passable(v, e))
-        in[static_cast<std::size_t>(e.to)].push_back(v);
-    }
-  }
+  const GraphReach reach(g);
   // The stations connected to each other with every line empty: the ones a full line may not cut.
   const auto connected = connectedStations(r);
   const auto isConnected = [&](const std::string& name) {
@@ -104,8 +59,9 @@ std::vector<RoadmapProblem> checkQueues(const Roadmap& r) {
       if (&o == &s || o.dock == kNoNode || !isConnected(o.name) || blocked[static_cast<std::size_t>(o.dock)])
         continue;
       ++tried;
-      auto f = reachable(g, in, o.dock, blocked, true);
-      auto t = reachable(g, in, o.dock, blocked, false);
+      const NodeId seed[] = {o.dock};
+      auto f = reach.from(seed, true, blocked);
+      auto t = reach.from(seed, false, blocked);
       std::size_t kept = 0;
       for (const auto& x : r.stations) {
         if (&x != &s && x.dock != kNoNode && isConnected(x.name))
@@ -142,9 +98,10 @@ std::vector<RoadmapProblem> checkQueues(const Roadmap& r) {
                      g.position(s.queue.back()),
                      "stations[" + std::to_string(i) + "].queue: station '" + s.name +
                          "': robots waiting in its full line (queue from " +
-                         pointText(g.position(s.queue.front())) + " to " +
-                         pointText(g.position(s.queue.back())) + ") cut off " + std::to_string(count[k]) +
-                         what + cut[k] + "; a queue must lie off the ways other robots need"});
+                         detail::pointText(g.position(s.queue.front())) + " to " +
+                         detail::pointText(g.position(s.queue.back())) + ") cut off " +
+                         std::to_string(count[k]) + what + cut[k] +
+                         "; a queue must lie off the ways other robots need"});
     }
   }
   return out;

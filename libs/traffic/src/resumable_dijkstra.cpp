@@ -113,10 +113,10 @@ void DistanceTable::settleAroundIn(PartialTable& t, std::span<const float> enter
     }
     return;
   }
-  std::vector<std::pair<NodeId, int>> todo{{v, 0}};
+  std::vector<std::pair<NodeId, int>> frontier{{v, 0}};
   std::vector<NodeId> seen{v};
-  for (std::size_t head = 0; head < todo.size(); ++head) {
-    const auto [u, depth] = todo[head];
+  for (std::size_t head = 0; head < frontier.size(); ++head) {
+    const auto [u, depth] = frontier[head];
     for (const Edge& e : graph_.edges(u)) {
       if (std::find(seen.begin(), seen.end(), e.to) != seen.end()) {
         continue;
@@ -124,7 +124,7 @@ void DistanceTable::settleAroundIn(PartialTable& t, std::span<const float> enter
       seen.push_back(e.to);
       settleIn(t, enterOf, e.to);
       if (depth + 1 < hops) {
-        todo.emplace_back(e.to, depth + 1);
+        frontier.emplace_back(e.to, depth + 1);
       }
     }
   }

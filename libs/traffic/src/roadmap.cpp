@@ -10,18 +10,13 @@
 
 #include "fleet/core/config.hpp"
 #include "fleet/site/reachability.hpp"
+#include "roadmap_geometry.hpp"
 
 namespace fleet::traffic {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string at(Vec2 p) {
-  std::ostringstream os;
-  os << "(" << std::round(p.x * 100.0) / 100.0 << ", " << std::round(p.y * 100.0) / 100.0 << ")";
-  return os.str();
-}
 
 double angleBetween(Vec2 a, Vec2 b) {
   const double c = a.normalized().dot(b.normalized());
@@ -369,8 +364,8 @@ struct Builder {
         std::ostringstream r;
         r << opt.radius;
         problem(RoadmapProblem::Severity::Error, st.name, dockAt,
-                "station '" + st.name + "' at " + at(dockAt) + ": the robot's disc (radius " + r.str() +
-                    " m) does not fit there: no dock node");
+                "station '" + st.name + "' at " + detail::pointText(dockAt) + ": the robot's disc (radius " +
+                    r.str() + " m) does not fit there: no dock node");
         stations.push_back(sn);
         continue;
       }
@@ -384,7 +379,8 @@ struct Builder {
         } else {
           problem(RoadmapProblem::Severity::Error, st.name, *st.approach,
                   "station '" + st.name + "': the robot cannot drive straight from its approach point " +
-                      at(*st.approach) + " to the dock " + at(dockAt) + "; joined along the row instead");
+                      detail::pointText(*st.approach) + " to the dock " + detail::pointText(dockAt) +
+                      "; joined along the row instead");
         }
       }
       stations.push_back(sn);
@@ -402,8 +398,9 @@ struct Builder {
           links.push_back({sn.dock, sn.exit, true, false});
         } else {
           problem(RoadmapProblem::Severity::Error, st.name, *e,
-                  "station '" + st.name + "': the robot cannot drive straight from the dock " + at(dockAt) +
-                      " to its exit " + at(*e) + "; left by its way in instead");
+                  "station '" + st.name + "': the robot cannot drive straight from the dock " +
+                      detail::pointText(dockAt) + " to its exit " + detail::pointText(*e) +
+                      "; left by its way in instead");
         }
       }
     }
@@ -437,7 +434,7 @@ struct Builder {
         d << 3.0 * opt.spacing;
         problem(RoadmapProblem::Severity::Error, st.name, ep,
                 "station '" + st.name + "': no lane node within " + d.str() + " m of its " +
-                    (sn.approach != kNoNode ? "approach point " : "dock ") + at(ep) +
+                    (sn.approach != kNoNode ? "approach point " : "dock ") + detail::pointText(ep) +
                     " that the robot reaches in a straight line: the station is not on the roadmap");
       }
       if (sn.exit != kNoNode) {
@@ -446,7 +443,7 @@ struct Builder {
         if (joinToLattice(sn.exit, {out}, kCone, Join::Out) == 0 &&
             joinToLattice(sn.exit, {}, 0.0, Join::Out) == 0) {
           problem(RoadmapProblem::Severity::Error, st.name, xp,
-                  "station '" + st.name + "': no lane node near its exit " + at(xp) +
+                  "station '" + st.name + "': no lane node near its exit " + detail::pointText(xp) +
                       " that the robot reaches in a straight line: robots could not leave the dock");
         }
       }
@@ -492,7 +489,7 @@ struct Builder {
       if (!fits(queue[q])) {
         problem(RoadmapProblem::Severity::Error, st.name, queue[q],
                 "station '" + st.name + "': the robot's disc does not fit on queue point " +
-                    std::to_string(q) + " " + at(queue[q]));
+                    std::to_string(q) + " " + detail::pointText(queue[q]));
         continue;
       }
       const Vec2 nextAt = pos[static_cast<std::size_t>(next)];
@@ -501,8 +498,8 @@ struct Builder {
         links.push_back({v, next, true, false});
       } else {
         problem(RoadmapProblem::Severity::Warning, st.name, queue[q],
-                "station '" + st.name + "': queue point " + std::to_string(q) + " " + at(queue[q]) +
-                    " cannot be driven straight to the one before it");
+                "station '" + st.name + "': queue point " + std::to_string(q) + " " +
+                    detail::pointText(queue[q]) + " cannot be driven straight to the one before it");
       }
       sn.queue.push_back(v);
       next = v;
@@ -752,7 +749,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
       if (!with.empty()) {
         b.problem(RoadmapProblem::Severity::Warning, sn.name, r.graph.position(v),
                   "station '" + sn.name + "': a robot waiting on queue point " + std::to_string(q) + " " +
-                      at(r.graph.position(v)) + " is too close to " + with + " (" +
+                      detail::pointText(r.graph.position(v)) + " is too close to " + with + " (" +
                       (with == "the dock" ? "it blocks the station" : "they cannot both be used") + ")");
       }
     }

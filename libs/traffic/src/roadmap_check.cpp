@@ -3,11 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <set>
 #include <sstream>
 
 #include "fleet/traffic/roadmap.hpp"
+#include "graph_reach.hpp"
 #include "roadmap_geometry.hpp"
 
 namespace fleet::traffic {
@@ -16,12 +16,6 @@ namespace {
 
 double cm(double v) {
   return std::round(v * 100.0) / 100.0;
-}
-
-std::string at(Vec2 p) {
-  std::ostringstream os;
-  os << "(" << cm(p.x) << ", " << cm(p.y) << ")";
-  return os.str();
 }
 
 std::string span(double lo, double hi) {
@@ -125,51 +119,6 @@ int mainComponent(const Roadmap& r, const std::vector<int>& comp) {
   return best;
 }
 
-// Nodes reachable from (forward) or reaching (backward) the component `c`.
-std::vector<std::uint8_t> reach(const Graph& g, const std::vector<int>& comp, int c, bool forward) {
-  std::vector<std::vector<NodeId>> in;
-  if (!forward) {
-    in.resize(g.size());
-    for (NodeId v = 0; v < static_cast<NodeId>(g.size()); ++v) {
-      for (const auto& e : g.edges(v)) {
-        if (g.passable(v, e)) {
-          in[static_cast<std::size_t>(e.to)].push_back(v);
-        }
-      }
-    }
-  }
-  std::vector<std::uint8_t> seen(g.size(), 0);
-  std::deque<NodeId> q;
-  for (std::size_t v = 0; v < g.size(); ++v) {
-    if (comp[v] == c) {
-      seen[v] = 1;
-      q.push_back(static_cast<NodeId>(v));
-    }
-  }
-  while (!q.empty()) {
-    const NodeId v = q.front();
-    q.pop_front();
-    auto visit = [&](NodeId w) {
-      if (!seen[static_cast<std::size_t>(w)]) {
-        seen[static_cast<std::size_t>(w)] = 1;
-        q.push_back(w);
-      }
-    };
-    if (forward) {
-      for (const auto& e : g.edges(v)) {
-        if (g.passable(v, e)) {
-          visit(e.to);
-        }
-      }
-    } else {
-      for (const NodeId w : in[static_cast<std::size_t>(v)]) {
-        visit(w);
-      }
-    }
-  }
-  return seen;
-}
-
 }  // namespace
 
 std::vector<RoadmapProblem> checkRoadmap(const Roadmap& r) {
@@ -180,8 +129,14 @@ std::vector<RoadmapProblem> checkRoadmap(const Roadmap& r) {
   }
   const auto comp = components(g);
   const int main = mainComponent(r, comp);
-  const auto from = reach(g, comp, main, true);
-  const auto to = reach(g, comp, main, false);
+  std::vector<NodeId> mainNodes;
+  for (std::size_t v = 0; v < g.size(); ++v) {
+    if (comp[v] == main)
+      mainNodes.push_back(static_cast<NodeId>(v));
+  }
+  const GraphReach reach(g);
+  const auto from = reach.from(mainNodes, true);
+  const auto to = reach.from(mainNodes, false);
   std::size_t connected = 0;
   for (const auto& s : r.stations) {
     connected += s.dock != kNoNode && comp[static_cast<std::size_t>(s.dock)] == main ? 1 : 0;
@@ -194,7 +149,7 @@ std::vector<RoadmapProblem> checkRoadmap(const Roadmap& r) {
     }
     const auto d = static_cast<std::size_t>(s.dock);
     const Vec2 p = g.position(s.dock);
-    const std::string who = "station '" + s.name + "' (dock at " + at(p) + ")";
+    const std::string who = "station '" + s.name + "' (dock at " + detail::pointText(p) + ")";
     if (!g.isOpen(s.dock)) {
       out.push_back({RoadmapProblem::Severity::Error, s.name, p, who + " is closed"});
     } else if (comp[d] != main) {
@@ -268,8 +223,8 @@ std::vector<RoadmapProblem> checkRoadmap(const Roadmap& r) {
                                                     : "no way in or out";
     out.push_back({RoadmapProblem::Severity::Warning, "", c,
                    std::to_string(members.size()) + " lane node" + (members.size() == 1 ? "" : "s") +
-                       " around " + at(c) + " (x " + span(lo.x, hi.x) + ", y " + span(lo.y, hi.y) +
-                       ") are outside the component that holds the stations: " + how});
+                       " around " + detail::pointText(c) + " (x " + span(lo.x, hi.x) + ", y " +
+                       span(lo.y, hi.y) + ") are outside the component that holds the stations: " + how});
   }
   return out;
 }

@@ -4,12 +4,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "fleet/core/vec2.hpp"
 #include "fleet/geometry/polygon.hpp"
 
 namespace fleet::traffic::detail {
+
+/// "(x, y)" rounded to centimetres, for problems and log lines.
+inline std::string pointText(Vec2 p) {
+  std::ostringstream os;
+  os << "(" << std::round(p.x * 100.0) / 100.0 << ", " << std::round(p.y * 100.0) / 100.0 << ")";
+  return os.str();
+}
 
 /// Euclidean distance without std::hypot's overflow care (several times faster; roadmap
 /// coordinates are metres).
