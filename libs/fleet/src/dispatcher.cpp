@@ -77,8 +77,14 @@ std::size_t Dispatcher::activeCount() const {
 }
 
 void Dispatcher::applied(const TaskRecord& r, DispatchResult& out) {
+  if (const auto was = open_.find(r.task.id); was != open_.end() && isWaiting(was->second.state)) {
+    countWaiting(was->second, -1);
+  }
   out.events.push_back({r.task.id, r.state, r.robotId, r.reason, r.updatedNs,
-                        r.stationChosen ? r.task.station : std::string()});
+                        r.stationChosen ? r.task.station : std::string(), etaOf(r)});
+  if (isWaiting(r.state)) {
+    countWaiting(r, +1);
+  }
   switch (r.state) {
     case TaskState::Assigned:
       ++counters_.assigned;
@@ -106,6 +112,73 @@ void Dispatcher::applied(const TaskRecord& r, DispatchResult& out) {
   }
 }
 
+void Dispatcher::countWaiting(const TaskRecord& r, int delta) {
+  auto& n = waitingByPriority_[r.task.priority];
+  n = delta > 0 ? n + 1 : (n > 0 ? n - 1 : 0);
+  if (n == 0) {
+    waitingByPriority_.erase(r.task.priority);
+  }
+}
+
+std::int64_t Dispatcher::etaOf(const TaskRecord& r) {
+  const double dwellS = static_cast<double>(r.task.loadNs + r.task.unloadNs) / 1e9;
+  const std::int64_t now = r.updatedNs;
+  switch (r.state) {
+    case TaskState::Assigned: {
+      const RobotInfo* robot = registry_.find(r.robotId);
+      return eta_.assigned(r.task.id, now, robot != nullptr ? travel_(r.task)(*robot) + dwellS : kInfeasible);
+    }
+    case TaskState::EnRoute:
+    case TaskState::Loading:
+    case TaskState::Delivering:
+    case TaskState::Unloading:
+      return eta_.active(r.task.id, now);
+    case TaskState::Done:
+      eta_.ended(r.task.id, now, true);
+      return now;
+    case TaskState::Failed:
+    case TaskState::Cancelled:
+      eta_.ended(r.task.id, now, false);
+      return 0;
+    case TaskState::Queued:
+    case TaskState::Requeued:
+      eta_.ended(r.task.id, now, false);
+      return waitingEta(r, now);
+  }
+  return 0;
+}
+
+std::int64_t Dispatcher::currentEta(const TaskRecord& r, std::int64_t nowNs) const {
+  if (isActive(r.state)) {
+    return eta_.active(r.task.id, nowNs);
+  }
+  return isWaiting(r.state) && !r.paused ? waitingEta(r, nowNs) : 0;
+}
+
+std::int64_t Dispatcher::waitingEta(const TaskRecord& r, std::int64_t nowNs) const {
+  // Ahead of it: every waiting task of a higher or the same priority (it joins its own last).
+  std::size_t ahead = 0;
+  for (const auto& [priority, n] : waitingByPriority_) {
+    if (priority < r.task.priority) {
+      break;
+    }
+    ahead += n;
+  }
+  const double dwellS = static_cast<double>(r.task.loadNs + r.task.unloadNs) / 1e9;
+  double predicted = eta_.typical();
+  if (predicted <= 0.0) {
+    // Before the first assignment: the nearest robot's way.
+    predicted = kInfeasible;
+    const auto travel = travel_(r.task);
+    for (const auto& robot : registry_.all()) {
+      if (!robot.lost) {
+        predicted = std::min(predicted, travel(robot) + dwellS);
+      }
+    }
+  }
+  return eta_.waiting(nowNs, ahead, registry_.onlineCount(), predicted);
+}
+
 Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {
   auto tasks = store_.openTasks();
   if (!tasks) {
@@ -113,11 +186,15 @@ Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {
   }
   DispatchResult out;
   open_.clear();
+  waitingByPriority_.clear();
   for (auto& r : *tasks) {
     if (isActive(r.state)) {
       registry_.expect(r.robotId, nowNs);
       registry_.setTask(r.robotId, r.task.id);
       out.assignments.push_back({r.robotId, r.task, r.revision, r.paused});
+    }
+    if (isWaiting(r.state)) {
+      countWaiting(r, +1);
     }
     std::string id = r.task.id;
     open_.emplace(std::move(id), std::move(r));
@@ -347,7 +424,8 @@ Expected<DispatchResult> Dispatcher::setPaused(const std::string& taskId, bool p
   if (changed) {
     out.events.push_back({taskId, it->second.state, it->second.robotId,
                           paused ? "paused by request" : "resumed by request", nowNs,
-                          it->second.stationChosen ? it->second.task.station : std::string()});
+                          it->second.stationChosen ? it->second.task.station : std::string(),
+                          currentEta(it->second, nowNs)});
   }
   return out;
 }
@@ -684,7 +762,7 @@ void Dispatcher::noteStationWaits(const StationChooser& chooser, std::int64_t no
     }
     r.reason = res->reason;
     r.updatedNs = res->updatedNs;
-    out.events.push_back({id, r.state, "", r.reason, nowNs, ""});
+    out.events.push_back({id, r.state, "", r.reason, nowNs, "", currentEta(r, nowNs)});
   }
 }
 

@@ -118,6 +118,42 @@ TEST_F(DispatcherTest, AssignsNearestAndTracksProgress) {
   EXPECT_EQ(dispatcher->onTaskStatus("near", "t1", S::Done, "", 3).error().code, errc::kNotFound);
 }
 
+// Every transition states when the task is expected to be done (TaskEta): at its robot's travel
+// once assigned, behind the queue while it waits, stretched by the pace of the tasks done.
+TEST_F(DispatcherTest, EveryTransitionStatesTheTasksEta) {
+  robot("r1", 10, 0.9, 0);  // 10 s from P-1 at 1 m/s (the test's travel: to the first station)
+  Task a = transport("a");
+  a.loadNs = 2 * kSec;
+  a.unloadNs = 3 * kSec;
+  DispatchResult submitted;
+  dispatcher->submit({a, transport("b")}, 0, &submitted);
+  ASSERT_EQ(submitted.events.size(), 2u);
+  // A free robot: a is due after its own way (10 s) and dwell (5 s); b, behind a on a fleet of
+  // one that has done nothing yet, after a's whole task and its own.
+  EXPECT_EQ(submitted.events[0].etaNs, 15 * kSec);
+  EXPECT_GT(submitted.events[1].etaNs, submitted.events[0].etaNs);
+  auto out = dispatcher->tick(kSec);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].state, S::Assigned);
+  EXPECT_EQ(out.events[0].etaNs, (1 + 15) * kSec);
+  auto r = dispatcher->onTaskStatus("r1", "a", S::EnRoute, "", 2 * kSec);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->events[0].etaNs, 16 * kSec) << "the estimate made at assignment stands";
+  // Done 30 s after its assignment: twice its prediction. The next estimate is stretched by it.
+  r = dispatcher->onTaskStatus("r1", "a", S::Done, "", 31 * kSec);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->events.back().state, S::Done);
+  EXPECT_EQ(r->events.back().etaNs, 31 * kSec);
+  robot("r1", 0, 0.9, 31 * kSec);  // at P-1 now: its own way 0 s
+  out = dispatcher->tick(32 * kSec);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].etaNs, 32 * kSec) << "predicted 0 s (no dwell) x pace 2";
+  // Cancelled: no estimate.
+  auto c = dispatcher->cancel("b", "no longer needed", 33 * kSec);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->events.back().etaNs, 0);
+}
+
 /// A robot in fault mode fails whatever it is given at once; offering it tasks only burned their
 /// attempts until it was held back after three failures.
 TEST_F(DispatcherTest, ARobotInFaultModeIsOfferedNoTaskUntilItRecovers) {

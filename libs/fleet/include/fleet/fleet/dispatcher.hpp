@@ -13,6 +13,7 @@
 #include "fleet/fleet/robot_registry.hpp"
 #include "fleet/fleet/station_choice.hpp"
 #include "fleet/fleet/station_map.hpp"
+#include "fleet/fleet/task_eta.hpp"
 #include "fleet/fleet/task_store.hpp"
 
 namespace fleet {
@@ -65,6 +66,9 @@ struct TaskEvent {
   std::string reason;
   std::int64_t stampNs = 0;
   std::string station;  ///< the station the dispatcher chose for the task (TaskRecord::stationChosen)
+  /// When the task is expected to be done (TaskEta), as estimated at this transition; 0: no
+  /// estimate (no robot could take it, or it ended without being done).
+  std::int64_t etaNs = 0;
 };
 
 /// A task a robot must now execute (publish as `TaskAssignment`, key robot_id).
@@ -167,6 +171,13 @@ class Dispatcher {
 
  private:
   void applied(const TaskRecord& r, DispatchResult& out);
+  /// The ETA of the transition to `r` (TaskEta), and what it teaches the estimator.
+  [[nodiscard]] std::int64_t etaOf(const TaskRecord& r);
+  /// The ETA of an open task now, without teaching the estimator (a pause, a new wait reason).
+  [[nodiscard]] std::int64_t currentEta(const TaskRecord& r, std::int64_t nowNs) const;
+  [[nodiscard]] std::int64_t waitingEta(const TaskRecord& r, std::int64_t nowNs) const;
+  /// Counts the waiting tasks per priority (`delta` +1 when one enters the queue, -1 when it leaves).
+  void countWaiting(const TaskRecord& r, int delta);
   /// The open task, or not_found / illegal_transition ("already done") for an operator request.
   Expected<std::map<std::string, TaskRecord, std::less<>>::iterator> findOpen(const std::string& taskId);
   void requeueOrFail(const TaskRecord& r, bool failedByRobot, const std::string& reason, std::int64_t nowNs,
@@ -205,6 +216,9 @@ class Dispatcher {
   /// one (a robot boxed in at its parking place failed the same task three times in a row).
   std::map<std::string, std::string, std::less<>> failedBy_;
   std::set<std::string, std::less<>> held_;  // robots held by the operator
+  TaskEta eta_;
+  /// Waiting tasks by priority: how many are ahead of a task entering the queue.
+  std::map<std::int32_t, std::size_t, std::greater<>> waitingByPriority_;
 };
 
 }  // namespace fleet
