@@ -65,7 +65,9 @@ CostMatrix effectiveCosts(std::span<const Task> tasks, std::span<const RobotInfo
       continue;  // no robot can take it: the whole row stays +inf
     }
     const double deferredLate = std::max(0.0, now + p.deferHorizonS + minTravel + handling - deadline);
-    const double skip = p.priorityWeightS * static_cast<double>(t.priority) + p.latenessWeight * deferredLate;
+    const double age = t.createdNs > 0 ? std::max(0.0, now - nsToSec(t.createdNs)) : 0.0;
+    const double skip = p.priorityWeightS * static_cast<double>(t.priority) +
+                        p.latenessWeight * deferredLate + p.ageWeight * age;
     for (std::size_t j = 0; j < robots.size(); ++j) {
       c.at(i, j) -= skip;  // +inf stays +inf
     }

@@ -229,6 +229,36 @@ TEST(Allocators, PriorityDecidesWhoIsServedWhenRobotsAreScarce) {
   EXPECT_EQ(as[0].task, 0u);
 }
 
+// No task starves: with one robot and a stream of tasks nearer to it, a far task is served once its
+// age outweighs the difference in travel (A = 1 s of travel per s waited), and not before.
+TEST(Allocators, AnOldFarTaskIsServedOnceItsAgeOutweighsANewNearOne) {
+  World w;
+  w.taskPos = {{90, 0, 0}, {10, 0, 0}};
+  w.tasks = {mkTask("t0"), mkTask("t1")};
+  w.robots = {mkRobot("r0")};
+  const HungarianAllocator h;
+  // t0 waited 70 s, t1 is new: 90 - 70 > 10, the near one still wins.
+  w.tasks[0].createdNs = 30 * kSec;
+  w.tasks[1].createdNs = 100 * kSec;
+  auto as = h.assign(w.tasks, w.robots, w.travel(), 100 * kSec);
+  ASSERT_EQ(as.size(), 1u);
+  EXPECT_EQ(as[0].task, 1u);
+  // (The greedy allocator, for backlogs too large for the Hungarian method, serves the oldest first.)
+  as = GreedyAllocator().assign(w.tasks, w.robots, w.travel(), 100 * kSec);
+  ASSERT_EQ(as.size(), 1u);
+  EXPECT_EQ(as[0].task, 0u);
+  // t0 waited 90 s: 90 - 90 < 10, its turn.
+  w.tasks[0].createdNs = 10 * kSec;
+  as = h.assign(w.tasks, w.robots, w.travel(), 100 * kSec);
+  ASSERT_EQ(as.size(), 1u);
+  EXPECT_EQ(as[0].task, 0u);
+  // Without the age term the far task would wait for ever behind near ones.
+  AllocationPolicy p;
+  p.ageWeight = 0.0;
+  const auto c = effectiveCosts(w.tasks, w.robots, w.travel(), p, 100 * kSec);
+  EXPECT_LT(c.at(1, 0), c.at(0, 0));
+}
+
 TEST(Allocators, DeadlinesPickTheUrgentTaskAndTheNearRobot) {
   World w;
   // Robot r0 at the origin; t1 has a deadline it only meets if served now.

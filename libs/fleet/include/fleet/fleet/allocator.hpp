@@ -33,6 +33,10 @@ struct AllocationPolicy {
   double priorityWeightS = 600.0;  ///< one priority step is worth this many seconds of travel
   double latenessWeight = 10.0;    ///< cost per second of predicted lateness past the deadline
   double deferHorizonS = 60.0;     ///< how much later a task left unassigned now is assumed to start
+  /// Seconds of travel one second of waiting is worth: a task waiting longer is served before a
+  /// nearer, newer one of its priority once its age outweighs the difference in travel, so no task
+  /// starves behind a stream of tasks closer to the robots (docs/algorithms.md, "Allocation").
+  double ageWeight = 1.0;
 };
 
 /// Whether `r` may take `t` at all: pinned tasks go to their robot only, a robot below the battery
@@ -59,6 +63,7 @@ struct CostMatrix {
 ///   cost(r, t) = travel(r, t) + L·late(r, t) − skip(t)
 ///   late(r, t) = max(0, now + travel(r, t) + load + unload − deadline)           (0 without deadline)
 ///   skip(t)    = W·priority(t) + L·max(0, now + H + minTravel(t) + load + unload − deadline)
+///                + A·(now − created(t))
 /// skip(t) is what leaving t for later costs; subtracting it makes "serve t now" cheaper the more
 /// urgent t is, which only matters when tasks outnumber robots (every robot gets a task, so which
 /// tasks to serve is decided by skip), while among robots for one task only travel and lateness
