@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <random>
@@ -130,14 +131,17 @@ TEST(CrashSafety, AcknowledgedWritesSurviveSigkill) {
       runWriter(path, round, fds[1], seed);
     }
     ::close(fds[1]);
-    // Read while the child runs so it never blocks on a full pipe, then kill it mid-flight.
-    const auto killAt =
-        std::chrono::steady_clock::now() + std::chrono::milliseconds(30 + static_cast<int>(rng() % 220));
+    // Read while the child runs so it never blocks on a full pipe, then kill it mid-flight: once it
+    // has acknowledged a random number of writes (not after a random time: on a loaded machine a
+    // writer killed after 30-250 ms had sometimes acknowledged almost nothing), or after 20 s.
+    const std::size_t killAfterAcks = 20 + rng() % 60;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     std::string acks;
     char buf[4096];
     bool killed = false;
     for (;;) {
-      if (!killed && std::chrono::steady_clock::now() >= killAt) {
+      if (!killed && (static_cast<std::size_t>(std::count(acks.begin(), acks.end(), '\n')) >= killAfterAcks ||
+                      std::chrono::steady_clock::now() >= deadline)) {
         ASSERT_EQ(::kill(pid, SIGKILL), 0);
         killed = true;
       }
