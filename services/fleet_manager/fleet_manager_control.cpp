@@ -77,8 +77,11 @@ msg::TaskAck FleetManagerNode::change(const msg::Task& req, std::int64_t nowNs, 
   auto r = dispatcher_->change(q, &fields);
   if (!r) {
     const auto& code = r.error().code;
-    if (!fields.empty()) {
-      return ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected, fieldsJson(fields), nowNs);
+    if (!fields.empty() || code == errc::kInvalid) {
+      // The store checks as the dispatcher does; should it refuse alone, its message is the field.
+      return ack(req, msg::AckResult::Invalid, msg::TaskState::Rejected,
+                 fieldsJson(fields.empty() ? std::vector<FieldError>{{"", r.error().message}} : fields),
+                 nowNs);
     }
     if (code == errc::kIllegalTransition) {
       // The ack carries the state the task is in, for the adapter's 409 to name.
