@@ -14,37 +14,13 @@
 #include "fleet/fleet/sqlite_task_store.hpp"
 #include "fleet/planning/map_io.hpp"
 #include "fleet/traffic/roadmap_travel.hpp"
+#include "manager_acks.hpp"
 
 namespace fleet::manager {
-namespace {
 
-msg::TaskState toMsg(TaskState s) {
-  return static_cast<msg::TaskState>(static_cast<int>(s));
-}
-
-msg::TaskAck ack(const msg::Task& req, msg::AckResult r, msg::TaskState state, std::string detail,
-                 std::int64_t nowNs) {
-  if (detail.size() > 1023) {
-    detail = detail.substr(0, 1020) + "...";
-  }
-  return {req.request_id, req.task_id, r, state, std::move(detail), nowNs};
-}
-
-/// An operator request (cancel, pause, resume) on an unknown or finished task.
-msg::TaskAck refused(const msg::Task& req, const Error& e, std::int64_t nowNs) {
-  return ack(req, e.code == errc::kNotFound ? msg::AckResult::NotFound : msg::AckResult::Refused,
-             msg::TaskState::Rejected, e.message, nowNs);
-}
-
-std::string fieldsJson(const std::vector<FieldError>& fields) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const auto& f : fields) {
-    a.push_back({{"path", f.path}, {"reason", f.reason}});
-  }
-  return a.dump();
-}
-
-}  // namespace
+using acks::ack;
+using acks::fieldsJson;
+using acks::toMsg;
 
 Settings readSettings(Config& cfg) {
   Settings s;
@@ -348,8 +324,8 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
 void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out) {
   for (const auto& e : r.events) {
     auto& seq = eventSeq_[e.taskId];
-    out.events.push_back(
-        {e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq, e.station});
+    out.events.push_back({e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq,
+                          e.station, e.changed, e.priority, e.deadlineNs});
     if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
       // Kept from the first event: a waiting task's later events (paused, why it waits) do not
       // restart its wait.
@@ -431,49 +407,9 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
   };
   for (const auto& req : requests) {
     ++metrics_.requests;
-    if (req.cancel) {
-      flush();  // a cancel must see the tasks submitted before it
-      auto r = dispatcher_->cancel(req.task_id, "cancelled by request", nowNs);
-      if (r) {
-        out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Cancelled, "", nowNs));
-        publish(std::move(*r), nowNs, out);
-      } else {
-        out.acks.push_back(refused(req, r.error(), nowNs));
-      }
-      continue;
-    }
-    if (req.control == msg::TaskControl::Query) {
-      flush();  // a query must see the tasks submitted before it
-      out.acks.push_back(query(req, nowNs));
-      continue;
-    }
-    if (req.control == msg::TaskControl::HoldRobot || req.control == msg::TaskControl::ReleaseRobot) {
-      flush();
-      const bool hold = req.control == msg::TaskControl::HoldRobot;
-      auto r = dispatcher_->setRobotHeld(req.robot, hold, nowNs);
-      if (r) {
-        const RobotInfo* info = dispatcher_->robots().find(req.robot);
-        out.acks.push_back(ack(req, msg::AckResult::Stored, msg::TaskState::Queued,
-                               info != nullptr ? info->taskId : std::string(), nowNs));
-        publish(std::move(*r), nowNs, out);
-      } else {
-        out.acks.push_back(refused(req, r.error(), nowNs));
-      }
-      continue;
-    }
-    if (req.control != msg::TaskControl::None) {
-      flush();  // a pause must see the tasks submitted before it
-      const bool pause = req.control == msg::TaskControl::Pause;
-      auto r = dispatcher_->setPaused(req.task_id, pause, nowNs);
-      if (r) {
-        const auto it = dispatcher_->openTasks().find(req.task_id);
-        const auto state =
-            it != dispatcher_->openTasks().end() ? toMsg(it->second.state) : msg::TaskState::Queued;
-        out.acks.push_back(ack(req, msg::AckResult::Stored, state, pause ? "paused" : "resumed", nowNs));
-        publish(std::move(*r), nowNs, out);
-      } else {
-        out.acks.push_back(refused(req, r.error(), nowNs));
-      }
+    if (req.cancel || req.control != msg::TaskControl::None) {
+      flush();  // a request on a task must see the tasks submitted before it
+      control(req, nowNs, out);
       continue;
     }
     // The typed fields are the task; the dispatcher validates it, once, against the site.
@@ -481,28 +417,6 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
     batchReq.push_back(&req);
   }
   flush();
-}
-
-msg::TaskAck FleetManagerNode::query(const msg::Task& req, std::int64_t nowNs) {
-  auto r = store_->get(req.task_id);
-  if (!r) {
-    return refused(req, r.error(), nowNs);
-  }
-  nlohmann::json d = {{"robot", r->robotId},
-                      {"reason", r->reason.substr(0, 255)},
-                      {"updated_ns", r->updatedNs},
-                      {"revision", r->revision},
-                      {"task", toJson(r->task)}};
-  if (r->stationChosen) {
-    d["station_chosen"] = true;  // task.station was chosen by the dispatcher, not sent
-  }
-  const auto replace = nlohmann::json::error_handler_t::replace;
-  std::string detail = d.dump(-1, ' ', false, replace);
-  if (detail.size() > 1023) {
-    d.erase("task");  // the state matters; the body is a nicety
-    detail = d.dump(-1, ' ', false, replace);
-  }
-  return ack(req, msg::AckResult::Stored, toMsg(r->state), std::move(detail), nowNs);
 }
 
 void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Outbox& out) {

@@ -161,8 +161,13 @@ class FleetManagerNode {
  private:
   FleetManagerNode() = default;
   void publish(DispatchResult r, std::int64_t nowNs, Outbox& out);
+  /// A request on one task or robot (cancel, TC_PAUSE / TC_RESUME, TC_QUERY, TC_HOLD_ROBOT /
+  /// TC_RELEASE_ROBOT, TC_CHANGE): its ack and what it changed (fleet_manager_control.cpp).
+  void control(const msg::Task& req, std::int64_t nowNs, Outbox& out);
   /// The answer to a TC_QUERY request: the stored state, robot, reason and body (JSON in detail).
   msg::TaskAck query(const msg::Task& req, std::int64_t nowNs);
+  /// TC_CHANGE: a waiting task's priority and/or deadline (Dispatcher::change).
+  msg::TaskAck change(const msg::Task& req, std::int64_t nowNs, Outbox& out);
   /// The robot's order; error "internal" when a station of the task is not on the site.
   Expected<msg::TaskAssignment> toAssignment(const AssignmentOrder& o, std::int64_t nowNs);
   std::uint32_t nextRevision(const std::string& robot, std::int64_t nowNs);

@@ -1,5 +1,5 @@
-// fleetctl's commands on the WMS adapter's HTTP API: submit, tasks, task, cancel, pause, resume,
-// robots, close, reopen, closures, follow, health and metrics, and the options --url, --ca-cert and
+// fleetctl's commands on the WMS adapter's HTTP API: submit, tasks, task, change, cancel, pause,
+// resume, robots, close, reopen, closures, follow, health and metrics, and the options --url, --ca-cert and
 // --token-file they reach the adapter with.
 
 #include <httplib.h>
@@ -11,6 +11,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,7 +35,11 @@ struct ApiOptions {
   int batch = 500;
   std::string state;  // tasks
   int limit = 100;
-  std::string id;  // task, cancel, pause, resume, close, reopen
+  std::string id;               // task, change, cancel, pause, resume, close, reopen
+  std::optional<int> priority;  // change
+  std::string deadline;         // change: RFC 3339
+  std::optional<std::int64_t> deadlineNs;
+  bool noDeadline = false;
   std::vector<double> closeArea;
   std::vector<int> closeNodes;
   std::vector<std::string> closeLanes;
@@ -303,6 +308,19 @@ void addApiCommands(CLI::App& app, Commands& commands) {
   tasks->add_option("--limit", o->limit)->check(CLI::Range(1, 100000));
   auto* task = app.add_subcommand("task", "show one task");
   task->add_option("id", o->id)->required();
+  auto* change = app.add_subcommand(
+      "change",
+      "change a waiting task's priority and/or deadline (PATCH /v1/tasks/ID); assigned ones are refused");
+  change->add_option("id", o->id)->required();
+  change->add_option("--priority", o->priority, "the new priority, higher first")
+      ->check(CLI::Range(-1000, 1000));
+  auto* dl =
+      change->add_option("--deadline", o->deadline, "the new deadline as RFC 3339, 2026-12-02T14:05:00Z");
+  auto* dlNs = change->add_option("--deadline-ns", o->deadlineNs, "the new deadline in ns of the fleet clock")
+                   ->check(CLI::NonNegativeNumber);
+  auto* none = change->add_flag("--no-deadline", o->noDeadline, "take the deadline away");
+  dl->excludes(dlNs)->excludes(none);
+  dlNs->excludes(none);
   auto* cancel = app.add_subcommand("cancel", "cancel a task");
   cancel->add_option("id", o->id)->required();
   auto* pause = app.add_subcommand(
@@ -343,6 +361,23 @@ void addApiCommands(CLI::App& app, Commands& commands) {
   add(tasks, listTasks);
   add(task,
       [](const ApiOptions& a, Client& c, const Headers& h) { return show(c.Get("/v1/tasks/" + a.id, h)); });
+  add(change, [](const ApiOptions& a, Client& c, const Headers& h) {
+    json body = json::object();
+    if (a.priority) {
+      body["priority"] = *a.priority;
+    }
+    if (!a.deadline.empty()) {
+      body["deadline"] = a.deadline;
+    } else if (a.deadlineNs) {
+      body["deadline_ns"] = *a.deadlineNs;
+    } else if (a.noDeadline) {
+      body["deadline_ns"] = 0;
+    }
+    if (body.empty()) {
+      return fail("change: give --priority, --deadline, --deadline-ns or --no-deadline");
+    }
+    return show(c.Patch("/v1/tasks/" + a.id, h, body.dump(), "application/json"));
+  });
   add(cancel, [](const ApiOptions& a, Client& c, const Headers& h) {
     return show(c.Delete("/v1/tasks/" + a.id, h));
   });

@@ -18,7 +18,7 @@ struct Command {
 using Commands = std::vector<Command>;
 
 // The WMS adapter's HTTP API: the options --url, --ca-cert and --token-file, and the subcommands
-// submit, tasks, task, cancel, pause, resume, robots, close, reopen, closures, follow, health and
+// submit, tasks, task, change, cancel, pause, resume, robots, close, reopen, closures, follow, health and
 // metrics (cmd_api.cpp).
 void addApiCommands(CLI::App& app, Commands& commands);
 // loadtest: a whole fleet here, fed tasks, faults injected, a report (cmd_loadtest.cpp).

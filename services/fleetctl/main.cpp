@@ -3,6 +3,7 @@
 //   fleetctl tasks [--state S]       list tasks          fleetctl task ID     one task
 //   fleetctl cancel ID               cancel a task       fleetctl robots      list robots
 //   fleetctl pause ID | resume ID    hold a task (its robot stands still) / let it go on
+//   fleetctl change ID [--priority N] [--deadline T | --deadline-ns N | --no-deadline]  a waiting task
 //   fleetctl follow [--count N] [--since ID]  print task events as they happen (after event ID)
 //   fleetctl health | metrics
 //   fleetctl loadtest [--robots N --humans M | --scenario F] [--fault ...]   run a whole fleet

@@ -3,13 +3,25 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "rfc3339.hpp"
+
 namespace fleet::wms {
 
 nlohmann::json loggedEventJson(const LoggedEvent& l) {
   const auto& e = l.event;
-  return {{"event_id", l.id},    {"id", e.task_id},     {"state", msg::toString(e.state)},
-          {"robot", e.robot_id}, {"reason", e.reason},  {"stamp_ns", e.stamp_ns},
-          {"seq", e.seq},        {"station", e.station}};
+  nlohmann::json j = {{"event_id", l.id},    {"id", e.task_id},     {"state", msg::toString(e.state)},
+                      {"robot", e.robot_id}, {"reason", e.reason},  {"stamp_ns", e.stamp_ns},
+                      {"seq", e.seq},        {"station", e.station}};
+  if (e.changed) {
+    // A change of the waiting task's priority and deadline: the values now in force.
+    j["changed"] = true;
+    j["priority"] = e.priority;
+    j["deadline_ns"] = e.deadline_ns;
+    if (e.deadline_ns > 0) {
+      j["deadline"] = toRfc3339(e.deadline_ns);
+    }
+  }
+  return j;
 }
 
 namespace {
@@ -27,6 +39,11 @@ LoggedEvent rowOf(const SqliteStmt& q) {
   l.event.reason = q.text(5);
   l.event.stamp_ns = q.integer(6);
   l.event.station = q.text(7);
+  if (!q.isNull(8)) {
+    l.event.changed = true;
+    l.event.priority = static_cast<std::int32_t>(q.integer(8));
+    l.event.deadline_ns = q.integer(9);
+  }
   return l;
 }
 
@@ -49,9 +66,19 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
       "CREATE TABLE IF NOT EXISTS task_events("
       " id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER NOT NULL,"
       " state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT NULL,"
-      " station TEXT NOT NULL, logged_ns INTEGER NOT NULL);"
+      " station TEXT NOT NULL, logged_ns INTEGER NOT NULL, priority INTEGER, deadline_ns INTEGER);"
       "CREATE INDEX IF NOT EXISTS task_events_by_task ON task_events(task_id, seq);"
       "CREATE INDEX IF NOT EXISTS task_events_by_time ON task_events(logged_ns);");
+  {
+    // A log written before changes of priority and deadline were logged gets their columns (NULL:
+    // not a change).
+    SqliteStmt q(*db_, "SELECT COUNT(*) FROM pragma_table_info('task_events') WHERE name = 'priority'");
+    if (q.step() && q.integer(0) == 0) {
+      db_->exec(
+          "ALTER TABLE task_events ADD COLUMN priority INTEGER;"
+          "ALTER TABLE task_events ADD COLUMN deadline_ns INTEGER;");
+    }
+  }
   {
     SqliteStmt q(*db_, "SELECT seq FROM sqlite_sequence WHERE name = 'task_events'");
     lastId_ = q.step() ? q.integer(0) : 0;
@@ -64,9 +91,11 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
   insert_ =
       std::make_unique<SqliteStmt>(*db_,
                                    "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, "
-                                   "station, logged_ns) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)");
+                                   "station, logged_ns, priority, deadline_ns) VALUES (?1, ?2, ?3, ?4, ?5, "
+                                   "?6, ?7, ?8, ?9, ?10)");
   SqliteStmt q(*db_,
-               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station FROM task_events "
+               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns FROM "
+               "task_events "
                "WHERE id > ?1 ORDER BY id");
   q.bind(1, std::max<std::int64_t>(prunedThrough_, lastId_ - static_cast<std::int64_t>(kMemoryTail)));
   while (q.step()) {
@@ -101,6 +130,11 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
             .bind(6, e.stamp_ns)
             .bind(7, e.station)
             .bind(8, nowNs);
+        if (e.changed) {
+          row.bind(9, std::int64_t{e.priority}).bind(10, e.deadline_ns);
+        } else {
+          row.bindNull(9).bindNull(10);
+        }
         row.run();
         row.reset();
         added.push_back({sqlite3_last_insert_rowid(db_->handle()), e});
@@ -169,7 +203,8 @@ std::vector<LoggedEvent> EventLog::after(std::int64_t after, std::size_t limit) 
   // Older than the memory holds: a client catching up from far back (bounded by `limit`).
   std::lock_guard dbLock(db_->mutex());
   SqliteStmt q(*db_,
-               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station FROM task_events "
+               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns FROM "
+               "task_events "
                "WHERE id > ?1 ORDER BY id LIMIT ?2");
   q.bind(1, after).bind(2, static_cast<std::int64_t>(limit));
   while (q.step()) {

@@ -12,6 +12,23 @@ constexpr std::size_t kEventBuffer = 10'000;
 bool terminal(msg::TaskState s) {
   return s == msg::TaskState::Done || s == msg::TaskState::Failed || s == msg::TaskState::Cancelled;
 }
+/// The task JSON `body` with the priority and deadline a change event carries (0: left out, as
+/// toJson leaves out a default).
+void applyChange(std::string& body, const msg::TaskEvent& e) {
+  auto j = nlohmann::json::parse(body, nullptr, false);
+  if (!j.is_object()) {
+    return;
+  }
+  for (const auto& [key, value] :
+       {std::pair{"priority", std::int64_t{e.priority}}, std::pair{"deadline_ns", e.deadline_ns}}) {
+    if (value != 0) {
+      j[key] = value;
+    } else {
+      j.erase(key);
+    }
+  }
+  body = j.dump();
+}
 }  // namespace
 
 void FleetView::setEventLog(EventLog* log) {
@@ -72,6 +89,9 @@ void FleetView::viewEvent(const msg::TaskEvent& e) {
       v.updatedNs = e.stamp_ns;
       v.seq = e.seq;
       v.station = e.station;
+      if (e.changed && !v.body.empty()) {
+        applyChange(v.body, e);
+      }
     }
     events_.push_back(e);
     ++eventCount_;

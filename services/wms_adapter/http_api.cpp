@@ -217,6 +217,10 @@ void HttpApi::routes() {
                 [this](const Request& req, Response& res) { postTasks(req, res); });
   server_.route("DELETE", R"(/v1/tasks/([^/]+))", Scope::Submit,
                 [this](const Request& req, Response& res) { deleteTask(req, res); });
+  // A change of a waiting task's priority and deadline: scoped as a submission (the WMS owns both).
+  server_.limitBody("PATCH", R"(/v1/tasks/([^/]+))", 64 * 1024, "the change route's fixed limit");
+  server_.route("PATCH", R"(/v1/tasks/([^/]+))", Scope::Submit,
+                [this](const Request& req, Response& res) { patchTask(req, res); });
   server_.route("POST", R"(/v1/tasks/([^/]+)/pause)", Scope::Operate,
                 [this](const Request& req, Response& res) { controlTask(req, res, true); });
   server_.route("POST", R"(/v1/tasks/([^/]+)/resume)", Scope::Operate,

@@ -98,11 +98,13 @@ class HttpApi {
   void observe(const Request& req, const Response& res, double seconds);
   void postTasks(const Request& req, Response& res);
   void deleteTask(const Request& req, Response& res);
-  /// A request on task `id` (cancel, pause, resume): a valid id and a reachable manager, else the
+  /// A request on task `id` (cancel, pause, resume, change): a valid id and a reachable manager, else the
   /// 400 / 503 reply is written ("nothing was <verb>") and false returned.
   bool admitTaskRequest(const std::string& id, const char* verb, Response& res);
   /// POST /v1/tasks/{id}/pause and /resume.
   void controlTask(const Request& req, Response& res, bool pause);
+  /// PATCH /v1/tasks/{id}: a waiting task's priority and deadline (http_api_change.cpp).
+  void patchTask(const Request& req, Response& res);
   /// PUT and DELETE /v1/traffic/closures/{id}.
   void putClosure(const Request& req, Response& res);
   void deleteClosure(const Request& req, Response& res);

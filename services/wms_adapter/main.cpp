@@ -26,10 +26,14 @@ int main(int argc, char** argv) {
   service::CommonOptions common;
   std::string stationsPath;
   int port = -1;
+  std::string eventsLog;
   app.add_option("-c,--config", configPath, "JSON configuration file");
   app.add_option("--stations", stationsPath,
                  "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   app.add_option("--port", port, "HTTP port (overrides the config; 0 = any free port)");
+  app.add_option("--events-log", eventsLog,
+                 "SQLite file of the event log and the webhook subscriptions (overrides the config's "
+                 "events.log; on a writable volume, event ids and webhooks survive a restart)");
   service::addCommonOptions(app, common);
   if (auto code = service::parse(app, argc, argv)) {
     return *code;
@@ -43,6 +47,9 @@ int main(int argc, char** argv) {
     auto api = wms::readApiSettings(cfg);
     if (port >= 0) {
       api.port = port;
+    }
+    if (!eventsLog.empty()) {
+      api.events.path = eventsLog;
     }
     if (stationsPath.empty()) {
       stationsPath = cfg.requireString("stations");

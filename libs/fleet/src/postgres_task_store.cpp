@@ -50,6 +50,13 @@ CREATE TABLE IF NOT EXISTS fleet_lease(
 );
 )sql";
 
+/// Version 4: the priority and deadline in force after a change (NULL until one; the body stays
+/// as submitted, so a retry of the submission is still the same request).
+constexpr const char* kSchemaV4 = R"sql(
+ALTER TABLE tasks ADD COLUMN IF NOT EXISTS priority INTEGER;
+ALTER TABLE tasks ADD COLUMN IF NOT EXISTS deadline_ns BIGINT;
+)sql";
+
 /// fleet_lease holds the fleet manager's lease (services/fleet_manager/manager_lease.hpp), whose
 /// epoch fences the store's writes (fenceWith).
 /// The steps from an older schema: each brings the database to its version. The first PostgreSQL
@@ -58,14 +65,15 @@ struct Migration {
   int version;
   const char* sql;
 };
-constexpr Migration kMigrations[] = {{3, kSchemaV3}};
+constexpr Migration kMigrations[] = {{3, kSchemaV3}, {4, kSchemaV4}};
 
 /// Key of the advisory lock two managers starting at once take around creating or migrating the
 /// schema ("fleetsch" in ASCII).
 constexpr const char* kSchemaLock = "SELECT pg_advisory_xact_lock(7379531807330298728)";
 
 constexpr const char* kRecordColumns =
-    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station";
+    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station, priority, "
+    "deadline_ns";
 
 Param num(std::int64_t v) {
   return std::to_string(v);
@@ -107,6 +115,9 @@ struct PostgresTaskStore::Impl {
     if (std::string chosen = s.text(row, 10); !chosen.empty()) {
       r.task.station = std::move(chosen);
       r.stationChosen = true;
+    }
+    if (!s.isNull(row, 11)) {
+      store_rules::setInForce(r, {static_cast<std::int32_t>(s.integer(row, 11)), s.integer(row, 12)});
     }
     return r;
   }
@@ -287,6 +298,9 @@ Expected<std::unique_ptr<PostgresTaskStore>> PostgresTaskStore::open(
   c.addStatement("fence", "SELECT epoch FROM fleet_lease WHERE name = $1 FOR SHARE");
   c.addStatement("pause", "UPDATE tasks SET paused = $1, updated_ns = $2 WHERE id = $3");
   c.addStatement("wait_reason", "UPDATE tasks SET reason = $1, updated_ns = $2 WHERE id = $3");
+  c.addStatement(
+      "change",
+      "UPDATE tasks SET priority = $1, deadline_ns = $2, updated_ns = $3, revision = $4 WHERE id = $5");
   c.addStatement("history",
                  "SELECT seq, task_id, from_state, to_state, robot, reason, stamp_ns FROM transitions "
                  "WHERE task_id = $1 ORDER BY seq");
@@ -420,6 +434,29 @@ Expected<TaskRecord> PostgresTaskStore::setWaitReason(std::string_view id, std::
     cur->reason = repaired;
     cur->updatedNs = stampNs;
     return cur;
+  });
+  return std::move(out.front());
+}
+
+Expected<ChangeResult> PostgresTaskStore::change(const ChangeRequest& q) {
+  std::lock_guard lock(mu_);
+  auto out = impl_->batch<ChangeResult>(1, [&](std::size_t) -> Expected<ChangeResult> {
+    auto cur = impl_->load(q.taskId, true);
+    if (!cur) {
+      return unexpected(cur.error());
+    }
+    auto applied = store_rules::applyChange(std::move(cur).value(), q);
+    if (!applied || !applied->changed) {
+      return applied;
+    }
+    const TaskRecord& r = applied->record;
+    if (auto ok = impl_->conn.run(
+            "change task", "change",
+            {num(r.task.priority), num(r.task.deadlineNs), num(r.updatedNs), num(r.revision), str(q.taskId)});
+        !ok) {
+      return unexpected(ok.error());
+    }
+    return applied;
   });
   return std::move(out.front());
 }

@@ -75,7 +75,9 @@ CREATE TABLE IF NOT EXISTS tasks(
   updated_ns INTEGER NOT NULL,
   revision INTEGER NOT NULL,
   paused INTEGER NOT NULL DEFAULT 0,
-  station TEXT NOT NULL DEFAULT ''
+  station TEXT NOT NULL DEFAULT '',
+  priority INTEGER,
+  deadline_ns INTEGER
 ) WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS tasks_by_state ON tasks(state, id);
 CREATE TABLE IF NOT EXISTS transitions(
@@ -91,18 +93,20 @@ CREATE INDEX IF NOT EXISTS transitions_by_task ON transitions(task_id, seq);
 )sql";
 
 /// PRAGMA user_version: store_rules::kSchemaVersion (version 2 added tasks.paused, version 3
-/// tasks.station; the body stays as submitted, so a retry of the request is still the same
-/// request). An older database gets the columns on open; a newer one is refused.
+/// tasks.station, version 4 tasks.priority and tasks.deadline_ns, NULL until a change; the body
+/// stays as submitted, so a retry of the request is still the same request). An older database
+/// gets the columns on open; a newer one is refused.
 constexpr int kSchemaVersion = store_rules::kSchemaVersion;
 
 constexpr const char* kRecordColumns =
-    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station";
+    "id, body, state, robot, attempts, reason, created_ns, updated_ns, revision, paused, station, priority, "
+    "deadline_ns";
 
 }  // namespace
 
 struct SqliteTaskStore::Impl {
   sqlite3* db = nullptr;
-  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open, pause, waitReason;
+  Stmt begin, commit, rollback, select, insert, update, log, history, counts, open, pause, waitReason, change;
 
   ~Impl() {
     // close_v2 defers the close until the statements (members, destroyed after this body) are
@@ -157,6 +161,9 @@ struct SqliteTaskStore::Impl {
     if (std::string chosen = s.text(10); !chosen.empty()) {
       r.task.station = std::move(chosen);
       r.stationChosen = true;
+    }
+    if (!s.isNull(11)) {
+      store_rules::setInForce(r, {static_cast<std::int32_t>(s.integer(11)), s.integer(12)});
     }
     return r;
   }
@@ -244,7 +251,9 @@ struct SqliteTaskStore::Impl {
     }
     for (const auto& [name, ddl] :
          {std::pair{"paused", "ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0"},
-          std::pair{"station", "ALTER TABLE tasks ADD COLUMN station TEXT NOT NULL DEFAULT ''"}}) {
+          std::pair{"station", "ALTER TABLE tasks ADD COLUMN station TEXT NOT NULL DEFAULT ''"},
+          std::pair{"priority", "ALTER TABLE tasks ADD COLUMN priority INTEGER"},
+          std::pair{"deadline_ns", "ALTER TABLE tasks ADD COLUMN deadline_ns INTEGER"}}) {
       cols.bind(1, std::string_view(name));
       const bool has = cols.step() == SQLITE_ROW && cols.integer(0) > 0;
       cols.reset();
@@ -342,7 +351,7 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
     return unexpected(ok.error());
   }
   const std::string sel = std::string("SELECT ") + kRecordColumns + " FROM tasks";
-  const std::array<std::pair<Stmt*, std::string>, 12> stmts = {{
+  const std::array<std::pair<Stmt*, std::string>, 13> stmts = {{
       {&impl->begin, "BEGIN IMMEDIATE"},
       {&impl->commit, "COMMIT"},
       {&impl->rollback, "ROLLBACK"},
@@ -364,6 +373,8 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
       {&impl->counts, "SELECT state, COUNT(*) FROM tasks GROUP BY state"},
       {&impl->pause, "UPDATE tasks SET paused = ?1, updated_ns = ?2 WHERE id = ?3"},
       {&impl->waitReason, "UPDATE tasks SET reason = ?1, updated_ns = ?2 WHERE id = ?3"},
+      {&impl->change,
+       "UPDATE tasks SET priority = ?1, deadline_ns = ?2, updated_ns = ?3, revision = ?4 WHERE id = ?5"},
       {&impl->open, sel + " WHERE state NOT IN ('done', 'failed', 'cancelled') ORDER BY created_ns, id"},
   }};
   for (const auto& [stmt, sql] : stmts) {
@@ -466,6 +477,29 @@ Expected<TaskRecord> SqliteTaskStore::setWaitReason(std::string_view id, std::st
   cur->reason = std::string(reason);
   cur->updatedNs = stampNs;
   return cur;
+}
+
+Expected<ChangeResult> SqliteTaskStore::change(const ChangeRequest& q) {
+  std::lock_guard lock(mu_);
+  auto cur = impl_->load(q.taskId);
+  if (!cur) {
+    return unexpected(cur.error());
+  }
+  auto applied = store_rules::applyChange(std::move(cur).value(), q);
+  if (!applied || !applied->changed) {
+    return applied;
+  }
+  const TaskRecord& r = applied->record;
+  auto& s = impl_->change;
+  s.bind(1, static_cast<std::int64_t>(r.task.priority));
+  s.bind(2, r.task.deadlineNs);
+  s.bind(3, r.updatedNs);
+  s.bind(4, r.revision);
+  s.bind(5, q.taskId);
+  if (auto ok = impl_->stepDone(s, "change task"); !ok) {
+    return unexpected(ok.error());
+  }
+  return applied;
 }
 
 Expected<TaskRecord> SqliteTaskStore::get(std::string_view id) {

@@ -20,15 +20,28 @@ Expected<void> checkSubmission(const Task& t) {
 }
 
 Expected<void> checkResubmission(const TaskRecord& existing, const std::string& body) {
-  Task asSubmitted = existing.task;
+  Task inForce = existing.task;
   if (existing.stationChosen) {
-    asSubmitted.station.clear();
+    inForce.station.clear();
   }
-  if (canonicalBody(asSubmitted) != body) {
-    return unexpected(errc::kConflict,
-                      "task '" + existing.task.id + "' already exists with a different body");
+  if (canonicalBody(inForce) == body) {
+    return {};
   }
-  return {};
+  if (existing.submitted) {
+    Task asSubmitted = inForce;
+    asSubmitted.priority = existing.submitted->priority;
+    asSubmitted.deadlineNs = existing.submitted->deadlineNs;
+    if (canonicalBody(asSubmitted) == body) {
+      return {};
+    }
+  }
+  return unexpected(errc::kConflict, "task '" + existing.task.id + "' already exists with a different body");
+}
+
+void setInForce(TaskRecord& r, const Urgency& inForce) {
+  r.submitted = Urgency{r.task.priority, r.task.deadlineNs};
+  r.task.priority = inForce.priority;
+  r.task.deadlineNs = inForce.deadlineNs;
 }
 
 TaskRecord newRecord(const Task& t, std::int64_t stampNs) {
@@ -111,6 +124,29 @@ Expected<void> checkWaitReason(const TaskRecord& r) {
                       "task '" + r.task.id + "' is " + std::string(toString(r.state)) + ", not waiting");
   }
   return {};
+}
+
+Expected<ChangeResult> applyChange(TaskRecord r, const ChangeRequest& q) {
+  if (!isWaiting(r.state)) {
+    return unexpected(errc::kIllegalTransition,
+                      "task '" + r.task.id + "' is " + std::string(toString(r.state)) +
+                          "; only a waiting (queued or requeued) task can be changed");
+  }
+  if (auto errs = validateChange(q, r.task); !errs.empty()) {
+    return unexpected(errc::kInvalid, makeValidationError(std::move(errs)).message);
+  }
+  const Urgency now{q.priority.value_or(r.task.priority), q.deadlineNs.value_or(r.task.deadlineNs)};
+  if (now == Urgency{r.task.priority, r.task.deadlineNs}) {
+    return ChangeResult{std::move(r), false};  // idempotent: nothing to write
+  }
+  if (!r.submitted) {
+    r.submitted = Urgency{r.task.priority, r.task.deadlineNs};
+  }
+  r.task.priority = now.priority;
+  r.task.deadlineNs = now.deadlineNs;
+  r.updatedNs = q.stampNs;
+  ++r.revision;
+  return ChangeResult{std::move(r), true};
 }
 
 }  // namespace fleet::store_rules

@@ -88,6 +88,8 @@ void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
   out.created_ns = in.created_ns;
   out.cancel = in.cancel;
   out.control = static_cast<fleet_TaskControl>(in.control);
+  out.set_priority = in.set_priority;
+  out.set_deadline = in.set_deadline;
 }
 msg::Task Traits<msg::Task>::fromC(const C& in) {
   msg::Task m;
@@ -104,7 +106,9 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.deadline_ns = in.deadline_ns;
   m.created_ns = in.created_ns;
   m.cancel = in.cancel;
-  m.control = getEnum(in.control, msg::TaskControl::ReleaseRobot);
+  m.control = getEnum(in.control, msg::TaskControl::Change);
+  m.set_priority = in.set_priority;
+  m.set_deadline = in.set_deadline;
   return m;
 }
 
@@ -135,12 +139,16 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   out.stamp_ns = in.stamp_ns;
   out.seq = in.seq;
   putStr(out.station, in.station, "TaskEvent.station");
+  out.changed = in.changed;
+  out.priority = in.priority;
+  out.deadline_ns = in.deadline_ns;
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
   return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
           getStr(in.robot_id), getStr(in.reason),
           in.stamp_ns,         in.seq,
-          getStr(in.station)};
+          getStr(in.station),  in.changed,
+          in.priority,         in.deadline_ns};
 }
 
 // ---- TaskAssignment

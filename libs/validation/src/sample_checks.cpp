@@ -121,7 +121,7 @@ std::optional<Rejection> check(const msg::Task& m) {
   // The fields of the task itself are the dispatcher's to judge (it answers with field errors).
   Checker c("Task");
   c.id(m.task_id, "task_id").id(m.request_id, "request_id");
-  c.known(m.kind, msg::TaskKind::Park, "kind").known(m.control, msg::TaskControl::ReleaseRobot, "control");
+  c.known(m.kind, msg::TaskKind::Park, "kind").known(m.control, msg::TaskControl::Change, "control");
   c.text(m.pickup, "pickup").text(m.dropoff, "dropoff").text(m.station, "station").text(m.robot, "robot");
   return c.done();
 }

@@ -4,7 +4,7 @@
 Per service: the same image, entrypoint and arguments (the adapter reads its stations from the
 wms_adapter.json that scripts/containers writes, which must name the pod's stations and listen on
 all addresses of its container), environment, mounts, health check, read-only root filesystem and
-no privilege escalation. Network: every service on the project network `fleet`, none in another's
+no privilege escalation; the adapter's event log (--events-log) on the writable data mount. Network: every service on the project network `fleet`, none in another's
 namespace; the compose DDS profile (in the images) with multicast off and exactly the DDS services'
 names as unicast peers; only the adapter publishes a port, on 127.0.0.1. Secure by default: each
 DDS service of compose.yaml, compose.vda5050.yaml and the Pod requires DDS Security and joins with
@@ -61,6 +61,15 @@ for name, c in pod.items():
               "wms_adapter.json: http.host must be 0.0.0.0, or the published port reaches nothing")
         args[i:i + 2] = ["--config", "/etc/fleet/wms_adapter.json"]
     check(s.get("command") == args, f"{name}: command {s.get('command')} != pod's args {args}")
+    if name == "wms-adapter":
+        # Event ids and webhook subscriptions survive a restart: the event log on the writable data
+        # mount in both.
+        log = args[args.index("--events-log") + 1] if "--events-log" in args else ""
+        writable = [m["mountPath"] for m in c.get("volumeMounts", []) if not m.get("readOnly", False)]
+        check(log.startswith("/var/lib/fleet/") and "/var/lib/fleet" in writable,
+              f"wms-adapter: --events-log {log!r} is not on the pod's writable /var/lib/fleet")
+        check(any(v.endswith(":/var/lib/fleet") for v in s.get("volumes", [])),
+              "wms-adapter: compose's /var/lib/fleet is not writable")
     entry = [a.replace('"$@"', '"$$@"') for a in c.get("command", [])] or None
     check(s.get("entrypoint") == entry, f"{name}: entrypoint {s.get('entrypoint')} != pod's command {entry}")
     # CYCLONEDDS_URI differs (the pod's loopback profile, compose's): checked below.

@@ -3,7 +3,7 @@
 non-root with a read-only root filesystem and no capabilities, requests and limits, liveness on
 /livez and readiness on /readyz at the port the service serves them (FLEET_METRICS_PORT), images
 tagged with the project version; the fleet manager one replica, strategy Recreate, its database on
-the PersistentVolumeClaim; a traffic manager (one replica, the ConfigMap's site): every robot agent
+the PersistentVolumeClaim; the adapter likewise with its event log (--events-log) on a claim; a traffic manager (one replica, the ConfigMap's site): every robot agent
 drives only what it releases; the robot agents one StatefulSet whose pods take their robots from the
 ConfigMap fleet-robots by their ordinal (an entry per replica, each robot once, at a station of the
 site; no --robot in the manifest's arguments); every ConfigMap, Secret, claim and config file
@@ -171,6 +171,14 @@ for name, dep in workloads.items():
                   "not the ConfigMap's site.json")
         if name == "wms-adapter":
             check(env.get("FLEET_WMS_TLS") == "required", "wms-adapter: FLEET_WMS_TLS is not required")
+            # Event ids and webhook subscriptions survive a restart: the event log on a claim of its
+            # own, one pod at a time (one writer).
+            log = args[args.index("--events-log") + 1] if "--events-log" in args else ""
+            m = mounts.get(os.path.dirname(log)) if log else None
+            check(m is not None and not m.get("readOnly", False) and "persistentVolumeClaim" in vols[m["name"]],
+                  f"wms-adapter: --events-log {log!r} is not on a writable PersistentVolumeClaim")
+            check(spec.get("replicas") == 1 and spec.get("strategy", {}).get("type") == "Recreate",
+                  "wms-adapter: with its event log on a claim, not one replica with strategy Recreate")
             cfg = args[args.index("--config") + 1] if "--config" in args else ""
             h = json.loads(configmaps["fleet-config"]["data"].get(os.path.basename(cfg), "{}")).get("http", {})
             for key in ("tls_certificate", "tls_key"):

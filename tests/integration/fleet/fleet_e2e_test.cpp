@@ -329,6 +329,66 @@ TEST_F(FleetE2E, PauseOverHttpHoldsTheRobotAndSurvivesAManagerKill) {
   EXPECT_EQ(getTask("job-p").value("state", ""), "done");
 }
 
+// PATCH /v1/tasks/{id} through the real adapter and manager: the change is stored (it outlives a
+// manager kill), comes back as a task event into the adapter's view, decides which task the one
+// robot gets first, and is refused with 409 naming the state once the task is assigned.
+TEST_F(FleetE2E, ChangeOverHttpReordersTheQueueAndIsRefusedOnceAssigned) {
+  for (const auto* body :
+       {R"({"id": "job-a", "kind": "transport", "pickup": "P-1", "dropoff": "D-1", "priority": 5})",
+        R"({"id": "job-b", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})"}) {
+    ASSERT_EQ(http_->Post("/v1/tasks", body, "application/json")->status, 201);
+  }
+  auto r = http_->Patch("/v1/tasks/job-b", R"({"priority": 50, "deadline": "2100-01-01T00:00:00Z"})",
+                        "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const json changed = json::parse(r->body, nullptr, false);
+  EXPECT_EQ(changed.value("priority", 0), 50);
+  EXPECT_EQ(changed.value("changed", false), true);
+  // The change comes back as a task event into the adapter's view.
+  json task;
+  auto end = Clk::now() + 10s;
+  while (Clk::now() < end) {
+    task = getTask("job-b").value("task", json::object());
+    if (task.value("priority", 0) == 50) {
+      break;
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(task.value("priority", 0), 50) << "the change event never reached the view";
+  EXPECT_EQ(task.value("deadline", std::string()), "2100-01-01T00:00:00Z");
+
+  manager_->kill(SIGKILL);
+  manager_->wait(5s);
+  startManager();
+  waitHealthy();
+  r = http_->Patch("/v1/tasks/job-b", R"({"priority": 50})", "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  EXPECT_EQ(json::parse(r->body, nullptr, false).value("changed", true), false)
+      << "the restarted manager lost the change";
+
+  transport::Participant p;
+  FakeRobots robots(p, 1);
+  std::string first;
+  end = Clk::now() + 15s;
+  while (Clk::now() < end && first.empty()) {
+    robots.publishStates();
+    for (const auto& a : robots.orders.take()) {
+      if (!a.task_id.empty() && first.empty()) {
+        first = a.task_id;
+      }
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(first, "job-b") << "priority 50 goes before priority 5";
+  r = http_->Patch("/v1/tasks/job-b", R"({"priority": 1})", "application/json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 409) << r->body;
+  const json refused = json::parse(r->body, nullptr, false);
+  EXPECT_EQ(refused.value("state", std::string()), "assigned");
+}
+
 // The Task topic was keyed by task id with history 1, so of two requests on one task at
 // once (the same POST twice, pause and resume together) the second could replace the first before
 // The manager took it, and the first was never answered (503 after the ack timeout, ~1 in 20).

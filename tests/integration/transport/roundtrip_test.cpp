@@ -120,7 +120,14 @@ TEST_F(RoundTrip, Task) {
   d.request_id = "req-3";
   d.pickup = kNonAscii;
   d.control = msg::TaskControl::Pause;
-  expectRoundTrip<msg::Task>({a, b, c, d});
+  msg::Task e = a;
+  e.task_id = "t-4";
+  e.request_id = "req-4";
+  e.control = msg::TaskControl::Change;
+  e.set_priority = true;
+  e.set_deadline = true;
+  e.deadline_ns = 0;
+  expectRoundTrip<msg::Task>({a, b, c, d, e});
 }
 
 TEST_F(RoundTrip, TaskAck) {
@@ -134,7 +141,8 @@ TEST_F(RoundTrip, TaskEvent) {
   expectRoundTrip<msg::TaskEvent>(
       {{"t-1", msg::TaskState::Unloading, "r-7", kNonAscii, 99, 4, ""},
        {"t-2", msg::TaskState::Rejected, "", std::string(255, 'x'), -1, 0, maxId()},
-       {"t-3", msg::TaskState::Assigned, "r-1", "allocated", 7, 2, "PARK-3"}});
+       {"t-3", msg::TaskState::Assigned, "r-1", "allocated", 7, 2, "PARK-3"},
+       {"t-4", msg::TaskState::Requeued, "", "changed by request", 8, 3, "", true, -1000, 9'000'000'000}});
 }
 
 TEST_F(RoundTrip, TaskAssignment) {

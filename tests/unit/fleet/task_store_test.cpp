@@ -1,6 +1,6 @@
-// Every TaskStore backend passes one suite (TaskStoreTest, parameterised by backend): SQLite in a
-// temporary file, PostgreSQL in a fresh schema on a server the suite starts itself
-// (tests/support/postgres_server.hpp). Backend-specific cases follow the suite.
+// Every TaskStore backend passes one suite (TaskStoreTest, parameterised by backend; the fixture is
+// task_store_fixture.hpp, and the changes of priority and deadline are in task_change_test.cpp).
+// Backend-specific cases follow the suite.
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -8,33 +8,16 @@
 #include <set>
 #include <thread>
 
-#include "fleet/fleet/errors.hpp"
-#include "fleet/fleet/pg_connection.hpp"
-#include "fleet/fleet/postgres_task_store.hpp"
-#include "fleet/fleet/sqlite_task_store.hpp"
-#include "postgres_server.hpp"
-#include "temp_dir.hpp"
+#include "task_store_fixture.hpp"
 
 namespace fleet {
 namespace {
 
+using store_test::Backend;
+using store_test::numbered;
+using store_test::TaskStoreTest;
+using store_test::transport;
 using S = TaskState;
-
-Task transport(std::string id, std::int32_t priority = 0) {
-  Task t;
-  t.id = std::move(id);
-  t.kind = TaskKind::Transport;
-  t.pickup = "P-1";
-  t.dropoff = "D-1";
-  t.priority = priority;
-  return t;
-}
-
-// Not `"t" + std::to_string(i)`: GCC 12 reports a false -Wrestrict on it.
-std::string numbered(std::string prefix, int i) {
-  prefix += std::to_string(i);
-  return prefix;
-}
 
 /// The tables of schema version 1 (before `paused`).
 constexpr const char* kSchemaV1 = R"sql(
@@ -59,101 +42,19 @@ std::unique_ptr<SqliteTaskStore> openStore(const std::string& path) {
   return std::move(s).value();
 }
 
-enum class Backend { Sqlite, Postgres };
-
-/// One store location per test; open() opens it again (a restart of the manager).
-class TaskStoreTest : public ::testing::TestWithParam<Backend> {
- public:
-  /// One server for the suite, started by the first PostgreSQL test.
-  static test::PostgresServer& server() {
-    if (!server_) {
-      server_ = std::make_unique<test::PostgresServer>();
-    }
-    return *server_;
-  }
-  static void TearDownTestSuite() { server_.reset(); }
-
- protected:
-  void SetUp() override {
-    if (GetParam() == Backend::Postgres) {
-      auto& s = server();
-      ASSERT_TRUE(s.ok()) << "the PostgreSQL test server did not start: " << s.error();
-      location_ = s.freshUrl();
-      ASSERT_TRUE(s.ok()) << s.error();
-    } else {
-      location_ = dir_.file("tasks.db");
-    }
-  }
-
-  Expected<std::unique_ptr<TaskStore>> tryOpen() {
-    if (GetParam() == Backend::Postgres) {
-      auto s = PostgresTaskStore::open({location_});
-      if (!s) {
-        return unexpected(s.error());
-      }
-      return std::unique_ptr<TaskStore>(std::move(*s));
-    }
-    auto s = SqliteTaskStore::open({location_});
-    if (!s) {
-      return unexpected(s.error());
-    }
-    return std::unique_ptr<TaskStore>(std::move(*s));
-  }
-  std::unique_ptr<TaskStore> open() {
-    auto s = tryOpen();
-    EXPECT_TRUE(s) << s.error().message;
-    return s ? std::move(s).value() : nullptr;
-  }
-  /// The schema version recorded in the store's database.
-  std::int64_t schemaVersion() {
-    if (GetParam() == Backend::Postgres) {
-      pg::Connection c(location_);
-      auto r = c.exec("read", "SELECT version FROM fleet_schema");
-      return r && r->rows() == 1 ? r->integer(0, 0) : -1;
-    }
-    sqlite3* db = nullptr;
-    sqlite3_open(location_.c_str(), &db);
-    sqlite3_stmt* st = nullptr;
-    sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &st, nullptr);
-    const std::int64_t v = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : -1;
-    sqlite3_finalize(st);
-    sqlite3_close(db);
-    return v;
-  }
-  /// Records `version` as a newer binary would have.
-  void setSchemaVersion(int version) {
-    if (GetParam() == Backend::Postgres) {
-      EXPECT_EQ(server().sql(location_, "UPDATE fleet_schema SET version = " + std::to_string(version)), "");
-      return;
-    }
-    sqlite3* db = nullptr;
-    sqlite3_open(location_.c_str(), &db);
-    EXPECT_EQ(sqlite3_exec(db, ("PRAGMA user_version = " + std::to_string(version)).c_str(), nullptr, nullptr,
-                           nullptr),
-              SQLITE_OK);
-    sqlite3_close(db);
-  }
-
-  test::TempDir dir_;
-  std::string location_;
-
- private:
-  static inline std::unique_ptr<test::PostgresServer> server_;
-};
-
 INSTANTIATE_TEST_SUITE_P(Backends, TaskStoreTest, ::testing::Values(Backend::Sqlite, Backend::Postgres),
                          [](const auto& p) { return p.param == Backend::Sqlite ? "sqlite" : "postgresql"; });
 
 TEST_P(TaskStoreTest, RecordsItsSchemaVersionAndRefusesANewerOne) {
   ASSERT_TRUE(open());
-  EXPECT_EQ(schemaVersion(), 3);
+  EXPECT_EQ(schemaVersion(), 4);
   ASSERT_TRUE(open()) << "opened again as it is";
   setSchemaVersion(9);
   auto s = tryOpen();
   ASSERT_FALSE(s) << "a schema newer than the binary";
   EXPECT_EQ(s.error().code, errc::kSchemaNewer);
   EXPECT_NE(s.error().message.find("schema version 9"), std::string::npos) << s.error().message;
-  EXPECT_NE(s.error().message.find("version 3"), std::string::npos) << s.error().message;
+  EXPECT_NE(s.error().message.find("version 4"), std::string::npos) << s.error().message;
   EXPECT_EQ(schemaVersion(), 9) << "left as it was";
 }
 
@@ -258,6 +159,30 @@ PRAGMA user_version = 2;
     ASSERT_TRUE(store->transition({"old", S::Assigned, "r1", "", 6, "K-1"}));
   }
   EXPECT_EQ(openStore(path)->get("old")->task.station, "K-1") << "migrated once, then used as version 3";
+}
+
+TEST(SqliteTaskStore, OpensAVersionThreeDatabaseAddingThePriorityAndDeadlineColumns) {
+  test::TempDir dir;
+  const std::string path = dir.file("v3.db");
+  // Version 3 as the migrations left it: version 1 plus `paused` and `station`.
+  writeDatabase(path, std::string(kSchemaV1) + R"sql(
+ALTER TABLE tasks ADD COLUMN paused INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE tasks ADD COLUMN station TEXT NOT NULL DEFAULT '';
+INSERT INTO tasks VALUES('old', 'goto', '{"id":"old","kind":"goto","priority":3,"station":"D-1"}', 'queued', '',
+  0, '', 5, 5, 1, 0, '');
+PRAGMA user_version = 3;
+)sql");
+  {
+    auto store = openStore(path);
+    const auto old = store->get("old");
+    ASSERT_TRUE(old) << old.error().message;
+    EXPECT_EQ(old->task.priority, 3) << "as submitted";
+    EXPECT_FALSE(old->submitted);
+    ASSERT_TRUE(store->change({"old", 9, std::nullopt, 6}));
+  }
+  const auto got = openStore(path)->get("old");
+  EXPECT_EQ(got->task.priority, 9) << "migrated once, then used as version 4";
+  EXPECT_EQ(got->submitted->priority, 3);
 }
 
 TEST_P(TaskStoreTest, SubmitIsIdempotentAndDetectsConflicts) {

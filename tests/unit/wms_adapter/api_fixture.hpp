@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -55,6 +56,12 @@ class FakeGateway : public TaskGateway {
         continue;
       }
       msg::TaskAck a{r.request_id, r.task_id, msg::AckResult::Stored, msg::TaskState::Queued, "", 0};
+      if (r.control != msg::TaskControl::None && onControl) {
+        controls.push_back(r.control);
+        controlRequests.push_back(r);
+        out.emplace_back(onControl(r));
+        continue;
+      }
       if (r.cancel || r.control != msg::TaskControl::None) {
         auto it = bodies.find(r.task_id);
         a.result = it == bodies.end() ? msg::AckResult::NotFound : msg::AckResult::Stored;
@@ -83,6 +90,9 @@ class FakeGateway : public TaskGateway {
   std::string closureProblem;  // sendClosure fails with this when not empty
   std::map<std::string, std::string> bodies;
   std::vector<msg::TaskControl> controls;
+  /// When set, answers every control request (pause, change, ...); they are kept in controlRequests.
+  std::function<msg::TaskAck(const msg::Task&)> onControl;
+  std::vector<msg::Task> controlRequests;
   bool online = true;
   bool silent = false;
   std::chrono::milliseconds delay{0};  // a slow manager

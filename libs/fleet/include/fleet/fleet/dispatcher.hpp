@@ -69,6 +69,10 @@ struct TaskEvent {
   /// When the task is expected to be done (TaskEta), as estimated at this transition; 0: no
   /// estimate (no robot could take it, or it ended without being done).
   std::int64_t etaNs = 0;
+  /// The event of a change (Dispatcher::change): priority and deadlineNs are the values in force.
+  bool changed = false;
+  std::int32_t priority = 0;
+  std::int64_t deadlineNs = 0;
 };
 
 /// A task a robot must now execute (publish as `TaskAssignment`, key robot_id).
@@ -154,6 +158,14 @@ class Dispatcher {
   /// stands where it is). not_found for a robot never seen.
   Expected<DispatchResult> setRobotHeld(const std::string& robotId, bool held, std::int64_t nowNs);
   [[nodiscard]] bool robotHeld(std::string_view robotId) const { return held_.count(robotId) > 0; }
+  /// Operator change of a waiting task's priority and/or deadline, stored (TaskStore::change) and
+  /// in force from the next allocation: every tick orders the queue (admission at busy stations,
+  /// the candidates of a long backlog) and costs its tasks by the values held here
+  /// (dispatcher_change.cpp). One event with `changed` set when a value differs; nothing when the
+  /// values were already in force. Errors: not_found; illegal_transition for a task that is active
+  /// or finished (the message names its state); invalid, with the field errors in `fields` when
+  /// given (a value out of range, a deadline before the task's created_ns).
+  Expected<DispatchResult> change(const ChangeRequest& q, std::vector<FieldError>* fields = nullptr);
 
   /// Periodic work: expire leases (requeue the lost robots' tasks), complete the charge tasks whose
   /// robot is charged (releasing it), send low robots to charge, and assign waiting tasks to idle

@@ -42,6 +42,7 @@ class PostgresTaskStore final : public TaskStore {
   Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) override;
   Expected<TaskRecord> setWaitReason(std::string_view id, std::string_view reason,
                                      std::int64_t stampNs) override;
+  Expected<ChangeResult> change(const ChangeRequest& r) override;
   Expected<TaskRecord> get(std::string_view id) override;
   Expected<std::vector<TaskRecord>> list(std::optional<TaskState> state, std::size_t limit,
                                          std::string_view afterId = {}) override;

@@ -13,6 +13,13 @@
 
 namespace fleet {
 
+/// How urgent a task is: what a change (TaskStore::change) may set on a waiting task.
+struct Urgency {
+  std::int32_t priority = 0;
+  std::int64_t deadlineNs = 0;  ///< 0 = none
+  bool operator==(const Urgency&) const = default;
+};
+
 /// A task with where it stands.
 struct TaskRecord {
   Task task;
@@ -21,7 +28,7 @@ struct TaskRecord {
   std::int32_t attempts = 0;  ///< times the task was assigned
   std::string reason;         ///< reason given with the latest transition
   std::int64_t updatedNs = 0;
-  std::int64_t revision = 0;  ///< transitions applied; 1 right after submit
+  std::int64_t revision = 0;  ///< transitions and changes applied; 1 right after submit
   /// Held by an operator: a waiting task is not dispatched, an active one's robot stands still
   /// with it. Not a state: the task keeps its state and transitions while paused.
   bool paused = false;
@@ -29,6 +36,9 @@ struct TaskRecord {
   /// submitted without one). Kept while the task is active and after it ended; cleared when the
   /// task goes back to the queue, as its next robot gets its own choice.
   bool stationChosen = false;
+  /// The priority and deadline as submitted, once a change (TaskStore::change) has set others:
+  /// `task` holds the values in force. Kept to tell a retry of the submission from a conflict.
+  std::optional<Urgency> submitted;
 };
 
 /// One row of the append-only transition log. `from` is empty for the submission itself.
@@ -69,6 +79,23 @@ struct TransitionRequest {
   std::string station;
 };
 
+/// A change of a waiting task's priority and/or deadline (PATCH /v1/tasks/{id}).
+struct ChangeRequest {
+  std::string taskId;
+  std::optional<std::int32_t> priority;    ///< in [kMinPriority, kMaxPriority]; unset: kept
+  std::optional<std::int64_t> deadlineNs;  ///< >= 0, 0 = none, not before created_ns; unset: kept
+  std::int64_t stampNs = 0;
+};
+
+/// The problems of a change of task `t` (task_change.cpp): nothing to set, a priority out of
+/// range, a negative deadline or one before t's created_ns. Paths "priority" and "deadline_ns".
+std::vector<FieldError> validateChange(const ChangeRequest& q, const Task& t);
+
+struct ChangeResult {
+  TaskRecord record;
+  bool changed = false;  ///< false: the values were already in force (a repeated request)
+};
+
 /// Durable tasks: a current-state table and an append-only transition log. Every call that
 /// changes state has committed when it returns. Error codes (fleet/fleet/errors.hpp): conflict
 /// (same id, different body), not_found, illegal_transition, wrong_robot, invalid, storage.
@@ -102,6 +129,14 @@ class TaskStore {
   /// Errors: not_found; illegal_transition for a task that is not queued or requeued.
   virtual Expected<TaskRecord> setWaitReason(std::string_view id, std::string_view reason,
                                              std::int64_t stampNs) = 0;
+  /// Sets a waiting (queued or requeued) task's priority and/or deadline durably; not a transition
+  /// (the log is unchanged) but the revision grows, as the task's events count it. The body as
+  /// submitted is kept: a re-submission is the same request when it equals that body or the body
+  /// with the values in force (store_rules::checkResubmission). Values already in force change
+  /// nothing (changed = false). Errors: not_found; illegal_transition for a task that is not
+  /// waiting (the message names its state); invalid for a value out of range, a deadline before
+  /// the task's created_ns, or a request that sets neither.
+  virtual Expected<ChangeResult> change(const ChangeRequest& r) = 0;
 
   virtual Expected<TaskRecord> get(std::string_view id) = 0;
   /// Tasks in `state` (all when empty) ordered by id, at most `limit`, with ids after `afterId`.

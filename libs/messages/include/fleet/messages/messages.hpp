@@ -14,7 +14,7 @@
 namespace fleet::msg {
 
 enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
-enum class TaskControl : std::uint8_t { None, Pause, Resume, Query, HoldRobot, ReleaseRobot };
+enum class TaskControl : std::uint8_t { None, Pause, Resume, Query, HoldRobot, ReleaseRobot, Change };
 enum class TaskState : std::uint8_t {
   Queued,
   Assigned,
@@ -49,6 +49,8 @@ struct Task {
   std::int64_t created_ns = 0;
   bool cancel = false;
   TaskControl control = TaskControl::None;
+  bool set_priority = false;  ///< Change: `priority` is the task's new priority
+  bool set_deadline = false;  ///< Change: `deadline_ns` is the task's new deadline (0 = none)
   bool operator==(const Task&) const = default;
 };
 
@@ -72,6 +74,11 @@ struct TaskEvent {
   std::int64_t stamp_ns = 0;
   std::uint32_t seq = 0;
   std::string station;  ///< chosen by the manager for a charge/park task sent without one
+  /// The event of a change (TaskControl::Change): priority and deadline_ns are the values now in
+  /// force. On any other event they are 0 and mean nothing.
+  bool changed = false;
+  std::int32_t priority = 0;
+  std::int64_t deadline_ns = 0;
   bool operator==(const TaskEvent&) const = default;
 };
 
