@@ -1,0 +1,264 @@
+// The task database fails over under a running fleet: two fleet managers on a primary PostgreSQL
+// and its streaming replica (pg_basebackup -R; synchronous_standby_names '*', so a commit returns,
+// and a task is acknowledged, only once the replica has it), given both in one libpq URL with
+// target_session_attrs=read-write. Tasks are submitted all along; the primary is killed with -9
+// (every process of it), the replica promoted with pg_ctl promote. The managers find the new
+// primary by themselves (one is active again, with the next epoch) and no acknowledged task is
+// lost or duplicated (the load test's ledger, on the promoted replica's rows).
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fleet_stack.hpp"
+#include "postgres_server.hpp"
+#include "task_ledger.hpp"
+#include "test_process.hpp"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const std::string kBin = FLEET_BINARY_DIR;
+const std::string kScenario = FLEET_SOURCE_DIR "/sim/scenarios/one_robot.json";
+
+std::optional<int> status(int port, const std::string& path, std::string* body = nullptr) {
+  httplib::Client c("127.0.0.1", port);
+  c.set_connection_timeout(1s);
+  c.set_read_timeout(2s);
+  auto r = c.Get(path);
+  if (!r) {
+    return std::nullopt;
+  }
+  if (body != nullptr) {
+    *body = r->body;
+  }
+  return r->status;
+}
+
+bool has(int port, const std::string& line) {
+  std::string body;
+  return status(port, "/metrics", &body) == 200 && body.find(line + "\n") != std::string::npos;
+}
+
+template <typename Cond>
+bool waitUntil(Cond&& cond, std::chrono::seconds within) {
+  const auto end = std::chrono::steady_clock::now() + within;
+  while (!cond() && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(50ms);
+  }
+  return cond();
+}
+
+/// Submits tasks f-0001, f-0002, ... one after the other, each until the manager acknowledges it
+/// (stored, or duplicate: an earlier attempt stored it), and keeps the acknowledged ids.
+class Intake {
+ public:
+  Intake() = default;
+  /// Submits the next task until acknowledged or `wait` passed; true when acknowledged.
+  bool submitNext(std::chrono::seconds wait) {
+    char id[16];
+    std::snprintf(id, sizeof id, "f-%04d", next_ + 1);
+    const auto task = fleet::test::transportTask(id, "P-1", "D-1");
+    const auto end = std::chrono::steady_clock::now() + wait;
+    while (std::chrono::steady_clock::now() < end) {
+      auto ack = client_.submit(task, 5s);
+      if (ack &&
+          (ack->result == fleet::msg::AckResult::Stored || ack->result == fleet::msg::AckResult::Duplicate)) {
+        std::lock_guard<std::mutex> lock(mu_);
+        ledger_.acknowledged(id);
+        ++next_;
+        return true;
+      }
+      if (ack) {
+        ++unavailable_;  // the database away: the same request again
+      }
+      std::this_thread::sleep_for(100ms);
+    }
+    return false;
+  }
+  std::size_t acknowledged() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return ledger_.count();
+  }
+  fleet::ctl::TaskLedger ledger() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return ledger_;
+  }
+  [[nodiscard]] int unavailable() const { return unavailable_; }
+
+ private:
+  fleet::test::TaskClient client_;
+  std::mutex mu_;
+  fleet::ctl::TaskLedger ledger_;
+  int next_ = 0;
+  std::atomic<int> unavailable_{0};
+};
+
+/// The task rows and transitions of the database at `url`, as the load test reads its database.
+std::pair<std::vector<fleet::ctl::TaskRow>, std::vector<fleet::ctl::TransitionRow>> readStore(
+    const std::string& url, std::string* error) {
+  std::pair<std::vector<fleet::ctl::TaskRow>, std::vector<fleet::ctl::TransitionRow>> out;
+  fleet::pg::Connection c(url);
+  auto tasks = c.exec("read tasks", "SELECT id, state FROM tasks");
+  auto transitions =
+      c.exec("read transitions", "SELECT task_id, to_state, stamp_ns FROM transitions ORDER BY seq");
+  if (!tasks || !transitions) {
+    *error = !tasks ? tasks.error().message : transitions.error().message;
+    return out;
+  }
+  for (int i = 0; i < tasks->rows(); ++i) {
+    out.first.push_back({tasks->text(i, 0), tasks->text(i, 1)});
+  }
+  for (int i = 0; i < transitions->rows(); ++i) {
+    out.second.push_back({transitions->text(i, 0), transitions->text(i, 1), transitions->integer(i, 2)});
+  }
+  return out;
+}
+
+/// The replica streams synchronously: the primary lists it as its synchronous standby.
+bool replicaIsSynchronous(const fleet::test::PostgresServer& primary) {
+  fleet::pg::Connection c(primary.url());
+  auto r = c.exec("replication", "SELECT count(*) FROM pg_stat_replication WHERE sync_state = 'sync'");
+  return r && r->rows() == 1 && r->integer(0, 0) == 1;
+}
+
+/// The fail-over with the replica promoted `promoteAfter` the kill of the primary; with
+/// `newEpoch`, a manager must be active with a later lease epoch afterwards.
+void failOver(std::chrono::seconds promoteAfter, bool newEpoch) {
+  fleet::test::PostgresServer::Options primaryOptions;
+  primaryOptions.synchronousStandbys = "*";
+  fleet::test::PostgresServer primary(primaryOptions);
+  ASSERT_TRUE(primary.ok()) << "the primary did not start: " << primary.error();
+  fleet::test::PostgresServer::Options replicaOptions;
+  replicaOptions.replicaOf = &primary;
+  fleet::test::PostgresServer replica(replicaOptions);
+  ASSERT_TRUE(replica.ok()) << "the replica did not start: " << replica.error();
+  ASSERT_TRUE(waitUntil([&] { return replicaIsSynchronous(primary); }, 30s))
+      << "the replica is not the primary's synchronous standby; its log:\n"
+      << replica.log();
+
+  const auto run = fleet::test::freshRun("fleet-db-failover-");
+  const std::string url = fleet::pgserver::PostgresServer::failoverUrl({&primary, &replica});
+  std::ofstream(run.dir / "manager.json") << nlohmann::json{{"store", url}, {"stations", kScenario}}.dump();
+  const std::vector<std::pair<std::string, std::string>> env = {{"FLEET_DDS_DOMAIN", run.domain}};
+  const int ops[2] = {fleet::test::freePort(), fleet::test::freePort()};
+  std::unique_ptr<fleet::test::ChildProcess> managers[2];
+  for (int i = 0; i < 2; ++i) {
+    managers[i] = std::make_unique<fleet::test::ChildProcess>(
+        kBin + "/services/fleet_manager/fleet_manager",
+        std::vector<std::string>{"--config", (run.dir / "manager.json").string(), "--metrics-port",
+                                 std::to_string(ops[i]), "--log-level", "warn"},
+        env);
+  }
+  auto activeOne = [&]() -> int {
+    for (int i = 0; i < 2; ++i) {
+      if (status(ops[i], "/readyz") == 200) {
+        return i;
+      }
+    }
+    return -1;
+  };
+  ASSERT_TRUE(waitUntil([&] { return activeOne() >= 0; }, 30s)) << "no manager became active";
+
+  Intake intake;
+  for (int i = 0; i < 10; ++i) {
+    ASSERT_TRUE(intake.submitNext(30s)) << "task " << i + 1 << " before the fail-over";
+  }
+  // Intake goes on through the fail-over.
+  std::atomic<bool> stop{false};
+  std::atomic<bool> stuck{false};
+  std::thread feeder([&] {
+    while (!stop) {
+      if (!intake.submitNext(60s)) {
+        stuck = true;
+        return;
+      }
+    }
+  });
+  std::this_thread::sleep_for(1s);
+  const std::size_t beforeKill = intake.acknowledged();
+  primary.crash();
+  const auto killed = std::chrono::steady_clock::now();
+  std::this_thread::sleep_for(promoteAfter);
+  ASSERT_EQ(replica.promote(), "") << replica.log();
+  const double promotedAfter =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+
+  // A manager active on the promoted replica (with newEpoch: a later epoch than before, having
+  // rebuilt its state from the store as a restarted manager does).
+  int active = -1;
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        active = activeOne();
+        return active >= 0 && (!newEpoch || (!has(ops[active], "fleet_manager_lease_epoch 1") &&
+                                             !has(ops[active], "fleet_manager_lease_epoch 0")));
+      },
+      30s))
+      << "no manager active on the promoted replica";
+  const double activeAfter = std::chrono::duration<double>(std::chrono::steady_clock::now() - killed).count();
+  const std::size_t atTakeover = intake.acknowledged();
+  // Intake resumes: more tasks acknowledged after the fail-over.
+  EXPECT_TRUE(waitUntil([&] { return intake.acknowledged() >= atTakeover + 5; }, 30s))
+      << "intake did not resume after the fail-over";
+  stop = true;
+  feeder.join();
+  EXPECT_FALSE(stuck) << "a task was not acknowledged within 60 s";
+  std::cout << "primary killed after " << beforeKill << " acknowledged tasks; replica promoted after "
+            << promotedAfter << " s; a manager active again after " << activeAfter << " s; "
+            << intake.acknowledged() << " acknowledged in all, " << intake.unavailable()
+            << " answers 'unavailable' while the database was away\n";
+
+  std::string error;
+  const auto [tasks, transitions] = readStore(replica.url(), &error);
+  ASSERT_EQ(error, "");
+  const auto acc = intake.ledger().reconcile(tasks, transitions);
+  EXPECT_EQ(acc.acknowledged, intake.acknowledged());
+  EXPECT_TRUE(acc.lost.empty()) << acc.lost.size() << " acknowledged tasks lost, the first "
+                                << acc.lost.front();
+  EXPECT_TRUE(acc.duplicated.empty()) << acc.duplicated.size() << " duplicated";
+  EXPECT_EQ(tasks.size(), intake.acknowledged() + acc.unacknowledgedKnown);
+  // The active manager holds each task once (no robots: all queued).
+  if (active >= 0) {
+    EXPECT_TRUE(waitUntil(
+        [&] {
+          return has(ops[active], "fleet_manager_tasks{state=\"queued\"} " + std::to_string(tasks.size()));
+        },
+        10s))
+        << "the active manager's queue is not the store's " << tasks.size() << " tasks";
+    EXPECT_TRUE(has(ops[1 - active], "fleet_manager_active 0")) << "exactly one active";
+  }
+  for (auto& m : managers) {
+    m->kill(SIGTERM);
+    EXPECT_EQ(m->wait(10s), 0);
+  }
+  fs::remove_all(run.dir);
+}
+
+// A cluster manager (Patroni) takes longer than the managers' lease (3 s) to decide: the active
+// manager's lease lapses while there is no primary, and a manager takes it again on the new one.
+TEST(DatabaseFailover, ManagersFollowAPromotedReplicaAndNoAcknowledgedTaskIsLostOrDuplicated) {
+  failOver(std::chrono::seconds(4), true);
+}
+
+// A promotion within the lease: the active manager may keep its lease (renewed on the new primary
+// before it lapsed) or lose it to either manager; either way intake goes on, nothing lost.
+TEST(DatabaseFailover, APromotionWithinTheLeaseLosesNothingEither) {
+  failOver(std::chrono::seconds(1), false);
+}
+
+}  // namespace
