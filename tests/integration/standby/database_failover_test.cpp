@@ -25,7 +25,7 @@
 
 #include "fleet_stack.hpp"
 #include "postgres_server.hpp"
-#include "task_ledger.hpp"
+#include "store_contents.hpp"
 #include "test_process.hpp"
 
 namespace fs = std::filesystem;
@@ -108,27 +108,6 @@ class Intake {
   int next_ = 0;
   std::atomic<int> unavailable_{0};
 };
-
-/// The task rows and transitions of the database at `url`, as the load test reads its database.
-std::pair<std::vector<fleet::ctl::TaskRow>, std::vector<fleet::ctl::TransitionRow>> readStore(
-    const std::string& url, std::string* error) {
-  std::pair<std::vector<fleet::ctl::TaskRow>, std::vector<fleet::ctl::TransitionRow>> out;
-  fleet::pg::Connection c(url);
-  auto tasks = c.exec("read tasks", "SELECT id, state FROM tasks");
-  auto transitions =
-      c.exec("read transitions", "SELECT task_id, to_state, stamp_ns FROM transitions ORDER BY seq");
-  if (!tasks || !transitions) {
-    *error = !tasks ? tasks.error().message : transitions.error().message;
-    return out;
-  }
-  for (int i = 0; i < tasks->rows(); ++i) {
-    out.first.push_back({tasks->text(i, 0), tasks->text(i, 1)});
-  }
-  for (int i = 0; i < transitions->rows(); ++i) {
-    out.second.push_back({transitions->text(i, 0), transitions->text(i, 1), transitions->integer(i, 2)});
-  }
-  return out;
-}
 
 /// The replica streams synchronously: the primary lists it as its synchronous standby.
 bool replicaIsSynchronous(const fleet::test::PostgresServer& primary) {
@@ -223,8 +202,7 @@ void failOver(std::chrono::seconds promoteAfter, bool newEpoch) {
             << intake.acknowledged() << " acknowledged in all, " << intake.unavailable()
             << " answers 'unavailable' while the database was away\n";
 
-  std::string error;
-  const auto [tasks, transitions] = readStore(replica.url(), &error);
+  const auto [tasks, transitions, error] = fleet::ctl::readPostgresStore(replica.url());
   ASSERT_EQ(error, "");
   const auto acc = intake.ledger().reconcile(tasks, transitions);
   EXPECT_EQ(acc.acknowledged, intake.acknowledged());
