@@ -236,24 +236,34 @@ void failOver(std::chrono::seconds promoteAfter, bool newEpoch) {
             << intake.acknowledged() << " acknowledged in all, " << intake.unavailable()
             << " answers 'unavailable' while the database was away\n";
 
-  // The robots finish what is left: nothing queued or active on the active manager.
+  // The robots finish what is left: every acknowledged task done in the store (the promoted
+  // replica), then nothing queued or active on the active manager.
+  const auto ledger = intake.ledger();
+  fleet::ctl::StoreContents store;
+  fleet::ctl::Accounting acc;
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        store = fleet::ctl::readPostgresStore(replica.url());
+        acc = ledger.reconcile(store.tasks, store.transitions);
+        return store.error.empty() && acc.done >= acc.acknowledged;
+      },
+      60s))
+      << "acknowledged tasks left undone after the fail-over: " << acc.acknowledged - acc.done;
   EXPECT_TRUE(waitUntil(
       [&] {
         active = activeOne();
         return active >= 0 && has(ops[active], "fleet_manager_tasks{state=\"queued\"} 0") &&
                has(ops[active], "fleet_manager_tasks{state=\"active\"} 0");
       },
-      60s))
-      << "tasks left undone after the fail-over";
+      10s));
   if (active >= 0) {
     EXPECT_TRUE(has(ops[1 - active], "fleet_manager_active 0")) << "exactly one active";
   }
   robotsStop = true;
   robotsLoop.join();
 
-  const auto [tasks, transitions, error] = fleet::ctl::readPostgresStore(replica.url());
-  ASSERT_EQ(error, "");
-  const auto acc = intake.ledger().reconcile(tasks, transitions);
+  ASSERT_EQ(store.error, "");
+  const auto& [tasks, transitions, error] = store;
   EXPECT_EQ(acc.acknowledged, intake.acknowledged());
   EXPECT_TRUE(acc.lost.empty()) << acc.lost.size() << " acknowledged tasks lost, the first "
                                 << acc.lost.front();
