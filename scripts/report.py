@@ -454,6 +454,13 @@ def loadtest_html(lt, saturated=""):
                      for e in lt.get("faults", []))
     faults = (f"<table><tr><th>simulated s</th><th>event</th></tr>{faults}</table>" if faults
               else "<p>none</p>")
+    # --store postgresql: two managers on a database of the run's own; each kill of the active one timed.
+    store = lt.get("store", {})
+    takeover = store.get("takeover_s", {})
+    store_html = (f"<p>Task store PostgreSQL, {store.get('managers', 2)} managers: {takeover.get('count', 0)} "
+                  f"takeover(s) after a kill of the active one, p50 {takeover.get('p50', 0):.2f} s, "
+                  f"max {takeover.get('max', 0):.2f} s; {store.get('takeovers_failed', 0)} not within 30 s.</p>"
+                  if store.get("backend") == "postgresql" else "")
     progress = [(p["wall_s"], p["sim_s"]) for p in lt.get("progress", [])]
     # The robot agent processes: the control rate they achieved and how their robots dealt with
     # each other (agent-K_metrics.json, collected by fleetctl loadtest).
@@ -481,7 +488,7 @@ Arrival rate {lt.get('rate_per_min', 0):g} tasks per simulated minute. Fault pla
 <div class="grid"><div><h3>Acknowledged tasks (fleetctl's ledger)</h3><table>{rows(acc)}</table>
 <h3>Throughput</h3><table>{rows(lt.get('throughput', {}))}</table></div>
 <div><h3>Latency of acknowledged tasks (s, simulated)</h3>{lat}
-<h3>Faults injected</h3>{faults}</div>
+<h3>Faults injected</h3>{faults}{store_html}</div>
 <div><h3>Simulated vs wall time</h3>{svg_line(progress, xlabel='wall time (s)', ylabel='simulated time (s)', why='no progress samples', diagonal='1× real time')}</div></div>
 {bound}
 {saturated}
@@ -557,7 +564,7 @@ def main(run):
     if lt:
         summary["loadtest"] = {k: lt.get(k) for k in ("accounting", "throughput", "real_time_factor", "wall_time_s",
                                                      "agent_processes", "fault_plan", "faults", "tasks",
-                                                     "wall_limited", "interrupted")}
+                                                     "wall_limited", "interrupted", "store")}
         summary["loadtest"]["kinematic_bound"] = {k: v for k, v in (lt.get("kinematic_bound") or {}).items()
                                                   if k != "per_task"}
         if lt.get("saturated"):

@@ -122,6 +122,13 @@ void addLoadtestCommand(CLI::App& app, Commands& commands) {
   loadtest->add_flag("--wall-clock", o->wallClock,
                      "run every service on the wall clock at 1x, as in production (default: lockstep); "
                      "reports the robot agents' achieved control rate");
+  loadtest
+      ->add_option("--store", o->store,
+                   "the fleet manager's task store: sqlite (one manager) or postgresql (a PostgreSQL server "
+                   "of the run's own in the run folder, on a Unix socket, and two managers on it: "
+                   "kill-manager kills the active one and the standby takes over)")
+      ->check(CLI::IsMember({"sqlite", "postgresql"}))
+      ->capture_default_str();
   loadtest->add_flag("--serve", o->serve,
                      "after the run, keep the dashboard up on its final state and serve the report (with "
                      "its replay) on 127.0.0.1 until Ctrl-C");

@@ -3,7 +3,8 @@
 // Faults a load test injects, parsed from `--fault` options. Times are simulated seconds since the
 // start of the run; down times are wall seconds (a process is down for real time, not sim time).
 //   kill-agent@T[+D][:K]   SIGKILL agent process K (default 0) at T, restart it D s later (default 2)
-//   kill-manager@T[+D]     SIGKILL the fleet manager at T, restart it D s later (default 1)
+//   kill-manager@T[+D]     SIGKILL the fleet manager at T, restart it D s later (default 1); with
+//                          --store postgresql the active one of the two (standby_managers.hpp)
 //   kill-traffic@T[+D]     SIGKILL the traffic manager at T, restart it D s later (default 1): robots
 //                          stop at the end of what was released to them; the new one rebuilds its
 //                          state from their progress reports

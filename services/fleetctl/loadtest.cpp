@@ -5,7 +5,6 @@
 #include <httplib.h>
 #include <netinet/in.h>
 #include <signal.h>
-#include <sqlite3.h>
 #include <sys/file.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -36,6 +35,8 @@
 #include "saturation.hpp"
 #include "scenario_gen.hpp"
 #include "scenario_tasks.hpp"
+#include "standby_managers.hpp"
+#include "store_contents.hpp"
 #include "supervisor.hpp"
 #include "task_ledger.hpp"
 #include "vda5050_setup.hpp"
@@ -116,46 +117,6 @@ std::string cycloneConfig(double drop) {
   return transport::loopbackConfig(false, static_cast<int>(std::lround(drop * 1000.0))) + "\n";
 }
 
-struct DbContents {
-  std::vector<TaskRow> tasks;
-  std::vector<TransitionRow> transitions;
-  std::string error;
-};
-
-DbContents readDb(const fs::path& path) {
-  DbContents out;
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    out.error = "cannot open " + path.string() + ": " + (db ? sqlite3_errmsg(db) : "out of memory");
-    sqlite3_close(db);
-    return out;
-  }
-  auto text = [](sqlite3_stmt* s, int c) {
-    const auto* p = sqlite3_column_text(s, c);
-    return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
-  };
-  sqlite3_stmt* s = nullptr;
-  if (sqlite3_prepare_v2(db, "SELECT id, state FROM tasks", -1, &s, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      out.tasks.push_back({text(s, 0), text(s, 1)});
-    }
-  } else {
-    out.error = sqlite3_errmsg(db);
-  }
-  sqlite3_finalize(s);
-  if (sqlite3_prepare_v2(db, "SELECT task_id, to_state, stamp_ns FROM transitions ORDER BY seq", -1, &s,
-                         nullptr) == SQLITE_OK) {
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      out.transitions.push_back({text(s, 0), text(s, 1), sqlite3_column_int64(s, 2)});
-    }
-  } else {
-    out.error = sqlite3_errmsg(db);
-  }
-  sqlite3_finalize(s);
-  sqlite3_close(db);
-  return out;
-}
-
 struct Run {
   LoadtestOptions o;  // a copy
   Supervisor sup;
@@ -167,6 +128,7 @@ struct Run {
   std::vector<Fault> faults;
   std::vector<bool> faultStarted, faultEnded;
   std::vector<Clock::time_point> faultEndAt;
+  std::vector<std::string> faultTarget;  // the process a kill fault killed (restarted D s later)
   json faultLog = json::array();
   TaskLedger ledger;
   std::vector<json> pending;            // generated or due from the list, not acknowledged yet
@@ -186,6 +148,7 @@ struct Run {
   std::mutex mu;                              // pending, ledger, counters
   std::atomic<bool> stopPosting{false};
   ProcessSpec managerSpec;
+  std::unique_ptr<StandbyManagers> standby;  // --store postgresql: the database and two managers
 
   explicit Run(const LoadtestOptions& opt) : o(opt), rng(opt.seed) {}
 
@@ -380,14 +343,20 @@ struct Run {
         }
         continue;
       }
-      const std::string who = killedService(f).empty() ? agentFor(f) : killedService(f);
+      std::string& who = faultTarget[i];
       if (!faultStarted[i] && simS >= f.atS) {
         faultStarted[i] = true;
         faultEndAt[i] =
             now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(f.downS));
+        who = killedService(f).empty() ? agentFor(f) : killedService(f);
         if (f.kind == Fault::Kind::StallRobot) {
           sup.signal(who, SIGSTOP);
           logFault("SIGSTOP " + who + " (robot " + f.robot + ")");
+        } else if (f.kind == Fault::Kind::KillManager && standby) {
+          // Two managers: the active one is killed, the standby takes over (timed).
+          who = standby->killActive(sup);
+          logFault(who.empty() ? std::string("no active fleet manager to kill")
+                               : "SIGKILL " + who + " (active)");
         } else {
           sup.killHard(who);
           logFault("SIGKILL " + who);
@@ -397,7 +366,7 @@ struct Run {
         if (f.kind == Fault::Kind::StallRobot) {
           sup.signal(who, SIGCONT);
           logFault("SIGCONT " + who);
-        } else {
+        } else if (!who.empty()) {
           sup.restart(who);
           logFault("restarted " + who);
         }
@@ -459,6 +428,7 @@ int Run::run() {
   faultStarted.assign(faults.size(), false);
   faultEnded.assign(faults.size(), false);
   faultEndAt.assign(faults.size(), Clock::now());
+  faultTarget.assign(faults.size(), "");
 
   // The scenario: a file as is, or one generated for the fleet size.
   fs::path scenarioPath = out / "scenario.json";
@@ -564,10 +534,13 @@ int Run::run() {
     if (process.rfind("agent-", 0) == 0) {
       return process;  // made for this run with its robots (below)
     }
-    static const std::map<std::string, std::string> kIdentity = {
-        {"fleet_manager", "fleet-manager"},     {"vda5050_bridge", "vda5050-bridge"},
-        {"wms_adapter", "wms-adapter"},         {"risk_map", "risk-map"},
-        {"traffic_manager", "traffic-manager"}, {"fleet-sim", "simulator"}};
+    static const std::map<std::string, std::string> kIdentity = {{"fleet_manager", "fleet-manager"},
+                                                                 {"fleet_manager_2", "fleet-manager"},
+                                                                 {"vda5050_bridge", "vda5050-bridge"},
+                                                                 {"wms_adapter", "wms-adapter"},
+                                                                 {"risk_map", "risk-map"},
+                                                                 {"traffic_manager", "traffic-manager"},
+                                                                 {"fleet-sim", "simulator"}};
     const auto it = kIdentity.find(process);
     return it == kIdentity.end() ? process : it->second;
   };
@@ -661,6 +634,14 @@ int Run::run() {
                  {"--config", fs::absolute(out / "manager.json").string(), "--log-level", "warn"},
                  env,
                  log("fleet_manager")};
+  if (o.store == "postgresql") {
+    standby = std::make_unique<StandbyManagers>(out, o.binDir);
+    if (!standby->ok()) {
+      say("cannot start PostgreSQL for --store postgresql: " + standby->error());
+      return 1;
+    }
+    say("store: PostgreSQL of the run's own at " + standby->url() + ", two fleet managers on it");
+  }
   std::vector<ProcessSpec> specs = {
       managerSpec,
       {"wms_adapter",
@@ -674,6 +655,11 @@ int Run::run() {
        {"--config", fs::absolute(out / "risk_map.json").string(), "--id", "risk_map", "--log-level", "info"},
        env,
        log("risk_map")}};
+  if (standby) {
+    auto two = standby->specs(managerSpec, freePort(), freePort());
+    specs.front() = two[0];
+    specs.insert(specs.begin() + 1, two[1]);
+  }
   const bool hasSite = scenario.contains("site") && scenario["site"].is_string();
   if (!hasSite) {
     // Every robot drives what the traffic manager releases, on the roadmap it builds from the site.
@@ -991,12 +977,12 @@ int Run::run() {
   // Faults still in progress end now, so the manager's final state is on disk and nothing is stopped.
   for (std::size_t i = 0; i < faults.size(); ++i) {
     if (faultStarted[i] && !faultEnded[i]) {
-      const std::string who =
-          killedService(faults[i]).empty() ? agentFor(faults[i]) : killedService(faults[i]);
+      const std::string& who = faultTarget[i];
       if (faults[i].kind == Fault::Kind::StallRobot) {
         sup.signal(who, SIGCONT);
         logFault("SIGCONT " + who + " (end of run)");
-      } else if (faults[i].kind == Fault::Kind::KillManager || faults[i].kind == Fault::Kind::KillTraffic) {
+      } else if (!who.empty() &&
+                 (faults[i].kind == Fault::Kind::KillManager || faults[i].kind == Fault::Kind::KillTraffic)) {
         sup.restart(who);
         logFault("restarted " + who + " (end of run)");
         std::this_thread::sleep_for(std::chrono::seconds(1));
@@ -1012,14 +998,24 @@ int Run::run() {
   }
   // The manager first: agents that exit while it runs lose their DDS liveliness, and it would
   // (rightly) requeue every active task as "robot lost" after the run had ended.
-  sup.stop("fleet_manager", 5.0);
+  if (standby) {
+    standby->stop(sup, 5.0);
+  } else {
+    sup.stop("fleet_manager", 5.0);
+  }
   // --serve keeps the adapter: its view holds the run's final state (robots, tasks, roadmap).
   const bool serving = o.serve && code == 0;
   sup.stopAll(5.0, serving ? "wms_adapter" : "");
   say(serving ? "fleet stopped (but the WMS adapter, for the dashboard)" : "fleet stopped");
 
   // Reconcile the acknowledged tasks with the manager's database.
-  const auto contents = readDb(db);
+  const auto contents = standby ? standby->read() : readSqliteStore(db);
+  if (standby) {
+    // The run's figures and the report read fleet.db: a copy of the PostgreSQL store.
+    if (auto e = copyPostgresToSqlite(standby->url(), db); !e.empty()) {
+      say(e);
+    }
+  }
   const Accounting acc = ledger.reconcile(contents.tasks, contents.transitions);
   json summary = readJson(out / "sim_summary.json").value_or(json::object());
   const double simTime = summary.value("sim_time_s", simS);
@@ -1063,7 +1059,8 @@ int Run::run() {
       {"faults", faultLog},
       {"fault_plan", json::array()},
       {"progress", progress},
-      {"db_error", contents.error}};
+      {"db_error", contents.error},
+      {"store", standby ? standby->reportJson() : json{{"backend", "sqlite"}}}};
   for (const auto& f : faults) {
     report["fault_plan"].push_back(describe(f));
   }
@@ -1114,6 +1111,9 @@ int Run::run() {
                     c.value("rejoins", 0));
       say(line);
     }
+  }
+  if (standby) {
+    say(standby->summaryLine());
   }
   say(boundLine(report["kinematic_bound"]));
   say(saturatedLine(report["saturated"]));

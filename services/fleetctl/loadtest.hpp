@@ -68,6 +68,10 @@ struct LoadtestOptions {
   /// After a run that ended normally, keep the WMS adapter up (the dashboard on the run's final
   /// state) and serve the report with its replay on another loopback port, until Ctrl-C.
   bool serve = false;
+  /// The fleet manager's task store: "sqlite" (one manager, the run folder's fleet.db) or
+  /// "postgresql" (a PostgreSQL server of the run's own and two managers on it, one standing by;
+  /// kill-manager kills the active one and the report times the takeover).
+  std::string store = "sqlite";
 };
 
 /// Runs the load test; returns the process exit code (0 ok, 3 lost or duplicated tasks, 1 error,

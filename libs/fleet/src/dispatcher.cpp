@@ -239,6 +239,12 @@ std::vector<Expected<SubmitResult>> Dispatcher::submit(const std::vector<Task>& 
     if (stored[k] && stored[k]->created) {
       ++counters_.submitted;
       applied(stored[k]->record, local);
+    } else if (stored[k] && !isTerminal(stored[k]->record.state) &&
+               !open_.contains(stored[k]->record.task.id)) {
+      // Stored by an earlier attempt whose answer was lost (the connection broke after the commit,
+      // as in a database fail-over): this dispatcher never took it in. Adopted at its retry, or
+      // nothing would assign it until the manager's next rebuild from the store.
+      applied(stored[k]->record, local);
     }
     results[where[k]] = std::move(stored[k]);
   }

@@ -196,6 +196,45 @@ TEST(LoadtestE2E, StalledRobotAndDroppedDdsPacketsNoTaskLostOrDuplicated) {
   EXPECT_EQ(processesMentioning(out.string()), 0);
 }
 
+TEST(LoadtestE2E, OnPostgresqlTheStandbyManagerTakesOverFromAKilledActiveOne) {
+  // --store postgresql: a PostgreSQL server of the run's own and two managers; each kill-manager
+  // kills whichever is active (the second kill the one that took over from the first), and the
+  // standby takes over (the killed one is restarted 8 s later, after the takeover: restarted
+  // sooner it could win the expired lease itself). The ledger reads the PostgreSQL store.
+  const fs::path out = fs::path(::testing::TempDir()) / ("loadtest-pg-" + std::to_string(getpid()));
+  fs::remove_all(out);
+  auto args = baseArgs(out, 6, kFaultRunS);
+  for (const char* a :
+       {"--store", "postgresql", "--fault", "kill-manager@40+8", "--fault", "kill-manager@90+8"}) {
+    args.emplace_back(a);
+  }
+  fleet::test::ChildProcess run(kFleetctl, args);
+  ASSERT_EQ(run.wait(std::chrono::seconds(200)), 0) << "see " << out;
+  const json r = json::parse(std::ifstream(out / "loadtest.json"));
+  expectEveryTaskAccountedFor(r);
+  const auto& store = r["store"];
+  EXPECT_EQ(store["backend"], "postgresql");
+  ASSERT_EQ(store["takeovers"].size(), 2U) << store.dump();
+  for (const auto& t : store["takeovers"]) {
+    ASSERT_TRUE(t.contains("took_s")) << t.dump();
+    EXPECT_LT(t["took_s"].get<double>(), 5.0) << "the standby took over after " << t.dump();
+    EXPECT_NE(t["killed"], t["by"]) << "the standby took over";
+  }
+  EXPECT_EQ(store["takeovers"][1]["killed"], store["takeovers"][0]["by"])
+      << "the second kill hit the new active one";
+  std::vector<std::string> kills;
+  for (const auto& e : r["faults"]) {
+    if (e["event"].get<std::string>().find("(active)") != std::string::npos) {
+      kills.push_back(e["event"].get<std::string>());
+    }
+  }
+  ASSERT_EQ(kills.size(), 2U) << faultEvents(r);
+  // Work goes on after each takeover (fleet.db: the run's copy of the PostgreSQL store).
+  expectTasksDoneAfter(r, out / "fleet.db", {kills[0].c_str(), kills[1].c_str()});
+  EXPECT_EQ(processesMentioning(out.string()), 0) << "the database and the managers stopped with the run";
+  fs::remove_all(out);
+}
+
 /// The closure of the reserved fault run (close@60+40 on x 12..18, y 8..12 m of the generated
 /// 8-robot warehouse: aisles between shelves, no station): the adapter took it (202) and no robot
 /// drove into the area while it was closed. A robot inside when it closed, or released into it

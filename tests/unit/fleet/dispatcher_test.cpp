@@ -154,6 +154,29 @@ TEST_F(DispatcherTest, EveryTransitionStatesTheTasksEta) {
   EXPECT_EQ(c->events.back().etaNs, 0);
 }
 
+/// A task the store holds but the dispatcher never took in: an earlier attempt's commit went
+/// through but its answer was lost (the connection to PostgreSQL broke after the commit, as in a
+/// database fail-over, DatabaseFailover.APromotionWithinTheLeaseLosesNothingEither). Its retry is
+/// a duplicate, and the dispatcher adopts it: else nothing assigns it until the next rebuild.
+TEST_F(DispatcherTest, ARetriedTaskStoredWithoutItsAnswerIsAdoptedAndAssigned) {
+  ASSERT_TRUE(store->submit(transport("t1"), 0));  // behind the dispatcher's back
+  robot("r1", 3, 0.9, 0);
+  EXPECT_TRUE(dispatcher->tick(kSec / 10).assignments.empty()) << "not known yet";
+  DispatchResult out;
+  auto rs = dispatcher->submit({transport("t1")}, 1, &out);
+  ASSERT_EQ(rs.size(), 1u);
+  ASSERT_TRUE(rs[0]);
+  EXPECT_FALSE(rs[0]->created) << "a duplicate";
+  EXPECT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(dispatcher->counters().submitted, 0);
+  auto tick = dispatcher->tick(kSec / 5);
+  ASSERT_EQ(tick.assignments.size(), 1u);
+  EXPECT_EQ(tick.assignments[0].robotId, "r1");
+  DispatchResult again;
+  dispatcher->submit({transport("t1")}, 2, &again);
+  EXPECT_TRUE(again.events.empty()) << "a task it knows is not adopted twice";
+}
+
 /// A robot in fault mode fails whatever it is given at once; offering it tasks only burned their
 /// attempts until it was held back after three failures.
 TEST_F(DispatcherTest, ARobotInFaultModeIsOfferedNoTaskUntilItRecovers) {
