@@ -1,5 +1,5 @@
 // The roadmap's lattice: where its rows and columns lie, its nodes and edges, and how other nodes
-// join it. Moved out of roadmap.cpp as it was.
+// join it.
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // The roadmap's stations: docks, approach points, ways out and queues, placed on the lattice
-// (docs/algorithms.md, "Stations as servers"). Moved out of roadmap.cpp as it was.
+// (docs/algorithms.md, "Stations as servers").
 
 #include <optional>
 #include <sstream>
