@@ -1,7 +1,7 @@
 #include "fleet_manager_node.hpp"
 
-#include "fleet/service/roadmap_config.hpp"
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
+#include "fleet/traffic/roadmap_config.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -47,7 +47,7 @@ Settings readSettings(Config& cfg) {
                          "travel_cost",
                          "roadmap"});
   s.travelCost = cfg.string("travel_cost", s.travelCost, {"path", "straight", "roadmap"});
-  s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
+  s.roadmap = traffic::readRoadmapOptions(cfg.child("roadmap"));
   auto map = cfg.child("map");
   map.rejectUnknownKeys({"file", "resolution", "origin_x", "origin_y"});
   s.mapFile = map.string("file", "");
@@ -413,7 +413,7 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
       continue;
     }
     // The typed fields are the task; the dispatcher validates it, once, against the site.
-    batch.push_back(service::fromWire(req, nowNs));
+    batch.push_back(fleet::fromWire(req, nowNs));
     batchReq.push_back(&req);
   }
   flush();

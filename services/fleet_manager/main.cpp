@@ -20,13 +20,13 @@
 #include "fleet/fleet/errors.hpp"
 #include "fleet/fleet/pg_connection.hpp"
 #include "fleet/fleet/postgres_task_store.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
 #include "manager_lease.hpp"
@@ -264,7 +264,7 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
       "1 on the active manager (the lease holder, or the only one on SQLite), 0 on a standby");
   auto& epochGauge =
       ops.registry().gauge("fleet_manager_lease_epoch", "Epoch of the lease this manager holds (0: none)");
-  auto loaded = service::loadSiteStations(settings.stationsFile);
+  auto loaded = fleet::loadSiteStations(settings.stationsFile);
   if (!loaded) {
     spdlog::critical("{}", loaded.error().message);
     return 2;

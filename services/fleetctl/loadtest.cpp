@@ -28,7 +28,7 @@
 #include "base_ends.hpp"
 #include "fault_plan.hpp"
 #include "fleet/core/config.hpp"
-#include "fleet/service/site_stations.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "run_bounds.hpp"
 #include "run_figures.hpp"
@@ -585,7 +585,7 @@ int Run::run() {
   const std::string siteFile =
       scenario.contains("site") && scenario["site"].is_string() ? scenario["site"].get<std::string>() : "";
   if (!siteFile.empty()) {
-    auto site = service::loadSiteFile(siteFile);
+    auto site = fleet::loadSiteFile(siteFile);
     if (!site) {
       std::cerr << "fleetctl loadtest: " << site.error().message << "\n";
       return 2;
@@ -703,7 +703,7 @@ int Run::run() {
     }
     const std::vector<std::string> ids(robots.end() - o.vda5050, robots.end());
     vdaRobots.insert(ids.begin(), ids.end());
-    auto site = service::loadSiteFile(scenario["site"].get<std::string>());
+    auto site = fleet::loadSiteFile(scenario["site"].get<std::string>());
     auto vda = prepareVda5050(out, ids, site ? site->name : std::string("site"), freePort(),
                               bin("services/vda5050_bridge/vda5050_bridge"), env, !o.wallClock);
     if (!vda) {

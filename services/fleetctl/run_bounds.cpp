@@ -15,7 +15,7 @@
 
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/config.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "gz_lines.hpp"
 #include "kinematic_bound.hpp"
 

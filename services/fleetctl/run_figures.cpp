@@ -6,7 +6,7 @@
 #include <map>
 
 #include "fleet/core/config.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "gz_lines.hpp"
 #include "run_fleet_bound.hpp"
 #include "run_ledger.hpp"

@@ -8,7 +8,7 @@
 
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/config.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::ctl {

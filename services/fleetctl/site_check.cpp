@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "fleet/core/config.hpp"
-#include "fleet/service/site_stations.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/site/site_report.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "site_svg.hpp"
@@ -115,7 +115,7 @@ nlohmann::json roadmapJson(const traffic::Roadmap& r, const RoadmapSummary& s) {
 int siteCheck(const std::string& file, double radius, double mapResolution, bool asJson,
               const std::string& svgFile) {
   // Geometry is left to the report, so a site with an unreachable station still shows the rest.
-  auto site = service::loadSiteFile(file, false, mapResolution);
+  auto site = fleet::loadSiteFile(file, false, mapResolution);
   if (!site) {
     std::cerr << site.error().message << "\n";
     return 2;

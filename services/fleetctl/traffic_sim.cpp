@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fleet/core/config.hpp"
-#include "fleet/service/site_stations.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/virtual_fleet.hpp"
 #include "run_fleet_bound.hpp"
@@ -71,7 +71,7 @@ std::string robotTimeLine(const nlohmann::json& rt) {
 }  // namespace
 
 int runTrafficSim(const TrafficSimOptions& o) {
-  const auto site = service::loadSiteFile(o.site);
+  const auto site = fleet::loadSiteFile(o.site);
   if (!site) {
     std::cerr << "fleetctl traffic-sim: " << site.error().message << "\n";
     return 2;

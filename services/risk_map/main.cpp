@@ -9,6 +9,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/service/clocked_loop.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
@@ -16,7 +17,6 @@
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "risk_map_node.hpp"
 
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
     auto settings = riskmap::readSettings(cfg);
     cfg.finish();
     if (!settings.site.empty()) {
-      const auto site = service::loadSiteFile(settings.site);
+      const auto site = fleet::loadSiteFile(settings.site);
       if (!site) {
         throw ConfigError({site.error().message});
       }

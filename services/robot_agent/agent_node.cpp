@@ -8,7 +8,7 @@
 #include "fleet/control/cruise.hpp"
 #include "fleet/core/ids.hpp"
 #include "fleet/core/logging.hpp"
-#include "fleet/service/risk_lookup_of.hpp"
+#include "fleet/risk/risk_lookup_of.hpp"
 #include "fleet/site/wall_segments.hpp"
 #include "fleet/validation/sample_checks.hpp"
 
@@ -161,7 +161,7 @@ void AgentNode::onRiskMaps(std::vector<msg::RiskMap> maps) {
   if (maps.empty() || !settings_.useRisk) {
     return;
   }
-  if (auto field = service::riskLookupOf(maps.back())) {
+  if (auto field = risk::riskLookupOf(maps.back())) {
     for (auto& a : agents_) {
       a->onRiskMap(*field);
     }

@@ -6,8 +6,8 @@
 #include "fleet/core/angles.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/ids.hpp"
-#include "fleet/sim/grid_map.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/grid_map.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "fleet/site/reachability.hpp"
 
 namespace fleet::agent {

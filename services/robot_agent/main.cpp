@@ -20,12 +20,12 @@
 #include "fleet/core/clock.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "fleet/service/step_order.hpp"
 #include "fleet/transport/dds.hpp"
 
@@ -370,7 +370,7 @@ int main(int argc, char** argv) {
     }
     agent::World world;
     if (!sitePath.empty()) {
-      auto st = service::loadSiteFile(sitePath);
+      auto st = fleet::loadSiteFile(sitePath);
       if (!st) {
         throw ConfigError({st.error().message});
       }

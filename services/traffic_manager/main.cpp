@@ -12,15 +12,15 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/site_stations.hpp"
+#include "fleet/risk/risk_lookup_of.hpp"
 #include "fleet/service/clocked_loop.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
-#include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/sample_edge.hpp"
 #include "fleet/service/service_ops.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "fleet/service/step_order.hpp"
 #include "fleet/transport/dds.hpp"
 #include "traffic_node.hpp"
@@ -163,7 +163,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     // Only the newest map matters; a map that does not decode is refused as any bad sample.
     if (auto maps = riskMaps ? riskMaps->take() : std::vector<msg::RiskMap>{};
         !maps.empty() && loop.haveClock()) {
-      if (auto risk = service::riskLookupOf(maps.back())) {
+      if (auto risk = risk::riskLookupOf(maps.back())) {
         node.onRiskMap(**risk, loop.now());
       } else {
         badInput.warn("risk_map", "RiskMap ignored: " + risk.error().message);
@@ -260,7 +260,7 @@ int main(int argc, char** argv) {
       settings.site = sitePath;
     if (settings.site.empty())
       throw ConfigError({"no site: give --site FILE or \"site\" in the config"});
-    const auto site = service::loadSiteFile(settings.site);
+    const auto site = fleet::loadSiteFile(settings.site);
     if (!site)
       throw ConfigError({site.error().message});
     service::installStopHandlers();

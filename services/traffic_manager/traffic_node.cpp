@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "fleet/core/clock.hpp"
-#include "fleet/service/roadmap_config.hpp"
+#include "fleet/traffic/roadmap_config.hpp"
 
 namespace fleet::trafficmgr {
 
@@ -49,7 +49,7 @@ Settings readSettings(Config& cfg) {
   s.yieldAfterS = cfg.number("yield_after_s", s.yieldAfterS, {0.0, 3600.0});
   s.yieldForS = cfg.number("yield_for_s", s.yieldForS, {0.0, 3600.0});
   s.yieldCostS = cfg.number("yield_cost_s", s.yieldCostS, {0.0, 3600.0});
-  s.roadmap = service::readRoadmapOptions(cfg.child("roadmap"));
+  s.roadmap = traffic::readRoadmapOptions(cfg.child("roadmap"));
   return s;
 }
 

@@ -10,9 +10,9 @@
 
 #include "fleet/core/bounded_json.hpp"
 #include "fleet/core/ids.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/fleet/task.hpp"
-#include "fleet/service/site_stations.hpp"
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
 #include "json_reply.hpp"
 #include "robot_time.hpp"
 #include "web_files.hpp"
@@ -144,7 +144,7 @@ json riskJson(const msg::RiskMap& m) {
 }
 
 json sitePictureOf(const std::string& path) {
-  auto loaded = service::loadSiteStations(path);
+  auto loaded = fleet::loadSiteStations(path);
   if (!loaded) {
     return {{"error", loaded.error().message}};
   }
@@ -490,7 +490,7 @@ void Dashboard::sendTo(const msg::RobotState& robot, const std::string& action, 
     replyJson(res, 400, {{"error", "invalid"}, {"message", task.error().message}, {"fields", fields}});
     return;
   }
-  const auto a = d_.gateway.submit({service::toWire(*task, d_.requestId(), now)},
+  const auto a = d_.gateway.submit({fleet::toWire(*task, d_.requestId(), now)},
                                    std::chrono::milliseconds(d_.ackTimeoutMs))[0];
   if (!a) {
     replyJson(res, 503, problem("unavailable", "the fleet manager did not acknowledge the task in time"));

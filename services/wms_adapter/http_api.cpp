@@ -12,7 +12,7 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/core/log_text.hpp"
 #include "fleet/fleet/task.hpp"
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
 #include "json_reply.hpp"
 #include "rfc3339.hpp"
 #include "status_routes.hpp"
@@ -406,7 +406,7 @@ void HttpApi::postTasks(const Request& req, Response& res) {
   const std::int64_t now = clock_.nowNs();
   std::vector<msg::Task> requests;
   for (const auto& t : *parsed) {
-    requests.push_back(service::toWire(t, nextRequestId(), now));
+    requests.push_back(fleet::toWire(t, nextRequestId(), now));
   }
   const auto acks = gateway_.submit(requests, std::chrono::milliseconds(settings_.ackTimeoutMs));
   json results = json::array();

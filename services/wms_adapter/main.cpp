@@ -10,12 +10,12 @@
 
 #include "dds_gateway.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
 #include "fleet/service/dds_security_check.hpp"
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "http_api.hpp"
 
 using namespace fleet;
@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       stationsPath = cfg.requireString("stations");
     }
     cfg.finish();
-    auto stations = service::loadStationMap(stationsPath);
+    auto stations = fleet::loadStationMap(stationsPath);
     if (!stations) {
       throw ConfigError({stations.error().message});
     }

@@ -11,7 +11,7 @@
 
 #include "fleet/fleet/station_map.hpp"
 #include "fleet/fleet/task.hpp"
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
 #include "fleet/validation/sample_checks.hpp"
 #include "fleet/validation/utf8.hpp"
 #include "fuzz_check.hpp"
@@ -55,7 +55,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto again = fleet::parseTask(fleet::toJson(t), &stations);
     require(again.has_value() && *again == t, "an accepted task's wire form parses back to it");
     require(!fleet::canonicalBody(t).empty(), "the canonical body is not empty");
-    const auto wire = fleet::service::toWire(t, "fuzz-request-1", 1);
+    const auto wire = fleet::toWire(t, "fuzz-request-1", 1);
     const auto refused = fleet::validation::check(wire);
     if (refused) {
       std::fprintf(stderr, "manager refuses: %s %s\n", refused->reason.c_str(), refused->detail.c_str());
@@ -65,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (expected.createdNs == 0) {
       expected.createdNs = 1;  // the adapter's clock stamps a task the client did not
     }
-    require(fleet::service::fromWire(wire, 1) == expected, "the manager reads the same task");
+    require(fleet::fromWire(wire, 1) == expected, "the manager reads the same task");
   }
   return 0;
 }

@@ -14,8 +14,8 @@
 
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
-#include "fleet/sim/grid_map.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/grid_map.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "traffic_node.hpp"
 #include "worker_pool.hpp"
 

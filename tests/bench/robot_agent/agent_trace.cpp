@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "agent.hpp"
+#include "fleet/risk/risk_lookup_of.hpp"
 #include "fleet/risk/rle.hpp"
-#include "fleet/service/risk_lookup_of.hpp"
 #include "fleet/site/site_loader.hpp"
 #include "traffic_node.hpp"
 
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
       for (const auto& r : risk::encodeRle(lv)) {
         m.runs.push_back({r.level, r.length});
       }
-      auto f = service::riskLookupOf(m);
+      auto f = risk::riskLookupOf(m);
       for (auto& a : agents) {
         a->onRiskMap(*f);
       }

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "fleet/fleet/site_stations.hpp"
 #include "fleet/planning/map_io.hpp"
-#include "fleet/service/site_stations.hpp"
 #include "fleet/site/site_loader.hpp"
 #include "fleet_manager_node.hpp"
 
@@ -253,7 +253,7 @@ TEST(TravelModel, RoadmapTimesAreTheRoadmapsDockToDockTimes) {
   const auto site = smallWarehouse();
   const auto roads = std::make_shared<const traffic::RoadmapTravel>(
       std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site)));
-  const StationMap st = service::stationMapOf(*site);
+  const StationMap st = fleet::stationMapOf(*site);
   Task t;
   t.id = "t";
   t.pickup = "P-1";
@@ -275,7 +275,7 @@ TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
   settings_.stationCapacityFromLines = true;
   settings_.travelCost = "roadmap";
   const auto site = smallWarehouse();
-  auto n = manager::FleetManagerNode::create(settings_, service::stationMapOf(*site), 1'000, site);
+  auto n = manager::FleetManagerNode::create(settings_, fleet::stationMapOf(*site), 1'000, site);
   ASSERT_TRUE(n) << n.error().message;
   auto& node = **n;
   const traffic::RoadmapTravel roads(std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site)));

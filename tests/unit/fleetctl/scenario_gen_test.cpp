@@ -7,7 +7,7 @@
 #include <fstream>
 #include <set>
 
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "scenario_tasks.hpp"
 
 namespace fleet::ctl {

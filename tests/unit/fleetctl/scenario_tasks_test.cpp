@@ -6,7 +6,7 @@
 #include <set>
 
 #include "fleet/core/config.hpp"
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 
 namespace fleet::ctl {
 namespace {

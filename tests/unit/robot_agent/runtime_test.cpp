@@ -11,8 +11,8 @@
 
 #include "agent.hpp"
 #include "fleet/planning/astar.hpp"
+#include "fleet/risk/risk_lookup_of.hpp"
 #include "fleet/risk/rle.hpp"
-#include "fleet/service/risk_lookup_of.hpp"
 #include "straight_releases.hpp"
 #include "worker_pool.hpp"
 
@@ -50,7 +50,7 @@ TEST(RiskLookup, LooksUpTheLevelUpperBoundOfTheCellAndZeroOffTheMap) {
   std::vector<std::uint8_t> levels(4 * 3, 0);
   levels[1 * 4 + 2] = 5;  // cell (2, 1)
   levels[0] = 10;
-  const auto f = service::riskLookupOf(riskMap(4, 3, 0.5, {-1.0, 2.0}, 10, levels));
+  const auto f = risk::riskLookupOf(riskMap(4, 3, 0.5, {-1.0, 2.0}, 10, levels));
   ASSERT_TRUE(f) << f.error().message;
   EXPECT_DOUBLE_EQ((*f)->at({-1.0 + 1.25, 2.0 + 0.75}), 0.5);
   EXPECT_DOUBLE_EQ((*f)->at({-0.99, 2.01}), 1.0);
@@ -63,15 +63,15 @@ TEST(RiskLookup, RejectsWhatARemoteWriterCouldGetWrong) {
   std::vector<std::uint8_t> levels(12, 1);
   auto m = riskMap(4, 3, 0.5, {}, 4, levels);
   m.runs.back().count += 1;
-  EXPECT_FALSE(service::riskLookupOf(m));
+  EXPECT_FALSE(risk::riskLookupOf(m));
   m = riskMap(4, 3, 0.5, {}, 4, levels);
   m.runs.front().level = 9;
-  EXPECT_FALSE(service::riskLookupOf(m));
+  EXPECT_FALSE(risk::riskLookupOf(m));
   m = riskMap(4, 3, 0.0, {}, 4, levels);
-  EXPECT_FALSE(service::riskLookupOf(m));
+  EXPECT_FALSE(risk::riskLookupOf(m));
   m = riskMap(4, 3, 0.5, {}, 4, levels);
   m.levels = 0;
-  EXPECT_FALSE(service::riskLookupOf(m));
+  EXPECT_FALSE(risk::riskLookupOf(m));
 }
 
 TEST(RiskAstar, WithoutRiskItCostsWhatPlainAstarCosts) {

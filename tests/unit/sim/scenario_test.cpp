@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "sim_fixtures.hpp"
 
 using namespace fleet;

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 
 namespace fleet::sim::test {
 

@@ -2,7 +2,7 @@
 
 #include <vector>
 
-#include "fleet/sim/grid_map.hpp"
+#include "fleet/scenario/grid_map.hpp"
 
 namespace fleet::sim {
 

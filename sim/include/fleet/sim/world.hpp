@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "fleet/control/twist.hpp"
+#include "fleet/scenario/scenario.hpp"
 #include "fleet/sim/flow_field.hpp"
-#include "fleet/sim/scenario.hpp"
 #include "fleet/sim/spatial_hash.hpp"
 
 namespace fleet::sim {

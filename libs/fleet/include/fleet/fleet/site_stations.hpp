@@ -7,7 +7,7 @@
 #include "fleet/fleet/station_map.hpp"
 #include "fleet/site/site.hpp"
 
-namespace fleet::service {
+namespace fleet {
 
 /// The site a service runs on, from a site.json (or a bare .map / ROS .yaml), or from a simulator
 /// scenario that names one with "site". Errors (code "invalid") list every problem of the file,
@@ -30,4 +30,4 @@ Expected<StationMap> loadStationMap(const std::string& path);
 /// A site's stations as the fleet library holds them (one kind each).
 StationMap stationMapOf(const site::Site& s);
 
-}  // namespace fleet::service
+}  // namespace fleet

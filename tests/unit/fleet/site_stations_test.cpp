@@ -1,7 +1,7 @@
 // How the fleet manager and the WMS adapter find their stations: a site, a scenario that names one,
 // or an older stations file.
 
-#include "fleet/service/site_stations.hpp"
+#include "fleet/fleet/site_stations.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-namespace fleet::service {
+namespace fleet {
 namespace {
 
 namespace fs = std::filesystem;
@@ -59,4 +59,4 @@ TEST(SiteStations, ABadSiteIsRefusedWithItsFileAndKeyPath) {
 }
 
 }  // namespace
-}  // namespace fleet::service
+}  // namespace fleet

@@ -1,6 +1,6 @@
-#include "fleet/service/risk_lookup_of.hpp"
+#include "fleet/risk/risk_lookup_of.hpp"
 
-namespace fleet::service {
+namespace fleet::risk {
 
 Expected<std::shared_ptr<const risk::RiskLookup>> riskLookupOf(const msg::RiskMap& m) {
   risk::EncodedRiskMap e;
@@ -17,4 +17,4 @@ Expected<std::shared_ptr<const risk::RiskLookup>> riskLookupOf(const msg::RiskMa
   return risk::RiskLookup::decode(e);
 }
 
-}  // namespace fleet::service
+}  // namespace fleet::risk

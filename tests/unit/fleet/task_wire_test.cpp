@@ -1,10 +1,10 @@
 // The task on the wire between the WMS adapter and the fleet manager.
 
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
 
 #include <gtest/gtest.h>
 
-namespace fleet::service {
+namespace fleet {
 namespace {
 
 // The adapter's toWire and the manager's fromWire are one pair: every field survives, exactly
@@ -39,4 +39,4 @@ TEST(TaskWire, EveryFieldSurvivesTheRoundTrip) {
 }
 
 }  // namespace
-}  // namespace fleet::service
+}  // namespace fleet

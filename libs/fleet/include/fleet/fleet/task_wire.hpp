@@ -9,11 +9,11 @@
 #include "fleet/fleet/task.hpp"
 #include "fleet/messages/messages.hpp"
 
-namespace fleet::service {
+namespace fleet {
 
 /// The request for `t` (its created time, or `nowNs` when the client left it out).
 msg::Task toWire(const Task& t, std::string requestId, std::int64_t nowNs);
 /// The task a request carries, as received at `nowNs` (unvalidated: the dispatcher checks it).
 Task fromWire(const msg::Task& m, std::int64_t nowNs);
 
-}  // namespace fleet::service
+}  // namespace fleet

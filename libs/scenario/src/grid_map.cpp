@@ -1,4 +1,4 @@
-#include "fleet/sim/grid_map.hpp"
+#include "fleet/scenario/grid_map.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
-#include "fleet/service/roadmap_config.hpp"
+#include "fleet/traffic/roadmap_config.hpp"
 
-namespace fleet::service {
+namespace fleet::traffic {
 
 traffic::RoadmapOptions readRoadmapOptions(Config r) {
   traffic::RoadmapOptions o;
@@ -16,4 +16,4 @@ traffic::RoadmapOptions readRoadmapOptions(Config r) {
   return o;
 }
 
-}  // namespace fleet::service
+}  // namespace fleet::traffic

@@ -1,6 +1,6 @@
-#include "fleet/service/task_wire.hpp"
+#include "fleet/fleet/task_wire.hpp"
 
-namespace fleet::service {
+namespace fleet {
 
 // The wire's kinds are the library's, in the same order (idl/fleet.idl TaskKind).
 msg::Task toWire(const Task& t, std::string requestId, std::int64_t nowNs) {
@@ -36,4 +36,4 @@ Task fromWire(const msg::Task& m, std::int64_t nowNs) {
   return t;
 }
 
-}  // namespace fleet::service
+}  // namespace fleet

@@ -1,4 +1,4 @@
-#include "fleet/service/site_stations.hpp"
+#include "fleet/fleet/site_stations.hpp"
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -7,7 +7,7 @@
 #include "fleet/core/config.hpp"
 #include "fleet/site/site_loader.hpp"
 
-namespace fleet::service {
+namespace fleet {
 
 namespace {
 
@@ -108,4 +108,4 @@ Expected<StationMap> loadStationMap(const std::string& path) {
   return std::move(s->stations);
 }
 
-}  // namespace fleet::service
+}  // namespace fleet

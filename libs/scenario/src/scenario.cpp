@@ -1,4 +1,4 @@
-#include "fleet/sim/scenario.hpp"
+#include "fleet/scenario/scenario.hpp"
 
 #include <cmath>
 #include <deque>

@@ -9,9 +9,9 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/risk/risk_lookup.hpp"
 
-namespace fleet::service {
+namespace fleet::risk {
 
 /// Errors those of risk::RiskLookup::decode (every field a remote writer could get wrong).
 Expected<std::shared_ptr<const risk::RiskLookup>> riskLookupOf(const msg::RiskMap& m);
 
-}  // namespace fleet::service
+}  // namespace fleet::risk

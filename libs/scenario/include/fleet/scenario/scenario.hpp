@@ -8,7 +8,7 @@
 #include "fleet/control/velocity_limits.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/core/pose2.hpp"
-#include "fleet/sim/grid_map.hpp"
+#include "fleet/scenario/grid_map.hpp"
 #include "fleet/site/site.hpp"
 
 namespace fleet::sim {
