@@ -325,7 +325,7 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
   for (const auto& e : r.events) {
     auto& seq = eventSeq_[e.taskId];
     out.events.push_back({e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq,
-                          e.station, e.changed, e.priority, e.deadlineNs});
+                          e.station, e.changed, e.priority, e.deadlineNs, e.etaNs});
     if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
       // Kept from the first event: a waiting task's later events (paused, why it waits) do not
       // restart its wait.

@@ -163,10 +163,11 @@ int listTasks(const ApiOptions& o, httplib::Client& c, const httplib::Headers& h
     return show(r);
   }
   auto body = json::parse(r->body);
-  std::printf("%-24s %-11s %-12s %s\n", "ID", "STATE", "ROBOT", "REASON");
+  // ETA: when the manager expects the task done (RFC 3339, UTC); "-" without an estimate.
+  std::printf("%-24s %-11s %-12s %-24s %s\n", "ID", "STATE", "ROBOT", "ETA", "REASON");
   for (const auto& x : body["tasks"]) {
-    std::printf("%-24s %-11s %-12s %s\n", x.value("id", "").c_str(), x.value("state", "").c_str(),
-                x.value("robot", "").c_str(), x.value("reason", "").c_str());
+    std::printf("%-24s %-11s %-12s %-24s %s\n", x.value("id", "").c_str(), x.value("state", "").c_str(),
+                x.value("robot", "").c_str(), x.value("eta", "-").c_str(), x.value("reason", "").c_str());
   }
   return 0;
 }

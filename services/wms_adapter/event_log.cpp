@@ -21,6 +21,10 @@ nlohmann::json loggedEventJson(const LoggedEvent& l) {
       j["deadline"] = toRfc3339(e.deadline_ns);
     }
   }
+  if (e.eta_ns > 0) {
+    j["eta_ns"] = e.eta_ns;
+    j["eta"] = toRfc3339(e.eta_ns);
+  }
   return j;
 }
 
@@ -44,6 +48,7 @@ LoggedEvent rowOf(const SqliteStmt& q) {
     l.event.priority = static_cast<std::int32_t>(q.integer(8));
     l.event.deadline_ns = q.integer(9);
   }
+  l.event.eta_ns = q.isNull(10) ? 0 : q.integer(10);
   return l;
 }
 
@@ -66,7 +71,8 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
       "CREATE TABLE IF NOT EXISTS task_events("
       " id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER NOT NULL,"
       " state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT NULL,"
-      " station TEXT NOT NULL, logged_ns INTEGER NOT NULL, priority INTEGER, deadline_ns INTEGER);"
+      " station TEXT NOT NULL, logged_ns INTEGER NOT NULL, priority INTEGER, deadline_ns INTEGER,"
+      " eta_ns INTEGER);"
       "CREATE INDEX IF NOT EXISTS task_events_by_task ON task_events(task_id, seq);"
       "CREATE INDEX IF NOT EXISTS task_events_by_time ON task_events(logged_ns);");
   {
@@ -80,6 +86,13 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
     }
   }
   {
+    // A log written before events carried an ETA gets its column (NULL: no estimate).
+    SqliteStmt q(*db_, "SELECT COUNT(*) FROM pragma_table_info('task_events') WHERE name = 'eta_ns'");
+    if (q.step() && q.integer(0) == 0) {
+      db_->exec("ALTER TABLE task_events ADD COLUMN eta_ns INTEGER;");
+    }
+  }
+  {
     SqliteStmt q(*db_, "SELECT seq FROM sqlite_sequence WHERE name = 'task_events'");
     lastId_ = q.step() ? q.integer(0) : 0;
   }
@@ -88,15 +101,17 @@ EventLog::EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db)
     prunedThrough_ = q.step() && !q.isNull(0) ? q.integer(0) - 1 : lastId_;
   }
   seen_ = std::make_unique<SqliteStmt>(*db_, "SELECT 1 FROM task_events WHERE task_id = ?1 AND seq = ?2");
-  insert_ =
-      std::make_unique<SqliteStmt>(*db_,
-                                   "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, "
-                                   "station, logged_ns, priority, deadline_ns) VALUES (?1, ?2, ?3, ?4, ?5, "
-                                   "?6, ?7, ?8, ?9, ?10)");
-  SqliteStmt q(*db_,
-               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns FROM "
-               "task_events "
-               "WHERE id > ?1 ORDER BY id");
+  insert_ = std::make_unique<SqliteStmt>(
+      *db_,
+      "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, "
+      "station, logged_ns, priority, deadline_ns, eta_ns) VALUES (?1, ?2, ?3, ?4, "
+      "?5, ?6, ?7, ?8, ?9, ?10, ?11)");
+  SqliteStmt q(
+      *db_,
+      "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns, eta_ns "
+      "FROM "
+      "task_events "
+      "WHERE id > ?1 ORDER BY id");
   q.bind(1, std::max<std::int64_t>(prunedThrough_, lastId_ - static_cast<std::int64_t>(kMemoryTail)));
   while (q.step()) {
     tail_.push_back(rowOf(q));
@@ -134,6 +149,11 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
           row.bind(9, std::int64_t{e.priority}).bind(10, e.deadline_ns);
         } else {
           row.bindNull(9).bindNull(10);
+        }
+        if (e.eta_ns > 0) {
+          row.bind(11, e.eta_ns);
+        } else {
+          row.bindNull(11);
         }
         row.run();
         row.reset();
@@ -202,10 +222,12 @@ std::vector<LoggedEvent> EventLog::after(std::int64_t after, std::size_t limit) 
   }
   // Older than the memory holds: a client catching up from far back (bounded by `limit`).
   std::lock_guard dbLock(db_->mutex());
-  SqliteStmt q(*db_,
-               "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns FROM "
-               "task_events "
-               "WHERE id > ?1 ORDER BY id LIMIT ?2");
+  SqliteStmt q(
+      *db_,
+      "SELECT id, task_id, seq, state, robot, reason, stamp_ns, station, priority, deadline_ns, eta_ns "
+      "FROM "
+      "task_events "
+      "WHERE id > ?1 ORDER BY id LIMIT ?2");
   q.bind(1, after).bind(2, static_cast<std::int64_t>(limit));
   while (q.step()) {
     out.push_back(rowOf(q));

@@ -89,6 +89,7 @@ void FleetView::viewEvent(const msg::TaskEvent& e) {
       v.updatedNs = e.stamp_ns;
       v.seq = e.seq;
       v.station = e.station;
+      v.etaNs = e.eta_ns;
       if (e.changed && !v.body.empty()) {
         applyChange(v.body, e);
       }

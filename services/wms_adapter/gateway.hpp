@@ -36,6 +36,8 @@ struct TaskView {
   std::string body;  // the task JSON, when this adapter submitted it
   /// The station the manager chose for a charge / park task sent without one (TaskEvent.station).
   std::string station;
+  /// When the task is expected done (TaskEvent.eta_ns of its newest event); 0: no estimate.
+  std::int64_t etaNs = 0;
 };
 
 class TaskGateway {

@@ -46,6 +46,11 @@ json viewJson(const TaskView& v) {
   if (!v.reason.empty()) {
     j["reason"] = v.reason;
   }
+  if (v.etaNs > 0) {
+    // When the manager expects the task done, as estimated at its newest transition.
+    j["eta_ns"] = v.etaNs;
+    j["eta"] = toRfc3339(v.etaNs);
+  }
   if (!v.body.empty()) {
     j["task"] = json::parse(v.body, nullptr, false);
   }

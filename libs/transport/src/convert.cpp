@@ -142,13 +142,20 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   out.changed = in.changed;
   out.priority = in.priority;
   out.deadline_ns = in.deadline_ns;
+  out.eta_ns = in.eta_ns;
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
-  return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
-          getStr(in.robot_id), getStr(in.reason),
-          in.stamp_ns,         in.seq,
-          getStr(in.station),  in.changed,
-          in.priority,         in.deadline_ns};
+  return {getStr(in.task_id),
+          getEnum(in.state, msg::TaskState::Rejected),
+          getStr(in.robot_id),
+          getStr(in.reason),
+          in.stamp_ns,
+          in.seq,
+          getStr(in.station),
+          in.changed,
+          in.priority,
+          in.deadline_ns,
+          in.eta_ns};
 }
 
 // ---- TaskAssignment

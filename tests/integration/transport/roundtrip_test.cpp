@@ -142,7 +142,9 @@ TEST_F(RoundTrip, TaskEvent) {
       {{"t-1", msg::TaskState::Unloading, "r-7", kNonAscii, 99, 4, ""},
        {"t-2", msg::TaskState::Rejected, "", std::string(255, 'x'), -1, 0, maxId()},
        {"t-3", msg::TaskState::Assigned, "r-1", "allocated", 7, 2, "PARK-3"},
-       {"t-4", msg::TaskState::Requeued, "", "changed by request", 8, 3, "", true, -1000, 9'000'000'000}});
+       {"t-4", msg::TaskState::Requeued, "", "changed by request", 8, 3, "", true, -1000, 9'000'000'000},
+       {"t-5", msg::TaskState::Assigned, "r-2", "allocated", 9, 2, "", false, 0, 0,
+        1'800'000'000'000'000'000}});
 }
 
 TEST_F(RoundTrip, TaskAssignment) {

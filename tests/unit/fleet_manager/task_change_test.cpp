@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 
 #include "fleet_manager_node.hpp"
 
@@ -198,4 +199,23 @@ TEST_F(TaskChange, AChangeOutlivesARestartAndTheEventsCountGoesOn) {
   node->onRequests({retry}, 20'000, out);
   EXPECT_EQ(ackOf(out, retry).result, msg::AckResult::Duplicate);
   EXPECT_EQ(node->dispatcher().openTasks().at("t1").task.priority, 7);
+}
+
+TEST_F(TaskChange, TheEventsOnTheWireCarryTheTasksEta) {
+  // The dispatcher's estimate (TaskEta) reaches the TaskEvent the adapter shows the WMS: a task
+  // assigned to the one robot is due after now, and the task waiting behind it later still.
+  auto node = open(0);
+  manager::Outbox out;
+  node->onRobotState(idle("r1", 1'000), 1'000);
+  node->onRequests({transport("t1", 0), transport("t2", 0)}, 2'000, out);
+  node->tick(3'000, out);
+  std::map<std::string, std::int64_t> eta;
+  for (const auto& e : out.events) {
+    eta[e.task_id] = e.eta_ns;  // the newest event of each task
+  }
+  ASSERT_EQ(out.assignments.size(), 1u);
+  const auto& first = out.assignments[0].task_id;
+  const auto& second = first == "t1" ? std::string("t2") : std::string("t1");
+  EXPECT_GT(eta[first], 3'000) << "an assigned task is due after now";
+  EXPECT_GT(eta[second], eta[first]) << "the waiting one after the robot's current task";
 }

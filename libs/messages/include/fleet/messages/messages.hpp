@@ -79,6 +79,9 @@ struct TaskEvent {
   bool changed = false;
   std::int32_t priority = 0;
   std::int64_t deadline_ns = 0;
+  /// When the task is expected done, as the manager estimated it at this transition (TaskEta,
+  /// UTC ns); 0: no estimate (no robot could take it, or it ended without being done).
+  std::int64_t eta_ns = 0;
   bool operator==(const TaskEvent&) const = default;
 };
 
