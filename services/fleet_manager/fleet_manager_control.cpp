@@ -9,7 +9,6 @@ namespace fleet::manager {
 using acks::ack;
 using acks::fieldsJson;
 using acks::refused;
-using acks::toMsg;
 
 void FleetManagerNode::control(const msg::Task& req, std::int64_t nowNs, Outbox& out) {
   if (req.cancel) {
@@ -51,8 +50,7 @@ void FleetManagerNode::control(const msg::Task& req, std::int64_t nowNs, Outbox&
       auto r = dispatcher_->setPaused(req.task_id, pause, nowNs);
       if (r) {
         const auto it = dispatcher_->openTasks().find(req.task_id);
-        const auto state =
-            it != dispatcher_->openTasks().end() ? toMsg(it->second.state) : msg::TaskState::Queued;
+        const auto state = it != dispatcher_->openTasks().end() ? it->second.state : msg::TaskState::Queued;
         out.acks.push_back(ack(req, msg::AckResult::Stored, state, pause ? "paused" : "resumed", nowNs));
         publish(std::move(*r), nowNs, out);
       } else {
@@ -86,7 +84,7 @@ msg::TaskAck FleetManagerNode::change(const msg::Task& req, std::int64_t nowNs, 
     if (code == errc::kIllegalTransition) {
       // The ack carries the state the task is in, for the adapter's 409 to name.
       const auto stored = store_->get(req.task_id);
-      return refused(req, r.error(), nowNs, stored ? toMsg(stored->state) : msg::TaskState::Rejected);
+      return refused(req, r.error(), nowNs, stored ? stored->state : msg::TaskState::Rejected);
     }
     if (code == errc::kNotFound) {
       return refused(req, r.error(), nowNs);
@@ -104,7 +102,7 @@ msg::TaskAck FleetManagerNode::change(const msg::Task& req, std::int64_t nowNs, 
                             {"deadline_ns", rec.task.deadlineNs},
                             {"changed", changed},
                             {"revision", rec.revision}};
-  return ack(req, msg::AckResult::Stored, toMsg(rec.state), d.dump(), nowNs);
+  return ack(req, msg::AckResult::Stored, rec.state, d.dump(), nowNs);
 }
 
 msg::TaskAck FleetManagerNode::query(const msg::Task& req, std::int64_t nowNs) {
@@ -126,7 +124,7 @@ msg::TaskAck FleetManagerNode::query(const msg::Task& req, std::int64_t nowNs) {
     d.erase("task");  // the state matters; the body is a nicety
     detail = d.dump(-1, ' ', false, replace);
   }
-  return ack(req, msg::AckResult::Stored, toMsg(r->state), std::move(detail), nowNs);
+  return ack(req, msg::AckResult::Stored, r->state, std::move(detail), nowNs);
 }
 
 }  // namespace fleet::manager

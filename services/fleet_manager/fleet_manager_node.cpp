@@ -20,7 +20,6 @@ namespace fleet::manager {
 
 using acks::ack;
 using acks::fieldsJson;
-using acks::toMsg;
 
 Settings readSettings(Config& cfg) {
   Settings s;
@@ -254,7 +253,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
     // transitions, as the event seq did, so an adapter that kept running sees no step back.
     const auto seq = static_cast<std::uint32_t>(r.revision);
     n->eventSeq_[id] = seq;
-    n->recovered_.events.push_back({id, toMsg(r.state), r.robotId, r.reason.substr(0, 255), nowNs, seq,
+    n->recovered_.events.push_back({id, r.state, r.robotId, r.reason.substr(0, 255), nowNs, seq,
                                     r.stationChosen ? r.task.station : std::string()});
   }
   // After the announcements: an order that cannot be rebuilt (its station left the site) fails
@@ -277,6 +276,7 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
   a.stamp_ns = nowNs;
   a.paused = o.paused;
   a.priority = o.task.priority;
+  a.epoch = epoch_;
   std::string missing;
   auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
     const Station* s = dispatcher_->stations().find(name);
@@ -321,11 +321,21 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
   return a;
 }
 
+void FleetManagerNode::setEpoch(std::int64_t epoch) {
+  epoch_ = epoch;
+  for (auto& e : recovered_.events) {
+    e.epoch = epoch;
+  }
+  for (auto& a : recovered_.assignments) {
+    a.epoch = epoch;
+  }
+}
+
 void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out) {
   for (const auto& e : r.events) {
     auto& seq = eventSeq_[e.taskId];
-    out.events.push_back({e.taskId, toMsg(e.state), e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq,
-                          e.station, e.changed, e.priority, e.deadlineNs, e.etaNs});
+    out.events.push_back({e.taskId, e.state, e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq, e.station,
+                          e.changed, e.priority, e.deadlineNs, e.etaNs, epoch_});
     if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
       // Kept from the first event: a waiting task's later events (paused, why it waits) do not
       // restart its wait.
@@ -367,6 +377,7 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
     a.revision = nextRevision(robot, nowNs);
     a.stamp_ns = nowNs;
     a.paused = dispatcher_->robotHeld(robot);  // a held robot stands still without an order too
+    a.epoch = epoch_;
     out.assignments.push_back(a);
   }
 }
@@ -391,7 +402,7 @@ void FleetManagerNode::onRequests(const std::vector<msg::Task>& requests, std::i
         const bool created = results[i]->created;
         ++(created ? metrics_.stored : metrics_.duplicates);
         out.acks.push_back(ack(req, created ? msg::AckResult::Stored : msg::AckResult::Duplicate,
-                               toMsg(results[i]->record.state), "", nowNs));
+                               results[i]->record.state, "", nowNs));
       } else {
         const auto& code = results[i].error().code;
         const auto result = code == errc::kConflict  ? msg::AckResult::Conflict
@@ -423,8 +434,8 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
   if (s.task_id.empty()) {
     return;
   }
-  const auto state = static_cast<TaskState>(static_cast<int>(s.state));
-  if (s.state == msg::TaskState::Rejected || state == TaskState::Queued || state == TaskState::Assigned) {
+  const TaskState state = s.state;
+  if (state == TaskState::Rejected || state == TaskState::Queued || state == TaskState::Assigned) {
     return;  // not a robot's report
   }
   auto r = dispatcher_->onTaskStatus(s.robot_id, s.task_id, state, s.error, nowNs);

@@ -148,6 +148,10 @@ class FleetManagerNode {
   /// Assignments to re-publish after a restart (from the store), and each open task's state as a
   /// TaskEvent, so an adapter that starts later learns every stored open task from the history.
   [[nodiscard]] const Outbox& recovered() const { return recovered_; }
+  /// The epoch of the lease this manager holds (0: none, the default): stamped on every
+  /// TaskAssignment and TaskEvent from now on, and on recovered(), so that readers drop what a
+  /// manager of an older epoch still sends (EpochFence).
+  void setEpoch(std::int64_t epoch);
 
   [[nodiscard]] const Dispatcher& dispatcher() const { return *dispatcher_; }
   [[nodiscard]] const Metrics& metrics() const { return metrics_; }
@@ -183,6 +187,7 @@ class FleetManagerNode {
   std::map<std::string, std::int64_t> queuedAt_;
   TaskReconciler reconciler_{0};
   Outbox recovered_;
+  std::int64_t epoch_ = 0;
   Metrics metrics_;
   metrics::Histogram ownAssignLatency_{assignLatencyBuckets()};
   metrics::Histogram* assignLatency_ = &ownAssignLatency_;

@@ -390,6 +390,9 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     }
     active = std::move(*created);
     auto& node = *active;
+    if (lease) {
+      node.setEpoch(lease->epoch());  // fences a predecessor that still sends (EpochFence)
+    }
     ops.health().setReady("lease", true);
     activeGauge.set(1);
     epochGauge.set(lease ? static_cast<double>(lease->epoch()) : 0.0);

@@ -13,10 +13,6 @@
 
 namespace fleet::manager::acks {
 
-inline msg::TaskState toMsg(TaskState s) {
-  return static_cast<msg::TaskState>(static_cast<int>(s));
-}
-
 /// The answer to `req`; `detail` cut to the field's 1023 characters.
 inline msg::TaskAck ack(const msg::Task& req, msg::AckResult r, msg::TaskState state, std::string detail,
                         std::int64_t nowNs) {

@@ -138,6 +138,16 @@ void AgentNode::onAssignments(std::vector<msg::TaskAssignment> assignments) {
   for (auto& a : assignments) {
     Agent* robot = hosted(a.robot_id);
     const auto why = refused(a);
+    if (!why && !managerEpoch_.admit(a.epoch)) {
+      // Sent by a fleet manager whose lease has passed to another: never acted on or answered.
+      if (robot != nullptr) {
+        refusals_.push_back({"TaskAssignment:stale_epoch", "ignored TaskAssignment for " + a.robot_id +
+                                                               " of manager epoch " +
+                                                               std::to_string(a.epoch) + " (newest " +
+                                                               std::to_string(managerEpoch_.newest()) + ")"});
+      }
+      continue;
+    }
     if (!why) {
       if (robot != nullptr) {
         robot->onAssignment(a);

@@ -21,6 +21,7 @@
 #include "agent.hpp"
 #include "agent_settings.hpp"
 #include "agent_world.hpp"
+#include "fleet/core/epoch_fence.hpp"
 #include "fleet/core/expected.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
@@ -114,6 +115,7 @@ class AgentNode {
   std::uint64_t cycles_ = 0;
   validation::Rejections rejections_;
   std::vector<Refusal> refusals_;
+  EpochFence managerEpoch_;  ///< TaskAssignments of an older fleet manager epoch are dropped
 };
 
 }  // namespace fleet::agent

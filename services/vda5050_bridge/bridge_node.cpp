@@ -81,6 +81,10 @@ void BridgeNode::sendOrder(Vehicle& v, const vda5050::Order& o, std::int64_t now
 }
 
 void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, BridgeOutbox& out) {
+  if (!managerEpoch_.admit(a.epoch)) {
+    ++counters_.stale_epoch;  // from a manager whose lease has passed to another: never acted on
+    return;
+  }
   auto it = vehicles_.find(a.robot_id);
   if (it == vehicles_.end()) {
     return;

@@ -47,6 +47,7 @@
 #include <utility>
 #include <vector>
 
+#include "fleet/core/epoch_fence.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/vda5050/order_builder.hpp"
 #include "fleet/vda5050/order_start.hpp"
@@ -108,6 +109,8 @@ struct BridgeCounters {
   /// from the traffic manager went further: an update that had not reached it (bridge or broker
   /// latency). The traffic manager counts the stops its own releases cause (base ends).
   std::uint64_t late_updates = 0;
+  /// TaskAssignments dropped because a fleet manager of a newer lease epoch had spoken (EpochFence).
+  std::uint64_t stale_epoch = 0;
 };
 
 class BridgeNode {
@@ -203,6 +206,7 @@ class BridgeNode {
   vda5050::KnownRoadmap roadmap_;
   std::optional<double> roadmap_radius_;  // m: Roadmap.robot_radius (none yet; 0: not stated, not checked)
   BridgeCounters counters_;
+  EpochFence managerEpoch_;
 };
 
 }  // namespace fleet::vdabridge

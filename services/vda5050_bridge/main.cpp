@@ -170,6 +170,8 @@ int run(const Settings& settings, const service::OpsSettings& opsSettings) {
   total("orders", "New orders sent", &vdabridge::BridgeCounters::orders);
   total("order_updates", "Order updates sent (more of the route released)",
         &vdabridge::BridgeCounters::updates);
+  total("stale_epoch_assignments", "TaskAssignments dropped: sent by a fleet manager of an older lease epoch",
+        &vdabridge::BridgeCounters::stale_epoch);
   total("cancels", "Orders cancelled", &vdabridge::BridgeCounters::cancels);
   total("releases_not_stitched", "Releases that did not extend the vehicle's base",
         &vdabridge::BridgeCounters::cannot_stitch);

@@ -43,6 +43,11 @@ void FleetView::dropEventLog(const EventLog* log) {
   }
 }
 
+std::uint64_t FleetView::staleEpochEvents() const {
+  std::lock_guard lock(logMutex_);
+  return static_cast<std::uint64_t>(managerEpoch_.dropped());
+}
+
 std::string FleetView::eventLogProblem() const {
   std::lock_guard lock(logMutex_);
   return logProblem_;
@@ -52,7 +57,16 @@ void FleetView::onEvent(const msg::TaskEvent& e) {
   onEvents({e});
 }
 
-void FleetView::onEvents(const std::vector<msg::TaskEvent>& events) {
+void FleetView::onEvents(const std::vector<msg::TaskEvent>& all) {
+  std::vector<msg::TaskEvent> events;
+  {
+    std::lock_guard lock(logMutex_);
+    for (const auto& e : all) {
+      if (managerEpoch_.admit(e.epoch)) {
+        events.push_back(e);
+      }
+    }
+  }
   for (const auto& e : events) {
     viewEvent(e);
   }

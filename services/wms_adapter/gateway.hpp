@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/core/epoch_fence.hpp"
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
 #include "proximity_counter.hpp"
@@ -89,6 +90,9 @@ class FleetView {
   /// Appends the event log refused (a disk error), and the last reason.
   [[nodiscard]] std::uint64_t eventLogFailures() const { return logFailures_.load(); }
   [[nodiscard]] std::string eventLogProblem() const;
+  /// Events dropped because a fleet manager of a newer lease epoch had spoken (EpochFence): a
+  /// manager that lost its lease cannot change a task's view, the event log or the stream.
+  [[nodiscard]] std::uint64_t staleEpochEvents() const;
   void onAccepted(const std::string& id, const std::string& body, msg::TaskState state, std::int64_t nowNs);
   void onRobot(const msg::RobotState& s);
   /// The risk map service's latest map (for the dashboard's iso-level layer).
@@ -181,6 +185,7 @@ class FleetView {
   EventLog* log_ = nullptr;
   std::string logProblem_;
   std::atomic<std::uint64_t> logFailures_{0};
+  EpochFence managerEpoch_;  // under logMutex_
   void viewEvent(const msg::TaskEvent& e);
   validation::Rejections rejections_;
 };

@@ -153,7 +153,7 @@ nlohmann::json HttpApi::eventLogJson() const {
   return {{"last_id", events_->lastId()},       {"pruned_through", events_->prunedThrough()},
           {"durable", events_->durable()},      {"append_failures", view_.eventLogFailures()},
           {"problem", view_.eventLogProblem()}, {"webhooks", hooks.size()},
-          {"webhooks_failing", failing}};
+          {"webhooks_failing", failing},        {"stale_epoch_events", view_.staleEpochEvents()}};
 }
 
 std::string HttpApi::nextRequestId() {

@@ -138,6 +138,7 @@ std::int64_t Dispatcher::etaOf(const TaskRecord& r) {
       return now;
     case TaskState::Failed:
     case TaskState::Cancelled:
+    case TaskState::Rejected:  // never a stored task's state
       eta_.ended(r.task.id, now, false);
       return 0;
     case TaskState::Queued:

@@ -7,9 +7,6 @@
 namespace fleet {
 namespace {
 
-constexpr std::array<std::string_view, 10> kStateNames = {"queued",     "assigned",  "en_route", "loading",
-                                                          "delivering", "unloading", "done",     "failed",
-                                                          "cancelled",  "requeued"};
 constexpr std::array<std::string_view, 4> kKindNames = {"transport", "goto", "charge", "park"};
 
 // Which step follows which on the happy path; failure, cancellation and requeue are added below.
@@ -38,13 +35,13 @@ bool forwardStep(TaskState from, TaskState to) {
 }  // namespace
 
 std::string_view toString(TaskState s) {
-  return kStateNames.at(static_cast<std::size_t>(s));
+  return taskStateName(s);
 }
 
 std::optional<TaskState> parseTaskState(std::string_view name) {
-  for (std::size_t i = 0; i < kStateNames.size(); ++i) {
-    if (kStateNames[i] == name) {
-      return static_cast<TaskState>(i);
+  for (const auto s : kAllTaskStates) {
+    if (taskStateName(s) == name) {
+      return s;
     }
   }
   return std::nullopt;
@@ -78,7 +75,7 @@ bool isWaiting(TaskState s) {
 
 Expected<void> checkTransition(TaskState from, TaskState to) {
   bool ok = false;
-  if (!isTerminal(from)) {
+  if (!isTerminal(from) && from != TaskState::Rejected) {  // a refused submission has no life after it
     ok = forwardStep(from, to) || to == TaskState::Failed || to == TaskState::Cancelled ||
          (to == TaskState::Requeued && isActive(from));
   }

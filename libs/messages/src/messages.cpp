@@ -5,9 +5,6 @@
 
 namespace fleet::msg {
 namespace {
-constexpr std::array<std::string_view, 11> kStates = {"queued",     "assigned",  "en_route", "loading",
-                                                      "delivering", "unloading", "done",     "failed",
-                                                      "cancelled",  "requeued",  "rejected"};
 constexpr std::array<std::string_view, 4> kKinds = {"transport", "goto", "charge", "park"};
 constexpr std::array<std::string_view, 7> kModes = {"idle",     "moving",  "waiting", "loading",
                                                     "charging", "blocked", "fault"};
@@ -25,7 +22,7 @@ bool lookup(const std::array<std::string_view, N>& names, const std::string& nam
 }  // namespace
 
 const char* toString(TaskState s) {
-  return kStates.at(static_cast<std::size_t>(s)).data();
+  return taskStateName(s).data();  // the names are string literals: NUL-terminated
 }
 const char* toString(TaskKind k) {
   return kKinds.at(static_cast<std::size_t>(k)).data();
@@ -34,7 +31,7 @@ const char* toString(RobotMode m) {
   return kModes.at(static_cast<std::size_t>(m)).data();
 }
 bool parse(const std::string& name, TaskState& out) {
-  return lookup(kStates, name, out);
+  return lookup(kTaskStateNames, name, out);
 }
 bool parse(const std::string& name, TaskKind& out) {
   return lookup(kKinds, name, out);

@@ -143,19 +143,15 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   out.priority = in.priority;
   out.deadline_ns = in.deadline_ns;
   out.eta_ns = in.eta_ns;
+  out.epoch = in.epoch;
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
-  return {getStr(in.task_id),
-          getEnum(in.state, msg::TaskState::Rejected),
-          getStr(in.robot_id),
-          getStr(in.reason),
-          in.stamp_ns,
-          in.seq,
-          getStr(in.station),
-          in.changed,
-          in.priority,
-          in.deadline_ns,
-          in.eta_ns};
+  return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
+          getStr(in.robot_id), getStr(in.reason),
+          in.stamp_ns,         in.seq,
+          getStr(in.station),  in.changed,
+          in.priority,         in.deadline_ns,
+          in.eta_ns,           in.epoch};
 }
 
 // ---- TaskAssignment
@@ -172,6 +168,7 @@ void Traits<msg::TaskAssignment>::toC(const msg::TaskAssignment& in, C& out, Are
   out.paused = in.paused;
   out.stamp_ns = in.stamp_ns;
   out.priority = in.priority;
+  out.epoch = in.epoch;
 }
 msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   msg::TaskAssignment m;
@@ -185,6 +182,7 @@ msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   m.paused = in.paused;
   m.stamp_ns = in.stamp_ns;
   m.priority = in.priority;
+  m.epoch = in.epoch;
   return m;
 }
 

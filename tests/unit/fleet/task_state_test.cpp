@@ -25,6 +25,19 @@ TEST(TaskState, NamesRoundTrip) {
   EXPECT_FALSE(parseTaskKind("deliver"));
 }
 
+TEST(TaskState, RejectedIsTheAnswerToARefusalNeverAStoredState) {
+  // One enum for the store, the wire and the API: its last value names a refused submission.
+  EXPECT_EQ(toString(TaskState::Rejected), "rejected");
+  EXPECT_EQ(kTaskStateNames.size(), kAllTaskStates.size() + 1);
+  EXPECT_FALSE(parseTaskState("rejected")) << "no stored task is in it";
+  EXPECT_FALSE(isWaiting(TaskState::Rejected));
+  EXPECT_FALSE(isActive(TaskState::Rejected));
+  for (auto s : kAllTaskStates) {
+    EXPECT_FALSE(checkTransition(s, TaskState::Rejected)) << toString(s);
+    EXPECT_FALSE(checkTransition(TaskState::Rejected, s)) << toString(s);
+  }
+}
+
 TEST(TaskState, HappyPathsAreLegal) {
   using S = TaskState;
   const std::vector<S> transport = {S::Queued,     S::Assigned,  S::EnRoute, S::Loading,

@@ -219,3 +219,47 @@ TEST_F(TaskChange, TheEventsOnTheWireCarryTheTasksEta) {
   EXPECT_GT(eta[first], 3'000) << "an assigned task is due after now";
   EXPECT_GT(eta[second], eta[first]) << "the waiting one after the robot's current task";
 }
+
+TEST_F(TaskChange, TheLeaseEpochIsStampedOnEveryAssignmentAndEventFromThenOn) {
+  {
+    auto node = open(0);
+    manager::Outbox out;
+    node->onRobotState(idle("r1", 1'000), 1'000);
+    node->onRequests({transport("t1", 0), transport("t2", 0)}, 2'000, out);
+    node->tick(3'000, out);
+    ASSERT_FALSE(out.assignments.empty());
+    for (const auto& e : out.events) {
+      EXPECT_EQ(e.epoch, 0) << "no lease: epoch 0";
+    }
+  }
+  // A standby that takes the lease (epoch 7) rebuilds from the store: what it re-publishes and
+  // everything after carries its epoch.
+  auto node = open(10'000);
+  node->setEpoch(7);
+  ASSERT_FALSE(node->recovered().events.empty());
+  ASSERT_FALSE(node->recovered().assignments.empty());
+  for (const auto& e : node->recovered().events) {
+    EXPECT_EQ(e.epoch, 7) << e.task_id;
+  }
+  for (const auto& a : node->recovered().assignments) {
+    EXPECT_EQ(a.epoch, 7) << a.robot_id;
+  }
+  manager::Outbox out;
+  const auto cancel = [] {
+    msg::Task t;
+    t.task_id = "t1";
+    t.request_id = "cancel-t1";
+    t.cancel = true;
+    return t;
+  }();
+  node->onRobotState(idle("r1", 11'000), 11'000);
+  node->onRequests({cancel}, 12'000, out);
+  node->tick(13'000, out);
+  ASSERT_FALSE(out.events.empty());
+  for (const auto& e : out.events) {
+    EXPECT_EQ(e.epoch, 7) << e.task_id;
+  }
+  for (const auto& a : out.assignments) {
+    EXPECT_EQ(a.epoch, 7) << a.robot_id;
+  }
+}

@@ -270,3 +270,32 @@ TEST(AgentSettings, TheProgressWatchTakesOneSetOfParametersFromTheFile) {
     EXPECT_NE(what.find("progress.stall_seconds"), std::string::npos) << what;
   }
 }
+
+TEST(AgentNode, AnOrderFromAManagerOfAnOlderEpochIsIgnoredOnceANewerOneHasSpoken) {
+  // A standby fleet manager took over (epoch 3) while the old one (epoch 2) still sends: its
+  // order is never acted on or answered, whatever its revision; the new manager's orders are.
+  auto node = nodeOn(floorWith({{"r1", {1.0, 1.0, 0.0}}, {"r2", {1.0, 8.0, 0.0}}}));
+  auto fresh = order("r1", "t-new");
+  fresh.epoch = 3;
+  node->onAssignments({fresh});
+  auto stale = order("r1", "t-old");
+  stale.epoch = 2;
+  stale.revision = 99;
+  auto staleOther = order("r2", "t-other");
+  staleOther.epoch = 2;
+  node->onAssignments({stale, staleOther});
+  const auto refusals = node->takeRefusals();
+  ASSERT_EQ(refusals.size(), 2u);
+  EXPECT_EQ(refusals[0].key, "TaskAssignment:stale_epoch");
+  EXPECT_NE(refusals[0].message.find("epoch 2 (newest 3)"), std::string::npos) << refusals[0].message;
+  const auto r1 = run(*node, "r1", 3);
+  ASSERT_FALSE(r1.empty());
+  EXPECT_EQ(r1.back().task_id, "t-new");
+  EXPECT_FALSE(node->find("r2")->busy()) << "the old manager's order for r2 was dropped too";
+
+  // Without a lease every manager says epoch 0: nothing is dropped.
+  auto plain = nodeOn(floorWith({{"r1", {1.0, 1.0, 0.0}}}));
+  plain->onAssignments({order("r1", "t1")});
+  EXPECT_TRUE(plain->takeRefusals().empty());
+  EXPECT_EQ(run(*plain, "r1", 2).back().task_id, "t1");
+}

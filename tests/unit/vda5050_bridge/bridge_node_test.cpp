@@ -540,5 +540,30 @@ TEST(Vda5050BridgeNode, ErrorsWithMissingFieldsDoNotUpsetTheBridge) {
   EXPECT_EQ(l.state().orderId, l.orders.back().orderId);
 }
 
+TEST(Vda5050BridgeNode, AnOrderFromAManagerOfAnOlderEpochIsIgnoredOnceANewerOneHasSpoken) {
+  // The vehicle drives task t1 of the manager of epoch 2; the manager it succeeded (epoch 1), still
+  // running, takes the task away: the bridge ignores it (counted) and the vehicle goes on.
+  Loop l;
+  msg::TaskAssignment a;
+  a.robot_id = "r1";
+  a.task_id = "t1";
+  a.epoch = 2;
+  a.goals = {{{5.0, 0.0, 0.0}, "", msg::GoalAction::None, 0.0}};
+  BridgeOutbox out;
+  l.bridge.onAssignment(a, l.now, out);
+  l.bridge.onRelease(release({0, 1}));
+  l.run(0.1);
+  ASSERT_TRUE(l.runUntilAt("n1", 20.0));
+  msg::TaskAssignment stale;
+  stale.robot_id = "r1";
+  stale.epoch = 1;
+  stale.revision = 99;
+  l.bridge.onAssignment(stale, l.now, out);
+  l.run(1.0);
+  EXPECT_EQ(count(l.instants, "cancelOrder"), 0U);
+  EXPECT_EQ(l.bridge.counters().stale_epoch, 1U);
+  EXPECT_EQ(l.bridge.counters().cancels, 0U);
+}
+
 }  // namespace
 }  // namespace fleet::vdabridge

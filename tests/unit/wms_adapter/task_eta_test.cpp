@@ -85,3 +85,20 @@ TEST(TaskEtaLog, AnOlderEventLogGetsTheColumnAndKeepsItsRows) {
   EXPECT_EQ(all[1].event.eta_ns, kEta);
   std::filesystem::remove_all(dir);
 }
+
+TEST_F(Api, EventsOfAnOlderManagerEpochChangeNoViewLogOrStream) {
+  // A standby manager took over (epoch 5); the one it fenced off (epoch 4) still sends an event.
+  start();
+  msg::TaskEvent fresh{"t-1", msg::TaskState::Assigned, "r-1", "allocated", 5, 2, ""};
+  fresh.epoch = 5;
+  view_.onEvent(fresh);
+  msg::TaskEvent stale{"t-1", msg::TaskState::Cancelled, "", "old manager", 6, 9, ""};
+  stale.epoch = 4;
+  view_.onEvent(stale);
+  const auto j = json::parse(client_->Get("/v1/tasks/t-1")->body);
+  EXPECT_EQ(j["state"], "assigned") << "the newer epoch's view stands";
+  EXPECT_EQ(api_->eventLog().after(0, 10).size(), 1u) << "the stale event is not logged";
+  EXPECT_EQ(view_.staleEpochEvents(), 1u);
+  const auto metrics = json::parse(client_->Get("/v1/metrics")->body);
+  EXPECT_EQ(metrics["event_log"]["stale_epoch_events"], 1);
+}

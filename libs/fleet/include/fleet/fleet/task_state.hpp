@@ -5,29 +5,14 @@
 #include <string_view>
 
 #include "fleet/core/expected.hpp"
+#include "fleet/core/task_state.hpp"
 
 namespace fleet {
 
 enum class TaskKind { Transport, Goto, Charge, Park };
 
-/// Life of a task. Transport tasks go queued → assigned → en_route → loading → delivering →
-/// unloading → done; go-to, charge and park tasks go queued → assigned → en_route → done.
-/// Any non-terminal state may end in failed or cancelled; an active task (assigned … unloading)
-/// may be requeued (its robot was lost or it failed with attempts left), and a requeued task is
-/// assigned again (directly or after going back to queued).
-enum class TaskState {
-  Queued,
-  Assigned,
-  EnRoute,
-  Loading,
-  Delivering,
-  Unloading,
-  Done,
-  Failed,
-  Cancelled,
-  Requeued
-};
-
+/// The states a stored task can be in (every TaskState but Rejected, the answer to a refused
+/// submission), in the enum's order.
 inline constexpr std::array<TaskState, 10> kAllTaskStates = {
     TaskState::Queued,     TaskState::Assigned,  TaskState::EnRoute, TaskState::Loading,
     TaskState::Delivering, TaskState::Unloading, TaskState::Done,    TaskState::Failed,

@@ -10,24 +10,14 @@
 
 #include "fleet/core/pose2.hpp"
 #include "fleet/core/robot_activity.hpp"
+#include "fleet/core/task_state.hpp"
 
 namespace fleet::msg {
 
 enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
 enum class TaskControl : std::uint8_t { None, Pause, Resume, Query, HoldRobot, ReleaseRobot, Change };
-enum class TaskState : std::uint8_t {
-  Queued,
-  Assigned,
-  EnRoute,
-  Loading,
-  Delivering,
-  Unloading,
-  Done,
-  Failed,
-  Cancelled,
-  Requeued,
-  Rejected
-};
+/// IDL TaskState (TS_QUEUED ... TS_REJECTED), in the same order: fleet/core/task_state.hpp.
+using TaskState = fleet::TaskState;
 enum class RobotMode : std::uint8_t { Idle, Moving, Waiting, Loading, Charging, Blocked, Fault };
 enum class SourceKind : std::uint8_t { Robot, Human };
 enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
@@ -82,6 +72,8 @@ struct TaskEvent {
   /// When the task is expected done, as the manager estimated it at this transition (TaskEta,
   /// UTC ns); 0: no estimate (no robot could take it, or it ended without being done).
   std::int64_t eta_ns = 0;
+  /// The publishing manager's lease epoch (0: no lease); readers drop events of an older one.
+  std::int64_t epoch = 0;
   bool operator==(const TaskEvent&) const = default;
 };
 
@@ -101,6 +93,8 @@ struct TaskAssignment {
   bool paused = false;
   std::int64_t stamp_ns = 0;
   std::int32_t priority = 0;  ///< the task's (higher first)
+  /// The publishing manager's lease epoch (0: no lease); readers drop orders of an older one.
+  std::int64_t epoch = 0;
   bool operator==(const TaskAssignment&) const = default;
 };
 
