@@ -632,7 +632,8 @@ EventSource Dashboard::stream() {
                          {"state", msg::toString(t.state)},
                          {"robot", t.robot},
                          {"reason", t.reason},
-                         {"stamp_ns", t.updatedNs}});
+                         {"stamp_ns", t.updatedNs},
+                         {"eta_ns", t.etaNs}});
       }
       std::string snapshot =
           "retry: 1000\nevent: snapshot\ndata: " +
@@ -653,7 +654,7 @@ EventSource Dashboard::stream() {
       chunk += "event: task\ndata: " +
                json{{"id", e.task_id},     {"state", msg::toString(e.state)}, {"robot", e.robot_id},
                     {"reason", e.reason},  {"stamp_ns", e.stamp_ns},          {"seq", e.seq},
-                    {"station", e.station}}
+                    {"station", e.station},    {"eta_ns", e.eta_ns}}
                    .dump(-1, ' ', false, json::error_handler_t::replace) +
                "\n\n";
     }

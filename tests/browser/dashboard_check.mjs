@@ -378,6 +378,46 @@ try {
     }, robot), 20000);
   }
 
+  // 4b. A waiting task changed from the queue's "change" dialog. Every robot is held through the
+  // API (a held robot is given no task), so the task submitted then stays queued; it is given
+  // priority 7 and a deadline 30 min ahead, and the adapter's task view has
+  // both (the deadline from this computer's clock, as the adapter stamps created times). Then it is
+  // cancelled and the robots are let go.
+  {
+    const api = async (method, p, body) => {
+      const r = await fetch(`${direct.origin}${p}`, { method, headers: { authorization: `Bearer ${token}`,
+        'content-type': 'application/json' }, body: body ? JSON.stringify(body) : undefined });
+      return { status: r.status, body: await r.json().catch(() => ({})) };
+    };
+    const robots = Object.keys(truth().robots);
+    const holds = await Promise.all(robots.map((r) => api('POST', `/v1/robots/${r}/pause`)));
+    const held = `ui-held-${Date.now()}`;
+    const posted = await api('POST', '/v1/tasks', { id: held, kind: 'transport', pickup: 'P-1', dropoff: 'D-2' });
+    check(posted.status === 201 && holds.every((h) => h.status < 300),
+          `a task to change is submitted while every robot is held (${posted.status}; ${holds.map((h) => h.status)})`);
+    const button = `#queue tr[data-task="${held}"] button`;
+    await until('the held task is listed with a change button', async () => {
+      const labels = await page.$$eval(button, (bs) => bs.map((b) => b.textContent));
+      return labels.includes('change');
+    }, 20000);
+    await page.evaluate((sel) => [...document.querySelectorAll(sel)].find((b) => b.textContent === 'change').click(), button);
+    await page.waitForSelector('#change[open]');
+    check((await page.$eval('#change-task', (el) => el.textContent)) === held, 'the change dialog names the task');
+    await page.type('#change-priority', '7');
+    await page.type('#change-deadline-min', '30');
+    await shot('4b-change.png');
+    await page.click('#change-ok');
+    const changed = await until('the change reached the task', async () => {
+      const v = await api('GET', `/v1/tasks/${held}`);
+      return v.body.task && v.body.task.priority === 7 && v.body.task.deadline_ns > 0 ? v.body.task : null;
+    }, 20000);
+    const ahead = changed ? (changed.deadline_ns / 1e6 - Date.now()) / 60000 : 0;
+    check(!!changed && Math.abs(ahead - 30) < 1,
+          `priority 7 and a deadline ${ahead.toFixed(1)} min ahead (${changed && changed.deadline})`);
+    await api('DELETE', `/v1/tasks/${held}`);
+    await Promise.all(robots.map((r) => api('POST', `/v1/robots/${r}/resume`)));
+  }
+
   // 5. The adapter restarts: the page says so, reconnects and catches up. Sessions are kept by the
   // adapter (logging out revokes them), so a restarted adapter knows none: the page asks for the
   // token again, and once given it is live and catches up.

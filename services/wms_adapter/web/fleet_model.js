@@ -128,7 +128,7 @@ export class FleetModel {
     if (e.state === 'done') {
       this.doneStamps.push(e.stamp_ns);
     }
-    Object.assign(t, { state: e.state, robot: e.robot, reason: e.reason, stamp_ns: e.stamp_ns });
+    Object.assign(t, { state: e.state, robot: e.robot, reason: e.reason, stamp_ns: e.stamp_ns, eta_ns: e.eta_ns || 0 });
     this.tasks.set(e.id, t);
     this.stamp(e.stamp_ns);
     this.log(`${e.id}: ${e.state}${e.robot ? ' (' + e.robot + ')' : ''}${e.reason ? ' — ' + e.reason : ''}`);

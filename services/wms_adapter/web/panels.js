@@ -30,11 +30,53 @@ export class Panels {
       ev.preventDefault();
       const pickup = document.getElementById('task-pickup').value;
       const dropoff = document.getElementById('task-dropoff').value;
+      const priority = Number(document.getElementById('task-priority').value || 0);
       const id = 'ui-' + new Date().toISOString().replace(/[-:.TZ]/g, '').slice(0, 14) + '-' +
                  Math.floor(Math.random() * 1e4);
-      this.confirmThen(`Submit transport task ${id}: ${pickup} → ${dropoff}?`, () =>
-        this.act(`task ${id}`, 'POST', '/v1/tasks', { id, kind: 'transport', pickup, dropoff }));
+      const task = { id, kind: 'transport', pickup, dropoff };
+      if (priority) {
+        task.priority = priority;
+      }
+      this.confirmThen(`Submit transport task ${id}: ${pickup} → ${dropoff}` +
+                       `${priority ? ', priority ' + priority : ''}?`, () =>
+        this.act(`task ${id}`, 'POST', '/v1/tasks', task));
     });
+  }
+
+  /** The change dialog for waiting task `id`: PATCH /v1/tasks/{id} with what was filled in. */
+  changeTask(id) {
+    const dlg = document.getElementById('change');
+    document.getElementById('change-task').textContent = id;
+    const priority = document.getElementById('change-priority');
+    const minutes = document.getElementById('change-deadline-min');
+    priority.value = '';
+    minutes.value = '';
+    dlg.returnValue = '';
+    dlg.onclose = () => {
+      if (dlg.returnValue !== 'ok') {
+        return;
+      }
+      const body = {};
+      if (priority.value !== '') {
+        body.priority = Number(priority.value);
+      }
+      if (minutes.value !== '') {
+        // As RFC 3339 from this computer's clock, as the adapter stamps a task's created time (a
+        // simulation's fleet clock is simulated and would put the deadline before the task).
+        const m = Number(minutes.value);
+        if (m > 0) {
+          body.deadline = new Date(Date.now() + m * 60000).toISOString();
+        } else {
+          body.deadline_ns = 0;
+        }
+      }
+      if (!Object.keys(body).length) {
+        this.model.log(`change ${id}: nothing to change`);
+        return;
+      }
+      this.act(`change ${id}`, 'PATCH', `/v1/tasks/${encodeURIComponent(id)}`, body);
+    };
+    dlg.showModal();
   }
 
   /** What the session may do (GET /v1/session): actions needing another scope are greyed out. */
@@ -157,12 +199,22 @@ export class Panels {
     const rows = open.slice(0, QUEUE_ROWS).map((t) => {
       const tr = document.createElement('tr');
       tr.dataset.task = t.id;
-      for (const text of [t.id, t.state || '?', t.robot || '']) {
+      for (const text of [t.id, t.state || '?', t.robot || '', etaText(t.eta_ns, this.model.latestStampNs)]) {
         const td = document.createElement('td');
         td.textContent = text;
         tr.append(td);
       }
       const td = document.createElement('td');
+      if (cancellable && (t.state === 'queued' || t.state === 'requeued')) {
+        const change = document.createElement('button');
+        change.type = 'button';
+        change.textContent = 'change';
+        change.dataset.scope = 'submit';
+        change.disabled = offline;
+        change.title = offline ? unreachable : 'its priority or deadline';
+        change.addEventListener('click', () => this.changeTask(t.id));
+        td.append(change);
+      }
       if (cancellable) {  // not offered at all without the scope: one greyed button per row is noise
         const cancel = document.createElement('button');
         cancel.type = 'button';
@@ -216,6 +268,18 @@ export class Panels {
     });
     list.replaceChildren(...items);
   }
+}
+
+/** "in 42 s", "in 3 min", "due" (past), "" (no estimate): the ETA against the fleet's newest stamp. */
+function etaText(etaNs, nowNs) {
+  if (!etaNs) {
+    return '';
+  }
+  const s = (etaNs - nowNs) / 1e9;
+  if (s <= 0) {
+    return 'due';
+  }
+  return s < 120 ? `in ${Math.round(s)} s` : `in ${Math.round(s / 60)} min`;
 }
 
 function fillList(dl, entries) {
