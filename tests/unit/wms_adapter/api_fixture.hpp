@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -21,6 +22,7 @@
 
 #include "http_api.hpp"
 #include "openapi_contract.hpp"
+#include "sqlite_db.hpp"
 
 namespace fleet::wms::testing {
 
@@ -126,6 +128,36 @@ class SpecWatch {
   std::mutex m_;
   std::vector<std::string> problems_;
 };
+
+/// An event log file as an older adapter wrote it: table task_events with the columns of the first
+/// version plus `extraColumns` (", priority INTEGER, ..."), and one event of task "old" logged `nowNs`
+/// (not pruned). In a fresh directory `name`_<pid> under the temporary directory; returns the path.
+inline std::string writeOlderEventLog(const std::string& name, const std::string& extraColumns,
+                                      std::int64_t nowNs) {
+  const auto dir = std::filesystem::temp_directory_path() / (name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "events.db").string();
+  SqliteDb db(path);
+  const std::string table =
+      "CREATE TABLE task_events(id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER "
+      "NOT NULL, state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT "
+      "NULL, station TEXT NOT NULL, logged_ns INTEGER NOT NULL" +
+      extraColumns + ");";
+  db.exec(table.c_str());
+  const std::string row =
+      "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, station, logged_ns) "
+      "VALUES ('old', 1, 'queued', '', 'submitted', 1, '', " +
+      std::to_string(nowNs) + ");";
+  db.exec(row.c_str());
+  return path;
+}
+
+inline std::int64_t wallNowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 inline StationMap stations() {
   return *StationMap::fromJson(json::parse(R"({"stations": [

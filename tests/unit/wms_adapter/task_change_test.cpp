@@ -192,26 +192,9 @@ TEST_F(TaskChangeApi, TheChangeEventUpdatesTheTaskViewAndIsLoggedWithTheNewValue
 }
 
 TEST(TaskChangeLog, ChangesSurviveInAnEventLogFileAndAnOlderFileGetsTheColumns) {
-  const auto dir = std::filesystem::temp_directory_path() / ("wms_change_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "events.db").string();
-  const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                       std::chrono::system_clock::now().time_since_epoch())
-                       .count();
-  {
-    // An event log as the adapter wrote it before changes were logged (logged now: not pruned).
-    SqliteDb db(path);
-    db.exec(
-        "CREATE TABLE task_events(id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER "
-        "NOT NULL, state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT "
-        "NULL, station TEXT NOT NULL, logged_ns INTEGER NOT NULL);");
-    const std::string row =
-        "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, station, logged_ns) "
-        "VALUES ('old', 1, 'queued', '', 'submitted', 1, '', " +
-        std::to_string(now) + ");";
-    db.exec(row.c_str());
-  }
+  // An event log as the adapter wrote it before changes were logged.
+  const auto now = wallNowNs();
+  const std::string path = writeOlderEventLog("wms_change", "", now);
   {
     EventLog log({path}, std::make_shared<SqliteDb>(path));
     msg::TaskEvent e{"old", msg::TaskState::Queued, "", "changed", 2, 2, ""};
@@ -227,5 +210,5 @@ TEST(TaskChangeLog, ChangesSurviveInAnEventLogFileAndAnOlderFileGetsTheColumns) 
   EXPECT_TRUE(all[1].event.changed);
   EXPECT_EQ(all[1].event.priority, -4);
   EXPECT_EQ(all[1].event.deadline_ns, 77);
-  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
 }

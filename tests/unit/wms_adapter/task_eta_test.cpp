@@ -52,26 +52,9 @@ TEST_F(Api, TheTasksViewAndItsLoggedEventStateTheEta) {
 }
 
 TEST(TaskEtaLog, AnOlderEventLogGetsTheColumnAndKeepsItsRows) {
-  const auto dir = std::filesystem::temp_directory_path() / ("wms_eta_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "events.db").string();
-  const auto now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                       std::chrono::system_clock::now().time_since_epoch())
-                       .count();
-  {
-    // The log as the adapter wrote it before events carried an ETA (with the change columns).
-    SqliteDb db(path);
-    db.exec(
-        "CREATE TABLE task_events(id INTEGER PRIMARY KEY AUTOINCREMENT, task_id TEXT NOT NULL, seq INTEGER "
-        "NOT NULL, state TEXT NOT NULL, robot TEXT NOT NULL, reason TEXT NOT NULL, stamp_ns INTEGER NOT "
-        "NULL, station TEXT NOT NULL, logged_ns INTEGER NOT NULL, priority INTEGER, deadline_ns INTEGER);");
-    const std::string row =
-        "INSERT INTO task_events(task_id, seq, state, robot, reason, stamp_ns, station, logged_ns) "
-        "VALUES ('old', 1, 'queued', '', 'submitted', 1, '', " +
-        std::to_string(now) + ");";
-    db.exec(row.c_str());
-  }
+  // The log as the adapter wrote it before events carried an ETA (with the change columns).
+  const auto now = wallNowNs();
+  const std::string path = writeOlderEventLog("wms_eta", ", priority INTEGER, deadline_ns INTEGER", now);
   {
     EventLog log({path}, std::make_shared<SqliteDb>(path));
     msg::TaskEvent e{"old", msg::TaskState::Assigned, "r-1", "allocated", 2, 2, ""};
@@ -83,7 +66,7 @@ TEST(TaskEtaLog, AnOlderEventLogGetsTheColumnAndKeepsItsRows) {
   ASSERT_EQ(all.size(), 2u);
   EXPECT_EQ(all[0].event.eta_ns, 0) << "the old row has no estimate";
   EXPECT_EQ(all[1].event.eta_ns, kEta);
-  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(std::filesystem::path(path).parent_path());
 }
 
 TEST_F(Api, EventsOfAnOlderManagerEpochChangeNoViewLogOrStream) {
