@@ -177,7 +177,16 @@ std::int64_t Dispatcher::waitingEta(const TaskRecord& r, std::int64_t nowNs) con
       }
     }
   }
-  return eta_.waiting(nowNs, ahead, registry_.onlineCount(), predicted);
+  // The robots that may take it: online and not held by the operator (a held robot is given no
+  // task). None: no estimate.
+  std::size_t robots = registry_.onlineCount();
+  for (const auto& id : held_) {
+    const RobotInfo* robot = registry_.find(id);
+    if (robot != nullptr && !robot->lost && robots > 0) {
+      --robots;
+    }
+  }
+  return eta_.waiting(nowNs, ahead, robots, predicted);
 }
 
 Expected<DispatchResult> Dispatcher::recover(std::int64_t nowNs) {

@@ -154,6 +154,22 @@ TEST_F(DispatcherTest, EveryTransitionStatesTheTasksEta) {
   EXPECT_EQ(c->events.back().etaNs, 0);
 }
 
+// A held robot is given no task, so it counts for no waiting task's estimate: with the only robot
+// held a new task has none (0), and once it is let go the next one has one again.
+TEST_F(DispatcherTest, AWaitingTaskHasNoEtaWhileEveryRobotIsHeld) {
+  robot("r1", 10, 0.9, 0);
+  ASSERT_TRUE(dispatcher->setRobotHeld("r1", true, 0));
+  DispatchResult held;
+  dispatcher->submit({transport("a")}, kSec, &held);
+  ASSERT_EQ(held.events.size(), 1u);
+  EXPECT_EQ(held.events[0].etaNs, 0) << "no robot may take it";
+  ASSERT_TRUE(dispatcher->setRobotHeld("r1", false, 2 * kSec));
+  DispatchResult free;
+  dispatcher->submit({transport("b")}, 3 * kSec, &free);
+  ASSERT_EQ(free.events.size(), 1u);
+  EXPECT_GT(free.events[0].etaNs, 3 * kSec);
+}
+
 /// A task the store holds but the dispatcher never took in: an earlier attempt's commit went
 /// through but its answer was lost (the connection to PostgreSQL broke after the commit, as in a
 /// database fail-over, DatabaseFailover.APromotionWithinTheLeaseLosesNothingEither). Its retry is
