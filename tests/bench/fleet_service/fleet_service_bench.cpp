@@ -1,5 +1,7 @@
-// The fleet manager and WMS adapter as real processes (durable SQLite, synchronous=FULL), with
-// 200 simulated robots online over DDS:
+// The fleet manager and WMS adapter as real processes, with 200 simulated robots online over DDS,
+// on each task store in one run: durable SQLite (synchronous=FULL, WAL), then PostgreSQL 15 (a
+// server of the bench's own on a Unix socket, fsync and synchronous commit on; the manager takes
+// the lease as a lone active manager does):
 //  - PostToAssignment: latency from the start of an HTTP POST of one task to the moment a robot
 //    receives its TaskAssignment (robots finish tasks at once, so one is always idle);
 //  - Intake: sustained HTTP intake with several clients posting batches (2xx = durably stored).
@@ -19,6 +21,7 @@
 
 #include "fleet/core/clock.hpp"
 #include "fleet/transport/dds.hpp"
+#include "postgres_server.hpp"
 #include "test_process.hpp"
 
 using namespace fleet;
@@ -31,7 +34,8 @@ namespace {
 constexpr int kRobots = 200;
 
 struct Fleet {
-  Fleet() {
+  /// `store`: "sqlite" or "postgresql".
+  explicit Fleet(const std::string& store) : name(store) {
     domain = std::to_string(test::uniqueDomain());
     setenv("FLEET_DDS_DOMAIN", domain.c_str(), 1);
     dir = std::filesystem::temp_directory_path() / ("fleet_bench_" + domain);
@@ -43,11 +47,19 @@ struct Fleet {
           {{"name", "S-" + std::to_string(i)}, {"x", 2.0 * i}, {"y", 5.0}, {"kinds", {"pickup", "dropoff"}}});
     }
     std::ofstream(dir / "stations.json") << json{{"stations", stations}}.dump();
-    std::ofstream(dir / "manager.json") << json{
-        {"db", (dir / "fleet.db").string()},
-        {"stations", (dir / "stations.json").string()},
-        {"lease_s", 5.0},
-        {"sync", "full"}}.dump();
+    json config = {{"stations", (dir / "stations.json").string()}, {"lease_s", 5.0}};
+    if (store == "postgresql") {
+      pg = std::make_unique<test::PostgresServer>(true);
+      if (!pg->ok()) {
+        error = "PostgreSQL: " + pg->error();
+        return;
+      }
+      config["store"] = pg->url();
+    } else {
+      config["db"] = (dir / "fleet.db").string();
+      config["sync"] = "full";
+    }
+    std::ofstream(dir / "manager.json") << config.dump();
     port = test::freePort();
     manager = std::make_unique<test::ChildProcess>(
         FLEET_BINARY_DIR "/services/fleet_manager/fleet_manager",
@@ -72,9 +84,12 @@ struct Fleet {
   }
   ~Fleet() {
     stop = true;
-    robots.join();
+    if (robots.joinable()) {
+      robots.join();
+    }
     adapter.reset();
     manager.reset();
+    pg.reset();
     std::filesystem::remove_all(dir);
   }
 
@@ -124,6 +139,9 @@ struct Fleet {
     }
   }
 
+  std::string name;
+  std::string error;  ///< why the fleet could not start (the benchmarks then fail with it)
+  std::unique_ptr<test::PostgresServer> pg;
   std::string domain;
   std::filesystem::path dir;
   int port = 0;
@@ -136,11 +154,29 @@ struct Fleet {
   std::map<std::string, Clk::time_point> received;
 };
 
-Fleet* gFleet = nullptr;
+std::unique_ptr<Fleet> gFleet;
 std::atomic<int> gNext{0};
 
-void BM_PostToAssignment(benchmark::State& state) {
-  Fleet& f = *gFleet;
+/// The fleet on `store`, started on first use; the other store's fleet is stopped first (the
+/// benchmarks of one store are registered together, so each fleet starts once).
+Fleet* fleetOn(const std::string& store, benchmark::State& state) {
+  if (!gFleet || gFleet->name != store) {
+    gFleet.reset();
+    gFleet = std::make_unique<Fleet>(store);
+  }
+  if (!gFleet->error.empty()) {
+    state.SkipWithError(gFleet->error.c_str());
+    return nullptr;
+  }
+  return gFleet.get();
+}
+
+void BM_PostToAssignment(benchmark::State& state, const std::string& store) {
+  Fleet* fleet = fleetOn(store, state);
+  if (fleet == nullptr) {
+    return;
+  }
+  Fleet& f = *fleet;
   f.finish = true;
   httplib::Client c("127.0.0.1", f.port);
   std::vector<double> ms;
@@ -182,8 +218,12 @@ void BM_PostToAssignment(benchmark::State& state) {
   }
 }
 
-void BM_Intake(benchmark::State& state) {
-  Fleet& f = *gFleet;
+void BM_Intake(benchmark::State& state, const std::string& store) {
+  Fleet* fleet = fleetOn(store, state);
+  if (fleet == nullptr) {
+    return;
+  }
+  Fleet& f = *fleet;
   f.finish = false;
   const int clients = static_cast<int>(state.range(0));
   const int batch = static_cast<int>(state.range(1));
@@ -222,8 +262,21 @@ void BM_Intake(benchmark::State& state) {
   state.counters["tasks_per_s"] = static_cast<double>(stored) / seconds;
 }
 
-BENCHMARK(BM_PostToAssignment)->Iterations(500)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Intake)
+BENCHMARK_CAPTURE(BM_PostToAssignment, sqlite, std::string("sqlite"))
+    ->Iterations(500)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Intake, sqlite, std::string("sqlite"))
+    ->Args({4, 50})
+    ->Args({8, 100})
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_PostToAssignment, postgresql, std::string("postgresql"))
+    ->Iterations(500)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Intake, postgresql, std::string("postgresql"))
     ->Args({4, 50})
     ->Args({8, 100})
     ->Iterations(1)
@@ -234,10 +287,8 @@ BENCHMARK(BM_Intake)
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  Fleet fleet;
-  gFleet = &fleet;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  gFleet = nullptr;
+  gFleet.reset();
   return 0;
 }
