@@ -197,6 +197,7 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   }
   std::unique_ptr<FleetManagerNode> n(new FleetManagerNode());
   n->settings_ = s;
+  n->site_ = site;
   n->reconciler_ = TaskReconciler(secToNs(s.reconcileS));
   n->store_ = std::move(*store);
   DispatcherConfig dc;
@@ -319,6 +320,27 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
   }
   a.revision = nextRevision(o.robotId, nowNs);
   return a;
+}
+
+std::vector<std::string> FleetManagerNode::onClosures(const std::vector<msg::TrafficClosure>& closures,
+                                                      std::int64_t nowNs, Outbox& out) {
+  std::vector<std::string> errors;
+  if (closures.empty() || !site_) {
+    return errors;
+  }
+  if (!closures_) {
+    closures_ = std::make_unique<ClosedStations>(traffic::buildRoadmap(*site_, settings_.roadmap));
+  }
+  for (const auto& c : closures) {
+    if (auto e = closures_->apply(c)) {
+      errors.push_back(std::move(*e));
+    }
+  }
+  auto closed = closures_->closed();
+  if (closed != dispatcher_->closedStations()) {
+    publish(dispatcher_->setClosedStations(std::move(closed), nowNs), nowNs, out);
+  }
+  return errors;
 }
 
 void FleetManagerNode::setEpoch(std::int64_t epoch) {

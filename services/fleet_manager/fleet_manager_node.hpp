@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "closed_stations.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/task_reconciler.hpp"
@@ -152,6 +153,12 @@ class FleetManagerNode {
   /// TaskAssignment and TaskEvent from now on, and on recovered(), so that readers drop what a
   /// manager of an older epoch still sends (EpochFence).
   void setEpoch(std::int64_t epoch);
+  /// Roadmap closures (TrafficClosure, as the traffic manager gets them): the stations they close
+  /// hold back their waiting tasks with a stated reason (Dispatcher::setClosedStations). Read on
+  /// the manager's own roadmap of the site (built at the first closure); without a site they are
+  /// ignored. Returns what was wrong with each closure refused (for the log); nothing changes then.
+  std::vector<std::string> onClosures(const std::vector<msg::TrafficClosure>& closures, std::int64_t nowNs,
+                                      Outbox& out);
 
   [[nodiscard]] const Dispatcher& dispatcher() const { return *dispatcher_; }
   [[nodiscard]] const Metrics& metrics() const { return metrics_; }
@@ -188,6 +195,8 @@ class FleetManagerNode {
   TaskReconciler reconciler_{0};
   Outbox recovered_;
   std::int64_t epoch_ = 0;
+  std::shared_ptr<const site::Site> site_;
+  std::unique_ptr<ClosedStations> closures_;
   Metrics metrics_;
   metrics::Histogram ownAssignLatency_{assignLatencyBuckets()};
   metrics::Histogram* assignLatency_ = &ownAssignLatency_;

@@ -296,12 +296,37 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
   transport::Writer<msg::TaskAck> acks(p);
   transport::Writer<msg::TaskEvent> events(p);
   transport::Writer<msg::TaskAssignment> assignments(p);
+  // Roadmap closures from operators (the WMS adapter): the stations they close hold back their
+  // tasks. Optional, as for the traffic manager, under permissions that predate the reader.
+  std::optional<transport::Reader<msg::TrafficClosure>> closuresIn;
+  try {
+    closuresIn.emplace(p);
+  } catch (const std::exception& e) {
+    spdlog::warn(
+        "fleet manager: run-time closures cannot be read (tasks to closed stations are assigned): {}",
+        e.what());
+  }
   transport::WaitSet ws(p);
   ws.attach(tasks);
+  if (closuresIn) {
+    ws.attach(*closuresIn);
+  }
   ws.attach(statuses);
   ws.attach(states);
   service::RateLimitedLog badInput;
   validation::Rejections rejections;  // samples refused at the edge, in the metrics as "samples"
+  // Every closure heard (by id, the newest), so a manager that becomes active again starts from them.
+  std::map<std::string, msg::TrafficClosure> closuresHeard;
+  const auto takeClosures = [&](std::vector<msg::TrafficClosure>& fresh) {
+    if (closuresIn) {
+      for (auto& c : closuresIn->take()) {
+        if (validation::admit(c, rejections)) {
+          closuresHeard[c.closure_id] = c;
+          fresh.push_back(std::move(c));
+        }
+      }
+    }
+  };
   std::unique_ptr<manager::FleetManagerNode> active;  // while this manager is active
   auto metrics = [&] {
     auto j = active ? active->metricsJson() : nlohmann::json::object();
@@ -393,6 +418,25 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
     if (lease) {
       node.setEpoch(lease->epoch());  // fences a predecessor that still sends (EpochFence)
     }
+    const auto applyClosures = [&](const std::vector<msg::TrafficClosure>& cs, manager::Outbox& into) {
+      for (const auto& e : node.onClosures(cs, clock.nowNs(), into)) {
+        badInput.warn("closure", "closure refused: " + e);
+      }
+      if (!cs.empty() && !node.dispatcher().closedStations().empty()) {
+        spdlog::warn("fleet manager: stations closed by roadmap closures: {} (their waiting tasks are held)",
+                     node.dispatcher().closedStations().size());
+      }
+    };
+    manager::Outbox closedOut;  // published after the recovered state
+    {
+      std::vector<msg::TrafficClosure> fresh;
+      takeClosures(fresh);
+      std::vector<msg::TrafficClosure> all;
+      for (const auto& [id, c] : closuresHeard) {
+        all.push_back(c);
+      }
+      applyClosures(all, closedOut);
+    }
     ops.health().setReady("lease", true);
     activeGauge.set(1);
     epochGauge.set(lease ? static_cast<double>(lease->epoch()) : 0.0);
@@ -409,6 +453,10 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
                    node.dispatcher().openTasks().size(),
                    pgStore ? pg::redacted(settings.store.url) : settings.db, rec.assignments.size());
       send(rec);
+      if (lease && !lease->held()) {
+        closedOut = {};
+      }
+      send(closedOut);
     }
     spdlog::info("fleet manager: {} stations, tick {} s, lease {} s, reconcile {} s, clock {}",
                  node.dispatcher().stations().size(), settings.tickS, settings.leaseS, settings.reconcileS,
@@ -470,6 +518,14 @@ int run(const manager::Settings& settings, const service::OpsSettings& opsSettin
       bool changed = !reqs.empty();
       if (!reqs.empty()) {
         node.onRequests(reqs, now, out);
+      }
+      {
+        std::vector<msg::TrafficClosure> fresh;
+        takeClosures(fresh);
+        if (!fresh.empty()) {
+          applyClosures(fresh, out);
+          changed = true;
+        }
       }
       for (const auto& s : service::admitted(heldStatuses.with(statuses.take()), rejections, badInput)) {
         node.onStatus(s, now, out);

@@ -14,6 +14,8 @@ namespace fleet::test {
 
 /// Robots played by the test: publish RobotState, obey TaskAssignment by reporting each step.
 struct FakeRobots {
+  /// Where the first robot stands; the others 1 m apart in x.
+  Vec2 origin{0, 0};
   explicit FakeRobots(transport::Participant& p, int n) : states(p), statuses(p), orders(p) {
     for (int i = 0; i < n; ++i) {
       ids.push_back("r" + std::to_string(i));
@@ -27,7 +29,7 @@ struct FakeRobots {
       msg::RobotState s;
       s.robot_id = ids[i];
       s.stamp_ns = c.nowNs();
-      s.pose = {static_cast<double>(i), 0, 0};
+      s.pose = {origin.x + static_cast<double>(i), origin.y, 0};
       s.battery = 0.9f;
       s.radius = 0.3f;
       s.task_id = current.count(ids[i]) ? current[ids[i]].task_id : "";

@@ -614,7 +614,7 @@ void Dispatcher::allocate(std::int64_t nowNs, DispatchResult& out) {
   std::vector<Task> waiting;
   bool choosing = false;
   for (const auto& [id, r] : open_) {
-    if (isWaiting(r.state) && !r.paused) {
+    if (isWaiting(r.state) && !r.paused && closedStationOf(r.task) == nullptr) {
       waiting.push_back(r.task);
       choosing = choosing || needsStation(r.task);
     }
@@ -795,6 +795,7 @@ DispatchResult Dispatcher::tick(std::int64_t nowNs) {
   completeCharged(nowNs, out);
   chargeLowRobots(nowNs, out);
   allocate(nowNs, out);
+  noteClosedStations(nowNs, out);
   // A released robot that got a new task in the same tick must not have it withdrawn by the empty
   // assignment published after it: the new order replaces the charge order anyway.
   std::erase_if(out.revoked, [&](const std::string& robot) {

@@ -435,3 +435,63 @@ TEST_F(FleetE2E, AdapterRestartedAfterAManagerRestartFindsEveryStoredTask) {
   }
   EXPECT_EQ(listed, ids.size() - 1);
 }
+
+// A roadmap closure over a station, made over HTTP: the adapter sends it (TrafficClosure), the
+// manager (on the site's roadmap) holds the waiting task to that station with the reason, and
+// assigns it once the closure is reopened.
+TEST_F(FleetE2E, AClosureOverHttpHoldsTheTaskToItsStationUntilReopened) {
+  // This test's fleet on the small warehouse's site (the manager needs its roadmap).
+  adapter_.reset();
+  manager_.reset();
+  const std::string site = FLEET_SOURCE_DIR "/sim/scenarios/small_warehouse.site.json";
+  std::ofstream(dir_ / "manager.json") << json{
+      {"db", (dir_ / "site.db").string()},
+      {"stations", site},
+      {"tick_s", 0.05},
+      {"lease_s", 2.0},
+      {"sync", "normal"}}.dump();
+  std::ofstream(dir_ / "stations.json") << std::ifstream(site).rdbuf();
+  startManager();
+  startAdapter();
+  waitHealthy();
+  auto r =
+      http_->Put("/v1/traffic/closures/spill",
+                 R"({"area": [[27.9, 3.3], [29.3, 3.3], [29.3, 4.7], [27.9, 4.7]], "reason": "wet floor"})",
+                 "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_LT(r->status, 300) << r->body;
+  std::this_thread::sleep_for(500ms);  // the manager has the closure before the task
+  r = http_->Post("/v1/tasks", R"({"id": "to-d1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})",
+                  "application/json");
+  ASSERT_EQ(r->status, 201) << r->body;
+  transport::Participant p;
+  FakeRobots robots(p, 2);
+  robots.origin = {3.0, 0.9};  // on PARK-1 and PARK-2
+  auto waitFor = [&](const std::function<bool(const json&)>& ok, std::chrono::seconds within) {
+    const auto end = Clk::now() + within;
+    json t;
+    while (Clk::now() < end) {
+      robots.publishStates();
+      robots.work();
+      t = getTask("to-d1");
+      if (ok(t)) {
+        break;
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    return t;
+  };
+  auto t =
+      waitFor([](const json& j) { return j.value("reason", "").find("closed") != std::string::npos; }, 10s);
+  EXPECT_EQ(t.value("reason", ""), "station D-1 closed: closure 'spill': wet floor") << t.dump();
+  EXPECT_EQ(t.value("state", ""), "queued");
+  EXPECT_FALSE(t.contains("eta_ns")) << "no estimate while held";
+  std::this_thread::sleep_for(1s);
+  EXPECT_EQ(getTask("to-d1").value("state", ""), "queued") << "robots are free, but the station is closed";
+
+  r = http_->Delete("/v1/traffic/closures/spill");
+  ASSERT_TRUE(r);
+  ASSERT_LT(r->status, 300) << r->body;
+  t = waitFor([](const json& j) { return j.value("state", "") == "done"; }, 20s);
+  EXPECT_EQ(t.value("state", ""), "done") << t.dump();
+}

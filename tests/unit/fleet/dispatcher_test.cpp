@@ -170,6 +170,36 @@ TEST_F(DispatcherTest, AWaitingTaskHasNoEtaWhileEveryRobotIsHeld) {
   EXPECT_GT(free.events[0].etaNs, 3 * kSec);
 }
 
+// A station closed at run time holds back the waiting tasks that need it, with a stated reason and
+// no estimate, while others are assigned; reopened, it says so and its task is assigned.
+TEST_F(DispatcherTest, AWaitingTaskToAClosedStationIsHeldWithItsReasonUntilItReopens) {
+  robot("r1", 10, 0.9, 0);
+  robot("r2", 12, 0.9, 0);
+  dispatcher->submit({transport("closed")}, 0);
+  auto held = dispatcher->setClosedStations({{"D-1", "closure 'spill': wet floor"}}, kSec / 10);
+  ASSERT_EQ(held.events.size(), 1u);
+  EXPECT_EQ(held.events[0].taskId, "closed");
+  EXPECT_EQ(held.events[0].reason, "station D-1 closed: closure 'spill': wet floor");
+  EXPECT_EQ(held.events[0].etaNs, 0) << "no estimate while held";
+  Task other;
+  other.id = "other";
+  other.kind = TaskKind::Goto;
+  other.station = "K-1";
+  dispatcher->submit({other}, 2 * kSec / 10);
+  auto out = dispatcher->tick(3 * kSec / 10);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "other") << "the closed station's task waits";
+  EXPECT_EQ(stateOf("closed"), S::Queued);
+  EXPECT_TRUE(dispatcher->tick(4 * kSec / 10).events.empty()) << "the reason is stated once";
+
+  auto reopened = dispatcher->setClosedStations({}, 5 * kSec / 10);
+  ASSERT_EQ(reopened.events.size(), 1u);
+  EXPECT_EQ(reopened.events[0].reason, "station D-1 open again; waiting for a robot");
+  out = dispatcher->tick(6 * kSec / 10);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "closed");
+}
+
 /// A task the store holds but the dispatcher never took in: an earlier attempt's commit went
 /// through but its answer was lost (the connection to PostgreSQL broke after the commit, as in a
 /// database fail-over, DatabaseFailover.APromotionWithinTheLeaseLosesNothingEither). Its retry is

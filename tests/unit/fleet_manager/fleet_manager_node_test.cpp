@@ -728,3 +728,62 @@ TEST_F(Node, AnOrderWhoseStationIsNotOnTheSiteFailsTheTaskInsteadOfDrivingToTheO
   EXPECT_TRUE(node->dispatcher().openTasks().empty());
   EXPECT_EQ(node->metricsJson()["bad_orders"], 1);
 }
+
+// A station closed at run time (an operator's roadmap closure over its dock, as the WMS adapter
+// sends it): the waiting task that needs it is held with a stated reason and no ETA, while a task
+// elsewhere is assigned; a closure naming a node not on the roadmap is refused and changes
+// nothing; once lifted the held task is assigned.
+TEST_F(Node, AClosureOverAStationHoldsItsWaitingTasksWithTheReasonUntilLifted) {
+  const auto site = smallWarehouse();
+  auto n = manager::FleetManagerNode::create(settings_, fleet::stationMapOf(*site), 1'000, site);
+  ASSERT_TRUE(n) << n.error().message;
+  auto& node = **n;
+  manager::Outbox out;
+  node.onRequests(
+      {request("to-d1", transport("to-d1")),
+       request("to-d2", R"({"id": "to-d2", "kind": "transport", "pickup": "P-2", "dropoff": "D-2"})")},
+      2'000, out);
+  const Pose2 d1 = site->station("D-1")->pose;
+  msg::TrafficClosure spill;
+  spill.closure_id = "spill";
+  spill.reason = "wet floor";
+  spill.area = {
+      {d1.x - 0.6, d1.y - 0.6}, {d1.x + 0.6, d1.y - 0.6}, {d1.x + 0.6, d1.y + 0.6}, {d1.x - 0.6, d1.y + 0.6}};
+  msg::TrafficClosure bad;
+  bad.closure_id = "bad";
+  bad.nodes = {1'000'000};
+  out = {};
+  const auto errors = node.onClosures({spill, bad}, 3'000, out);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("node 1000000 is not on the roadmap"), std::string::npos) << errors[0];
+  ASSERT_EQ(node.dispatcher().closedStations().count("D-1"), 1u);
+  EXPECT_EQ(node.dispatcher().closedStations().count("D-2"), 0u);
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].task_id, "to-d1");
+  EXPECT_EQ(out.events[0].reason, "station D-1 closed: closure 'spill': wet floor");
+  EXPECT_EQ(out.events[0].eta_ns, 0);
+
+  const auto& park = site->stations.front();
+  node.onRobotState({"r1",
+                     4'000,
+                     {park.pose.x, park.pose.y, park.pose.theta},
+                     {},
+                     0,
+                     0,
+                     msg::RobotMode::Idle,
+                     0.9f,
+                     "",
+                     0.3f},
+                    4'000);
+  out = {};
+  node.tick(5'000, out);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task_id, "to-d2") << "the task to the closed station waits";
+
+  spill.active = false;
+  out = {};
+  EXPECT_TRUE(node.onClosures({spill}, 6'000, out).empty());
+  EXPECT_TRUE(node.dispatcher().closedStations().empty());
+  ASSERT_EQ(out.events.size(), 1u);
+  EXPECT_EQ(out.events[0].reason, "station D-1 open again; waiting for a robot");
+}

@@ -158,6 +158,16 @@ class Dispatcher {
   /// stands where it is). not_found for a robot never seen.
   Expected<DispatchResult> setRobotHeld(const std::string& robotId, bool held, std::int64_t nowNs);
   [[nodiscard]] bool robotHeld(std::string_view robotId) const { return held_.count(robotId) > 0; }
+  /// Stations closed at run time (a roadmap closure closed or cut off their dock), each with why
+  /// (e.g. "closure 'spill': wet floor"); replaces the set before. A waiting task with a closed
+  /// station is not assigned, and its wait reason (an event) says "station D-2 closed: ..."; once
+  /// reopened it says so and the task is assigned again. An active task is left to its robot (the
+  /// traffic manager holds it at its last released node). dispatcher_closures.cpp.
+  DispatchResult setClosedStations(std::map<std::string, std::string, std::less<>> closed,
+                                   std::int64_t nowNs);
+  [[nodiscard]] const std::map<std::string, std::string, std::less<>>& closedStations() const {
+    return closedStations_;
+  }
   /// Operator change of a waiting task's priority and/or deadline, stored (TaskStore::change) and
   /// in force from the next allocation: every tick orders the queue (admission at busy stations,
   /// the candidates of a long backlog) and costs its tasks by the values held here
@@ -207,6 +217,9 @@ class Dispatcher {
   /// Says in their reason why charge / park tasks without a station still wait (every station of
   /// their kind taken), and takes it back once one is free again.
   void noteStationWaits(const StationChooser& chooser, std::int64_t nowNs, DispatchResult& out);
+  /// The closed station of `t` (nullptr: none) and the wait reasons of the waiting tasks it holds.
+  [[nodiscard]] const std::string* closedStationOf(const Task& t) const;
+  void noteClosedStations(std::int64_t nowNs, DispatchResult& out);
   /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig).
   void admitByStationCapacity(std::vector<Task>& waiting) const;
 
@@ -227,7 +240,8 @@ class Dispatcher {
   /// Task id -> the robot that failed it last: the retry goes to another idle robot if there is
   /// one (a robot boxed in at its parking place failed the same task three times in a row).
   std::map<std::string, std::string, std::less<>> failedBy_;
-  std::set<std::string, std::less<>> held_;  // robots held by the operator
+  std::set<std::string, std::less<>> held_;                         // robots held by the operator
+  std::map<std::string, std::string, std::less<>> closedStations_;  // station -> why
   TaskEta eta_;
   /// Waiting tasks by priority: how many are ahead of a task entering the queue.
   std::map<std::int32_t, std::size_t, std::greater<>> waitingByPriority_;

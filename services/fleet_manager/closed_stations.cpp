@@ -1,0 +1,76 @@
+#include "closed_stations.hpp"
+
+#include <algorithm>
+
+namespace fleet::manager {
+
+ClosedStations::ClosedStations(traffic::Roadmap roadmap) : roadmap_(std::move(roadmap)) {
+  for (auto& s : traffic::connectedStations(roadmap_)) {
+    connectedAtStart_.insert(std::move(s));
+  }
+}
+
+std::optional<std::string> ClosedStations::apply(const msg::TrafficClosure& c) {
+  const auto& g = roadmap_.graph;
+  for (const auto v : c.nodes) {
+    if (!g.valid(v)) {
+      return "closure \"" + c.closure_id + "\": node " + std::to_string(v) + " is not on the roadmap";
+    }
+  }
+  std::vector<std::pair<traffic::NodeId, traffic::NodeId>> lanes;
+  for (const auto& e : c.lanes) {
+    const bool edge = g.valid(e.from) && g.valid(e.to) &&
+                      std::any_of(g.edges(e.from).begin(), g.edges(e.from).end(),
+                                  [&](const traffic::Edge& x) { return x.to == e.to; });
+    if (!edge) {
+      return "closure \"" + c.closure_id + "\": there is no roadmap edge " + std::to_string(e.from) + " -> " +
+             std::to_string(e.to);
+    }
+    lanes.emplace_back(e.from, e.to);
+  }
+  if (c.active && c.area.empty() && c.nodes.empty() && c.lanes.empty()) {
+    return "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";
+  }
+  if (auto it = inForce_.find(c.closure_id); it != inForce_.end()) {
+    for (const auto& part : it->second.parts) {
+      roadmap_.reopen(part);
+    }
+    inForce_.erase(it);
+  }
+  if (c.active) {
+    InForce f;
+    f.reason = c.reason.empty() ? "no reason given" : c.reason;
+    if (!c.area.empty()) {
+      f.parts.push_back(roadmap_.closeArea(c.area));
+    }
+    if (!c.nodes.empty()) {
+      f.parts.push_back(roadmap_.closeNodes({c.nodes.begin(), c.nodes.end()}));
+    }
+    if (!lanes.empty()) {
+      f.parts.push_back(roadmap_.closeEdges(lanes));
+    }
+    inForce_.emplace(c.closure_id, std::move(f));
+  }
+  return std::nullopt;
+}
+
+std::map<std::string, std::string, std::less<>> ClosedStations::closed() const {
+  std::map<std::string, std::string, std::less<>> out;
+  if (inForce_.empty()) {
+    return out;
+  }
+  std::string why;
+  for (const auto& [id, f] : inForce_) {
+    why += (why.empty() ? "closure '" : "; closure '") + id + "': " + f.reason;
+  }
+  const auto now = traffic::connectedStations(roadmap_);
+  const std::set<std::string, std::less<>> open(now.begin(), now.end());
+  for (const auto& s : connectedAtStart_) {
+    if (open.count(s) == 0) {
+      out.emplace(s, why);
+    }
+  }
+  return out;
+}
+
+}  // namespace fleet::manager
