@@ -11,22 +11,13 @@ ClosedStations::ClosedStations(traffic::Roadmap roadmap) : roadmap_(std::move(ro
 }
 
 std::optional<std::string> ClosedStations::apply(const msg::TrafficClosure& c) {
-  const auto& g = roadmap_.graph;
-  for (const auto v : c.nodes) {
-    if (!g.valid(v)) {
-      return "closure \"" + c.closure_id + "\": node " + std::to_string(v) + " is not on the roadmap";
-    }
-  }
   std::vector<std::pair<traffic::NodeId, traffic::NodeId>> lanes;
   for (const auto& e : c.lanes) {
-    const bool edge = g.valid(e.from) && g.valid(e.to) &&
-                      std::any_of(g.edges(e.from).begin(), g.edges(e.from).end(),
-                                  [&](const traffic::Edge& x) { return x.to == e.to; });
-    if (!edge) {
-      return "closure \"" + c.closure_id + "\": there is no roadmap edge " + std::to_string(e.from) + " -> " +
-             std::to_string(e.to);
-    }
     lanes.emplace_back(e.from, e.to);
+  }
+  if (auto problem =
+          traffic::closureProblem(roadmap_, c.closure_id, {c.nodes.begin(), c.nodes.end()}, lanes)) {
+    return problem;
   }
   if (c.active && c.area.empty() && c.nodes.empty() && c.lanes.empty()) {
     return "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";

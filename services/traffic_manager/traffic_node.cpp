@@ -135,26 +135,14 @@ bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs, bool timedOut) {
 
 TrafficNode::ClosureResult TrafficNode::onClosure(const msg::TrafficClosure& c) {
   ClosureResult out;
-  const auto& g = roadmap_.graph;
-  // Everything is checked before anything changes: a closure is applied whole or not at all.
-  for (const auto v : c.nodes) {
-    if (!g.valid(v)) {
-      out.error = "closure \"" + c.closure_id + "\": node " + std::to_string(v) +
-                  " is not on the roadmap (0.." + std::to_string(g.size() - 1) + ")";
-      return out;
-    }
-  }
   std::vector<std::pair<NodeId, NodeId>> lanes;
   for (const auto& e : c.lanes) {
-    const bool edge = g.valid(e.from) && g.valid(e.to) &&
-                      std::any_of(g.edges(e.from).begin(), g.edges(e.from).end(),
-                                  [&](const traffic::Edge& x) { return x.to == e.to; });
-    if (!edge) {
-      out.error = "closure \"" + c.closure_id + "\": there is no roadmap edge " + std::to_string(e.from) +
-                  " -> " + std::to_string(e.to);
-      return out;
-    }
     lanes.emplace_back(e.from, e.to);
+  }
+  if (auto problem =
+          traffic::closureProblem(roadmap_, c.closure_id, {c.nodes.begin(), c.nodes.end()}, lanes)) {
+    out.error = std::move(*problem);
+    return out;
   }
   if (c.active && c.area.empty() && c.nodes.empty() && c.lanes.empty()) {
     out.error = "closure \"" + c.closure_id + "\": closes nothing (no area, nodes or lanes)";

@@ -280,6 +280,28 @@ Closure Roadmap::close(std::vector<NodeId> nodes, std::vector<std::pair<NodeId, 
   return c;
 }
 
+std::optional<std::string> closureProblem(const Roadmap& r, const std::string& id,
+                                          const std::vector<NodeId>& nodes,
+                                          const std::vector<std::pair<NodeId, NodeId>>& lanes) {
+  const auto& g = r.graph;
+  for (const auto v : nodes) {
+    if (!g.valid(v)) {
+      return "closure \"" + id + "\": node " + std::to_string(v) + " is not on the roadmap (0.." +
+             std::to_string(g.size() - 1) + ")";
+    }
+  }
+  for (const auto& [a, b] : lanes) {
+    const bool edge =
+        g.valid(a) && g.valid(b) &&
+        std::any_of(g.edges(a).begin(), g.edges(a).end(), [&](const Edge& x) { return x.to == b; });
+    if (!edge) {
+      return "closure \"" + id + "\": there is no roadmap edge " + std::to_string(a) + " -> " +
+             std::to_string(b);
+    }
+  }
+  return std::nullopt;
+}
+
 Closure Roadmap::closeNodes(const std::vector<NodeId>& nodes) {
   return close(nodes, {});
 }

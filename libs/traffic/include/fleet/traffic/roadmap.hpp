@@ -29,6 +29,7 @@
 // checkRoadmap() tells the state of the whole roadmap.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -171,5 +172,12 @@ std::vector<RoadmapProblem> checkQueues(const Roadmap& r);
 
 /// Names of the stations whose dock is in that main component.
 std::vector<std::string> connectedStations(const Roadmap& r);
+
+/// What is wrong with run-time closure `id` of `nodes` and directed `lanes` on `r`: a node that is
+/// not on the roadmap or a lane that is not one of its edges (the first found, named), or nullopt.
+/// Checked before a closure changes anything: it is applied whole or not at all.
+std::optional<std::string> closureProblem(const Roadmap& r, const std::string& id,
+                                          const std::vector<NodeId>& nodes,
+                                          const std::vector<std::pair<NodeId, NodeId>>& lanes);
 
 }  // namespace fleet::traffic
