@@ -219,7 +219,7 @@ void Agent::onRelease(const msg::TrafficRelease& r) {
   (void)follow_.offer(rel, localizer_.pose().position());
 }
 
-void Agent::endTask(TaskStage final, const std::string& reason, std::int64_t nowNs) {
+void Agent::endTask(TaskState final, const std::string& reason, std::int64_t nowNs) {
   tasks_.finish(final, reason, nowNs);
   progress_.taskEnded();
 }
@@ -253,7 +253,7 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     w_ = 0.0;
     follow_.holdStill();
     if (tasks_.busy()) {
-      endTask(TaskStage::Failed, "localization estimate implausible", nowNs);
+      endTask(TaskState::Failed, "localization estimate implausible", nowNs);
     }
     report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
     return out;
@@ -365,7 +365,7 @@ void Agent::watchProgress(std::int64_t nowNs) {
   sample.waiting = drove_.waiting;
   switch (progress_.check(sample)) {
     case ProgressVerdict::kFailTask:
-      endTask(TaskStage::Failed,
+      endTask(TaskState::Failed,
               "no progress towards " + tasks_.goal().station + " for " +
                   std::to_string(progress_.failAfterS()) + " s",
               nowNs);
@@ -423,8 +423,7 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
     out.discs.discs = predictDiscs(pose, P, v, w, prediction);
   }
   if (auto r = tasks_.takeReport()) {
-    out.status =
-        msg::TaskStatus{p_.id, r->task, r->revision, wireState(r->stage), r->progress, r->reason, r->stampNs};
+    out.status = msg::TaskStatus{p_.id, r->task, r->revision, r->stage, r->progress, r->reason, r->stampNs};
   }
   out.traffic = trafficProgress(nowNs);
 }

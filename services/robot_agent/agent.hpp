@@ -153,7 +153,7 @@ class Agent : private DriveStack {
   /// Command, state and predicted discs for the chosen twist and mode.
   void report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode);
   /// The task ends (failed: `reason` says why).
-  void endTask(TaskStage final, const std::string& reason, std::int64_t nowNs);
+  void endTask(TaskState final, const std::string& reason, std::int64_t nowNs);
   /// The cycle along the releases: the task runner's tick, then the release follower's twist.
   void followRelease(std::int64_t nowNs, double dt, double& v, double& w, msg::RobotMode& mode);
   /// Where the robot is going (the task's goal; idle, its home), if anywhere.

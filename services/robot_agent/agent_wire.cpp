@@ -67,26 +67,4 @@ Order orderOf(const msg::TaskAssignment& a) {
   return o;
 }
 
-msg::TaskState wireState(TaskStage st) {
-  switch (st) {
-    case TaskStage::Queued:
-      return msg::TaskState::Queued;
-    case TaskStage::Assigned:
-      return msg::TaskState::Assigned;
-    case TaskStage::EnRoute:
-      return msg::TaskState::EnRoute;
-    case TaskStage::Loading:
-      return msg::TaskState::Loading;
-    case TaskStage::Delivering:
-      return msg::TaskState::Delivering;
-    case TaskStage::Unloading:
-      return msg::TaskState::Unloading;
-    case TaskStage::Done:
-      return msg::TaskState::Done;
-    case TaskStage::Failed:
-      return msg::TaskState::Failed;
-  }
-  return msg::TaskState::Failed;
-}
-
 }  // namespace fleet::agent

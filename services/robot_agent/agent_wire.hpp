@@ -17,7 +17,5 @@ OtherRobot::Mode modeOf(msg::RobotMode m);
 TaskGoal goalOf(const msg::Goal& g);
 /// An assignment as the task runner takes it.
 Order orderOf(const msg::TaskAssignment& a);
-/// A task stage as the wire says it.
-msg::TaskState wireState(TaskStage st);
 
 }  // namespace fleet::agent

@@ -31,7 +31,7 @@ TaskRunner::OrderChange TaskRunner::accept(const Order& o) {
   task_ = o.task;
   goals_ = o.goals;
   goal_ = 0;
-  reported_ = TaskStage::Assigned;
+  reported_ = TaskState::Assigned;
   phase_ = Phase::Idle;  // started on the next step, which knows the time
   return OrderChange::kNewTask;
 }
@@ -52,32 +52,32 @@ void TaskRunner::refuse(const Order& o, const std::string& why) {
   // Another task's order leaves the current task as it was: the robot goes on with it and still
   // reports it (RobotState, TaskStatus), so the fleet manager sees both.
   refusals_.push_back(
-      TaskReport{o.task, o.revision, TaskStage::Failed, 0.0f, ("refused: " + why).substr(0, 255), o.stampNs});
+      TaskReport{o.task, o.revision, TaskState::Failed, 0.0f, ("refused: " + why).substr(0, 255), o.stampNs});
 }
 
-TaskStage TaskRunner::stageFor(std::size_t index, bool dwelling) const {
+TaskState TaskRunner::stageFor(std::size_t index, bool dwelling) const {
   const auto action = goals_[index].action;
   if (dwelling) {
     if (action == GoalAction::Load) {
-      return TaskStage::Loading;
+      return TaskState::Loading;
     }
     if (action == GoalAction::Unload) {
-      return TaskStage::Unloading;
+      return TaskState::Unloading;
     }
   }
   for (std::size_t i = 0; i < index; ++i) {
     if (goals_[i].action == GoalAction::Load) {
-      return TaskStage::Delivering;
+      return TaskState::Delivering;
     }
   }
-  return TaskStage::EnRoute;
+  return TaskState::EnRoute;
 }
 
 float TaskRunner::progress() const {
   return goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
 }
 
-void TaskRunner::reportStage(TaskStage st, std::int64_t nowNs) {
+void TaskRunner::reportStage(TaskState st, std::int64_t nowNs) {
   reported_ = st;
   pending_ = TaskReport{task_, revision_, st, progress(), "", nowNs};
 }
@@ -94,7 +94,7 @@ void TaskRunner::arrive(std::int64_t nowNs) {
   phase_ = Phase::Dwelling;
   phaseStartNs_ = nowNs;
   const auto st = stageFor(goal_, true);
-  if (st != reported_ && (st == TaskStage::Loading || st == TaskStage::Unloading)) {
+  if (st != reported_ && (st == TaskState::Loading || st == TaskState::Unloading)) {
     reportStage(st, nowNs);
   }
 }
@@ -116,13 +116,13 @@ TaskTick TaskRunner::tick(std::int64_t nowNs) {
     leg(nowNs);
     return TaskTick::kLegBegan;
   }
-  finish(TaskStage::Done, "", nowNs);
+  finish(TaskState::Done, "", nowNs);
   return TaskTick::kDone;
 }
 
-void TaskRunner::finish(TaskStage final, const std::string& reason, std::int64_t nowNs) {
+void TaskRunner::finish(TaskState final, const std::string& reason, std::int64_t nowNs) {
   pending_ = TaskReport{
-      task_, revision_, final, final == TaskStage::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
+      task_, revision_, final, final == TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;

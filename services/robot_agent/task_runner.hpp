@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fleet/core/pose2.hpp"
+#include "fleet/core/task_state.hpp"
 
 namespace fleet::agent {
 
@@ -30,22 +31,10 @@ struct TaskGoal {
   bool operator==(const TaskGoal&) const = default;
 };
 
-/// What the robot says of its task (the wire's TaskState values the agent reports).
-enum class TaskStage : std::uint8_t {
-  Queued,
-  Assigned,
-  EnRoute,
-  Loading,
-  Delivering,
-  Unloading,
-  Done,
-  Failed
-};
-
 struct TaskReport {
   std::string task;
   std::uint32_t revision = 0;
-  TaskStage stage = TaskStage::Queued;
+  TaskState stage = TaskState::Queued;
   float progress = 0.0f;  ///< goals done / goals
   std::string reason;     ///< why it failed, or a notice (sensor loss); at most 255 bytes
   std::int64_t stampNs = 0;
@@ -93,7 +82,7 @@ class TaskRunner {
   void arrive(std::int64_t nowNs);
   [[nodiscard]] bool dwellOver(std::int64_t nowNs) const;
   /// The task ends: reports `final` with `reason`; Idle.
-  void finish(TaskStage final, const std::string& reason, std::int64_t nowNs);
+  void finish(TaskState final, const std::string& reason, std::int64_t nowNs);
   /// A notice about the task in its current stage (e.g. sensor loss), if there is a task.
   void notice(const std::string& reason, std::int64_t nowNs);
   /// The operator's hold lasted `heldNs`: the phase's clock starts that much later.
@@ -119,9 +108,9 @@ class TaskRunner {
 
  private:
   /// The stage the task is in while driving to, or dwelling at, goal `index`.
-  [[nodiscard]] TaskStage stageFor(std::size_t index, bool dwelling) const;
+  [[nodiscard]] TaskState stageFor(std::size_t index, bool dwelling) const;
   [[nodiscard]] float progress() const;
-  void reportStage(TaskStage st, std::int64_t nowNs);
+  void reportStage(TaskState st, std::int64_t nowNs);
   /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
   void leg(std::int64_t nowNs);
 
@@ -133,7 +122,7 @@ class TaskRunner {
   std::size_t goal_ = 0;
   Phase phase_ = Phase::Idle;
   std::int64_t phaseStartNs_ = 0;
-  TaskStage reported_ = TaskStage::Queued;
+  TaskState reported_ = TaskState::Queued;
   std::optional<TaskReport> pending_;
   std::vector<TaskReport> refusals_;  // orders refused, reported before the task's own (oldest first)
 };

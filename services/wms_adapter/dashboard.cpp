@@ -652,9 +652,10 @@ EventSource Dashboard::stream() {
     cur->events = d_.view.eventsAfter(cur->events, std::chrono::milliseconds(0), evs);
     for (const auto& e : evs) {
       chunk += "event: task\ndata: " +
-               json{{"id", e.task_id},     {"state", msg::toString(e.state)}, {"robot", e.robot_id},
-                    {"reason", e.reason},  {"stamp_ns", e.stamp_ns},          {"seq", e.seq},
-                    {"station", e.station},    {"eta_ns", e.eta_ns}}
+               json{{"id", e.task_id},        {"state", msg::toString(e.state)},
+                    {"robot", e.robot_id},    {"reason", e.reason},
+                    {"stamp_ns", e.stamp_ns}, {"seq", e.seq},
+                    {"station", e.station},   {"eta_ns", e.eta_ns}}
                    .dump(-1, ' ', false, json::error_handler_t::replace) +
                "\n\n";
     }

@@ -795,7 +795,11 @@ DispatchResult Dispatcher::tick(std::int64_t nowNs) {
   completeCharged(nowNs, out);
   chargeLowRobots(nowNs, out);
   allocate(nowNs, out);
-  noteClosedStations(nowNs, out);
+  if (!closedStations_.empty()) {
+    // Tasks that came in since a station closed get its reason; reopening is stated by
+    // setClosedStations, so a tick without closures does not walk the open tasks.
+    noteClosedStations(nowNs, out);
+  }
   // A released robot that got a new task in the same tick must not have it withdrawn by the empty
   // assignment published after it: the new order replaces the charge order anyway.
   std::erase_if(out.revoked, [&](const std::string& robot) {

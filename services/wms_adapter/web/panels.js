@@ -205,27 +205,23 @@ export class Panels {
         tr.append(td);
       }
       const td = document.createElement('td');
+      const button = (text, title, onClick) => {
+        const b = document.createElement('button');
+        b.type = 'button';
+        b.textContent = text;
+        b.dataset.scope = 'submit';
+        b.disabled = offline;
+        b.title = offline ? unreachable : title;
+        b.addEventListener('click', onClick);
+        td.append(b);
+      };
       if (cancellable && (t.state === 'queued' || t.state === 'requeued')) {
-        const change = document.createElement('button');
-        change.type = 'button';
-        change.textContent = 'change';
-        change.dataset.scope = 'submit';
-        change.disabled = offline;
-        change.title = offline ? unreachable : 'its priority or deadline';
-        change.addEventListener('click', () => this.changeTask(t.id));
-        td.append(change);
+        button('change', 'its priority or deadline', () => this.changeTask(t.id));
       }
       if (cancellable) {  // not offered at all without the scope: one greyed button per row is noise
-        const cancel = document.createElement('button');
-        cancel.type = 'button';
-        cancel.textContent = 'cancel';
-        cancel.dataset.scope = 'submit';
-        cancel.disabled = offline;
-        cancel.title = offline ? unreachable : '';
-        cancel.addEventListener('click', () =>
+        button('cancel', '', () =>
           this.confirmThen(`Cancel task ${t.id}?`, () =>
             this.act(`cancel ${t.id}`, 'DELETE', `/v1/tasks/${encodeURIComponent(t.id)}`)));
-        td.append(cancel);
       }
       tr.append(td);
       return tr;

@@ -71,6 +71,14 @@ class TaskChange : public ::testing::Test {
     EXPECT_TRUE(n) << (n ? "" : n.error().message);
     return std::move(*n);
   }
+  /// Robot r1 idle, tasks t1 and t2 submitted and one of them assigned: what that published.
+  static manager::Outbox oneRobotTwoTasks(manager::FleetManagerNode& node) {
+    manager::Outbox out;
+    node.onRobotState(idle("r1", 1'000), 1'000);
+    node.onRequests({transport("t1", 0), transport("t2", 0)}, 2'000, out);
+    node.tick(3'000, out);
+    return out;
+  }
   /// The one ack in `out` to `req`.
   static msg::TaskAck ackOf(const manager::Outbox& out, const msg::Task& req) {
     for (const auto& a : out.acks) {
@@ -205,10 +213,7 @@ TEST_F(TaskChange, TheEventsOnTheWireCarryTheTasksEta) {
   // The dispatcher's estimate (TaskEta) reaches the TaskEvent the adapter shows the WMS: a task
   // assigned to the one robot is due after now, and the task waiting behind it later still.
   auto node = open(0);
-  manager::Outbox out;
-  node->onRobotState(idle("r1", 1'000), 1'000);
-  node->onRequests({transport("t1", 0), transport("t2", 0)}, 2'000, out);
-  node->tick(3'000, out);
+  const auto out = oneRobotTwoTasks(*node);
   std::map<std::string, std::int64_t> eta;
   for (const auto& e : out.events) {
     eta[e.task_id] = e.eta_ns;  // the newest event of each task
@@ -223,10 +228,7 @@ TEST_F(TaskChange, TheEventsOnTheWireCarryTheTasksEta) {
 TEST_F(TaskChange, TheLeaseEpochIsStampedOnEveryAssignmentAndEventFromThenOn) {
   {
     auto node = open(0);
-    manager::Outbox out;
-    node->onRobotState(idle("r1", 1'000), 1'000);
-    node->onRequests({transport("t1", 0), transport("t2", 0)}, 2'000, out);
-    node->tick(3'000, out);
+    const auto out = oneRobotTwoTasks(*node);
     ASSERT_FALSE(out.assignments.empty());
     for (const auto& e : out.events) {
       EXPECT_EQ(e.epoch, 0) << "no lease: epoch 0";

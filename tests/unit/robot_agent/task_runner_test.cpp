@@ -13,7 +13,6 @@ using agent::Order;
 using agent::Phase;
 using agent::TaskGoal;
 using agent::TaskRunner;
-using agent::TaskStage;
 using agent::TaskTick;
 
 namespace {
@@ -28,8 +27,8 @@ Order transport(std::uint32_t revision = 1, bool paused = false) {
                paused};
 }
 
-std::vector<TaskStage> stages(TaskRunner& r) {
-  std::vector<TaskStage> out;
+std::vector<TaskState> stages(TaskRunner& r) {
+  std::vector<TaskState> out;
   while (auto rep = r.takeReport()) {
     out.push_back(rep->stage);
   }
@@ -47,7 +46,7 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
   EXPECT_EQ(r.tick(1 * kSec), TaskTick::kLegBegan);
   auto rep = r.takeReport();
   ASSERT_TRUE(rep);
-  EXPECT_EQ(rep->stage, TaskStage::EnRoute);
+  EXPECT_EQ(rep->stage, TaskState::EnRoute);
   EXPECT_EQ(rep->task, "t1");
   EXPECT_EQ(rep->revision, 1u);
   EXPECT_EQ(rep->progress, 0.0f);
@@ -56,7 +55,7 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
   EXPECT_FALSE(r.takeReport());
   r.arrive(3 * kSec);
   EXPECT_EQ(r.phase(), Phase::Dwelling);
-  EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Loading});
+  EXPECT_EQ(stages(r), std::vector<TaskState>{TaskState::Loading});
   EXPECT_EQ(r.tick(4 * kSec), TaskTick::kNone) << "dwelling 2 s";
   EXPECT_EQ(r.phase(), Phase::Dwelling);
   EXPECT_EQ(r.tick(5 * kSec), TaskTick::kLegBegan) << "the dwell is over: on to the next goal";
@@ -64,16 +63,16 @@ TEST(TaskRunner, ATransportGoesThroughItsStatesOnceEach) {
   EXPECT_EQ(r.goal().station, "D-1");
   rep = r.takeReport();
   ASSERT_TRUE(rep);
-  EXPECT_EQ(rep->stage, TaskStage::Delivering);
+  EXPECT_EQ(rep->stage, TaskState::Delivering);
   EXPECT_EQ(rep->progress, 0.5f);
   r.arrive(9 * kSec);
-  EXPECT_EQ(stages(r), std::vector<TaskStage>{TaskStage::Unloading});
+  EXPECT_EQ(stages(r), std::vector<TaskState>{TaskState::Unloading});
   EXPECT_EQ(r.tick(9 * kSec + kSec / 2), TaskTick::kNone);
   EXPECT_EQ(r.tick(10 * kSec), TaskTick::kDone) << "the last dwell is over";
   EXPECT_EQ(r.tick(11 * kSec), TaskTick::kNone) << "ended once";
   rep = r.takeReport();
   ASSERT_TRUE(rep);
-  EXPECT_EQ(rep->stage, TaskStage::Done);
+  EXPECT_EQ(rep->stage, TaskState::Done);
   EXPECT_EQ(rep->progress, 1.0f);
   EXPECT_FALSE(r.busy());
   EXPECT_EQ(r.phase(), Phase::Idle);
@@ -120,9 +119,9 @@ TEST(TaskRunner, NoticesNeedATaskAndFailuresKeepAtMost255BytesOfReason) {
   r.notice("sensor stream lost", kSec);
   auto rep = r.takeReport();
   ASSERT_TRUE(rep);
-  EXPECT_EQ(rep->stage, TaskStage::EnRoute) << "a notice says the stage the task is in";
+  EXPECT_EQ(rep->stage, TaskState::EnRoute) << "a notice says the stage the task is in";
   EXPECT_EQ(rep->reason, "sensor stream lost");
-  r.finish(TaskStage::Failed, std::string(400, 'x'), 2 * kSec);
+  r.finish(TaskState::Failed, std::string(400, 'x'), 2 * kSec);
   rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->reason.size(), 255u);
@@ -158,7 +157,7 @@ TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailedAndTheCurrentTaskG
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->task, "t9");
   EXPECT_EQ(rep->revision, 2u);
-  EXPECT_EQ(rep->stage, TaskStage::Failed);
+  EXPECT_EQ(rep->stage, TaskState::Failed);
   EXPECT_EQ(rep->reason, "refused: assignment has no goals");
   EXPECT_EQ(rep->stampNs, 5 * kSec);
   // The current task's own reports are not lost behind a refusal: both come, the refusal first.
@@ -168,7 +167,7 @@ TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailedAndTheCurrentTaskG
   rep = r.takeReport();
   ASSERT_TRUE(rep);
   EXPECT_EQ(rep->task, "t1");
-  EXPECT_EQ(rep->stage, TaskStage::Loading);
+  EXPECT_EQ(rep->stage, TaskState::Loading);
   // Its own task refused (at the process's edge, whatever the order holds): dropped and reported.
   r.refuse(transport(3), "bad pose");
   EXPECT_FALSE(r.busy());
