@@ -8,9 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
-#include <deque>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <thread>
 
@@ -30,11 +28,19 @@
 #include "fleet/transport/dds.hpp"
 #include "fleet_manager_node.hpp"
 #include "manager_lease.hpp"
+#include "manager_metrics.hpp"
+#include "manager_standby.hpp"
 
 using namespace fleet;
 using namespace std::chrono_literals;
 
 namespace {
+
+using manager::awaitLease;
+using manager::ManagerMetrics;
+using manager::openStore;
+using manager::pause;
+using manager::Recent;
 
 void writeMetrics(const std::string& path, const nlohmann::json& j) {
   const std::string tmp = path + ".tmp";
@@ -44,210 +50,6 @@ void writeMetrics(const std::string& path, const nlohmann::json& j) {
   }
   std::rename(tmp.c_str(), path.c_str());
 }
-
-/// The manager's Prometheus metrics, mirrored from the node once a second (the node counts in plain
-/// integers on the loop's thread; the registry's counters advance by the difference).
-class ManagerMetrics {
- public:
-  explicit ManagerMetrics(service::ServiceOps& ops) : r_(ops.registry()) {
-    for (const char* outcome : {"done", "failed", "cancelled", "requeued"}) {
-      outcomes_.push_back({&r_.counter("fleet_manager_tasks_total",
-                                       "Tasks that reached an outcome (requeued: given back to the queue)",
-                                       {{"outcome", outcome}})});
-    }
-    for (const char* result : {"stored", "duplicate", "rejected"}) {
-      requests_.push_back({&r_.counter("fleet_manager_task_requests_total",
-                                       "Task requests received over DDS, by result", {{"result", result}})});
-    }
-    for (const char* action : {"requeued", "stale_report"}) {
-      reconciled_.push_back({&r_.counter(
-          "fleet_manager_reconciled_total",
-          "Robots whose reported task disagreed with the store for reconcile_s: their task requeued, or "
-          "a stale report logged",
-          {{"action", action}})});
-    }
-    for (const char* state : {"queued", "active"}) {
-      tasks_.push_back(
-          &r_.gauge("fleet_manager_tasks", "Open tasks: queued (waiting) or active", {{"state", state}}));
-    }
-    for (const char* state : {"idle", "busy", "lost", "fault"}) {
-      robots_.push_back(
-          &r_.gauge("fleet_manager_robots", "Robots known to the manager, by state", {{"state", state}}));
-    }
-  }
-  metrics::Histogram& assignLatency() {
-    return r_.histogram("fleet_manager_assign_latency_seconds",
-                        "Time from queued to assigned, per assignment",
-                        manager::FleetManagerNode::assignLatencyBuckets());
-  }
-  metrics::Histogram& loopSeconds() {
-    return r_.histogram("fleet_manager_loop_seconds",
-                        "Wall time of one turn of the manager's loop (work only)",
-                        metrics::exponentialBuckets(1e-5, 2.0, 18));
-  }
-  /// A manager that stands by again reports no tasks and no robots (sums over managers count the
-  /// active one only).
-  void clear() {
-    for (auto* g : tasks_) {
-      g->set(0);
-    }
-    for (auto* g : robots_) {
-      g->set(0);
-    }
-  }
-  void update(const manager::FleetManagerNode& node) {
-    const auto& c = node.dispatcher().counters();
-    const auto& m = node.metrics();
-    outcomes_[0].to(c.done);
-    outcomes_[1].to(c.failed);
-    outcomes_[2].to(c.cancelled);
-    outcomes_[3].to(c.requeued);
-    requests_[0].to(m.stored);
-    requests_[1].to(m.duplicates);
-    requests_[2].to(m.rejected);
-    reconciled_[0].to(m.reconciledRequeued);
-    reconciled_[1].to(m.reconciledStale);
-    tasks_[0]->set(static_cast<double>(node.dispatcher().waitingCount()));
-    tasks_[1]->set(static_cast<double>(node.dispatcher().activeCount()));
-    double idle = 0;
-    double busy = 0;
-    double lost = 0;
-    double fault = 0;
-    for (const auto& r : node.dispatcher().robots().all()) {
-      (r.lost ? lost : (r.fault ? fault : (r.taskId.empty() ? idle : busy))) += 1.0;
-    }
-    robots_[0]->set(idle);
-    robots_[1]->set(busy);
-    robots_[2]->set(lost);
-    robots_[3]->set(fault);
-  }
-
- private:
-  /// A counter following a cumulative count kept elsewhere.
-  struct Mirrored {
-    metrics::Counter* counter;
-    std::int64_t last = 0;
-    void to(std::int64_t now) {
-      if (now > last) {
-        counter->inc(static_cast<std::uint64_t>(now - last));
-        last = now;
-      }
-    }
-  };
-  metrics::Registry& r_;
-  std::vector<Mirrored> outcomes_;
-  std::vector<Mirrored> requests_;
-  std::vector<Mirrored> reconciled_;
-  std::vector<metrics::Gauge*> tasks_;
-  std::vector<metrics::Gauge*> robots_;
-};
-
-/// Sleeps `d` in short steps; false when a stop was requested meanwhile.
-bool pause(std::chrono::milliseconds d, service::ServiceOps& ops) {
-  const auto until = std::chrono::steady_clock::now() + d;
-  while (std::chrono::steady_clock::now() < until) {
-    if (service::stopRequested()) {
-      return false;
-    }
-    ops.refresh();
-    std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(
-        100ms, std::max<std::chrono::steady_clock::duration>(until - std::chrono::steady_clock::now(), 0ms)));
-  }
-  return !service::stopRequested();
-}
-
-/// The task store, opened with retries: an unreachable PostgreSQL is waited for with back-off
-/// (1 s doubling to 10 s; /readyz says task_store not ready). Null when the store cannot be used
-/// (exit 2: a SQLite file that cannot be opened, a schema newer than the binary) or a stop was
-/// requested (`stopped`).
-std::unique_ptr<TaskStore> openStore(const manager::Settings& settings, service::ServiceOps& ops,
-                                     bool& stopped) {
-  const bool pgStore = settings.store.backend == manager::StoreSettings::Backend::Postgres;
-  const std::string where = pgStore ? pg::redacted(settings.store.url) : settings.db;
-  auto backoff = 1000ms;
-  for (;;) {
-    auto s = manager::openTaskStore(settings);
-    if (s) {
-      return std::move(*s);
-    }
-    if (!pgStore || s.error().code != errc::kStorage) {
-      spdlog::critical("fleet manager: cannot open task store {}: {}", where, s.error().message);
-      return nullptr;
-    }
-    ops.health().setReady("task_store", false);
-    spdlog::warn("fleet manager: task store {} unreachable, not ready, retrying in {} s: {}", where,
-                 backoff.count() / 1000.0, s.error().message);
-    if (!pause(backoff, ops)) {
-      stopped = true;
-      return nullptr;
-    }
-    backoff = std::min(backoff * 2, std::chrono::milliseconds(10000));
-  }
-}
-
-/// Samples a standby takes off the wire while it waits: its readers' caches must not grow, and the
-/// requests and reports of the last `window` are handed to the manager once it is active (the
-/// takeover gap loses none; requests are idempotent, a report already applied is refused as stale).
-template <class T>
-class Recent {
- public:
-  explicit Recent(std::chrono::steady_clock::duration window) : window_(window) {}
-  void add(std::vector<T> samples) {
-    const auto now = std::chrono::steady_clock::now();
-    for (auto& s : samples) {
-      held_.emplace_back(now, std::move(s));
-    }
-    while (!held_.empty() && now - held_.front().first > window_) {
-      held_.pop_front();
-    }
-  }
-  /// The held samples, oldest first, followed by `fresh`; nothing is held afterwards.
-  std::vector<T> with(std::vector<T> fresh) {
-    if (held_.empty()) {
-      return fresh;
-    }
-    std::vector<T> out;
-    out.reserve(held_.size() + fresh.size());
-    for (auto& [at, s] : held_) {
-      out.push_back(std::move(s));
-    }
-    held_.clear();
-    std::move(fresh.begin(), fresh.end(), std::back_inserter(out));
-    return out;
-  }
-
- private:
-  std::chrono::steady_clock::duration window_;
-  std::deque<std::pair<std::chrono::steady_clock::time_point, T>> held_;
-};
-
-/// Stands by until this manager holds the lease, calling `drain` on every poll; false when a stop
-/// was requested.
-template <class Drain>
-bool awaitLease(manager::ManagerLease& lease, const manager::Settings& settings, service::ServiceOps& ops,
-                Drain&& drain) {
-  const auto poll = std::chrono::milliseconds(static_cast<int>(settings.store.leaseRenewS * 500));
-  bool said = false;
-  std::string lastError;
-  for (;;) {
-    auto got = lease.tryAcquire();
-    if (got && *got) {
-      return true;
-    }
-    if (!got && got.error().message != lastError) {
-      lastError = got.error().message;
-      spdlog::warn("fleet manager: cannot reach the lease: {}", lastError);
-    } else if (got && !said) {
-      said = true;
-      spdlog::info("fleet manager: standing by: lease '{}' held by another manager", lease.options().name);
-    }
-    drain();
-    if (!pause(poll, ops)) {
-      return false;
-    }
-  }
-}
-
 int run(const manager::Settings& settings, const service::OpsSettings& opsSettings) {
   service::ServiceOps ops("fleet_manager");
   const bool pgStore = settings.store.backend == manager::StoreSettings::Backend::Postgres;

@@ -1,0 +1,69 @@
+// Station admission: waiting tasks held back while a station they need has as many active tasks
+// as its capacity allows.
+
+#include "fleet/fleet/dispatcher.hpp"
+
+#include <algorithm>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <vector>
+
+#include "dispatcher_detail.hpp"
+
+namespace fleet {
+
+using dispatcher_detail::stationsOf;
+
+namespace {
+// The stations an active task loads now when load is counted by phase: where its robot is going.
+std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) {
+  // Its pickup until it has loaded there, its drop-off for the whole task: a loaded robot must not
+  // find its drop-off's line full (docs/algorithms.md, "Traffic: stations as servers").
+  const bool delivering = state == TaskState::Delivering || state == TaskState::Unloading;
+  std::vector<const std::string*> s;
+  for (const std::string* n : {&t.pickup, &t.dropoff, &t.station}) {
+    if (!n->empty() && !(delivering && n == &t.pickup)) {
+      s.push_back(n);
+    }
+  }
+  return s;
+}
+}  // namespace
+
+void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
+  std::unordered_map<std::string, std::size_t> load;
+  for (const auto& [id, r] : open_) {
+    if (isActive(r.state)) {
+      for (const std::string* s :
+           cfg_.stationLoadByPhase ? phaseStationsOf(r.task, r.state) : stationsOf(r.task)) {
+        ++load[*s];
+      }
+    }
+  }
+  // Oldest first (pinned and urgent before that), so a busy station's queue is served in order.
+  std::stable_sort(waiting.begin(), waiting.end(), [](const Task& a, const Task& b) {
+    return std::tuple(a.robot.empty(), -a.priority, a.createdNs) <
+           std::tuple(b.robot.empty(), -b.priority, b.createdNs);
+  });
+  std::vector<Task> admitted;
+  for (auto& t : waiting) {
+    const auto stations = cfg_.stationLoadByPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
+    // A robot's own charge task is never held back: its battery does not wait for the queue.
+    const bool full =
+        t.robot.empty() && std::any_of(stations.begin(), stations.end(), [&](const std::string* s) {
+          const auto it = cfg_.stationCapacities.find(*s);
+          const std::size_t cap = it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
+          return cap > 0 && load[*s] >= cap;
+        });
+    if (!full) {
+      for (const std::string* s : stations) {
+        ++load[*s];
+      }
+      admitted.push_back(std::move(t));
+    }
+  }
+  waiting = std::move(admitted);
+}
+
+}  // namespace fleet
