@@ -9,30 +9,35 @@
 //
 // Retention: the newest `retainEvents` events, none older than `retainSeconds`; a resume from an id
 // the log no longer holds is told so (prunedThrough()), never served a silent gap.
+//
+// The rows live in an EventStore (event_store.hpp): a SQLite file of this adapter's own, or a
+// PostgreSQL database that adapter replicas share (`events.log` a postgresql:// URL). A shared log
+// also looks for the other replicas' rows four times a second, so each replica serves the same ids
+// in the same order and a client resumes on either.
 
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "event_store.hpp"
 #include "fleet/messages/messages.hpp"
 #include "sqlite_db.hpp"
 
 namespace fleet::wms {
 
 struct EventLogSettings {
-  std::string path;  // events.log: a SQLite file; empty = in memory (ids restart with the process)
+  /// events.log: a SQLite file, or a postgresql:// URL (shared by replicas); empty = in memory
+  /// (ids restart with the process).
+  std::string path;
   std::int64_t retainEvents = 100'000;
   std::int64_t retainSeconds = 7 * 24 * 3600;
-};
-
-struct LoggedEvent {
-  std::int64_t id = 0;
-  msg::TaskEvent event;
 };
 
 /// The JSON an event is sent as, on the stream and to webhooks: the task event's fields (task id
@@ -43,6 +48,11 @@ class EventLog {
  public:
   /// Throws std::runtime_error when the file cannot be opened or is not an event log.
   EventLog(EventLogSettings settings, std::shared_ptr<SqliteDb> db);
+  /// On any store; a shared one is read for the other replicas' rows on a thread of its own.
+  EventLog(EventLogSettings settings, std::unique_ptr<EventStore> store);
+  ~EventLog();
+  EventLog(const EventLog&) = delete;
+  EventLog& operator=(const EventLog&) = delete;
   /// Logs the events not logged before (same task id and seq; seq 0 is always new) in one
   /// transaction, `nowNs` being the wall clock (for retention); returns how many were new.
   std::size_t append(const std::vector<msg::TaskEvent>& events, std::int64_t nowNs);
@@ -57,18 +67,26 @@ class EventLog {
   bool waitAfter(std::int64_t after, std::chrono::milliseconds timeout) const;
   /// Wakes every waitAfter (to stop).
   void wakeAll();
+  /// Takes the rows other replicas added to a shared store (done by its thread; for tests), and
+  /// hands them to the listener.
+  void catchUp();
+  /// Called (on the catching-up thread) with the rows catchUp took; set once, before any.
+  void onCatchUp(std::function<void(const std::vector<LoggedEvent>&)> listener) {
+    listener_ = std::move(listener);
+  }
   [[nodiscard]] const EventLogSettings& settings() const { return s_; }
-  [[nodiscard]] bool durable() const { return db_->durable(); }
+  [[nodiscard]] bool durable() const { return store_->durable(); }
+  [[nodiscard]] bool shared() const { return store_->shared(); }
 
   static constexpr std::size_t kMemoryTail = 4096;
 
  private:
-  void prune(std::int64_t nowNs);  // db mutex held
+  void take(const std::vector<LoggedEvent>& rows);  // into the tail, in id order
+  void prune(std::int64_t nowNs);                   // writer_ held
 
   EventLogSettings s_;
-  std::shared_ptr<SqliteDb> db_;
-  std::unique_ptr<SqliteStmt> seen_;  // prepared once: an append is the hot path
-  std::unique_ptr<SqliteStmt> insert_;
+  std::unique_ptr<EventStore> store_;
+  std::mutex writer_;     // one append, prune or catch-up at a time (the store's ids in order)
   mutable std::mutex m_;  // the tail and the ids below; never held across a disk write
   mutable std::condition_variable cv_;
   std::deque<LoggedEvent> tail_;
@@ -76,6 +94,8 @@ class EventLog {
   std::int64_t prunedThrough_ = 0;
   std::int64_t prunedAtNs_ = 0;
   bool woken_ = false;
+  std::function<void(const std::vector<LoggedEvent>&)> listener_;
+  std::thread poller_;  // a shared store: the other replicas' rows
 };
 
 }  // namespace fleet::wms

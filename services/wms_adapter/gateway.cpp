@@ -85,6 +85,19 @@ void FleetView::onEvents(const std::vector<msg::TaskEvent>& all) {
   }
 }
 
+void FleetView::catchUp(const std::vector<msg::TaskEvent>& events) {
+  for (const auto& e : events) {
+    {
+      std::lock_guard lock(m_);
+      const auto it = tasks_.find(e.task_id);
+      if (it != tasks_.end() && it->second.seq >= e.seq) {
+        continue;  // heard already, or a newer one
+      }
+    }
+    viewEvent(e);
+  }
+}
+
 void FleetView::viewEvent(const msg::TaskEvent& e) {
   {
     std::lock_guard lock(m_);

@@ -130,6 +130,9 @@ class FleetView {
     std::uint64_t version = 0;  ///< grows whenever a figure changes
   };
   [[nodiscard]] Proximity proximity() const;
+  /// Events from the event log this view may not have heard (at start, and those other replicas
+  /// logged): each changes the view only when its task is unknown or older in the view.
+  void catchUp(const std::vector<msg::TaskEvent>& events);
   /// A task as the manager's store has it (the answer to a query), for a task the view lacked.
   void onStored(const msg::TaskAck& a, std::int64_t nowNs);
   /// Samples refused (or repaired) on their way into the view, for /v1/metrics.

@@ -14,6 +14,7 @@
 #include "fleet/fleet/task.hpp"
 #include "fleet/fleet/task_wire.hpp"
 #include "json_reply.hpp"
+#include "postgres_event_store.hpp"
 #include "rfc3339.hpp"
 #include "status_routes.hpp"
 #include "task_times.hpp"
@@ -117,6 +118,19 @@ TokenStore tokenStoreOf(const ApiSettings& s) {
 }
 }  // namespace
 
+namespace {
+
+std::vector<msg::TaskEvent> eventsOf(const std::vector<LoggedEvent>& rows) {
+  std::vector<msg::TaskEvent> out;
+  out.reserve(rows.size());
+  for (const auto& r : rows) {
+    out.push_back(r.event);
+  }
+  return out;
+}
+
+}  // namespace
+
 HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& gateway, FleetView& view,
                  const Clock& clock)
     : settings_(std::move(settings)),
@@ -131,9 +145,27 @@ HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& 
   std::random_device rd;
   instance_ = std::to_string(rd() % 1'000'000);
   try {
-    stateDb_ = std::make_shared<SqliteDb>(settings_.events.path);
-    events_ = std::make_unique<EventLog>(settings_.events, stateDb_);
+    if (isPostgresUrl(settings_.events.path)) {
+      // Shared by the adapter replicas on that database (postgres_event_store.hpp).
+      events_ = std::make_unique<EventLog>(settings_.events,
+                                           std::make_unique<PostgresEventStore>(settings_.events.path));
+      stateDb_ = std::make_shared<SqliteDb>("");
+    } else {
+      stateDb_ = std::make_shared<SqliteDb>(settings_.events.path);
+      events_ = std::make_unique<EventLog>(settings_.events, stateDb_);
+    }
     webhooks_ = std::make_unique<Webhooks>(settings_.webhooks, stateDb_, *events_);
+    // The view starts from what the log holds (a restarted adapter lists the tasks it had), and
+    // takes what other replicas logged.
+    for (std::int64_t at = events_->prunedThrough();;) {
+      const auto rows = events_->after(at, 4096);
+      if (rows.empty()) {
+        break;
+      }
+      view_.catchUp(eventsOf(rows));
+      at = rows.back().id;
+    }
+    events_->onCatchUp([this](const std::vector<LoggedEvent>& rows) { view_.catchUp(eventsOf(rows)); });
   } catch (const std::runtime_error& e) {
     throw ConfigError({std::string("events.log: ") + e.what()});
   }

@@ -1,0 +1,172 @@
+// The event log on PostgreSQL, shared by adapter replicas (postgres_event_store.hpp): a transition
+// heard by two replicas is logged once, both serve the same ids in the same order, a reopened log
+// keeps its ids, retention says what is gone, and concurrent appends never show a reader an id
+// below one it has already seen. Against a PostgreSQL server the test starts itself.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <thread>
+
+#include "event_log.hpp"
+#include "postgres_event_store.hpp"
+#include "postgres_server.hpp"
+
+using namespace fleet;
+using namespace fleet::wms;
+
+namespace {
+
+msg::TaskEvent ev(const std::string& task, std::uint32_t seq,
+                  msg::TaskState state = msg::TaskState::Assigned) {
+  return {task, state, "r1", "", static_cast<std::int64_t>(seq) * 1000, seq, ""};
+}
+
+std::vector<std::pair<std::int64_t, std::string>> rows(const EventLog& log) {
+  std::vector<std::pair<std::int64_t, std::string>> out;
+  for (const auto& l : log.after(0, 1000)) {
+    out.emplace_back(l.id, l.event.task_id + "#" + std::to_string(l.event.seq));
+  }
+  return out;
+}
+
+std::unique_ptr<EventLog> open(const std::string& url, EventLogSettings s = {}) {
+  s.path = url;
+  return std::make_unique<EventLog>(s, std::make_unique<PostgresEventStore>(url));
+}
+
+class SharedEventLog : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { server_ = new test::PostgresServer(); }
+  static void TearDownTestSuite() {
+    delete server_;
+    server_ = nullptr;
+  }
+  void SetUp() override { ASSERT_TRUE(server_->ok()) << server_->error(); }
+  static test::PostgresServer* server_;
+};
+test::PostgresServer* SharedEventLog::server_ = nullptr;
+
+TEST_F(SharedEventLog, TwoReplicasLogATransitionOnceAndServeTheSameIds) {
+  const std::string url = server_->freshUrl();
+  auto a = open(url);
+  auto b = open(url);
+  EXPECT_TRUE(a->shared());
+  EXPECT_TRUE(a->durable());
+  // Both hear t1#1; each hears one the other does not.
+  EXPECT_EQ(a->append({ev("t1", 1), ev("t2", 1)}, 1'000), 2u);
+  EXPECT_EQ(b->append({ev("t1", 1)}, 1'000), 2u);  // none new, but it now has both of a's
+  EXPECT_EQ(b->append({ev("t3", 1)}, 1'000), 1u);
+  a->catchUp();
+  const auto expected =
+      std::vector<std::pair<std::int64_t, std::string>>{{1, "t1#1"}, {2, "t2#1"}, {3, "t3#1"}};
+  EXPECT_EQ(rows(*a), expected);
+  EXPECT_EQ(rows(*b), expected);
+  EXPECT_EQ(a->lastId(), 3);
+  EXPECT_EQ(b->lastId(), 3);
+  // seq 0 is always new (the manager never sends it; a hand-made event might).
+  a->append({ev("t4", 0), ev("t4", 0)}, 1'000);
+  EXPECT_EQ(a->lastId(), 5);
+}
+
+TEST_F(SharedEventLog, TheOtherReplicasRowsReachTheListenerAndWakeTheStream) {
+  const std::string url = server_->freshUrl();
+  auto a = open(url);
+  auto b = open(url);
+  std::atomic<int> heard{0};
+  b->onCatchUp([&](const std::vector<LoggedEvent>& rows) { heard += static_cast<int>(rows.size()); });
+  a->append({ev("t1", 1), ev("t1", 2)}, 1'000);
+  // b's own thread takes them (four times a second); its stream wakes.
+  EXPECT_TRUE(b->waitAfter(0, std::chrono::seconds(5)));
+  for (int i = 0; i < 100 && b->lastId() < 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(b->lastId(), 2);
+  EXPECT_EQ(heard.load(), 2);
+}
+
+TEST_F(SharedEventLog, AReopenedLogKeepsItsIdsAndRetentionSaysWhatIsGone) {
+  const std::string url = server_->freshUrl();
+  EventLogSettings s;
+  s.retainEvents = 3;
+  {
+    auto a = open(url, s);
+    for (std::uint32_t i = 1; i <= 5; ++i) {
+      a->append({ev("t1", i)}, 1'000);
+    }
+  }
+  auto again = open(url, s);
+  EXPECT_EQ(again->lastId(), 5);
+  again->append({ev("t1", 3)}, 1'000);  // heard before, still held: not logged again
+  EXPECT_EQ(again->lastId(), 5);
+  again->append({ev("t1", 6)}, 2'000'000'000);  // a second later: retention runs
+  EXPECT_EQ(again->lastId(), 6);
+  EXPECT_EQ(again->prunedThrough(), 3);
+  const auto held = again->after(0, 100);
+  ASSERT_EQ(held.size(), 3u);
+  EXPECT_EQ(held.front().id, 4);
+  // By age: everything logged before the cut goes; the ids are not given again.
+  EventLogSettings aged = s;
+  aged.retainSeconds = 1;
+  auto old = open(url, aged);
+  old->append({ev("t2", 1)}, 100'000'000'000);
+  EXPECT_EQ(old->lastId(), 7);
+  EXPECT_EQ(old->prunedThrough(), 6);
+}
+
+TEST_F(SharedEventLog, ConcurrentAppendsNeverShowAReaderAnIdBelowOneItHasSeen) {
+  const std::string url = server_->freshUrl();
+  auto a = open(url);
+  auto b = open(url);
+  auto reader = open(url);
+  std::atomic<bool> done{false};
+  std::vector<std::thread> writers;
+  for (auto* log : {a.get(), b.get()}) {
+    writers.emplace_back([log, name = log == a.get() ? "a" : "b"] {
+      for (std::uint32_t i = 1; i <= 200; ++i) {
+        log->append({ev(std::string(name) + std::to_string(i % 7), i)}, 1'000);
+      }
+    });
+  }
+  std::int64_t seen = 0;
+  std::size_t taken = 0;
+  bool ordered = true;
+  std::thread watcher([&] {
+    while (!done) {
+      reader->catchUp();
+      for (const auto& l : reader->after(seen, 1000)) {
+        ordered = ordered && l.id > seen;
+        seen = l.id;
+        ++taken;
+      }
+    }
+  });
+  for (auto& w : writers) {
+    w.join();
+  }
+  done = true;
+  watcher.join();
+  reader->catchUp();
+  for (const auto& l : reader->after(seen, 1000)) {
+    seen = l.id;
+    ++taken;
+  }
+  EXPECT_TRUE(ordered);
+  EXPECT_EQ(taken, 400u);  // every row, none skipped by a late commit
+  a->catchUp();
+  b->catchUp();
+  EXPECT_EQ(rows(*a), rows(*b));
+  EXPECT_EQ(rows(*a), rows(*reader));
+}
+
+TEST_F(SharedEventLog, AnUnreachableDatabaseIsAnErrorNamingItWithoutThePassword) {
+  try {
+    PostgresEventStore store("postgresql://fleet:secret@/postgres?host=/nonexistent-dir&connect_timeout=1");
+    FAIL() << "opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).find("secret"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nonexistent-dir"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
