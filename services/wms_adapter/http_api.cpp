@@ -149,12 +149,13 @@ HttpApi::HttpApi(ApiSettings settings, const StationMap& stations, TaskGateway& 
       // Shared by the adapter replicas on that database (postgres_event_store.hpp).
       events_ = std::make_unique<EventLog>(settings_.events,
                                            std::make_unique<PostgresEventStore>(settings_.events.path));
-      stateDb_ = std::make_shared<SqliteDb>("");
+      webhooks_ = std::make_unique<Webhooks>(
+          settings_.webhooks, std::make_unique<PostgresWebhookStore>(settings_.events.path), *events_);
     } else {
       stateDb_ = std::make_shared<SqliteDb>(settings_.events.path);
       events_ = std::make_unique<EventLog>(settings_.events, stateDb_);
+      webhooks_ = std::make_unique<Webhooks>(settings_.webhooks, stateDb_, *events_);
     }
-    webhooks_ = std::make_unique<Webhooks>(settings_.webhooks, stateDb_, *events_);
     // The view starts from what the log holds (a restarted adapter lists the tasks it had), and
     // takes what other replicas logged.
     for (std::int64_t at = events_->prunedThrough();;) {

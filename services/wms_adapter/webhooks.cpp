@@ -36,47 +36,119 @@ nlohmann::json webhookJson(const WebhookStatus& s, std::int64_t lastEventId) {
           {"last_success_ns", s.lastSuccessNs}};
 }
 
+namespace {
+
+constexpr std::int64_t kLeaseNs = 5'000'000'000;  // a replica's hold on a subscription it delivers
+constexpr auto kSyncEvery = std::chrono::seconds(1);
+
+}  // namespace
+
 Webhooks::Webhooks(WebhookSettings settings, std::shared_ptr<SqliteDb> db, EventLog& log)
-    : s_(std::move(settings)), db_(std::move(db)), log_(log) {
-  std::vector<std::shared_ptr<Sub>> loaded;
+    : Webhooks(std::move(settings), std::make_unique<SqliteWebhookStore>(std::move(db)), log) {}
+
+Webhooks::Webhooks(WebhookSettings settings, std::unique_ptr<WebhookStore> store, EventLog& log)
+    : s_(std::move(settings)), store_(std::move(store)), replica_(randomHex(8)), log_(log) {
+  const auto stored = store_->load();
   {
-    std::lock_guard dbLock(db_->mutex());
-    db_->exec(
-        "CREATE TABLE IF NOT EXISTS webhooks("
-        " id TEXT PRIMARY KEY, url TEXT NOT NULL, secret TEXT NOT NULL, created_ns INTEGER NOT NULL,"
-        " delivered_through INTEGER NOT NULL, state TEXT NOT NULL, deliveries INTEGER NOT NULL,"
-        " failures INTEGER NOT NULL, last_error TEXT NOT NULL, last_attempt_ns INTEGER NOT NULL,"
-        " last_success_ns INTEGER NOT NULL)");
-    SqliteStmt q(*db_,
-                 "SELECT id, url, secret, created_ns, delivered_through, state, deliveries, failures, "
-                 "last_error, last_attempt_ns, last_success_ns FROM webhooks ORDER BY created_ns");
-    while (q.step()) {
-      auto sub = std::make_shared<Sub>();
-      auto& st = sub->status;
-      st.id = q.text(0);
-      st.url = q.text(1);
-      sub->secret = q.text(2);
-      st.createdNs = q.integer(3);
-      st.deliveredThrough = q.integer(4);
-      st.state = q.text(5);
-      st.deliveries = q.integer(6);
-      st.failures = q.integer(7);
-      st.lastError = q.text(8);
-      st.lastAttemptNs = q.integer(9);
-      st.lastSuccessNs = q.integer(10);
-      auto target = parseWebhookUrl(st.url, nullptr);
-      if (!target) {
-        continue;  // stored by a build that checked it: cannot happen short of editing the file
+    std::lock_guard lock(m_);
+    for (const auto& w : stored) {
+      if (auto sub = subOf(w)) {
+        subs_[sub->status.id] = sub;
+        start(sub);
       }
-      sub->target = *target;
-      loaded.push_back(std::move(sub));
     }
   }
-  std::lock_guard lock(m_);
-  for (auto& sub : loaded) {
-    subs_[sub->status.id] = sub;
-    start(sub);
+  if (store_->shared()) {
+    syncer_ = std::thread([this] {
+      std::unique_lock lock(m_);
+      while (!stop_) {
+        syncCv_.wait_for(lock, kSyncEvery, [&] { return stop_.load(); });
+        if (stop_) {
+          break;
+        }
+        lock.unlock();
+        sync();
+        lock.lock();
+      }
+    });
   }
+}
+
+std::shared_ptr<Webhooks::Sub> Webhooks::subOf(const StoredWebhook& w) {
+  auto target = parseWebhookUrl(w.status.url, nullptr);
+  if (!target) {
+    return nullptr;  // stored by a build that checked it: cannot happen short of editing the store
+  }
+  auto sub = std::make_shared<Sub>();
+  sub->status = w.status;
+  sub->secret = w.secret;
+  sub->target = *target;
+  return sub;
+}
+
+void Webhooks::sync() {
+  std::vector<StoredWebhook> stored;
+  try {
+    stored = store_->load();
+  } catch (const std::exception&) {
+    return;  // the database is away: the next round looks again
+  }
+  std::vector<std::shared_ptr<Sub>> gone;
+  {
+    std::lock_guard lock(m_);
+    if (stop_) {
+      return;
+    }
+    std::map<std::string, const StoredWebhook*> byId;
+    for (const auto& w : stored) {
+      byId[w.status.id] = &w;
+      if (!subs_.count(w.status.id)) {
+        if (auto sub = subOf(w)) {
+          subs_[w.status.id] = sub;
+          start(sub);
+        }
+      }
+    }
+    for (auto it = subs_.begin(); it != subs_.end();) {
+      const auto found = byId.find(it->first);
+      if (found == byId.end()) {
+        gone.push_back(it->second);
+        it = subs_.erase(it);
+        continue;
+      }
+      // Delivered by another replica: its status as stored (GET /v1/webhooks on either).
+      std::lock_guard sl(it->second->m);
+      if (found->second->status.lastAttemptNs > it->second->status.lastAttemptNs) {
+        it->second->status = found->second->status;
+      }
+      ++it;
+    }
+  }
+  for (auto& sub : gone) {
+    {
+      std::lock_guard sl(sub->m);
+      sub->removed = true;
+    }
+    sub->cv.notify_all();
+  }
+}
+
+bool Webhooks::mine(Sub& sub, std::int64_t& cursor) {
+  if (!store_->shared()) {
+    return true;
+  }
+  WebhookStore::Claim claim;
+  try {
+    claim = store_->claim(sub.status.id, replica_, WallClock{}.nowNs(), kLeaseNs);
+  } catch (const std::exception&) {
+    return false;  // the database is away: nobody can take the lease from the one holding it
+  }
+  if (claim.granted && claim.deliveredThrough && *claim.deliveredThrough > cursor) {
+    cursor = *claim.deliveredThrough;  // another replica delivered up to there
+    std::lock_guard sl(sub.m);
+    sub.status.deliveredThrough = cursor;
+  }
+  return claim.granted;
 }
 
 Webhooks::~Webhooks() {
@@ -88,6 +160,7 @@ void Webhooks::stop() {
   std::vector<std::thread> threads;
   {
     std::lock_guard lock(m_);
+    syncCv_.notify_all();
     for (auto& [id, sub] : subs_) {
       std::lock_guard sl(sub->m);
       sub->cv.notify_all();
@@ -97,6 +170,9 @@ void Webhooks::stop() {
   log_.wakeAll();
   for (auto& t : threads) {
     t.join();
+  }
+  if (syncer_.joinable()) {
+    syncer_.join();
   }
 }
 
@@ -122,19 +198,7 @@ std::optional<Webhooks::Created> Webhooks::create(const std::string& url, std::s
     return std::nullopt;
   }
   st.deliveredThrough = log_.lastId();  // events from now on
-  {
-    std::lock_guard dbLock(db_->mutex());
-    SqliteStmt ins(*db_,
-                   "INSERT INTO webhooks(id, url, secret, created_ns, delivered_through, state, deliveries, "
-                   "failures, last_error, last_attempt_ns, last_success_ns) "
-                   "VALUES (?1, ?2, ?3, ?4, ?5, 'active', 0, 0, '', 0, 0)");
-    ins.bind(1, st.id)
-        .bind(2, st.url)
-        .bind(3, sub->secret)
-        .bind(4, st.createdNs)
-        .bind(5, st.deliveredThrough);
-    ins.run();
-  }
+  store_->insert({st, sub->secret});
   subs_[st.id] = sub;
   start(sub);
   return Created{st, sub->secret};
@@ -145,20 +209,22 @@ bool Webhooks::remove(const std::string& id) {
   {
     std::lock_guard lock(m_);
     const auto it = subs_.find(id);
-    if (it == subs_.end()) {
+    if (it != subs_.end()) {
+      sub = it->second;
+      subs_.erase(it);
+    }
+    // In a shared store another replica may have made it a moment ago.
+    if (!store_->remove(id) && !sub) {
       return false;
     }
-    sub = it->second;
-    subs_.erase(it);
-    std::lock_guard dbLock(db_->mutex());
-    SqliteStmt del(*db_, "DELETE FROM webhooks WHERE id = ?1");
-    del.bind(1, id).run();
   }
-  {
-    std::lock_guard sl(sub->m);
-    sub->removed = true;
+  if (sub) {
+    {
+      std::lock_guard sl(sub->m);
+      sub->removed = true;
+    }
+    sub->cv.notify_all();
   }
-  sub->cv.notify_all();
   return true;
 }
 
@@ -184,20 +250,7 @@ std::optional<WebhookStatus> Webhooks::find(const std::string& id) const {
 }
 
 void Webhooks::store(const Sub& sub) {
-  std::lock_guard dbLock(db_->mutex());
-  SqliteStmt up(*db_,
-                "UPDATE webhooks SET delivered_through = ?2, state = ?3, deliveries = ?4, failures = ?5, "
-                "last_error = ?6, last_attempt_ns = ?7, last_success_ns = ?8 WHERE id = ?1");
-  const auto& st = sub.status;
-  up.bind(1, st.id)
-      .bind(2, st.deliveredThrough)
-      .bind(3, st.state)
-      .bind(4, st.deliveries)
-      .bind(5, st.failures)
-      .bind(6, st.lastError)
-      .bind(7, st.lastAttemptNs)
-      .bind(8, st.lastSuccessNs);
-  up.run();
+  store_->update(sub.status);
 }
 
 std::optional<std::string> Webhooks::deliver(Sub& sub, std::int64_t eventId, const std::string& body) {
@@ -253,6 +306,12 @@ void Webhooks::run(const std::shared_ptr<Sub>& sub) {
     return stop_ || sub->removed;
   };
   while (!over()) {
+    if (!mine(*sub, cursor)) {
+      // Another replica holds it: look again when its lease could have run out.
+      std::unique_lock sl(sub->m);
+      sub->cv.wait_for(sl, std::chrono::seconds(1), [&] { return stop_ || sub->removed; });
+      continue;
+    }
     // What to send next: a gap when retention passed the cursor, else the next event.
     std::int64_t id = 0;
     nlohmann::json body;

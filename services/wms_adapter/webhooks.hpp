@@ -13,6 +13,10 @@
 // failures in a row the subscription is marked `failing` (GET /v1/webhooks shows it with the last
 // error) and is tried once every failing_retry_ms, becoming `active` again with its first success.
 // A cursor the log's retention has passed gets a `gap` delivery naming the ids missed.
+//
+// The subscriptions live in a WebhookStore (webhook_store.hpp): the adapter's SQLite file, or the
+// PostgreSQL database replicas share; there each replica sees every subscription (it looks again
+// every second) and delivers those whose lease it holds.
 
 #include <atomic>
 #include <condition_variable>
@@ -28,6 +32,7 @@
 
 #include "event_log.hpp"
 #include "sqlite_db.hpp"
+#include "webhook_store.hpp"
 
 namespace fleet::wms {
 
@@ -42,25 +47,14 @@ struct WebhookSettings {
   std::string caFile;            // CA certificates for https receivers (empty: the system's)
 };
 
-/// A subscription as GET /v1/webhooks shows it (the secret only on creation).
-struct WebhookStatus {
-  std::string id;
-  std::string url;
-  std::string state = "active";  // "active" or "failing"
-  std::int64_t createdNs = 0;
-  std::int64_t deliveredThrough = 0;  // the newest event id the receiver acknowledged
-  std::int64_t deliveries = 0;        // acknowledged deliveries
-  std::int64_t failures = 0;          // failed attempts in a row
-  std::string lastError;
-  std::int64_t lastAttemptNs = 0;
-  std::int64_t lastSuccessNs = 0;
-};
-
 class Webhooks {
  public:
   /// Loads the stored subscriptions and starts their delivery. Throws std::runtime_error when the
   /// database cannot be read.
   Webhooks(WebhookSettings settings, std::shared_ptr<SqliteDb> db, EventLog& log);
+  /// On any store; a shared one is looked at every second for subscriptions made or removed
+  /// through other replicas.
+  Webhooks(WebhookSettings settings, std::unique_ptr<WebhookStore> store, EventLog& log);
   ~Webhooks();
   Webhooks(const Webhooks&) = delete;
   Webhooks& operator=(const Webhooks&) = delete;
@@ -87,16 +81,23 @@ class Webhooks {
   /// One POST of `body` for event `eventId`; nothing on a 2xx, else why it failed.
   std::optional<std::string> deliver(Sub& sub, std::int64_t eventId, const std::string& body);
   void store(const Sub& sub);  // writes the status (cursor, counts, state); throws on a disk error
+  /// A shared store: whether this replica delivers `sub` now; takes a newer stored cursor.
+  bool mine(Sub& sub, std::int64_t& cursor);
+  void sync();  // a shared store: start what other replicas made, stop what they removed
+  std::shared_ptr<Sub> subOf(const StoredWebhook& w);
   std::vector<LoggedEvent> readAfter(std::int64_t cursor);  // the next event; none on a read error
   void start(const std::shared_ptr<Sub>& sub);
 
   WebhookSettings s_;
-  std::shared_ptr<SqliteDb> db_;
+  std::unique_ptr<WebhookStore> store_;
+  std::string replica_;  // this adapter, as a lease holder
   EventLog& log_;
   mutable std::mutex m_;
   std::map<std::string, std::shared_ptr<Sub>> subs_;
   std::vector<std::thread> threads_;  // joined by stop()
   std::atomic<bool> stop_{false};
+  std::thread syncer_;  // a shared store
+  std::condition_variable syncCv_;
 };
 
 /// A subscription's JSON (without its secret).

@@ -1,16 +1,23 @@
-// The event log on PostgreSQL, shared by adapter replicas (postgres_event_store.hpp): a transition
-// heard by two replicas is logged once, both serve the same ids in the same order, a reopened log
-// keeps its ids, retention says what is gone, and concurrent appends never show a reader an id
-// below one it has already seen. Against a PostgreSQL server the test starts itself.
+// The event log and the webhook subscriptions on PostgreSQL, shared by adapter replicas
+// (postgres_event_store.hpp, webhook_store.hpp): a transition heard by two replicas is logged once,
+// both serve the same ids in the same order, a reopened log keeps its ids, retention says what is
+// gone, concurrent appends never show a reader an id below one it has already seen; a subscription
+// made on one replica is listed and delivered by either, one at a time, and the other takes over
+// the deliveries when the first one dies. Against a PostgreSQL server the test starts itself.
 
 #include <gtest/gtest.h>
 
+#include <httplib.h>
+
 #include <atomic>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include "event_log.hpp"
 #include "postgres_event_store.hpp"
 #include "postgres_server.hpp"
+#include "webhooks.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
@@ -169,4 +176,103 @@ TEST_F(SharedEventLog, AnUnreachableDatabaseIsAnErrorNamingItWithoutThePassword)
   }
 }
 
+/// Counts each event id it is sent (answers 204).
+class Receiver {
+ public:
+  Receiver() {
+    server_.Post("/hooks/fleet", [this](const httplib::Request& req, httplib::Response& res) {
+      std::lock_guard lock(m_);
+      ++got_[std::stoll(req.get_header_value("X-Fleet-Event-Id"))];
+      res.status = 204;
+    });
+    port_ = server_.bind_to_any_port("127.0.0.1");
+    thread_ = std::thread([this] { server_.listen_after_bind(); });
+  }
+  ~Receiver() {
+    server_.stop();
+    thread_.join();
+  }
+  [[nodiscard]] std::string url() const {
+    return "http://127.0.0.1:" + std::to_string(port_) + "/hooks/fleet";
+  }
+  std::map<std::int64_t, int> got() {
+    std::lock_guard lock(m_);
+    return got_;
+  }
+  /// Waits up to `seconds` for `n` distinct ids.
+  bool waitFor(std::size_t n, int seconds) {
+    for (int i = 0; i < seconds * 50; ++i) {
+      if (got().size() >= n) {
+        return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  }
+
+ private:
+  httplib::Server server_;
+  int port_ = 0;
+  std::thread thread_;
+  std::mutex m_;
+  std::map<std::int64_t, int> got_;
+};
+
+/// An adapter replica's status push: its event log and webhooks on the shared database.
+struct Replica {
+  std::unique_ptr<EventLog> log;
+  std::unique_ptr<Webhooks> hooks;
+  explicit Replica(const std::string& url) : log(open(url)) {
+    WebhookSettings w;
+    w.backoffMs = 50;
+    hooks = std::make_unique<Webhooks>(w, std::make_unique<PostgresWebhookStore>(url), *log);
+  }
+  ~Replica() {
+    hooks->stop();
+    hooks.reset();
+  }
+};
+
 }  // namespace
+
+TEST_F(SharedEventLog, ASubscriptionIsDeliveredByOneReplicaAndTakenOverWhenItDies) {
+  const std::string url = server_->freshUrl();
+  Receiver rx;
+  auto a = std::make_unique<Replica>(url);
+  Replica b(url);
+  const auto made = a->hooks->create(rx.url(), "", 1'000);
+  ASSERT_TRUE(made);
+  const std::string id = made->status.id;
+  // b lists it within its next look (once a second), and removing an unknown one is refused.
+  for (int i = 0; i < 150 && !b.hooks->find(id); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(b.hooks->find(id));
+  EXPECT_FALSE(b.hooks->remove("wh-none"));
+  // Events heard by both: each delivered, by one replica at a time.
+  for (std::uint32_t i = 1; i <= 5; ++i) {
+    a->log->append({ev("t1", i)}, 1'000);
+    b.log->append({ev("t1", i)}, 1'000);
+  }
+  ASSERT_TRUE(rx.waitFor(5, 10));
+  // a dies: b takes the deliveries over once a's lease has run out, from the stored cursor.
+  a.reset();
+  for (std::uint32_t i = 6; i <= 8; ++i) {
+    b.log->append({ev("t1", i)}, 1'000);
+  }
+  ASSERT_TRUE(rx.waitFor(8, 15));
+  const auto got = rx.got();
+  for (std::int64_t e = 1; e <= 8; ++e) {
+    EXPECT_EQ(got.count(e), 1u) << "event " << e;
+  }
+  for (const auto& [e, n] : got) {
+    EXPECT_EQ(n, 1) << "event " << e << " delivered " << n << " times";
+  }
+  const auto status = b.hooks->find(id);
+  ASSERT_TRUE(status);
+  EXPECT_EQ(status->deliveredThrough, 8);
+  // Removed through b: gone from the store.
+  EXPECT_TRUE(b.hooks->remove(id));
+  Replica c(url);
+  EXPECT_TRUE(c.hooks->list().empty());
+}
