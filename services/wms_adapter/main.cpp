@@ -4,12 +4,15 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <thread>
 
 #include "dds_gateway.hpp"
 #include "fleet/core/logging.hpp"
+#include "fleet/fleet/pg_connection.hpp"
 #include "fleet/fleet/site_stations.hpp"
 #include "fleet/service/command_line.hpp"
 #include "fleet/service/common_options.hpp"
@@ -17,8 +20,39 @@
 #include "fleet/service/runtime.hpp"
 #include "fleet/service/service_ops.hpp"
 #include "http_api.hpp"
+#include "postgres_event_store.hpp"
 
 using namespace fleet;
+
+namespace {
+
+/// The shared event log's database (adapter replicas, events.log a postgresql:// URL), tried until
+/// it answers: 1 s doubling to 10 s, one line per try naming the URL without its password; not
+/// ready meanwhile (the API is not served). A malformed URL stops the start (exit 2). False when
+/// stopped while waiting.
+bool waitForEventDatabase(const std::string& url) {
+  if (auto ok = fleet::pg::checkUrl(url); !ok) {
+    throw fleet::ConfigError({"events.log: " + ok.error().message});
+  }
+  for (double wait = 1.0;; wait = std::min(10.0, wait * 2)) {
+    fleet::pg::Connection probe(url);
+    const auto ok = probe.ensure();
+    if (ok) {
+      spdlog::info("wms adapter: event log on {} (shared by the adapters on it)", fleet::pg::redacted(url));
+      return true;
+    }
+    spdlog::warn("wms adapter: events.log {}: {}; trying again in {:.0f} s", fleet::pg::redacted(url),
+                 ok.error().message, wait);
+    for (int k = 0; k < static_cast<int>(wait * 10); ++k) {
+      if (fleet::service::stopRequested()) {
+        return false;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"wms_adapter: HTTP/JSON task intake for the fleet"};
@@ -33,7 +67,8 @@ int main(int argc, char** argv) {
   app.add_option("--port", port, "HTTP port (overrides the config; 0 = any free port)");
   app.add_option("--events-log", eventsLog,
                  "SQLite file of the event log and the webhook subscriptions (overrides the config's "
-                 "events.log; on a writable volume, event ids and webhooks survive a restart)");
+                 "events.log; on a writable volume, event ids and webhooks survive a restart), or a "
+                 "postgresql:// URL that adapter replicas share");
   service::addCommonOptions(app, common);
   if (auto code = service::parse(app, argc, argv)) {
     return *code;
@@ -64,6 +99,9 @@ int main(int argc, char** argv) {
     ops.health().setReady("fleet_manager", false);
     if (!ops.start(common.ops)) {
       return service::kExitUsage;
+    }
+    if (wms::isPostgresUrl(api.events.path) && !waitForEventDatabase(api.events.path)) {
+      return 0;  // stopped while waiting
     }
     transport::Participant participant;
     wms::FleetView view;

@@ -62,7 +62,7 @@ void readStatusSettings(Config& cfg, EventLogSettings& events, WebhookSettings& 
   w.caFile = wh.string("ca_file", "");
 }
 
-std::optional<std::int64_t> resumePoint(const Request& req, const EventLog& log, Response& res) {
+std::optional<std::int64_t> resumePoint(const Request& req, EventLog& log, Response& res) {
   std::string field;
   std::string text;
   if (const auto h = req.get_header_value("Last-Event-ID"); !h.empty()) {
@@ -82,6 +82,14 @@ std::optional<std::int64_t> resumePoint(const Request& req, const EventLog& log,
     return std::nullopt;
   }
   const std::int64_t id = std::stoll(text);
+  if (log.shared() && id > log.lastId()) {
+    // An id another replica gave a moment ago, before this one looked: look now.
+    try {
+      log.catchUp();
+    } catch (const std::exception&) {
+      // The database is away: judged on what this replica holds.
+    }
+  }
   const std::int64_t last = log.lastId();
   const std::int64_t pruned = log.prunedThrough();
   if (id > last) {

@@ -22,6 +22,6 @@ void addStatusRoutes(HttpServer& server, EventLog& log, Webhooks& webhooks,
 
 /// Where a stream resumes: after the Last-Event-ID header's id, else after ?since=, else after the
 /// newest event (only new ones). On a bad or expired id the reply is written and nothing returned.
-std::optional<std::int64_t> resumePoint(const Request& req, const EventLog& log, Response& res);
+std::optional<std::int64_t> resumePoint(const Request& req, EventLog& log, Response& res);
 
 }  // namespace fleet::wms
