@@ -397,7 +397,9 @@ int main(int argc, char** argv) {
   std::string store;
   app.add_option("--db", db, "SQLite task database (overrides the config)");
   app.add_option("--store", store,
-                 "sqlite:PATH or a postgresql:// URL (overrides the config's store and db)");
+                 "sqlite:PATH or a postgresql:// URL (overrides the config's store and db; default: "
+                 "$FLEET_STORE)")
+      ->envname("FLEET_STORE");
   app.add_option("--stations", stations,
                  "site.json, or a scenario naming one, or a stations JSON file (overrides the config)");
   service::addCommonOptions(app, common);

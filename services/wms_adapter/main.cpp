@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   app.add_option("--events-log", eventsLog,
                  "SQLite file of the event log and the webhook subscriptions (overrides the config's "
                  "events.log; on a writable volume, event ids and webhooks survive a restart), or a "
-                 "postgresql:// URL that adapter replicas share");
+                 "postgresql:// URL that adapter replicas share; default: $FLEET_EVENTS_LOG")
+      ->envname("FLEET_EVENTS_LOG");
   service::addCommonOptions(app, common);
   if (auto code = service::parse(app, argc, argv)) {
     return *code;

@@ -8,8 +8,12 @@
 # files) is removed, also on failure. Exit 77 (ctest skip) only when podman cannot run containers
 # here at all.
 # Plain: deploy/compose.yaml with the development overlay deploy/compose.dev.yaml (two robots, both
-# the robot agent's; no DDS Security, http): both tasks must be done through compose.yaml's traffic
-# manager, which must have released routes. With "secure": the secure default as deployed,
+# the robot agent's; no DDS Security, http) and the PostgreSQL overlays deploy/compose.postgres.yaml
+# and compose.dev.postgres.yaml: the task store and the adapters' event log in the postgres
+# container, two fleet managers and two WMS adapters. Both tasks must be done through compose.yaml's
+# traffic manager, which must have released routes, while the active manager is killed (-9) as the
+# simulator starts: the other must be active within 10 s, the killed one stand by when started
+# again, and the second adapter must show the same tasks and the same event ids. With "secure": the secure default as deployed,
 # deploy/compose.yaml and deploy/compose.vda5050.yaml without the dev overlays, the files of
 # `scripts/dds-security site` (written by scripts/containers files): DDS Security with an identity per
 # service, the traffic manager and the bridge included, https on the API (fleetctl trusts the site
@@ -56,7 +60,8 @@ if ((SECURE)); then
   SERVICES+=(mosquitto vda5050-bridge)
   files+=(-f deploy/compose.vda5050.yaml)
 else
-  files+=(-f deploy/compose.dev.yaml)
+  SERVICES+=(postgres fleet-manager-2 wms-adapter-2)
+  files+=(-f deploy/compose.dev.yaml -f deploy/compose.postgres.yaml -f deploy/compose.dev.postgres.yaml)
 fi
 scenario=sim/scenarios/two_robots.json ntasks=2
 compose() { timeout 120 podman-compose -p "$P" "${files[@]}" "$@"; }
@@ -71,6 +76,7 @@ cleanup() {
   # podman-compose 1.0.3 leaves the network (and a container whose start it lost) behind.
   podman ps -aq --filter "label=io.podman.compose.project=$P" | xargs -r podman rm -f -t 1 >/dev/null 2>&1
   podman network rm -f "$NET" >/dev/null 2>&1
+  podman volume rm -f "${P}_fleet-pg" >/dev/null 2>&1
   rm -rf "$dir"
 }
 trap cleanup EXIT
@@ -86,6 +92,7 @@ for k in $(seq 0 99); do
   fi
 done
 [[ -n $port ]] || fail "no free loopback port for the API"
+port2=$((port + 3000))  # the second adapter (PostgreSQL overlay)
 
 # The broker's port inside the network: not MQTT's 1883, as every test's broker.
 export FLEET_MQTT_PORT=$((18830 + $$ % 1000))
@@ -94,6 +101,7 @@ export FLEET_MQTT_PORT=$((18830 + $$ % 1000))
 DEV=$((1 - SECURE)) VDA5050=$SECURE scripts/containers files "$dir" "$scenario" 150 "$ntasks" >/dev/null ||
   fail "writing the mounted files failed"
 export FLEET_CONFIG_DIR=$dir/config FLEET_DATA_DIR=$dir/data FLEET_WMS_PORT=$port FLEET_SIM_SECONDS=150
+export FLEET_WMS_PORT_2=$port2 FLEET_PG_PASSWORD=pg-$$-$RANDOM
 if ((SECURE)); then
   FLEET_AGENT_ROBOTS=$(cat "$dir/config/agent_robots")
   export FLEET_AGENT_ROBOTS
@@ -125,6 +133,17 @@ done
 echo "containers: $(for s in "${SERVICES[@]}"; do printf '%s=%s ' "$s" "${ip[$s]}"; done)"
 [[ $(podman port "${P}_wms-adapter_1") == "8080/tcp -> 127.0.0.1:$port" ]] ||
   fail "the API is not published on 127.0.0.1:$port only: $(podman port "${P}_wms-adapter_1")"
+# The active one of two fleet managers (its /readyz 200; the other's 503), waiting up to `$1` s.
+active_manager() {
+  local m
+  for _ in $(seq $(($1 * 2))); do
+    for m in fleet-manager fleet-manager-2; do
+      podman exec "${P}_${m}_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 && { echo "$m"; return 0; }
+    done
+    sleep 0.5
+  done
+  return 1
+}
 
 if ((SECURE)); then
   ctl() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "https://127.0.0.1:$port" --ca-cert "$dir/config/dds/ca.pem" "$@"; }
@@ -140,10 +159,48 @@ if ((SECURE)); then  # https only: plain http on the API's port gets no answer
 fi
 ctl submit "$dir/config/tasks.csv" | tee "$dir/submit.txt"
 grep -q "submitted $ntasks tasks, 0 refused" "$dir/submit.txt" || fail "the WMS adapter did not accept the tasks"
+if ((!SECURE)); then
+  # Two managers on PostgreSQL: kill -9 of the active one with the tasks acknowledged, before the
+  # simulator starts (lockstep runs the whole scenario in seconds); the other takes over and assigns.
+  first=$(active_manager 30) || fail "no fleet manager is active"
+  other=fleet-manager-2
+  [[ $first == fleet-manager-2 ]] && other=fleet-manager
+  podman exec "${P}_${other}_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 && fail "both managers are ready"
+  podman kill -s KILL "${P}_${first}_1" >/dev/null
+  killed=$SECONDS
+  for _ in $(seq 20); do
+    podman exec "${P}_${other}_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 && break
+    sleep 0.5
+  done
+  podman exec "${P}_${other}_1" /usr/local/bin/fleet-probe /readyz >/dev/null 2>&1 ||
+    fail "$other did not take over within 10 s of the kill of $first"
+  echo "killed the active manager $first: $other active after $((SECONDS - killed)) s"
+  podman start "${P}_${first}_1" >/dev/null || fail "$first did not start again"
+  # The new active manager assigns the tasks it rebuilt from the store before the simulator runs.
+  for _ in $(seq 40); do
+    ctl task job-000 2>/dev/null | grep -q '"state": "queued"' || break
+    sleep 0.5
+  done
+fi
 touch "$dir/data/start"  # the simulator starts now (deploy/compose.yaml)
 
 wait_tasks_done "$ntasks" 120
 check_traffic_manager_released "${P}_traffic-manager_1"
+if ((!SECURE)); then
+  # The second adapter: the same tasks done, the same event ids (one log in the database).
+  ctl2() { "$BUILD_DIR/services/fleetctl/fleetctl" --url "http://127.0.0.1:$port2" "$@"; }
+  for ((k = 0; k < ntasks; ++k)); do
+    id=$(printf 'job-%03d' "$k")
+    ctl2 task "$id" | grep -q '"state": "done"' || fail "the second adapter does not show $id done"
+  done
+  ids() { "$@" follow --since 0 --count 4 --seconds 10 | python3 -c 'import json,sys; print(" ".join(str(json.loads(l)["event_id"]) for l in sys.stdin if l.strip()))'; }
+  e1=$(ids ctl) e2=$(ids ctl2)
+  [[ -n $e1 && $e1 == "$e2" ]] || fail "the adapters number the events differently: '$e1' and '$e2'"
+  echo "both adapters show the tasks done and the events as $e1"
+  # The killed manager, started again, stands by.
+  standby=$(active_manager 5)
+  [[ $standby == "$other" ]] || fail "after the restart of $first the active manager is '$standby', not $other"
+fi
 ((SECURE)) && check_vehicle_took_part "${P}_vda5050-bridge_1" "$dir/data"
 
 for s in "${SERVICES[@]}"; do

@@ -4,7 +4,7 @@
 Per service: the same image, entrypoint and arguments (the adapter reads its stations from the
 wms_adapter.json that scripts/containers writes, which must name the pod's stations and listen on
 all addresses of its container), environment, mounts, health check, read-only root filesystem and
-no privilege escalation; the adapter's event log (--events-log) on the writable data mount. Network: every service on the project network `fleet`, none in another's
+no privilege escalation; the adapter's event log (--events-log or FLEET_EVENTS_LOG) on the writable data mount. Network: every service on the project network `fleet`, none in another's
 namespace; the compose DDS profile (in the images) with multicast off and exactly the DDS services'
 names as unicast peers; only the adapter publishes a port, on 127.0.0.1. Secure by default: each
 DDS service of compose.yaml, compose.vda5050.yaml and the Pod requires DDS Security and joins with
@@ -27,6 +27,10 @@ compose = doc["services"]
 # under the same rules; the services it only adds settings to are compose.yaml's.
 overlay = yaml.safe_load(open(f"{src}/deploy/compose.vda5050.yaml"))["services"]
 added = {n: s for n, s in overlay.items() if n not in compose}
+# The PostgreSQL overlay's second manager and second adapter: DDS services under the same rules;
+# its database is not one.
+pg_overlay = yaml.safe_load(open(f"{src}/deploy/compose.postgres.yaml"))["services"]
+added.update({n: s for n, s in pg_overlay.items() if n not in compose and n != "postgres"})
 NOT_DDS = ("fleetctl", "mosquitto")
 pod = {c["name"]: c for c in yaml.safe_load(open(f"{src}/deploy/fleet-pod.yaml"))["spec"]["containers"]}
 problems = []
@@ -64,7 +68,8 @@ for name, c in pod.items():
     if name == "wms-adapter":
         # Event ids and webhook subscriptions survive a restart: the event log on the writable data
         # mount in both.
-        log = args[args.index("--events-log") + 1] if "--events-log" in args else ""
+        penv = {e["name"]: e["value"] for e in c.get("env", [])}
+        log = args[args.index("--events-log") + 1] if "--events-log" in args else penv.get("FLEET_EVENTS_LOG", "")
         writable = [m["mountPath"] for m in c.get("volumeMounts", []) if not m.get("readOnly", False)]
         check(log.startswith("/var/lib/fleet/") and "/var/lib/fleet" in writable,
               f"wms-adapter: --events-log {log!r} is not on the pod's writable /var/lib/fleet")
@@ -104,9 +109,9 @@ for name, s in {**compose, **added}.items():
     check("network_mode" not in s, f"{name}: network_mode {s.get('network_mode')}: every service joins `fleet`")
     check(s.get("networks") == ["fleet"], f"{name}: networks {s.get('networks')} != ['fleet']")
     ports = s.get("ports", [])
-    if name == "wms-adapter":
+    if name in ("wms-adapter", "wms-adapter-2"):
         check(len(ports) == 1 and str(ports[0]).startswith("127.0.0.1:") and str(ports[0]).endswith(":8080"),
-              f"wms-adapter: ports {ports}: the API only, on the host's loopback")
+              f"{name}: ports {ports}: the API only, on the host's loopback")
     else:
         check(not ports, f"{name}: publishes {ports}")
 check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_URL") == "https://wms-adapter:8080",
@@ -117,10 +122,13 @@ check(compose.get("fleetctl", {}).get("environment", {}).get("FLEET_WMS_CA_CERT"
 # Secure by default: every DDS service of the files (the VDA 5050 overlay's bridge included) and of
 # the Pod requires DDS Security and joins with its own identity, the profile first and the
 # identity's security.xml from the site's files under /etc/fleet/dds; the adapter requires https.
-IDENTITY = {"robot-agent": "agents", "fleet-sim": "simulator"}
-full = {**compose, **overlay}
+# A second manager or adapter joins as the first one: the same role, the same identity.
+IDENTITY = {"robot-agent": "agents", "fleet-sim": "simulator", "fleet-manager-2": "fleet-manager",
+            "wms-adapter-2": "wms-adapter"}
+full = {**compose, **overlay, **pg_overlay}
 for name, s in full.items():
-    env = dict(compose.get(name, {}).get("environment", {}) or {}, **(overlay.get(name, {}).get("environment") or {}))
+    env = dict(compose.get(name, {}).get("environment", {}) or {}, **(overlay.get(name, {}).get("environment") or {}),
+               **(pg_overlay.get(name, {}).get("environment") or {}))
     if name not in dds:
         continue
     ident = IDENTITY.get(name, name)
@@ -141,12 +149,15 @@ for c in list(pod.values()) + pod_vda["containers"]:
 check({"name": "FLEET_WMS_TLS", "value": "required"} in pod["wms-adapter"]["env"], "pod wms-adapter: FLEET_WMS_TLS is not required")
 # The dev overlays: off for every DDS service (and https off for the adapter), the plain profile.
 dev = {**yaml.safe_load(open(f"{src}/deploy/compose.dev.yaml"))["services"],
-       **yaml.safe_load(open(f"{src}/deploy/compose.dev.vda5050.yaml"))["services"]}
+       **yaml.safe_load(open(f"{src}/deploy/compose.dev.vda5050.yaml"))["services"],
+       **yaml.safe_load(open(f"{src}/deploy/compose.dev.postgres.yaml"))["services"]}
 pod_dev = yaml.safe_load(open(f"{src}/deploy/fleet-pod.dev.yaml"))["env"]
 for name in dds:
     env = dev.get(name, {}).get("environment", {})
     check(env.get("FLEET_DDS_SECURITY") == "off" and env.get("CYCLONEDDS_URI") == f"file:///usr/share/fleet/{PROFILE}",
           f"compose dev overlays: {name} keeps DDS Security")
+    if name in pg_overlay:
+        continue  # no pod of two managers and two adapters
     penv = {e["name"]: e["value"] for e in pod_dev.get(name, [])}
     check(penv.get("FLEET_DDS_SECURITY") == "off" and penv.get("CYCLONEDDS_URI") == "file:///usr/share/fleet/cyclonedds-local.xml",
           f"fleet-pod.dev.yaml: {name} keeps DDS Security")
@@ -165,5 +176,5 @@ check(any(line.startswith("COPY ") and PROFILE in line and "/usr/share/fleet/" i
 
 for p in problems:
     print("compose.yaml:", p)
-print(f"{len(pod)} services compared, {len(added)} of the VDA 5050 overlay checked, {len(peers)} DDS peers, {len(problems)} problems")
+print(f"{len(pod)} services compared, {len(added)} of the VDA 5050 and PostgreSQL overlays checked, {len(peers)} DDS peers, {len(problems)} problems")
 sys.exit(1 if problems else 0)
