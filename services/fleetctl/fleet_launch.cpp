@@ -1,9 +1,7 @@
 #include "fleet_launch.hpp"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
-#include <sys/file.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -13,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "fleet/core/dds_domain_lock.hpp"
 #include "fleet/fleet/site_stations.hpp"
 #include "fleet/transport/dds.hpp"
 #include "run_files.hpp"
@@ -282,24 +281,9 @@ std::string FleetPlan::logOf(const std::string& process) const {
   return fs::absolute(out / (process + ".log")).string();
 }
 
-// A DDS domain no other run on this machine uses: two fleets on one domain take each other's
-// orders (robots are keyed by id, and every fleet has an r1). Runs and tests hold a lock file per
-// domain for their lifetime (the convention of tests/support/test_process.hpp); the lock is
-// released when this process ends.
+// A domain of 100..219 (tests take 10..209: the lock files keep the two apart).
 int lockFreeDomain() {
-  const int start = static_cast<int>(std::random_device{}() % 120);
-  for (int k = 0; k < 120; ++k) {
-    const int d = 100 + (start + k) % 120;
-    const std::string path = "/tmp/fleet-test-dds-domain-" + std::to_string(d) + ".lock";
-    const int fd = open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
-    if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0) {
-      return d;  // fd stays open: the lock lives as long as the process
-    }
-    if (fd >= 0) {
-      close(fd);
-    }
-  }
-  return 100 + start;
+  return lockFreeDdsDomain(100, 120, static_cast<int>(std::random_device{}() % 120));
 }
 
 int freePort() {

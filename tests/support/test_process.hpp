@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "fleet/core/dds_domain_lock.hpp"
+
 namespace fleet::test {
 
 class ChildProcess {
@@ -94,21 +96,7 @@ class ChildProcess {
 /// two checkouts testing at once) never hear each other: the first of 10..209, starting from one
 /// derived from the pid, whose lock file this process can lock. The lock is held until exit.
 inline int uniqueDomain() {
-  static const int domain = [] {
-    const int start = static_cast<int>(getpid() % 200);
-    for (int k = 0; k < 200; ++k) {
-      const int d = 10 + (start + k) % 200;
-      const std::string path = "/tmp/fleet-test-dds-domain-" + std::to_string(d) + ".lock";
-      const int fd = open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
-      if (fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0) {
-        return d;  // fd stays open: the lock lives as long as the process
-      }
-      if (fd >= 0) {
-        close(fd);
-      }
-    }
-    return 10 + start;
-  }();
+  static const int domain = lockFreeDdsDomain(10, 200, static_cast<int>(getpid() % 200));
   return domain;
 }
 
