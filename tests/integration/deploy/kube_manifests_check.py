@@ -264,6 +264,10 @@ for p in peers:
         continue
     s = services.get(p)
     check(s is not None and s["spec"].get("clusterIP") == "None", f"DDS peer {p} is not a headless Service or an agent pod")
+    # A pod not ready yet (a standby manager, a manager waiting for its store) is still a DDS peer:
+    # pods started after it must resolve it by the Service's name.
+    check(s is None or s["spec"].get("publishNotReadyAddresses") is True,
+          f"DDS peer {p}: the Service leaves pods that are not ready out of DNS (publishNotReadyAddresses)")
     if s:
         check(any(s["spec"]["selector"].items() <= d["spec"]["template"]["metadata"]["labels"].items()
                   for d in deployments.values()), f"Service {p} selects no Deployment")
