@@ -104,6 +104,9 @@ std::size_t EventLog::append(const std::vector<msg::TaskEvent>& events, std::int
   // By count when 1 % over (one DELETE per many appends), by age once a second.
   const std::int64_t held = (rows.empty() ? known : rows.back().id) - prunedThrough();
   take(rows);
+  if (store_->shared() && listener_ && !rows.empty()) {
+    listener_(rows);  // other replicas' rows among them: catchUp will not see them again
+  }
   if (nowNs - prunedAtNs_ >= kPruneEveryNs || held > s_.retainEvents + s_.retainEvents / 100) {
     prune(nowNs);
   }

@@ -54,7 +54,9 @@ class EventLog {
   EventLog(const EventLog&) = delete;
   EventLog& operator=(const EventLog&) = delete;
   /// Logs the events not logged before (same task id and seq; seq 0 is always new) in one
-  /// transaction, `nowNs` being the wall clock (for retention); returns how many were new.
+  /// transaction, `nowNs` being the wall clock (for retention); returns how many rows the log took
+  /// (in a shared store also the other replicas' rows since the last look, which the listener of
+  /// onCatchUp gets too).
   std::size_t append(const std::vector<msg::TaskEvent>& events, std::int64_t nowNs);
   /// Up to `limit` events with an id above `after`, oldest first. Served from memory for recent
   /// ids (no disk read: the event stream asks from the HTTP server's I/O thread).
@@ -70,7 +72,8 @@ class EventLog {
   /// Takes the rows other replicas added to a shared store (done by its thread; for tests), and
   /// hands them to the listener.
   void catchUp();
-  /// Called (on the catching-up thread) with the rows catchUp took; set once, before any.
+  /// Called with the rows a shared log took (by catchUp, on its thread, or with an append); set
+  /// once, before any.
   void onCatchUp(std::function<void(const std::vector<LoggedEvent>&)> listener) {
     listener_ = std::move(listener);
   }

@@ -103,7 +103,7 @@ TEST_F(FleetLaunchTest, ADropFaultGivesEveryProcessItsLossyCycloneConfiguration)
   std::ifstream in(out / "cyclonedds.xml");
   std::string xml;
   std::getline(in, xml, '\0');
-  EXPECT_NE(xml.find("50"), std::string::npos);  // 50 per mille
+  EXPECT_NE(xml.find("<XmitLossiness>50</XmitLossiness>"), std::string::npos) << xml;  // per mille
 }
 
 TEST_F(FleetLaunchTest, DdsSecurityNeedsEveryIdentityAndNoDropFault) {

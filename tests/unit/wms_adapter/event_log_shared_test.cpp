@@ -91,6 +91,12 @@ TEST_F(SharedEventLog, TheOtherReplicasRowsReachTheListenerAndWakeTheStream) {
   }
   EXPECT_EQ(b->lastId(), 2);
   EXPECT_EQ(heard.load(), 2);
+  // Rows of a's that b takes with an append of its own reach the listener too (its thread will
+  // not see them again).
+  a->append({ev("t2", 1)}, 1'000);
+  b->append({ev("t3", 1)}, 1'000);
+  EXPECT_EQ(b->lastId(), 4);
+  EXPECT_GE(heard.load(), 4);
 }
 
 TEST_F(SharedEventLog, AReopenedLogKeepsItsIdsAndRetentionSaysWhatIsGone) {
