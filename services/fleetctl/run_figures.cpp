@@ -3,10 +3,12 @@
 #include <sqlite3.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <map>
 
 #include "fleet/core/config.hpp"
 #include "fleet/scenario/scenario.hpp"
+#include "fleet/traffic/roadmap.hpp"
 #include "gz_lines.hpp"
 #include "run_fleet_bound.hpp"
 #include "run_ledger.hpp"
@@ -39,13 +41,38 @@ std::map<std::string, LedgerTask> taskStations(const fs::path& dbPath) {
   return out;
 }
 
+/// m beyond the farthest place of a station's line at which a robot still counts as in it (it
+/// follows its line within a few tenths of a metre).
+constexpr double kLineTolerance = 0.5;
+
 /// Both ledgers over the replay: {"robot_time": ..., "stations": ...} or {"error": ...}.
 json ledgers(const fs::path& runDir) {
   const sim::Scenario scn = sim::loadScenario((runDir / "scenario.json").string());
+  // Each station's line (queue places and approach) as the traffic manager's roadmap lays it out:
+  // a dock cycle counts when the next robot stood within it.
+  std::map<std::string, double> lineReach;
+  if (scn.site) {
+    const traffic::Roadmap roadmap = traffic::buildRoadmap(*scn.site);
+    for (const auto& st : roadmap.stations) {
+      if (st.dock == traffic::kNoNode) {
+        continue;
+      }
+      std::vector<traffic::NodeId> line = st.queue;
+      line.push_back(st.approach);
+      double reach = 0.0;
+      for (const traffic::NodeId v : line) {
+        if (v != traffic::kNoNode) {
+          reach = std::max(reach, (roadmap.graph.position(v) - roadmap.graph.position(st.dock)).norm());
+        }
+      }
+      lineReach[st.name] = reach + kLineTolerance;
+    }
+  }
   std::vector<LedgerStation> stations;
   for (const auto& s : scn.stations) {
     if (s.kind == site::StationKind::Pickup || s.kind == site::StationKind::Dropoff) {
-      stations.push_back({s.name, s.pose.position()});
+      const auto it = lineReach.find(s.name);
+      stations.push_back({s.name, s.pose.position(), it == lineReach.end() ? 0.0 : it->second});
     }
   }
   std::vector<std::string> robots;

@@ -115,9 +115,15 @@ void RunLedger::step(double t, const std::vector<RobotSample>& robots) {
   }
   // Queues after the goals are known, for the departures below.
   std::vector<std::size_t> queue(stations_.size(), 0);
+  std::vector<std::size_t> inLine(stations_.size(), 0);  // of those, standing in the station's line
   for (std::size_t r = 0; r < robots_.size(); ++r) {
     if (state_[r].goal >= 0 && state_[r].goal != dockedNow[r]) {
-      ++queue[static_cast<std::size_t>(state_[r].goal)];
+      const auto g = static_cast<std::size_t>(state_[r].goal);
+      ++queue[g];
+      const double reach = stations_[g].lineReach;
+      if (reach <= 0.0 || (robots[r].position - stations_[g].dock).norm() <= reach) {
+        ++inLine[g];
+      }
     }
   }
   for (std::size_t r = 0; r < robots_.size(); ++r) {
@@ -128,7 +134,7 @@ void RunLedger::step(double t, const std::vector<RobotSample>& robots) {
     if (a.docked >= 0) {  // left
       StationAcc& s = acc_[static_cast<std::size_t>(a.docked)];
       s.occupancy.push_back(t - a.dockedSince);
-      s.nextQueued = queue[static_cast<std::size_t>(a.docked)] > 0;
+      s.nextQueued = inLine[static_cast<std::size_t>(a.docked)] > 0;
     }
     if (dockedNow[r] >= 0) {  // arrived
       StationAcc& s = acc_[static_cast<std::size_t>(dockedNow[r])];
@@ -227,7 +233,7 @@ std::vector<std::string> ledgerLines(const nlohmann::json& rt, const nlohmann::j
     char buf[320];
     std::snprintf(buf, sizeof buf,
                   "stations: busiest %s utilisation %.0f %%, %d visits, queue mean %.2f max %d, dock cycle "
-                  "p50 %.1f s p90 %.1f s (%d cycles with the next robot queued); %zu stations visited",
+                  "p50 %.1f s p90 %.1f s (%d cycles with the next robot in line); %zu stations visited",
                   s.value("name", std::string("?")).c_str(), 100.0 * s.value("utilisation", 0.0),
                   s.value("visits", 0), s.value("queue_mean", 0.0), s.value("queue_max", 0),
                   s.value("cycle_p50_s", 0.0), s.value("cycle_p90_s", 0.0), s.value("cycles", 0),

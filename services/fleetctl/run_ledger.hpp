@@ -11,8 +11,10 @@
 //   run time), queue length over time (robots whose current goal is that station and are not
 //   docked there: the goal is the task's pickup until the robot has been docked there, then its
 //   drop-off), and the dock cycle — from one robot's dock arrival to the next's, counted when the
-//   next was already queued as the first left (the same definition as the fleet bound's c_s,
-//   station_cycle.hpp) — and the occupancy per visit.
+//   next stood in the station's line as the first left (within `lineReach` of the dock: its queue
+//   places and approach as the roadmap lays them out), so it is the station's own cycle as the
+//   fleet bound's c_s is (station_cycle.hpp), not the next robot's drive from afar — and the
+//   occupancy per visit. The virtual fleet counts its cycles the same way (virtual_fleet.cpp).
 
 #include <cstddef>
 #include <map>
@@ -29,6 +31,9 @@ namespace fleet::ctl {
 struct LedgerStation {
   std::string name;
   Vec2 dock;
+  /// m from the dock within which a robot bound for the station stands in its line (the farthest
+  /// of its queue places and approach, plus a tolerance); 0: wherever it is.
+  double lineReach = 0.0;
 };
 
 struct LedgerTask {

@@ -138,13 +138,34 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   TrafficControl traffic(g, starts, topt);
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
-  std::vector<Bot> bots(o.robots);
   // The station ledger: dock arrivals, and the dock cycle from one arrival to the next, counted
-  // when the next robot was already in line as the last one left (station_cycle.hpp's quantity).
+  // when the next robot stood in the station's line (a queue place or the approach) as the last one
+  // left (station_cycle.hpp's quantity: enter from the queue head, dwell, leave).
   std::vector<double> lastArrival(g.size(), -1.0);
   std::vector<std::uint8_t> queuedAtLeave(g.size(), 0);
   std::vector<std::size_t> visits(g.size(), 0);
   std::vector<std::vector<double>> cycles(g.size());
+  // Whether another robot in the line of the station docked at `dock` stands on one of the line's
+  // nodes (its queue places or its approach) as `r` leaves: only then is the next arrival the
+  // station's own cycle, not the next robot's drive from afar.
+  std::vector<std::vector<NodeId>> lineNodes(g.size());
+  for (const auto& s : roadmap.stations) {
+    if (s.dock == kNoNode)
+      continue;
+    auto& nodes = lineNodes[static_cast<std::size_t>(s.dock)];
+    nodes = s.queue;
+    if (s.approach != kNoNode)
+      nodes.push_back(s.approach);
+  }
+  std::vector<Bot> bots(o.robots);
+  auto nextStandsInLine = [&](std::size_t r, NodeId dock) {
+    const auto& nodes = lineNodes[static_cast<std::size_t>(dock)];
+    for (std::size_t q : traffic.line(dock)) {
+      if (q != r && bots[q].to == kNoNode && std::find(nodes.begin(), nodes.end(), bots[q].at) != nodes.end())
+        return true;
+    }
+    return false;
+  };
   // Admission by slots (docs/algorithms.md, "Stations as servers"): a station serves as many robots
   // at once as its line holds (dock and queue places). A robot counts at its pickup until it has
   // loaded there, and at its drop-off from the moment it is given the task (it will carry its load
@@ -244,7 +265,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         if (b.dwellLeft > 0.0)
           continue;
         traffic.setHeld(r, false);
-        queuedAtLeave[static_cast<std::size_t>(b.at)] = traffic.line(b.at).size() > 1 ? 1 : 0;
+        queuedAtLeave[static_cast<std::size_t>(b.at)] = nextStandsInLine(r, b.at) ? 1 : 0;
         if (b.phase == 0) {
           b.phase = 1;
           --uses[static_cast<std::size_t>(b.pickup)];  // loaded: its pickup slot is free

@@ -2,6 +2,8 @@
 
 #include "run_ledger.hpp"
 
+#include <map>
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -93,6 +95,28 @@ TEST(RunLedger, StationVisitsUtilisationQueueAndCycle) {
   EXPECT_EQ(s[0]["queue_max"], 2);
   EXPECT_EQ(s[1]["name"], "B");
   EXPECT_EQ(s[1]["visits"], 0);
+}
+
+// A dock cycle is the station's own only when the next robot stood in its line as the last one
+// left: a robot still driving from afar then is not counted, one within the line's reach is.
+TEST(RunLedger, ADockCycleCountsOnlyWhenTheNextRobotStoodInTheLine) {
+  const std::map<std::string, LedgerTask> tasks{{"t0", {"A", "B"}}, {"t1", {"A", "B"}}};
+  const Vec2 far{3, 0}, dock{0, 0}, near{1, 0};
+  for (const bool nextNear : {false, true}) {
+    SCOPED_TRACE(nextNear ? "next in line" : "next far");
+    RunLedger l({"r0", "r1"}, {{"A", {0, 0}, 2.0}, {"B", {9, 0}, 2.0}}, tasks);
+    const Vec2 next = nextNear ? near : far;
+    l.step(0.0, {at(far, "moving", "t0"), at(far, "moving", "t1")});
+    l.step(1.0, {at(dock, "loading", "t0"), at(next, "moving", "t1")});
+    l.step(5.0, {at(near, "moving", "t0"), at(next, "moving", "t1")});  // r0 leaves
+    l.step(7.0, {at(far, "moving", "t0"), at(dock, "loading", "t1")});
+    const auto s = l.stationsJson();
+    ASSERT_FALSE(s.empty());
+    EXPECT_EQ(s[0]["name"], "A");
+    EXPECT_EQ(s[0]["visits"], 2);
+    EXPECT_EQ(s[0]["cycles"], nextNear ? 1 : 0) << s.dump();
+    EXPECT_EQ(s[0]["queue_max"], 2);  // the queue counts robots bound for A wherever they are
+  }
 }
 
 }  // namespace

@@ -543,31 +543,36 @@ TEST(VirtualFleet, AStationCapKeepsTasksApartAndTheRestParked) {
 }
 
 // One pickup and one drop-off shared by six robots: only they are visited, and the station ledger
-// counts a dock cycle (arrival to the next arrival, the next robot in line as the last one left)
-// that is at least the dwell and the next robot's drive in.
+// counts a dock cycle (arrival to the next arrival) only when the next robot stood in the station's
+// line (a queue place or the approach) as the last one left: the station's own cycle, at least the
+// dwell and here at most 12 s (6.4-10.8 s measured over seeds 1-8). Counting every robot that had
+// joined the line, wherever it was, gave ~19 s at D-2 (the next robot's drive from afar), which
+// this bound catches.
 TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;
   o.robots = 6;
-  o.duration = 400.0;
-  o.stations = {"P-5", "D-2"};
+  o.duration = 600.0;
+  o.admission = false;  // six robots on two stations: lines that fill
+  o.stations = {"P-3", "D-2"};
   const auto r = runVirtualFleet(map, o);
   SCOPED_TRACE(formatResult(r));
   EXPECT_GT(r.tasksDone, 5U);
   ASSERT_EQ(r.stations.size(), 2U);
   std::size_t cycles = 0;
   for (const auto& st : r.stations) {
-    EXPECT_TRUE(st.name == "P-5" || st.name == "D-2") << st.name;
+    EXPECT_TRUE(st.name == "P-3" || st.name == "D-2") << st.name;
     EXPECT_GE(st.visits, r.tasksDone) << st.name;
     cycles += st.cycles;
-    if (st.cycles > 0) {
-      EXPECT_GE(st.cycleP50, o.dwell) << st.name;
-      EXPECT_GE(st.cycleP90, st.cycleP50) << st.name;
-    }
+    if (st.cycles == 0)
+      continue;
+    EXPECT_GE(st.cycleP50, o.dwell) << st.name;
+    EXPECT_GE(st.cycleP90, st.cycleP50) << st.name;
+    EXPECT_LE(st.cycleP50, 12.0) << st.name;
   }
-  EXPECT_GT(cycles, 0U) << "six robots on one pickup queue behind each other";
+  EXPECT_GE(cycles, 3U) << "robots stood in line behind each other";
   for (const auto& t : r.tasks) {
-    EXPECT_EQ(t.pickup, map.station("P-5")->dock);
+    EXPECT_EQ(t.pickup, map.station("P-3")->dock);
     EXPECT_EQ(t.dropoff, map.station("D-2")->dock);
   }
   o.stations = {"P-5"};  // no drop-off among them
