@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <map>
 
+#include "fleet/control/cruise.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/scenario/scenario.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -44,6 +45,8 @@ std::map<std::string, LedgerTask> taskStations(const fs::path& dbPath) {
 /// m beyond the farthest place of a station's line at which a robot still counts as in it (it
 /// follows its line within a few tenths of a metre).
 constexpr double kLineTolerance = 0.5;
+/// m within which a robot is at a dock or at a station's entry (RunLedger's dockTolerance).
+constexpr double kDockTolerance = 0.25;
 
 /// Both ledgers over the replay: {"robot_time": ..., "stations": ...} or {"error": ...}.
 json ledgers(const fs::path& runDir) {
@@ -51,6 +54,8 @@ json ledgers(const fs::path& runDir) {
   // Each station's line (queue places and approach) as the traffic manager's roadmap lays it out:
   // a dock cycle counts when the next robot stood within it.
   std::map<std::string, double> lineReach;
+  std::map<std::string, std::pair<Vec2, double>> entries;  // the last leg's start and its time
+  const double cruise = scn.robots.empty() ? 0.0 : control::agentCruiseSpeed(scn.robots.front().limits);
   if (scn.site) {
     const traffic::Roadmap roadmap = traffic::buildRoadmap(*scn.site);
     for (const auto& st : roadmap.stations) {
@@ -66,20 +71,37 @@ json ledgers(const fs::path& runDir) {
         }
       }
       lineReach[st.name] = reach + kLineTolerance;
+      // The last leg: from the approach, or from the queue's head for a station entered along a row.
+      const traffic::NodeId entry = st.approach != traffic::kNoNode ? st.approach
+                                    : st.queue.empty()              ? traffic::kNoNode
+                                                                    : st.queue.front();
+      // The ledger times the leg from the last step within its tolerance of the entry (a turn on
+      // the spot there included in neither) to the first within it of the dock: that span at cruise.
+      if (entry != traffic::kNoNode && roadmap.graph.edge(entry, st.dock) != nullptr && cruise > 0.0) {
+        const double length = (roadmap.graph.position(st.dock) - roadmap.graph.position(entry)).norm();
+        entries[st.name] = {roadmap.graph.position(entry),
+                            std::max(0.0, length - 2.0 * kDockTolerance) / cruise};
+      }
     }
   }
   std::vector<LedgerStation> stations;
   for (const auto& s : scn.stations) {
     if (s.kind == site::StationKind::Pickup || s.kind == site::StationKind::Dropoff) {
       const auto it = lineReach.find(s.name);
-      stations.push_back({s.name, s.pose.position(), it == lineReach.end() ? 0.0 : it->second});
+      LedgerStation ls{s.name, s.pose.position(), it == lineReach.end() ? 0.0 : it->second};
+      if (const auto e = entries.find(s.name); e != entries.end()) {
+        ls.hasEntry = true;
+        ls.entry = e->second.first;
+        ls.dockModelS = e->second.second;
+      }
+      stations.push_back(ls);
     }
   }
   std::vector<std::string> robots;
   for (const auto& r : scn.robots) {
     robots.push_back(r.id);
   }
-  RunLedger ledger(robots, stations, taskStations(runDir / "fleet.db"));
+  RunLedger ledger(robots, stations, taskStations(runDir / "fleet.db"), kDockTolerance);
   const fs::path replay = runDir / "replay.jsonl.gz";
   gzFile f = gzopen(replay.c_str(), "rb");
   if (f == nullptr) {

@@ -11,6 +11,9 @@ namespace fleet::ctl {
 
 namespace {
 
+/// s a docking may take beyond the roadmap's time for the last leg (the timed releases' aim).
+constexpr double kDockingSlackS = 2.0;
+
 double round3(double x) {
   return std::round(x * 1000.0) / 1000.0;
 }
@@ -101,6 +104,12 @@ void RunLedger::step(double t, const std::vector<RobotSample>& robots) {
       ++derivedSteps_;
     }
     dockedNow[r] = stationAt(x.position);
+    for (std::size_t s = 0; s < stations_.size(); ++s) {
+      if (stations_[s].hasEntry && (stations_[s].entry - x.position).norm() <= tolerance_) {
+        a.atEntry = static_cast<int>(s);
+        a.entryT = t;
+      }
+    }
     if (x.task != a.task) {
       a.task = x.task;
       a.pickedUp = false;
@@ -139,6 +148,10 @@ void RunLedger::step(double t, const std::vector<RobotSample>& robots) {
     if (dockedNow[r] >= 0) {  // arrived
       StationAcc& s = acc_[static_cast<std::size_t>(dockedNow[r])];
       ++s.visits;
+      if (a.atEntry == dockedNow[r]) {
+        s.docking.push_back(t - a.entryT);
+      }
+      a.atEntry = -1;
       if (s.lastArrival >= 0.0 && s.nextQueued) {
         s.cycles.push_back(t - s.lastArrival);
       }
@@ -212,6 +225,20 @@ nlohmann::json RunLedger::stationsJson() const {
                    {"cycle_p90_s", round3(c.p90)},
                    {"occupancy_p50_s", round3(o.p50)},
                    {"occupancy_p90_s", round3(o.p90)}});
+    if (stations_[s].hasEntry) {
+      const Percentiles d = percentiles(a.docking);
+      const double model = stations_[s].dockModelS;
+      const auto over = std::count_if(a.docking.begin(), a.docking.end(),
+                                      [&](double x) { return x > model + kDockingSlackS; });
+      out.back().update(
+          {{"dock_model_s", round3(model)},
+           {"dockings", d.count},
+           {"docking_p50_s", round3(d.p50)},
+           {"docking_p90_s", round3(d.p90)},
+           {"docking_max_s",
+            round3(a.docking.empty() ? 0.0 : *std::max_element(a.docking.begin(), a.docking.end()))},
+           {"dockings_over_model", over}});
+    }
   }
   return out;
 }
@@ -239,6 +266,26 @@ std::vector<std::string> ledgerLines(const nlohmann::json& rt, const nlohmann::j
                   s.value("cycle_p50_s", 0.0), s.value("cycle_p90_s", 0.0), s.value("cycles", 0),
                   stations.size());
     out.push_back(buf);
+    // Docking against the roadmap's time for the last leg, over every station that has an entry.
+    std::vector<std::string> over;
+    int dockings = 0;
+    int late = 0;
+    double worst = 0.0;
+    for (const auto& st : stations) {
+      if (!st.contains("dockings")) {
+        continue;
+      }
+      dockings += st.value("dockings", 0);
+      late += st.value("dockings_over_model", 0);
+      worst = std::max(worst, st.value("docking_max_s", 0.0) - st.value("dock_model_s", 0.0));
+    }
+    if (dockings > 0) {
+      std::snprintf(buf, sizeof buf,
+                    "docking: %d of %d dockings within the roadmap's time for the last leg + %.0f s; the "
+                    "latest %.1f s over it",
+                    dockings - late, dockings, kDockingSlackS, worst);
+      out.push_back(buf);
+    }
   }
   return out;
 }

@@ -15,6 +15,9 @@
 //   places and approach as the roadmap lays them out), so it is the station's own cycle as the
 //   fleet bound's c_s is (station_cycle.hpp), not the next robot's drive from afar — and the
 //   occupancy per visit. The virtual fleet counts its cycles the same way (virtual_fleet.cpp).
+//   And the docking time per visit: from the robot's last step within `dockTolerance` of the
+//   station's entry (the start of its last leg) to its arrival at the dock, against the roadmap's
+//   time for that leg (a robot on timed releases docks within it + 2 s).
 
 #include <cstddef>
 #include <map>
@@ -30,10 +33,17 @@ namespace fleet::ctl {
 
 struct LedgerStation {
   std::string name;
-  Vec2 dock;
+  Vec2 dock{};
   /// m from the dock within which a robot bound for the station stands in its line (the farthest
   /// of its queue places and approach, plus a tolerance); 0: wherever it is.
   double lineReach = 0.0;
+  /// Where the last leg into the dock starts (its approach, or its queue's head for a station
+  /// entered along a row) and the modelled time of the span the ledger times (from the last step
+  /// within `dockTolerance` of the entry to the first within it of the dock: the leg less twice the
+  /// tolerance, at cruise); without an entry no docking time is measured.
+  bool hasEntry = false;
+  Vec2 entry{};
+  double dockModelS = 0.0;
 };
 
 struct LedgerTask {
@@ -76,6 +86,7 @@ class RunLedger {
     bool nextQueued = false;  ///< someone was queued when the last robot left
     std::vector<double> cycles;
     std::vector<double> occupancy;
+    std::vector<double> docking;      ///< s from leaving the entry to docked, per visit
     std::vector<std::size_t> series;  ///< queue length every seriesEveryS
   };
   struct RobotAcc {
@@ -85,6 +96,8 @@ class RunLedger {
     std::string task;
     bool pickedUp = false;
     int goal = -1;
+    int atEntry = -1;  ///< station whose entry it was at last (-1: none since its last dock)
+    double entryT = 0.0;
   };
   int stationAt(Vec2 p) const;
   int stationIndex(const std::string& name) const;

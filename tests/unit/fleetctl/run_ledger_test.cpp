@@ -119,5 +119,39 @@ TEST(RunLedger, ADockCycleCountsOnlyWhenTheNextRobotStoodInTheLine) {
   }
 }
 
+// Docking: from the robot's last step at the station's entry to its arrival at the dock, against
+// the roadmap's time for that leg; a robot waiting at the entry is not docking yet, and a visit
+// without a step at the entry (the robot came another way) is not measured.
+TEST(RunLedger, DockingIsTimedFromLeavingTheEntryAgainstTheLegsModelledTime) {
+  LedgerStation a{"A", {0, 0}};
+  a.hasEntry = true;
+  a.entry = {1, 0};
+  a.dockModelS = 1.5;
+  RunLedger l({"r0", "r1"}, {a, {"B", {9, 0}}}, {{"t0", {"A", "B"}}, {"t1", {"A", "B"}}});
+  const Vec2 far{3, 0}, dock{0, 0}, entry{1, 0}, between{0.5, 0};
+  l.step(0.0, {at(entry, "waiting", "t0"), at(far, "moving", "t1")});
+  l.step(4.0, {at(entry, "moving", "t0"), at(far, "moving", "t1")});  // waited 4 s at the entry
+  l.step(5.0, {at(between, "moving", "t0"), at(far, "moving", "t1")});
+  l.step(5.5, {at(dock, "loading", "t0"), at(far, "moving", "t1")});  // 1.5 s after leaving it
+  l.step(9.0, {at(far, "moving", "t0"), at(entry, "moving", "t1")});
+  l.step(14.0, {at(far, "moving", "t0"), at(dock, "loading", "t1")});  // 5 s: over 1.5 + 2
+  const auto s = l.stationsJson();
+  ASSERT_FALSE(s.empty());
+  EXPECT_EQ(s[0]["name"], "A");
+  EXPECT_EQ(s[0]["dockings"], 2);
+  EXPECT_DOUBLE_EQ(s[0]["dock_model_s"].get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(s[0]["docking_max_s"].get<double>(), 5.0);
+  EXPECT_EQ(s[0]["dockings_over_model"], 1);
+  const auto lines = ledgerLines(l.robotTimeJson(), s);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_NE(lines[2].find("1 of 2 dockings within"), std::string::npos) << lines[2];
+  // B has no entry: no docking figures.
+  for (const auto& st : s) {
+    if (st["name"] == "B") {
+      EXPECT_FALSE(st.contains("dockings"));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace fleet::ctl
