@@ -63,15 +63,25 @@ def robot_time_html(rt, w=640, bar=14):
             f"<p class=\"note\">{html.escape(str(rt.get('note', '')))} (source here: {html.escape(str(rt.get('source')))}).</p>")
 
 
+def docking_cell(s):
+    if "dockings" not in s:
+        return "<td class=\"r\">–</td>"
+    return (f"<td class=\"r\">{s['docking_p50_s']:.1f} / {s['docking_p90_s']:.1f} / {s['docking_max_s']:.1f} "
+            f"(model {s['dock_model_s']:.2f}; {s['dockings'] - s['dockings_over_model']} of {s['dockings']} within +2 s)</td>")
+
+
 def stations_html(stations):
     if not stations:
         return ""
     rows = "".join(
         f"<tr><td>{html.escape(s['name'])}</td><td class=\"r\">{s['visits']}</td><td class=\"r\">{100 * s['utilisation']:.0f} %</td>"
         f"<td class=\"r\">{s['queue_mean']:.2f} / {s['queue_max']}</td><td class=\"r\">{s['cycle_p50_s']:.1f} / {s['cycle_p90_s']:.1f} ({s['cycles']})</td>"
-        f"<td class=\"r\">{s['occupancy_p50_s']:.1f} / {s['occupancy_p90_s']:.1f}</td></tr>" for s in stations)
+        f"<td class=\"r\">{s['occupancy_p50_s']:.1f} / {s['occupancy_p90_s']:.1f}</td>{docking_cell(s)}</tr>" for s in stations)
     return f"""<h3>Stations</h3><table><tr><th>station</th><th>visits</th><th>utilisation (docked ÷ run)</th>
-<th>queue mean / max</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th></tr>{rows}</table>
+<th>queue mean / max</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th>
+<th>docking p50 / p90 / max [s]</th></tr>{rows}</table>
 <p class="note">Docked: the robot's centre within 0.25 m of the station's pose. Queue: robots whose current goal is the
-station and are not docked there. Dock cycle: one robot's dock arrival to the next's, counted when the next was already
-queued as the first left (the fleet bound's c<sub>s</sub> is its least value with ideal motion).</p>"""
+station and are not docked there. Dock cycle: one robot's dock arrival to the next's, counted when the next stood in the
+station's line (its queue places and approach) as the first left (the fleet bound's c<sub>s</sub> is its least value with
+ideal motion). Docking: from the robot's last step within 0.25 m of the station's entry (approach, or queue head) to the
+dock, against that span at cruise.</p>"""
