@@ -58,8 +58,11 @@ TrafficNode::TrafficNode(const site::Site& site, Settings settings, std::uint32_
       epoch_(epoch),
       roadmap_(traffic::buildRoadmap(site, settings_.roadmap)),
       reach_(roadmap_.graph, std::size_t{64} << 20) {
+  traffic::TrafficOptions options = settings_.traffic;
+  // The plan kept in time takes each turn on the spot at its real duration.
+  options.turnTime = [this](NodeId a, NodeId b, NodeId c) { return roadmap_.extraTurn(a, b, c); };
   control_ =
-      std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, settings_.traffic);
+      std::make_unique<traffic::TrafficControl>(roadmap_.graph, std::vector<NodeId>{}, std::move(options));
   if (settings_.stationLines)
     control_->setStations(traffic::stationLines(roadmap_));
 }

@@ -67,6 +67,9 @@ Settings readSettings(Config& cfg);
 class TrafficNode {
  public:
   TrafficNode(const site::Site& site, Settings settings, std::uint32_t epoch);
+  // The planner's turn times refer to the roadmap held here: the node stays where it was made.
+  TrafficNode(const TrafficNode&) = delete;
+  TrafficNode& operator=(const TrafficNode&) = delete;
 
   [[nodiscard]] std::uint32_t epoch() const { return epoch_; }
   [[nodiscard]] const traffic::Roadmap& roadmap() const { return roadmap_; }

@@ -269,7 +269,7 @@ const std::vector<NodeId>& Pibt::step() {
         best_[i] = d;
       }
     }
-    if (controlled_[i] != 0) {
+    if (controlled_[i] != 0 && !busy(i)) {
       next_[i] = kNoNode;
       order_.push_back(static_cast<std::int32_t>(i));
     } else {
@@ -300,12 +300,15 @@ const std::vector<NodeId>& Pibt::step() {
     agentAt_[idx(now_[i])] = -1;
   }
   for (std::size_t i = 0; i < n; ++i) {
-    still_[i] = next_[i] == now_[i] ? still_[i] + 1 : 0;
+    const bool counted = !busy(i);
+    if (counted)
+      still_[i] = next_[i] == now_[i] ? still_[i] + 1 : 0;
     if (next_[i] != now_[i])
       prev_[i] = now_[i];
     now_[i] = next_[i];
     agentAt_[idx(now_[i])] = static_cast<std::int32_t>(i);
-    updateProgress(i);
+    if (counted)
+      updateProgress(i);
   }
   advanceForced();
   settleTables();  // the blockers' search reads around where the agents are now

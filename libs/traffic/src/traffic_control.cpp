@@ -1,6 +1,7 @@
 #include "fleet/traffic/traffic_control.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -8,6 +9,12 @@
 #include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::traffic {
+
+namespace {
+/// s of plan time the options counted in lattice edges (maxLag) stand for: a 0.5 m
+/// lattice edge at 0.8 m/s with a little turning.
+constexpr double kStepSeconds = 0.7;
+}  // namespace
 
 namespace {
 /// Above any task priority a WMS sends (they are small integers).
@@ -40,7 +47,11 @@ TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> start
       stall_(starts.size(), 0),
       lastEnd_(starts.begin(), starts.end()),
       evadeUntil_(starts.size(), -1),
-      baseEnds_(starts.size()) {}
+      baseEnds_(starts.size()),
+      ready_(starts.size(), 0.0),
+      busy_(starts.size(), 0),
+      stepTime_(1, 0.0),
+      came_(starts.size(), kNoNode) {}
 
 void TrafficControl::setStations(std::vector<StationLine> stations) {
   for (std::size_t r = 0; r < robots(); ++r)
@@ -213,6 +224,9 @@ std::size_t TrafficControl::addRobot(NodeId start) {
   lastEnd_.push_back(start);
   evadeUntil_.push_back(-1);
   baseEnds_.emplace_back();
+  ready_.push_back(clock_);
+  busy_.push_back(0);
+  came_.push_back(kNoNode);
   replan();
   return r;
 }
@@ -332,9 +346,12 @@ int TrafficControl::update() {
       if (s >= 0 && (oldest < 0 || s < oldest))
         oldest = s;
     }
-    if (oldest >= 0 && execution_.plannedSteps() - oldest >= options_.maxLag)
+    if (oldest >= 0 && lagging(oldest))
       replan();
+    const std::vector<NodeId> before = planner_->positions();
+    beforeTimedStep();
     execution_.append(planner_->step());
+    afterTimedStep(before);
     afterStep();
     ++steps;
     sinceStep_ = 0;
@@ -365,7 +382,7 @@ void TrafficControl::freeDocks() {
 }
 
 void TrafficControl::afterStep() {
-  const auto now = execution_.plannedSteps();
+  const auto now = evadeClock();
   for (std::size_t i = 0; i < stations_.size(); ++i)
     orderLine(i);
   freeDocks();
@@ -383,6 +400,8 @@ void TrafficControl::afterStep() {
       lastEnd_[r] = execution_.plannedEnd(r);
       continue;
     }
+    if (busy_[r] != 0)
+      continue;  // still driving in the plan: neither moved nor standing this step
     // Planned to stand still this step?
     const bool moved = execution_.plannedEnd(r) != kNoNode && lastEnd_[r] != execution_.plannedEnd(r);
     lastEnd_[r] = execution_.plannedEnd(r);
@@ -464,7 +483,7 @@ void TrafficControl::clearWayFor(std::size_t robot) {
     if (refuge == kNoNode)
       continue;
     planner_->setGoal(q, refuge);
-    evadeUntil_[q] = execution_.plannedSteps() + options_.evadeSteps;
+    evadeUntil_[q] = evadeClock() + std::llround(1000.0 * options_.evadeSeconds);
     ++stats_.evasions;
   }
 }
@@ -473,6 +492,56 @@ void TrafficControl::replan() {
   const auto ends = execution_.truncateToReleased();
   planner_->reset(ends);
   ++stats_.replans;
+  // Everyone decides again from where its release ends.
+  std::fill(ready_.begin(), ready_.end(), clock_);
+  std::fill(came_.begin(), came_.end(), kNoNode);
+}
+
+std::int64_t TrafficControl::evadeClock() const {
+  return std::llround(1000.0 * clock_);  // ms of plan time
+}
+
+bool TrafficControl::lagging(std::int64_t oldest) const {
+  const auto k = static_cast<std::size_t>(std::max<std::int64_t>(0, oldest));
+  const double at = k < stepTime_.size() ? stepTime_[k] : clock_;
+  return clock_ - at >= kStepSeconds * static_cast<double>(options_.maxLag);
+}
+
+void TrafficControl::beforeTimedStep() {
+  double earliest = std::numeric_limits<double>::infinity();
+  for (std::size_t r = 0; r < robots(); ++r) {
+    if (held_[r] == 0)
+      earliest = std::min(earliest, ready_[r]);
+  }
+  if (earliest != std::numeric_limits<double>::infinity())
+    clock_ = std::max(clock_, earliest);
+  for (std::size_t r = 0; r < robots(); ++r)
+    busy_[r] = held_[r] == 0 && ready_[r] > clock_ + options_.timedQuantum ? 1 : 0;
+  planner_->setBusy(busy_);
+}
+
+void TrafficControl::afterTimedStep(const std::vector<NodeId>& before) {
+  const auto step = static_cast<std::size_t>(execution_.plannedSteps());
+  if (stepTime_.size() <= step)
+    stepTime_.resize(step + 1, clock_);
+  stepTime_[step] = clock_;
+  const auto& pos = planner_->positions();
+  for (std::size_t r = 0; r < robots(); ++r) {
+    if (held_[r] != 0) {
+      ready_[r] = clock_;
+    } else if (busy_[r] == 0) {
+      if (pos[r] == before[r]) {
+        ready_[r] = clock_ + options_.timedWait;
+        continue;
+      }
+      const Edge* e = graph_.edge(before[r], pos[r]);
+      double d = e != nullptr ? e->duration : 1.0;
+      if (options_.turnTime && came_[r] != kNoNode)
+        d += options_.turnTime(came_[r], before[r], pos[r]);
+      ready_[r] = clock_ + d;
+      came_[r] = before[r];
+    }
+  }
 }
 
 void TrafficControl::graphChanged() {

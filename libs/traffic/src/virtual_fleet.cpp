@@ -135,6 +135,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   TrafficOptions topt = o.traffic;
   topt.pibt.seed = o.seed;
+  // The plan kept in time takes each turn on the spot at its real duration.
+  topt.turnTime = [&roadmap](NodeId a, NodeId b, NodeId c) { return roadmap.extraTurn(a, b, c); };
   TrafficControl traffic(g, starts, topt);
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));

@@ -134,6 +134,13 @@ class Pibt {
   /// Plans and takes one step: every agent's node at the next step, conflict-free (and rotation-free
   /// unless Rotations::kAllow).
   const std::vector<NodeId>& step();
+  /// Agents still driving their last move in a plan kept in time (TrafficControl): the next
+  /// step leaves them where they are, pushes none of them and counts no standing for them. Empty or
+  /// all 0: none. Agents on a way out of a knot are never busy.
+  void setBusy(std::vector<std::uint8_t> busy) { busy_ = std::move(busy); }
+  [[nodiscard]] bool busy(std::size_t agent) const {
+    return agent < busy_.size() && busy_[agent] != 0 && forcedGroup_[agent] < 0;
+  }
 
   [[nodiscard]] bool escalated(std::size_t agent) const { return escalatedAt_[agent] >= 0; }
   /// Whether the agent is on a way out of a knot (its next moves are fixed).
@@ -213,6 +220,7 @@ class Pibt {
   std::vector<int> elapsed_;
   std::vector<double> epsilon_;
   std::vector<std::uint8_t> controlled_;
+  std::vector<std::uint8_t> busy_;  ///< setBusy()
   std::vector<std::uint8_t> onStack_;
   bool rebaseProgress_ = false;            ///< the distances changed: best_ from the new ones
   std::vector<float> best_;                ///< nearest it has been to its goal since the goal was set

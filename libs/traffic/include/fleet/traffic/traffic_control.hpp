@@ -5,14 +5,18 @@
 // robot is released its route a few nodes at a time. A traffic manager service wraps it; the virtual
 // fleet (virtual_fleet.hpp) drives it in tests and benchmarks.
 //
-// Planning runs ahead of the robots, not of a clock: a step is added while a robot on its way has
-// fewer than two nodes planned past its last report. A robot that falls `maxLag` steps behind the
-// plan (a person in the aisle, a slow dock) holds back only the robots that depend on it;
+// Planning runs ahead of the robots: a step is added while a robot on its way has fewer than two
+// nodes planned past its last report. The plan is kept in time: each robot decides its next move
+// when the plan has it at the end of its last one (edge and turn at their real durations), so a
+// robot with long edges does not fall behind a plan that moved everyone one edge per step. A robot
+// that falls `maxLag` edges' time behind the plan (a person in the aisle, a slow dock) holds back
+// only the robots that depend on it;
 // the unreleased plan is then dropped and planned again from where everyone's release ends, so the
 // fleet does not keep planning around where the late robot was supposed to be. Held robots (docking,
 // faulted, paused, a vendor's vehicle that does not follow) are obstacles the plan goes around.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -25,18 +29,26 @@
 namespace fleet::traffic {
 
 struct TrafficOptions {
-  std::int64_t maxLag = 24;  ///< steps a robot may be behind the plan before it is re-planned
-  std::int64_t maxStepsPerUpdate = 64;
+  /// A robot may be behind the plan by this many lattice edges' time (0.7 s each) before the
+  /// unreleased plan is dropped and planned again.
+  std::int64_t maxLag = 24;
+  /// Planner steps per update() at most: a step of the timed plan moves only the robots due then,
+  /// so the plan's clock advances by ~timedQuantum a step (8 a 0.1 s update keeps it ahead of the
+  /// robots; at 300 robots 64 let it run minutes ahead, re-planning all the while).
+  std::int64_t maxStepsPerUpdate = 16;
   /// A robot planned to stand this many steps in a row stops asking for steps at once; while only
   /// such robots want planning, one step is planned every `standingEvery` updates.
   int standingSteps = 2;
   int standingEvery = 5;
-  /// A robot planned to stand still this many steps short of its goal makes the robots standing
-  /// in its way (on nodes its next few nodes exclude) drive away for `evadeSteps` (PIBT moves
-  /// robots one step at a time; a robot whose footprint reaches past the next node cannot clear
-  /// the way in one step, so a dock exit or a queue behind a waiting robot would stay shut).
+  /// A robot planned to stand still this many of its decisions short of its goal makes the robots
+  /// standing in its way (on nodes its next few nodes exclude) drive away for `evadeSeconds` of plan
+  /// time (PIBT moves robots one step at a time; a robot whose footprint reaches past the next node
+  /// cannot clear the way in one step, so a dock exit or a queue behind a waiting robot would stay
+  /// shut). 3 s: about the ten steps an evasion lasted when every step moved every robot one edge
+  /// at once; 7 s (ten lattice edges at 0.7 s) kept the robot sent away too long for the one that
+  /// stood behind it (TrafficControl.ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront).
   int evadeAfter = 6;
-  int evadeSteps = 10;
+  double evadeSeconds = 3.0;
   int evadeLookahead = 3;
   ReleaseOptions release;
   /// Switchable dependencies: a robot whose next node waits on a robot at least this many route
@@ -46,6 +58,15 @@ struct TrafficOptions {
   /// Detours on: on a roadmap robots wait in line at stations and stand at docks, and an agent
   /// whose shortest way passes one would otherwise wait beside a free way round (docs/algorithms.md).
   PibtOptions pibt{.detourAfter = 4};
+  /// The plan is kept in time: each robot decides its next move when the plan has it at the end of
+  /// its last one (the edge's duration plus `turnTime`), a robot planned to stand again `timedWait`
+  /// s later; robots due within `timedQuantum` s of the earliest decide together, the others are
+  /// left driving (docs/algorithms.md, "A plan kept in time").
+  double timedQuantum = 0.1;
+  double timedWait = 0.5;
+  /// s of turning on the spot at `at` between `prev` and `next` beyond the edge's duration
+  /// (Roadmap::extraTurn), for the timed plan; empty: none.
+  std::function<double(NodeId prev, NodeId at, NodeId next)> turnTime{};
 };
 
 /// A station robots dock at one at a time: its dock node and the nodes to wait on in line,
@@ -154,6 +175,8 @@ class TrafficControl {
   void setNodeCost(std::vector<float> cost);
 
   [[nodiscard]] const TrafficStats& stats() const { return stats_; }
+  /// s of plan time of the newest planned step.
+  [[nodiscard]] double planClock() const { return clock_; }
   [[nodiscard]] const BaseEnds& baseEnds(std::size_t robot) const { return baseEnds_.at(robot); }
   [[nodiscard]] const PibtStats& plannerStats() const { return planner_->stats(); }
   [[nodiscard]] const Execution& execution() const { return execution_; }
@@ -192,6 +215,16 @@ class TrafficControl {
   std::vector<BaseEnds> baseEnds_;
   TrafficStats stats_;
   int sinceStep_ = 0;  ///< update() calls since the last planned step
+  // The plan kept in time.
+  void beforeTimedStep();
+  void afterTimedStep(const std::vector<NodeId>& before);
+  [[nodiscard]] bool lagging(std::int64_t oldest) const;
+  [[nodiscard]] std::int64_t evadeClock() const;
+  std::vector<double> ready_;       ///< per robot: plan time of its next decision
+  std::vector<std::uint8_t> busy_;  ///< per robot: still driving in the plan this step
+  std::vector<double> stepTime_;    ///< plan time of each plan step
+  std::vector<NodeId> came_;        ///< per robot: the node before its planned end (kNoNode: none)
+  double clock_ = 0.0;
 };
 
 }  // namespace fleet::traffic
