@@ -579,6 +579,8 @@ try:
     if state != "done" or robot not in [r["id"] for r in robots]:
         fail(f"the task did not reach done with a robot of fleet-robots (state {state}, robot {robot})")
     out = [line for line in rogue.communicate(timeout=60)[0].strip().splitlines() if not line.startswith("time=")]
+    if rogue.returncode not in (0, 3, 4):  # dds_probe's: ran, writer refused, participant refused
+        fail(f"the uncertified container did not run (exit {rogue.returncode}): {out[-3:]}")
     status, _ = http(f"{base}/v1/tasks/rogue-0", token)
     if status != 404:
         fail(f"a Task written by a container without a certificate reached the manager (GET rogue-0: {status})")
