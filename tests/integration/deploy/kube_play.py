@@ -345,10 +345,13 @@ def standby_takeover():
     epoch = metric(text[first], "fleet_manager_lease_epoch")
     print(f"{first} active (lease epoch {epoch:.0f}), {other} standing by, after {time.time() - t0:.0f} s")
 
-    # Two short tasks through the first adapter, acknowledged (201: stored by the active manager).
+    # Two short tasks through the first adapter, acknowledged (201: stored by the active manager):
+    # the robots at the first two parking places drive apart, one to the first charger (left of
+    # them), the other two places along the row (right), so that neither waits for the other.
     base, base2 = (f"https://{pod_ip(a)}:8080" for a in adapters)
-    parking = [s["name"] for s in json.loads(configmap["site.json"])["stations"] if s["kind"] == "parking"]
-    tasks = {f"pg-{i}": parking[len(robots) + 2 + i] for i in range(len(robots))}
+    stations = json.loads(configmap["site.json"])["stations"]
+    parking = [s["name"] for s in stations if s["kind"] == "parking"]
+    tasks = {"pg-0": next(s["name"] for s in stations if s["kind"] == "charging"), "pg-1": parking[len(robots) + 1]}
     for task, station in tasks.items():
         status, body = http(f"{base}/v1/tasks", token, {"id": task, "kind": "goto", "station": station})
         if status != 201:
@@ -382,7 +385,7 @@ def standby_takeover():
         if all(s in ("done", "failed", "cancelled") for s in states.values()):
             break
         time.sleep(0.5)
-    print(f"tasks {states} after {time.time() - t0:.0f} s")
+    print(f"tasks {states} after {time.time() - t0:.0f} s, {time.time() - killed:.0f} s after the kill")
     if any(s != "done" for s in states.values()):
         fail(f"the tasks did not all reach done: {states}")
 
