@@ -37,8 +37,8 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(0, 1000));
   trafficSim
       ->add_option("--max-lag", o->maxLag,
-                   "planner steps a robot may fall behind the plan before everyone's unreleased plan is "
-                   "dropped and planned again (default: the traffic layer's)")
+                   "lattice edges' time (0.7 s each) a robot may fall behind the plan before everyone's "
+                   "unreleased plan is dropped and planned again (default: the traffic layer's)")
       ->check(CLI::Range(1, 100000));
   trafficSim
       ->add_option("--prefer-straight", o->straight,
