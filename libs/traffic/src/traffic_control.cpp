@@ -14,9 +14,6 @@ namespace {
 /// s of plan time the options counted in lattice edges (maxLag) stand for: a 0.5 m
 /// lattice edge at 0.8 m/s with a little turning.
 constexpr double kStepSeconds = 0.7;
-}  // namespace
-
-namespace {
 /// Above any task priority a WMS sends (they are small integers).
 constexpr int kLeavingBoost = 1 << 20;
 }  // namespace
@@ -348,10 +345,12 @@ int TrafficControl::update() {
     }
     if (oldest >= 0 && lagging(oldest))
       replan();
-    const std::vector<NodeId> before = planner_->positions();
+    // Plan times are needed from the oldest unreleased step on (lagging()): drop those before it.
+    forgetStepTimes(oldest >= 0 ? oldest : execution_.plannedSteps());
+    before_ = planner_->positions();
     beforeTimedStep();
     execution_.append(planner_->step());
-    afterTimedStep(before);
+    afterTimedStep();
     afterStep();
     ++steps;
     sinceStep_ = 0;
@@ -502,9 +501,21 @@ std::int64_t TrafficControl::evadeClock() const {
 }
 
 bool TrafficControl::lagging(std::int64_t oldest) const {
-  const auto k = static_cast<std::size_t>(std::max<std::int64_t>(0, oldest));
-  const double at = k < stepTime_.size() ? stepTime_[k] : clock_;
+  const std::int64_t k = oldest - stepTimeFirst_;
+  const double at = k >= 0 && k < static_cast<std::int64_t>(stepTime_.size())
+                        ? stepTime_[static_cast<std::size_t>(k)]
+                        : clock_;
   return clock_ - at >= kStepSeconds * static_cast<double>(options_.maxLag);
+}
+
+void TrafficControl::forgetStepTimes(std::int64_t before) {
+  // In batches, so the record is not shifted every step; it stays bounded however long the run.
+  const std::int64_t drop =
+      std::min<std::int64_t>(before - stepTimeFirst_, static_cast<std::int64_t>(stepTime_.size()));
+  if (drop >= 1024) {
+    stepTime_.erase(stepTime_.begin(), stepTime_.begin() + drop);
+    stepTimeFirst_ += drop;
+  }
 }
 
 void TrafficControl::beforeTimedStep() {
@@ -520,8 +531,9 @@ void TrafficControl::beforeTimedStep() {
   planner_->setBusy(busy_);
 }
 
-void TrafficControl::afterTimedStep(const std::vector<NodeId>& before) {
-  const auto step = static_cast<std::size_t>(execution_.plannedSteps());
+void TrafficControl::afterTimedStep() {
+  const std::vector<NodeId>& before = before_;
+  const auto step = static_cast<std::size_t>(execution_.plannedSteps() - stepTimeFirst_);
   if (stepTime_.size() <= step)
     stepTime_.resize(step + 1, clock_);
   stepTime_[step] = clock_;

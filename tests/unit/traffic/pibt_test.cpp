@@ -83,6 +83,27 @@ TEST(Pibt, ALoneAgentDrivesAShortestPath) {
   EXPECT_EQ(p.elapsed(0), 0);
 }
 
+/// A busy agent (still driving its last move in a plan kept in time) stays where the plan has it
+/// and is not pushed: the agent behind waits, and goes on once the busy one decides again.
+TEST(Pibt, ABusyAgentIsNeitherPlannedNorPushed) {
+  const GridMap m = gridOf({"....."});
+  const std::vector<NodeId> start = {m.node(1, 0), m.node(2, 0)};
+  Pibt p(m.graph, start);
+  p.setGoal(0, m.node(4, 0));  // behind, wants to pass through where agent 1 stands
+  p.setGoal(1, m.node(3, 0));  // busy: would otherwise move on (and be pushed)
+  const std::vector<std::uint8_t> busy = {0, 1};
+  p.setBusy(busy);
+  for (int i = 0; i < 3; ++i) {
+    p.step();
+    EXPECT_EQ(p.positions()[1], m.node(2, 0)) << "the busy agent moved or was pushed";
+    EXPECT_EQ(p.positions()[0], m.node(1, 0));
+  }
+  p.setBusy(std::vector<std::uint8_t>{0, 0});
+  p.step();
+  EXPECT_EQ(p.positions()[1], m.node(3, 0));
+  EXPECT_EQ(p.positions()[0], m.node(2, 0));
+}
+
 /// On an open grid a goal 5 across and 5 up has 252 shortest ways. Picking among them at random
 /// zigzags (a real robot stops to turn at each zig); preferring the straightest takes one turn.
 TEST(Pibt, AmongEquallyShortMovesTheStraightestIsTakenWhenAsked) {

@@ -137,7 +137,7 @@ class Pibt {
   /// Agents still driving their last move in a plan kept in time (TrafficControl): the next
   /// step leaves them where they are, pushes none of them and counts no standing for them. Empty or
   /// all 0: none. Agents on a way out of a knot are never busy.
-  void setBusy(std::vector<std::uint8_t> busy) { busy_ = std::move(busy); }
+  void setBusy(std::span<const std::uint8_t> busy) { busy_.assign(busy.begin(), busy.end()); }
   [[nodiscard]] bool busy(std::size_t agent) const {
     return agent < busy_.size() && busy_[agent] != 0 && forcedGroup_[agent] < 0;
   }

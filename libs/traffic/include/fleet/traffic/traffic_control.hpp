@@ -217,13 +217,16 @@ class TrafficControl {
   int sinceStep_ = 0;  ///< update() calls since the last planned step
   // The plan kept in time.
   void beforeTimedStep();
-  void afterTimedStep(const std::vector<NodeId>& before);
+  void afterTimedStep();
+  void forgetStepTimes(std::int64_t before);
   [[nodiscard]] bool lagging(std::int64_t oldest) const;
   [[nodiscard]] std::int64_t evadeClock() const;
   std::vector<double> ready_;       ///< per robot: plan time of its next decision
   std::vector<std::uint8_t> busy_;  ///< per robot: still driving in the plan this step
-  std::vector<double> stepTime_;    ///< plan time of each plan step
-  std::vector<NodeId> came_;        ///< per robot: the node before its planned end (kNoNode: none)
+  std::vector<double> stepTime_;    ///< plan time of plan steps stepTimeFirst_, stepTimeFirst_ + 1, ...
+  std::int64_t stepTimeFirst_ = 0;
+  std::vector<NodeId> before_;  ///< the planner's positions before a step (kept: no allocation a step)
+  std::vector<NodeId> came_;    ///< per robot: the node before its planned end (kNoNode: none)
   double clock_ = 0.0;
 };
 
