@@ -86,7 +86,8 @@ TEST_F(SharedEventLog, TheOtherReplicasRowsReachTheListenerAndWakeTheStream) {
   a->append({ev("t1", 1), ev("t1", 2)}, 1'000);
   // b's own thread takes them (four times a second); its stream wakes.
   EXPECT_TRUE(b->waitAfter(0, std::chrono::seconds(5)));
-  for (int i = 0; i < 100 && b->lastId() < 2; ++i) {
+  // The thread moves lastId() before it calls the listener: wait for both.
+  for (int i = 0; i < 100 && (b->lastId() < 2 || heard.load() < 2); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_EQ(b->lastId(), 2);
@@ -96,6 +97,9 @@ TEST_F(SharedEventLog, TheOtherReplicasRowsReachTheListenerAndWakeTheStream) {
   a->append({ev("t2", 1)}, 1'000);
   b->append({ev("t3", 1)}, 1'000);
   EXPECT_EQ(b->lastId(), 4);
+  for (int i = 0; i < 100 && heard.load() < 4; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   EXPECT_GE(heard.load(), 4);
 }
 
