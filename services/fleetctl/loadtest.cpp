@@ -36,7 +36,7 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 std::atomic<int> gSignal{0};
-extern "C" void onSignal(int sig) {
+extern "C" void onLoadtestSignal(int sig) {
   gSignal = sig;
 }
 
@@ -254,7 +254,7 @@ int Run::run() {
           : o.maxTasks;  // --until-done: stop once this many tasks are finished
 
   struct sigaction sa {};
-  sa.sa_handler = onSignal;
+  sa.sa_handler = onLoadtestSignal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);

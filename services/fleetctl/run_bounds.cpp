@@ -1,5 +1,7 @@
 #include "run_bounds.hpp"
 
+#include "round3.hpp"
+
 #include <sqlite3.h>
 #include <zlib.h>
 
@@ -36,10 +38,6 @@ struct DoneTask {
   std::string dropoff;
   double dwellS = 0.0;
 };
-
-double round3(double x) {
-  return std::round(x * 1000.0) / 1000.0;
-}
 
 std::optional<std::string> readDoneTasks(const fs::path& dbPath, std::vector<DoneTask>& out) {
   sqlite3* db = nullptr;

@@ -1,5 +1,7 @@
 #include "run_fleet_bound.hpp"
 
+#include "round3.hpp"
+
 #include <sqlite3.h>
 
 #include <cmath>
@@ -17,10 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-double round3(double x) {
-  return std::round(x * 1000.0) / 1000.0;
-}
 
 /// The transport tasks of the run in posting order (first transition), with their dwell.
 std::optional<std::string> readList(const fs::path& dbPath, std::vector<ListTask>& out, std::size_t& other) {

@@ -1,5 +1,7 @@
 #include "run_ledger.hpp"
 
+#include "round3.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,10 +15,6 @@ namespace {
 
 /// s a docking may take beyond the roadmap's time for the last leg (the timed releases' aim).
 constexpr double kDockingSlackS = 2.0;
-
-double round3(double x) {
-  return std::round(x * 1000.0) / 1000.0;
-}
 
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "saturation.hpp"
 
+#include "round3.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -73,12 +75,6 @@ SaturatedWindow saturatedWindow(const std::vector<TransitionRow>& transitions, s
   w.perRobotPerH = static_cast<double>(w.done) / static_cast<double>(robots) * 3600.0 / (w.toS - w.fromS);
   return w;
 }
-
-namespace {
-double round3(double v) {
-  return std::round(v * 1000.0) / 1000.0;
-}
-}  // namespace
 
 nlohmann::json saturatedJson(const SaturatedWindow& w) {
   nlohmann::json j = {{"found", w.found},

@@ -36,8 +36,6 @@ constexpr double kLeaveDistance = 1.0;
 /// against 10.8, mean of seeds 1-3, 7, 8, docs/benchmarks.md.)
 /// (The hold lasts until the robot has moved the progress watch's movedM from where it began.)
 constexpr double kBlockedAfterS = 3.0;
-/// A progress report at least this often [s], whatever changed.
-constexpr double kHeartbeatS = 1.0;
 /// The local planner sees this much of the base ahead [m]. Given the whole base, a sampling
 /// planner measured its progress to the base's end: on a base that bends back (round a corner and
 /// back along the next aisle) the robot got no closer to that end for a while, DWA took it for a

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "pg_errors.hpp"
+
 namespace fleet::wms {
 namespace {
 
@@ -26,23 +28,8 @@ constexpr const char* kSelect =
     "SELECT id, task_id, COALESCE(seq, 0), state, robot, reason, stamp_ns, station, priority, deadline_ns, "
     "eta_ns FROM wms_task_events";
 
-std::runtime_error failed(const std::string& url, const Error& e) {
-  return std::runtime_error(pg::redacted(url) + ": " + e.message);
-}
-
-template <class T>
-T orThrow(const std::string& url, Expected<T> r) {
-  if (!r) {
-    throw failed(url, r.error());
-  }
-  return std::move(*r);
-}
-
-void orThrow(const std::string& url, Expected<void> r) {
-  if (!r) {
-    throw failed(url, r.error());
-  }
-}
+using pg_errors::failed;
+using pg_errors::orThrow;
 
 std::vector<LoggedEvent> rowsOf(const pg::Result& r) {
   std::vector<LoggedEvent> out;

@@ -2,10 +2,12 @@
 
 #include <stdexcept>
 
+#include "pg_errors.hpp"
+
 namespace fleet::wms {
 namespace {
 
-constexpr const char* kSelect =
+constexpr const char* kSelectWebhooks =
     "SELECT id, url, secret, created_ns, delivered_through, state, deliveries, failures, last_error, "
     "last_attempt_ns, last_success_ns FROM ";
 
@@ -26,7 +28,7 @@ SqliteWebhookStore::SqliteWebhookStore(std::shared_ptr<SqliteDb> db) : db_(std::
 std::vector<StoredWebhook> SqliteWebhookStore::load() {
   std::vector<StoredWebhook> out;
   std::lock_guard dbLock(db_->mutex());
-  SqliteStmt q(*db_, (std::string(kSelect) + "webhooks ORDER BY created_ns").c_str());
+  SqliteStmt q(*db_, (std::string(kSelectWebhooks) + "webhooks ORDER BY created_ns").c_str());
   while (q.step()) {
     StoredWebhook w;
     auto& st = w.status;
@@ -87,16 +89,8 @@ void SqliteWebhookStore::update(const WebhookStatus& st) {
 
 namespace {
 
-std::runtime_error failed(const std::string& url, const Error& e) {
-  return std::runtime_error(pg::redacted(url) + ": " + e.message);
-}
-
-pg::Result orThrow(const std::string& url, Expected<pg::Result> r) {
-  if (!r) {
-    throw failed(url, r.error());
-  }
-  return std::move(*r);
-}
+using pg_errors::failed;
+using pg_errors::orThrow;
 
 }  // namespace
 
@@ -119,8 +113,8 @@ PostgresWebhookStore::PostgresWebhookStore(const std::string& url) : url_(url), 
 
 std::vector<StoredWebhook> PostgresWebhookStore::load() {
   std::lock_guard lock(m_);
-  const auto r = orThrow(
-      url_, conn_.exec("read the webhooks", std::string(kSelect) + "wms_webhooks ORDER BY created_ns, id"));
+  const auto r = orThrow(url_, conn_.exec("read the webhooks", std::string(kSelectWebhooks) +
+                                                                   "wms_webhooks ORDER BY created_ns, id"));
   std::vector<StoredWebhook> out;
   for (int i = 0; i < r.rows(); ++i) {
     StoredWebhook w;
