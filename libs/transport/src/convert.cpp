@@ -1,6 +1,7 @@
 // Copies between the C++ messages and the idlc-generated C structs. Writing never truncates: a
 // string or sequence over its IDL bound is a MessageError naming the field.
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -73,7 +74,7 @@ E getEnum(C c, E maxValue) {
 }  // namespace
 
 // ---- Task
-void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
+void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena& arena) {
   putStr(out.task_id, in.task_id, "Task.task_id");
   putStr(out.request_id, in.request_id, "Task.request_id");
   out.kind = static_cast<fleet_TaskKind>(in.kind);
@@ -90,12 +91,18 @@ void Traits<msg::Task>::toC(const msg::Task& in, C& out, Arena&) {
   out.control = static_cast<fleet_TaskControl>(in.control);
   out.set_priority = in.set_priority;
   out.set_deadline = in.set_deadline;
+  putSeq(out.steps, in.steps, 16, arena, "Task.steps", [](const msg::TaskStep& st, fleet_TaskStep& c) {
+    c.action = static_cast<fleet_StepAction>(st.action);
+    putStr(c.station, st.station, "Task.steps[].station");
+    putStr(c.load_id, st.load_id, "Task.steps[].load_id");
+    c.duration_ns = st.duration_ns;
+  });
 }
 msg::Task Traits<msg::Task>::fromC(const C& in) {
   msg::Task m;
   m.task_id = getStr(in.task_id);
   m.request_id = getStr(in.request_id);
-  m.kind = getEnum(in.kind, msg::TaskKind::Park);
+  m.kind = getEnum(in.kind, msg::TaskKind::Multistop);
   m.pickup = getStr(in.pickup);
   m.dropoff = getStr(in.dropoff);
   m.station = getStr(in.station);
@@ -109,6 +116,10 @@ msg::Task Traits<msg::Task>::fromC(const C& in) {
   m.control = getEnum(in.control, msg::TaskControl::Change);
   m.set_priority = in.set_priority;
   m.set_deadline = in.set_deadline;
+  m.steps = getSeq(in.steps, [](const fleet_TaskStep& c) {
+    return msg::TaskStep{getEnum(c.action, msg::StepAction::Charge), getStr(c.station), getStr(c.load_id),
+                         c.duration_ns};
+  });
   return m;
 }
 
@@ -144,6 +155,7 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   out.deadline_ns = in.deadline_ns;
   out.eta_ns = in.eta_ns;
   out.epoch = in.epoch;
+  out.step = in.step;
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
   return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
@@ -151,7 +163,8 @@ msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
           in.stamp_ns,         in.seq,
           getStr(in.station),  in.changed,
           in.priority,         in.deadline_ns,
-          in.eta_ns,           in.epoch};
+          in.eta_ns,           in.epoch,
+          in.step};
 }
 
 // ---- TaskAssignment
@@ -169,6 +182,18 @@ void Traits<msg::TaskAssignment>::toC(const msg::TaskAssignment& in, C& out, Are
   out.stamp_ns = in.stamp_ns;
   out.priority = in.priority;
   out.epoch = in.epoch;
+  // One id per goal, or none at all when no goal carries a load.
+  const bool loads = std::any_of(in.goals.begin(), in.goals.end(), [](const msg::Goal& g) { return !g.load_id.empty(); });
+  const std::size_t n = loads ? in.goals.size() : 0;
+  // fleet_Id is a char array, which the arena cannot allocate as an element type: bytes instead.
+  auto* ids = n == 0 ? nullptr : reinterpret_cast<fleet_Id*>(arena.alloc<char>(n * sizeof(fleet_Id)));
+  for (std::size_t i = 0; i < n; ++i) {
+    putStr(ids[i], in.goals[i].load_id, "TaskAssignment.goals[].load_id");
+  }
+  out.goal_load_ids._buffer = ids;
+  out.goal_load_ids._length = static_cast<std::uint32_t>(n);
+  out.goal_load_ids._maximum = static_cast<std::uint32_t>(n);
+  out.goal_load_ids._release = false;
 }
 msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   msg::TaskAssignment m;
@@ -183,6 +208,10 @@ msg::TaskAssignment Traits<msg::TaskAssignment>::fromC(const C& in) {
   m.stamp_ns = in.stamp_ns;
   m.priority = in.priority;
   m.epoch = in.epoch;
+  // Ids past the goals (a sender's mistake) have no goal to go with and are left out.
+  for (std::uint32_t i = 0; i < in.goal_load_ids._length && i < m.goals.size(); ++i) {
+    m.goals[i].load_id = getStr(in.goal_load_ids._buffer[i]);
+  }
   return m;
 }
 
@@ -195,10 +224,11 @@ void Traits<msg::TaskStatus>::toC(const msg::TaskStatus& in, C& out, Arena&) {
   out.progress = in.progress;
   putStr(out.error, in.error, "TaskStatus.error");
   out.stamp_ns = in.stamp_ns;
+  out.step = in.step;
 }
 msg::TaskStatus Traits<msg::TaskStatus>::fromC(const C& in) {
   return {getStr(in.robot_id), getStr(in.task_id), in.revision, getEnum(in.state, msg::TaskState::Rejected),
-          in.progress,         getStr(in.error),   in.stamp_ns};
+          in.progress,         getStr(in.error),   in.stamp_ns, in.step};
 }
 
 // ---- RobotState
