@@ -69,9 +69,10 @@ Expected<std::vector<msg::Goal>> taskGoals(const Task& t, const StationMap& stat
       break;
   }
   if (goals.empty() || !missing.empty()) {
-    return unexpected(errc::kInternal, "task '" + t.id + "' has " +
-                                           (missing.empty() ? std::string("no station")
-                                                            : "station '" + missing + "', which is not on this site"));
+    return unexpected(errc::kInternal,
+                      "task '" + t.id + "' has " +
+                          (missing.empty() ? std::string("no station")
+                                           : "station '" + missing + "', which is not on this site"));
   }
   return goals;
 }

@@ -74,8 +74,8 @@ void FleetManagerNode::stepEvent(const std::string& taskId, std::int64_t nowNs, 
   e.deadline_ns = 0;
   e.epoch = epoch_;
   e.step = it->second.step;
-  std::string what = "step " + std::to_string(it->second.step) + " of " + std::to_string(it->second.steps) + ": " +
-                     std::string(toString(step.action));
+  std::string what = "step " + std::to_string(it->second.step) + " of " + std::to_string(it->second.steps) +
+                     ": " + std::string(toString(step.action));
   if (!step.loadId.empty()) {
     what += " " + step.loadId;
   }

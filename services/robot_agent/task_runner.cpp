@@ -127,8 +127,8 @@ TaskTick TaskRunner::tick(std::int64_t nowNs) {
 }
 
 void TaskRunner::finish(TaskState final, const std::string& reason, std::int64_t nowNs) {
-  pending_ = TaskReport{task_, revision_, final, final == TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255),
-                        nowNs, step()};
+  pending_ = TaskReport{
+      task_, revision_, final, final == TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs, step()};
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;

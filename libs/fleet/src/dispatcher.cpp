@@ -220,8 +220,9 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
   // A multi-stop task picks and drops more than once: it stays en_route until it is done (which
   // stop it is at travels beside its state), whatever stage the robot reports for a stop.
   const TaskState reached =
-      cur.task.kind == TaskKind::Multistop && isActive(state) && state != TaskState::Assigned ? TaskState::EnRoute
-                                                                                               : state;
+      cur.task.kind == TaskKind::Multistop && isActive(state) && state != TaskState::Assigned
+          ? TaskState::EnRoute
+          : state;
   if (reached == cur.state) {
     return out;  // a repeated report
   }

@@ -20,8 +20,8 @@ std::string join(std::string_view prefix, std::string_view field) {
   return std::string(prefix) + "." + std::string(field);
 }
 
-void checkStation(const std::string& name, std::string_view path, StationKind need, const StationMap* stations,
-                  std::vector<FieldError>& out) {
+void checkStation(const std::string& name, std::string_view path, StationKind need,
+                  const StationMap* stations, std::vector<FieldError>& out) {
   if (!isValidId(name)) {
     out.push_back({std::string(path), "not a valid station id (1-63 characters of A-Z a-z 0-9 _ . : -)"});
     return;
@@ -159,7 +159,7 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
   static const std::set<std::string, std::less<>> kKnown = {
       "id",       "kind",        "pickup",           "dropoff",
       "station",  "robot",       "load_duration_ns", "unload_duration_ns",
-      "priority", "deadline_ns", "created_ns",         "steps"};
+      "priority", "deadline_ns", "created_ns",       "steps"};
   for (const auto& [key, value] : j.items()) {
     if (!kKnown.contains(key)) {
       errs.push_back({join(prefix, key), "unknown field"});
@@ -225,8 +225,8 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
     if (auto k = parseTaskKind(kind)) {
       t.kind = *k;
     } else {
-      errs.push_back(
-          {join(prefix, "kind"), "unknown kind '" + kind + "' (expected transport, goto, charge, park or multistop)"});
+      errs.push_back({join(prefix, "kind"),
+                      "unknown kind '" + kind + "' (expected transport, goto, charge, park or multistop)"});
       typesOk = false;
     }
   }

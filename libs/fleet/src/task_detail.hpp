@@ -17,8 +17,8 @@ namespace fleet::task_detail {
 std::string join(std::string_view prefix, std::string_view field);
 
 /// A valid id naming a station of the site (when `stations` is given) of kind `need`.
-void checkStation(const std::string& name, std::string_view path, StationKind need, const StationMap* stations,
-                  std::vector<FieldError>& out);
+void checkStation(const std::string& name, std::string_view path, StationKind need,
+                  const StationMap* stations, std::vector<FieldError>& out);
 
 /// Reads `steps` (an array of step objects) into `t.steps`: types, unknown fields, actions. False
 /// when a type was wrong (the semantic checks then say nothing more).

@@ -44,7 +44,8 @@ void checkStepStation(const TaskStep& s, std::size_t i, const std::string& path,
     if (s.action != StepAction::Wait) {
       out.push_back({path, "required for " + stepName(s.action)});
     } else if (i == 0) {
-      out.push_back({path, "required for a wait that is the first step (there is no stop before it to wait at)"});
+      out.push_back(
+          {path, "required for a wait that is the first step (there is no stop before it to wait at)"});
     }
     return;
   }
@@ -105,7 +106,8 @@ bool parseSteps(const nlohmann::json& steps, std::string_view prefix, Task& t, s
   }
   if (steps.size() > kMaxSteps) {
     // Checked before the elements: a huge array is refused without reading it.
-    out.push_back({path, "at most " + std::to_string(kMaxSteps) + " steps, got " + std::to_string(steps.size())});
+    out.push_back(
+        {path, "at most " + std::to_string(kMaxSteps) + " steps, got " + std::to_string(steps.size())});
     return false;
   }
   bool ok = true;
@@ -146,7 +148,8 @@ bool parseSteps(const nlohmann::json& steps, std::string_view prefix, Task& t, s
       if (auto a = parseStepAction(action)) {
         s.action = *a;
       } else {
-        out.push_back({p + ".action", "unknown action '" + action + "' (expected goto, pick, drop, wait or charge)"});
+        out.push_back(
+            {p + ".action", "unknown action '" + action + "' (expected goto, pick, drop, wait or charge)"});
         ok = false;
       }
     }
@@ -154,7 +157,8 @@ bool parseSteps(const nlohmann::json& steps, std::string_view prefix, Task& t, s
     ok = str("load_id", s.loadId) && ok;
     if (auto it = j.find("duration_ns"); it != j.end()) {
       if (!it->is_number_integer() || (!it->is_number_unsigned() && it->get<std::int64_t>() < 0) ||
-          (it->is_number_unsigned() && it->get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxHandlingNs))) {
+          (it->is_number_unsigned() &&
+           it->get<std::uint64_t>() > static_cast<std::uint64_t>(kMaxHandlingNs))) {
         out.push_back({p + ".duration_ns", "must be an integer in [0, 3600e9] ns"});
         ok = false;
       } else {
@@ -169,13 +173,13 @@ bool parseSteps(const nlohmann::json& steps, std::string_view prefix, Task& t, s
 void validateSteps(const Task& t, const StationMap* stations, std::string_view prefix,
                    std::vector<FieldError>& out) {
   if (t.steps.empty()) {
-    out.push_back({join(prefix, "steps"), "required for a multistop task (1 to " + std::to_string(kMaxSteps) +
-                                              " steps)"});
+    out.push_back({join(prefix, "steps"),
+                   "required for a multistop task (1 to " + std::to_string(kMaxSteps) + " steps)"});
     return;
   }
   if (t.steps.size() > kMaxSteps) {
-    out.push_back({join(prefix, "steps"), "at most " + std::to_string(kMaxSteps) + " steps, got " +
-                                              std::to_string(t.steps.size())});
+    out.push_back({join(prefix, "steps"),
+                   "at most " + std::to_string(kMaxSteps) + " steps, got " + std::to_string(t.steps.size())});
     return;
   }
   std::map<std::string, std::size_t, std::less<>> held;  // load on the robot -> the step that picked it
@@ -196,7 +200,8 @@ void validateSteps(const Task& t, const StationMap* stations, std::string_view p
     } else if (s.action == StepAction::Pick) {
       held.emplace(s.loadId, i);
     } else if (s.action == StepAction::Drop && held.erase(s.loadId) == 0) {
-      out.push_back({p + ".load_id", "load '" + s.loadId + "' is not on the robot here (no pick of it before)"});
+      out.push_back(
+          {p + ".load_id", "load '" + s.loadId + "' is not on the robot here (no pick of it before)"});
     }
     if (s.durationNs < 0 || s.durationNs > kMaxHandlingNs) {
       out.push_back({p + ".duration_ns", "must be in [0, 3600e9] ns"});

@@ -19,7 +19,8 @@ msg::Task toWire(const Task& t, std::string requestId, std::int64_t nowNs) {
   m.deadline_ns = t.deadlineNs;
   m.created_ns = t.createdNs != 0 ? t.createdNs : nowNs;
   for (const auto& s : t.steps) {
-    m.steps.push_back({static_cast<msg::StepAction>(static_cast<int>(s.action)), s.station, s.loadId, s.durationNs});
+    m.steps.push_back(
+        {static_cast<msg::StepAction>(static_cast<int>(s.action)), s.station, s.loadId, s.durationNs});
   }
   return m;
 }
@@ -38,7 +39,8 @@ Task fromWire(const msg::Task& m, std::int64_t nowNs) {
   t.deadlineNs = m.deadline_ns;
   t.createdNs = m.created_ns != 0 ? m.created_ns : nowNs;
   for (const auto& s : m.steps) {
-    t.steps.push_back({static_cast<StepAction>(static_cast<int>(s.action)), s.station, s.load_id, s.duration_ns});
+    t.steps.push_back(
+        {static_cast<StepAction>(static_cast<int>(s.action)), s.station, s.load_id, s.duration_ns});
   }
   return t;
 }

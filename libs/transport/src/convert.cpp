@@ -158,12 +158,18 @@ void Traits<msg::TaskEvent>::toC(const msg::TaskEvent& in, C& out, Arena&) {
   out.step = in.step;
 }
 msg::TaskEvent Traits<msg::TaskEvent>::fromC(const C& in) {
-  return {getStr(in.task_id),  getEnum(in.state, msg::TaskState::Rejected),
-          getStr(in.robot_id), getStr(in.reason),
-          in.stamp_ns,         in.seq,
-          getStr(in.station),  in.changed,
-          in.priority,         in.deadline_ns,
-          in.eta_ns,           in.epoch,
+  return {getStr(in.task_id),
+          getEnum(in.state, msg::TaskState::Rejected),
+          getStr(in.robot_id),
+          getStr(in.reason),
+          in.stamp_ns,
+          in.seq,
+          getStr(in.station),
+          in.changed,
+          in.priority,
+          in.deadline_ns,
+          in.eta_ns,
+          in.epoch,
           in.step};
 }
 
@@ -183,7 +189,8 @@ void Traits<msg::TaskAssignment>::toC(const msg::TaskAssignment& in, C& out, Are
   out.priority = in.priority;
   out.epoch = in.epoch;
   // One id per goal, or none at all when no goal carries a load.
-  const bool loads = std::any_of(in.goals.begin(), in.goals.end(), [](const msg::Goal& g) { return !g.load_id.empty(); });
+  const bool loads =
+      std::any_of(in.goals.begin(), in.goals.end(), [](const msg::Goal& g) { return !g.load_id.empty(); });
   const std::size_t n = loads ? in.goals.size() : 0;
   // fleet_Id is a char array, which the arena cannot allocate as an element type: bytes instead.
   auto* ids = n == 0 ? nullptr : reinterpret_cast<fleet_Id*>(arena.alloc<char>(n * sizeof(fleet_Id)));

@@ -72,7 +72,8 @@ TEST(TaskSteps, ParsesFiveStepsAndRoundTrips) {
 
 TEST(TaskSteps, KindMayBeLeftOutWithSteps) {
   const auto st = stepStations();
-  auto r = parseTask(nlohmann::json::parse(R"({"id": "m", "steps": [{"action": "goto", "station": "X"}]})"), &st);
+  auto r =
+      parseTask(nlohmann::json::parse(R"({"id": "m", "steps": [{"action": "goto", "station": "X"}]})"), &st);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->kind, TaskKind::Multistop);
   EXPECT_EQ(toJson(*r)["kind"], "multistop");
@@ -81,9 +82,10 @@ TEST(TaskSteps, KindMayBeLeftOutWithSteps) {
 }
 
 TEST(TaskSteps, UnknownStationIsNamedByItsPath) {
-  EXPECT_EQ(reasonAt(withSteps(R"([{"action": "goto", "station": "X"}, {"action": "goto", "station": "NOPE"}])"),
-                     "steps[1].station"),
-            "unknown station 'NOPE'");
+  EXPECT_EQ(
+      reasonAt(withSteps(R"([{"action": "goto", "station": "X"}, {"action": "goto", "station": "NOPE"}])"),
+               "steps[1].station"),
+      "unknown station 'NOPE'");
 }
 
 TEST(TaskSteps, StationOfTheWrongKindForTheAction) {
@@ -98,8 +100,9 @@ TEST(TaskSteps, StationOfTheWrongKindForTheAction) {
 TEST(TaskSteps, PickAndDropNeedALoadId) {
   EXPECT_EQ(reasonAt(withSteps(R"([{"action": "pick", "station": "P-1"}])"), "steps[0].load_id"),
             "required for a pick step");
-  EXPECT_EQ(reasonAt(withSteps(R"([{"action": "goto", "station": "X", "load_id": "L"}])"), "steps[0].load_id"),
-            "not allowed for a goto step");
+  EXPECT_EQ(
+      reasonAt(withSteps(R"([{"action": "goto", "station": "X", "load_id": "L"}])"), "steps[0].load_id"),
+      "not allowed for a goto step");
 }
 
 TEST(TaskSteps, DropOfALoadNotPicked) {
@@ -116,8 +119,9 @@ TEST(TaskSteps, ALoadPickedTwiceOrNeverDropped) {
                                   {"action": "drop", "station": "D-2", "load_id": "A"}])"),
                      "steps[1].load_id"),
             "load 'A' is already on the robot (picked at steps[0])");
-  EXPECT_EQ(reasonAt(withSteps(R"([{"action": "pick", "station": "P-1", "load_id": "B"}])"), "steps[0].load_id"),
-            "load 'B' is picked but never dropped");
+  EXPECT_EQ(
+      reasonAt(withSteps(R"([{"action": "pick", "station": "P-1", "load_id": "B"}])"), "steps[0].load_id"),
+      "load 'B' is picked but never dropped");
 }
 
 TEST(TaskSteps, TooManySteps) {
@@ -147,24 +151,27 @@ TEST(TaskSteps, ActionsAndTypes) {
   EXPECT_EQ(reasonAt(withSteps(R"([{"action": "wait", "station": "X", "duration_ns": -1}])"),
                      "steps[0].duration_ns"),
             "must be an integer in [0, 3600e9] ns");
-  EXPECT_EQ(reasonAt(withSteps(R"("goto X")"), "steps"), "expected an array of steps, got string");
-  EXPECT_EQ(reasonAt(withSteps(R"([7])"), "steps[0]"), "expected a step object, got number");
+  EXPECT_EQ(reasonAt(withSteps(R"("goto X")"), "steps"), "expected an array of steps, got a string");
+  EXPECT_EQ(reasonAt(withSteps(R"([7])"), "steps[0]"), "expected a step object, got an integer");
 }
 
 TEST(TaskSteps, StepsBelongToMultistopTasksOnly) {
-  EXPECT_EQ(reasonAt(R"({"id": "t", "kind": "goto", "station": "X", "steps": [{"action": "goto", "station": "X"}]})",
-                     "steps"),
-            "not allowed for a goto task");
-  EXPECT_EQ(reasonAt(withSteps(R"([{"action": "goto", "station": "X"}])").replace(1, 0, R"("pickup": "P-1", )"),
-                     "pickup"),
-            "not allowed for a multistop task");
+  EXPECT_EQ(
+      reasonAt(
+          R"({"id": "t", "kind": "goto", "station": "X", "steps": [{"action": "goto", "station": "X"}]})",
+          "steps"),
+      "not allowed for a goto task");
+  EXPECT_EQ(
+      reasonAt(withSteps(R"([{"action": "goto", "station": "X"}])").replace(1, 0, R"("pickup": "P-1", )"),
+               "pickup"),
+      "not allowed for a multistop task");
 }
 
 TEST(TaskSteps, PathsInABatchNameTheTask) {
   const auto st = stepStations();
-  auto r = parseTasks(nlohmann::json::parse(R"({"tasks": [)" + withSteps(R"([{"action": "goto", "station": "Q"}])") +
-                                            "]}"),
-                      &st);
+  auto r = parseTasks(
+      nlohmann::json::parse(R"({"tasks": [)" + withSteps(R"([{"action": "goto", "station": "Q"}])") + "]}"),
+      &st);
   ASSERT_FALSE(r);
   ASSERT_EQ(r.error().fields.size(), 1u);
   EXPECT_EQ(r.error().fields[0].path, "tasks[0].steps[0].station");

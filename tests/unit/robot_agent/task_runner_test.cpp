@@ -210,7 +210,7 @@ TEST(TaskRunner, EveryLegOfAMultiStopOrderIsReportedWithItsStep) {
   }
   take();
   const std::vector<std::pair<TaskState, std::uint32_t>> expected = {
-      {TaskState::EnRoute, 1},    {TaskState::Loading, 1},    {TaskState::Delivering, 2},
+      {TaskState::EnRoute, 1},   {TaskState::Loading, 1},    {TaskState::Delivering, 2},
       {TaskState::Unloading, 2}, {TaskState::Delivering, 3}, {TaskState::Delivering, 4},
       {TaskState::Done, 4}};
   EXPECT_EQ(seen, expected);

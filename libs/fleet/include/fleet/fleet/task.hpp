@@ -43,15 +43,15 @@ struct TaskStep {
 struct Task {
   std::string id;
   TaskKind kind = TaskKind::Transport;
-  std::string pickup;           ///< transport only
-  std::string dropoff;          ///< transport only
-  std::string station;          ///< goto (required), charge and park (optional)
-  std::string robot;            ///< optional: only this robot may take the task
-  std::int64_t loadNs = 0;      ///< transport only: time spent loading at the pickup
-  std::int64_t unloadNs = 0;    ///< transport only: time spent unloading at the dropoff
-  std::int32_t priority = 0;    ///< higher first, in [kMinPriority, kMaxPriority]
-  std::int64_t deadlineNs = 0;  ///< 0 = none
-  std::int64_t createdNs = 0;   ///< set by the intake when the client leaves it out
+  std::string pickup;             ///< transport only
+  std::string dropoff;            ///< transport only
+  std::string station;            ///< goto (required), charge and park (optional)
+  std::string robot;              ///< optional: only this robot may take the task
+  std::int64_t loadNs = 0;        ///< transport only: time spent loading at the pickup
+  std::int64_t unloadNs = 0;      ///< transport only: time spent unloading at the dropoff
+  std::int32_t priority = 0;      ///< higher first, in [kMinPriority, kMaxPriority]
+  std::int64_t deadlineNs = 0;    ///< 0 = none
+  std::int64_t createdNs = 0;     ///< set by the intake when the client leaves it out
   std::vector<TaskStep> steps{};  ///< multistop only, 1..kMaxSteps
 
   bool operator==(const Task&) const = default;

@@ -18,8 +18,8 @@ inline constexpr std::array<TaskState, 10> kAllTaskStates = {
     TaskState::Queued,     TaskState::Assigned,  TaskState::EnRoute, TaskState::Loading,
     TaskState::Delivering, TaskState::Unloading, TaskState::Done,    TaskState::Failed,
     TaskState::Cancelled,  TaskState::Requeued};
-inline constexpr std::array<TaskKind, 5> kAllTaskKinds = {TaskKind::Transport, TaskKind::Goto, TaskKind::Charge,
-                                                          TaskKind::Park, TaskKind::Multistop};
+inline constexpr std::array<TaskKind, 5> kAllTaskKinds = {
+    TaskKind::Transport, TaskKind::Goto, TaskKind::Charge, TaskKind::Park, TaskKind::Multistop};
 
 /// Wire names: "queued", "assigned", "en_route", "loading", "delivering", "unloading", "done",
 /// "failed", "cancelled", "requeued".

@@ -48,8 +48,8 @@ struct Task {
   std::int64_t created_ns = 0;
   bool cancel = false;
   TaskControl control = TaskControl::None;
-  bool set_priority = false;  ///< Change: `priority` is the task's new priority
-  bool set_deadline = false;  ///< Change: `deadline_ns` is the task's new deadline (0 = none)
+  bool set_priority = false;      ///< Change: `priority` is the task's new priority
+  bool set_deadline = false;      ///< Change: `deadline_ns` is the task's new deadline (0 = none)
   std::vector<TaskStep> steps{};  ///< Multistop: the stops in order (at most 16)
   bool operator==(const Task&) const = default;
 };
