@@ -415,6 +415,25 @@ try {
     check(!!changed && Math.abs(ahead - 30) < 1,
           `priority 7 and a deadline ${ahead.toFixed(1)} min ahead (${changed && changed.deadline})`);
     await api('DELETE', `/v1/tasks/${held}`);
+    // A multi-stop task from the form (kind "Multi-stop", its stops as text), stored with its
+    // steps while the robots are still held; then cancelled.
+    await page.select('#task-kind', 'multistop');
+    await page.type('#task-steps', 'pick:P-1:L-9; drop:D-2:L-9; wait:::2');
+    await page.click('#task-form button[type=submit]');
+    await page.waitForSelector('#confirm[open]');
+    const multiPrompt = await page.$eval('#confirm-text', (el) => el.textContent);
+    const multiId = (multiPrompt.match(/task (ui-[^:]+):/) || [])[1];
+    check(!!multiId && multiPrompt.includes('pick P-1 L-9 → drop D-2 L-9 → wait'),
+          `the confirmation names the stops (${multiPrompt})`);
+    await page.click('#confirm-ok');
+    const multi = await until('the multi-stop task is stored with its steps', async () => {
+      const v = await api('GET', `/v1/tasks/${multiId}`);
+      return v.status === 200 && v.body.task && v.body.task.steps ? v.body.task : null;
+    }, 20000);
+    check(!!multi && multi.kind === 'multistop' && multi.steps.length === 3 && multi.steps[1].load_id === 'L-9',
+          `the multi-stop task from the form is stored with its 3 steps (${JSON.stringify(multi)})`);
+    await api('DELETE', `/v1/tasks/${multiId}`);
+    await page.select('#task-kind', 'transport');
     await Promise.all(robots.map((r) => api('POST', `/v1/robots/${r}/resume`)));
   }
 

@@ -1,6 +1,7 @@
 // The steps of a multi-stop task: parsed from and written to the wire form, checked against the
 // site, and the stations the task visits.
 
+#include <algorithm>
 #include <array>
 #include <map>
 #include <set>
@@ -65,12 +66,11 @@ std::string_view toString(StepAction a) {
 }
 
 std::optional<StepAction> parseStepAction(std::string_view name) {
-  for (std::size_t i = 0; i < kActionNames.size(); ++i) {
-    if (kActionNames[i] == name) {
-      return static_cast<StepAction>(i);
-    }
+  const auto it = std::find(kActionNames.begin(), kActionNames.end(), name);
+  if (it == kActionNames.end()) {
+    return std::nullopt;
   }
-  return std::nullopt;
+  return static_cast<StepAction>(it - kActionNames.begin());
 }
 
 std::vector<const std::string*> taskStops(const Task& t) {
