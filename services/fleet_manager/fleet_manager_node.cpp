@@ -15,6 +15,7 @@
 #include "fleet/planning/map_io.hpp"
 #include "fleet/traffic/roadmap_travel.hpp"
 #include "manager_acks.hpp"
+#include "task_goals.hpp"
 
 namespace fleet::manager {
 
@@ -116,8 +117,8 @@ TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning
   // Stations are copied in: the model outlives the caller's map.
   return [stations, cache, speed](const Task& t) -> RobotTravel {
     std::vector<Vec2> stops;
-    for (const auto* name : {&t.pickup, &t.dropoff, &t.station}) {
-      if (const Station* s = name->empty() ? nullptr : stations.find(*name)) {
+    for (const auto* name : taskStops(t)) {
+      if (const Station* s = stations.find(*name)) {
         stops.push_back(s->pose.position());
       }
     }
@@ -150,12 +151,8 @@ TravelModel makeTravelModel(const StationMap& stations, std::shared_ptr<planning
 TravelModel makeRoadmapTravelModel(const StationMap& stations,
                                    std::shared_ptr<const traffic::RoadmapTravel> roads) {
   return [stations, roads](const Task& t) -> RobotTravel {
-    std::vector<const std::string*> stops;
-    for (const auto* name : {&t.pickup, &t.dropoff, &t.station}) {
-      if (!name->empty() && stations.find(*name) != nullptr) {
-        stops.push_back(name);
-      }
-    }
+    auto stops = taskStops(t);
+    std::erase_if(stops, [&](const std::string* name) { return stations.find(*name) == nullptr; });
     if (stops.empty()) {
       return [](const RobotInfo&) { return 0.0; };  // a charge/park task the dispatcher resolves
     }
@@ -278,46 +275,12 @@ Expected<msg::TaskAssignment> FleetManagerNode::toAssignment(const AssignmentOrd
   a.paused = o.paused;
   a.priority = o.task.priority;
   a.epoch = epoch_;
-  std::string missing;
-  auto goal = [&](const std::string& name, msg::GoalAction action, double duration) {
-    const Station* s = dispatcher_->stations().find(name);
-    if (s == nullptr) {
-      // Never a goal at a made-up pose: the robot would drive to (0, 0) and report it reached.
-      missing = name;
-      return;
-    }
-    msg::Goal g;
-    g.station = name;
-    g.pose = s->pose;
-    g.action = action;
-    g.duration_s = duration;
-    a.goals.push_back(g);
-  };
-  switch (o.task.kind) {
-    case TaskKind::Transport:
-      goal(o.task.pickup, msg::GoalAction::Load, nsToSec(o.task.loadNs));
-      if (missing.empty()) {
-        goal(o.task.dropoff, msg::GoalAction::Unload, nsToSec(o.task.unloadNs));
-      }
-      break;
-    case TaskKind::Goto:
-      goal(o.task.station, msg::GoalAction::None, 0);
-      break;
-    case TaskKind::Charge:
-      // Dwell until the manager ends the task (battery at charge_until), at most charge_max_s.
-      goal(o.task.station, msg::GoalAction::Charge, settings_.chargeMaxS);
-      break;
-    case TaskKind::Park:
-      goal(o.task.station, msg::GoalAction::Park, 0);
-      break;
-  }
-  if (a.goals.empty() || !missing.empty()) {
+  auto goals = taskGoals(o.task, dispatcher_->stations(), settings_.chargeMaxS);
+  if (!goals) {
     return unexpected(errc::kInternal,
-                      "internal error: task '" + o.task.id + "' has " +
-                          (missing.empty() ? std::string("no station")
-                                           : "station '" + missing + "', which is not on this site") +
-                          "; no order sent to robot " + o.robotId);
+                      "internal error: " + goals.error().message + "; no order sent to robot " + o.robotId);
   }
+  a.goals = std::move(*goals);
   a.revision = nextRevision(o.robotId, nowNs);
   return a;
 }
@@ -358,6 +321,10 @@ void FleetManagerNode::publish(DispatchResult r, std::int64_t nowNs, Outbox& out
     auto& seq = eventSeq_[e.taskId];
     out.events.push_back({e.taskId, e.state, e.robotId, e.reason.substr(0, 255), e.stampNs, ++seq, e.station,
                           e.changed, e.priority, e.deadlineNs, e.etaNs, epoch_});
+    if (e.state == TaskState::Queued || e.state == TaskState::Assigned) {
+      trackSteps(e.taskId);
+    }
+    stampStep(out.events.back());
     if (e.state == TaskState::Queued || e.state == TaskState::Requeued) {
       // Kept from the first event: a waiting task's later events (paused, why it waits) do not
       // restart its wait.
@@ -460,9 +427,15 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
   if (state == TaskState::Rejected || state == TaskState::Queued || state == TaskState::Assigned) {
     return;  // not a robot's report
   }
+  const bool newStep = noteStep(s);
   auto r = dispatcher_->onTaskStatus(s.robot_id, s.task_id, state, s.error, nowNs);
   if (r) {
+    const bool told = std::any_of(r->events.begin(), r->events.end(),
+                                  [&](const TaskEvent& e) { return e.taskId == s.task_id; });
     publish(std::move(*r), nowNs, out);
+    if (newStep && !told) {
+      stepEvent(s.task_id, nowNs, out);
+    }
     return;
   }
   // A robot working on a task it no longer holds (cancelled, or given to another robot while it

@@ -185,6 +185,23 @@ class FleetManagerNode {
   /// Acts on the disagreements between robots' reports and the store that outlasted the grace
   /// (fleet_manager_reconcile.cpp).
   void reconcile(std::int64_t nowNs, Outbox& out);
+  /// A multi-stop task's robot reported stop `s.step`: remembered; true when it is a new stop
+  /// (task_progress.cpp).
+  bool noteStep(const msg::TaskStatus& s);
+  /// Follows the stops of task `taskId` from now on, if it is a multi-stop task.
+  void trackSteps(const std::string& taskId);
+  /// Puts the task's current stop on event `e` (and keeps `e` as its last event).
+  void stampStep(msg::TaskEvent& e);
+  /// An event telling the task's new stop, its state unchanged.
+  void stepEvent(const std::string& taskId, std::int64_t nowNs, Outbox& out);
+
+  /// A multi-stop task's progress: its stop (from 1; 0 before the first report), its number of
+  /// steps and the last event published about it.
+  struct StepProgress {
+    std::uint32_t step = 0;
+    std::uint32_t steps = 0;
+    msg::TaskEvent last;
+  };
 
   Settings settings_;
   std::unique_ptr<TaskStore> store_;
@@ -192,6 +209,7 @@ class FleetManagerNode {
   std::map<std::string, std::uint32_t> eventSeq_;
   std::map<std::string, std::uint32_t> revisions_;
   std::map<std::string, std::int64_t> queuedAt_;
+  std::map<std::string, StepProgress> progress_;
   TaskReconciler reconciler_{0};
   Outbox recovered_;
   std::int64_t epoch_ = 0;

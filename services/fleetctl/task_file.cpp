@@ -41,7 +41,51 @@ Expected<std::vector<std::string>> splitCsv(const std::string& line) {
   return out;
 }
 
+/// `text` cut at each `sep`.
+std::vector<std::string> cut(const std::string& text, char sep) {
+  std::vector<std::string> out(1);
+  for (const char c : text) {
+    if (c == sep) {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
+
+Expected<nlohmann::json> stepsFromText(const std::string& text) {
+  nlohmann::json steps = nlohmann::json::array();
+  int n = 0;
+  for (const auto& one : cut(text, ';')) {
+    ++n;
+    const auto parts = cut(one, ':');
+    if (parts.size() > 4 || parts[0].empty()) {
+      return unexpected("invalid", "step " + std::to_string(n) + " \"" + one +
+                                       "\": expected action:station[:load_id[:seconds]]");
+    }
+    nlohmann::json step = {{"action", parts[0]}};
+    if (parts.size() > 1 && !parts[1].empty()) {
+      step["station"] = parts[1];
+    }
+    if (parts.size() > 2 && !parts[2].empty()) {
+      step["load_id"] = parts[2];
+    }
+    if (parts.size() > 3 && !parts[3].empty()) {
+      double s = 0;
+      auto [p, ec] = std::from_chars(parts[3].data(), parts[3].data() + parts[3].size(), s);
+      if (ec != std::errc() || p != parts[3].data() + parts[3].size() || s < 0) {
+        return unexpected("invalid",
+                          "step " + std::to_string(n) + ": expected seconds >= 0, got \"" + parts[3] + "\"");
+      }
+      step["duration_ns"] = static_cast<long long>(s * 1e9);
+    }
+    steps.push_back(std::move(step));
+  }
+  return steps;
+}
 
 std::string withoutBom(const std::string& text) {
   return text.rfind("\xEF\xBB\xBF", 0) == 0 ? text.substr(3) : text;
@@ -74,7 +118,7 @@ Expected<nlohmann::json> csvToTasks(const std::string& textIn, const std::string
     if (header.empty()) {
       header = *fields;
       for (const auto& h : header) {
-        if (!kText.count(h) && !kInt.count(h) && !kSeconds.count(h)) {
+        if (!kText.count(h) && !kInt.count(h) && !kSeconds.count(h) && h != "steps") {
           problems.push_back(where + ": unknown column \"" + h + "\"");
         }
       }
@@ -95,7 +139,14 @@ Expected<nlohmann::json> csvToTasks(const std::string& textIn, const std::string
       if (v.empty()) {
         continue;
       }
-      if (kText.count(col)) {
+      if (col == "steps") {
+        auto steps = stepsFromText(v);
+        if (!steps) {
+          problems.push_back(where + ": column steps: " + steps.error().message);
+          continue;
+        }
+        t[col] = std::move(*steps);
+      } else if (kText.count(col)) {
         t[col] = v;
       } else if (kInt.count(col)) {
         long long n = 0;

@@ -423,7 +423,8 @@ void Agent::report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg
     out.discs.discs = predictDiscs(pose, P, v, w, prediction);
   }
   if (auto r = tasks_.takeReport()) {
-    out.status = msg::TaskStatus{p_.id, r->task, r->revision, r->stage, r->progress, r->reason, r->stampNs};
+    out.status =
+        msg::TaskStatus{p_.id, r->task, r->revision, r->stage, r->progress, r->reason, r->stampNs, r->step};
   }
   out.traffic = trafficProgress(nowNs);
 }

@@ -55,7 +55,7 @@ static_assert(static_cast<int>(GoalAction::Park) == static_cast<int>(msg::GoalAc
               static_cast<int>(GoalAction::Load) == static_cast<int>(msg::GoalAction::Load));
 
 TaskGoal goalOf(const msg::Goal& g) {
-  return {g.pose, g.station, static_cast<GoalAction>(g.action), g.duration_s};
+  return {g.pose, g.station, static_cast<GoalAction>(g.action), g.duration_s, g.load_id};
 }
 
 Order orderOf(const msg::TaskAssignment& a) {

@@ -1,5 +1,6 @@
 #include "task_runner.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "fleet/core/clock.hpp"
@@ -77,15 +78,20 @@ float TaskRunner::progress() const {
   return goals_.empty() ? 0.0f : static_cast<float>(goal_) / static_cast<float>(goals_.size());
 }
 
+std::uint32_t TaskRunner::step() const {
+  return goals_.empty() ? 0U : static_cast<std::uint32_t>(std::min(goal_ + 1, goals_.size()));
+}
+
 void TaskRunner::reportStage(TaskState st, std::int64_t nowNs) {
   reported_ = st;
-  pending_ = TaskReport{task_, revision_, st, progress(), "", nowNs};
+  pending_ = TaskReport{task_, revision_, st, progress(), "", nowNs, step()};
 }
 
 void TaskRunner::leg(std::int64_t nowNs) {
   phase_ = Phase::Driving;
   phaseStartNs_ = nowNs;
-  if (const auto st = stageFor(goal_, false); st != reported_) {
+  // Every leg after the first is reported, its stage changed or not: the next stop is news.
+  if (const auto st = stageFor(goal_, false); st != reported_ || goal_ > 0) {
     reportStage(st, nowNs);
   }
 }
@@ -122,7 +128,7 @@ TaskTick TaskRunner::tick(std::int64_t nowNs) {
 
 void TaskRunner::finish(TaskState final, const std::string& reason, std::int64_t nowNs) {
   pending_ = TaskReport{
-      task_, revision_, final, final == TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs};
+      task_, revision_, final, final == TaskState::Done ? 1.0f : 0.0f, reason.substr(0, 255), nowNs, step()};
   task_.clear();
   goals_.clear();
   phase_ = Phase::Idle;
@@ -130,7 +136,7 @@ void TaskRunner::finish(TaskState final, const std::string& reason, std::int64_t
 
 void TaskRunner::notice(const std::string& reason, std::int64_t nowNs) {
   if (busy()) {
-    pending_ = TaskReport{task_, revision_, reported_, progress(), reason, nowNs};
+    pending_ = TaskReport{task_, revision_, reported_, progress(), reason, nowNs, step()};
   }
 }
 

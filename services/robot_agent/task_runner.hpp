@@ -9,7 +9,9 @@
 //   Idle ──tick()──► Driving ──arrive()──► Dwelling ──tick(): dwell over──► Driving ... ──► Idle
 //
 // Reports follow the task: Assigned on a new order, EnRoute / Delivering when a leg begins (once
-// per change), Loading / Unloading on arriving at such a goal, Done / Failed at the end.
+// per change, and at every leg after the first, so each stop of a multi-stop order is told),
+// Loading / Unloading on arriving at such a goal, Done / Failed at the end. Each report names the
+// goal it is about (step, from 1).
 
 #include <cstdint>
 #include <optional>
@@ -28,6 +30,7 @@ struct TaskGoal {
   std::string station;
   GoalAction action = GoalAction::None;
   double dwellS = 0.0;
+  std::string loadId{};  ///< the load a pick (Load) or drop (Unload) goal handles; may be empty
   bool operator==(const TaskGoal&) const = default;
 };
 
@@ -38,6 +41,7 @@ struct TaskReport {
   float progress = 0.0f;  ///< goals done / goals
   std::string reason;     ///< why it failed, or a notice (sensor loss); at most 255 bytes
   std::int64_t stampNs = 0;
+  std::uint32_t step = 0;  ///< the goal the robot is at or driving to, from 1 (the last when done); 0: none
 };
 
 struct Order {
@@ -110,6 +114,8 @@ class TaskRunner {
   /// The stage the task is in while driving to, or dwelling at, goal `index`.
   [[nodiscard]] TaskState stageFor(std::size_t index, bool dwelling) const;
   [[nodiscard]] float progress() const;
+  /// The current goal from 1 (0 without goals).
+  [[nodiscard]] std::uint32_t step() const;
   void reportStage(TaskState st, std::int64_t nowNs);
   /// A leg towards the current goal begins: Driving; reports EnRoute / Delivering if that changed.
   void leg(std::int64_t nowNs);

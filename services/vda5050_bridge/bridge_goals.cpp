@@ -47,6 +47,15 @@ void BridgeNode::trackGoals(Vehicle& v, const vda5050::VehicleView& view, std::i
         }
         v.charge_arrived_ns = -1;
         v.charge_attempts = 0;
+      } else if (g.duration_s > 0) {
+        // A wait (or a goal that dwells without an action): the vehicle stands there that long.
+        if (v.dwell_since_ns < 0) {
+          v.dwell_since_ns = nowNs;
+        }
+        if (static_cast<double>(nowNs - v.dwell_since_ns) * 1e-9 < g.duration_s) {
+          return;
+        }
+        v.dwell_since_ns = -1;
       }
     }
     ++v.goal;

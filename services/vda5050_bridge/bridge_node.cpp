@@ -91,9 +91,11 @@ void BridgeNode::onAssignment(const msg::TaskAssignment& a, std::int64_t nowNs, 
     v.charge_action.clear();
     v.charge_arrived_ns = -1;
     v.charge_attempts = 0;
+    v.dwell_since_ns = -1;
     v.failure.clear();
     freshChance(v);
     v.reported = msg::TaskState::Queued;
+    v.reported_goal = 0;
   }
   v.revision = a.revision;
   v.priority = a.task_id.empty() ? 0 : a.priority;
@@ -177,10 +179,11 @@ void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
       st = msg::TaskState::EnRoute;
     }
   }
-  if (st == v.reported) {
+  if (st == v.reported && v.goal == v.reported_goal) {
     return;
   }
   v.reported = st;
+  v.reported_goal = v.goal;
   msg::TaskStatus ts;
   ts.robot_id = v.entry.robot_id;
   ts.task_id = v.task_id;
@@ -189,6 +192,7 @@ void BridgeNode::reportTask(Vehicle& v, std::int64_t nowNs, BridgeOutbox& out) {
   ts.progress = v.goals.empty() ? 1.0F : static_cast<float>(v.goal) / static_cast<float>(v.goals.size());
   ts.error = v.failure.substr(0, 255);
   ts.stamp_ns = nowNs;
+  ts.step = static_cast<std::uint32_t>(std::min(v.goal + 1, v.goals.size()));
   out.statuses.push_back(std::move(ts));
 }
 

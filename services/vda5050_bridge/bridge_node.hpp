@@ -144,6 +144,8 @@ class BridgeNode {
     std::size_t goal = 0;
     bool paused = false;
     msg::TaskState reported = msg::TaskState::Queued;
+    std::size_t reported_goal = 0;     // the goal of the last status sent (a new stop is reported)
+    std::int64_t dwell_since_ns = -1;  // at a goal that dwells without an action (a wait) from then
     bool cancel_sent = false;
     std::uint32_t instant_header = 0;
     std::optional<Pose2> home;  // where it was first seen: it parks there when it has no task

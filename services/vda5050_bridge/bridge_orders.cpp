@@ -135,6 +135,9 @@ void BridgeNode::followRelease(Vehicle& v, const vda5050::VehicleView& view, std
       if (!g.station.empty()) {
         a.actionParameters.push_back({"stationId", g.station});
       }
+      if (!g.load_id.empty()) {
+        a.actionParameters.push_back({"loadId", g.load_id});  // VDA 5050 pick / drop parameter
+      }
       a.actionParameters.push_back({"duration", g.duration_s});
       in.actions.emplace_back(r.base.back().node, std::move(a));
     }

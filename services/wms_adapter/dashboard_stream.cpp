@@ -198,7 +198,8 @@ EventSource Dashboard::stream() {
                          {"robot", t.robot},
                          {"reason", t.reason},
                          {"stamp_ns", t.updatedNs},
-                         {"eta_ns", t.etaNs}});
+                         {"eta_ns", t.etaNs},
+                         {"step", t.step}});
       }
       std::string snapshot =
           "retry: 1000\nevent: snapshot\ndata: " +
@@ -220,7 +221,8 @@ EventSource Dashboard::stream() {
                json{{"id", e.task_id},        {"state", msg::toString(e.state)},
                     {"robot", e.robot_id},    {"reason", e.reason},
                     {"stamp_ns", e.stamp_ns}, {"seq", e.seq},
-                    {"station", e.station},   {"eta_ns", e.eta_ns}}
+                    {"station", e.station},   {"eta_ns", e.eta_ns},
+                    {"step", e.step}}
                    .dump(-1, ' ', false, json::error_handler_t::replace) +
                "\n\n";
     }

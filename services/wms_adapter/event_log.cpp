@@ -26,6 +26,9 @@ nlohmann::json loggedEventJson(const LoggedEvent& l) {
     j["eta_ns"] = e.eta_ns;
     j["eta"] = toRfc3339(e.eta_ns);
   }
+  if (e.step > 0) {
+    j["step"] = e.step;  // a multi-stop task's stop, from 1
+  }
   return j;
 }
 

@@ -117,6 +117,7 @@ void FleetView::viewEvent(const msg::TaskEvent& e) {
       v.seq = e.seq;
       v.station = e.station;
       v.etaNs = e.eta_ns;
+      v.step = e.step;
       if (e.changed && !v.body.empty()) {
         applyChange(v.body, e);
       }

@@ -39,6 +39,8 @@ struct TaskView {
   std::string station;
   /// When the task is expected done (TaskEvent.eta_ns of its newest event); 0: no estimate.
   std::int64_t etaNs = 0;
+  /// A multi-stop task's stop its robot is at or driving to, from 1 (TaskEvent.step); 0: not known.
+  std::uint32_t step = 0;
 };
 
 class TaskGateway {

@@ -58,6 +58,10 @@ json viewJson(const TaskView& v) {
   if (j.contains("task")) {
     showTaskTimes(j["task"]);
   }
+  if (v.step > 0) {
+    // A multi-stop task: the stop its robot is at or driving to, from 1 (the last once done).
+    j["step"] = v.step;
+  }
   if (!v.station.empty()) {
     // Chosen by the manager for a charge / park task sent without a station.
     j["station"] = v.station;

@@ -378,6 +378,7 @@ try {
     }, robot), 20000);
   }
 
+  let multiId = null; // the multi-stop task submitted from the form in 4b
   // 4b. A waiting task changed from the queue's "change" dialog. Every robot is held through the
   // API (a held robot is given no task), so the task submitted then stays queued; it is given
   // priority 7 and a deadline 30 min ahead, and the adapter's task view has
@@ -415,6 +416,24 @@ try {
     check(!!changed && Math.abs(ahead - 30) < 1,
           `priority 7 and a deadline ${ahead.toFixed(1)} min ahead (${changed && changed.deadline})`);
     await api('DELETE', `/v1/tasks/${held}`);
+    // A multi-stop task from the form (kind "Multi-stop", its stops as text), stored with its
+    // steps while the robots are still held; a robot carries it out once they are let go (6.).
+    await page.select('#task-kind', 'multistop');
+    await page.type('#task-steps', 'pick:P-1:L-9; drop:D-2:L-9; wait:::2');
+    await page.click('#task-form button[type=submit]');
+    await page.waitForSelector('#confirm[open]');
+    const multiPrompt = await page.$eval('#confirm-text', (el) => el.textContent);
+    multiId = (multiPrompt.match(/task (ui-[^:]+):/) || [])[1];
+    check(!!multiId && multiPrompt.includes('pick P-1 L-9 → drop D-2 L-9 → wait'),
+          `the confirmation names the stops (${multiPrompt})`);
+    await page.click('#confirm-ok');
+    const multi = await until('the multi-stop task is stored with its steps', async () => {
+      const v = await api('GET', `/v1/tasks/${multiId}`);
+      return v.status === 200 && v.body.task && v.body.task.steps ? v.body.task : null;
+    }, 20000);
+    check(!!multi && multi.kind === 'multistop' && multi.steps.length === 3 && multi.steps[1].load_id === 'L-9',
+          `the multi-stop task from the form is stored with its 3 steps (${JSON.stringify(multi)})`);
+    await page.select('#task-kind', 'transport');
     await Promise.all(robots.map((r) => api('POST', `/v1/robots/${r}/resume`)));
   }
 
@@ -436,6 +455,12 @@ try {
     return t && t.state === 'done';
   }, taskId), 150000);
   check(true, `task ${taskId} done`);
+  const multiDone = await until('the multi-stop task from the form is done, stop by stop', async () => {
+    const r = await fetch(`${direct.origin}/v1/tasks/${multiId}`, { headers: { authorization: `Bearer ${token}` } });
+    const v = await r.json().catch(() => ({}));
+    return v.state === 'done' ? v : null;
+  }, 150000);
+  check(!!multiDone && multiDone.step === 3, `the multi-stop task ${multiId} is done at its 3rd stop (${JSON.stringify(multiDone)})`);
   await page.mouse.click(5, 5);
   await shot('5-done.png');
 

@@ -23,7 +23,7 @@ double pairCost(const Task& t, double travelS, const AllocationPolicy& p, std::i
   if (t.deadlineNs <= 0) {
     return travelS;
   }
-  const double finish = nsToSec(nowNs) + travelS + nsToSec(t.loadNs + t.unloadNs);
+  const double finish = nsToSec(nowNs) + travelS + nsToSec(taskDwellNs(t));
   return travelS + p.latenessWeight * std::max(0.0, finish - nsToSec(t.deadlineNs));
 }
 
@@ -43,7 +43,7 @@ CostMatrix effectiveCosts(std::span<const Task> tasks, std::span<const RobotInfo
   const double now = nsToSec(nowNs);
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const Task& t = tasks[i];
-    const double handling = nsToSec(t.loadNs + t.unloadNs);
+    const double handling = nsToSec(taskDwellNs(t));
     const double deadline = t.deadlineNs > 0 ? nsToSec(t.deadlineNs) : kInfeasible;
     double minTravel = kInfeasible;
     const RobotTravel fromRobot = travel(t);

@@ -217,12 +217,18 @@ Expected<DispatchResult> Dispatcher::onTaskStatus(const std::string& robotId, co
     }
     return out;
   }
-  if (state == cur.state) {
+  // A multi-stop task picks and drops more than once: it stays en_route until it is done (which
+  // stop it is at travels beside its state), whatever stage the robot reports for a stop.
+  const TaskState reached =
+      cur.task.kind == TaskKind::Multistop && isActive(state) && state != TaskState::Assigned
+          ? TaskState::EnRoute
+          : state;
+  if (reached == cur.state) {
     return out;  // a repeated report
   }
   const auto path = happyPath(cur.task.kind);
   const auto from = std::find(path.begin(), path.end(), cur.state);
-  const auto to = std::find(path.begin(), path.end(), state);
+  const auto to = std::find(path.begin(), path.end(), reached);
   if (from == path.end() || to == path.end() || to <= from) {
     return unexpected(errc::kIllegalTransition, "task '" + taskId + "': robot reported " +
                                                     std::string(toString(state)) + " while it is " +

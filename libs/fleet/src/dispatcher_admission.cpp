@@ -20,13 +20,10 @@ namespace {
 std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) {
   // Its pickup until it has loaded there, its drop-off for the whole task: a loaded robot must not
   // find its drop-off's line full (docs/algorithms.md, "Traffic: stations as servers").
+  // A multi-stop task reports no loading phase: all of its stops count until it ends.
   const bool delivering = state == TaskState::Delivering || state == TaskState::Unloading;
-  std::vector<const std::string*> s;
-  for (const std::string* n : {&t.pickup, &t.dropoff, &t.station}) {
-    if (!n->empty() && !(delivering && n == &t.pickup)) {
-      s.push_back(n);
-    }
-  }
+  auto s = taskStops(t);
+  std::erase_if(s, [&](const std::string* n) { return delivering && n == &t.pickup; });
   return s;
 }
 }  // namespace

@@ -13,8 +13,8 @@ const std::string* Dispatcher::closedStationOf(const Task& t) const {
   if (closedStations_.empty()) {
     return nullptr;
   }
-  for (const std::string* s : {&t.pickup, &t.dropoff, &t.station}) {
-    if (!s->empty() && closedStations_.count(*s) > 0) {
+  for (const std::string* s : taskStops(t)) {
+    if (closedStations_.count(*s) > 0) {
       return s;
     }
   }

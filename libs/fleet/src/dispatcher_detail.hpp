@@ -19,15 +19,9 @@ inline std::vector<TaskState> happyPath(TaskKind kind) {
   return {S::Assigned, S::EnRoute, S::Done};
 }
 
-// The stations a task occupies while it is active.
+// The stations a task occupies while it is active: every stop, one entry a visit.
 inline std::vector<const std::string*> stationsOf(const Task& t) {
-  std::vector<const std::string*> s;
-  for (const std::string* n : {&t.pickup, &t.dropoff, &t.station}) {
-    if (!n->empty()) {
-      s.push_back(n);
-    }
-  }
-  return s;
+  return taskStops(t);
 }
 
 }  // namespace fleet::dispatcher_detail

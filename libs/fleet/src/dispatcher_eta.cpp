@@ -17,7 +17,7 @@ void Dispatcher::countWaiting(const TaskRecord& r, int delta) {
 }
 
 std::int64_t Dispatcher::etaOf(const TaskRecord& r) {
-  const double dwellS = static_cast<double>(r.task.loadNs + r.task.unloadNs) / 1e9;
+  const double dwellS = static_cast<double>(taskDwellNs(r.task)) / 1e9;
   const std::int64_t now = r.updatedNs;
   switch (r.state) {
     case TaskState::Assigned: {
@@ -61,7 +61,7 @@ std::int64_t Dispatcher::waitingEta(const TaskRecord& r, std::int64_t nowNs) con
     }
     ahead += n;
   }
-  const double dwellS = static_cast<double>(r.task.loadNs + r.task.unloadNs) / 1e9;
+  const double dwellS = static_cast<double>(taskDwellNs(r.task)) / 1e9;
   double predicted = eta_.typical();
   if (predicted <= 0.0) {
     // Before the first assignment: the nearest robot's way.

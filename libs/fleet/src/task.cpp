@@ -8,9 +8,10 @@
 #include "fleet/core/ids.hpp"
 #include "fleet/fleet/errors.hpp"
 #include "fleet/fleet/station_map.hpp"
+#include "task_detail.hpp"
 
 namespace fleet {
-namespace {
+namespace task_detail {
 
 std::string join(std::string_view prefix, std::string_view field) {
   if (prefix.empty()) {
@@ -36,6 +37,13 @@ void checkStation(const std::string& name, std::string_view path, StationKind ne
         {std::string(path), "station '" + name + "' is not a " + std::string(toString(need)) + " station"});
   }
 }
+
+}  // namespace task_detail
+
+namespace {
+
+using task_detail::checkStation;
+using task_detail::join;
 
 void forbid(bool present, std::string_view prefix, std::string_view field, TaskKind kind,
             std::vector<FieldError>& out) {
@@ -77,7 +85,17 @@ std::vector<FieldError> validateTask(const Task& t, const StationMap* stations, 
   if (t.deadlineNs > 0 && t.createdNs > 0 && t.deadlineNs < t.createdNs) {
     out.push_back({join(prefix, "deadline_ns"), "is before created_ns"});
   }
-  if (t.kind == TaskKind::Transport) {
+  if (t.kind != TaskKind::Multistop) {
+    forbid(!t.steps.empty(), prefix, "steps", t.kind, out);
+  }
+  if (t.kind == TaskKind::Multistop) {
+    forbid(!t.pickup.empty(), prefix, "pickup", t.kind, out);
+    forbid(!t.dropoff.empty(), prefix, "dropoff", t.kind, out);
+    forbid(!t.station.empty(), prefix, "station", t.kind, out);
+    forbid(t.loadNs != 0, prefix, "load_duration_ns", t.kind, out);
+    forbid(t.unloadNs != 0, prefix, "unload_duration_ns", t.kind, out);
+    task_detail::validateSteps(t, stations, prefix, out);
+  } else if (t.kind == TaskKind::Transport) {
     if (t.pickup.empty()) {
       out.push_back({join(prefix, "pickup"), "required for a transport task"});
     } else {
@@ -141,7 +159,7 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
   static const std::set<std::string, std::less<>> kKnown = {
       "id",       "kind",        "pickup",           "dropoff",
       "station",  "robot",       "load_duration_ns", "unload_duration_ns",
-      "priority", "deadline_ns", "created_ns"};
+      "priority", "deadline_ns", "created_ns",       "steps"};
   for (const auto& [key, value] : j.items()) {
     if (!kKnown.contains(key)) {
       errs.push_back({join(prefix, key), "unknown field"});
@@ -198,13 +216,17 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
   };
   str("id", t.id, true);
   std::string kind;
-  str("kind", kind, true);
+  // With steps the kind may be left out: such a task is a multi-stop task.
+  str("kind", kind, !j.contains("steps"));
+  if (!j.contains("kind") && j.contains("steps")) {
+    t.kind = TaskKind::Multistop;
+  }
   if (!kind.empty()) {
     if (auto k = parseTaskKind(kind)) {
       t.kind = *k;
     } else {
-      errs.push_back(
-          {join(prefix, "kind"), "unknown kind '" + kind + "' (expected transport, goto, charge or park)"});
+      errs.push_back({join(prefix, "kind"),
+                      "unknown kind '" + kind + "' (expected transport, goto, charge, park or multistop)"});
       typesOk = false;
     }
   }
@@ -220,6 +242,9 @@ Expected<Task, ValidationError> parseTask(const nlohmann::json& j, const Station
   t.priority = static_cast<std::int32_t>(prio);
   integer("deadline_ns", t.deadlineNs, 0, kMaxI64);
   integer("created_ns", t.createdNs, 0, kMaxI64);
+  if (auto it = j.find("steps"); it != j.end() && !task_detail::parseSteps(*it, prefix, t, errs)) {
+    typesOk = false;
+  }
   if (typesOk) {
     auto more = validateTask(t, stations, prefix);
     errs.insert(errs.end(), more.begin(), more.end());
@@ -304,6 +329,9 @@ nlohmann::json toJson(const Task& t) {
   putInt("priority", t.priority);
   putInt("deadline_ns", t.deadlineNs);
   putInt("created_ns", t.createdNs);
+  if (!t.steps.empty()) {
+    j["steps"] = task_detail::stepsToJson(t.steps);
+  }
   return j;
 }
 

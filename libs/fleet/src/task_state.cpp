@@ -7,7 +7,7 @@
 namespace fleet {
 namespace {
 
-constexpr std::array<std::string_view, 4> kKindNames = {"transport", "goto", "charge", "park"};
+constexpr std::array<std::string_view, 5> kKindNames = {"transport", "goto", "charge", "park", "multistop"};
 
 // Which step follows which on the happy path; failure, cancellation and requeue are added below.
 bool forwardStep(TaskState from, TaskState to) {

@@ -2,7 +2,8 @@
 
 namespace fleet {
 
-// The wire's kinds are the library's, in the same order (idl/fleet.idl TaskKind).
+// The wire's kinds and step actions are the library's, in the same order (idl/fleet.idl TaskKind,
+// StepAction).
 msg::Task toWire(const Task& t, std::string requestId, std::int64_t nowNs) {
   msg::Task m;
   m.task_id = t.id;
@@ -17,6 +18,10 @@ msg::Task toWire(const Task& t, std::string requestId, std::int64_t nowNs) {
   m.priority = t.priority;
   m.deadline_ns = t.deadlineNs;
   m.created_ns = t.createdNs != 0 ? t.createdNs : nowNs;
+  for (const auto& s : t.steps) {
+    m.steps.push_back(
+        {static_cast<msg::StepAction>(static_cast<int>(s.action)), s.station, s.loadId, s.durationNs});
+  }
   return m;
 }
 
@@ -33,6 +38,10 @@ Task fromWire(const msg::Task& m, std::int64_t nowNs) {
   t.priority = m.priority;
   t.deadlineNs = m.deadline_ns;
   t.createdNs = m.created_ns != 0 ? m.created_ns : nowNs;
+  for (const auto& s : m.steps) {
+    t.steps.push_back(
+        {static_cast<StepAction>(static_cast<int>(s.action)), s.station, s.load_id, s.duration_ns});
+  }
   return t;
 }
 

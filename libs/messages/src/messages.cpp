@@ -5,7 +5,7 @@
 
 namespace fleet::msg {
 namespace {
-constexpr std::array<std::string_view, 4> kKinds = {"transport", "goto", "charge", "park"};
+constexpr std::array<std::string_view, 5> kKinds = {"transport", "goto", "charge", "park", "multistop"};
 constexpr std::array<std::string_view, 7> kModes = {"idle",     "moving",  "waiting", "loading",
                                                     "charging", "blocked", "fault"};
 

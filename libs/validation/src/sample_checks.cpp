@@ -121,8 +121,13 @@ std::optional<Rejection> check(const msg::Task& m) {
   // The fields of the task itself are the dispatcher's to judge (it answers with field errors).
   Checker c("Task");
   c.id(m.task_id, "task_id").id(m.request_id, "request_id");
-  c.known(m.kind, msg::TaskKind::Park, "kind").known(m.control, msg::TaskControl::Change, "control");
+  c.known(m.kind, msg::TaskKind::Multistop, "kind").known(m.control, msg::TaskControl::Change, "control");
   c.text(m.pickup, "pickup").text(m.dropoff, "dropoff").text(m.station, "station").text(m.robot, "robot");
+  c.size(m.steps.size(), 16, "steps");
+  for (const auto& st : m.steps) {
+    c.known(st.action, msg::StepAction::Charge, "steps[].action");
+    c.text(st.station, "steps[].station").text(st.load_id, "steps[].load_id");
+  }
   return c.done();
 }
 
@@ -151,6 +156,7 @@ std::optional<Rejection> check(const msg::TaskAssignment& m) {
     c.pose(g.pose, "goals[].pose").optionalId(g.station, "goals[].station");
     c.known(g.action, msg::GoalAction::Park, "goals[].action");
     c.within(g.duration_s, 0.0, kMaxDwellS, "goals[].duration_s");
+    c.optionalId(g.load_id, "goals[].load_id");
   }
   return c.done();
 }

@@ -4,6 +4,8 @@
 // Actions the session's scopes do not allow are greyed out (the server would refuse them: 403),
 // and robot actions while the fleet manager is unreachable (503).
 
+import { stepsFromText } from './task_steps.js';
+
 const QUEUE_ROWS = 100;
 const EVENT_ROWS = 50;
 
@@ -26,19 +28,40 @@ export class Panels {
     for (const button of document.querySelectorAll('[data-robot-action]')) {
       button.addEventListener('click', () => this.robotAction(button.dataset.robotAction));
     }
+    const kind = document.getElementById('task-kind');
+    kind.addEventListener('change', () => {
+      const multi = kind.value === 'multistop';
+      for (const el of document.querySelectorAll('#task-form .transport-field')) el.hidden = multi;
+      for (const el of document.querySelectorAll('#task-form .multistop-field')) el.hidden = !multi;
+      document.getElementById('task-pickup').required = !multi;
+      document.getElementById('task-dropoff').required = !multi;
+    });
     document.getElementById('task-form').addEventListener('submit', (ev) => {
       ev.preventDefault();
-      const pickup = document.getElementById('task-pickup').value;
-      const dropoff = document.getElementById('task-dropoff').value;
       const priority = Number(document.getElementById('task-priority').value || 0);
       const id = 'ui-' + new Date().toISOString().replace(/[-:.TZ]/g, '').slice(0, 14) + '-' +
                  Math.floor(Math.random() * 1e4);
-      const task = { id, kind: 'transport', pickup, dropoff };
+      let task;
+      let what;
+      if (kind.value === 'multistop') {
+        const text = document.getElementById('task-steps').value;
+        try {
+          task = { id, kind: 'multistop', steps: stepsFromText(text) };
+        } catch (e) {
+          this.model.log(`task ${id}: ${e.message}`);
+          return;
+        }
+        what = `multi-stop task ${id}: ${task.steps.map((s) => [s.action, s.station, s.load_id].filter(Boolean).join(' ')).join(' → ')}`;
+      } else {
+        const pickup = document.getElementById('task-pickup').value;
+        const dropoff = document.getElementById('task-dropoff').value;
+        task = { id, kind: 'transport', pickup, dropoff };
+        what = `transport task ${id}: ${pickup} → ${dropoff}`;
+      }
       if (priority) {
         task.priority = priority;
       }
-      this.confirmThen(`Submit transport task ${id}: ${pickup} → ${dropoff}` +
-                       `${priority ? ', priority ' + priority : ''}?`, () =>
+      this.confirmThen(`Submit ${what}${priority ? ', priority ' + priority : ''}?`, () =>
         this.act(`task ${id}`, 'POST', '/v1/tasks', task));
     });
   }

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
@@ -126,6 +127,79 @@ TEST_F(FleetE2E, PostedTaskReachesARobotAndIsDone) {
   r = http_->Post("/v1/tasks", R"({"id": "job-1", "kind": "transport", "pickup": "P-2", "dropoff": "D-1"})",
                   "application/json");
   EXPECT_EQ(r->status, 409);
+}
+
+// A three-stop task over HTTP: checked against the site by the adapter (a bad step is a 400 naming
+// it), sent with its steps to the manager, ordered to a robot as one goal a stop with the load ids,
+// and followed stop by stop (GET shows the stop) until done.
+TEST_F(FleetE2E, AThreeStopTaskIsOrderedStopByStopAndDone) {
+  transport::Participant p;
+  FakeRobots robots(p, 1);
+  auto r = http_->Post("/v1/tasks", R"({"id": "multi-bad", "steps": [
+      {"action": "pick", "station": "P-1", "load_id": "L-1"},
+      {"action": "drop", "station": "P-2", "load_id": "L-1"}]})",
+                       "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 400) << r->body;
+  const auto bad = json::parse(r->body);
+  ASSERT_EQ(bad["fields"].size(), 1u) << r->body;
+  EXPECT_EQ(bad["fields"][0]["path"], "steps[1].station");
+  EXPECT_EQ(bad["fields"][0]["reason"], "station 'P-2' is not a dropoff station");
+  r = http_->Post("/v1/tasks", R"({"id": "multi-1", "kind": "multistop", "steps": [
+      {"action": "pick", "station": "P-1", "load_id": "L-1"},
+      {"action": "drop", "station": "D-1", "load_id": "L-1"},
+      {"action": "goto", "station": "C-1"}]})",
+                  "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 201) << r->body;
+  std::optional<msg::TaskAssignment> order;
+  const auto end = Clk::now() + 20s;
+  while (Clk::now() < end && !order) {
+    robots.publishStates();
+    for (auto& a : robots.orders.take()) {
+      if (a.task_id == "multi-1") {
+        order = a;
+      }
+    }
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_TRUE(order) << "no order for the task";
+  ASSERT_EQ(order->goals.size(), 3u);
+  EXPECT_EQ(order->goals[0].station, "P-1");
+  EXPECT_EQ(order->goals[0].action, msg::GoalAction::Load);
+  EXPECT_EQ(order->goals[0].load_id, "L-1");
+  EXPECT_EQ(order->goals[1].action, msg::GoalAction::Unload);
+  EXPECT_EQ(order->goals[1].load_id, "L-1");
+  EXPECT_EQ(order->goals[2].station, "C-1");
+  auto report = [&](msg::TaskState st, std::uint32_t step) {
+    robots.statuses.write(
+        {order->robot_id, "multi-1", order->revision, st, 0.0f, "", WallClock().nowNs(), step});
+  };
+  // The view of the task until `pred` holds (at most 10 s).
+  auto viewUntil = [&](const std::function<bool(const json&)>& pred) {
+    json t;
+    const auto until = Clk::now() + 10s;
+    while (Clk::now() < until && !pred(t = getTask("multi-1"))) {
+      robots.publishStates();
+      std::this_thread::sleep_for(50ms);
+    }
+    return t;
+  };
+  report(msg::TaskState::EnRoute, 1);
+  report(msg::TaskState::Loading, 1);
+  report(msg::TaskState::Delivering, 2);
+  auto t = viewUntil([](const json& v) { return v.value("step", 0) == 2; });
+  EXPECT_EQ(t.value("step", 0), 2) << t.dump();
+  EXPECT_EQ(t.value("state", ""), "en_route") << t.dump();
+  EXPECT_EQ(t.value("reason", ""), "step 2 of 3: drop L-1 at D-1");
+  ASSERT_TRUE(t.contains("task"));
+  EXPECT_EQ(t["task"]["steps"].size(), 3u);
+  report(msg::TaskState::Unloading, 2);
+  report(msg::TaskState::Delivering, 3);
+  report(msg::TaskState::Done, 3);
+  t = viewUntil([](const json& v) { return v.value("state", "") == "done"; });
+  EXPECT_EQ(t.value("state", ""), "done") << t.dump();
+  EXPECT_EQ(t.value("step", 0), 3);
 }
 
 TEST_F(FleetE2E, KillNineUnderLoadLosesNothingAcknowledged) {

@@ -127,7 +127,16 @@ TEST_F(RoundTrip, Task) {
   e.set_priority = true;
   e.set_deadline = true;
   e.deadline_ns = 0;
-  expectRoundTrip<msg::Task>({a, b, c, d, e});
+  msg::Task f = a;  // a multi-stop task: 16 steps of every action, the longest ids
+  f.task_id = "t-5";
+  f.request_id = "req-5";
+  f.kind = msg::TaskKind::Multistop;
+  f.pickup = f.dropoff = "";
+  for (int i = 0; i < 16; ++i) {
+    f.steps.push_back({static_cast<msg::StepAction>(i % 5), i % 2 ? maxId() : "S-" + std::to_string(i),
+                       i % 3 ? "" : maxId(), i * 1'000'000'007LL});
+  }
+  expectRoundTrip<msg::Task>({a, b, c, d, e, f});
 }
 
 TEST_F(RoundTrip, TaskAck) {
@@ -144,7 +153,9 @@ TEST_F(RoundTrip, TaskEvent) {
        {"t-3", msg::TaskState::Assigned, "r-1", "allocated", 7, 2, "PARK-3"},
        {"t-4", msg::TaskState::Requeued, "", "changed by request", 8, 3, "", true, -1000, 9'000'000'000},
        {"t-5", msg::TaskState::Assigned, "r-2", "allocated", 9, 2, "", false, 0, 0,
-        1'800'000'000'000'000'000}});
+        1'800'000'000'000'000'000},
+       {"t-6", msg::TaskState::EnRoute, "r-3", "step 3 of 4: drop L-1 at D-1", 10, 3, "", false, 0, 0, 0, 0,
+        3}});
 }
 
 TEST_F(RoundTrip, TaskAssignment) {
@@ -156,12 +167,17 @@ TEST_F(RoundTrip, TaskAssignment) {
                        static_cast<msg::GoalAction>(i % 5),
                        i * 0.25});
   }
-  expectRoundTrip<msg::TaskAssignment>({a, b});
+  msg::TaskAssignment c = b;  // loads on some goals (goal_load_ids on the wire)
+  c.robot_id = "r-3";
+  c.goals[0].load_id = "L-1";
+  c.goals[15].load_id = maxId();
+  expectRoundTrip<msg::TaskAssignment>({a, b, c});
 }
 
 TEST_F(RoundTrip, TaskStatus) {
   expectRoundTrip<msg::TaskStatus>({{"r-1", "t-1", 2, msg::TaskState::EnRoute, 0.5f, "", 7},
-                                    {"r-2", "", 0, msg::TaskState::Failed, 1.0f, kNonAscii, 8}});
+                                    {"r-2", "", 0, msg::TaskState::Failed, 1.0f, kNonAscii, 8},
+                                    {"r-3", "t-3", 5, msg::TaskState::Delivering, 0.25f, "", 9, 16}});
 }
 
 TEST_F(RoundTrip, RobotState) {

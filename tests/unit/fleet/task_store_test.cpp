@@ -372,6 +372,34 @@ TEST_P(TaskStoreTest, ReopenRebuildsOpenState) {
   EXPECT_EQ((*open)[1].attempts, 1);
 }
 
+TEST_P(TaskStoreTest, AMultistopTasksStepsSurviveARestart) {
+  Task m;
+  m.id = "m-1";
+  m.kind = TaskKind::Multistop;
+  m.steps = {{StepAction::Pick, "P-1", "L-42", 2'000'000'000},
+             {StepAction::Drop, "D-1", "L-42", 0},
+             {StepAction::Wait, "", "", 5'000'000'000},
+             {StepAction::Charge, "C-1", "", 0}};
+  {
+    auto store = open();
+    ASSERT_TRUE(store->submit(m, 1));
+    ASSERT_TRUE(store->transition("m-1", S::Assigned, "r1", "", 2));
+  }
+  auto store = open();  // a restart
+  auto open = store->openTasks();
+  ASSERT_TRUE(open);
+  ASSERT_EQ(open->size(), 1u);
+  EXPECT_EQ((*open)[0].task.kind, TaskKind::Multistop);
+  EXPECT_EQ((*open)[0].task.steps, m.steps);
+  EXPECT_EQ(store->get("m-1")->task.steps, m.steps);
+  auto again = store->submit(m, 3);
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_FALSE(again->created) << "the same steps: the same request";
+  Task other = m;
+  other.steps[2].durationNs = 6'000'000'000;
+  EXPECT_EQ(store->submit(other, 3).error().code, errc::kConflict) << "other steps: another task";
+}
+
 TEST_P(TaskStoreTest, JsonViewsOfRecordsAndLog) {
   auto store = open();
   ASSERT_TRUE(store->submit(transport("t1", 2), 100));

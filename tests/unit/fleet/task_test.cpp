@@ -123,10 +123,10 @@ TEST(Task, ValidationNamesFieldAndReason) {
 TEST(Task, ValidationOfTypesAndKinds) {
   auto st = testStations();
   EXPECT_EQ(errorsOf(R"({"kind": "transport"})", &st), (std::vector<FieldError>{{"id", "required"}}));
-  EXPECT_EQ(
-      errorsOf(R"({"id": 7, "kind": "fly"})", &st),
-      (std::vector<FieldError>{{"id", "expected a string, got an integer"},
-                               {"kind", "unknown kind 'fly' (expected transport, goto, charge or park)"}}));
+  EXPECT_EQ(errorsOf(R"({"id": 7, "kind": "fly"})", &st),
+            (std::vector<FieldError>{
+                {"id", "expected a string, got an integer"},
+                {"kind", "unknown kind 'fly' (expected transport, goto, charge, park or multistop)"}}));
   EXPECT_EQ(errorsOf(R"({"id": "a", "kind": "transport", "pickup": "P-1"})", &st),
             (std::vector<FieldError>{{"dropoff", "required for a transport task"}}));
   EXPECT_EQ(errorsOf(R"({"id": "a", "kind": "goto"})", &st),

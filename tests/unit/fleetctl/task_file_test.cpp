@@ -38,6 +38,26 @@ TEST(TaskFile, CsvErrorsNameLineAndColumn) {
   EXPECT_FALSE(csvToTasks("kind\ngoto\n", "n.csv"));
 }
 
+TEST(TaskFile, CsvStepsColumnMakesAMultiStopTask) {
+  auto t = csvToTasks("id,steps\nm1,pick:P-1:L-42:2;drop:D-2:L-42;wait:::5;goto:X;charge:C-1\n", "m.csv");
+  ASSERT_TRUE(t) << t.error().message;
+  ASSERT_EQ(t->size(), 1u);
+  const auto& steps = (*t)[0]["steps"];
+  ASSERT_EQ(steps.size(), 5u);
+  EXPECT_EQ(
+      steps[0],
+      (nlohmann::json{
+          {"action", "pick"}, {"station", "P-1"}, {"load_id", "L-42"}, {"duration_ns", 2'000'000'000LL}}));
+  EXPECT_EQ(steps[2], (nlohmann::json{{"action", "wait"}, {"duration_ns", 5'000'000'000LL}}));
+  EXPECT_EQ(steps[4], (nlohmann::json{{"action", "charge"}, {"station", "C-1"}}));
+  auto bad = csvToTasks("id,steps\nm1,goto:X;:Y\nm2,wait:::soon\n", "b.csv");
+  ASSERT_FALSE(bad);
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("b.csv:2: column steps: step 2 \":Y\": expected action:station"));
+  EXPECT_THAT(bad.error().message,
+              HasSubstr("b.csv:3: column steps: step 1: expected seconds >= 0, got \"soon\""));
+}
+
 TEST(TaskFile, JsonShapes) {
   const auto dir = std::filesystem::temp_directory_path();
   auto write = [&](const std::string& name, const std::string& text) {

@@ -157,6 +157,43 @@ TEST(Agent, DeliversATransportTaskReportingEveryState) {
   EXPECT_FALSE(out.discs.discs.empty());
 }
 
+TEST(Agent, CarriesOutAMultiStopOrderStopByStopReportingEachStop) {
+  auto p = params();
+  p.returnHomeS = -1.0;
+  AgentRun run(p);
+  auto a = transport();
+  a.goals[0].load_id = "L-1";
+  a.goals[1].load_id = "L-1";
+  a.goals.push_back({{5.0, 6.0, 1.57}, "D-1", msg::GoalAction::None, 2.0});  // a wait where it dropped
+  a.goals.push_back({{1.0, 6.0, 3.14}, "X", msg::GoalAction::None, 0.0});
+  run.a.onAssignment(a);
+  std::int64_t waitBegan = -1;
+  run.until(2500, [&] {
+    if (waitBegan < 0 && !run.statuses.empty() && run.statuses.back().step == 3) {
+      waitBegan = run.statuses.back().stamp_ns;
+    }
+    return run.reported(msg::TaskState::Done);
+  });
+  ASSERT_TRUE(run.reported(msg::TaskState::Done));
+  std::vector<std::uint32_t> steps;
+  for (const auto& s : run.statuses) {
+    if (steps.empty() || steps.back() != s.step) {
+      steps.push_back(s.step);
+    }
+  }
+  EXPECT_EQ(steps, (std::vector<std::uint32_t>{1, 2, 3, 4})) << "each stop reported, in order";
+  const auto& done = run.statuses.back();
+  EXPECT_EQ(done.state, msg::TaskState::Done);
+  EXPECT_EQ(done.step, 4u);
+  ASSERT_GE(waitBegan, 0);
+  // The last leg began after the wait's two seconds at the drop-off.
+  const auto lastLeg = std::find_if(run.statuses.begin(), run.statuses.end(),
+                                    [](const msg::TaskStatus& s) { return s.step == 4; });
+  ASSERT_NE(lastLeg, run.statuses.end());
+  EXPECT_GE(lastLeg->stamp_ns - waitBegan, 2 * 1'000'000'000LL);
+  EXPECT_LT(distance(run.world.truth, Pose2{1.0, 6.0, 0}), 0.2);
+}
+
 TEST(Agent, IdleAwayFromHomeItAsksForTheWayHomeAndTheTripIsNoTask) {
   AgentRun run;
   auto order = transport();

@@ -181,3 +181,37 @@ TEST(TaskRunner, AnOrderWithoutGoalsIsRefusedAndReportedFailedAndTheCurrentTaskG
   r.refuse(Order{"", 4, {}, false, 0}, "x");
   EXPECT_FALSE(r.takeReport());
 }
+
+TEST(TaskRunner, EveryLegOfAMultiStopOrderIsReportedWithItsStep) {
+  TaskRunner r;
+  Order o{"m1",
+          1,
+          {TaskGoal{{5.0, 1.0, 0.0}, "P-1", GoalAction::Load, 1.0, "L-1"},
+           TaskGoal{{5.0, 6.0, 0.0}, "D-1", GoalAction::Unload, 1.0, "L-1"},
+           TaskGoal{{5.0, 6.0, 0.0}, "D-1", GoalAction::None, 1.0},
+           TaskGoal{{1.0, 6.0, 0.0}, "X", GoalAction::None, 0.0}}};
+  ASSERT_EQ(r.accept(o), TaskRunner::OrderChange::kNewTask);
+  EXPECT_EQ(r.goal().loadId, "L-1");
+  std::vector<std::pair<TaskState, std::uint32_t>> seen;
+  auto take = [&] {
+    while (auto rep = r.takeReport()) {
+      seen.emplace_back(rep->stage, rep->step);
+    }
+  };
+  std::int64_t t = 0;
+  while (r.busy() && t < 100 * kSec) {
+    r.tick(t);
+    take();
+    if (r.phase() == Phase::Driving) {
+      r.arrive(t);  // there at once
+      take();
+    }
+    t += kSec / 2;
+  }
+  take();
+  const std::vector<std::pair<TaskState, std::uint32_t>> expected = {
+      {TaskState::EnRoute, 1},   {TaskState::Loading, 1},    {TaskState::Delivering, 2},
+      {TaskState::Unloading, 2}, {TaskState::Delivering, 3}, {TaskState::Delivering, 4},
+      {TaskState::Done, 4}};
+  EXPECT_EQ(seen, expected);
+}

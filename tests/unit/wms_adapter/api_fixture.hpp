@@ -41,7 +41,8 @@ class FakeGateway : public TaskGateway {
                 r.load_ns,
                 r.unload_ns,
                 r.priority,
-                r.deadline_ns}
+                r.deadline_ns,
+                r.steps.size()}
         .dump();
   }
 
@@ -73,6 +74,7 @@ class FakeGateway : public TaskGateway {
         a.result = it->second == fields(r) ? msg::AckResult::Duplicate : msg::AckResult::Conflict;
       } else {
         bodies[r.task_id] = fields(r);
+        stored.push_back(r);
       }
       out.emplace_back(a);
     }
@@ -91,6 +93,7 @@ class FakeGateway : public TaskGateway {
   std::vector<msg::TrafficClosure> closuresSent;
   std::string closureProblem;  // sendClosure fails with this when not empty
   std::map<std::string, std::string> bodies;
+  std::vector<msg::Task> stored;  ///< the requests stored, in order
   std::vector<msg::TaskControl> controls;
   /// When set, answers every control request (pause, change, ...); they are kept in controlRequests.
   std::function<msg::TaskAck(const msg::Task&)> onControl;

@@ -9,7 +9,8 @@
 
 namespace fleet {
 
-enum class TaskKind { Transport, Goto, Charge, Park };
+/// Multistop: the task is its steps (task.hpp TaskStep), visited in order.
+enum class TaskKind { Transport, Goto, Charge, Park, Multistop };
 
 /// The states a stored task can be in (every TaskState but Rejected, the answer to a refused
 /// submission), in the enum's order.
@@ -17,14 +18,14 @@ inline constexpr std::array<TaskState, 10> kAllTaskStates = {
     TaskState::Queued,     TaskState::Assigned,  TaskState::EnRoute, TaskState::Loading,
     TaskState::Delivering, TaskState::Unloading, TaskState::Done,    TaskState::Failed,
     TaskState::Cancelled,  TaskState::Requeued};
-inline constexpr std::array<TaskKind, 4> kAllTaskKinds = {TaskKind::Transport, TaskKind::Goto,
-                                                          TaskKind::Charge, TaskKind::Park};
+inline constexpr std::array<TaskKind, 5> kAllTaskKinds = {
+    TaskKind::Transport, TaskKind::Goto, TaskKind::Charge, TaskKind::Park, TaskKind::Multistop};
 
 /// Wire names: "queued", "assigned", "en_route", "loading", "delivering", "unloading", "done",
 /// "failed", "cancelled", "requeued".
 std::string_view toString(TaskState s);
 std::optional<TaskState> parseTaskState(std::string_view name);
-/// Wire names: "transport", "goto", "charge", "park".
+/// Wire names: "transport", "goto", "charge", "park", "multistop".
 std::string_view toString(TaskKind k);
 std::optional<TaskKind> parseTaskKind(std::string_view name);
 

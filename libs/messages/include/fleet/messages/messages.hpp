@@ -14,7 +14,8 @@
 
 namespace fleet::msg {
 
-enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park };
+enum class TaskKind : std::uint8_t { Transport, GoTo, Charge, Park, Multistop };
+enum class StepAction : std::uint8_t { Goto, Pick, Drop, Wait, Charge };
 enum class TaskControl : std::uint8_t { None, Pause, Resume, Query, HoldRobot, ReleaseRobot, Change };
 /// IDL TaskState (TS_QUEUED ... TS_REJECTED), in the same order: fleet/core/task_state.hpp.
 using TaskState = fleet::TaskState;
@@ -23,6 +24,14 @@ enum class SourceKind : std::uint8_t { Robot, Human };
 enum class GoalAction : std::uint8_t { None, Load, Unload, Charge, Park };
 /// IDL RobotActivity (RA_UNSET ... RA_FAULTED), in the same order: fleet/core/robot_activity.hpp.
 using RobotActivity = fleet::RobotActivity;
+
+struct TaskStep {
+  StepAction action = StepAction::Goto;
+  std::string station;
+  std::string load_id;
+  std::int64_t duration_ns = 0;
+  bool operator==(const TaskStep&) const = default;
+};
 
 struct Task {
   std::string task_id;
@@ -39,8 +48,9 @@ struct Task {
   std::int64_t created_ns = 0;
   bool cancel = false;
   TaskControl control = TaskControl::None;
-  bool set_priority = false;  ///< Change: `priority` is the task's new priority
-  bool set_deadline = false;  ///< Change: `deadline_ns` is the task's new deadline (0 = none)
+  bool set_priority = false;      ///< Change: `priority` is the task's new priority
+  bool set_deadline = false;      ///< Change: `deadline_ns` is the task's new deadline (0 = none)
+  std::vector<TaskStep> steps{};  ///< Multistop: the stops in order (at most 16)
   bool operator==(const Task&) const = default;
 };
 
@@ -74,6 +84,8 @@ struct TaskEvent {
   std::int64_t eta_ns = 0;
   /// The publishing manager's lease epoch (0: no lease); readers drop events of an older one.
   std::int64_t epoch = 0;
+  /// A multi-stop task's stop the robot is at or driving to, from 1; 0: not known.
+  std::uint32_t step = 0;
   bool operator==(const TaskEvent&) const = default;
 };
 
@@ -82,6 +94,8 @@ struct Goal {
   std::string station;
   GoalAction action = GoalAction::None;
   double duration_s = 0;
+  /// The load a pick or drop carries (on the wire TaskAssignment.goal_load_ids, as Goal is @final).
+  std::string load_id{};
   bool operator==(const Goal&) const = default;
 };
 
@@ -106,6 +120,8 @@ struct TaskStatus {
   float progress = 0;
   std::string error;
   std::int64_t stamp_ns = 0;
+  /// The goal the robot is at or driving to, from 1 (the last when done); 0: not said.
+  std::uint32_t step = 0;
   bool operator==(const TaskStatus&) const = default;
 };
 
