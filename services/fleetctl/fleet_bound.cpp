@@ -31,10 +31,20 @@ std::optional<std::string> badInput(const FleetBoundInput& in) {
       return "a robot start is not finite";
     }
   }
+  bool anyStation = false;
   for (const auto& t : in.tasks) {
-    if (!finiteNonNegative(t.loadS) || !finiteNonNegative(t.unloadS)) {
-      return "a task's load or unload time is negative or not finite";
+    if (t.stops.empty()) {
+      return "a task without a stop";
     }
+    for (const auto& stop : t.stops) {
+      if (!finiteNonNegative(stop.dwellS)) {
+        return "a stop's dwell (load, unload, wait) is negative or not finite";
+      }
+      anyStation = anyStation || !stop.station.empty();
+    }
+  }
+  if (!anyStation) {
+    return "no task visits a station";
   }
   return std::nullopt;
 }
@@ -53,23 +63,31 @@ Expected<FleetBound> fleetBound(const planning::OccupancyGrid& freeMap, const Fl
     byName[s.name] = &s;
   }
   for (const auto& t : in.tasks) {
-    for (const auto* name : {&t.pickup, &t.dropoff}) {
-      if (!byName.count(*name)) {
-        return unexpected("unknown_station", "station '" + *name + "' is not on the site");
+    for (const auto& stop : t.stops) {
+      if (!stop.station.empty() && !byName.count(stop.station)) {
+        return unexpected("unknown_station", "station '" + stop.station + "' is not on the site");
       }
     }
   }
-  // Every leg of the chain, grouped by its goal so that each station's field is built once.
+  // The chain's stations in order (a wait where the robot stands adds dwell, no way), and every
+  // leg of it grouped by its goal so that each station's field is built once.
+  std::vector<std::string> chain;
+  double dwell = 0.0;
+  for (const auto& t : in.tasks) {
+    for (const auto& stop : t.stops) {
+      dwell += stop.dwellS;
+      if (!stop.station.empty()) {
+        chain.push_back(stop.station);
+      }
+    }
+  }
   std::map<std::string, std::vector<Vec2>> froms;  // goal station → from points
   auto dock = [&](const std::string& name) { return byName.at(name)->geometry.dock; };
   for (const auto& s : in.starts) {
-    froms[in.tasks.front().pickup].push_back(s);
+    froms[chain.front()].push_back(s);
   }
-  for (std::size_t i = 0; i < in.tasks.size(); ++i) {
-    froms[in.tasks[i].dropoff].push_back(dock(in.tasks[i].pickup));
-    if (i > 0) {
-      froms[in.tasks[i].pickup].push_back(dock(in.tasks[i - 1].dropoff));
-    }
+  for (std::size_t i = 1; i < chain.size(); ++i) {
+    froms[chain[i]].push_back(dock(chain[i - 1]));
   }
   std::map<std::pair<std::string, std::pair<double, double>>, double> length;
   try {
@@ -98,19 +116,13 @@ Expected<FleetBound> fleetBound(const planning::OccupancyGrid& freeMap, const Fl
   FleetBound b;
   b.robots = in.starts.size();
   b.tasks = in.tasks.size();
-  double first = way(in.starts.front(), in.tasks.front().pickup);
+  double first = way(in.starts.front(), chain.front());
   for (const auto& s : in.starts) {
-    first = std::min(first, way(s, in.tasks.front().pickup));  // the best start: the bound stays one
+    first = std::min(first, way(s, chain.front()));  // the best start: the bound stays one
   }
-  double dwell = 0.0;
   b.chainDriveM = first;
-  for (std::size_t i = 0; i < in.tasks.size(); ++i) {
-    const auto& t = in.tasks[i];
-    if (i > 0) {
-      b.chainDriveM += way(dock(in.tasks[i - 1].dropoff), t.pickup);
-    }
-    b.chainDriveM += way(dock(t.pickup), t.dropoff);
-    dwell += t.loadS + t.unloadS;
+  for (std::size_t i = 1; i < chain.size(); ++i) {
+    b.chainDriveM += way(dock(chain[i - 1]), chain[i]);
   }
   b.chainS = b.chainDriveM / in.cruise + dwell;
   const auto n = static_cast<double>(b.tasks);
@@ -120,12 +132,13 @@ Expected<FleetBound> fleetBound(const planning::OccupancyGrid& freeMap, const Fl
   // Station loads: visits and the dwell they bring.
   std::map<std::string, std::pair<std::size_t, double>> visits;  // name → (visits, dwell sum)
   for (const auto& t : in.tasks) {
-    auto& p = visits[t.pickup];
-    ++p.first;
-    p.second += t.loadS;
-    auto& d = visits[t.dropoff];
-    ++d.first;
-    d.second += t.unloadS;
+    for (const auto& stop : t.stops) {
+      if (!stop.station.empty()) {
+        auto& v = visits[stop.station];
+        ++v.first;
+        v.second += stop.dwellS;
+      }
+    }
   }
   for (const auto& [name, v] : visits) {
     StationLoad s;

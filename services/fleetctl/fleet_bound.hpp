@@ -3,9 +3,9 @@
 // The fleet bound of a run (docs/algorithms.md, "Fleet bound"): the most tasks per hour a fleet
 // could do on a task list, min(robot bound, station bound).
 // - Robot bound = robots × a lone robot's rate on the same list: every task posted at once and done
-//   in posting order, each chained from the last drop-off (the first from the best robot start),
-//   with ideal motion — the disc's shortest way on the free map at the cruise speed — plus each
-//   task's load and unload dwell.
+//   in posting order, each chained from the last stop of the one before (the first from the best
+//   robot start), with ideal motion — the disc's shortest way on the free map at the cruise speed —
+//   plus each stop's dwell (a transport task: load and unload).
 // - Station bound = min over stations s of 3600 / (c_s × f_s): c_s the station's mean least dock
 //   cycle over its visits (station_cycle.hpp, with each visit's dwell), f_s its visits per task.
 // Computed from the site and the list alone (no simulation). Pure: no DDS, no logging.
@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fleet/core/expected.hpp"
@@ -27,12 +28,19 @@ struct BoundStation {
   DockGeometry geometry;  ///< dock = the station's pose
 };
 
-/// One transport task of the list, in posting order.
+/// One stop of a task: a station visited (empty: a wait where the robot stands) and its dwell.
+struct ListStop {
+  std::string station;
+  double dwellS = 0.0;
+};
+
+/// One task of the list, in posting order: its stops in order (a transport task is its pickup with
+/// the load time and its drop-off with the unload time; a multi-stop task, each of its steps).
 struct ListTask {
-  std::string pickup;
-  std::string dropoff;
-  double loadS = 0.0;
-  double unloadS = 0.0;
+  std::vector<ListStop> stops;
+  static ListTask transport(std::string pickup, std::string dropoff, double loadS, double unloadS) {
+    return {{{std::move(pickup), loadS}, {std::move(dropoff), unloadS}}};
+  }
 };
 
 struct FleetBoundInput {
@@ -45,7 +53,7 @@ struct FleetBoundInput {
 
 struct StationLoad {
   std::string name;
-  std::size_t visits = 0;  ///< pickups and drop-offs of the list there
+  std::size_t visits = 0;  ///< the list's stops there (a transport task: its pickup and drop-off)
   double share = 0.0;      ///< f_s = visits ÷ tasks
   double moveS = 0.0;      ///< the cycle's motion part
   double cycleS = 0.0;     ///< c_s = moveS + mean dwell of its visits

@@ -20,7 +20,34 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-/// The transport tasks of the run in posting order (first transition), with their dwell.
+/// A stored task's stops (ListTask), or none when it visits no station the bound counts (goto,
+/// charge and park tasks: not the list's work). A multi-stop task is its steps, each with its
+/// duration; a transport task its pickup and drop-off with their load and unload time.
+std::optional<ListTask> stopsOf(const json& b) {
+  const auto seconds = [](const json& o, const char* key) {
+    const auto it = o.find(key);
+    return it != o.end() && it->is_number() ? it->get<double>() * 1e-9 : 0.0;
+  };
+  if (const auto steps = b.find("steps"); steps != b.end() && steps->is_array() && !steps->empty()) {
+    ListTask t;
+    for (const auto& step : *steps) {
+      if (!step.is_object()) {
+        return std::nullopt;
+      }
+      const auto station = step.find("station");
+      t.stops.push_back({station != step.end() && station->is_string() ? station->get<std::string>() : "",
+                         seconds(step, "duration_ns")});
+    }
+    return t;
+  }
+  if (b.value("pickup", "").empty() || b.value("dropoff", "").empty()) {
+    return std::nullopt;
+  }
+  return ListTask::transport(b.value("pickup", ""), b.value("dropoff", ""), seconds(b, "load_duration_ns"),
+                             seconds(b, "unload_duration_ns"));
+}
+
+/// The tasks of the run in posting order (first transition), with their stops and dwell.
 std::optional<std::string> readList(const fs::path& dbPath, std::vector<ListTask>& out, std::size_t& other) {
   sqlite3* db = nullptr;
   if (sqlite3_open_v2(dbPath.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
@@ -38,13 +65,12 @@ std::optional<std::string> readList(const fs::path& dbPath, std::vector<ListTask
     while (sqlite3_step(s) == SQLITE_ROW) {
       const auto* p = sqlite3_column_text(s, 0);
       const json b = json::parse(p ? reinterpret_cast<const char*>(p) : "", nullptr, false);
-      if (!b.is_object() || b.value("pickup", "").empty() || b.value("dropoff", "").empty()) {
+      auto task = b.is_object() ? stopsOf(b) : std::nullopt;
+      if (!task) {
         ++other;
         continue;
       }
-      out.push_back({b.value("pickup", ""), b.value("dropoff", ""),
-                     static_cast<double>(b.value("load_duration_ns", std::int64_t{0})) * 1e-9,
-                     static_cast<double>(b.value("unload_duration_ns", std::int64_t{0})) * 1e-9});
+      out.push_back(std::move(*task));
     }
   } else {
     error = std::string("task database: ") + sqlite3_errmsg(db);
@@ -67,27 +93,27 @@ json fleetBoundJson(const FleetBound& b, double fleetRatePerH, double cruise, do
                         {"bound_per_h", round3(s.boundPerH)}});
   }
   const double bound = b.perH();
-  return {
-      {"definition",
-       "min(robot bound, station bound): robots × a lone robot's rate on this task list (posted at once, "
-       "done in posting order, each chained from the last drop-off, the disc's shortest way at cruise plus "
-       "load and unload) and min over stations of 3600 / (c_s × f_s) (c_s its least dock cycle, f_s its "
-       "visits per task); docs/algorithms.md, \"Fleet bound\""},
-      {"robots", b.robots},
-      {"tasks", b.tasks},
-      {"cruise_m_s", cruise},
-      {"radius_m", radius},
-      {"lone_chain_m", round3(b.chainDriveM)},
-      {"lone_chain_s", round3(b.chainS)},
-      {"lone_rate_per_h", round3(b.lonePerH)},
-      {"robot_bound_per_h", round3(b.robotPerH)},
-      {"station_bound_per_h", round3(b.stationPerH)},
-      {"binding_station", b.bindingStation},
-      {"binds", b.robotsBind() ? "robots" : "stations"},
-      {"bound_per_h", round3(bound)},
-      {"fleet_rate_per_h", round3(fleetRatePerH)},
-      {"fraction_of_bound", bound > 0.0 ? round3(fleetRatePerH / bound) : 0.0},
-      {"stations", stations}};
+  return {{"definition",
+           "min(robot bound, station bound): robots × a lone robot's rate on this task list (posted at once, "
+           "done in posting order, each chained from the last stop of the one before, the disc's shortest "
+           "way at cruise plus "
+           "load and unload) and min over stations of 3600 / (c_s × f_s) (c_s its least dock cycle, f_s its "
+           "visits per task); docs/algorithms.md, \"Fleet bound\""},
+          {"robots", b.robots},
+          {"tasks", b.tasks},
+          {"cruise_m_s", cruise},
+          {"radius_m", radius},
+          {"lone_chain_m", round3(b.chainDriveM)},
+          {"lone_chain_s", round3(b.chainS)},
+          {"lone_rate_per_h", round3(b.lonePerH)},
+          {"robot_bound_per_h", round3(b.robotPerH)},
+          {"station_bound_per_h", round3(b.stationPerH)},
+          {"binding_station", b.bindingStation},
+          {"binds", b.robotsBind() ? "robots" : "stations"},
+          {"bound_per_h", round3(bound)},
+          {"fleet_rate_per_h", round3(fleetRatePerH)},
+          {"fraction_of_bound", bound > 0.0 ? round3(fleetRatePerH / bound) : 0.0},
+          {"stations", stations}};
 }
 
 json runFleetBound(const fs::path& runDir, double fleetRatePerH) {

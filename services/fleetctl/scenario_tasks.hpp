@@ -4,7 +4,13 @@
 // the WMS adapter's HTTP API, each when the simulated clock reaches its `at_s`.
 //
 //   "tasks": [{"at_s": 0, "pickup": "P-1", "dropoff": "D-2"},
-//             {"at_s": 4.5, "pickup": "P-3", "dropoff": "D-1", "id": "order-17", "priority": 5}]
+//             {"at_s": 4.5, "pickup": "P-3", "dropoff": "D-1", "id": "order-17", "priority": 5},
+//             {"at_s": 9, "steps": [{"action": "pick", "station": "P-2", "load_id": "L-1"},
+//                                   {"action": "drop", "station": "D-3", "load_id": "L-1"},
+//                                   {"action": "wait", "duration_ns": 3000000000}]}]
+//
+// An entry has a pickup and a drop-off (a transport task, 2 s load and unload) or `steps` (a
+// multi-stop task, the steps exactly as the HTTP API takes them, checked by the same rules).
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -18,8 +24,9 @@ namespace fleet::ctl {
 struct ScenarioTask {
   std::string id;       // as given, else generated ("task-001" after its place in the list)
   double atS = 0;       // simulated seconds after the start at which it is posted
-  std::string pickup;   // a station of kind pickup
-  std::string dropoff;  // a station of kind dropoff
+  std::string pickup;   // a station of kind pickup (empty for a multi-stop task)
+  std::string dropoff;  // a station of kind dropoff (empty for a multi-stop task)
+  nlohmann::json steps = nlohmann::json::array();  // a multi-stop task's steps as the API takes them
   std::optional<std::int64_t> priority;
 };
 
@@ -51,7 +58,8 @@ const nlohmann::json& scenarioStations(const nlohmann::json& scenario);
 std::optional<std::vector<ScenarioTask>> parseScenarioTasks(const nlohmann::json& scenario,
                                                             const std::string& origin);
 
-/// The task as the HTTP API takes it (transport, 2 s load and unload, as generated tasks).
+/// The task as the HTTP API takes it (transport, 2 s load and unload, as generated tasks; or
+/// multi-stop with its steps).
 nlohmann::json toTaskRequest(const ScenarioTask& t);
 
 }  // namespace fleet::ctl

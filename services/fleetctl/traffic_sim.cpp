@@ -31,7 +31,7 @@ nlohmann::json virtualFleetBound(const site::Site& site, const traffic::Roadmap&
     names[s.dock] = s.name;
   in.stations = boundStations(roadmap);
   for (const auto& t : r.tasks)
-    in.tasks.push_back({names[t.pickup], names[t.dropoff], dwell, dwell});
+    in.tasks.push_back(ListTask::transport(names[t.pickup], names[t.dropoff], dwell, dwell));
   for (const auto v : r.starts)
     in.starts.push_back(g.position(v));
   in.radius = roadmap.options.radius;

@@ -30,7 +30,7 @@ FleetBoundInput twoTasks(std::vector<Vec2> starts) {
   FleetBoundInput in;
   in.stations = {{"A", {{1.0, 1.0}, Vec2{1.0, 2.0}, {{1.0, 3.0}}, std::nullopt}},
                  {"B", {{4.0, 1.0}, std::nullopt, {}, std::nullopt}}};
-  in.tasks = {{"A", "B", 1.0, 2.0}, {"A", "B", 1.0, 2.0}};
+  in.tasks = {ListTask::transport("A", "B", 1.0, 2.0), ListTask::transport("A", "B", 1.0, 2.0)};
   in.starts = std::move(starts);
   in.radius = 0.2;
   in.cruise = 1.0;
@@ -85,7 +85,7 @@ TEST(FleetBound, ManyRobotsAreBoundByTheBusiestStationAndTheBestStartCounts) {
 
 TEST(FleetBound, BadInputIsNamed) {
   auto in = twoTasks({{1.0, 3.0}});
-  in.tasks[1].dropoff = "C";
+  in.tasks[1].stops[1].station = "C";
   auto b = fleetBound(room(), in);
   ASSERT_FALSE(b);
   EXPECT_EQ(b.error().code, "unknown_station");
@@ -96,9 +96,35 @@ TEST(FleetBound, BadInputIsNamed) {
   in.cruise = 0.0;
   EXPECT_EQ(fleetBound(room(), in).error().code, "bad_input");
   in = twoTasks({{1.0, 3.0}});
-  in.tasks[0].loadS = -1.0;
+  in.tasks[0].stops[0].dwellS = -1.0;
+  EXPECT_EQ(fleetBound(room(), in).error().code, "bad_input");
+  in = twoTasks({{1.0, 3.0}});
+  in.tasks[1].stops.clear();  // a task without a stop
+  EXPECT_EQ(fleetBound(room(), in).error().code, "bad_input");
+  in = twoTasks({{1.0, 3.0}});
+  in.tasks = {ListTask{{{"", 5.0}}}};  // only waits: no station to go to
   EXPECT_EQ(fleetBound(room(), in).error().code, "bad_input");
   EXPECT_EQ(fleetBound(OccupancyGrid(), twoTasks({{1.0, 3.0}})).error().code, "bad_input");
+}
+
+// A multi-stop task is its stops in order: each one a leg of the chain and a visit of its station,
+// a wait where the robot stands only dwell.
+TEST(FleetBound, AMultiStopTaskChainsEveryStopAndVisitsEachStation) {
+  auto in = twoTasks({{1.0, 3.0}});
+  // A (pick, 1 s) → B (drop, 2 s) → wait 4 s where it stands → A (goto, 0 s), then A → B as before.
+  in.tasks[0] = ListTask{{{"A", 1.0}, {"B", 2.0}, {"", 4.0}, {"A", 0.0}}};
+  const auto b = fleetBound(room(), in);
+  ASSERT_TRUE(b) << b.error().message;
+  // start→A 2 m, A→B 3, B→A 3 (the goto), A→A 0 (the next task's pickup), A→B 3 = 11 m; dwell
+  // 1 + 2 + 4 + 0 + 1 + 2 = 10 s: 21 s for 2 tasks.
+  EXPECT_NEAR(b->chainDriveM, 11.0, 1e-6);
+  EXPECT_NEAR(b->chainS, 21.0, 1e-6);
+  // A visited 3 times in 2 tasks, B twice.
+  ASSERT_EQ(b->stations.size(), 2U);
+  for (const auto& s : b->stations) {
+    EXPECT_EQ(s.visits, s.name == "A" ? 3U : 2U) << s.name;
+    EXPECT_NEAR(s.share, s.name == "A" ? 1.5 : 1.0, 1e-12) << s.name;
+  }
 }
 
 TEST(FleetBound, AStationBehindAWallIsUnreachable) {

@@ -119,6 +119,37 @@ TEST(ScenarioTasks, EveryBadEntryIsNamedWithItsKeyPathAllAtOnce) {
   EXPECT_FALSE(has(ps, "small_warehouse.json: tasks[0]")) << text;
 }
 
+// A multi-stop entry carries its steps as the HTTP API takes them, checked by the fleet manager's
+// rules at start: what the manager would refuse is named with the entry's key path.
+TEST(ScenarioTasks, AMultiStopEntryIsPostedWithItsStepsAndItsBadStepsAreNamed) {
+  const json steps = json::parse(R"([{"action": "pick", "station": "P-1", "load_id": "L-1"},
+    {"action": "drop", "station": "D-2", "load_id": "L-1"}, {"action": "wait", "duration_ns": 3000000000}])");
+  const auto list =
+      parseScenarioTasks(withTasks(json::array({{{"at_s", 1}, {"steps", steps}, {"id", "m-1"}}})), "s.json");
+  ASSERT_TRUE(list.has_value());
+  ASSERT_EQ(list->size(), 1U);
+  EXPECT_TRUE((*list)[0].pickup.empty());
+  const json r = toTaskRequest((*list)[0]);
+  EXPECT_EQ(r["kind"], "multistop");
+  EXPECT_EQ(r["steps"], steps);
+  EXPECT_FALSE(r.contains("pickup"));
+
+  const auto ps = problems(withTasks(json::parse(R"([
+    {"at_s": 0, "steps": [{"action": "pick", "station": "P-9", "load_id": "L-1"},
+                          {"action": "drop", "station": "P-1", "load_id": "L-1"}]},
+    {"at_s": 0, "pickup": "P-1", "steps": [{"action": "goto", "station": "D-1"}]},
+    {"at_s": 0, "steps": [{"action": "fly", "station": "D-1"}]},
+    {"at_s": 0, "steps": "P-1 then D-1"},
+    {"at_s": 0, "steps": [{"action": "goto", "station": "D-1"}, {"action": "wait"}]}])")));
+  const std::string text = all(ps);
+  EXPECT_TRUE(has(ps, "small_warehouse.json: tasks[0].steps[0].station: unknown station 'P-9'")) << text;
+  EXPECT_TRUE(has(ps, "tasks[0].steps[1].station")) << text;  // a drop at a pickup station
+  EXPECT_TRUE(has(ps, "tasks[1].steps: a task has steps or a pickup and a drop-off, not both")) << text;
+  EXPECT_TRUE(has(ps, "tasks[2].steps[0].action")) << text;
+  EXPECT_TRUE(has(ps, "tasks[3].steps: expected an array of steps")) << text;
+  EXPECT_TRUE(has(ps, "tasks[4].steps[1]")) << text;  // a wait without a duration
+}
+
 TEST(ScenarioTasks, TasksMustBeAnArray) {
   const auto ps = problems(withTasks(json{{"at_s", 0}}));
   ASSERT_EQ(ps.size(), 1u) << all(ps);
