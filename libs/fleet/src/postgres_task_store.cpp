@@ -296,8 +296,10 @@ Expected<std::unique_ptr<PostgresTaskStore>> PostgresTaskStore::open(
       "INSERT INTO transitions(task_id, from_state, to_state, robot, reason, stamp_ns) "
       "SELECT id, $9, $1, $10, $4, $5 FROM up");
   c.addStatement("fence", "SELECT epoch FROM fleet_lease WHERE name = $1 FOR SHARE");
-  c.addStatement("pause", "UPDATE tasks SET paused = $1, updated_ns = $2 WHERE id = $3");
-  c.addStatement("wait_reason", "UPDATE tasks SET reason = $1, updated_ns = $2 WHERE id = $3");
+  c.addStatement("pause",
+                 "UPDATE tasks SET paused = $1, updated_ns = $2, revision = revision + 1 WHERE id = $3");
+  c.addStatement("wait_reason",
+                 "UPDATE tasks SET reason = $1, updated_ns = $2, revision = revision + 1 WHERE id = $3");
   c.addStatement(
       "change",
       "UPDATE tasks SET priority = $1, deadline_ns = $2, updated_ns = $3, revision = $4 WHERE id = $5");
@@ -406,6 +408,7 @@ Expected<TaskRecord> PostgresTaskStore::setPaused(std::string_view id, bool paus
     }
     cur->paused = paused;
     cur->updatedNs = stampNs;
+    ++cur->revision;  // an event of the task's: the revision counts it (task_store.hpp)
     return cur;
   });
   return std::move(out.front());
@@ -433,6 +436,7 @@ Expected<TaskRecord> PostgresTaskStore::setWaitReason(std::string_view id, std::
     }
     cur->reason = repaired;
     cur->updatedNs = stampNs;
+    ++cur->revision;  // an event of the task's: the revision counts it (task_store.hpp)
     return cur;
   });
   return std::move(out.front());

@@ -371,8 +371,9 @@ Expected<std::unique_ptr<SqliteTaskStore>> SqliteTaskStore::open(const SqliteTas
        "?1 "
        "ORDER BY seq"},
       {&impl->counts, "SELECT state, COUNT(*) FROM tasks GROUP BY state"},
-      {&impl->pause, "UPDATE tasks SET paused = ?1, updated_ns = ?2 WHERE id = ?3"},
-      {&impl->waitReason, "UPDATE tasks SET reason = ?1, updated_ns = ?2 WHERE id = ?3"},
+      {&impl->pause, "UPDATE tasks SET paused = ?1, updated_ns = ?2, revision = revision + 1 WHERE id = ?3"},
+      {&impl->waitReason,
+       "UPDATE tasks SET reason = ?1, updated_ns = ?2, revision = revision + 1 WHERE id = ?3"},
       {&impl->change,
        "UPDATE tasks SET priority = ?1, deadline_ns = ?2, updated_ns = ?3, revision = ?4 WHERE id = ?5"},
       {&impl->open, sel + " WHERE state NOT IN ('done', 'failed', 'cancelled') ORDER BY created_ns, id"},
@@ -452,6 +453,7 @@ Expected<TaskRecord> SqliteTaskStore::setPaused(std::string_view id, bool paused
   }
   cur->paused = paused;
   cur->updatedNs = stampNs;
+  ++cur->revision;  // an event of the task's: the revision counts it (task_store.hpp)
   return cur;
 }
 
@@ -476,6 +478,7 @@ Expected<TaskRecord> SqliteTaskStore::setWaitReason(std::string_view id, std::st
   }
   cur->reason = std::string(reason);
   cur->updatedNs = stampNs;
+  ++cur->revision;  // an event of the task's: the revision counts it (task_store.hpp)
   return cur;
 }
 

@@ -67,8 +67,9 @@ TEST_P(TaskStoreTest, PausedFlagIsDurableAndRefusedOnFinishedTasks) {
     ASSERT_TRUE(p) << p.error().message;
     EXPECT_TRUE(p->paused);
     EXPECT_EQ(p->state, S::Assigned);
-    EXPECT_EQ(p->revision, 2) << "not a transition";
-    EXPECT_EQ(store->history("t1")->size(), 2u);
+    EXPECT_EQ(p->revision, 3) << "not a transition, but an event of the task's: the revision counts it";
+    EXPECT_EQ(store->history("t1")->size(), 2u) << "not a transition";
+    EXPECT_EQ(store->setPaused("t1", true, 3)->revision, 3) << "unchanged: no event, no count";
     // A transition keeps the flag.
     EXPECT_TRUE(store->transition("t1", S::EnRoute, "r1", "", 4)->paused);
     EXPECT_EQ(store->setPaused("nope", true, 5).error().code, errc::kNotFound);
@@ -134,6 +135,8 @@ TEST_P(TaskStoreTest, AChosenStationIsStoredWithTheAssignmentAndDroppedOnRequeue
   ASSERT_TRUE(w) << w.error().message;
   EXPECT_EQ(store->get("park-1")->reason, "waiting for a free parking station");
   EXPECT_EQ(store->history("park-1")->size(), 3u) << "not a transition";
+  EXPECT_EQ(w->revision, 4) << "but an event of the task's: the revision counts it";
+  EXPECT_EQ(store->get("park-1")->revision, 4);
   ASSERT_TRUE(store->transition({"park-1", S::Assigned, "r3", "allocated", 6, "K-1"}));
   EXPECT_EQ(store->setWaitReason("park-1", "x", 7).error().code, errc::kIllegalTransition);
   ASSERT_TRUE(store->transition("park-1", S::EnRoute, "r3", "", 8));

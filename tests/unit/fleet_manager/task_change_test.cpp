@@ -265,3 +265,36 @@ TEST_F(TaskChange, TheLeaseEpochIsStampedOnEveryAssignmentAndEventFromThenOn) {
     EXPECT_EQ(a.epoch, 7) << a.robot_id;
   }
 }
+
+// A pause is an event of the task's without a transition: the stored revision counts it, so a
+// restarted manager numbers the next event after it. Before (2026-12-03) the revision counted only
+// transitions and changes: after a restart the resume repeated the pause's seq and the adapter's
+// event log, which keeps one event per (task, seq), dropped it — the WMS never heard "resumed".
+TEST_F(TaskChange, APauseOutlivesARestartAndTheNextEventIsNumberedAfterIt) {
+  std::uint32_t pausedSeq = 0;
+  {
+    auto node = open(0);
+    manager::Outbox out;
+    node->onRequests({transport("t1", 0)}, 1'000, out);
+    msg::Task pause;
+    pause.task_id = "t1";
+    pause.request_id = "pause-1";
+    pause.control = msg::TaskControl::Pause;
+    out = {};
+    node->onRequests({pause}, 2'000, out);
+    ASSERT_FALSE(out.events.empty());
+    pausedSeq = out.events.back().seq;
+    EXPECT_EQ(pausedSeq, 2U) << "queued (1), paused (2)";
+  }
+  auto node = open(10'000);
+  ASSERT_EQ(node->recovered().events.size(), 1U);
+  EXPECT_EQ(node->recovered().events[0].seq, pausedSeq) << "the announcement repeats the last event's seq";
+  msg::Task resume;
+  resume.task_id = "t1";
+  resume.request_id = "resume-1";
+  resume.control = msg::TaskControl::Resume;
+  manager::Outbox out;
+  node->onRequests({resume}, 20'000, out);
+  ASSERT_FALSE(out.events.empty());
+  EXPECT_EQ(out.events.back().seq, pausedSeq + 1) << "numbered after the pause, not again as it";
+}

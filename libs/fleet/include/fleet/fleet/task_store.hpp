@@ -28,7 +28,8 @@ struct TaskRecord {
   std::int32_t attempts = 0;  ///< times the task was assigned
   std::string reason;         ///< reason given with the latest transition
   std::int64_t updatedNs = 0;
-  std::int64_t revision = 0;  ///< transitions and changes applied; 1 right after submit
+  std::int64_t revision =
+      0;  ///< transitions, changes, pauses and wait reasons applied (the task's events); 1 right after submit
   /// Held by an operator: a waiting task is not dispatched, an active one's robot stands still
   /// with it. Not a state: the task keeps its state and transitions while paused.
   bool paused = false;
@@ -122,11 +123,14 @@ class TaskStore {
   /// Several transitions in one commit; each is checked against the state left by the ones before.
   virtual std::vector<Expected<TaskRecord>> transitionBatch(const std::vector<TransitionRequest>& rs) = 0;
 
-  /// Sets the task's `paused` flag durably (not a transition: the log is unchanged). Errors:
-  /// not_found; illegal_transition for a task already done, failed or cancelled.
+  /// Sets the task's `paused` flag durably (not a transition: the log is unchanged, but the
+  /// revision grows, as the task's events count it: a restarted manager numbers its next event
+  /// after the pause's). Errors: not_found; illegal_transition for a task already done, failed or
+  /// cancelled.
   virtual Expected<TaskRecord> setPaused(std::string_view id, bool paused, std::int64_t stampNs) = 0;
-  /// Sets the reason of a waiting task (why it still waits) durably, without a transition.
-  /// Errors: not_found; illegal_transition for a task that is not queued or requeued.
+  /// Sets the reason of a waiting task (why it still waits) durably, without a transition (the
+  /// revision grows, as the task's events count it). Errors: not_found; illegal_transition for a
+  /// task that is not queued or requeued.
   virtual Expected<TaskRecord> setWaitReason(std::string_view id, std::string_view reason,
                                              std::int64_t stampNs) = 0;
   /// Sets a waiting (queued or requeued) task's priority and/or deadline durably; not a transition
