@@ -1,5 +1,5 @@
 // Station admission: waiting tasks held back while a station they need has as many active tasks
-// as its capacity allows.
+// as its capacity allows, each saying which line holds it (and when it is past its deadline).
 
 #include "fleet/fleet/dispatcher.hpp"
 
@@ -28,7 +28,7 @@ std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) 
 }
 }  // namespace
 
-void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
+std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
   std::unordered_map<std::string, std::size_t> load;
   for (const auto& [id, r] : open_) {
     if (isActive(r.state)) {
@@ -44,23 +44,57 @@ void Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
            std::tuple(b.robot.empty(), -b.priority, b.createdNs);
   });
   std::vector<Task> admitted;
+  std::vector<HeldAtStation> held;
   for (auto& t : waiting) {
     const auto stations = cfg_.stationLoadByPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
+    const auto capacityOf = [&](const std::string& s) {
+      const auto it = cfg_.stationCapacities.find(s);
+      return it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
+    };
     // A robot's own charge task is never held back: its battery does not wait for the queue.
-    const bool full =
-        t.robot.empty() && std::any_of(stations.begin(), stations.end(), [&](const std::string* s) {
-          const auto it = cfg_.stationCapacities.find(*s);
-          const std::size_t cap = it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
-          return cap > 0 && load[*s] >= cap;
-        });
-    if (!full) {
+    const auto full = t.robot.empty() ? std::find_if(stations.begin(), stations.end(),
+                                                     [&](const std::string* s) {
+                                                       const std::size_t cap = capacityOf(*s);
+                                                       return cap > 0 && load[*s] >= cap;
+                                                     })
+                                      : stations.end();
+    if (full == stations.end()) {
       for (const std::string* s : stations) {
         ++load[*s];
       }
       admitted.push_back(std::move(t));
+    } else {
+      held.push_back({t.id, **full, capacityOf(**full)});
     }
   }
   waiting = std::move(admitted);
+  return held;
+}
+
+void Dispatcher::noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs,
+                                    DispatchResult& out) {
+  for (const auto& h : held) {
+    const auto it = open_.find(h.taskId);
+    if (it == open_.end() || !isWaiting(it->second.state) || it->second.paused) {
+      continue;
+    }
+    auto& r = it->second;
+    const bool late = r.task.deadlineNs > 0 && nowNs > r.task.deadlineNs;
+    const std::string why = std::string(late ? "past its deadline and still waiting" : "waiting") +
+                            " for a place in station " + h.station + "'s line (it holds " +
+                            std::to_string(h.capacity) + ", all taken by other tasks)";
+    if (why == r.reason) {
+      continue;  // said already: no store write, no event
+    }
+    auto res = store_.setWaitReason(h.taskId, why.substr(0, 255), nowNs);
+    if (!res) {
+      out.errors.push_back(res.error());
+      continue;
+    }
+    r.reason = res->reason;
+    r.updatedNs = res->updatedNs;
+    out.events.push_back({h.taskId, r.state, "", r.reason, nowNs, "", currentEta(r, nowNs)});
+  }
 }
 
 }  // namespace fleet

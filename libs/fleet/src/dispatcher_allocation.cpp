@@ -53,7 +53,7 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
     return;
   }
   if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
-    admitByStationCapacity(waiting);
+    noteAdmissionWaits(admitByStationCapacity(waiting), nowNs, out);
     if (waiting.empty()) {
       return;
     }

@@ -446,6 +446,46 @@ TEST_F(DispatcherTest, StationCapacityHoldsTasksBackOldestFirst) {
   EXPECT_EQ(next.assignments[0].task.id, "t3");
 }
 
+/// A task held back by a full line says so in its reason (one event, no repeat while nothing
+/// changes), and once its deadline has passed, that too: the WMS sees why it waits and that it is
+/// late, and the task stays queued (nothing is dropped).
+TEST_F(DispatcherTest, ATaskHeldByAFullLineSaysWhereAndWhenItIsPastItsDeadline) {
+  cfg.stationCapacity = 1;
+  reopen();
+  robot("r1", 0, 0.9, 0);
+  robot("r2", 1, 0.9, 0);
+  Task late = transport("late");
+  late.deadlineNs = 10 * kSec;
+  dispatcher->submit({transport("first"), late}, 0);
+  const auto reasonIn = [](const DispatchResult& r, const std::string& id) {
+    for (const auto& e : r.events) {
+      if (e.taskId == id) {
+        return e.reason;
+      }
+    }
+    return std::string("(no event)");
+  };
+  auto out = dispatcher->tick(1 * kSec);
+  ASSERT_EQ(out.assignments.size(), 1U);
+  EXPECT_EQ(out.assignments[0].task.id, "first");
+  EXPECT_EQ(reasonIn(out, "late"),
+            "waiting for a place in station P-1's line (it holds 1, all taken by other tasks)");
+  EXPECT_EQ(reasonIn(dispatcher->tick(2 * kSec), "late"), "(no event)") << "said once";
+  robot("r1", 0, 0.9, 11 * kSec);  // both still there: r1 on "first", r2 idle
+  robot("r2", 1, 0.9, 11 * kSec);
+  out = dispatcher->tick(11 * kSec);
+  EXPECT_EQ(reasonIn(out, "late"),
+            "past its deadline and still waiting for a place in station P-1's line "
+            "(it holds 1, all taken by other tasks)");
+  for (const auto& a : out.assignments) {
+    EXPECT_NE(a.task.id, "late") << "still held";
+  }
+  const auto rec = store->get("late");
+  ASSERT_TRUE(rec);
+  EXPECT_EQ(rec->state, S::Queued);
+  EXPECT_EQ(rec->reason, reasonIn(out, "late")) << "stored: a restarted manager says the same";
+}
+
 /// Per-station capacities (a station's line on the roadmap in reserved traffic) override the
 /// global one, and 0 there means no limit at that station.
 TEST_F(DispatcherTest, AStationsOwnCapacityOverridesTheGlobalOne) {

@@ -220,8 +220,17 @@ class Dispatcher {
   /// The closed station of `t` (nullptr: none) and the wait reasons of the waiting tasks it holds.
   [[nodiscard]] const std::string* closedStationOf(const Task& t) const;
   void noteClosedStations(std::int64_t nowNs, DispatchResult& out);
-  /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig).
-  void admitByStationCapacity(std::vector<Task>& waiting) const;
+  /// A task admission held back: the first of its stations whose line was full, and its capacity.
+  struct HeldAtStation {
+    std::string taskId;
+    std::string station;
+    std::size_t capacity = 0;
+  };
+  /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig); returns them.
+  std::vector<HeldAtStation> admitByStationCapacity(std::vector<Task>& waiting) const;
+  /// Says in their reason that (and where) the held tasks wait for a place in a station's line,
+  /// and when one has waited past its deadline.
+  void noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs, DispatchResult& out);
 
   TaskStore& store_;
   StationMap stations_;
