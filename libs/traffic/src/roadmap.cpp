@@ -59,7 +59,40 @@ const char* toString(NodeKind k) {
   return kNames[static_cast<int>(k)];
 }
 
+namespace {
+
+std::size_t errorCount(const Roadmap& r) {
+  return static_cast<std::size_t>(
+      std::count_if(r.problems.begin(), r.problems.end(),
+                    [](const RoadmapProblem& p) { return p.severity == RoadmapProblem::Severity::Error; }));
+}
+
+}  // namespace
+
+// The lattice kept clear of parked robots; where the site leaves no room for that (a parking row
+// in a corridor of its own width: stations cut off without the lanes beside it), the lattice as
+// the map allows, with a warning that parked robots block lanes there.
 Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
+  Roadmap r = detail::buildRoadmapOnce(s, options);
+  if (!options.parkingClear || errorCount(r) == 0) {
+    return r;
+  }
+  RoadmapOptions as = options;
+  as.parkingClear = false;
+  Roadmap plain = detail::buildRoadmapOnce(s, as);
+  if (errorCount(plain) >= errorCount(r)) {
+    return r;
+  }
+  const auto parking = s.ofKind(site::StationKind::Parking);
+  plain.problems.push_back({RoadmapProblem::Severity::Warning, "",
+                            parking.empty() ? Vec2{} : parking.front()->pose.position(),
+                            "the parking places stand too close to the lanes for lanes clear of them (the "
+                            "lanes beside them are the only way between stations): a robot parked there "
+                            "blocks the lanes next to it"});
+  return plain;
+}
+
+Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& options) {
   const auto& in = options;
   if (!(in.cruiseSpeed > 0.0) || in.spacing < 0.0 || (in.spacing > 0.0 && in.spacing < 0.05) ||
       !(in.targetSpacing >= 0.05) || in.radius < 0.0 || in.stopGap < 0.0 || in.corridorSlack < 0.0 ||
@@ -69,7 +102,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
         "RoadmapOptions: cruiseSpeed > 0, spacing 0 or >= 0.05 m, targetSpacing >= 0.05 m, radius, stopGap, "
         "corridorSlack, nodeClearance, edgeClearance, margin and followingDistance >= 0, queueLength 0..50");
   }
-  detail::RoadmapBuilder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}};
+  detail::RoadmapBuilder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}, {}, {}, {}};
   auto& o = b.opt;
   const double res = s.map.size() > 0 ? s.map.resolution() : 1.0;
   if (o.radius <= 0.0) {
@@ -86,6 +119,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   if (o.followingDistance <= 0.0) {
     o.followingDistance = std::ceil(sep.ahead * 20.0 - 1e-9) / 20.0;
   }
+  b.sep = sep;
 
   Roadmap r;
   if (s.map.size() > 0) {
@@ -197,7 +231,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   r.latticeOrigin = b.latticeOrigin;
   std::vector<std::uint8_t> waiting(r.kinds.size(), 0);
   for (std::size_t v = 0; v < r.kinds.size(); ++v) {
-    waiting[v] = r.kinds[v] != NodeKind::Lane ? 1 : 0;
+    waiting[v] = r.kinds[v] == NodeKind::Parking ? 2 : r.kinds[v] != NodeKind::Lane ? 1 : 0;
   }
   addGeometricConflicts(r.graph, sep, waiting);
 

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -42,6 +43,8 @@ struct RoadmapBuilder {
   std::vector<RoadmapProblem> problems;
   std::vector<StationNodes> stations;
   std::size_t latticeCount = 0;  // nodes [0, latticeCount) are the lattice
+  std::vector<std::uint8_t>
+      latticeLinked;  // per lattice node: it has a lattice edge (stations join only those)
   Vec2 latticeOrigin;
 
   NodeId add(Vec2 p, NodeKind k) {
@@ -53,6 +56,15 @@ struct RoadmapBuilder {
   [[nodiscard]] bool latticeFits(Vec2 p) const {
     return site::discFits(grid, p, opt.radius + opt.nodeClearance);
   }
+  // Parking places (robots rest there for long) with RoadmapOptions::parkingClear: the lattice
+  // keeps its nodes and edges clear of a robot parked there, so that it excludes no lane (a
+  // "well-formed" site, docs/algorithms.md "Parked robots block no lane"). Chargers are not in
+  // it: on the shipped sites they stand in a corridor along the wall that the rule would cut off.
+  std::vector<Vec2> resting;
+  Separation sep;  // set before the lattice is laid
+  /// Neither standing at `a` (a == b) nor driving a→b or b→a comes too close to a robot resting
+  /// (roadmap_conflicts.hpp, unsafe()).
+  [[nodiscard]] bool clearOfResting(Vec2 a, Vec2 b) const;
   [[nodiscard]] bool sweeps(Vec2 a, Vec2 b) const { return site::segmentFits(grid, a, b, opt.radius); }
   [[nodiscard]] bool passes(Vec2 a, Vec2 b) const {
     return site::segmentFits(grid, a, b, opt.radius + opt.edgeClearance);

@@ -154,10 +154,12 @@ std::size_t conflictPairs(const Graph& g) {
 std::size_t addGeometricConflicts(Graph& g, const Separation& s, const std::vector<std::uint8_t>& waiting) {
   const std::size_t before = conflictPairs(g);
   const auto n = static_cast<NodeId>(g.size());
-  // Which of the held pairs to make conflict: one with the fewest nodes robots wait on, the
-  // closest of those.
+  // Which of the held pairs to make conflict: one with the least weight of nodes robots wait on
+  // (a place robots rest at weighs most), the closest of those.
   auto waits = [&](NodeId v) {
-    return static_cast<std::size_t>(v) < waiting.size() && waiting[static_cast<std::size_t>(v)] != 0 ? 1 : 0;
+    return static_cast<std::size_t>(v) < waiting.size()
+               ? static_cast<int>(waiting[static_cast<std::size_t>(v)])
+               : 0;
   };
   std::vector<DirectedEdge> edges;
   double longest = 0.0;

@@ -57,6 +57,14 @@ std::vector<float> cellClearance(const planning::OccupancyGrid& g) {
 
 }  // namespace
 
+bool RoadmapBuilder::clearOfResting(Vec2 a, Vec2 b) const {
+  const bool moving = distance(a, b) > 1e-9;
+  return std::none_of(resting.begin(), resting.end(), [&](Vec2 r) {
+    const Motion rests{r, r, false};
+    return unsafe({a, b, moving}, rests, sep) || (moving && unsafe({b, a, true}, rests, sep));
+  });
+}
+
 // Lattice points are cell centres `k` cells apart. Of the k ways to lay the node rows, the one
 // through most cells on a ridge of the clearance across y (the middle of an aisle running along
 // x), and likewise for the columns: node lines run down the middle of aisles rather than two
@@ -98,6 +106,13 @@ void RoadmapBuilder::buildLattice() {
   const double cells = opt.spacing / res;
   const int k = std::abs(cells - std::round(cells)) < 1e-6 ? static_cast<int>(std::round(cells)) : 1;
   latticeOrigin = chooseLatticeOrigin(k);
+  resting.clear();
+  for (const auto& st : site.stations) {
+    if (opt.parkingClear && st.kind == site::StationKind::Parking) {
+      resting.push_back(st.pose.position());
+    }
+  }
+  const auto open = [&](Vec2 p) { return latticeFits(p) && clearOfResting(p, p); };
   const Vec2 hi = grid.origin() + Vec2{grid.width() * res, grid.height() * res};
   const double lwd = std::max(0.0, std::floor((hi.x - latticeOrigin.x) / opt.spacing) + 1.0);
   const double lhd = std::max(0.0, std::floor((hi.y - latticeOrigin.y) / opt.spacing) + 1.0);
@@ -122,7 +137,7 @@ void RoadmapBuilder::buildLattice() {
   };
   for (int b = 0; b < hh; b += 2) {
     for (int a = 0; a < hw; a += 2) {
-      if (latticeFits(point(a, b))) {
+      if (open(point(a, b))) {
         id[static_cast<std::size_t>(b * hw + a)] = add(point(a, b), NodeKind::Lane);
       }
     }
@@ -132,10 +147,10 @@ void RoadmapBuilder::buildLattice() {
     for (int a = 0; a < hw; a += 2) {
       const bool right = a + 2 < hw && at(a, b) == kNoNode && at(a + 2, b) == kNoNode;
       const bool up = b + 2 < hh && at(a, b) == kNoNode && at(a, b + 2) == kNoNode;
-      if (right && latticeFits(point(a + 1, b))) {
+      if (right && open(point(a + 1, b))) {
         filled.emplace_back(a + 1, b);
       }
-      if (up && latticeFits(point(a, b + 1))) {
+      if (up && open(point(a, b + 1))) {
         filled.emplace_back(a, b + 1);
       }
     }
@@ -149,7 +164,9 @@ void RoadmapBuilder::buildLattice() {
     steps.insert(steps.end(), {{2, 2}, {-2, 2}});
   }
   auto link = [&](NodeId u, NodeId v) {
-    if (passes(pos[static_cast<std::size_t>(u)], pos[static_cast<std::size_t>(v)])) {
+    const Vec2 pu = pos[static_cast<std::size_t>(u)];
+    const Vec2 pv = pos[static_cast<std::size_t>(v)];
+    if (passes(pu, pv) && clearOfResting(pu, pv)) {
       links.push_back({u, v, true, true});
     }
   };
@@ -176,6 +193,13 @@ void RoadmapBuilder::buildLattice() {
       }
     }
   }
+  // A lattice node left without an edge (all of them too close to a parked robot) leads nowhere:
+  // a station joined to it would be cut off.
+  latticeLinked.assign(latticeCount, 0);
+  for (const auto& l : links) {
+    latticeLinked[static_cast<std::size_t>(l.a)] = 1;
+    latticeLinked[static_cast<std::size_t>(l.b)] = 1;
+  }
 }
 
 // Joins `v` to the lattice nodes within one spacing that the disc reaches in a straight line
@@ -192,6 +216,9 @@ int RoadmapBuilder::joinToLattice(NodeId v, const std::vector<Vec2>& dirs, doubl
   std::vector<std::pair<double, NodeId>> near;
   const double reach2 = std::pow(3.0 * opt.spacing + 1e-9, 2);
   for (NodeId w = 0; w < static_cast<NodeId>(latticeCount); ++w) {
+    if (latticeLinked[static_cast<std::size_t>(w)] == 0) {
+      continue;
+    }
     const Vec2 d = pos[static_cast<std::size_t>(w)] - p;
     if (d.squaredNorm() > reach2) {
       continue;

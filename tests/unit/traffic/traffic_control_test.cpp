@@ -106,6 +106,7 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   RoadmapOptions o;
   o.nodeClearance = 0.0;
   o.edgeClearance = 0.0;
+  o.parkingClear = false;  // the lanes beside the parking row, as a site without room for others has
   Roadmap map = smallWarehouse(o);
   const NodeId park = map.station("PARK-1")->dock;
   // The lane node just right of the dock's exit (PARK-1 at (3, 0.9) is left by (3, 1.9)): it
@@ -165,8 +166,12 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
 /// parked robot is where it wants to be, so neither the escape nor the untangling saw a knot, and
 /// evasion finds the parked robot no refuge (its only way out is excluded by r7). Once the knot is
 /// untied both get where they are going, and the parked robot back to its place.
+/// The lanes beside the parking row are the lattice a site without room for lanes clear of parked
+/// robots gets (RoadmapOptions::parkingClear false); the shipped lattice has no such knot.
 TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
-  Roadmap map = smallWarehouse();
+  RoadmapOptions lanesBesideParking;
+  lanesBesideParking.parkingClear = false;
+  Roadmap map = smallWarehouse(lanesBesideParking);
   const TwentyRobots fleet;
   const auto index = [&](const std::string& n) { return fleet.index(n); };
   const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
@@ -545,9 +550,10 @@ TEST(VirtualFleet, AStationCapKeepsTasksApartAndTheRestParked) {
 // One pickup and one drop-off shared by six robots: only they are visited, and the station ledger
 // counts a dock cycle (arrival to the next arrival) only when the next robot stood in the station's
 // line (a queue place or the approach) as the last one left: the station's own cycle, at least the
-// dwell and here at most 12 s (6.4-10.8 s measured over seeds 1-8). Counting every robot that had
-// joined the line, wherever it was, gave ~19 s at D-2 (the next robot's drive from afar), which
-// this bound catches.
+// dwell. At the dead-end drop-off D-2 that is 10.3-12.4 s p50 over seeds 1-8; counting every
+// robot that had joined the line, wherever it was, gave ~19 s (the next robot's drive from afar),
+// which the 15 s bound here catches. The drive-through pickup P-3 cycles in ~6.5 s or, when the
+// next robot is held on its way into the line, in ~25 s: too few cycles a run to bound its median.
 TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;
@@ -555,26 +561,31 @@ TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
   o.duration = 600.0;
   o.admission = false;  // six robots on two stations: lines that fill
   o.stations = {"P-3", "D-2"};
-  const auto r = runVirtualFleet(map, o);
-  SCOPED_TRACE(formatResult(r));
-  EXPECT_GT(r.tasksDone, 5U);
-  ASSERT_EQ(r.stations.size(), 2U);
   std::size_t cycles = 0;
-  for (const auto& st : r.stations) {
-    EXPECT_TRUE(st.name == "P-3" || st.name == "D-2") << st.name;
-    EXPECT_GE(st.visits, r.tasksDone) << st.name;
-    cycles += st.cycles;
-    if (st.cycles == 0)
-      continue;
-    EXPECT_GE(st.cycleP50, o.dwell) << st.name;
-    EXPECT_GE(st.cycleP90, st.cycleP50) << st.name;
-    EXPECT_LE(st.cycleP50, 12.0) << st.name;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    o.seed = seed;
+    const auto r = runVirtualFleet(map, o);
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_GT(r.tasksDone, 5U);
+    ASSERT_EQ(r.stations.size(), 2U);
+    for (const auto& st : r.stations) {
+      EXPECT_TRUE(st.name == "P-3" || st.name == "D-2") << st.name;
+      EXPECT_GE(st.visits, r.tasksDone) << st.name;
+      cycles += st.cycles;
+      if (st.cycles == 0)
+        continue;
+      EXPECT_GE(st.cycleP50, o.dwell) << st.name;
+      EXPECT_GE(st.cycleP90, st.cycleP50) << st.name;
+      if (st.name == "D-2") {
+        EXPECT_LE(st.cycleP50, 15.0) << st.name;
+      }
+    }
+    for (const auto& t : r.tasks) {
+      EXPECT_EQ(t.pickup, map.station("P-3")->dock);
+      EXPECT_EQ(t.dropoff, map.station("D-2")->dock);
+    }
   }
-  EXPECT_GE(cycles, 3U) << "robots stood in line behind each other";
-  for (const auto& t : r.tasks) {
-    EXPECT_EQ(t.pickup, map.station("P-3")->dock);
-    EXPECT_EQ(t.dropoff, map.station("D-2")->dock);
-  }
+  EXPECT_GE(cycles, 6U) << "robots stood in line behind each other";
   o.stations = {"P-5"};  // no drop-off among them
   EXPECT_THROW(runVirtualFleet(map, o), std::invalid_argument);
 }
@@ -625,14 +636,14 @@ TEST(VirtualFleet, ALoneRobot) {
 
 /// The stall of the CI check of 2cc34ae (2026-12-03, `FleetScenario.TwentyRobotsOneHundredTasks…`,
 /// 99 of 100 done): r2, on its way to P-2, drove east on the lane just above the parking row while
-/// the 19 others stood parked in every place below it, and stood at node 77 (11.75, 1.75) for the
-/// rest of the run: "planned 0 nodes ahead, waiting on nobody". Reproduced here deterministically
-/// (every seed tried, 1–6): its best move (78, east) is excluded by r10 parked at PARK-10, whose only
-/// way out is excluded by r2, so the push fails and PIBT keeps r2 where it is; the one free
-/// neighbour (76, west) ranks below standing, and neither a detour, the escape nor the knot search
-/// moves it. Disabled until the planner gets past it (the flow issue's new planner, or a knot rule
-/// for a robot beside a content parked one): it fails today.
-TEST(TrafficControl, DISABLED_ARobotOnTheLaneAboveAFullParkingRowGoesOn) {
+/// the 19 others stood parked in every place below it, and stood at (11.75, 1.75) for the rest of
+/// the run: "planned 0 nodes ahead, waiting on nobody". On the lattice beside the parking row its
+/// best move (east) was excluded by r10 parked at PARK-10 (a diagonal lane edge led towards it),
+/// whose only way out was excluded by r2; the one free neighbour (west) ranked below standing, and
+/// neither a detour, the escape nor the knot search moved it (every seed tried, 1-6). The lattice
+/// now keeps clear of parked robots (RoadmapOptions::parkingClear), so nothing parked excludes a
+/// lane and r2 drives on.
+TEST(TrafficControl, ARobotOnTheLaneAboveAFullParkingRowGoesOn) {
   Roadmap map = smallWarehouse();
   const TwentyRobots fleet;
   const auto index = [&](const std::string& n) { return fleet.index(n); };

@@ -72,6 +72,10 @@ struct RoadmapOptions {
   double edgeClearance = 0.07;
   int queueLength = 3;             ///< generated queue nodes per station (pickup, drop-off, charger)
   double followingDistance = 0.0;  ///< m between generated queue nodes; 0: the `ahead` separation
+  /// true: the lattice keeps its nodes and edges clear of robots parked at the parking places, so
+  /// a parked robot excludes no lane (buildRoadmap falls back to false, with a warning, on a site
+  /// that leaves no room for it); false: the lattice as the map allows.
+  bool parkingClear = true;
 };
 
 enum class NodeKind : std::uint8_t { Lane, Station, Approach, Queue, Parking, Charger, Exit };
@@ -102,6 +106,12 @@ struct Closure {
   std::vector<std::pair<NodeId, NodeId>> edges;  ///< directed a→b
   std::vector<std::string> cutOff;               ///< stations connected before the closure and not after it
 };
+
+class Roadmap;
+namespace detail {
+/// buildRoadmap without its fall-back (RoadmapOptions::parkingClear as given).
+Roadmap buildRoadmapOnce(const site::Site& site, const RoadmapOptions& options);
+}  // namespace detail
 
 class Roadmap {
  public:
@@ -137,7 +147,7 @@ class Roadmap {
   void reopen(const Closure& c);
 
  private:
-  friend Roadmap buildRoadmap(const site::Site&, const RoadmapOptions&);
+  friend Roadmap detail::buildRoadmapOnce(const site::Site&, const RoadmapOptions&);
   Closure close(std::vector<NodeId> nodes, std::vector<std::pair<NodeId, NodeId>> edges);
   double turnRate_ = 1.5;   ///< rad/s
   double turnAccel_ = 3.0;  ///< rad/s²

@@ -17,9 +17,11 @@
 // How: every pair of motions (standing on a node, or driving an edge) whose held nodes are disjoint
 // and which could come too close (unsafe()) must have a conflicting pair of held nodes. Standing
 // robots too close make their nodes conflict; for the rest, when no held pair conflicts yet, one
-// held pair is made to conflict (greedy, deterministic): of those with the fewest nodes robots wait
-// on (docks, approach and queue nodes), the closest — so that neighbouring parking places or queue
-// nodes are not made to exclude each other when a lane node next to them can carry the conflict.
+// held pair is made to conflict (greedy, deterministic): of those with the least weight of nodes
+// robots wait on (docks, approach and queue nodes; parking places, where robots rest, weigh most),
+// the closest — so that neighbouring parking places or queue nodes are not made to exclude each
+// other when a lane node next to them can carry the conflict, and a robot leaving its parking place
+// is given the conflict on its way out (the approach) rather than where it rests.
 // Edges sharing a node never need a conflict: their robots hold that node.
 
 #include <cstddef>
@@ -56,8 +58,8 @@ struct Motion {
 bool unsafe(const Motion& a, const Motion& b, const Separation& s);
 
 /// Adds the conflicts described above to `g` for every node and every edge (open or not: closures
-/// are temporary, conflicts are not). `waiting[v]` != 0 marks the nodes robots wait on (may be
-/// empty). Returns the number of conflicting pairs added.
+/// are temporary, conflicts are not). `waiting[v]`: 0 a lane node, 1 a node robots wait on, 2 a
+/// place robots rest at (may be empty: all lanes). Returns the number of conflicting pairs added.
 std::size_t addGeometricConflicts(Graph& g, const Separation& s,
                                   const std::vector<std::uint8_t>& waiting = {});
 
