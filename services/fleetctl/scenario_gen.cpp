@@ -10,16 +10,18 @@ namespace {
 constexpr double kRes = 0.5;            // m per cell, as in the template
 constexpr double kAreaPerRobot = 30.0;  // m², the small warehouse's floor per robot
 constexpr double kParkDx = 1.2;         // m between parked robots
-constexpr double kRowDy = 1.6;          // m between parking rows (1 m lane for 0.3 m robots)
-// One parking row, when the fleet fits in one: 0.9 m off the wall like the small warehouse's, its
-// ends 2.5 m from the side walls, so a lane 0.85 m above it that a parked robot leaves clear runs
-// under the shelves and round both ends (a well-formed site: the roadmap's lattice keeps clear of
-// parked robots, RoadmapOptions::parkingClear). Several rows keep the layout below, 1.6 m apart
-// with the lanes beside the parked robots (the roadmap falls back to those, with a warning): rows
-// further apart made the lane under each a 60 m dead end and the fleet stood (virtual fleet, site
-// for 100: 2-12 tasks in 600 s against 17-35).
-constexpr double kOneRowY = 0.9;
-constexpr double kOneRowEnd = 2.5;
+// Parking, a well-formed site (a parked robot is in nobody's way: the roadmap's lattice keeps clear
+// of parked robots, RoadmapOptions::parkingClear). Rows face north, the first 0.9 m off the wall
+// like the small warehouse's, each with a lane 0.85 m above it; a row's ends 2.5 m from the side
+// walls so the lanes join round them. A fleet that fits in one row parks in one; several rows are
+// kRowDy apart and made of blocks of kBlock places with a lane's gap between blocks, so every lane
+// between rows is joined to the others every ~11 m. Rows 2 m apart without the gaps made each lane
+// a 60 m dead end and the site for 100 stood (virtual fleet, seeds 1-4: 2-12 tasks in 600 s; with
+// the gaps 65-70; the earlier rows 1.6 m apart with lanes beside the parked robots 17-35).
+constexpr double kRowY = 0.9;
+constexpr double kRowEnd = 2.5;
+constexpr double kRowDy = 2.0;
+constexpr int kBlock = 8;
 constexpr double kStationGap = 2.5;  // m between pickups / drop-offs / chargers
 
 nlohmann::json station(const std::string& name, const char* kind, double x, double y, double theta) {
@@ -48,12 +50,18 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   const double area = std::max(600.0, kAreaPerRobot * n);
   double widthM = std::max(30.0, std::round(std::sqrt(area * 1.5)));
   // Parking: rows along the bottom margin; the margin grows with the number of rows.
-  const bool oneRow = sized <= static_cast<int>(std::floor((widthM - 2.0 * kOneRowEnd) / kParkDx)) + 1;
-  const int perRow = oneRow ? sized : static_cast<int>(std::floor((widthM - 4.0) / kParkDx)) + 1;
+  const bool oneRow = sized <= static_cast<int>(std::floor((widthM - 2.0 * kRowEnd) / kParkDx)) + 1;
+  const auto placeX = [&](int i) { return kRowEnd + i * kParkDx + (oneRow ? 0 : i / kBlock) * kParkDx; };
+  int perRow = sized;
+  if (!oneRow) {
+    perRow = 0;
+    while (placeX(perRow) <= widthM - kRowEnd) {
+      ++perRow;
+    }
+  }
   const int rows = (sized + perRow - 1) / perRow;
-  const double rowX = oneRow ? kOneRowEnd : 2.0;
-  const double rowY = oneRow ? kOneRowY : 1.25;
-  const double marginM = std::max(2.5, std::ceil((1.25 + (rows - 1) * kRowDy + 1.0) / kRes) * kRes);
+  // The bottom margin holds the rows, the last one's lane and that lane's clearance (0.85 + 0.4 m).
+  const double marginM = std::max(2.5, std::ceil((kRowY + (rows - 1) * kRowDy + 1.25) / kRes) * kRes);
   double heightM = std::max(20.0, std::round(area / widthM) + 2.0 * (marginM - 2.5));
   const int wCells = static_cast<int>(widthM / kRes);
   const int hCells = static_cast<int>(heightM / kRes);
@@ -84,7 +92,7 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
     for (int i = 0; i < perRow && k < sized; ++i) {
       ++k;
       stations.push_back(
-          station("PARK-" + std::to_string(k), "parking", rowX + i * kParkDx, rowY + r * kRowDy, 1.5708));
+          station("PARK-" + std::to_string(k), "parking", placeX(i), kRowY + r * kRowDy, 1.5708));
     }
   }
   // Chargers, pickups, drop-offs: about one per ten, four and five robots, as room allows.

@@ -59,9 +59,9 @@ TEST_P(GeneratedScenario, LoadsInTheSimulatorAndFitsTheFleet) {
 }
 
 // The traffic manager's roadmap of the generated site has no errors: every station connected both
-// ways, and no station's full line cuts off another (traffic::checkQueues). A fleet that parks in
-// one row gets a well-formed site: the lattice keeps clear of parked robots (no fall-back); several
-// rows keep the lanes beside the parked robots (scenario_gen.cpp says why).
+// ways, and no station's full line cuts off another (traffic::checkQueues); and the site is
+// well-formed where robots rest: the lattice keeps clear of parked robots (no fall-back), in one
+// parking row (1, 20 robots) and in several (100, 500).
 TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
   const int n = GetParam();
   auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
@@ -72,8 +72,7 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
   for (const auto& p : r.problems) {
     EXPECT_NE(p.severity, traffic::RoadmapProblem::Severity::Error) << p.what;
   }
-  EXPECT_EQ(r.options.parkingClear, n <= 20) << n << " robots";
-  if (n <= 20 && !r.options.parkingClear) {
+  if (!r.options.parkingClear) {
     // Why the lattice clear of parked robots was not taken: its errors.
     for (const auto& p : traffic::detail::buildRoadmapOnce(*s.site, {}).problems) {
       ADD_FAILURE() << p.what;
