@@ -60,8 +60,8 @@ struct RoadmapBuilder {
   // keeps its nodes and edges clear of a robot parked there, so that it excludes no lane (a
   // "well-formed" site, docs/algorithms.md "Parked robots block no lane"). Chargers are not in
   // it: on the shipped sites they stand in a corridor along the wall that the rule would cut off.
-  std::vector<Vec2> resting;
-  Separation sep;  // set before the lattice is laid
+  std::vector<Vec2> resting;  // sorted by x
+  Separation sep;             // set before the lattice is laid
   /// Neither standing at `a` (a == b) nor driving a→b or b→a comes too close to a robot resting
   /// (roadmap_conflicts.hpp, unsafe()).
   [[nodiscard]] bool clearOfResting(Vec2 a, Vec2 b) const;

@@ -59,10 +59,23 @@ std::vector<float> cellClearance(const planning::OccupancyGrid& g) {
 
 bool RoadmapBuilder::clearOfResting(Vec2 a, Vec2 b) const {
   const bool moving = distance(a, b) > 1e-9;
-  return std::none_of(resting.begin(), resting.end(), [&](Vec2 r) {
-    const Motion rests{r, r, false};
-    return unsafe({a, b, moving}, rests, sep) || (moving && unsafe({b, a, true}, rests, sep));
-  });
+  // No motion reaches further than `ahead` beyond its own segment (roadmap_conflicts.hpp): only the
+  // parking places in that box can be too close. `resting` is sorted by x.
+  const double lo = std::min(a.x, b.x) - sep.ahead;
+  const double hi = std::max(a.x, b.x) + sep.ahead;
+  const double ylo = std::min(a.y, b.y) - sep.ahead;
+  const double yhi = std::max(a.y, b.y) + sep.ahead;
+  auto it = std::lower_bound(resting.begin(), resting.end(), lo, [](Vec2 r, double x) { return r.x < x; });
+  for (; it != resting.end() && it->x <= hi; ++it) {
+    if (it->y < ylo || it->y > yhi) {
+      continue;
+    }
+    const Motion rests{*it, *it, false};
+    if (unsafe({a, b, moving}, rests, sep) || (moving && unsafe({b, a, true}, rests, sep))) {
+      return false;
+    }
+  }
+  return true;
 }
 
 // Lattice points are cell centres `k` cells apart. Of the k ways to lay the node rows, the one
@@ -112,6 +125,7 @@ void RoadmapBuilder::buildLattice() {
       resting.push_back(st.pose.position());
     }
   }
+  std::sort(resting.begin(), resting.end(), [](Vec2 p, Vec2 q) { return p.x < q.x; });
   const auto open = [&](Vec2 p) { return latticeFits(p) && clearOfResting(p, p); };
   const Vec2 hi = grid.origin() + Vec2{grid.width() * res, grid.height() * res};
   const double lwd = std::max(0.0, std::floor((hi.x - latticeOrigin.x) / opt.spacing) + 1.0);
