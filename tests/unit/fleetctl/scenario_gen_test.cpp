@@ -72,6 +72,8 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
   for (const auto& p : r.problems) {
     EXPECT_NE(p.severity, traffic::RoadmapProblem::Severity::Error) << p.what;
   }
+  EXPECT_TRUE(r.options.parkingClear)
+      << n << " robots: the roadmap fell back to lanes beside the parked robots";
   if (!r.options.parkingClear) {
     // Why the lattice clear of parked robots was not taken: its errors.
     for (const auto& p : traffic::detail::buildRoadmapOnce(*s.site, {}).problems) {
