@@ -51,7 +51,7 @@ void DistanceTable::setBlocked(NodeId v, bool blocked) {
   auto& b = blocked_[static_cast<std::size_t>(v)];
   if ((b != 0) != blocked) {
     b = blocked ? 1 : 0;
-    dirty_ = true;
+    changed_.push_back(v);
   }
 }
 
@@ -62,20 +62,61 @@ bool DistanceTable::setNodeCost(std::vector<float> cost) {
   if (cost == nodeCost_) {
     return false;
   }
+  const std::size_t n = graph_.size();
+  const auto at = [n](const std::vector<float>& c, std::size_t v) { return c.size() == n ? c[v] : 0.0F; };
+  if ((cost.size() == n || cost.empty()) && (nodeCost_.size() == n || nodeCost_.empty())) {
+    for (std::size_t v = 0; v < n; ++v) {
+      if (at(cost, v) != at(nodeCost_, v)) {
+        changed_.push_back(static_cast<NodeId>(v));
+      }
+    }
+  } else {
+    dirty_ = true;  // a table of another size: start over
+  }
   nodeCost_ = std::move(cost);
-  dirty_ = true;
   return true;
+}
+
+float DistanceTable::baseEnter(std::size_t v) const {
+  const bool open = graph_.isOpen(static_cast<NodeId>(v)) && blocked_[v] == 0;
+  return !open ? kUnreachable : nodeCost_.size() == graph_.size() ? nodeCost_[v] : 0.0F;
+}
+
+void DistanceTable::applyChanges() {
+  if (dirty_ || changed_.size() > graph_.size() / 2) {
+    invalidate();
+    return;
+  }
+  for (const NodeId w : changed_) {
+    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
+  }
+  // A search that has not settled a changed node has not used its entering cost (it is read when
+  // the node is settled and relaxes its predecessors); its settled distances are final for the new
+  // costs (a way through the node costs at least the node's own distance, no less than any settled
+  // one) and its frontier is the one a search started now would have. A table that has is
+  // restarted from its goal, searched again only as far as it is read.
+  for (std::size_t slot = 0; slot < used_; ++slot) {
+    PartialTable& t = tables_[slot];
+    if (t.empty() || t.settledCount == 0) {
+      continue;
+    }
+    if (std::any_of(changed_.begin(), changed_.end(), [&](NodeId w) { return t.isSettled(w); })) {
+      start(t.goal, t);
+      ++computed_;
+    }
+  }
+  changed_.clear();
 }
 
 void DistanceTable::invalidate() {
   dirty_ = false;
+  changed_.clear();
   blocked_.resize(graph_.size(), 0);
   buildReverse();
   // Entering each node in a goal's table: its node cost, never when closed or blocked.
   baseEnter_.resize(graph_.size());
   for (std::size_t v = 0; v < graph_.size(); ++v) {
-    const bool open = graph_.isOpen(static_cast<NodeId>(v)) && blocked_[v] == 0;
-    baseEnter_[v] = !open ? kUnreachable : nodeCost_.size() == graph_.size() ? nodeCost_[v] : 0.0F;
+    baseEnter_[v] = baseEnter(v);
   }
   const std::size_t n = std::max<std::size_t>(graph_.size(), 1);
   const std::size_t byBudget = maxBytes_ / (n * sizeof(float));
@@ -144,8 +185,8 @@ std::size_t DistanceTable::acquireSlot() {
 }
 
 std::size_t DistanceTable::acquire(NodeId goal) {
-  if (dirty_) {
-    invalidate();
+  if (dirty_ || !changed_.empty()) {
+    applyChanges();
   }
   const auto g = static_cast<std::size_t>(goal);
   std::int32_t slot = slotOfGoal_[g];
@@ -212,11 +253,7 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
     return;
   }
   d[static_cast<std::size_t>(goal)] = 0.0F;
-  if (nodeCost_.size() == graph_.size()) {
-    dijkstra(goal, nodeCost_, d);
-    return;
-  }
-  if (unit_) {
+  {  // breadth-first: every edge lasts the same and no node costs more (to())
     queue_.clear();
     queue_.push_back(goal);
     for (std::size_t head = 0; head < queue_.size(); ++head) {
@@ -235,56 +272,6 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
         if (open(p)) {
           queue_.push_back(p);
         }
-      }
-    }
-    return;
-  }
-  dijkstra(goal, {}, d);
-}
-
-void DistanceTable::withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& d) {
-  if (dirty_) {
-    invalidate();
-  }
-  d.assign(graph_.size(), kUnreachable);
-  if (!graph_.valid(goal) || !graph_.isOpen(goal) || extra.size() != graph_.size()) {
-    return;
-  }
-  d[static_cast<std::size_t>(goal)] = 0.0F;
-  if (nodeCost_.size() == graph_.size()) {
-    combined_.resize(extra.size());
-    for (std::size_t v = 0; v < extra.size(); ++v) {
-      combined_[v] = extra[v] + nodeCost_[v];
-    }
-    dijkstra(goal, combined_, d);
-    return;
-  }
-  dijkstra(goal, extra, d);
-}
-
-void DistanceTable::dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d) {
-  const auto open = [&](NodeId v) { return graph_.isOpen(v) && blocked_[static_cast<std::size_t>(v)] == 0; };
-  heap_.clear();
-  heap_.emplace_back(0.0F, goal);
-  const auto later = std::greater<>{};
-  while (!heap_.empty()) {
-    std::pop_heap(heap_.begin(), heap_.end(), later);
-    const auto [du, u] = heap_.back();
-    heap_.pop_back();
-    if (du > d[static_cast<std::size_t>(u)] || (u != goal && !open(u))) {
-      continue;
-    }
-    // Driving p→u costs the edge plus what standing in u's way costs (nothing for the goal).
-    const float enter = u == goal || extra.empty() ? 0.0F : extra[static_cast<std::size_t>(u)];
-    for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
-         k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
-      const NodeId p = revFrom_[k];
-      const float nd = du + revDuration_[k] + enter;
-      auto& dp = d[static_cast<std::size_t>(p)];
-      if (nd < dp) {
-        dp = nd;
-        heap_.emplace_back(nd, p);
-        std::push_heap(heap_.begin(), heap_.end(), later);
       }
     }
   }

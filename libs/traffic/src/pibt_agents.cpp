@@ -37,6 +37,7 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   still_.assign(n, 0);
   detour_.assign(n, {});
   detourFrom_.assign(n, 0.0F);
+  detourAt_.assign(n, kNoNode);
   tries_.assign(n, 0);
   visited_.assign(n, 0);
   forced_.assign(n, {});
@@ -244,6 +245,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
     prev_.resize(n, kNoNode);
     detour_.resize(n);
     detourFrom_.resize(n, 0.0F);
+    detourAt_.resize(n, kNoNode);
     tries_.resize(n, 0);
     visited_.resize(n, 0);
     forced_.resize(n);

@@ -2,6 +2,7 @@
 // standing robots") and the settling of every agent's table where the planner reads it ("Tables
 // searched only as far as they are read").
 
+#include <cmath>
 #include <vector>
 
 #include "fleet/traffic/pibt.hpp"
@@ -28,8 +29,8 @@ void Pibt::planDetours() {
       dropDetour(i);
       continue;
     }
-    if (!detour_[i].empty() && distances_.distance(now_[i], goal_[i]) < detourFrom_[i]) {
-      dropDetour(i);  // past what it went round: the shortest way is its way again
+    if (!detour_[i].empty() && (distances_.distance(now_[i], goal_[i]) < detourFrom_[i] || !nearDetour(i))) {
+      dropDetour(i);  // past what it went round, or out of its disc: the shortest way again
     }
     if (budget == 0 || stalled_[i] < options_.detourAfter || still_[i] < options_.detourAfter) {
       continue;
@@ -58,7 +59,8 @@ void Pibt::planDetours() {
       own(w);
     }
     const float from = distances_.distance(now_[i], goal_[i]);
-    distances_.startWithExtraCost(goal_[i], extra_, detour_[i]);
+    distances_.detourAround(goal_[i], now_[i], options_.detourRadius, extra_, detour_[i]);
+    detourAt_[i] = now_[i];
     --budget;
     ++stats_.detours;
     const float there = distances_.settle(detour_[i], now_[i]);
@@ -71,6 +73,12 @@ void Pibt::planDetours() {
     stalled_[i] = 0;
   }
   settleTables();
+}
+
+bool Pibt::nearDetour(std::size_t i) const {
+  const Vec2 a = graph_.position(now_[i]);
+  const Vec2 b = graph_.position(detourAt_[i]);
+  return std::hypot(a.x - b.x, a.y - b.y) <= options_.detourKeep;
 }
 
 void Pibt::settleTable(std::size_t i, int hops) {

@@ -1,13 +1,11 @@
-// A detour table searched only as far as it is read (DistanceTable::startWithExtraCost / settle).
+// A goal's table searched only as far as it is read (DistanceTable::distance / settle).
 //
-// The planner reads an agent's detour table at the agent's node and its neighbours (and, to
-// untangle a knot, a few steps further): a Dijkstra from the goal that stops once those nodes are
-// settled and resumes when the agent has moved gives them the very values a whole-graph search
-// gives, having visited the nodes closer to the goal than the agent only (on the generated site
-// for 300 robots ~1,200 of ~19,000 nodes on average: most detours are short, to a parking place or
-// along a station's line). What the graph looked like when the detour was taken is kept in the
-// per-node entering cost, a node that could not be entered then costing infinity, so a resumed
-// search is the search that would have run to the end then.
+// The planner reads an agent's table at the agent's node and its neighbours (and, to untangle a
+// knot, a few steps further): a Dijkstra from the goal that stops once those nodes are settled and
+// resumes when another agent reads further off gives them the very values a whole-graph search
+// gives, having visited the nodes closer to the goal than the agents only. Each node's entering
+// cost is read when the node is settled, which is what lets a change of it restart only the tables
+// that have settled the node (DistanceTable::applyChanges).
 
 #include <algorithm>
 #include <functional>
@@ -16,39 +14,12 @@
 
 namespace fleet::traffic {
 
-void DistanceTable::startWithExtraCost(NodeId goal, std::span<const float> extra, PartialTable& out) {
-  if (dirty_) {
-    invalidate();
-  }
-  const std::size_t n = graph_.size();
-  out.goal = goal;
-  out.dist.assign(n, kUnreachable);
-  out.settled.assign((n + 63) / 64, 0);
-  out.heap.clear();
-  out.settledCount = 0;
-  if (!graph_.valid(goal) || !graph_.isOpen(goal) || extra.size() != n) {
-    out.enter.assign(n, kUnreachable);
-    return;  // nothing reachable: an empty frontier
-  }
-  out.enter.resize(n);
-  const bool nodeCost = nodeCost_.size() == n;
-  for (std::size_t v = 0; v < n; ++v) {
-    // The same float a whole search adds (extra + node cost); closed and blocked: never entered.
-    const bool open = graph_.isOpen(static_cast<NodeId>(v)) && blocked_[v] == 0;
-    out.enter[v] = !open ? kUnreachable : nodeCost ? extra[v] + nodeCost_[v] : extra[v];
-  }
-  const auto g = static_cast<std::size_t>(goal);
-  out.enter[g] = 0.0F;  // arriving costs nothing; a blocked goal is still expanded
-  out.dist[g] = 0.0F;
-  out.heap.emplace_back(0.0F, goal);
-}
-
 float DistanceTable::settle(PartialTable& t, NodeId v) const {
-  return settleIn(t, t.enter, v);
+  return settleIn(t, baseEnter_, v);
 }
 
 void DistanceTable::settleAround(PartialTable& t, NodeId v, int hops) const {
-  settleAroundIn(t, t.enter, v, hops);
+  settleAroundIn(t, baseEnter_, v, hops);
 }
 
 float DistanceTable::settleIn(PartialTable& t, std::span<const float> enterOf, NodeId v) const {
@@ -74,7 +45,7 @@ float DistanceTable::settleIn(PartialTable& t, std::span<const float> enterOf, N
     ++t.settledCount;
     const float enter = un == t.goal ? 0.0F : enterOf[u];
     if (enter != kUnreachable) {
-      // Driving p→u costs the edge plus entering u (DistanceTable::dijkstra's expression).
+      // Driving p→u costs the edge plus entering u (a node's entering cost is paid by whoever drives in).
       for (std::uint32_t k = revStart_[u]; k < revStart_[u + 1]; ++k) {
         const NodeId p = revFrom_[k];
         const float nd = du + revDuration_[k] + enter;

@@ -10,6 +10,7 @@
 using namespace fleet;
 using namespace fleet::traffic;
 using fleet::traffic::test::gridOf;
+using fleet::traffic::test::randomDigraph;
 
 namespace {
 
@@ -238,4 +239,74 @@ TEST(DistanceTable, BlockedNodesAreRoutedAroundButStayReachableAsGoals) {
   EXPECT_EQ(t.distance(m.node(2, 0), m.node(4, 0)), 2.0F);  // and off it
   t.setBlocked(m.node(2, 0), false);
   EXPECT_EQ(t.distance(m.node(0, 0), m.node(4, 0)), 4.0F);
+}
+
+// Blocking, unblocking and node costs restart only the tables that have read a changed node
+// (applyChanges): after any sequence of changes and partial reads, every table a cached search
+// gives holds what a table built afresh with the same state holds, exactly.
+TEST(DistanceTable, ChangesRestartOnlyTheTablesThatReadThemAndLeaveEveryValueExact) {
+  std::mt19937_64 rng(23);
+  for (int round = 0; round < 40; ++round) {
+    const int n = 25 + round % 17;
+    const Graph g = randomDigraph(n, n, round % 2 == 0, rng);
+    std::uniform_int_distribution<int> node(0, n - 1);
+    std::uniform_int_distribution<int> quarter(1, 8);
+    DistanceTable cached(g);
+    std::vector<std::uint8_t> blocked(static_cast<std::size_t>(n), 0);
+    std::vector<float> cost;
+    std::uint64_t restarts = 0;
+    for (int q = 0; q < 30; ++q) {
+      // Read a few nodes of a few goals: tables settled part of the way, some whole (to()).
+      for (int k = 0; k < 4; ++k) {
+        const NodeId goal = node(rng);
+        if (k == 0 && q % 3 == 0) {
+          (void)cached.to(goal);
+        } else {
+          (void)cached.distance(node(rng), goal);
+        }
+      }
+      const std::uint64_t before = cached.computed();
+      const int what = q % 4;
+      if (what < 2) {
+        const NodeId v = node(rng);
+        blocked[static_cast<std::size_t>(v)] ^= 1U;
+        cached.setBlocked(v, blocked[static_cast<std::size_t>(v)] != 0);
+      } else if (what == 2) {
+        cost.assign(static_cast<std::size_t>(n), 0.0F);
+        cost[static_cast<std::size_t>(node(rng))] = static_cast<float>(quarter(rng));
+        cost[static_cast<std::size_t>(node(rng))] = static_cast<float>(quarter(rng)) * 0.5F;
+        cached.setNodeCost(cost);
+      } else if (q % 8 == 7) {
+        cost.clear();
+        cached.setNodeCost(cost);
+      }
+      DistanceTable fresh(g);
+      for (int v = 0; v < n; ++v) {
+        fresh.setBlocked(v, blocked[static_cast<std::size_t>(v)] != 0);
+      }
+      fresh.setNodeCost(cost);
+      for (int k = 0; k < 6; ++k) {
+        const NodeId goal = node(rng);
+        const NodeId from = node(rng);
+        EXPECT_EQ(cached.distance(from, goal), fresh.distance(from, goal))
+            << "round " << round << " query " << q << ": " << from << " -> " << goal;
+      }
+      restarts += cached.computed() - before;
+    }
+    EXPECT_GT(restarts, 0U) << "round " << round << ": some change reached a table";
+  }
+}
+
+TEST(DistanceTable, ABlockedNodeTheSearchHasNotReachedKeepsTheTable) {
+  const GridMap m = gridOf({"........................"});
+  DistanceTable t(m.graph);
+  EXPECT_EQ(t.distance(m.node(2, 0), m.node(0, 0)), 2.0F);  // settled round the goal only
+  const std::uint64_t before = t.computed();
+  t.setBlocked(m.node(20, 0), true);  // far past what was read
+  EXPECT_EQ(t.distance(m.node(3, 0), m.node(0, 0)), 3.0F);
+  EXPECT_EQ(t.computed(), before) << "the table went on where it was";
+  EXPECT_EQ(t.distance(m.node(23, 0), m.node(0, 0)), kInf) << "and honours the block it reaches";
+  t.setBlocked(m.node(1, 0), true);  // settled: the table starts again
+  EXPECT_EQ(t.distance(m.node(3, 0), m.node(0, 0)), kInf);
+  EXPECT_EQ(t.computed(), before + 1);
 }

@@ -30,6 +30,25 @@ inline GridMap gridOf(const std::vector<std::string>& rows) {
   return m ? std::move(*m) : GridMap{};
 }
 
+/// n nodes in rows of `perRow` (1 m apart) and 3n random directed edges: every edge 1 s
+/// (`unit`) or a random multiple of 0.25 s, so that shortest ways tie and sums stay exact.
+inline Graph randomDigraph(int n, int perRow, bool unit, std::mt19937_64& rng) {
+  Graph g;
+  for (int i = 0; i < n; ++i) {
+    g.addNode({static_cast<double>(i % perRow), static_cast<double>(i / perRow)});
+  }
+  std::uniform_int_distribution<int> node(0, n - 1);
+  std::uniform_int_distribution<int> quarter(1, 8);
+  for (int e = 0; e < n * 3; ++e) {
+    const int a = node(rng);
+    const int b = node(rng);
+    if (a != b) {
+      g.addEdge(a, b, unit ? 1.0 : 0.25 * quarter(rng));
+    }
+  }
+  return g;
+}
+
 /// A random w x h map with about `density` of its cells blocked, cut down to its largest connected
 /// part (every goal reachable from every start).
 inline GridMap randomMap(int w, int h, double density, std::mt19937_64& rng) {

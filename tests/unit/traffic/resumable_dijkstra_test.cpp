@@ -1,6 +1,6 @@
-// DistanceTable::startWithExtraCost / settle (resumable_dijkstra.cpp): a detour table searched only
-// as far as it is read gives, where settled, bit for bit what the whole search (withExtraCost)
-// gives, keeps the graph's state of when it started, and visits little when read near the goal.
+// DistanceTable::distance / settleAround (resumable_dijkstra.cpp): a goal's table searched only as
+// far as it is read gives, where settled, bit for bit what the whole search (to()) gives, and
+// visits little when read near the goal.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -53,27 +53,22 @@ TEST(ResumableDijkstra, SettledNodesHoldTheWholeSearchsValuesExactly) {
       }
       t.setNodeCost(cost);
     }
-    std::bernoulli_distribution dear(round % 2 == 0 ? 0.15 : 0.5);
+    DistanceTable whole(g);
+    for (int v = 0; v < n; ++v) {
+      whole.setBlocked(v, t.blocked(v));
+    }
+    whole.setNodeCost(std::vector<float>(t.nodeCost().begin(), t.nodeCost().end()));
     for (int q = 0; q < 6; ++q) {
-      std::vector<float> extra(static_cast<std::size_t>(n), 0.0F);
-      for (auto& x : extra) {
-        x = dear(rng) ? (q % 2 == 0 ? 30.0F : static_cast<float>(quarter(rng))) : 0.0F;
-      }
       const NodeId goal = node(rng);
-      std::vector<float> whole;
-      t.withExtraCost(goal, extra, whole);
-      PartialTable part;
-      t.startWithExtraCost(goal, extra, part);
+      const std::vector<float> all(whole.to(goal).begin(), whole.to(goal).end());
       for (int k = 0; k < n; ++k) {
         const NodeId v = node(rng);
         // Exact: the planner ranks moves by these values, so plans stay the same only if they are.
-        EXPECT_EQ(t.settle(part, v), whole[static_cast<std::size_t>(v)]) << "node " << v << " goal " << goal;
-        EXPECT_TRUE(part.isSettled(v));
+        EXPECT_EQ(t.distance(v, goal), all[static_cast<std::size_t>(v)]) << "node " << v << " goal " << goal;
       }
       for (int v = 0; v < n; ++v) {
-        t.settle(part, v);
+        EXPECT_EQ(t.distance(v, goal), all[static_cast<std::size_t>(v)]) << "node " << v << " goal " << goal;
       }
-      EXPECT_EQ(part.dist, whole);
     }
   }
 }
@@ -87,43 +82,15 @@ TEST(ResumableDijkstra, SearchesOnlyAsFarAsItIsRead) {
       "....................",
   });
   DistanceTable t(m.graph);
-  const std::vector<float> none(m.graph.size(), 0.0F);
-  PartialTable part;
-  t.startWithExtraCost(m.node(0, 0), none, part);
-  EXPECT_EQ(t.settle(part, m.node(1, 0)), 1.0F);
-  EXPECT_LE(part.settledCount, 4U);  // (0, 0), then at most the three at distance 1
-  t.settleAround(part, m.node(1, 0), 1);
-  EXPECT_TRUE(part.isSettled(m.node(2, 0)));
-  EXPECT_TRUE(part.isSettled(m.node(1, 1)));
-  EXPECT_FALSE(part.isSettled(m.node(19, 3)));
-  EXPECT_EQ(t.settle(part, m.node(19, 3)), 22.0F);
-  EXPECT_EQ(part.settledCount, m.graph.size());  // the far corner is the last node settled
-}
-
-// What is blocked after the search started does not change it: a table taken then would not
-// change either.
-TEST(ResumableDijkstra, KeepsTheStateOfWhenItStarted) {
-  const GridMap m = gridOf({"......", "......"});
-  DistanceTable t(m.graph);
-  std::vector<float> extra(m.graph.size(), 0.0F);
-  extra[static_cast<std::size_t>(m.node(2, 0))] = 30.0F;
-  std::vector<float> whole;
-  t.withExtraCost(m.node(0, 0), extra, whole);
-  PartialTable part;
-  t.startWithExtraCost(m.node(0, 0), extra, part);
-  t.settle(part, m.node(1, 0));
-  t.setBlocked(m.node(2, 1), true);
-  t.setBlocked(m.node(3, 0), true);
-  t.to(m.node(5, 1));  // the table rebuilds its state after the change
-  for (NodeId v = 0; v < static_cast<NodeId>(m.graph.size()); ++v) {
-    EXPECT_EQ(t.settle(part, v), whole[static_cast<std::size_t>(v)]) << v;
-  }
-  // A closed goal: nothing reachable, nothing to search.
-  Graph g = m.graph;
-  g.setOpen(0, false);
-  DistanceTable closed(g);
-  closed.startWithExtraCost(0, extra, part);
-  EXPECT_EQ(closed.settle(part, 1), DistanceTable::kUnreachable);
+  const NodeId goal = m.node(0, 0);
+  EXPECT_EQ(t.distance(m.node(1, 0), goal), 1.0F);
+  const float* part = t.partialTo(goal);
+  EXPECT_EQ(part[static_cast<std::size_t>(m.node(19, 3))], DistanceTable::kUnreachable) << "not searched yet";
+  t.settleAround(goal, m.node(1, 0), 1);
+  EXPECT_EQ(part[static_cast<std::size_t>(m.node(2, 0))], 2.0F);
+  EXPECT_EQ(part[static_cast<std::size_t>(m.node(1, 1))], 2.0F);
+  EXPECT_EQ(t.distance(m.node(19, 3), goal), 22.0F);
+  EXPECT_EQ(t.computed(), 1U) << "one search, resumed";
 }
 
 }  // namespace

@@ -10,6 +10,12 @@
 // on one gets the distance of leaving it (it may drive off, nothing may drive on). After closing or
 // reopening anything, or adding nodes or edges, call invalidate(). Nodes blocked by setBlocked()
 // (fixed obstacles the graph does not know about) count as closed.
+//
+// Blocking, unblocking and node costs change often (a robot held for a few seconds, people moving
+// through the risk map) while most tables are searched only from the goal as far as they were
+// read. Such a change restarts only the tables whose search has settled a changed node: a search
+// that has not reached it yet never used its cost, so its settled distances and its frontier are
+// those of a search started after the change (distance_table.cpp, applyChanges()).
 
 #include <cstdint>
 #include <limits>
@@ -20,12 +26,11 @@
 
 namespace fleet::traffic {
 
-/// A backward search to one goal kept open (DistanceTable::startWithExtraCost): a distance is
+/// A backward search to one goal kept open (a goal's table, DistanceTable::distance): a distance is
 /// final once its node is settled (DistanceTable::settle), until then an upper bound.
 struct PartialTable {
   NodeId goal = kNoNode;
   std::vector<float> dist;                     ///< final where settled, else an upper bound
-  std::vector<float> enter;                    ///< whole cost of entering each node; infinite: never
   std::vector<std::uint64_t> settled;          ///< one bit per node
   std::vector<std::pair<float, NodeId>> heap;  ///< the search's frontier
   std::uint64_t settledCount = 0;
@@ -77,38 +82,36 @@ class DistanceTable {
   bool setNodeCost(std::vector<float> cost);
   [[nodiscard]] std::span<const float> nodeCost() const { return nodeCost_; }
 
-  /// Distances to `goal` where driving into node v costs `extra[v]` on top of the edge's duration
-  /// (soft obstacles: robots that have stood in the way for a while, which a detour may be worth
-  /// going round). Dijkstra, not cached; `extra[goal]` is ignored and closed or blocked nodes are
-  /// honoured as in to(). `extra` has one entry per node.
-  void withExtraCost(NodeId goal, std::span<const float> extra, std::vector<float>& out);
-  /// The same distances, searched only as far as asked (resumable_dijkstra.cpp): starts the search
-  /// with what is closed, blocked and costs what now, and settle() goes on with that state whatever
-  /// changes later (as a table computed now would). A planner reads a detour table only around its
-  /// robot, a few hundred of a roadmap's nodes, while a whole search visits all of them.
-  void startWithExtraCost(NodeId goal, std::span<const float> extra, PartialTable& out);
-  /// Goes on with `t`'s search until `v` is settled; returns its final distance (kUnreachable when
-  /// there is no route). Valid while the graph's edges stay as they were (graph changes drop tables).
+  /// Goes on with `t`'s search (a goal's table or a detour) until `v` is settled; returns its final
+  /// distance (kUnreachable when there is no route).
   float settle(PartialTable& t, NodeId v) const;
   /// Settles `v` and every node within `hops` edges of it.
   void settleAround(PartialTable& t, NodeId v, int hops) const;
-
+  /// A detour table round `from` only (local_detour.cpp): the distances to `goal` of the nodes
+  /// `from` reaches without going farther than `radius` (m) from it, entering v costing `extra[v]`
+  /// more inside, leaving the disc valued at the goal table's distance; every other node
+  /// unreachable. Searched whole (a few thousand nodes at most), every node final.
+  void detourAround(NodeId goal, NodeId from, double radius, std::span<const float> extra, PartialTable& out);
   [[nodiscard]] std::size_t capacity() const { return capacity_; }
   [[nodiscard]] std::size_t cached() const { return used_; }
-  /// Tables computed since construction (misses), for benchmarks and tests.
+  /// Tables computed or restarted since construction (misses), for benchmarks and tests.
   [[nodiscard]] std::uint64_t computed() const { return computed_; }
   /// true when every edge has the same duration (breadth-first search).
   [[nodiscard]] bool unitDurations() const { return unit_; }
 
  private:
   void buildReverse();
+  /// Entering v in a goal's table: its node cost, infinite when closed or blocked.
+  [[nodiscard]] float baseEnter(std::size_t v) const;
+  /// Takes in what setBlocked()/setNodeCost() changed since the last query: restarts the tables
+  /// that read a changed node (everything when a change is too wide to be worth sorting out).
+  void applyChanges();
+  /// A whole table by breadth-first search (unit durations, no node cost).
   void compute(NodeId goal, std::vector<float>& d);
   std::size_t acquire(NodeId goal);
   void start(NodeId goal, PartialTable& t) const;
   float settleIn(PartialTable& t, std::span<const float> enterOf, NodeId v) const;
   void settleAroundIn(PartialTable& t, std::span<const float> enterOf, NodeId v, int hops) const;
-  /// Dijkstra from `goal` (d[goal] already 0), entering v costing extra[v] more when given.
-  void dijkstra(NodeId goal, std::span<const float> extra, std::vector<float>& d);
   std::size_t acquireSlot();
   void touch(std::size_t slot);
   void unlink(std::size_t slot);
@@ -135,11 +138,12 @@ class DistanceTable {
   std::uint64_t computed_ = 0;
   std::vector<std::uint8_t> blocked_;
   std::vector<float> nodeCost_;
-  std::vector<float> combined_;  ///< withExtraCost's extra + nodeCost_
   bool dirty_ = false;
+  std::vector<NodeId> changed_;  ///< nodes whose entering cost changed since the last query
   // Search scratch, kept to avoid allocating per table.
   std::vector<NodeId> queue_;
-  std::vector<std::pair<float, NodeId>> heap_;
+  std::vector<NodeId> region_;          ///< detourAround's disc
+  std::vector<std::uint8_t> inRegion_;  ///< per node, 1 while in detourAround's disc
 };
 
 }  // namespace fleet::traffic

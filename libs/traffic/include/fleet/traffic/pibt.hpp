@@ -82,8 +82,13 @@ struct PibtOptions {
   int detourAfter = 0;
   /// Extra cost (the edges' duration unit) of entering what a standing agent excludes.
   float detourPenalty = 30.0F;
-  /// Detour tables computed per step at most (each is one search of the whole graph).
+  /// Detour tables computed per step at most.
   int maxDetoursPerStep = 4;
+  /// A detour is searched within this distance (graph units: m on a roadmap) of the agent and kept
+  /// while the agent stays within `detourKeep` of where it was taken (local_detour.cpp): what it goes
+  /// round is near it. The rest of the disc is room for the few moves an untangling reads ahead.
+  double detourRadius = 12.0;
+  double detourKeep = 5.0;
   std::size_t distanceCacheBytes = std::size_t{256} << 20;
   /// Moves whose distances to the goal differ by at most this much count as equally good (0: exact;
   /// sums of edge durations along equally long ways differ in the last bits).
@@ -196,6 +201,8 @@ class Pibt {
   /// Every agent's table at its node and neighbours: all a step reads of it but to untangle.
   void settleTables();
   void dropDetour(std::size_t agent);
+  /// Whether agent i is still within `detourKeep` of where its detour was taken.
+  [[nodiscard]] bool nearDetour(std::size_t i) const;
   void resizeForGraph();
   void cover(NodeId v, int delta);
   /// An agent other than `except` standing on what v excludes, or -1.
@@ -234,6 +241,7 @@ class Pibt {
   std::vector<std::uint32_t> visited_;       ///< stamps for the cycle search
   std::vector<PartialTable> detour_;         ///< detour table to its goal, empty when none
   std::vector<float> detourFrom_;            ///< regular distance when the detour was taken
+  std::vector<NodeId> detourAt_;             ///< where the detour was taken (its disc's centre)
   std::vector<float> extra_;                 ///< per node scratch: detour penalties
   std::vector<int> standCover_;              ///< per node scratch: standing agents excluding it
   std::vector<std::vector<NodeId>> forced_;  ///< way out of a knot: its node per step, from now
