@@ -54,6 +54,7 @@ Expected<std::unique_ptr<Client>> Client::start(ClientOptions options, MessageHa
   mosquitto_connect_callback_set(c->handle_, &Client::onConnect);
   mosquitto_disconnect_callback_set(c->handle_, &Client::onDisconnect);
   mosquitto_message_callback_set(c->handle_, &Client::onMessage);
+  mosquitto_publish_callback_set(c->handle_, &Client::onPublish);
   mosquitto_threaded_set(c->handle_, true);
   // The first attempt here, so that bad options fail at once; a broker that is down (refused,
   // unreachable) is tried again by the network thread.
@@ -92,8 +93,11 @@ Client::~Client() {
   if (handle_ != nullptr) {
     // A clean disconnect: the broker drops the last will (it is for connections that break).
     if (connected_.load()) {
-      // Give queued messages (an OFFLINE before the disconnect) a moment to leave.
-      for (int i = 0; i < 20 && mosquitto_want_write(handle_); ++i) {
+      // Queued messages (an OFFLINE before the disconnect) leave first: until the broker has
+      // acknowledged them (QoS 1) or they are written (QoS 0), for 2 s at most. Waiting only for the
+      // queue to empty (200 ms) lost the OFFLINE when the network thread was slow to run.
+      for (int i = 0; i < 200 && (unsent_.load() > 0 || mosquitto_want_write(handle_)) && connected_.load();
+           ++i) {
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }
     }
@@ -116,8 +120,13 @@ void Client::subscribe(const std::string& pattern, int qos) {
 }
 
 bool Client::publish(const std::string& topic, const std::string& payload, int qos, bool retain) {
-  return mosquitto_publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()), payload.data(),
-                           qos, retain) == MOSQ_ERR_SUCCESS;
+  unsent_.fetch_add(1);
+  const bool ok = mosquitto_publish(handle_, nullptr, topic.c_str(), static_cast<int>(payload.size()),
+                                    payload.data(), qos, retain) == MOSQ_ERR_SUCCESS;
+  if (!ok) {
+    unsent_.fetch_sub(1);
+  }
+  return ok;
 }
 
 void Client::onConnect(mosquitto* m, void* self, int rc) {
@@ -136,6 +145,10 @@ void Client::onConnect(mosquitto* m, void* self, int rc) {
 
 void Client::onDisconnect(mosquitto* /*m*/, void* self, int /*rc*/) {
   static_cast<Client*>(self)->connected_.store(false);
+}
+
+void Client::onPublish(mosquitto* /*m*/, void* self, int /*mid*/) {
+  static_cast<Client*>(self)->unsent_.fetch_sub(1);
 }
 
 void Client::onMessage(mosquitto* /*m*/, void* self, const mosquitto_message* msg) {

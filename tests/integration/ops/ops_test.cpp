@@ -239,6 +239,9 @@ TEST(OpsBadInput, ATaskDatabaseThatCannotBeOpenedIsOneLineAndExitTwo) {
 
 TEST_F(OpsFleet, ThePortOfARunningServiceIsRefusedToASecondOneWithExitTwo) {
   const int taken = fleet_->ports.at("fleet_manager");
+  // The fleet starts with the suite: until the manager listens the port is free, and the second
+  // service would take it (and the manager exit 2 instead).
+  ASSERT_TRUE(waitFor(taken, "/livez", 200, 30s)) << "the fleet manager never listened on " << taken;
   const auto r = run(kBin + "/services/risk_map/risk_map --metrics-port " + std::to_string(taken));
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("cannot listen on 127.0.0.1:" + std::to_string(taken)), std::string::npos) << r.out;

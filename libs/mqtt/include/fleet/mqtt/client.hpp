@@ -71,6 +71,7 @@ class Client {
   Client(ClientOptions options, MessageHandler on_message);
   static void onConnect(mosquitto* m, void* self, int rc);
   static void onDisconnect(mosquitto* m, void* self, int rc);
+  static void onPublish(mosquitto* m, void* self, int mid);
   static void onMessage(mosquitto* m, void* self, const mosquitto_message* msg);
 
   ClientOptions options_;
@@ -82,6 +83,8 @@ class Client {
   std::atomic<std::uint64_t> connects_{0};
   std::atomic<std::uint64_t> refusals_{0};
   std::atomic<bool> stopping_{false};
+  /// Messages handed to publish() not yet sent (QoS 0) or acknowledged by the broker (QoS 1, 2).
+  std::atomic<std::int64_t> unsent_{0};
   std::thread thread_;
 };
 
