@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "fleet/avoidance/dynamic_window.hpp"
@@ -185,6 +186,7 @@ class Agent : private DriveStack {
   std::int64_t pausedSinceNs_ = -1;  // holding since (its length is added to the task's timers)
   MotionGate gate_;                  // stop rule, cross traffic, speed zones
   std::vector<OtherRobot> others_;
+  std::unordered_map<std::string, std::size_t> otherAt_;  // robot id -> its entry in others_
   double v_ = 0.0;
   double w_ = 0.0;
   double battery_ = 1.0;
