@@ -128,8 +128,11 @@ void AgentNode::onRobotStates(std::vector<msg::RobotState> states) {
     if (byId_.count(s.robot_id) != 0) {
       continue;  // hosted here: handed over in-process after the step
     }
-    for (auto& a : agents_) {
-      a->onOtherRobot(s);
+    if (const auto o = Agent::otherOf(s)) {
+      const std::size_t slot = slotOf(s.robot_id);
+      for (auto& a : agents_) {
+        a->onOtherRobot(slot, *o);
+      }
     }
   }
 }
@@ -189,10 +192,17 @@ const std::vector<AgentOutput>& AgentNode::step(std::int64_t nowNs, double dt) {
     outs_[i].people =
         peopleReports_[i].due(agents_[i]->id(), nowNs, agents_[i]->perception(), agents_[i]->sensorLost());
   });
+  others_.resize(agents_.size());
+  for (std::size_t i = 0; i < agents_.size(); ++i) {
+    others_[i] = Agent::otherOf(outs_[i].state);
+    if (hostedSlot_.size() <= i) {
+      hostedSlot_.push_back(slotOf(agents_[i]->id()));
+    }
+  }
   pool_.forEach(agents_.size(), [&](std::size_t j) {
     for (std::size_t i = 0; i < agents_.size(); ++i) {
-      if (i != j) {
-        agents_[j]->onOtherRobot(outs_[i].state);
+      if (i != j && others_[i]) {
+        agents_[j]->onOtherRobot(hostedSlot_[i], *others_[i]);
       }
     }
   });

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "agent.hpp"
@@ -111,7 +112,12 @@ class AgentNode {
   std::map<std::string, Agent*> byId_;
   WorkerPool pool_;
   std::vector<AgentOutput> outs_;
-  std::vector<PeopleReport> peopleReports_;  // one per agent, phases spread over the period
+  /// Each robot id heard of, numbered once for all hosted agents (Agent::onOtherRobot by slot).
+  std::size_t slotOf(const std::string& id) { return slots_.try_emplace(id, slots_.size()).first->second; }
+  std::unordered_map<std::string, std::size_t> slots_;
+  std::vector<std::size_t> hostedSlot_;            // per hosted agent, its robot's slot
+  std::vector<std::optional<OtherRobot>> others_;  // per hosted agent, its state this cycle as others see it
+  std::vector<PeopleReport> peopleReports_;        // one per agent, phases spread over the period
   std::uint64_t cycles_ = 0;
   validation::Rejections rejections_;
   std::vector<Refusal> refusals_;

@@ -549,3 +549,34 @@ TEST(Agent, AbsurdWheelTotalsAreRefusedAndTheTaskGoesOn) {
   EXPECT_TRUE(run.a.busy());
   EXPECT_FALSE(run.reported(msg::TaskState::Failed));
 }
+
+TEST(Agent, EachOtherRobotHasOneEntryAsLastHeardHoweverItIsFed) {
+  msg::RobotState s;
+  s.robot_id = "r2";
+  s.pose = {2.0, 1.0, 0.0};
+  s.v = 0.5;
+  s.stamp_ns = 1;
+  // By its state (the agent numbers the ids itself).
+  agent::Agent a(params(), emptyGrid());
+  a.onOtherRobot(s);
+  s.pose = {3.0, 1.0, 0.0};
+  s.stamp_ns = 2;
+  a.onOtherRobot(s);
+  msg::RobotState own = s;
+  own.robot_id = "r1";
+  a.onOtherRobot(own);
+  ASSERT_EQ(a.others().size(), 1U) << "one entry for r2, none for the agent's own robot";
+  EXPECT_EQ(a.others()[0].pos.x, 3.0);
+  EXPECT_EQ(a.others()[0].stampNs, 2);
+  EXPECT_NEAR(a.others()[0].velocity.x, 0.5, 1e-12);
+  // Converted once and numbered by the process (AgentNode): the same.
+  agent::Agent b(params(), emptyGrid());
+  b.onOtherRobot(7, *agent::Agent::otherOf(s));
+  s.pose = {4.0, 1.0, 0.0};
+  b.onOtherRobot(7, *agent::Agent::otherOf(s));
+  b.onOtherRobot(2, *agent::Agent::otherOf(own));
+  ASSERT_EQ(b.others().size(), 1U);
+  EXPECT_EQ(b.others()[0].pos.x, 4.0);
+  s.pose.x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(agent::Agent::otherOf(s).has_value()) << "a pose that is not finite is not a place";
+}
