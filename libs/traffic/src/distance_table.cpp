@@ -230,12 +230,7 @@ void DistanceTable::settleAround(NodeId goal, NodeId v, int hops) {
 }
 
 void DistanceTable::start(NodeId goal, PartialTable& t) const {
-  const std::size_t n = graph_.size();
-  t.goal = goal;
-  t.dist.assign(n, kUnreachable);
-  t.settled.assign((n + 63) / 64, 0);
-  t.heap.clear();
-  t.settledCount = 0;
+  t.reset(goal, graph_.size());
   // A closed goal is not reachable at all (an empty frontier); a blocked one is where the route
   // leads: the way up to it is what an agent waiting for it needs.
   if (graph_.isOpen(goal)) {
@@ -253,25 +248,24 @@ void DistanceTable::compute(NodeId goal, std::vector<float>& d) {
     return;
   }
   d[static_cast<std::size_t>(goal)] = 0.0F;
-  {  // breadth-first: every edge lasts the same and no node costs more (to())
-    queue_.clear();
-    queue_.push_back(goal);
-    for (std::size_t head = 0; head < queue_.size(); ++head) {
-      const NodeId u = queue_[head];
-      const float du = d[static_cast<std::size_t>(u)] + unitDuration_;
-      for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
-           k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
-        const NodeId p = revFrom_[k];
-        auto& dp = d[static_cast<std::size_t>(p)];
-        if (dp != kUnreachable) {
-          continue;
-        }
-        dp = du;
-        // A closed node learns how far it is from the goal (a robot on it may drive off) but
-        // routes never pass through it.
-        if (open(p)) {
-          queue_.push_back(p);
-        }
+  // Breadth-first: every edge lasts the same and no node costs more (to()).
+  queue_.clear();
+  queue_.push_back(goal);
+  for (std::size_t head = 0; head < queue_.size(); ++head) {
+    const NodeId u = queue_[head];
+    const float du = d[static_cast<std::size_t>(u)] + unitDuration_;
+    for (std::uint32_t k = revStart_[static_cast<std::size_t>(u)];
+         k < revStart_[static_cast<std::size_t>(u) + 1]; ++k) {
+      const NodeId p = revFrom_[k];
+      auto& dp = d[static_cast<std::size_t>(p)];
+      if (dp != kUnreachable) {
+        continue;
+      }
+      dp = du;
+      // A closed node learns how far it is from the goal (a robot on it may drive off) but
+      // routes never pass through it.
+      if (open(p)) {
+        queue_.push_back(p);
       }
     }
   }

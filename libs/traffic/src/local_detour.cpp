@@ -23,11 +23,7 @@ void DistanceTable::detourAround(NodeId goal, NodeId from, double radius, std::s
     applyChanges();
   }
   const std::size_t n = graph_.size();
-  out.goal = goal;
-  out.dist.assign(n, kUnreachable);
-  out.settled.assign((n + 63) / 64, 0);
-  out.heap.clear();
-  out.settledCount = 0;
+  out.reset(goal, n);
   if (!graph_.valid(goal) || !graph_.valid(from) || !graph_.isOpen(goal) || extra.size() != n) {
     out.goal = kNoNode;
     return;

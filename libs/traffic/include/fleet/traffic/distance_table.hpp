@@ -37,6 +37,14 @@ struct PartialTable {
 
   [[nodiscard]] bool empty() const { return goal == kNoNode; }
   void clear() { goal = kNoNode; }
+  /// A search to `goal` over `n` nodes that has settled nothing and has an empty frontier.
+  void reset(NodeId g, std::size_t n) {
+    goal = g;
+    dist.assign(n, std::numeric_limits<float>::infinity());
+    settled.assign((n + 63) / 64, 0);
+    heap.clear();
+    settledCount = 0;
+  }
   [[nodiscard]] const float* data() const { return dist.data(); }
   [[nodiscard]] bool isSettled(NodeId v) const {
     const auto i = static_cast<std::size_t>(v);
