@@ -94,8 +94,16 @@ Settings readSettings(Config& cfg) {
   } else {
     s.stationCapacity = static_cast<int>(cfg.integer("station_capacity", s.stationCapacity, {0, 1000}));
   }
-  s.stationLoadByPhase =
-      cfg.string("station_load", s.stationLoadByPhase ? "phase" : "task", {"task", "phase"}) == "phase";
+  {
+    static constexpr const char* kLoads[] = {"task", "phase", "arrival"};
+    const std::string load =
+        cfg.string("station_load", kLoads[static_cast<int>(s.stationLoad)], {"task", "phase", "arrival"});
+    for (int i = 0; i < 3; ++i) {
+      if (load == kLoads[i]) {
+        s.stationLoad = static_cast<StationLoad>(i);
+      }
+    }
+  }
   s.batteryThreshold = cfg.number("battery_threshold", s.batteryThreshold, {0.0, 1.0});
   s.chargeUntil = cfg.number("charge_until", s.chargeUntil, {0.0, 1.0});
   if (s.chargeUntil <= s.batteryThreshold) {
@@ -201,12 +209,14 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
   dc.maxAttempts = s.maxAttempts;
   dc.stationCapacity = static_cast<std::size_t>(s.stationCapacity);
   std::shared_ptr<const traffic::RoadmapTravel> roads;
-  if (s.travelCost == "roadmap" || s.stationCapacityFromLines) {
+  const bool byArrival = s.stationLoad == StationLoad::Arrival;
+  if (s.travelCost == "roadmap" || s.stationCapacityFromLines || byArrival) {
     if (!site) {
-      return unexpected(Error{
-          errc::kInvalid,
-          std::string(s.travelCost == "roadmap" ? "travel_cost \"roadmap\"" : "station_capacity \"queue\"") +
-              " needs a site (stations from a site file or a scenario naming one)"});
+      return unexpected(
+          Error{errc::kInvalid, std::string(s.travelCost == "roadmap" ? "travel_cost \"roadmap\""
+                                            : byArrival               ? "station_load \"arrival\""
+                                                                      : "station_capacity \"queue\"") +
+                                    " needs a site (stations from a site file or a scenario naming one)"});
     }
     roads = std::make_shared<const traffic::RoadmapTravel>(
         std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site, s.roadmap)));
@@ -219,7 +229,18 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
       }
     }
   }
-  dc.stationLoadByPhase = s.stationLoadByPhase;
+  dc.stationLoad = s.stationLoad;
+  if (byArrival) {
+    // Unknown stations (not on the roadmap, or without a dock) are never reached: +infinity.
+    const auto orNever = [](std::optional<double> v) { return v.value_or(kInfeasible); };
+    dc.stationTimes.toStation = [roads, orNever](Vec2 from, const std::string& name) {
+      return orNever(roads->toStation(from, name));
+    };
+    dc.stationTimes.between = [roads, orNever](const std::string& a, const std::string& b) {
+      return orNever(roads->between(a, b));
+    };
+    dc.stationTimes.dockMove = [roads](const std::string& name) { return roads->dockMoveSeconds(name); };
+  }
   dc.robotFailLimit = s.robotFailLimit;
   dc.robotHoldNs = secToNs(s.robotHoldS);
   dc.leaseNs = secToNs(s.leaseS);

@@ -51,9 +51,10 @@ struct Settings {
   /// `"station_capacity": "queue"`: each station takes as many active tasks as its line on the
   /// roadmap holds (dock and queue nodes); stations without one keep stationCapacity.
   bool stationCapacityFromLines = false;
-  /// "phase": a task loads its pickup until it has loaded, then its drop-off; "task" (false): both
-  /// for the whole task. See DispatcherConfig::stationLoadByPhase.
-  bool stationLoadByPhase = false;
+  /// "task": a task loads its pickup and its drop-off for the whole task; "phase": its pickup until
+  /// it has loaded, then its drop-off; "arrival": each from its robot's predicted arrival there
+  /// (needs the site). See DispatcherConfig::stationLoad.
+  StationLoad stationLoad = StationLoad::Task;
   int robotFailLimit = 3;    ///< failures in a row before a robot is held back (0: never)
   double robotHoldS = 60.0;  ///< ... for this long
   double batteryThreshold = 0.2;

@@ -45,8 +45,10 @@ void addLoadtestCommand(CLI::App& app, Commands& commands) {
   loadtest
       ->add_option("--station-load", o->stationLoad,
                    "how a task loads its stations: task (pickup and drop-off for the whole task) or phase "
-                   "(the pickup until loaded, the drop-off for the whole task)")
-      ->check(CLI::IsMember({"task", "phase"}))
+                   "(the pickup until loaded, the drop-off for the whole task) or arrival (each from the "
+                   "robot's predicted "
+                   "arrival there until served)")
+      ->check(CLI::IsMember({"task", "phase", "arrival"}))
       ->capture_default_str();
   loadtest
       ->add_option(

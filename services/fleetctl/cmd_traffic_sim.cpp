@@ -1,6 +1,8 @@
 // fleetctl traffic-sim: the traffic layer driving a virtual fleet on a site (no simulator).
 
+#include <map>
 #include <memory>
+#include <string>
 
 #include "commands.hpp"
 #include "traffic_sim.hpp"
@@ -68,9 +70,12 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
   trafficSim
       ->add_option(
           "--admission", o->admission,
-          "1: a task is given only when its pickup and drop-off each have a free slot (a place in "
-          "their line); a robot with no admissible task waits at a parking place; 0: every task at once")
-      ->check(CLI::Range(0, 1))
+          "slots: a task is given only when its pickup and drop-off each have a free place in their "
+          "line, a robot counting from its task until served; arrival: a place for the time the robot "
+          "will get there; a robot with no admissible task waits at a parking place; none: every task at "
+          "once (0, 1, 2 name them too)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, int>{{"none", 0}, {"slots", 1}, {"arrival", 2}}, CLI::ignore_case))
       ->capture_default_str();
   trafficSim
       ->add_option("--station-slots", o->stationSlots,

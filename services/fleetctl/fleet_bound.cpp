@@ -176,17 +176,7 @@ std::vector<BoundStation> boundStations(const traffic::Roadmap& roadmap) {
     if (s.dock == traffic::kNoNode) {
       continue;
     }
-    DockGeometry geo{g.position(s.dock), std::nullopt, {}, std::nullopt};
-    if (s.approach != traffic::kNoNode) {
-      geo.approach = g.position(s.approach);
-    }
-    if (!s.queue.empty()) {
-      geo.queue.push_back(g.position(s.queue.front()));
-    }
-    if (s.exit != traffic::kNoNode) {
-      geo.exit = g.position(s.exit);
-    }
-    out.push_back({s.name, geo});
+    out.push_back({s.name, traffic::dockGeometry(g, s)});
   }
   return out;
 }

@@ -19,9 +19,12 @@
 #include "fleet/core/expected.hpp"
 #include "fleet/core/vec2.hpp"
 #include "fleet/planning/occupancy_grid.hpp"
-#include "station_cycle.hpp"
+#include "fleet/traffic/station_cycle.hpp"
 
 namespace fleet::ctl {
+
+using traffic::DockGeometry;
+using traffic::dockMoveSeconds;
 
 struct BoundStation {
   std::string name;

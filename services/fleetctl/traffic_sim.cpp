@@ -116,7 +116,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
     v.stationLines = o.stationLines != 0;
-    v.admission = o.admission != 0;
+    v.admission = static_cast<traffic::Admission>(o.admission);
     v.stationSlots = static_cast<std::size_t>(o.stationSlots);
     v.stations = o.stations;
     if (o.maxLag > 0)

@@ -26,7 +26,7 @@ struct TrafficSimOptions {
   double detourPenalty = -1.0;  ///< s added for entering what a standing robot excludes; <0: the default
   int queueLength = -1;         ///< generated queue nodes per station; -1: the roadmap's default
   int stationLines = 1;         ///< 1: robots wait in line at stations' queues; 0: all planned to the dock
-  int admission = 1;            ///< VirtualFleetOptions::admission
+  int admission = 1;            ///< VirtualFleetOptions::admission: 0 none, 1 slots, 2 arrival
   int stationSlots = 0;         ///< VirtualFleetOptions::stationSlots: slots per station (0: its line)
   std::vector<std::string> stations;  ///< VirtualFleetOptions::stations
   bool json = false;

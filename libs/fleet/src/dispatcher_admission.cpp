@@ -29,28 +29,20 @@ std::vector<const std::string*> phaseStationsOf(const Task& t, TaskState state) 
 }  // namespace
 
 std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByStationCapacity(std::vector<Task>& waiting) const {
+  const bool byPhase = cfg_.stationLoad != StationLoad::Task;
   std::unordered_map<std::string, std::size_t> load;
   for (const auto& [id, r] : open_) {
     if (isActive(r.state)) {
-      for (const std::string* s :
-           cfg_.stationLoadByPhase ? phaseStationsOf(r.task, r.state) : stationsOf(r.task)) {
+      for (const std::string* s : byPhase ? phaseStationsOf(r.task, r.state) : stationsOf(r.task)) {
         ++load[*s];
       }
     }
   }
-  // Oldest first (pinned and urgent before that), so a busy station's queue is served in order.
-  std::stable_sort(waiting.begin(), waiting.end(), [](const Task& a, const Task& b) {
-    return std::tuple(a.robot.empty(), -a.priority, a.createdNs) <
-           std::tuple(b.robot.empty(), -b.priority, b.createdNs);
-  });
+  dispatcher_detail::oldestFirst(waiting);
   std::vector<Task> admitted;
   std::vector<HeldAtStation> held;
   for (auto& t : waiting) {
-    const auto stations = cfg_.stationLoadByPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
-    const auto capacityOf = [&](const std::string& s) {
-      const auto it = cfg_.stationCapacities.find(s);
-      return it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
-    };
+    const auto stations = byPhase ? phaseStationsOf(t, TaskState::Assigned) : stationsOf(t);
     // A robot's own charge task is never held back: its battery does not wait for the queue.
     const auto full = t.robot.empty() ? std::find_if(stations.begin(), stations.end(),
                                                      [&](const std::string* s) {
@@ -71,6 +63,11 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByStationCapacity(std::v
   return held;
 }
 
+std::size_t Dispatcher::capacityOf(const std::string& station) const {
+  const auto it = cfg_.stationCapacities.find(station);
+  return it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
+}
+
 void Dispatcher::noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs,
                                     DispatchResult& out) {
   for (const auto& h : held) {
@@ -80,9 +77,10 @@ void Dispatcher::noteAdmissionWaits(const std::vector<HeldAtStation>& held, std:
     }
     auto& r = it->second;
     const bool late = r.task.deadlineNs > 0 && nowNs > r.task.deadlineNs;
-    const std::string why = std::string(late ? "past its deadline and still waiting" : "waiting") +
-                            " for a place in station " + h.station + "'s line (it holds " +
-                            std::to_string(h.capacity) + ", all taken by other tasks)";
+    const std::string why =
+        std::string(late ? "past its deadline and still waiting" : "waiting") + " for a place in station " +
+        h.station + "'s line (it holds " + std::to_string(h.capacity) +
+        (h.byArrival ? ", all taken when a robot could get there)" : ", all taken by other tasks)");
     if (why == r.reason) {
       continue;  // said already: no store write, no event
     }

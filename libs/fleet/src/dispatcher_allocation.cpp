@@ -52,7 +52,12 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
   if (waiting.empty() || idle.empty()) {
     return;
   }
-  if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
+  if (cfg_.stationLoad == StationLoad::Arrival && cfg_.stationTimes.known()) {
+    noteAdmissionWaits(admitByArrival(waiting, idle), nowNs, out);
+    if (waiting.empty()) {
+      return;
+    }
+  } else if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
     noteAdmissionWaits(admitByStationCapacity(waiting), nowNs, out);
     if (waiting.empty()) {
       return;

@@ -3,7 +3,9 @@
 // What the dispatcher's files share about a task: the states it passes through and the stations it
 // occupies.
 
+#include <algorithm>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "fleet/fleet/task.hpp"
@@ -22,6 +24,14 @@ inline std::vector<TaskState> happyPath(TaskKind kind) {
 // The stations a task occupies while it is active: every stop, one entry a visit.
 inline std::vector<const std::string*> stationsOf(const Task& t) {
   return taskStops(t);
+}
+
+/// Oldest first (pinned and urgent before that), so a busy station's queue is served in order.
+inline void oldestFirst(std::vector<Task>& waiting) {
+  std::stable_sort(waiting.begin(), waiting.end(), [](const Task& a, const Task& b) {
+    return std::tuple(a.robot.empty(), -a.priority, a.createdNs) <
+           std::tuple(b.robot.empty(), -b.priority, b.createdNs);
+  });
 }
 
 }  // namespace fleet::dispatcher_detail

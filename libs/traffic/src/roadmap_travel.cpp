@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "fleet/traffic/distance_table.hpp"
+#include "fleet/traffic/station_cycle.hpp"
 
 namespace fleet::traffic {
 
@@ -14,6 +15,8 @@ RoadmapTravel::RoadmapTravel(std::shared_ptr<const Roadmap> roadmap) : roadmap_(
     t.dock = st.dock;
     if (st.dock != kNoNode) {
       t.line = 1 + st.queue.size();
+      t.move = traffic::dockMoveSeconds(dockGeometry(roadmap_->graph, st), roadmap_->options.radius,
+                                        roadmap_->options.cruiseSpeed);
       const auto d = tables.to(st.dock);
       t.toDock.assign(d.begin(), d.end());
     }
@@ -46,6 +49,11 @@ std::optional<double> RoadmapTravel::between(const std::string& a, const std::st
     return std::nullopt;
   }
   return static_cast<double>(to->toDock[static_cast<std::size_t>(from->dock)]);
+}
+
+double RoadmapTravel::dockMoveSeconds(const std::string& name) const {
+  const StationTable* t = find(name);
+  return t == nullptr ? 0.0 : t->move;
 }
 
 std::size_t RoadmapTravel::lineCapacity(const std::string& name) const {

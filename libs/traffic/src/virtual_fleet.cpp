@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+
+#include "fleet/traffic/station_book.hpp"
 
 namespace fleet::traffic {
 namespace {
@@ -27,7 +31,8 @@ struct Bot {
   NodeId dropoff = kNoNode;
   double taskStart = 0.0;
   double lastProgress = 0.0;
-  bool idle = false;  // no admissible task (station cap): sent to a parking place
+  bool idle = false;     // no admissible task: sent to a parking place
+  double nextTry = 0.0;  // s: when an idle robot asks for a task again (once a second)
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -168,25 +173,19 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     return false;
   };
-  // Admission by slots (docs/algorithms.md, "Stations as servers"): a station serves as many robots
-  // at once as its line holds (dock and queue places). A robot counts at its pickup until it has
-  // loaded there, and at its drop-off from the moment it is given the task (it will carry its load
-  // there, and a loaded robot must not find the line full). A task is admitted when both have a
-  // free slot; otherwise the robot waits for one at a parking place.
+  // Admission (docs/algorithms.md, "Admission by slots", "Admission by predicted arrival"). By
+  // predicted arrival a task is given when its robot gets a place in its pickup's line for the time
+  // it will get there, and then in its drop-off's line for the time it will have loaded and driven
+  // on. The book is rebuilt from every robot's position once a tick: free-flow times, so a robot
+  // held up is booked later.
+  std::vector<NodeId> served = pickups;
+  served.insert(served.end(), dropoffs.begin(), dropoffs.end());
+  StationBook book(roadmap, served, o.dwell, o.stationSlots);
+  double bookedAt = -1.0;
+  // Admission by slots: the robots bound for each station now, its pickup until loaded, its
+  // drop-off for the whole task.
   std::vector<std::size_t> uses(g.size(), 0);
-  std::vector<std::size_t> slots(g.size(), 0);
-  for (const auto& s : roadmap.stations) {
-    if (s.dock != kNoNode)
-      slots[static_cast<std::size_t>(s.dock)] = o.stationSlots > 0 ? o.stationSlots : 1 + s.queue.size();
-  }
-  auto admissible = [&](const std::vector<NodeId>& stations) {
-    std::vector<NodeId> out;
-    for (NodeId s : stations) {
-      if (!o.admission || uses[static_cast<std::size_t>(s)] < slots[static_cast<std::size_t>(s)])
-        out.push_back(s);
-    }
-    return out;
-  };
+  const auto hasSlot = [&](NodeId s) { return uses[static_cast<std::size_t>(s)] < book.slots(s); };
   // The parking place nearest to robot r that no robot stands on or is sent to.
   auto freeParking = [&](std::size_t r) {
     NodeId best = kNoNode;
@@ -203,26 +202,89 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     return best;
   };
+  // Seconds until robot b gets to `dock` with nobody in its way: from the node it drives to (the
+  // rest of its edge first) or the node it stands on (0 at the dock itself).
+  auto arrivalAt = [&](const Bot& b, NodeId dock) {
+    return b.to != kNoNode ? b.left + book.travel(b.to, dock) : book.travel(b.at, dock);
+  };
+  auto rebook = [&](double now) {
+    if (bookedAt == now)
+      return;
+    bookedAt = now;
+    book.clear();
+    std::vector<std::pair<std::size_t, std::size_t>> loading;  // robot, its booking at its pickup
+    for (std::size_t q = 0; q < bots.size(); ++q) {
+      const Bot& b = bots[q];
+      if (b.idle || b.pickup == kNoNode)
+        continue;
+      if (b.phase == 0)
+        loading.emplace_back(q, book.book(b.pickup, arrivalAt(b, b.pickup)));
+      else
+        book.book(b.dropoff, arrivalAt(b, b.dropoff));
+    }
+    for (const auto& [q, k] : loading) {
+      const Bot& b = bots[q];
+      book.book(b.dropoff, book.leave(b.pickup, k) + book.travel(b.pickup, b.dropoff));
+    }
+  };
+  // A task for robot r: without admission any pickup and drop-off; by slots, any with a free slot;
+  // by arrival, the pickups in a random order, the first whose line has a place for r's arrival and
+  // some drop-off one after it.
+  auto drawTask = [&](const Bot& b, double now) -> std::pair<NodeId, NodeId> {
+    if (o.admission == Admission::None) {
+      const NodeId p = pickups[rng() % pickups.size()];
+      return {p, dropoffs[rng() % dropoffs.size()]};
+    }
+    if (o.admission == Admission::Slots) {
+      std::vector<NodeId> ps, ds;
+      std::copy_if(pickups.begin(), pickups.end(), std::back_inserter(ps), hasSlot);
+      std::copy_if(dropoffs.begin(), dropoffs.end(), std::back_inserter(ds), hasSlot);
+      if (ps.empty() || ds.empty())
+        return {kNoNode, kNoNode};
+      const NodeId p = ps[rng() % ps.size()];
+      return {p, ds[rng() % ds.size()]};
+    }
+    rebook(now);
+    std::vector<NodeId> order = pickups;
+    std::shuffle(order.begin(), order.end(), rng);
+    std::vector<NodeId> ds;
+    for (NodeId p : order) {
+      const SlotOffer atPickup = book.offer(p, arrivalAt(b, p));
+      if (!atPickup.admitted)
+        continue;
+      ds.clear();
+      for (NodeId d : dropoffs) {
+        if (book.offer(d, atPickup.leave + book.travel(p, d)).admitted)
+          ds.push_back(d);
+      }
+      if (!ds.empty()) {
+        const NodeId d = ds[rng() % ds.size()];
+        const std::size_t k = book.book(p, arrivalAt(b, p));
+        book.book(d, book.leave(p, k) + book.travel(p, d));
+        return {p, d};
+      }
+    }
+    return {kNoNode, kNoNode};
+  };
   auto newTask = [&](std::size_t r, double now) {
     Bot& b = bots[r];
-    if (b.pickup != kNoNode) {  // the task just finished frees its drop-off
-      --uses[static_cast<std::size_t>(b.dropoff)];
-      b.pickup = b.dropoff = kNoNode;
-    }
-    const auto ps = admissible(pickups);
-    const auto ds = admissible(dropoffs);
-    if (ps.empty() || ds.empty()) {
+    if (b.dropoff != kNoNode)
+      --uses[static_cast<std::size_t>(b.dropoff)];  // the task just finished frees its drop-off
+    b.pickup = b.dropoff = kNoNode;
+    const auto [p, d] = drawTask(b, now);
+    if (p == kNoNode) {
       if (!b.idle)  // nothing admissible: wait at a parking place
         traffic.setGoal(r, freeParking(r));
       b.idle = true;
+      b.nextTry = now + 1.0;
       return;
     }
     b.idle = false;
-    b.pickup = ps[rng() % ps.size()];
-    b.dropoff = ds[rng() % ds.size()];
+    b.pickup = p;
+    b.dropoff = d;
+    ++uses[static_cast<std::size_t>(p)];
+    ++uses[static_cast<std::size_t>(d)];
     res.tasks.push_back({b.pickup, b.dropoff});
-    ++uses[static_cast<std::size_t>(b.pickup)];
-    ++uses[static_cast<std::size_t>(b.dropoff)];
     b.phase = 0;
     b.taskStart = now;
     b.lastProgress = now;
@@ -256,7 +318,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
 
     for (std::size_t r = 0; r < o.robots; ++r) {
       Bot& b = bots[r];
-      if (b.idle && b.dwellLeft <= 0.0) {
+      if (b.idle && b.dwellLeft <= 0.0 && now >= b.nextTry) {
         newTask(r, now);
         b.lastProgress = now;  // waiting for work is not waiting on traffic
       }

@@ -518,7 +518,7 @@ TEST_F(DispatcherTest, AStationCapacityOfZeroIsNoLimitThere) {
 TEST_F(DispatcherTest, StationLoadByPhaseFreesThePickupOnceLoaded) {
   cfg.stationCapacity = 1;
   cfg.stationCapacities = {{"D-1", 2}};
-  cfg.stationLoadByPhase = true;
+  cfg.stationLoad = StationLoad::Phase;
   reopen();
   for (int i = 0; i < 4; ++i) {
     robot("r" + std::to_string(i), i, 0.9, 0);

@@ -332,6 +332,24 @@ TEST(Settings, StationCapacityIsANumberOrQueueAndRoadmapCostsNeedASite) {
   std::filesystem::remove(noSite.db);
 }
 
+TEST(Settings, StationLoadIsTaskPhaseOrArrivalAndArrivalNeedsASite) {
+  auto arrival = Config::fromText(R"({"stations": "s.json", "station_load": "arrival"})", "manager.json");
+  EXPECT_EQ(manager::readSettings(arrival).stationLoad, StationLoad::Arrival);
+  arrival.finish();
+  auto bad = Config::fromText(R"({"stations": "s.json", "station_load": "eta"})", "manager.json");
+  manager::readSettings(bad);
+  ASSERT_EQ(bad.problems().size(), 1U);
+  EXPECT_THAT(bad.problems()[0], HasSubstr("station_load: expected one of"));
+  auto noSite = manager::Settings{};
+  noSite.stationLoad = StationLoad::Arrival;
+  noSite.db = (std::filesystem::temp_directory_path() / ("fm_nosite_arr_" + std::to_string(getpid()) + ".db"))
+                  .string();
+  auto n = manager::FleetManagerNode::create(noSite, stations(), 1'000);
+  ASSERT_FALSE(n);
+  EXPECT_THAT(n.error().message, HasSubstr("station_load \"arrival\" needs a site"));
+  std::filesystem::remove(noSite.db);
+}
+
 TEST(Settings, StoreIsSqliteByDefaultOrAPostgresqlUrl) {
   auto defaults = Config::fromText(R"({"stations": "s.json"})", "manager.json");
   auto s = manager::readSettings(defaults);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "fleet/core/expected.hpp"
+#include "fleet/core/vec2.hpp"
 #include "fleet/fleet/allocator.hpp"
 #include "fleet/fleet/robot_registry.hpp"
 #include "fleet/fleet/station_choice.hpp"
@@ -17,6 +19,21 @@
 #include "fleet/fleet/task_store.hpp"
 
 namespace fleet {
+
+enum class StationLoad { Task, Phase, Arrival };
+
+/// What admission by predicted arrival knows of the site; the fleet manager fills it from the
+/// roadmap (free-flow times, nobody in the way).
+struct StationTimes {
+  /// Seconds from a position to a station's dock (+infinity: no way there).
+  std::function<double(Vec2, const std::string&)> toStation;
+  /// Seconds from one station's dock to another's.
+  std::function<double(const std::string&, const std::string&)> between;
+  /// Seconds of a station's least dock cycle without the dwell: enter from the queue head, leave.
+  std::function<double(const std::string&)> dockMove;
+
+  [[nodiscard]] bool known() const { return toStation && between && dockMove; }
+};
 
 struct DispatcherConfig {
   AllocationPolicy policy;
@@ -35,13 +52,17 @@ struct DispatcherConfig {
   /// Per-station capacities that override stationCapacity (0: no limit at that station). With
   /// reserved traffic, each station's line on the roadmap (dock and queue nodes) gives its own.
   std::unordered_map<std::string, std::size_t> stationCapacities;
-  /// How an active task loads its stations. Whole task (false): its pickup and its drop-off from
-  /// assignment to the end, so with 9 stations and a capacity of 2 at most ~8 tasks are active
-  /// while 20 robots wait. By phase (true): its pickup until it has loaded there, its drop-off for
-  /// the whole task (a loaded robot must not find its drop-off's line full); admission checks
-  /// both. With reserved traffic the stations' lines (dock and queue nodes) take the robots that
-  /// arrive while a station is busy.
-  bool stationLoadByPhase = false;
+  /// How an active task loads its stations. Task: its pickup and its drop-off from assignment to
+  /// the end, so with 9 stations and a capacity of 2 at most ~8 tasks are active while 20 robots
+  /// wait. Phase: its pickup until it has loaded there, its drop-off for the whole task (a loaded
+  /// robot must not find its drop-off's line full); admission checks both. Arrival: a robot counts
+  /// in a station's line from the time it is predicted to get there until it is served
+  /// (fleet/core/station_slots.hpp), so a robot minutes away holds no place now; a task is admitted
+  /// when its pickup's line has a place when the nearest idle robot could get there and its
+  /// drop-off's line one after it has loaded (needs `stationTimes`; docs/algorithms.md, "Admission
+  /// by predicted arrival").
+  StationLoad stationLoad = StationLoad::Task;
+  StationTimes stationTimes;
   /// A robot that fails this many tasks in a row gets no task for robotHoldNs: an agent that fails
   /// every order at once (a pose estimate inside a shelf after a restart) would otherwise burn
   /// through the queue, each task failing its attempts on it. 0: never held.
@@ -225,9 +246,15 @@ class Dispatcher {
     std::string taskId;
     std::string station;
     std::size_t capacity = 0;
+    bool byArrival = false;  ///< no place for when a robot could get there
   };
   /// Drops from `waiting` the tasks whose stations are at capacity (DispatcherConfig); returns them.
   std::vector<HeldAtStation> admitByStationCapacity(std::vector<Task>& waiting) const;
+  /// The same by predicted arrival (StationLoad::Arrival): keeps at most as many tasks as there are
+  /// `idle` robots, the oldest that get a place (dispatcher_arrival.cpp).
+  std::vector<HeldAtStation> admitByArrival(std::vector<Task>& waiting,
+                                            const std::vector<RobotInfo>& idle) const;
+  [[nodiscard]] std::size_t capacityOf(const std::string& station) const;
   /// Says in their reason that (and where) the held tasks wait for a place in a station's line,
   /// and when one has waited past its deadline.
   void noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs, DispatchResult& out);

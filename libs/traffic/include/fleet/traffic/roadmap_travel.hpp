@@ -33,6 +33,9 @@ class RoadmapTravel {
   [[nodiscard]] std::optional<double> between(const std::string& a, const std::string& b) const;
   /// Robots the station's line holds at once: its dock and its queue nodes; 0 when it has no dock.
   [[nodiscard]] std::size_t lineCapacity(const std::string& name) const;
+  /// Seconds of the station's least dock cycle without its dwell (station_cycle.hpp): enter from
+  /// the queue head, leave; 0 when it has no dock.
+  [[nodiscard]] double dockMoveSeconds(const std::string& name) const;
 
   [[nodiscard]] const Roadmap& roadmap() const { return *roadmap_; }
 
@@ -40,6 +43,7 @@ class RoadmapTravel {
   struct StationTable {
     NodeId dock = kNoNode;
     std::size_t line = 0;
+    double move = 0.0;
     std::vector<float> toDock;  ///< seconds from every node to the dock
   };
   [[nodiscard]] const StationTable* find(const std::string& name) const;

@@ -22,6 +22,8 @@
 
 namespace fleet::traffic {
 
+enum class Admission { None, Slots, Arrival };
+
 struct VirtualFleetOptions {
   std::size_t robots = 20;
   std::uint64_t seed = 1;
@@ -32,12 +34,13 @@ struct VirtualFleetOptions {
   double stopChance = 0.01;  ///< per edge: the robot stops on it for U(0, stopMax) s
   double stopMax = 10.0;
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
-  /// Admission by slots: a task is given only when its pickup and its drop-off each have a free
-  /// place in their line (dock and queue places; `stationSlots` places instead when above 0); a robot
-  /// counts at its pickup until it has loaded and at its drop-off for the whole task. A robot with
-  /// no admissible task drives to the nearest parking place no robot is sent to and takes the next
-  /// admissible task from there. false: every task at once.
-  bool admission = true;
+  /// How tasks are admitted. Slots: a task is given only when its pickup and its drop-off each
+  /// have a free place in their line (dock and queue places; `stationSlots` places instead when
+  /// above 0); a robot counts at its pickup until it has loaded and at its drop-off for the whole
+  /// task. Arrival: each place is taken from the robot's predicted arrival until it is served
+  /// (StationBook). A robot with no admissible task drives to the nearest parking place no robot
+  /// is sent to and asks again every second. None: every task at once.
+  Admission admission = Admission::Slots;
   std::size_t stationSlots = 0;
   /// Tasks only between these pickups and drop-offs (by name); empty: all of them.
   std::vector<std::string> stations;

@@ -1,9 +1,9 @@
-#include "station_cycle.hpp"
+#include "fleet/traffic/station_cycle.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace fleet::ctl {
+namespace fleet::traffic {
 
 double dockMoveSeconds(const DockGeometry& g, double radius, double cruise) {
   if (!(cruise > 0.0) || !std::isfinite(cruise) || !std::isfinite(radius) || radius < 0.0) {
@@ -21,4 +21,18 @@ double dockMoveSeconds(const DockGeometry& g, double radius, double cruise) {
   return std::isfinite(s) ? s : 0.0;
 }
 
-}  // namespace fleet::ctl
+DockGeometry dockGeometry(const Graph& g, const StationNodes& s) {
+  DockGeometry geo{g.position(s.dock), std::nullopt, {}, std::nullopt};
+  if (s.approach != kNoNode) {
+    geo.approach = g.position(s.approach);
+  }
+  if (!s.queue.empty()) {
+    geo.queue.push_back(g.position(s.queue.front()));
+  }
+  if (s.exit != kNoNode) {
+    geo.exit = g.position(s.exit);
+  }
+  return geo;
+}
+
+}  // namespace fleet::traffic

@@ -28,8 +28,9 @@
 #include <vector>
 
 #include "fleet/core/vec2.hpp"
+#include "fleet/traffic/roadmap.hpp"
 
-namespace fleet::ctl {
+namespace fleet::traffic {
 
 struct DockGeometry {
   Vec2 dock;
@@ -42,4 +43,7 @@ struct DockGeometry {
 /// above over the cruise. 0 for a cruise ≤ 0 or anything not finite (the caller checks its inputs).
 [[nodiscard]] double dockMoveSeconds(const DockGeometry& g, double radius, double cruise);
 
-}  // namespace fleet::ctl
+/// A station's geometry on the roadmap: its dock, approach, queue head and exit nodes' positions.
+[[nodiscard]] DockGeometry dockGeometry(const Graph& g, const StationNodes& s);
+
+}  // namespace fleet::traffic
