@@ -357,6 +357,61 @@ void BM_DispatchTick(benchmark::State& state) {
 }
 BENCHMARK(BM_DispatchTick)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
+/// A dispatcher tick with station admission at 300 robots: 200 tasks under way (robots spread over
+/// the site), 1,000 waiting, 100 idle robots, every station's line 3 places. Arg 0: slots counted
+/// now (StationLoad::Phase); arg 1: by predicted arrival (StationLoad::Arrival, straight lines at
+/// 1 m/s, 4 s of dock motion). The ratio is what booking every robot's arrival costs.
+void BM_AdmissionTick(benchmark::State& state) {
+  const bool byArrival = state.range(0) == 1;
+  const std::string dir = benchDir();
+  std::filesystem::create_directories(dir);
+  std::mt19937 rng(5);
+  Site site(rng);
+  DispatcherConfig cfg;
+  cfg.stationLoad = byArrival ? StationLoad::Arrival : StationLoad::Phase;
+  for (const Station* st : site.stations.all()) {
+    cfg.stationCapacities[st->name] = 3;
+  }
+  const auto at = [&site](const std::string& name) { return site.stations.find(name)->pose; };
+  cfg.stationTimes.toStation = [at](Vec2 from, const std::string& name) {
+    const Pose2 p = at(name);
+    return std::hypot(from.x - p.x, from.y - p.y);
+  };
+  cfg.stationTimes.between = [at](const std::string& a, const std::string& b) {
+    return std::hypot(at(a).x - at(b).x, at(a).y - at(b).y);
+  };
+  cfg.stationTimes.dockMove = [](const std::string&) { return 4.0; };
+  std::vector<double> ms;
+  std::size_t round = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    auto store = SqliteTaskStore::open({dir + "/tasks.db"});
+    if (!store) {
+      state.SkipWithError(store.error().message.c_str());
+      return;
+    }
+    Dispatcher d(**store, site.stations, site.travelModel(), cfg);
+    const auto robots = Site::robots(rng, 300);
+    for (std::size_t j = 0; j < robots.size(); ++j) {
+      d.onRobotState({robots[j].id, robots[j].pose, 0.9, 0});
+    }
+    d.submit(site.tasks(rng, 200, numbered("a", round, "-")), 0);
+    (void)d.tick(1);  // as many under way as their stations' lines take
+    d.submit(site.tasks(rng, 1000, numbered("w", round++, "-")), 2);
+    state.ResumeTiming();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto out = d.tick(3);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    benchmark::DoNotOptimize(out.assignments.data());
+    state.counters["active"] = static_cast<double>(d.activeCount());
+  }
+  state.counters["p50_ms"] = quantile(ms, 0.50);
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_AdmissionTick)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
 }  // namespace
 }  // namespace fleet
 
