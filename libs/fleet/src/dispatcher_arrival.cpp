@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <limits>
 #include <string>
-#include <tuple>
 #include <unordered_map>
 #include <vector>
 
