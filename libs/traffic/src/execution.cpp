@@ -374,11 +374,22 @@ bool Execution::rederive(const std::vector<std::uint8_t>* only) {
     std::int64_t index;
     bool operator<(const At& o) const { return node < o.node; }
   };
+  // Every entry on a node an entry whose dependencies are derived looks at: its own and the nodes
+  // it conflicts with. With `only`, that is the nodes marked and those conflicting with one (the
+  // conflicts are symmetric); the rest are left out of the sort, which was most of a let-pass.
+  const auto looked = [&](NodeId x) {
+    if (only == nullptr || (*only)[static_cast<std::size_t>(x)] != 0)
+      return true;
+    const auto c = graph_.conflicts(x);
+    return std::any_of(c.begin(), c.end(), [&](NodeId y) { return (*only)[static_cast<std::size_t>(y)] != 0; });
+  };
   std::vector<At> at;
   for (std::size_t r = 0; r < routes_.size(); ++r) {
     const Route& route = routes_[r];
-    for (std::int64_t i = route.first; i <= route.last(); ++i)
-      at.push_back(At{route[i].node, static_cast<std::uint32_t>(r), i});
+    for (std::int64_t i = route.first; i <= route.last(); ++i) {
+      if (looked(route[i].node))
+        at.push_back(At{route[i].node, static_cast<std::uint32_t>(r), i});
+    }
   }
   std::sort(at.begin(), at.end());
   std::vector<std::int64_t> lastBefore(routes_.size(), -1);

@@ -30,9 +30,10 @@ void DistanceTable::detourAround(NodeId goal, NodeId from, double radius, std::s
   }
   // The disc: nodes reachable from `from` along open edges without leaving it.
   const Vec2 c = graph_.position(from);
+  const double r2 = radius * radius;
   const auto inside = [&](NodeId v) {
     const Vec2 p = graph_.position(v);
-    return std::hypot(p.x - c.x, p.y - c.y) <= radius;
+    return (p.x - c.x) * (p.x - c.x) + (p.y - c.y) * (p.y - c.y) <= r2;  // hypot's care for overflow costs
   };
   auto& region = region_;
   region.clear();
