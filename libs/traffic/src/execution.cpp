@@ -381,7 +381,8 @@ bool Execution::rederive(const std::vector<std::uint8_t>* only) {
     if (only == nullptr || (*only)[static_cast<std::size_t>(x)] != 0)
       return true;
     const auto c = graph_.conflicts(x);
-    return std::any_of(c.begin(), c.end(), [&](NodeId y) { return (*only)[static_cast<std::size_t>(y)] != 0; });
+    return std::any_of(c.begin(), c.end(),
+                       [&](NodeId y) { return (*only)[static_cast<std::size_t>(y)] != 0; });
   };
   std::vector<At> at;
   for (std::size_t r = 0; r < routes_.size(); ++r) {

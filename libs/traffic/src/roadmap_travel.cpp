@@ -42,6 +42,17 @@ std::optional<double> RoadmapTravel::toStation(Vec2 from, const std::string& nam
   return leg + static_cast<double>(t->toDock[static_cast<std::size_t>(start)]);
 }
 
+std::optional<double> RoadmapTravel::fromNode(NodeId from, const std::string& name) const {
+  const StationTable* t = find(name);
+  if (t == nullptr) {
+    return std::nullopt;
+  }
+  if (from < 0 || static_cast<std::size_t>(from) >= t->toDock.size()) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return static_cast<double>(t->toDock[static_cast<std::size_t>(from)]);
+}
+
 std::optional<double> RoadmapTravel::between(const std::string& a, const std::string& b) const {
   const StationTable* from = find(a);
   const StationTable* to = find(b);

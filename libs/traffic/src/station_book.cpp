@@ -7,28 +7,19 @@
 #include <stdexcept>
 #include <string>
 
-#include "fleet/traffic/distance_table.hpp"
-#include "fleet/traffic/station_cycle.hpp"
-
 namespace fleet::traffic {
 
-StationBook::StationBook(const Roadmap& roadmap, const std::vector<NodeId>& docks, double dwell,
+StationBook::StationBook(const RoadmapTravel& roads, const std::vector<NodeId>& docks, double dwell,
                          std::size_t slots)
-    : index_(roadmap.graph.size(), -1) {
-  DistanceTable tables(roadmap.graph);
-  for (const auto& s : roadmap.stations) {
+    : roads_(roads), index_(roads.roadmap().graph.size(), -1) {
+  for (const auto& s : roads.roadmap().stations) {
     if (s.dock == kNoNode || std::find(docks.begin(), docks.end(), s.dock) == docks.end() ||
         index_[static_cast<std::size_t>(s.dock)] >= 0) {
       continue;
     }
-    Line l;
-    l.cycle = dwell + dockMoveSeconds(dockGeometry(roadmap.graph, s), roadmap.options.radius,
-                                      roadmap.options.cruiseSpeed);
-    l.slots = slots > 0 ? slots : 1 + s.queue.size();
-    const auto d = tables.to(s.dock);
-    l.toDock.assign(d.begin(), d.end());
     index_[static_cast<std::size_t>(s.dock)] = static_cast<int>(lines_.size());
-    lines_.push_back(std::move(l));
+    lines_.push_back(
+        {s.name, dwell + roads.dockMoveSeconds(s.name), slots > 0 ? slots : roads.lineCapacity(s.name), {}});
   }
 }
 
@@ -47,11 +38,7 @@ StationBook::Line& StationBook::at(NodeId dock) {
 }
 
 double StationBook::travel(NodeId from, NodeId dock) const {
-  const auto& t = at(dock).toDock;
-  if (from < 0 || static_cast<std::size_t>(from) >= t.size()) {
-    return std::numeric_limits<double>::infinity();
-  }
-  return static_cast<double>(t[static_cast<std::size_t>(from)]);
+  return roads_.fromNode(from, at(dock).name).value_or(std::numeric_limits<double>::infinity());
 }
 
 void StationBook::clear() {

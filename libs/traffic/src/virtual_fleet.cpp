@@ -6,11 +6,13 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
+#include "fleet/traffic/roadmap_travel.hpp"
 #include "fleet/traffic/station_book.hpp"
 
 namespace fleet::traffic {
@@ -180,7 +182,9 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   // held up is booked later.
   std::vector<NodeId> served = pickups;
   served.insert(served.end(), dropoffs.begin(), dropoffs.end());
-  StationBook book(roadmap, served, o.dwell, o.stationSlots);
+  // Not owned: the roadmap outlives the run.
+  const RoadmapTravel roads(std::shared_ptr<const Roadmap>(&roadmap, [](const Roadmap*) {}));
+  StationBook book(roads, served, o.dwell, o.stationSlots);
   double bookedAt = -1.0;
   // Admission by slots: the robots bound for each station now, its pickup until loaded, its
   // drop-off for the whole task.

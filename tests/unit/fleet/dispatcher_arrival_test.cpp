@@ -118,13 +118,14 @@ TEST_F(DispatcherArrivalTest, ALoadThatWouldMeetItsDropOffsLineFullIsHeld) {
 }
 
 TEST_F(DispatcherArrivalTest, NoMoreTasksAreAdmittedThanThereAreIdleRobots) {
-  // Three tasks to three drop-offs and one idle robot: one is admitted, and the others are not
-  // said to wait for a place (they wait for a robot).
-  cfg.stationCapacities.clear();
-  SetUp();
+  // One idle robot at P-1 (a line of one) and two tasks: t1 takes the robot. t2 is not looked at
+  // this dispatch, so it is not said to wait for a place in P-1's line, which t1's booking would
+  // otherwise fill (it waits for a robot).
   robot("r1", 0, 0);
-  dispatcher->submit({transport("t1", "D-1"), transport("t2", "D-2"), transport("t3", "D-1")}, 0);
-  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
+  dispatcher->submit({transport("t1", "D-1"), transport("t2", "D-2")}, 0);
+  const auto out = dispatcher->tick(1);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "t1");
   EXPECT_EQ(reasonOf("t2").find("waiting for a place"), std::string::npos) << reasonOf("t2");
 }
 

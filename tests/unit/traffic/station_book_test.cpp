@@ -1,6 +1,7 @@
-// The virtual fleet's station book (admission by predicted arrival) on the small warehouse: travel
-// times equal the roadmap's, each line's cycle is the dwell plus the fleet bound's least dock
-// motion, and a booked robot's leave agrees with the line's arithmetic (fleet/core/station_slots).
+// The virtual fleet's station book (admission by predicted arrival) on the small warehouse: from a
+// node its travel times are the roadmap's dock-to-dock ones, each line's cycle is the dwell plus
+// the fleet bound's least dock motion, and a booked robot's leave agrees with the line's arithmetic
+// (fleet/core/station_slots).
 
 #include "fleet/traffic/station_book.hpp"
 
@@ -34,8 +35,8 @@ std::vector<NodeId> served(const Roadmap& r) {
 
 TEST(StationBook, TravelAndCycleAreTheRoadmapsAndTheFleetBoundsAndLinesAsLongAsTheQueues) {
   const auto map = smallWarehouse();
-  const StationBook book(*map, served(*map), 2.0);
   const RoadmapTravel roads(map);
+  const StationBook book(roads, served(*map), 2.0);
   for (const auto& s : map->stations) {
     if (s.dock == kNoNode || (s.kind != site::StationKind::Pickup && s.kind != site::StationKind::Dropoff)) {
       continue;
@@ -53,12 +54,13 @@ TEST(StationBook, TravelAndCycleAreTheRoadmapsAndTheFleetBoundsAndLinesAsLongAsT
   }
   EXPECT_THROW((void)book.cycle(map->stations.front().dock), std::out_of_range)
       << "a parking place is not served";
-  EXPECT_EQ(StationBook(*map, served(*map), 2.0, 1).slots(served(*map).front()), 1U);
+  EXPECT_EQ(StationBook(roads, served(*map), 2.0, 1).slots(served(*map).front()), 1U);
 }
 
 TEST(StationBook, ABookedRobotLeavesWhenTheLinesArithmeticSays) {
   const auto map = smallWarehouse();
-  StationBook book(*map, served(*map), 2.0);
+  const RoadmapTravel roads(map);
+  StationBook book(roads, served(*map), 2.0);
   const NodeId dock = served(*map).front();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> when(-5.0, 60.0);

@@ -29,6 +29,8 @@ class RoadmapTravel {
   /// cruise speed, then the roadmap. nullopt: no such station, or it has no dock (the robot's disc
   /// does not fit there); +infinity: no route.
   [[nodiscard]] std::optional<double> toStation(Vec2 from, const std::string& name) const;
+  /// Seconds from roadmap node `from` to station `name`'s dock (nullopt and +infinity as above).
+  [[nodiscard]] std::optional<double> fromNode(NodeId from, const std::string& name) const;
   /// Seconds from station `a`'s dock to station `b`'s (nullopt and +infinity as above).
   [[nodiscard]] std::optional<double> between(const std::string& a, const std::string& b) const;
   /// Robots the station's line holds at once: its dock and its queue nodes; 0 when it has no dock.

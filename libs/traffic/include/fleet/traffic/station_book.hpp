@@ -4,22 +4,25 @@
 // "Admission by predicted arrival"; the line's arithmetic is fleet/core/station_slots.hpp). Each
 // served station (pickup, drop-off) has a line of `slots` robots (its dock and queue places) and
 // serves a robot in its least dock cycle (station_cycle.hpp, plus the dwell). Robots bound for a
-// station are booked with their predicted arrival, in seconds from now on free-flow roadmap times;
-// the book is rebuilt from the robots' positions whenever the caller likes (every tick in the
-// virtual fleet), so a robot that is late is booked later, not lost.
+// station are booked with their predicted arrival, in seconds from now on the roadmap's free-flow
+// times (RoadmapTravel); the book is rebuilt from the robots' positions whenever the caller likes
+// (every tick in the virtual fleet), so a robot that is late is booked later, not lost.
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "fleet/core/station_slots.hpp"
-#include "fleet/traffic/roadmap.hpp"
+#include "fleet/traffic/roadmap_travel.hpp"
 
 namespace fleet::traffic {
 
 class StationBook {
  public:
   /// `docks`: the stations served (their dock nodes). `slots` above 0 replaces every line's length.
-  StationBook(const Roadmap& roadmap, const std::vector<NodeId>& docks, double dwell, std::size_t slots = 0);
+  /// `roads` must outlive the book.
+  StationBook(const RoadmapTravel& roads, const std::vector<NodeId>& docks, double dwell,
+              std::size_t slots = 0);
 
   /// Free-flow seconds from node `from` to the dock (+infinity: no way).
   [[nodiscard]] double travel(NodeId from, NodeId dock) const;
@@ -39,14 +42,15 @@ class StationBook {
 
  private:
   struct Line {
+    std::string name;
     double cycle = 0.0;
     std::size_t slots = 0;
-    std::vector<float> toDock;
     std::vector<double> arrivals;  // booked, in booking order
   };
   [[nodiscard]] const Line& at(NodeId dock) const;
   Line& at(NodeId dock);
 
+  const RoadmapTravel& roads_;
   std::vector<int> index_;  // by dock node: its line, -1: not served
   std::vector<Line> lines_;
 };
