@@ -87,9 +87,17 @@ void DistanceTable::applyChanges() {
     invalidate();
     return;
   }
-  for (const NodeId w : changed_) {
-    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
-  }
+  // A node blocked and unblocked again since the last query (a replan takes every fixed robot off
+  // its node and puts it back) is not a change: only nodes whose entering cost differs restart.
+  std::erase_if(changed_, [this](NodeId w) {
+    const auto v = static_cast<std::size_t>(w);
+    const float enter = baseEnter(v);
+    if (enter == baseEnter_[v]) {
+      return true;
+    }
+    baseEnter_[v] = enter;
+    return false;
+  });
   // A search that has not settled a changed node has not used its entering cost (it is read when
   // the node is settled and relaxes its predecessors); its settled distances are final for the new
   // costs (a way through the node costs at least the node's own distance, no less than any settled
