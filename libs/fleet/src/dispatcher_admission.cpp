@@ -76,10 +76,13 @@ void Dispatcher::noteAdmissionWaits(const std::vector<HeldAtStation>& held, std:
     }
     auto& r = it->second;
     const bool late = r.task.deadlineNs > 0 && nowNs > r.task.deadlineNs;
+    const std::string waiting = late ? "past its deadline and still waiting" : "waiting";
     const std::string why =
-        std::string(late ? "past its deadline and still waiting" : "waiting") + " for a place in station " +
-        h.station + "'s line (it holds " + std::to_string(h.capacity) +
-        (h.byArrival ? ", all taken when a robot could get there)" : ", all taken by other tasks)");
+        h.station.empty()
+            ? waiting + " for a robot (every idle one has an older or more urgent task)"
+            : waiting + std::string(dispatcher_detail::kPlaceInLine) + h.station + "'s line (it holds " +
+                  std::to_string(h.capacity) +
+                  (h.byArrival ? ", all taken when a robot could get there)" : ", all taken by other tasks)");
     if (why == r.reason) {
       continue;  // said already: no store write, no event
     }

@@ -94,7 +94,14 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Ta
   std::vector<HeldAtStation> held;
   for (auto& t : waiting) {
     if (admitted.size() >= idle.size()) {
-      break;  // no robot for the rest this tick: they wait for one, not for a place
+      // No robot for it this dispatch: it waits for one, not for a place. A reason it was given
+      // when a place was what it lacked would stay until it is looked at again: taken back (a
+      // HeldAtStation without a station). Others are left alone (no store write).
+      const auto it = open_.find(t.id);
+      if (it != open_.end() && it->second.reason.find(dispatcher_detail::kPlaceInLine) != std::string::npos) {
+        held.push_back({t.id, "", 0, false});
+      }
+      continue;
     }
     if (!t.robot.empty()) {  // a robot's own charge task is never held back
       admitted.push_back(std::move(t));

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <vector>
 
@@ -33,5 +34,8 @@ inline void oldestFirst(std::vector<Task>& waiting) {
            std::tuple(b.robot.empty(), -b.priority, b.createdNs);
   });
 }
+
+/// What a task's wait reason says when a station's line had no place for it (noteAdmissionWaits).
+inline constexpr std::string_view kPlaceInLine = " for a place in station ";
 
 }  // namespace fleet::dispatcher_detail

@@ -129,5 +129,26 @@ TEST_F(DispatcherArrivalTest, NoMoreTasksAreAdmittedThanThereAreIdleRobots) {
   EXPECT_EQ(reasonOf("t2").find("waiting for a place"), std::string::npos) << reasonOf("t2");
 }
 
+TEST_F(DispatcherArrivalTest, ATaskNoRobotIsLeftForNoLongerSaysItWaitsForAPlace) {
+  // t2 waits for a place in P-1's line; when P-1 is free again an urgent t3 takes the only idle
+  // robot, so t2 is not looked at. Its reason must not still name P-1's line.
+  robot("r1", 0, 0);
+  dispatcher->submit({transport("t1", "D-1")}, 0);
+  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
+  robot("r2", 1, 2);
+  dispatcher->submit({transport("t2", "D-2")}, 2);
+  EXPECT_TRUE(dispatcher->tick(3).assignments.empty());
+  ASSERT_NE(reasonOf("t2").find("for a place in station P-1"), std::string::npos) << reasonOf("t2");
+  ASSERT_TRUE(dispatcher->onTaskStatus("r1", "t1", S::Delivering, "", 4));
+  robot("r1", 15, 5);
+  Task urgent = transport("t3", "D-2");
+  urgent.priority = 5;
+  dispatcher->submit({urgent}, 5);
+  const auto out = dispatcher->tick(6);
+  ASSERT_EQ(out.assignments.size(), 1u);
+  EXPECT_EQ(out.assignments[0].task.id, "t3");
+  EXPECT_EQ(reasonOf("t2"), "waiting for a robot (every idle one has an older or more urgent task)");
+}
+
 }  // namespace
 }  // namespace fleet

@@ -244,7 +244,7 @@ class Dispatcher {
   /// A task admission held back: the first of its stations whose line was full, and its capacity.
   struct HeldAtStation {
     std::string taskId;
-    std::string station;
+    std::string station;  ///< empty: not looked at, every idle robot went to an older task
     std::size_t capacity = 0;
     bool byArrival = false;  ///< no place for when a robot could get there
   };
