@@ -59,6 +59,16 @@ class DispatcherArrivalTest : public ::testing::Test {
     dispatcher->onRobotState({id, {x, 0, 0}, 0.9, t});
   }
   std::string reasonOf(const std::string& id) { return store->get(id).value().reason; }
+  /// r1 stands at P-1 with t1 (to D-1); r2 is 1 s away and t2 (to D-2) is held: its robot would
+  /// find r1 still loading, and P-1's line holds one.
+  void t2WaitsBehindT1AtP1() {
+    robot("r1", 0, 0);
+    dispatcher->submit({transport("t1", "D-1")}, 0);
+    ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
+    robot("r2", 1, 2);
+    dispatcher->submit({transport("t2", "D-2")}, 2);
+    EXPECT_TRUE(dispatcher->tick(3).assignments.empty());
+  }
 
   test::TempDir dir;
   StationMap map = stations();
@@ -84,12 +94,7 @@ TEST_F(DispatcherArrivalTest, ARobotFarFromItsPickupLeavesTheLineToOneThatWillBe
 TEST_F(DispatcherArrivalTest, ARobotThatWouldMeetTheLineFullWaitsAndSaysWhy) {
   // r1 stands at P-1 with t1; r2 is 1 s away: its robot would find r1 still loading, and the line
   // holds one. t2 waits with a reason naming the station, and goes once t1 has loaded and left.
-  robot("r1", 0, 0);
-  dispatcher->submit({transport("t1", "D-1")}, 0);
-  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
-  robot("r2", 1, 2);
-  dispatcher->submit({transport("t2", "D-2")}, 2);
-  EXPECT_TRUE(dispatcher->tick(3).assignments.empty());
+  t2WaitsBehindT1AtP1();
   EXPECT_EQ(reasonOf("t2"),
             "waiting for a place in station P-1's line (it holds 1, all taken when a robot "
             "could get there)");
@@ -132,12 +137,7 @@ TEST_F(DispatcherArrivalTest, NoMoreTasksAreAdmittedThanThereAreIdleRobots) {
 TEST_F(DispatcherArrivalTest, ATaskNoRobotIsLeftForNoLongerSaysItWaitsForAPlace) {
   // t2 waits for a place in P-1's line; when P-1 is free again an urgent t3 takes the only idle
   // robot, so t2 is not looked at. Its reason must not still name P-1's line.
-  robot("r1", 0, 0);
-  dispatcher->submit({transport("t1", "D-1")}, 0);
-  ASSERT_EQ(dispatcher->tick(1).assignments.size(), 1u);
-  robot("r2", 1, 2);
-  dispatcher->submit({transport("t2", "D-2")}, 2);
-  EXPECT_TRUE(dispatcher->tick(3).assignments.empty());
+  t2WaitsBehindT1AtP1();
   ASSERT_NE(reasonOf("t2").find("for a place in station P-1"), std::string::npos) << reasonOf("t2");
   ASSERT_TRUE(dispatcher->onTaskStatus("r1", "t1", S::Delivering, "", 4));
   robot("r1", 15, 5);
