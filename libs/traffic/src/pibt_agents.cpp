@@ -27,7 +27,6 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   task_.assign(n, 0);
   elapsed_.assign(n, 0);
   controlled_.assign(n, 1);
-  routedAround_.assign(n, 0);
   onStack_.assign(n, 0);
   best_.assign(n, DistanceTable::kUnreachable);
   stalled_.assign(n, 0);
@@ -140,14 +139,9 @@ void Pibt::cover(NodeId v, int delta) {
   }
 }
 
-void Pibt::setControlled(std::size_t agent, bool controlled, bool routeAround) {
-  const bool around = !controlled && routeAround;
-  if ((routedAround_[agent] != 0) != around) {
-    cover(now_[agent], around ? 1 : -1);
-    routedAround_[agent] = around ? 1 : 0;
-    if (!controlled && controlled_[agent] == 0) {
-      return;  // only routed round now: it was out of control already
-    }
+void Pibt::setControlled(std::size_t agent, bool controlled) {
+  if ((controlled_[agent] != 0) != controlled) {
+    cover(now_[agent], controlled ? -1 : 1);
   }
   controlled_[agent] = controlled ? 1 : 0;
   dropForced(forcedGroup_[agent]);
@@ -174,7 +168,7 @@ bool Pibt::setPosition(std::size_t agent, NodeId v) {
   if (!graph_.valid(v) || standingOn(v, static_cast<std::int32_t>(agent)) >= 0) {
     return false;
   }
-  if (routedAround_[agent] != 0) {
+  if (controlled_[agent] == 0) {
     cover(now_[agent], -1);
     cover(v, 1);
   }
@@ -227,7 +221,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
     }
   }
   for (std::size_t i = 0; i < now_.size(); ++i) {
-    if (routedAround_[i] != 0)
+    if (controlled_[i] == 0)
       cover(now_[i], -1);
     agentAt_[idx(now_[i])] = -1;
   }
@@ -240,7 +234,6 @@ void Pibt::reset(std::span<const NodeId> positions) {
     task_.resize(n, 0);
     elapsed_.resize(n, 0);
     controlled_.resize(n, 1);
-    routedAround_.resize(n, 0);
     onStack_.resize(n, 0);
     best_.resize(n, DistanceTable::kUnreachable);
     stalled_.resize(n, 0);
@@ -298,7 +291,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
   now_.assign(positions.begin(), positions.end());
   for (std::size_t i = 0; i < n; ++i) {
     agentAt_[idx(now_[i])] = static_cast<std::int32_t>(i);
-    if (routedAround_[i] != 0)
+    if (controlled_[i] == 0)
       cover(now_[i], 1);
   }
   if (n > old) {

@@ -39,8 +39,7 @@ void Pibt::planDetours() {
       // What every agent that has stood still as long excludes, counted per node.
       cover.assign(graph_.size(), 0);
       for (std::size_t b = 0; b < n; ++b) {
-        // Agents the tables already route round are left out (out of control and routed around).
-        if (routedAround_[b] == 0 && still_[b] >= options_.detourAfter) {
+        if (controlled_[b] != 0 && still_[b] >= options_.detourAfter) {
           ++cover[idx(now_[b])];
           for (const NodeId w : graph_.conflicts(now_[b])) {
             ++cover[idx(w)];

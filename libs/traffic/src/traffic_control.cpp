@@ -262,7 +262,7 @@ void TrafficControl::setHeld(std::size_t robot, bool held) {
       replan();
     }
   }
-  planner_->setControlled(robot, !held, !arrived(robot));
+  planner_->setControlled(robot, !held);
 }
 
 void TrafficControl::retractStanding(std::size_t robot) {

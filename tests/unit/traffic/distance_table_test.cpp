@@ -226,6 +226,27 @@ TEST(DistanceTable, BoundedCacheRecomputesEvictedGoalsAndKeepsRecentOnes) {
   EXPECT_EQ(t.computed(), before);
 }
 
+TEST(DistanceTable, ANodeBlockedAndUnblockedBetweenQueriesRestartsNoTable) {
+  const GridMap m = gridOf({
+      ".....",
+      ".....",
+  });
+  DistanceTable t(m.graph);
+  const NodeId goal = m.node(4, 0);
+  const NodeId v = m.node(2, 0);
+  (void)t.to(goal);  // settled everywhere, v included
+  const auto before = t.computed();
+  // A replan takes every fixed robot off its node and puts it back: no change to restart for.
+  t.setBlocked(v, true);
+  t.setBlocked(v, false);
+  EXPECT_EQ(t.distance(m.node(0, 0), goal), 4.0F);
+  EXPECT_EQ(t.computed(), before);
+  // A real change does restart the table that settled the node, and routes round it.
+  t.setBlocked(v, true);
+  EXPECT_EQ(t.distance(m.node(0, 0), goal), 6.0F);
+  EXPECT_EQ(t.computed(), before + 1);
+}
+
 TEST(DistanceTable, BlockedNodesAreRoutedAroundButStayReachableAsGoals) {
   const GridMap m = gridOf({
       ".....",

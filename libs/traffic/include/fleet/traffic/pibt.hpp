@@ -124,15 +124,8 @@ class Pibt {
   /// Higher first; every other priority rule only breaks ties of this one.
   void setTaskPriority(std::size_t agent, int priority) { task_[agent] = priority; }
   /// An agent out of control is a fixed obstacle on its node until it is controlled again.
-  /// `routeAround`: the distance tables also take its node and what it excludes out of every route
-  /// (DistanceTable::setBlocked); without it agents only stand round it (and detour round it once
-  /// they have stood still `detourAfter` steps, as round any agent standing that long). A stop of a
-  /// few seconds (a robot dwelling at a dock) is better not routed round: blocking restarts every
-  /// table that has settled those nodes. A second call with `routeAround` set only adds the blocking.
-  void setControlled(std::size_t agent, bool controlled, bool routeAround = true);
+  void setControlled(std::size_t agent, bool controlled);
   [[nodiscard]] bool controlled(std::size_t agent) const { return controlled_[agent] != 0; }
-  /// Whether the routes go round the agent (out of control and routed around).
-  [[nodiscard]] bool routedAround(std::size_t agent) const { return routedAround_[agent] != 0; }
   /// Moves an agent (a robot reported somewhere else, a vendor's vehicle moved). Refused (false) when
   /// the node is invalid or conflicts with another agent's node.
   bool setPosition(std::size_t agent, NodeId v);
@@ -234,8 +227,7 @@ class Pibt {
   std::vector<int> elapsed_;
   std::vector<double> epsilon_;
   std::vector<std::uint8_t> controlled_;
-  std::vector<std::uint8_t> routedAround_;  ///< its cover is in the distance tables (setControlled)
-  std::vector<std::uint8_t> busy_;          ///< setBusy()
+  std::vector<std::uint8_t> busy_;  ///< setBusy()
   std::vector<std::uint8_t> onStack_;
   bool rebaseProgress_ = false;            ///< the distances changed: best_ from the new ones
   std::vector<float> best_;                ///< nearest it has been to its goal since the goal was set

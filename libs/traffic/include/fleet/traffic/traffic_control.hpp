@@ -139,11 +139,6 @@ class TrafficControl {
   [[nodiscard]] std::vector<std::size_t> line(NodeId dock) const;
 
   /// A held robot stands where it is and is planned around (docking, faulted, paused, manual).
-  /// Held anywhere but at its goal, the routes go round it at once (Pibt::setControlled's
-  /// `routeAround`); held at its goal (docking, dwelling, charging) it is a stop of seconds at a
-  /// dead end, so the others stand behind it or detour round it as round any robot standing that
-  /// long: taking its node out of the routes would restart every distance table that has settled
-  /// it, twice a stop (docs/algorithms.md, "A robot held at its goal is not routed round").
   void setHeld(std::size_t robot, bool held);
   /// The robot stands at its last reported node and will not drive on (held there by a person for
   /// long): what was released beyond that node is taken back and it is planned from there, so it
