@@ -88,32 +88,59 @@ void DistanceTable::applyChanges() {
     return;
   }
   // A node blocked and unblocked again since the last query (a replan takes every fixed robot off
-  // its node and puts it back) is not a change: only nodes whose entering cost differs restart.
-  std::erase_if(changed_, [this](NodeId w) {
+  // its node and puts it back) is not a change: only nodes whose entering cost differs count.
+  raised_.clear();
+  lowered_.clear();
+  for (const NodeId w : changed_) {
     const auto v = static_cast<std::size_t>(w);
     const float enter = baseEnter(v);
     if (enter == baseEnter_[v]) {
-      return true;
+      continue;  // no change, or a node listed twice and already taken
     }
-    baseEnter_[v] = enter;
-    return false;
-  });
-  // A search that has not settled a changed node has not used its entering cost (it is read when
-  // the node is settled and relaxes its predecessors); its settled distances are final for the new
-  // costs (a way through the node costs at least the node's own distance, no less than any settled
-  // one) and its frontier is the one a search started now would have. A table that has is
-  // restarted from its goal, searched again only as far as it is read.
-  for (std::size_t slot = 0; slot < used_; ++slot) {
-    PartialTable& t = tables_[slot];
-    if (t.empty() || t.settledCount == 0) {
-      continue;
-    }
-    if (std::any_of(changed_.begin(), changed_.end(), [&](NodeId w) { return t.isSettled(w); })) {
-      start(t.goal, t);
-      ++computed_;
-    }
+    (enter > baseEnter_[v] ? raised_ : lowered_).push_back(w);
+    oldEnter_[v] = baseEnter_[v];
   }
   changed_.clear();
+  if (onChange_ == OnChange::kRestart) {
+    for (const auto* list : {&raised_, &lowered_}) {
+      for (const NodeId w : *list) {
+        baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
+      }
+    }
+    for (std::size_t slot = 0; slot < used_; ++slot) {
+      PartialTable& t = tables_[slot];
+      const auto read = [&t](NodeId w) { return t.isSettled(w); };
+      if (!t.empty() && (std::any_of(raised_.begin(), raised_.end(), read) ||
+                         std::any_of(lowered_.begin(), lowered_.end(), read))) {
+        start(t.goal, t);
+        ++computed_;
+      }
+    }
+    return;
+  }
+  // A search that has not settled a changed node has not used its entering cost (it is read when
+  // the node is settled and relaxes its predecessors): its settled distances are final for the new
+  // costs and its frontier is the one a search started now would have. A table that has is
+  // repaired: first for the raised costs alone, then for the lowered ones (each repair needs a
+  // table exact for the costs before it).
+  for (const NodeId w : raised_) {
+    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
+  }
+  std::vector<std::uint8_t> touched(used_, 0);
+  for (std::size_t slot = 0; slot < used_; ++slot) {
+    if (!raised_.empty() && !tables_[slot].empty() && repairRaised(tables_[slot])) {
+      touched[slot] = 1;
+    }
+  }
+  for (const NodeId w : lowered_) {
+    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
+  }
+  for (std::size_t slot = 0; slot < used_; ++slot) {
+    if (!lowered_.empty() && !tables_[slot].empty() && repairLowered(tables_[slot])) {
+      touched[slot] = 1;
+    }
+    repaired_ += touched[slot];
+  }
 }
 
 void DistanceTable::invalidate() {
@@ -123,6 +150,8 @@ void DistanceTable::invalidate() {
   buildReverse();
   // Entering each node in a goal's table: its node cost, never when closed or blocked.
   baseEnter_.resize(graph_.size());
+  oldEnter_.assign(graph_.size(), 0.0F);
+  mark_.assign(graph_.size(), 0);
   for (std::size_t v = 0; v < graph_.size(); ++v) {
     baseEnter_[v] = baseEnter(v);
   }
@@ -217,6 +246,7 @@ std::span<const float> DistanceTable::to(NodeId goal) {
     t.heap.clear();
     std::fill(t.settled.begin(), t.settled.end(), ~std::uint64_t{0});
     t.settledCount = graph_.size();
+    t.radius = kUnreachable;
   }
   settleIn(t, baseEnter_, kNoNode);
   return t.dist;

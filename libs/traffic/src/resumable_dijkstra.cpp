@@ -38,11 +38,13 @@ float DistanceTable::settleIn(PartialTable& t, std::span<const float> enterOf, N
     const auto [du, un] = heap.back();
     heap.pop_back();
     const auto u = static_cast<std::size_t>(un);
-    if (du > t.dist[u] || t.isSettled(un)) {
+    // An entry is stale unless it holds the node's distance (a repair may have raised it).
+    if (du != t.dist[u] || t.isSettled(un)) {
       continue;
     }
     t.settled[u >> 6] |= std::uint64_t{1} << (u & 63);
     ++t.settledCount;
+    t.radius = std::max(t.radius, du);
     const float enter = un == t.goal ? 0.0F : enterOf[u];
     if (enter != kUnreachable) {
       // Driving p→u costs the edge plus entering u (a node's entering cost is paid by whoever drives in).
@@ -62,10 +64,14 @@ float DistanceTable::settleIn(PartialTable& t, std::span<const float> enterOf, N
     }
   }
   // Frontier exhausted: every node left is unreachable (its bound is infinite), hence final.
+  t.radius = kUnreachable;
   if (v == kNoNode) {
     return kUnreachable;
   }
-  t.settled[want >> 6] |= std::uint64_t{1} << (want & 63);
+  if (!t.isSettled(v)) {
+    t.settled[want >> 6] |= std::uint64_t{1} << (want & 63);
+    ++t.settledCount;
+  }
   return t.dist[want];
 }
 

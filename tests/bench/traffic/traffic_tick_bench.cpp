@@ -4,11 +4,20 @@
 // change), seed 1, with admission by station slots (everyone:0) and with every robot given a task
 // from the start (everyone:1). One iteration is one whole run; its update p50 / p99 are the counters.
 // Targets: p99 <= 50 ms at 300 robots and <= 200 ms at 1,000 on one core.
+//
+// BM_DockDwellTables: what a robot dwelling at a dock costs the goal tables on the site for 300
+// robots: 300 robots stand still, each with a station's dock as its goal, their tables read at
+// their node and its neighbours; one iteration blocks the nodes round one dock (a robot arrives),
+// reads every table again, unblocks them (it leaves) and reads again. repair:0 restarts every table
+// that had settled a changed node (the reference), repair:1 repairs it in place (the default).
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <stdexcept>
+
+#include "fleet/traffic/distance_table.hpp"
 
 #include "fleet/site/site_loader.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -66,6 +75,81 @@ BENCHMARK(BM_TrafficTick)
     ->ArgsProduct({{100, 300, 1000}, {0, 1}})
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
+
+void BM_DockDwellTables(benchmark::State& state) {
+  const site::Site site = siteFor(300);
+  const traffic::Roadmap roadmap = traffic::buildRoadmap(site, {});
+  const traffic::Graph& g = roadmap.graph;
+  traffic::DistanceTable tables(g);
+  tables.setOnChange(state.range(0) == 0 ? traffic::DistanceTable::OnChange::kRestart
+                                         : traffic::DistanceTable::OnChange::kRepair);
+  // Each dock with what a robot on it covers: the nodes within a robot's width of it.
+  std::vector<std::vector<traffic::NodeId>> covers;
+  std::vector<traffic::NodeId> docks;
+  for (const auto& st : roadmap.stations) {
+    if (st.dock == traffic::kNoNode) {
+      continue;
+    }
+    docks.push_back(st.dock);
+    auto& cover = covers.emplace_back();
+    const Vec2 c = g.position(st.dock);
+    for (std::size_t v = 0; v < g.size(); ++v) {
+      const Vec2 p = g.position(static_cast<traffic::NodeId>(v));
+      if ((p.x - c.x) * (p.x - c.x) + (p.y - c.y) * (p.y - c.y) <= 0.7 * 0.7) {
+        cover.push_back(static_cast<traffic::NodeId>(v));
+      }
+    }
+  }
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<std::size_t> anyNode(0, g.size() - 1);
+  std::uniform_int_distribution<std::size_t> anyDock(0, docks.size() - 1);
+  std::vector<traffic::NodeId> at;
+  std::vector<traffic::NodeId> goal;
+  while (at.size() < 300) {
+    const auto v = static_cast<traffic::NodeId>(anyNode(rng));
+    if (g.isOpen(v) && !g.edges(v).empty()) {
+      at.push_back(v);
+      goal.push_back(docks[anyDock(rng)]);
+    }
+  }
+  tables.reserve(docks.size() + 1);
+  const auto read = [&] {
+    float sum = 0.0F;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+      sum += tables.distance(at[i], goal[i]) > 0.0F ? 1.0F : 0.0F;
+      for (const traffic::Edge& e : g.edges(at[i])) {
+        sum += tables.distance(e.to, goal[i]) > 0.0F ? 1.0F : 0.0F;
+      }
+    }
+    benchmark::DoNotOptimize(sum);
+  };
+  read();
+  const std::uint64_t computed0 = tables.computed();
+  const std::uint64_t repaired0 = tables.repaired();
+  std::size_t next = 0;
+  for (auto _ : state) {
+    const auto& cover = covers[(next++ * 37) % covers.size()];  // spread over the site's docks
+    for (const traffic::NodeId v : cover) {
+      tables.setBlocked(v, true);
+    }
+    read();
+    for (const traffic::NodeId v : cover) {
+      tables.setBlocked(v, false);
+    }
+    read();
+  }
+  const auto n = static_cast<double>(state.iterations());
+  state.counters["nodes"] = static_cast<double>(g.size());
+  state.counters["docks"] = static_cast<double>(docks.size());
+  state.counters["restarts_per_dwell"] = static_cast<double>(tables.computed() - computed0) / n;
+  state.counters["repairs_per_dwell"] = static_cast<double>(tables.repaired() - repaired0) / n;
+}
+BENCHMARK(BM_DockDwellTables)
+    ->ArgName("repair")
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(40)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

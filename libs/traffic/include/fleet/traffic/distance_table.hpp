@@ -13,9 +13,10 @@
 //
 // Blocking, unblocking and node costs change often (a robot held for a few seconds, people moving
 // through the risk map) while most tables are searched only from the goal as far as they were
-// read. Such a change restarts only the tables whose search has settled a changed node: a search
-// that has not reached it yet never used its cost, so its settled distances and its frontier are
-// those of a search started after the change (distance_table.cpp, applyChanges()).
+// read. Such a change leaves alone the tables whose search has not settled a changed node (it
+// never used its cost: its settled distances and its frontier are those of a search started after
+// the change) and repairs the others in place: only the distances the change really moves are
+// searched again (distance_repair.cpp), every value as exact as a search started afresh.
 
 #include <cstdint>
 #include <limits>
@@ -34,6 +35,9 @@ struct PartialTable {
   std::vector<std::uint64_t> settled;          ///< one bit per node
   std::vector<std::pair<float, NodeId>> heap;  ///< the search's frontier
   std::uint64_t settledCount = 0;
+  /// The largest settled distance (infinite once the frontier ran out): every node not settled is
+  /// at least this far from the goal, which is what lets a change be repaired in place.
+  float radius = 0.0F;
 
   [[nodiscard]] bool empty() const { return goal == kNoNode; }
   void clear() { goal = kNoNode; }
@@ -44,6 +48,7 @@ struct PartialTable {
     settled.assign((n + 63) / 64, 0);
     heap.clear();
     settledCount = 0;
+    radius = 0.0F;
   }
   [[nodiscard]] const float* data() const { return dist.data(); }
   [[nodiscard]] bool isSettled(NodeId v) const {
@@ -55,6 +60,9 @@ struct PartialTable {
 class DistanceTable {
  public:
   static constexpr float kUnreachable = std::numeric_limits<float>::infinity();
+  /// What a change does to a table that has settled a changed node: repaired in place (the
+  /// default), or restarted from its goal (the simple reference, kept for tests and benchmarks).
+  enum class OnChange : std::uint8_t { kRepair, kRestart };
 
   /// Keeps at most `maxBytes` of tables (at least one table, and at least reserve()'s count).
   explicit DistanceTable(const Graph& graph, std::size_t maxBytes = std::size_t{256} << 20);
@@ -104,6 +112,9 @@ class DistanceTable {
   [[nodiscard]] std::size_t cached() const { return used_; }
   /// Tables computed or restarted since construction (misses), for benchmarks and tests.
   [[nodiscard]] std::uint64_t computed() const { return computed_; }
+  /// Tables repaired in place after a change (applyChanges), for benchmarks and tests.
+  [[nodiscard]] std::uint64_t repaired() const { return repaired_; }
+  void setOnChange(OnChange c) { onChange_ = c; }
   /// true when every edge has the same duration (breadth-first search).
   [[nodiscard]] bool unitDurations() const { return unit_; }
 
@@ -111,9 +122,15 @@ class DistanceTable {
   void buildReverse();
   /// Entering v in a goal's table: its node cost, infinite when closed or blocked.
   [[nodiscard]] float baseEnter(std::size_t v) const;
-  /// Takes in what setBlocked()/setNodeCost() changed since the last query: restarts the tables
-  /// that read a changed node (everything when a change is too wide to be worth sorting out).
+  /// Takes in what setBlocked()/setNodeCost() changed since the last query: repairs the tables
+  /// that read a changed node (drops everything when a change is too wide to be worth sorting out).
   void applyChanges();
+  /// distance_repair.cpp: the table after raised_'s nodes cost more to enter (their old cost in
+  /// oldEnter_, the new one in baseEnter_), then after lowered_'s cost less. true when it changed.
+  bool repairRaised(PartialTable& t);
+  bool repairLowered(PartialTable& t);
+  /// The least way from `v` to the goal through the nodes `t` has settled.
+  [[nodiscard]] float viaSettled(const PartialTable& t, NodeId v) const;
   /// A whole table by breadth-first search (unit durations, no node cost).
   void compute(NodeId goal, std::vector<float>& d);
   std::size_t acquire(NodeId goal);
@@ -144,10 +161,21 @@ class DistanceTable {
   std::int32_t tail_ = -1;
   std::size_t used_ = 0;
   std::uint64_t computed_ = 0;
+  std::uint64_t repaired_ = 0;
+  OnChange onChange_ = OnChange::kRepair;
   std::vector<std::uint8_t> blocked_;
   std::vector<float> nodeCost_;
   bool dirty_ = false;
   std::vector<NodeId> changed_;  ///< nodes whose entering cost changed since the last query
+  // Repair scratch (distance_repair.cpp): the nodes costing more / less to enter, the former's old
+  // costs, a mark per node, a list of marked nodes and a heap.
+  std::vector<NodeId> raised_;
+  std::vector<NodeId> lowered_;
+  std::vector<float> oldEnter_;
+  std::vector<std::uint8_t> mark_;
+  std::vector<NodeId> marked_;
+  std::vector<NodeId> affected_;
+  std::vector<std::pair<float, NodeId>> work_;
   // Search scratch, kept to avoid allocating per table.
   std::vector<NodeId> queue_;
   std::vector<NodeId> region_;          ///< detourAround's disc
