@@ -173,22 +173,13 @@ struct Builder {
     plan.robotsOfProcess[name] = ids;
     std::error_code ec;
     fs::remove(out / (name + "_metrics.json"), ec);  // not a previous run's
-    std::vector<std::string> args = {"--scenario",
-                                     fs::absolute(run.file).string(),
-                                     "--clock",
-                                     o.wallClock ? "wall" : "lockstep",
-                                     "--metrics",
-                                     abs(name + "_metrics.json"),
-                                     "--id",
-                                     name,
-                                     "--robots",
-                                     joined(ids),
-                                     "--local-planner",
-                                     o.localPlanner,
-                                     "--return-home",
-                                     std::to_string(o.returnHomeS),
-                                     "--log-level",
-                                     "warn"};
+    fs::remove(out / (name + "_poses.json"), ec);
+    std::vector<std::string> args = {
+        "--scenario", fs::absolute(run.file).string(), "--clock", o.wallClock ? "wall" : "lockstep",
+        "--metrics", abs(name + "_metrics.json"), "--id", name, "--robots", joined(ids), "--local-planner",
+        o.localPlanner, "--return-home", std::to_string(o.returnHomeS),
+        // A restarted agent (a fault, the supervisor) resumes where its robots are.
+        "--pose-file", abs(name + "_poses.json"), "--log-level", "warn"};
     if (!o.agentConfig.empty()) {
       args.emplace_back("--config");
       args.push_back(fs::absolute(o.agentConfig).string());

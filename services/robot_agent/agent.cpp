@@ -17,7 +17,13 @@ namespace {
 
 LocalizerParams localizerParams(const AgentParams& p) {
   LocalizerParams lp;
-  lp.start = p.start;
+  lp.start = p.resumeAt.value_or(p.start);
+  if (p.resumeAt) {
+    // It may have rolled on after its process stopped (its last command held for the driver's
+    // timeout, then braking) and since the pose was written.
+    lp.startVarianceXY = kResumeVarianceXY;
+    lp.startVarianceTheta = kResumeVarianceTheta;
+  }
   lp.wheelBase = p.wheelBase;
   lp.sensorTimeoutS = p.sensorTimeoutS;
   lp.vMax = p.vMax;
@@ -48,7 +54,7 @@ Agent::Agent(AgentParams params, std::shared_ptr<const planning::OccupancyGrid> 
     : p_(std::move(params)),
       raw_(std::move(raw)),
       localizer_(localizerParams(p_)),
-      lastPlausiblePose_(p_.start),
+      lastPlausiblePose_(p_.resumeAt.value_or(p_.start)),
       gate_(GateParams{p_.radius, p_.stopGap, p_.headway, p_.robotStopGap, p_.limits, p_.speedLimit, false}),
       progress_(p_.progress),
       follow_(FollowerParams{p_.radius, p_.vMax, p_.wMax, p_.limits}, raw_, progress_) {

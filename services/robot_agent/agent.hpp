@@ -48,6 +48,9 @@ avoidance::DwaParams agentDwaDefaults();
 struct AgentParams {
   std::string id;
   Pose2 start;
+  /// Where the robot was when its process last saw it (the pose file, pose_store.hpp): the
+  /// localization starts there, less certain, instead of at `start` (which stays its parking place).
+  std::optional<Pose2> resumeAt;
   double radius = 0.3;
   double wheelBase = 0.4;
   double vMax = 0.8;                                  // m/s cruise
@@ -127,6 +130,8 @@ class Agent : private DriveStack {
 
   [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
+  /// Where it goes when idle (its start pose, its parking place).
+  [[nodiscard]] const Pose2& home() const { return p_.start; }
   [[nodiscard]] bool busy() const { return tasks_.busy(); }
   /// The current order is paused by the operator: the robot stands still with it.
   [[nodiscard]] bool paused() const { return tasks_.paused(); }

@@ -14,7 +14,8 @@
 
 namespace fleet::agent {
 
-Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const Settings& s) {
+Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const Settings& s,
+                                                       const SavedPoses& resume) {
   MapFacts facts;
   // Robots keep clear of the map with the site's no-go zones blocked; the walls the localizer
   // matches its scan lines against come from the map itself (a zone is no wall).
@@ -49,6 +50,9 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     AgentParams p;
     p.id = r.id;
     p.start = r.start;
+    if (const auto it = resume.find(r.id); it != resume.end()) {
+      p.resumeAt = it->second.pose;
+    }
     p.radius = r.radius;
     p.wheelBase = r.wheelBase;
     p.vMax = control::agentCruiseSpeed(r.limits);

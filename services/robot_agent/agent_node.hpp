@@ -27,6 +27,7 @@
 #include "fleet/messages/messages.hpp"
 #include "fleet/validation/rejections.hpp"
 #include "people_report.hpp"
+#include "pose_store.hpp"
 #include "worker_pool.hpp"
 
 namespace fleet::agent {
@@ -50,7 +51,9 @@ class AgentNode {
  public:
   /// An Agent for every robot of `world` (only those in `s.only` when it names any). Fails when
   /// none is left; an agent that cannot be built (an unknown planner) throws std::invalid_argument.
-  static Expected<std::unique_ptr<AgentNode>> create(const World& world, const Settings& s);
+  /// A robot with a pose in `resume` (the pose file's fresh ones) starts its localization there.
+  static Expected<std::unique_ptr<AgentNode>> create(const World& world, const Settings& s,
+                                                     const SavedPoses& resume = {});
 
   // The inputs of a cycle; samples are checked, then handed to the robot they are for.
   /// A frame for a robot hosted elsewhere is ignored.

@@ -29,6 +29,7 @@ struct Settings {
   double sensorTimeoutS = 0.5;
   double returnHomeS = 5.0;
   bool useRisk = true;
+  std::string poseFile;  // empty: none (pose_store.hpp)
 };
 
 /// The options of `Settings` that were given on the command line: they win over the file.

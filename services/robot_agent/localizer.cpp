@@ -16,7 +16,7 @@ estimation::PoseEkf makeEkf(const LocalizerParams& p) {
   ep.compassVariance = 0.02 * 0.02;
   ep.bearingVariance = 0.01 * 0.01;
   Eigen::Matrix3d p0 = Eigen::Matrix3d::Zero();
-  p0.diagonal() << 0.01, 0.01, 0.001;
+  p0.diagonal() << p.startVarianceXY, p.startVarianceXY, p.startVarianceTheta;
   auto e = estimation::PoseEkf::create(ep, p.start, p0);
   return std::move(*e);  // parameters are constants above: cannot fail
 }

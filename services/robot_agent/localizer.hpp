@@ -93,8 +93,15 @@ struct StreamCheck {
 /// shelf end 2 m away gives 6 points, so the seed and the minimum are small.
 estimation::LineExtractionParams agentLineExtraction();
 
+/// How uncertain a pose the localization resumes from is (a robot restarted where it was):
+/// variances of (0.5 m)² and (0.1 rad)², what a robot rolls on after its process stops.
+constexpr double kResumeVarianceXY = 0.25;
+constexpr double kResumeVarianceTheta = 0.01;
+
 struct LocalizerParams {
   Pose2 start;
+  double startVarianceXY = 0.01;      ///< m², the start pose's variance in x and in y
+  double startVarianceTheta = 0.001;  ///< rad²
   double wheelBase = 0.4;
   double sensorTimeoutS = 0.5;  ///< no reading for this long (of the cycle clock): the stream is lost
   /// How far the robot may have rolled unseen in a gap (its last command held, then braking).

@@ -34,6 +34,13 @@ using namespace std::chrono_literals;
 
 namespace {
 
+/// Wall clock in ms since the epoch (the pose file's stamps).
+std::int64_t unixMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
 /// The process around the node: how it is clocked, its lockstep id, where its metrics go.
 struct Process {
   bool lockstep = false;
@@ -65,7 +72,22 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
                                                "Wall mode: cycles that took longer than the period");
   const bool lockstep = proc.lockstep;
   const std::string& id = proc.id;
-  auto created = agent::AgentNode::create(world, settings);
+  // Robots restarted where they were (the pose file), not at their parking places.
+  agent::SavedPoses resume;
+  if (!settings.poseFile.empty()) {
+    auto saved = agent::readPoseFile(settings.poseFile);
+    if (!saved) {
+      spdlog::error("robot agent {}: {}; its robots start at their start poses", proc.id,
+                    saved.error().message);
+    } else {
+      resume = agent::freshPoses(*saved, unixMs(), agent::kPoseFreshS);
+      if (saved->size() != resume.size()) {
+        spdlog::warn("robot agent {}: {} of the pose file's {} poses are older than {} s: not used", proc.id,
+                     saved->size() - resume.size(), saved->size(), agent::kPoseFreshS);
+      }
+    }
+  }
+  auto created = agent::AgentNode::create(world, settings, resume);
   if (created) {
     logMapFacts((*created)->mapFacts(), settings.lineUpdates);
   } else {
@@ -73,6 +95,27 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     return 2;
   }
   agent::AgentNode& node = **created;
+  for (const auto& [robot, saved] : resume) {
+    if (node.find(robot) != nullptr) {
+      spdlog::info("robot agent {}: {} resumes at ({:.2f}, {:.2f}, {:.2f}) from the pose file", proc.id,
+                   robot, saved.pose.x, saved.pose.y, saved.pose.theta);
+    }
+  }
+  agent::PoseWriter poseWriter(settings.poseFile, agent::kPoseWritePeriodMs);
+  bool poseWriteFailed = false;
+  auto writePoses = [&] {
+    agent::SavedPoses poses;
+    const std::int64_t now = unixMs();
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      poses[node.agent(i).id()] = agent::SavedPose{node.agent(i).pose(), now};
+    }
+    const auto written = poseWriter.write(poses, now);
+    if (!written && !poseWriteFailed) {
+      spdlog::error("robot agent {}: {} (tried again every {} ms)", proc.id, written.error().message,
+                    agent::kPoseWritePeriodMs);
+    }
+    poseWriteFailed = !written;
+  };
   transport::Participant part;
   transport::Reader<msg::SensorFrame> frames(part, transport::qos::sensor(lockstep));
   transport::Reader<msg::TaskAssignment> assignments(part);
@@ -220,6 +263,9 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
         peopleSeen->write(*out.people);
       }
     }
+    if (poseWriter.due(unixMs())) {
+      writePoses();
+    }
     cyclesTotal.inc();
     // Constant cost and memory whatever the uptime (a bucket increment, no sample kept).
     cycleSeconds.observe(
@@ -303,6 +349,9 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     stepDone.write({id, msg::StepDone::kLeave});
   }
   writeMetrics();
+  if (poseWriter.enabled()) {
+    writePoses();
+  }
   spdlog::info("robot agent {}: stopped after {} cycles", id, node.cycles());
   return 0;
 }
@@ -334,6 +383,10 @@ int main(int argc, char** argv) {
                  "start (parking) pose")
       ->check(CLI::Range(-1.0, 3600.0));
   app.add_flag("--no-risk", noRisk, "ignore RiskMap (planners without the risk term)");
+  app.add_option(
+      "--pose-file", settings.poseFile,
+      "keep each hosted robot's last pose in this file (written every 0.2 s) and, started again, "
+      "start each robot's localization there instead of at its start pose (docs/operator-guide.md)");
   std::string sitePath;
   std::vector<std::string> robotSpecs;
   auto* scenarioOpt =

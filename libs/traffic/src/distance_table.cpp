@@ -122,7 +122,33 @@ void DistanceTable::applyChanges() {
   // the node is settled and relaxes its predecessors): its settled distances are final for the new
   // costs and its frontier is the one a search started now would have. A table that has is
   // repaired: first for the raised costs alone, then for the lowered ones (each repair needs a
-  // table exact for the costs before it).
+  // table exact for the costs before it) — when it was read since the last change and the change
+  // is a few nodes (robots stopping and leaving). One that was not read (a goal nobody drives to
+  // any more, kept by the cache) is dropped, to be searched again only if asked for: repairing
+  // every cached table on every change cost the full stack's traffic manager ticks of a second at
+  // 300 robots, growing with the cache. So is every table a wide change reaches (the risk map's
+  // costs moving with 150 people: thousands of nodes, whose repairs took half the traffic
+  // manager's time): searched again as far as read, the restart costs less than the repair there.
+  const bool few = raised_.size() + lowered_.size() <= kRepairMaxChanges;
+  const auto readsAChange = [this](const PartialTable& t) {
+    const auto settled = [&t](NodeId w) { return t.isSettled(w); };
+    return std::any_of(raised_.begin(), raised_.end(), settled) ||
+           std::any_of(lowered_.begin(), lowered_.end(), settled);
+  };
+  for (std::size_t slot = 0; slot < used_; ++slot) {
+    if (!tables_[slot].empty() && (!few || readAt_[slot] != batch_) && readsAChange(tables_[slot])) {
+      drop(slot);
+    }
+  }
+  ++batch_;
+  if (!few) {
+    for (const auto* list : {&raised_, &lowered_}) {
+      for (const NodeId w : *list) {
+        baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
+      }
+    }
+    return;
+  }
   for (const NodeId w : raised_) {
     baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
   }
@@ -143,6 +169,22 @@ void DistanceTable::applyChanges() {
   }
 }
 
+void DistanceTable::drop(std::size_t slot) {
+  slotOfGoal_[static_cast<std::size_t>(goalOfSlot_[slot])] = -1;
+  goalOfSlot_[slot] = kNoNode;
+  tables_[slot].clear();
+  // Next to be reused: the tail of the least-recently-used list.
+  unlink(slot);
+  prev_[slot] = tail_;
+  next_[slot] = -1;
+  if (tail_ >= 0) {
+    next_[static_cast<std::size_t>(tail_)] = static_cast<std::int32_t>(slot);
+  } else {
+    head_ = static_cast<std::int32_t>(slot);
+  }
+  tail_ = static_cast<std::int32_t>(slot);
+}
+
 void DistanceTable::invalidate() {
   dirty_ = false;
   changed_.clear();
@@ -160,6 +202,7 @@ void DistanceTable::invalidate() {
   capacity_ = std::max<std::size_t>({byBudget, capacity_, 1});
   slotOfGoal_.assign(graph_.size(), -1);
   goalOfSlot_.clear();
+  readAt_.clear();
   tables_.clear();
   prev_.clear();
   next_.clear();
@@ -210,6 +253,7 @@ std::size_t DistanceTable::acquireSlot() {
     if (used_ == tables_.size()) {
       tables_.emplace_back();
       goalOfSlot_.push_back(kNoNode);
+      readAt_.push_back(0);
       prev_.push_back(-1);
       next_.push_back(-1);
     }
@@ -217,7 +261,9 @@ std::size_t DistanceTable::acquireSlot() {
   }
   const auto slot = static_cast<std::size_t>(tail_);
   unlink(slot);
-  slotOfGoal_[static_cast<std::size_t>(goalOfSlot_[slot])] = -1;
+  if (goalOfSlot_[slot] != kNoNode) {
+    slotOfGoal_[static_cast<std::size_t>(goalOfSlot_[slot])] = -1;
+  }
   return slot;
 }
 
@@ -236,6 +282,7 @@ std::size_t DistanceTable::acquire(NodeId goal) {
     ++computed_;
   }
   touch(static_cast<std::size_t>(slot));
+  readAt_[static_cast<std::size_t>(slot)] = batch_;
   return static_cast<std::size_t>(slot);
 }
 

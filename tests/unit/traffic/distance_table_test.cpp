@@ -371,3 +371,64 @@ TEST(DistanceTable, ABlockedNodeTheSearchHasNotReachedKeepsTheTable) {
   EXPECT_EQ(t.computed(), before);
   EXPECT_EQ(t.repaired(), 1U);
 }
+
+// A change repairs the tables read since the change before it; a table nobody read since then (a
+// goal no robot drives to any more, kept by the cache) is dropped and searched again only when
+// asked for, exactly as before.
+TEST(DistanceTable, ATableNobodyReadSinceTheLastChangeIsDroppedNotRepaired) {
+  const GridMap m = gridOf({
+      "..........",
+      "..........",
+      "..........",
+  });
+  DistanceTable t(m.graph);
+  const NodeId a = m.node(9, 0);
+  const NodeId b = m.node(9, 2);
+  (void)t.to(a);
+  (void)t.to(b);
+  const auto computed = t.computed();
+  t.setBlocked(m.node(5, 1), true);
+  EXPECT_EQ(t.distance(m.node(0, 1), b), 10.0F);  // both were read: both repaired
+  EXPECT_EQ(t.repaired(), 2U);
+  t.setBlocked(m.node(5, 0), true);
+  EXPECT_EQ(t.distance(m.node(0, 0), b), 11.0F);  // only b was read since: a is dropped
+  EXPECT_EQ(t.repaired(), 3U);
+  EXPECT_EQ(t.computed(), computed);
+  EXPECT_EQ(t.distance(m.node(0, 0), a), 13.0F);  // searched again when asked for: round both
+  EXPECT_EQ(t.computed(), computed + 1);
+  DistanceTable fresh(m.graph);
+  fresh.setBlocked(m.node(5, 1), true);
+  fresh.setBlocked(m.node(5, 0), true);
+  for (NodeId v = 0; v < static_cast<NodeId>(m.graph.size()); ++v) {
+    EXPECT_EQ(t.distance(v, a), fresh.distance(v, a)) << v;
+    EXPECT_EQ(t.distance(v, b), fresh.distance(v, b)) << v;
+  }
+}
+
+// A change of more than kRepairMaxChanges nodes at once (the risk map's costs moving with many
+// people) restarts the tables it reaches instead of repairing them: exact all the same.
+TEST(DistanceTable, AWideChangeRestartsTheTablesItReaches) {
+  std::vector<std::string> rows(10, std::string(20, '.'));
+  const GridMap m = gridOf(rows);
+  DistanceTable t(m.graph);
+  const NodeId a = m.node(19, 0);
+  const NodeId b = m.node(0, 9);
+  (void)t.to(a);
+  (void)t.to(b);
+  const auto computed = t.computed();
+  std::vector<float> cost(m.graph.size(), 0.0F);
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::size_t> any(0, cost.size() - 1);
+  for (std::size_t k = 0; k < 3 * DistanceTable::kRepairMaxChanges / 2; ++k) {
+    cost[any(rng)] = 0.5F;
+  }
+  t.setNodeCost(cost);
+  DistanceTable fresh(m.graph);
+  fresh.setNodeCost(cost);
+  for (NodeId v = 0; v < static_cast<NodeId>(m.graph.size()); ++v) {
+    EXPECT_EQ(t.distance(v, a), fresh.distance(v, a)) << v;
+    EXPECT_EQ(t.distance(v, b), fresh.distance(v, b)) << v;
+  }
+  EXPECT_EQ(t.repaired(), 0U);
+  EXPECT_EQ(t.computed(), computed + 2);
+}

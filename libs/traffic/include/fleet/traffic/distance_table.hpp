@@ -16,7 +16,9 @@
 // read. Such a change leaves alone the tables whose search has not settled a changed node (it
 // never used its cost: its settled distances and its frontier are those of a search started after
 // the change) and repairs the others in place: only the distances the change really moves are
-// searched again (distance_repair.cpp), every value as exact as a search started afresh.
+// searched again (distance_repair.cpp), every value as exact as a search started afresh. A table
+// not read since the change before, and every table a change of more than kRepairMaxChanges nodes
+// reaches, is dropped instead and searched again from its goal when next asked for.
 
 #include <cstdint>
 #include <limits>
@@ -63,6 +65,8 @@ class DistanceTable {
   /// What a change does to a table that has settled a changed node: repaired in place (the
   /// default), or restarted from its goal (the simple reference, kept for tests and benchmarks).
   enum class OnChange : std::uint8_t { kRepair, kRestart };
+  /// A change of more nodes than this at once restarts the tables it reaches instead (applyChanges).
+  static constexpr std::size_t kRepairMaxChanges = 64;
 
   /// Keeps at most `maxBytes` of tables (at least one table, and at least reserve()'s count).
   explicit DistanceTable(const Graph& graph, std::size_t maxBytes = std::size_t{256} << 20);
@@ -140,6 +144,8 @@ class DistanceTable {
   std::size_t acquireSlot();
   void touch(std::size_t slot);
   void unlink(std::size_t slot);
+  /// Forgets the slot's table and makes the slot the next one reused.
+  void drop(std::size_t slot);
 
   const Graph& graph_;
   std::size_t maxBytes_;
@@ -153,6 +159,8 @@ class DistanceTable {
   // Cache: slot per goal, slots on an intrusive LRU list (head = most recent).
   std::vector<std::int32_t> slotOfGoal_;
   std::vector<NodeId> goalOfSlot_;
+  std::vector<std::uint64_t> readAt_;  ///< per slot, batch_ when its table was last asked for
+  std::uint64_t batch_ = 0;            ///< change batches taken in (applyChanges)
   std::vector<PartialTable> tables_;
   std::vector<float> baseEnter_;  ///< entering each node in a goal's table (infinite: closed or blocked)
   std::vector<std::int32_t> prev_;
