@@ -94,9 +94,12 @@ struct StreamCheck {
 estimation::LineExtractionParams agentLineExtraction();
 
 /// How uncertain a pose the localization resumes from is (a robot restarted where it was):
-/// variances of (0.5 m)² and (0.1 rad)², what a robot rolls on after its process stops.
-constexpr double kResumeVarianceXY = 0.25;
-constexpr double kResumeVarianceTheta = 0.01;
+/// variances of (0.7 m)² and (0.5 rad)². A robot rolls on after its process stops (its last
+/// command for the driver's 0.5 s timeout, then braking: ~0.7 m from cruise, up to ~0.9 rad
+/// turning) and the pose was written up to 0.2 s before; the compass and the lines must not be
+/// gated out (a 0.45 rad heading error against 0.1 rad was, and the robot stayed lost).
+constexpr double kResumeVarianceXY = 0.49;
+constexpr double kResumeVarianceTheta = 0.25;
 
 struct LocalizerParams {
   Pose2 start;

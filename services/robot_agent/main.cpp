@@ -103,13 +103,13 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   }
   agent::PoseWriter poseWriter(settings.poseFile, agent::kPoseWritePeriodMs);
   bool poseWriteFailed = false;
-  auto writePoses = [&] {
+  auto writePoses = [&](std::int64_t clockMs) {
     agent::SavedPoses poses;
-    const std::int64_t now = unixMs();
+    const std::int64_t stamp = unixMs();
     for (std::size_t i = 0; i < node.size(); ++i) {
-      poses[node.agent(i).id()] = agent::SavedPose{node.agent(i).pose(), now};
+      poses[node.agent(i).id()] = agent::SavedPose{node.agent(i).pose(), stamp};
     }
-    const auto written = poseWriter.write(poses, now);
+    const auto written = poseWriter.write(poses, clockMs);
     if (!written && !poseWriteFailed) {
       spdlog::error("robot agent {}: {} (tried again every {} ms)", proc.id, written.error().message,
                     agent::kPoseWritePeriodMs);
@@ -263,8 +263,8 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
         peopleSeen->write(*out.people);
       }
     }
-    if (poseWriter.due(unixMs())) {
-      writePoses();
+    if (poseWriter.due(now / 1'000'000)) {  // the agent's clock: simulated time in lockstep
+      writePoses(now / 1'000'000);
     }
     cyclesTotal.inc();
     // Constant cost and memory whatever the uptime (a bucket increment, no sample kept).
@@ -350,7 +350,7 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   }
   writeMetrics();
   if (poseWriter.enabled()) {
-    writePoses();
+    writePoses(0);
   }
   spdlog::info("robot agent {}: stopped after {} cycles", id, node.cycles());
   return 0;

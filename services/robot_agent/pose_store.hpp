@@ -31,7 +31,8 @@ using SavedPoses = std::map<std::string, SavedPose>;
 
 /// A saved pose is used when at most this old (wall clock) when the process starts.
 constexpr double kPoseFreshS = 600.0;
-/// The file is written at most this often.
+/// The file is written this often, of the agent's clock (simulated time in lockstep: a run
+/// faster than real time writing by the wall clock left the pose a metre behind).
 constexpr std::int64_t kPoseWritePeriodMs = 200;
 
 /// Reads a pose file. A missing file is an empty map; anything else wrong (not JSON, a robot
@@ -45,18 +46,18 @@ Expected<void> writePoseFile(const std::string& path, const SavedPoses& poses);
 /// back, counts as fresh).
 SavedPoses freshPoses(const SavedPoses& poses, std::int64_t nowUnixMs, double maxAgeS);
 
-/// When to write: at most once every `periodMs` of wall time.
+/// When to write: at most once every `periodMs` of the caller's clock.
 class PoseWriter {
  public:
   PoseWriter(std::string path, std::int64_t periodMs) : path_(std::move(path)), periodMs_(periodMs) {}
   [[nodiscard]] bool enabled() const { return !path_.empty(); }
-  [[nodiscard]] bool due(std::int64_t nowUnixMs) const {
-    return enabled() && (last_ < 0 || nowUnixMs - last_ >= periodMs_);
+  [[nodiscard]] bool due(std::int64_t nowMs) const {
+    return enabled() && (last_ < 0 || nowMs - last_ >= periodMs_);
   }
-  /// Writes and remembers when; a failure is returned for the caller to log (the next is tried
-  /// a period later all the same).
-  Expected<void> write(const SavedPoses& poses, std::int64_t nowUnixMs) {
-    last_ = nowUnixMs;
+  /// Writes (`now` the caller's clock) and remembers when; a failure is returned for the caller to
+  /// log (the next is tried a period later all the same).
+  Expected<void> write(const SavedPoses& poses, std::int64_t nowMs) {
+    last_ = nowMs;
     return writePoseFile(path_, poses);
   }
 

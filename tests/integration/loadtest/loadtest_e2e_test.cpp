@@ -244,7 +244,8 @@ TEST(LoadtestE2E, OnPostgresqlTheStandbyManagerTakesOverFromAKilledActiveOne) {
 /// last wrote (--pose-file), not at the robot's start. (Seeded at their starts, the restarted
 /// agent's robots were 5-22 m off for the rest of the run, and one touched a shelf.) Right after
 /// the restart a robot is off by what it rolled while its agent was down (up to ~0.7 m from
-/// cruise, then braking) and the file's age (0.2 s): 0.96 m seen; then the scan pulls it back.
+/// cruise, then braking) and the file's age (0.2 s of its clock): 0.04-0.32 m seen; then the scan
+/// pulls it back.
 void expectEveryRobotLocalized(const fs::path& out) {
   const json loc = json::parse(std::ifstream(out / "localization.json"));
   ASSERT_TRUE(loc.contains("per_robot")) << loc.dump();
