@@ -16,7 +16,9 @@ std::size_t OccupancyGrid::freeCount() const {
 
 std::optional<Cell> OccupancyGrid::cellAt(Vec2 p) const {
   const Vec2 l = (p - origin_) / resolution_;
-  if (!std::isfinite(l.x) || !std::isfinite(l.y)) {
+  // Off the grid before the cast: a point far away (a site file's 4e14 m) is no int.
+  if (!std::isfinite(l.x) || !std::isfinite(l.y) || l.x < 0.0 || l.y < 0.0 || l.x >= width_ ||
+      l.y >= height_) {
     return std::nullopt;
   }
   const Cell c{static_cast<int>(std::floor(l.x)), static_cast<int>(std::floor(l.y))};

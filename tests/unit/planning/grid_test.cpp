@@ -16,6 +16,9 @@ TEST(OccupancyGrid, FrameIsYUpWithOriginAndResolution) {
   EXPECT_EQ(g.cellAt({2.99, 3.49}), (Cell{9, 4}));
   EXPECT_FALSE(g.cellAt({3.0, 1.0}).has_value());
   EXPECT_FALSE(g.cellAt({-2.01, 1.0}).has_value());
+  // Far off the grid: no cell, and no int overflow on the way (fuzz.site_json found 4.4e14 m).
+  EXPECT_FALSE(g.cellAt({4.4e14, 1.0}).has_value());
+  EXPECT_FALSE(g.cellAt({-2.0, -1e300}).has_value());
   const Vec2 c = g.cellCenter({3, 2});
   EXPECT_DOUBLE_EQ(c.x, -2.0 + 3.5 * 0.5);
   EXPECT_DOUBLE_EQ(c.y, 1.0 + 2.5 * 0.5);
