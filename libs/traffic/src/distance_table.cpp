@@ -98,15 +98,11 @@ void DistanceTable::applyChanges() {
       continue;  // no change, or a node listed twice and already taken
     }
     (enter > baseEnter_[v] ? raised_ : lowered_).push_back(w);
-    oldEnter_[v] = baseEnter_[v];
   }
   changed_.clear();
   if (onChange_ == OnChange::kRestart) {
-    for (const auto* list : {&raised_, &lowered_}) {
-      for (const NodeId w : *list) {
-        baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
-      }
-    }
+    takeIn(raised_);
+    takeIn(lowered_);
     for (std::size_t slot = 0; slot < used_; ++slot) {
       PartialTable& t = tables_[slot];
       const auto read = [&t](NodeId w) { return t.isSettled(w); };
@@ -142,30 +138,29 @@ void DistanceTable::applyChanges() {
   }
   ++batch_;
   if (!few) {
-    for (const auto* list : {&raised_, &lowered_}) {
-      for (const NodeId w : *list) {
-        baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
-      }
-    }
+    takeIn(raised_);
+    takeIn(lowered_);
     return;
   }
-  for (const NodeId w : raised_) {
-    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
-  }
+  takeIn(raised_);
   std::vector<std::uint8_t> touched(used_, 0);
   for (std::size_t slot = 0; slot < used_; ++slot) {
     if (!raised_.empty() && !tables_[slot].empty() && repairRaised(tables_[slot])) {
       touched[slot] = 1;
     }
   }
-  for (const NodeId w : lowered_) {
-    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
-  }
+  takeIn(lowered_);
   for (std::size_t slot = 0; slot < used_; ++slot) {
     if (!lowered_.empty() && !tables_[slot].empty() && repairLowered(tables_[slot])) {
       touched[slot] = 1;
     }
     repaired_ += touched[slot];
+  }
+}
+
+void DistanceTable::takeIn(std::span<const NodeId> nodes) {
+  for (const NodeId w : nodes) {
+    baseEnter_[static_cast<std::size_t>(w)] = baseEnter(static_cast<std::size_t>(w));
   }
 }
 
@@ -192,7 +187,6 @@ void DistanceTable::invalidate() {
   buildReverse();
   // Entering each node in a goal's table: its node cost, never when closed or blocked.
   baseEnter_.resize(graph_.size());
-  oldEnter_.assign(graph_.size(), 0.0F);
   mark_.assign(graph_.size(), 0);
   for (std::size_t v = 0; v < graph_.size(); ++v) {
     baseEnter_[v] = baseEnter(v);

@@ -129,8 +129,8 @@ class DistanceTable {
   /// Takes in what setBlocked()/setNodeCost() changed since the last query: repairs the tables
   /// that read a changed node (drops everything when a change is too wide to be worth sorting out).
   void applyChanges();
-  /// distance_repair.cpp: the table after raised_'s nodes cost more to enter (their old cost in
-  /// oldEnter_, the new one in baseEnter_), then after lowered_'s cost less. true when it changed.
+  /// distance_repair.cpp: the table after raised_'s nodes cost more to enter (the new cost already
+  /// in baseEnter_), then after lowered_'s cost less. true when it changed.
   bool repairRaised(PartialTable& t);
   bool repairLowered(PartialTable& t);
   /// The least way from `v` to the goal through the nodes `t` has settled.
@@ -144,6 +144,8 @@ class DistanceTable {
   std::size_t acquireSlot();
   void touch(std::size_t slot);
   void unlink(std::size_t slot);
+  /// baseEnter_ of `nodes` from what is blocked, closed and costed now.
+  void takeIn(std::span<const NodeId> nodes);
   /// Forgets the slot's table and makes the slot the next one reused.
   void drop(std::size_t slot);
 
@@ -175,11 +177,10 @@ class DistanceTable {
   std::vector<float> nodeCost_;
   bool dirty_ = false;
   std::vector<NodeId> changed_;  ///< nodes whose entering cost changed since the last query
-  // Repair scratch (distance_repair.cpp): the nodes costing more / less to enter, the former's old
-  // costs, a mark per node, a list of marked nodes and a heap.
+  // Repair scratch (distance_repair.cpp): the nodes costing more / less to enter, a mark per node,
+  // a list of marked nodes and a heap.
   std::vector<NodeId> raised_;
   std::vector<NodeId> lowered_;
-  std::vector<float> oldEnter_;
   std::vector<std::uint8_t> mark_;
   std::vector<NodeId> marked_;
   std::vector<NodeId> affected_;
