@@ -152,6 +152,27 @@ TEST(SafetyLayer, WithoutStaticSlowingOnlyDiscsSlowTheRobot) {
   EXPECT_LT(layer.filter(v, {0.45, 0.0}).twist.v, 0.45);
 }
 
+TEST(Dwa, RolloutPointsFollowTheExactArc) {
+  // arcPoints carries the heading's sine and cosine from point to point; every point must still lie
+  // on the exact arc (integrateExact), for turns both ways, straight lines and near-straight ones.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Vec2> pts;
+  for (int trial = 0; trial < 500; ++trial) {
+    const Pose2 start{10.0 * u(rng), 10.0 * u(rng), 3.2 * u(rng)};
+    const double omega = trial % 5 == 0 ? 1e-10 * u(rng) : trial % 7 == 0 ? 1e-6 * u(rng) : 2.0 * u(rng);
+    const Twist tw{u(rng), omega};
+    const int count = 1 + trial % 12;
+    arcPoints(start, tw, 1.7, count, pts);
+    ASSERT_EQ(pts.size(), static_cast<std::size_t>(count));
+    for (int k = 1; k <= count; ++k) {
+      const Pose2 exact = DiffDriveKinematics::integrateExact(start, tw, 1.7 * k / count);
+      EXPECT_NEAR(distance(pts[static_cast<std::size_t>(k - 1)], exact.position()), 0.0, 1e-9)
+          << "trial " << trial << " point " << k;
+    }
+  }
+}
+
 TEST(Dwa, SamplesStayInsideTheDynamicWindow) {
   DynamicWindowPlanner dwa;
   LocalView v;
@@ -266,6 +287,81 @@ TEST(Dwa, WeightsChangeTheChoice) {
 
 namespace fleet::avoidance {
 namespace {
+
+// Discs too far for any rollout to come within clearanceCap of are left out of the rollouts'
+// check: adding any number of them (moving towards the robot at up to 1.5 m/s, just past that
+// reach) changes no sample and no command, with and without pruning.
+TEST(Dwa, DiscsBeyondTheClearanceCapChangeNothing) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int farDiscs = 0;
+  int insideChanged = 0;
+  for (int k = 0; k < 200; ++k) {
+    DwaParams params;
+    params.prune = k % 2 == 0;
+    std::vector<Vec2> scan;
+    for (int i = 0; i < static_cast<int>(rng() % 200); ++i)
+      scan.push_back({3.0 * u(rng), 3.0 * u(rng)});
+    std::vector<MovingDisc> discs;
+    for (int i = 0; i < static_cast<int>(rng() % 5); ++i)
+      discs.push_back({{2.5 * u(rng), 2.5 * u(rng)}, {0.5 * u(rng), 0.5 * u(rng)}, 0.3});
+    LocalView v;
+    v.robot = {{0.0, 0.0, 3.0 * u(rng)}, {0.4 + 0.4 * u(rng), 0.5 * u(rng)}, 0.3};
+    const std::vector<Vec2> path{{5.0 * u(rng), 5.0 * u(rng)}};
+    v.path = path;
+    v.scan = scan;
+    v.discs = discs;
+    DynamicWindowPlanner a(params);
+    const Command ca = a.plan(v);
+    // The farthest a rollout's point gets: the window's fastest speed over the horizon (a robot
+    // faster than its limit brakes by at most one cycle's deceleration).
+    const double vHi = std::min(v.robot.twist.v + v.limits.accelMax * v.dt, v.limits.vMax);
+    const double vLo = std::max(0.0, v.robot.twist.v - v.limits.accelMax * v.dt);
+    const double travel = std::max(vHi, vLo) * params.simTime;
+    std::vector<MovingDisc> more = discs;
+    for (int i = 0; i < 30; ++i) {
+      const double speed = 1.5 * std::abs(u(rng));
+      const double r = 0.2 + 0.2 * std::abs(u(rng));
+      const double d = travel + speed * params.simTime + v.robot.radius + r + params.clearanceCap + 1e-6 +
+                       0.02 * std::abs(u(rng));
+      // Most of them ahead, where the fastest rollouts end.
+      const double a0 = i % 3 == 0 ? 3.2 * u(rng) : v.robot.pose.theta + 0.3 * u(rng);
+      const Vec2 at{d * std::cos(a0), d * std::sin(a0)};
+      more.push_back({at, at * (-speed / d), r});  // heading straight at the robot
+      ++farDiscs;
+    }
+    // The rule is tight: a disc just inside that reach, straight ahead and coming at the robot,
+    // does change the clearance of the fastest straight rollout.
+    {
+      const double speed = 1.0;
+      const double d = travel + speed * params.simTime + v.robot.radius + 0.3 + params.clearanceCap - 0.01;
+      const Vec2 dir{std::cos(v.robot.pose.theta), std::sin(v.robot.pose.theta)};
+      std::vector<MovingDisc> inside = discs;
+      inside.push_back({dir * d, dir * -speed, 0.3});
+      v.discs = inside;
+      DynamicWindowPlanner c(params);
+      (void)c.plan(v);
+      for (std::size_t i = 0; i < a.lastSamples().size(); ++i)
+        insideChanged += c.lastSamples()[i].clearance != a.lastSamples()[i].clearance ? 1 : 0;
+    }
+    v.discs = more;
+    DynamicWindowPlanner b(params);
+    const Command cb = b.plan(v);
+    EXPECT_EQ(ca.twist, cb.twist) << k;
+    EXPECT_EQ(ca.status, cb.status) << k;
+    ASSERT_EQ(a.lastSamples().size(), b.lastSamples().size());
+    for (std::size_t i = 0; i < a.lastSamples().size(); ++i) {
+      const DwaSample& x = a.lastSamples()[i];
+      const DwaSample& y = b.lastSamples()[i];
+      EXPECT_EQ(x.score, y.score) << k << " sample " << i;
+      EXPECT_EQ(x.clearance, y.clearance) << k << " sample " << i;
+      EXPECT_EQ(x.admissible, y.admissible) << k << " sample " << i;
+      EXPECT_EQ(x.evaluated, y.evaluated) << k << " sample " << i;
+    }
+  }
+  EXPECT_EQ(farDiscs, 6000);
+  EXPECT_GT(insideChanged, 0);
+}
 
 // The pruned search must pick exactly the command the exhaustive one picks.
 TEST(Dwa, PrunedSearchChoosesTheSameCommandAsTheExhaustiveOne) {

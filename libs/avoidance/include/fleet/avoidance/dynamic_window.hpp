@@ -53,6 +53,10 @@ struct DwaSample {
   bool evaluated = false;
 };
 
+/// The positions at t = duration k / count, k = 1..count, of a robot leaving `start` with the
+/// constant twist `tw` (exact circular arcs, as DiffDriveKinematics::integrateExact), into `out`.
+void arcPoints(const Pose2& start, Twist tw, double duration, int count, std::vector<Vec2>& out);
+
 /// Pick the carrot: the point `lookahead` along the path from the path point nearest the robot.
 Vec2 carrotOnPath(std::span<const Vec2> path, Vec2 robot, double lookahead);
 
@@ -76,6 +80,8 @@ class DynamicWindowPlanner final : public LocalPlanner {
   DwaParams params_;
   std::vector<DwaSample> samples_;
   std::vector<Vec2> near_;
+  std::vector<MovingDisc> near_discs_;  ///< the discs a rollout can come within clearanceCap of
+  std::vector<Vec2> arc_;               ///< the rollout's points at the disc check's times
   std::vector<double> upper_;
   std::vector<double> disc_clr_;
   std::vector<std::size_t> order_;
