@@ -270,6 +270,27 @@ bool Agent::sensorStreamLost(std::int64_t nowNs) {
   return c.lost;
 }
 
+bool Agent::poseDoubtful(std::int64_t nowNs) {
+  if (!p_.lineUpdates || !p_.walls || p_.walls->empty()) {
+    return false;  // nothing to judge the estimate by
+  }
+  const LineStats& s = localizer_.lineStats();
+  const auto c = poseWatch_.update(nowNs, s.extracted, s.accepted);
+  if (c == PoseWatch::Change::kDoubted) {
+    doubtedSinceNs_ = nowNs;
+    tasks_.notice(poseWatch_.why(), nowNs);
+  } else if (c == PoseWatch::Change::kTrusted) {
+    // The time it stood is no time without progress.
+    progress_.afterOutage(nowNs - doubtedSinceNs_);
+    doubtedSinceNs_ = -1;
+    if (planner_) {
+      planner_->reset();
+    }
+    tasks_.notice("", nowNs);
+  }
+  return poseWatch_.doubted();
+}
+
 AgentOutput Agent::step(std::int64_t nowNs, double dt) {
   if (!localizer_.plausible()) {
     // The estimate left the world (non-finite, or farther than any map): nothing it would plan or
@@ -286,7 +307,18 @@ AgentOutput Agent::step(std::int64_t nowNs, double dt) {
     return out;
   }
   if (!sensorStreamLost(nowNs)) {
-    return drive(nowNs, dt);
+    if (!poseDoubtful(nowNs)) {
+      return drive(nowNs, dt);
+    }
+    // Its walls are not where the map has them: wherever it drove it would drive from the wrong
+    // place. Hold still and say why (the task is kept; the manager's timers decide), and go on when
+    // its lines match again.
+    AgentOutput out;
+    v_ = 0.0;
+    w_ = 0.0;
+    follow_.holdStill();
+    report(out, nowNs, 0.0, 0.0, msg::RobotMode::Fault);
+    return out;
   }
   // Blind: hold still and say why; the task is kept and resumes when frames come back.
   AgentOutput out;
@@ -482,7 +514,8 @@ std::optional<msg::TrafficProgress> Agent::trafficProgress(std::int64_t nowNs) {
     p.goal_station = g->station;
   }
   p.priority = tasks_.priority();
-  p.holding = tasks_.phase() == Phase::Dwelling || paused() || localizer_.lost() || follow_.dockingLeg();
+  p.holding = tasks_.phase() == Phase::Dwelling || paused() || localizer_.lost() || poseWatch_.doubted() ||
+              follow_.dockingLeg();
   p.blocked = follow_.blocked();
   p.follows = true;
   p.stamp_ns = nowNs;

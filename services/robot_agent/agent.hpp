@@ -32,6 +32,7 @@
 #include "localizer.hpp"
 #include "motion_gate.hpp"
 #include "other_robot.hpp"
+#include "pose_watch.hpp"
 #include "progress_watch.hpp"
 #include "release_follower.hpp"
 #include "release_tracker.hpp"
@@ -127,6 +128,9 @@ class Agent : private DriveStack {
   AgentOutput step(std::int64_t nowNs, double dt);
   /// True while the sensor stream is considered lost (as of the last step).
   [[nodiscard]] bool sensorLost() const { return localizer_.lost(); }
+  /// True while its laser lines say its pose estimate is wrong (PoseWatch): it stands, faulted.
+  [[nodiscard]] bool poseDoubted() const { return poseWatch_.doubted(); }
+  [[nodiscard]] const PoseWatch& poseWatch() const { return poseWatch_; }
 
   [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
@@ -163,6 +167,7 @@ class Agent : private DriveStack {
   /// The localizer's stream watch; on loss and on recovery queues a TaskStatus with the reason and
   /// shifts the task's timers so the outage does not count as being stuck.
   bool sensorStreamLost(std::int64_t nowNs);
+  bool poseDoubtful(std::int64_t nowNs);
   /// Command, state and predicted discs for the chosen twist and mode.
   void report(AgentOutput& out, std::int64_t nowNs, double v, double w, msg::RobotMode mode);
   /// The task ends (failed: `reason` says why).
@@ -205,6 +210,8 @@ class Agent : private DriveStack {
   double battery_ = 1.0;
   /// Whether the robot gets anywhere, and the planner's recoveries.
   ProgressWatch progress_;
+  PoseWatch poseWatch_;
+  std::int64_t doubtedSinceNs_ = -1;
   std::uint64_t plannerRecoveries_ = 0;
   ReleaseFollower follow_;                            // drives the released base
   FollowCommand drove_;                               // this cycle's (reset at the start of a cycle)

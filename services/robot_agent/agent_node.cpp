@@ -247,6 +247,14 @@ LineStats AgentNode::lineStats() const {
   return ls;
 }
 
+std::uint64_t AgentNode::poseDoubts() const {
+  std::uint64_t n = 0;
+  for (const auto& a : agents_) {
+    n += a->poseWatch().doubts();
+  }
+  return n;
+}
+
 ReleaseCounts AgentNode::releaseCounts() const {
   ReleaseCounts rc;
   for (const auto& a : agents_) {
@@ -276,7 +284,8 @@ nlohmann::json AgentNode::statsJson() const {
                        {"unmatched_no_wall_facing", ls.noWallFacing},
                        {"unmatched_outside_gate", ls.outsideGate},
                        {"unmatched_no_overlap", ls.noOverlap},
-                       {"unmatched_ambiguous", ls.ambiguous}};
+                       {"unmatched_ambiguous", ls.ambiguous},
+                       {"pose_doubts", poseDoubts()}};
   m["traffic"] = {{"releases_taken", rc.accepted},
                   {"ignored_foreign", rc.foreign},
                   {"ignored_stale", rc.stale},

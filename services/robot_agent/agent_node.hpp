@@ -96,6 +96,8 @@ class AgentNode {
   [[nodiscard]] Agent::Conduct conduct() const;
   [[nodiscard]] LineStats lineStats() const;
   [[nodiscard]] ReleaseCounts releaseCounts() const;
+  /// Times a hosted robot's pose was doubted by its laser lines (PoseWatch), cumulative.
+  [[nodiscard]] std::uint64_t poseDoubts() const;
   /// For the --metrics file: "samples" (refused at the edge), "conduct", "localization", "traffic".
   [[nodiscard]] nlohmann::json statsJson() const;
 

@@ -15,6 +15,7 @@
 #include "agent.hpp"
 #include "fleet/control/diff_drive_kinematics.hpp"
 #include "fleet/core/angles.hpp"
+#include "room_scan.hpp"
 #include "straight_releases.hpp"
 
 using namespace fleet;
@@ -50,9 +51,31 @@ struct World {
     f.range_max = 8.0f;
     f.detections = detections;
     f.battery = 0.9f;
+    if (room) {
+      scan(f);
+    }
     return f;
   }
+
+  // With `room`: the walls of a 10 × 8 m room round the origin's corner, scanned as the simulator
+  // does (72 rays over 360° from -π, 8 m; a miss reads 8 m) from the true pose.
+  bool room = false;
+  void scan(msg::SensorFrame& f) const {
+    f.angle_min = static_cast<float>(-kPi);
+    f.angle_increment = static_cast<float>(test::kRoomRayStep);
+    f.ranges = test::roomRanges(truth, 10.0, 8.0);
+  }
 };
+
+// The room's inner faces, as the site's wall segments.
+std::shared_ptr<const std::vector<estimation::MapSegment>> roomWalls() {
+  auto w = std::make_shared<std::vector<estimation::MapSegment>>();
+  w->push_back({Vec2{0, 0}, Vec2{10, 0}, {0, 1}});
+  w->push_back({Vec2{0, 8}, Vec2{10, 8}, {0, -1}});
+  w->push_back({Vec2{0, 0}, Vec2{0, 8}, {1, 0}});
+  w->push_back({Vec2{10, 0}, Vec2{10, 8}, {-1, 0}});
+  return w;
+}
 
 std::shared_ptr<const planning::OccupancyGrid> emptyGrid() {
   return std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
@@ -314,6 +337,56 @@ TEST(Agent, SensorStreamLossStopsReportsAndResumes) {
   run.until(1500, [&] { return run.reported(msg::TaskState::Done); });
   EXPECT_TRUE(run.reported(msg::TaskState::Done));
   EXPECT_FALSE(run.a.sensorLost());
+}
+
+TEST(Agent, InARoomItsLinesMatchTheWallsAndItsPoseIsNeverDoubted) {
+  auto p = params();
+  p.walls = roomWalls();
+  AgentRun run(p);
+  run.world.room = true;
+  run.a.onAssignment(transport());
+  bool fault = false;
+  for (int i = 0; i < 1500 && !run.reported(msg::TaskState::Done); ++i)
+    fault = run.step().state.mode == msg::RobotMode::Fault || fault;
+  EXPECT_TRUE(run.reported(msg::TaskState::Done));
+  EXPECT_FALSE(fault);
+  EXPECT_EQ(run.a.poseWatch().doubts(), 0u);
+  EXPECT_GT(run.a.lineStats().accepted, 300u) << "the lines were fused all the way";
+}
+
+TEST(Agent, ARobotWhoseWallsAreNotWhereItThinksStopsFaultedAndSaysWhy) {
+  // It believes it is at (1, 1) facing east; it stands at (2.5, 2.2) facing 0.4 rad north of it (a
+  // restarted agent without its robots' poses, a robot carried off): every wall it sees is
+  // somewhere the map has none.
+  auto p = params();
+  p.walls = roomWalls();
+  AgentRun run(p);
+  run.world.room = true;
+  run.world.truth = {2.5, 2.2, 0.4};
+  run.a.onAssignment(transport());
+  int faultAt = -1;
+  std::vector<agent::AgentOutput> outs;
+  for (int i = 0; i < 200; ++i) {
+    outs.push_back(run.step());
+    if (faultAt < 0 && outs.back().state.mode == msg::RobotMode::Fault)
+      faultAt = i;
+  }
+  ASSERT_GE(faultAt, 0) << "never doubted";
+  EXPECT_LE(faultAt, 60) << "a whole window (5 s) and a cycle";
+  EXPECT_TRUE(run.a.poseDoubted());
+  for (std::size_t k = static_cast<std::size_t>(faultAt); k < outs.size(); ++k) {
+    EXPECT_EQ(outs[k].command.v, 0.0) << k;
+    EXPECT_EQ(outs[k].command.w, 0.0) << k;
+    EXPECT_EQ(outs[k].state.mode, msg::RobotMode::Fault) << k;
+  }
+  const auto said = std::find_if(run.statuses.begin(), run.statuses.end(), [](const msg::TaskStatus& t) {
+    return t.error.find("localization doubtful") != std::string::npos;
+  });
+  ASSERT_NE(said, run.statuses.end());
+  EXPECT_EQ(said->task_id, "t1");
+  EXPECT_NE(said->state, msg::TaskState::Failed) << "the task is kept; the manager's timers decide";
+  EXPECT_TRUE(run.a.busy());
+  EXPECT_EQ(run.a.poseWatch().doubts(), 1u);
 }
 
 TEST(Agent, PausedOrderHoldsStillLongerThanTheFailTimeoutAndResumes) {

@@ -2,6 +2,7 @@
 // the people tracked from reading to reading, and the stream watch out.
 
 #include "localizer.hpp"
+#include "room_scan.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +15,7 @@
 #include <random>
 
 #include "fleet/core/angles.hpp"
+#include "room_scan.hpp"
 
 using namespace fleet;
 using agent::Localizer;
@@ -177,23 +179,9 @@ std::shared_ptr<const std::vector<estimation::MapSegment>> room(Vec2 shift = {})
 SensorReading scanFrom(const Pose2& truth, std::int64_t stampNs) {
   SensorReading r = straight(stampNs, 0.0);
   r.angleMin = static_cast<float>(-kPi);
-  r.angleIncrement = static_cast<float>(2.0 * kPi / 72.0);
+  r.angleIncrement = static_cast<float>(fleet::test::kRoomRayStep);
   r.rangeMax = 8.0f;
-  for (int i = 0; i < 72; ++i) {
-    const double a = truth.theta - kPi + i * 2.0 * kPi / 72.0;
-    const double c = std::cos(a);
-    const double s = std::sin(a);
-    double t = 8.0;
-    if (c > 1e-9)
-      t = std::min(t, (6.0 - truth.x) / c);
-    if (c < -1e-9)
-      t = std::min(t, -truth.x / c);
-    if (s > 1e-9)
-      t = std::min(t, (4.0 - truth.y) / s);
-    if (s < -1e-9)
-      t = std::min(t, -truth.y / s);
-    r.ranges.push_back(static_cast<float>(t));
-  }
+  r.ranges = fleet::test::roomRanges(truth, 6.0, 4.0);
   return r;
 }
 
