@@ -15,7 +15,6 @@
 #include <random>
 
 #include "fleet/core/angles.hpp"
-#include "room_scan.hpp"
 
 using namespace fleet;
 using agent::Localizer;
