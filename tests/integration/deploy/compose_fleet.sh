@@ -216,6 +216,11 @@ for s in "${SERVICES[@]}"; do
   [[ -z $groups ]] || fail "$c joined multicast groups $groups"
   echo "$c running, healthy, no multicast group"
 done
+# The agent keeps its robots' poses in the data volume (--pose-file), for a restarted container.
+poses=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["robots"]))' "$dir/data/agent_poses.json" 2>&1) ||
+  fail "the robot agent wrote no readable pose file in the data volume: $poses"
+((poses > 0)) || fail "the robot agent's pose file names no robot"
+echo "robot agent: pose file with $poses robots in the data volume"
 sim=$(podman inspect --format '{{.State.Status}} {{.State.ExitCode}}' "${P}_fleet-sim_1")
 [[ $sim == "running 0" || $sim == "exited 0" ]] || fail "the simulator ended badly ($sim)"
 
