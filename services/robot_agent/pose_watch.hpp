@@ -18,11 +18,12 @@
 namespace fleet::agent {
 
 struct PoseWatchParams {
-  double windowS = 5.0;
+  double windowS = 10.0;
   std::uint64_t minLines = 20;
   /// Normal driving fuses ~98 % of the lines (300 robots among 150 people, 2026-12-04); a robot 1 m
-  /// or 0.3 rad off fuses none.
-  double doubtBelow = 0.2;
+  /// or 0.3 rad off ~7 %. 5 s and 20 % stopped robots standing among parked robots, whose scan is
+  /// mostly their neighbours' flanks (docs/algorithms.md, "A robot its lines call lost stops").
+  double doubtBelow = 0.1;
   double trustAbove = 0.6;
 };
 
@@ -40,7 +41,7 @@ class PoseWatch {
   [[nodiscard]] std::uint64_t accepted() const { return accepted_; }
   /// Times the pose was doubted, cumulative.
   [[nodiscard]] std::uint64_t doubts() const { return doubts_; }
-  /// "localization doubtful: 2 of 131 laser lines matched the site's walls in the last 5.0 s".
+  /// "localization doubtful: 2 of 131 laser lines matched the site's walls in the last 10.0 s".
   [[nodiscard]] std::string why() const;
 
  private:

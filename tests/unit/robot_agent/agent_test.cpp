@@ -372,7 +372,7 @@ TEST(Agent, ARobotWhoseWallsAreNotWhereItThinksStopsFaultedAndSaysWhy) {
       faultAt = i;
   }
   ASSERT_GE(faultAt, 0) << "never doubted";
-  EXPECT_LE(faultAt, 60) << "a whole window (5 s) and a cycle";
+  EXPECT_LE(faultAt, 110) << "a whole window (10 s) and a cycle";
   EXPECT_TRUE(run.a.poseDoubted());
   for (std::size_t k = static_cast<std::size_t>(faultAt); k < outs.size(); ++k) {
     EXPECT_EQ(outs[k].command.v, 0.0) << k;

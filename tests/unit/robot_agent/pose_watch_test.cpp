@@ -15,7 +15,8 @@ constexpr std::int64_t kTick = 100'000'000;  // 0.1 s
 // Feeds `cycles` cycles of `lines` extracted lines each, `fused` of them accepted; returns the
 // changes seen, in order.
 struct Feed {
-  PoseWatch watch;
+  // The mechanism at round numbers (the defaults are checked on their own below).
+  PoseWatch watch{PoseWatchParams{.windowS = 5.0, .minLines = 20, .doubtBelow = 0.2, .trustAbove = 0.6}};
   std::int64_t now = 0;
   std::uint64_t extracted = 0;
   std::uint64_t accepted = 0;
@@ -96,4 +97,24 @@ TEST(PoseWatch, CountsThatStartAgainAreJudgedAfresh) {
   EXPECT_TRUE(f.watch.doubted()) << "not a whole window of the new counts yet";
   f.run(50, 3, 3);
   EXPECT_FALSE(f.watch.doubted());
+}
+
+TEST(PoseWatch, ByDefaultAFullyRefusedRobotIsDoubtedWithinTenSecondsAndOneFusingAFifthIsNot) {
+  // The defaults: a 10 s window, doubted under a tenth fused (a robot among parked robots and
+  // people fuses more than that; a lost one ~7 %).
+  PoseWatch lost;
+  PoseWatch crowded;
+  std::uint64_t e = 0;
+  std::uint64_t a = 0;
+  int doubtedAt = -1;
+  for (int i = 1; i <= 300; ++i) {
+    e += 3;
+    a += i % 5 == 0 ? 3 : 0;  // a fifth of the lines fused
+    if (lost.update(i * kTick, e, 0) == PoseWatch::Change::kDoubted)
+      doubtedAt = i;
+    (void)crowded.update(i * kTick, e, a);
+  }
+  EXPECT_GE(doubtedAt, 100);
+  EXPECT_LE(doubtedAt, 101);
+  EXPECT_FALSE(crowded.doubted());
 }
