@@ -101,14 +101,16 @@ PostgresWebhookStore::PostgresWebhookStore(const std::string& url) : url_(url), 
   orThrow(
       url_,
       conn_.exec("create the webhook table",
-                 "SELECT pg_advisory_lock(8606010379466966901);"
+                 // One implicit transaction: the lock is held until the table's creation commits
+                 // (a session lock released inside the transaction let a second replica's CREATE
+                 // race the uncommitted catalog row: "duplicate key ... pg_type_typname_nsp_index").
+                 "SELECT pg_advisory_xact_lock(8606010379466966901);"
                  "CREATE TABLE IF NOT EXISTS wms_webhooks("
                  " id TEXT PRIMARY KEY, url TEXT NOT NULL, secret TEXT NOT NULL, created_ns BIGINT NOT NULL,"
                  " delivered_through BIGINT NOT NULL, state TEXT NOT NULL, deliveries BIGINT NOT NULL,"
                  " failures BIGINT NOT NULL, last_error TEXT NOT NULL, last_attempt_ns BIGINT NOT NULL,"
                  " last_success_ns BIGINT NOT NULL, owner TEXT NOT NULL DEFAULT '',"
-                 " owner_until_ns BIGINT NOT NULL DEFAULT 0);"
-                 "SELECT pg_advisory_unlock(8606010379466966901)"));
+                 " owner_until_ns BIGINT NOT NULL DEFAULT 0)"));
 }
 
 std::vector<StoredWebhook> PostgresWebhookStore::load() {

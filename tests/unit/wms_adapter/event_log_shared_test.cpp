@@ -12,12 +12,15 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "event_log.hpp"
 #include "postgres_event_store.hpp"
 #include "postgres_server.hpp"
 #include "webhook_receiver.hpp"
+#include "webhook_store.hpp"
 #include "webhooks.hpp"
 
 using namespace fleet;
@@ -249,4 +252,39 @@ TEST_F(SharedEventLog, ASubscriptionIsDeliveredByOneReplicaAndTakenOverWhenItDie
   EXPECT_TRUE(b.hooks->remove(id));
   Replica c(url);
   EXPECT_TRUE(c.hooks->list().empty());
+}
+
+// Replicas start together: each creates the tables it needs when missing. Every one of them must
+// open on a fresh database, however their CREATE statements interleave (a lock released before the
+// creation committed once let the second replica fail with PostgreSQL's duplicate pg_type row).
+TEST_F(SharedEventLog, ReplicasStartingTogetherAllOpenTheirTables) {
+  constexpr int kRounds = 6;
+  constexpr int kReplicas = 6;
+  for (int round = 0; round < kRounds; ++round) {
+    const std::string url = server_->freshUrl();
+    std::atomic<int> ready{0};
+    std::mutex m;
+    std::vector<std::string> errors;
+    std::vector<std::thread> replicas;
+    for (int i = 0; i < kReplicas; ++i) {
+      replicas.emplace_back([&] {
+        ready.fetch_add(1);
+        while (ready.load() < kReplicas) {
+          std::this_thread::yield();
+        }
+        try {
+          PostgresWebhookStore hooks(url);
+          PostgresEventStore events(url);
+          (void)hooks.load();
+        } catch (const std::exception& e) {
+          std::lock_guard lock(m);
+          errors.emplace_back(e.what());
+        }
+      });
+    }
+    for (auto& t : replicas) {
+      t.join();
+    }
+    EXPECT_TRUE(errors.empty()) << "round " << round << ": " << errors.front();
+  }
 }
