@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "fleet/core/bends.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/site/reachability.hpp"
 #include "roadmap_builder.hpp"
@@ -201,27 +202,39 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
 
   r.turnRate_ = std::max(1e-3, s.robot.limits.omegaMax);
   r.turnAccel_ = std::max(1e-3, s.robot.limits.alphaMax);
-  // Turning: an edge's duration includes the smallest turn any way into its start needs (a lower
-  // bound without knowing where the robot came from; exact at nodes with one way in).
+  // Turning (bendTime): an edge's duration includes the least turning any way into its start needs
+  // (a lower bound without knowing where the robot came from; exact at nodes with one way in).
   const auto nn = static_cast<NodeId>(r.graph.size());
   std::vector<std::vector<NodeId>> into(r.graph.size());
+  r.baseDuration_.assign(r.graph.size(), {});
+  r.tightBend_.assign(r.graph.size(), 0);
   for (NodeId v = 0; v < nn; ++v) {
     for (const auto& e : r.graph.edges(v)) {
       into[static_cast<std::size_t>(e.to)].push_back(v);
+      r.baseDuration_[static_cast<std::size_t>(v)].push_back(e.duration);
     }
+    r.tightBend_[static_cast<std::size_t>(v)] =
+        s.map.size() > 0 && !site::discFits(s.map, r.graph.position(v), o.radius + bends::kTightClearance)
+            ? 1
+            : 0;
   }
   r.turnIncluded_.assign(r.graph.size(), {});
   for (NodeId v = 0; v < nn; ++v) {
-    const Vec2 pv = r.graph.position(v);
-    const std::vector<Edge> out(r.graph.edges(v).begin(), r.graph.edges(v).end());
-    for (const auto& e : out) {
-      double turn = into[static_cast<std::size_t>(v)].empty() ? 0.0 : detail::kPi;
-      for (const NodeId w : into[static_cast<std::size_t>(v)]) {
-        turn = std::min(turn, detail::angleBetween(pv - r.graph.position(w), r.graph.position(e.to) - pv));
+    const auto& ways = into[static_cast<std::size_t>(v)];
+    for (std::size_t k = 0; k < r.graph.edges(v).size(); ++k) {
+      double least = ways.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+      for (const NodeId w : ways) {
+        least = std::min(least, r.bendTime(w, v, k));
       }
-      const double t = r.turnTime(turn);
-      r.turnIncluded_[static_cast<std::size_t>(v)].push_back(t);
-      r.graph.addEdge(v, e.to, e.duration + t);
+      r.turnIncluded_[static_cast<std::size_t>(v)].push_back(least);
+    }
+  }
+  for (NodeId v = 0; v < nn; ++v) {
+    const std::vector<Edge> out(r.graph.edges(v).begin(), r.graph.edges(v).end());
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      r.graph.addEdge(
+          v, out[k].to,
+          r.baseDuration_[static_cast<std::size_t>(v)][k] + r.turnIncluded_[static_cast<std::size_t>(v)][k]);
     }
   }
 
@@ -345,6 +358,38 @@ double Roadmap::turnTime(double angle) const {
   return a >= ramp ? a / turnRate_ + turnRate_ / turnAccel_ : 2.0 * std::sqrt(a / turnAccel_);
 }
 
+double Roadmap::baseDuration(NodeId from, NodeId to) const {
+  const auto out = graph.edges(from);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (out[k].to == to) {
+      return baseDuration_[static_cast<std::size_t>(from)][k];
+    }
+  }
+  return 0.0;
+}
+
+double Roadmap::bendTime(NodeId prev, NodeId atNode, std::size_t out) const {
+  const Edge& e = graph.edges(atNode)[out];
+  const Vec2 p = graph.position(atNode);
+  const double angle = detail::angleBetween(p - graph.position(prev), graph.position(e.to) - p);
+  if (angle < 1e-9) {
+    return 0.0;
+  }
+  // Corners (fleet/core/bends.hpp), and the leg onto a dock, which the agent starts facing the dock:
+  // on the spot.
+  const bool corner = angle > bends::kDrivenRound ||
+                      (tightBend_[static_cast<std::size_t>(atNode)] != 0 && angle > bends::kTight) ||
+                      kind(atNode) == NodeKind::Station || kind(e.to) == NodeKind::Station;
+  if (corner) {
+    return turnTime(angle);
+  }
+  // Driven round: the robot turns while it drives the second half of the edge in and the first half
+  // of the edge out at cruise; what the turn needs beyond that is the bend's cost.
+  const double along =
+      0.5 * (baseDuration(prev, atNode) + baseDuration_[static_cast<std::size_t>(atNode)][out]);
+  return std::max(0.0, turnTime(angle) - along);
+}
+
 double Roadmap::extraTurn(NodeId prev, NodeId atNode, NodeId next) const {
   if (!graph.valid(prev) || !graph.valid(atNode) || !graph.valid(next)) {
     return 0.0;
@@ -352,9 +397,7 @@ double Roadmap::extraTurn(NodeId prev, NodeId atNode, NodeId next) const {
   const auto out = graph.edges(atNode);
   for (std::size_t k = 0; k < out.size(); ++k) {
     if (out[k].to == next) {
-      const Vec2 p = graph.position(atNode);
-      const double exact = turnTime(detail::angleBetween(p - graph.position(prev), graph.position(next) - p));
-      return std::max(0.0, exact - turnIncluded_[static_cast<std::size_t>(atNode)][k]);
+      return std::max(0.0, bendTime(prev, atNode, k) - turnIncluded_[static_cast<std::size_t>(atNode)][k]);
     }
   }
   return 0.0;

@@ -142,6 +142,69 @@ TEST(Roadmap, DurationsAreDriveTimeAndTheTurnsANodeForces) {
   EXPECT_NEAR(r.turnTime(0.5), 2.0 * std::sqrt(0.5 / 3.0), 1e-9);  // too short to reach 1.5 rad/s
 }
 
+/// Turns are timed as the agent takes them (fleet/core/bends.hpp): the lattice's 45° bends driven
+/// round where the disc has room, costing only what turning by the angle needs beyond driving the
+/// two half edges at cruise; corners, tight bends and the legs onto docks on the spot. Checked on
+/// every bend of the shipped small warehouse: never more than the turn on the spot, exactly it for
+/// corners, and what an edge's duration folds in plus extraTurn() is the bend's whole time.
+TEST(Roadmap, BendsAreDrivenRoundWhereTheAgentDrivesRoundAndCornersTurnedOnTheSpot) {
+  const auto site = shipped("small_warehouse.site.json");
+  const Roadmap r = buildRoadmap(site);
+  std::size_t roomy = 0;
+  std::size_t tight = 0;
+  std::size_t corners = 0;
+  for (NodeId v = 0; v < static_cast<NodeId>(r.graph.size()); ++v) {
+    const Vec2 p = r.graph.position(v);
+    for (NodeId w = 0; w < static_cast<NodeId>(r.graph.size()); ++w) {
+      const Edge* in = r.graph.edge(w, v);
+      if (in == nullptr)
+        continue;
+      const auto out = r.graph.edges(v);
+      for (std::size_t k = 0; k < out.size(); ++k) {
+        const Vec2 a = p - r.graph.position(w);
+        const Vec2 b = r.graph.position(out[k].to) - p;
+        const double angle = std::acos(std::clamp(a.dot(b) / (a.norm() * b.norm()), -1.0, 1.0));
+        const double t = r.bendTime(w, v, k);
+        // The edge's duration holds its drive and the least bend into it; extraTurn the rest.
+        const double folded = out[k].duration - r.baseDuration(v, out[k].to);
+        EXPECT_NEAR(folded + r.extraTurn(w, v, out[k].to), std::max(t, folded), 1e-9);
+        EXPECT_LE(t, r.turnTime(angle) + 1e-6);
+        const bool station = r.kind(v) == NodeKind::Station || r.kind(out[k].to) == NodeKind::Station;
+        const bool room = site::discFits(site.map, p, r.options.radius + 0.2);
+        if (angle > 0.9 || station || (!room && angle > 0.3)) {
+          EXPECT_NEAR(t, r.turnTime(angle), 1e-6) << v;
+          corners += angle > 1e-6 ? 1 : 0;
+        } else if (angle > 1e-6) {
+          const double along = 0.5 * (r.baseDuration(w, v) + r.baseDuration(v, out[k].to));
+          EXPECT_NEAR(t, std::max(0.0, r.turnTime(angle) - along), 1e-6) << v;
+          (room ? roomy : tight) += 1;
+        }
+      }
+    }
+  }
+  EXPECT_GT(roomy, 100U);
+  EXPECT_GT(corners, 100U);
+  // A 45° bend between a 0.5 m axis step and a diagonal in the open: turning by π/4 takes 1.02 s
+  // and the half edges 0.75 s, so the bend costs 0.27 s where the turn on the spot cost 1.02 s.
+  std::size_t found = 0;
+  for (NodeId mid = 0; mid < static_cast<NodeId>(r.graph.size()) && found == 0; ++mid) {
+    const Vec2 p = r.graph.position(mid);
+    const NodeId west = r.nearest(p - Vec2{0.5, 0.0});
+    const NodeId ne = r.nearest(p + Vec2{0.5, 0.5});
+    if (r.kind(mid) != NodeKind::Lane || !site::discFits(site.map, p, r.options.radius + 0.2) ||
+        r.graph.edge(west, mid) == nullptr || r.graph.edge(mid, ne) == nullptr ||
+        distance(r.graph.position(ne), p + Vec2{0.5, 0.5}) > 1e-6 ||
+        distance(r.graph.position(west), p - Vec2{0.5, 0.0}) > 1e-6)
+      continue;
+    ++found;
+    const double whole =
+        r.graph.edge(mid, ne)->duration - r.baseDuration(mid, ne) + r.extraTurn(west, mid, ne);
+    EXPECT_NEAR(whole, r.turnTime(kPi / 4) - 0.5 * (0.625 + std::sqrt(0.5) / 0.8), 1e-9);
+  }
+  EXPECT_EQ(found, 1U);
+  EXPECT_NEAR(r.turnTime(kPi / 4), kPi / 4 / 1.5 + 0.5, 1e-9);
+}
+
 // ---- stations and queues ----------------------------------------------------------------------
 
 TEST(Roadmap, StationsHaveDockApproachAndGeneratedQueueInOrder) {

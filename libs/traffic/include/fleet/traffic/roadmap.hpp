@@ -16,10 +16,11 @@
 //   apart back from the approach point (or along the row) while the disc fits. A queue is a line:
 //   one way toward the station (tail → … → head → approach), entered at its tail from behind, left
 //   sideways from any of its nodes, so no robot joining or leaving drives at those waiting.
-// - Edge durations: length at the cruise speed (slower in speed-limit zones) plus the smallest turn
-//   on the spot any way into the edge's start needs (exact where a node has one way in, e.g. the
-//   180° turn out of a dock; zero inside the lattice, where a straight way in exists); extraTurn()
-//   gives the rest for a planner that knows where a robot came from.
+// - Edge durations: length at the cruise speed (slower in speed-limit zones) plus the least turning
+//   any way into the edge's start needs (exact where a node has one way in, e.g. the 180° turn out
+//   of a dock; zero inside the lattice, where a straight way in exists); extraTurn() gives the rest
+//   for a planner that knows where a robot came from. Turns are timed as the agent takes them
+//   (bendTime): corners on the spot, the lattice's 45° bends driven round.
 // - One-way zones drop every edge that runs against the zone's direction (> 90° off) anywhere.
 // - Conflicts: roadmap_conflicts.hpp (the guarantee is stated there).
 //
@@ -131,6 +132,14 @@ class Roadmap {
   [[nodiscard]] NodeId nearest(Vec2 p, bool openOnly = true) const;
   /// Turning time at `at` between prev→at and at→next beyond what at→next's duration includes.
   [[nodiscard]] double extraTurn(NodeId prev, NodeId at, NodeId next) const;
+  /// The whole time the bend prev→at→(at's out-edge `out`) costs, as the agent takes it
+  /// (fleet/core/bends.hpp): a corner (sharper than bends::kDrivenRound, or than bends::kTight
+  /// where the disc has little room, or onto or off a dock) turned on the spot, turnTime(angle);
+  /// a bend driven round, what turning by the angle takes beyond driving the two half edges at
+  /// cruise (0 for most).
+  [[nodiscard]] double bendTime(NodeId prev, NodeId at, std::size_t out) const;
+  /// An edge's duration without the turning folded into it.
+  [[nodiscard]] double baseDuration(NodeId from, NodeId to) const;
   /// Time to turn on the spot by `angle` rad with the site robot's limits.
   [[nodiscard]] double turnTime(double angle) const;
   [[nodiscard]] std::size_t edgeCount() const;  ///< directed edges
@@ -160,6 +169,8 @@ class Roadmap {
   std::vector<std::uint16_t> nodeClosures_;               ///< closures covering each node
   std::vector<std::vector<std::uint16_t>> edgeClosures_;  ///< per node, per out-edge
   std::vector<std::vector<double>> turnIncluded_;         ///< per node, per out-edge: s of turning
+  std::vector<std::vector<double>> baseDuration_;         ///< per node, per out-edge: s of driving
+  std::vector<std::uint8_t> tightBend_;                   ///< per node: the disc has little room
 };
 
 /// Builds the roadmap of `site` (its map with no-go zones blocked, its stations and zones). What
