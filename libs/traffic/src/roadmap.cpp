@@ -214,7 +214,7 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
       r.baseDuration_[static_cast<std::size_t>(v)].push_back(e.duration);
     }
     r.tightBend_[static_cast<std::size_t>(v)] =
-        s.map.size() > 0 && !site::discFits(s.map, r.graph.position(v), o.radius + bends::kTightClearance)
+        b.grid.size() > 0 && !site::discFits(b.grid, r.graph.position(v), o.radius + bends::kTightClearance)
             ? 1
             : 0;
   }

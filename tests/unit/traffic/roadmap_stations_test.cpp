@@ -150,6 +150,7 @@ TEST(Roadmap, DurationsAreDriveTimeAndTheTurnsANodeForces) {
 TEST(Roadmap, BendsAreDrivenRoundWhereTheAgentDrivesRoundAndCornersTurnedOnTheSpot) {
   const auto site = shipped("small_warehouse.site.json");
   const Roadmap r = buildRoadmap(site);
+  const auto drivable = site.drivable();  // the agent's map: no-go zones blocked
   std::size_t roomy = 0;
   std::size_t tight = 0;
   std::size_t corners = 0;
@@ -170,7 +171,7 @@ TEST(Roadmap, BendsAreDrivenRoundWhereTheAgentDrivesRoundAndCornersTurnedOnTheSp
         EXPECT_NEAR(folded + r.extraTurn(w, v, out[k].to), std::max(t, folded), 1e-9);
         EXPECT_LE(t, r.turnTime(angle) + 1e-6);
         const bool station = r.kind(v) == NodeKind::Station || r.kind(out[k].to) == NodeKind::Station;
-        const bool room = site::discFits(site.map, p, r.options.radius + 0.2);
+        const bool room = site::discFits(drivable, p, r.options.radius + 0.2);
         if (angle > 0.9 || station || (!room && angle > 0.3)) {
           EXPECT_NEAR(t, r.turnTime(angle), 1e-6) << v;
           corners += angle > 1e-6 ? 1 : 0;
@@ -191,7 +192,7 @@ TEST(Roadmap, BendsAreDrivenRoundWhereTheAgentDrivesRoundAndCornersTurnedOnTheSp
     const Vec2 p = r.graph.position(mid);
     const NodeId west = r.nearest(p - Vec2{0.5, 0.0});
     const NodeId ne = r.nearest(p + Vec2{0.5, 0.5});
-    if (r.kind(mid) != NodeKind::Lane || !site::discFits(site.map, p, r.options.radius + 0.2) ||
+    if (r.kind(mid) != NodeKind::Lane || !site::discFits(drivable, p, r.options.radius + 0.2) ||
         r.graph.edge(west, mid) == nullptr || r.graph.edge(mid, ne) == nullptr ||
         distance(r.graph.position(ne), p + Vec2{0.5, 0.5}) > 1e-6 ||
         distance(r.graph.position(west), p - Vec2{0.5, 0.0}) > 1e-6)
