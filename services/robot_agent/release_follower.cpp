@@ -42,18 +42,15 @@ constexpr double kBlockedAfterS = 3.0;
 /// back along the next aisle) the robot got no closer to that end for a while, DWA took it for a
 /// local minimum and swerved off the base to escape it.
 constexpr double kPlannerWindow = 2.0;
-/// Base nodes where the way turns by more than bends::kDrivenRound (more than the 45° of a diagonal
-/// on the roadmap lattice, which the planner drives round) are corners: the robot drives straight
-/// onto the node and turns there on the spot, as the roadmap's turn times assume. Left to the local
-/// planner or the follower, it rounded a right angle in an arc that cut 0.17 m off it (DWA), or
-/// turned 0.5 m early (the follower's carrot) at speed and slid off the base while it braked.
-constexpr double kSharpTurn = bends::kDrivenRound;
-/// So are bends of more than bends::kTight at a node where the disc keeps less than
-/// bends::kTightClearance of free space: rounded, the outside of the bend swings towards the shelf
-/// (a robot leaving a parking row came within 0.003 m of a corner, 40 robots).
-constexpr double kTightTurn = bends::kTight;
-constexpr double kTightClearance = bends::kTightClearance;
-/// ... coming onto the node at most this fast [m/s] (it slides a centimetre while it brakes) ...
+// Corners (fleet/core/bends.hpp): base nodes where the way turns by more than bends::kDrivenRound
+// (the 45° of a diagonal on the roadmap lattice the planner drives round), or by more than
+// bends::kTight where the disc keeps less than bends::kTightClearance of free space. The robot
+// drives straight onto the node and turns there on the spot, as the roadmap's turn times assume.
+// Left to the local planner or the follower, it rounded a right angle in an arc that cut 0.17 m off
+// it (DWA), or turned 0.5 m early (the follower's carrot) at speed and slid off the base while it
+// braked; a tight bend rounded swung its outside towards the shelf (a robot leaving a parking row
+// came within 0.003 m of a corner, 40 robots).
+/// Onto a corner at most this fast [m/s] (it slides a centimetre while it brakes) ...
 constexpr double kTurnSpeed = 0.15;
 /// ... from this far before it [m] ...
 constexpr double kCornerApproach = 0.8;
@@ -326,8 +323,8 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   if (undockFrom_ && distance(here, *undockFrom_) > kLeaveDistance) {
     undockFrom_.reset();
   }
-  const auto turn = releases_.nextTurn(kSharpTurn, kTightTurn, [&](Vec2 at) {
-    return raw_ && !site::discFits(*raw_, at, p_.radius + kTightClearance);
+  const auto turn = releases_.nextTurn(bends::kDrivenRound, bends::kTight, [&](Vec2 at) {
+    return raw_ && !site::discFits(*raw_, at, p_.radius + bends::kTightClearance);
   });
   const bool cornering =
       !settling && turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;

@@ -208,7 +208,9 @@ TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
     stepOnTime(tc);
   EXPECT_TRUE(tc.arrived(b)) << "r7 " << tc.explain(b);
   EXPECT_TRUE(tc.arrived(c)) << "r6 is not back at its place: " << tc.explain(c);
-  EXPECT_EQ(tc.at(a), front) << "r1 " << tc.explain(a);
+  // r1 at least comes up to where r7 stood (home is better: a planner that unties the larger knot
+  // must not fail this).
+  EXPECT_TRUE(tc.arrived(a) || tc.at(a) == front) << "r1 " << tc.explain(a);
   EXPECT_GE(tc.plannerStats().untangles, 1U);
 }
 
