@@ -57,6 +57,11 @@ void addLoadtestCommand(CLI::App& app, Commands& commands) {
           "there may go first (switchable dependencies); 0: never (default: the traffic manager's)")
       ->check(CLI::Range(0, 1000));
   loadtest
+      ->add_option("--guidance", o->guidance,
+                   "reserved traffic: the roadmap's flow guidance (roadmap.guidance of the traffic and fleet "
+                   "managers; 0: none; default: theirs)")
+      ->check(CLI::Range(0.0, 100.0));
+  loadtest
       ->add_option("--yield-after", o->yieldAfterS,
                    "reserved traffic: seconds a robot reports itself blocked (a person in front of it) "
                    "before it is made to yield; 0: never (default: the traffic manager's)")

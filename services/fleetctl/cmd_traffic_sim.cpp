@@ -28,6 +28,11 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   trafficSim
+      ->add_option("--guidance", o->guidance,
+                   "flow guidance: driving against the usual flow between pickups and drop-offs costs routes "
+                   "1 + this times the edge's time (0: none; default: the roadmap's)")
+      ->check(CLI::Range(0.0, 100.0));
+  trafficSim
       ->add_option("--stop-gap", o->stopGap,
                    "m of free space the robot's motion gate needs ahead of a driving robot (default: the "
                    "roadmap's)")

@@ -72,17 +72,19 @@ struct Builder {
     fs::remove(out / "fleet.db-wal", ec);
     fs::remove(out / "fleet.db-shm", ec);
     fs::remove(out / "traffic_manager_summary.json", ec);  // not a previous run's
-    writeTextFile(out / "manager.json", json{{"stations", fs::absolute(run.file).string()},
-                                             {"db", fs::absolute(plan.db).string()},
-                                             {"clock", "sim"},
-                                             {"lease_s", 3.0},
-                                             {"station_capacity", o.stationCapacity == "queue"
-                                                                      ? json(o.stationCapacity)
-                                                                      : json(std::stoi(o.stationCapacity))},
-                                             {"station_load", o.stationLoad},
-                                             {"travel_cost", o.travelCost},
-                                             {"metrics_file", abs("manager_metrics.json")}}
-                                            .dump(1));
+    json manager{{"stations", fs::absolute(run.file).string()},
+                 {"db", fs::absolute(plan.db).string()},
+                 {"clock", "sim"},
+                 {"lease_s", 3.0},
+                 {"station_capacity", o.stationCapacity == "queue" ? json(o.stationCapacity)
+                                                                   : json(std::stoi(o.stationCapacity))},
+                 {"station_load", o.stationLoad},
+                 {"travel_cost", o.travelCost},
+                 {"metrics_file", abs("manager_metrics.json")}};
+    if (o.guidance >= 0.0) {
+      manager["roadmap"] = json{{"guidance", o.guidance}};
+    }
+    writeTextFile(out / "manager.json", manager.dump(1));
     // 0.1 m cells up to ~1.2 M cells, coarser beyond (the fusion cost grows with the cell count);
     // the site gives the grid's origin and extent (a ROS map's origin need not be 0, 0).
     const double area = run.widthM * run.heightM;
@@ -99,6 +101,9 @@ struct Builder {
     }
     if (o.yieldAfterS >= 0.0) {
       tm["yield_after_s"] = o.yieldAfterS;
+    }
+    if (o.guidance >= 0.0) {
+      tm["roadmap"] = json{{"guidance", o.guidance}};
     }
     tm["summary_file"] = abs("traffic_manager_summary.json");
     writeTextFile(out / "traffic_manager.json", tm.dump(1));

@@ -98,6 +98,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
     ro.queueLength = o.queueLength;
   if (o.stopGap >= 0.0)
     ro.stopGap = o.stopGap;
+  if (o.guidance >= 0.0)
+    ro.guidance = o.guidance;
   auto roadmap = traffic::buildRoadmap(*site, ro);
   for (const auto& name : o.stations) {
     const auto* st = roadmap.station(name);
@@ -189,6 +191,11 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"passes", r.passes},
                      {"update_p99_ms", r.updateP99Ms},
                      {"density", r.density},
+                     {"guidance",
+                      {{"weight", roadmap.options.guidance},
+                       {"contraflow_before", roadmap.guidance.contraflowBefore},
+                       {"contraflow_after", roadmap.guidance.contraflowAfter},
+                       {"route_time_ratio", roadmap.guidance.lengthRatio}}},
                      {"time_driving", r.driving},
                      {"time_dwelling", r.dwelling},
                      {"time_waiting_on_others", r.waitingOnOthers},

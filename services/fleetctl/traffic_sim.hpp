@@ -19,6 +19,7 @@ struct TrafficSimOptions {
   double spacing = 0.0;     ///< roadmap lattice spacing (m); 0: the default
   double stopChance = 0.01;
   double stopGap = -1.0;        ///< m the motion gate keeps ahead of a driving robot; <0: the default
+  double guidance = -1.0;       ///< flow guidance weight (RoadmapOptions::guidance); <0: the default
   int straight = -1;            ///< 1/0: planner prefers straight moves among equal ones; -1: the default
   int letPass = -1;             ///< Execution::letPass threshold in route nodes; 0 off; -1: the default
   int maxLag = -1;              ///< planner steps a robot may fall behind before a re-plan; -1: the default

@@ -60,7 +60,7 @@ float DistanceTable::viaSettled(const PartialTable& t, NodeId v) const {
     }
     const float enter = e.to == t.goal ? 0.0F : baseEnter_[u];
     if (enter != kUnreachable && t.dist[u] != kUnreachable) {
-      best = std::min(best, t.dist[u] + static_cast<float>(e.duration) + enter);
+      best = std::min(best, t.dist[u] + static_cast<float>(e.cost()) + enter);
     }
   }
   return best;
@@ -121,7 +121,7 @@ bool DistanceTable::repairRaised(PartialTable& t) {
         continue;
       }
       const float enter = e.to == t.goal ? 0.0F : baseEnter_[u];  // unchanged: not raised
-      if (enter != kUnreachable && t.dist[u] + static_cast<float>(e.duration) + enter == dp) {
+      if (enter != kUnreachable && t.dist[u] + static_cast<float>(e.cost()) + enter == dp) {
         kept = true;
         break;
       }

@@ -20,7 +20,7 @@ void DistanceTable::buildReverse() {
         continue;
       }
       ++revStart_[static_cast<std::size_t>(e.to) + 1];
-      const auto d = static_cast<float>(e.duration);
+      const auto d = static_cast<float>(e.cost());
       if (first) {
         unitDuration_ = d;
         first = false;
@@ -42,7 +42,7 @@ void DistanceTable::buildReverse() {
       }
       const std::uint32_t k = fill[static_cast<std::size_t>(e.to)]++;
       revFrom_[k] = static_cast<NodeId>(a);
-      revDuration_[k] = static_cast<float>(e.duration);
+      revDuration_[k] = static_cast<float>(e.cost());
     }
   }
 }

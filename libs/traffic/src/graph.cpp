@@ -23,7 +23,7 @@ void Graph::addEdge(NodeId a, NodeId b, double duration) {
       return;
     }
   }
-  out.push_back(Edge{b, duration, true});
+  out.push_back(Edge{b, duration, true, 1.0F});
 }
 
 void Graph::addConflict(NodeId a, NodeId b) {
@@ -50,16 +50,28 @@ bool Graph::conflicting(NodeId a, NodeId b) const {
   return std::binary_search(c.begin(), c.end(), b);
 }
 
-bool Graph::setEdgeOpen(NodeId a, NodeId b, bool open) {
+Edge* Graph::findEdge(NodeId a, NodeId b) {
   if (!valid(a))
-    return false;
+    return nullptr;
   for (auto& e : edges_[static_cast<std::size_t>(a)]) {
-    if (e.to == b) {
-      e.open = open;
-      return true;
-    }
+    if (e.to == b)
+      return &e;
   }
-  return false;
+  return nullptr;
+}
+
+bool Graph::setEdgeOpen(NodeId a, NodeId b, bool open) {
+  Edge* e = findEdge(a, b);
+  if (e != nullptr)
+    e->open = open;
+  return e != nullptr;
+}
+
+bool Graph::setEdgeGuide(NodeId a, NodeId b, float guide) {
+  Edge* e = guide >= 1.0F ? findEdge(a, b) : nullptr;
+  if (e != nullptr)
+    e->guide = guide;
+  return e != nullptr;
 }
 
 const Edge* Graph::edge(NodeId a, NodeId b) const {

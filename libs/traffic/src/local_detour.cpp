@@ -67,7 +67,7 @@ void DistanceTable::detourAround(NodeId goal, NodeId from, double radius, std::s
       }
       const float on = distance(e.to, goal);
       if (on != kUnreachable) {
-        best = std::min(best, on + static_cast<float>(e.duration) + baseEnter_[w]);
+        best = std::min(best, on + static_cast<float>(e.cost()) + baseEnter_[w]);
       }
     }
     if (best != kUnreachable) {

@@ -73,15 +73,39 @@ std::size_t errorCount(const Roadmap& r) {
 // The lattice kept clear of parked robots; where the site leaves no room for that (a parking row
 // in a corridor of its own width: stations cut off without the lanes beside it), the lattice as
 // the map allows, with a warning that parked robots block lanes there.
+namespace {
+
+// Every pickup to every drop-off and back: the trips a task list between them makes.
+void guide(Roadmap& r) {
+  std::vector<Trip> trips;
+  for (const auto& p : r.stations) {
+    if (p.kind != site::StationKind::Pickup || p.dock == kNoNode)
+      continue;
+    for (const auto& d : r.stations) {
+      if (d.kind != site::StationKind::Dropoff || d.dock == kNoNode)
+        continue;
+      trips.push_back({p.dock, d.dock, 1.0});
+      trips.push_back({d.dock, p.dock, 1.0});
+    }
+  }
+  GuidanceOptions o;
+  o.weight = r.options.guidance;
+  r.guidance = guideByFlow(r.graph, trips, o);
+}
+
+}  // namespace
+
 Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   Roadmap r = detail::buildRoadmapOnce(s, options);
   if (!options.parkingClear || errorCount(r) == 0) {
+    guide(r);
     return r;
   }
   RoadmapOptions as = options;
   as.parkingClear = false;
   Roadmap plain = detail::buildRoadmapOnce(s, as);
   if (errorCount(plain) >= errorCount(r)) {
+    guide(r);
     return r;
   }
   const auto parking = s.ofKind(site::StationKind::Parking);
@@ -90,6 +114,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
                             "the parking places stand too close to the lanes for lanes clear of them (the "
                             "lanes beside them are the only way between stations): a robot parked there "
                             "blocks the lanes next to it"});
+  guide(plain);
   return plain;
 }
 
@@ -98,10 +123,11 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
   if (!(in.cruiseSpeed > 0.0) || in.spacing < 0.0 || (in.spacing > 0.0 && in.spacing < 0.05) ||
       !(in.targetSpacing >= 0.05) || in.radius < 0.0 || in.stopGap < 0.0 || in.corridorSlack < 0.0 ||
       in.nodeClearance < 0.0 || in.edgeClearance < 0.0 || in.margin < 0.0 || in.queueLength < 0 ||
-      in.queueLength > 50 || in.followingDistance < 0.0) {
+      in.queueLength > 50 || in.followingDistance < 0.0 || !(in.guidance >= 0.0 && in.guidance <= 100.0)) {
     throw std::invalid_argument(
         "RoadmapOptions: cruiseSpeed > 0, spacing 0 or >= 0.05 m, targetSpacing >= 0.05 m, radius, stopGap, "
-        "corridorSlack, nodeClearance, edgeClearance, margin and followingDistance >= 0, queueLength 0..50");
+        "corridorSlack, nodeClearance, edgeClearance, margin and followingDistance >= 0, queueLength 0..50, "
+        "guidance 0..100");
   }
   detail::RoadmapBuilder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}, {}, {}, {}};
   auto& o = b.opt;

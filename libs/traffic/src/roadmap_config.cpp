@@ -4,7 +4,8 @@ namespace fleet::traffic {
 
 traffic::RoadmapOptions readRoadmapOptions(Config r) {
   traffic::RoadmapOptions o;
-  r.rejectUnknownKeys({"spacing", "cruise_speed", "margin", "queue_length", "diagonals", "radius"});
+  r.rejectUnknownKeys(
+      {"spacing", "cruise_speed", "margin", "queue_length", "diagonals", "radius", "guidance"});
   o.spacing = r.number("spacing", 0.0, {0.0, 10.0});
   // 0: the site's robot. Larger: a fleet with vehicles larger than the site's robot (VDA 5050
   // vehicles are refused when their footprint does not fit the roadmap's robot).
@@ -13,6 +14,9 @@ traffic::RoadmapOptions readRoadmapOptions(Config r) {
   o.margin = r.number("margin", o.margin, {0.0, 2.0});
   o.queueLength = static_cast<int>(r.integer("queue_length", o.queueLength, {0, 50}));
   o.diagonals = r.boolean("diagonals", o.diagonals);
+  // Flow guidance (guidance.hpp): 0 off; 0.5 made the small warehouse's 10 and 20 robots faster
+  // and the site for 100 slower (docs/benchmarks.md), so it is a site's choice.
+  o.guidance = r.number("guidance", o.guidance, {0.0, 100.0});
   return o;
 }
 

@@ -1,12 +1,52 @@
 #include "fleet/traffic/roadmap_travel.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
+#include <numeric>
+#include <span>
 #include <utility>
 
 #include "fleet/traffic/distance_table.hpp"
 #include "fleet/traffic/station_cycle.hpp"
 
 namespace fleet::traffic {
+
+namespace {
+
+// Seconds from every node to `goal` along the way the planner routes it: `cost` is the goal's
+// table in route costs (durations times the flow guidance), and each node's way goes on by its
+// cheapest edge, as the planner's does; the seconds are the durations along it. Nodes are taken
+// cheapest first, so each one's successor is known before it.
+std::vector<float> routeSeconds(const Graph& g, std::span<const float> cost, NodeId goal) {
+  std::vector<float> sec(cost.size(), DistanceTable::kUnreachable);
+  std::vector<NodeId> order(cost.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](NodeId a, NodeId b) {
+    return cost[static_cast<std::size_t>(a)] < cost[static_cast<std::size_t>(b)];
+  });
+  sec[static_cast<std::size_t>(goal)] = 0.0F;
+  for (NodeId v : order) {
+    const float cv = cost[static_cast<std::size_t>(v)];
+    if (v == goal || !std::isfinite(cv))
+      continue;
+    const Edge* best = nullptr;
+    double bestCost = std::numeric_limits<double>::infinity();
+    for (const Edge& e : g.edges(v)) {
+      const double c = e.cost() + static_cast<double>(cost[static_cast<std::size_t>(e.to)]);
+      if (g.passable(v, e) && c < bestCost && std::isfinite(sec[static_cast<std::size_t>(e.to)])) {
+        bestCost = c;
+        best = &e;
+      }
+    }
+    if (best != nullptr)
+      sec[static_cast<std::size_t>(v)] =
+          static_cast<float>(best->duration) + sec[static_cast<std::size_t>(best->to)];
+  }
+  return sec;
+}
+
+}  // namespace
 
 RoadmapTravel::RoadmapTravel(std::shared_ptr<const Roadmap> roadmap) : roadmap_(std::move(roadmap)) {
   DistanceTable tables(roadmap_->graph);
@@ -18,7 +58,10 @@ RoadmapTravel::RoadmapTravel(std::shared_ptr<const Roadmap> roadmap) : roadmap_(
       t.move = traffic::dockMoveSeconds(dockGeometry(roadmap_->graph, st), roadmap_->options.radius,
                                         roadmap_->options.cruiseSpeed);
       const auto d = tables.to(st.dock);
-      t.toDock.assign(d.begin(), d.end());
+      if (roadmap_->options.guidance > 0.0)
+        t.toDock = routeSeconds(roadmap_->graph, d, st.dock);  // the guided way's seconds
+      else
+        t.toDock.assign(d.begin(), d.end());
     }
     stations_.emplace(st.name, std::move(t));
   }

@@ -427,7 +427,7 @@ void TrafficControl::clearWayFor(std::size_t robot) {
     for (const Edge& e : graph_.edges(v)) {
       if (!graph_.passable(v, e))
         continue;
-      const double c = e.duration + static_cast<double>(dist[static_cast<std::size_t>(e.to)]);
+      const double c = e.cost() + static_cast<double>(dist[static_cast<std::size_t>(e.to)]);
       if (c < bestCost + 1e-6 && (best == kNoNode || c < bestCost)) {
         best = e.to;
         bestCost = c;

@@ -7,7 +7,10 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <queue>
 #include <string>
 #include <vector>
 
@@ -68,6 +71,29 @@ inline std::vector<std::string> hall() {
 inline nlohmann::json twoStations() {
   return {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 2.5, 0.0}}},
           {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 2.5, kPi}}}};
+}
+
+// Dijkstra forward from `from` over open edges by their durations, written apart from
+// DistanceTable's backward search and the guidance's router: the shortest time to `to`.
+inline double shortestTime(const Graph& g, NodeId from, NodeId to) {
+  std::vector<double> d(g.size(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, NodeId>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  d[static_cast<std::size_t>(from)] = 0.0;
+  open.push({0.0, from});
+  while (!open.empty()) {
+    const auto [dv, v] = open.top();
+    open.pop();
+    if (dv > d[static_cast<std::size_t>(v)])
+      continue;
+    for (const auto& e : g.edges(v)) {
+      if (g.passable(v, e) && dv + e.duration < d[static_cast<std::size_t>(e.to)]) {
+        d[static_cast<std::size_t>(e.to)] = dv + e.duration;
+        open.push({dv + e.duration, e.to});
+      }
+    }
+  }
+  return d[static_cast<std::size_t>(to)];
 }
 
 }  // namespace fleet::traffic::test

@@ -12,6 +12,7 @@
 #include <queue>
 
 #include "fleet/site/site_loader.hpp"
+#include "roadmap_test_support.hpp"
 
 namespace fleet::traffic {
 namespace {
@@ -24,31 +25,9 @@ std::shared_ptr<const Roadmap> smallWarehouse() {
   return std::make_shared<const Roadmap>(buildRoadmap(site));
 }
 
-// Dijkstra forward from `from` over open edges, written here apart from DistanceTable's backward one.
+// The shortest time over open edges, searched forward apart from DistanceTable's backward one.
 double forward(const Roadmap& r, NodeId from, NodeId to) {
-  std::vector<double> d(r.graph.size(), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, NodeId>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-  d[static_cast<std::size_t>(from)] = 0.0;
-  open.push({0.0, from});
-  while (!open.empty()) {
-    const auto [dv, v] = open.top();
-    open.pop();
-    if (dv > d[static_cast<std::size_t>(v)]) {
-      continue;
-    }
-    for (const auto& e : r.graph.edges(v)) {
-      if (!r.graph.passable(v, e)) {
-        continue;
-      }
-      const double nd = dv + e.duration;
-      if (nd < d[static_cast<std::size_t>(e.to)]) {
-        d[static_cast<std::size_t>(e.to)] = nd;
-        open.push({nd, e.to});
-      }
-    }
-  }
-  return d[static_cast<std::size_t>(to)];
+  return test::shortestTime(r.graph, from, to);
 }
 
 TEST(RoadmapTravel, StationToStationIsTheShortestRouteOnTheRoadmap) {

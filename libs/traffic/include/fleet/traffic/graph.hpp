@@ -21,6 +21,11 @@ struct Edge {
   NodeId to = kNoNode;
   double duration = 1.0;  ///< s on a roadmap (drive plus turn), 1 step on a grid
   bool open = true;
+  /// What choosing this edge costs a route, as a multiple of its duration (>= 1): the guidance
+  /// (guidance.hpp) makes driving against the site's usual flow dearer. Routes and distance tables
+  /// use cost(); timing (releases, the robot's motion) uses duration.
+  float guide = 1.0F;
+  [[nodiscard]] double cost() const { return duration * static_cast<double>(guide); }
 };
 
 class Graph {
@@ -50,12 +55,16 @@ class Graph {
   [[nodiscard]] bool isOpen(NodeId v) const { return open_[static_cast<std::size_t>(v)] != 0; }
   /// false when there is no edge a→b.
   bool setEdgeOpen(NodeId a, NodeId b, bool open);
+  /// Sets Edge::guide of a→b (>= 1); false when there is no edge a→b.
+  bool setEdgeGuide(NodeId a, NodeId b, float guide);
   /// The open edge a→b, or nullptr.
   [[nodiscard]] const Edge* edge(NodeId a, NodeId b) const;
   /// An open edge from an open node to an open node.
   [[nodiscard]] bool passable(NodeId a, const Edge& e) const { return e.open && isOpen(a) && isOpen(e.to); }
 
  private:
+  Edge* findEdge(NodeId a, NodeId b);  ///< a→b, open or not; nullptr when there is none
+
   std::vector<Vec2> position_;
   std::vector<std::vector<Edge>> edges_;
   std::vector<std::vector<NodeId>> conflicts_;

@@ -39,6 +39,7 @@
 #include "fleet/core/vec2.hpp"
 #include "fleet/site/site.hpp"
 #include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/guidance.hpp"
 #include "fleet/traffic/roadmap_conflicts.hpp"
 
 namespace fleet::traffic {
@@ -77,6 +78,9 @@ struct RoadmapOptions {
   /// a parked robot excludes no lane (buildRoadmap falls back to false, with a warning, on a site
   /// that leaves no room for it); false: the lattice as the map allows.
   bool parkingClear = true;
+  /// Flow guidance (guidance.hpp): driving against the flow of the trips between the site's
+  /// pickups and drop-offs costs routes 1 + this times the edge's duration; 0: none.
+  double guidance = 0.0;
 };
 
 enum class NodeKind : std::uint8_t { Lane, Station, Approach, Queue, Parking, Charger, Exit };
@@ -117,6 +121,7 @@ Roadmap buildRoadmapOnce(const site::Site& site, const RoadmapOptions& options);
 class Roadmap {
  public:
   Graph graph;
+  GuidanceStats guidance;              ///< what the flow guidance did (RoadmapOptions::guidance)
   std::vector<NodeKind> kinds;         ///< per node
   std::vector<StationNodes> stations;  ///< in the site's order
   RoadmapOptions options;              ///< as used: spacing, radius and following distance resolved

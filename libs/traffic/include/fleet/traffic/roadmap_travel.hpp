@@ -6,8 +6,9 @@
 // or the grid's shortest path does not know. One backward search per station at construction, so a
 // query is a nearest-node lookup and a table read: the dispatcher asks robots × tasks of them a tick.
 //
-// The times are free-flow (nobody in the way) and the roadmap as built: closures made at run time
-// by the traffic manager are not seen here.
+// The times are those of the way the planner routes (with flow guidance, RoadmapOptions::guidance,
+// that can be longer than the shortest), free-flow (nobody in the way) and the roadmap as built: closures
+// made at run time by the traffic manager are not seen here.
 
 #include <cstddef>
 #include <memory>
