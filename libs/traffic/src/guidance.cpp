@@ -22,24 +22,14 @@ int binOf(Vec2 d) {
   return ((k % kBins) + kBins) % kBins;
 }
 
-// Circular distance between two direction bins (0..4).
-int apart(int a, int b) {
-  const int d = std::abs(a - b) % kBins;
-  return std::min(d, kBins - d);
-}
-
-// Share of the flow through `v` heading against bin k (more than 90° off) among the flow heading
-// with or against it: 0 when everyone goes the same way, 1 when everyone else comes the other way.
-double against(const Bins& at, int k) {
-  double opp = 0.0;
-  double same = 0.0;
-  for (int j = 0; j < kBins; ++j) {
-    const int d = apart(j, k);
-    if (d >= 3)
-      opp += at[static_cast<std::size_t>(j)];
-    else if (d <= 1)
-      same += at[static_cast<std::size_t>(j)];
-  }
+// Share of the flow through a node heading against bin k (more than 90° off: the three bins
+// opposite) among the flow heading with or against it (k and its two neighbours): 0 when everyone
+// goes the same way, 1 when everyone else comes the other way. Crossing flow is left out.
+double against(const Bins& at, std::size_t k) {
+  const auto bin = [&](std::size_t j) { return at[(k + j) % kBins]; };
+  // Flows taken out again (re-routing) can leave rounding residue either side of 0.
+  const double opp = std::max(bin(3) + bin(4) + bin(5), 0.0);
+  const double same = std::max(bin(7) + bin(0) + bin(1), 0.0);
   return opp + same > 1e-12 ? opp / (opp + same) : 0.0;
 }
 
@@ -129,8 +119,19 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
     if (graph.valid(t.from) && graph.valid(t.to) && t.from != t.to && t.share > 0.0)
       byGoal[t.to].push_back(&t);
   }
+  // Each edge's direction bin, worked out once: edge i of node a at first[a] + i.
+  std::vector<std::size_t> first(graph.size() + 1, 0);
+  std::vector<std::uint8_t> bins;
+  for (std::size_t a = 0; a < graph.size(); ++a) {
+    first[a] = bins.size();
+    for (const Edge& e : graph.edges(static_cast<NodeId>(a)))
+      bins.push_back(
+          static_cast<std::uint8_t>(binOf(graph.position(e.to) - graph.position(static_cast<NodeId>(a)))));
+  }
+  first[graph.size()] = bins.size();
   const auto binAt = [&](NodeId a, const Edge& e) {
-    return static_cast<std::size_t>(binOf(graph.position(e.to) - graph.position(a)));
+    const auto i = static_cast<std::size_t>(&e - graph.edges(a).data());
+    return static_cast<std::size_t>(bins[first[static_cast<std::size_t>(a)] + i]);
   };
   // The flow per node and direction: a robot driving into v counts at v and at every node it
   // excludes there.
@@ -144,8 +145,7 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
     }
   };
   const auto guided = [&](NodeId a, const Edge& e) {
-    return e.duration * (1.0 + options.weight * against(flow[static_cast<std::size_t>(e.to)],
-                                                        static_cast<int>(binAt(a, e))));
+    return e.duration * (1.0 + options.weight * against(flow[static_cast<std::size_t>(e.to)], binAt(a, e)));
   };
   const auto plain = [](NodeId, const Edge& e) { return e.duration; };
   std::vector<std::vector<Route>> routes;  // per goal group, per trip
@@ -164,8 +164,7 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
     for (const auto& [goal, ts] : byGoal) {
       for (std::size_t i = 0; i < ts.size(); ++i) {
         for (const auto& [a, e] : rs[gi][i]) {
-          opp += ts[i]->share * e->duration *
-                 against(flow[static_cast<std::size_t>(e->to)], static_cast<int>(binAt(a, *e)));
+          opp += ts[i]->share * e->duration * against(flow[static_cast<std::size_t>(e->to)], binAt(a, *e));
           total += ts[i]->share * e->duration;
         }
       }
@@ -207,8 +206,7 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
   // The guide from the whole flow.
   for (std::size_t a = 0; a < graph.size(); ++a) {
     for (const Edge& e : graph.edges(static_cast<NodeId>(a))) {
-      const double share =
-          against(flow[static_cast<std::size_t>(e.to)], static_cast<int>(binAt(static_cast<NodeId>(a), e)));
+      const double share = against(flow[static_cast<std::size_t>(e.to)], binAt(static_cast<NodeId>(a), e));
       graph.setEdgeGuide(static_cast<NodeId>(a), e.to, static_cast<float>(1.0 + options.weight * share));
     }
   }
