@@ -313,7 +313,11 @@ std::vector<std::string> FleetManagerNode::onClosures(const std::vector<msg::Tra
     return errors;
   }
   if (!closures_) {
-    closures_ = std::make_unique<ClosedStations>(traffic::buildRoadmap(*site_, settings_.roadmap));
+    // Reachability only: no flow guidance (route costs), which would cost seconds here on a large
+    // site, inside the handling of a message.
+    traffic::RoadmapOptions reach = settings_.roadmap;
+    reach.guidance = 0.0;
+    closures_ = std::make_unique<ClosedStations>(traffic::buildRoadmap(*site_, reach));
   }
   for (const auto& c : closures) {
     if (auto e = closures_->apply(c)) {

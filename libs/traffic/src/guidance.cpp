@@ -8,6 +8,7 @@
 #include <map>
 #include <numbers>
 #include <queue>
+#include <stdexcept>
 
 namespace fleet::traffic {
 
@@ -110,13 +111,15 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
     for (const Edge& e : graph.edges(static_cast<NodeId>(a)))
       graph.setEdgeGuide(static_cast<NodeId>(a), e.to, 1.0F);
   }
+  if (!std::isfinite(options.weight) || options.weight < 0.0)
+    throw std::invalid_argument("guideByFlow: the weight must be finite and >= 0");
   if (!(options.weight > 0.0) || trips.empty() || options.rounds < 1)
     return stats;
   const Router router(graph);
   // Trips by their goal: one table routes them all.
   std::map<NodeId, std::vector<const Trip*>> byGoal;
   for (const Trip& t : trips) {
-    if (graph.valid(t.from) && graph.valid(t.to) && t.from != t.to && t.share > 0.0)
+    if (graph.valid(t.from) && graph.valid(t.to) && t.from != t.to && std::isfinite(t.share) && t.share > 0.0)
       byGoal[t.to].push_back(&t);
   }
   // Each edge's direction bin, worked out once: edge i of node a at first[a] + i.

@@ -14,10 +14,12 @@ namespace fleet::traffic {
 
 namespace {
 
-// Seconds from every node to `goal` along the way the planner routes it: `cost` is the goal's
-// table in route costs (durations times the flow guidance), and each node's way goes on by its
-// cheapest edge, as the planner's does; the seconds are the durations along it. Nodes are taken
-// cheapest first, so each one's successor is known before it.
+// Seconds from every node to `goal` along the table's cheapest way: `cost` is the goal's table in
+// route costs (durations times the flow guidance), each node's way goes on by the edge whose cost
+// plus the next node's is least, and the seconds are the durations along it. The planner follows
+// that way as far as other robots let it (PIBT takes the neighbour nearest in the table, which is
+// the same way wherever the edges round a node cost alike). Nodes are taken cheapest first, so
+// each one's successor is known before it.
 std::vector<float> routeSeconds(const Graph& g, std::span<const float> cost, NodeId goal) {
   std::vector<float> sec(cost.size(), DistanceTable::kUnreachable);
   std::vector<NodeId> order(cost.size());

@@ -428,7 +428,9 @@ void TrafficControl::clearWayFor(std::size_t robot) {
       if (!graph_.passable(v, e))
         continue;
       const double c = e.cost() + static_cast<double>(dist[static_cast<std::size_t>(e.to)]);
-      if (c < bestCost + 1e-6 && (best == kNoNode || c < bestCost)) {
+      // The tables hold floats: a way's next node can come out a few ulps dearer than the node's
+      // own distance (1e-5 relative covers a float's rounding on both sides).
+      if (c < bestCost + 1e-5 * (1.0 + std::abs(bestCost)) && (best == kNoNode || c < bestCost)) {
         best = e.to;
         bestCost = c;
       }

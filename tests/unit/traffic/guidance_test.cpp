@@ -168,7 +168,8 @@ TEST(Guidance, TravelTimesAreTheSecondsOfTheGuidedWay) {
         continue;
       // Walk the planner's way (its cheapest edge each time) and add up the durations.
       double seconds = 0.0;
-      for (NodeId v = from; v != st.dock;) {
+      std::size_t steps = 0;
+      for (NodeId v = from; v != st.dock && steps <= g.size(); ++steps) {
         const Edge* best = nullptr;
         double bestCost = std::numeric_limits<double>::infinity();
         for (const Edge& e : g.edges(v)) {
@@ -182,6 +183,7 @@ TEST(Guidance, TravelTimesAreTheSecondsOfTheGuidedWay) {
         seconds += best->duration;
         v = best->to;
       }
+      ASSERT_LE(steps, g.size()) << "the cheapest way from " << from << " to " << st.name << " does not end";
       const double got = *travel.fromNode(from, st.name);
       EXPECT_NEAR(got, seconds, 1e-3 * (1.0 + seconds)) << st.name << " from " << from;
       const double fastest = test::shortestTime(g, from, st.dock);
@@ -194,7 +196,62 @@ TEST(Guidance, TravelTimesAreTheSecondsOfTheGuidedWay) {
   EXPECT_GT(longer, 0U);  // some guided ways are longer than the shortest: the times say so
 }
 
+// The tables repaired in place after robots block nodes (DistanceTable's default) equal tables
+// searched afresh with the same blocks, on guided costs as on durations.
+TEST(Guidance, TablesRepairedAfterABlockEqualFreshOnesOnGuidedCosts) {
+  const auto roadmap = smallWarehouse(0.5);
+  const Graph& g = roadmap->graph;
+  DistanceTable repaired(g);
+  std::vector<NodeId> goals;
+  for (const auto& st : roadmap->stations) {
+    if (st.dock != kNoNode && (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff))
+      goals.push_back(st.dock);
+  }
+  ASSERT_GE(goals.size(), 4U);
+  for (NodeId goal : goals)
+    (void)repaired.to(goal);  // searched whole before the change
+  const std::vector<NodeId> blocks{101, 202, 303, 404, 505, 606};
+  for (NodeId v : blocks)
+    repaired.setBlocked(v, true);
+  DistanceTable fresh(g);
+  fresh.setOnChange(DistanceTable::OnChange::kRestart);
+  for (NodeId v : blocks)
+    fresh.setBlocked(v, true);
+  for (NodeId goal : goals) {
+    const auto a = repaired.to(goal);
+    const std::vector<float> got(a.begin(), a.end());
+    const auto b = fresh.to(goal);
+    for (std::size_t v = 0; v < got.size(); ++v) {
+      if (std::isinf(b[v])) {
+        EXPECT_TRUE(std::isinf(got[v])) << "goal " << goal << " node " << v;
+      } else {
+        EXPECT_NEAR(got[v], b[v], 1e-4F * (1.0F + b[v])) << "goal " << goal << " node " << v;
+      }
+    }
+  }
+  EXPECT_GT(repaired.repaired(), 0U);
+}
+
 TEST(Guidance, ABadWeightIsRefusedByName) {
+  TwoAisles s;
+  const std::vector<Trip> trips{{s.a, s.b, 1.0}};
+  GuidanceOptions inf;
+  inf.weight = std::numeric_limits<double>::infinity();
+  EXPECT_THROW((void)guideByFlow(s.g, trips, inf), std::invalid_argument);
+  GuidanceOptions negative;
+  negative.weight = -0.5;
+  EXPECT_THROW((void)guideByFlow(s.g, trips, negative), std::invalid_argument);
+  // A trip with a share that is not finite adds nothing.
+  GuidanceOptions on;
+  on.weight = 1.0;
+  const std::vector<Trip> notFinite{{s.a, s.b, std::numeric_limits<double>::quiet_NaN()},
+                                    {s.b, s.a, std::numeric_limits<double>::infinity()}};
+  EXPECT_EQ(guideByFlow(s.g, notFinite, on).contraflowBefore, 0.0);
+  for (NodeId v = 0; v < static_cast<NodeId>(s.g.size()); ++v) {
+    for (const Edge& e : s.g.edges(v))
+      EXPECT_EQ(e.guide, 1.0F);
+  }
+
   const auto site =
       site::loadSite((fs::path(FLEET_SOURCE_DIR) / "sim/scenarios/small_warehouse.site.json").string());
   RoadmapOptions o;

@@ -94,7 +94,8 @@ class DistanceTable {
   void setBlocked(NodeId v, bool blocked);
   [[nodiscard]] bool blocked(NodeId v) const { return blocked_[static_cast<std::size_t>(v)] != 0; }
 
-  /// A standing cost (s) of driving into each node, on top of the edges' durations, in every table
+  /// A standing cost (s) of driving into each node, on top of the edges' route costs (their
+  /// durations unless the roadmap has flow guidance, Edge::cost), in every table
   /// from the next query on (the traffic manager's collision-probability map: people-dense space
   /// costs more). One entry per node, each finite and >= 0; empty: none. Tables are recomputed
   /// when it changed; searches are then Dijkstra's even on unit grids.

@@ -44,7 +44,9 @@ struct GuidanceStats {
 };
 
 /// Sets every edge's guide in `graph` from `trips` (guide 1 everywhere when weight is 0 or there
-/// are no trips). Deterministic.
+/// are no trips; trips with a share that is not finite and > 0, or unreachable, add nothing).
+/// Deterministic. Throws std::invalid_argument for a weight that is not finite and >= 0.
+/// Computed once, on the graph as built: closures made later do not re-guide it.
 GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const GuidanceOptions& options);
 
 }  // namespace fleet::traffic

@@ -66,7 +66,7 @@ struct PibtOptions {
   /// can be escalated; 0: never (plain PIBT).
   int escapeAfter = 16;
   /// Distance an escalated agent gains on where it was escalated before it drops back (cells on a
-  /// unit grid, the edges' duration unit on a roadmap).
+  /// unit grid, the edges' cost unit on a roadmap: seconds, times the flow guidance if any).
   double escapeProgress = 16.0;
   /// Agents a search for a way out of a knot may move together (untangle.hpp; at most 4); below 2:
   /// never search, escalate only.
@@ -80,7 +80,8 @@ struct PibtOptions {
   /// passes an agent waiting in line, or one stuck itself, otherwise waits for ever beside a free
   /// way round. 0: never (plain PIBT).
   int detourAfter = 0;
-  /// Extra cost (the edges' duration unit) of entering what a standing agent excludes.
+  /// Extra cost (the edges' cost unit: seconds, times the flow guidance if any) of entering what a
+  /// standing agent excludes.
   float detourPenalty = 30.0F;
   /// Detour tables computed per step at most.
   int maxDetoursPerStep = 4;
@@ -90,8 +91,9 @@ struct PibtOptions {
   double detourRadius = 12.0;
   double detourKeep = 5.0;
   std::size_t distanceCacheBytes = std::size_t{256} << 20;
-  /// Moves whose distances to the goal differ by at most this much count as equally good (0: exact;
-  /// sums of edge durations along equally long ways differ in the last bits).
+  /// Moves whose distances to the goal (in the edges' cost unit) differ by at most this much count
+  /// as equally good (0: exact; sums of edge durations along equally long ways differ in the last
+  /// bits).
   float tieTolerance = 0.0F;
   /// Among equally good moves, prefer the one that turns least from the agent's last move. On a
   /// lattice with diagonals many shortest ways exist; picking among them at random zigzags, and a
