@@ -68,13 +68,6 @@ std::size_t errorCount(const Roadmap& r) {
                     [](const RoadmapProblem& p) { return p.severity == RoadmapProblem::Severity::Error; }));
 }
 
-}  // namespace
-
-// The lattice kept clear of parked robots; where the site leaves no room for that (a parking row
-// in a corridor of its own width: stations cut off without the lanes beside it), the lattice as
-// the map allows, with a warning that parked robots block lanes there.
-namespace {
-
 // Every pickup to every drop-off and back: the trips a task list between them makes.
 void guide(Roadmap& r) {
   std::vector<Trip> trips;
@@ -93,19 +86,18 @@ void guide(Roadmap& r) {
   r.guidance = guideByFlow(r.graph, trips, o);
 }
 
-}  // namespace
-
-Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
+// The lattice kept clear of parked robots; where the site leaves no room for that (a parking row
+// in a corridor of its own width: stations cut off without the lanes beside it), the lattice as
+// the map allows, with a warning that parked robots block lanes there.
+Roadmap clearOfParkingWherePossible(const site::Site& s, const RoadmapOptions& options) {
   Roadmap r = detail::buildRoadmapOnce(s, options);
   if (!options.parkingClear || errorCount(r) == 0) {
-    guide(r);
     return r;
   }
   RoadmapOptions as = options;
   as.parkingClear = false;
   Roadmap plain = detail::buildRoadmapOnce(s, as);
   if (errorCount(plain) >= errorCount(r)) {
-    guide(r);
     return r;
   }
   const auto parking = s.ofKind(site::StationKind::Parking);
@@ -114,8 +106,16 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
                             "the parking places stand too close to the lanes for lanes clear of them (the "
                             "lanes beside them are the only way between stations): a robot parked there "
                             "blocks the lanes next to it"});
-  guide(plain);
   return plain;
+}
+
+}  // namespace
+
+// Guided once, on the lattice chosen (not on both when the fall-back is tried).
+Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
+  Roadmap r = clearOfParkingWherePossible(s, options);
+  guide(r);
+  return r;
 }
 
 Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& options) {
