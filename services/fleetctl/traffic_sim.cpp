@@ -1,5 +1,6 @@
 #include "traffic_sim.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -66,6 +67,27 @@ std::string robotTimeLine(const nlohmann::json& rt) {
     line += buf;
   }
   return line;
+}
+
+// Driving per task against free flow (docs/algorithms.md, "Driving per task"): what the tasks done
+// drove, what the same tasks take with nobody in the way, and the share of the driving that brought
+// the robot no nearer its goal.
+nlohmann::json drivingPerTaskJson(const traffic::VirtualFleetResult& r) {
+  const auto n = static_cast<double>(std::max<std::size_t>(r.tasksDone, 1));
+  const auto round3 = [](double x) { return std::round(x * 1000.0) / 1000.0; };
+  return {{"driven_s", round3(r.taskDriven / n)},
+          {"free_flow_s", round3(r.taskFreeFlow / n)},
+          {"stretch", r.taskFreeFlow > 0.0 ? round3(r.taskDriven / r.taskFreeFlow) : 0.0},
+          {"not_nearer_share", r.taskDriven > 0.0 ? round3(r.taskDrivenAway / r.taskDriven) : 0.0}};
+}
+
+std::string drivingPerTaskLine(const nlohmann::json& d) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "driving per task: %.1f s, %.2f x its free flow (%.1f s), %.0f %% of it no nearer the goal",
+                d.value("driven_s", 0.0), d.value("stretch", 0.0), d.value("free_flow_s", 0.0),
+                100.0 * d.value("not_nearer_share", 0.0));
+  return buf;
 }
 
 }  // namespace
@@ -165,6 +187,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                           {"dock_cycle_p50_s", st.cycleP50},
                           {"dock_cycle_p90_s", st.cycleP90}});
     }
+    const nlohmann::json driving = drivingPerTaskJson(r);
     nlohmann::json waits = nlohmann::json::array();
     for (const auto& w : r.waits)
       waits.push_back({{"place", w.place}, {"robot_s", w.seconds}});
@@ -173,6 +196,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"waits", waits},
                      {"fleet_bound", bound},
                      {"robot_time", robotTime},
+                     {"driving_per_task", driving},
                      {"stations", stations},
                      {"robots", r.robots},
                      {"duration_s", r.duration},
@@ -204,6 +228,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";
       std::cout << "  " << fleetBoundLine(bound) << "\n" << robotTimeLine(robotTime) << "\n";
+      std::cout << "  " << drivingPerTaskLine(driving) << "\n";
       std::cout << "  stations:";
       for (const auto& st : r.stations) {
         std::cout << " " << st.name << " " << st.visits << " visits";

@@ -33,8 +33,11 @@ struct Bot {
   NodeId dropoff = kNoNode;
   double taskStart = 0.0;
   double lastProgress = 0.0;
-  bool idle = false;     // no admissible task: sent to a parking place
-  double nextTry = 0.0;  // s: when an idle robot asks for a task again (once a second)
+  bool idle = false;        // no admissible task: sent to a parking place
+  double nextTry = 0.0;     // s: when an idle robot asks for a task again (once a second)
+  double freeFlow = 0.0;    // s: the task's free-flow driving, from where the robot took it
+  double driven = 0.0;      // s driven on the task so far (turns and docking included)
+  double drivenAway = 0.0;  // s of it on edges that brought the robot no nearer its goal
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -290,6 +293,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     ++uses[static_cast<std::size_t>(d)];
     res.tasks.push_back({b.pickup, b.dropoff});
     b.phase = 0;
+    b.freeFlow = arrivalAt(b, p) + book.travel(p, d);
+    b.driven = b.drivenAway = 0.0;
     b.taskStart = now;
     b.lastProgress = now;
     traffic.setGoal(r, b.pickup);
@@ -341,6 +346,11 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         } else {
           ++res.tasksDone;
           taskTimes.push_back(now - b.taskStart);
+          if (std::isfinite(b.freeFlow)) {
+            res.taskDriven += b.driven;
+            res.taskFreeFlow += b.freeFlow;
+            res.taskDrivenAway += b.drivenAway;
+          }
           newTask(r, now);
         }
         b.lastProgress = now;
@@ -393,6 +403,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       } else if (b.to != kNoNode && b.stopLeft > 0.0) {
         res.robotTime[r].add(RobotActivity::HeldByPerson, o.dt);
       } else if (b.to != kNoNode) {
+        const NodeId goal = b.phase == 0 ? b.pickup : b.dropoff;
+        b.driven += o.dt;
+        if (book.travel(b.to, goal) >= book.travel(b.at, goal))
+          b.drivenAway += o.dt;
         res.robotTime[r].add(
             b.turnLeft > 0.0 || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving, o.dt);
       } else {
@@ -462,6 +476,20 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
                             std::move(rel[r].base), std::move(rel[r].horizon)});
       }
       res.frames.push_back(std::move(f));
+    }
+  }
+  // Driving per task counts the tasks under way at the end too, with the free-flow way they have
+  // made (their free flow less what is left of it): a short run would otherwise count only the tasks
+  // that went well.
+  for (const Bot& b : bots) {
+    if (b.idle || b.pickup == kNoNode)
+      continue;
+    const double left =
+        b.phase == 0 ? arrivalAt(b, b.pickup) + book.travel(b.pickup, b.dropoff) : arrivalAt(b, b.dropoff);
+    if (std::isfinite(b.freeFlow) && std::isfinite(left)) {
+      res.taskDriven += b.driven;
+      res.taskDrivenAway += b.drivenAway;
+      res.taskFreeFlow += b.freeFlow - left;
     }
   }
   for (std::size_t r = 0; r < o.robots; ++r) {

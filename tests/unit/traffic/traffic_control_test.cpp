@@ -79,6 +79,14 @@ std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
       waits += w.seconds;
     }
     EXPECT_NEAR(waits, waited, 1e-6 * (1.0 + waited));
+    // Driving per task: part of the robots' driving, turning and docking; the part no nearer the
+    // goal is part of it.
+    double moving = 0.0;
+    for (const auto& l : r.robotTime)
+      moving += l.seconds(RobotActivity::Driving) + l.seconds(RobotActivity::TurningDocking);
+    EXPECT_GE(r.taskDrivenAway, 0.0);
+    EXPECT_LE(r.taskDrivenAway, r.taskDriven);
+    EXPECT_LE(r.taskDriven, moving + 1e-6);
     for (std::size_t i = 1; i < r.waits.size(); ++i)
       EXPECT_GE(r.waits[i - 1].seconds, r.waits[i].seconds);
     if (o.robots > 1) {
@@ -687,6 +695,33 @@ TEST(VirtualFleet, ALoneRobot) {
   std::cout << formatResult(r) << "\n";
   EXPECT_GT(r.tasksDone, 10U);
   EXPECT_EQ(r.refusedReports, 0U);
+}
+
+/// Driving per task against free flow: a lone robot without stops or jitter drives every task
+/// towards its goal, never faster than free flow and slower only by the turns the roadmap's
+/// durations leave out; robots in each other's way drive more per task, some of it no nearer their
+/// goals.
+TEST(VirtualFleet, DrivingPerTaskIsFreeFlowAloneAndMoreInACrowd) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 1;
+  o.duration = 1200.0;
+  o.jitter = 0.0;
+  o.stopChance = 0.0;
+  const auto alone = runVirtualFleet(map, o);
+  ASSERT_GT(alone.tasksDone, 10U);
+  const double turning = alone.robotTime[0].seconds(RobotActivity::TurningDocking);
+  EXPECT_EQ(alone.taskDrivenAway, 0.0);
+  EXPECT_GE(alone.taskDriven, alone.taskFreeFlow - o.dt * static_cast<double>(alone.tasks.size()));
+  EXPECT_LE(alone.taskDriven, alone.taskFreeFlow + turning + o.dt * static_cast<double>(alone.tasks.size()));
+  EXPECT_GT(alone.taskDriven, alone.taskFreeFlow);  // the lattice's corners cost more than its durations
+  o.robots = 20;
+  o.duration = 300.0;
+  o.admission = Admission::None;
+  const auto crowd = runVirtualFleet(map, o);
+  ASSERT_GT(crowd.tasksDone, 0U);
+  EXPECT_GT(crowd.taskDriven / crowd.taskFreeFlow, 1.2 * alone.taskDriven / alone.taskFreeFlow);
+  EXPECT_GT(crowd.taskDrivenAway, 0.0);
 }
 
 /// The stall of the CI check of 2cc34ae (2026-12-03, `FleetScenario.TwentyRobotsOneHundredTasks…`,
