@@ -28,6 +28,13 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   trafficSim
+      ->add_option(
+          "--turn-scale", o->turnScale,
+          "the robots' turns on the spot take this times their time, the plans unchanged (0: turning "
+          "costs nothing; shows what turning costs the fleet)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  trafficSim
       ->add_option("--guidance", o->guidance,
                    "flow guidance: driving against the usual flow between pickups and drop-offs costs routes "
                    "1 + this times the edge's time (0: none; default: the roadmap's)")

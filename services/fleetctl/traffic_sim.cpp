@@ -139,6 +139,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.duration = o.duration;
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
+    v.turnScale = o.turnScale;
     v.stationLines = o.stationLines != 0;
     v.admission = static_cast<traffic::Admission>(o.admission);
     v.stationSlots = static_cast<std::size_t>(o.stationSlots);

@@ -18,6 +18,7 @@ struct TrafficSimOptions {
   std::string seeds = "1";  ///< "1-8" or "3"
   double spacing = 0.0;     ///< roadmap lattice spacing (m); 0: the default
   double stopChance = 0.01;
+  double turnScale = 1.0;       ///< the virtual robots' turns on the spot take this times their time
   double stopGap = -1.0;        ///< m the motion gate keeps ahead of a driving robot; <0: the default
   double guidance = -1.0;       ///< flow guidance weight (RoadmapOptions::guidance); <0: the default
   int straight = -1;            ///< 1/0: planner prefers straight moves among equal ones; -1: the default

@@ -97,6 +97,8 @@ std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near) {
 }
 
 VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& o) {
+  if (!(o.turnScale >= 0.0 && std::isfinite(o.turnScale)))
+    throw std::invalid_argument("virtual fleet: turnScale must be a finite number >= 0");
   const Graph& g = roadmap.graph;
   std::vector<NodeId> pickups, dropoffs, parking;
   const auto chosen = [&](const std::string& name) {
@@ -368,7 +370,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         b.to = *(it + 1);
         const Edge* e = g.edge(b.at, b.to);
         double d = e != nullptr ? e->duration : 1.0;
-        const double turn = b.prev != kNoNode ? roadmap.extraTurn(b.prev, b.at, b.to) : 0.0;
+        const double turn = b.prev != kNoNode ? o.turnScale * roadmap.extraTurn(b.prev, b.at, b.to) : 0.0;
         const double stretch = 1.0 + o.jitter * unit(rng);
         d = (d + turn) * stretch;
         b.turnLeft = turn * stretch;
@@ -403,10 +405,6 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       } else if (b.to != kNoNode && b.stopLeft > 0.0) {
         res.robotTime[r].add(RobotActivity::HeldByPerson, o.dt);
       } else if (b.to != kNoNode) {
-        const NodeId goal = b.phase == 0 ? b.pickup : b.dropoff;
-        b.driven += o.dt;
-        if (book.travel(b.to, goal) >= book.travel(b.at, goal))
-          b.drivenAway += o.dt;
         res.robotTime[r].add(
             b.turnLeft > 0.0 || b.dockEdge ? RobotActivity::TurningDocking : RobotActivity::Driving, o.dt);
       } else {
@@ -424,6 +422,12 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           continue;
         }
         const double s = std::min(b.left, budget);
+        if (!b.idle && b.pickup != kNoNode) {  // driving per task: the time on the edge itself
+          const NodeId goal = b.phase == 0 ? b.pickup : b.dropoff;
+          b.driven += s;
+          if (book.travel(b.to, goal) >= book.travel(b.at, goal))
+            b.drivenAway += s;
+        }
         b.left -= s;
         b.turnLeft -= s;
         budget -= s;

@@ -33,6 +33,9 @@ struct VirtualFleetOptions {
   double jitter = 0.2;       ///< every edge takes its duration × U(1, 1 + jitter)
   double stopChance = 0.01;  ///< per edge: the robot stops on it for U(0, stopMax) s
   double stopMax = 10.0;
+  /// The robots' turns on the spot take this times the roadmap's turn time (extraTurn); the plans
+  /// are unchanged. 1: the robot; 0: one that turns at once — what turning costs the fleet.
+  double turnScale = 1.0;
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
   /// How tasks are admitted. Slots: a task is given only when its pickup and its drop-off each
   /// have a free place in their line (dock and queue places; `stationSlots` places instead when
