@@ -113,7 +113,9 @@ GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const Guida
   }
   if (!std::isfinite(options.weight) || options.weight < 0.0)
     throw std::invalid_argument("guideByFlow: the weight must be finite and >= 0");
-  if (!(options.weight > 0.0) || trips.empty() || options.rounds < 1)
+  if (options.rounds < 1)
+    throw std::invalid_argument("guideByFlow: rounds must be at least 1");
+  if (!(options.weight > 0.0) || trips.empty())
     return stats;
   const Router router(graph);
   // Trips by their goal: one table routes them all.

@@ -45,7 +45,8 @@ struct GuidanceStats {
 
 /// Sets every edge's guide in `graph` from `trips` (guide 1 everywhere when weight is 0 or there
 /// are no trips; trips with a share that is not finite and > 0, or unreachable, add nothing).
-/// Deterministic. Throws std::invalid_argument for a weight that is not finite and >= 0.
+/// Deterministic. Throws std::invalid_argument for a weight that is not finite and >= 0, or fewer
+/// than one round.
 /// Computed once, on the graph as built: closures made later do not re-guide it.
 GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const GuidanceOptions& options);
 
