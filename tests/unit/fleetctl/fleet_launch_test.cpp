@@ -90,6 +90,20 @@ TEST_F(FleetLaunchTest, AStalledRobotRunsAloneAndTheRestRoundRobinOverTheAgents)
   EXPECT_EQ(risk["grid"]["resolution"], 0.1);
 }
 
+// `--guidance W` reaches both services that build the roadmap (the traffic manager plans on it, the
+// fleet manager costs tasks and predicts arrivals on it), and without it neither is given one.
+TEST_F(FleetLaunchTest, GuidanceGoesToTheTrafficAndFleetManagersAlike) {
+  auto run = prepareScenario(o, out);
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(planFleet(o, *run, {}, out, nullptr));
+  EXPECT_FALSE(json::parse(std::ifstream(out / "manager.json")).contains("roadmap"));
+  EXPECT_FALSE(json::parse(std::ifstream(out / "traffic_manager.json")).contains("roadmap"));
+  o.guidance = 0.5;
+  ASSERT_TRUE(planFleet(o, *run, {}, out, nullptr));
+  EXPECT_EQ(json::parse(std::ifstream(out / "manager.json"))["roadmap"]["guidance"], 0.5);
+  EXPECT_EQ(json::parse(std::ifstream(out / "traffic_manager.json"))["roadmap"]["guidance"], 0.5);
+}
+
 TEST_F(FleetLaunchTest, ADropFaultGivesEveryProcessItsLossyCycloneConfiguration) {
   auto run = prepareScenario(o, out);
   ASSERT_TRUE(run);
