@@ -30,8 +30,8 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
   trafficSim
       ->add_option(
           "--turn-scale", o->turnScale,
-          "the robots' turns on the spot take this times their time, the plans unchanged (0: turning "
-          "costs nothing; shows what turning costs the fleet)")
+          "factor on the virtual robots' time to turn on the spot; the plans keep the modelled turn time "
+          "(1: as modelled, 0: instant turns, to measure what turning costs the fleet)")
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
   trafficSim

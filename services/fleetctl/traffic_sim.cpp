@@ -69,11 +69,11 @@ std::string robotTimeLine(const nlohmann::json& rt) {
   return line;
 }
 
-// Driving per task against free flow (docs/algorithms.md, "Driving per task"): what the tasks done
-// drove, what the same tasks take with nobody in the way, and the share of the driving that brought
-// the robot no nearer its goal.
+// Driving per task against free flow (docs/algorithms.md, "Driving per task"): what the tasks drove,
+// done and under way (per task: over the tasks they add up to), what the same tasks take with nobody
+// in the way, and the share of the driving that brought the robot no nearer its goal.
 nlohmann::json drivingPerTaskJson(const traffic::VirtualFleetResult& r) {
-  const auto n = static_cast<double>(std::max<std::size_t>(r.tasksDone, 1));
+  const double n = r.taskShare > 0.0 ? r.taskShare : 1.0;
   const auto round3 = [](double x) { return std::round(x * 1000.0) / 1000.0; };
   return {{"driven_s", round3(r.taskDriven / n)},
           {"free_flow_s", round3(r.taskFreeFlow / n)},
@@ -93,6 +93,10 @@ std::string drivingPerTaskLine(const nlohmann::json& d) {
 }  // namespace
 
 int runTrafficSim(const TrafficSimOptions& o) {
+  if (!std::isfinite(o.turnScale) || o.turnScale < 0.0) {
+    std::cerr << "fleetctl traffic-sim: --turn-scale must be a number from 0 to 10\n";
+    return 2;
+  }
   const auto site = fleet::loadSiteFile(o.site);
   if (!site) {
     std::cerr << "fleetctl traffic-sim: " << site.error().message << "\n";

@@ -106,15 +106,16 @@ using Route = std::vector<std::pair<NodeId, const Edge*>>;
 }  // namespace
 
 GuidanceStats guideByFlow(Graph& graph, std::span<const Trip> trips, const GuidanceOptions& options) {
+  // Refused before anything is changed.
+  if (!std::isfinite(options.weight) || options.weight < 0.0)
+    throw std::invalid_argument("guideByFlow: the weight must be finite and >= 0");
+  if (options.rounds < 1)
+    throw std::invalid_argument("guideByFlow: rounds must be at least 1");
   GuidanceStats stats;
   for (std::size_t a = 0; a < graph.size(); ++a) {
     for (const Edge& e : graph.edges(static_cast<NodeId>(a)))
       graph.setEdgeGuide(static_cast<NodeId>(a), e.to, 1.0F);
   }
-  if (!std::isfinite(options.weight) || options.weight < 0.0)
-    throw std::invalid_argument("guideByFlow: the weight must be finite and >= 0");
-  if (options.rounds < 1)
-    throw std::invalid_argument("guideByFlow: rounds must be at least 1");
   if (!(options.weight > 0.0) || trips.empty())
     return stats;
   const Router router(graph);

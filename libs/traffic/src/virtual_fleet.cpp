@@ -352,6 +352,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
             res.taskDriven += b.driven;
             res.taskFreeFlow += b.freeFlow;
             res.taskDrivenAway += b.drivenAway;
+            res.taskShare += 1.0;
           }
           newTask(r, now);
         }
@@ -483,8 +484,9 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
   }
   // Driving per task counts the tasks under way at the end too, with the free-flow way they have
-  // made (their free flow less what is left of it): a short run would otherwise count only the tasks
-  // that went well.
+  // made (their free flow less what is left of it) and that share of a task: a short run would
+  // otherwise count only the tasks that went well. (One left with no way to its goal is left out,
+  // driving and all: the roadmap's stations are connected, so it does not happen.)
   for (const Bot& b : bots) {
     if (b.idle || b.pickup == kNoNode)
       continue;
@@ -494,6 +496,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       res.taskDriven += b.driven;
       res.taskDrivenAway += b.drivenAway;
       res.taskFreeFlow += b.freeFlow - left;
+      if (b.freeFlow > 0.0)
+        res.taskShare += std::clamp((b.freeFlow - left) / b.freeFlow, 0.0, 1.0);
     }
   }
   for (std::size_t r = 0; r < o.robots; ++r) {

@@ -235,7 +235,7 @@ TEST(Guidance, TablesRepairedAfterABlockEqualFreshOnesOnGuidedCosts) {
 // The rounds after the first take each goal's trips out and route them again against everyone
 // else's flow (one round: the goals routed first never see the later ones). On the small warehouse
 // they shorten the routes, keep the travel against the flow below half the unguided share, and
-// change guides. No round is refused.
+// change guides. Zero rounds are refused.
 TEST(Guidance, RippingUpAndRoutingAgainShortensTheRoutes) {
   const auto site =
       site::loadSite((fs::path(FLEET_SOURCE_DIR) / "sim/scenarios/small_warehouse.site.json").string());

@@ -136,12 +136,13 @@ struct VirtualFleetResult {
   /// under way at the end: the seconds their robots drove (turns and docking included, stops for
   /// people not); the free-flow seconds of the way they made (from where the robot was when it took
   /// the task to the pickup, then on to the drop-off, nobody in the way: StationBook::travel; for a
-  /// task under way, that less the free flow still left); and the part of the driving on edges
-  /// that brought the robot no nearer its goal (pushed aside, evading, going round). Divided by the
-  /// tasks done they are the driving per task and its free flow.
+  /// task under way, that less the free flow still left); the part of the driving on edges that
+  /// brought the robot no nearer its goal (pushed aside, evading, going round); and the tasks they
+  /// add up to (1 for each done, the share of its free flow made for each under way).
   double taskDriven = 0.0;
   double taskFreeFlow = 0.0;
   double taskDrivenAway = 0.0;
+  double taskShare = 0.0;
 };
 
 /// Per node, the place a robot standing there is at, as the wait ledger names it: "<station> dock",
