@@ -307,6 +307,16 @@ NodeId Execution::at(std::size_t robot) const {
 NodeId Execution::releasedEnd(std::size_t robot) const {
   return routes_.at(robot)[routes_[robot].released].node;
 }
+NodeId Execution::releasedFrom(std::size_t robot) const {
+  const Route& route = routes_.at(robot);
+  const NodeId end = route[route.released].node;
+  for (std::int64_t i = route.released - 1; i >= route.first; --i) {
+    if (route[i].node != end) {
+      return route[i].node;
+    }
+  }
+  return kNoNode;
+}
 NodeId Execution::plannedEnd(std::size_t robot) const {
   return routes_.at(robot).entries.back().node;
 }

@@ -146,8 +146,33 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
   const NodeId back = prev_[a];
   const bool straight = options_.preferStraight && back != kNoNode;
   const Vec2 heading = straight ? graph_.position(from) - graph_.position(back) : Vec2{};
-  const auto add = [&](NodeId v) {
-    const float d = table != nullptr ? table[idx(v)] : (v == from ? 0.0F : 1.0F);
+  // With a heading table: the edge it arrived by (its heading), -1 when unknown.
+  const float* surcharge = surcharge_[a];
+  const std::int64_t arrived = surcharge != nullptr && back != kNoNode ? heading_->edgeIndex(back, from) : -1;
+  // Standing: the cost-to-go the way it faces; facing no known way, that of its best way out.
+  float standing = arrived >= 0 ? surcharge[arrived] : 0.0F;
+  if (surcharge != nullptr && arrived < 0 && table[idx(from)] != DistanceTable::kUnreachable) {
+    standing = DistanceTable::kUnreachable;
+    const auto es = graph_.edges(from);
+    for (std::size_t k = 0; k < es.size(); ++k) {
+      if (graph_.passable(from, es[k]) && table[idx(es[k].to)] != DistanceTable::kUnreachable) {
+        standing = std::min(standing, static_cast<float>(es[k].cost()) + table[idx(es[k].to)] +
+                                          surcharge[heading_->edgeIndex(from, k)] - table[idx(from)]);
+      }
+    }
+    standing = standing == DistanceTable::kUnreachable ? 0.0F : std::max(0.0F, standing);
+  }
+  const auto add = [&](NodeId v, std::size_t out) {
+    float d = table != nullptr ? table[idx(v)] : (v == from ? 0.0F : 1.0F);
+    if (surcharge != nullptr && d != DistanceTable::kUnreachable) {
+      if (v == from) {
+        d += standing;
+      } else {
+        const std::size_t e = heading_->edgeIndex(from, out);
+        d += surcharge[e] +
+             (arrived >= 0 ? heading_->turn(static_cast<std::size_t>(arrived), from, out) : 0.0F);
+      }
+    }
     const std::int32_t o = agentAt_[idx(v)];
     const auto occupied = static_cast<std::uint32_t>(o >= 0 && o != agent);
     // Ties go to free nodes first, then (if asked) to the smallest turn, then at random (the seed
@@ -164,16 +189,18 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
         v, d,
         options_.preferStraight ? (occupied << 31) | (turn << 28) | (draw >> 3) : (occupied << 31) | draw};
   };
-  add(from);
+  add(from, 0);
   // In its line on one of the line's nodes: forward or nowhere.
   const bool inLine = line_[a] >= 0 && !lineOf_.empty() && lineOf_[idx(from)] == line_[a];
-  for (const Edge& e : graph_.edges(from)) {
+  const auto out = graph_.edges(from);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const Edge& e = out[k];
     if (inLine && e.to != lineForward_[idx(from)]) {
       continue;
     }
     // Leaving a closed node is allowed (a robot stranded on it must get off); entering one is not.
     if (e.open && graph_.isOpen(e.to)) {
-      add(e.to);
+      add(e.to, k);
     }
   }
   if (forcedGroup_[a] >= 0) {
@@ -284,6 +311,7 @@ const std::vector<NodeId>& Pibt::step() {
     const bool fb = forcedGroup_[idx(b)] >= 0;
     return fa != fb ? fa : before(a, b);
   });
+  findHeadingTables();
   for (const std::int32_t i : order_) {
     if (next_[idx(i)] == kNoNode) {
       plan(i, -1, 0);
@@ -317,6 +345,32 @@ const std::vector<NodeId>& Pibt::step() {
   }
   ++stats_.steps;
   return now_;
+}
+
+void Pibt::findHeadingTables() {
+  if (!heading_) {
+    return;
+  }
+  const std::size_t n = now_.size();
+  // Only a goal's own table has a heading table (a detour's way differs).
+  const auto wants = [&](std::size_t i) { return table_[i] != nullptr && detour_[i].empty(); };
+  // The agents deciding this step first, by priority, then those still driving.
+  goals_.clear();
+  for (const std::int32_t i : order_) {
+    if (wants(idx(i))) {
+      goals_.push_back(goal_[idx(i)]);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (wants(i) && busy(i)) {
+      goals_.push_back(goal_[i]);
+    }
+  }
+  heading_->want(goals_);
+  heading_->work(options_.headingWorkPerStep);
+  for (std::size_t i = 0; i < n; ++i) {
+    surcharge_[i] = wants(i) ? heading_->find(goal_[i]) : nullptr;
+  }
 }
 
 void Pibt::reconsiderRefused() {

@@ -24,6 +24,10 @@ Pibt::Pibt(const Graph& graph, std::span<const NodeId> starts, PibtOptions optio
   prev_.assign(n, kNoNode);
   goal_.assign(n, kNoNode);
   table_.assign(n, nullptr);
+  surcharge_.assign(n, nullptr);
+  if (options_.turnTime) {
+    heading_ = std::make_unique<HeadingTable>(graph, options_.turnTime, options_.headingCacheBytes);
+  }
   task_.assign(n, 0);
   elapsed_.assign(n, 0);
   controlled_.assign(n, 1);
@@ -98,8 +102,12 @@ void Pibt::resizeForGraph() {
 
 void Pibt::graphChanged() {
   distances_.invalidate();
+  if (heading_) {
+    heading_->invalidate();
+  }
   resizeForGraph();
   std::fill(table_.begin(), table_.end(), nullptr);
+  std::fill(surcharge_.begin(), surcharge_.end(), nullptr);
   std::fill(best_.begin(), best_.end(), DistanceTable::kUnreachable);
   for (auto& d : detour_) {
     d.clear();
@@ -195,7 +203,7 @@ void Pibt::setLine(std::size_t agent, std::int32_t line) {
   line_.at(agent) = line;
 }
 
-void Pibt::reset(std::span<const NodeId> positions) {
+void Pibt::reset(std::span<const NodeId> positions, std::span<const NodeId> cameFrom) {
   if (positions.size() < now_.size()) {
     throw std::invalid_argument("Pibt::reset: " + std::to_string(positions.size()) + " positions for " +
                                 std::to_string(now_.size()) + " agents");
@@ -231,6 +239,7 @@ void Pibt::reset(std::span<const NodeId> positions) {
     next_.resize(n, kNoNode);
     goal_.resize(n, kNoNode);
     table_.resize(n, nullptr);
+    surcharge_.resize(n, nullptr);
     task_.resize(n, 0);
     elapsed_.resize(n, 0);
     controlled_.resize(n, 1);
@@ -261,6 +270,9 @@ void Pibt::reset(std::span<const NodeId> positions) {
       best_[i] = DistanceTable::kUnreachable;
       stalled_[i] = 0;
       prev_[i] = kNoNode;
+    }
+    if (i < cameFrom.size() && graph_.valid(cameFrom[i]) && cameFrom[i] != positions[i]) {
+      prev_[i] = cameFrom[i];
     }
   }
   // A way out of a knot goes on from where the new positions are on it (the robots were released

@@ -30,10 +30,23 @@ std::vector<StationLine> stationLines(const Roadmap& roadmap) {
   return lines;
 }
 
+namespace {
+// The planner knows the robots' headings when the plan times their turns (PibtOptions::turnTime).
+PibtOptions plannerOptions(const TrafficOptions& options) {
+  PibtOptions p = options.pibt;
+  if (!p.turnTime) {
+    p.turnTime = options.turnTime;
+  }
+  p.headingWorkPerStep = options.headingWorkPerUpdate /
+                         static_cast<std::size_t>(std::max<std::int64_t>(1, options.maxStepsPerUpdate));
+  return p;
+}
+}  // namespace
+
 TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> starts, TrafficOptions options)
     : graph_(graph),
       options_(options),
-      planner_(std::make_unique<Pibt>(graph, starts, options.pibt)),
+      planner_(std::make_unique<Pibt>(graph, starts, plannerOptions(options))),
       execution_(graph, starts, options.release),
       goal_(starts.size(), kNoNode),
       held_(starts.size(), 0),
@@ -491,11 +504,13 @@ void TrafficControl::clearWayFor(std::size_t robot) {
 
 void TrafficControl::replan() {
   const auto ends = execution_.truncateToReleased();
-  planner_->reset(ends);
+  for (std::size_t r = 0; r < robots(); ++r) {
+    came_[r] = execution_.releasedFrom(r);
+  }
+  planner_->reset(ends, came_);
   ++stats_.replans;
-  // Everyone decides again from where its release ends.
+  // Everyone decides again from where its release ends, facing the way it came.
   std::fill(ready_.begin(), ready_.end(), clock_);
-  std::fill(came_.begin(), came_.end(), kNoNode);
 }
 
 std::int64_t TrafficControl::evadeClock() const {

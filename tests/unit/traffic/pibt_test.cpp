@@ -16,6 +16,8 @@ using fleet::traffic::test::firstViolations;
 using fleet::traffic::test::gridOf;
 using fleet::traffic::test::randomMap;
 using fleet::traffic::test::runLifelong;
+using fleet::traffic::test::turnsAlong;
+using fleet::traffic::test::walkToGoal;
 
 namespace {
 
@@ -123,16 +125,9 @@ TEST(Pibt, AmongEquallyShortMovesTheStraightestIsTakenWhenAsked) {
     const std::vector<NodeId> start = {m.node(0, 5)};
     Pibt p(m.graph, start, o);
     p.setGoal(0, m.node(5, 0));
-    std::vector<Vec2> path{m.graph.position(start[0])};
-    for (int k = 0; k < 20 && p.positions()[0] != m.node(5, 0); ++k)
-      path.push_back(m.graph.position(p.step()[0]));
+    const auto path = walkToGoal(m.graph, p, 20);
     EXPECT_EQ(path.size(), 11U) << "a shortest way either way";
-    int n = 0;
-    for (std::size_t i = 2; i < path.size(); ++i) {
-      const Vec2 a = path[i - 1] - path[i - 2], b = path[i] - path[i - 1];
-      n += a.dot(b) < a.norm() * b.norm() - 1e-9 ? 1 : 0;
-    }
-    return n;
+    return turnsAlong(path);
   };
   int randomTurns = 0;
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {

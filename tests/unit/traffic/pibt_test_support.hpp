@@ -97,6 +97,25 @@ inline GridMap randomMap(int w, int h, double density, std::mt19937_64& rng) {
   return gridOf(rows);
 }
 
+/// A lone agent 0 stepped to its goal (at most `limit` steps): the positions it stood on, its start
+/// first.
+inline std::vector<Vec2> walkToGoal(const Graph& g, Pibt& p, int limit) {
+  std::vector<Vec2> path{g.position(p.positions()[0])};
+  for (int k = 0; k < limit && p.positions()[0] != p.goal(0); ++k)
+    path.push_back(g.position(p.step()[0]));
+  return path;
+}
+
+/// Changes of direction along a path of positions.
+inline int turnsAlong(const std::vector<Vec2>& path) {
+  int n = 0;
+  for (std::size_t i = 2; i < path.size(); ++i) {
+    const Vec2 a = path[i - 1] - path[i - 2], b = path[i] - path[i - 1];
+    n += a.dot(b) < a.norm() * b.norm() - 1e-9 ? 1 : 0;
+  }
+  return n;
+}
+
 /// Lifelong run: `n` agents on random distinct nodes, a new random goal whenever one is reached
 /// (and, with `goalChurn`, at random for that share of agents every step). Keeps every configuration.
 struct LifelongRun {

@@ -100,6 +100,9 @@ class Execution {
   /// Last reported node, last released node, last planned node of a robot.
   [[nodiscard]] NodeId at(std::size_t robot) const;
   [[nodiscard]] NodeId releasedEnd(std::size_t robot) const;
+  /// The node the robot's released route enters releasedEnd() from (its heading there), kNoNode
+  /// when that part of the route is gone or it never moved.
+  [[nodiscard]] NodeId releasedFrom(std::size_t robot) const;
   [[nodiscard]] NodeId plannedEnd(std::size_t robot) const;
   /// Plan step of the robot's last reported node (how far along the plan it is).
   [[nodiscard]] std::int64_t progressStep(std::size_t robot) const;

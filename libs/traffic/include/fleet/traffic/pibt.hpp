@@ -40,15 +40,21 @@
 //   one is closer to its goal.
 // - Fixed agents' nodes are taken out of the routes (DistanceTable::setBlocked), since PIBT only
 //   moves greedily and would otherwise wait behind a stopped robot for ever.
+// - Headings: given the robots' turn times (PibtOptions::turnTime), moves are ranked by the turn
+//   into them plus the goal's cost-to-go with the turns on the way (heading_table.hpp), so a
+//   robot keeps to ways it need not stop and turn on, and standing is ranked the way it faces.
 //
 // Deterministic for a seed: same graph, starts, goals and calls, same plan.
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "fleet/traffic/distance_table.hpp"
 #include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/heading_table.hpp"
 #include "fleet/traffic/rotation_pass.hpp"
 
 namespace fleet::traffic {
@@ -91,6 +97,15 @@ struct PibtOptions {
   double detourRadius = 12.0;
   double detourKeep = 5.0;
   std::size_t distanceCacheBytes = std::size_t{256} << 20;
+  /// s of turning on the spot at `at` between prev→at and at→next beyond the edge's duration
+  /// (Roadmap::extraTurn). Given, the planner knows each agent's heading: a move is ranked by the
+  /// turn into it plus the goal's cost-to-go with the turns on the way (heading_table.hpp), and
+  /// standing by the cost-to-go the way the agent faces. Empty: by the node distance alone.
+  std::function<double(NodeId prev, NodeId at, NodeId next)> turnTime{};
+  /// Turns the heading tables' searches may relax per step (HeadingTable::work): bounds the time
+  /// a step spends on goals it has not seen; their agents rank moves by distance until it is done.
+  std::size_t headingWorkPerStep = 400000;
+  std::size_t headingCacheBytes = std::size_t{64} << 20;
   /// Moves whose distances to the goal (in the edges' cost unit) differ by at most this much count
   /// as equally good (0: exact; sums of edge durations along equally long ways differ in the last
   /// bits).
@@ -136,11 +151,15 @@ class Pibt {
   /// goal, controlled). Goals, task priorities, the steps since each reached its goal and the
   /// distance cache are kept, so re-planning does not reset PIBT's fairness. std::invalid_argument
   /// (nothing changed) when the positions are invalid or conflict.
-  void reset(std::span<const NodeId> positions);
+  /// `cameFrom` (optional, per position): the node each agent arrived from, its heading at the new
+  /// position (kNoNode: unknown); without it an agent that moved has no heading.
+  void reset(std::span<const NodeId> positions, std::span<const NodeId> cameFrom = {});
 
   /// Plans and takes one step: every agent's node at the next step, conflict-free (and rotation-free
   /// unless Rotations::kAllow).
   const std::vector<NodeId>& step();
+  /// The heading tables, nullptr without PibtOptions::turnTime.
+  [[nodiscard]] const HeadingTable* headingTables() const { return heading_.get(); }
   /// Agents still driving their last move in a plan kept in time (TrafficControl): the next
   /// step leaves them where they are, pushes none of them and counts no standing for them. Empty or
   /// all 0: none. Agents on a way out of a knot are never busy.
@@ -197,6 +216,8 @@ class Pibt {
   void advanceForced();
   void dropForced(std::int32_t group);
   void planDetours();
+  /// Each agent's heading table for this step (searching those not there yet, within the budget).
+  void findHeadingTables();
   /// Settles agent i's table (its goal's or its detour's, both searched only as far as read) at
   /// its node and within `hops` edges of it.
   void settleTable(std::size_t i, int hops);
@@ -214,6 +235,7 @@ class Pibt {
   const Graph& graph_;
   PibtOptions options_;
   DistanceTable distances_;
+  std::unique_ptr<HeadingTable> heading_;  ///< with PibtOptions::turnTime only
   RotationPass rotationPass_;
   PibtStats stats_;
   std::uint64_t rng_;
@@ -225,6 +247,7 @@ class Pibt {
   std::vector<NodeId> prev_;  ///< the node it last moved from (its heading), kNoNode: unknown
   std::vector<NodeId> goal_;
   std::vector<const float*> table_;
+  std::vector<const float*> surcharge_;  ///< its goal's heading table this step, nullptr: none
   std::vector<int> task_;
   std::vector<int> elapsed_;
   std::vector<double> epsilon_;
@@ -261,6 +284,7 @@ class Pibt {
   std::vector<NodeId> lineForward_;       ///< the line's next node toward the dock
 
   std::vector<std::int32_t> order_;
+  std::vector<NodeId> goals_;          ///< scratch: the goals wanting a heading table this step
   std::vector<Candidate> candidates_;  ///< (max degree + 1) per recursion depth
   std::size_t stride_ = 1;
   std::vector<std::int32_t> search_;   ///< cycle search stack
