@@ -67,7 +67,7 @@ void HeadingTable::build() {
   }
 }
 
-std::int64_t HeadingTable::edgeIndex(NodeId from, NodeId to) const {
+std::int64_t HeadingTable::edgeBetween(NodeId from, NodeId to) const {
   if (!graph_.valid(from) || static_cast<std::size_t>(from) >= builtFor_) {
     return -1;
   }
@@ -250,10 +250,23 @@ const float* HeadingTable::compute(NodeId goal) {
   if (const float* s = find(goal)) {
     return s;
   }
-  ask(goal);
-  // Searches queued before it finish first.
+  if (!graph_.valid(goal)) {
+    return nullptr;
+  }
+  // The search under way first (it is never given up), then the goal's alone: a search queued
+  // after it could otherwise evict its table within a small byte budget.
+  std::deque<NodeId> queued;
+  queued.swap(queue_);
+  if (searching_ != goal) {
+    queue_.push_back(goal);
+  }
   while (find(goal) == nullptr && (searching_ != kNoNode || !queue_.empty())) {
     work(std::numeric_limits<std::size_t>::max());
+  }
+  for (const NodeId g : queued) {
+    if (g != goal) {
+      queue_.push_back(g);
+    }
   }
   return find(goal);
 }

@@ -148,16 +148,19 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
   const Vec2 heading = straight ? graph_.position(from) - graph_.position(back) : Vec2{};
   // With a heading table: the edge it arrived by (its heading), -1 when unknown.
   const float* surcharge = surcharge_[a];
-  const std::int64_t arrived = surcharge != nullptr && back != kNoNode ? heading_->edgeIndex(back, from) : -1;
+  const std::int64_t arrived =
+      surcharge != nullptr && back != kNoNode ? heading_->edgeBetween(back, from) : -1;
   // Standing: the cost-to-go the way it faces; facing no known way, that of its best way out.
-  float standing = arrived >= 0 ? surcharge[arrived] : 0.0F;
-  if (surcharge != nullptr && arrived < 0 && table[idx(from)] != DistanceTable::kUnreachable) {
+  float standing = arrived >= 0 && table[idx(from)] > 0.0F ? surcharge[arrived] : 0.0F;
+  // On its goal (distance 0) it has nowhere to turn to: standing costs nothing.
+  if (surcharge != nullptr && arrived < 0 && table[idx(from)] != DistanceTable::kUnreachable &&
+      table[idx(from)] > 0.0F) {
     standing = DistanceTable::kUnreachable;
     const auto es = graph_.edges(from);
     for (std::size_t k = 0; k < es.size(); ++k) {
       if (graph_.passable(from, es[k]) && table[idx(es[k].to)] != DistanceTable::kUnreachable) {
         standing = std::min(standing, static_cast<float>(es[k].cost()) + table[idx(es[k].to)] +
-                                          surcharge[heading_->edgeIndex(from, k)] - table[idx(from)]);
+                                          surcharge[heading_->outEdge(from, k)] - table[idx(from)]);
       }
     }
     standing = standing == DistanceTable::kUnreachable ? 0.0F : std::max(0.0F, standing);
@@ -168,7 +171,7 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
       if (v == from) {
         d += standing;
       } else {
-        const std::size_t e = heading_->edgeIndex(from, out);
+        const std::size_t e = heading_->outEdge(from, out);
         d += surcharge[e] +
              (arrived >= 0 ? heading_->turn(static_cast<std::size_t>(arrived), from, out) : 0.0F);
       }

@@ -271,8 +271,12 @@ void Pibt::reset(std::span<const NodeId> positions, std::span<const NodeId> came
       stalled_[i] = 0;
       prev_[i] = kNoNode;
     }
-    if (i < cameFrom.size() && graph_.valid(cameFrom[i]) && cameFrom[i] != positions[i]) {
-      prev_[i] = cameFrom[i];
+    // A heading is an edge into the new position; anything else is no heading.
+    if (i < cameFrom.size() && graph_.valid(cameFrom[i])) {
+      const auto into = graph_.edges(cameFrom[i]);
+      if (std::any_of(into.begin(), into.end(), [&](const Edge& e) { return e.to == positions[i]; })) {
+        prev_[i] = cameFrom[i];
+      }
     }
   }
   // A way out of a knot goes on from where the new positions are on it (the robots were released

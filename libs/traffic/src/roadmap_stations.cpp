@@ -4,6 +4,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fleet/traffic/traffic_control.hpp"
 #include "roadmap_builder.hpp"
 #include "roadmap_geometry.hpp"
 
@@ -253,3 +254,19 @@ void RoadmapBuilder::joinQueue(const StationNodes& sn) {
 }
 
 }  // namespace fleet::traffic::detail
+
+namespace fleet::traffic {
+
+std::vector<StationLine> stationLines(const Roadmap& roadmap) {
+  std::vector<StationLine> lines;
+  for (const auto& st : roadmap.stations) {
+    if (st.dock != kNoNode &&
+        (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
+         st.kind == site::StationKind::Charging)) {
+      lines.push_back({st.dock, st.queue, st.approach});
+    }
+  }
+  return lines;
+}
+
+}  // namespace fleet::traffic

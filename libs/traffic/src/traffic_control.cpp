@@ -16,21 +16,7 @@ namespace {
 constexpr double kStepSeconds = 0.7;
 /// Above any task priority a WMS sends (they are small integers).
 constexpr int kLeavingBoost = 1 << 20;
-}  // namespace
 
-std::vector<StationLine> stationLines(const Roadmap& roadmap) {
-  std::vector<StationLine> lines;
-  for (const auto& st : roadmap.stations) {
-    if (st.dock != kNoNode &&
-        (st.kind == site::StationKind::Pickup || st.kind == site::StationKind::Dropoff ||
-         st.kind == site::StationKind::Charging)) {
-      lines.push_back({st.dock, st.queue, st.approach});
-    }
-  }
-  return lines;
-}
-
-namespace {
 // The planner knows the robots' headings when the plan times their turns (PibtOptions::turnTime).
 PibtOptions plannerOptions(const TrafficOptions& options) {
   PibtOptions p = options.pibt;

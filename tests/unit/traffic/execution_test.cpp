@@ -92,6 +92,25 @@ TEST(Execution, EachReleaseSaysWhyItsBaseEndsThere) {
   EXPECT_STREQ(toString(BaseCut::Limit), "limit");
 }
 
+TEST(Execution, ReleasedFromIsTheNodeTheReleasedRouteEntersItsEndFrom) {
+  const Graph g = grid(8, 1);
+  const std::vector<NodeId> start{0};
+  ReleaseOptions o;
+  o.baseAhead = 2.0;  // two unit edges
+  Execution ex(g, start, o);
+  EXPECT_EQ(ex.releasedFrom(0), kNoNode) << "it never moved";
+  for (const NodeId v : {1, 1, 2, 3, 4, 5})
+    ex.append(std::vector<NodeId>{v});
+  const auto base = ex.release(0).base;
+  ASSERT_EQ(base, (std::vector<NodeId>{0, 1, 2}));
+  EXPECT_EQ(ex.releasedEnd(0), 2);
+  EXPECT_EQ(ex.releasedFrom(0), 1) << "a step standing on the way is no heading";
+  ASSERT_EQ(ex.reached(0, 2), Report::Accepted);
+  ex.release(0);
+  EXPECT_EQ(ex.releasedEnd(0), 4);
+  EXPECT_EQ(ex.releasedFrom(0), 3);
+}
+
 TEST(Execution, ABaseNeverPassesANodeTwice) {
   const Graph g = grid(3, 2);  // 0 1 2 / 3 4 5
   const std::vector<NodeId> start{0};

@@ -104,16 +104,20 @@ TEST(HeadingTable, ACorridorChargesTheTurnOnlyToTheRobotFacingAway) {
   const GridMap m = gridOf({"......"});
   HeadingTable table(m.graph, squareTurns(m.graph));
   const float* s = table.compute(m.node(5, 0));
-  const auto east = table.edgeIndex(m.node(1, 0), m.node(2, 0));
-  const auto west = table.edgeIndex(m.node(3, 0), m.node(2, 0));
+  const auto east = table.edgeBetween(m.node(1, 0), m.node(2, 0));
+  const auto west = table.edgeBetween(m.node(3, 0), m.node(2, 0));
   ASSERT_GE(east, 0);
   ASSERT_GE(west, 0);
   EXPECT_FLOAT_EQ(s[east], 0.0F) << "facing the goal";
   EXPECT_FLOAT_EQ(s[west], 2.5F) << "facing away: the way back starts with a reversal";
-  EXPECT_FLOAT_EQ(table.turn(static_cast<std::size_t>(west), m.node(2, 0), 0) +
-                      table.turn(static_cast<std::size_t>(west), m.node(2, 0), 1),
-                  2.5F)
-      << "arriving westward, going on west is straight and going east is back";
+  // Arriving westward at (2,0): going on west is straight, going back east a reversal.
+  const NodeId at = m.node(2, 0);
+  const auto outWest = static_cast<std::size_t>(table.edgeBetween(at, m.node(1, 0))) - table.outEdge(at, 0);
+  const auto outEast = static_cast<std::size_t>(table.edgeBetween(at, m.node(3, 0))) - table.outEdge(at, 0);
+  EXPECT_FLOAT_EQ(table.turn(static_cast<std::size_t>(west), at, outWest), 0.0F);
+  EXPECT_FLOAT_EQ(table.turn(static_cast<std::size_t>(west), at, outEast), 2.5F);
+  EXPECT_FLOAT_EQ(table.turn(static_cast<std::size_t>(east), at, outEast), 0.0F);
+  EXPECT_FLOAT_EQ(table.turn(static_cast<std::size_t>(east), at, outWest), 2.5F);
 }
 
 TEST(HeadingTable, SlicedSearchesGiveTheWholeSearchsTablesAndSkipWhatIsNoLongerWanted) {
@@ -170,7 +174,7 @@ TEST(HeadingTable, AClosedEdgeIsRoutedRoundAfterInvalidate) {
   GridMap m = gridOf({"...", "...", "..."});
   HeadingTable table(m.graph, squareTurns(m.graph));
   const NodeId goal = m.node(2, 1);
-  const auto in = table.edgeIndex(m.node(0, 1), m.node(1, 1));  // heading east, straight on
+  const auto in = table.edgeBetween(m.node(0, 1), m.node(1, 1));  // heading east, straight on
   ASSERT_GE(in, 0);
   EXPECT_FLOAT_EQ(table.compute(goal)[in], 0.0F);
   m.graph.setEdgeOpen(m.node(1, 1), m.node(2, 1), false);
@@ -208,6 +212,19 @@ TEST(Pibt, WithTurnTimesALoneAgentTakesTheWayWithTheFewestTurns) {
   EXPECT_EQ(Pibt(m.graph, std::vector<NodeId>{0}).headingTables(), nullptr) << "no turn times, no tables";
 }
 
+TEST(Pibt, AnAgentOnItsGoalStaysThereWithOrWithoutAHeading) {
+  const GridMap m = gridOf({"......"});
+  PibtOptions o;
+  o.turnTime = squareTurns(m.graph);
+  Pibt p(m.graph, std::vector<NodeId>{m.node(2, 0)}, o);  // no heading yet
+  p.setGoal(0, m.node(2, 0));
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(p.step()[0], m.node(2, 0)) << "step " << k;
+  p.reset(std::vector<NodeId>{m.node(2, 0)}, std::vector<NodeId>{m.node(3, 0)});  // facing west
+  for (int k = 0; k < 5; ++k)
+    EXPECT_EQ(p.step()[0], m.node(2, 0)) << "facing west, step " << k;
+}
+
 TEST(Pibt, AResetKeepsTheHeadingItIsGiven) {
   // A ring round a wall: from the middle of the left side the goal, the middle of the right side,
   // is as far round the top as round the bottom. The agent goes on the way it faces.
@@ -225,4 +242,12 @@ TEST(Pibt, AResetKeepsTheHeadingItIsGiven) {
     const NodeId ahead = m.node(0, 2 - fromY);  // facing away from where it came from
     EXPECT_EQ(p.step()[0], ahead) << "came from y=" << fromY;
   }
+  // A node it cannot have come from (not a neighbour) gives no heading: it is refused quietly and
+  // the agent still reaches its goal.
+  PibtOptions o;
+  o.turnTime = squareTurns(m.graph);
+  Pibt p(m.graph, std::vector<NodeId>{m.node(0, 0)}, o);
+  p.setGoal(0, m.node(2, 1));
+  p.reset(std::vector<NodeId>{m.node(0, 1)}, std::vector<NodeId>{m.node(2, 2)});
+  EXPECT_EQ(walkToGoal(m.graph, p, 10).size(), 5U);
 }

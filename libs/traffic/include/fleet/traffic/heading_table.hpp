@@ -41,11 +41,11 @@ class HeadingTable {
   HeadingTable(const Graph& graph, TurnTime turn, std::size_t maxBytes = std::size_t{64} << 20);
 
   /// Directed edge index of `at`'s out-edge number `out` (graph.edges(at)[out]).
-  [[nodiscard]] std::size_t edgeIndex(NodeId at, std::size_t out) const {
+  [[nodiscard]] std::size_t outEdge(NodeId at, std::size_t out) const {
     return offset_[static_cast<std::size_t>(at)] + out;
   }
   /// Index of the edge from→to, -1 when there is none.
-  [[nodiscard]] std::int64_t edgeIndex(NodeId from, NodeId to) const;
+  [[nodiscard]] std::int64_t edgeBetween(NodeId from, NodeId to) const;
   /// Turning at `at` having arrived by edge `in` (an index) and leaving by out-edge number `out`.
   [[nodiscard]] float turn(std::size_t in, NodeId at, std::size_t out) const;
   [[nodiscard]] std::size_t edges() const { return tail_.size(); }

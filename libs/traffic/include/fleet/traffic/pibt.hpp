@@ -103,8 +103,10 @@ struct PibtOptions {
   /// standing by the cost-to-go the way the agent faces. Empty: by the node distance alone.
   std::function<double(NodeId prev, NodeId at, NodeId next)> turnTime{};
   /// Turns the heading tables' searches may relax per step (HeadingTable::work): bounds the time
-  /// a step spends on goals it has not seen; their agents rank moves by distance until it is done.
-  std::size_t headingWorkPerStep = 400000;
+  /// a step spends on goals it has not seen (100,000: ~4 ms on the site for 100); their agents
+  /// rank moves by distance until their table is done. TrafficControl sets it from
+  /// TrafficOptions::headingWorkPerUpdate.
+  std::size_t headingWorkPerStep = 100000;
   std::size_t headingCacheBytes = std::size_t{64} << 20;
   /// Moves whose distances to the goal (in the edges' cost unit) differ by at most this much count
   /// as equally good (0: exact; sums of edge durations along equally long ways differ in the last

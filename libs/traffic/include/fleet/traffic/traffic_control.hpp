@@ -36,9 +36,9 @@ struct TrafficOptions {
   /// so the plan's clock advances by ~timedQuantum a step (8 a 0.1 s update keeps it ahead of the
   /// robots; at 300 robots 64 let it run minutes ahead, re-planning all the while).
   std::int64_t maxStepsPerUpdate = 16;
-  /// Turns the planner's heading-table searches may relax per update() (spread over its steps:
-  /// PibtOptions::headingWorkPerStep = this ÷ maxStepsPerUpdate), ~4 ms on the machines measured
-  /// (docs/benchmarks.md, "Heading tables").
+  /// Turns the planner's heading-table searches may relax per update(), spread over its steps:
+  /// it replaces pibt.headingWorkPerStep with this ÷ maxStepsPerUpdate. 100,000 turns took up to
+  /// ~4 ms on the site for 100 (docs/benchmarks.md, "Heading tables").
   std::size_t headingWorkPerUpdate = 100000;
   /// A robot planned to stand this many steps in a row stops asking for steps at once; while only
   /// such robots want planning, one step is planned every `standingEvery` updates.
