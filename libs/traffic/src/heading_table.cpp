@@ -95,16 +95,6 @@ const float* HeadingTable::find(NodeId goal) {
   return t.surcharge.data();
 }
 
-void HeadingTable::ask(NodeId goal) {
-  if (!graph_.valid(goal) || searching_ == goal ||
-      std::find(queue_.begin(), queue_.end(), goal) != queue_.end()) {
-    return;
-  }
-  if (!slotOf_.contains(goal)) {
-    queue_.push_back(goal);
-  }
-}
-
 void HeadingTable::want(std::span<const NodeId> goals) {
   queue_.clear();
   if (++stamp_ == 0) {

@@ -77,13 +77,9 @@ TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
   runSeeds(map, o);
 }
 
-/// Five robots chained on random tasks. Before detours, pacing and leaving docks first, three
-/// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
-/// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the
-/// robot waiting for it). A lone robot does 6 or 7.
 // Robots that follow their releases at once (no latency) reach the end of their base short of
 // their target only where the plan holds them (a dependency) or has not gone on yet, never because
-// A longer base was free but late: the release keeps ahead of a robot on time.
+// a longer base was free but late: the release keeps ahead of a robot on time.
 TEST(VirtualFleet, ARobotOnTimeNeverReachesABaseEndThatMoreWasFreeBeyond) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;
@@ -96,6 +92,10 @@ TEST(VirtualFleet, ARobotOnTimeNeverReachesABaseEndThatMoreWasFreeBeyond) {
   }
 }
 
+/// Five robots chained on random tasks. Before detours, pacing and leaving docks first, three
+/// seeds did 3, 7 and 24 tasks in 600 s (robots stood for hundreds of seconds next to a free way
+/// round a robot waiting in line, and one leaving a drop-off spur was pushed back onto it by the
+/// robot waiting for it). A lone robot does 6 or 7.
 TEST(VirtualFleet, FiveRobotsKeepWorkingOnTheSmallWarehouse) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;

@@ -50,11 +50,9 @@ class HeadingTable {
   [[nodiscard]] float turn(std::size_t in, NodeId at, std::size_t out) const;
   [[nodiscard]] std::size_t edges() const { return tail_.size(); }
 
-  /// The goal's surcharge per arriving edge, nullptr until its search has finished (ask()).
-  /// Valid until the next work(), ask() or invalidate(). Unreachable edges hold 0.
+  /// The goal's surcharge per arriving edge, nullptr until its search has finished (want()).
+  /// Valid until the next work(), compute() or invalidate(). Unreachable edges hold 0.
   [[nodiscard]] const float* find(NodeId goal);
-  /// Queues the goal's search unless it is done or queued.
-  void ask(NodeId goal);
   /// The goals wanted now: the searches queued become those of them without a table, in their
   /// order (the search under way is finished first, wanted or not).
   void want(std::span<const NodeId> goals);
