@@ -387,13 +387,20 @@ bool Execution::rederive(const std::vector<std::uint8_t>* only) {
   // Every entry on a node an entry whose dependencies are derived looks at: its own and the nodes
   // it conflicts with. With `only`, that is the nodes marked and those conflicting with one (the
   // conflicts are symmetric); the rest are left out of the sort, which was most of a let-pass.
-  const auto looked = [&](NodeId x) {
-    if (only == nullptr || (*only)[static_cast<std::size_t>(x)] != 0)
-      return true;
-    const auto c = graph_.conflicts(x);
-    return std::any_of(c.begin(), c.end(),
-                       [&](NodeId y) { return (*only)[static_cast<std::size_t>(y)] != 0; });
-  };
+  // Marked once per node (a marked node and its conflicts) rather than asked per entry: asking
+  // per entry walked every entry's conflicts, a fifth of a let-pass at 1,000 robots.
+  std::vector<std::uint8_t> lookedAt;
+  if (only != nullptr) {
+    lookedAt.assign(graph_.size(), 0);
+    for (std::size_t x = 0; x < only->size(); ++x) {
+      if ((*only)[x] == 0)
+        continue;
+      lookedAt[x] = 1;
+      for (NodeId y : graph_.conflicts(static_cast<NodeId>(x)))
+        lookedAt[static_cast<std::size_t>(y)] = 1;
+    }
+  }
+  const auto looked = [&](NodeId x) { return only == nullptr || lookedAt[static_cast<std::size_t>(x)] != 0; };
   std::vector<At> at;
   for (std::size_t r = 0; r < routes_.size(); ++r) {
     const Route& route = routes_[r];
