@@ -239,7 +239,7 @@ TEST(Guidance, TablesRepairedAfterABlockEqualFreshOnesOnGuidedCosts) {
 TEST(Guidance, RippingUpAndRoutingAgainShortensTheRoutes) {
   const auto site =
       site::loadSite((fs::path(FLEET_SOURCE_DIR) / "sim/scenarios/small_warehouse.site.json").string());
-  const Roadmap plain = buildRoadmap(site, RoadmapOptions{});
+  const Roadmap plain = buildRoadmap(site, {.guidance = 0.0});
   std::vector<NodeId> pickups, dropoffs;
   for (const auto& s : plain.stations) {
     if (s.kind == site::StationKind::Pickup)

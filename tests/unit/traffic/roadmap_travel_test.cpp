@@ -19,10 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Unguided: travel is then the shortest time. On a guided roadmap it is the seconds of the guided
+// way (Guidance.TravelTimesAreTheSecondsOfTheGuidedWay).
 std::shared_ptr<const Roadmap> smallWarehouse() {
   const auto site =
       site::loadSite((fs::path(FLEET_SOURCE_DIR) / "sim/scenarios/small_warehouse.site.json").string());
-  return std::make_shared<const Roadmap>(buildRoadmap(site));
+  return std::make_shared<const Roadmap>(buildRoadmap(site, {.guidance = 0.0}));
 }
 
 // The shortest time over open edges, searched forward apart from DistanceTable's backward one.

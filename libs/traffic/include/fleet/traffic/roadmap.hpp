@@ -79,8 +79,11 @@ struct RoadmapOptions {
   /// that leaves no room for it); false: the lattice as the map allows.
   bool parkingClear = true;
   /// Flow guidance (guidance.hpp): driving against the flow of the trips between the site's
-  /// pickups and drop-offs costs routes 1 + this times the edge's duration; 0: none.
-  double guidance = 0.0;
+  /// pickups and drop-offs costs routes 1 + this times the edge's duration; 0: none. 0.5 since
+  /// 2026-12-05: with heading tables it gains on the small warehouse and the site for 300 and
+  /// loses nothing beyond the seeds' spread on the site for 100 (docs/algorithms.md, "Traffic:
+  /// flow guidance").
+  double guidance = 0.5;
 };
 
 enum class NodeKind : std::uint8_t { Lane, Station, Approach, Queue, Parking, Charger, Exit };
