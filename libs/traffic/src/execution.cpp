@@ -388,7 +388,8 @@ bool Execution::rederive(const std::vector<std::uint8_t>* only) {
   // it conflicts with. With `only`, that is the nodes marked and those conflicting with one (the
   // conflicts are symmetric); the rest are left out of the sort, which was most of a let-pass.
   // Marked once per node (a marked node and its conflicts) rather than asked per entry: asking
-  // per entry walked every entry's conflicts, a fifth of a let-pass at 1,000 robots.
+  // per entry walked every entry's conflicts: the update's p50 at 1,000 robots fell by a quarter
+  // without it.
   std::vector<std::uint8_t> lookedAt;
   if (only != nullptr) {
     lookedAt.assign(graph_.size(), 0);

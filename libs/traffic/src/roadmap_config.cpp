@@ -14,8 +14,9 @@ traffic::RoadmapOptions readRoadmapOptions(Config r) {
   o.margin = r.number("margin", o.margin, {0.0, 2.0});
   o.queueLength = static_cast<int>(r.integer("queue_length", o.queueLength, {0, 50}));
   o.diagonals = r.boolean("diagonals", o.diagonals);
-  // Flow guidance (guidance.hpp): 0 off; 0.5 made the small warehouse's 10 and 20 robots faster
-  // and the site for 100 slower (docs/benchmarks.md), so it is a site's choice.
+  // Flow guidance (guidance.hpp): 0 off; the default 0.5 makes the small warehouse's 10 and 20
+  // robots and the site for 300 faster, the site for 100 within its seeds' spread
+  // (docs/benchmarks.md, "Flow guidance").
   o.guidance = r.number("guidance", o.guidance, {0.0, 100.0});
   return o;
 }

@@ -328,8 +328,9 @@ TEST(Guidance, ABadWeightIsRefusedByName) {
     ASSERT_FALSE(e.problems().empty());
     EXPECT_NE(e.problems().front().find("guidance"), std::string::npos) << e.problems().front();
   }
-  Config good = Config::fromText(R"({"guidance": 0.5})", "traffic.json");
-  EXPECT_EQ(readRoadmapOptions(good).guidance, 0.5);
+  // Not the default (0.5): the key must be read.
+  Config good = Config::fromText(R"({"guidance": 0.25})", "traffic.json");
+  EXPECT_EQ(readRoadmapOptions(good).guidance, 0.25);
   EXPECT_NO_THROW(good.finish());
 }
 
