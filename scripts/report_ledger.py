@@ -70,15 +70,35 @@ def docking_cell(s):
             f"(model {s['dock_model_s']:.2f}; {s['dockings'] - s['dockings_over_model']} of {s['dockings']} within +2 s)</td>")
 
 
+def queue_sparkline(series, every_s, top, w=160, h=22):
+    """The station's queue over the run as a step line (one sample every `every_s` s), all rows on
+    one scale (`top` robots at the top), so stations compare at a glance."""
+    if not series or every_s <= 0:
+        return "–"
+    top = max(1, top)
+    n = len(series)
+    pts = []
+    for i, q in enumerate(series):
+        x0, x1 = w * i / n, w * (i + 1) / n
+        y = h - 1 - (h - 2) * min(q, top) / top
+        pts.append(f"{x0:.1f},{y:.1f} {x1:.1f},{y:.1f}")
+    return (f'<svg class="queue" width="{w}" height="{h}" role="img" aria-label="queue over the run">'
+            f'<rect width="{w}" height="{h}" fill="#f4f4f4"/><polyline fill="none" stroke="#ff7f0e" stroke-width="1.5" '
+            f'points="{" ".join(pts)}"><title>{n} samples every {every_s:g} s, max {max(series)}</title></polyline></svg>')
+
+
 def stations_html(stations):
     if not stations:
         return ""
+    top = max((max(s.get("queue_series") or [0]) for s in stations), default=0)
     rows = "".join(
         f"<tr><td>{html.escape(s['name'])}</td><td class=\"r\">{s['visits']}</td><td class=\"r\">{100 * s['utilisation']:.0f} %</td>"
-        f"<td class=\"r\">{s['queue_mean']:.2f} / {s['queue_max']}</td><td class=\"r\">{s['cycle_p50_s']:.1f} / {s['cycle_p90_s']:.1f} ({s['cycles']})</td>"
+        f"<td class=\"r\">{s['queue_mean']:.2f} / {s['queue_max']}</td>"
+        f"<td>{queue_sparkline(s.get('queue_series'), s.get('queue_every_s', 0), top)}</td>"
+        f"<td class=\"r\">{s['cycle_p50_s']:.1f} / {s['cycle_p90_s']:.1f} ({s['cycles']})</td>"
         f"<td class=\"r\">{s['occupancy_p50_s']:.1f} / {s['occupancy_p90_s']:.1f}</td>{docking_cell(s)}</tr>" for s in stations)
     return f"""<h3>Stations</h3><table><tr><th>station</th><th>visits</th><th>utilisation (docked ÷ run)</th>
-<th>queue mean / max</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th>
+<th>queue mean / max</th><th>queue over the run (0–{top})</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th>
 <th>docking p50 / p90 / max [s]</th></tr>{rows}</table>
 <p class="note">Docked: the robot's centre within 0.25 m of the station's pose. Queue: robots whose current goal is the
 station and are not docked there. Dock cycle: one robot's dock arrival to the next's, counted when the next stood in the

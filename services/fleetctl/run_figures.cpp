@@ -57,7 +57,10 @@ json ledgers(const fs::path& runDir) {
   std::map<std::string, std::pair<Vec2, double>> entries;  // the last leg's start and its time
   const double cruise = scn.robots.empty() ? 0.0 : control::agentCruiseSpeed(scn.robots.front().limits);
   if (scn.site) {
-    const traffic::Roadmap roadmap = traffic::buildRoadmap(*scn.site);
+    // Geometry only: no flow guidance (its start-up is ~15 s on the site for 1,000 robots).
+    traffic::RoadmapOptions geometry;
+    geometry.guidance = 0.0;
+    const traffic::Roadmap roadmap = traffic::buildRoadmap(*scn.site, geometry);
     for (const auto& st : roadmap.stations) {
       if (st.dock == traffic::kNoNode) {
         continue;

@@ -190,7 +190,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
                           {"visits", st.visits},
                           {"dock_cycles", st.cycles},
                           {"dock_cycle_p50_s", st.cycleP50},
-                          {"dock_cycle_p90_s", st.cycleP90}});
+                          {"dock_cycle_p90_s", st.cycleP90},
+                          {"utilisation", st.utilisation},
+                          {"queue_mean", st.queueMean},
+                          {"queue_max", st.queueMax}});
     }
     const nlohmann::json driving = drivingPerTaskJson(r);
     nlohmann::json waits = nlohmann::json::array();
@@ -236,7 +239,9 @@ int runTrafficSim(const TrafficSimOptions& o) {
       std::cout << "  " << drivingPerTaskLine(driving) << "\n";
       std::cout << "  stations:";
       for (const auto& st : r.stations) {
-        std::cout << " " << st.name << " " << st.visits << " visits";
+        std::cout << " " << st.name << " " << st.visits << " visits, " << std::fixed << std::setprecision(0)
+                  << 100.0 * st.utilisation << " % docked, queue " << std::setprecision(1) << st.queueMean
+                  << " / " << st.queueMax;
         if (st.cycles > 0)
           std::cout << ", dock cycle p50 " << std::fixed << std::setprecision(1) << st.cycleP50 << " / p90 "
                     << st.cycleP90 << " s (" << st.cycles << ")";

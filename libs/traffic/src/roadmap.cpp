@@ -304,7 +304,8 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
 
   // Queue nodes are for waiting while the station is busy: one that excludes the dock or another
   // place in the same line (possible with the site's own queue points) cannot serve.
-  for (const auto& sn : r.stations) {
+  for (std::size_t i = 0; i < r.stations.size(); ++i) {  // in the site's order
+    const auto& sn = r.stations[i];
     for (std::size_t q = 0; q < sn.queue.size(); ++q) {
       const NodeId v = sn.queue[q];
       std::string with;
@@ -316,7 +317,8 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
       }
       if (!with.empty()) {
         b.problem(RoadmapProblem::Severity::Warning, sn.name, r.graph.position(v),
-                  "station '" + sn.name + "': a robot waiting on queue point " + std::to_string(q) + " " +
+                  "stations[" + std::to_string(i) + "].queue: station '" + sn.name +
+                      "': a robot waiting on queue point " + std::to_string(q) + " " +
                       detail::pointText(r.graph.position(v)) + " is too close to " + with + " (" +
                       (with == "the dock" ? "it blocks the station" : "they cannot both be used") + ")");
       }

@@ -72,6 +72,11 @@ struct RoadmapBuilder {
   void problem(RoadmapProblem::Severity sev, const std::string& station, Vec2 p, const std::string& what) {
     problems.push_back({sev, station, p, what});
   }
+  /// The key path of a field of `st` (one of site.stations) in site.json, as problems name it:
+  /// "stations[2].exit: ...".
+  [[nodiscard]] std::string keyOf(const site::Station& st, const char* field) const {
+    return "stations[" + std::to_string(&st - site.stations.data()) + "]." + field + ": ";
+  }
 
   // roadmap_lattice.cpp: the lattice and the joins to it.
   Vec2 chooseLatticeOrigin(int k);

@@ -96,8 +96,8 @@ void RoadmapBuilder::placeStations() {
       std::ostringstream r;
       r << opt.radius;
       problem(RoadmapProblem::Severity::Error, st.name, dockAt,
-              "station '" + st.name + "' at " + detail::pointText(dockAt) + ": the robot's disc (radius " +
-                  r.str() + " m) does not fit there: no dock node");
+              keyOf(st, "pose") + "station '" + st.name + "' at " + detail::pointText(dockAt) +
+                  ": the robot's disc (radius " + r.str() + " m) does not fit there: no dock node");
       stations.push_back(sn);
       continue;
     }
@@ -110,7 +110,8 @@ void RoadmapBuilder::placeStations() {
         sn.approach = add(*st.approach, NodeKind::Approach);
       } else {
         problem(RoadmapProblem::Severity::Error, st.name, *st.approach,
-                "station '" + st.name + "': the robot cannot drive straight from its approach point " +
+                keyOf(st, "approach") + "station '" + st.name +
+                    "': the robot cannot drive straight from its approach point " +
                     detail::pointText(*st.approach) + " to the dock " + detail::pointText(dockAt) +
                     "; joined along the row instead");
       }
@@ -123,16 +124,25 @@ void RoadmapBuilder::placeStations() {
     if (sn.dock == kNoNode || st.kind == site::StationKind::Parking) {
       continue;
     }
-    if (const auto e = placeExit(st, sn)) {
+    const auto e = placeExit(st, sn);
+    if (!e && nextPlaces(st.kind)) {
+      // Not refused (a dead end with no room beside it still serves), but said: the robot leaving
+      // meets the next in line on the way in, so the dock cycles slower (docs/algorithms.md,
+      // "Stations as servers").
+      problem(RoadmapProblem::Severity::Warning, st.name, st.pose.position(),
+              keyOf(st, "exit") + "station '" + st.name + "': no room for a way out apart from its way in " +
+                  "(give one, or room beside the approach point); left by its way in");
+    }
+    if (e) {
       const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];
       if (fits(*e) && sweeps(dockAt, *e)) {
         sn.exit = add(*e, NodeKind::Exit);
         links.push_back({sn.dock, sn.exit, true, false});
       } else {
         problem(RoadmapProblem::Severity::Error, st.name, *e,
-                "station '" + st.name + "': the robot cannot drive straight from the dock " +
-                    detail::pointText(dockAt) + " to its exit " + detail::pointText(*e) +
-                    "; left by its way in instead");
+                keyOf(st, "exit") + "station '" + st.name +
+                    "': the robot cannot drive straight from the dock " + detail::pointText(dockAt) +
+                    " to its exit " + detail::pointText(*e) + "; left by its way in instead");
       }
     }
   }
@@ -165,7 +175,8 @@ void RoadmapBuilder::placeStations() {
       std::ostringstream d;
       d << 3.0 * opt.spacing;
       problem(RoadmapProblem::Severity::Error, st.name, ep,
-              "station '" + st.name + "': no lane node within " + d.str() + " m of its " +
+              keyOf(st, sn.approach != kNoNode ? "approach" : "pose") + "station '" + st.name +
+                  "': no lane node within " + d.str() + " m of its " +
                   (sn.approach != kNoNode ? "approach point " : "dock ") + detail::pointText(ep) +
                   " that the robot reaches in a straight line: the station is not on the roadmap");
     }
@@ -175,7 +186,8 @@ void RoadmapBuilder::placeStations() {
       if (joinToLattice(sn.exit, {out}, kCone, Join::Out) == 0 &&
           joinToLattice(sn.exit, {}, 0.0, Join::Out) == 0) {
         problem(RoadmapProblem::Severity::Error, st.name, xp,
-                "station '" + st.name + "': no lane node near its exit " + detail::pointText(xp) +
+                keyOf(st, "exit") + "station '" + st.name + "': no lane node near its exit " +
+                    detail::pointText(xp) +
                     " that the robot reaches in a straight line: robots could not leave the dock");
       }
     }
@@ -220,8 +232,9 @@ void RoadmapBuilder::placeQueue(const site::Station& st, StationNodes& sn) {
   for (std::size_t q = 0; q < queue.size(); ++q) {
     if (!fits(queue[q])) {
       problem(RoadmapProblem::Severity::Error, st.name, queue[q],
-              "station '" + st.name + "': the robot's disc does not fit on queue point " + std::to_string(q) +
-                  " " + detail::pointText(queue[q]));
+              keyOf(st, "queue") + "station '" + st.name +
+                  "': the robot's disc does not fit on queue point " + std::to_string(q) + " " +
+                  detail::pointText(queue[q]));
       continue;
     }
     const Vec2 nextAt = pos[static_cast<std::size_t>(next)];
@@ -230,7 +243,7 @@ void RoadmapBuilder::placeQueue(const site::Station& st, StationNodes& sn) {
       links.push_back({v, next, true, false});
     } else {
       problem(RoadmapProblem::Severity::Warning, st.name, queue[q],
-              "station '" + st.name + "': queue point " + std::to_string(q) + " " +
+              keyOf(st, "queue") + "station '" + st.name + "': queue point " + std::to_string(q) + " " +
                   detail::pointText(queue[q]) + " cannot be driven straight to the one before it");
     }
     sn.queue.push_back(v);

@@ -159,6 +159,11 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   std::vector<std::uint8_t> queuedAtLeave(g.size(), 0);
   std::vector<std::size_t> visits(g.size(), 0);
   std::vector<std::vector<double>> cycles(g.size());
+  // Utilisation and queue, as the load test's ledger counts them (docs/algorithms.md, "Robot-time and
+  // station ledgers"): docked = standing on the dock node; queue = robots whose goal is the dock and
+  // that do not stand on it. Per tick, robot-seconds and the largest count.
+  std::vector<double> dockedS(g.size(), 0.0), queueS(g.size(), 0.0);
+  std::vector<std::size_t> queueNow(g.size(), 0), queueMax(g.size(), 0);
   // Whether another robot in the line of the station docked at `dock` stands on one of the line's
   // nodes (its queue places or its approach) as `r` leaves: only then is the next arrival the
   // station's own cycle, not the next robot's drive from afar.
@@ -470,6 +475,24 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     res.contacts += contactNow ? 1 : 0;
     res.holdViolations += holdNow ? 1 : 0;
+    for (std::size_t r = 0; r < o.robots; ++r) {
+      const Bot& b = bots[r];
+      if (b.idle || b.pickup == kNoNode)
+        continue;
+      const auto goal = static_cast<std::size_t>(b.phase == 0 ? b.pickup : b.dropoff);
+      if (b.to == kNoNode && static_cast<std::size_t>(b.at) == goal)
+        dockedS[goal] += o.dt;
+      else
+        ++queueNow[goal];
+    }
+    for (const auto& st : roadmap.stations) {
+      if (st.dock == kNoNode)
+        continue;
+      const auto d = static_cast<std::size_t>(st.dock);
+      queueS[d] += o.dt * static_cast<double>(queueNow[d]);
+      queueMax[d] = std::max(queueMax[d], queueNow[d]);
+      queueNow[d] = 0;
+    }
     if (o.recordEvery > 0.0 && now + 1e-9 >= nextFrame) {
       nextFrame += o.recordEvery;
       FleetFrame f;
@@ -548,9 +571,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   for (const auto& st : roadmap.stations) {
     if (st.dock == kNoNode || visits[static_cast<std::size_t>(st.dock)] == 0)
       continue;
-    const auto& c = cycles[static_cast<std::size_t>(st.dock)];
-    res.stations.push_back({st.name, visits[static_cast<std::size_t>(st.dock)], c.size(), percentile(c, 0.5),
-                            percentile(c, 0.9)});
+    const auto d = static_cast<std::size_t>(st.dock);
+    const auto& c = cycles[d];
+    res.stations.push_back({st.name, visits[d], c.size(), percentile(c, 0.5), percentile(c, 0.9),
+                            dockedS[d] / o.duration, queueS[d] / o.duration, queueMax[d]});
   }
   std::map<std::string, double> waits;
   for (std::size_t v = 0; v < g.size(); ++v) {

@@ -401,6 +401,33 @@ TEST(Roadmap, QueuePointsTooCloseToTheStationAreAWarning) {
   EXPECT_EQ(r.problems.front().severity, RoadmapProblem::Severity::Warning);
   EXPECT_NE(r.problems.front().what.find("too close to the dock"), std::string::npos)
       << r.problems.front().what;
+  EXPECT_EQ(r.problems.front().what.rfind("stations[1].queue: ", 0), 0U) << r.problems.front().what;
+}
+
+// A dead end one robot wide: no room beside the approach point for a way out apart from the way
+// in. The station still serves (left by its way in), and the site is told so by its key path.
+TEST(Roadmap, AStationWithNoRoomForAWayOutIsAWarningNamingItsExit) {
+  auto rows = hall();
+  for (const std::size_t y : {1, 2, 3, 6, 7, 8}) {
+    for (std::size_t c = 14; c <= 20; ++c) {
+      rows[y][c] = '@';
+    }
+  }
+  const Roadmap r = buildRoadmap(rowsSite(rows, twoStations()));
+  EXPECT_EQ(errors(r), 0U) << describe(r.problems);
+  const auto* b = r.station("B");
+  ASSERT_NE(b->dock, kNoNode);
+  EXPECT_EQ(b->exit, kNoNode);
+  const auto w = std::find_if(r.problems.begin(), r.problems.end(), [](const RoadmapProblem& p) {
+    return p.what.find("no room for a way out") != std::string::npos;
+  });
+  ASSERT_NE(w, r.problems.end()) << describe(r.problems);
+  EXPECT_EQ(w->severity, RoadmapProblem::Severity::Warning);
+  EXPECT_EQ(w->station, "B");
+  EXPECT_EQ(w->what.rfind("stations[1].exit: station 'B'", 0), 0U) << w->what;
+  EXPECT_EQ(connectedStations(r), (std::vector<std::string>{"A", "B"}));
+  // A has room: no warning for it.
+  EXPECT_NE(r.station("A")->exit, kNoNode);
 }
 
 TEST(Roadmap, StationThatCannotBeConnectedIsAClearProblem) {
@@ -425,6 +452,7 @@ TEST(Roadmap, StationThatCannotBeConnectedIsAClearProblem) {
   ASSERT_EQ(errors(r2), 1U) << describe(r2.problems);
   EXPECT_NE(r2.problems.front().what.find("station 'C' at (0.75, 2.5)"), std::string::npos)
       << r2.problems.front().what;
+  EXPECT_EQ(r2.problems.front().what.rfind("stations[2].pose: ", 0), 0U) << r2.problems.front().what;
   EXPECT_EQ(r2.station("C")->dock, kNoNode);
 }
 

@@ -213,7 +213,9 @@ TEST(VirtualFleet, OnePlaceALineKeepsSomeRobotsParkedAndWorkGoesOn) {
 // robot that had joined the line, wherever it was, gave ~19 s (the next robot's drive from afar),
 // which the 15 s bound here catches. The drive-through pickup P-3 cycles in ~6.5 s or, when the
 // next robot is held on its way into the line, in ~25 s: too few cycles a run to bound its median.
-TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
+// The stations' utilisation and queues are the load test's definitions (cross-checked: with every
+// robot on a task they account for the whole fleet).
+TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCyclesAndLines) {
   Roadmap map = smallWarehouse();
   VirtualFleetOptions o;
   o.robots = 6;
@@ -227,6 +229,17 @@ TEST(VirtualFleet, TasksBetweenTheChosenStationsOnlyWithTheirDockCycles) {
     SCOPED_TRACE(formatResult(r));
     EXPECT_GT(r.tasksDone, 5U);
     ASSERT_EQ(r.stations.size(), 2U);
+    // Every robot always has a task (no admission), so each stands on its goal's dock or is in its
+    // queue: the two stations' docked and queued robot-time add up to the fleet's.
+    double inLines = 0.0;
+    for (const auto& st : r.stations) {
+      inLines += st.utilisation + st.queueMean;
+      EXPECT_GE(st.utilisation, static_cast<double>(st.visits - 1) * o.dwell / o.duration) << st.name;
+      EXPECT_LE(st.utilisation, 1.0) << st.name;
+      EXPECT_LE(st.queueMax, o.robots) << st.name;
+      EXPECT_LE(st.queueMean, static_cast<double>(st.queueMax)) << st.name;
+    }
+    EXPECT_NEAR(inLines, static_cast<double>(o.robots), 1e-6);
     for (const auto& st : r.stations) {
       EXPECT_TRUE(st.name == "P-3" || st.name == "D-2") << st.name;
       EXPECT_GE(st.visits, r.tasksDone) << st.name;

@@ -116,13 +116,19 @@ struct VirtualFleetResult {
   std::vector<std::string> stalls;
   std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0
   /// The station ledger: per visited pickup and drop-off, its dock arrivals and its dock cycle —
-  /// from one arrival to the next, counted when the next robot was in line as the last one left.
+  /// from one arrival to the next, counted when the next robot was in line as the last one left —
+  /// its utilisation (time a robot stood on the dock ÷ the run) and its queue (robots whose goal is
+  /// the dock and that do not stand on it: mean over the run and most at once), as a load test's
+  /// ledger counts them.
   struct StationLedger {
     std::string name;
     std::size_t visits = 0;
     std::size_t cycles = 0;
     double cycleP50 = 0.0;  ///< s
     double cycleP90 = 0.0;
+    double utilisation = 0.0;
+    double queueMean = 0.0;
+    std::size_t queueMax = 0;
   };
   std::vector<StationLedger> stations;
   /// Where the robots waited on other robots: the "waiting on another robot" of `robotTime`, split
