@@ -230,7 +230,9 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
     }
   }
   dc.stationLoad = s.stationLoad;
-  if (byArrival) {
+  if (roads) {
+    // Admission by predicted arrival, and the queue wait in every assignment's cost (whenever the
+    // roadmap is built: reserved traffic's lines, roadmap travel cost, or arrival).
     // Unknown stations (not on the roadmap, or without a dock) are never reached: +infinity.
     const auto orNever = [](std::optional<double> v) { return v.value_or(kInfeasible); };
     dc.stationTimes.toStation = [roads, orNever](Vec2 from, const std::string& name) {

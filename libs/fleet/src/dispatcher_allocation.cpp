@@ -1,15 +1,18 @@
 #include "fleet/fleet/dispatcher.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <vector>
 
 #include "dispatcher_detail.hpp"
+#include "station_lines.hpp"
 
 namespace fleet {
 
@@ -88,6 +91,32 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
       }
       auto options = std::make_shared<const StationChooser::Options>(chooser->options(t, travel_));
       return [options, chooser](const RobotInfo& r) { return chooser->best(*options, r).travelS; };
+    };
+  }
+  if (cfg_.stationTimes.known()) {
+    // Expected queue wait (docs/algorithms.md, "Assignment: expected queue wait"): a transport task
+    // costs a robot its travel plus its wait in the task's two lines, so of two tasks as near the
+    // one whose stations are free goes first, and a robot that will get there after a line has
+    // cleared pays nothing for it. The lines as booked now (robots with a task), each robot's
+    // arrival at a pickup computed once.
+    auto lines = std::make_shared<StationLines>(bookLines());
+    auto arrivals = std::make_shared<std::unordered_map<std::string, double>>();
+    travel = [this, lines, arrivals, base = std::move(travel)](const Task& t) -> RobotTravel {
+      RobotTravel inner = base(t);
+      if (t.kind != TaskKind::Transport) {
+        return inner;
+      }
+      return [this, lines, arrivals, inner, &t](const RobotInfo& r) {
+        const double c = inner(r);
+        if (!std::isfinite(c)) {
+          return c;
+        }
+        auto [it, fresh] = arrivals->try_emplace(r.id + '\n' + t.pickup, 0.0);
+        if (fresh) {
+          it->second = cfg_.stationTimes.toStation(r.pose.position(), t.pickup);
+        }
+        return c + lines->expectedWait(t, it->second);
+      };
     };
   }
   if (!failedBy_.empty() && idle.size() > 1) {

@@ -16,31 +16,26 @@
 #include "fleet/fleet/dispatcher.hpp"
 
 #include "dispatcher_detail.hpp"
+#include "station_lines.hpp"
 
 namespace fleet {
 
 namespace {
 constexpr double kNever = std::numeric_limits<double>::infinity();
-
-struct Line {
-  std::vector<double> arrivals;  // s from now
-  double move = 0.0;             // s of the dock cycle without the dwell
-  std::size_t slots = 0;         // 0: no limit
-};
 }  // namespace
 
-std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Task>& waiting,
-                                                                  const std::vector<RobotInfo>& idle) const {
+StationLines::Line& StationLines::line(const std::string& s) {
+  auto [it, fresh] = lines_.try_emplace(s);
+  if (fresh) {
+    it->second.move = times_.dockMove(s);
+    it->second.slots = capacity_(s);
+  }
+  return it->second;
+}
+
+StationLines Dispatcher::bookLines() const {
   const StationTimes& times = cfg_.stationTimes;
-  std::unordered_map<std::string, Line> lines;
-  const auto line = [&](const std::string& s) -> Line& {
-    auto [it, fresh] = lines.try_emplace(s);
-    if (fresh) {
-      it->second.move = times.dockMove(s);
-      it->second.slots = capacityOf(s);
-    }
-    return it->second;
-  };
+  StationLines lines(times, [this](const std::string& s) { return capacityOf(s); });
   // Robots with a transport task not yet loaded: booked at their pickup first; their drop-off
   // arrival follows from when the pickup's line will have served them.
   struct Loading {
@@ -55,28 +50,36 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Ta
     const RobotInfo* robot = registry_.find(r.robotId);
     if (r.task.kind != TaskKind::Transport || robot == nullptr) {
       for (const std::string* s : taskStops(r.task)) {  // other tasks: every stop, from now on
-        line(*s).arrivals.push_back(0.0);
+        lines.line(*s).arrivals.push_back(0.0);
       }
       continue;
     }
     const Vec2 at = robot->pose.position();
     if (r.state == TaskState::Delivering || r.state == TaskState::Unloading) {
-      line(r.task.dropoff).arrivals.push_back(times.toStation(at, r.task.dropoff));
+      lines.line(r.task.dropoff).arrivals.push_back(times.toStation(at, r.task.dropoff));
     } else {
       const double a = times.toStation(at, r.task.pickup);
-      line(r.task.pickup).arrivals.push_back(a);
+      lines.line(r.task.pickup).arrivals.push_back(a);
       loading.push_back({&r.task, a});
     }
   }
   for (const auto& [t, a] : loading) {
-    Line& p = line(t->pickup);
+    auto& p = lines.line(t->pickup);
     std::vector<double> others = p.arrivals;
     if (const auto it = std::find(others.begin(), others.end(), a); it != others.end()) {
       others.erase(it);
     }
     const double leave = offerSlot(others, a, p.move + nsToSec(t->loadNs), 0).leave;
-    line(t->dropoff).arrivals.push_back(leave + times.between(t->pickup, t->dropoff));
+    lines.line(t->dropoff).arrivals.push_back(leave + times.between(t->pickup, t->dropoff));
   }
+  return lines;
+}
+
+std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Task>& waiting,
+                                                                  const std::vector<RobotInfo>& idle) const {
+  const StationTimes& times = cfg_.stationTimes;
+  StationLines lines = bookLines();
+  const auto line = [&](const std::string& s) -> StationLines::Line& { return lines.line(s); };
 
   // The nearest idle robot's arrival at each pickup, once per station.
   std::unordered_map<std::string, double> nearest;
@@ -111,7 +114,7 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Ta
       // Other kinds hold every stop from now on, as they are booked once active.
       const auto stops = taskStops(t);
       const auto full = std::find_if(stops.begin(), stops.end(), [&](const std::string* s) {
-        const Line& l = line(*s);
+        const auto& l = line(*s);
         return !offerSlot(l.arrivals, 0.0, l.move, l.slots).admitted;
       });
       if (full != stops.end()) {
@@ -124,14 +127,14 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByArrival(std::vector<Ta
       admitted.push_back(std::move(t));
       continue;
     }
-    Line& p = line(t.pickup);
+    auto& p = line(t.pickup);
     const double a = soonest(t.pickup);
     const SlotOffer atPickup = offerSlot(p.arrivals, a, p.move + nsToSec(t.loadNs), p.slots);
     if (!atPickup.admitted) {
       held.push_back({t.id, t.pickup, p.slots, true});
       continue;
     }
-    Line& d = line(t.dropoff);
+    auto& d = line(t.dropoff);
     const double ad = atPickup.leave + times.between(t.pickup, t.dropoff);
     if (!offerSlot(d.arrivals, ad, d.move + nsToSec(t.unloadNs), d.slots).admitted) {
       held.push_back({t.id, t.dropoff, d.slots, true});

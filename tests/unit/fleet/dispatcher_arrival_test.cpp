@@ -9,6 +9,7 @@
 
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/sqlite_task_store.hpp"
+#include "line_world.hpp"
 #include "temp_dir.hpp"
 
 namespace fleet {
@@ -25,13 +26,7 @@ StationMap stations() {
 }
 
 Task transport(std::string id, std::string dropoff = "D-1") {
-  Task t;
-  t.id = std::move(id);
-  t.pickup = "P-1";
-  t.dropoff = std::move(dropoff);
-  t.loadNs = 2'000'000'000;
-  t.unloadNs = 2'000'000'000;
-  return t;
+  return test::transportTask(std::move(id), "P-1", std::move(dropoff));
 }
 
 class DispatcherArrivalTest : public ::testing::Test {
@@ -39,21 +34,11 @@ class DispatcherArrivalTest : public ::testing::Test {
   void SetUp() override {
     cfg.stationLoad = StationLoad::Arrival;
     cfg.stationCapacities = {{"P-1", 1}, {"D-1", 1}, {"D-2", 1}};
-    const auto x = [this](const std::string& name) { return map.find(name)->pose.x; };
-    cfg.stationTimes.toStation = [x](Vec2 from, const std::string& name) {
-      return std::hypot(from.x - x(name), from.y);
-    };
-    cfg.stationTimes.between = [x](const std::string& a, const std::string& b) {
-      return std::abs(x(a) - x(b));
-    };
-    cfg.stationTimes.dockMove = [](const std::string&) { return 2.0; };
+    cfg.stationTimes = test::straightLineTimes(map);
     auto s = SqliteTaskStore::open({dir.file("tasks.db")});
     ASSERT_TRUE(s) << s.error().message;
     store = std::move(s).value();
-    const auto travel = [this](const RobotInfo& r, const Task& t) {
-      return std::abs(r.pose.x - map.find(t.pickup)->pose.x);
-    };
-    dispatcher = std::make_unique<Dispatcher>(*store, map, travel, cfg);
+    dispatcher = std::make_unique<Dispatcher>(*store, map, test::distanceToPickup(map), cfg);
   }
   void robot(const std::string& id, double x, std::int64_t t) {
     dispatcher->onRobotState({id, {x, 0, 0}, 0.9, t});

@@ -62,6 +62,10 @@ struct DispatcherConfig {
   /// drop-off's line one after it has loaded (needs `stationTimes`; docs/algorithms.md, "Admission
   /// by predicted arrival").
   StationLoad stationLoad = StationLoad::Task;
+  /// The roadmap's free-flow times. When known, besides admission by predicted arrival they price
+  /// the queues: a transport task costs a robot its travel plus the wait it would have in its
+  /// pickup's and its drop-off's lines behind the robots booked there (docs/algorithms.md,
+  /// "Assignment: expected queue wait").
   StationTimes stationTimes;
   /// A robot that fails this many tasks in a row gets no task for robotHoldNs: an agent that fails
   /// every order at once (a pose estimate inside a shelf after a restart) would otherwise burn
@@ -132,6 +136,8 @@ struct DispatcherCounters {
 /// The fleet manager's logic without DDS: owns the open tasks in memory, the robot registry and
 /// the allocation, and writes every change through the TaskStore before reporting it. Not
 /// thread-safe: the service calls it from one thread (or under one lock).
+class StationLines;  // dispatcher_arrival.cpp, src/station_lines.hpp
+
 class Dispatcher {
  public:
   Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg = {});
@@ -255,6 +261,9 @@ class Dispatcher {
   std::vector<HeldAtStation> admitByArrival(std::vector<Task>& waiting,
                                             const std::vector<RobotInfo>& idle) const;
   [[nodiscard]] std::size_t capacityOf(const std::string& station) const;
+  /// The robots with an active task booked in the lines of the stations they are bound for, at
+  /// their predicted arrival (needs `stationTimes`; dispatcher_arrival.cpp).
+  [[nodiscard]] StationLines bookLines() const;
   /// Says in their reason that (and where) the held tasks wait for a place in a station's line,
   /// and when one has waited past its deadline.
   void noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs, DispatchResult& out);
