@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <algorithm>
+#include <string>
 
 #include "fleet/site/site_loader.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -54,55 +55,61 @@ void stepOnTime(TrafficControl& tc) {
 TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
   // The earlier lattice (nodes beside shelf corners too), where the lane node in
   // front of PARK-1 has no way round the exit it excludes: the knot this test needs.
-  RoadmapOptions o;
-  o.nodeClearance = 0.0;
-  o.edgeClearance = 0.0;
-  o.parkingClear = false;  // the lanes beside the parking row, as a site without room for others has
-  Roadmap map = smallWarehouse(o);
-  const NodeId park = map.station("PARK-1")->dock;
-  // The lane node just right of the dock's exit (PARK-1 at (3, 0.9) is left by (3, 1.9)): it
-  // excludes the exit, and every node it can step to excludes the exit or the dock.
-  const NodeId exit = map.graph.edges(park)[0].to;
-  const NodeId front = map.nearest({3.25, 1.75});
-  ASSERT_TRUE(map.graph.conflicting(front, exit));
-  ASSERT_NE(front, kNoNode);
-  const std::vector<NodeId> starts{park, front};
-  const NodeId goal0 = map.station("P-4")->dock, goal1 = map.station("P-1")->dock;
-  // Evasion alone gets it off the dock, detours alone get both robots to their goals (the robot in
-  // front goes round the parked one's exit instead of waiting on it), so does the planner's
-  // untangling alone (a search over a few steps of both robots), and so do all together (the
-  // default); none of them: both stay for ever. (Evasion alone no longer gets both to their goals
-  // here since steps for robots the plan keeps standing are paced: they swap places back and forth.)
-  enum class Way { Neither, Evasion, Detour, Untangle, All };
-  for (Way way : {Way::Neither, Way::Evasion, Way::Detour, Way::Untangle, Way::All}) {
-    const bool evade = way != Way::Neither;
-    TrafficOptions opt;
-    if (way != Way::All) {
-      opt.evadeAfter = way == Way::Evasion ? 6 : 1000000;
-      opt.pibt.detourAfter = way == Way::Detour ? 4 : 0;
-      opt.pibt.untangleGroup = way == Way::Untangle ? 4 : 0;
-    }
-    TrafficControl tc(map.graph, starts, opt);
-    tc.setGoal(0, goal0);
-    tc.setGoal(1, goal1);
-    bool left = false;
-    for (int t = 0; t < 600; ++t) {
-      stepOnTime(tc);
-      left = left || tc.at(0) != park;
-    }
-    EXPECT_EQ(left, evade) << "way " << static_cast<int>(way);
-    if (way == Way::Detour || way == Way::Untangle || way == Way::All) {
-      EXPECT_TRUE(tc.arrived(0)) << "way " << static_cast<int>(way);
-      EXPECT_TRUE(tc.arrived(1)) << "way " << static_cast<int>(way);
-    }
-    if (way == Way::Evasion) {
-      EXPECT_GE(tc.stats().evasions, 1U);
-    }
-    if (way == Way::Detour) {
-      EXPECT_GE(tc.plannerStats().detours, 1U);
-    }
-    if (way == Way::Untangle) {
-      EXPECT_GE(tc.plannerStats().untangles, 1U);
+  // On the guided roadmap (the default) and the plain one: the evasion and the detour read their
+  // goal's table, which flow guidance prices.
+  for (const double guidance : {0.5, 0.0}) {
+    SCOPED_TRACE("guidance " + std::to_string(guidance));
+    RoadmapOptions o;
+    o.nodeClearance = 0.0;
+    o.edgeClearance = 0.0;
+    o.parkingClear = false;  // the lanes beside the parking row, as a site without room for others has
+    o.guidance = guidance;
+    Roadmap map = smallWarehouse(o);
+    const NodeId park = map.station("PARK-1")->dock;
+    // The lane node just right of the dock's exit (PARK-1 at (3, 0.9) is left by (3, 1.9)): it
+    // excludes the exit, and every node it can step to excludes the exit or the dock.
+    const NodeId exit = map.graph.edges(park)[0].to;
+    const NodeId front = map.nearest({3.25, 1.75});
+    ASSERT_TRUE(map.graph.conflicting(front, exit));
+    ASSERT_NE(front, kNoNode);
+    const std::vector<NodeId> starts{park, front};
+    const NodeId goal0 = map.station("P-4")->dock, goal1 = map.station("P-1")->dock;
+    // Evasion alone gets it off the dock, detours alone get both robots to their goals (the robot in
+    // front goes round the parked one's exit instead of waiting on it), so does the planner's
+    // untangling alone (a search over a few steps of both robots), and so do all together (the
+    // default); none of them: both stay for ever. (Evasion alone no longer gets both to their goals
+    // here since steps for robots the plan keeps standing are paced: they swap places back and forth.)
+    enum class Way { Neither, Evasion, Detour, Untangle, All };
+    for (Way way : {Way::Neither, Way::Evasion, Way::Detour, Way::Untangle, Way::All}) {
+      const bool evade = way != Way::Neither;
+      TrafficOptions opt;
+      if (way != Way::All) {
+        opt.evadeAfter = way == Way::Evasion ? 6 : 1000000;
+        opt.pibt.detourAfter = way == Way::Detour ? 4 : 0;
+        opt.pibt.untangleGroup = way == Way::Untangle ? 4 : 0;
+      }
+      TrafficControl tc(map.graph, starts, opt);
+      tc.setGoal(0, goal0);
+      tc.setGoal(1, goal1);
+      bool left = false;
+      for (int t = 0; t < 600; ++t) {
+        stepOnTime(tc);
+        left = left || tc.at(0) != park;
+      }
+      EXPECT_EQ(left, evade) << "way " << static_cast<int>(way);
+      if (way == Way::Detour || way == Way::Untangle || way == Way::All) {
+        EXPECT_TRUE(tc.arrived(0)) << "way " << static_cast<int>(way);
+        EXPECT_TRUE(tc.arrived(1)) << "way " << static_cast<int>(way);
+      }
+      if (way == Way::Evasion) {
+        EXPECT_GE(tc.stats().evasions, 1U);
+      }
+      if (way == Way::Detour) {
+        EXPECT_GE(tc.plannerStats().detours, 1U);
+      }
+      if (way == Way::Untangle) {
+        EXPECT_GE(tc.plannerStats().untangles, 1U);
+      }
     }
   }
 }
@@ -125,44 +132,48 @@ TEST(TrafficControl, ARobotBlockingADockExitIsSentAway) {
 /// up behind them after they are back and stands there: a knot of one robot and every parked robot
 /// west of it, larger than the search's group of four; docs/algorithms.md, "Bends driven round").
 TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
-  RoadmapOptions lanesBesideParking;
-  lanesBesideParking.parkingClear = false;
-  Roadmap map = smallWarehouse(lanesBesideParking);
-  const TwentyRobots fleet;
-  const auto index = [&](const std::string& n) { return fleet.index(n); };
-  const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
-  const NodeId behind = map.nearest({9.25, 1.75});  // r1
-  const NodeId front = map.nearest({8.25, 1.75});   // r7
-  const NodeId park6 = home("r6");
-  const NodeId r10 = map.station("PARK-10")->approach;  // r10 docks there, held
-  // The case: PARK-6 excludes every way west from r7's node, and its way out is excluded by it.
-  for (const Edge& e : map.graph.edges(front)) {
-    if (map.graph.position(e.to).x < map.graph.position(front).x) {
-      ASSERT_TRUE(map.graph.conflicting(e.to, park6)) << e.to;
+  for (const double guidance : {0.5, 0.0}) {  // the guided roadmap (the default) and the plain one
+    SCOPED_TRACE("guidance " + std::to_string(guidance));
+    RoadmapOptions lanesBesideParking;
+    lanesBesideParking.parkingClear = false;
+    lanesBesideParking.guidance = guidance;
+    Roadmap map = smallWarehouse(lanesBesideParking);
+    const TwentyRobots fleet;
+    const auto index = [&](const std::string& n) { return fleet.index(n); };
+    const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
+    const NodeId behind = map.nearest({9.25, 1.75});  // r1
+    const NodeId front = map.nearest({8.25, 1.75});   // r7
+    const NodeId park6 = home("r6");
+    const NodeId r10 = map.station("PARK-10")->approach;  // r10 docks there, held
+    // The case: PARK-6 excludes every way west from r7's node, and its way out is excluded by it.
+    for (const Edge& e : map.graph.edges(front)) {
+      if (map.graph.position(e.to).x < map.graph.position(front).x) {
+        ASSERT_TRUE(map.graph.conflicting(e.to, park6)) << e.to;
+      }
     }
+    ASSERT_EQ(map.graph.edges(park6).size(), 1U);
+    ASSERT_TRUE(map.graph.conflicting(map.graph.edges(park6)[0].to, front));
+    std::vector<NodeId> starts;
+    for (const auto& n : fleet.names)
+      starts.push_back(n == "r1" ? behind : n == "r7" ? front : n == "r10" ? r10 : home(n));
+    TrafficOptions options;
+    options.pibt.seed = 2;  // the traffic manager's in that run
+    TrafficControl tc(map.graph, starts, options);
+    tc.setStations(stationLines(map));
+    for (const auto& n : fleet.names)
+      tc.setGoal(index(n), n == "r7" ? map.station("P-2")->dock : home(n));
+    tc.setHeld(index("r10"), true);
+    const std::size_t a = index("r1"), b = index("r7");
+    const std::size_t c = index("r6");
+    for (int t = 0; t < 600 && !(tc.arrived(a) && tc.arrived(b) && tc.arrived(c)); ++t)
+      stepOnTime(tc);
+    EXPECT_TRUE(tc.arrived(b)) << "r7 " << tc.explain(b);
+    EXPECT_TRUE(tc.arrived(c)) << "r6 is not back at its place: " << tc.explain(c);
+    // r1 at least comes up to where r7 stood (home is better: a planner that unties the larger knot
+    // must not fail this).
+    EXPECT_TRUE(tc.arrived(a) || tc.at(a) == front) << "r1 " << tc.explain(a);
+    EXPECT_GE(tc.plannerStats().untangles, 1U);
   }
-  ASSERT_EQ(map.graph.edges(park6).size(), 1U);
-  ASSERT_TRUE(map.graph.conflicting(map.graph.edges(park6)[0].to, front));
-  std::vector<NodeId> starts;
-  for (const auto& n : fleet.names)
-    starts.push_back(n == "r1" ? behind : n == "r7" ? front : n == "r10" ? r10 : home(n));
-  TrafficOptions options;
-  options.pibt.seed = 2;  // the traffic manager's in that run
-  TrafficControl tc(map.graph, starts, options);
-  tc.setStations(stationLines(map));
-  for (const auto& n : fleet.names)
-    tc.setGoal(index(n), n == "r7" ? map.station("P-2")->dock : home(n));
-  tc.setHeld(index("r10"), true);
-  const std::size_t a = index("r1"), b = index("r7");
-  const std::size_t c = index("r6");
-  for (int t = 0; t < 600 && !(tc.arrived(a) && tc.arrived(b) && tc.arrived(c)); ++t)
-    stepOnTime(tc);
-  EXPECT_TRUE(tc.arrived(b)) << "r7 " << tc.explain(b);
-  EXPECT_TRUE(tc.arrived(c)) << "r6 is not back at its place: " << tc.explain(c);
-  // r1 at least comes up to where r7 stood (home is better: a planner that unties the larger knot
-  // must not fail this).
-  EXPECT_TRUE(tc.arrived(a) || tc.at(a) == front) << "r1 " << tc.explain(a);
-  EXPECT_GE(tc.plannerStats().untangles, 1U);
 }
 
 /// The stall of a full-stack load test run (2026-11-27, seed 5: r20, r7 and r11 stood from 206 s
@@ -176,49 +187,54 @@ TEST(TrafficControl, ARobotParkedAcrossTheLaneMakesRoomForTwoStandingInFront) {
 /// let r7 out two steps later. Nobody waited for anybody in a cycle, and r20 is not where it wants
 /// to be: neither the escape nor the untangling saw a knot.
 TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
-  Roadmap map = smallWarehouse();
-  const TwentyRobots fleet;
-  const auto index = [&](const std::string& n) { return fleet.index(n); };
-  const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
-  const auto* p5 = map.station("P-5");
-  const NodeId beside = map.nearest({25.75, 15.75});  // r20
-  const NodeId west = map.nearest({24.75, 15.75});    // r6
-  const NodeId queued = map.nearest({25.5, 13.75});   // r11, in P-5's queue
-  ASSERT_NE(std::find(p5->queue.begin(), p5->queue.end(), queued), p5->queue.end());
-  // Since stations became servers the dock is left by an exit of its own, not by its approach
-  // (docs/algorithms.md, "Traffic: stations as servers"): r20 beside the approach no longer shuts
-  // the way out. The run's places and lines are kept as a regression: nobody stalls.
-  ASSERT_EQ(map.graph.edges(p5->dock).size(), 1U);
-  ASSERT_EQ(map.graph.edges(p5->dock)[0].to, p5->exit);
-  std::vector<NodeId> starts;
-  for (const auto& n : fleet.names) {
-    starts.push_back(n == "r20"   ? beside
-                     : n == "r6"  ? west
-                     : n == "r7"  ? p5->dock
-                     : n == "r11" ? queued
-                                  : home(n));
+  for (const double guidance : {0.5, 0.0}) {  // the guided roadmap (the default) and the plain one
+    SCOPED_TRACE("guidance " + std::to_string(guidance));
+    RoadmapOptions o;
+    o.guidance = guidance;
+    Roadmap map = smallWarehouse(o);
+    const TwentyRobots fleet;
+    const auto index = [&](const std::string& n) { return fleet.index(n); };
+    const auto home = [&](const std::string& n) { return TwentyRobots::home(map, n); };
+    const auto* p5 = map.station("P-5");
+    const NodeId beside = map.nearest({25.75, 15.75});  // r20
+    const NodeId west = map.nearest({24.75, 15.75});    // r6
+    const NodeId queued = map.nearest({25.5, 13.75});   // r11, in P-5's queue
+    ASSERT_NE(std::find(p5->queue.begin(), p5->queue.end(), queued), p5->queue.end());
+    // Since stations became servers the dock is left by an exit of its own, not by its approach
+    // (docs/algorithms.md, "Traffic: stations as servers"): r20 beside the approach no longer shuts
+    // the way out. The run's places and lines are kept as a regression: nobody stalls.
+    ASSERT_EQ(map.graph.edges(p5->dock).size(), 1U);
+    ASSERT_EQ(map.graph.edges(p5->dock)[0].to, p5->exit);
+    std::vector<NodeId> starts;
+    for (const auto& n : fleet.names) {
+      starts.push_back(n == "r20"   ? beside
+                       : n == "r6"  ? west
+                       : n == "r7"  ? p5->dock
+                       : n == "r11" ? queued
+                                    : home(n));
+    }
+    TrafficOptions options;
+    options.pibt.seed = 5;  // the traffic manager's in that run
+    TrafficControl tc(map.graph, starts, options);
+    tc.setStations(stationLines(map));
+    for (const auto& n : fleet.names)
+      tc.setGoal(index(n), home(n));
+    const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
+    const NodeId d4 = map.station("D-4")->dock;
+    // The lines as they were: r7 on P-5's dock with r11 in line behind it, then sent on to D-1 (it
+    // leaves the dock first); r20 first in D-4's line, r6 after it.
+    tc.setGoal(r7, p5->dock);
+    tc.setGoal(r11, p5->dock);
+    tc.setGoal(r20, d4);
+    tc.setGoal(r6, d4);
+    tc.setGoal(r7, map.station("D-1")->dock);
+    ASSERT_EQ(tc.target(r11), queued);
+    for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t)
+      stepOnTime(tc);
+    EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
+    EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
+    EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
   }
-  TrafficOptions options;
-  options.pibt.seed = 5;  // the traffic manager's in that run
-  TrafficControl tc(map.graph, starts, options);
-  tc.setStations(stationLines(map));
-  for (const auto& n : fleet.names)
-    tc.setGoal(index(n), home(n));
-  const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
-  const NodeId d4 = map.station("D-4")->dock;
-  // The lines as they were: r7 on P-5's dock with r11 in line behind it, then sent on to D-1 (it
-  // leaves the dock first); r20 first in D-4's line, r6 after it.
-  tc.setGoal(r7, p5->dock);
-  tc.setGoal(r11, p5->dock);
-  tc.setGoal(r20, d4);
-  tc.setGoal(r6, d4);
-  tc.setGoal(r7, map.station("D-1")->dock);
-  ASSERT_EQ(tc.target(r11), queued);
-  for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t)
-    stepOnTime(tc);
-  EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
-  EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
-  EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
 }
 
 /// A lone robot released one node on (its goal was there), then given a goal behind it: the plan
