@@ -98,7 +98,7 @@ def stations_html(stations):
         f"<td class=\"r\">{s['cycle_p50_s']:.1f} / {s['cycle_p90_s']:.1f} ({s['cycles']})</td>"
         f"<td class=\"r\">{s['occupancy_p50_s']:.1f} / {s['occupancy_p90_s']:.1f}</td>{docking_cell(s)}</tr>" for s in stations)
     return f"""<h3>Stations</h3><table><tr><th>station</th><th>visits</th><th>utilisation (docked ÷ run)</th>
-<th>queue mean / max</th><th>queue over the run (0–{top})</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th>
+<th>queue mean / max</th><th>queue over the run (0–{max(1, top)})</th><th>dock cycle p50 / p90 [s] (cycles)</th><th>occupancy per visit p50 / p90 [s]</th>
 <th>docking p50 / p90 / max [s]</th></tr>{rows}</table>
 <p class="note">Docked: the robot's centre within 0.25 m of the station's pose. Queue: robots whose current goal is the
 station and are not docked there. Dock cycle: one robot's dock arrival to the next's, counted when the next stood in the

@@ -83,6 +83,11 @@ struct RoadmapBuilder {
   void buildLattice();
   enum class Join { Both, Out, In };
   int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how);
+  /// A station's entry or exit: edges that keep the corridor's clearance (`passes`) in the cone of
+  /// `dirs`, else such edges in any direction, and only then edges that clear the disc alone (in
+  /// the cone, then anywhere). A robot a few centimetres off its node on an edge that clears only
+  /// its disc is held there by the motion gate for good.
+  int joinClear(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how);
   int joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how, bool wide);
 
   // Queues keep a following distance from every station node placed so far.

@@ -225,6 +225,20 @@ int RoadmapBuilder::joinToLattice(NodeId v, const std::vector<Vec2>& dirs, doubl
   return joined > 0 ? joined : joinToLattice(v, dirs, cone, how, false);
 }
 
+int RoadmapBuilder::joinClear(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how) {
+  for (const bool wide : {true, false}) {
+    if (!dirs.empty()) {
+      if (const int joined = joinToLattice(v, dirs, cone, how, wide); joined > 0) {
+        return joined;
+      }
+    }
+    if (const int joined = joinToLattice(v, {}, 0.0, how, wide); joined > 0) {
+      return joined;
+    }
+  }
+  return 0;
+}
+
 int RoadmapBuilder::joinToLattice(NodeId v, const std::vector<Vec2>& dirs, double cone, Join how, bool wide) {
   const Vec2 p = pos[static_cast<std::size_t>(v)];
   std::vector<std::pair<double, NodeId>> near;

@@ -131,7 +131,7 @@ void RoadmapBuilder::placeStations() {
       // "Stations as servers").
       problem(RoadmapProblem::Severity::Warning, st.name, st.pose.position(),
               keyOf(st, "exit") + "station '" + st.name + "': no room for a way out apart from its way in " +
-                  "(give one, or room beside the approach point); left by its way in");
+                  "(give one in site.json); left by its way in");
     }
     if (e) {
       const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];
@@ -167,10 +167,9 @@ void RoadmapBuilder::placeStations() {
     // at neighbouring approach points do not drive at each other); a dock without one from any side.
     const NodeId entry = entryOf(sn);
     const Vec2 ep = pos[static_cast<std::size_t>(entry)];
-    int joined = inDirs.empty() ? 0 : joinToLattice(entry, inDirs, kCone, in);
-    if (joined == 0) {
-      joined = joinToLattice(entry, {}, 0.0, in);
-    }
+    // Clearance before direction (joinClear): a parking place below a shelf corner was joined up
+    // past the corner by an edge that cleared only the disc, and its robot stood there for good.
+    const int joined = joinClear(entry, inDirs, kCone, in);
     if (joined == 0) {
       std::ostringstream d;
       d << 3.0 * opt.spacing;
@@ -183,8 +182,7 @@ void RoadmapBuilder::placeStations() {
     if (sn.exit != kNoNode) {
       const Vec2 xp = pos[static_cast<std::size_t>(sn.exit)];
       const Vec2 out = (xp - dockAt).normalized();
-      if (joinToLattice(sn.exit, {out}, kCone, Join::Out) == 0 &&
-          joinToLattice(sn.exit, {}, 0.0, Join::Out) == 0) {
+      if (joinClear(sn.exit, {out}, kCone, Join::Out) == 0) {
         problem(RoadmapProblem::Severity::Error, st.name, xp,
                 keyOf(st, "exit") + "station '" + st.name + "': no lane node near its exit " +
                     detail::pointText(xp) +

@@ -160,10 +160,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   std::vector<std::size_t> visits(g.size(), 0);
   std::vector<std::vector<double>> cycles(g.size());
   // Utilisation and queue, as the load test's ledger counts them (docs/algorithms.md, "Robot-time and
-  // station ledgers"): docked = standing on the dock node; queue = robots whose goal is the dock and
-  // that do not stand on it. Per tick, robot-seconds and the largest count.
+  // station ledgers"): docked = some robot stands on the dock node, whatever its goal (one that has
+  // served and waits to leave too); queue = robots whose goal is the dock and that do not stand on
+  // it. Per tick, seconds docked, robot-seconds queued and the largest queue.
   std::vector<double> dockedS(g.size(), 0.0), queueS(g.size(), 0.0);
   std::vector<std::size_t> queueNow(g.size(), 0), queueMax(g.size(), 0);
+  std::vector<std::uint8_t> dockedNow(g.size(), 0);
+  std::size_t ticks = 0;
   // Whether another robot in the line of the station docked at `dock` stands on one of the line's
   // nodes (its queue places or its approach) as `r` leaves: only then is the next arrival the
   // station's own cycle, not the next robot's drive from afar.
@@ -475,24 +478,28 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     res.contacts += contactNow ? 1 : 0;
     res.holdViolations += holdNow ? 1 : 0;
+    ++ticks;
     for (std::size_t r = 0; r < o.robots; ++r) {
       const Bot& b = bots[r];
+      if (b.to == kNoNode)
+        dockedNow[static_cast<std::size_t>(b.at)] = 1;
       if (b.idle || b.pickup == kNoNode)
         continue;
       const auto goal = static_cast<std::size_t>(b.phase == 0 ? b.pickup : b.dropoff);
-      if (b.to == kNoNode && static_cast<std::size_t>(b.at) == goal)
-        dockedS[goal] += o.dt;
-      else
+      if (b.to != kNoNode || static_cast<std::size_t>(b.at) != goal)
         ++queueNow[goal];
     }
     for (const auto& st : roadmap.stations) {
       if (st.dock == kNoNode)
         continue;
       const auto d = static_cast<std::size_t>(st.dock);
+      dockedS[d] += dockedNow[d] != 0 ? o.dt : 0.0;
       queueS[d] += o.dt * static_cast<double>(queueNow[d]);
       queueMax[d] = std::max(queueMax[d], queueNow[d]);
       queueNow[d] = 0;
     }
+    for (std::size_t r = 0; r < o.robots; ++r)
+      dockedNow[static_cast<std::size_t>(bots[r].at)] = 0;
     if (o.recordEvery > 0.0 && now + 1e-9 >= nextFrame) {
       nextFrame += o.recordEvery;
       FleetFrame f;
@@ -573,8 +580,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       continue;
     const auto d = static_cast<std::size_t>(st.dock);
     const auto& c = cycles[d];
+    const double ran = static_cast<double>(ticks) * o.dt;  // the loop's own time (a tick over, at times)
     res.stations.push_back({st.name, visits[d], c.size(), percentile(c, 0.5), percentile(c, 0.9),
-                            dockedS[d] / o.duration, queueS[d] / o.duration, queueMax[d]});
+                            ran > 0.0 ? dockedS[d] / ran : 0.0, ran > 0.0 ? queueS[d] / ran : 0.0,
+                            queueMax[d]});
   }
   std::map<std::string, double> waits;
   for (std::size_t v = 0; v < g.size(); ++v) {

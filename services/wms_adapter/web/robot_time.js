@@ -75,6 +75,7 @@ export class RobotTimeCard {
       const bar = document.createElement('div');
       bar.className = 'stacked-bar';
       bar.dataset.robot = r.id;
+      bar.dataset.seconds = String(r.seconds || 0);  // 0: listed, nothing filed yet (an empty bar)
       RobotTimeCard.fill(bar, r);
       rows.append(name, bar);
     }

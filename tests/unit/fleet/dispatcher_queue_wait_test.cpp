@@ -21,7 +21,7 @@ namespace {
 StationMap stations() {
   StationMap m;
   EXPECT_TRUE(m.add({"P-1", {0, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
-  EXPECT_TRUE(m.add({"P-2", {4, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
+  EXPECT_TRUE(m.add({"P-2", {2, 0, 0}, static_cast<std::uint8_t>(StationKind::Pickup)}));
   EXPECT_TRUE(m.add({"D-1", {20, 0, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
   EXPECT_TRUE(m.add({"D-2", {24, 0, 0}, static_cast<std::uint8_t>(StationKind::Dropoff)}));
   return m;
@@ -70,18 +70,20 @@ class DispatcherQueueWaitTest : public ::testing::Test {
 };
 
 TEST_F(DispatcherQueueWaitTest, ANearTaskBehindABusyLineGoesAfterAFreeOneABitFurther) {
-  // r2 at x = 1: tA's pickup is 1 s away but r1 holds it until 4 s (a 3 s wait, then D-1 is free
-  // when it comes at 28): 1 + 3 = 4 s. tB's is 3 s away and free: 3 s. Travel alone picks tA.
+  // r2 at x = 0.5: tA's pickup is 0.5 s away but r1 holds it until 4 s (a 3.5 s wait, then D-1 is
+  // free when it comes at 28): 0.5 + 3.5 = 4 s. tB's is 1.5 s away and free: 1.5 s. Travel alone
+  // picks tA.
   start(false);
-  EXPECT_EQ(taskFor(1.0), "tA");
+  EXPECT_EQ(taskFor(0.5), "tA");
   dispatcher.reset();
   start(true);
-  EXPECT_EQ(taskFor(1.0), "tB");
+  EXPECT_EQ(taskFor(0.5), "tB");
 }
 
 TEST_F(DispatcherQueueWaitTest, ARobotThatGetsThereAfterTheLineHasClearedPaysNoWait) {
   // r2 at x = -10: 10 s from P-1 (clear from 4 s on, so no wait there, and at D-1 at 34 after r1
-  // left at 28) against 14 s from P-2. Counting robots bound for a station would charge tA for r1.
+  // left at 28) against 12 s from P-2: any wait of 2 s or more charged to tA would give it tB.
+  // Counting robots bound for a station would charge tA for r1 (4 s).
   start(true);
   EXPECT_EQ(taskFor(-10.0), "tA");
 }

@@ -1,5 +1,6 @@
 #include "scenario_gen.hpp"
 
+#include "fleet/site/reachability.hpp"
 #include "fleet/traffic/roadmap.hpp"
 
 #include <gtest/gtest.h>
@@ -82,7 +83,40 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 100, 500));
+// Every parking place is joined to the lanes by edges that keep the motion gate's corridor clear of
+// shelves (RoadmapOptions::edgeClearance), where such edges exist: on the site for 40, PARK-39
+// (15.7, 2.9) was joined from its approach up past the shelf corner at (15.5, 4.5) by the one edge
+// in front of it, which cleared the disc by 1.4 cm, and its robot stood at the approach for the
+// rest of the run, held by the shelf (2026-12-05, `fleetctl loadtest --robots 40 --seed 1` and 4).
+TEST_P(GeneratedScenario, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
+  const int n = GetParam();
+  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
+  ASSERT_TRUE(doc) << doc.error().message;
+  const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
+  ASSERT_NE(s.site, nullptr);
+  const traffic::Roadmap r = traffic::buildRoadmap(*s.site);
+  const auto drivable = s.site->drivable();
+  const double clear = r.options.radius + r.options.edgeClearance;
+  std::size_t checked = 0;
+  for (const auto& st : r.stations) {
+    if (st.kind != site::StationKind::Parking || st.dock == traffic::kNoNode) {
+      continue;
+    }
+    const traffic::NodeId entry = st.approach != traffic::kNoNode ? st.approach : st.dock;
+    for (const auto& e : r.graph.edges(entry)) {
+      if (r.kind(e.to) != traffic::NodeKind::Lane) {
+        continue;
+      }
+      ++checked;
+      EXPECT_TRUE(site::segmentFits(drivable, r.graph.position(entry), r.graph.position(e.to), clear))
+          << st.name << ": the edge to (" << r.graph.position(e.to).x << ", " << r.graph.position(e.to).y
+          << ") comes closer than " << clear << " m to a shelf or wall";
+    }
+  }
+  EXPECT_GT(checked, 0U);
+}
+
+INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 40, 100, 500));
 
 TEST(ScenarioGen, BiggerFleetsGetBiggerWarehouses) {
   double last = 0;

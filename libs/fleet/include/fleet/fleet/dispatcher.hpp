@@ -133,11 +133,11 @@ struct DispatcherCounters {
   std::int64_t charged = 0;     ///< charge tasks the dispatcher completed (battery reached chargeUntil)
 };
 
+class StationLines;  // dispatcher_arrival.cpp, src/station_lines.hpp
+
 /// The fleet manager's logic without DDS: owns the open tasks in memory, the robot registry and
 /// the allocation, and writes every change through the TaskStore before reporting it. Not
 /// thread-safe: the service calls it from one thread (or under one lock).
-class StationLines;  // dispatcher_arrival.cpp, src/station_lines.hpp
-
 class Dispatcher {
  public:
   Dispatcher(TaskStore& store, StationMap stations, TravelModel travel, DispatcherConfig cfg = {});

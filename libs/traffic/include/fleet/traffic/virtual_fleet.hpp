@@ -117,9 +117,9 @@ struct VirtualFleetResult {
   std::vector<FleetFrame> frames;  ///< when VirtualFleetOptions::recordEvery > 0
   /// The station ledger: per visited pickup and drop-off, its dock arrivals and its dock cycle —
   /// from one arrival to the next, counted when the next robot was in line as the last one left —
-  /// its utilisation (time a robot stood on the dock ÷ the run) and its queue (robots whose goal is
-  /// the dock and that do not stand on it: mean over the run and most at once), as a load test's
-  /// ledger counts them.
+  /// its utilisation (time some robot stood on the dock ÷ the run, whatever that robot's goal) and
+  /// its queue (robots whose goal is the dock and that do not stand on it: mean over the run and
+  /// most at once), as a load test's ledger counts them.
   struct StationLedger {
     std::string name;
     std::size_t visits = 0;
