@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <memory>
 #include <set>
+#include <stdexcept>
 
 #include "fleet/scenario/scenario.hpp"
 #include "scenario_tasks.hpp"
@@ -63,13 +65,26 @@ TEST_P(GeneratedScenario, LoadsInTheSimulatorAndFitsTheFleet) {
 // ways, and no station's full line cuts off another (traffic::checkQueues); and the site is
 // well-formed where robots rest: the lattice keeps clear of parked robots (no fall-back), in one
 // parking row (1, 20 robots) and in several (100, 500).
+/// The site generated for n robots (and n / 2 people) and the traffic manager's roadmap of it.
+struct GeneratedSite {
+  std::shared_ptr<const site::Site> site;
+  traffic::Roadmap roadmap;
+};
+GeneratedSite generatedSite(int n) {
+  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
+  if (!doc) {
+    throw std::runtime_error(doc.error().message);
+  }
+  const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
+  if (s.site == nullptr) {
+    throw std::runtime_error("the generated scenario has no site");
+  }
+  return {s.site, traffic::buildRoadmap(*s.site)};
+}
+
 TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
   const int n = GetParam();
-  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
-  ASSERT_TRUE(doc) << doc.error().message;
-  const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
-  ASSERT_NE(s.site, nullptr);
-  const traffic::Roadmap r = traffic::buildRoadmap(*s.site);
+  const auto [where, r] = generatedSite(n);
   for (const auto& p : r.problems) {
     EXPECT_NE(p.severity, traffic::RoadmapProblem::Severity::Error) << p.what;
   }
@@ -77,7 +92,7 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
       << n << " robots: the roadmap fell back to lanes beside the parked robots";
   if (!r.options.parkingClear) {
     // Why the lattice clear of parked robots was not taken: its errors.
-    for (const auto& p : traffic::detail::buildRoadmapOnce(*s.site, {}).problems) {
+    for (const auto& p : traffic::detail::buildRoadmapOnce(*where, {}).problems) {
       ADD_FAILURE() << p.what;
     }
   }
@@ -89,13 +104,8 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
 // in front of it, which cleared the disc by 1.4 cm, and its robot stood at the approach for the
 // rest of the run, held by the shelf (2026-12-05, `fleetctl loadtest --robots 40 --seed 1` and 4).
 TEST_P(GeneratedScenario, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
-  const int n = GetParam();
-  auto doc = generateScenario(smallTemplate(), {n, n / 2, 60, 3});
-  ASSERT_TRUE(doc) << doc.error().message;
-  const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
-  ASSERT_NE(s.site, nullptr);
-  const traffic::Roadmap r = traffic::buildRoadmap(*s.site);
-  const auto drivable = s.site->drivable();
+  const auto [where, r] = generatedSite(GetParam());
+  const auto drivable = where->drivable();
   const double clear = r.options.radius + r.options.edgeClearance;
   std::size_t checked = 0;
   for (const auto& st : r.stations) {
