@@ -103,7 +103,9 @@ TEST_P(GeneratedScenario, ItsRoadmapHasNoErrorsAndNoQueueCutsTheSite) {
 // (15.7, 2.9) was joined from its approach up past the shelf corner at (15.5, 4.5) by the one edge
 // in front of it, which cleared the disc by 1.4 cm, and its robot stood at the approach for the
 // rest of the run, held by the shelf (2026-12-05, `fleetctl loadtest --robots 40 --seed 1` and 4).
-TEST_P(GeneratedScenario, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
+class GeneratedParking : public ::testing::TestWithParam<int> {};
+
+TEST_P(GeneratedParking, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
   const auto [where, r] = generatedSite(GetParam());
   const auto drivable = where->drivable();
   const double clear = r.options.radius + r.options.edgeClearance;
@@ -127,6 +129,9 @@ TEST_P(GeneratedScenario, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 40, 100, 500));
+// Up to 100 robots: the site for 500 parks in the same blocks as the one for 100, and its roadmap
+// takes ~15 s to build on 2 cores.
+INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedParking, ::testing::Values(1, 20, 40, 100));
 
 TEST(ScenarioGen, BiggerFleetsGetBiggerWarehouses) {
   double last = 0;
