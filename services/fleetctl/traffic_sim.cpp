@@ -8,6 +8,9 @@
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <utility>
+#include <vector>
 
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/site_stations.hpp"
@@ -41,6 +44,63 @@ nlohmann::json virtualFleetBound(const site::Site& site, const traffic::Roadmap&
   if (!b)
     return {{"error", b.error().code + ": " + b.error().message}};
   return fleetBoundJson(*b, r.tasksPerHour, in.cruise, in.radius);
+}
+
+/// "  waiting on robots, on what: ..." (wait_cause.hpp), shares of the fleet's waiting, most first.
+std::string waitCausesLine(const traffic::VirtualFleetResult& r) {
+  static const std::map<traffic::WaitCause, const char*> kSaid = {
+      {traffic::WaitCause::SameWay, "one driving the same way"},
+      {traffic::WaitCause::HeadOn, "one driving head-on"},
+      {traffic::WaitCause::Across, "one driving across"},
+      {traffic::WaitCause::Standing, "one standing"},
+      {traffic::WaitCause::Dwelling, "one dwelling"},
+      {traffic::WaitCause::NoneNamed, "none named (the plan)"}};
+  double total = 0.0;
+  std::vector<std::pair<double, traffic::WaitCause>> v;
+  for (const auto c : traffic::kWaitCauses) {
+    total += r.waitCauses[static_cast<std::size_t>(c)];
+    v.emplace_back(r.waitCauses[static_cast<std::size_t>(c)], c);
+  }
+  std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::ostringstream os;
+  os << "  waiting on robots, on what:";
+  for (const auto& [sec, c] : v) {
+    if (total > 0.0 && sec > 0.0)
+      os << " " << kSaid.at(c) << " " << std::fixed << std::setprecision(0) << 100.0 * sec / total << " %;";
+  }
+  return os.str();
+}
+
+/// "  busiest queues (10 s each, ▁ 0 … █ 4): D-3 ▁▂▅█…; D-2 …": the two stations with the longest
+/// mean queue, their queue over the run on one scale; empty when no station had a queue.
+std::string busiestQueuesLine(const traffic::VirtualFleetResult& r) {
+  std::vector<const traffic::VirtualFleetResult::StationLedger*> by;
+  for (const auto& st : r.stations) {
+    if (st.queueMean > 0.0 && !st.queueSeries.empty())
+      by.push_back(&st);
+  }
+  if (by.empty())
+    return "";
+  std::stable_sort(by.begin(), by.end(),
+                   [](const auto* a, const auto* b) { return a->queueMean > b->queueMean; });
+  by.resize(std::min<std::size_t>(by.size(), 2));
+  double top = 0.0;
+  for (const auto* st : by)
+    top = std::max(top, *std::max_element(st->queueSeries.begin(), st->queueSeries.end()));
+  static const char* const kBars[] = {"\u2581", "\u2582", "\u2583", "\u2584",
+                                      "\u2585", "\u2586", "\u2587", "\u2588"};
+  std::ostringstream os;
+  os << "  busiest queues (" << std::fixed << std::setprecision(0) << by.front()->seriesEvery << " s each, "
+     << kBars[0] << " 0 \u2026 " << kBars[7] << " " << std::setprecision(1) << top << "):";
+  for (const auto* st : by) {
+    os << " " << st->name << " ";
+    for (const double q : st->queueSeries) {
+      const auto i = top > 0.0 ? static_cast<int>(std::lround(7.0 * q / top)) : 0;
+      os << kBars[std::clamp(i, 0, 7)];
+    }
+    os << ";";
+  }
+  return os.str();
 }
 
 nlohmann::json robotTimeJson(const traffic::VirtualFleetResult& r) {
@@ -193,8 +253,13 @@ int runTrafficSim(const TrafficSimOptions& o) {
                           {"dock_cycle_p90_s", st.cycleP90},
                           {"utilisation", st.utilisation},
                           {"queue_mean", st.queueMean},
-                          {"queue_max", st.queueMax}});
+                          {"queue_max", st.queueMax},
+                          {"queue_every_s", st.seriesEvery},
+                          {"queue_series", st.queueSeries}});
     }
+    nlohmann::json causes = nlohmann::json::object();
+    for (const auto c : traffic::kWaitCauses)
+      causes[traffic::toString(c)] = r.waitCauses[static_cast<std::size_t>(c)];
     const nlohmann::json driving = drivingPerTaskJson(r);
     nlohmann::json waits = nlohmann::json::array();
     for (const auto& w : r.waits)
@@ -202,6 +267,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     if (o.json) {
       all.push_back({{"seed", seed},
                      {"waits", waits},
+                     {"wait_causes", causes},
                      {"fleet_bound", bound},
                      {"robot_time", robotTime},
                      {"driving_per_task", driving},
@@ -256,8 +322,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
         for (std::size_t i = 0; i < r.waits.size() && i < 8; ++i)
           std::cout << " " << r.waits[i].place << " " << std::setprecision(0)
                     << 100.0 * r.waits[i].seconds / waited << " %;";
-        std::cout << "\n";
+        std::cout << "\n" << waitCausesLine(r) << "\n";
       }
+      if (const std::string q = busiestQueuesLine(r); !q.empty())
+        std::cout << q << "\n";
       for (const auto& s : r.stalls)
         std::cout << "  stalled: " << s << "\n";
     }

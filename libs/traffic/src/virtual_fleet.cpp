@@ -14,6 +14,7 @@
 
 #include "fleet/traffic/roadmap_travel.hpp"
 #include "fleet/traffic/station_book.hpp"
+#include "station_tally.hpp"
 
 namespace fleet::traffic {
 namespace {
@@ -39,15 +40,6 @@ struct Bot {
   double driven = 0.0;      // s driven on the task so far (turns and docking included)
   double drivenAway = 0.0;  // s of it on edges that brought the robot no nearer its goal
 };
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty())
-    return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(
-      std::min<double>(static_cast<double>(v.size() - 1), std::floor(p * static_cast<double>(v.size()))));
-  return v[i];
-}
 
 }  // namespace
 
@@ -152,36 +144,16 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   TrafficControl traffic(g, starts, topt);
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
-  // The station ledger: dock arrivals, and the dock cycle from one arrival to the next, counted
-  // when the next robot stood in the station's line (a queue place or the approach) as the last one
-  // left (station_cycle.hpp's quantity: enter from the queue head, dwell, leave).
-  std::vector<double> lastArrival(g.size(), -1.0);
-  std::vector<std::uint8_t> queuedAtLeave(g.size(), 0);
-  std::vector<std::size_t> visits(g.size(), 0);
-  std::vector<std::vector<double>> cycles(g.size());
-  // Utilisation and queue, as the load test's ledger counts them (docs/algorithms.md, "Robot-time and
-  // station ledgers"): docked = some robot stands on the dock node, whatever its goal (one that has
-  // served and waits to leave too); queue = robots whose goal is the dock and that do not stand on
-  // it. Per tick, seconds docked, robot-seconds queued and the largest queue.
-  std::vector<double> dockedS(g.size(), 0.0), queueS(g.size(), 0.0);
-  std::vector<std::size_t> queueNow(g.size(), 0), queueMax(g.size(), 0);
-  std::vector<std::uint8_t> dockedNow(g.size(), 0);
-  std::size_t ticks = 0;
+  // The station ledger (station_tally.hpp).
+  if (!(o.queueSeriesEvery > 0.0 && std::isfinite(o.queueSeriesEvery)))
+    throw std::invalid_argument("virtual fleet: queueSeriesEvery must be a finite number > 0");
+  StationTally tally(roadmap, o.queueSeriesEvery);
+  std::vector<Bot> bots(o.robots);
   // Whether another robot in the line of the station docked at `dock` stands on one of the line's
   // nodes (its queue places or its approach) as `r` leaves: only then is the next arrival the
   // station's own cycle, not the next robot's drive from afar.
-  std::vector<std::vector<NodeId>> lineNodes(g.size());
-  for (const auto& s : roadmap.stations) {
-    if (s.dock == kNoNode)
-      continue;
-    auto& nodes = lineNodes[static_cast<std::size_t>(s.dock)];
-    nodes = s.queue;
-    if (s.approach != kNoNode)
-      nodes.push_back(s.approach);
-  }
-  std::vector<Bot> bots(o.robots);
   auto nextStandsInLine = [&](std::size_t r, NodeId dock) {
-    const auto& nodes = lineNodes[static_cast<std::size_t>(dock)];
+    const auto& nodes = tally.lineNodes(dock);
     for (std::size_t q : traffic.line(dock)) {
       if (q != r && bots[q].to == kNoNode && std::find(nodes.begin(), nodes.end(), bots[q].at) != nodes.end())
         return true;
@@ -326,10 +298,36 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   double nextFrame = 0.0;
   double tDrive = 0.0, tDwell = 0.0, tWait = 0.0, tStand = 0.0;
 
+  std::vector<NodeId> standing, queued;
+  // What robot r, standing with a task, waits on (wait_cause.hpp): the robot the execution names
+  // first, and r's next node (released or planned).
+  std::vector<Release> rel(o.robots);
+  auto waitCause = [&](std::size_t r) {
+    const Bot& b = bots[r];
+    WaitSeen seen;
+    seen.at = g.position(b.at);
+    const auto& base = rel[r].base;
+    const auto it = std::find(base.begin(), base.end(), b.at);
+    const NodeId next = it != base.end() && it + 1 != base.end() ? *(it + 1)
+                        : !rel[r].horizon.empty()                ? rel[r].horizon.front()
+                                                                 : kNoNode;
+    if (next != kNoNode)
+      seen.way = g.position(next) - seen.at;
+    const auto on = traffic.waitingOn(r);
+    seen.named = !on.empty();
+    if (seen.named) {
+      const Bot& q = bots[on.front()];
+      seen.otherAt = g.position(q.at);
+      seen.otherDriving = q.to != kNoNode;
+      if (seen.otherDriving)
+        seen.otherWay = g.position(q.to) - g.position(q.at);
+      seen.otherDwelling = q.dwellLeft > 0.0;
+    }
+    return classifyWait(seen);
+  };
   for (double now = 0.0; now < o.duration; now += o.dt) {
     const auto t0 = std::chrono::steady_clock::now();
     traffic.update();
-    std::vector<Release> rel(o.robots);
     for (std::size_t r = 0; r < o.robots; ++r)
       rel[r] = traffic.release(r);
     updateMs.push_back(
@@ -348,7 +346,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         if (b.dwellLeft > 0.0)
           continue;
         traffic.setHeld(r, false);
-        queuedAtLeave[static_cast<std::size_t>(b.at)] = nextStandsInLine(r, b.at) ? 1 : 0;
+        tally.left(b.at, nextStandsInLine(r, b.at));
         if (b.phase == 0) {
           b.phase = 1;
           --uses[static_cast<std::size_t>(b.pickup)];  // loaded: its pickup slot is free
@@ -396,12 +394,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
           b.at == traffic.goal(r)) {
         b.dwellLeft = o.dwell;
         traffic.setHeld(r, true);
-        const auto d = static_cast<std::size_t>(b.at);
-        ++visits[d];
-        if (lastArrival[d] >= 0.0 && queuedAtLeave[d] != 0)
-          cycles[d].push_back(now - lastArrival[d]);
-        lastArrival[d] = now;
-        queuedAtLeave[d] = 0;
+        tally.arrived(b.at, now);
       }
       if (b.to != kNoNode)
         tDrive += o.dt;
@@ -419,6 +412,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       } else {
         res.robotTime[r].add(RobotActivity::WaitingOnRobot, o.dt);
         waitedAt[static_cast<std::size_t>(b.at)] += o.dt;
+        res.waitCauses[static_cast<std::size_t>(waitCause(r))] += o.dt;
       }
       // Spend the tick: a stop first (the edge goes on once the person has passed), then the edge,
       // then the next released edges.
@@ -478,28 +472,19 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     res.contacts += contactNow ? 1 : 0;
     res.holdViolations += holdNow ? 1 : 0;
-    ++ticks;
+    standing.clear();
+    queued.clear();
     for (std::size_t r = 0; r < o.robots; ++r) {
       const Bot& b = bots[r];
       if (b.to == kNoNode)
-        dockedNow[static_cast<std::size_t>(b.at)] = 1;
+        standing.push_back(b.at);
       if (b.idle || b.pickup == kNoNode)
         continue;
-      const auto goal = static_cast<std::size_t>(b.phase == 0 ? b.pickup : b.dropoff);
-      if (b.to != kNoNode || static_cast<std::size_t>(b.at) != goal)
-        ++queueNow[goal];
+      const NodeId goal = b.phase == 0 ? b.pickup : b.dropoff;
+      if (b.to != kNoNode || b.at != goal)
+        queued.push_back(goal);
     }
-    for (const auto& st : roadmap.stations) {
-      if (st.dock == kNoNode)
-        continue;
-      const auto d = static_cast<std::size_t>(st.dock);
-      dockedS[d] += dockedNow[d] != 0 ? o.dt : 0.0;
-      queueS[d] += o.dt * static_cast<double>(queueNow[d]);
-      queueMax[d] = std::max(queueMax[d], queueNow[d]);
-      queueNow[d] = 0;
-    }
-    for (std::size_t r = 0; r < o.robots; ++r)
-      dockedNow[static_cast<std::size_t>(bots[r].at)] = 0;
+    tally.tick(o.dt, standing, queued);
     if (o.recordEvery > 0.0 && now + 1e-9 >= nextFrame) {
       nextFrame += o.recordEvery;
       FleetFrame f;
@@ -575,16 +560,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.passes = traffic.stats().passes;
   for (std::size_t r = 0; r < traffic.robots(); ++r)
     res.baseEnds += traffic.baseEnds(r);
-  for (const auto& st : roadmap.stations) {
-    if (st.dock == kNoNode || visits[static_cast<std::size_t>(st.dock)] == 0)
-      continue;
-    const auto d = static_cast<std::size_t>(st.dock);
-    const auto& c = cycles[d];
-    const double ran = static_cast<double>(ticks) * o.dt;  // the loop's own time (a tick over, at times)
-    res.stations.push_back({st.name, visits[d], c.size(), percentile(c, 0.5), percentile(c, 0.9),
-                            ran > 0.0 ? dockedS[d] / ran : 0.0, ran > 0.0 ? queueS[d] / ran : 0.0,
-                            queueMax[d]});
-  }
+  res.stations = tally.ledger();
   std::map<std::string, double> waits;
   for (std::size_t v = 0; v < g.size(); ++v) {
     if (waitedAt[v] > 0.0)
@@ -594,8 +570,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     res.waits.push_back({p, sec});
   std::stable_sort(res.waits.begin(), res.waits.end(),
                    [](const auto& a, const auto& b) { return a.seconds > b.seconds; });
-  res.updateP50Ms = percentile(updateMs, 0.5);
-  res.updateP99Ms = percentile(updateMs, 0.99);
+  res.updateP50Ms = nearestRankPercentile(updateMs, 0.5);
+  res.updateP99Ms = nearestRankPercentile(updateMs, 0.99);
   if (o.robots < 2)
     res.minSeparation = 0.0;
   return res;

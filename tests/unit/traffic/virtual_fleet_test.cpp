@@ -51,6 +51,30 @@ std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
       waits += w.seconds;
     }
     EXPECT_NEAR(waits, waited, 1e-6 * (1.0 + waited));
+    // ... and by what the robot waited on did, nothing lost or added either.
+    double caused = 0.0;
+    for (const double c : r.waitCauses) {
+      EXPECT_GE(c, 0.0);
+      caused += c;
+    }
+    EXPECT_NEAR(caused, waited, 1e-6 * (1.0 + waited));
+    // The station ledger's queue series: one mean per queueSeriesEvery s, the last over what was
+    // left; weighted by their spans they give the run's mean queue, and none is above the most.
+    const double ran = r.robotTime.front().total();
+    for (const auto& st : r.stations) {
+      SCOPED_TRACE(st.name);
+      EXPECT_EQ(st.seriesEvery, o.queueSeriesEvery);
+      EXPECT_EQ(st.queueSeries.size(), static_cast<std::size_t>(std::ceil(ran / o.queueSeriesEvery - 1e-6)));
+      double sum = 0.0;
+      for (std::size_t i = 0; i < st.queueSeries.size(); ++i) {
+        const double span =  // the last one over what was left of the run
+            i + 1 < st.queueSeries.size() ? o.queueSeriesEvery
+                                          : ran - o.queueSeriesEvery * static_cast<double>(i);
+        sum += st.queueSeries[i] * span;
+        EXPECT_LE(st.queueSeries[i], static_cast<double>(st.queueMax) + 1e-9);
+      }
+      EXPECT_NEAR(sum / ran, st.queueMean, 1e-6);
+    }
     // Driving per task: part of the robots' driving, turning and docking, and on an unguided
     // roadmap never less than the free flow of the way made (every edge takes at least its
     // duration, and a table's distances fall by at most an edge's duration along it; float tables:
@@ -313,6 +337,31 @@ TEST(VirtualFleet, ALoneRobot) {
   std::cout << formatResult(r) << "\n";
   EXPECT_GT(r.tasksDone, 10U);
   EXPECT_EQ(r.refusedReports, 0U);
+  // Nobody to wait on: what standing it does with a task is the plan's own (none named).
+  for (const auto c : kWaitCauses) {
+    if (c != WaitCause::NoneNamed) {
+      EXPECT_EQ(r.waitCauses[static_cast<std::size_t>(c)], 0.0) << toString(c);
+    }
+  }
+}
+
+/// Twenty robots on the small warehouse wait on each other in every way the split names (following
+/// down a lane, meeting head-on, at crossings, behind robots standing). Bad input: a span for the
+/// queue series that is not a positive number is refused.
+TEST(VirtualFleet, TwentyRobotsWaitOnEachOtherInEveryWay) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  o.seed = 1;
+  const auto r = runVirtualFleet(map, o);
+  SCOPED_TRACE(formatResult(r));
+  for (const auto c : {WaitCause::SameWay, WaitCause::HeadOn, WaitCause::Across, WaitCause::Standing})
+    EXPECT_GT(r.waitCauses[static_cast<std::size_t>(c)], 10.0) << toString(c);
+  for (const double every : {0.0, -1.0, std::nan("")}) {
+    o.queueSeriesEvery = every;
+    EXPECT_THROW(runVirtualFleet(map, o), std::invalid_argument) << every;
+  }
 }
 
 /// Driving per task against free flow: a lone robot without stops or jitter drives every task

@@ -12,6 +12,7 @@
 // It answers "how good is the plan and its execution" in milliseconds per simulated minute, and is
 // the reference the full-stack figures are compared with.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "fleet/core/robot_activity.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/traffic_control.hpp"
+#include "fleet/traffic/wait_cause.hpp"
 
 namespace fleet::traffic {
 
@@ -49,6 +51,8 @@ struct VirtualFleetOptions {
   std::vector<std::string> stations;
   /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
   double recordEvery = 0.0;
+  /// s over which each station's queue is averaged for its series (StationLedger::queueSeries).
+  double queueSeriesEvery = 10.0;
   TrafficOptions traffic;
 };
 
@@ -129,6 +133,10 @@ struct VirtualFleetResult {
     double utilisation = 0.0;
     double queueMean = 0.0;
     std::size_t queueMax = 0;
+    /// The queue over the run: its mean over each `seriesEvery` s, in order (the last one over
+    /// what was left of the run, when that is shorter).
+    std::vector<double> queueSeries;
+    double seriesEvery = 0.0;
   };
   std::vector<StationLedger> stations;
   /// Where the robots waited on other robots: the "waiting on another robot" of `robotTime`, split
@@ -138,6 +146,9 @@ struct VirtualFleetResult {
     double seconds = 0.0;  ///< robot-seconds
   };
   std::vector<WaitPlace> waits;
+  /// The same waiting split by what the robot waited on did (wait_cause.hpp), in kWaitCauses'
+  /// order: robot-seconds, adding up to the fleet's waiting time.
+  std::array<double, kWaitCauses.size()> waitCauses{};
   /// Driving per task (docs/algorithms.md, "Driving per task"), summed over the tasks done and those
   /// under way at the end: the seconds their robots drove (turns and docking included, stops for
   /// people not); the free-flow seconds of the way they made (from where the robot was when it took
