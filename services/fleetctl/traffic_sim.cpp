@@ -103,6 +103,48 @@ std::string busiestQueuesLine(const traffic::VirtualFleetResult& r) {
   return os.str();
 }
 
+/// The fleet against lone robots as they drive here (docs/algorithms.md, "Fleet bound": against a
+/// lone robot as it drives): one virtual robot runs the fleet's drawn list in order, chained, with
+/// the same jitter, people and turns; robots × its rate is what the fleet would do if robots never
+/// met. Its share of the fleet bound's ideal motion says what the robot model costs a lone robot.
+nlohmann::json loneAsItDrives(traffic::Roadmap& roadmap, const traffic::VirtualFleetOptions& fleet,
+                              const traffic::VirtualFleetResult& r, const nlohmann::json& bound) {
+  if (r.tasks.empty())
+    return {{"error", "the fleet drew no task"}};
+  traffic::VirtualFleetOptions v = fleet;
+  v.robots = 1;
+  v.list = r.tasks;
+  v.recordEvery = 0.0;
+  // Long enough for any list: a lone robot takes about a minute a task on the shipped sites.
+  v.duration = 3600.0 * static_cast<double>(r.tasks.size());
+  const auto lone = traffic::runVirtualFleet(roadmap, v);
+  if (lone.tasksDone < r.tasks.size())
+    return {{"error", "the lone robot did not finish the list"}};
+  const double perH = lone.tasksPerHour;
+  const double robotsPerH = perH * static_cast<double>(r.robots);
+  const double ideal = bound.value("lone_rate_per_h", 0.0);
+  const auto round3 = [](double x) { return std::round(x * 1000.0) / 1000.0; };
+  return {{"tasks", r.tasks.size()},
+          {"lone_s", round3(lone.duration)},
+          {"lone_rate_per_h", round3(perH)},
+          {"of_ideal_motion", ideal > 0.0 ? round3(perH / ideal) : 0.0},
+          {"robots_rate_per_h", round3(robotsPerH)},
+          {"fraction", robotsPerH > 0.0 ? round3(r.tasksPerHour / robotsPerH) : 0.0}};
+}
+
+std::string loneAsItDrivesLine(const nlohmann::json& l) {
+  if (l.contains("error"))
+    return "  against lone robots as they drive: " + l["error"].get<std::string>();
+  char buf[240];
+  std::snprintf(
+      buf, sizeof buf,
+      "  against lone robots as they drive: %.0f %% of robots x a lone robot's %.1f/h on this list as it "
+      "drives here (%.0f %% of its ideal motion)",
+      100.0 * l.value("fraction", 0.0), l.value("lone_rate_per_h", 0.0),
+      100.0 * l.value("of_ideal_motion", 0.0));
+  return buf;
+}
+
 nlohmann::json robotTimeJson(const traffic::VirtualFleetResult& r) {
   ActivityLedger fleet;
   nlohmann::json per = nlohmann::json::array();
@@ -243,6 +285,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
       }
     }
     const nlohmann::json bound = virtualFleetBound(*site, roadmap, r, v.dwell);
+    const nlohmann::json lone = loneAsItDrives(roadmap, v, r, bound);
     const nlohmann::json robotTime = robotTimeJson(r);
     nlohmann::json stations = nlohmann::json::array();
     for (const auto& st : r.stations) {
@@ -269,6 +312,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"waits", waits},
                      {"wait_causes", causes},
                      {"fleet_bound", bound},
+                     {"lone_as_it_drives", lone},
                      {"robot_time", robotTime},
                      {"driving_per_task", driving},
                      {"stations", stations},
@@ -301,7 +345,9 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"stalls", r.stalls}});
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";
-      std::cout << "  " << fleetBoundLine(bound) << "\n" << robotTimeLine(robotTime) << "\n";
+      std::cout << "  " << fleetBoundLine(bound) << "\n"
+                << loneAsItDrivesLine(lone) << "\n"
+                << robotTimeLine(robotTime) << "\n";
       std::cout << "  " << drivingPerTaskLine(driving) << "\n";
       std::cout << "  stations:";
       for (const auto& st : r.stations) {

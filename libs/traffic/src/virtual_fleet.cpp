@@ -112,6 +112,14 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
             ? "virtual fleet: the roadmap needs a pickup and a drop-off station"
             : "virtual fleet: the stations chosen hold no pickup or no drop-off on the roadmap");
   }
+  for (const auto& t : o.list) {
+    if (std::find(pickups.begin(), pickups.end(), t.pickup) == pickups.end() ||
+        std::find(dropoffs.begin(), dropoffs.end(), t.dropoff) == dropoffs.end()) {
+      throw std::invalid_argument("virtual fleet: list task " + std::to_string(&t - o.list.data()) + " (" +
+                                  std::to_string(t.pickup) + " -> " + std::to_string(t.dropoff) +
+                                  ") is not from a pickup's dock to a drop-off's on the roadmap");
+    }
+  }
   // Starts: parking docks, then lane nodes that conflict with nothing taken so far.
   std::vector<NodeId> starts;
   auto fits = [&](NodeId v) {
@@ -219,7 +227,14 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   // A task for robot r: without admission any pickup and drop-off; by slots, any with a free slot;
   // by arrival, the pickups in a random order, the first whose line has a place for r's arrival and
   // some drop-off one after it.
+  std::size_t listed = 0;  // o.list's tasks given so far
   auto drawTask = [&](const Bot& b, double now) -> std::pair<NodeId, NodeId> {
+    if (!o.list.empty()) {
+      if (listed == o.list.size())
+        return {kNoNode, kNoNode};
+      const auto& t = o.list[listed++];
+      return {t.pickup, t.dropoff};
+    }
     if (o.admission == Admission::None) {
       const NodeId p = pickups[rng() % pickups.size()];
       return {p, dropoffs[rng() % dropoffs.size()]};
@@ -325,6 +340,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     return classifyWait(seen);
   };
+  double ranUntil = o.duration;  // a list's run ends when its last task is done
   for (double now = 0.0; now < o.duration; now += o.dt) {
     const auto t0 = std::chrono::steady_clock::now();
     traffic.update();
@@ -497,6 +513,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       }
       res.frames.push_back(std::move(f));
     }
+    if (!o.list.empty() && res.tasksDone == o.list.size()) {
+      ranUntil = now + o.dt;
+      break;
+    }
   }
   // Driving per task counts the tasks under way at the end too, with the free-flow way they have
   // made (their free flow less what is left of it) and that share of a task: a short run would
@@ -517,11 +537,11 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   }
   for (std::size_t r = 0; r < o.robots; ++r) {
     const Bot& b = bots[r];
-    if (o.duration - b.lastProgress < 60.0)
+    if (ranUntil - b.lastProgress < 60.0)
       continue;
     std::ostringstream os;
     os << "robot " << r << " at node " << b.at << " (" << g.position(b.at).x << ", " << g.position(b.at).y
-       << ") for " << (o.duration - b.lastProgress) << " s, goal " << traffic.goal(r) << ", held "
+       << ") for " << (ranUntil - b.lastProgress) << " s, goal " << traffic.goal(r) << ", held "
        << traffic.held(r) << ", planned " << traffic.execution().pendingNodes(r)
        << " nodes ahead, released to " << traffic.execution().releasedEnd(r) << ", waiting on";
     for (auto q : traffic.waitingOn(r))
@@ -539,7 +559,8 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     }
     res.stalls.push_back(os.str());
   }
-  res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / o.duration;
+  res.duration = ranUntil;
+  res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / ranUntil;
   if (const double total = tDrive + tDwell + tWait + tStand; total > 0.0) {
     res.driving = tDrive / total;
     res.dwelling = tDwell / total;

@@ -22,6 +22,14 @@ Roadmap smallWarehouse(RoadmapOptions options = {}) {
   return buildRoadmap(test::shipped("small_warehouse.site.json"), options);
 }
 
+VirtualFleetOptions twentyRobotsFor300s(std::uint64_t seed) {
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  o.seed = seed;
+  return o;
+}
+
 /// Robots follow the releases, late at random. What holds whatever the planner does: no two robots
 /// ever hold conflicting nodes, their centres keep the contact distance, no report is refused.
 /// (How much work they get done is the planner's business: measured in docs/benchmarks.md.)
@@ -345,15 +353,48 @@ TEST(VirtualFleet, ALoneRobot) {
   }
 }
 
+/// A list run: the robots take the list's tasks in order, whatever the admission, and the run ends
+/// when the last one is done. One robot on a fleet's drawn list is that list's lone robot as it
+/// drives here: it does the whole list, in order, at a lone robot's rate (the same robot model;
+/// `fleetctl traffic-sim` divides the fleet by robots × its rate). A list naming a node that is no
+/// pickup's or drop-off's dock is refused.
+TEST(VirtualFleet, ALoneRobotRunsAFleetsListInOrderAndStopsWhenItIsDone) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o = twentyRobotsFor300s(2);
+  const auto fleet = runVirtualFleet(map, o);
+  ASSERT_GT(fleet.tasks.size(), 20U);
+
+  VirtualFleetOptions lone = o;
+  lone.robots = 1;
+  lone.list = fleet.tasks;
+  lone.duration = 1e6;
+  const auto r = runVirtualFleet(map, lone);
+  SCOPED_TRACE(formatResult(r));
+  ASSERT_EQ(r.tasks.size(), fleet.tasks.size());
+  for (std::size_t i = 0; i < r.tasks.size(); ++i) {
+    EXPECT_EQ(r.tasks[i].pickup, fleet.tasks[i].pickup) << i;
+    EXPECT_EQ(r.tasks[i].dropoff, fleet.tasks[i].dropoff) << i;
+  }
+  EXPECT_EQ(r.tasksDone, fleet.tasks.size());
+  EXPECT_LT(r.duration, lone.duration);  // ended with the list, not the cap
+  EXPECT_NEAR(r.tasksPerHour, 3600.0 * static_cast<double>(r.tasksDone) / r.duration, 1e-9);
+  EXPECT_NEAR(r.robotTime.front().total(), r.duration, lone.dt + 1e-6);
+  // A lone robot on the small warehouse does a task in about a minute (54/h over 600 s, 16 seeds):
+  // the list's rate is the robot's, not the fleet's.
+  EXPECT_GT(r.tasksPerHour, 35.0);
+  EXPECT_LT(r.tasksPerHour, 75.0);
+  EXPECT_GT(static_cast<double>(r.robots) * r.tasksPerHour * 20.0, fleet.tasksPerHour);
+
+  lone.list.front().pickup = fleet.tasks.front().dropoff;  // a drop-off's dock as the pickup
+  EXPECT_THROW(runVirtualFleet(map, lone), std::invalid_argument);
+}
+
 /// Twenty robots on the small warehouse wait on each other in every way the split names (following
 /// down a lane, meeting head-on, at crossings, behind robots standing). Bad input: a span for the
 /// queue series that is not a positive number is refused.
 TEST(VirtualFleet, TwentyRobotsWaitOnEachOtherInEveryWay) {
   Roadmap map = smallWarehouse();
-  VirtualFleetOptions o;
-  o.robots = 20;
-  o.duration = 300.0;
-  o.seed = 1;
+  VirtualFleetOptions o = twentyRobotsFor300s(1);
   const auto r = runVirtualFleet(map, o);
   SCOPED_TRACE(formatResult(r));
   for (const auto c : {WaitCause::SameWay, WaitCause::HeadOn, WaitCause::Across, WaitCause::Standing})

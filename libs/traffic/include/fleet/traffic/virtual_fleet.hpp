@@ -26,6 +26,12 @@ namespace fleet::traffic {
 
 enum class Admission { None, Slots, Arrival };
 
+/// A transport task of the virtual fleet: its pickup's and its drop-off's dock nodes.
+struct VirtualTask {
+  NodeId pickup = kNoNode;
+  NodeId dropoff = kNoNode;
+};
+
 struct VirtualFleetOptions {
   std::size_t robots = 20;
   std::uint64_t seed = 1;
@@ -49,6 +55,11 @@ struct VirtualFleetOptions {
   std::size_t stationSlots = 0;
   /// Tasks only between these pickups and drop-offs (by name); empty: all of them.
   std::vector<std::string> stations;
+  /// A task list to run instead of drawn tasks: each robot that asks takes the next one, whatever
+  /// the admission, and the run ends when the last one is done (VirtualFleetResult::duration is then
+  /// the time that took). One robot on a fleet's drawn list is that list's lone robot as it drives
+  /// here (the same jitter, people and turns), against the fleet bound's ideal motion.
+  std::vector<VirtualTask> list;
   /// s of simulated time between recorded frames (VirtualFleetResult::frames); 0: none.
   double recordEvery = 0.0;
   /// s over which each station's queue is averaged for its series (StationLedger::queueSeries).
@@ -110,10 +121,7 @@ struct VirtualFleetResult {
   std::vector<ActivityLedger> robotTime;
   /// The tasks in the order they were drawn (the list the fleet bound is computed on), and where
   /// each robot started.
-  struct DrawnTask {
-    NodeId pickup = kNoNode;
-    NodeId dropoff = kNoNode;
-  };
+  using DrawnTask = VirtualTask;
   std::vector<DrawnTask> tasks;
   std::vector<NodeId> starts;
   /// Robots waiting longer than a minute at the end: where, for what, behind whom.
