@@ -3,18 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fleet/core/percentiles.hpp"
 #include "fleet/traffic/roadmap.hpp"
 
 namespace fleet::traffic {
-
-double nearestRankPercentile(std::vector<double> v, double p) {
-  if (v.empty())
-    return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(
-      std::min<double>(static_cast<double>(v.size() - 1), std::floor(p * static_cast<double>(v.size()))));
-  return v[i];
-}
 
 StationTally::StationTally(const Roadmap& roadmap, double seriesEvery)
     : roadmap_(roadmap),
@@ -30,7 +22,8 @@ StationTally::StationTally(const Roadmap& roadmap, double seriesEvery)
       queueNow_(roadmap.graph.size(), 0),
       queueMax_(roadmap.graph.size(), 0),
       dockedNow_(roadmap.graph.size(), 0),
-      series_(roadmap.graph.size()) {
+      series_(roadmap.graph.size()),
+      nextClose_(seriesEvery) {
   for (const auto& s : roadmap.stations) {
     if (s.dock == kNoNode)
       continue;
@@ -54,16 +47,17 @@ void StationTally::arrived(NodeId dock, double now) {
   queuedAtLeave_[d] = 0;
 }
 
-void StationTally::tick(double dt, const std::vector<NodeId>& standing, const std::vector<NodeId>& queued) {
+void StationTally::tick(double now, double dt, const std::vector<NodeId>& standing,
+                        const std::vector<NodeId>& queued) {
   for (const NodeId v : standing)
     dockedNow_[static_cast<std::size_t>(v)] = 1;
   for (const NodeId v : queued)
     ++queueNow_[static_cast<std::size_t>(v)];
   ran_ += dt;
   bucketRan_ += dt;
-  // A bucket closes once it holds `every_` s (within a hundredth of a tick: dt does not add up
-  // exactly in floating point).
-  const bool closes = bucketRan_ >= every_ - 0.01 * dt;
+  // A mean closes when the tick reaches the next multiple of every_ (within a thousandth of a tick:
+  // the ticks' times are k × dt in floating point).
+  const bool closes = now + dt >= nextClose_ - 1e-3 * dt;
   for (const auto& st : roadmap_.stations) {
     if (st.dock == kNoNode)
       continue;
@@ -79,8 +73,11 @@ void StationTally::tick(double dt, const std::vector<NodeId>& standing, const st
     }
     queueNow_[d] = 0;
   }
-  if (closes)
+  if (closes) {
     bucketRan_ = 0.0;
+    while (nextClose_ <= now + dt + 1e-3 * dt)
+      nextClose_ += every_;
+  }
   for (const NodeId v : standing)
     dockedNow_[static_cast<std::size_t>(v)] = 0;
 }
@@ -96,8 +93,9 @@ std::vector<VirtualFleetResult::StationLedger> StationTally::ledger() const {
     l.name = st.name;
     l.visits = visits_[d];
     l.cycles = c.size();
-    l.cycleP50 = nearestRankPercentile(c, 0.5);
-    l.cycleP90 = nearestRankPercentile(c, 0.9);
+    const Percentiles pc = percentiles(c);
+    l.cycleP50 = pc.p50;
+    l.cycleP90 = pc.p90;
     l.utilisation = ran_ > 0.0 ? dockedS_[d] / ran_ : 0.0;  // the loop's own time (a tick over, at times)
     l.queueMean = ran_ > 0.0 ? queueS_[d] / ran_ : 0.0;
     l.queueMax = queueMax_[d];

@@ -18,13 +18,9 @@ namespace fleet::traffic {
 
 class Roadmap;
 
-/// The value at rank floor(p × n) of the sorted values (the last one for p = 1); 0 for none. The
-/// virtual fleet's percentiles (dock cycles, update times).
-double nearestRankPercentile(std::vector<double> v, double p);
-
 class StationTally {
  public:
-  /// The queue series takes one mean every `seriesEvery` s (> 0).
+  /// The queue series takes one mean every `seriesEvery` s (at least a tick: the caller checks).
   StationTally(const Roadmap& roadmap, double seriesEvery);
 
   /// The nodes of the line of the station docked at `dock`: its queue places and its approach.
@@ -36,9 +32,10 @@ class StationTally {
   void left(NodeId dock, bool nextInLine);
   /// A robot reached the dock `dock` at `now` to dwell there.
   void arrived(NodeId dock, double now);
-  /// One tick of `dt` s: robots stand on `standing` (a robot on no edge), and one robot is in the
-  /// queue of each dock in `queued` (once per robot).
-  void tick(double dt, const std::vector<NodeId>& standing, const std::vector<NodeId>& queued);
+  /// The tick from `now` to `now + dt`: robots stand on `standing` (a robot on no edge), and one
+  /// robot is in the queue of each dock in `queued` (once per robot). A series mean closes at each
+  /// multiple of seriesEvery the tick reaches.
+  void tick(double now, double dt, const std::vector<NodeId>& standing, const std::vector<NodeId>& queued);
   /// The ledger of the visited stations, in the roadmap's order.
   [[nodiscard]] std::vector<VirtualFleetResult::StationLedger> ledger() const;
 
@@ -56,6 +53,7 @@ class StationTally {
   std::vector<std::vector<double>> series_;
   double ran_ = 0.0;
   double bucketRan_ = 0.0;
+  double nextClose_ = 0.0;
 };
 
 }  // namespace fleet::traffic

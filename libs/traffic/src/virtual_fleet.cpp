@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "fleet/core/percentiles.hpp"
 #include "fleet/traffic/roadmap_travel.hpp"
 #include "fleet/traffic/station_book.hpp"
 #include "station_tally.hpp"
@@ -43,52 +44,12 @@ struct Bot {
 
 }  // namespace
 
-std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near) {
-  const Graph& g = roadmap.graph;
-  std::vector<std::string> out(g.size());
-  std::vector<std::pair<Vec2, const std::string*>> docks;
-  for (const auto& s : roadmap.stations) {
-    if (s.dock == kNoNode)
-      continue;
-    const bool served = s.kind == site::StationKind::Pickup || s.kind == site::StationKind::Dropoff;
-    if (served)
-      docks.emplace_back(g.position(s.dock), &s.name);
-    if (s.kind == site::StationKind::Parking) {
-      out[static_cast<std::size_t>(s.dock)] = "parking";
-      continue;
-    }
-    const auto label = [&](NodeId v, const char* what) {
-      if (v != kNoNode && out[static_cast<std::size_t>(v)].empty())
-        out[static_cast<std::size_t>(v)] = s.name + " " + what;
-    };
-    label(s.dock, "dock");
-    label(s.approach, "approach");
-    for (NodeId q : s.queue)
-      label(q, "queue");
-    label(s.exit, "exit");
-  }
-  for (NodeId v = 0; static_cast<std::size_t>(v) < g.size(); ++v) {
-    auto& l = out[static_cast<std::size_t>(v)];
-    if (!l.empty())
-      continue;
-    if (roadmap.kind(v) == NodeKind::Parking) {
-      l = "parking";
-      continue;
-    }
-    const std::string* best = nullptr;
-    double bestD = near;
-    for (const auto& [p, name] : docks) {
-      if (const double d = (p - g.position(v)).norm(); d <= bestD) {
-        bestD = d;
-        best = name;
-      }
-    }
-    l = best != nullptr ? "lane by " + *best : "lane";
-  }
-  return out;
-}
-
 VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& o) {
+  if (!(o.dt > 0.0 && std::isfinite(o.dt)))
+    throw std::invalid_argument("virtual fleet: dt must be a finite number > 0");
+  if (!(o.queueSeriesEvery >= o.dt && std::isfinite(o.queueSeriesEvery)))
+    throw std::invalid_argument(
+        "virtual fleet: queueSeriesEvery must be a finite number of at least a tick (dt)");
   if (!(o.turnScale >= 0.0 && std::isfinite(o.turnScale)))
     throw std::invalid_argument("virtual fleet: turnScale must be a finite number >= 0");
   const Graph& g = roadmap.graph;
@@ -153,8 +114,6 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   if (o.stationLines)
     traffic.setStations(stationLines(roadmap));
   // The station ledger (station_tally.hpp).
-  if (!(o.queueSeriesEvery > 0.0 && std::isfinite(o.queueSeriesEvery)))
-    throw std::invalid_argument("virtual fleet: queueSeriesEvery must be a finite number > 0");
   StationTally tally(roadmap, o.queueSeriesEvery);
   std::vector<Bot> bots(o.robots);
   // Whether another robot in the line of the station docked at `dock` stands on one of the line's
@@ -314,38 +273,33 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   double tDrive = 0.0, tDwell = 0.0, tWait = 0.0, tStand = 0.0;
 
   std::vector<NodeId> standing, queued;
-  // What robot r, standing with a task, waits on (wait_cause.hpp): the robot the execution names
-  // first, and r's next node (released or planned).
+  // What robot r, standing with a task, waits on (wait_cause.hpp), as things stood at the start of
+  // the tick: the robots before r in the loop have moved on by the time r is filed, and a robot
+  // that has just reported its next node is no longer named.
   std::vector<Release> rel(o.robots);
-  auto waitCause = [&](std::size_t r) {
-    const Bot& b = bots[r];
-    WaitSeen seen;
-    seen.at = g.position(b.at);
-    const auto& base = rel[r].base;
-    const auto it = std::find(base.begin(), base.end(), b.at);
-    const NodeId next = it != base.end() && it + 1 != base.end() ? *(it + 1)
-                        : !rel[r].horizon.empty()                ? rel[r].horizon.front()
-                                                                 : kNoNode;
-    if (next != kNoNode)
-      seen.way = g.position(next) - seen.at;
-    const auto on = traffic.waitingOn(r);
-    seen.named = !on.empty();
-    if (seen.named) {
-      const Bot& q = bots[on.front()];
-      seen.otherAt = g.position(q.at);
-      seen.otherDriving = q.to != kNoNode;
-      if (seen.otherDriving)
-        seen.otherWay = g.position(q.to) - g.position(q.at);
-      seen.otherDwelling = q.dwellLeft > 0.0;
+  std::vector<WaitSnapshot> seenAtStart(o.robots);
+  auto snapshot = [&]() {
+    for (std::size_t q = 0; q < o.robots; ++q) {
+      const Bot& b = bots[q];
+      auto& w = seenAtStart[q];
+      w.at = b.at;
+      w.to = b.to;
+      w.dwelling = b.dwellLeft > 0.0;
+      const auto on = b.to == kNoNode ? traffic.waitingOn(q) : std::vector<std::size_t>{};
+      w.on = on.empty() ? o.robots : on.front();
     }
-    return classifyWait(seen);
   };
+  auto waitCause = [&](std::size_t r) { return classifyWait(waitSeen(g, seenAtStart, r, rel[r])); };
   double ranUntil = o.duration;  // a list's run ends when its last task is done
-  for (double now = 0.0; now < o.duration; now += o.dt) {
+  // Whole ticks: the k-th starts at k × dt (a sum of dt drifts, and ran a tick over at times).
+  const auto ticksToRun = static_cast<std::size_t>(std::ceil(o.duration / o.dt - 1e-9));
+  for (std::size_t tick = 0; tick < ticksToRun; ++tick) {
+    const double now = static_cast<double>(tick) * o.dt;
     const auto t0 = std::chrono::steady_clock::now();
     traffic.update();
     for (std::size_t r = 0; r < o.robots; ++r)
       rel[r] = traffic.release(r);
+    snapshot();
     updateMs.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 
@@ -500,7 +454,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       if (b.to != kNoNode || b.at != goal)
         queued.push_back(goal);
     }
-    tally.tick(o.dt, standing, queued);
+    tally.tick(now, o.dt, standing, queued);
     if (o.recordEvery > 0.0 && now + 1e-9 >= nextFrame) {
       nextFrame += o.recordEvery;
       FleetFrame f;
@@ -591,8 +545,9 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
     res.waits.push_back({p, sec});
   std::stable_sort(res.waits.begin(), res.waits.end(),
                    [](const auto& a, const auto& b) { return a.seconds > b.seconds; });
-  res.updateP50Ms = nearestRankPercentile(updateMs, 0.5);
-  res.updateP99Ms = nearestRankPercentile(updateMs, 0.99);
+  const Percentiles up = percentiles(std::move(updateMs));
+  res.updateP50Ms = up.p50;
+  res.updateP99Ms = up.p99;
   if (o.robots < 2)
     res.minSeparation = 0.0;
   return res;

@@ -1,5 +1,7 @@
 #include "fleet/traffic/wait_cause.hpp"
 
+#include <algorithm>
+
 namespace fleet::traffic {
 
 const char* toString(WaitCause c) {
@@ -43,6 +45,30 @@ WaitCause classifyWait(const WaitSeen& s) {
   if (cosine < -kCos60)
     return WaitCause::HeadOn;
   return WaitCause::Across;
+}
+
+WaitSeen waitSeen(const Graph& g, const std::vector<WaitSnapshot>& robots, std::size_t r,
+                  const Release& release) {
+  const WaitSnapshot& me = robots.at(r);
+  WaitSeen seen;
+  seen.at = g.position(me.at);
+  const auto& base = release.base;
+  const auto it = std::find(base.begin(), base.end(), me.at);
+  const NodeId next = it != base.end() && it + 1 != base.end() ? *(it + 1)
+                      : !release.horizon.empty()               ? release.horizon.front()
+                                                               : kNoNode;
+  if (next != kNoNode)
+    seen.way = g.position(next) - seen.at;
+  seen.named = me.on < robots.size();
+  if (seen.named) {
+    const WaitSnapshot& q = robots[me.on];
+    seen.otherAt = g.position(q.at);
+    seen.otherDriving = q.to != kNoNode;
+    if (seen.otherDriving)
+      seen.otherWay = g.position(q.to) - g.position(q.at);
+    seen.otherDwelling = q.dwelling;
+  }
+  return seen;
 }
 
 }  // namespace fleet::traffic

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace fleet::traffic {
 namespace {
@@ -60,6 +61,41 @@ TEST(WaitCause, WhatTheOtherDoesComesFirst) {
   EXPECT_EQ(classifyWait(s), WaitCause::Standing);
   s.named = false;  // nobody named: whatever else was filled in
   EXPECT_EQ(classifyWait(s), WaitCause::NoneNamed);
+}
+
+/// What a fleet loop sees of a wait, from the tick's snapshot: the waiting robot's next node (after
+/// its node in the base, else the horizon's first), the robot it waits on and what that one does.
+TEST(WaitCause, SeenFromTheTicksSnapshotAndTheRelease) {
+  Graph g;
+  const NodeId a = g.addNode({0.0, 0.0});
+  const NodeId b = g.addNode({0.5, 0.0});
+  const NodeId c = g.addNode({1.0, 0.0});
+  const NodeId d = g.addNode({1.0, 0.5});
+  std::vector<WaitSnapshot> robots(2);
+  robots[0] = {a, kNoNode, false, 1};  // stands on a, waits on robot 1
+  robots[1] = {c, d, false, 2};        // drives c -> d, across robot 0's way
+  Release rel;
+  rel.base = {a, b};
+  WaitSeen s = waitSeen(g, robots, 0, rel);
+  EXPECT_TRUE(s.named);
+  EXPECT_DOUBLE_EQ(s.way.x, 0.5);
+  EXPECT_DOUBLE_EQ(s.way.y, 0.0);
+  EXPECT_TRUE(s.otherDriving);
+  EXPECT_EQ(classifyWait(s), WaitCause::Across);
+  // Its base ends on its node: the horizon's first node is its way.
+  rel.base = {a};
+  rel.horizon = {d};
+  s = waitSeen(g, robots, 0, rel);
+  EXPECT_DOUBLE_EQ(s.way.x, 1.0);
+  EXPECT_DOUBLE_EQ(s.way.y, 0.5);
+  // The other standing at the start of the tick (whatever it did later in the tick): standing.
+  robots[1].to = kNoNode;
+  EXPECT_EQ(classifyWait(waitSeen(g, robots, 0, rel)), WaitCause::Standing);
+  robots[1].dwelling = true;
+  EXPECT_EQ(classifyWait(waitSeen(g, robots, 0, rel)), WaitCause::Dwelling);
+  // Nobody named (an index past the robots).
+  robots[0].on = robots.size();
+  EXPECT_EQ(classifyWait(waitSeen(g, robots, 0, rel)), WaitCause::NoneNamed);
 }
 
 TEST(WaitCause, EveryCauseHasItsOwnName) {

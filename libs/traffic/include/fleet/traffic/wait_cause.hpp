@@ -19,9 +19,13 @@
 // Pure: no DDS, no logging.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "fleet/core/vec2.hpp"
+#include "fleet/traffic/execution.hpp"
+#include "fleet/traffic/graph.hpp"
 
 namespace fleet::traffic {
 
@@ -46,6 +50,21 @@ struct WaitSeen {
   Vec2 otherWay;  ///< its edge (to less from) when it drives
   bool otherDwelling = false;
 };
+
+/// A robot as a fleet loop saw it at the start of a tick, before any robot moved in it.
+struct WaitSnapshot {
+  NodeId at = kNoNode;  ///< its last node
+  NodeId to = kNoNode;  ///< the node it drives to; kNoNode: standing
+  bool dwelling = false;
+  /// Standing: the robot it waits on, the first the execution names; anything ≥ the robots' count
+  /// when it names none (or the robot drives).
+  std::size_t on = static_cast<std::size_t>(-1);
+};
+
+/// What is seen of robot r's wait, from the tick's snapshot of every robot and r's release: its
+/// next node is the one after its node in its base, else the horizon's first.
+WaitSeen waitSeen(const Graph& g, const std::vector<WaitSnapshot>& robots, std::size_t r,
+                  const Release& release);
 
 /// The cause, by the rules above (a lattice's edges meet at multiples of 45°: a way one bend off
 /// counts as the same way or head-on). A driving robot with an edge of no length counts as
