@@ -1,6 +1,7 @@
 #include "traffic_sim.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -159,6 +160,54 @@ std::vector<double> rounded(std::vector<double> v) {
   return v;
 }
 
+/// Several seeds end with their means (text output): tasks done (mean ± sd), the shares of the
+/// fleet bound and of lone robots as they drive, the robot-time ledger and the wait split, each
+/// over all the seeds' robot time.
+class SeedsSummary {
+ public:
+  void add(const traffic::VirtualFleetResult& r, const nlohmann::json& bound, const nlohmann::json& lone) {
+    tasks_.push_back(static_cast<double>(r.tasksDone));
+    perH_ += r.tasksPerHour;
+    ofBound_ += bound.value("fraction_of_bound", 0.0);
+    ofLone_ += lone.value("fraction", 0.0);
+    loneErrors_ += lone.contains("error") ? 1 : 0;
+    for (const auto& l : r.robotTime)
+      ledger_.add(l);
+    for (std::size_t i = 0; i < causes_.size(); ++i)
+      causes_[i] += r.waitCauses[i];
+  }
+  [[nodiscard]] std::string line() const {
+    const auto n = static_cast<double>(tasks_.size());
+    double mean = 0.0, var = 0.0;
+    for (const double t : tasks_)
+      mean += t / n;
+    for (const double t : tasks_)
+      var += (t - mean) * (t - mean) / n;
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(1) << "over " << tasks_.size() << " seeds: " << mean << " ± "
+       << std::sqrt(var) << " tasks (" << std::setprecision(0) << perH_ / n << "/h), " << 100.0 * ofBound_ / n
+       << " % of the fleet bound, ";
+    if (loneErrors_ == 0)
+      os << 100.0 * ofLone_ / n << " % of lone robots as they drive\n";
+    else
+      os << "against lone robots as they drive: " << loneErrors_ << " seeds without a lone run\n";
+    os << "  robot time:";
+    for (const auto c : kLedgerActivities)
+      os << " " << toString(c) << " " << 100.0 * ledger_.share(c) << " %";
+    traffic::VirtualFleetResult all;
+    all.waitCauses = causes_;
+    os << "\n" << waitCausesLine(all);
+    return os.str();
+  }
+
+ private:
+  std::vector<double> tasks_;
+  double perH_ = 0.0, ofBound_ = 0.0, ofLone_ = 0.0;
+  int loneErrors_ = 0;
+  ActivityLedger ledger_;
+  std::array<double, traffic::kWaitCauses.size()> causes_{};
+};
+
 nlohmann::json robotTimeJson(const traffic::VirtualFleetResult& r) {
   ActivityLedger fleet;
   nlohmann::json per = nlohmann::json::array();
@@ -253,6 +302,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
   }
   int rc = 0;
   nlohmann::json all = nlohmann::json::array();
+  SeedsSummary summary;
   for (int seed = first; seed <= last; ++seed) {
     traffic::VirtualFleetOptions v;
     v.robots = static_cast<std::size_t>(o.robots);
@@ -301,6 +351,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     const nlohmann::json bound = virtualFleetBound(*site, roadmap, r, v.dwell);
     const nlohmann::json lone = loneAsItDrives(roadmap, v, r, bound);
     const nlohmann::json robotTime = robotTimeJson(r);
+    summary.add(r, bound, lone);
     nlohmann::json stations = nlohmann::json::array();
     for (const auto& st : r.stations) {
       stations.push_back({{"name", st.name},
@@ -392,6 +443,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
   }
   if (o.json)
     std::cout << all.dump(1) << "\n";
+  else if (last > first)
+    std::cout << summary.line() << "\n";
   return rc;
 }
 

@@ -1,15 +1,18 @@
 // `fleetctl traffic-sim --html`: the replay page holds the run it shows (every frame, every robot,
 // released nodes on the roadmap), and a page it cannot write is bad input (exit 2). Its roadmap
-// options reach the roadmap it drives on (--queue-length).
+// options reach the roadmap it drives on (--queue-length). Several seeds end with their means.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "run_command.hpp"
 
@@ -72,6 +75,47 @@ TEST(TrafficSimView, ThePageReplaysTheRunItReports) {
   EXPECT_TRUE(released);
   // The last frame's count is the run's count (the frame is taken before the last tick's tasks).
   EXPECT_LE(lastDone, printed[0]["tasks_done"].get<std::size_t>());
+}
+
+// Several seeds end with their means: the tasks' mean and spread are those of the seeds' own lines,
+// and the robot-time ledger and the wait split follow; one seed prints no such line.
+TEST(TrafficSimView, SeveralSeedsEndWithTheirMeans) {
+  const auto r = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                                         " --robots 6 --duration 120 --seeds 1-3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::vector<double> tasks;
+  std::istringstream lines(r.output);
+  std::string line, summary;
+  while (std::getline(lines, line)) {
+    int seed = 0, robots = 0, done = 0;
+    double duration = 0.0;
+    if (std::sscanf(line.c_str(), "seed %d: %d robots, %lf s: %d tasks", &seed, &robots, &duration, &done) ==
+        4)
+      tasks.push_back(done);
+    if (line.rfind("over ", 0) == 0)
+      summary = line;
+  }
+  ASSERT_EQ(tasks.size(), 3U) << r.output;
+  ASSERT_FALSE(summary.empty()) << r.output;
+  double mean = 0.0, var = 0.0;
+  for (const double t : tasks)
+    mean += t / 3.0;
+  for (const double t : tasks)
+    var += (t - mean) * (t - mean) / 3.0;
+  double printedMean = 0.0, printedSd = 0.0;
+  ASSERT_EQ(std::sscanf(summary.c_str(), "over 3 seeds: %lf ± %lf tasks", &printedMean, &printedSd), 2)
+      << summary;
+  EXPECT_NEAR(printedMean, mean, 0.051) << summary;
+  EXPECT_NEAR(printedSd, std::sqrt(var), 0.051) << summary;
+  EXPECT_NE(summary.find("% of the fleet bound"), std::string::npos) << summary;
+  const auto after = r.output.substr(r.output.find(summary));
+  EXPECT_NE(after.find("  robot time: no_task"), std::string::npos) << after;
+  EXPECT_NE(after.find("  waiting on robots, on what:"), std::string::npos) << after;
+
+  const auto one = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                                           " --robots 6 --duration 120 --seeds 1");
+  ASSERT_EQ(one.code, 0) << one.output;
+  EXPECT_EQ(one.output.find("\nover "), std::string::npos) << one.output;
 }
 
 TEST(TrafficSimView, APageItCannotWriteIsBadInput) {
