@@ -17,6 +17,7 @@
 #include "fleet/fleet/site_stations.hpp"
 #include "fleet/traffic/roadmap.hpp"
 #include "fleet/traffic/virtual_fleet.hpp"
+#include "round3.hpp"
 #include "run_fleet_bound.hpp"
 #include "traffic_sim_view.hpp"
 
@@ -47,8 +48,10 @@ nlohmann::json virtualFleetBound(const site::Site& site, const traffic::Roadmap&
   return fleetBoundJson(*b, r.tasksPerHour, in.cruise, in.radius);
 }
 
+using WaitCauseSeconds = std::array<double, traffic::kWaitCauses.size()>;
+
 /// "  waiting on robots, on what: ..." (wait_cause.hpp), shares of the fleet's waiting, most first.
-std::string waitCausesLine(const traffic::VirtualFleetResult& r) {
+std::string waitCausesLine(const WaitCauseSeconds& seconds) {
   static const std::map<traffic::WaitCause, const char*> kSaid = {
       {traffic::WaitCause::SameWay, "one driving the same way"},
       {traffic::WaitCause::HeadOn, "one driving head-on"},
@@ -59,8 +62,8 @@ std::string waitCausesLine(const traffic::VirtualFleetResult& r) {
   double total = 0.0;
   std::vector<std::pair<double, traffic::WaitCause>> v;
   for (const auto c : traffic::kWaitCauses) {
-    total += r.waitCauses[static_cast<std::size_t>(c)];
-    v.emplace_back(r.waitCauses[static_cast<std::size_t>(c)], c);
+    total += seconds[static_cast<std::size_t>(c)];
+    v.emplace_back(seconds[static_cast<std::size_t>(c)], c);
   }
   std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   std::ostringstream os;
@@ -132,7 +135,6 @@ nlohmann::json loneAsItDrives(traffic::Roadmap& roadmap, const traffic::VirtualF
   const double perH = lone.tasksPerHour;
   const double robotsPerH = perH * static_cast<double>(r.robots);
   const double ideal = bound.value("lone_rate_per_h", 0.0);
-  const auto round3 = [](double x) { return std::round(x * 1000.0) / 1000.0; };
   return {{"tasks", r.tasks.size()},
           {"lone_s", round3(lone.duration)},
           {"lone_rate_per_h", round3(perH)},
@@ -156,7 +158,7 @@ std::string loneAsItDrivesLine(const nlohmann::json& l) {
 
 std::vector<double> rounded(std::vector<double> v) {
   for (double& x : v)
-    x = std::round(x * 1000.0) / 1000.0;
+    x = round3(x);
   return v;
 }
 
@@ -194,9 +196,7 @@ class SeedsSummary {
     os << "  robot time:";
     for (const auto c : kLedgerActivities)
       os << " " << toString(c) << " " << 100.0 * ledger_.share(c) << " %";
-    traffic::VirtualFleetResult all;
-    all.waitCauses = causes_;
-    os << "\n" << waitCausesLine(all);
+    os << "\n" << waitCausesLine(causes_);
     return os.str();
   }
 
@@ -205,7 +205,7 @@ class SeedsSummary {
   double perH_ = 0.0, ofBound_ = 0.0, ofLone_ = 0.0;
   int loneErrors_ = 0;
   ActivityLedger ledger_;
-  std::array<double, traffic::kWaitCauses.size()> causes_{};
+  WaitCauseSeconds causes_{};
 };
 
 nlohmann::json robotTimeJson(const traffic::VirtualFleetResult& r) {
@@ -239,7 +239,6 @@ std::string robotTimeLine(const nlohmann::json& rt) {
 // in the way, and the share of the driving that brought the robot no nearer its goal.
 nlohmann::json drivingPerTaskJson(const traffic::VirtualFleetResult& r) {
   const double n = r.taskShare > 0.0 ? r.taskShare : 1.0;
-  const auto round3 = [](double x) { return std::round(x * 1000.0) / 1000.0; };
   return {{"driven_s", round3(r.taskDriven / n)},
           {"free_flow_s", round3(r.taskFreeFlow / n)},
           {"stretch", r.taskFreeFlow > 0.0 ? round3(r.taskDriven / r.taskFreeFlow) : 0.0},
@@ -433,7 +432,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
         for (std::size_t i = 0; i < r.waits.size() && i < 8; ++i)
           std::cout << " " << r.waits[i].place << " " << std::setprecision(0)
                     << 100.0 * r.waits[i].seconds / waited << " %;";
-        std::cout << "\n" << waitCausesLine(r) << "\n";
+        std::cout << "\n" << waitCausesLine(r.waitCauses) << "\n";
       }
       if (const std::string q = busiestQueuesLine(r); !q.empty())
         std::cout << q << "\n";

@@ -285,8 +285,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       w.at = b.at;
       w.to = b.to;
       w.dwelling = b.dwellLeft > 0.0;
-      const auto on = b.to == kNoNode ? traffic.waitingOn(q) : std::vector<std::size_t>{};
-      w.on = on.empty() ? o.robots : on.front();
+      w.on = o.robots;
+      // Whom it waits on only for a robot that can be filed as waiting this tick: standing with a
+      // task, not dwelling (the execution's query walks the robot's pending nodes).
+      if (b.to == kNoNode && !b.idle && b.pickup != kNoNode && !w.dwelling) {
+        if (const auto on = traffic.waitingOn(q); !on.empty())
+          w.on = on.front();
+      }
     }
   };
   auto waitCause = [&](std::size_t r) { return classifyWait(waitSeen(g, seenAtStart, r, rel[r])); };
