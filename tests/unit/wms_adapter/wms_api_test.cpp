@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <future>
 #include <thread>
 
 #include "api_fixture.hpp"
@@ -15,6 +16,63 @@ using ::testing::HasSubstr;
 
 namespace {
 const std::string kTask = R"({"id": "t-1", "kind": "transport", "pickup": "P-1", "dropoff": "D-1"})";
+
+/// Follows GET /v1/events on a thread of its own until `until` has arrived. Without since= the
+/// stream starts with the next new event, so a test publishes only once waitOpen() is true: the
+/// server fixes the stream's start before it sends the response head. The server's keep-alive
+/// comments (one a second) keep a client's read timeout from ever firing, so the reader also gives
+/// up after `limit`: a lost event fails the test instead of hanging it.
+class EventStreamReader {
+ public:
+  EventStreamReader(int port, std::string until, std::chrono::seconds limit = std::chrono::seconds(20))
+      : until_(std::move(until)), limit_(limit), opened_(openedPromise_.get_future()) {
+    thread_ = std::thread([this, port] {
+      httplib::Client c("127.0.0.1", port);
+      c.set_read_timeout(5, 0);
+      const auto end = std::chrono::steady_clock::now() + limit_;
+      bool told = false;
+      c.Get(
+          "/v1/events",
+          [&](const httplib::Response& r) {
+            told = true;
+            openedPromise_.set_value(r.status == 200);
+            return r.status == 200;
+          },
+          [&](const char* data, std::size_t n) {
+            received_.append(data, n);
+            arrived_ = received_.find(until_) != std::string::npos;
+            return !arrived_ && std::chrono::steady_clock::now() < end;
+          });
+      if (!told) {
+        openedPromise_.set_value(false);  // no answer: connection refused or timed out
+      }
+    });
+  }
+  ~EventStreamReader() { finish(); }
+  EventStreamReader(const EventStreamReader&) = delete;
+  EventStreamReader& operator=(const EventStreamReader&) = delete;
+  /// True once the server has answered 200 with the stream's head (events from now on arrive).
+  bool waitOpen() { return opened_.wait_for(limit_) == std::future_status::ready && opened_.get(); }
+  /// Waits for the reader to stop (`until` arrived, the stream ended, or `limit` passed); true when
+  /// `until` arrived.
+  bool finish() {
+    if (thread_.joinable()) {
+      thread_.join();
+    }
+    return arrived_;
+  }
+  /// What arrived; read after finish().
+  [[nodiscard]] const std::string& received() const { return received_; }
+
+ private:
+  std::string until_;
+  std::chrono::seconds limit_;
+  std::promise<bool> openedPromise_;
+  std::future<bool> opened_;
+  std::string received_;
+  bool arrived_ = false;
+  std::thread thread_;
+};
 }  // namespace
 
 TEST_F(Api, CreateThenIdempotentRepeatThenConflict) {
@@ -150,19 +208,13 @@ TEST_F(Api, NoTokenMeansOpenAndListensOnLoopback) {
 
 TEST_F(Api, EventsStreamAndMetrics) {
   start();
-  std::string received;
-  std::thread reader([&] {
-    httplib::Client c("127.0.0.1", api_->port());
-    c.set_read_timeout(5, 0);
-    c.Get("/v1/events", [&](const char* data, std::size_t n) {
-      received.append(data, n);
-      return received.find("\"state\":\"done\"") == std::string::npos;
-    });
-  });
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EventStreamReader reader(api_->port(), "\"state\":\"done\"");
+  ASSERT_TRUE(reader.waitOpen()) << "GET /v1/events did not answer 200 with an open stream";
   view_.onEvent({"t-5", msg::TaskState::Assigned, "r1", "", 1, 1, ""});
   view_.onEvent({"t-5", msg::TaskState::Done, "r1", "", 2, 2, ""});
-  reader.join();
+  ASSERT_TRUE(reader.finish()) << "the stream did not bring the done event; it brought:\n"
+                               << reader.received();
+  const auto& received = reader.received();
   EXPECT_THAT(received, HasSubstr("event: task"));
   EXPECT_THAT(received, HasSubstr("\"state\":\"assigned\""));
   auto m = json::parse(client_->Get("/v1/metrics")->body);
@@ -193,20 +245,13 @@ TEST_F(Api, PauseAndResumeReachTheManagerAndAnswerWithTheState) {
 // past the edge unrepaired is now written with U+FFFD; the stream and the list keep working.
 TEST_F(Api, TextThatIsNotUtf8NeitherStopsTheStreamNorBreaksTheList) {
   start();
-  std::string received;
-  std::thread reader([&] {
-    httplib::Client c("127.0.0.1", api_->port());
-    c.set_read_timeout(5, 0);
-    c.Get("/v1/events", [&](const char* data, std::size_t n) {
-      received.append(data, n);
-      return received.find("\"state\":\"done\"") == std::string::npos;
-    });
-  });
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EventStreamReader reader(api_->port(), "\"state\":\"done\"");
+  ASSERT_TRUE(reader.waitOpen()) << "GET /v1/events did not answer 200 with an open stream";
   view_.onEvent({"t-7", msg::TaskState::Failed, "r1", "motor \xFF\xFE fault", 1, 1, ""});
   view_.onEvent({"t-8", msg::TaskState::Done, "r1", "", 2, 1, ""});
-  reader.join();
-  EXPECT_THAT(received, HasSubstr("motor \xEF\xBF\xBD\xEF\xBF\xBD fault"));
+  ASSERT_TRUE(reader.finish()) << "the stream did not bring the done event; it brought:\n"
+                               << reader.received();
+  EXPECT_THAT(reader.received(), HasSubstr("motor \xEF\xBF\xBD\xEF\xBF\xBD fault"));
   auto r = client_->Get("/v1/tasks");
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200) << r->body;
