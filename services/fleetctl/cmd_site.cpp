@@ -1,10 +1,12 @@
-// fleetctl site check: validate a site or map file and print what it holds.
+// fleetctl site check: validate a site or map file and print what it holds; fleetctl site lines:
+// spell out each station's line (approach, queue, exit) as the roadmap builds it.
 
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
 #include "site_check.hpp"
+#include "site_lines.hpp"
 
 namespace fleet::ctl {
 
@@ -34,9 +36,17 @@ void addSiteCommand(CLI::App& app, Commands& commands) {
       ->capture_default_str();
   siteCheck->add_flag("--json", o->json, "print the report as JSON");
   siteCheck->add_option("--svg", o->svg, "draw the map, the roadmap and the stations into this SVG file");
+  auto* siteLines = site->add_subcommand(
+      "lines",
+      "write the site with each station's approach, queue and exit spelled out as the roadmap builds them");
+  auto lines = std::make_shared<std::pair<std::string, std::string>>("", "-");
+  siteLines->add_option("file", lines->first, "site.json")->required();
+  siteLines->add_option("--out", lines->second, "where to write the site (-: stdout; may be the file itself)")
+      ->capture_default_str();
   site->require_subcommand(1);
   commands.push_back(
       {siteCheck, [o] { return fleet::ctl::siteCheck(o->file, o->radius, o->resolution, o->json, o->svg); }});
+  commands.push_back({siteLines, [lines] { return fleet::ctl::siteLines(lines->first, lines->second); }});
 }
 
 }  // namespace fleet::ctl

@@ -8,6 +8,7 @@
 #include "fleet/fleet/site_stations.hpp"
 #include "run_files.hpp"
 #include "scenario_gen.hpp"
+#include "site_lines.hpp"
 
 namespace fleet::ctl {
 namespace {
@@ -63,6 +64,10 @@ Expected<void> generated(const LoadtestOptions& o, const fs::path& out, RunScena
   }
   auto [site, rest] = splitSite(*g);
   writeTextFile(out / "site.json", site.dump(1));
+  // The site says where robots enter, wait at and leave each station, as a shipped site does.
+  if (auto lines = spellOutLinesInPlace((out / "site.json").string()); !lines) {
+    return unexpected(lines.error());
+  }
   rest["site"] = fs::absolute(out / "site.json").string();
   run.scenario = resolveScenarioSite(rest, (out / "scenario.json").string());
   return {};

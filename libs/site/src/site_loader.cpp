@@ -90,7 +90,13 @@ void readStations(Config& c, Site& s) {
       x.approachGiven = true;
     }
     Vec2 out;
-    if (readPoint(st, "exit", out, false)) {
+    if (const auto* e = st.find("exit"); e != nullptr && e->is_string()) {
+      if (e->get<std::string>() == "entry") {
+        x.exitByEntry = true;
+      } else {
+        st.problem("exit", "expected [x, y] in m or \"entry\" (left by its way in), got " + e->dump());
+      }
+    } else if (readPoint(st, "exit", out, false)) {
       x.exit = out;
     }
     if (const auto* q = st.find("queue")) {

@@ -61,7 +61,7 @@ std::optional<Vec2> RoadmapBuilder::nextPlaces(site::StationKind k) const {
 // approach point, on the side towards where robots go next. The candidate must fit, be reached
 // from the dock in a straight line and keep a following distance from every station node placed.
 std::optional<Vec2> RoadmapBuilder::placeExit(const site::Station& st, const StationNodes& sn) const {
-  if (st.exit) {
+  if (st.exit || st.exitByEntry) {
     return st.exit;
   }
   const auto next = nextPlaces(st.kind);
@@ -125,13 +125,13 @@ void RoadmapBuilder::placeStations() {
       continue;
     }
     const auto e = placeExit(st, sn);
-    if (!e && nextPlaces(st.kind)) {
-      // Not refused (a dead end with no room beside it still serves), but said: the robot leaving
-      // meets the next in line on the way in, so the dock cycles slower (docs/algorithms.md,
-      // "Stations as servers").
-      problem(RoadmapProblem::Severity::Warning, st.name, st.pose.position(),
-              keyOf(st, "exit") + "station '" + st.name + "': no room for a way out apart from its way in " +
-                  "(give one in site.json); left by its way in");
+    if (!e && !st.exitByEntry && nextPlaces(st.kind)) {
+      // A dead end left by its way in still serves, but the robot leaving meets the next in line
+      // on the way in and the dock cycles slower (docs/algorithms.md, "Stations as servers"): the
+      // site must say so ("exit": "entry") or give a way out.
+      problem(RoadmapProblem::Severity::Error, st.name, st.pose.position(),
+              keyOf(st, "exit") + "station '" + st.name + "': no room for a way out apart from its way in: " +
+                  "give one in site.json, or \"exit\": \"entry\" to have it left by its way in");
     }
     if (e) {
       const Vec2 dockAt = pos[static_cast<std::size_t>(sn.dock)];

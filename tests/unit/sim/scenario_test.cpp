@@ -168,6 +168,13 @@ TEST(Scenario, NamingASiteIsTheSameAsCarryingItInline) {
         inlined[k] = site[k];
       }
     }
+    // Stations carried inline give their poses only: where robots enter, wait and leave a station
+    // (approach, queue, exit) is said in a site file, which the traffic manager plans on.
+    for (auto& st : inlined["stations"]) {
+      st.erase("approach");
+      st.erase("queue");
+      st.erase("exit");
+    }
     for (const auto& [k, v] : site["robot"].items()) {
       if (v.is_object() && inlined["robot_defaults"].contains(k)) {
         inlined["robot_defaults"][k].update(v);

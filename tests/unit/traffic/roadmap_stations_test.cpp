@@ -227,7 +227,8 @@ TEST(Roadmap, BendsAreDrivenRoundWhereTheAgentDrivesRoundAndCornersTurnedOnTheSp
 
 // ---- stations and queues ----------------------------------------------------------------------
 
-TEST(Roadmap, StationsHaveDockApproachAndGeneratedQueueInOrder) {
+// The shipped site spells its lines out (fleetctl site lines) as the roadmap generated them.
+TEST(Roadmap, StationsHaveDockApproachAndQueueInOrder) {
   const Roadmap r = buildRoadmap(shipped("small_warehouse.site.json"));
   const double f = r.options.followingDistance;
   EXPECT_NEAR(f, 1.0, 1e-9);  // 2 × 0.3 + 0.3 stop gap + 0.1 margin
@@ -242,7 +243,7 @@ TEST(Roadmap, StationsHaveDockApproachAndGeneratedQueueInOrder) {
     // Three places unless a wall (P-1's row ends) or another station's line (P-5's beside D-4) is
     // in the way.
     EXPECT_EQ(st->queue.size(), st->name == "P-1" ? 2U : st->name == "D-4" ? 1U : 3U) << name;
-    EXPECT_TRUE(st->queueGenerated) << name;
+    EXPECT_FALSE(st->queueGenerated) << name;  // the site's own points
     const NodeId entry = st->approach != kNoNode ? st->approach : st->dock;
     NodeId next = entry;
     double lastDistance = 0.0;
@@ -374,9 +375,11 @@ TEST(Roadmap, AQueueInTheOnlyCorridorBetweenTwoRoomsIsRefusedByItsKeyPath) {
       rows[r].replace(9, 4, "@@@@");
     }
   }
-  nlohmann::json st = {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 4.0, kPi / 2}}},
-                       {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 4.0, kPi / 2}}},
-                       {{"name", "C"}, {"kind", "dropoff"}, {"pose", {7.5, 4.0, kPi / 2}}}};
+  // C has no room for a way out of its own: left by its way in, on purpose.
+  nlohmann::json st = {
+      {{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 4.0, kPi / 2}}},
+      {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 4.0, kPi / 2}}},
+      {{"name", "C"}, {"kind", "dropoff"}, {"pose", {7.5, 4.0, kPi / 2}}, {"exit", "entry"}}};
   const Roadmap fine = buildRoadmap(rowsSite(rows, st));
   EXPECT_EQ(errors(fine), 0U) << describe(fine.problems);
   // C docked from the west at the corridor's mouth, its queue points in the corridor: robots waiting
@@ -405,8 +408,9 @@ TEST(Roadmap, QueuePointsTooCloseToTheStationAreAWarning) {
 }
 
 // A dead end one robot wide: no room beside the approach point for a way out apart from the way
-// in. The station still serves (left by its way in), and the site is told so by its key path.
-TEST(Roadmap, AStationWithNoRoomForAWayOutIsAWarningNamingItsExit) {
+// in. Refused by its key path unless the site says it is left by its way in ("exit": "entry"); then
+// it serves that way.
+TEST(Roadmap, AStationWithNoRoomForAWayOutIsRefusedUnlessTheSiteLeavesItByItsEntry) {
   auto rows = hall();
   for (const std::size_t y : {1, 2, 3, 6, 7, 8}) {
     for (std::size_t c = 14; c <= 20; ++c) {
@@ -414,20 +418,25 @@ TEST(Roadmap, AStationWithNoRoomForAWayOutIsAWarningNamingItsExit) {
     }
   }
   const Roadmap r = buildRoadmap(rowsSite(rows, twoStations()));
-  EXPECT_EQ(errors(r), 0U) << describe(r.problems);
-  const auto* b = r.station("B");
+  ASSERT_EQ(errors(r), 1U) << describe(r.problems);
+  const auto& p = *std::find_if(r.problems.begin(), r.problems.end(), [](const RoadmapProblem& q) {
+    return q.severity == RoadmapProblem::Severity::Error;
+  });
+  EXPECT_EQ(p.station, "B");
+  EXPECT_EQ(p.what.rfind("stations[1].exit: station 'B': no room for a way out", 0), 0U) << p.what;
+  EXPECT_NE(p.what.find("\"exit\": \"entry\""), std::string::npos) << p.what;
+  // A has room: nothing said of it.
+  EXPECT_NE(r.station("A")->exit, kNoNode);
+
+  auto st = twoStations();
+  st[1]["exit"] = "entry";
+  const Roadmap byEntry = buildRoadmap(rowsSite(rows, st));
+  EXPECT_EQ(errors(byEntry), 0U) << describe(byEntry.problems);
+  const auto* b = byEntry.station("B");
   ASSERT_NE(b->dock, kNoNode);
   EXPECT_EQ(b->exit, kNoNode);
-  const auto w = std::find_if(r.problems.begin(), r.problems.end(), [](const RoadmapProblem& p) {
-    return p.what.find("no room for a way out") != std::string::npos;
-  });
-  ASSERT_NE(w, r.problems.end()) << describe(r.problems);
-  EXPECT_EQ(w->severity, RoadmapProblem::Severity::Warning);
-  EXPECT_EQ(w->station, "B");
-  EXPECT_EQ(w->what.rfind("stations[1].exit: station 'B'", 0), 0U) << w->what;
-  EXPECT_EQ(connectedStations(r), (std::vector<std::string>{"A", "B"}));
-  // A has room: no warning for it.
-  EXPECT_NE(r.station("A")->exit, kNoNode);
+  EXPECT_EQ(connectedStations(byEntry), (std::vector<std::string>{"A", "B"}));
+  EXPECT_NE(byEntry.station("A")->exit, kNoNode);
 }
 
 TEST(Roadmap, StationThatCannotBeConnectedIsAClearProblem) {

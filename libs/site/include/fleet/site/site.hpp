@@ -41,6 +41,10 @@ struct Station {
   /// by a way of its own, so the leaving robot never meets the next in line). Given in site.json
   /// or placed by the roadmap (roadmap.hpp); none for parking places.
   std::optional<Vec2> exit;
+  /// site.json's `"exit": "entry"`: a dead end left by its way in, said on purpose (the leaving
+  /// robot meets the next in line there). Without it a pickup or drop-off the roadmap finds no
+  /// way out for is refused.
+  bool exitByEntry = false;
 };
 
 inline constexpr double kDefaultApproachDistance = 1.0;  // m
