@@ -10,6 +10,7 @@
 
 #include "../fleet/temp_dir.hpp"
 #include "api_fixture.hpp"
+#include "event_stream_reader.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
@@ -147,13 +148,16 @@ class StatusPush : public Api {
 
 TEST_F(StatusPush, AStreamSendsIdsAndResumesAfterLastEventIdWithNothingMissedOrRepeated) {
   start();
-  std::string first;
-  std::thread reader([&] { first = stream("/v1/events", "", "\"seq\":3"); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // Without since= or Last-Event-ID the stream starts after the newest event when the server
+  // handles the request: publish only once it has answered.
+  EventStreamReader reader(api_->port(), "\"seq\":3");
+  ASSERT_TRUE(reader.waitOpen()) << "GET /v1/events did not answer 200 with an open stream";
   view_.onEvent(ev("t-1", 1));
   view_.onEvent(ev("t-1", 2));
   view_.onEvent(ev("t-1", 3));
-  reader.join();
+  ASSERT_TRUE(reader.finish()) << "the stream did not bring the third event; it brought:\n"
+                               << reader.received();
+  const auto& first = reader.received();
   ASSERT_THAT(streamIds(first), ElementsAre(1, 2, 3)) << first;
   EXPECT_THAT(first, HasSubstr("id: 2\nevent: task\ndata: {\"event_id\":2,\"id\":\"t-1\""));
   // Disconnected after 2 (as a client that lost its connection mid-stream); meanwhile 3 more.
