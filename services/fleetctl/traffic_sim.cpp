@@ -406,6 +406,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"time_dwelling", r.dwelling},
                      {"time_waiting_on_others", r.waitingOnOthers},
                      {"time_planned_to_stand", r.standingPlanned},
+                     {"longest_wait_at", r.longestWaitAt},
                      {"stalls", r.stalls}});
     } else {
       std::cout << "seed " << seed << ": " << traffic::formatResult(r) << "\n";
@@ -436,6 +437,9 @@ int runTrafficSim(const TrafficSimOptions& o) {
       }
       if (const std::string q = busiestQueuesLine(r); !q.empty())
         std::cout << q << "\n";
+      if (!r.longestWaitAt.empty())
+        std::cout << "  longest wait " << std::setprecision(1) << r.longestWait << " s: " << r.longestWaitAt
+                  << "\n";
       for (const auto& s : r.stalls)
         std::cout << "  stalled: " << s << "\n";
     }

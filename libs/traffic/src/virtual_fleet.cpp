@@ -266,6 +266,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.density = static_cast<double>(o.robots) / static_cast<double>(g.size());
   std::vector<double> updateMs, taskTimes;
   const std::vector<std::string> place = waitPlaces(roadmap);
+  struct Longest {
+    std::size_t robot = 0;
+    NodeId at = kNoNode;
+    double from = 0.0;
+    NodeId goal = kNoNode;
+    std::vector<std::size_t> on;
+  } longest;
   std::vector<double> waitedAt(g.size(), 0.0);
   const double contact = roadmap.separation.contact - roadmap.separation.margin;
   std::vector<Vec2> where(o.robots);
@@ -419,7 +426,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         b.lastProgress = now;
         takeNext();
       }
-      res.longestWait = std::max(res.longestWait, now - b.lastProgress);
+      if (now - b.lastProgress > res.longestWait) {
+        res.longestWait = now - b.lastProgress;
+        if (longest.robot != r || longest.from != b.lastProgress) {
+          longest = {r, b.at, b.lastProgress, traffic.goal(r), {}};
+        }
+        longest.on = traffic.waitingOn(r);  // whom it waits on as the wait goes on
+      }
     }
     // What the traffic layer promises.
     for (std::size_t r = 0; r < o.robots; ++r) {
@@ -517,6 +530,13 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       }
     }
     res.stalls.push_back(os.str());
+  }
+  if (longest.at != kNoNode) {
+    std::vector<std::pair<std::size_t, NodeId>> on;
+    for (const auto q : longest.on)
+      on.emplace_back(q, bots[q].at);
+    res.longestWaitAt =
+        describeWait(roadmap, place, longest.robot, longest.at, longest.from, longest.goal, on);
   }
   res.duration = ranUntil;
   res.tasksPerHour = static_cast<double>(res.tasksDone) * 3600.0 / ranUntil;

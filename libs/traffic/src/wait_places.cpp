@@ -1,6 +1,8 @@
 // The wait ledger's place names (virtual_fleet.hpp, waitPlaces): a station's own nodes by their
-// role, parking, and lane nodes by the nearest pickup or drop-off dock within reach.
+// role, parking, and lane nodes by the nearest pickup or drop-off dock within reach; and a wait
+// described by its place, its goal and whom it waits on (describeWait).
 
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,6 +54,27 @@ std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near) {
     l = best != nullptr ? "lane by " + *best : "lane";
   }
   return out;
+}
+
+std::string describeWait(const Roadmap& roadmap, const std::vector<std::string>& places, std::size_t robot,
+                         NodeId at, double from, NodeId goal,
+                         std::span<const std::pair<std::size_t, NodeId>> on) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(1);
+  const Vec2 p = roadmap.graph.position(at);
+  os << "robot " << robot << " at node " << at << " (" << p.x << ", " << p.y << "), "
+     << places[static_cast<std::size_t>(at)] << ", from " << from << " s, goal node " << goal;
+  for (const auto& s : roadmap.stations) {
+    if (goal != kNoNode && s.dock == goal)
+      os << " (" << s.name << ")";
+  }
+  os << ", waiting on";
+  for (const auto& [q, v] : on)
+    os << " " << q << "@" << v;
+  if (on.empty())
+    os << " nobody named (its plan keeps it there)";
+  return os.str();
 }
 
 }  // namespace fleet::traffic

@@ -393,6 +393,20 @@ TEST(VirtualFleet, TwentyRobotsWaitOnEachOtherInEveryWay) {
   SCOPED_TRACE(formatResult(r));
   for (const auto c : {WaitCause::SameWay, WaitCause::HeadOn, WaitCause::Across, WaitCause::Standing})
     EXPECT_GT(r.waitCauses[static_cast<std::size_t>(c)], 10.0) << toString(c);
+  // The longest wait is told by its robot, node and place, as the wait ledger names places.
+  ASSERT_GT(r.longestWait, 0.0);
+  const auto places = waitPlaces(map);
+  bool named = false;
+  for (NodeId v = 0; static_cast<std::size_t>(v) < map.graph.size(); ++v) {
+    const std::string at = " at node " + std::to_string(v) + " (";
+    if (r.longestWaitAt.find(at) != std::string::npos) {
+      named =
+          r.longestWaitAt.find("), " + places[static_cast<std::size_t>(v)] + ", from ") != std::string::npos;
+      break;
+    }
+  }
+  EXPECT_EQ(r.longestWaitAt.rfind("robot ", 0), 0U) << r.longestWaitAt;
+  EXPECT_TRUE(named) << r.longestWaitAt;
   for (const double every : {0.0, -1.0, std::nan(""), 0.05}) {  // 0.05: less than a tick
     o.queueSeriesEvery = every;
     EXPECT_THROW(runVirtualFleet(map, o), std::invalid_argument) << every;

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,9 @@ struct VirtualFleetResult {
   std::size_t contacts = 0;        ///< ticks with two centres closer than the roadmap's contact distance
   std::size_t holdViolations = 0;  ///< ticks with two robots holding conflicting nodes
   double longestWait = 0.0;        ///< s the longest a robot with a task went without reaching a node
+  /// Where and on whom that longest wait was, as it ended or at the end of the run: "robot 7 at
+  /// node 312 (24.5, 7.5), D-3 queue, from 118.0 s, goal node 1071 (D-3), waiting on 3@1070".
+  std::string longestWaitAt;
   std::uint64_t plannerSteps = 0;
   std::uint64_t replans = 0;
   std::uint64_t refusedReports = 0;
@@ -175,6 +179,13 @@ struct VirtualFleetResult {
 /// nodes, "parking", and lane nodes "lane by <station>" within `near` m of the nearest pickup or
 /// drop-off dock, otherwise "lane".
 std::vector<std::string> waitPlaces(const Roadmap& roadmap, double near = 2.0);
+
+/// A robot's wait as VirtualFleetResult::longestWaitAt gives it: where (node, position and its
+/// place in `places`), since when, its goal (and the station docked there) and whom it waits on
+/// (robot and the node it stands on; none: its own plan keeps it there).
+std::string describeWait(const Roadmap& roadmap, const std::vector<std::string>& places, std::size_t robot,
+                         NodeId at, double from, NodeId goal,
+                         std::span<const std::pair<std::size_t, NodeId>> on);
 
 /// Runs the virtual fleet on `roadmap`. Robots start on the parking docks (then on spread-out lane
 /// nodes if there are more robots than parking places). Throws std::invalid_argument when the
