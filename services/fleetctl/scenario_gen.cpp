@@ -23,6 +23,9 @@ constexpr double kRowEnd = 2.5;
 constexpr double kRowDy = 2.0;
 constexpr int kBlock = 8;
 constexpr double kStationGap = 2.5;  // m between pickups / drop-offs / chargers
+// Margin (m) deep enough for a pickup's line along its axis: the dock 1.5 m from the wall, its
+// approach point, three queue places 1 m apart and a lane below them.
+constexpr double kPickupLineMargin = 4.0;
 
 nlohmann::json station(const std::string& name, const char* kind, double x, double y, double theta) {
   return {{"name", name}, {"kind", kind}, {"pose", {x, y, theta}}};
@@ -110,9 +113,19 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
     stations.push_back(station("CHG-" + std::to_string(i + 1), "charging", 1.5,
                                spread(sideY0, sideY1, chargers, i), 3.1416));
   }
+  // Pickups as servers where the top margin holds their lines (several parking rows make it
+  // deep): facing the floor, each is approached from below, queued for along its axis and left
+  // beside its approach point, so pickups 2.5 m apart each keep a line of three. Docked facing the
+  // wall they were approached along the row, and a neighbour 2.5 m away left no room for a queue:
+  // one place a pickup, and admission by slots gave 77 % of the robot time no task on the site for
+  // 300 (docs/benchmarks.md, "Generated sites: pickups as servers"). The row ends 6 m from the
+  // east wall, clear of the top drop-off's line. A shallow margin (one parking row) keeps the row
+  // along the wall: lines down its axis there cut the top drop-off off.
+  const bool pickupLines = marginM >= kPickupLineMargin;
   for (int i = 0; i < pickups; ++i) {
-    stations.push_back(station("P-" + std::to_string(i + 1), "pickup", spread(3.5, widthM - 3.5, pickups, i),
-                               heightM - 1.5, 1.5708));
+    stations.push_back(station("P-" + std::to_string(i + 1), "pickup",
+                               spread(3.5, widthM - (pickupLines ? 6.0 : 3.5), pickups, i), heightM - 1.5,
+                               pickupLines ? -1.5708 : 1.5708));
   }
   for (int i = 0; i < dropoffs; ++i) {
     stations.push_back(station("D-" + std::to_string(i + 1), "dropoff", widthM - 1.5,

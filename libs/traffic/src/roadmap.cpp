@@ -273,6 +273,17 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
     waiting[v] = r.kinds[v] == NodeKind::Parking ? 2 : r.kinds[v] != NodeKind::Lane ? 1 : 0;
   }
   addGeometricConflicts(r.graph, sep, waiting);
+  // A robot waiting on a station's approach point must not shut the docked robot's way out: where
+  // the exit excludes the approach, the dock excludes it too, so the next robot in line waits on
+  // the queue until the dock is left (otherwise the docked robot waits for the exit and the next
+  // one, which moves only forward in its line, for the dock: a deadlock, seen on the generated
+  // sites' pickups).
+  for (const auto& st : r.stations) {
+    if (st.dock != kNoNode && st.approach != kNoNode && st.exit != kNoNode &&
+        r.graph.conflicting(st.exit, st.approach) && !r.graph.conflicting(st.dock, st.approach)) {
+      r.graph.addConflict(st.dock, st.approach);
+    }
+  }
 
   // Nearest-node lookup.
   if (r.graph.size() > 0) {
