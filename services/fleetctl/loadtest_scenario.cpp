@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iostream>
 #include <optional>
 
 #include "fleet/core/config.hpp"
@@ -64,9 +65,12 @@ Expected<void> generated(const LoadtestOptions& o, const fs::path& out, RunScena
   }
   auto [site, rest] = splitSite(*g);
   writeTextFile(out / "site.json", site.dump(1));
-  // The site says where robots enter, wait at and leave each station, as a shipped site does.
+  // The site says where robots enter, wait at and leave each station, as a shipped site does. A
+  // generated site whose roadmap has problems (the site for 60: docs/algorithms.md, "Generated
+  // sites") still runs, its lines left to the roadmap as before, and says why.
   if (auto lines = spellOutLinesInPlace((out / "site.json").string()); !lines) {
-    return unexpected(lines.error());
+    std::cerr << "loadtest: warning: the generated site's station lines are not written into it:\n"
+              << lines.error().message << "\n";
   }
   rest["site"] = fs::absolute(out / "site.json").string();
   run.scenario = resolveScenarioSite(rest, (out / "scenario.json").string());
