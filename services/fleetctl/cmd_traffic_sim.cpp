@@ -70,6 +70,11 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
                    "traffic layer's)")
       ->check(CLI::Range(0.0, 1e6));
   trafficSim
+      ->add_option("--occupied-cost", o->occupiedCost,
+                   "s the planner adds to a move into what a standing robot excludes, which would push "
+                   "it (0: plain PIBT; default: the traffic layer's)")
+      ->check(CLI::Range(0.0, 600.0));
+  trafficSim
       ->add_option("--queue-length", o->queueLength,
                    "queue nodes generated for a station the site gives none (default: the roadmap's)")
       ->check(CLI::Range(0, 50));

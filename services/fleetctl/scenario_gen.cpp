@@ -23,9 +23,6 @@ constexpr double kRowEnd = 2.5;
 constexpr double kRowDy = 2.0;
 constexpr int kBlock = 8;
 constexpr double kStationGap = 2.5;  // m between pickups / drop-offs / chargers
-// Margin (m) deep enough for a pickup's line along its axis: the dock 1.5 m from the wall, its
-// approach point, three queue places 1 m apart and a lane below them.
-constexpr double kPickupLineMargin = 6.0;
 
 nlohmann::json station(const std::string& name, const char* kind, double x, double y, double theta) {
   return {{"name", name}, {"kind", kind}, {"pose", {x, y, theta}}};
@@ -113,21 +110,9 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
     stations.push_back(station("CHG-" + std::to_string(i + 1), "charging", 1.5,
                                spread(sideY0, sideY1, chargers, i), 3.1416));
   }
-  // Pickups as servers where the top margin holds their lines (three or more parking rows make it
-  // 6 m deep: the sites for 100 robots and more): facing the floor, each is approached from below,
-  // queued for along its axis and left beside its approach point, so pickups 2.5 m apart each keep
-  // a line of three. Docked facing the wall they were approached along the row, and a neighbour
-  // 2.5 m away left no room for a queue: one place a pickup, and admission by slots gave 77 % of
-  // the robot time no task on the site for 300 (docs/benchmarks.md, "Generated sites: pickups as
-  // servers"). The row ends 6 m from the east wall, clear of the top drop-off's line. A shallower
-  // margin keeps the row along the wall: there the lines down the axis end among the shelves, and
-  // the site for 40 did fewer tasks with them (76.5 against 87.9, virtual fleet; 68 against 101
-  // in the full stack, seed 1).
-  const bool pickupLines = marginM >= kPickupLineMargin;
   for (int i = 0; i < pickups; ++i) {
-    stations.push_back(station("P-" + std::to_string(i + 1), "pickup",
-                               spread(3.5, widthM - (pickupLines ? 6.0 : 3.5), pickups, i), heightM - 1.5,
-                               pickupLines ? -1.5708 : 1.5708));
+    stations.push_back(station("P-" + std::to_string(i + 1), "pickup", spread(3.5, widthM - 3.5, pickups, i),
+                               heightM - 1.5, 1.5708));
   }
   for (int i = 0; i < dropoffs; ++i) {
     stations.push_back(station("D-" + std::to_string(i + 1), "dropoff", widthM - 1.5,

@@ -325,6 +325,8 @@ int runTrafficSim(const TrafficSimOptions& o) {
       v.traffic.pibt.detourAfter = o.detourAfter;
     if (o.detourPenalty >= 0.0)
       v.traffic.pibt.detourPenalty = static_cast<float>(o.detourPenalty);
+    if (o.occupiedCost >= 0.0)
+      v.traffic.pibt.occupiedCost = static_cast<float>(o.occupiedCost);
     const bool record = !o.html.empty() && seed == first;
     if (record)
       v.recordEvery = 0.5;

@@ -15,12 +15,11 @@ using traffic::NodeId;
 
 Settings readSettings(Config& cfg) {
   Settings s;
-  cfg.rejectUnknownKeys(
-      {"site",          "rate_hz",      "settle_s",     "robot_timeout_s", "place_tolerance",
-       "clock",         "lockstep",     "max_lag",      "base_ahead",      "max_base_nodes",
-       "horizon_nodes", "seed",         "detour_after", "detour_penalty",  "station_lines",
-       "let_pass",      "roadmap",      "risk_cost_s",  "risk_period_s",   "yield_after_s",
-       "yield_for_s",   "yield_cost_s", "summary_file"});
+  cfg.rejectUnknownKeys({"site",          "rate_hz",     "settle_s",     "robot_timeout_s", "place_tolerance",
+                         "clock",         "lockstep",    "max_lag",      "base_ahead",      "max_base_nodes",
+                         "horizon_nodes", "seed",        "detour_after", "detour_penalty",  "occupied_cost_s",
+                         "station_lines", "let_pass",    "roadmap",      "risk_cost_s",     "risk_period_s",
+                         "yield_after_s", "yield_for_s", "yield_cost_s", "summary_file"});
   s.site = cfg.string("site", "");
   s.summaryFile = cfg.string("summary_file", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
@@ -44,6 +43,8 @@ Settings readSettings(Config& cfg) {
       static_cast<int>(cfg.integer("detour_after", s.traffic.pibt.detourAfter, {0, 100000}));
   s.traffic.pibt.detourPenalty =
       static_cast<float>(cfg.number("detour_penalty", s.traffic.pibt.detourPenalty, {0.0, 1e6}));
+  s.traffic.pibt.occupiedCost =
+      static_cast<float>(cfg.number("occupied_cost_s", s.traffic.pibt.occupiedCost, {0.0, 600.0}));
   s.riskCostS = cfg.number("risk_cost_s", s.riskCostS, {0.0, 3600.0});
   s.riskPeriodS = cfg.number("risk_period_s", s.riskPeriodS, {0.0, 3600.0});
   s.yieldAfterS = cfg.number("yield_after_s", s.yieldAfterS, {0.0, 3600.0});

@@ -178,6 +178,11 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
     }
     const std::int32_t o = agentAt_[idx(v)];
     const auto occupied = static_cast<std::uint32_t>(o >= 0 && o != agent);
+    // Making a robot move costs it a move (PibtOptions::occupiedCost).
+    if (options_.occupiedCost > 0.0F && v != from && d != DistanceTable::kUnreachable &&
+        standingOn(v, agent) >= 0) {
+      d += options_.occupiedCost;
+    }
     // Ties go to free nodes first, then (if asked) to the smallest turn, then at random (the seed
     // makes the random part repeatable).
     std::uint32_t turn = 0;

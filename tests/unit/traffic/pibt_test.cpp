@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numeric>
 #include <random>
+#include <tuple>
 
 #include "fleet/traffic/plan_check.hpp"
 #include "pibt_test_support.hpp"
@@ -169,6 +170,41 @@ TEST(Pibt, PriorityInheritancePushesAnIdleAgentAhead) {
   EXPECT_EQ(stepsUntilAllReached(p, 20, &plan), 4);  // no step lost to the idle agent
   EXPECT_EQ(p.positions()[1], m.node(5, 0));
   EXPECT_TRUE(checkPlan(m.graph, plan).empty());
+}
+
+// A push priced (PibtOptions::occupiedCost): agent 0 at A heads for G by B (1.0 s from G, agent 1
+// standing there without a goal) or by C (1.1 s from G, free). Plain PIBT ranks B first and pushes
+// agent 1 off it; priced at 0.5 s, the free way wins and agent 1 stays where it is.
+TEST(Pibt, APricedPushLetsAFreeWayNearlyAsShortWin) {
+  Graph g;
+  const NodeId a = g.addNode({0.0, 0.0});
+  const NodeId b = g.addNode({1.0, 0.0});
+  const NodeId c = g.addNode({1.0, -1.0});
+  const NodeId goal = g.addNode({2.0, 0.0});
+  const NodeId aside = g.addNode({1.0, 1.0});
+  for (const auto& [u, v, s] :
+       {std::tuple{a, b, 1.0}, {b, goal, 1.0}, {a, c, 1.2}, {c, goal, 1.1}, {b, aside, 1.0}}) {
+    g.addEdge(u, v, s);
+    g.addEdge(v, u, s);
+  }
+  for (const float price : {0.0F, 0.5F}) {
+    PibtOptions o;
+    o.occupiedCost = price;
+    const std::vector<NodeId> starts = {a, b};
+    Pibt p(g, starts, o);
+    p.setGoal(0, goal);
+    const auto& next = p.step();
+    if (price == 0.0F) {
+      EXPECT_EQ(next[0], b);
+      EXPECT_NE(next[1], b) << "pushed off";
+    } else {
+      EXPECT_EQ(next[0], c);
+      EXPECT_EQ(next[1], b) << "left standing";
+    }
+    const auto path = walkToGoal(g, p, 10);
+    ASSERT_FALSE(path.empty());
+    EXPECT_EQ(path.back(), g.position(goal)) << "price " << price;
+  }
 }
 
 TEST(Pibt, HeadOnInACorridorOneBacksOutAndBothGetThrough) {

@@ -116,6 +116,13 @@ struct PibtOptions {
   /// lattice with diagonals many shortest ways exist; picking among them at random zigzags, and a
   /// real robot stops to turn at every zig (the plan counts each edge as one step whatever the turn).
   bool preferStraight = false;
+  /// Added to a move's rank (the edges' cost unit: seconds on a roadmap) when another agent stands
+  /// on the node or on one it excludes. Plain PIBT ranks such a move by distance alone (the free
+  /// node wins only a tie) and then pushes the agent standing there, which on a roadmap often
+  /// steps away from its own goal and back: a move of someone else's for every push. Priced, a
+  /// free way nearly as short wins. 0: plain PIBT (pibt2's ranking). docs/algorithms.md, "Traffic:
+  /// lifelong planner".
+  float occupiedCost = 0.0F;
 };
 
 struct PibtStats {
