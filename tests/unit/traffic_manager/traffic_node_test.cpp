@@ -482,6 +482,24 @@ TEST(TrafficNode, DetoursAreOnByDefaultAndCanBeTurnedOff) {
   EXPECT_FLOAT_EQ(s.traffic.pibt.detourPenalty, 12.5F);
 }
 
+// A push is priced by default (1 s, PibtOptions::occupiedCost); 0 gives PIBT's plain ranking; a
+// negative price is bad input named by its key.
+TEST(TrafficNode, PushesArePricedByDefaultAndThePriceIsChecked) {
+  Config none = Config::fromText("{}", "test");
+  EXPECT_FLOAT_EQ(readSettings(none).traffic.pibt.occupiedCost, 1.0F);
+  Config plain = Config::fromText(R"({"occupied_cost_s": 0})", "test");
+  EXPECT_FLOAT_EQ(readSettings(plain).traffic.pibt.occupiedCost, 0.0F);
+  EXPECT_TRUE(plain.ok());
+  Config bad = Config::fromText(R"({"occupied_cost_s": -1})", "test");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  bool named = false;
+  for (const auto& p : bad.problems()) {
+    named = named || p.find("occupied_cost_s") != std::string::npos;
+  }
+  EXPECT_TRUE(named);
+}
+
 TEST(TrafficNode, RobotsSentToOneStationWaitInItsLine) {
   // Both are sent to P-1: the first is planned to its dock, the second to its queue, not to the
   // dock's only way in. With the lines off (as before they were wired in) both target the dock.
