@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "fleet/site/site_loader.hpp"
 
@@ -33,7 +37,20 @@ traffic::Roadmap roadmapOf(const fs::path& p) {
   return traffic::buildRoadmap(site, o);
 }
 
-/// Every difference between two roadmaps' nodes, edges and conflicts, one per line.
+/// `v`'s out-neighbours and the nodes it excludes, each sorted.
+std::pair<std::vector<traffic::NodeId>, std::vector<traffic::NodeId>> around(const traffic::Graph& g,
+                                                                             traffic::NodeId v) {
+  std::vector<traffic::NodeId> out;
+  for (const auto& e : g.edges(v)) {
+    out.push_back(e.to);
+  }
+  std::vector<traffic::NodeId> excludes(g.conflicts(v).begin(), g.conflicts(v).end());
+  std::sort(out.begin(), out.end());
+  std::sort(excludes.begin(), excludes.end());
+  return {out, excludes};
+}
+
+/// Every node whose position, kind, edges or conflicts differ between two roadmaps, one per line.
 std::string differences(const traffic::Roadmap& a, const traffic::Roadmap& b) {
   std::ostringstream d;
   if (a.graph.size() != b.graph.size()) {
@@ -42,33 +59,13 @@ std::string differences(const traffic::Roadmap& a, const traffic::Roadmap& b) {
   }
   for (traffic::NodeId v = 0; v < static_cast<traffic::NodeId>(a.graph.size()); ++v) {
     const Vec2 p = a.graph.position(v);
-    const Vec2 q = b.graph.position(v);
-    if ((p - q).norm() > 1e-12 ||
-        a.kinds[static_cast<std::size_t>(v)] != b.kinds[static_cast<std::size_t>(v)]) {
-      d << "node " << v << " at (" << p.x << ", " << p.y << ") vs (" << q.x << ", " << q.y << ")\n";
-    }
-    std::vector<traffic::NodeId> ea, eb;
-    for (const auto& e : a.graph.edges(v)) {
-      ea.push_back(e.to);
-    }
-    for (const auto& e : b.graph.edges(v)) {
-      eb.push_back(e.to);
-    }
-    std::sort(ea.begin(), ea.end());
-    std::sort(eb.begin(), eb.end());
-    if (ea != eb) {
-      d << "edges of node " << v << " at (" << p.x << ", " << p.y << ") differ:";
-      for (auto x : ea) d << " " << x << "(" << a.graph.position(x).x << "," << a.graph.position(x).y << ")";
-      d << " |";
-      for (auto x : eb) d << " " << x << "(" << b.graph.position(x).x << "," << b.graph.position(x).y << ")";
-      d << "\n";
-    }
-    std::vector<traffic::NodeId> ca(a.graph.conflicts(v).begin(), a.graph.conflicts(v).end());
-    std::vector<traffic::NodeId> cb(b.graph.conflicts(v).begin(), b.graph.conflicts(v).end());
-    std::sort(ca.begin(), ca.end());
-    std::sort(cb.begin(), cb.end());
-    if (ca != cb) {
-      d << "conflicts of node " << v << " at (" << p.x << ", " << p.y << ") differ\n";
+    const auto [outA, exA] = around(a.graph, v);
+    const auto [outB, exB] = around(b.graph, v);
+    const bool same = (p - b.graph.position(v)).norm() <= 1e-12 &&
+                      a.kinds[static_cast<std::size_t>(v)] == b.kinds[static_cast<std::size_t>(v)];
+    if (!same || outA != outB || exA != exB) {
+      d << "node " << v << " at (" << p.x << ", " << p.y << "):" << (same ? "" : " position or kind")
+        << (outA == outB ? "" : " edges") << (exA == exB ? "" : " conflicts") << " differ\n";
     }
   }
   return d.str();
