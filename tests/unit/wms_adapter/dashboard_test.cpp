@@ -14,11 +14,13 @@
 
 #include "api_fixture.hpp"
 #include "browser_session.hpp"
+#include "event_stream_reader.hpp"
 #include "http_api.hpp"
 #include "traffic_layer.hpp"
 
 using namespace fleet;
 using namespace fleet::wms;
+using fleet::wms::testing::EventStreamReader;
 using fleet::wms::testing::RawClient;
 using nlohmann::json;
 using ::testing::HasSubstr;
@@ -100,15 +102,30 @@ msg::TrafficRelease release(const std::string& robot, std::uint32_t epoch, std::
   return r;
 }
 
-/// The data of every `event: name` in an SSE text, in order.
+/// The data of every `event: name` in an SSE text, in order; one not complete yet (a stream read
+/// so far) is left out.
 std::vector<json> eventsNamed(const std::string& text, const std::string& name) {
   std::vector<json> out;
   const std::string head = "event: " + name + "\ndata: ";
   for (auto at = text.find(head); at != std::string::npos; at = text.find(head, at + 1)) {
     const auto start = at + head.size();
-    out.push_back(json::parse(text.substr(start, text.find("\n\n", start) - start)));
+    const auto end = text.find("\n\n", start);
+    if (end == std::string::npos) {
+      break;
+    }
+    out.push_back(json::parse(text.substr(start, end - start)));
   }
   return out;
+}
+
+/// The dashboard's stream makes its snapshot when the server first polls it, after the response
+/// head: a test changes the fleet only once the snapshot has arrived, or the change is in the
+/// snapshot and never sent as one.
+::testing::AssertionResult snapshotArrived(EventStreamReader& stream) {
+  if (stream.waitFor("event: snapshot")) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "GET /v1/stream sent no snapshot; it sent:\n" << stream.received();
 }
 
 class Dash : public ::testing::Test {
@@ -291,26 +308,24 @@ TEST_F(Dash, HomeGoesToTheRobotsParkingPlaceAndChargeToTheNearestCharger) {
 
 TEST_F(Dash, TheStreamStartsWithASnapshotThenSendsWhatChanged) {
   start("");
-  std::string got;
-  std::thread feeder([this] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
-    view_.onRobot(robot("r2", 8.0, 2.0, 2));
-    view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1, ""});
-    msg::RiskMap m;
-    m.width = 4;
-    m.height = 2;
-    m.resolution = 0.5;
-    m.levels = 3;
-    m.runs = {{0, 5}, {3, 2}, {1, 1}};
-    view_.onRisk(m);
+  EventStreamReader stream(api_->port(), "/v1/stream", [](const std::string& got) {
+    return got.find("event: robots") != std::string::npos && got.find("event: task") != std::string::npos &&
+           got.find("event: risk") != std::string::npos;
   });
-  auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
-    got.append(data, n);
-    return got.find("event: robots") == std::string::npos || got.find("event: task") == std::string::npos ||
-           got.find("event: risk") == std::string::npos;
-  });
-  feeder.join();
-  ASSERT_THAT(got, HasSubstr("event: snapshot"));
+  ASSERT_TRUE(snapshotArrived(stream));
+  view_.onRobot(robot("r2", 8.0, 2.0, 2));
+  view_.onEvent(msg::TaskEvent{"t<1>", msg::TaskState::Assigned, "r2", "", 5, 1, ""});
+  msg::RiskMap m;
+  m.width = 4;
+  m.height = 2;
+  m.resolution = 0.5;
+  m.levels = 3;
+  m.runs = {{0, 5}, {3, 2}, {1, 1}};
+  view_.onRisk(m);
+  ASSERT_TRUE(stream.finish())
+      << "the stream did not bring the robot, the task and the risk map; it brought:\n"
+      << stream.received();
+  const std::string got = stream.received();
   const auto snap = got.find("event: snapshot\ndata: ");
   const auto snapEnd = got.find("\n\n", snap);
   const json s = json::parse(got.substr(snap + 22, snapEnd - snap - 22));
@@ -392,26 +407,38 @@ TEST_F(Dash, TheStreamSendsTheRoadmapOnceThenReleasesAndQueuesAsTheyChange) {
   view_.onRoadmap(smallRoadmap(7));
   view_.onRelease(release("r1", 7, 1, {0, 1}, {6, 5}));
   view_.onRobot(robot("r2", 5.0, 3.0, 2));  // waiting at the head of P-1's queue
-  std::string got;
-  std::thread feeder([this] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(400));
-    view_.onRelease(release("r1", 7, 2, {1, 6}, {5}));
-    view_.onRelease(release("r2", 7, 1, {5}, {}));
-    view_.onRobot(robot("r1", 5.0, 4.0, 3));  // joins the queue behind r2
-    std::this_thread::sleep_for(std::chrono::milliseconds(600));
-    view_.onRoadmap(smallRoadmap(9));  // a restarted traffic manager
-  });
-  // Until the second roadmap and the releases after it have arrived.
-  auto secondRoadmapAt = [&] {
+  auto secondRoadmapAt = [](const std::string& got) {
     const auto first = got.find("event: roadmap");
     return first == std::string::npos ? first : got.find("event: roadmap", first + 1);
   };
-  auto r = client_->Get("/v1/stream", [&](const char* data, std::size_t n) {
-    got.append(data, n);
-    const auto at = secondRoadmapAt();
-    return at == std::string::npos || got.find("event: releases", at) == std::string::npos;
+  // Until the second roadmap and the releases after it have arrived.
+  EventStreamReader stream(api_->port(), "/v1/stream", [&](const std::string& got) {
+    const auto at = secondRoadmapAt(got);
+    return at != std::string::npos && got.find("event: releases", at) != std::string::npos;
   });
-  feeder.join();
+  ASSERT_TRUE(snapshotArrived(stream));
+  view_.onRelease(release("r1", 7, 2, {1, 6}, {5}));
+  view_.onRelease(release("r2", 7, 1, {5}, {}));
+  view_.onRobot(robot("r1", 5.0, 4.0, 3));  // joins the queue behind r2
+  // A new roadmap starts the releases again: it comes once the stream has sent these changes.
+  const bool changesSent = stream.waitFor([](const std::string& got) {
+    bool r1 = false;
+    bool r2 = false;
+    for (const auto& e : eventsNamed(got, "releases")) {
+      for (const auto& rel : e["releases"]) {
+        r1 = r1 || (rel["robot"] == "r1" && rel["seq"] == 2);
+        r2 = r2 || rel["robot"] == "r2";
+      }
+    }
+    const auto queues = eventsNamed(got, "queues");
+    return r1 && r2 && !queues.empty() && queues.back()["queues"][0]["waiting"] == json::array({"r2", "r1"});
+  });
+  ASSERT_TRUE(changesSent) << "the stream did not bring the new releases and queue; it brought:\n"
+                           << stream.received();
+  view_.onRoadmap(smallRoadmap(9));  // a restarted traffic manager
+  ASSERT_TRUE(stream.finish()) << "the stream did not bring the new roadmap and its releases; it brought:\n"
+                               << stream.received();
+  const std::string got = stream.received();
   const auto roadmaps = eventsNamed(got, "roadmap");
   ASSERT_EQ(roadmaps.size(), 2u) << "the roadmap once, and again when it changed";
   EXPECT_EQ(roadmaps[0]["epoch"], 7);
@@ -419,7 +446,7 @@ TEST_F(Dash, TheStreamSendsTheRoadmapOnceThenReleasesAndQueuesAsTheyChange) {
   EXPECT_EQ(roadmaps[1]["epoch"], 9);
   EXPECT_LT(got.find("event: roadmap"), got.find("event: releases")) << "the page needs the nodes first";
 
-  const auto before = eventsNamed(got.substr(0, secondRoadmapAt()), "releases");
+  const auto before = eventsNamed(got.substr(0, secondRoadmapAt(got)), "releases");
   ASSERT_GE(before.size(), 2u);
   EXPECT_EQ(before[0]["all"], true) << "the first is the whole set";
   ASSERT_EQ(before[0]["releases"].size(), 1u);
@@ -436,7 +463,7 @@ TEST_F(Dash, TheStreamSendsTheRoadmapOnceThenReleasesAndQueuesAsTheyChange) {
   ASSERT_EQ(changed.size(), 2u) << "only what changed: r1's new release and r2's first";
   EXPECT_EQ(changed["r1"]["seq"], 2);
   EXPECT_EQ(changed["r2"]["base"], json::array({5}));
-  const auto after = eventsNamed(got.substr(secondRoadmapAt()), "releases");
+  const auto after = eventsNamed(got.substr(secondRoadmapAt(got)), "releases");
   ASSERT_EQ(after.size(), 1u);
   EXPECT_EQ(after[0]["all"], true) << "a new roadmap: the set starts again";
   EXPECT_EQ(after[0]["releases"], json::array()) << "the old traffic manager's releases are gone";
