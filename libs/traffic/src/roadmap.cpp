@@ -86,61 +86,17 @@ void guide(Roadmap& r) {
   r.guidance = guideByFlow(r.graph, trips, o);
 }
 
-// A queue the roadmap generates never cuts the site: a generated line whose robots, all standing
-// in it, would cut off another station (checkQueues) loses its last place, and the roadmap is
-// built again, until no generated line does (each round shortens a line, so it ends within
-// queueLength + 1 rounds). A line the site gives is the site's to change: that stays an error.
-// Found on the sites `fleetctl loadtest` generates for 30, 60 and 70 robots: a row of pickups
-// each left along the row towards the next, whose line along the row shut the way out of the one
-// before it.
-Roadmap linesThatCutNothing(const site::Site& s, const RoadmapOptions& options) {
-  std::vector<int> caps(s.stations.size(), options.queueLength);
-  Roadmap r = detail::buildRoadmapOnce(s, options, caps);
-  std::vector<std::string> shortened;
-  for (int round = 0; round <= options.queueLength; ++round) {
-    bool changed = false;
-    for (std::size_t i = 0; i < r.stations.size() && i < caps.size(); ++i) {
-      const auto& sn = r.stations[i];
-      const bool cuts = std::any_of(r.problems.begin(), r.problems.end(), [&](const RoadmapProblem& p) {
-        return p.severity == RoadmapProblem::Severity::Error && p.station == sn.name &&
-               p.what.find("].queue: ") != std::string::npos && p.what.find(" cut off ") != std::string::npos;
-      });
-      if (cuts && sn.queueGenerated && !sn.queue.empty()) {
-        caps[i] = static_cast<int>(sn.queue.size()) - 1;
-        changed = true;
-      }
-    }
-    if (!changed) {
-      break;
-    }
-    r = detail::buildRoadmapOnce(s, options, caps);
-  }
-  for (std::size_t i = 0; i < r.stations.size() && i < caps.size(); ++i) {
-    if (caps[i] < options.queueLength) {
-      const auto& sn = r.stations[i];
-      r.problems.push_back({RoadmapProblem::Severity::Warning, sn.name,
-                            sn.dock != kNoNode ? r.graph.position(sn.dock) : Vec2{},
-                            "stations[" + std::to_string(i) + "].queue: station '" + sn.name +
-                                "': its line has " + std::to_string(sn.queue.size()) + " queue place" +
-                                (sn.queue.size() == 1 ? "" : "s") +
-                                ": a longer one would cut off another station when full (give its "
-                                "queue points in site.json for another line)"});
-    }
-  }
-  return r;
-}
-
 // The lattice kept clear of parked robots; where the site leaves no room for that (a parking row
 // in a corridor of its own width: stations cut off without the lanes beside it), the lattice as
 // the map allows, with a warning that parked robots block lanes there.
 Roadmap clearOfParkingWherePossible(const site::Site& s, const RoadmapOptions& options) {
-  Roadmap r = linesThatCutNothing(s, options);
+  Roadmap r = detail::buildRoadmapOnce(s, options);
   if (!options.parkingClear || errorCount(r) == 0) {
     return r;
   }
   RoadmapOptions as = options;
   as.parkingClear = false;
-  Roadmap plain = linesThatCutNothing(s, as);
+  Roadmap plain = detail::buildRoadmapOnce(s, as);
   if (errorCount(plain) >= errorCount(r)) {
     return r;
   }
@@ -162,8 +118,7 @@ Roadmap buildRoadmap(const site::Site& s, const RoadmapOptions& options) {
   return r;
 }
 
-Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& options,
-                                 std::span<const int> queueCaps) {
+Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& options) {
   const auto& in = options;
   if (!(in.cruiseSpeed > 0.0) || in.spacing < 0.0 || (in.spacing > 0.0 && in.spacing < 0.05) ||
       !(in.targetSpacing >= 0.05) || in.radius < 0.0 || in.stopGap < 0.0 || in.corridorSlack < 0.0 ||
@@ -174,7 +129,7 @@ Roadmap detail::buildRoadmapOnce(const site::Site& s, const RoadmapOptions& opti
         "corridorSlack, nodeClearance, edgeClearance, margin and followingDistance >= 0, queueLength 0..50, "
         "guidance 0..100");
   }
-  detail::RoadmapBuilder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, queueCaps, {}, {}, {}, {}};
+  detail::RoadmapBuilder b{s, options, s.drivable(), {}, {}, {}, {}, {}, 0, {}, {}, {}, {}};
   auto& o = b.opt;
   const double res = s.map.size() > 0 ? s.map.resolution() : 1.0;
   if (o.radius <= 0.0) {

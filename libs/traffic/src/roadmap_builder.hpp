@@ -42,8 +42,7 @@ struct RoadmapBuilder {
   std::vector<Link> links;
   std::vector<RoadmapProblem> problems;
   std::vector<StationNodes> stations;
-  std::size_t latticeCount = 0;    // nodes [0, latticeCount) are the lattice
-  std::span<const int> queueCaps;  // per site station: at most this many generated queue nodes
+  std::size_t latticeCount = 0;  // nodes [0, latticeCount) are the lattice
   std::vector<std::uint8_t>
       latticeLinked;  // per lattice node: it has a lattice edge (stations join only those)
   Vec2 latticeOrigin;
@@ -102,7 +101,7 @@ struct RoadmapBuilder {
   }
 
   // roadmap_stations.cpp: docks, approach points, ways out and queues.
-  std::vector<Vec2> generateQueue(Vec2 base, const std::vector<Vec2>& dirs, int length);
+  std::vector<Vec2> generateQueue(Vec2 base, const std::vector<Vec2>& dirs);
   [[nodiscard]] NodeId entryOf(const StationNodes& sn) const {
     return sn.approach != kNoNode ? sn.approach : sn.dock;
   }
@@ -110,7 +109,7 @@ struct RoadmapBuilder {
   [[nodiscard]] std::optional<Vec2> nextPlaces(site::StationKind k) const;
   [[nodiscard]] std::optional<Vec2> placeExit(const site::Station& st, const StationNodes& sn) const;
   void placeStations();
-  void placeQueue(const site::Station& st, StationNodes& sn, int length);
+  void placeQueue(const site::Station& st, StationNodes& sn);
   void joinQueue(const StationNodes& sn);
 
   // roadmap.cpp: the zones' say on an edge.

@@ -11,13 +11,13 @@
 namespace fleet::traffic::detail {
 
 // Back from `base` along each of `dirs` in turn while the disc fits; the longest line wins.
-std::vector<Vec2> RoadmapBuilder::generateQueue(Vec2 base, const std::vector<Vec2>& dirs, int length) {
+std::vector<Vec2> RoadmapBuilder::generateQueue(Vec2 base, const std::vector<Vec2>& dirs) {
   const double f = opt.followingDistance;
   std::vector<Vec2> best;
   for (const Vec2 d : dirs) {
     std::vector<Vec2> pts;
     Vec2 prev = base;
-    for (int k = 1; k <= length; ++k) {
+    for (int k = 1; k <= opt.queueLength; ++k) {
       const Vec2 p = base + d * (f * k);
       if (!fits(p) || !sweeps(prev, p) || !clearOfStations(p, f)) {
         break;
@@ -28,7 +28,7 @@ std::vector<Vec2> RoadmapBuilder::generateQueue(Vec2 base, const std::vector<Vec
     if (pts.size() > best.size()) {
       best = pts;
     }
-    if (static_cast<int>(best.size()) == length) {
+    if (static_cast<int>(best.size()) == opt.queueLength) {
       break;
     }
   }
@@ -191,8 +191,7 @@ void RoadmapBuilder::placeStations() {
     }
   }
   for (std::size_t i = 0; i < site.stations.size(); ++i) {
-    placeQueue(site.stations[i], stations[i],
-               i < queueCaps.size() ? std::min(queueCaps[i], opt.queueLength) : opt.queueLength);
+    placeQueue(site.stations[i], stations[i]);
   }
   for (const auto& sn : stations) {
     joinQueue(sn);
@@ -201,13 +200,13 @@ void RoadmapBuilder::placeStations() {
 
 // A queue is a line toward the station: entered at its tail from behind, driven one way toward
 // the station, left sideways (so a robot joining or leaving never drives at the robots waiting).
-void RoadmapBuilder::placeQueue(const site::Station& st, StationNodes& sn, int length) {
+void RoadmapBuilder::placeQueue(const site::Station& st, StationNodes& sn) {
   if (sn.dock == kNoNode) {
     return;
   }
   const NodeId entry = entryOf(sn);
   std::vector<Vec2> queue = st.queue;
-  if (queue.empty() && st.kind != site::StationKind::Parking && length > 0) {
+  if (queue.empty() && st.kind != site::StationKind::Parking && opt.queueLength > 0) {
     // Back from the approach point along the station's axis first; along the row when the axis
     // is blocked or the station has no straight approach: on the side away from its way out.
     const Vec2 h = st.pose.heading();
@@ -224,7 +223,7 @@ void RoadmapBuilder::placeQueue(const site::Station& st, StationNodes& sn, int l
     if (sn.exit == kNoNode || sn.approach != kNoNode) {
       dirs.push_back(-side);
     }
-    queue = generateQueue(pos[static_cast<std::size_t>(entry)], dirs, length);
+    queue = generateQueue(pos[static_cast<std::size_t>(entry)], dirs);
     sn.queueGenerated = !queue.empty();
   }
   NodeId next = entry;

@@ -396,48 +396,6 @@ TEST(Roadmap, AQueueInTheOnlyCorridorBetweenTwoRoomsIsRefusedByItsKeyPath) {
   EXPECT_EQ(connectedStations(r), (std::vector<std::string>{"A", "B", "C"}));
 }
 
-// The same corridor with C's line left to the roadmap: the line it would generate back from C's
-// approach point runs into the corridor and, full, would cut the west room off. A generated line
-// never cuts the site: it is shortened until it does not, and a warning says so.
-TEST(Roadmap, AGeneratedLineIsShortenedUntilItCutsOffNoStation) {
-  auto rows = hall();
-  for (std::size_t r = 1; r + 1 < rows.size(); ++r) {
-    if (r != 4 && r != 5) {
-      rows[r].replace(9, 4, "@@@@");
-    }
-  }
-  nlohmann::json st = {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 4.0, kPi / 2}}},
-                       {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 4.0, kPi / 2}}},
-                       {{"name", "C"},
-                        {"kind", "dropoff"},
-                        {"pose", {8.0, 2.5, kPi}},
-                        {"approach", {7.0, 2.5}},
-                        {"exit", "entry"}}};
-  const Roadmap r = buildRoadmap(rowsSite(rows, st));
-  EXPECT_EQ(errors(r), 0U) << describe(r.problems);
-  const auto* c = r.station("C");
-  ASSERT_NE(c, nullptr);
-  EXPECT_LT(c->queue.size(), 3U);
-  for (const NodeId q : c->queue) {
-    EXPECT_GT(r.graph.position(q).x, 6.5 + 0.3) << "a queue place in the corridor";
-  }
-  const auto w = std::find_if(r.problems.begin(), r.problems.end(), [](const RoadmapProblem& p) {
-    return p.what.rfind("stations[2].queue: station 'C': its line has ", 0) == 0;
-  });
-  ASSERT_NE(w, r.problems.end()) << describe(r.problems);
-  EXPECT_EQ(w->severity, RoadmapProblem::Severity::Warning);
-  EXPECT_NE(w->what.find("its line has " + std::to_string(c->queue.size()) + " queue place"),
-            std::string::npos)
-      << w->what;
-  // Without the corridor nothing is cut: the full line, and nothing said.
-  const Roadmap open = buildRoadmap(rowsSite(hall(), st));
-  EXPECT_EQ(open.station("C")->queue.size(), 3U);
-  EXPECT_EQ(errors(open), 0U) << describe(open.problems);
-  EXPECT_TRUE(std::none_of(open.problems.begin(), open.problems.end(), [](const RoadmapProblem& p) {
-    return p.what.find("its line has") != std::string::npos;
-  })) << describe(open.problems);
-}
-
 TEST(Roadmap, QueuePointsTooCloseToTheStationAreAWarning) {
   nlohmann::json st = twoStations();
   st[1]["queue"] = {{9.0, 2.8}};  // 0.58 m from the dock

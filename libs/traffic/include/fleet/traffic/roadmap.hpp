@@ -31,7 +31,6 @@
 
 #include <cstdint>
 #include <optional>
-#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -118,11 +117,8 @@ struct Closure {
 
 class Roadmap;
 namespace detail {
-/// buildRoadmap without its fall-backs (RoadmapOptions::parkingClear as given, every generated
-/// queue as long as it fits). `queueCaps[i]`: at most that many generated queue nodes for the
-/// site's station i (missing: RoadmapOptions::queueLength).
-Roadmap buildRoadmapOnce(const site::Site& site, const RoadmapOptions& options,
-                         std::span<const int> queueCaps = {});
+/// buildRoadmap without its fall-back (RoadmapOptions::parkingClear as given).
+Roadmap buildRoadmapOnce(const site::Site& site, const RoadmapOptions& options);
 }  // namespace detail
 
 class Roadmap {
@@ -168,7 +164,7 @@ class Roadmap {
   void reopen(const Closure& c);
 
  private:
-  friend Roadmap detail::buildRoadmapOnce(const site::Site&, const RoadmapOptions&, std::span<const int>);
+  friend Roadmap detail::buildRoadmapOnce(const site::Site&, const RoadmapOptions&);
   Closure close(std::vector<NodeId> nodes, std::vector<std::pair<NodeId, NodeId>> edges);
   double turnRate_ = 1.5;   ///< rad/s
   double turnAccel_ = 3.0;  ///< rad/s²
