@@ -23,6 +23,13 @@ constexpr double kRowEnd = 2.5;
 constexpr double kRowDy = 2.0;
 constexpr int kBlock = 8;
 constexpr double kStationGap = 2.5;  // m between pickups / drop-offs / chargers
+// Pickups dock along the top wall, entered along the row and left towards the next one, so each
+// takes its line (three places a following distance apart, 3 m), its exit (1 m) and a following
+// distance to the next one's line (1 m) beside its dock (0.5 m). Closer, the next one's line
+// shuts its way out when full: the roadmap refuses that (the sites for 30, 60 and 70 robots) or
+// leaves no room for a line at all (24 of the 25 pickups of the site for 100: one robot admitted
+// a pickup).
+constexpr double kPickupGap = 5.5;
 
 nlohmann::json station(const std::string& name, const char* kind, double x, double y, double theta) {
   return {{"name", name}, {"kind", kind}, {"pose", {x, y, theta}}};
@@ -95,13 +102,15 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
           station("PARK-" + std::to_string(k), "parking", placeX(i), kRowY + r * kRowDy, 1.5708));
     }
   }
-  // Chargers, pickups, drop-offs: about one per ten, four and five robots, as room allows.
+  // Chargers, pickups, drop-offs: about one per ten, four and five robots, as room allows (pickups
+  // at most one per kPickupGap of the top wall).
   const double sideY0 = marginM + 1.0;
   const double sideY1 = heightM - marginM - 1.0;
   const int sideRoom = std::max(1, static_cast<int>((sideY1 - sideY0) / kStationGap) + 1);
   const int topRoom = std::max(1, static_cast<int>((widthM - 6.0) / kStationGap) + 1);
   const int chargers = std::clamp(sized / 10, 3, sideRoom);
-  const int pickups = std::clamp(sized / 4, 5, topRoom);
+  const int pickupRoom = static_cast<int>((widthM - 7.0) / kPickupGap) + 1;  // spread from 3.5 m in
+  const int pickups = std::clamp(sized / 4, 5, std::max(5, std::min(topRoom, pickupRoom)));
   const int dropoffs = std::clamp(sized / 5, 4, sideRoom);
   auto spread = [](double lo, double hi, int count, int i) {
     return count == 1 ? (lo + hi) / 2 : lo + (hi - lo) * i / (count - 1);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <memory>
 #include <set>
@@ -128,7 +129,24 @@ TEST_P(GeneratedParking, ItsParkingPlacesLeaveByEdgesClearOfTheShelves) {
   EXPECT_GT(checked, 0U);
 }
 
-INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 40, 100, 500));
+// Every pickup and drop-off has a line of two places at least (three where the wall or the next
+// station leaves room): the places admission by slots admits robots on. Pickups along the top wall
+// 2.5-5 m apart had one or none (the next pickup's line would have shut the way out), so by slots
+// one robot was admitted a pickup on the site for 100.
+TEST_P(GeneratedScenario, EveryPickupAndDropOffHasALine) {
+  const auto [where, r] = generatedSite(GetParam());
+  std::size_t checked = 0;
+  for (const auto& st : r.stations) {
+    if (st.kind != site::StationKind::Pickup && st.kind != site::StationKind::Dropoff) {
+      continue;
+    }
+    ++checked;
+    EXPECT_GE(st.queue.size(), 2U) << GetParam() << " robots: " << st.name;
+  }
+  EXPECT_GE(checked, 9U);
+}
+
+INSTANTIATE_TEST_SUITE_P(Fleets, GeneratedScenario, ::testing::Values(1, 20, 30, 40, 60, 70, 100, 500));
 
 // No robot waiting on a station's approach point shuts the docked robot's way out: where the exit
 // excludes the approach, so does the dock (buildRoadmap), else the docked robot waits for its exit
@@ -140,16 +158,18 @@ TEST(GeneratedSite, ANextInLineOnTheApproachNeverShutsTheDockedRobotsWayOut) {
   ASSERT_TRUE(doc) << doc.error().message;
   const double top = (*doc)["map"]["warehouse"]["height"].get<double>() * 0.5;
   const double width = (*doc)["map"]["warehouse"]["width"].get<double>() * 0.5;
-  std::size_t turned = 0;
-  for (auto& st : (*doc)["stations"]) {
-    if (st["kind"] == "pickup") {
-      // Facing the floor, the row ending 6 m from the east wall (clear of the top drop-off's line).
-      const double x = st["pose"][0].get<double>();
-      st["pose"] = {3.5 + (x - 3.5) * (width - 9.5) / (width - 7.0), top - 1.5, -1.5708};
-      ++turned;
-    }
+  // The run's 25 pickups 2.25 m apart, facing the floor, the row ending 6 m from the east wall
+  // (clear of the top drop-off's line); the generator now spaces its own pickups wider.
+  auto& stations = (*doc)["stations"];
+  stations.erase(std::remove_if(stations.begin(), stations.end(),
+                                [](const nlohmann::json& st) { return st["kind"] == "pickup"; }),
+                 stations.end());
+  const std::size_t turned = 25;
+  for (std::size_t i = 0; i < turned; ++i) {
+    stations.push_back({{"name", "P-" + std::to_string(i + 1)},
+                        {"kind", "pickup"},
+                        {"pose", {3.5 + (width - 9.5) * static_cast<double>(i) / 24.0, top - 1.5, -1.5708}}});
   }
-  ASSERT_GE(turned, 10U);
   const sim::Scenario s = sim::parseScenario(*doc, "generated", ".");
   ASSERT_NE(s.site, nullptr);
   const traffic::Roadmap r = traffic::buildRoadmap(*s.site);
