@@ -22,7 +22,7 @@ constexpr double kRowY = 0.9;
 constexpr double kRowEnd = 2.5;
 constexpr double kRowDy = 2.0;
 constexpr int kBlock = 8;
-constexpr double kStationGap = 2.5;  // m between pickups / drop-offs / chargers
+constexpr double kStationGap = 2.5;  // m between drop-offs / chargers
 // Pickups dock along the top wall, entered along the row and left towards the next one, so each
 // takes its line (three places a following distance apart, 3 m), its exit (1 m) and a following
 // distance to the next one's line (1 m) beside its dock (0.5 m). Closer, the next one's line
@@ -107,10 +107,9 @@ Expected<nlohmann::json> generateScenario(const nlohmann::json& templ, const Sce
   const double sideY0 = marginM + 1.0;
   const double sideY1 = heightM - marginM - 1.0;
   const int sideRoom = std::max(1, static_cast<int>((sideY1 - sideY0) / kStationGap) + 1);
-  const int topRoom = std::max(1, static_cast<int>((widthM - 6.0) / kStationGap) + 1);
+  const int topRoom = static_cast<int>((widthM - 7.0) / kPickupGap) + 1;  // spread from 3.5 m in
   const int chargers = std::clamp(sized / 10, 3, sideRoom);
-  const int pickupRoom = static_cast<int>((widthM - 7.0) / kPickupGap) + 1;  // spread from 3.5 m in
-  const int pickups = std::clamp(sized / 4, 5, std::max(5, std::min(topRoom, pickupRoom)));
+  const int pickups = std::clamp(sized / 4, 5, std::max(5, topRoom));
   const int dropoffs = std::clamp(sized / 5, 4, sideRoom);
   auto spread = [](double lo, double hi, int count, int i) {
     return count == 1 ? (lo + hi) / 2 : lo + (hi - lo) * i / (count - 1);
