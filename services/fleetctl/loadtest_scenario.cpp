@@ -66,8 +66,9 @@ Expected<void> generated(const LoadtestOptions& o, const fs::path& out, RunScena
   auto [site, rest] = splitSite(*g);
   writeTextFile(out / "site.json", site.dump(1));
   // The site says where robots enter, wait at and leave each station, as a shipped site does. A
-  // generated site whose roadmap has problems (the site for 60: docs/algorithms.md, "Generated
-  // sites") still runs, its lines left to the roadmap as before, and says why.
+  // generated site whose roadmap has errors (none of the sizes tried since the pickups are spaced
+  // for their lines: docs/algorithms.md, "Generated sites' pickups spaced for their lines") still
+  // runs, its lines left to the roadmap, and says why.
   if (auto lines = spellOutLinesInPlace((out / "site.json").string()); !lines) {
     std::cerr << "loadtest: warning: the generated site's station lines are not written into it:\n"
               << lines.error().message << "\n";

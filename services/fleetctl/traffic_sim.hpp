@@ -26,12 +26,11 @@ struct TrafficSimOptions {
   int maxLag = -1;              ///< planner steps a robot may fall behind before a re-plan; -1: the default
   int detourAfter = -1;         ///< planner steps before a detour round standing robots; -1: the default
   double detourPenalty = -1.0;  ///< s added for entering what a standing robot excludes; <0: the default
-  double occupiedCost =
-      -1.0;              ///< s added to the planner's rank of a move that pushes a robot; <0: the default
-  int queueLength = -1;  ///< generated queue nodes per station; -1: the roadmap's default
-  int stationLines = 1;  ///< 1: robots wait in line at stations' queues; 0: all planned to the dock
-  int admission = 1;     ///< VirtualFleetOptions::admission: 0 none, 1 slots, 2 arrival
-  int stationSlots = 0;  ///< VirtualFleetOptions::stationSlots: slots per station (0: its line)
+  double occupiedCost = -1.0;   ///< s added to a move that pushes a robot; <0: the default
+  int queueLength = -1;         ///< generated queue nodes per station; -1: the roadmap's default
+  int stationLines = 1;         ///< 1: robots wait in line at stations' queues; 0: all planned to the dock
+  int admission = 1;            ///< VirtualFleetOptions::admission: 0 none, 1 slots, 2 arrival
+  int stationSlots = 0;         ///< VirtualFleetOptions::stationSlots: slots per station (0: its line)
   std::vector<std::string> stations;  ///< VirtualFleetOptions::stations
   bool json = false;
   std::string html;  ///< write a replay page of the first seed's run here (empty: none)

@@ -158,7 +158,7 @@ TEST(GeneratedSite, ANextInLineOnTheApproachNeverShutsTheDockedRobotsWayOut) {
   ASSERT_TRUE(doc) << doc.error().message;
   const double top = (*doc)["map"]["warehouse"]["height"].get<double>() * 0.5;
   const double width = (*doc)["map"]["warehouse"]["width"].get<double>() * 0.5;
-  // The run's 25 pickups 2.25 m apart, facing the floor, the row ending 6 m from the east wall
+  // The run's 25 pickups about 2.4 m apart, facing the floor, the row ending 6 m from the east wall
   // (clear of the top drop-off's line); the generator now spaces its own pickups wider.
   auto& stations = (*doc)["stations"];
   stations.erase(std::remove_if(stations.begin(), stations.end(),
