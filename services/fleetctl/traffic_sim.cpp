@@ -390,6 +390,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"min_separation_m", r.minSeparation},
                      {"contacts", r.contacts},
                      {"hold_violations", r.holdViolations},
+                     {"line_leaves", r.lineLeaves},
                      {"longest_wait_s", r.longestWait},
                      {"replans", r.replans},
                      {"evasions", r.evasions},

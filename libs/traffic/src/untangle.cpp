@@ -76,7 +76,8 @@ std::optional<UntangleResult> untangle(const Graph& graph, const UntangleProblem
     for (std::size_t i = 0; i < k && !found; ++i) {
       const Config c = items[head].config;
       for (const Edge& e : graph.edges(c[i])) {
-        if (!e.open || !graph.isOpen(e.to) || !clearOfMembers(c, i, e.to) || !clearOfOthers(e.to))
+        if (!e.open || !graph.isOpen(e.to) || (p.mayMove && !p.mayMove(i, c[i], e.to)) ||
+            !clearOfMembers(c, i, e.to) || !clearOfOthers(e.to))
           continue;
         Config n = c;
         n[i] = e.to;

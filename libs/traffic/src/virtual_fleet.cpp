@@ -422,6 +422,15 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         b.prev = b.at;
         b.at = b.to;
         b.to = kNoNode;
+        // Off its station's line sideways while still in it (a line is one way: it loses its place).
+        if (const NodeId dock = traffic.goal(r); dock != kNoNode && b.at != dock) {
+          const auto& nodes = tally.lineNodes(dock);
+          const auto on = [&](NodeId v) { return std::find(nodes.begin(), nodes.end(), v) != nodes.end(); };
+          if (on(b.prev) && !on(b.at)) {
+            const auto line = traffic.line(dock);
+            res.lineLeaves += std::find(line.begin(), line.end(), r) != line.end() ? 1 : 0;
+          }
+        }
         traffic.reached(r, b.at);
         b.lastProgress = now;
         takeNext();
@@ -590,7 +599,7 @@ std::string formatResult(const VirtualFleetResult& r) {
   os.precision(1);
   os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans << ", evasions "
      << r.evasions << ", detours " << r.detours << ", escalations " << r.escalations << ", untangles "
-     << r.untangles << ", passes " << r.passes << ", update p50/p99 ";
+     << r.untangles << ", passes " << r.passes << ", line leaves " << r.lineLeaves << ", update p50/p99 ";
   os.precision(3);
   os << r.updateP50Ms << "/" << r.updateP99Ms << " ms, density " << r.density;
   os.precision(0);

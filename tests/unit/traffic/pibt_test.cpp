@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "fleet/traffic/plan_check.hpp"
+#include "fleet/traffic/untangle.hpp"
 #include "pibt_test_support.hpp"
 
 using namespace fleet;
@@ -391,6 +392,50 @@ TEST(Pibt, ARobotParkedBehindOneOnTheLaneGetsOutOnlyByUntangling) {
       }
     }
   }
+}
+
+// A way out of a knot moves a member only where its filter lets it: a robot waiting in a station's
+// line moves forward along it, never sideways out of it (sent sideways it lost its place in the
+// line: full stack, 40 robots, seed 13, a robot stood 71 s at its line's tail). Robot 1 wants to
+// pass where robot 0 stands; robot 0 has three ways to make room.
+TEST(Untangle, AMemberMovesOnlyWhereItsFilterAllows) {
+  Graph g;
+  const NodeId x = g.addNode({0, 0});
+  const NodeId b = g.addNode({1, 0});
+  const NodeId goal = g.addNode({2, 0});
+  const NodeId side = g.addNode({1, 1});
+  const NodeId forward = g.addNode({1, -1});
+  for (const NodeId v : {x, goal, side, forward}) {
+    g.addEdge(b, v);
+    g.addEdge(v, b);
+  }
+  const std::vector<float> toGoal{2, 1, 0, 2, 2};
+  UntangleProblem p;
+  p.starts = {b, x};
+  p.tables = {nullptr, toGoal.data()};
+  p.counts = {0, 1};
+  p.clearOfOthers = [](NodeId) { return true; };
+  const auto robot0Visits = [&](const UntangleResult& r) {
+    std::vector<NodeId> at;
+    for (const auto& config : r.steps)
+      at.push_back(config[0]);
+    return at;
+  };
+  // Unfiltered, the first way found sends robot 0 on to the goal's node.
+  const auto free = untangle(g, p);
+  ASSERT_TRUE(free.has_value());
+  EXPECT_EQ(free->improved, 1U);
+  EXPECT_EQ(robot0Visits(*free), (std::vector<NodeId>{b, goal, goal}));
+  // Only forward: robot 0 makes room there and nowhere else.
+  p.mayMove = [&](std::size_t member, NodeId from, NodeId to) {
+    return member != 0 || (from == b && to == forward);
+  };
+  const auto ahead = untangle(g, p);
+  ASSERT_TRUE(ahead.has_value());
+  EXPECT_EQ(robot0Visits(*ahead), (std::vector<NodeId>{b, forward, forward}));
+  // Its forward way shut: no way out, rather than one that takes it out of its line.
+  p.mayMove = [&](std::size_t member, NodeId, NodeId) { return member != 0; };
+  EXPECT_FALSE(untangle(g, p).has_value());
 }
 
 TEST(Pibt, FixedAgentsAreObstaclesThatNeverMove) {

@@ -41,6 +41,7 @@ std::vector<VirtualFleetResult> runSeeds(Roadmap& map, VirtualFleetOptions o) {
     const auto r = runVirtualFleet(map, o);
     SCOPED_TRACE(formatResult(r));
     EXPECT_EQ(r.holdViolations, 0U);
+    EXPECT_EQ(r.lineLeaves, 0U);
     EXPECT_EQ(r.contacts, 0U);
     EXPECT_EQ(r.refusedReports, 0U);
     // The robot-time ledger: every robot's nine categories add up to the run, tick by tick.

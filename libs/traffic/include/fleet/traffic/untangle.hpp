@@ -38,6 +38,9 @@ struct UntangleProblem {
   /// Whether a member may stand on (or drive into) v as far as everyone outside the group goes: v
   /// and what it excludes hold nobody else.
   std::function<bool(NodeId)> clearOfOthers;
+  /// Whether member i may move from one node to the next at all (a robot waiting in a station's
+  /// line moves only forward along it); empty: every open edge.
+  std::function<bool(std::size_t member, NodeId from, NodeId to)> mayMove{};
   int maxSteps = 12;
   std::size_t maxConfigurations = 20000;
 };

@@ -93,7 +93,10 @@ struct VirtualFleetResult {
   double minSeparation = 0.0;      ///< m between two robot centres, over the whole run
   std::size_t contacts = 0;        ///< ticks with two centres closer than the roadmap's contact distance
   std::size_t holdViolations = 0;  ///< ticks with two robots holding conflicting nodes
-  double longestWait = 0.0;        ///< s the longest a robot with a task went without reaching a node
+  /// Robots that drove off their station's line sideways while still in it (a line is one way: the
+  /// robot loses its place, the next in line goes before it). The planner never plans it: 0.
+  std::size_t lineLeaves = 0;
+  double longestWait = 0.0;  ///< s the longest a robot with a task went without reaching a node
   /// Where and on whom that longest wait was, as it ended or at the end of the run: "robot 7 at
   /// node 312 (24.5, 7.5), D-3 queue, from 118.0 s, goal node 1071 (D-3), waiting on 3@1070".
   std::string longestWaitAt;
