@@ -592,8 +592,9 @@ std::string TrafficControl::explain(std::size_t robot) const {
         continue;
       os << " " << e.to;
       for (std::size_t q = 0; q < robots(); ++q) {
+        // A held robot (docking, faulted, held by a person) is planned round, not pushed.
         if (q != robot && graph_.conflicting(e.to, execution_.at(q)))
-          os << " [" << q << "]";
+          os << " [" << q << (held(q) ? " held" : "") << "]";
       }
     }
   }

@@ -310,6 +310,26 @@ TEST(TrafficControl, AClosedNodeOnTheWayIsGoneRoundOnceTheGraphChanged) {
   EXPECT_LE(updates, 6) << "stood in front of the closed node";
 }
 
+/// The stall report names a robot in the way that is held (docking, faulted, held by a person):
+/// the plan goes round it rather than pushing it, so a robot waiting on "nobody" whose only way out
+/// such a robot excludes is told apart from one the plan merely keeps where it is.
+TEST(TrafficControl, AStallReportMarksAHeldRobotInTheWay) {
+  // 0 - 1 - 2 in a row, 1 m apart; 1 and 2 exclude each other.
+  Graph g;
+  for (const Vec2 p : {Vec2{0, 0}, Vec2{1, 0}, Vec2{2, 0}})
+    g.addNode(p);
+  for (const auto& [a, b] : {std::pair{0, 1}, std::pair{1, 2}}) {
+    g.addEdge(a, b);
+    g.addEdge(b, a);
+  }
+  g.addConflict(1, 2);
+  const std::vector<NodeId> starts{0, 2};
+  TrafficControl tc(g, starts);
+  EXPECT_NE(tc.explain(0).find("ways out: 1 [1]"), std::string::npos) << tc.explain(0);
+  tc.setHeld(1, true);
+  EXPECT_NE(tc.explain(0).find("ways out: 1 [1 held]"), std::string::npos) << tc.explain(0);
+}
+
 TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   Roadmap map = smallWarehouse();
   const auto* d1 = map.station("D-1");

@@ -171,7 +171,8 @@ class TrafficControl {
 
   /// One line on where the robot is and what holds it: its node, goal and target, whether it is
   /// held, how far it is planned and released, the robots it waits on (index@node), and each way
-  /// out of its node with the robots whose node excludes it. For reports of robots that do not move.
+  /// out of its node with the robots whose node excludes it ("[33 held]": one held there, which the
+  /// plan goes round rather than pushes). For reports of robots that do not move.
   [[nodiscard]] std::string explain(std::size_t robot) const;
 
   /// Call after closing or reopening nodes or edges: drops the planner's distances and plans again
