@@ -198,13 +198,11 @@ bool Pibt::plan(std::int32_t agent, std::int32_t parent, std::size_t depth) {
         options_.preferStraight ? (occupied << 31) | (turn << 28) | (draw >> 3) : (occupied << 31) | draw};
   };
   add(from, 0);
-  // In its line on one of the line's nodes: forward or nowhere.
-  const bool inLine = line_[a] >= 0 && !lineOf_.empty() && lineOf_[idx(from)] == line_[a];
   const auto out = graph_.edges(from);
   for (std::size_t k = 0; k < out.size(); ++k) {
     const Edge& e = out[k];
-    if (inLine && e.to != lineForward_[idx(from)]) {
-      continue;
+    if (!lineAllows(a, from, e.to)) {
+      continue;  // in its line on one of the line's nodes: forward or nowhere
     }
     // Leaving a closed node is allowed (a robot stranded on it must get off); entering one is not.
     if (e.open && graph_.isOpen(e.to)) {

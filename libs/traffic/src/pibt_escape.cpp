@@ -190,9 +190,7 @@ bool Pibt::untangleKnot(std::span<const std::int32_t> knot, std::span<const std:
     // A robot waiting in its station's line moves only forward, in a way out as in a step (left
     // sideways, it lost its place: the line orders robots off its nodes last).
     problem.mayMove = [&](std::size_t j, NodeId from, NodeId to) {
-      const auto a = idx(group[j]);
-      return line_[a] < 0 || lineOf_.empty() || lineOf_[idx(from)] != line_[a] ||
-             to == lineForward_[idx(from)];
+      return lineAllows(idx(group[j]), from, to);
     };
     problem.maxSteps = options_.untangleSteps;
     problem.maxConfigurations = options_.untangleConfigurations;

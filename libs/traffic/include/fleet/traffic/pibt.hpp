@@ -239,6 +239,13 @@ class Pibt {
   void cover(NodeId v, int delta);
   /// An agent other than `except` standing on what v excludes, or -1.
   [[nodiscard]] std::int32_t standingOn(NodeId v, std::int32_t except) const;
+  /// Whether the agent may move from `from` to `to` as far as its station's line goes: waiting on
+  /// one of its line's nodes, only forward along the line (a step's moves and a way out of a knot
+  /// alike); anywhere otherwise.
+  [[nodiscard]] bool lineAllows(std::size_t agent, NodeId from, NodeId to) const {
+    const auto f = static_cast<std::size_t>(from);
+    return line_[agent] < 0 || lineOf_.empty() || lineOf_[f] != line_[agent] || to == lineForward_[f];
+  }
   std::uint64_t random();
 
   const Graph& graph_;
