@@ -80,9 +80,16 @@ constexpr double kAligned = 0.05;
 /// shelves, a robot's way to a parking place's approach passed a shelf corner 0.29 m off (less than its
 /// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed
 /// 3). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
-/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.)
-constexpr double kRejoinOff = 0.15;
+/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.) Less than the
+/// reach tolerance (0.15 m): a robot that counted its node reached 0.149 m off, below a shelf
+/// corner that the straight way on passed 0.31 m off, stood held by it for good when the rule
+/// acted only beyond the tolerance (240 s, its task failed; dense check, seed 24). More than
+/// where a rejoin ends (the base's end within 0.10 m, BaseEndParams::settleBeyond, mostly ~0.02 m).
+constexpr double kRejoinOff = 0.05;
 constexpr double kRejoinAfterS = 10.0;
+/// Held by a person, the robot backs onto its node from this far off [m] (the reach tolerance): a
+/// robot that stopped for a person just past its node stands there held by the person.
+constexpr double kGiveWayOff = 0.15;
 /// Held that long by a person between its node and the next (which it holds both of), the robot
 /// backs onto its node and stands there reporting itself blocked for kGiveWayS or until a new
 /// release. The person gets room, and the traffic manager may re-plan it (yield_after_s), which it
@@ -242,9 +249,10 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   // Off its node and held by a static obstacle: back to the node first, then along the roadmap's
   // edge, which clears the shelves. Held by a person: back to the node, and give way (kGiveWayS).
   const auto own = releases_.at();
-  const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && distance(here, *own) > kRejoinOff &&
-                      standing_.sinceNs >= 0 && nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-                      (standing_.byObstacle || personInTheWay);
+  const double off = own ? distance(here, *own) : 0.0;
+  const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
+                      nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
+                      ((standing_.byObstacle && off > kRejoinOff) || (personInTheWay && off > kGiveWayOff));
   if (rejoined_ && rejoinForPerson_) {
     // Back on its node: it stands there, and the base from there afterwards.
     rejoinForPerson_ = false;
@@ -304,8 +312,10 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   double left = follower_.pathLength() - r->progress;
   const Vec2 toEnd = basePath_.back() - here;
   const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
-  const BaseEnd end =
-      baseEnd(left, toEnd, facing, r->finalApproach, {.atEnd = kAtEnd, .behindWithin = kAtGoal});
+  // Rejoining, its node may be behind it within the reach tolerance: it drives onto it all the
+  // same (counting it reached there stood it in the rejoin it began, every cycle).
+  const BaseEnd end = baseEnd(left, toEnd, facing, r->finalApproach,
+                              {.atEnd = kAtEnd, .behindWithin = rejoining_ ? kAtEnd : kAtGoal});
   const bool settling = end == BaseEnd::kSettle;
   if (settling) {
     left = toEnd.norm();  // what the stop at the end brakes for
