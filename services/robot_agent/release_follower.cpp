@@ -80,12 +80,17 @@ constexpr double kAligned = 0.05;
 /// shelves, a robot's way to a parking place's approach passed a shelf corner 0.29 m off (less than its
 /// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed
 /// 3). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
-/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.) Less than the
-/// reach tolerance (0.15 m): a robot that counted its node reached 0.149 m off, below a shelf
-/// corner that the straight way on passed 0.31 m off, stood held by it for good when the rule
-/// acted only beyond the tolerance (240 s, its task failed; dense check, seed 24). More than
-/// where a rejoin ends (the base's end within 0.10 m, BaseEndParams::settleBeyond, mostly ~0.02 m).
+/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.) Measured off the
+/// roadmap's edge from the node to the next one, not off the node: a robot standing on that edge
+/// gains nothing by going back (held there, it reports itself blocked and is planned round). Less
+/// than the reach tolerance (0.15 m): a robot that counted its node reached 0.149 m off (0.13 m
+/// off the edge), below a shelf corner that the straight way on passed 0.31 m off, stood held by
+/// it for good when the rule acted only beyond the tolerance (240 s, its task failed; dense
+/// check, seed 24). More than where a rejoin ends (kRejoinEnd): one rejoin puts the robot on the
+/// edge, and the rule does not send it back again.
 constexpr double kRejoinOff = 0.05;
+/// A rejoin ends within this [m] of the node (BaseEndParams::settleBeyond while rejoining).
+constexpr double kRejoinEnd = 0.03;
 constexpr double kRejoinAfterS = 10.0;
 /// Held by a person, the robot backs onto its node from this far off [m] (the reach tolerance): a
 /// robot that stopped for a person just past its node stands there held by the person.
@@ -130,6 +135,14 @@ std::vector<Vec2> stretch(const std::vector<Vec2>& pts, double from, double leng
     out.push_back(pts.back());
   }
   return out;
+}
+
+/// Distance [m] from p to the segment a-b.
+double offSegment(Vec2 p, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = ab.dot(ab);
+  const double t = len2 > 1e-12 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return distance(p, a + ab * t);
 }
 
 control::PathFollowerParams followerParams() {
@@ -249,10 +262,13 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   // Off its node and held by a static obstacle: back to the node first, then along the roadmap's
   // edge, which clears the shelves. Held by a person: back to the node, and give way (kGiveWayS).
   const auto own = releases_.at();
+  const auto onward = releases_.next();
   const double off = own ? distance(here, *own) : 0.0;
-  const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
-                      nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-                      ((standing_.byObstacle && off > kRejoinOff) || (personInTheWay && off > kGiveWayOff));
+  const double offEdge = own && onward ? offSegment(here, *own, *onward) : off;
+  const bool rejoin =
+      !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
+      nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
+      ((standing_.byObstacle && offEdge > kRejoinOff) || (personInTheWay && off > kGiveWayOff));
   if (rejoined_ && rejoinForPerson_) {
     // Back on its node: it stands there, and the base from there afterwards.
     rejoinForPerson_ = false;
@@ -314,8 +330,10 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const Vec2 facing{std::cos(pose.theta), std::sin(pose.theta)};
   // Rejoining, its node may be behind it within the reach tolerance: it drives onto it all the
   // same (counting it reached there stood it in the rejoin it began, every cycle).
-  const BaseEnd end = baseEnd(left, toEnd, facing, r->finalApproach,
-                              {.atEnd = kAtEnd, .behindWithin = rejoining_ ? kAtEnd : kAtGoal});
+  const BaseEnd end =
+      baseEnd(left, toEnd, facing, r->finalApproach,
+              rejoining_ ? BaseEndParams{.atEnd = kAtEnd, .settleBeyond = kRejoinEnd, .behindWithin = kAtEnd}
+                         : BaseEndParams{.atEnd = kAtEnd, .behindWithin = kAtGoal});
   const bool settling = end == BaseEnd::kSettle;
   if (settling) {
     left = toEnd.norm();  // what the stop at the end brakes for
@@ -336,8 +354,9 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const auto turn = releases_.nextTurn(bends::kDrivenRound, bends::kTight, [&](Vec2 at) {
     return raw_ && !site::discFits(*raw_, at, p_.radius + bends::kTightClearance);
   });
-  const bool cornering =
-      !settling && turn && turn->distance < kCornerApproach && distance(here, turn->at) > kOnCorner;
+  // (Not while rejoining: the corner is on the base beyond the node it drives back to.)
+  const bool cornering = !settling && !rejoining_ && turn && turn->distance < kCornerApproach &&
+                         distance(here, turn->at) > kOnCorner;
   const bool planning = stack.hasPlanner() && !r->finalApproach && !cornering && !settling && !undockFrom_ &&
                         r->crossTrack < kMaxCrossTrack && !progress_.followerDrives(nowNs);
   bool localBlocked = false;

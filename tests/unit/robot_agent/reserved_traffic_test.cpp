@@ -94,13 +94,12 @@ struct Sim {
 
   /// A new agent standing at `start` (on a free floor, or on `grid`).
   void restartAt(Pose2 start, std::shared_ptr<const planning::OccupancyGrid> grid = nullptr) {
-    scanned.reset();
+    scanned = grid;
     if (!grid) {
       grid = std::make_shared<const planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
     }
     params.start = start;
     truth = start;
-    scanned = grid;
     agent = std::make_unique<agent::Agent>(params, grid);
   }
 
@@ -601,6 +600,29 @@ TEST_P(ReservedPlanner, JustWithinReachOfItsNodeWithAShelfCornerInTheWayItRejoin
   expectRejoinRoundCorner(sim, {18, 34, 18, 22} /* x 4.5..8.5, y 4.5..5.5 */, {8.45, 4.04, 0.69},
                           {2472, 8.5, 3.9}, {2473, 9.25, 4.75}, {8.5, 4.5},
                           msg::Goal{{13.0, 4.75, 0.0}, "P-9", msg::GoalAction::Load, 2.0});
+}
+
+TEST_P(ReservedPlanner, HeldByAnObstacleOnItsEdgeItDoesNotGoBackButReportsItselfBlocked) {
+  // An obstacle the roadmap does not know stands on the edge ahead: the robot stops in front of it
+  // on the edge, past its node. Going back to the node gains nothing (the edge is the way on), so
+  // it stands and reports itself blocked, for the traffic manager to plan round it; rejoining it
+  // went back and forth every 10 s, and never stood held long enough to say it was blocked.
+  Sim sim(GetParam());
+  auto grid = std::make_shared<planning::OccupancyGrid>(40, 40, 0.25, Vec2{0, 0});
+  for (int cy = 19; cy < 21; ++cy) {  // x 2.25 .. 2.5, y 4.75 .. 5.25
+    grid->setBlocked({9, cy});
+  }
+  sim.restartAt({lane(0).x, kY, 0.0}, grid);
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(1, lane(0, 6)));
+  bool blocked = false;
+  while (sim.now() < 40.0) {
+    const auto out = sim.step();
+    blocked = blocked || (out.traffic && out.traffic->blocked);
+  }
+  EXPECT_LT(sim.maxX, 2.25 - sim.params.radius) << "touched the obstacle";
+  EXPECT_EQ(sim.agent->conduct().rejoins, 0u);
+  EXPECT_TRUE(blocked) << "never reported itself blocked";
 }
 
 TEST_P(ReservedPlanner, HeldByARobotBesideItsWayItTurnsToItsWayAndGoesOn) {
