@@ -74,28 +74,31 @@ constexpr double kStanding = 0.05;
 constexpr double kMisaligned = 0.2;
 constexpr double kAligned = 0.05;
 
-/// Standing this far [m] off the node it last reached (more than the reach tolerance), held by a
-/// static obstacle for kRejoinAfterS [s], the robot drives back onto the node before it goes on. Its straight
-/// way from there to the next node is no roadmap edge: from 0.28 m off its node in the gap between two
-/// shelves, a robot's way to a parking place's approach passed a shelf corner 0.29 m off (less than its
-/// radius) and the stop rule held it for good (2,100 s, and five robots behind it; full stack, seed
-/// 3). (Also after 3 s and when its own planner stood it: 104-121 rejoins a run of 20 robots, and
-/// The one seed of three that was slower did 29 tasks in 600 s instead of 39-42.) Measured off the
-/// roadmap's edge from the node to the next one, not off the node: a robot standing on that edge
-/// gains nothing by going back (held there, it reports itself blocked and is planned round). Less
-/// than the reach tolerance (0.15 m): a robot that counted its node reached 0.149 m off (0.13 m
-/// off the edge), below a shelf corner that the straight way on passed 0.31 m off, stood held by
-/// it for good when the rule acted only beyond the tolerance (240 s, its task failed; dense
-/// check, seed 24). More than where a rejoin ends (kRejoinEnd): one rejoin puts the robot on the
-/// edge, and the rule does not send it back again.
+/// Held by a static obstacle for kRejoinAfterS [s], the robot drives back onto the node it last
+/// reached before it goes on, when it stands more than kRejoinOff [m] off the roadmap's edge from
+/// that node to the next, or more than the reach tolerance (kOffItsNode) off the node. Its
+/// straight way from there to the next node is no roadmap edge: from 0.28 m off its node in the
+/// gap between two shelves, a robot's way to a parking place's approach passed a shelf corner
+/// 0.29 m off (less than its radius) and the stop rule held it for good (2,100 s, and five robots
+/// behind it; full stack, seed 3). (Also after 3 s and when its own planner stood it: 104-121
+/// rejoins a run of 20 robots, and the one seed of three that was slower did 29 tasks in 600 s
+/// instead of 39-42.) Off the edge: a robot that counted its node reached 0.149 m off (0.13 m off
+/// the edge) stood below a shelf corner its straight way on passed 0.31 m off, held for good
+/// while the rule acted only beyond the reach tolerance (240 s, its task failed; dense check,
+/// seed 24). Off the node as well: driving the straight way from a node reached 0.10 m short, a
+/// robot comes nearer the edge as it nears the next node, and one stood 0.046 m off the edge, 0.6 m
+/// past its node, with a shelf corner 0.05 m from its body (223 s; dense check, seed 29). Within
+/// both, it is on its edge just past its node, and going back gains nothing: it stands, reports
+/// itself blocked and is planned round (rejoining there, it went back and forth and never said it
+/// was blocked; further past its node it still does, every kRejoinAfterS). More than where a rejoin
+/// ends (kRejoinEnd), so one rejoin puts it on the edge.
 constexpr double kRejoinOff = 0.05;
+constexpr double kOffItsNode = 0.15;
 /// A rejoin ends within this [m] of the node (BaseEndParams::settleBeyond while rejoining).
 constexpr double kRejoinEnd = 0.03;
 constexpr double kRejoinAfterS = 10.0;
-/// Held by a person, the robot backs onto its node from this far off [m] (the reach tolerance): a
-/// robot that stopped for a person just past its node stands there held by the person.
-constexpr double kGiveWayOff = 0.15;
-/// Held that long by a person between its node and the next (which it holds both of), the robot
+/// Held that long by a person between its node and the next (which it holds both of), more than
+/// kOffItsNode past its node (just past it, it stands there held by the person), the robot
 /// backs onto its node and stands there reporting itself blocked for kGiveWayS or until a new
 /// release. The person gets room, and the traffic manager may re-plan it (yield_after_s), which it
 /// does only for a robot on its node: the node ahead can then go to others. (Two robots stood
@@ -265,10 +268,10 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const auto onward = releases_.next();
   const double off = own ? distance(here, *own) : 0.0;
   const double offEdge = own && onward ? offSegment(here, *own, *onward) : off;
-  const bool rejoin =
-      !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
-      nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
-      ((standing_.byObstacle && offEdge > kRejoinOff) || (personInTheWay && off > kGiveWayOff));
+  const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
+                      nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
+                      ((standing_.byObstacle && (offEdge > kRejoinOff || off > kOffItsNode)) ||
+                       (personInTheWay && off > kOffItsNode));
   if (rejoined_ && rejoinForPerson_) {
     // Back on its node: it stands there, and the base from there afterwards.
     rejoinForPerson_ = false;

@@ -575,7 +575,8 @@ void expectRejoinRoundCorner(Sim& sim, std::array<int, 4> shelf, Pose2 start, ms
     (void)sim.step();
     closest = std::min(closest, distance(sim.truth.position(), corner));
   }
-  EXPECT_EQ(sim.lastNode(), b.node) << "held at " << sim.truth.x << ", " << sim.truth.y;
+  EXPECT_EQ(sim.lastNode(), b.node) << "held at " << sim.truth.x << ", " << sim.truth.y << ": "
+                                    << sim.agent->standingStill().why;
   EXPECT_GT(closest, sim.params.radius) << "touched the corner";
   EXPECT_EQ(sim.agent->conduct().rejoins, 1u);
 }
@@ -600,6 +601,19 @@ TEST_P(ReservedPlanner, JustWithinReachOfItsNodeWithAShelfCornerInTheWayItRejoin
   expectRejoinRoundCorner(sim, {18, 34, 18, 22} /* x 4.5..8.5, y 4.5..5.5 */, {8.45, 4.04, 0.69},
                           {2472, 8.5, 3.9}, {2473, 9.25, 4.75}, {8.5, 4.5},
                           msg::Goal{{13.0, 4.75, 0.0}, "P-9", msg::GoalAction::Load, 2.0});
+}
+
+TEST_P(ReservedPlanner, OnItsEdgeFarPastItsNodeWithAShelfCornerBesideItRejoinsThroughItsNode) {
+  // As r35 stood 223 s in the full-stack dense check (seed 29, 40 robots; shifted by (-30, -10)
+  // here): it counted its node A reached 0.10 m short and drove the straight way from there to B,
+  // nearing the edge A-B as it neared B, and its stop rule held it 0.046 m off the edge, 0.6 m past
+  // A, with a shelf corner 0.05 m from its body. Off the edge by less than the rule's 0.05 m, it
+  // never went back to A; off A by more than the reach tolerance, it does. (It starts on that
+  // straight way where the harness's gate holds it, 0.048 m off the edge.)
+  Sim sim(GetParam());
+  expectRejoinRoundCorner(sim, {8, 24, 18, 22} /* x 2..6, y 4.5..5.5 */, {6.30, 5.72, -1.31},
+                          {1115, 6.25, 6.25}, {2570, 6.5, 4.928542}, {6.0, 5.5},
+                          msg::Goal{{6.5, 1.0, -M_PI_2}, "P-9", msg::GoalAction::Load, 2.0});
 }
 
 TEST_P(ReservedPlanner, HeldByAnObstacleOnItsEdgeItDoesNotGoBackButReportsItselfBlocked) {
