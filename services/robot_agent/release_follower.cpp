@@ -9,6 +9,7 @@
 #include "fleet/core/angles.hpp"
 #include "fleet/core/bends.hpp"
 #include "fleet/core/clock.hpp"
+#include "fleet/core/segment.hpp"
 #include "fleet/site/reachability.hpp"
 
 namespace fleet::agent {
@@ -140,14 +141,6 @@ std::vector<Vec2> stretch(const std::vector<Vec2>& pts, double from, double leng
   return out;
 }
 
-/// Distance [m] from p to the segment a-b.
-double offSegment(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double len2 = ab.dot(ab);
-  const double t = len2 > 1e-12 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return distance(p, a + ab * t);
-}
-
 control::PathFollowerParams followerParams() {
   control::PathFollowerParams fp;
   fp.lookahead = kLookahead;
@@ -267,7 +260,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const auto own = releases_.at();
   const auto onward = releases_.next();
   const double off = own ? distance(here, *own) : 0.0;
-  const double offEdge = own && onward ? offSegment(here, *own, *onward) : off;
+  const double offEdge = own && onward ? pointSegmentDistance(here, *own, *onward) : off;
   const bool rejoin = !rejoining_ && releases_.nodesAhead() && own && standing_.sinceNs >= 0 &&
                       nsToSec(nowNs - standing_.sinceNs) > kRejoinAfterS &&
                       ((standing_.byObstacle && (offEdge > kRejoinOff || off > kOffItsNode)) ||

@@ -5,19 +5,11 @@
 #include <limits>
 
 #include "fleet/core/angles.hpp"
+#include "fleet/core/segment.hpp"
 
 namespace fleet::avoidance {
 
 namespace {
-
-double segmentPointDistance(Vec2 a, Vec2 b, Vec2 p) {
-  const Vec2 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  double s = len2 > 0.0 ? (p - a).dot(ab) / len2 : 0.0;
-  s = std::clamp(s, 0.0, 1.0);
-  const Vec2 d = a + ab * s - p;
-  return std::sqrt(d.squaredNorm());
-}
 
 constexpr double kStraight = 1e-6;
 
@@ -89,7 +81,7 @@ struct Arc {
 
   [[nodiscard]] double distanceTo(Vec2 p) const {
     if (straight)
-      return segmentPointDistance(a, end, p);
+      return pointSegmentDistance(p, a, end);
     const Vec2 rp = p - c;
     // The position rotates about c by ω·t whatever the sign of v.
     if (inSweep(rp))

@@ -405,8 +405,7 @@ void Pibt::updateProgress(std::size_t i) {
   const bool atGoal = goal_[i] != kNoNode && now_[i] == goal_[i];
   // A place in its station's line is where it waits, not where it is going: its steps go on
   // counting there, so through traffic does not take the place ahead of it every time it frees.
-  const bool waitingInLine = line_[i] >= 0 && !lineOf_.empty() && lineOf_[idx(now_[i])] == line_[i];
-  elapsed_[i] = (goal_[i] == kNoNode || (atGoal && !waitingInLine)) ? 0 : elapsed_[i] + 1;
+  elapsed_[i] = (goal_[i] == kNoNode || (atGoal && !onOwnLine(i, now_[i]))) ? 0 : elapsed_[i] + 1;
   const float d = table_[i] != nullptr ? table_[i][idx(now_[i])] : DistanceTable::kUnreachable;
   if (controlled_[i] == 0 || d == DistanceTable::kUnreachable) {
     // No goal, no route to it, or not ours to move: nothing to escape from.

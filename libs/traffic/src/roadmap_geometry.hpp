@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fleet/core/segment.hpp"
 #include "fleet/core/vec2.hpp"
 #include "fleet/geometry/polygon.hpp"
 
@@ -26,12 +27,7 @@ inline double fastDistance(Vec2 a, Vec2 b) {
   return std::sqrt((a - b).squaredNorm());
 }
 
-inline double pointSegmentDistance(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double t = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return fastDistance(p, a + ab * t);
-}
+using fleet::pointSegmentDistance;
 
 inline bool segmentsCross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
   const double d1 = (b - a).cross(c - a);

@@ -243,8 +243,12 @@ class Pibt {
   /// one of its line's nodes, only forward along the line (a step's moves and a way out of a knot
   /// alike); anywhere otherwise.
   [[nodiscard]] bool lineAllows(std::size_t agent, NodeId from, NodeId to) const {
-    const auto f = static_cast<std::size_t>(from);
-    return line_[agent] < 0 || lineOf_.empty() || lineOf_[f] != line_[agent] || to == lineForward_[f];
+    return !onOwnLine(agent, from) || to == lineForward_[static_cast<std::size_t>(from)];
+  }
+  /// Whether `v` is a node of the station line the agent waits in (a queue place or the approach:
+  /// where it waits, not where it is going).
+  [[nodiscard]] bool onOwnLine(std::size_t agent, NodeId v) const {
+    return line_[agent] >= 0 && !lineOf_.empty() && lineOf_[static_cast<std::size_t>(v)] == line_[agent];
   }
   std::uint64_t random();
 
