@@ -12,6 +12,7 @@ namespace {
 /// m/s past a static point the route leads away from (see clearSpeed): slow enough for the
 /// cross-traffic check to stop the robot should its arc turn towards the point after all.
 constexpr double kCreepSpeed = 0.15;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Distance from `p` to the polyline `route`.
 double distanceToRoute(const std::vector<Vec2>& route, Vec2 p) {
@@ -227,8 +228,27 @@ double MotionGate::zoneSpeed(const GateView& view, double v) const {
                   p_.speedLimit(at.position() + at.heading() * (v < 0.0 ? -ahead : ahead)));
 }
 
+double MotionGate::besidePeopleSpeed(const GateView& view) const {
+  double speed = std::numeric_limits<double>::infinity();
+  if (!view.seen.valid) {
+    return speed;
+  }
+  const Pose2 toRobot = view.seen.pose.inverse();
+  for (const auto& h : view.seen.people) {
+    const Vec2 at = toRobot.transform(h.pos);
+    const double side = std::abs(at.y) - p_.radius - h.radius;
+    if (at.x <= -p_.radius || side > p_.personSideGap) {
+      continue;  // behind the robot, or far enough beside its way
+    }
+    const double along = at.x - h.radius - p_.radius;  // from the robot's front to the person
+    speed = std::min(speed, std::max(p_.nearPersonSpeed, along / p_.headway));
+  }
+  return speed;
+}
+
 MotionGate::Hold MotionGate::heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const {
-  if (const double limit = zoneSpeed(view, v); std::abs(v) > limit) {
+  if (const double limit = std::min(zoneSpeed(view, v), v > 0.0 ? besidePeopleSpeed(view) : kInf);
+      std::abs(v) > limit) {
     const double scaled = std::max(0.0, limit) * (v < 0.0 ? -1.0 : 1.0);
     w *= std::abs(v) > 1e-9 ? scaled / v : 1.0;
     v = scaled;

@@ -36,6 +36,14 @@ struct GateParams {
   /// The cross-traffic check's slow-down zone counts walls and shelves too (see
   /// avoidance::SafetyParams::slowForStatic; false in reserved traffic).
   bool slowForStatic = true;
+  /// A person beside the corridor ahead, at most this far from its edge [m], may step into it
+  /// faster than the cross-traffic check (which extrapolates at the person's velocity) foresees:
+  /// the robot keeps a speed it can stop from before the person's place along its way (the stop
+  /// rule's law on the gap along), and at most nearPersonSpeed while the person is level with it.
+  /// (A person overtaking a robot 0.33 m to its side turned onto its way 0.45 m ahead; from
+  /// 0.8 m/s the robot needed 0.40 m to stop and touched them, docs/algorithms.md.)
+  double personSideGap = 0.35;
+  double nearPersonSpeed = 0.3;  ///< m/s
 };
 
 /// What the gate looks at in one cycle (non-owning: the caller keeps it alive for the call).
@@ -86,8 +94,12 @@ class MotionGate {
   /// The site's speed limit for the robot now: the lowest at its position and at the point it
   /// would reach within its headway (so it slows before a slow zone, not inside it); +inf: none.
   [[nodiscard]] double zoneSpeed(const GateView& view, double v) const;
-  /// Speed zones, stop rule and cross-traffic check on (v, w), which come out limited (a speed
-  /// zone keeps the curvature and does not count as being held); held: the robot is held.
+  /// The speed for the people beside the corridor ahead (see GateParams::personSideGap); +inf:
+  /// none there.
+  [[nodiscard]] double besidePeopleSpeed(const GateView& view) const;
+  /// Speed zones, people beside the way, stop rule and cross-traffic check on (v, w), which come
+  /// out limited (a speed zone or a person beside keeps the curvature and does not count as being
+  /// held); held: the robot is held.
   Hold heldUp(const GateView& view, double& v, double& w, Blocker& blocker) const;
 
  private:
