@@ -121,10 +121,11 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     const traffic::BaseEnds ends = fleetBaseEnds(node.baseEnds());
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
-        "re-plans, {} risk updates, {} yields, tick {:.2f} ms (max {:.2f}), base ends reached short of the "
+        "re-plans, {} risk updates, {} yields, {} gave back, tick {:.2f} ms (max {:.2f}), base ends reached "
+        "short of the "
         "target: {} held by others, {} at the plan's end, {} with more free (late), refused at the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
-        c.riskUpdates, c.yields, c.lastTickMs, c.maxTickMs, ends.held, ends.planEnd, ends.limit,
+        c.riskUpdates, c.yields, c.gaveBack, c.lastTickMs, c.maxTickMs, ends.held, ends.planEnd, ends.limit,
         rejections.toJson().dump());
     // Robots standing still with somewhere to go, and why: the first thing to read when the fleet
     // is slow (a minute of its clock, sim or wall).
@@ -222,6 +223,7 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
         {"planned_steps", c.plannedSteps},
         {"replans", c.replans},
         {"yields", c.yields},
+        {"gave_back", c.gaveBack},
         {"max_tick_ms", c.maxTickMs},
         {"base_ends", {{"held", all.held}, {"plan_end", all.planEnd}, {"limit", all.limit}}},
         {"base_ends_by_robot", ends}};

@@ -13,6 +13,12 @@ namespace fleet::trafficmgr {
 using traffic::kNoNode;
 using traffic::NodeId;
 
+namespace {
+/// s a robot reports itself blocked on its node (by a person: a robot ahead is waited on, not
+/// reported) before it gives back the node after its own. Its agent reports after 3 s held.
+constexpr double kGiveBackAfterS = 10.0;
+}  // namespace
+
 Settings readSettings(Config& cfg) {
   Settings s;
   cfg.rejectUnknownKeys({"site",          "rate_hz",     "settle_s",     "robot_timeout_s", "place_tolerance",
@@ -116,6 +122,19 @@ bool TrafficNode::updateYield(Robot& r, std::int64_t nowNs, bool timedOut) {
       if (n.node != reported && (Vec2{n.x, n.y} - Vec2{r.last.pose.x, r.last.pose.y}).norm() <= 1.5)
         r.blockedAhead.push_back(n.node);
     }
+  }
+  if (r.blockedSinceNs < 0) {
+    r.gaveBack = false;
+  } else if (!r.gaveBack && r.yieldUntilNs < 0 &&
+             static_cast<double>(nowNs - r.blockedSinceNs) * 1e-9 >= kGiveBackAfterS) {
+    // Held, it keeps the node after its own (TrafficControl::setHeld), so the plan places it there
+    // and the robots behind it and across its way wait on a step it cannot make (a robot waited
+    // 180 s behind one held by a person in a 40-robot run). Blocked on its node this long, it gives
+    // that node back and stays held where it stands; unlike yielding, it is not planned meanwhile,
+    // so it does not shuttle back and forth while the person stays.
+    control_->retractStanding(static_cast<std::size_t>(r.index));
+    r.gaveBack = true;
+    ++counters_.gaveBack;
   }
   bool changed = false;
   if (r.yieldUntilNs >= 0 && nowNs >= r.yieldUntilNs) {

@@ -116,7 +116,8 @@ class TrafficNode {
     std::uint64_t plannedSteps = 0;
     std::uint64_t replans = 0;
     std::uint64_t riskUpdates = 0;
-    std::uint64_t yields = 0;  ///< robots made to yield to a person (yieldAfterS)
+    std::uint64_t yields = 0;    ///< robots made to yield to a person (yieldAfterS)
+    std::uint64_t gaveBack = 0;  ///< robots blocked on their node that gave back the next (kGiveBackAfterS)
     double lastTickMs = 0.0;
     double maxTickMs = 0.0;
   };
@@ -144,11 +145,13 @@ class TrafficNode {
     traffic::NodeId lastNode = traffic::kNoNode;
     std::int64_t movedNs = 0;  ///< when it last reported a node other than lastNode
     std::int64_t blockedSinceNs = -1;
-    std::int64_t yieldUntilNs = -1;             ///< yielding: its blocked report does not hold it until then
+    bool gaveBack = false;           ///< blocked on its node long enough to give back the node after it
+    std::int64_t yieldUntilNs = -1;  ///< yielding: its blocked report does not hold it until then
     std::vector<traffic::NodeId> yieldNodes;    ///< the nodes ahead that cost more meanwhile
     std::vector<traffic::NodeId> blockedAhead;  ///< its way ahead when it said it was blocked
   };
-  /// Starts or ends the robot's yielding (yieldAfterS); true when the node costs changed.
+  /// Gives back what a robot blocked on its node has been released beyond it (kGiveBackAfterS),
+  /// starts or ends its yielding (yieldAfterS); true when the node costs changed.
   bool updateYield(Robot& r, std::int64_t nowNs, bool timedOut);
   /// The risk costs plus the yielding robots' costs, to the planner.
   void applyNodeCost();

@@ -325,19 +325,27 @@ TEST(TrafficNode, ClosuresAreCheckedWholeReplacedByIdAndReopenedOnce) {
 /// way ahead, then reports itself blocked where it stands for 10 s (a person in front of it).
 /// Returns whether it was released another way meanwhile (a base[1] other than the one towards
 /// the person) and how many yields the node counted.
-std::pair<bool, std::uint64_t> blockedFor10s(double yieldAfterS) {
-  auto s = settings();
-  s.yieldAfterS = yieldAfterS;
-  TrafficNode node(smallWarehouse(), s, 3);
+/// r1 sent from PARK-1 to P-1 (epoch 3) drives a second or so and stops on a node with at least two
+/// more released ahead of it; `now` is then the time after its last report.
+msg::TrafficRelease driveAWhile(TrafficNode& node, std::int64_t& now) {
   node.onProgress(at("r1", stationPose("PARK-1"), "P-1"), 0);
   msg::TrafficRelease last;
-  std::int64_t now = 2 * kS;
+  now = 2 * kS;
   for (int i = 0; i < 200 && !(last.base.size() >= 3 && i >= 10); ++i, now += kS / 10) {
     for (const auto& r : node.tick(now))
       last = r;
     if (last.base.size() > 1 && !(last.base.size() >= 3 && i >= 9))
       node.onProgress(at("r1", {last.base[1].x, last.base[1].y, 0}, "P-1", last.base[1].node, 3), now);
   }
+  return last;
+}
+
+std::pair<bool, std::uint64_t> blockedFor10s(double yieldAfterS) {
+  auto s = settings();
+  s.yieldAfterS = yieldAfterS;
+  TrafficNode node(smallWarehouse(), s, 3);
+  std::int64_t now = 0;
+  const msg::TrafficRelease last = driveAWhile(node, now);
   EXPECT_GE(last.base.size(), 3U);
   if (last.base.size() < 3)
     return {false, 0};
@@ -367,6 +375,49 @@ TEST(TrafficNode, ARobotBlockedByAPersonForLongIsReleasedAnotherWay) {
   const auto [otherWayOff, yieldsOff] = blockedFor10s(0.0);
   EXPECT_EQ(yieldsOff, 0U);
   EXPECT_FALSE(otherWayOff) << "held: no new way";
+}
+
+// Held by a person on its node, a robot keeps the node after its own released, so the plan
+// places it there and others wait on a step it cannot make. Blocked 10 s, it gives that node back:
+// released and planned only where it stands, still held (not sent another way). Unblocked, it goes
+// on from there.
+TEST(TrafficNode, ARobotBlockedOnItsNodeGivesBackTheNextAfterAWhileAndStaysHeld) {
+  TrafficNode node(smallWarehouse(), settings(), 3);
+  std::int64_t now = 0;
+  msg::TrafficRelease last = driveAWhile(node, now);
+  ASSERT_GE(last.base.size(), 3U);
+  const auto here = last.base[0];
+  auto blocked = at("r1", {here.x, here.y, 0}, "P-1", here.node, 3);
+  blocked.blocked = true;
+  const auto& ex = node.control()->execution();
+  const std::int64_t from = now;
+  for (; now < from + 9 * kS; now += kS / 10) {
+    node.onProgress(blocked, now);
+    for (const auto& r : node.tick(now))
+      last = r;
+  }
+  EXPECT_NE(ex.releasedEnd(0), here.node) << "gave back before 10 s";
+  EXPECT_EQ(node.counters().gaveBack, 0U);
+  for (; now < from + 12 * kS; now += kS / 10) {
+    node.onProgress(blocked, now);
+    for (const auto& r : node.tick(now))
+      last = r;
+  }
+  EXPECT_EQ(node.counters().gaveBack, 1U);
+  EXPECT_EQ(ex.releasedEnd(0), here.node);
+  EXPECT_EQ(ex.plannedEnd(0), here.node) << "planned on past where it stands";
+  ASSERT_EQ(last.base.size(), 1U) << "the agent was not told";
+  EXPECT_EQ(last.base[0].node, here.node);
+  EXPECT_TRUE(node.control()->held(0));
+  // The person leaves: it is released on again.
+  blocked.blocked = false;
+  for (int i = 0; i < 30 && last.base.size() < 2; ++i, now += kS / 10) {
+    node.onProgress(blocked, now);
+    for (const auto& r : node.tick(now))
+      last = r;
+  }
+  EXPECT_GE(last.base.size(), 2U);
+  EXPECT_EQ(node.counters().gaveBack, 1U);
 }
 
 TEST(TrafficNode, FollowingTheReleasesReachesTheGoal) {
