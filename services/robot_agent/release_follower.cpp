@@ -430,6 +430,11 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   }
   const Vec2 toCarrot = r->target.position() - here;
   const double bearing = angleDiff(std::atan2(toCarrot.y, toCarrot.x), pose.theta);
+  // Turning on the spot below, the robot is still held by what is in its way: the hold's clock and
+  // why it stands go by this. (Turned to its corner node, held by a person, turned back towards its
+  // carrot and to the node again, a robot was never held at the end of a cycle: it stood 196 s
+  // without saying it was blocked, a robot waiting 120 s behind it; dense check, seed 8.)
+  const bool heldAhead = held;
   if (held && toCarrot.norm() > 0.1 && std::abs(bearing) > 0.25) {
     // Something ahead while the way bends away from it: turn towards the carrot on the spot, which
     // sweeps nothing. (Only for walls at first, as reactive: a robot 7 cm off its lane facing 24°
@@ -443,6 +448,8 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   const bool byKnownRobot = blocker.robot && stack.knowsRobot(blocker.id);
   if (held) {
     mode = msg::RobotMode::Waiting;
+  }
+  if (heldAhead) {
     standByObstacle_ = !blocker.robot && blocker.id.empty();
     standByPerson_ = !blocker.robot && blocker.id == "human";
     standWhy_ = blocker.robot        ? "held by robot " + blocker.id + (byKnownRobot ? "" : " (unknown)")
@@ -455,7 +462,7 @@ FollowCommand ReleaseFollower::drive(const FollowCycle& c, DriveStack& stack) {
   if (heldSinceNs_ >= 0 && distance(here, heldAt_) > progress_.params().movedM) {
     heldSinceNs_ = -1;
   }
-  if (held && !byKnownRobot && heldSinceNs_ < 0) {
+  if (heldAhead && !byKnownRobot && heldSinceNs_ < 0) {
     heldSinceNs_ = nowNs;
     heldAt_ = here;
   }

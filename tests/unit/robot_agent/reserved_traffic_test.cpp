@@ -165,6 +165,35 @@ TEST_P(ReservedPlanner, APersonOnTheBaseStopsTheRobotWhichReportsItselfBlockedAf
   EXPECT_EQ(sim.lastNode(), 16);
 }
 
+TEST_P(ReservedPlanner, HeldByAPersonOnItsWayToACornerNodeItReportsItselfBlocked) {
+  // As r39 stood 196 s in the full-stack dense check (seed 8, 40 robots; shifted by (-10, +1)
+  // here): 0.24 m short of a corner node B, its way turning west there, a person 0.6 m ahead to
+  // its right. Turned to face B it was held by the person, and held it turned on the spot towards
+  // its carrot past the corner; the corner rule turned it back to B. Never held at the end of a
+  // cycle, it never said it was blocked, and a robot behind it waited 120 s on a step it could
+  // not make. Held by the person while it turns, it reports itself blocked after 3 s.
+  Sim sim(GetParam());
+  sim.restartAt({5.684, 4.661, 2.26});
+  sim.people = {{5.9, 5.22}};
+  sim.agent->onAssignment(order(kFarPickup));
+  sim.agent->onRelease(release(
+      1, {{100, 5.62, 3.94}, {101, 5.70, 4.90}, {102, 5.20, 4.75}, {103, 4.70, 4.75}, {104, 4.20, 4.75}}));
+  std::optional<double> blockedAt;
+  while (sim.now() < 20.0) {
+    const auto out = sim.step();
+    if (out.traffic && out.traffic->blocked && !blockedAt) {
+      blockedAt = sim.now();
+    }
+  }
+  EXPECT_GE(sim.minToPeople, 0.25 + 0.3) << "touched the person";
+  ASSERT_TRUE(blockedAt) << "never reported blocked; standing: " << sim.agent->standingStill().why;
+  EXPECT_LT(*blockedAt, 5.0);
+  // 0.76 m past its node, it then backs onto it and gives way (as below).
+  EXPECT_EQ(sim.agent->standingStill().why, "giving way to a person");
+  EXPECT_LT(distance(sim.truth.position(), {5.62, 3.94}), 0.2);
+  EXPECT_FALSE(sim.failed());
+}
+
 TEST_P(ReservedPlanner, HeldByAPersonPastItsNodeItBacksOntoItAndGivesWay) {
   // The person stands so that the robot stops 0.3 m past node 5 (x = 3.5), holding node 6 too: the
   // traffic manager re-plans only a robot on its node. After 10 s it backs onto node 5 and stands
