@@ -361,3 +361,24 @@ TEST(Humans, SomeoneWedgedBetweenAShelfCornerAndARobotGetsOut) {
     EXPECT_GT(moved(seed), 0.5) << "seed " << seed << ": the person stayed wedged where they stood";
   }
 }
+
+TEST(Humans, SomeoneBesideAStandingRobotWithTooNarrowAGapToAShelfTurnsAway) {
+  // As in the dense fleet check (seed 8; shifted by -8 m in x here): a robot stands 0.54 m below a
+  // shelf face (its disc to the face), less than a person needs (0.5 m across and the 0.05 m keep
+  // distance), the person beside it 0.6 m off, their way west through that gap. The way runs 69°
+  // off the robot's bearing, outside the 60° that counted as "into the robot", so the person kept
+  // choosing goals beyond it and stood there for minutes, the robot held by them.
+  auto nearTime = [](std::uint64_t seed) {
+    auto j = carvedRoom(seed, [](int r, int c) { return !((r == 19 || r == 20) && c >= 15 && c <= 18); });
+    j["robots"] = {{{"id", "r1"}, {"start", {7.684, 3.661, 2.26}}}};
+    j["points_of_interest"] = {{1.0, 4.2}, {2.0, 4.3}, {3.0, 4.2}, {1.5, 4.0}, {16.0, 4.0}, {17.0, 2.0}};
+    j["humans"] = {{"list", {{{"id", "h"}, {"start", {7.9, 4.22}}}}}, {"stop_probability", 0.0}};
+    World w(test::parse(j));
+    return longestStayNear(w, 900, {{7.684, 3.661}}, 1.0);  // 90 s
+  };
+  double worst = 0.0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    worst = std::max(worst, nearTime(seed));
+  }
+  EXPECT_LT(worst, 15.0) << "someone stood within 1 m of the robot for that many seconds at a time";
+}
