@@ -229,7 +229,7 @@ double MotionGate::zoneSpeed(const GateView& view, double v) const {
 }
 
 double MotionGate::besidePeopleSpeed(const GateView& view) const {
-  double speed = std::numeric_limits<double>::infinity();
+  double speed = kInf;
   if (!view.seen.valid) {
     return speed;
   }

@@ -122,8 +122,8 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     spdlog::info(
         "traffic manager: {} robots ({} placed), {} reports ({} refused), {} releases, {} steps planned, {} "
         "re-plans, {} risk updates, {} yields, {} gave back, tick {:.2f} ms (max {:.2f}), base ends reached "
-        "short of the "
-        "target: {} held by others, {} at the plan's end, {} with more free (late), refused at the edge: {}",
+        "short of the target: {} held by others, {} at the plan's end, {} with more free (late), refused at "
+        "the edge: {}",
         node.robotsKnown(), node.robotsPlaced(), c.reports, c.refused, c.releases, c.plannedSteps, c.replans,
         c.riskUpdates, c.yields, c.gaveBack, c.lastTickMs, c.maxTickMs, ends.held, ends.planEnd, ends.limit,
         rejections.toJson().dump());

@@ -14,8 +14,9 @@ using traffic::kNoNode;
 using traffic::NodeId;
 
 namespace {
-/// s a robot reports itself blocked on its node (by a person: a robot ahead is waited on, not
-/// reported) before it gives back the node after its own. Its agent reports after 3 s held.
+/// s a robot reports itself blocked on its node (by a person or something the map does not show: a
+/// robot ahead is waited on, not reported) before it gives back the node after its own. Its agent
+/// reports after 3 s held.
 constexpr double kGiveBackAfterS = 10.0;
 }  // namespace
 
