@@ -51,6 +51,17 @@ const planning::OccupancyGrid& emptyMap() {
   return map;
 }
 
+/// heldUp on 0.8 m/s along a 0.5 m⁻¹ curve comes out at `speed` on the same curve, not held.
+void expectSlowedNotHeld(const MotionGate& gate, const GateView& view, double speed, const char* what) {
+  double v = 0.8;
+  double w = 0.4;
+  Blocker b;
+  const auto hold = gate.heldUp(view, v, w, b);
+  EXPECT_DOUBLE_EQ(v, speed) << what;
+  EXPECT_DOUBLE_EQ(w, 0.4 * speed / 0.8) << what << ": same curvature";
+  EXPECT_FALSE(hold.held) << what << " is no hold";
+}
+
 }  // namespace
 
 TEST(MotionGate, NothingSeenKeepsTheSpeed) {
@@ -280,13 +291,7 @@ TEST(MotionGate, SpeedZonesSlowTheRobotBeforeItEntersAndKeepTheCurvature) {
   const GateView view{seen, others, emptyMap(), {}, false};
   // At (2, 2) facing +x: 0.8 m/s reaches the zone within the 1 s headway.
   EXPECT_DOUBLE_EQ(gate.zoneSpeed(view, 0.8), 0.3);
-  double v = 0.8;
-  double w = 0.4;
-  Blocker b;
-  const auto hold = gate.heldUp(view, v, w, b);
-  EXPECT_DOUBLE_EQ(v, 0.3);
-  EXPECT_DOUBLE_EQ(w, 0.4 * 0.3 / 0.8) << "same curvature";
-  EXPECT_FALSE(hold.held) << "a speed zone is no hold";
+  expectSlowedNotHeld(gate, view, 0.3, "a speed zone");
   // Slow enough not to reach it within the headway's look-ahead (at least the radius): unchanged.
   EXPECT_TRUE(std::isinf(gate.zoneSpeed(view, 0.2)));
   // Backing away from it: unchanged; without zones: unchanged.
@@ -312,13 +317,7 @@ TEST(MotionGate, APersonBesideTheWayCloseAheadSlowsTheRobotAndKeepsTheCurvature)
   const Perception level = seeing({{{2.3, 2.85}, {}, 0.25, true}});
   const GateView view{level, others, emptyMap(), {0.8, 0.4}, false};
   EXPECT_DOUBLE_EQ(gate.besidePeopleSpeed(view), 0.3);
-  double v = 0.8;
-  double w = 0.4;
-  Blocker b;
-  const auto hold = gate.heldUp(view, v, w, b);
-  EXPECT_DOUBLE_EQ(v, 0.3);
-  EXPECT_DOUBLE_EQ(w, 0.4 * 0.3 / 0.8) << "same curvature";
-  EXPECT_FALSE(hold.held) << "slowed, not held";
+  expectSlowedNotHeld(gate, view, 0.3, "a person beside");
   // 0.7 m ahead of the front, as beside: the stop rule's law on the gap along (headway 1 s).
   EXPECT_NEAR(
       gate.besidePeopleSpeed({seeing({{{3.25, 2.85}, {}, 0.25, true}}), others, emptyMap(), {}, false}), 0.7,
