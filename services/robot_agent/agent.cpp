@@ -18,7 +18,12 @@ namespace {
 LocalizerParams localizerParams(const AgentParams& p) {
   LocalizerParams lp;
   lp.start = p.resumeAt.value_or(p.start);
-  if (p.resumeAt) {
+  if (p.resumeAt && p.resumeWheels) {
+    // The roll since the pose was written comes from the first reading's wheel totals.
+    lp.startWheels = p.resumeWheels;
+    lp.startVarianceXY = kResumeWheelsVarianceXY;
+    lp.startVarianceTheta = kResumeWheelsVarianceTheta;
+  } else if (p.resumeAt) {
     // It may have rolled on after its process stopped (its last command held for the driver's
     // timeout, then braking) and since the pose was written.
     lp.startVarianceXY = kResumeVarianceXY;

@@ -52,6 +52,8 @@ struct AgentParams {
   /// Where the robot was when its process last saw it (the pose file, pose_store.hpp): the
   /// localization starts there, less certain, instead of at `start` (which stays its parking place).
   std::optional<Pose2> resumeAt;
+  /// The driver's wheel totals kept with `resumeAt`: the roll since is known, the start is certain.
+  std::optional<WheelTotals> resumeWheels;
   double radius = 0.3;
   double wheelBase = 0.4;
   double vMax = 0.8;                                  // m/s cruise
@@ -133,6 +135,10 @@ class Agent : private DriveStack {
   [[nodiscard]] const PoseWatch& poseWatch() const { return poseWatch_; }
 
   [[nodiscard]] Pose2 pose() const { return localizer_.pose(); }
+  [[nodiscard]] const Eigen::Matrix3d& covariance() const { return localizer_.covariance(); }
+  /// The driver's wheel totals the pose is as of (kept with it in the pose file).
+  [[nodiscard]] std::optional<WheelTotals> wheelTotals() const { return localizer_.wheelTotals(); }
+  [[nodiscard]] bool resumeTotalsRefused() const { return localizer_.resumeTotalsRefused(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
   /// Where it goes when idle (its start pose, its parking place).
   [[nodiscard]] const Pose2& home() const { return p_.start; }

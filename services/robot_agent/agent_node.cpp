@@ -52,6 +52,7 @@ Expected<std::unique_ptr<AgentNode>> AgentNode::create(const World& world, const
     p.start = r.start;
     if (const auto it = resume.find(r.id); it != resume.end()) {
       p.resumeAt = it->second.pose;
+      p.resumeWheels = it->second.wheels;
     }
     p.radius = r.radius;
     p.wheelBase = r.wheelBase;
@@ -255,6 +256,11 @@ std::uint64_t AgentNode::poseDoubts() const {
   return n;
 }
 
+std::uint64_t AgentNode::resumeTotalsRefused() const {
+  return static_cast<std::uint64_t>(
+      std::count_if(agents_.begin(), agents_.end(), [](const auto& a) { return a->resumeTotalsRefused(); }));
+}
+
 ReleaseCounts AgentNode::releaseCounts() const {
   ReleaseCounts rc;
   for (const auto& a : agents_) {
@@ -285,7 +291,8 @@ nlohmann::json AgentNode::statsJson() const {
                        {"unmatched_outside_gate", ls.outsideGate},
                        {"unmatched_no_overlap", ls.noOverlap},
                        {"unmatched_ambiguous", ls.ambiguous},
-                       {"pose_doubts", poseDoubts()}};
+                       {"pose_doubts", poseDoubts()},
+                       {"resume_totals_refused", resumeTotalsRefused()}};
   m["traffic"] = {{"releases_taken", rc.accepted},
                   {"ignored_foreign", rc.foreign},
                   {"ignored_stale", rc.stale},

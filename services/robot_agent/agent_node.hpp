@@ -98,6 +98,9 @@ class AgentNode {
   [[nodiscard]] ReleaseCounts releaseCounts() const;
   /// Times a hosted robot's pose was doubted by its laser lines (PoseWatch), cumulative.
   [[nodiscard]] std::uint64_t poseDoubts() const;
+  /// Robots resumed with wheel totals from the pose file that did not fit their first reading (the
+  /// driver restarted): they started less certain (Localizer::resumeTotalsRefused).
+  [[nodiscard]] std::uint64_t resumeTotalsRefused() const;
   /// For the --metrics file: "samples" (refused at the edge), "conduct", "localization", "traffic".
   [[nodiscard]] nlohmann::json statsJson() const;
 

@@ -47,6 +47,19 @@ std::vector<Vec2> Perception::scanPoints(double maxRange) const {
 
 Localizer::Localizer(LocalizerParams params) : p_(std::move(params)), ekf_(makeEkf(p_)) {
   seen_.pose = ekf_.pose();
+  if (p_.startWheels) {
+    haveTotals_ = true;
+    wheelLeft_ = p_.startWheels->left;
+    wheelRight_ = p_.startWheels->right;
+    checkResumeRoll_ = true;
+  }
+}
+
+std::optional<WheelTotals> Localizer::wheelTotals() const {
+  if (!haveTotals_) {
+    return std::nullopt;
+  }
+  return WheelTotals{wheelLeft_, wheelRight_};
 }
 
 bool Localizer::plausible() const {
@@ -69,6 +82,22 @@ void Localizer::onReading(const SensorReading& f) {
   if (totals && haveTotals_) {
     dsLeft = f.wheelLeftTotal - wheelLeft_;
     dsRight = f.wheelRightTotal - wheelRight_;
+  }
+  if (checkResumeRoll_) {
+    checkResumeRoll_ = false;
+    // Totals kept over a restart: only a roll a robot makes after its process stopped is believed.
+    // Anything else (the driver counts from zero again) leaves the motion since unknown.
+    if (!totals || !(std::abs(dsLeft) <= kResumeRollMaxM && std::abs(dsRight) <= kResumeRollMaxM)) {
+      resumeTotalsRefused_ = true;
+      haveTotals_ = false;
+      dsLeft = f.dsLeft;
+      dsRight = f.dsRight;
+      Eigen::Matrix3d wide = ekf_.covariance();
+      wide(0, 0) = std::max(wide(0, 0), kResumeVarianceXY);
+      wide(1, 1) = std::max(wide(1, 1), kResumeVarianceXY);
+      wide(2, 2) = std::max(wide(2, 2), kResumeVarianceTheta);
+      (void)ekf_.reset(ekf_.pose(), wide);
+    }
   }
   if (totals) {
     wheelLeft_ = f.wheelLeftTotal;

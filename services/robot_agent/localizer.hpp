@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "fleet/estimation/line_extraction.hpp"
 #include "fleet/estimation/line_matching.hpp"
 #include "fleet/estimation/pose_ekf.hpp"
+#include "wheel_totals.hpp"
 
 namespace fleet::agent {
 
@@ -100,11 +102,24 @@ estimation::LineExtractionParams agentLineExtraction();
 /// gated out (a 0.45 rad heading error against 0.1 rad was, and the robot stayed lost).
 constexpr double kResumeVarianceXY = 0.49;
 constexpr double kResumeVarianceTheta = 0.25;
+/// ... and with the driver's wheel totals kept beside the pose: the roll since is known exactly,
+/// what is left is the saved estimate's own error, variances of (0.1 m)² and (0.1 rad)². The wide
+/// variances above let a line match a shelf face one row (2.5 m) off: a robot resumed 1.2 m
+/// behind where it stood localized on the wrong row and drove into the shelf's side.
+constexpr double kResumeWheelsVarianceXY = 0.01;
+constexpr double kResumeWheelsVarianceTheta = 0.01;
+/// A wheel's travel between the kept totals and the first reading after a resume above this is no
+/// roll (the driver restarted and counts from zero, or it is another one): not used, the start
+/// covariance is widened to the kResumeVariance* ones.
+constexpr double kResumeRollMaxM = 2.0;
 
 struct LocalizerParams {
   Pose2 start;
   double startVarianceXY = 0.01;      ///< m², the start pose's variance in x and in y
   double startVarianceTheta = 0.001;  ///< rad²
+  /// The driver's wheel totals at `start` (a robot resumed from the pose file): the first reading's
+  /// totals give the motion since. Checked against kResumeRollMaxM.
+  std::optional<WheelTotals> startWheels;
   double wheelBase = 0.4;
   double sensorTimeoutS = 0.5;  ///< no reading for this long (of the cycle clock): the stream is lost
   /// How far the robot may have rolled unseen in a gap (its last command held, then braking).
@@ -165,6 +180,11 @@ class Localizer {
   [[nodiscard]] const LineStats& lineStats() const { return lineStats_; }
   /// Of the latest reading (one entry per correction tried, accepted or not).
   [[nodiscard]] const std::vector<Update>& lastUpdates() const { return updates_; }
+  /// The driver's wheel totals of the reading the estimate is as of (none before the first
+  /// reading with totals, or from a driver that does not send them).
+  [[nodiscard]] std::optional<WheelTotals> wheelTotals() const;
+  /// Wheel totals kept over a restart that did not fit the first reading (kResumeRollMaxM).
+  [[nodiscard]] bool resumeTotalsRefused() const { return resumeTotalsRefused_; }
 
  private:
   void track(const SensorReading& r);
@@ -177,6 +197,8 @@ class Localizer {
   bool haveTotals_ = false;       // the previous reading had wheel totals
   double wheelLeft_ = 0.0;        // ... these
   double wheelRight_ = 0.0;
+  bool checkResumeRoll_ = false;  // the totals above were kept over a restart, not yet checked
+  bool resumeTotalsRefused_ = false;
   std::int64_t peopleStampNs_ = -1;
   std::uint64_t rejected_ = 0;
   LineStats lineStats_;

@@ -97,8 +97,9 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
   agent::AgentNode& node = **created;
   for (const auto& [robot, saved] : resume) {
     if (node.find(robot) != nullptr) {
-      spdlog::info("robot agent {}: {} resumes at ({:.2f}, {:.2f}, {:.2f}) from the pose file", proc.id,
-                   robot, saved.pose.x, saved.pose.y, saved.pose.theta);
+      spdlog::info("robot agent {}: {} resumes at ({:.2f}, {:.2f}, {:.2f}) from the pose file{}", proc.id,
+                   robot, saved.pose.x, saved.pose.y, saved.pose.theta,
+                   saved.wheels ? " with its wheel totals" : " without wheel totals (less certain)");
     }
   }
   agent::PoseWriter poseWriter(settings.poseFile, agent::kPoseWritePeriodMs);
@@ -107,7 +108,7 @@ int run(const agent::World& world, const agent::Settings& settings, const Proces
     agent::SavedPoses poses;
     const std::int64_t stamp = unixMs();
     for (std::size_t i = 0; i < node.size(); ++i) {
-      poses[node.agent(i).id()] = agent::SavedPose{node.agent(i).pose(), stamp};
+      poses[node.agent(i).id()] = agent::SavedPose{node.agent(i).pose(), stamp, node.agent(i).wheelTotals()};
     }
     const auto written = poseWriter.write(poses, clockMs);
     if (!written && !poseWriteFailed) {

@@ -42,6 +42,23 @@ Expected<SavedPoses> readPoseFile(const std::string& path) {
       return unexpected("pose_file", at + ".saved_unix_ms: required integer");
     }
     s.savedUnixMs = p["saved_unix_ms"].get<std::int64_t>();
+    const bool left = p.contains("wheel_left_total");
+    const bool right = p.contains("wheel_right_total");
+    if (left != right) {
+      return unexpected("pose_file", at + "." + (left ? "wheel_right_total" : "wheel_left_total") +
+                                         ": required with the other wheel's total");
+    }
+    if (left) {
+      WheelTotals w;
+      for (const auto& [key, value] :
+           {std::pair{"wheel_left_total", &w.left}, std::pair{"wheel_right_total", &w.right}}) {
+        if (!p[key].is_number() || !std::isfinite(p[key].get<double>())) {
+          return unexpected("pose_file", at + "." + key + ": required finite number");
+        }
+        *value = p[key].get<double>();
+      }
+      s.wheels = w;
+    }
     out[id] = s;
   }
   return out;
@@ -51,8 +68,12 @@ Expected<void> writePoseFile(const std::string& path, const SavedPoses& poses) {
   nlohmann::json j;
   j["robots"] = nlohmann::json::object();
   for (const auto& [id, s] : poses) {
-    j["robots"][id] = {
-        {"x", s.pose.x}, {"y", s.pose.y}, {"theta", s.pose.theta}, {"saved_unix_ms", s.savedUnixMs}};
+    auto& r = j["robots"][id];
+    r = {{"x", s.pose.x}, {"y", s.pose.y}, {"theta", s.pose.theta}, {"saved_unix_ms", s.savedUnixMs}};
+    if (s.wheels) {
+      r["wheel_left_total"] = s.wheels->left;
+      r["wheel_right_total"] = s.wheels->right;
+    }
   }
   const std::string tmp = path + ".tmp";
   {

@@ -8,23 +8,28 @@
 // (LoadtestE2E.ReservedTrafficThroughEveryFault...; docs/algorithms.md, "Restarting where the
 // robot is"). A real base keeps its last pose over a reboot the same way.
 //
-// The file is JSON, {"robots": {"r7": {"x": .., "y": .., "theta": .., "saved_unix_ms": ..}}},
+// The file is JSON, {"robots": {"r7": {"x": .., "y": .., "theta": .., "saved_unix_ms": ..,
+// "wheel_left_total": .., "wheel_right_total": ..}}} (the wheel totals optional, both or neither),
 // written whole to a temporary file and renamed over the old one, so a process killed while
 // writing leaves the previous file. A pose older than `maxAgeS` when read is not used (the robot
 // may have been moved while nobody watched it).
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "fleet/core/expected.hpp"
 #include "fleet/core/pose2.hpp"
+#include "wheel_totals.hpp"
 
 namespace fleet::agent {
 
 struct SavedPose {
   Pose2 pose;
   std::int64_t savedUnixMs = 0;  ///< wall clock (ms since the epoch) when it was written
+  /// The driver's wheel totals the pose is as of: with them the roll since is known exactly.
+  std::optional<WheelTotals> wheels;
 };
 
 using SavedPoses = std::map<std::string, SavedPose>;

@@ -73,6 +73,55 @@ TEST(Localizer, WheelTotalsKeepTheMotionOfLostReadings) {
   EXPECT_NEAR(loc.pose().x, 2.5, 1e-9) << "1.5 m driven, 0.55 m of it unseen";
 }
 
+// A robot resumed from the pose file with the driver's wheel totals: whatever it rolled after its
+// process stopped comes from the first reading's totals, so its start can be certain (a start as
+// uncertain as a roll it cannot see let a line match a shelf face one row off).
+TEST(Localizer, ResumedWithItsWheelTotalsTheRollSinceIsKnown) {
+  auto p = params({4.0, 2.0, 0.0});
+  p.startWheels = agent::WheelTotals{100.0, 100.0};
+  p.startVarianceXY = agent::kResumeWheelsVarianceXY;
+  p.startVarianceTheta = agent::kResumeWheelsVarianceTheta;
+  Localizer loc(p);
+  auto r = straight(50 * kTick, 0.0);  // a second process's first reading: its own increment 0
+  r.wheelTotalsValid = true;
+  r.wheelLeftTotal = 100.9;  // rolled 0.9 m while no process watched it
+  r.wheelRightTotal = 100.9;
+  loc.onReading(r);
+  EXPECT_NEAR(loc.pose().x, 4.9, 1e-9);
+  EXPECT_NEAR(loc.pose().y, 2.0, 1e-9);
+  EXPECT_LT(loc.covariance()(0, 0), 0.02);
+  EXPECT_FALSE(loc.resumeTotalsRefused());
+  ASSERT_TRUE(loc.wheelTotals());
+  EXPECT_EQ(loc.wheelTotals()->left, 100.9) << "kept for the next pose written";
+}
+
+TEST(Localizer, KeptTotalsThatDoNotFitAreRefusedAndTheStartIsUncertain) {
+  for (const double total : {0.3, 102.5, 97.0}) {  // the driver restarted; rolls no robot makes
+    auto p = params({4.0, 2.0, 0.0});
+    p.startWheels = agent::WheelTotals{100.0, 100.0};
+    p.startVarianceXY = agent::kResumeWheelsVarianceXY;
+    Localizer loc(p);
+    auto r = straight(kTick, 0.1);  // the driver's increment: 1 cm
+    r.wheelTotalsValid = true;
+    r.wheelLeftTotal = total;
+    r.wheelRightTotal = total;
+    loc.onReading(r);
+    EXPECT_TRUE(loc.resumeTotalsRefused()) << total;
+    EXPECT_NEAR(loc.pose().x, 4.01, 1e-9) << total << ": the increment, not the totals' difference";
+    EXPECT_GE(loc.covariance()(0, 0), agent::kResumeVarianceXY) << total;
+    EXPECT_GE(loc.covariance()(2, 2), agent::kResumeVarianceTheta) << total;
+    ASSERT_TRUE(loc.wheelTotals());
+    EXPECT_EQ(loc.wheelTotals()->left, total) << "counted from this reading on";
+  }
+  // A first reading without totals leaves the roll unknown too.
+  auto p = params({4.0, 2.0, 0.0});
+  p.startWheels = agent::WheelTotals{100.0, 100.0};
+  Localizer loc(p);
+  loc.onReading(straight(kTick, 0.1));
+  EXPECT_TRUE(loc.resumeTotalsRefused());
+  EXPECT_FALSE(loc.wheelTotals());
+}
+
 TEST(Localizer, WithoutTotalsAGapWidensTheCovariance) {
   Localizer loc(params());
   loc.onReading(straight(kTick, 0.5));

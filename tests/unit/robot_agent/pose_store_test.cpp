@@ -35,8 +35,8 @@ void writeText(const fs::path& p, const std::string& text) {
 TEST(PoseStore, WrittenPosesAreReadBackExactly) {
   const auto path = scratch("poses.json").string();
   SavedPoses poses;
-  poses["r1"] = SavedPose{Pose2{12.345678901, -3.25, 2.9}, 1'796'000'000'123};
-  poses["r7"] = SavedPose{Pose2{19.0, 9.7, -1.175}, 1'796'000'000'456};
+  poses["r1"] = SavedPose{Pose2{12.345678901, -3.25, 2.9}, 1'796'000'000'123, {}};
+  poses["r7"] = SavedPose{Pose2{19.0, 9.7, -1.175}, 1'796'000'000'456, WheelTotals{1234.5678, -0.125}};
   ASSERT_TRUE(writePoseFile(path, poses));
   const auto back = readPoseFile(path);
   ASSERT_TRUE(back) << back.error().message;
@@ -47,6 +47,10 @@ TEST(PoseStore, WrittenPosesAreReadBackExactly) {
     EXPECT_EQ(back->at(id).pose.theta, s.pose.theta) << id;
     EXPECT_EQ(back->at(id).savedUnixMs, s.savedUnixMs) << id;
   }
+  EXPECT_FALSE(back->at("r1").wheels) << "a pose without wheel totals (a driver that sends none)";
+  ASSERT_TRUE(back->at("r7").wheels);
+  EXPECT_EQ(back->at("r7").wheels->left, 1234.5678);
+  EXPECT_EQ(back->at("r7").wheels->right, -0.125);
   EXPECT_FALSE(fs::exists(path + ".tmp")) << "the temporary file was renamed over the old one";
 }
 
@@ -66,6 +70,11 @@ TEST(PoseStore, ADamagedFileIsAnErrorNamingWhatIsWrong) {
       {R"({"robots": {"r1": {"x": 1, "y": 2, "saved_unix_ms": 5}}})",
        "robots.r1.theta: required finite number"},
       {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0}}})", "robots.r1.saved_unix_ms: required integer"},
+      {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "wheel_left_total": 3}}})",
+       "robots.r1.wheel_right_total: required with the other wheel's total"},
+      {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "wheel_left_total": 3,
+          "wheel_right_total": null}}})",
+       "robots.r1.wheel_right_total: required finite number"},
   };
   for (const auto& [text, why] : cases) {
     const auto path = scratch("damaged.json");
@@ -79,9 +88,9 @@ TEST(PoseStore, ADamagedFileIsAnErrorNamingWhatIsWrong) {
 
 TEST(PoseStore, OnlyFreshPosesAreUsed) {
   SavedPoses poses;
-  poses["old"] = SavedPose{Pose2{1, 1, 0}, 1'000};
-  poses["fresh"] = SavedPose{Pose2{2, 2, 0}, 600'000};
-  poses["ahead"] = SavedPose{Pose2{3, 3, 0}, 900'000};  // a clock set back since: still fresh
+  poses["old"] = SavedPose{Pose2{1, 1, 0}, 1'000, {}};
+  poses["fresh"] = SavedPose{Pose2{2, 2, 0}, 600'000, {}};
+  poses["ahead"] = SavedPose{Pose2{3, 3, 0}, 900'000, {}};  // a clock set back since: still fresh
   const auto fresh = freshPoses(poses, 700'000, 600.0);
   EXPECT_EQ(fresh.count("old"), 0U);
   EXPECT_EQ(fresh.count("fresh"), 1U);
@@ -112,7 +121,12 @@ TEST(PoseStore, ANodeStartsAResumedRobotWhereItWasAndKeepsItsHome) {
   Settings s;
   s.threads = 1;
   SavedPoses resume;
-  resume["r2"] = SavedPose{Pose2{15.0, 12.0, 1.5}, 0};
+  resume["r2"] = SavedPose{Pose2{15.0, 12.0, 1.5}, 0, {}};
+  World::Robot third;
+  third.id = "r3";
+  third.start = Pose2{3, 1, 0};
+  w.robots.push_back(third);
+  resume["r3"] = SavedPose{Pose2{16.0, 12.0, 1.5}, 0, WheelTotals{40.0, 41.0}};
   auto node = AgentNode::create(w, s, resume);
   ASSERT_TRUE(node) << node.error().message;
   const Agent* r1 = (*node)->find("r1");
@@ -125,4 +139,11 @@ TEST(PoseStore, ANodeStartsAResumedRobotWhereItWasAndKeepsItsHome) {
   EXPECT_EQ(r2->pose().theta, 1.5);
   EXPECT_EQ(r2->home().x, 2.0) << "its home is still its start pose";
   EXPECT_EQ(r2->home().y, 1.0);
+  EXPECT_FALSE(r2->wheelTotals()) << "kept without totals: none until its first reading";
+  EXPECT_GT(r2->covariance()(0, 0), 0.4) << "the roll since is unknown: it starts uncertain";
+  const Agent* r3 = (*node)->find("r3");
+  ASSERT_NE(r3, nullptr);
+  ASSERT_TRUE(r3->wheelTotals()) << "kept with its wheel totals";
+  EXPECT_EQ(r3->wheelTotals()->left, 40.0);
+  EXPECT_LT(r3->covariance()(0, 0), 0.02) << "the roll since comes from the wheels: it starts certain";
 }
