@@ -70,8 +70,23 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   const auto& rm = node.roadmap();
   spdlog::info("traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}", site.name,
                rm.graph.size(), rm.edgeCount(), rm.stations.size(), epoch);
+  // A roadmap error (a station with no way in or out, a line whose robots cut others off) is the
+  // site's: refused at start, each named by its key path, as `fleetctl site check` does. Warnings
+  // are said and planned with.
+  std::size_t errors = 0;
   for (const auto& p : rm.problems) {
-    spdlog::warn("traffic manager: roadmap: {}", p.what);
+    if (p.severity == traffic::RoadmapProblem::Severity::Error) {
+      spdlog::critical("traffic manager: {}: {}", settings.site, p.what);
+      ++errors;
+    } else {
+      spdlog::warn("traffic manager: roadmap: {}", p.what);
+    }
+  }
+  if (errors > 0) {
+    spdlog::critical(
+        "traffic manager: {} refused: {} roadmap error(s) (`fleetctl site check` names them too)",
+        settings.site, errors);
+    return service::kExitUsage;
   }
   transport::Participant p;
   // In lockstep the reader keeps every report of a robot until it is taken (a report of the next step

@@ -89,4 +89,38 @@ TEST_F(BadSite, AStationInTheWallIsReportedOnceTheFileParses) {
   EXPECT_NE(r.output.find("is inside an obstacle"), std::string::npos) << r.output;
 }
 
+// A site that parses but whose roadmap cannot serve a station: B docks at the end of a dead end one
+// robot wide, with no room for a way out apart from its way in (and the site does not say it is
+// left by its way in). The traffic manager refuses it at start as `fleetctl site check` does,
+// naming the file and the key path; planning round it would send robots in that never come out.
+TEST_F(BadSite, AStationWithNoWayOutIsRefusedByTheTrafficManagerNamingTheKeyPath) {
+  std::vector<std::string> rows(10, "@" + std::string(20, '.') + "@");
+  rows.front() = rows.back() = std::string(22, '@');
+  for (const std::size_t y : {1, 2, 3, 6, 7, 8}) {
+    for (std::size_t c = 14; c <= 20; ++c) {
+      rows[y][c] = '@';
+    }
+  }
+  const nlohmann::json site = {
+      {"format", "fleet-site/1"},
+      {"name", "dead-end"},
+      {"map", {{"rows", rows}, {"resolution", 0.5}}},
+      {"robot", {{"radius", 0.3}}},
+      {"stations",
+       {{{"name", "A"}, {"kind", "pickup"}, {"pose", {1.5, 2.5, 0.0}}},
+        {{"name", "B"}, {"kind", "dropoff"}, {"pose", {9.5, 2.5, 3.14159265358979}}}}}};
+  const std::string file = (dir_ / "dead-end.site.json").string();
+  std::ofstream(file) << site.dump(1);
+  const std::string why = "stations[1].exit: station 'B': no room for a way out";
+  const auto check = run(std::string(FLEET_BINARY_DIR) + "/services/fleetctl/fleetctl site check " + file);
+  EXPECT_EQ(check.code, 2) << check.output;
+  EXPECT_NE(check.output.find(why), std::string::npos) << check.output;
+  // Bounded: a traffic manager that took the site would plan on until stopped (timeout's code 124).
+  const auto tm = run("timeout 20 " + std::string(FLEET_BINARY_DIR) +
+                      "/services/traffic_manager/traffic_manager --site " + file);
+  EXPECT_EQ(tm.code, 2) << tm.output;
+  EXPECT_NE(tm.output.find(file + ": " + why), std::string::npos) << tm.output;
+  EXPECT_NE(tm.output.find("refused: 1 roadmap error"), std::string::npos) << tm.output;
+}
+
 }  // namespace
