@@ -47,9 +47,6 @@ traffic::BaseEnds fleetBaseEnds(const std::map<std::string, traffic::BaseEnds>& 
 int run(const site::Site& site, const trafficmgr::Settings& settings, const std::string& id,
         const service::OpsSettings& opsSettings) {
   service::ServiceOps ops("traffic_manager");
-  if (!ops.start(opsSettings)) {
-    return service::kExitUsage;
-  }
   auto& tickSeconds =
       ops.registry().histogram("traffic_manager_tick_seconds", "Wall time of one planning tick (all robots)",
                                metrics::exponentialBuckets(1e-5, 2.0, 20));
@@ -71,8 +68,8 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
   spdlog::info("traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}", site.name,
                rm.graph.size(), rm.edgeCount(), rm.stations.size(), epoch);
   // A roadmap error (a station with no way in or out, a line whose robots cut others off) is the
-  // site's: refused at start, each named by its key path, as `fleetctl site check` does. Warnings
-  // are said and planned with.
+  // site's: refused at start, each named by its key path, as `fleetctl site check` does, before the
+  // ops port answers /livez. Warnings are said and planned with.
   std::size_t errors = 0;
   for (const auto& p : rm.problems) {
     if (p.severity == traffic::RoadmapProblem::Severity::Error) {
@@ -86,6 +83,9 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
     spdlog::critical(
         "traffic manager: {} refused: {} roadmap error(s) (`fleetctl site check` names them too)",
         settings.site, errors);
+    return service::kExitUsage;
+  }
+  if (!ops.start(opsSettings)) {
     return service::kExitUsage;
   }
   transport::Participant p;
