@@ -139,6 +139,7 @@ class Agent : private DriveStack {
   /// The driver's wheel totals the pose is as of (kept with it in the pose file).
   [[nodiscard]] std::optional<WheelTotals> wheelTotals() const { return localizer_.wheelTotals(); }
   [[nodiscard]] bool resumeTotalsRefused() const { return localizer_.resumeTotalsRefused(); }
+  [[nodiscard]] std::uint64_t driverRestarts() const { return localizer_.driverRestarts(); }
   [[nodiscard]] const std::string& id() const { return p_.id; }
   /// Where it goes when idle (its start pose, its parking place).
   [[nodiscard]] const Pose2& home() const { return p_.start; }

@@ -261,6 +261,14 @@ std::uint64_t AgentNode::resumeTotalsRefused() const {
       std::count_if(agents_.begin(), agents_.end(), [](const auto& a) { return a->resumeTotalsRefused(); }));
 }
 
+std::uint64_t AgentNode::driverRestarts() const {
+  std::uint64_t n = 0;
+  for (const auto& a : agents_) {
+    n += a->driverRestarts();
+  }
+  return n;
+}
+
 ReleaseCounts AgentNode::releaseCounts() const {
   ReleaseCounts rc;
   for (const auto& a : agents_) {
@@ -292,7 +300,8 @@ nlohmann::json AgentNode::statsJson() const {
                        {"unmatched_no_overlap", ls.noOverlap},
                        {"unmatched_ambiguous", ls.ambiguous},
                        {"pose_doubts", poseDoubts()},
-                       {"resume_totals_refused", resumeTotalsRefused()}};
+                       {"resume_totals_refused", resumeTotalsRefused()},
+                       {"driver_restarts", driverRestarts()}};
   m["traffic"] = {{"releases_taken", rc.accepted},
                   {"ignored_foreign", rc.foreign},
                   {"ignored_stale", rc.stale},

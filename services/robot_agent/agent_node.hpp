@@ -101,6 +101,8 @@ class AgentNode {
   /// Robots resumed with wheel totals from the pose file that did not fit their first reading (the
   /// driver restarted): they started less certain (Localizer::resumeTotalsRefused).
   [[nodiscard]] std::uint64_t resumeTotalsRefused() const;
+  /// Driver restarts seen under the running agents, summed (Localizer::driverRestarts).
+  [[nodiscard]] std::uint64_t driverRestarts() const;
   /// For the --metrics file: "samples" (refused at the edge), "conduct", "localization", "traffic".
   [[nodiscard]] nlohmann::json statsJson() const;
 

@@ -10,6 +10,7 @@ SensorReading readingOf(const msg::SensorFrame& f) {
   r.wheelTotalsValid = f.wheel_totals_valid;
   r.wheelLeftTotal = f.wheel_left_total;
   r.wheelRightTotal = f.wheel_right_total;
+  r.driverSession = f.driver_session;
   r.compassValid = f.compass_valid;
   r.compass = f.compass;
   r.bearings.reserve(f.landmarks.size());

@@ -51,6 +51,7 @@ Localizer::Localizer(LocalizerParams params) : p_(std::move(params)), ekf_(makeE
     haveTotals_ = true;
     wheelLeft_ = p_.startWheels->left;
     wheelRight_ = p_.startWheels->right;
+    session_ = p_.startWheels->session;
     checkResumeRoll_ = true;
   }
 }
@@ -59,7 +60,7 @@ std::optional<WheelTotals> Localizer::wheelTotals() const {
   if (!haveTotals_) {
     return std::nullopt;
   }
-  return WheelTotals{wheelLeft_, wheelRight_};
+  return WheelTotals{wheelLeft_, wheelRight_, session_};
 }
 
 bool Localizer::plausible() const {
@@ -79,6 +80,13 @@ void Localizer::onReading(const SensorReading& f) {
   double dsRight = f.dsRight;
   const bool totals =
       f.wheelTotalsValid && std::isfinite(f.wheelLeftTotal) && std::isfinite(f.wheelRightTotal);
+  // Totals of another run of the driver (it restarted and counts from zero): their difference to
+  // the last is no motion (up to 10 m of it passed the odometry's plausibility check as a jump).
+  const bool otherRun = totals && session_ != 0 && f.driverSession != 0 && f.driverSession != session_;
+  if (otherRun && !checkResumeRoll_) {
+    ++driverRestarts_;
+    haveTotals_ = false;
+  }
   if (totals && haveTotals_) {
     dsLeft = f.wheelLeftTotal - wheelLeft_;
     dsRight = f.wheelRightTotal - wheelRight_;
@@ -86,8 +94,10 @@ void Localizer::onReading(const SensorReading& f) {
   if (checkResumeRoll_) {
     checkResumeRoll_ = false;
     // Totals kept over a restart: only a roll a robot makes after its process stopped is believed.
-    // Anything else (the driver counts from zero again) leaves the motion since unknown.
-    if (!totals || !(std::abs(dsLeft) <= kResumeRollMaxM && std::abs(dsRight) <= kResumeRollMaxM)) {
+    // Anything else (the driver counts from zero again: another session, or totals that moved by
+    // more than a roll when the driver tells none) leaves the motion since unknown.
+    if (!totals || otherRun ||
+        !(std::abs(dsLeft) <= kResumeRollMaxM && std::abs(dsRight) <= kResumeRollMaxM)) {
       resumeTotalsRefused_ = true;
       haveTotals_ = false;
       dsLeft = f.dsLeft;
@@ -102,6 +112,7 @@ void Localizer::onReading(const SensorReading& f) {
   if (totals) {
     wheelLeft_ = f.wheelLeftTotal;
     wheelRight_ = f.wheelRightTotal;
+    session_ = f.driverSession;
   }
   const bool motionKnown = totals && haveTotals_;
   haveTotals_ = totals;

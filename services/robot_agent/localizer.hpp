@@ -35,6 +35,7 @@ struct SensorReading {
   bool wheelTotalsValid = false;  ///< the totals below are set (older drivers leave them out)
   double wheelLeftTotal = 0;      ///< [m] since the driver started
   double wheelRightTotal = 0;
+  std::uint64_t driverSession = 0;  ///< the driver's run the totals count in (0: not told)
   bool compassValid = false;
   double compass = 0;
   std::vector<std::pair<std::int32_t, float>> bearings;  ///< landmark id, bearing [rad]
@@ -185,6 +186,9 @@ class Localizer {
   [[nodiscard]] std::optional<WheelTotals> wheelTotals() const;
   /// Wheel totals kept over a restart that did not fit the first reading (kResumeRollMaxM).
   [[nodiscard]] bool resumeTotalsRefused() const { return resumeTotalsRefused_; }
+  /// Readings whose driver session differed from the one before (the driver restarted under a
+  /// running agent): the motion of that interval is the reading's own increment, not the totals'.
+  [[nodiscard]] std::uint64_t driverRestarts() const { return driverRestarts_; }
 
  private:
   void track(const SensorReading& r);
@@ -197,6 +201,8 @@ class Localizer {
   bool haveTotals_ = false;       // the previous reading had wheel totals
   double wheelLeft_ = 0.0;        // ... these
   double wheelRight_ = 0.0;
+  std::uint64_t session_ = 0;  // ... and the driver's run they count in
+  std::uint64_t driverRestarts_ = 0;
   bool checkResumeRoll_ = false;  // the totals above were kept over a restart, not yet checked
   bool resumeTotalsRefused_ = false;
   std::int64_t peopleStampNs_ = -1;

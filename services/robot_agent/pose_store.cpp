@@ -57,7 +57,15 @@ Expected<SavedPoses> readPoseFile(const std::string& path) {
         }
         *value = p[key].get<double>();
       }
+      if (p.contains("driver_session")) {
+        if (!p["driver_session"].is_number_unsigned()) {
+          return unexpected("pose_file", at + ".driver_session: required non-negative integer");
+        }
+        w.session = p["driver_session"].get<std::uint64_t>();
+      }
       s.wheels = w;
+    } else if (p.contains("driver_session")) {
+      return unexpected("pose_file", at + ".driver_session: required with the wheel totals");
     }
     out[id] = s;
   }
@@ -73,6 +81,9 @@ Expected<void> writePoseFile(const std::string& path, const SavedPoses& poses) {
     if (s.wheels) {
       r["wheel_left_total"] = s.wheels->left;
       r["wheel_right_total"] = s.wheels->right;
+      if (s.wheels->session != 0) {
+        r["driver_session"] = s.wheels->session;
+      }
     }
   }
   const std::string tmp = path + ".tmp";

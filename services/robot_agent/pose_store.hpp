@@ -9,7 +9,8 @@
 // robot is"). A real base keeps its last pose over a reboot the same way.
 //
 // The file is JSON, {"robots": {"r7": {"x": .., "y": .., "theta": .., "saved_unix_ms": ..,
-// "wheel_left_total": .., "wheel_right_total": ..}}} (the wheel totals optional, both or neither),
+// "wheel_left_total": .., "wheel_right_total": .., "driver_session": ..}}} (the wheel totals
+// optional, both or neither; the driver's session, the run they count in, only with them),
 // written whole to a temporary file and renamed over the old one, so a process killed while
 // writing leaves the previous file. A pose older than `maxAgeS` when read is not used (the robot
 // may have been moved while nobody watched it).

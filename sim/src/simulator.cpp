@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -40,6 +41,18 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// The simulated drivers' run: new and nonzero each time the process starts (its wheel totals start
+// from zero again), so an agent never takes the totals of two runs for motion. From the operating
+// system's entropy, not the scenario's seed: a restart with the same seed is another run.
+std::uint64_t driverSession() {
+  static const std::uint64_t session = [] {
+    std::random_device rd;
+    const std::uint64_t s = (static_cast<std::uint64_t>(rd()) << 32U) ^ rd();
+    return s != 0 ? s : 1;
+  }();
+  return session;
+}
+
 msg::SensorFrame toMsg(const sim::World& w, const sim::SensorReading& r, std::int64_t stamp) {
   msg::SensorFrame f;
   f.robot_id = w.scenario().robots[r.robot].id;
@@ -50,6 +63,7 @@ msg::SensorFrame toMsg(const sim::World& w, const sim::SensorReading& r, std::in
   f.wheel_totals_valid = true;
   f.wheel_left_total = r.wheelLeftTotal;
   f.wheel_right_total = r.wheelRightTotal;
+  f.driver_session = driverSession();
   f.angle_min = r.angleMin;
   f.angle_increment = r.angleIncrement;
   f.range_max = r.rangeMax;

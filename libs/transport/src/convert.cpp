@@ -170,6 +170,7 @@ void Traits<msg::SensorFrame>::toC(const msg::SensorFrame& in, C& out, Arena& ar
   out.wheel_totals_valid = in.wheel_totals_valid;
   out.wheel_left_total = in.wheel_left_total;
   out.wheel_right_total = in.wheel_right_total;
+  out.driver_session = in.driver_session;
 }
 msg::SensorFrame Traits<msg::SensorFrame>::fromC(const C& in) {
   msg::SensorFrame m;
@@ -195,6 +196,7 @@ msg::SensorFrame Traits<msg::SensorFrame>::fromC(const C& in) {
   m.wheel_totals_valid = in.wheel_totals_valid;
   m.wheel_left_total = in.wheel_left_total;
   m.wheel_right_total = in.wheel_right_total;
+  m.driver_session = in.driver_session;
   return m;
 }
 

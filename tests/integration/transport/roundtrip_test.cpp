@@ -239,6 +239,10 @@ TEST_F(RoundTrip, SensorFrame) {
   b.compass_valid = true;
   b.compass = 1.25;
   b.charging = true;
+  b.wheel_totals_valid = true;
+  b.wheel_left_total = 1234.5;
+  b.wheel_right_total = -0.25;
+  b.driver_session = 0xF00D'CAFE'1234'5679ULL;  // every bit of a 64-bit session
   expectRoundTrip<msg::SensorFrame>({a, b});
 }
 

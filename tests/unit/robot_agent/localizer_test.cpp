@@ -122,6 +122,71 @@ TEST(Localizer, KeptTotalsThatDoNotFitAreRefusedAndTheStartIsUncertain) {
   EXPECT_FALSE(loc.wheelTotals());
 }
 
+// Totals that would fit as a roll but come from another run of the driver (it restarted while the
+// agent was down and has driven 0.4 m since): the driver's session tells them apart, where the
+// roll check alone would have taken 0.4 − 0.1 m as the motion since.
+TEST(Localizer, KeptTotalsOfAnotherDriverRunAreRefusedEvenWhenTheyFitAsARoll) {
+  for (const std::uint64_t session : {std::uint64_t{7}, std::uint64_t{8}}) {
+    auto p = params({4.0, 2.0, 0.0});
+    p.startWheels = agent::WheelTotals{0.1, 0.1, 7};
+    p.startVarianceXY = agent::kResumeWheelsVarianceXY;
+    p.startVarianceTheta = agent::kResumeWheelsVarianceTheta;
+    Localizer loc(p);
+    auto r = straight(kTick, 0.1);  // the driver's increment: 1 cm
+    r.wheelTotalsValid = true;
+    r.wheelLeftTotal = 0.4;
+    r.wheelRightTotal = 0.4;
+    r.driverSession = session;
+    loc.onReading(r);
+    ASSERT_TRUE(loc.wheelTotals());
+    EXPECT_EQ(loc.wheelTotals()->session, session) << "kept for the next pose written";
+    if (session == 7) {  // the same run: a 0.3 m roll, taken
+      EXPECT_FALSE(loc.resumeTotalsRefused());
+      EXPECT_NEAR(loc.pose().x, 4.3, 1e-9);
+      EXPECT_LT(loc.covariance()(0, 0), 0.02);
+    } else {  // another run: the roll since is unknown
+      EXPECT_TRUE(loc.resumeTotalsRefused());
+      EXPECT_NEAR(loc.pose().x, 4.01, 1e-9) << "the increment, not the totals' difference";
+      EXPECT_GE(loc.covariance()(0, 0), agent::kResumeVarianceXY);
+    }
+    EXPECT_EQ(loc.driverRestarts(), 0U) << "a resume is no restart under a running agent";
+  }
+}
+
+// The driver restarts under a running agent and counts from zero again: the totals' difference
+// (−3.95 m here, under the odometry's 10 m plausibility bound) is no motion. The reading's own
+// increment is.
+TEST(Localizer, ADriverRestartedUnderARunningAgentIsNoJump) {
+  Localizer loc(params());
+  double total = 0.0;
+  for (int k = 1; k <= 80; ++k) {
+    total += 0.05;
+    auto r = straight(k * kTick, 0.5);
+    r.wheelTotalsValid = true;
+    r.wheelLeftTotal = total;
+    r.wheelRightTotal = total;
+    r.driverSession = 5;
+    loc.onReading(r);
+  }
+  ASSERT_NEAR(loc.pose().x, 5.0, 1e-9);
+  auto r = straight(81 * kTick, 0.5);  // the new run's first reading: 5 cm since it started
+  r.wheelTotalsValid = true;
+  r.wheelLeftTotal = 0.05;
+  r.wheelRightTotal = 0.05;
+  r.driverSession = 6;
+  loc.onReading(r);
+  EXPECT_NEAR(loc.pose().x, 5.05, 1e-9);
+  EXPECT_EQ(loc.driverRestarts(), 1U);
+  r = straight(82 * kTick, 0.5);
+  r.wheelTotalsValid = true;
+  r.wheelLeftTotal = r.wheelRightTotal = 0.10;
+  r.driverSession = 6;
+  loc.onReading(r);
+  EXPECT_NEAR(loc.pose().x, 5.10, 1e-9) << "the new run's totals from then on";
+  EXPECT_EQ(loc.driverRestarts(), 1U);
+  EXPECT_EQ(loc.rejected(), 0U);
+}
+
 TEST(Localizer, WithoutTotalsAGapWidensTheCovariance) {
   Localizer loc(params());
   loc.onReading(straight(kTick, 0.5));

@@ -37,10 +37,13 @@ TEST(PoseStore, WrittenPosesAreReadBackExactly) {
   SavedPoses poses;
   poses["r1"] = SavedPose{Pose2{12.345678901, -3.25, 2.9}, 1'796'000'000'123, {}};
   poses["r7"] = SavedPose{Pose2{19.0, 9.7, -1.175}, 1'796'000'000'456, WheelTotals{1234.5678, -0.125}};
+  // The driver's session: a random 64-bit value, above what a double holds exactly.
+  poses["r9"] =
+      SavedPose{Pose2{1.0, 2.0, 0.5}, 1'796'000'000'789, WheelTotals{3.5, 3.25, 0xF00D'CAFE'1234'5679ULL}};
   ASSERT_TRUE(writePoseFile(path, poses));
   const auto back = readPoseFile(path);
   ASSERT_TRUE(back) << back.error().message;
-  ASSERT_EQ(back->size(), 2U);
+  ASSERT_EQ(back->size(), 3U);
   for (const auto& [id, s] : poses) {
     EXPECT_EQ(back->at(id).pose.x, s.pose.x) << id;
     EXPECT_EQ(back->at(id).pose.y, s.pose.y) << id;
@@ -51,6 +54,9 @@ TEST(PoseStore, WrittenPosesAreReadBackExactly) {
   ASSERT_TRUE(back->at("r7").wheels);
   EXPECT_EQ(back->at("r7").wheels->left, 1234.5678);
   EXPECT_EQ(back->at("r7").wheels->right, -0.125);
+  EXPECT_EQ(back->at("r7").wheels->session, 0U) << "a driver that tells no session";
+  ASSERT_TRUE(back->at("r9").wheels);
+  EXPECT_EQ(back->at("r9").wheels->session, 0xF00D'CAFE'1234'5679ULL) << "every bit of it";
   EXPECT_FALSE(fs::exists(path + ".tmp")) << "the temporary file was renamed over the old one";
 }
 
@@ -75,6 +81,14 @@ TEST(PoseStore, ADamagedFileIsAnErrorNamingWhatIsWrong) {
       {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "wheel_left_total": 3,
           "wheel_right_total": null}}})",
        "robots.r1.wheel_right_total: required finite number"},
+      {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "driver_session": 7}}})",
+       "robots.r1.driver_session: required with the wheel totals"},
+      {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "wheel_left_total": 3,
+          "wheel_right_total": 3, "driver_session": -7}}})",
+       "robots.r1.driver_session: required non-negative integer"},
+      {R"({"robots": {"r1": {"x": 1, "y": 2, "theta": 0, "saved_unix_ms": 5, "wheel_left_total": 3,
+          "wheel_right_total": 3, "driver_session": "7"}}})",
+       "robots.r1.driver_session: required non-negative integer"},
   };
   for (const auto& [text, why] : cases) {
     const auto path = scratch("damaged.json");

@@ -246,6 +246,8 @@ struct SensorFrame {
   bool wheel_totals_valid = false;  ///< wheel_*_total are set (older drivers leave them out)
   double wheel_left_total = 0;      ///< [m] since the driver started
   double wheel_right_total = 0;
+  /// The driver's run the totals count in, new and nonzero each time it starts; 0: not told.
+  std::uint64_t driver_session = 0;
   bool operator==(const SensorFrame&) const = default;
 };
 
