@@ -230,6 +230,9 @@ Expected<std::unique_ptr<FleetManagerNode>> FleetManagerNode::create(const Setti
     }
   }
   dc.stationLoad = s.stationLoad;
+  // The lines' places are scaled by the admission governor (admission_governor.hpp) when admission
+  // counts them by task or phase; by predicted arrival they are places in time, not scaled.
+  n->governed_ = s.stationCapacityFromLines && !byArrival;
   if (roads) {
     // Admission by predicted arrival, and the queue wait in every assignment's cost (whenever the
     // roadmap is built: reserved traffic's lines, roadmap travel cost, or arrival).
@@ -483,6 +486,9 @@ void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs
     return;
   }
   const RobotInfo* info = dispatcher_->robots().find(s.robot_id);
+  if (governed_ && s.activity != RobotActivity::Unset) {
+    activity_[s.robot_id] = s.activity;
+  }
   reconciler_.observe(s.robot_id, s.task_id, info != nullptr ? info->taskId : std::string(), nowNs);
 }
 
@@ -494,7 +500,27 @@ void FleetManagerNode::onRobotLost(const std::string& robotId, std::int64_t nowN
 void FleetManagerNode::tick(std::int64_t nowNs, Outbox& out) {
   // First: a requeued task is assigned again in the same tick.
   reconcile(nowNs, out);
+  govern(nowNs);
   publish(dispatcher_->tick(nowNs), nowNs, out);
+}
+
+void FleetManagerNode::govern(std::int64_t nowNs) {
+  if (!governed_) {
+    return;
+  }
+  if (governedAtNs_ >= 0 && nowNs > governedAtNs_) {
+    const double dt = static_cast<double>(nowNs - governedAtNs_) * 1e-9;
+    for (const auto& [id, a] : activity_) {
+      const RobotInfo* r = dispatcher_->robots().find(id);
+      if (r != nullptr && !r->lost) {
+        governor_.add(a, dt);
+      }
+    }
+    if (governor_.tick(dt, dispatcher_->heldInLines() > 0)) {
+      dispatcher_->setLineScale(governor_.scale());
+    }
+  }
+  governedAtNs_ = nowNs;
 }
 
 std::vector<double> FleetManagerNode::assignLatencyBuckets() {
@@ -524,6 +550,10 @@ nlohmann::json FleetManagerNode::metricsJson() const {
           {"assignments", metrics_.assignments},
           {"bad_orders", metrics_.badOrders},
           {"reconciled", reconciled},
+          {"admission",
+           {{"line_scale", governor_.scale()},
+            {"waiting_on_robot_share", governor_.lastWaitingShare()},
+            {"no_task_share", governor_.lastIdleShare()}}},
           {"assign_latency_ms", {{"p50", pct(0.5)}, {"p99", pct(0.99)}, {"samples", lat.count}}}};
 }
 

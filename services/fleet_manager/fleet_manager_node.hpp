@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "closed_stations.hpp"
+#include "fleet/core/admission_governor.hpp"
 #include "fleet/core/config.hpp"
 #include "fleet/fleet/dispatcher.hpp"
 #include "fleet/fleet/task_reconciler.hpp"
@@ -186,6 +187,9 @@ class FleetManagerNode {
   /// Acts on the disagreements between robots' reports and the store that outlasted the grace
   /// (fleet_manager_reconcile.cpp).
   void reconcile(std::int64_t nowNs, Outbox& out);
+  /// Files the robots' time since the last tick with the admission governor and applies its factor
+  /// to the dispatcher's line capacities.
+  void govern(std::int64_t nowNs);
   /// A multi-stop task's robot reported stop `s.step`: remembered; true when it is a new stop
   /// (task_progress.cpp).
   bool noteStep(const msg::TaskStatus& s);
@@ -217,6 +221,12 @@ class FleetManagerNode {
   std::shared_ptr<const site::Site> site_;
   std::unique_ptr<ClosedStations> closures_;
   Metrics metrics_;
+  /// The lines' places scaled by what the fleet's robot time did (admission by the lines' slots
+  /// only): each robot's latest activity, filed for the time between ticks.
+  bool governed_ = false;
+  AdmissionGovernor governor_;
+  std::map<std::string, RobotActivity> activity_;
+  std::int64_t governedAtNs_ = -1;
   metrics::Histogram ownAssignLatency_{assignLatencyBuckets()};
   metrics::Histogram* assignLatency_ = &ownAssignLatency_;
 };

@@ -88,7 +88,9 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
       ->add_option(
           "--admission", o->admission,
           "slots: a task is given only when its pickup and drop-off each have a free place in their "
-          "line, a robot counting from its task until served; arrival: a place for the time the robot "
+          "line (its places scaled by the admission governor, as in the fleet manager; --station-slots is a "
+          "fixed cap), a robot "
+          "counting from its task until served; arrival: a place for the time the robot "
           "will get there; a robot with no admissible task waits at a parking place; none: every task at "
           "once (0, 1, 2 name them too)")
       ->transform(CLI::CheckedTransformer(

@@ -398,6 +398,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"escalations", r.escalations},
                      {"untangles", r.untangles},
                      {"passes", r.passes},
+                     {"line_scale", r.lineScale},
                      {"update_p99_ms", r.updateP99Ms},
                      {"density", r.density},
                      {"guidance",

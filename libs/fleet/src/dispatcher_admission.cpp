@@ -4,6 +4,7 @@
 #include "fleet/fleet/dispatcher.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -64,7 +65,14 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByStationCapacity(std::v
 
 std::size_t Dispatcher::capacityOf(const std::string& station) const {
   const auto it = cfg_.stationCapacities.find(station);
-  return it == cfg_.stationCapacities.end() ? cfg_.stationCapacity : it->second;
+  if (it == cfg_.stationCapacities.end()) {
+    return cfg_.stationCapacity;
+  }
+  return static_cast<std::size_t>(std::floor(lineScale_ * static_cast<double>(it->second) + 1e-9));
+}
+
+void Dispatcher::setLineScale(double k) {
+  lineScale_ = std::isfinite(k) ? std::max(1.0, k) : 1.0;
 }
 
 void Dispatcher::noteAdmissionWaits(const std::vector<HeldAtStation>& held, std::int64_t nowNs,

@@ -52,6 +52,7 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
     const auto it = failStreak_.find(r.id);
     return robotHeld(r.id) || (it != failStreak_.end() && it->second.holdUntilNs > nowNs);
   });
+  heldInLines_ = 0;
   if (waiting.empty() || idle.empty()) {
     return;
   }
@@ -61,7 +62,9 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
       return;
     }
   } else if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
-    noteAdmissionWaits(admitByStationCapacity(waiting), nowNs, out);
+    const auto held = admitByStationCapacity(waiting);
+    heldInLines_ = held.size();
+    noteAdmissionWaits(held, nowNs, out);
     if (waiting.empty()) {
       return;
     }

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "fleet/core/admission_governor.hpp"
 #include "fleet/core/percentiles.hpp"
 #include "fleet/traffic/roadmap_travel.hpp"
 #include "fleet/traffic/station_book.hpp"
@@ -141,7 +142,15 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   // Admission by slots: the robots bound for each station now, its pickup until loaded, its
   // drop-off for the whole task.
   std::vector<std::size_t> uses(g.size(), 0);
-  const auto hasSlot = [&](NodeId s) { return uses[static_cast<std::size_t>(s)] < book.slots(s); };
+  // The lines' places scaled by what the traffic did (admission_governor.hpp), as the fleet manager.
+  AdmissionGovernor governor;
+  bool heldInLine = false;  // a robot asked for work since the last tick and nothing was admissible
+  // A fixed number of slots a station (`stationSlots`) is a cap, as a numeric station_capacity in
+  // the fleet manager: not scaled.
+  const auto hasSlot = [&](NodeId s) {
+    const std::size_t places = book.slots(s);
+    return uses[static_cast<std::size_t>(s)] < (o.stationSlots > 0 ? places : governor.slots(places));
+  };
   // The parking place nearest to robot r that no robot stands on or is sent to.
   auto freeParking = [&](std::size_t r) {
     NodeId best = kNoNode;
@@ -202,8 +211,10 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
       std::vector<NodeId> ps, ds;
       std::copy_if(pickups.begin(), pickups.end(), std::back_inserter(ps), hasSlot);
       std::copy_if(dropoffs.begin(), dropoffs.end(), std::back_inserter(ds), hasSlot);
-      if (ps.empty() || ds.empty())
+      if (ps.empty() || ds.empty()) {
+        heldInLine = true;
         return {kNoNode, kNoNode};
+      }
       const NodeId p = ps[rng() % ps.size()];
       return {p, ds[rng() % ds.size()]};
     }
@@ -305,6 +316,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   double ranUntil = o.duration;  // a list's run ends when its last task is done
   // Whole ticks: the k-th starts at k × dt (a sum of dt drifts, and ran a tick over at times).
   const auto ticksToRun = static_cast<std::size_t>(std::ceil(o.duration / o.dt - 1e-9));
+  ActivityLedger fleetBefore;  // the fleet's robot time up to the last tick (for the governor)
   for (std::size_t tick = 0; tick < ticksToRun; ++tick) {
     const double now = static_cast<double>(tick) * o.dt;
     const auto t0 = std::chrono::steady_clock::now();
@@ -443,6 +455,19 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
         longest.on = traffic.waitingOn(r);  // whom it waits on as the wait goes on
       }
     }
+    // The tick's robot time to the admission governor (the fleet-wide ledger's growth), then its step.
+    if (o.admission == Admission::Slots && o.stationSlots == 0) {
+      ActivityLedger fleetNow;
+      for (const auto& rt : res.robotTime)
+        fleetNow.add(rt);
+      for (std::size_t a = 0; a < kRobotActivities; ++a) {
+        const auto act = static_cast<RobotActivity>(a);
+        governor.add(act, fleetNow.seconds(act) - fleetBefore.seconds(act));
+      }
+      fleetBefore = fleetNow;
+      governor.tick(o.dt, heldInLine);
+      heldInLine = false;
+    }
     // What the traffic layer promises.
     for (std::size_t r = 0; r < o.robots; ++r) {
       const Bot& b = bots[r];
@@ -567,6 +592,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.escalations = traffic.plannerStats().escalations;
   res.untangles = traffic.plannerStats().untangles;
   res.passes = traffic.stats().passes;
+  res.lineScale = governor.scale();
   for (std::size_t r = 0; r < traffic.robots(); ++r)
     res.baseEnds += traffic.baseEnds(r);
   res.stations = tally.ledger();
@@ -599,7 +625,9 @@ std::string formatResult(const VirtualFleetResult& r) {
   os.precision(1);
   os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans << ", evasions "
      << r.evasions << ", detours " << r.detours << ", escalations " << r.escalations << ", untangles "
-     << r.untangles << ", passes " << r.passes << ", line leaves " << r.lineLeaves << ", update p50/p99 ";
+     << r.untangles << ", passes " << r.passes << ", line leaves " << r.lineLeaves << ", line scale ";
+  os.precision(2);
+  os << r.lineScale << ", update p50/p99 ";
   os.precision(3);
   os << r.updateP50Ms << "/" << r.updateP99Ms << " ms, density " << r.density;
   os.precision(0);

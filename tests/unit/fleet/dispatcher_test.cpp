@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -499,6 +500,34 @@ TEST_F(DispatcherTest, AStationsOwnCapacityOverridesTheGlobalOne) {
   auto out = dispatcher->tick(1);
   EXPECT_EQ(out.assignments.size(), 3u) << "P-1 and D-1 each hold three";
   EXPECT_TRUE(dispatcher->tick(2).assignments.empty());
+}
+
+/// The admission governor's factor scales the lines' places (floor(k × places)), never below them,
+/// and leaves the global capacity of stations without a line alone.
+TEST_F(DispatcherTest, TheLineScaleWidensEachLinesPlacesFromTheNextTick) {
+  cfg.stationCapacity = 1;
+  cfg.stationCapacities = {{"P-1", 2}, {"D-1", 2}};
+  reopen();
+  for (int i = 0; i < 6; ++i) {
+    robot("r" + std::to_string(i), i, 0.9, 0);
+  }
+  std::vector<Task> tasks;
+  for (int i = 1; i <= 5; ++i) {
+    tasks.push_back(transport("t" + std::to_string(i)));
+  }
+  dispatcher->submit(tasks, 0);
+  EXPECT_EQ(dispatcher->tick(1).assignments.size(), 2u) << "two places in each line";
+  EXPECT_EQ(dispatcher->heldInLines(), 3u) << "three held for a place, robots idle";
+  dispatcher->setLineScale(1.75);  // floor(1.75 × 2) = 3
+  EXPECT_EQ(dispatcher->tick(2).assignments.size(), 1u);
+  dispatcher->setLineScale(2.0);
+  EXPECT_EQ(dispatcher->tick(3).assignments.size(), 1u);
+  EXPECT_EQ(dispatcher->heldInLines(), 1u);
+  dispatcher->setLineScale(0.2);  // below the lines' own places: 1
+  EXPECT_EQ(dispatcher->lineScale(), 1.0);
+  dispatcher->setLineScale(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(dispatcher->lineScale(), 1.0);
+  EXPECT_TRUE(dispatcher->tick(4).assignments.empty()) << "four active, two places again";
 }
 
 TEST_F(DispatcherTest, AStationCapacityOfZeroIsNoLimitThere) {

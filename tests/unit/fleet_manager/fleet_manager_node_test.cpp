@@ -1,6 +1,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <set>
+
 #include <filesystem>
 #include <fstream>
 
@@ -271,22 +274,45 @@ TEST(TravelModel, RoadmapTimesAreTheRoadmapsDockToDockTimes) {
   EXPECT_GT(model(t)(atDropoff), line);
 }
 
-TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
-  settings_.stationCapacityFromLines = true;
-  settings_.travelCost = "roadmap";
-  const auto site = smallWarehouse();
-  auto n = manager::FleetManagerNode::create(settings_, fleet::stationMapOf(*site), 1'000, site);
-  ASSERT_TRUE(n) << n.error().message;
-  auto& node = **n;
-  const traffic::RoadmapTravel roads(std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*site)));
-  const std::size_t line = std::min(roads.lineCapacity("P-1"), roads.lineCapacity("D-1"));
-  ASSERT_GT(line, 2U) << "the small warehouse's pickups and drop-offs have queues";
+namespace {
+// A node admitting by the small warehouse's lines with `tasks` transport tasks P-1 → D-1 posted,
+// and the places of the shorter of the two lines.
+struct ByLines {
+  std::shared_ptr<const site::Site> site;
+  std::unique_ptr<manager::FleetManagerNode> node;
+  std::size_t line = 0;
+};
+ByLines byLines(manager::Settings settings, int tasks) {
+  settings.stationCapacityFromLines = true;
+  settings.travelCost = "roadmap";
+  ByLines b;
+  b.site = smallWarehouse();
+  auto n = manager::FleetManagerNode::create(settings, fleet::stationMapOf(*b.site), 1'000, b.site);
+  EXPECT_TRUE(n) << n.error().message;
+  if (!n) {
+    return b;
+  }
+  b.node = std::move(*n);
+  const traffic::RoadmapTravel roads(
+      std::make_shared<const traffic::Roadmap>(traffic::buildRoadmap(*b.site)));
+  b.line = std::min(roads.lineCapacity("P-1"), roads.lineCapacity("D-1"));
   manager::Outbox out;
   std::vector<msg::Task> reqs;
-  for (int i = 0; i < 8; ++i) {
+  for (int i = 0; i < tasks; ++i) {
     reqs.push_back(request("t" + std::to_string(i), transport("t" + std::to_string(i))));
   }
-  node.onRequests(reqs, 2'000, out);
+  b.node->onRequests(reqs, 2'000, out);
+  return b;
+}
+}  // namespace
+
+TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
+  const auto b = byLines(settings_, 8);
+  ASSERT_TRUE(b.node);
+  auto& node = *b.node;
+  const auto& site = b.site;
+  const std::size_t line = b.line;
+  ASSERT_GT(line, 2U) << "the small warehouse's pickups and drop-offs have queues";
   for (int i = 0; i < 8; ++i) {
     const auto& park = site->stations[static_cast<std::size_t>(i)];  // parking places, one robot each
     node.onRobotState({"r" + std::to_string(i),
@@ -304,6 +330,38 @@ TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
   manager::Outbox assigned;
   node.tick(4'000, assigned);
   EXPECT_EQ(assigned.assignments.size(), line) << "P-1 and D-1 each take as many as their lines hold";
+}
+
+// Robots idle while tasks wait for a place in a line, none waiting on another robot: after a
+// window of it (30 s) the admission governor widens every line by a quarter (admission_governor.hpp).
+TEST_F(Node, IdleRobotsWhileTasksWaitForALineWidenTheLinesAfterAWindow) {
+  const auto b = byLines(settings_, 12);
+  ASSERT_TRUE(b.node);
+  auto& node = *b.node;
+  const auto& site = b.site;
+  const std::size_t line = b.line;
+  std::set<std::string> working;
+  constexpr std::int64_t kStep = 200'000'000;  // the manager's 0.2 s tick
+  for (std::int64_t t = kStep; t <= 31 * 1'000'000'000LL; t += kStep) {
+    for (int i = 0; i < 12; ++i) {
+      const std::string id = "r" + std::to_string(i);
+      const auto& park = site->stations[static_cast<std::size_t>(i)];
+      msg::RobotState s{
+          id, t, {park.pose.x, park.pose.y, park.pose.theta}, {}, 0, 0, msg::RobotMode::Idle, 0.9f, "", 0.3f};
+      s.activity = working.count(id) > 0 ? RobotActivity::Driving : RobotActivity::NoTask;
+      node.onRobotState(s, t);
+    }
+    manager::Outbox o;
+    node.tick(t, o);
+    for (const auto& a : o.assignments) {
+      working.insert(a.robot_id);
+    }
+  }
+  EXPECT_EQ(node.metricsJson()["admission"]["line_scale"], 1.25);
+  EXPECT_GT(node.metricsJson()["admission"]["no_task_share"].get<double>(), 0.5);
+  EXPECT_EQ(node.metricsJson()["admission"]["waiting_on_robot_share"], 0.0);
+  EXPECT_EQ(working.size(), static_cast<std::size_t>(std::floor(1.25 * static_cast<double>(line))))
+      << "a line of " << line << " places admits a quarter more";
 }
 
 TEST(Settings, StationCapacityIsANumberOrQueueAndRoadmapCostsNeedASite) {

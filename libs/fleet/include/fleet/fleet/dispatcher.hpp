@@ -210,6 +210,13 @@ class Dispatcher {
   /// for its robot with the assignment (stored with it); while every such station is taken it waits,
   /// and its reason says so.
   DispatchResult tick(std::int64_t nowNs);
+  /// Scales the per-station capacities (`stationCapacities`, the lines' places) to floor(k × places),
+  /// k ≥ 1, from the next tick on: the admission governor's factor (fleet/core/admission_governor.hpp).
+  void setLineScale(double k);
+  [[nodiscard]] double lineScale() const { return lineScale_; }
+  /// Waiting tasks the last tick's admission held back for want of a place in a line (0 when no
+  /// robot was idle or no task waited).
+  [[nodiscard]] std::size_t heldInLines() const { return heldInLines_; }
 
   [[nodiscard]] const RobotRegistry& robots() const { return registry_; }
   [[nodiscard]] const StationMap& stations() const { return stations_; }
@@ -290,6 +297,8 @@ class Dispatcher {
   TaskEta eta_;
   /// Waiting tasks by priority: how many are ahead of a task entering the queue.
   std::map<std::int32_t, std::size_t, std::greater<>> waitingByPriority_;
+  double lineScale_ = 1.0;
+  std::size_t heldInLines_ = 0;
 };
 
 }  // namespace fleet

@@ -48,9 +48,10 @@ struct VirtualFleetOptions {
   bool stationLines = true;  ///< robots wait in line at the stations' queue nodes (TrafficControl)
   /// How tasks are admitted. Slots: a task is given only when its pickup and its drop-off each
   /// have a free place in their line (dock and queue places; `stationSlots` places instead when
-  /// above 0); a robot counts at its pickup until it has loaded and at its drop-off for the whole
-  /// task. Arrival: each place is taken from the robot's predicted arrival until it is served
-  /// (StationBook). A robot with no admissible task drives to the nearest parking place no robot
+  /// above 0, a fixed cap), the lines' places scaled by the admission governor as in the fleet
+  /// manager (fleet/core/admission_governor.hpp); a robot counts at its pickup until it has loaded and at
+  /// its drop-off for the whole task. Arrival: each place is taken from the robot's predicted arrival until
+  /// it is served (StationBook). A robot with no admissible task drives to the nearest parking place no robot
   /// is sent to and asks again every second. None: every task at once.
   Admission admission = Admission::Slots;
   std::size_t stationSlots = 0;
@@ -108,8 +109,10 @@ struct VirtualFleetResult {
   std::uint64_t escalations = 0;  ///< agents the planner escalated out of a wait cycle
   std::uint64_t untangles = 0;    ///< knots the planner searched a way out of
   std::uint64_t passes = 0;       ///< robots let past late ones (TrafficStats)
-  BaseEnds baseEnds;              ///< the robots' base ends reached short of their target, summed
-  double updateP50Ms = 0.0;       ///< wall time of one traffic update (planning and releases)
+  /// The admission governor's factor on the lines' places at the end (admission by slots; 1: none).
+  double lineScale = 1.0;
+  BaseEnds baseEnds;         ///< the robots' base ends reached short of their target, summed
+  double updateP50Ms = 0.0;  ///< wall time of one traffic update (planning and releases)
   double updateP99Ms = 0.0;
   double density = 0.0;  ///< robots ÷ roadmap nodes
   /// Where the robots' time went, fractions of robot-time summing to 1: driving an edge, dwelling at
