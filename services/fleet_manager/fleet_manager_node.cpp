@@ -482,13 +482,18 @@ void FleetManagerNode::onStatus(const msg::TaskStatus& s, std::int64_t nowNs, Ou
 void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs) {
   const auto update = dispatcher_->onRobotState(
       {s.robot_id, s.pose, static_cast<double>(s.battery), nowNs, s.mode == msg::RobotMode::Fault});
-  if (update == RobotRegistry::Update::Stale || settings_.reconcileS <= 0) {
+  if (update == RobotRegistry::Update::Stale) {
+    return;
+  }
+  if (governed_) {  // an agent that fills no activity: what its mode and task say
+    activity_[s.robot_id] = s.activity != RobotActivity::Unset
+                                ? s.activity
+                                : activityFromMode(msg::toString(s.mode), !s.task_id.empty());
+  }
+  if (settings_.reconcileS <= 0) {
     return;
   }
   const RobotInfo* info = dispatcher_->robots().find(s.robot_id);
-  if (governed_ && s.activity != RobotActivity::Unset) {
-    activity_[s.robot_id] = s.activity;
-  }
   reconciler_.observe(s.robot_id, s.task_id, info != nullptr ? info->taskId : std::string(), nowNs);
 }
 
@@ -509,7 +514,9 @@ void FleetManagerNode::govern(std::int64_t nowNs) {
     return;
   }
   if (governedAtNs_ >= 0 && nowNs > governedAtNs_) {
-    const double dt = static_cast<double>(nowNs - governedAtNs_) * 1e-9;
+    // At most a second a tick: a clock that jumped (a stalled process, a paused run) must not let
+    // one snapshot of the robots stand for a whole window.
+    const double dt = std::min(1.0, static_cast<double>(nowNs - governedAtNs_) * 1e-9);
     for (const auto& [id, a] : activity_) {
       const RobotInfo* r = dispatcher_->robots().find(id);
       if (r != nullptr && !r->lost) {

@@ -82,7 +82,8 @@ void Localizer::onReading(const SensorReading& f) {
       f.wheelTotalsValid && std::isfinite(f.wheelLeftTotal) && std::isfinite(f.wheelRightTotal);
   // Totals of another run of the driver (it restarted and counts from zero): their difference to
   // the last is no motion (up to 10 m of it passed the odometry's plausibility check as a jump).
-  const bool otherRun = totals && session_ != 0 && f.driverSession != 0 && f.driverSession != session_;
+  // A driver that told a session and now tells another (or none) is not the run it was.
+  const bool otherRun = totals && session_ != 0 && f.driverSession != session_;
   if (otherRun && !checkResumeRoll_) {
     ++driverRestarts_;
     haveTotals_ = false;

@@ -10,7 +10,12 @@ bool AdmissionGovernor::tick(double elapsedS, bool tasksHeld) {
   if (std::isfinite(elapsedS) && elapsedS > 0.0) {
     sinceStepS_ += elapsedS;
   }
-  if (sinceStepS_ < c_.windowS || window_.total() <= 0.0) {
+  if (sinceStepS_ < c_.windowS) {
+    return false;
+  }
+  if (window_.total() <= 0.0) {  // nobody reported: nothing to decide on, start a new window
+    sinceStepS_ = 0.0;
+    held_ = false;
     return false;
   }
   lastWaiting_ = window_.share(RobotActivity::WaitingOnRobot);

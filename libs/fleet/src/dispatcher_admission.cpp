@@ -56,7 +56,10 @@ std::vector<Dispatcher::HeldAtStation> Dispatcher::admitByStationCapacity(std::v
       }
       admitted.push_back(std::move(t));
     } else {
-      held.push_back({t.id, **full, capacityOf(**full)});
+      // The line's own places in the reason (not the governor's scaled slots): what an operator
+      // sees on the site, and a reason that does not change, with a store write, at every step.
+      const auto own = cfg_.stationCapacities.find(**full);
+      held.push_back({t.id, **full, own != cfg_.stationCapacities.end() ? own->second : capacityOf(**full)});
     }
   }
   waiting = std::move(admitted);

@@ -63,7 +63,11 @@ void Dispatcher::assignWaiting(std::vector<Task> waiting, StationChooser* choose
     }
   } else if (cfg_.stationCapacity > 0 || !cfg_.stationCapacities.empty()) {
     const auto held = admitByStationCapacity(waiting);
-    heldInLines_ = held.size();
+    // Only those a wider line could admit: a fixed capacity (a parking place) is not scaled.
+    heldInLines_ =
+        static_cast<std::size_t>(std::count_if(held.begin(), held.end(), [&](const HeldAtStation& h) {
+          return cfg_.stationCapacities.count(h.station) > 0;
+        }));
     noteAdmissionWaits(held, nowNs, out);
     if (waiting.empty()) {
       return;

@@ -82,4 +82,8 @@ TEST(AdmissionGovernor, AHeldTaskAnywhereInTheWindowCountsAndBadTimesAreIgnored)
   EXPECT_TRUE(g.tick(20.0, false)) << "30 s in: the held task 20 s ago counts";
   EXPECT_EQ(g.scale(), 1.25);
   EXPECT_FALSE(g.tick(30.0, true)) << "an empty window decides nothing";
+  // ... and is over: a tenth of a second filed after it is no window to step on.
+  g.add(RobotActivity::NoTask, 0.1);
+  EXPECT_FALSE(g.tick(0.1, true));
+  EXPECT_EQ(g.scale(), 1.25);
 }

@@ -521,8 +521,11 @@ TEST_F(DispatcherTest, TheLineScaleWidensEachLinesPlacesFromTheNextTick) {
   dispatcher->setLineScale(1.75);  // floor(1.75 × 2) = 3
   EXPECT_EQ(dispatcher->tick(2).assignments.size(), 1u);
   dispatcher->setLineScale(2.0);
-  EXPECT_EQ(dispatcher->tick(3).assignments.size(), 1u);
+  const auto third = dispatcher->tick(3);
+  EXPECT_EQ(third.assignments.size(), 1u);
   EXPECT_EQ(dispatcher->heldInLines(), 1u);
+  EXPECT_NE(store->get("t5")->reason.find("(it holds 2,"), std::string::npos)
+      << store->get("t5")->reason << ": the line's own places, not the scaled slots";
   dispatcher->setLineScale(0.2);  // below the lines' own places: 1
   EXPECT_EQ(dispatcher->lineScale(), 1.0);
   dispatcher->setLineScale(std::numeric_limits<double>::quiet_NaN());

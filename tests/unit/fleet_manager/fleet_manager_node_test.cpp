@@ -335,6 +335,7 @@ TEST_F(Node, QueueCapacityLetsAsManyTasksAtAStationAsItsLineHolds) {
 // Robots idle while tasks wait for a place in a line, none waiting on another robot: after a
 // window of it (30 s) the admission governor widens every line by a quarter (admission_governor.hpp).
 TEST_F(Node, IdleRobotsWhileTasksWaitForALineWidenTheLinesAfterAWindow) {
+  settings_.reconcileS = 0;  // reconciling off: the robots' activity is still filed
   const auto b = byLines(settings_, 12);
   ASSERT_TRUE(b.node);
   auto& node = *b.node;

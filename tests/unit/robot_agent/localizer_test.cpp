@@ -184,6 +184,13 @@ TEST(Localizer, ADriverRestartedUnderARunningAgentIsNoJump) {
   loc.onReading(r);
   EXPECT_NEAR(loc.pose().x, 5.10, 1e-9) << "the new run's totals from then on";
   EXPECT_EQ(loc.driverRestarts(), 1U);
+  r = straight(83 * kTick, 0.5);  // a driver that told a session and now tells none: another run
+  r.wheelTotalsValid = true;
+  r.wheelLeftTotal = r.wheelRightTotal = 0.05;
+  r.driverSession = 0;
+  loc.onReading(r);
+  EXPECT_NEAR(loc.pose().x, 5.15, 1e-9);
+  EXPECT_EQ(loc.driverRestarts(), 2U);
   EXPECT_EQ(loc.rejected(), 0U);
 }
 
