@@ -54,7 +54,7 @@ TEST(AdmissionGovernor, NoStepUpWithoutAHeldTaskOrWithoutIdleRobots) {
   AdmissionGovernor g;
   EXPECT_FALSE(window(g, 100, 4, 64, false)) << "robots idle, but no task waits for a place";
   EXPECT_FALSE(window(g, 100, 4, 2, true)) << "nearly every robot works already";
-  EXPECT_FALSE(window(g, 100, 10, 40, true)) << "in the band: waiting neither few nor many";
+  EXPECT_FALSE(window(g, 100, 7, 40, true)) << "in the band: waiting neither few nor many";
   EXPECT_EQ(g.scale(), 1.0);
 }
 
