@@ -485,10 +485,8 @@ void FleetManagerNode::onRobotState(const msg::RobotState& s, std::int64_t nowNs
   if (update == RobotRegistry::Update::Stale) {
     return;
   }
-  if (governed_) {  // an agent that fills no activity: what its mode and task say
-    activity_[s.robot_id] = s.activity != RobotActivity::Unset
-                                ? s.activity
-                                : activityFromMode(msg::toString(s.mode), !s.task_id.empty());
+  if (governed_) {
+    activity_[s.robot_id] = msg::activityOf(s);
   }
   if (settings_.reconcileS <= 0) {
     return;

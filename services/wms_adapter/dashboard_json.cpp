@@ -49,7 +49,7 @@ json robotJson(const msg::RobotState& r, const msg::PeopleSeen* people) {
           {"v", r.v},
           {"w", r.w},
           {"mode", msg::toString(r.mode)},
-          {"activity", toString(RobotTimeLedger::activityOf(r))},
+          {"activity", toString(msg::activityOf(r))},
           {"fault", r.mode == msg::RobotMode::Fault},
           {"paused", r.paused},
           {"battery", r.battery},

@@ -2,18 +2,13 @@
 
 namespace fleet::wms {
 
-RobotActivity RobotTimeLedger::activityOf(const msg::RobotState& s) {
-  return s.activity != RobotActivity::Unset ? s.activity
-                                            : activityFromMode(msg::toString(s.mode), !s.task_id.empty());
-}
-
 void RobotTimeLedger::onState(const msg::RobotState& s) {
   auto it = last_.find(s.robot_id);
   if (it == last_.end()) {
     if (last_.size() >= kMaxRobots) {
       return;
     }
-    last_[s.robot_id] = {s.stamp_ns, activityOf(s)};
+    last_[s.robot_id] = {s.stamp_ns, msg::activityOf(s)};
     robots_[s.robot_id];  // listed from its first sample, with nothing filed yet
     return;
   }
@@ -25,7 +20,7 @@ void RobotTimeLedger::onState(const msg::RobotState& s) {
   if (gap <= kMaxGapNs) {
     robots_[s.robot_id].add(l.activity, static_cast<double>(gap) * 1e-9);
   }
-  l = {s.stamp_ns, activityOf(s)};
+  l = {s.stamp_ns, msg::activityOf(s)};
 }
 
 ActivityLedger RobotTimeLedger::fleet() const {

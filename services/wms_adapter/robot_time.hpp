@@ -31,9 +31,6 @@ class RobotTimeLedger {
   /// The fleet's: every robot's summed.
   [[nodiscard]] ActivityLedger fleet() const;
 
-  /// What a sample says the robot is doing.
-  [[nodiscard]] static RobotActivity activityOf(const msg::RobotState& s);
-
  private:
   struct Last {
     std::int64_t stampNs = 0;

@@ -30,6 +30,10 @@ const char* toString(TaskKind k) {
 const char* toString(RobotMode m) {
   return kModes.at(static_cast<std::size_t>(m)).data();
 }
+RobotActivity activityOf(const RobotState& s) {
+  return s.activity != RobotActivity::Unset ? s.activity
+                                            : activityFromMode(toString(s.mode), !s.task_id.empty());
+}
 bool parse(const std::string& name, TaskState& out) {
   return lookup(kTaskStateNames, name, out);
 }

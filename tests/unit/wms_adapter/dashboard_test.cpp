@@ -757,7 +757,7 @@ TEST(RobotTimeLedger, AnUnsetActivityIsReadFromTheModeAndANewerSampleOnly) {
   s.mode = msg::RobotMode::Moving;
   s.task_id = "t1";
   s.stamp_ns = 1'000'000'000;
-  EXPECT_EQ(fleet::wms::RobotTimeLedger::activityOf(s), fleet::RobotActivity::Driving);
+  EXPECT_EQ(fleet::msg::activityOf(s), fleet::RobotActivity::Driving);
   l.onState(s);
   s.stamp_ns = 500'000'000;  // older (delivered late): nothing filed, nothing changed
   l.onState(s);
@@ -766,6 +766,6 @@ TEST(RobotTimeLedger, AnUnsetActivityIsReadFromTheModeAndANewerSampleOnly) {
   s.task_id.clear();
   l.onState(s);
   EXPECT_NEAR(l.robots().at("a").seconds(fleet::RobotActivity::Driving), 1.0, 1e-9);
-  EXPECT_EQ(fleet::wms::RobotTimeLedger::activityOf(s), fleet::RobotActivity::NoTask);
+  EXPECT_EQ(fleet::msg::activityOf(s), fleet::RobotActivity::NoTask);
   EXPECT_NEAR(l.fleet().total(), 1.0, 1e-9);
 }

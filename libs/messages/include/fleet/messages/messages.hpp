@@ -391,6 +391,9 @@ struct TrafficProgress {
 const char* toString(TaskState s);
 const char* toString(TaskKind k);
 const char* toString(RobotMode m);
+/// What a state says its robot is doing: its activity, or when the agent leaves it Unset what its
+/// mode and task say (fleet::activityFromMode).
+RobotActivity activityOf(const RobotState& s);
 /// Inverse of toString; false when the name is unknown.
 bool parse(const std::string& name, TaskState& out);
 bool parse(const std::string& name, TaskKind& out);
