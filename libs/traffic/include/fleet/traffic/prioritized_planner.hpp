@@ -1,0 +1,89 @@
+#pragma once
+
+// Prioritized planning over safe intervals, windowed (Silver's cooperative A*, in continuous time
+// with SIPP as the single-robot search; Li et al.'s rolling-horizon collision resolution, RHCR,
+// AAAI 2021, for the window): robots are planned one after another in priority order, each the
+// earliest timed path (sipp.hpp) that keeps to the reservations of those planned before it. A robot
+// not planned yet stands where it is, so its node is unsafe from when it stands there until it is
+// planned; a robot that finds no path stays where it stands (its node stays reserved) — the plan is
+// free of conflicts whatever is found. Reservations count only within `window` s of the plan's
+// start: later conflicts are left to the next plan, made well before then (a lifelong planner plans
+// again every few seconds from where the robots are).
+//
+// A robot standing where it is until it is planned blocks those planned before it. When a robot
+// finds no path, the robots standing on its way (as it would drive with nobody standing) inherit its
+// priority: they are planned just before it, each to its own goal if it can get there, else to the
+// earliest refuge off that way (a siding, a lane beside), and everyone is planned again
+// (`yieldRounds` times at most; a robot yielding does not make the one it yields to yield back).
+// This is PIBT's priority inheritance in time instead of in one step.
+//
+// Held robots (faulted, docking, a vendor's vehicle) are obstacles for good. A robot without a goal
+// stays where it is unless it stands on the way of a robot that failed.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/safe_intervals.hpp"
+#include "fleet/traffic/sipp.hpp"
+
+namespace fleet::traffic {
+
+struct PlanRequest {
+  NodeId at = kNoNode;        ///< where it stands from `ready` on
+  NodeId cameFrom = kNoNode;  ///< its heading there (kNoNode: none)
+  double ready = 0.0;         ///< s: from when
+  NodeId goal = kNoNode;      ///< kNoNode: none (it stays)
+  int priority = 0;           ///< higher first; ties: the longer waiting since its last goal first
+  double waiting = 0.0;       ///< s since it last reached a goal (the fairness tie-break)
+  bool held = false;          ///< an obstacle on `at` for good
+  /// What it was released already and drives before `ready` (ends on `at`): reserved as it is.
+  TimedPath committed;
+};
+
+struct PrioritizedOptions {
+  double window = 15.0;               ///< s of reservations that count (from the earliest ready)
+  std::size_t maxExpansions = 50000;  ///< per robot's search
+  int yieldRounds = 3;                ///< plans again with robots yielding at most this often
+};
+
+struct PrioritizedStats {
+  std::uint64_t plans = 0;
+  std::uint64_t robotsPlanned = 0;
+  std::uint64_t failures = 0;  ///< robots with a goal not planned to it (no path found)
+  std::uint64_t yields = 0;    ///< robots planned before one whose way they stood on
+  std::uint64_t refuges = 0;   ///< robots planned out of another's way instead of to their goal
+};
+
+class PrioritizedPlanner {
+ public:
+  PrioritizedPlanner(const Graph& graph, Sipp::TurnTime turn = {}, PrioritizedOptions options = {});
+
+  /// One timed path per request (the first node `at` from `ready`; the last stays there: leave =
+  /// kForever). Robots' `at` nodes must not conflict.
+  std::vector<TimedPath> plan(std::span<const PlanRequest> robots);
+
+  /// The order plan() takes the robots in (held first, then by priority, goal, waiting, index).
+  [[nodiscard]] static std::vector<std::size_t> order(std::span<const PlanRequest> robots);
+
+  [[nodiscard]] const PrioritizedStats& stats() const { return stats_; }
+  [[nodiscard]] const SippStats& searchStats() const { return sipp_.stats(); }
+  void graphChanged() { sipp_.graphChanged(); }
+  /// The table the last plan() left (tests).
+  [[nodiscard]] const ReservationTable& reservations() const { return table_; }
+
+ private:
+  void reserveFixed(std::span<const PlanRequest> robots, bool starts);
+  std::vector<std::size_t> pass(std::span<const PlanRequest> robots, std::span<const std::size_t> order,
+                                const std::vector<std::vector<std::uint8_t>>& clear, double until,
+                                std::vector<TimedPath>& paths);
+
+  const Graph& graph_;
+  PrioritizedOptions options_;
+  Sipp sipp_;
+  ReservationTable table_;
+  PrioritizedStats stats_;
+};
+
+}  // namespace fleet::traffic

@@ -1,0 +1,89 @@
+#pragma once
+
+// Safe interval path planning for one robot on a roadmap, in the robot's own units (Phillips and
+// Likhachev, ICRA 2011): the state is the node, the safe interval the robot is in there
+// (safe_intervals.hpp) and the node it came from — its heading, since turning on the spot before
+// the next edge takes time (Roadmap::extraTurn). Its actions are the robot's: wait (within the safe
+// interval), turn on the spot and drive an edge, each at its real duration; the result is the
+// earliest arrival at the goal that keeps to every other robot's reservations and can stay there
+// until `holdUntil`. A* over those states with the goal's driving time as the heuristic (turns left
+// out: admissible), so the earliest arrival is exact (SIPP's optimality, heading included; the
+// tests check it against a search over every time step).
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "fleet/traffic/graph.hpp"
+#include "fleet/traffic/safe_intervals.hpp"
+
+namespace fleet::traffic {
+
+struct SippQuery {
+  NodeId start = kNoNode;
+  NodeId cameFrom = kNoNode;  ///< the node it arrived at `start` from (its heading); kNoNode: none
+  double startTime = 0.0;     ///< s: it stands on `start` from then (must be safe there then)
+  /// kNoNode: a refuge — the earliest node it can stay on until `holdUntil` that is not marked in
+  /// `avoid` (a robot getting out of another's way).
+  NodeId goal = kNoNode;
+  /// It must be able to stay on the goal from its arrival until then (kForever: for good).
+  double holdUntil = kForever;
+  const std::vector<std::uint8_t>* avoid = nullptr;  ///< per node, for a refuge
+};
+
+struct SippStats {
+  std::uint64_t searches = 0;
+  std::uint64_t expanded = 0;
+  std::uint64_t failures = 0;  ///< no path, or the expansion budget ran out
+};
+
+class Sipp {
+ public:
+  /// s of turning at `at` between prev→at and at→next beyond at→next's duration (>= 0).
+  using TurnTime = std::function<double(NodeId prev, NodeId at, NodeId next)>;
+
+  explicit Sipp(const Graph& graph, TurnTime turn = {}, std::size_t maxExpansions = 200000);
+
+  /// The earliest timed path from the query's start to its goal that keeps to `table`'s safe
+  /// intervals, or nullopt (none within the expansion budget, or the start is unsafe at the start
+  /// time). The path's first node is the start (enter = arrive = startTime); its last node's leave
+  /// is `holdUntil`.
+  std::optional<TimedPath> plan(const ReservationTable& table, const SippQuery& query);
+
+  /// s of driving from `v` to `goal` with nobody in the way and no turns (the heuristic; kForever
+  /// when the goal cannot be reached).
+  double drivingTime(NodeId v, NodeId goal);
+  /// Call after opening or closing nodes or edges: drops the heuristics.
+  void graphChanged() { heuristics_.clear(); }
+  [[nodiscard]] const SippStats& stats() const { return stats_; }
+
+ private:
+  struct State {
+    NodeId node;
+    NodeId from;
+    std::int32_t interval;
+    std::int32_t parent;
+    double arrive;
+    double depart;  ///< when it left the parent's node
+    double intervalEnd;
+  };
+  const std::vector<float>& heuristic(NodeId goal);
+  const std::vector<Interval>& intervals(const ReservationTable& table, NodeId v, double from);
+
+  const Graph& graph_;
+  TurnTime turn_;
+  std::size_t maxExpansions_;
+  std::vector<std::vector<std::pair<NodeId, float>>> reverse_;  ///< per node: (tail, duration)
+  std::unordered_map<NodeId, std::vector<float>> heuristics_;
+  // Per query.
+  std::vector<std::uint32_t> intervalStamp_;
+  std::vector<std::vector<Interval>> intervals_;
+  std::uint32_t stamp_ = 0;
+  std::vector<State> states_;
+  std::unordered_map<std::uint64_t, double> best_;
+  SippStats stats_;
+};
+
+}  // namespace fleet::traffic

@@ -1,0 +1,144 @@
+#include "fleet/traffic/prioritized_planner.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace fleet::traffic {
+
+PrioritizedPlanner::PrioritizedPlanner(const Graph& graph, Sipp::TurnTime turn, PrioritizedOptions options)
+    : graph_(graph), options_(options), sipp_(graph, std::move(turn), options.maxExpansions), table_(graph) {}
+
+std::vector<std::size_t> PrioritizedPlanner::order(std::span<const PlanRequest> robots) {
+  std::vector<std::size_t> idx(robots.size());
+  std::iota(idx.begin(), idx.end(), std::size_t{0});
+  std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
+    const auto& ra = robots[a];
+    const auto& rb = robots[b];
+    if (ra.held != rb.held)
+      return ra.held;
+    if (ra.priority != rb.priority)
+      return ra.priority > rb.priority;
+    const bool ga = ra.goal != kNoNode && ra.goal != ra.at;
+    const bool gb = rb.goal != kNoNode && rb.goal != rb.at;
+    if (ga != gb)
+      return ga;
+    return ra.waiting > rb.waiting;
+  });
+  return idx;
+}
+
+void PrioritizedPlanner::reserveFixed(std::span<const PlanRequest> robots, bool starts) {
+  table_.clear();
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const auto& r = robots[i];
+    if (!r.committed.empty()) {
+      // Driven as released: each node until it has arrived at the next, the last until `ready`
+      // (its own reservation of `at` takes over then).
+      TimedPath c = r.committed;
+      c.back().leave = r.ready;
+      table_.reserve(c, kForever, ReservationTable::kNobody);
+    }
+    if (r.held || starts)
+      table_.reserve(r.at, {r.ready, kForever},
+                     r.held ? ReservationTable::kNobody : static_cast<std::int32_t>(i));
+  }
+}
+
+std::vector<std::size_t> PrioritizedPlanner::pass(std::span<const PlanRequest> robots,
+                                                  std::span<const std::size_t> order,
+                                                  const std::vector<std::vector<std::uint8_t>>& clear,
+                                                  double until, std::vector<TimedPath>& paths) {
+  // Everyone stands where it is until it is planned.
+  reserveFixed(robots, true);
+  paths.assign(robots.size(), {});
+  for (std::size_t i = 0; i < robots.size(); ++i)
+    paths[i] = {TimedNode{robots[i].at, robots[i].ready, robots[i].ready, kForever}};
+  std::vector<std::size_t> failed;
+  for (const std::size_t i : order) {
+    const auto& r = robots[i];
+    if (r.held)
+      continue;
+    ++stats_.robotsPlanned;
+    const auto owner = static_cast<std::int32_t>(i);
+    const bool wantsGoal = r.goal != kNoNode && r.goal != r.at;
+    const bool mustClear = !clear[i].empty() && clear[i][static_cast<std::size_t>(r.at)] != 0;
+    if (!wantsGoal && !mustClear)
+      continue;  // it stays, as reserved
+    table_.release(owner);
+    std::optional<TimedPath> found;
+    if (wantsGoal)
+      found = sipp_.plan(table_, {r.at, r.cameFrom, r.ready, r.goal, until});
+    if (!found && mustClear) {
+      // Out of the way of the robot it yields to: the earliest place off that robot's way.
+      SippQuery q{r.at, r.cameFrom, r.ready, kNoNode, until, &clear[i]};
+      found = sipp_.plan(table_, q);
+      if (found)
+        ++stats_.refuges;
+    }
+    if (found) {
+      found->back().leave = kForever;
+      paths[i] = std::move(*found);
+    }
+    if (wantsGoal && paths[i].back().node != r.goal)
+      failed.push_back(i);
+    table_.reserve(paths[i], until, owner);
+    if (paths[i].back().arrive <= until)  // it stays where its path ends beyond the window
+      table_.reserve(paths[i].back().node, {paths[i].back().arrive, kForever}, owner);
+  }
+  return failed;
+}
+
+std::vector<TimedPath> PrioritizedPlanner::plan(std::span<const PlanRequest> robots) {
+  ++stats_.plans;
+  double start = kForever;
+  for (const auto& r : robots)
+    start = std::min(start, r.ready);
+  const double until = start + options_.window;
+  auto ord = order(robots);
+  std::vector<std::vector<std::uint8_t>> clear(robots.size());
+  std::vector<TimedPath> paths;
+  std::vector<std::size_t> failed;
+  for (int round = 0;; ++round) {
+    failed = pass(robots, ord, clear, until, paths);
+    if (failed.empty() || round >= options_.yieldRounds)
+      break;
+    // Priority inheritance, a robot at a time: the robots standing on a failed robot's way (as it
+    // would drive with nobody standing anywhere) are planned before it and get out of that way.
+    bool changed = false;
+    for (const std::size_t i : failed) {
+      if (!clear[i].empty())
+        continue;  // yielding itself: it does not make the one it yields to yield back
+      reserveFixed(robots, false);
+      const auto& r = robots[i];
+      const auto way = sipp_.plan(table_, {r.at, r.cameFrom, r.ready, r.goal, until});
+      if (!way)
+        continue;
+      std::vector<std::uint8_t> marks(graph_.size(), 0);
+      for (const auto& n : *way) {
+        marks[static_cast<std::size_t>(n.node)] = 1;
+        for (const NodeId w : graph_.conflicts(n.node))
+          marks[static_cast<std::size_t>(w)] = 1;
+      }
+      const auto posOf = [&](std::size_t k) { return std::find(ord.begin(), ord.end(), k) - ord.begin(); };
+      for (std::size_t j = 0; j < robots.size(); ++j) {
+        if (j == i || robots[j].held || !clear[j].empty() ||
+            marks[static_cast<std::size_t>(robots[j].at)] == 0)
+          continue;
+        if (posOf(j) < posOf(i) && std::find(failed.begin(), failed.end(), j) == failed.end() &&
+            marks[static_cast<std::size_t>(paths[j].back().node)] == 0)
+          continue;  // planned before it and gone from its way
+        clear[j] = marks;
+        ord.erase(ord.begin() + posOf(j));
+        ord.insert(ord.begin() + posOf(i), j);
+        ++stats_.yields;
+        changed = true;
+      }
+    }
+    if (!changed)
+      break;
+  }
+  stats_.failures += failed.size();
+  return paths;
+}
+
+}  // namespace fleet::traffic
