@@ -22,6 +22,11 @@ void addTrafficSimCommand(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(1.0, 1e7))
       ->capture_default_str();
   trafficSim->add_option("--seeds", o->seeds, "a seed or a range, e.g. 1-8")->capture_default_str();
+  trafficSim
+      ->add_option("--core", o->core,
+                   "the traffic layer's planner: pibt (lifelong PIBT, one step at a time) or sipp (windowed "
+                   "prioritized planning over safe intervals)")
+      ->capture_default_str();
   trafficSim->add_option("--spacing", o->spacing, "roadmap lattice spacing in m (0: default)")
       ->check(CLI::Range(0.0, 10.0));
   trafficSim->add_option("--stop-chance", o->stopChance, "per edge: chance a robot stops on it up to 10 s")

@@ -257,6 +257,11 @@ std::string drivingPerTaskLine(const nlohmann::json& d) {
 }  // namespace
 
 int runTrafficSim(const TrafficSimOptions& o) {
+  const auto core = traffic::plannerCoreFrom(o.core);
+  if (!core) {
+    std::cerr << "fleetctl traffic-sim: --core must be pibt or sipp, not '" << o.core << "'\n";
+    return 2;
+  }
   if (!std::isfinite(o.turnScale) || o.turnScale < 0.0) {
     std::cerr << "fleetctl traffic-sim: --turn-scale must be a number from 0 to 10\n";
     return 2;
@@ -309,6 +314,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
     v.seed = static_cast<std::uint64_t>(seed);
     v.stopChance = o.stopChance;
     v.turnScale = o.turnScale;
+    v.traffic.core = *core;
     v.stationLines = o.stationLines != 0;
     v.admission = static_cast<traffic::Admission>(o.admission);
     v.stationSlots = static_cast<std::size_t>(o.stationSlots);
@@ -398,6 +404,10 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"escalations", r.escalations},
                      {"untangles", r.untangles},
                      {"passes", r.passes},
+                     {"core", o.core},
+                     {"yields", r.yields},
+                     {"refuges", r.refuges},
+                     {"refused_moves", r.refusedMoves},
                      {"line_scale", r.lineScale},
                      {"update_p99_ms", r.updateP99Ms},
                      {"density", r.density},

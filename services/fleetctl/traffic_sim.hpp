@@ -15,8 +15,9 @@ struct TrafficSimOptions {
   std::string site;
   int robots = 20;
   double duration = 600.0;
-  std::string seeds = "1";  ///< "1-8" or "3"
-  double spacing = 0.0;     ///< roadmap lattice spacing (m); 0: the default
+  std::string seeds = "1";    ///< "1-8" or "3"
+  std::string core = "pibt";  ///< the traffic layer's planner core (TrafficOptions::core)
+  double spacing = 0.0;       ///< roadmap lattice spacing (m); 0: the default
   double stopChance = 0.01;
   double turnScale = 1.0;       ///< the virtual robots' turns on the spot take this times their time
   double stopGap = -1.0;        ///< m the motion gate keeps ahead of a driving robot; <0: the default

@@ -317,6 +317,15 @@ NodeId Execution::releasedFrom(std::size_t robot) const {
   }
   return kNoNode;
 }
+std::vector<NodeId> Execution::releasedRoute(std::size_t robot) const {
+  const Route& route = routes_.at(robot);
+  std::vector<NodeId> out;
+  for (std::int64_t i = route.progress; i <= route.released; ++i) {
+    if (out.empty() || out.back() != route[i].node)
+      out.push_back(route[i].node);
+  }
+  return out;
+}
 NodeId Execution::plannedEnd(std::size_t robot) const {
   return routes_.at(robot).entries.back().node;
 }

@@ -1,6 +1,7 @@
 #include "fleet/traffic/prioritized_planner.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace fleet::traffic {
@@ -33,15 +34,47 @@ void PrioritizedPlanner::reserveFixed(std::span<const PlanRequest> robots, bool 
     const auto& r = robots[i];
     if (!r.committed.empty()) {
       // Driven as released: each node until it has arrived at the next, the last until `ready`
-      // (its own reservation of `at` takes over then).
+      // (its own reservation of `at` takes over then). The execution has the robot on `at` before
+      // any new move, so `at` is taken from when the release begins.
       TimedPath c = r.committed;
       c.back().leave = r.ready;
       table_.reserve(c, kForever, ReservationTable::kNobody);
+      table_.reserve(r.at, {c.front().enter, r.ready}, ReservationTable::kNobody);
     }
     if (r.held || starts)
       table_.reserve(r.at, {r.ready, kForever},
                      r.held ? ReservationTable::kNobody : static_cast<std::int32_t>(i));
   }
+}
+
+bool PrioritizedPlanner::keepsPlace(const PlanRequest& r) const {
+  // A robot waiting on its line's nodes is never sent out of the way: it would lose its place.
+  return r.line >= 0 && lineOf_.size() == graph_.size() && lineOf_[static_cast<std::size_t>(r.at)] == r.line;
+}
+
+std::optional<TimedPath> PrioritizedPlanner::reuse(std::size_t i, const PlanRequest& r) const {
+  // The rest of its last plan, when it is where that plan has it about when it has it there, the
+  // plan still goes to its goal and still keeps to everyone's reservations (moved later by how
+  // late it is). Most robots are on time between two plans: no search for them.
+  if (i >= previous_.size() || previous_[i].empty() || previous_[i].back().node != r.goal)
+    return std::nullopt;
+  const auto& old = previous_[i];
+  const auto k = static_cast<std::size_t>(
+      std::find_if(old.begin(), old.end(), [&](const TimedNode& n) { return n.node == r.at; }) - old.begin());
+  if (k + 1 >= old.size() || std::abs(old[k].arrive - r.ready) > options_.reuseSlack)
+    return std::nullopt;
+  TimedPath rest(old.begin() + static_cast<std::ptrdiff_t>(k), old.end());
+  const double late = std::max(0.0, r.ready - rest.front().arrive);
+  for (auto& n : rest) {
+    n.enter += late;
+    n.arrive += late;
+    n.leave += late;
+  }
+  rest.front().enter = rest.front().arrive = r.ready;
+  rest.back().leave = kForever;
+  if (table_.firstConflict(rest) >= 0)
+    return std::nullopt;
+  return rest;
 }
 
 std::vector<std::size_t> PrioritizedPlanner::pass(std::span<const PlanRequest> robots,
@@ -54,20 +87,30 @@ std::vector<std::size_t> PrioritizedPlanner::pass(std::span<const PlanRequest> r
   for (std::size_t i = 0; i < robots.size(); ++i)
     paths[i] = {TimedNode{robots[i].at, robots[i].ready, robots[i].ready, kForever}};
   std::vector<std::size_t> failed;
-  for (const std::size_t i : order) {
+  std::vector<std::size_t> deferred;
+  // One robot's turn; `last`: its second try (or the only one it gets).
+  const auto planOne = [&](std::size_t i, bool last) {
     const auto& r = robots[i];
-    if (r.held)
-      continue;
-    ++stats_.robotsPlanned;
     const auto owner = static_cast<std::int32_t>(i);
     const bool wantsGoal = r.goal != kNoNode && r.goal != r.at;
     const bool mustClear = !clear[i].empty() && clear[i][static_cast<std::size_t>(r.at)] != 0;
     if (!wantsGoal && !mustClear)
-      continue;  // it stays, as reserved
+      return;  // it stays, as reserved
     table_.release(owner);
-    std::optional<TimedPath> found;
-    if (wantsGoal)
-      found = sipp_.plan(table_, {r.at, r.cameFrom, r.ready, r.goal, until});
+    std::optional<TimedPath> found = wantsGoal ? reuse(i, r) : std::nullopt;
+    const bool lines = r.line >= 0 && lineOf_.size() == graph_.size();
+    const SippQuery toGoal{r.at,    r.cameFrom,          r.ready,  r.goal,   until,
+                           nullptr, lines ? r.line : -1, &lineOf_, &forward_};
+    if (found)
+      ++stats_.reused;
+    else if (wantsGoal)
+      found = sipp_.plan(table_, toGoal);
+    if (!found && !last && !mustClear) {
+      // Its way may be shut only by robots standing until their turn: it goes again after them.
+      table_.reserve(r.at, {r.ready, kForever}, owner);
+      deferred.push_back(i);
+      return;
+    }
     if (!found && mustClear) {
       // Out of the way of the robot it yields to: the earliest place off that robot's way.
       SippQuery q{r.at, r.cameFrom, r.ready, kNoNode, until, &clear[i]};
@@ -84,7 +127,16 @@ std::vector<std::size_t> PrioritizedPlanner::pass(std::span<const PlanRequest> r
     table_.reserve(paths[i], until, owner);
     if (paths[i].back().arrive <= until)  // it stays where its path ends beyond the window
       table_.reserve(paths[i].back().node, {paths[i].back().arrive, kForever}, owner);
+  };
+  for (const std::size_t i : order) {
+    if (robots[i].held)
+      continue;
+    ++stats_.robotsPlanned;
+    planOne(i, false);
   }
+  stats_.deferred += deferred.size();
+  for (const std::size_t i : deferred)
+    planOne(i, true);
   return failed;
 }
 
@@ -94,6 +146,7 @@ std::vector<TimedPath> PrioritizedPlanner::plan(std::span<const PlanRequest> rob
   for (const auto& r : robots)
     start = std::min(start, r.ready);
   const double until = start + options_.window;
+  until_ = until;
   auto ord = order(robots);
   std::vector<std::vector<std::uint8_t>> clear(robots.size());
   std::vector<TimedPath> paths;
@@ -121,7 +174,7 @@ std::vector<TimedPath> PrioritizedPlanner::plan(std::span<const PlanRequest> rob
       }
       const auto posOf = [&](std::size_t k) { return std::find(ord.begin(), ord.end(), k) - ord.begin(); };
       for (std::size_t j = 0; j < robots.size(); ++j) {
-        if (j == i || robots[j].held || !clear[j].empty() ||
+        if (j == i || robots[j].held || keepsPlace(robots[j]) || !clear[j].empty() ||
             marks[static_cast<std::size_t>(robots[j].at)] == 0)
           continue;
         if (posOf(j) < posOf(i) && std::find(failed.begin(), failed.end(), j) == failed.end() &&
@@ -138,6 +191,7 @@ std::vector<TimedPath> PrioritizedPlanner::plan(std::span<const PlanRequest> rob
       break;
   }
   stats_.failures += failed.size();
+  previous_ = paths;
   return paths;
 }
 

@@ -6,7 +6,7 @@
 namespace fleet::traffic {
 
 namespace {
-constexpr std::size_t kSippHeuristics = 512;
+constexpr std::size_t kSippHeuristics = 128;
 
 struct SippOpen {
   double f;
@@ -22,47 +22,108 @@ struct SippOpen {
 Sipp::Sipp(const Graph& graph, TurnTime turn, std::size_t maxExpansions)
     : graph_(graph), turn_(std::move(turn)), maxExpansions_(maxExpansions) {}
 
-const std::vector<float>& Sipp::heuristic(NodeId goal) {
-  if (auto it = heuristics_.find(goal); it != heuristics_.end())
-    return it->second;
-  if (reverse_.size() != graph_.size()) {
-    reverse_.assign(graph_.size(), {});
-    for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
-      for (const Edge& e : graph_.edges(v))
-        reverse_[static_cast<std::size_t>(e.to)].emplace_back(v, static_cast<float>(e.duration));
+void Sipp::index() {
+  if (edgeStart_.size() == graph_.size() + 1)
+    return;
+  edgeStart_.assign(graph_.size() + 1, 0);
+  for (std::size_t v = 0; v < graph_.size(); ++v)
+    edgeStart_[v + 1] = edgeStart_[v] + graph_.edges(static_cast<NodeId>(v)).size();
+  edgeTail_.assign(edgeStart_.back(), kNoNode);
+  reverse_.assign(graph_.size(), {});
+  for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
+    const auto out = graph_.edges(v);
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const std::size_t e = edgeStart_[static_cast<std::size_t>(v)] + k;
+      edgeTail_[e] = v;
+      reverse_[static_cast<std::size_t>(out[k].to)].push_back(static_cast<std::uint32_t>(e));
     }
   }
+  turnStart_.assign(graph_.size() + 1, 0);
+  for (std::size_t v = 0; v < graph_.size(); ++v)
+    turnStart_[v + 1] = turnStart_[v] + reverse_[v].size() * graph_.edges(static_cast<NodeId>(v)).size();
+  turns_.assign(turnStart_.back(), -1.0F);
+}
+
+double Sipp::turnAt(NodeId from, NodeId at, std::size_t out) {
+  if (!turn_ || from == kNoNode)
+    return 0.0;
+  // Computed once per (way in, way out) at each node: the turn function measures angles.
+  const auto& in = reverse_[static_cast<std::size_t>(at)];
+  std::size_t k = 0;
+  while (k < in.size() && edgeTail_[in[k]] != from)
+    ++k;
+  if (k == in.size())
+    return turn_(from, at, graph_.edges(at)[out].to);
+  float& t = turns_[turnStart_[static_cast<std::size_t>(at)] + k * graph_.edges(at).size() + out];
+  if (t < 0.0F)
+    t = static_cast<float>(turn_(from, at, graph_.edges(at)[out].to));
+  return static_cast<double>(t);
+}
+
+std::int64_t Sipp::edgeIndex(NodeId from, NodeId to) const {
+  if (!graph_.valid(from))
+    return -1;
+  const auto out = graph_.edges(from);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    if (out[k].to == to)
+      return static_cast<std::int64_t>(edgeStart_[static_cast<std::size_t>(from)] + k);
+  }
+  return -1;
+}
+
+const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
+  if (auto it = heuristics_.find(goal); it != heuristics_.end())
+    return it->second;
+  index();
   if (heuristics_.size() >= kSippHeuristics)
     heuristics_.clear();
-  std::vector<float> d(graph_.size(), std::numeric_limits<float>::infinity());
-  using Item = std::pair<float, NodeId>;
+  // Backward over the edges (the robot's heading: the edge it arrived by), turns included: the
+  // exact time to the goal with nobody in the way, so a robot alone is searched along its path.
+  // Rounded down a little: float sums must not overestimate the double-precision search's.
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  constexpr float kDown = 1.0F - 1e-6F;
+  Heuristic h{std::vector<float>(graph_.size(), kInf), std::vector<float>(edgeTail_.size(), kInf)};
+  using Item = std::pair<float, std::uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-  d[static_cast<std::size_t>(goal)] = 0.0F;
-  heap.emplace(0.0F, goal);
+  h.node[static_cast<std::size_t>(goal)] = 0.0F;
+  for (const std::uint32_t e : reverse_[static_cast<std::size_t>(goal)]) {
+    const NodeId u = edgeTail_[e];
+    if (graph_.passable(u, graph_.edges(u)[e - edgeStart_[static_cast<std::size_t>(u)]])) {
+      h.edge[e] = 0.0F;
+      heap.emplace(0.0F, e);
+    }
+  }
   while (!heap.empty()) {
-    const auto [dv, v] = heap.top();
+    const auto [hf, f] = heap.top();
     heap.pop();
-    if (dv > d[static_cast<std::size_t>(v)])
+    if (hf > h.edge[f])
       continue;
-    for (const auto& [u, dur] : reverse_[static_cast<std::size_t>(v)]) {
-      const Edge* e = graph_.edge(u, v);
-      if (e == nullptr || !graph_.passable(u, *e))
+    // f = v → w: from arriving at v, leaving by f costs its turn, its duration and h(f).
+    const NodeId v = edgeTail_[f];
+    const std::size_t k = f - edgeStart_[static_cast<std::size_t>(v)];
+    const float viaF = (static_cast<float>(graph_.edges(v)[k].duration) + hf) * kDown;
+    if (v != goal)
+      h.node[static_cast<std::size_t>(v)] = std::min(h.node[static_cast<std::size_t>(v)], viaF);
+    if (v == goal)
+      continue;  // arriving at the goal ends the way
+    for (const std::uint32_t e : reverse_[static_cast<std::size_t>(v)]) {
+      const NodeId u = edgeTail_[e];
+      if (!graph_.passable(u, graph_.edges(u)[e - edgeStart_[static_cast<std::size_t>(u)]]))
         continue;
-      // Rounded down a little: float sums must not overestimate the double-precision search's.
-      const float du = (dv + dur) * (1.0F - 1e-6F);
-      if (du < d[static_cast<std::size_t>(u)]) {
-        d[static_cast<std::size_t>(u)] = du;
-        heap.emplace(du, u);
+      const float cand = (static_cast<float>(turnAt(u, v, k)) + viaF) * kDown;
+      if (cand < h.edge[e]) {
+        h.edge[e] = cand;
+        heap.emplace(cand, e);
       }
     }
   }
-  return heuristics_.emplace(goal, std::move(d)).first->second;
+  return heuristics_.emplace(goal, std::move(h)).first->second;
 }
 
 double Sipp::drivingTime(NodeId v, NodeId goal) {
   if (!graph_.valid(v) || !graph_.valid(goal))
     return kForever;
-  const float h = heuristic(goal)[static_cast<std::size_t>(v)];
+  const float h = heuristic(goal).node[static_cast<std::size_t>(v)];
   return h == std::numeric_limits<float>::infinity() ? kForever : static_cast<double>(h);
 }
 
@@ -82,6 +143,7 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     ++stats_.failures;
     return std::nullopt;
   }
+  index();
   if (intervalStamp_.size() != graph_.size()) {
     intervalStamp_.assign(graph_.size(), 0);
     intervals_.assign(graph_.size(), {});
@@ -89,9 +151,13 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
   }
   ++stamp_;
   // A refuge has no heuristic (Dijkstra in time).
-  const std::vector<float>* h = refuge ? nullptr : &heuristic(q.goal);
-  auto hOf = [&](NodeId v) {
-    return h == nullptr ? 0.0 : static_cast<double>((*h)[static_cast<std::size_t>(v)]);
+  const Heuristic* h = refuge ? nullptr : &heuristic(q.goal);
+  // From a node arrived at by edge `in` (-1: no heading).
+  auto hOf = [&](NodeId v, std::int64_t in) {
+    if (h == nullptr)
+      return 0.0;
+    return static_cast<double>(in >= 0 ? h->edge[static_cast<std::size_t>(in)]
+                                       : h->node[static_cast<std::size_t>(v)]);
   };
   auto isGoal = [&](NodeId v) {
     return refuge ? (q.avoid == nullptr || (*q.avoid)[static_cast<std::size_t>(v)] == 0) : v == q.goal;
@@ -105,13 +171,21 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
   };
   // The start's interval: the one holding the start time.
   const auto& startIv = intervals(table, q.start, q.startTime);
-  if (startIv.empty() || startIv.front().from > q.startTime || hOf(q.start) == kForever) {
+  const std::int64_t startIn = edgeIndex(q.cameFrom, q.start);
+  if (startIv.empty() || startIv.front().from > q.startTime || hOf(q.start, startIn) == kForever) {
+    ++stats_.failures;
+    return std::nullopt;
+  }
+  // A goal it cannot stay on long enough at any time is not searched for (a robot standing there
+  // until its turn): the search would otherwise try every state before it gave up.
+  if (!refuge && (intervals(table, q.goal, q.startTime).empty() ||
+                  intervals(table, q.goal, q.startTime).back().to < q.holdUntil)) {
     ++stats_.failures;
     return std::nullopt;
   }
   std::priority_queue<SippOpen> open;
   states_.push_back({q.start, q.cameFrom, 0, -1, q.startTime, q.startTime, startIv.front().to});
-  open.push({q.startTime + hOf(q.start), q.startTime, 0});
+  open.push({q.startTime + hOf(q.start, startIn), q.startTime, 0});
   std::size_t expanded = 0;
   std::int32_t found = -1;
   while (!open.empty()) {
@@ -126,14 +200,19 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     }
     if (++expanded > maxExpansions_)
       break;
-    for (const Edge& e : graph_.edges(s.node)) {
-      if (!graph_.passable(s.node, e))
+    const auto sv = static_cast<std::size_t>(s.node);
+    const NodeId onlyTo =
+        (q.line >= 0 && q.lineOf != nullptr && (*q.lineOf)[sv] == q.line) ? (*q.forward)[sv] : kNoNode;
+    const auto out = graph_.edges(s.node);
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      const Edge& e = out[k];
+      if (!graph_.passable(s.node, e) || (onlyTo != kNoNode && e.to != onlyTo))
         continue;
       const NodeId w = e.to;
-      const double hw = hOf(w);
+      const double hw = hOf(w, static_cast<std::int64_t>(edgeStart_[sv] + k));
       if (hw == kForever)
         continue;
-      const double turn = (turn_ && s.from != kNoNode) ? turn_(s.from, s.node, w) : 0.0;
+      const double turn = turnAt(s.from, s.node, k);
       const double earliest = s.arrive + turn;
       // It stands on its node until it has arrived at the next.
       const double latest = s.intervalEnd - e.duration;
@@ -148,8 +227,8 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
         const double arrive = depart + e.duration;
         if (depart > latest || arrive > iw.to)
           continue;
-        const auto k = key(w, s.node, static_cast<std::int32_t>(j));
-        auto [it, fresh] = best_.try_emplace(k, arrive);
+        const auto stateKey = key(w, s.node, static_cast<std::int32_t>(j));
+        auto [it, fresh] = best_.try_emplace(stateKey, arrive);
         if (!fresh) {
           if (arrive >= it->second)
             continue;

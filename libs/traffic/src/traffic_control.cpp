@@ -14,8 +14,6 @@ namespace {
 /// s of plan time the options counted in lattice edges (maxLag) stand for: a 0.5 m
 /// lattice edge at 0.8 m/s with a little turning.
 constexpr double kStepSeconds = 0.7;
-/// Above any task priority a WMS sends (they are small integers).
-constexpr int kLeavingBoost = 1 << 20;
 
 // The planner knows the robots' headings when the plan times their turns (PibtOptions::turnTime).
 PibtOptions plannerOptions(const TrafficOptions& options) {
@@ -34,6 +32,7 @@ TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> start
       options_(options),
       planner_(std::make_unique<Pibt>(graph, starts, plannerOptions(options))),
       execution_(graph, starts, options.release),
+
       goal_(starts.size(), kNoNode),
       held_(starts.size(), 0),
       priority_(starts.size(), 0),
@@ -47,7 +46,9 @@ TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> start
       ready_(starts.size(), 0.0),
       busy_(starts.size(), 0),
       stepTime_(1, 0.0),
-      came_(starts.size(), kNoNode) {}
+      came_(starts.size(), kNoNode),
+      timed_(graph, options.turnTime, options.prioritized),
+      lastGoalAt_(starts.size(), 0.0) {}
 
 void TrafficControl::setStations(std::vector<StationLine> stations) {
   for (std::size_t r = 0; r < robots(); ++r)
@@ -76,6 +77,7 @@ void TrafficControl::setStations(std::vector<StationLine> stations) {
       }
     }
   }
+  timed_.setLines(lineOf, forward);
   planner_->setLines(std::move(lineOf), std::move(forward));
   leaving_.assign(stations_.size(), -1);
   // Robots wait only where they leave the dock's ways in and out free: a queue node next to a dock
@@ -139,9 +141,15 @@ void TrafficControl::plannerPriority(std::size_t robot) {
   // A robot driving off a dock goes first: the robots in line for the dock would otherwise (they
   // have waited longer, so PIBT ranks them higher) push it back onto the dock whenever its way out
   // passes them, and it would never leave.
-  const bool leaving =
-      std::find(leaving_.begin(), leaving_.end(), static_cast<std::int64_t>(robot)) != leaving_.end();
-  planner_->setTaskPriority(robot, priority_[robot] + (leaving ? kLeavingBoost : 0));
+  planner_->setTaskPriority(robot, priority_[robot] + (leavingDock(robot) ? kLeavingBoost : 0));
+}
+
+bool TrafficControl::leavingDock(std::size_t robot) const {
+  return std::find(leaving_.begin(), leaving_.end(), static_cast<std::int64_t>(robot)) != leaving_.end();
+}
+
+NodeId TrafficControl::standing(std::size_t robot) const {
+  return options_.core == PlannerCore::Sipp ? execution_.at(robot) : planner_->positions()[robot];
 }
 
 void TrafficControl::leaveLine(std::size_t robot) {
@@ -152,7 +160,7 @@ void TrafficControl::leaveLine(std::size_t robot) {
   // The robot whose turn it was keeps the dock until it has driven off it: the next in line
   // waits at the head of the queue instead of pushing into the only way out.
   const NodeId dock = stations_[static_cast<std::size_t>(s)].dock;
-  if (!l.empty() && l.front() == robot && graph_.conflicting(planner_->positions()[robot], dock)) {
+  if (!l.empty() && l.front() == robot && graph_.conflicting(standing(robot), dock)) {
     leaving_[static_cast<std::size_t>(s)] = static_cast<std::int64_t>(robot);
     plannerPriority(robot);
   }
@@ -167,10 +175,9 @@ void TrafficControl::orderLine(std::size_t station) {
   if (l.size() < 2)
     return;
   const auto& st = stations_[station];
-  const auto& pos = planner_->positions();
   // Place along the line where the robot stands: dock, approach, then the queue from its head.
   auto place = [&](std::size_t r) -> std::size_t {
-    const NodeId v = pos[r];
+    const NodeId v = standing(r);
     if (v == st.dock)
       return 0;
     if (v == st.approach)
@@ -223,7 +230,9 @@ std::size_t TrafficControl::addRobot(NodeId start) {
   ready_.push_back(clock_);
   busy_.push_back(0);
   came_.push_back(kNoNode);
+  lastGoalAt_.push_back(now_);
   replan();
+  lastTimedPlan_ = -1e18;  // the timed core plans it in at the next update
   return r;
 }
 
@@ -273,6 +282,8 @@ void TrafficControl::retractStanding(std::size_t robot) {
 
 Report TrafficControl::reached(std::size_t robot, NodeId node) {
   const Report r = execution_.reached(robot, node);
+  if (r == Report::Accepted && node == target_[robot])
+    lastGoalAt_[robot] = now_;
   if (r == Report::NotReleased || r == Report::UnknownRobot)
     ++stats_.refusedReports;
   // At the end of its base short of where it is being taken: say why the base ended there.
@@ -327,6 +338,8 @@ TrafficControl::Need TrafficControl::needsPlanning() const {
 }
 
 int TrafficControl::update() {
+  if (options_.core == PlannerCore::Sipp)
+    return updateTimed();
   int steps = 0;
   ++sinceStep_;
   freeDocks();  // robots report between planner steps too
@@ -355,13 +368,17 @@ int TrafficControl::update() {
     sinceStep_ = 0;
   }
   stats_.steps += static_cast<std::uint64_t>(steps);
+  letLatePass();
+  return steps;
+}
+
+void TrafficControl::letLatePass() {
   if (options_.letPassBehind > 0) {
     for (std::size_t r = 0; r < robots(); ++r) {
       if (held_[r] == 0 && !execution_.waitingOn(r).empty() && execution_.letPass(r, options_.letPassBehind))
         ++stats_.passes;
     }
   }
-  return steps;
 }
 
 void TrafficControl::freeDocks() {
@@ -564,7 +581,9 @@ void TrafficControl::afterTimedStep() {
 
 void TrafficControl::graphChanged() {
   planner_->graphChanged();  // its cached distances still route through what was closed
+  timed_.graphChanged();
   replan();
+  lastTimedPlan_ = -1e18;
 }
 
 void TrafficControl::setNodeCost(std::vector<float> cost) {

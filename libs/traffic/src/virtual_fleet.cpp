@@ -320,6 +320,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   for (std::size_t tick = 0; tick < ticksToRun; ++tick) {
     const double now = static_cast<double>(tick) * o.dt;
     const auto t0 = std::chrono::steady_clock::now();
+    traffic.setNow(now);
     traffic.update();
     for (std::size_t r = 0; r < o.robots; ++r)
       rel[r] = traffic.release(r);
@@ -592,6 +593,9 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.escalations = traffic.plannerStats().escalations;
   res.untangles = traffic.plannerStats().untangles;
   res.passes = traffic.stats().passes;
+  res.yields = traffic.timedStats().yields;
+  res.refuges = traffic.timedStats().refuges;
+  res.refusedMoves = traffic.stats().refusedMoves;
   res.lineScale = governor.scale();
   for (std::size_t r = 0; r < traffic.robots(); ++r)
     res.baseEnds += traffic.baseEnds(r);
@@ -625,7 +629,8 @@ std::string formatResult(const VirtualFleetResult& r) {
   os.precision(1);
   os << r.longestWait << " s, planner steps " << r.plannerSteps << ", replans " << r.replans << ", evasions "
      << r.evasions << ", detours " << r.detours << ", escalations " << r.escalations << ", untangles "
-     << r.untangles << ", passes " << r.passes << ", line leaves " << r.lineLeaves << ", line scale ";
+     << r.untangles << ", passes " << r.passes << ", yields " << r.yields << ", refuges " << r.refuges
+     << ", refused moves " << r.refusedMoves << ", line leaves " << r.lineLeaves << ", line scale ";
   os.precision(2);
   os << r.lineScale << ", update p50/p99 ";
   os.precision(3);

@@ -169,3 +169,20 @@ TEST(TrafficSimView, QueueLengthShapesTheRoadmapAndOutOfRangeIsBadInput) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("--queue-length"), std::string::npos) << r.output;
 }
+
+// `--core sipp` runs the traffic layer on the timed core (its JSON says so and counts its yields);
+// a core it does not know is bad input naming the option.
+TEST(TrafficSimView, TheTimedCoreRunsByNameAndAnUnknownCoreIsBadInput) {
+  const auto r = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite +
+                                         " --robots 6 --duration 60 --core sipp --json");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output.substr(r.output.find('[')));
+  ASSERT_EQ(j.size(), 1U);
+  EXPECT_EQ(j[0]["core"], "sipp");
+  EXPECT_EQ(j[0]["refused_moves"], 0);
+  EXPECT_EQ(j[0]["contacts"], 0);
+  EXPECT_EQ(j[0]["evasions"], 0);  // the timed core has none: robots inherit priority instead
+  const auto bad = fleet::test::runCommand(kFleetctl + " traffic-sim --site " + kSite + " --core lacam");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--core must be pibt or sipp, not 'lacam'"), std::string::npos) << bad.output;
+}

@@ -115,6 +115,26 @@ TEST(VirtualFleet, TwentyRobotsOnTheSmallWarehouseNeverMeet) {
   runSeeds(map, o);
 }
 
+// The timed core (windowed prioritized planning over safe intervals) keeps every promise the
+// PIBT core does — no conflicting holds, no contact, no line left sideways, no refused report — and
+// no move of its plans is refused by the execution (they are conflict-free by construction). 20
+// robots in 300 s did 34 to 37 tasks on seeds 1–3 (the PIBT core 32 to 34; 2026-12-06); a deadlock
+// would leave far fewer.
+TEST(VirtualFleet, TheTimedCoreKeepsEveryPromiseAndTheFleetWorking) {
+  Roadmap map = smallWarehouse();
+  VirtualFleetOptions o;
+  o.robots = 20;
+  o.duration = 300.0;
+  o.traffic.core = PlannerCore::Sipp;
+  for (const auto& r : runSeeds(map, o)) {
+    SCOPED_TRACE(formatResult(r));
+    EXPECT_EQ(r.refusedMoves, 0U);
+    EXPECT_EQ(r.evasions, 0U);
+    EXPECT_GE(r.tasksDone, 28U);
+    EXPECT_LT(r.longestWait, 120.0);
+  }
+}
+
 // Robots that follow their releases at once (no latency) reach the end of their base short of
 // their target only where the plan holds them (a dependency) or has not gone on yet, never because
 // a longer base was free but late: the release keeps ahead of a robot on time.

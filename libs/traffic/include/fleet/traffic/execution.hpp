@@ -104,6 +104,9 @@ class Execution {
   /// when that part of the route is gone or it never moved.
   [[nodiscard]] NodeId releasedFrom(std::size_t robot) const;
   [[nodiscard]] NodeId plannedEnd(std::size_t robot) const;
+  /// The released route ahead of the robot, from its last reported node to its last released one
+  /// (each node once).
+  [[nodiscard]] std::vector<NodeId> releasedRoute(std::size_t robot) const;
   /// Plan step of the robot's last reported node (how far along the plan it is).
   [[nodiscard]] std::int64_t progressStep(std::size_t robot) const;
   /// Plan step of the robot's first planned node not released yet, -1 when everything is released.

@@ -21,6 +21,7 @@
 // stays where it is unless it stands on the way of a robot that failed.
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -38,14 +39,22 @@ struct PlanRequest {
   int priority = 0;           ///< higher first; ties: the longer waiting since its last goal first
   double waiting = 0.0;       ///< s since it last reached a goal (the fairness tie-break)
   bool held = false;          ///< an obstacle on `at` for good
-  /// What it was released already and drives before `ready` (ends on `at`): reserved as it is.
+  /// The station line it waits in, -1: on that line's nodes it moves only forward and is never
+  /// sent out of another's way (it would lose its place).
+  std::int32_t line = -1;
+  /// What it was released already and drives before `ready` (ends on `at`): reserved as it is,
+  /// and `at` from the first node's `enter` on (a plan executed by dependencies has the robot on
+  /// `at` before any move planned now: nobody may plan into what `at` excludes before it).
   TimedPath committed;
 };
 
 struct PrioritizedOptions {
-  double window = 15.0;               ///< s of reservations that count (from the earliest ready)
-  std::size_t maxExpansions = 50000;  ///< per robot's search
-  int yieldRounds = 3;                ///< plans again with robots yielding at most this often
+  double window = 5.0;               ///< s of reservations that count (from the earliest ready)
+  std::size_t maxExpansions = 5000;  ///< per robot's search
+  int yieldRounds = 1;               ///< plans again with robots yielding at most this often
+  /// A robot that is where its last plan has it within this many s keeps the rest of that plan
+  /// when it still keeps to the reservations (no search).
+  double reuseSlack = 0.5;
 };
 
 struct PrioritizedStats {
@@ -54,6 +63,8 @@ struct PrioritizedStats {
   std::uint64_t failures = 0;  ///< robots with a goal not planned to it (no path found)
   std::uint64_t yields = 0;    ///< robots planned before one whose way they stood on
   std::uint64_t refuges = 0;   ///< robots planned out of another's way instead of to their goal
+  std::uint64_t deferred = 0;  ///< robots planned again after the others (their way was shut)
+  std::uint64_t reused = 0;    ///< robots that kept the rest of their last plan
 };
 
 class PrioritizedPlanner {
@@ -66,8 +77,15 @@ class PrioritizedPlanner {
 
   /// The order plan() takes the robots in (held first, then by priority, goal, waiting, index).
   [[nodiscard]] static std::vector<std::size_t> order(std::span<const PlanRequest> robots);
+  /// Station lines: per node, the line it belongs to (-1) and the next node toward the dock.
+  void setLines(std::vector<std::int32_t> lineOf, std::vector<NodeId> forward) {
+    lineOf_ = std::move(lineOf);
+    forward_ = std::move(forward);
+  }
 
   [[nodiscard]] const PrioritizedStats& stats() const { return stats_; }
+  /// The last plan's window ends then (s): its paths are free of conflicts before it.
+  [[nodiscard]] double windowEnd() const { return until_; }
   [[nodiscard]] const SippStats& searchStats() const { return sipp_.stats(); }
   void graphChanged() { sipp_.graphChanged(); }
   /// The table the last plan() left (tests).
@@ -75,6 +93,8 @@ class PrioritizedPlanner {
 
  private:
   void reserveFixed(std::span<const PlanRequest> robots, bool starts);
+  [[nodiscard]] std::optional<TimedPath> reuse(std::size_t i, const PlanRequest& r) const;
+  [[nodiscard]] bool keepsPlace(const PlanRequest& r) const;
   std::vector<std::size_t> pass(std::span<const PlanRequest> robots, std::span<const std::size_t> order,
                                 const std::vector<std::vector<std::uint8_t>>& clear, double until,
                                 std::vector<TimedPath>& paths);
@@ -84,6 +104,10 @@ class PrioritizedPlanner {
   Sipp sipp_;
   ReservationTable table_;
   PrioritizedStats stats_;
+  std::vector<std::int32_t> lineOf_;
+  std::vector<NodeId> forward_;
+  std::vector<TimedPath> previous_;  ///< per robot: its path in the last plan
+  double until_ = 0.0;
 };
 
 }  // namespace fleet::traffic

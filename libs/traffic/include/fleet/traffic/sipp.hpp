@@ -6,8 +6,9 @@
 // the next edge takes time (Roadmap::extraTurn). Its actions are the robot's: wait (within the safe
 // interval), turn on the spot and drive an edge, each at its real duration; the result is the
 // earliest arrival at the goal that keeps to every other robot's reservations and can stay there
-// until `holdUntil`. A* over those states with the goal's driving time as the heuristic (turns left
-// out: admissible), so the earliest arrival is exact (SIPP's optimality, heading included; the
+// until `holdUntil`. A* over those states with the goal's driving time with its turns from the
+// edge the robot arrived by as the heuristic (exact for a robot alone, admissible and consistent
+// with others: waiting only adds), so the earliest arrival is exact (SIPP's optimality, heading included; the
 // tests check it against a search over every time step).
 
 #include <cstdint>
@@ -31,6 +32,11 @@ struct SippQuery {
   /// It must be able to stay on the goal from its arrival until then (kForever: for good).
   double holdUntil = kForever;
   const std::vector<std::uint8_t>* avoid = nullptr;  ///< per node, for a refuge
+  /// A robot in a station's line moves only forward along it: on a node whose `lineOf` is `line`,
+  /// its one move is to `forward` of that node (kNoNode: any). Null or line < 0: no line.
+  std::int32_t line = -1;
+  const std::vector<std::int32_t>* lineOf = nullptr;
+  const std::vector<NodeId>* forward = nullptr;
 };
 
 struct SippStats {
@@ -52,8 +58,8 @@ class Sipp {
   /// is `holdUntil`.
   std::optional<TimedPath> plan(const ReservationTable& table, const SippQuery& query);
 
-  /// s of driving from `v` to `goal` with nobody in the way and no turns (the heuristic; kForever
-  /// when the goal cannot be reached).
+  /// s of driving from `v` to `goal` with nobody in the way, turns included, starting in the best
+  /// heading (kForever when the goal cannot be reached).
   double drivingTime(NodeId v, NodeId goal);
   /// Call after opening or closing nodes or edges: drops the heuristics.
   void graphChanged() { heuristics_.clear(); }
@@ -69,14 +75,26 @@ class Sipp {
     double depart;  ///< when it left the parent's node
     double intervalEnd;
   };
-  const std::vector<float>& heuristic(NodeId goal);
+  /// Per goal: the time to it from each node (no heading) and from arriving by each edge.
+  struct Heuristic {
+    std::vector<float> node;
+    std::vector<float> edge;
+  };
+  const Heuristic& heuristic(NodeId goal);
+  void index();
+  double turnAt(NodeId from, NodeId at, std::size_t out);
+  [[nodiscard]] std::int64_t edgeIndex(NodeId from, NodeId to) const;
   const std::vector<Interval>& intervals(const ReservationTable& table, NodeId v, double from);
 
   const Graph& graph_;
   TurnTime turn_;
   std::size_t maxExpansions_;
-  std::vector<std::vector<std::pair<NodeId, float>>> reverse_;  ///< per node: (tail, duration)
-  std::unordered_map<NodeId, std::vector<float>> heuristics_;
+  std::vector<std::size_t> edgeStart_;               ///< per node: its first out-edge's index
+  std::vector<NodeId> edgeTail_;                     ///< per edge
+  std::vector<std::vector<std::uint32_t>> reverse_;  ///< per node: the edges into it
+  std::unordered_map<NodeId, Heuristic> heuristics_;
+  std::vector<std::size_t> turnStart_;  ///< per node: its (way in, way out) turns in turns_
+  std::vector<float> turns_;            ///< s, -1 until computed
   // Per query.
   std::vector<std::uint32_t> intervalStamp_;
   std::vector<std::vector<Interval>> intervals_;

@@ -18,17 +18,41 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fleet/traffic/execution.hpp"
 #include "fleet/traffic/graph.hpp"
 #include "fleet/traffic/pibt.hpp"
+#include "fleet/traffic/prioritized_planner.hpp"
 
 namespace fleet::traffic {
 
+/// The planner at the traffic layer's core.
+enum class PlannerCore : std::uint8_t {
+  /// Lifelong PIBT one step at a time (pibt.hpp), kept in time by the plan's clock, with the
+  /// evasions, detours, untangling and escalation that keep it moving on a roadmap.
+  Pibt,
+  /// Windowed prioritized planning over safe intervals (prioritized_planner.hpp): every robot's
+  /// timed path from where its release ends, planned again every `TrafficOptions::replanEvery` s
+  /// (and when a robot runs short), appended to the execution in time order.
+  Sipp,
+};
+const char* toString(PlannerCore c);
+/// "pibt" or "sipp"; nullopt for anything else.
+std::optional<PlannerCore> plannerCoreFrom(std::string_view name);
+
 struct TrafficOptions {
+  PlannerCore core = PlannerCore::Pibt;
+  /// The timed core (PlannerCore::Sipp): its window and searches, how often it plans again (s of
+  /// the traffic layer's clock), and the clock's step per update() when setNow() is not called.
+  PrioritizedOptions prioritized{};
+  double replanEvery = 2.0;
+  double replanAtLeast = 1.0;
+  double tick = 0.1;
   /// A robot may be behind the plan by this many lattice edges' time (0.7 s each) before the
   /// unreleased plan is dropped and planned again.
   std::int64_t maxLag = 24;
@@ -97,6 +121,9 @@ struct TrafficStats {
   std::uint64_t refusedReports = 0;
   std::uint64_t evasions = 0;  ///< robots sent out of another's way
   std::uint64_t passes = 0;    ///< robots let past late ones (switched dependencies)
+  /// Timed plans the execution refused a move of (PlannerCore::Sipp; the plan is conflict-free by
+  /// construction, so this stays 0).
+  std::uint64_t refusedMoves = 0;
 };
 
 /// Times a robot reported the last node of its base short of where it was being taken, by why the
@@ -163,6 +190,12 @@ class TrafficControl {
   /// Plans as far ahead as the options say (re-planning first if a robot fell too far behind).
   /// Returns the number of steps planned.
   int update();
+  /// The traffic layer's clock (s), for the timed core's plans; without it each update() is
+  /// `TrafficOptions::tick` s.
+  void setNow(double seconds) {
+    now_ = seconds;
+    nowGiven_ = true;
+  }
   /// What the robot may drive now and what it may expect after that.
   Release release(std::size_t robot) { return execution_.release(robot); }
   [[nodiscard]] std::vector<std::size_t> waitingOn(std::size_t robot) const {
@@ -189,8 +222,12 @@ class TrafficControl {
   [[nodiscard]] const PibtStats& plannerStats() const { return planner_->stats(); }
   [[nodiscard]] const Execution& execution() const { return execution_; }
   [[nodiscard]] const Pibt& planner() const { return *planner_; }
+  /// The timed core's statistics (PlannerCore::Sipp; zero otherwise).
+  [[nodiscard]] const PrioritizedStats& timedStats() const { return timed_.stats(); }
 
  private:
+  /// A robot leaving a dock goes before every task priority a WMS sends (small integers).
+  static constexpr int kLeavingBoost = 1 << 20;
   void replan();
   void leaveLine(std::size_t robot);
   void updateLine(std::size_t station);
@@ -202,6 +239,14 @@ class TrafficControl {
   void clearWayFor(std::size_t robot);
   enum class Need : std::uint8_t { None, Later, Now };
   [[nodiscard]] Need needsPlanning() const;
+  /// Where the robot stands for the lines: the planner's position (PIBT) or its last report.
+  [[nodiscard]] NodeId standing(std::size_t robot) const;
+  [[nodiscard]] bool leavingDock(std::size_t robot) const;
+  // The timed core (traffic_control_timed.cpp).
+  int updateTimed();
+  /// Robots waiting on late ones go first where that keeps the execution free of deadlock.
+  void letLatePass();
+  int planTimed();
 
   const Graph& graph_;
   TrafficOptions options_;
@@ -236,6 +281,12 @@ class TrafficControl {
   std::vector<NodeId> before_;  ///< the planner's positions before a step (kept: no allocation a step)
   std::vector<NodeId> came_;    ///< per robot: the node before its planned end (kNoNode: none)
   double clock_ = 0.0;
+  // The timed core.
+  PrioritizedPlanner timed_;
+  double now_ = 0.0;
+  bool nowGiven_ = false;
+  double lastTimedPlan_ = -1e18;
+  std::vector<double> lastGoalAt_;  ///< per robot: when it last reached its target
 };
 
 }  // namespace fleet::traffic

@@ -109,6 +109,11 @@ struct VirtualFleetResult {
   std::uint64_t escalations = 0;  ///< agents the planner escalated out of a wait cycle
   std::uint64_t untangles = 0;    ///< knots the planner searched a way out of
   std::uint64_t passes = 0;       ///< robots let past late ones (TrafficStats)
+  /// The timed core (PlannerCore::Sipp): robots planned before one whose way they stood on, robots
+  /// sent to a refuge off it, and moves the execution refused (0: the plans are conflict-free).
+  std::uint64_t yields = 0;
+  std::uint64_t refuges = 0;
+  std::uint64_t refusedMoves = 0;
   /// The admission governor's factor on the lines' places at the end (admission by slots; 1: none).
   double lineScale = 1.0;
   BaseEnds baseEnds;         ///< the robots' base ends reached short of their target, summed
