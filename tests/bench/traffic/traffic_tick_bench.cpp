@@ -10,14 +10,22 @@
 // their node and its neighbours; one iteration blocks the nodes round one dock (a robot arrives),
 // reads every table again, unblocks them (it leaves) and reads again. repair:0 restarts every table
 // that had settled a changed node (the reference), repair:1 repairs it in place (the default).
+//
+// core:1 runs BM_TrafficTick on the timed core (TrafficOptions::core = Sipp) at 100 and 300 robots.
+// BM_PrioritizedPlan: one plan of the timed core for 20 / 100 / 300 robots standing on random nodes
+// of the site for that many, each with a random dock as its goal, every robot searched (no plan
+// kept: reuseSlack < 0), the goals' heuristics and the turns already computed by a first plan: what
+// a re-plan of everyone costs as robots are added.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <random>
 #include <stdexcept>
 
 #include "fleet/traffic/distance_table.hpp"
+#include "fleet/traffic/prioritized_planner.hpp"
 
 #include "fleet/site/site_loader.hpp"
 #include "fleet/traffic/roadmap.hpp"
@@ -59,6 +67,7 @@ void BM_TrafficTick(benchmark::State& state) {
   // 0: admission by station slots (the default: ~50 of 300 robots working); 1: none, every robot
   // has a task from the start (what the tick must carry when the stations do not limit the fleet).
   o.admission = state.range(1) == 0 ? traffic::Admission::Slots : traffic::Admission::None;
+  o.traffic.core = state.range(2) == 0 ? traffic::PlannerCore::Pibt : traffic::PlannerCore::Sipp;
   traffic::VirtualFleetResult r;
   for (auto _ : state) {
     r = traffic::runVirtualFleet(roadmap, o);
@@ -71,8 +80,10 @@ void BM_TrafficTick(benchmark::State& state) {
   state.counters["tasks_done"] = static_cast<double>(r.tasksDone);
 }
 BENCHMARK(BM_TrafficTick)
-    ->ArgNames({"robots", "everyone"})
-    ->ArgsProduct({{100, 300, 1000}, {0, 1}})
+    ->ArgNames({"robots", "everyone", "core"})
+    ->ArgsProduct({{100, 300, 1000}, {0, 1}, {0}})
+    ->Args({100, 0, 1})
+    ->Args({300, 0, 1})
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
@@ -150,6 +161,50 @@ BENCHMARK(BM_DockDwellTables)
     ->Arg(1)
     ->Iterations(40)
     ->Unit(benchmark::kMillisecond);
+
+void BM_PrioritizedPlan(benchmark::State& state) {
+  const auto robots = static_cast<std::size_t>(state.range(0));
+  const site::Site site = siteFor(static_cast<int>(robots));
+  const traffic::Roadmap roadmap = traffic::buildRoadmap(site, {});
+  const auto& g = roadmap.graph;
+  std::mt19937_64 rng(1);
+  std::uniform_int_distribution<traffic::NodeId> node(0, static_cast<traffic::NodeId>(g.size()) - 1);
+  std::vector<traffic::NodeId> docks;
+  for (const auto& st : roadmap.stations) {
+    if (st.dock != traffic::kNoNode)
+      docks.push_back(st.dock);
+  }
+  std::uniform_int_distribution<std::size_t> dock(0, docks.size() - 1);
+  std::vector<traffic::PlanRequest> req;
+  std::vector<traffic::NodeId> taken;
+  while (req.size() < robots) {
+    const traffic::NodeId v = node(rng);
+    if (std::any_of(taken.begin(), taken.end(),
+                    [&](traffic::NodeId u) { return u == v || g.conflicting(u, v); }))
+      continue;
+    taken.push_back(v);
+    traffic::PlanRequest r;
+    r.at = v;
+    r.goal = docks[dock(rng)];
+    r.waiting = static_cast<double>(req.size());
+    req.push_back(r);
+  }
+  traffic::PrioritizedPlanner planner(g,
+                                      [&roadmap](traffic::NodeId a, traffic::NodeId b, traffic::NodeId c) {
+                                        return roadmap.extraTurn(a, b, c);
+                                      },
+                                      {.reuseSlack = -1.0});
+  planner.plan(req);  // the heuristics and turns, once
+  const auto before = planner.stats();
+  for (auto _ : state)
+    benchmark::DoNotOptimize(planner.plan(req));
+  const auto& after = planner.stats();
+  const auto plans = static_cast<double>(after.plans - before.plans);
+  state.counters["nodes"] = static_cast<double>(g.size());
+  state.counters["failures"] = static_cast<double>(after.failures - before.failures) / plans;
+  state.counters["yields"] = static_cast<double>(after.yields - before.yields) / plans;
+}
+BENCHMARK(BM_PrioritizedPlan)->ArgName("robots")->Arg(20)->Arg(100)->Arg(300)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
