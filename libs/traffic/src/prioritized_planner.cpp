@@ -64,6 +64,10 @@ std::optional<TimedPath> PrioritizedPlanner::reuse(std::size_t i, const PlanRequ
   if (k + 1 >= old.size() || std::abs(old[k].arrive - r.ready) > options_.reuseSlack)
     return std::nullopt;
   TimedPath rest(old.begin() + static_cast<std::ptrdiff_t>(k), old.end());
+  for (std::size_t j = 0; j + 1 < rest.size(); ++j) {
+    if (graph_.edge(rest[j].node, rest[j + 1].node) == nullptr || !graph_.isOpen(rest[j + 1].node))
+      return std::nullopt;  // closed since
+  }
   const double late = std::max(0.0, r.ready - rest.front().arrive);
   for (auto& n : rest) {
     n.enter += late;

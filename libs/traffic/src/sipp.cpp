@@ -6,7 +6,9 @@
 namespace fleet::traffic {
 
 namespace {
-constexpr std::size_t kSippHeuristics = 128;
+/// Bytes of goal heuristics kept, least recently used dropped first (one goal on the site for 300
+/// robots: ~0.6 MB).
+constexpr std::size_t kSippHeuristicBytes = std::size_t{256} << 20;
 
 struct SippOpen {
   double f;
@@ -60,6 +62,12 @@ double Sipp::turnAt(NodeId from, NodeId at, std::size_t out) {
   return static_cast<double>(t);
 }
 
+bool Sipp::usable(std::uint32_t e) const {
+  const NodeId u = edgeTail_[e];
+  const Edge& edge = graph_.edges(u)[e - edgeStart_[static_cast<std::size_t>(u)]];
+  return edge.open && graph_.isOpen(edge.to);
+}
+
 std::int64_t Sipp::edgeIndex(NodeId from, NodeId to) const {
   if (!graph_.valid(from))
     return -1;
@@ -72,26 +80,36 @@ std::int64_t Sipp::edgeIndex(NodeId from, NodeId to) const {
 }
 
 const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
-  if (auto it = heuristics_.find(goal); it != heuristics_.end())
+  ++useClock_;
+  if (auto it = heuristics_.find(goal); it != heuristics_.end()) {
+    it->second.used = useClock_;
     return it->second;
+  }
   index();
-  if (heuristics_.size() >= kSippHeuristics)
-    heuristics_.clear();
+  const std::size_t bytes = sizeof(float) * (graph_.size() + edgeTail_.size());
+  while (!heuristics_.empty() && (heuristics_.size() + 1) * bytes > kSippHeuristicBytes) {
+    auto oldest = heuristics_.begin();
+    for (auto it = heuristics_.begin(); it != heuristics_.end(); ++it) {
+      if (it->second.used < oldest->second.used)
+        oldest = it;
+    }
+    heuristics_.erase(oldest);
+  }
   // Backward over the edges (the robot's heading: the edge it arrived by), turns included: the
   // exact time to the goal with nobody in the way, so a robot alone is searched along its path.
   // Rounded down a little: float sums must not overestimate the double-precision search's.
   constexpr float kInf = std::numeric_limits<float>::infinity();
   constexpr float kDown = 1.0F - 1e-6F;
-  Heuristic h{std::vector<float>(graph_.size(), kInf), std::vector<float>(edgeTail_.size(), kInf)};
+  Heuristic h{std::vector<float>(graph_.size(), kInf), std::vector<float>(edgeTail_.size(), kInf), useClock_};
   using Item = std::pair<float, std::uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
   h.node[static_cast<std::size_t>(goal)] = 0.0F;
+  // Every edge gets its value, open or not (a robot may have arrived by an edge closed since, or
+  // stand on a closed node: it may still drive off); only usable moves are searched on from.
   for (const std::uint32_t e : reverse_[static_cast<std::size_t>(goal)]) {
-    const NodeId u = edgeTail_[e];
-    if (graph_.passable(u, graph_.edges(u)[e - edgeStart_[static_cast<std::size_t>(u)]])) {
-      h.edge[e] = 0.0F;
+    h.edge[e] = 0.0F;
+    if (usable(e))
       heap.emplace(0.0F, e);
-    }
   }
   while (!heap.empty()) {
     const auto [hf, f] = heap.top();
@@ -107,13 +125,11 @@ const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
     if (v == goal)
       continue;  // arriving at the goal ends the way
     for (const std::uint32_t e : reverse_[static_cast<std::size_t>(v)]) {
-      const NodeId u = edgeTail_[e];
-      if (!graph_.passable(u, graph_.edges(u)[e - edgeStart_[static_cast<std::size_t>(u)]]))
-        continue;
-      const float cand = (static_cast<float>(turnAt(u, v, k)) + viaF) * kDown;
+      const float cand = (static_cast<float>(turnAt(edgeTail_[e], v, k)) + viaF) * kDown;
       if (cand < h.edge[e]) {
         h.edge[e] = cand;
-        heap.emplace(cand, e);
+        if (usable(e))
+          heap.emplace(cand, e);
       }
     }
   }
@@ -164,11 +180,7 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
   };
   states_.clear();
   best_.clear();
-  auto key = [](NodeId v, NodeId from, std::int32_t k) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)) << 40) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from + 1)) << 16) ^
-           static_cast<std::uint64_t>(k);
-  };
+  auto key = [](NodeId v, NodeId from, std::int32_t k) { return StateKey{v, from, k}; };
   // The start's interval: the one holding the start time.
   const auto& startIv = intervals(table, q.start, q.startTime);
   const std::int64_t startIn = edgeIndex(q.cameFrom, q.start);
@@ -206,8 +218,8 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     const auto out = graph_.edges(s.node);
     for (std::size_t k = 0; k < out.size(); ++k) {
       const Edge& e = out[k];
-      if (!graph_.passable(s.node, e) || (onlyTo != kNoNode && e.to != onlyTo))
-        continue;
+      if (!e.open || !graph_.isOpen(e.to) || (onlyTo != kNoNode && e.to != onlyTo))
+        continue;  // a robot on a closed node may still drive off it
       const NodeId w = e.to;
       const double hw = hOf(w, static_cast<std::int64_t>(edgeStart_[sv] + k));
       if (hw == kForever)

@@ -232,7 +232,6 @@ std::size_t TrafficControl::addRobot(NodeId start) {
   came_.push_back(kNoNode);
   lastGoalAt_.push_back(now_);
   replan();
-  lastTimedPlan_ = -1e18;  // the timed core plans it in at the next update
   return r;
 }
 
@@ -515,6 +514,7 @@ void TrafficControl::replan() {
   }
   planner_->reset(ends, came_);
   ++stats_.replans;
+  lastTimedPlan_ = -1e18;  // the timed core plans again at the next update
   // Everyone decides again from where its release ends, facing the way it came.
   std::fill(ready_.begin(), ready_.end(), clock_);
 }
@@ -583,7 +583,6 @@ void TrafficControl::graphChanged() {
   planner_->graphChanged();  // its cached distances still route through what was closed
   timed_.graphChanged();
   replan();
-  lastTimedPlan_ = -1e18;
 }
 
 void TrafficControl::setNodeCost(std::vector<float> cost) {

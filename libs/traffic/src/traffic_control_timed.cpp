@@ -58,12 +58,17 @@ int TrafficControl::planTimed() {
     double t = now_;
     q.committed.push_back({route.front(), t, t, t});
     for (std::size_t k = 1; k < route.size(); ++k) {
-      const Edge* e = graph_.edge(route[k - 1], route[k]);
-      double turn = 0.0;
+      // Its duration whether the edge is open or closed since it was released.
+      double duration = 1.0;
+      for (const Edge& e : graph_.edges(route[k - 1])) {
+        if (e.to == route[k])
+          duration = e.duration;
+      }
+      double turn = 0.0;  // (the first edge's turn is not known: where it came from is not kept)
       if (k >= 2 && options_.turnTime)
         turn = options_.turnTime(route[k - 2], route[k - 1], route[k]);
       const double enter = t + turn;
-      const double arrive = enter + (e != nullptr ? e->duration : 1.0);
+      const double arrive = enter + duration;
       q.committed.back().leave = enter;
       q.committed.push_back({route[k], enter, arrive, arrive});
       t = arrive;

@@ -203,6 +203,27 @@ TEST(Sipp, ItWaitsForARobotCrossingItsWayRatherThanDriveIntoIt) {
   EXPECT_DOUBLE_EQ(q->front().leave, 4.0);
 }
 
+TEST(Sipp, ARobotOnAClosedNodeOrArrivedByAClosedEdgeStillDrivesOff) {
+  Graph g = lineGraph(4);
+  Sipp sipp(g, quarterTurns(g));
+  ReservationTable t(g);
+  g.setOpen(0, false);  // closed under the robot: it may still leave
+  sipp.graphChanged();
+  const auto p = sipp.plan(t, {0, kNoNode, 0.0, 3});
+  ASSERT_TRUE(p.has_value());
+  EXPECT_DOUBLE_EQ(p->back().arrive, 3.0);
+  g.setOpen(0, true);
+  g.setEdgeOpen(0, 1, false);  // the edge it came by, closed behind it
+  sipp.graphChanged();
+  const auto q = sipp.plan(t, {1, 0, 0.0, 3});
+  ASSERT_TRUE(q.has_value());
+  EXPECT_DOUBLE_EQ(q->back().arrive, 2.0);
+  // Nothing drives into a closed node.
+  g.setOpen(2, false);
+  sipp.graphChanged();
+  EXPECT_FALSE(sipp.plan(t, {1, 0, 0.0, 3}).has_value());
+}
+
 TEST(Sipp, EarliestArrivalMatchesAPlainSearchOverEveryQuarterSecond) {
   std::mt19937_64 rng(11);
   int compared = 0;
@@ -326,6 +347,11 @@ TEST(PrioritizedPlanner, PlansOnTheSmallWarehouseAreFreeOfConflictsAndHeldRobots
     PrioritizedPlanner planner(g, [&](NodeId a, NodeId b, NodeId c) { return roadmap.extraTurn(a, b, c); },
                                {.window = kForever});
     const auto paths = planner.plan(rs);
+    // With the 5 s window: free of conflicts within it.
+    PrioritizedPlanner windowed(g, [&](NodeId a, NodeId b, NodeId c) { return roadmap.extraTurn(a, b, c); });
+    const auto near = windowed.plan(rs);
+    EXPECT_DOUBLE_EQ(windowed.windowEnd(), 5.0);
+    EXPECT_EQ(pairwiseConflict(g, near, windowed.windowEnd()), "") << "trial " << trial;
     ASSERT_EQ(paths.size(), rs.size());
     EXPECT_EQ(pairwiseConflict(g, paths, kForever), "") << "trial " << trial;
     EXPECT_EQ(paths[7].size(), 1U);  // held: stands

@@ -129,7 +129,7 @@ TEST(VirtualFleet, TheTimedCoreKeepsEveryPromiseAndTheFleetWorking) {
   for (const auto& r : runSeeds(map, o)) {
     SCOPED_TRACE(formatResult(r));
     EXPECT_EQ(r.refusedMoves, 0U);
-    EXPECT_EQ(r.evasions, 0U);
+    EXPECT_GT(r.yields, 0U);  // 20 robots stand on each other's ways: priority inheritance at work
     EXPECT_GE(r.tasksDone, 28U);
     EXPECT_LT(r.longestWait, 120.0);
   }

@@ -87,7 +87,11 @@ class PrioritizedPlanner {
   /// The last plan's window ends then (s): its paths are free of conflicts before it.
   [[nodiscard]] double windowEnd() const { return until_; }
   [[nodiscard]] const SippStats& searchStats() const { return sipp_.stats(); }
-  void graphChanged() { sipp_.graphChanged(); }
+  /// Call after opening or closing nodes or edges: drops the heuristics and the plans kept.
+  void graphChanged() {
+    sipp_.graphChanged();
+    previous_.clear();
+  }
   /// The table the last plan() left (tests).
   [[nodiscard]] const ReservationTable& reservations() const { return table_; }
 

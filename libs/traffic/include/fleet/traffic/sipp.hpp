@@ -7,8 +7,9 @@
 // interval), turn on the spot and drive an edge, each at its real duration; the result is the
 // earliest arrival at the goal that keeps to every other robot's reservations and can stay there
 // until `holdUntil`. A* over those states with the goal's driving time with its turns from the
-// edge the robot arrived by as the heuristic (exact for a robot alone, admissible and consistent
-// with others: waiting only adds), so the earliest arrival is exact (SIPP's optimality, heading included; the
+// edge the robot arrived by as the heuristic (a robot alone's own time, rounded down by a
+// millionth: admissible and consistent; with others waiting only adds), so the earliest arrival is
+// exact (SIPP's optimality, heading included; the
 // tests check it against a search over every time step).
 
 #include <cstdint>
@@ -79,11 +80,29 @@ class Sipp {
   struct Heuristic {
     std::vector<float> node;
     std::vector<float> edge;
+    std::uint64_t used = 0;  ///< when last read (least recently used dropped first)
+  };
+  struct StateKey {
+    NodeId node;
+    NodeId from;
+    std::int32_t interval;
+    bool operator==(const StateKey&) const = default;
+  };
+  struct StateKeyHash {
+    std::size_t operator()(const StateKey& k) const {
+      const auto a = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.node));
+      const auto b = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.from));
+      const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.interval));
+      return static_cast<std::size_t>(
+          ((a * 0x9E3779B97F4A7C15ULL) ^ (b + 0x632BE59BD9B4E019ULL)) * 0xBF58476D1CE4E5B9ULL ^ c);
+    }
   };
   const Heuristic& heuristic(NodeId goal);
   void index();
   double turnAt(NodeId from, NodeId at, std::size_t out);
   [[nodiscard]] std::int64_t edgeIndex(NodeId from, NodeId to) const;
+  /// Edge `e` (an index) can be driven now: open, into an open node.
+  [[nodiscard]] bool usable(std::uint32_t e) const;
   const std::vector<Interval>& intervals(const ReservationTable& table, NodeId v, double from);
 
   const Graph& graph_;
@@ -100,7 +119,8 @@ class Sipp {
   std::vector<std::vector<Interval>> intervals_;
   std::uint32_t stamp_ = 0;
   std::vector<State> states_;
-  std::unordered_map<std::uint64_t, double> best_;
+  std::unordered_map<StateKey, double, StateKeyHash> best_;
+  std::uint64_t useClock_ = 0;
   SippStats stats_;
 };
 
