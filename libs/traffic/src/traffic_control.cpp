@@ -32,7 +32,6 @@ TrafficControl::TrafficControl(const Graph& graph, std::span<const NodeId> start
       options_(options),
       planner_(std::make_unique<Pibt>(graph, starts, plannerOptions(options))),
       execution_(graph, starts, options.release),
-
       goal_(starts.size(), kNoNode),
       held_(starts.size(), 0),
       priority_(starts.size(), 0),

@@ -14,6 +14,11 @@
 // the unreleased plan is then dropped and planned again from where everyone's release ends, so the
 // fleet does not keep planning around where the late robot was supposed to be. Held robots (docking,
 // faulted, paused, a vendor's vehicle that does not follow) are obstacles the plan goes around.
+//
+// The planner is one of two cores (TrafficOptions::core): PIBT as above (the default), or the timed
+// core — every robot's timed path by windowed prioritized planning over safe intervals
+// (prioritized_planner.hpp), planned again from where the releases end and appended to the same
+// execution (traffic_control_timed.cpp).
 
 #include <cstdint>
 #include <functional>
