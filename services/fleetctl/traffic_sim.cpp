@@ -404,7 +404,7 @@ int runTrafficSim(const TrafficSimOptions& o) {
                      {"escalations", r.escalations},
                      {"untangles", r.untangles},
                      {"passes", r.passes},
-                     {"core", o.core},
+                     {"core", traffic::toString(*core)},
                      {"yields", r.yields},
                      {"refuges", r.refuges},
                      {"refused_moves", r.refusedMoves},

@@ -135,7 +135,6 @@ std::vector<std::size_t> PrioritizedPlanner::pass(std::span<const PlanRequest> r
   for (const std::size_t i : order) {
     if (robots[i].held)
       continue;
-    ++stats_.robotsPlanned;
     planOne(i, false);
   }
   stats_.deferred += deferred.size();

@@ -303,6 +303,11 @@ TEST(PrioritizedPlanner, TwoRobotsMeetingInACorridorPassAtTheSiding) {
   EXPECT_EQ(planner.stats().yields, 1U);
   EXPECT_EQ(planner.stats().refuges, 1U);
   EXPECT_EQ(planner.stats().failures, 1U);  // robot 1, not at its goal in this plan
+  // Planned again from the same place and time, robot 0 keeps the rest of its plan (no search).
+  const auto again = planner.plan(rs);
+  EXPECT_GE(planner.stats().reused, 1U);
+  ASSERT_EQ(again[0].size(), paths[0].size());
+  EXPECT_DOUBLE_EQ(again[0].back().arrive, 6.0);
   // The next plan, from where this one ends, takes robot 1 home.
   rs[0].at = 4;
   rs[0].cameFrom = 3;

@@ -59,7 +59,6 @@ struct PrioritizedOptions {
 
 struct PrioritizedStats {
   std::uint64_t plans = 0;
-  std::uint64_t robotsPlanned = 0;
   std::uint64_t failures = 0;  ///< robots with a goal not planned to it (no path found)
   std::uint64_t yields = 0;    ///< robots planned before one whose way they stood on
   std::uint64_t refuges = 0;   ///< robots planned out of another's way instead of to their goal
