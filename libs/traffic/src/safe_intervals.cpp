@@ -79,6 +79,12 @@ std::vector<Interval> ReservationTable::unsafe(NodeId v) const {
 
 std::vector<Interval> ReservationTable::safe(NodeId v, double from) const {
   std::vector<Interval> out;
+  safe(v, from, out);
+  return out;
+}
+
+void ReservationTable::safe(NodeId v, double from, std::vector<Interval>& out) const {
+  out.clear();
   double start = from;
   for (const Span& u : unsafe_[static_cast<std::size_t>(v)]) {
     if (u.to < start)
@@ -87,10 +93,9 @@ std::vector<Interval> ReservationTable::safe(NodeId v, double from) const {
       out.push_back({start, u.from});
     start = std::max(start, u.to);
     if (start == kForever)
-      return out;
+      return;
   }
   out.push_back({start, kForever});
-  return out;
 }
 
 bool ReservationTable::safeOver(NodeId v, double a, double b) const {

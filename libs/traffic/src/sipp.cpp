@@ -1,7 +1,10 @@
 #include "fleet/traffic/sipp.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <queue>
+#include <utility>
 
 namespace fleet::traffic {
 
@@ -10,15 +13,15 @@ namespace {
 /// robots: ~0.6 MB).
 constexpr std::size_t kSippHeuristicBytes = std::size_t{256} << 20;
 
-struct SippOpen {
-  double f;
-  double g;
-  std::int32_t state;
-  bool operator<(const SippOpen& o) const {
-    // std::priority_queue pops the largest: least f first, then the later arrival (deeper).
-    return f != o.f ? f > o.f : g < o.g;
-  }
-};
+/// f is ordered in steps of this many s: states whose f differs by less than the heuristic's
+/// float rounding are ties, taken deepest first (a lattice has many ways of the same length).
+constexpr double kFStep = 1e-3;
+/// The heap's order (std::push_heap keeps the largest on top): least f first, then the later
+/// arrival (deeper).
+constexpr auto kLaterFirst = [](const auto& a, const auto& b) { return a.f != b.f ? a.f > b.f : a.g < b.g; };
+std::int64_t fKey(double f) {
+  return static_cast<std::int64_t>(std::floor(f / kFStep));
+}
 }  // namespace
 
 Sipp::Sipp(const Graph& graph, TurnTime turn, std::size_t maxExpansions)
@@ -31,31 +34,33 @@ void Sipp::index() {
   for (std::size_t v = 0; v < graph_.size(); ++v)
     edgeStart_[v + 1] = edgeStart_[v] + graph_.edges(static_cast<NodeId>(v)).size();
   edgeTail_.assign(edgeStart_.back(), kNoNode);
+  inPos_.assign(edgeStart_.back(), 0);
   reverse_.assign(graph_.size(), {});
   for (NodeId v = 0; static_cast<std::size_t>(v) < graph_.size(); ++v) {
     const auto out = graph_.edges(v);
     for (std::size_t k = 0; k < out.size(); ++k) {
       const std::size_t e = edgeStart_[static_cast<std::size_t>(v)] + k;
       edgeTail_[e] = v;
-      reverse_[static_cast<std::size_t>(out[k].to)].push_back(static_cast<std::uint32_t>(e));
+      auto& in = reverse_[static_cast<std::size_t>(out[k].to)];
+      inPos_[e] = static_cast<std::uint32_t>(in.size());
+      in.push_back(static_cast<std::uint32_t>(e));
     }
   }
   turnStart_.assign(graph_.size() + 1, 0);
   for (std::size_t v = 0; v < graph_.size(); ++v)
     turnStart_[v + 1] = turnStart_[v] + reverse_[v].size() * graph_.edges(static_cast<NodeId>(v)).size();
   turns_.assign(turnStart_.back(), -1.0F);
+  bestStamp_.assign(edgeTail_.size() + graph_.size(), 0);
+  bestHead_.assign(edgeTail_.size() + graph_.size(), -1);
 }
 
-double Sipp::turnAt(NodeId from, NodeId at, std::size_t out) {
+double Sipp::turnAt(NodeId from, std::int32_t inEdge, NodeId at, std::size_t out) {
   if (!turn_ || from == kNoNode)
     return 0.0;
-  // Computed once per (way in, way out) at each node: the turn function measures angles.
-  const auto& in = reverse_[static_cast<std::size_t>(at)];
-  std::size_t k = 0;
-  while (k < in.size() && edgeTail_[in[k]] != from)
-    ++k;
-  if (k == in.size())
+  if (inEdge < 0)  // `from` is no edge's tail: measured each time
     return turn_(from, at, graph_.edges(at)[out].to);
+  // Computed once per (way in, way out) at each node: the turn function measures angles.
+  const std::size_t k = inPos_[static_cast<std::size_t>(inEdge)];
   float& t = turns_[turnStart_[static_cast<std::size_t>(at)] + k * graph_.edges(at).size() + out];
   if (t < 0.0F)
     t = static_cast<float>(turn_(from, at, graph_.edges(at)[out].to));
@@ -86,6 +91,7 @@ const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
     return it->second;
   }
   index();
+  ++stats_.heuristics;
   const std::size_t bytes = sizeof(float) * (graph_.size() + edgeTail_.size());
   while (!heuristics_.empty() && (heuristics_.size() + 1) * bytes > kSippHeuristicBytes) {
     auto oldest = heuristics_.begin();
@@ -97,42 +103,49 @@ const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
   }
   // Backward over the edges (the robot's heading: the edge it arrived by), turns included: the
   // exact time to the goal with nobody in the way, so a robot alone is searched along its path.
-  // Rounded down a little: float sums must not overestimate the double-precision search's.
-  constexpr float kInf = std::numeric_limits<float>::infinity();
-  constexpr float kDown = 1.0F - 1e-6F;
-  Heuristic h{std::vector<float>(graph_.size(), kInf), std::vector<float>(edgeTail_.size(), kInf), useClock_};
-  using Item = std::pair<float, std::uint32_t>;
+  // Summed in double and each value stored rounded down to a float once (never above the
+  // forward search's sums; rounding at every step instead compounds — 0.2 s at 300 s from the
+  // goal — and makes every state nearer the start look better, so the search went breadth first).
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> node(graph_.size(), kInf), edge(edgeTail_.size(), kInf);
+  using Item = std::pair<double, std::uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-  h.node[static_cast<std::size_t>(goal)] = 0.0F;
+  node[static_cast<std::size_t>(goal)] = 0.0;
   // Every edge gets its value, open or not (a robot may have arrived by an edge closed since, or
   // stand on a closed node: it may still drive off); only usable moves are searched on from.
   for (const std::uint32_t e : reverse_[static_cast<std::size_t>(goal)]) {
-    h.edge[e] = 0.0F;
+    edge[e] = 0.0;
     if (usable(e))
-      heap.emplace(0.0F, e);
+      heap.emplace(0.0, e);
   }
   while (!heap.empty()) {
     const auto [hf, f] = heap.top();
     heap.pop();
-    if (hf > h.edge[f])
+    if (hf > edge[f])
       continue;
     // f = v → w: from arriving at v, leaving by f costs its turn, its duration and h(f).
     const NodeId v = edgeTail_[f];
     const std::size_t k = f - edgeStart_[static_cast<std::size_t>(v)];
-    const float viaF = (static_cast<float>(graph_.edges(v)[k].duration) + hf) * kDown;
-    if (v != goal)
-      h.node[static_cast<std::size_t>(v)] = std::min(h.node[static_cast<std::size_t>(v)], viaF);
+    const double viaF = graph_.edges(v)[k].duration + hf;
     if (v == goal)
       continue;  // arriving at the goal ends the way
+    node[static_cast<std::size_t>(v)] = std::min(node[static_cast<std::size_t>(v)], viaF);
     for (const std::uint32_t e : reverse_[static_cast<std::size_t>(v)]) {
-      const float cand = (static_cast<float>(turnAt(edgeTail_[e], v, k)) + viaF) * kDown;
-      if (cand < h.edge[e]) {
-        h.edge[e] = cand;
+      const double cand = turnAt(edgeTail_[e], static_cast<std::int32_t>(e), v, k) + viaF;
+      if (cand < edge[e]) {
+        edge[e] = cand;
         if (usable(e))
           heap.emplace(cand, e);
       }
     }
   }
+  const auto down = [](double d) {
+    auto f = static_cast<float>(d);
+    return static_cast<double>(f) > d ? std::nextafter(f, 0.0F) : f;
+  };
+  Heuristic h{std::vector<float>(node.size()), std::vector<float>(edge.size()), useClock_};
+  std::transform(node.begin(), node.end(), h.node.begin(), down);
+  std::transform(edge.begin(), edge.end(), h.edge.begin(), down);
   return heuristics_.emplace(goal, std::move(h)).first->second;
 }
 
@@ -147,9 +160,23 @@ const std::vector<Interval>& Sipp::intervals(const ReservationTable& table, Node
   const auto i = static_cast<std::size_t>(v);
   if (intervalStamp_[i] != stamp_) {
     intervalStamp_[i] = stamp_;
-    intervals_[i] = table.safe(v, from);
+    table.safe(v, from, intervals_[i]);
   }
   return intervals_[i];
+}
+
+std::pair<Sipp::Best*, bool> Sipp::bestOf(std::size_t slot, std::int32_t interval, double arrive) {
+  if (bestStamp_[slot] != stamp_) {
+    bestStamp_[slot] = stamp_;
+    bestHead_[slot] = -1;
+  }
+  for (std::int32_t b = bestHead_[slot]; b >= 0; b = bestPool_[static_cast<std::size_t>(b)].next) {
+    if (bestPool_[static_cast<std::size_t>(b)].interval == interval)
+      return {&bestPool_[static_cast<std::size_t>(b)], false};
+  }
+  bestPool_.push_back({interval, bestHead_[slot], arrive});
+  bestHead_[slot] = static_cast<std::int32_t>(bestPool_.size() - 1);
+  return {&bestPool_.back(), true};
 }
 
 std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQuery& q) {
@@ -179,8 +206,8 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     return refuge ? (q.avoid == nullptr || (*q.avoid)[static_cast<std::size_t>(v)] == 0) : v == q.goal;
   };
   states_.clear();
-  best_.clear();
-  auto key = [](NodeId v, NodeId from, std::int32_t k) { return StateKey{v, from, k}; };
+  bestPool_.clear();
+  open_.clear();
   // The start's interval: the one holding the start time.
   const auto& startIv = intervals(table, q.start, q.startTime);
   const std::int64_t startIn = edgeIndex(q.cameFrom, q.start);
@@ -195,16 +222,18 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     ++stats_.failures;
     return std::nullopt;
   }
-  std::priority_queue<SippOpen> open;
-  states_.push_back({q.start, q.cameFrom, 0, -1, q.startTime, q.startTime, startIv.front().to});
-  open.push({q.startTime + hOf(q.start, startIn), q.startTime, 0});
+  const auto startEdge = static_cast<std::int32_t>(startIn);
+  states_.push_back({q.start, q.cameFrom, startEdge, 0, -1, q.startTime, q.startTime, startIv.front().to});
+  open_.push_back({fKey(q.startTime + hOf(q.start, startIn)), q.startTime, 0});
+  bestOf(slotOf(q.start, startEdge), 0, q.startTime);
   std::size_t expanded = 0;
   std::int32_t found = -1;
-  while (!open.empty()) {
-    const SippOpen top = open.top();
-    open.pop();
+  while (!open_.empty()) {
+    std::pop_heap(open_.begin(), open_.end(), kLaterFirst);
+    const Open top = open_.back();
+    open_.pop_back();
     const State s = states_[static_cast<std::size_t>(top.state)];
-    if (top.g > best_.try_emplace(key(s.node, s.from, s.interval), top.g).first->second)
+    if (top.g > bestOf(slotOf(s.node, s.inEdge), s.interval, top.g).first->arrive)
       continue;  // reached earlier since
     if (isGoal(s.node) && s.intervalEnd >= q.holdUntil) {
       found = top.state;
@@ -221,10 +250,11 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
       if (!e.open || !graph_.isOpen(e.to) || (onlyTo != kNoNode && e.to != onlyTo))
         continue;  // a robot on a closed node may still drive off it
       const NodeId w = e.to;
-      const double hw = hOf(w, static_cast<std::int64_t>(edgeStart_[sv] + k));
+      const auto viaE = static_cast<std::int32_t>(edgeStart_[sv] + k);
+      const double hw = hOf(w, viaE);
       if (hw == kForever)
         continue;
-      const double turn = turnAt(s.from, s.node, k);
+      const double turn = turnAt(s.from, s.inEdge, s.node, k);
       const double earliest = s.arrive + turn;
       // It stands on its node until it has arrived at the next.
       const double latest = s.intervalEnd - e.duration;
@@ -239,15 +269,16 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
         const double arrive = depart + e.duration;
         if (depart > latest || arrive > iw.to)
           continue;
-        const auto stateKey = key(w, s.node, static_cast<std::int32_t>(j));
-        auto [it, fresh] = best_.try_emplace(stateKey, arrive);
+        const auto [best, fresh] =
+            bestOf(static_cast<std::size_t>(viaE), static_cast<std::int32_t>(j), arrive);
         if (!fresh) {
-          if (arrive >= it->second)
+          if (arrive >= best->arrive)
             continue;
-          it->second = arrive;
+          best->arrive = arrive;
         }
-        states_.push_back({w, s.node, static_cast<std::int32_t>(j), top.state, arrive, depart, iw.to});
-        open.push({arrive + hw, arrive, static_cast<std::int32_t>(states_.size() - 1)});
+        states_.push_back({w, s.node, viaE, static_cast<std::int32_t>(j), top.state, arrive, depart, iw.to});
+        open_.push_back({fKey(arrive + hw), arrive, static_cast<std::int32_t>(states_.size() - 1)});
+        std::push_heap(open_.begin(), open_.end(), kLaterFirst);
       }
     }
   }

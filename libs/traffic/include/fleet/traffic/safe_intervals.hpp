@@ -67,6 +67,8 @@ class ReservationTable {
   [[nodiscard]] std::vector<Interval> unsafe(NodeId v) const;
   /// The node's safe intervals from `from` on, in time order (the complement of unsafe()).
   [[nodiscard]] std::vector<Interval> safe(NodeId v, double from = 0.0) const;
+  /// The same into `out` (cleared first; its storage reused: a search asks for many nodes).
+  void safe(NodeId v, double from, std::vector<Interval>& out) const;
   /// Whether the node is safe over the whole of [a, b].
   [[nodiscard]] bool safeOver(NodeId v, double a, double b) const;
   /// The first path node (index) and time at which `path` enters what the table holds unsafe, or

@@ -7,10 +7,11 @@
 // interval), turn on the spot and drive an edge, each at its real duration; the result is the
 // earliest arrival at the goal that keeps to every other robot's reservations and can stay there
 // until `holdUntil`. A* over those states with the goal's driving time with its turns from the
-// edge the robot arrived by as the heuristic (a robot alone's own time, rounded down by a
-// millionth: admissible and consistent; with others waiting only adds), so the earliest arrival is
-// exact (SIPP's optimality, heading included; the
-// tests check it against a search over every time step).
+// edge the robot arrived by as the heuristic (a robot alone's own time, each value rounded down to
+// a float: admissible; with others waiting only adds), so the earliest arrival is exact to the
+// millisecond (SIPP's optimality, heading included; states are ordered by f in 1 ms steps, deepest
+// first within one, so the many equally short ways of a lattice are not all searched; the tests
+// check it against a search over every time step).
 
 #include <cstdint>
 #include <functional>
@@ -43,7 +44,8 @@ struct SippQuery {
 struct SippStats {
   std::uint64_t searches = 0;
   std::uint64_t expanded = 0;
-  std::uint64_t failures = 0;  ///< no path, or the expansion budget ran out
+  std::uint64_t failures = 0;    ///< no path, or the expansion budget ran out
+  std::uint64_t heuristics = 0;  ///< goals' driving-time tables computed (each a backward search)
 };
 
 class Sipp {
@@ -69,7 +71,8 @@ class Sipp {
  private:
   struct State {
     NodeId node;
-    NodeId from;
+    NodeId from;          ///< the node before (kNoNode: none)
+    std::int32_t inEdge;  ///< the edge it arrived by (-1: the start, or `from` is no edge's tail)
     std::int32_t interval;
     std::int32_t parent;
     double arrive;
@@ -82,24 +85,24 @@ class Sipp {
     std::vector<float> edge;
     std::uint64_t used = 0;  ///< when last read (least recently used dropped first)
   };
-  struct StateKey {
-    NodeId node;
-    NodeId from;
+  /// The earliest arrival found so far per state (the edge arrived by, the safe interval): a
+  /// list per edge in one pool, reset by a stamp per query (no hashing, no allocation).
+  struct Best {
     std::int32_t interval;
-    bool operator==(const StateKey&) const = default;
+    std::int32_t next;
+    double arrive;
   };
-  struct StateKeyHash {
-    std::size_t operator()(const StateKey& k) const {
-      const auto a = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.node));
-      const auto b = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.from));
-      const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.interval));
-      return static_cast<std::size_t>(
-          ((a * 0x9E3779B97F4A7C15ULL) ^ (b + 0x632BE59BD9B4E019ULL)) * 0xBF58476D1CE4E5B9ULL ^ c);
-    }
-  };
+  /// The slot of a state's (edge arrived by | node without a heading).
+  [[nodiscard]] std::size_t slotOf(NodeId v, std::int32_t inEdge) const {
+    return inEdge >= 0 ? static_cast<std::size_t>(inEdge) : edgeTail_.size() + static_cast<std::size_t>(v);
+  }
+  /// The best arrival of the state (its slot, its interval), inserting `arrive` when it has none;
+  /// returns the entry and whether it was new.
+  std::pair<Best*, bool> bestOf(std::size_t slot, std::int32_t interval, double arrive);
   const Heuristic& heuristic(NodeId goal);
   void index();
-  double turnAt(NodeId from, NodeId at, std::size_t out);
+  /// The turn at `at` from arriving by edge `inEdge` (from `from`) into its out-edge `out`.
+  double turnAt(NodeId from, std::int32_t inEdge, NodeId at, std::size_t out);
   [[nodiscard]] std::int64_t edgeIndex(NodeId from, NodeId to) const;
   /// Edge `e` (an index) can be driven now: open, into an open node.
   [[nodiscard]] bool usable(std::uint32_t e) const;
@@ -110,6 +113,7 @@ class Sipp {
   std::size_t maxExpansions_;
   std::vector<std::size_t> edgeStart_;               ///< per node: its first out-edge's index
   std::vector<NodeId> edgeTail_;                     ///< per edge
+  std::vector<std::uint32_t> inPos_;                 ///< per edge: its place among its head's reverse_
   std::vector<std::vector<std::uint32_t>> reverse_;  ///< per node: the edges into it
   std::unordered_map<NodeId, Heuristic> heuristics_;
   std::vector<std::size_t> turnStart_;  ///< per node: its (way in, way out) turns in turns_
@@ -119,7 +123,15 @@ class Sipp {
   std::vector<std::vector<Interval>> intervals_;
   std::uint32_t stamp_ = 0;
   std::vector<State> states_;
-  std::unordered_map<StateKey, double, StateKeyHash> best_;
+  std::vector<std::uint32_t> bestStamp_;  ///< per slot
+  std::vector<std::int32_t> bestHead_;    ///< per slot: its first entry in bestPool_
+  std::vector<Best> bestPool_;
+  struct Open {
+    std::int64_t f;  ///< arrival + heuristic, in steps (sipp.cpp)
+    double g;
+    std::int32_t state;
+  };
+  std::vector<Open> open_;  ///< a heap
   std::uint64_t useClock_ = 0;
   SippStats stats_;
 };

@@ -229,6 +229,8 @@ class TrafficControl {
   [[nodiscard]] const Pibt& planner() const { return *planner_; }
   /// The timed core's statistics (PlannerCore::Sipp; zero otherwise).
   [[nodiscard]] const PrioritizedStats& timedStats() const { return timed_.stats(); }
+  /// The timed core's single-robot searches (their count, states expanded, failures, goal tables).
+  [[nodiscard]] const SippStats& searchStats() const { return timed_.searchStats(); }
 
  private:
   /// A robot leaving a dock goes before every task priority a WMS sends (small integers).
