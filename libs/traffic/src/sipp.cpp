@@ -19,6 +19,11 @@ constexpr double kFStep = 1e-3;
 /// The heap's order (std::push_heap keeps the largest on top): least f first, then the later
 /// arrival (deeper).
 constexpr auto kLaterFirst = [](const auto& a, const auto& b) { return a.f != b.f ? a.f > b.f : a.g < b.g; };
+/// The float at or below `d` (a goal table's values never exceed the sums they stand for).
+float down(double d) {
+  const auto f = static_cast<float>(d);
+  return static_cast<double>(f) > d ? std::nextafter(f, 0.0F) : f;
+}
 std::int64_t fKey(double f) {
   return static_cast<std::int64_t>(std::floor(f / kFStep));
 }
@@ -84,7 +89,7 @@ std::int64_t Sipp::edgeIndex(NodeId from, NodeId to) const {
   return -1;
 }
 
-const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
+Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
   ++useClock_;
   if (auto it = heuristics_.find(goal); it != heuristics_.end()) {
     it->second.used = useClock_;
@@ -92,68 +97,85 @@ const Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
   }
   index();
   ++stats_.heuristics;
+  // A table's values (its search's heap comes and goes).
   const std::size_t bytes = sizeof(float) * (graph_.size() + edgeTail_.size());
   while (!heuristics_.empty() && (heuristics_.size() + 1) * bytes > kSippHeuristicBytes) {
-    auto oldest = heuristics_.begin();
-    for (auto it = heuristics_.begin(); it != heuristics_.end(); ++it) {
-      if (it->second.used < oldest->second.used)
-        oldest = it;
+    NodeId oldest = kNoNode;
+    std::uint64_t oldestUse = std::numeric_limits<std::uint64_t>::max();
+    for (const auto& [g, table] : heuristics_) {
+      if (table.used < oldestUse) {
+        oldest = g;
+        oldestUse = table.used;
+      }
     }
     heuristics_.erase(oldest);
   }
   // Backward over the edges (the robot's heading: the edge it arrived by), turns included: the
   // exact time to the goal with nobody in the way, so a robot alone is searched along its path.
-  // Summed in double and each value stored rounded down to a float once (never above the
-  // forward search's sums; rounding at every step instead compounds — 0.2 s at 300 s from the
-  // goal — and makes every state nearer the start look better, so the search went breadth first).
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<double> node(graph_.size(), kInf), edge(edgeTail_.size(), kInf);
-  using Item = std::pair<double, std::uint32_t>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
-  node[static_cast<std::size_t>(goal)] = 0.0;
   // Every edge gets its value, open or not (a robot may have arrived by an edge closed since, or
-  // stand on a closed node: it may still drive off); only usable moves are searched on from.
+  // stand on a closed node: it may still drive off); only usable moves are searched on from. The
+  // search runs only as far as the values read need (settle()). Summed in double, each value kept
+  // rounded down to a float (never above the forward search's sums; rounding at every step instead
+  // compounds — 0.2 s at 300 s from the goal — and made every state nearer the start look better,
+  // so the search went breadth first).
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  Heuristic h{std::vector<float>(graph_.size(), kInf),
+              std::vector<float>(edgeTail_.size(), kInf),
+              {},
+              goal,
+              useClock_};
+  h.node[static_cast<std::size_t>(goal)] = 0.0F;
   for (const std::uint32_t e : reverse_[static_cast<std::size_t>(goal)]) {
-    edge[e] = 0.0;
+    h.edge[e] = 0.0F;
     if (usable(e))
-      heap.emplace(0.0, e);
+      h.heap.emplace_back(0.0, e);
   }
-  while (!heap.empty()) {
-    const auto [hf, f] = heap.top();
-    heap.pop();
-    if (hf > edge[f])
-      continue;
+  std::make_heap(h.heap.begin(), h.heap.end(), std::greater<>());
+  return heuristics_.emplace(goal, std::move(h)).first->second;
+}
+
+void Sipp::settle(Heuristic& h, const float& value) {
+  // A value below every key left is final: a later candidate is at least its key, and rounds down
+  // to no less than the value.
+  while (!h.heap.empty() && h.heap.front().first <= static_cast<double>(value)) {
+    std::pop_heap(h.heap.begin(), h.heap.end(), std::greater<>());
+    const auto [hf, f] = h.heap.back();
+    h.heap.pop_back();
+    if (down(hf) > h.edge[f])
+      continue;  // a lower value came since
     // f = v → w: from arriving at v, leaving by f costs its turn, its duration and h(f).
     const NodeId v = edgeTail_[f];
     const std::size_t k = f - edgeStart_[static_cast<std::size_t>(v)];
     const double viaF = graph_.edges(v)[k].duration + hf;
-    if (v == goal)
+    if (v == h.goal)
       continue;  // arriving at the goal ends the way
-    node[static_cast<std::size_t>(v)] = std::min(node[static_cast<std::size_t>(v)], viaF);
+    h.node[static_cast<std::size_t>(v)] = std::min(h.node[static_cast<std::size_t>(v)], down(viaF));
     for (const std::uint32_t e : reverse_[static_cast<std::size_t>(v)]) {
       const double cand = turnAt(edgeTail_[e], static_cast<std::int32_t>(e), v, k) + viaF;
-      if (cand < edge[e]) {
-        edge[e] = cand;
-        if (usable(e))
-          heap.emplace(cand, e);
+      if (down(cand) < h.edge[e]) {
+        h.edge[e] = down(cand);
+        if (usable(e)) {
+          h.heap.emplace_back(cand, e);
+          std::push_heap(h.heap.begin(), h.heap.end(), std::greater<>());
+        }
       }
     }
   }
-  const auto down = [](double d) {
-    auto f = static_cast<float>(d);
-    return static_cast<double>(f) > d ? std::nextafter(f, 0.0F) : f;
-  };
-  Heuristic h{std::vector<float>(node.size()), std::vector<float>(edge.size()), useClock_};
-  std::transform(node.begin(), node.end(), h.node.begin(), down);
-  std::transform(edge.begin(), edge.end(), h.edge.begin(), down);
-  return heuristics_.emplace(goal, std::move(h)).first->second;
+  if (h.heap.empty())
+    h.heap.shrink_to_fit();
+}
+
+double Sipp::toGoal(Heuristic& h, NodeId v, std::int64_t in) {
+  const float& x = in >= 0 ? h.edge[static_cast<std::size_t>(in)] : h.node[static_cast<std::size_t>(v)];
+  if (!h.heap.empty() && h.heap.front().first <= static_cast<double>(x))
+    settle(h, x);
+  return x == std::numeric_limits<float>::infinity() ? kForever : static_cast<double>(x);
 }
 
 double Sipp::drivingTime(NodeId v, NodeId goal) {
   if (!graph_.valid(v) || !graph_.valid(goal))
     return kForever;
-  const float h = heuristic(goal).node[static_cast<std::size_t>(v)];
-  return h == std::numeric_limits<float>::infinity() ? kForever : static_cast<double>(h);
+  return toGoal(heuristic(goal), v, -1);
 }
 
 const std::vector<Interval>& Sipp::intervals(const ReservationTable& table, NodeId v, double from) {
@@ -194,13 +216,12 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
   }
   ++stamp_;
   // A refuge has no heuristic (Dijkstra in time).
-  const Heuristic* h = refuge ? nullptr : &heuristic(q.goal);
+  Heuristic* h = refuge ? nullptr : &heuristic(q.goal);
   // From a node arrived at by edge `in` (-1: no heading).
   auto hOf = [&](NodeId v, std::int64_t in) {
     if (h == nullptr)
       return 0.0;
-    return static_cast<double>(in >= 0 ? h->edge[static_cast<std::size_t>(in)]
-                                       : h->node[static_cast<std::size_t>(v)]);
+    return toGoal(*h, v, in);
   };
   auto isGoal = [&](NodeId v) {
     return refuge ? (q.avoid == nullptr || (*q.avoid)[static_cast<std::size_t>(v)] == 0) : v == q.goal;

@@ -79,10 +79,14 @@ class Sipp {
     double depart;  ///< when it left the parent's node
     double intervalEnd;
   };
-  /// Per goal: the time to it from each node (no heading) and from arriving by each edge.
+  /// Per goal: the time to it from each node (no heading) and from arriving by each edge, by a
+  /// backward search run only as far as the values read need: a value is final once no key left
+  /// in the search's heap is below it.
   struct Heuristic {
     std::vector<float> node;
     std::vector<float> edge;
+    std::vector<std::pair<double, std::uint32_t>> heap;  ///< the search's frontier (a min-heap)
+    NodeId goal = kNoNode;
     std::uint64_t used = 0;  ///< when last read (least recently used dropped first)
   };
   /// The earliest arrival found so far per state (the edge arrived by, the safe interval): a
@@ -99,7 +103,11 @@ class Sipp {
   /// The best arrival of the state (its slot, its interval), inserting `arrive` when it has none;
   /// returns the entry and whether it was new.
   std::pair<Best*, bool> bestOf(std::size_t slot, std::int32_t interval, double arrive);
-  const Heuristic& heuristic(NodeId goal);
+  Heuristic& heuristic(NodeId goal);
+  /// Runs the goal's backward search until `value` (one of its values, read as it changes) is final.
+  void settle(Heuristic& h, const float& value);
+  /// The final time to the goal from node `v` arrived at by edge `in` (-1: no heading).
+  double toGoal(Heuristic& h, NodeId v, std::int64_t in);
   void index();
   /// The turn at `at` from arriving by edge `inEdge` (from `from`) into its out-edge `out`.
   double turnAt(NodeId from, std::int32_t inEdge, NodeId at, std::size_t out);
