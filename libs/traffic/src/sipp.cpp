@@ -13,8 +13,11 @@ namespace {
 /// robots: ~0.6 MB).
 constexpr std::size_t kSippHeuristicBytes = std::size_t{256} << 20;
 
-/// f is ordered in steps of this many s: states whose f differs by less than the heuristic's
-/// float rounding are ties, taken deepest first (a lattice has many ways of the same length).
+/// f is ordered in steps of this many s, counted from the start's f and rounded to the nearest:
+/// states whose f differs by less than the sums' rounding are ties, taken deepest first (a lattice
+/// has many ways of the same length; with an exact heuristic they all have the start's f, in the
+/// middle of its step whatever the durations — a grid of steps fixed in time split them whenever
+/// their f fell on a step's edge, e.g. 0.1 s edges from a whole second).
 constexpr double kFStep = 1e-3;
 /// The heap's order (std::push_heap keeps the largest on top): least f first, then the later
 /// arrival (deeper).
@@ -24,8 +27,8 @@ float down(double d) {
   const auto f = static_cast<float>(d);
   return static_cast<double>(f) > d ? std::nextafter(f, 0.0F) : f;
 }
-std::int64_t fKey(double f) {
-  return static_cast<std::int64_t>(std::floor(f / kFStep));
+std::int64_t fKey(double f, double f0) {
+  return static_cast<std::int64_t>(std::llround((f - f0) / kFStep));
 }
 }  // namespace
 
@@ -97,9 +100,16 @@ Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
   }
   index();
   ++stats_.heuristics;
-  // A table's values (its search's heap comes and goes).
-  const std::size_t bytes = sizeof(float) * (graph_.size() + edgeTail_.size());
-  while (!heuristics_.empty() && (heuristics_.size() + 1) * bytes > kSippHeuristicBytes) {
+  // Every table's values and what is left of its search's heap, with a new one's values.
+  const auto held = [&] {
+    std::size_t b = sizeof(float) * (graph_.size() + edgeTail_.size());
+    for (const auto& [g, table] : heuristics_) {
+      b += sizeof(float) * (table.node.size() + table.edge.size()) +
+           sizeof(std::pair<double, std::uint32_t>) * table.heap.capacity();
+    }
+    return b;
+  };
+  while (!heuristics_.empty() && held() > kSippHeuristicBytes) {
     NodeId oldest = kNoNode;
     std::uint64_t oldestUse = std::numeric_limits<std::uint64_t>::max();
     for (const auto& [g, table] : heuristics_) {
@@ -135,8 +145,8 @@ Sipp::Heuristic& Sipp::heuristic(NodeId goal) {
 }
 
 void Sipp::settle(Heuristic& h, const float& value) {
-  // A value below every key left is final: a later candidate is at least its key, and rounds down
-  // to no less than the value.
+  // A value below every key left is final: a later candidate is at least that key, and rounds
+  // down to no less than the value.
   while (!h.heap.empty() && h.heap.front().first <= static_cast<double>(value)) {
     std::pop_heap(h.heap.begin(), h.heap.end(), std::greater<>());
     const auto [hf, f] = h.heap.back();
@@ -152,6 +162,9 @@ void Sipp::settle(Heuristic& h, const float& value) {
     h.node[static_cast<std::size_t>(v)] = std::min(h.node[static_cast<std::size_t>(v)], down(viaF));
     for (const std::uint32_t e : reverse_[static_cast<std::size_t>(v)]) {
       const double cand = turnAt(edgeTail_[e], static_cast<std::int32_t>(e), v, k) + viaF;
+      // A lower sum that rounds to the same float is not searched on from: a value may stand up to
+      // a float step per edge of its way above the least sum (~1e-5 s at 100 s from the goal; the
+      // search's arrival is that much from the earliest at most, far below its 1 ms steps).
       if (down(cand) < h.edge[e]) {
         h.edge[e] = down(cand);
         if (usable(e)) {
@@ -214,7 +227,11 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
     intervals_.assign(graph_.size(), {});
     stamp_ = 0;
   }
-  ++stamp_;
+  if (++stamp_ == 0) {  // wrapped: every stamp might look current again
+    std::fill(intervalStamp_.begin(), intervalStamp_.end(), 0);
+    std::fill(bestStamp_.begin(), bestStamp_.end(), 0);
+    stamp_ = 1;
+  }
   // A refuge has no heuristic (Dijkstra in time).
   Heuristic* h = refuge ? nullptr : &heuristic(q.goal);
   // From a node arrived at by edge `in` (-1: no heading).
@@ -245,7 +262,8 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
   }
   const auto startEdge = static_cast<std::int32_t>(startIn);
   states_.push_back({q.start, q.cameFrom, startEdge, 0, -1, q.startTime, q.startTime, startIv.front().to});
-  open_.push_back({fKey(q.startTime + hOf(q.start, startIn)), q.startTime, 0});
+  const double f0 = q.startTime + hOf(q.start, startIn);
+  open_.push_back({0, q.startTime, 0});
   bestOf(slotOf(q.start, startEdge), 0, q.startTime);
   std::size_t expanded = 0;
   std::int32_t found = -1;
@@ -298,7 +316,7 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
           best->arrive = arrive;
         }
         states_.push_back({w, s.node, viaE, static_cast<std::int32_t>(j), top.state, arrive, depart, iw.to});
-        open_.push_back({fKey(arrive + hw), arrive, static_cast<std::int32_t>(states_.size() - 1)});
+        open_.push_back({fKey(arrive + hw, f0), arrive, static_cast<std::int32_t>(states_.size() - 1)});
         std::push_heap(open_.begin(), open_.end(), kLaterFirst);
       }
     }

@@ -184,35 +184,40 @@ TEST(Sipp, AloneItDrivesTheShortestWayWithItsTurns) {
 }
 
 TEST(Sipp, AloneOnALargeGridItSearchesAlongItsWayNotTheGrid) {
-  // 120 x 120 nodes 0.5 s apart, no turning time, corner to corner: every staircase is a way of
-  // the same length. With the exact heuristic a robot alone is searched along one of them: a few
-  // states per node of its way. The heuristic's float rounding must not make states nearer the
-  // start look better (it once compounded step by step, and this search went over the whole grid).
+  // 120 x 120 nodes, no turning time, corner to corner: every staircase is a way of the same length.
+  // With the exact heuristic a robot alone is searched along one of them: a few states per node of
+  // its way. Ties must stay ties: the heuristic's float rounding once compounded step by step and
+  // made states nearer the start look better, and f in steps fixed in time split ties whose f fell
+  // on a step's edge (0.3 s and 0.1 s edges, or a start half a millisecond in).
   constexpr int n = 120;
-  Graph g;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      g.addNode({0.5 * x, 0.5 * y});
-  for (int y = 0; y < n; ++y) {
-    for (int x = 0; x < n; ++x) {
-      const int v = y * n + x;
-      if (x + 1 < n) {
-        g.addEdge(v, v + 1, 0.5);
-        g.addEdge(v + 1, v, 0.5);
+  for (const double d : {0.5, 0.3, 0.1}) {
+    for (const double start : {0.0, 0.0005}) {
+      Graph g;
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          g.addNode({0.5 * x, 0.5 * y});
+      for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+          const int v = y * n + x;
+          if (x + 1 < n) {
+            g.addEdge(v, v + 1, d);
+            g.addEdge(v + 1, v, d);
+          }
+          if (y + 1 < n) {
+            g.addEdge(v, v + n, d);
+            g.addEdge(v + n, v, d);
+          }
+        }
       }
-      if (y + 1 < n) {
-        g.addEdge(v, v + n, 0.5);
-        g.addEdge(v + n, v, 0.5);
-      }
+      Sipp sipp(g);
+      ReservationTable t(g);
+      const auto p = sipp.plan(t, {0, kNoNode, start, n * n - 1});
+      ASSERT_TRUE(p.has_value());
+      EXPECT_NEAR(p->back().arrive, start + (2 * (n - 1)) * d, 1e-3);
+      EXPECT_EQ(p->size(), static_cast<std::size_t>(2 * (n - 1) + 1));
+      EXPECT_LE(sipp.stats().expanded, 4 * p->size()) << d << " s edges from " << start << " s";
     }
   }
-  Sipp sipp(g);
-  ReservationTable t(g);
-  const auto p = sipp.plan(t, {0, kNoNode, 0.0, n * n - 1});
-  ASSERT_TRUE(p.has_value());
-  EXPECT_NEAR(p->back().arrive, (2 * (n - 1)) * 0.5, 1e-3);
-  EXPECT_EQ(p->size(), static_cast<std::size_t>(2 * (n - 1) + 1));
-  EXPECT_LE(sipp.stats().expanded, 4 * p->size()) << "of " << g.size() << " nodes";
 }
 
 TEST(Sipp, ItWaitsForARobotCrossingItsWayRatherThanDriveIntoIt) {
@@ -261,11 +266,20 @@ TEST(Sipp, AGoalsTableIsThePlainFixedPointWhateverOrderItIsReadIn) {
   // A goal's table is searched only as far as the values read need. Read in a random order, a
   // little at a time, every value is the one a plain fixed point over (edge arrived by) gives:
   // t(u→v) = 0 at the goal, else the least turn + duration + t(next edge); a node's time the least
-  // over its edges out.
+  // over its edges out. Durations and turns that are no binary fractions, so the floats round.
   std::mt19937_64 rng(5);
   for (int trial = 0; trial < 40; ++trial) {
-    const Graph g = test::randomDigraph(60, 6, false, rng);
-    const auto turn = quarterTurns(g);
+    const Graph quarters = test::randomDigraph(60, 6, false, rng);
+    Graph g;
+    for (NodeId u = 0; static_cast<std::size_t>(u) < quarters.size(); ++u)
+      g.addNode(quarters.position(u));
+    for (NodeId u = 0; static_cast<std::size_t>(u) < quarters.size(); ++u)
+      for (const Edge& e : quarters.edges(u))
+        g.addEdge(u, e.to, 1.1 * e.duration);
+    const auto quarter = quarterTurns(g);
+    const Sipp::TurnTime turn = [&quarter](NodeId a, NodeId b, NodeId c) {
+      return 0.7 * quarter(a, b, c) + (quarter(a, b, c) > 0.0 ? 0.1 : 0.0);
+    };
     const NodeId goal = static_cast<NodeId>(trial % 60);
     struct E {
       NodeId from, to;
@@ -304,8 +318,19 @@ TEST(Sipp, AGoalsTableIsThePlainFixedPointWhateverOrderItIsReadIn) {
       if (want == kForever) {
         EXPECT_EQ(got, kForever) << "trial " << trial << " node " << v;
       } else {
-        EXPECT_LE(got, want) << "trial " << trial << " node " << v;  // kept rounded down
-        EXPECT_GE(got, want - 1e-4) << "trial " << trial << " node " << v;
+        // Kept as floats rounded down: within a float step per edge of the way (sipp.cpp).
+        EXPECT_NEAR(got, want, 1e-4) << "trial " << trial << " node " << v;
+      }
+    }
+    // The values by the edge arrived by, read through a lone robot's search from that heading.
+    ReservationTable t(g);
+    for (std::size_t j = 0; j < edges.size(); j += 7) {
+      const auto p = sipp.plan(t, {edges[j].to, edges[j].from, 0.0, goal});
+      ASSERT_EQ(p.has_value(), te[j] < kForever || edges[j].to == goal) << "trial " << trial << " edge " << j;
+      if (p && edges[j].to != goal) {
+        // (turns are kept as floats: a few 1e-8 s each)
+        EXPECT_GE(p->back().arrive, te[j] - 1e-6) << "trial " << trial << " edge " << j;
+        EXPECT_LE(p->back().arrive, te[j] + 1e-3) << "trial " << trial << " edge " << j;
       }
     }
   }
@@ -350,7 +375,9 @@ TEST(Sipp, EarliestArrivalMatchesAPlainSearchOverEveryQuarterSecond) {
         << "trial " << trial << " sipp " << (p ? p->back().arrive : -1.0) << " plain " << plain;
     if (p) {
       ++found;
-      EXPECT_NEAR(p->back().arrive, plain, 1e-3) << "trial " << trial;  // f in 1 ms steps
+      // Never before the earliest; at most a step of f (1 ms) after it.
+      EXPECT_GE(p->back().arrive, plain - 1e-9) << "trial " << trial;
+      EXPECT_LE(p->back().arrive, plain + 1e-3) << "trial " << trial;
       EXPECT_EQ(t.firstConflict(*p), -1) << "trial " << trial;
       EXPECT_EQ(p->front().node, start);
       EXPECT_EQ(p->back().node, goal);

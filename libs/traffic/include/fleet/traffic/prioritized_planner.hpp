@@ -52,7 +52,7 @@ struct PrioritizedOptions {
   double window = 5.0;  ///< s of reservations that count (from the earliest ready)
   /// States per robot's search. A search that runs out is a robot whose way is shut: on the site for
   /// 100 with 100 robots those were three fifths of every state searched at 5,000; at 2,000 the
-  /// virtual fleet does as many tasks (docs/benchmarks.md, "A timed core").
+  /// virtual fleet does as many tasks (docs/algorithms.md, "What a search costs").
   std::size_t maxExpansions = 2000;
   int yieldRounds = 1;  ///< plans again with robots yielding at most this often
   /// A robot that is where its last plan has it within this many s keeps the rest of that plan

@@ -7,11 +7,12 @@
 // interval), turn on the spot and drive an edge, each at its real duration; the result is the
 // earliest arrival at the goal that keeps to every other robot's reservations and can stay there
 // until `holdUntil`. A* over those states with the goal's driving time with its turns from the
-// edge the robot arrived by as the heuristic (a robot alone's own time, each value rounded down to
-// a float: admissible; with others waiting only adds), so the earliest arrival is exact to the
-// millisecond (SIPP's optimality, heading included; states are ordered by f in 1 ms steps, deepest
-// first within one, so the many equally short ways of a lattice are not all searched; the tests
-// check it against a search over every time step).
+// edge the robot arrived by as the heuristic (a robot alone's own time, kept as floats rounded
+// down from double sums: within a float step per edge of it; with others waiting only adds), so the
+// arrival is the earliest to within a millisecond (SIPP's optimality, heading included; states are
+// ordered by f in 1 ms steps counted from the start's f, deepest first within one, so the many
+// equally short ways of a lattice are not all searched; the tests check it against a search over
+// every time step).
 
 #include <cstdint>
 #include <functional>
