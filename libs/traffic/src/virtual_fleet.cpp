@@ -596,10 +596,7 @@ VirtualFleetResult runVirtualFleet(Roadmap& roadmap, const VirtualFleetOptions& 
   res.yields = traffic.timedStats().yields;
   res.refuges = traffic.timedStats().refuges;
   res.refusedMoves = traffic.stats().refusedMoves;
-  res.searches = traffic.searchStats().searches;
-  res.searchFailures = traffic.searchStats().failures;
-  res.searchExpanded = traffic.searchStats().expanded;
-  res.goalTables = traffic.searchStats().heuristics;
+  res.search = traffic.searchStats();
   res.lineScale = governor.scale();
   for (std::size_t r = 0; r < traffic.robots(); ++r)
     res.baseEnds += traffic.baseEnds(r);

@@ -78,10 +78,10 @@ void BM_TrafficTick(benchmark::State& state) {
   state.counters["planner_steps"] = static_cast<double>(r.plannerSteps);
   state.counters["detours"] = static_cast<double>(r.detours);
   state.counters["tasks_done"] = static_cast<double>(r.tasksDone);
-  state.counters["searches"] = static_cast<double>(r.searches);
-  state.counters["search_failures"] = static_cast<double>(r.searchFailures);
-  state.counters["expanded"] = static_cast<double>(r.searchExpanded);
-  state.counters["goal_tables"] = static_cast<double>(r.goalTables);
+  state.counters["searches"] = static_cast<double>(r.search.searches);
+  state.counters["search_failures"] = static_cast<double>(r.search.failures);
+  state.counters["expanded"] = static_cast<double>(r.search.expanded);
+  state.counters["goal_tables"] = static_cast<double>(r.search.heuristics);
 }
 BENCHMARK(BM_TrafficTick)
     ->ArgNames({"robots", "everyone", "core"})

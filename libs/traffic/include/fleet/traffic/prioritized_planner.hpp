@@ -94,8 +94,6 @@ class PrioritizedPlanner {
     sipp_.graphChanged();
     previous_.clear();
   }
-  /// The table the last plan() left (tests).
-  [[nodiscard]] const ReservationTable& reservations() const { return table_; }
 
  private:
   void reserveFixed(std::span<const PlanRequest> robots, bool starts);

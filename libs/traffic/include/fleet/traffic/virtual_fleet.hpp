@@ -115,11 +115,8 @@ struct VirtualFleetResult {
   std::uint64_t refuges = 0;
   std::uint64_t refusedMoves = 0;
   /// The timed core's single-robot searches: how many, how many found no way, states expanded and
-  /// goals' driving-time tables computed (SippStats).
-  std::uint64_t searches = 0;
-  std::uint64_t searchFailures = 0;
-  std::uint64_t searchExpanded = 0;
-  std::uint64_t goalTables = 0;
+  /// goals' driving-time tables computed.
+  SippStats search;
   /// The admission governor's factor on the lines' places at the end (admission by slots; 1: none).
   double lineScale = 1.0;
   BaseEnds baseEnds;         ///< the robots' base ends reached short of their target, summed
