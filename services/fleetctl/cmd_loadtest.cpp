@@ -62,6 +62,12 @@ void addLoadtestCommand(CLI::App& app, Commands& commands) {
                    "managers; 0: none; default: theirs)")
       ->check(CLI::Range(0.0, 100.0));
   loadtest
+      ->add_option("--core", o->core,
+                   "reserved traffic: the traffic manager's planner core, pibt (lifelong PIBT, one step at a "
+                   "time) or sipp (windowed prioritized planning over safe intervals; default: the traffic "
+                   "manager's)")
+      ->check(CLI::IsMember({"pibt", "sipp"}));
+  loadtest
       ->add_option("--yield-after", o->yieldAfterS,
                    "reserved traffic: seconds a robot reports itself blocked (a person in front of it) "
                    "before it is made to yield; 0: never (default: the traffic manager's)")

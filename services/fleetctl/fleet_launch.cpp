@@ -99,6 +99,9 @@ struct Builder {
     if (o.letPass >= 0) {
       tm["let_pass"] = o.letPass;
     }
+    if (!o.core.empty()) {
+      tm["core"] = o.core;
+    }
     if (o.yieldAfterS >= 0.0) {
       tm["yield_after_s"] = o.yieldAfterS;
     }

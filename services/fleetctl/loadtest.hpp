@@ -37,6 +37,7 @@ struct LoadtestOptions {
   std::string agentConfig;    // robot agents' --config (a JSON file; empty: none)
   int letPass = -1;           // the traffic manager's let_pass (route nodes; 0 off); -1: its default
   double guidance = -1.0;     // roadmap.guidance of the traffic and fleet managers; <0: their default
+  std::string core;           // the traffic manager's planner core (pibt or sipp); empty: its default
   double yieldAfterS = -1.0;  // the traffic manager's yield_after_s (0 off); < 0: its default
   /// The fleet manager's station_load (task or phase) and station_capacity (active tasks per
   /// station, "0": no limit, or "queue": as many as the station's line on the roadmap holds, dock

@@ -16,7 +16,7 @@ struct TrafficSimOptions {
   int robots = 20;
   double duration = 600.0;
   std::string seeds = "1";    ///< "1-8" or "3"
-  std::string core = "pibt";  ///< the traffic layer's planner core (TrafficOptions::core)
+  std::string core = "sipp";  ///< the traffic layer's planner core (TrafficOptions::core)
   double spacing = 0.0;       ///< roadmap lattice spacing (m); 0: the default
   double stopChance = 0.01;
   double turnScale = 1.0;       ///< the virtual robots' turns on the spot take this times their time

@@ -26,7 +26,7 @@ Settings readSettings(Config& cfg) {
                          "clock",         "lockstep",    "max_lag",      "base_ahead",      "max_base_nodes",
                          "horizon_nodes", "seed",        "detour_after", "detour_penalty",  "occupied_cost_s",
                          "station_lines", "let_pass",    "roadmap",      "risk_cost_s",     "risk_period_s",
-                         "yield_after_s", "yield_for_s", "yield_cost_s", "summary_file"});
+                         "yield_after_s", "yield_for_s", "yield_cost_s", "summary_file",    "core"});
   s.site = cfg.string("site", "");
   s.summaryFile = cfg.string("summary_file", "");
   s.rateHz = cfg.number("rate_hz", 10.0, {0.0, 1000.0, true});
@@ -38,6 +38,8 @@ Settings readSettings(Config& cfg) {
   s.stationLines = cfg.boolean("station_lines", s.stationLines);
   if (s.lockstep && s.clock != "sim")
     cfg.problem("lockstep", "requires \"clock\": \"sim\"");
+  s.traffic.core =
+      *traffic::plannerCoreFrom(cfg.string("core", traffic::toString(s.traffic.core), {"pibt", "sipp"}));
   s.traffic.maxLag = cfg.integer("max_lag", s.traffic.maxLag, {1, 100000});
   s.traffic.letPassBehind = cfg.integer("let_pass", s.traffic.letPassBehind, {0, 100000});
   s.traffic.release.baseAhead = cfg.number("base_ahead", s.traffic.release.baseAhead, {0.0, 100.0});

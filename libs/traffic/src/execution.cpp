@@ -103,41 +103,9 @@ void Execution::append(std::span<const NodeId> next) {
     for (std::size_t r : movers)
       routes_[r].entries.pop_back();
   };
-  // Dependencies: wait until the last visitor of every node excluding the target has moved on to
-  // The first node of its route that no longer conflicts with the target.
-  std::vector<std::int64_t> need(n, -1);
   std::vector<std::vector<std::size_t>> sameStep(n);
-  for (std::size_t r : movers) {
-    auto& entry = routes_[r].entries.back();
-    const NodeId v = entry.node;
-    std::fill(need.begin(), need.end(), -1);
-    auto visitor = [&](NodeId x) {
-      const Visit lv = lastVisit_[static_cast<std::size_t>(x)];
-      if (lv.robot < 0 || static_cast<std::size_t>(lv.robot) == r)
-        return;
-      const auto q = static_cast<std::size_t>(lv.robot);
-      const Route& qr = routes_[q];
-      // After letPass() a visitor may stand later in the order than this step: stay behind it.
-      if (lv.index >= qr.first)
-        entry.order = std::max(entry.order, qr[lv.index].order + 1);
-      std::int64_t i = std::max(lv.index + 1, qr.first);
-      while (i <= qr.last() && graph_.conflicting(qr[i].node, v))
-        ++i;
-      // i <= last: the configuration check guarantees q's current node does not conflict.
-      need[q] = std::max(need[q], i);
-    };
-    visitor(v);
-    for (NodeId x : graph_.conflicts(v))
-      visitor(x);
-    for (std::size_t q = 0; q < n; ++q) {
-      if (need[q] < 0 || routes_[q].progress >= need[q])
-        continue;
-      entry.deps.push_back(Dependency{static_cast<std::uint32_t>(q), need[q]});
-      const bool movesNow = routes_[q].entries.back().step == step;
-      if (movesNow && need[q] == routes_[q].last())
-        sameStep[r].push_back(q);
-    }
-  }
+  for (std::size_t r : movers)
+    sameStep[r] = depend(r, step);
   // A cycle of same-step dependencies (a rotation, or a swap) could never be executed.
   std::vector<std::uint8_t> mark(n, 0);  // 0 new, 1 on the stack, 2 done
   std::vector<std::size_t> cycle;
@@ -188,6 +156,80 @@ void Execution::append(std::span<const NodeId> next) {
     const auto& route = routes_[r];
     lastVisit_[static_cast<std::size_t>(route.entries.back().node)] =
         Visit{static_cast<std::int32_t>(r), route.last()};
+  }
+  step_ = step;
+}
+
+std::vector<std::size_t> Execution::depend(std::size_t r, std::int64_t step) {
+  // Wait until the last visitor of every node excluding the target has moved on to the first node
+  // of its route that no longer conflicts with the target.
+  auto& entry = routes_[r].entries.back();
+  const NodeId v = entry.node;
+  std::vector<std::pair<std::size_t, std::int64_t>> need;  // robot, route index: a conflict set's few
+  auto visitor = [&](NodeId x) {
+    const Visit lv = lastVisit_[static_cast<std::size_t>(x)];
+    if (lv.robot < 0 || static_cast<std::size_t>(lv.robot) == r)
+      return;
+    const auto q = static_cast<std::size_t>(lv.robot);
+    const Route& qr = routes_[q];
+    // After letPass() a visitor may stand later in the order than this step: stay behind it.
+    if (lv.index >= qr.first)
+      entry.order = std::max(entry.order, qr[lv.index].order + 1);
+    std::int64_t i = std::max(lv.index + 1, qr.first);
+    while (i <= qr.last() && graph_.conflicting(qr[i].node, v))
+      ++i;
+    // i <= last: the configuration check guarantees q's current node does not conflict.
+    const auto it = std::find_if(need.begin(), need.end(), [&](const auto& n) { return n.first == q; });
+    if (it == need.end())
+      need.emplace_back(q, i);
+    else
+      it->second = std::max(it->second, i);
+  };
+  visitor(v);
+  for (NodeId x : graph_.conflicts(v))
+    visitor(x);
+  std::sort(need.begin(), need.end());  // by robot, as the dependencies have always been listed
+  std::vector<std::size_t> sameStep;
+  for (const auto& [q, i] : need) {
+    if (routes_[q].progress >= i)
+      continue;
+    entry.deps.push_back(Dependency{static_cast<std::uint32_t>(q), i});
+    const bool movesNow = routes_[q].entries.back().step == step;
+    if (movesNow && i == routes_[q].last())
+      sameStep.push_back(q);
+  }
+  return sameStep;
+}
+
+void Execution::appendMove(std::size_t robot, NodeId to) {
+  auto fail = [](const std::string& what) { throw PlanStepError("plan step refused: " + what); };
+  if (robot >= routes_.size())
+    fail("no robot " + std::to_string(robot));
+  const NodeId from = routes_[robot].entries.back().node;
+  if (!graph_.valid(to))
+    fail("robot " + std::to_string(robot) + " to node " + std::to_string(to) + " off the graph");
+  const std::int64_t step = step_ + 1;
+  if (to != from) {
+    const Edge* e = graph_.edge(from, to);
+    if (e == nullptr || !graph_.isOpen(to)) {
+      fail("robot " + std::to_string(robot) + " from node " + std::to_string(from) + " to " +
+           std::to_string(to) + ": no open edge");
+    }
+    for (std::size_t q = 0; q < routes_.size(); ++q) {
+      const NodeId at = routes_[q].entries.back().node;
+      if (q == robot || (at != to && !graph_.conflicting(at, to)))
+        continue;
+      const auto [a, b] = std::minmax(robot, q);
+      fail(at == to ? "robots " + std::to_string(a) + " and " + std::to_string(b) + " on node " +
+                          std::to_string(to)
+                    : "robots " + std::to_string(robot) + " and " + std::to_string(q) +
+                          " on conflicting nodes " + std::to_string(to) + " and " + std::to_string(at));
+    }
+    auto& route = routes_[robot];
+    const std::int64_t order = std::max(step * kOrderPerStep, route.entries.back().order + 1);
+    route.entries.push_back(Entry{to, step, (graph_.position(to) - graph_.position(from)).norm(), {}, order});
+    depend(robot, step);  // nobody else moves in this step: no same-step dependency
+    lastVisit_[static_cast<std::size_t>(to)] = Visit{static_cast<std::int32_t>(robot), route.last()};
   }
   step_ = step;
 }

@@ -52,6 +52,21 @@ bool PrioritizedPlanner::keepsPlace(const PlanRequest& r) const {
   return r.line >= 0 && lineOf_.size() == graph_.size() && lineOf_[static_cast<std::size_t>(r.at)] == r.line;
 }
 
+void PrioritizedPlanner::setNodeCost(std::vector<float> cost) {
+  const std::vector<float> before = sipp_.nodeCost();
+  if (!sipp_.setNodeCost(std::move(cost)))
+    return;
+  const auto& now = sipp_.nodeCost();
+  const auto at = [](const std::vector<float>& c, NodeId v) {
+    return c.empty() ? 0.0F : c[static_cast<std::size_t>(v)];
+  };
+  for (auto& path : previous_) {
+    if (std::any_of(path.begin(), path.end(),
+                    [&](const TimedNode& n) { return at(now, n.node) > at(before, n.node); }))
+      path.clear();
+  }
+}
+
 std::optional<TimedPath> PrioritizedPlanner::reuse(std::size_t i, const PlanRequest& r) const {
   // The rest of its last plan, when it is where that plan has it about when it has it there, the
   // plan still goes to its goal and still keeps to everyone's reservations (moved later by how

@@ -184,6 +184,15 @@ double Sipp::toGoal(Heuristic& h, NodeId v, std::int64_t in) {
   return x == std::numeric_limits<float>::infinity() ? kForever : static_cast<double>(x);
 }
 
+bool Sipp::setNodeCost(std::vector<float> cost) {
+  if (std::all_of(cost.begin(), cost.end(), [](float c) { return c == 0.0F; }))
+    cost.clear();
+  if (cost == cost_)
+    return false;
+  cost_ = std::move(cost);  // the goals' tables stay: costs are not in them (sipp.hpp)
+  return true;
+}
+
 double Sipp::drivingTime(NodeId v, NodeId goal) {
   if (!graph_.valid(v) || !graph_.valid(goal))
     return kForever;
@@ -295,7 +304,8 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
       const double turn = turnAt(s.from, s.inEdge, s.node, k);
       const double earliest = s.arrive + turn;
       // It stands on its node until it has arrived at the next.
-      const double latest = s.intervalEnd - e.duration;
+      const double took = duration(e);
+      const double latest = s.intervalEnd - took;
       if (earliest > latest)
         continue;
       const auto& ivs = intervals(table, w, q.startTime);
@@ -304,7 +314,7 @@ std::optional<TimedPath> Sipp::plan(const ReservationTable& table, const SippQue
         if (iw.from > latest)
           break;
         const double depart = std::max(earliest, iw.from);
-        const double arrive = depart + e.duration;
+        const double arrive = depart + took;
         if (depart > latest || arrive > iw.to)
           continue;
         const auto [best, fresh] =

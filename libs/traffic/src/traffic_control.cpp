@@ -585,6 +585,7 @@ void TrafficControl::graphChanged() {
 }
 
 void TrafficControl::setNodeCost(std::vector<float> cost) {
+  timed_.setNodeCost(cost);
   planner_->setNodeCost(std::move(cost));
 }
 

@@ -96,16 +96,12 @@ int TrafficControl::planTimed() {
   }
   std::sort(moves.begin(), moves.end());
 
-  std::vector<NodeId> config(ends.begin(), ends.end());
   int appended = 0;
   for (const auto& [time, r, node] : moves) {
-    const NodeId was = config[r];
-    config[r] = node;
     try {
-      execution_.append(config);
+      execution_.appendMove(r, node);
       ++appended;
     } catch (const PlanStepError&) {
-      config[r] = was;
       ++stats_.refusedMoves;
       break;
     }

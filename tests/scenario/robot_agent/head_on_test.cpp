@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -85,9 +86,13 @@ TEST(AgentLockstep, HeadOnInAPassageOneRobotWideResolves) {
   EXPECT_EQ(summary["contacts"]["robot_robot"], 0);
   EXPECT_EQ(summary["contacts"]["robot_shelf"], 0);
   EXPECT_EQ(summary["lockstep_step_timeouts"], 0);
-  // They did meet: the encounter, not two robots that never saw each other.
+  // They did meet, or the plan sent one round by the second passage (the timed core plans both
+  // ways in time, so one may go round rather than wait): the encounter was resolved, not two
+  // robots that never shared a way.
   const double closest = summary["min_separation_m"]["robot_robot"].get<double>();
-  std::cout << "closest robot-robot gap " << closest << " m\n";
-  EXPECT_LT(closest, 1.0);
+  const double d1 = summary["per_robot"]["r1"]["distance_m"].get<double>();
+  const double d2 = summary["per_robot"]["r2"]["distance_m"].get<double>();
+  std::cout << "closest robot-robot gap " << closest << " m; driven " << d1 << " / " << d2 << " m\n";
+  EXPECT_TRUE(closest < 1.0 || std::abs(d1 - d2) > 4.0) << "neither met nor went round";
   std::filesystem::remove_all(dir);
 }

@@ -191,6 +191,69 @@ TEST(Execution, BadReportsAreRefusedAndTheRobotStaysHeld) {
 /// its end (no deadlock). Plans are drawn step by step as a planner would: robots decide in random
 /// order, a robot may follow one that decided to move away, and half-way the unreleased plan is
 /// dropped and planning starts again from the released ends.
+// One robot's move appended by itself is the configuration with that move appended: the same
+// refusals, dependencies, releases and waits, on random moves (many refused: onto others, off the
+// edges) with robots reporting as they go, on a grid whose nodes exclude their neighbours.
+TEST(Execution, AMoveAppendedAloneIsTheConfigurationWithThatMove) {
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    std::mt19937 rng(seed);
+    const Graph g = grid(10, 7, seed % 2 == 0 ? 1 : 0, {12, 13, 33, 47});
+    std::vector<NodeId> pos;
+    for (NodeId v = 0; static_cast<std::size_t>(v) < g.size() && pos.size() < 9; v += 3) {
+      if (g.isOpen(v) && std::none_of(pos.begin(), pos.end(), [&](NodeId p) { return g.conflicting(p, v); }))
+        pos.push_back(v);
+    }
+    const std::size_t n = pos.size();
+    Execution whole(g, pos, ReleaseOptions{2.0, 4, 3});
+    Execution alone(g, pos, ReleaseOptions{2.0, 4, 3});
+    int refused = 0, moved = 0;
+    for (int k = 0; k < 400; ++k) {
+      const std::size_t r = rng() % n;
+      const auto out = g.edges(pos[r]);
+      // Mostly along an edge, sometimes a node it has no edge to, or standing still.
+      const NodeId to = rng() % 10 == 0                  ? static_cast<NodeId>(rng() % g.size())
+                        : out.empty() || rng() % 10 == 0 ? pos[r]
+                                                         : out[rng() % out.size()].to;
+      const bool moves = to != pos[r];
+      std::vector<NodeId> next = pos;
+      next[r] = to;
+      std::string a, b;
+      try {
+        whole.append(next);
+      } catch (const PlanStepError& e) {
+        a = e.what();
+      }
+      try {
+        alone.appendMove(r, to);
+      } catch (const PlanStepError& e) {
+        b = e.what();
+      }
+      ASSERT_EQ(a.empty(), b.empty()) << "seed " << seed << " move " << k << ": " << a << " | " << b;
+      if (a.empty()) {
+        pos = next;
+        moved += moves ? 1 : 0;
+      } else {
+        ++refused;
+      }
+      ASSERT_EQ(whole.plannedSteps(), alone.plannedSteps());
+      // Robots report their next released node now and then, the same on both.
+      for (std::size_t q = 0; q < n; ++q) {
+        const auto ra = whole.release(q);
+        const auto rb = alone.release(q);
+        ASSERT_EQ(ra.base, rb.base) << "seed " << seed << " move " << k << " robot " << q;
+        ASSERT_EQ(whole.describe(q), alone.describe(q)) << "seed " << seed << " move " << k;
+        ASSERT_EQ(whole.waitingOn(q), alone.waitingOn(q));
+        if (ra.base.size() > 1 && rng() % 3 == 0) {
+          ASSERT_EQ(whole.reached(q, ra.base[1]), Report::Accepted);
+          ASSERT_EQ(alone.reached(q, ra.base[1]), Report::Accepted);
+        }
+      }
+    }
+    EXPECT_GT(refused, 10) << "seed " << seed;
+    EXPECT_GT(moved, 100) << "seed " << seed;
+  }
+}
+
 void randomExecution(int exclusion, std::uint32_t seed, int* passes = nullptr) {
   std::mt19937 rng(seed);
   const int w = 12, h = 9;

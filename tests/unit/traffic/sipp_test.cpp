@@ -33,6 +33,28 @@ Graph lineGraph(int n) {
   return g;
 }
 
+/// A 3 x 3 grid 1 m apart (node y * 3 + x), 4-connected by 1 s edges both ways.
+Graph threeByThree() {
+  Graph g;
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 3; ++x)
+      g.addNode({static_cast<double>(x), static_cast<double>(y)});
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 3; ++x) {
+      const int v = y * 3 + x;
+      if (x + 1 < 3) {
+        g.addEdge(v, v + 1, 1.0);
+        g.addEdge(v + 1, v, 1.0);
+      }
+      if (y + 1 < 3) {
+        g.addEdge(v, v + 3, 1.0);
+        g.addEdge(v + 3, v, 1.0);
+      }
+    }
+  }
+  return g;
+}
+
 /// Turning on the spot: none straight on, 0.5 s for a bend, 1 s to go back the way it came.
 Sipp::TurnTime quarterTurns(const Graph& g) {
   return [&g](NodeId prev, NodeId at, NodeId next) {
@@ -149,23 +171,7 @@ TEST(SafeIntervals, AReservationSpreadsOverTheConflictsAndTheSafeIntervalsAreIts
 
 TEST(Sipp, AloneItDrivesTheShortestWayWithItsTurns) {
   // A 3 x 3 grid: from a corner to the opposite one, one bend (0.5 s) on the way.
-  Graph g;
-  for (int y = 0; y < 3; ++y)
-    for (int x = 0; x < 3; ++x)
-      g.addNode({static_cast<double>(x), static_cast<double>(y)});
-  for (int y = 0; y < 3; ++y) {
-    for (int x = 0; x < 3; ++x) {
-      const int v = y * 3 + x;
-      if (x + 1 < 3) {
-        g.addEdge(v, v + 1, 1.0);
-        g.addEdge(v + 1, v, 1.0);
-      }
-      if (y + 1 < 3) {
-        g.addEdge(v, v + 3, 1.0);
-        g.addEdge(v + 3, v, 1.0);
-      }
-    }
-  }
+  const Graph g = threeByThree();
   Sipp sipp(g, quarterTurns(g));
   ReservationTable t(g);
   const auto p = sipp.plan(t, {0, kNoNode, 0.0, 8});
@@ -181,6 +187,95 @@ TEST(Sipp, AloneItDrivesTheShortestWayWithItsTurns) {
   ASSERT_TRUE(back.has_value());
   EXPECT_DOUBLE_EQ(back->back().arrive, 2.0);
   EXPECT_DOUBLE_EQ(back->front().leave, 1.0);
+}
+
+// A node's cost (the risk map's, a yield's) is planned as time on the edges into it: the robot goes
+// round a dear node when that is sooner, and through it as if slowly otherwise.
+TEST(Sipp, ADearNodeIsGoneRoundWhenThatIsSoonerAndDrivenThroughAsTimeOtherwise) {
+  // A 3 x 3 grid; from 0 to 2 along the bottom row through 1 (2 s), or round by 3, 4, 5 (4 edges and
+  // two bends: 5 s).
+  const Graph g = threeByThree();
+  Sipp sipp(g, quarterTurns(g));
+  ReservationTable t(g);
+  const auto through = [](const TimedPath& p, NodeId v) {
+    return std::any_of(p.begin(), p.end(), [&](const TimedNode& n) { return n.node == v; });
+  };
+  const auto plain = sipp.plan(t, {0, kNoNode, 0.0, 2});
+  ASSERT_TRUE(plain.has_value());
+  EXPECT_DOUBLE_EQ(plain->back().arrive, 2.0);
+  EXPECT_TRUE(through(*plain, 1));
+  std::vector<float> cost(9, 0.0F);
+  cost[1] = 10.0F;
+  EXPECT_TRUE(sipp.setNodeCost(cost));
+  EXPECT_FALSE(sipp.setNodeCost(cost));            // the same costs change nothing
+  EXPECT_NEAR(sipp.drivingTime(0, 2), 2.0, 1e-4);  // the goal's table is driving time alone
+  const auto round = sipp.plan(t, {0, kNoNode, 0.0, 2});
+  ASSERT_TRUE(round.has_value());
+  EXPECT_DOUBLE_EQ(round->back().arrive, 5.0);
+  EXPECT_FALSE(through(*round, 1));
+  cost[1] = 2.0F;  // through it (1 + 2 s, then 1 s) is sooner than round
+  EXPECT_TRUE(sipp.setNodeCost(cost));
+  const auto slow = sipp.plan(t, {0, kNoNode, 0.0, 2});
+  ASSERT_TRUE(slow.has_value());
+  EXPECT_DOUBLE_EQ(slow->back().arrive, 4.0);
+  ASSERT_TRUE(through(*slow, 1));
+  EXPECT_DOUBLE_EQ((*slow)[1].arrive - (*slow)[1].enter, 3.0);  // its reservation the longer
+  // No cost anywhere is no cost at all.
+  EXPECT_TRUE(sipp.setNodeCost(std::vector<float>(9, 0.0F)));
+  EXPECT_DOUBLE_EQ(sipp.plan(t, {0, kNoNode, 0.0, 2})->back().arrive, 2.0);
+}
+
+// Cross-check: costs searched as time find the same arrivals as a graph whose edges into each node
+// take that much longer (random graphs with conflicts, reservations and turns), though their goals'
+// tables leave the costs out.
+TEST(Sipp, NodeCostsPlanAsAGraphWithLongerEdgesInto) {
+  std::mt19937_64 rng(23);
+  int found = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    Graph g = test::randomDigraph(14, 4, false, rng);
+    std::uniform_int_distribution<int> node(0, 13);
+    std::uniform_int_distribution<int> quarter(0, 12);
+    std::vector<float> cost(14, 0.0F);
+    for (auto& c : cost)
+      c = trial % 2 == 0 ? 0.25F * static_cast<float>(quarter(rng)) : 0.0F;
+    Graph longer;
+    for (NodeId v = 0; v < 14; ++v)
+      longer.addNode(g.position(v));
+    for (NodeId v = 0; v < 14; ++v) {
+      for (const Edge& e : g.edges(v))
+        longer.addEdge(v, e.to, e.duration + static_cast<double>(cost[static_cast<std::size_t>(e.to)]));
+    }
+    for (int c = 0; c < 4; ++c) {
+      const int a = node(rng);
+      const int b = node(rng);
+      if (a != b) {
+        g.addConflict(a, b);
+        longer.addConflict(a, b);
+      }
+    }
+    const NodeId start = node(rng);
+    const NodeId goal = (start + 1 + node(rng) % 13) % 14;
+    ReservationTable t(g), tl(longer);
+    for (int r = 0; r < 8; ++r) {
+      const NodeId v = node(rng);
+      const double from = 0.25 * quarter(rng);
+      if (v == start || g.conflicting(v, start))
+        continue;
+      t.reserve(v, {from, from + 2.0});
+      tl.reserve(v, {from, from + 2.0});
+    }
+    Sipp costed(g, quarterTurns(g));
+    costed.setNodeCost(cost);
+    Sipp plain(longer, quarterTurns(longer));
+    const auto a = costed.plan(t, {start, kNoNode, 0.0, goal});
+    const auto b = plain.plan(tl, {start, kNoNode, 0.0, goal});
+    ASSERT_EQ(a.has_value(), b.has_value()) << "trial " << trial;
+    if (a) {
+      ++found;
+      EXPECT_NEAR(a->back().arrive, b->back().arrive, 1e-6) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(found, 20);
 }
 
 TEST(Sipp, AloneOnALargeGridItSearchesAlongItsWayNotTheGrid) {

@@ -523,6 +523,19 @@ TEST(TrafficNode, SettingsNameWhatIsWrong) {
   EXPECT_NE(all.find("detour_after"), std::string::npos) << all;
 }
 
+// The timed core by default; `core` names either; anything else is bad input named by its key.
+TEST(TrafficNode, TheTimedCoreIsTheDefaultAndTheCoreIsChosenByName) {
+  Config none = Config::fromText("{}", "test");
+  EXPECT_EQ(readSettings(none).traffic.core, traffic::PlannerCore::Sipp);
+  Config pibt = Config::fromText(R"({"core": "pibt"})", "test");
+  EXPECT_EQ(readSettings(pibt).traffic.core, traffic::PlannerCore::Pibt);
+  ASSERT_TRUE(pibt.ok());
+  Config bad = Config::fromText(R"({"core": "astar"})", "test");
+  readSettings(bad);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.problems().front().find("core"), std::string::npos) << bad.problems().front();
+}
+
 TEST(TrafficNode, DetoursAreOnByDefaultAndCanBeTurnedOff) {
   Config none = Config::fromText("{}", "test");
   EXPECT_EQ(readSettings(none).traffic.pibt.detourAfter, 4);

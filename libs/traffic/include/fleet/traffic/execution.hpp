@@ -81,6 +81,11 @@ class Execution {
   /// naming robots and nodes when a robot moves along no open edge, two robots end on conflicting
   /// nodes, or robots each enter what the next one leaves in a cycle; nothing is appended then.
   void append(std::span<const NodeId> next);
+  /// append() of the configuration in which `robot` alone moves to `to` (or stays, on its last
+  /// node), the others where their routes end: the same checks, dependencies and order, at the
+  /// cost of the robot's conflicts rather than the fleet's (the timed core appends its plans one
+  /// move at a time). The configuration the others stand in is taken as append() left it.
+  void appendMove(std::size_t robot, NodeId to);
 
   /// The robot reports it has arrived at `node`. Accepted only for a released node ahead of its
   /// last report (reports may skip nodes: reaching a node implies passing the ones before it).
@@ -176,6 +181,9 @@ class Execution {
   };
 
   [[nodiscard]] bool satisfied(const Entry& e) const;
+  /// Sets the dependencies of `robot`'s newest entry (plan step `step`); returns the robots it
+  /// waits on that enter their newest entry in this same step.
+  std::vector<std::size_t> depend(std::size_t robot, std::int64_t step);
   void prune(std::size_t robot);
   void rebuildVisitors();
   /// Derives every unreleased entry's dependencies from `order` (released entries come first);

@@ -94,6 +94,9 @@ class PrioritizedPlanner {
     sipp_.graphChanged();
     previous_.clear();
   }
+  /// A standing cost (s) of driving into each node (Sipp::setNodeCost); a plan kept through a node
+  /// that became dearer is searched again.
+  void setNodeCost(std::vector<float> cost);
 
  private:
   void reserveFixed(std::span<const PlanRequest> robots, bool starts);

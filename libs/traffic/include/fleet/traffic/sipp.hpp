@@ -67,6 +67,14 @@ class Sipp {
   double drivingTime(NodeId v, NodeId goal);
   /// Call after opening or closing nodes or edges: drops the heuristics.
   void graphChanged() { heuristics_.clear(); }
+  /// A standing cost (s) of driving into each node (empty: none), planned as time: an edge into
+  /// v is searched as taking its duration + cost[v], so a robot plans round a dear node when that is
+  /// sooner, and through it as if slowly (its reservations the longer). The risk map's
+  /// collision-probability costs and a yield's come this way. The goals' tables leave costs out
+  /// (driving time alone: still never above the time to the goal, so the search stays exact), so
+  /// costs renewed every few seconds do not recompute them. Returns whether it changed anything.
+  bool setNodeCost(std::vector<float> cost);
+  [[nodiscard]] const std::vector<float>& nodeCost() const { return cost_; }
   [[nodiscard]] const SippStats& stats() const { return stats_; }
 
  private:
@@ -113,6 +121,11 @@ class Sipp {
   /// The turn at `at` from arriving by edge `inEdge` (from `from`) into its out-edge `out`.
   double turnAt(NodeId from, std::int32_t inEdge, NodeId at, std::size_t out);
   [[nodiscard]] std::int64_t edgeIndex(NodeId from, NodeId to) const;
+  /// s an edge is searched as taking: its duration and its head's cost.
+  [[nodiscard]] double duration(const Edge& e) const {
+    return cost_.empty() ? e.duration
+                         : e.duration + static_cast<double>(cost_[static_cast<std::size_t>(e.to)]);
+  }
   /// Edge `e` (an index) can be driven now: open, into an open node.
   [[nodiscard]] bool usable(std::uint32_t e) const;
   const std::vector<Interval>& intervals(const ReservationTable& table, NodeId v, double from);
@@ -120,6 +133,7 @@ class Sipp {
   const Graph& graph_;
   TurnTime turn_;
   std::size_t maxExpansions_;
+  std::vector<float> cost_;                          ///< per node (empty: none)
   std::vector<std::size_t> edgeStart_;               ///< per node: its first out-edge's index
   std::vector<NodeId> edgeTail_;                     ///< per edge
   std::vector<std::uint32_t> inPos_;                 ///< per edge: its place among its head's reverse_

@@ -51,7 +51,7 @@ const char* toString(PlannerCore c);
 std::optional<PlannerCore> plannerCoreFrom(std::string_view name);
 
 struct TrafficOptions {
-  PlannerCore core = PlannerCore::Pibt;
+  PlannerCore core = PlannerCore::Sipp;
   /// The timed core (PlannerCore::Sipp): its window and searches, how often it plans again (s of
   /// the traffic layer's clock), and the clock's step per update() when setNow() is not called.
   PrioritizedOptions prioritized{};
@@ -216,8 +216,9 @@ class TrafficControl {
   /// Call after closing or reopening nodes or edges: drops the planner's distances and plans again
   /// from the released ends.
   void graphChanged();
-  /// A standing cost (s) of driving into each node (Pibt::setNodeCost): the collision-probability
-  /// map's weight on the plan. Plans already released stand; new steps route by it.
+  /// A standing cost (s) of driving into each node: the collision-probability map's weight on the
+  /// plan, and a yield's. The PIBT core routes by it (Pibt::setNodeCost); the timed core plans it
+  /// as time (Sipp::setNodeCost). Plans already released stand; new steps route by it.
   void setNodeCost(std::vector<float> cost);
 
   [[nodiscard]] const TrafficStats& stats() const { return stats_; }
