@@ -65,8 +65,10 @@ int run(const site::Site& site, const trafficmgr::Settings& settings, const std:
                          : static_cast<std::uint32_t>((wall.nowNs() / 1'000'000) & 0x7fffffff) | 1U;
   trafficmgr::TrafficNode node(site, settings, epoch);
   const auto& rm = node.roadmap();
-  spdlog::info("traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}", site.name,
-               rm.graph.size(), rm.edgeCount(), rm.stations.size(), epoch);
+  spdlog::info(
+      "traffic manager: site '{}', roadmap {} nodes, {} edges, {} stations, epoch {}, planner core {}",
+      site.name, rm.graph.size(), rm.edgeCount(), rm.stations.size(), epoch,
+      traffic::toString(settings.traffic.core));
   // A roadmap error (a station with no way in or out, a line whose robots cut others off) is the
   // site's: refused at start, each named by its key path, as `fleetctl site check` does, before the
   // ops port answers /livez. Warnings are said and planned with.

@@ -47,11 +47,23 @@ void DistanceTable::buildReverse() {
   }
 }
 
+void DistanceTable::noteChange(NodeId v) {
+  // More than half the nodes changed is a start over anyway (applyChanges()): the list stays
+  // bounded even when nothing is queried for a long time (a table kept by a core not running).
+  if (dirty_)
+    return;
+  changed_.push_back(v);
+  if (changed_.size() > graph_.size() / 2) {
+    dirty_ = true;
+    changed_.clear();
+  }
+}
+
 void DistanceTable::setBlocked(NodeId v, bool blocked) {
   auto& b = blocked_[static_cast<std::size_t>(v)];
   if ((b != 0) != blocked) {
     b = blocked ? 1 : 0;
-    changed_.push_back(v);
+    noteChange(v);
   }
 }
 
@@ -67,7 +79,7 @@ bool DistanceTable::setNodeCost(std::vector<float> cost) {
   if ((cost.size() == n || cost.empty()) && (nodeCost_.size() == n || nodeCost_.empty())) {
     for (std::size_t v = 0; v < n; ++v) {
       if (at(cost, v) != at(nodeCost_, v)) {
-        changed_.push_back(static_cast<NodeId>(v));
+        noteChange(static_cast<NodeId>(v));
       }
     }
   } else {

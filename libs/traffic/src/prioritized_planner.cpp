@@ -60,9 +60,16 @@ void PrioritizedPlanner::setNodeCost(std::vector<float> cost) {
   const auto at = [](const std::vector<float>& c, NodeId v) {
     return c.empty() ? 0.0F : c[static_cast<std::size_t>(v)];
   };
+  // A node on a kept plan dearer or cheaper: it may go round now, or its timing is off. A node a
+  // second or more cheaper anywhere (a yield's end): a way round it may no longer be the earliest,
+  // so every plan is searched again; smaller falls (the risk map's renewals, at most risk_cost_s a
+  // node) leave plans that go round them, which are searched again anyway when they stop fitting.
+  bool fell = false;
+  for (std::size_t v = 0; v < graph_.size() && !fell; ++v)
+    fell = at(now, static_cast<NodeId>(v)) <= at(before, static_cast<NodeId>(v)) - 1.0F;
   for (auto& path : previous_) {
-    if (std::any_of(path.begin(), path.end(),
-                    [&](const TimedNode& n) { return at(now, n.node) > at(before, n.node); }))
+    if (fell || std::any_of(path.begin(), path.end(),
+                            [&](const TimedNode& n) { return at(now, n.node) != at(before, n.node); }))
       path.clear();
   }
 }
@@ -176,10 +183,10 @@ std::vector<TimedPath> PrioritizedPlanner::plan(std::span<const PlanRequest> rob
     // Priority inheritance, a robot at a time: the robots standing on a failed robot's way (as it
     // would drive with nobody standing anywhere) are planned before it and get out of that way.
     bool changed = false;
+    reserveFixed(robots, false);  // only what is released and the held robots (the loop keeps it)
     for (const std::size_t i : failed) {
       if (!clear[i].empty())
         continue;  // yielding itself: it does not make the one it yields to yield back
-      reserveFixed(robots, false);
       const auto& r = robots[i];
       const auto way = sipp_.plan(table_, {r.at, r.cameFrom, r.ready, r.goal, until});
       if (!way)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace fleet::traffic {
@@ -185,6 +187,12 @@ double Sipp::toGoal(Heuristic& h, NodeId v, std::int64_t in) {
 }
 
 bool Sipp::setNodeCost(std::vector<float> cost) {
+  if (!cost.empty() && cost.size() != graph_.size()) {
+    throw std::invalid_argument("sipp: " + std::to_string(cost.size()) + " node costs for " +
+                                std::to_string(graph_.size()) + " nodes");
+  }
+  if (std::any_of(cost.begin(), cost.end(), [](float c) { return !(c >= 0.0F) || !std::isfinite(c); }))
+    throw std::invalid_argument("sipp: a node cost that is negative or not a finite number");
   if (std::all_of(cost.begin(), cost.end(), [](float c) { return c == 0.0F; }))
     cost.clear();
   if (cost == cost_)

@@ -585,8 +585,16 @@ void TrafficControl::graphChanged() {
 }
 
 void TrafficControl::setNodeCost(std::vector<float> cost) {
-  timed_.setNodeCost(cost);
-  planner_->setNodeCost(std::move(cost));
+  if (options_.core == PlannerCore::Sipp)
+    timed_.setNodeCost(std::move(cost));
+  else
+    planner_->setNodeCost(std::move(cost));
+}
+
+std::span<const float> TrafficControl::nodeCost() const {
+  if (options_.core == PlannerCore::Sipp)
+    return timed_.nodeCost();
+  return planner_->distances().nodeCost();
 }
 
 std::string TrafficControl::explain(std::size_t robot) const {

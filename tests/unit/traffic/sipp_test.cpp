@@ -10,6 +10,7 @@
 #include <map>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 
 #include "fleet/traffic/prioritized_planner.hpp"
 #include "fleet/traffic/safe_intervals.hpp"
@@ -226,8 +227,8 @@ TEST(Sipp, ADearNodeIsGoneRoundWhenThatIsSoonerAndDrivenThroughAsTimeOtherwise) 
 }
 
 // Cross-check: costs searched as time find the same arrivals as a graph whose edges into each node
-// take that much longer (random graphs with conflicts, reservations and turns), though their goals'
-// tables leave the costs out.
+// take that much longer (random graphs with conflicts, reservations and turns; every other graph
+// without costs, as a control), though their goals' tables leave the costs out.
 TEST(Sipp, NodeCostsPlanAsAGraphWithLongerEdgesInto) {
   std::mt19937_64 rng(23);
   int found = 0;
@@ -486,6 +487,33 @@ TEST(Sipp, EarliestArrivalMatchesAPlainSearchOverEveryQuarterSecond) {
   }
   EXPECT_GT(compared, 80);
   EXPECT_GT(found, 30);
+}
+
+// A plan kept while on time is searched again once a node on it costs more (the risk map, a yield)
+// or less: the robot then goes round, and back through once the cost is gone.
+TEST(PrioritizedPlanner, APlanKeptThroughANodeWhoseCostChangedIsSearchedAgain) {
+  const Graph g = threeByThree();
+  PrioritizedPlanner planner(g, quarterTurns(g));
+  std::vector<PlanRequest> rs(1);
+  rs[0].at = 0;
+  rs[0].goal = 2;
+  const auto through = [](const TimedPath& p, NodeId v) {
+    return std::any_of(p.begin(), p.end(), [&](const TimedNode& n) { return n.node == v; });
+  };
+  EXPECT_TRUE(through(planner.plan(rs)[0], 1));
+  EXPECT_TRUE(through(planner.plan(rs)[0], 1));
+  EXPECT_EQ(planner.stats().reused, 1U);
+  std::vector<float> cost(9, 0.0F);
+  cost[1] = 10.0F;
+  planner.setNodeCost(cost);
+  EXPECT_FALSE(through(planner.plan(rs)[0], 1));  // searched again: round by 3, 4, 5
+  EXPECT_EQ(planner.stats().reused, 1U);
+  planner.setNodeCost({});
+  EXPECT_TRUE(through(planner.plan(rs)[0], 1));  // the way round is no longer the earliest
+  EXPECT_EQ(planner.stats().reused, 1U);
+  EXPECT_THROW(planner.setNodeCost(std::vector<float>(4, 1.0F)), std::invalid_argument);
+  cost[1] = -1.0F;
+  EXPECT_THROW(planner.setNodeCost(cost), std::invalid_argument);
 }
 
 TEST(PrioritizedPlanner, TwoRobotsMeetingInACorridorPassAtTheSiding) {

@@ -222,27 +222,31 @@ TEST(TrafficControl, ARobotBesideALeavingDockGoesOnToItsGoal) {
                        : n == "r11" ? queued
                                     : home(n));
     }
-    TrafficOptions options;
-    options.pibt.seed = 5;  // the traffic manager's in that run
-    TrafficControl tc(map.graph, starts, options);
-    tc.setStations(stationLines(map));
-    for (const auto& n : fleet.names)
-      tc.setGoal(index(n), home(n));
-    const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
-    const NodeId d4 = map.station("D-4")->dock;
-    // The lines as they were: r7 on P-5's dock with r11 in line behind it, then sent on to D-1 (it
-    // leaves the dock first); r20 first in D-4's line, r6 after it.
-    tc.setGoal(r7, p5->dock);
-    tc.setGoal(r11, p5->dock);
-    tc.setGoal(r20, d4);
-    tc.setGoal(r6, d4);
-    tc.setGoal(r7, map.station("D-1")->dock);
-    ASSERT_EQ(tc.target(r11), queued);
-    for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t)
-      stepOnTime(tc);
-    EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
-    EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
-    EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
+    for (const PlannerCore core : {PlannerCore::Sipp, PlannerCore::Pibt}) {
+      SCOPED_TRACE(toString(core));
+      TrafficOptions options;
+      options.core = core;
+      options.pibt.seed = 5;  // the traffic manager's in that run
+      TrafficControl tc(map.graph, starts, options);
+      tc.setStations(stationLines(map));
+      for (const auto& n : fleet.names)
+        tc.setGoal(index(n), home(n));
+      const std::size_t r6 = index("r6"), r7 = index("r7"), r11 = index("r11"), r20 = index("r20");
+      const NodeId d4 = map.station("D-4")->dock;
+      // The lines as they were: r7 on P-5's dock with r11 in line behind it, then sent on to D-1
+      // (it leaves the dock first); r20 first in D-4's line, r6 after it.
+      tc.setGoal(r7, p5->dock);
+      tc.setGoal(r11, p5->dock);
+      tc.setGoal(r20, d4);
+      tc.setGoal(r6, d4);
+      tc.setGoal(r7, map.station("D-1")->dock);
+      ASSERT_EQ(tc.target(r11), queued);
+      for (int t = 0; t < 600 && !(tc.arrived(r7) && tc.arrived(r11) && tc.arrived(r20)); ++t)
+        stepOnTime(tc);
+      EXPECT_TRUE(tc.arrived(r20)) << "r20 " << tc.explain(r20);
+      EXPECT_TRUE(tc.arrived(r7)) << "r7 " << tc.explain(r7);
+      EXPECT_TRUE(tc.arrived(r11)) << "r11 " << tc.explain(r11);
+    }
   }
 }
 
@@ -260,28 +264,33 @@ TEST(TrafficControl, APlanThatComesBackToTheRobotsNodeIsPlannedOn) {
     g.addEdge(i + 1, i);
   }
   const std::vector<NodeId> starts{3};
-  TrafficControl tc(g, starts);
-  ASSERT_TRUE(tc.setGoal(0, 4));
-  tc.update();
-  auto rel = tc.release(0);
-  ASSERT_EQ(rel.base, (std::vector<NodeId>{3, 4}));
-  ASSERT_TRUE(tc.setGoal(0, 0));  // before the robot reports 4
-  for (int t = 0; t < 5; ++t)
+  for (const PlannerCore core : {PlannerCore::Sipp, PlannerCore::Pibt}) {
+    SCOPED_TRACE(toString(core));
+    TrafficOptions options;
+    options.core = core;
+    TrafficControl tc(g, starts, options);
+    ASSERT_TRUE(tc.setGoal(0, 4));
     tc.update();
-  rel = tc.release(0);
-  // Planned 3 4 3 2 1 0: released up to 4 only, since a base passing the robot's node twice is
-  // taken as driven by the agent (Execution.ABaseNeverPassesANodeTwice); the rest once it reports 4.
-  ASSERT_EQ(rel.base, (std::vector<NodeId>{3, 4})) << tc.explain(0);
-  EXPECT_NE(rel.base.back(), 3) << "the base must lead somewhere, not back to where the robot stands";
-  // Reporting the end of every base gets it there.
-  for (int t = 0; t < 100 && !tc.arrived(0); ++t) {
-    tc.update();
+    auto rel = tc.release(0);
+    ASSERT_EQ(rel.base, (std::vector<NodeId>{3, 4}));
+    ASSERT_TRUE(tc.setGoal(0, 0));  // before the robot reports 4
+    for (int t = 0; t < 5; ++t)
+      tc.update();
     rel = tc.release(0);
-    if (rel.base.size() > 1) {
-      EXPECT_EQ(tc.reached(0, rel.base.back()), Report::Accepted);
+    // Planned 3 4 3 2 1 0: released up to 4 only, since a base passing the robot's node twice is
+    // taken as driven by the agent (Execution.ABaseNeverPassesANodeTwice); the rest once it reports 4.
+    ASSERT_EQ(rel.base, (std::vector<NodeId>{3, 4})) << tc.explain(0);
+    EXPECT_NE(rel.base.back(), 3) << "the base must lead somewhere, not back to where the robot stands";
+    // Reporting the end of every base gets it there.
+    for (int t = 0; t < 100 && !tc.arrived(0); ++t) {
+      tc.update();
+      rel = tc.release(0);
+      if (rel.base.size() > 1) {
+        EXPECT_EQ(tc.reached(0, rel.base.back()), Report::Accepted);
+      }
     }
+    EXPECT_TRUE(tc.arrived(0));
   }
-  EXPECT_TRUE(tc.arrived(0));
 }
 
 // A node closed on the robot's way after it was planned: told so, the planner forgets the distances
@@ -299,24 +308,30 @@ TEST(TrafficControl, AClosedNodeOnTheWayIsGoneRoundOnceTheGraphChanged) {
     g.addEdge(b, a);
   }
   const std::vector<NodeId> starts{0};
-  TrafficControl tc(g, starts);
-  ASSERT_TRUE(tc.setGoal(0, 2));
-  tc.update();  // distances to 2 computed through 1
-  g.setOpen(1, false);
-  tc.graphChanged();
-  std::vector<NodeId> reported;
-  int updates = 0;
-  for (; updates < 100 && !tc.arrived(0); ++updates) {
-    tc.update();
-    const auto rel = tc.release(0);
-    if (rel.base.size() > 1) {
-      EXPECT_EQ(tc.reached(0, rel.base[1]), Report::Accepted);
-      reported.push_back(rel.base[1]);
+  for (const PlannerCore core : {PlannerCore::Sipp, PlannerCore::Pibt}) {
+    SCOPED_TRACE(toString(core));
+    g.setOpen(1, true);
+    TrafficOptions options;
+    options.core = core;
+    TrafficControl tc(g, starts, options);
+    ASSERT_TRUE(tc.setGoal(0, 2));
+    tc.update();  // distances (or the goal's table) to 2 computed through 1
+    g.setOpen(1, false);
+    tc.graphChanged();
+    std::vector<NodeId> reported;
+    int updates = 0;
+    for (; updates < 100 && !tc.arrived(0); ++updates) {
+      tc.update();
+      const auto rel = tc.release(0);
+      if (rel.base.size() > 1) {
+        EXPECT_EQ(tc.reached(0, rel.base[1]), Report::Accepted);
+        reported.push_back(rel.base[1]);
+      }
     }
+    EXPECT_TRUE(tc.arrived(0)) << tc.explain(0);
+    EXPECT_EQ(reported, (std::vector<NodeId>{3, 4, 5, 2}));
+    EXPECT_LE(updates, 6) << "stood in front of the closed node";
   }
-  EXPECT_TRUE(tc.arrived(0)) << tc.explain(0);
-  EXPECT_EQ(reported, (std::vector<NodeId>{3, 4, 5, 2}));
-  EXPECT_LE(updates, 6) << "stood in front of the closed node";
 }
 
 /// The stall report names a robot in the way that is held (docking, faulted, held by a person):
@@ -351,13 +366,13 @@ TEST(TrafficControl, RobotsWaitInLineAtABusyStation) {
   for (std::size_t r = 0; r < 3; ++r)
     tc.setGoal(r, d1->dock);
   EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{0, 1, 2}));
-  EXPECT_EQ(tc.planner().goal(0), d1->dock);
-  EXPECT_EQ(tc.planner().goal(1), d1->queue[0]);
-  EXPECT_EQ(tc.planner().goal(2), d1->queue[1]);
+  EXPECT_EQ(tc.target(0), d1->dock);
+  EXPECT_EQ(tc.target(1), d1->queue[0]);
+  EXPECT_EQ(tc.target(2), d1->queue[1]);
   tc.setGoal(0, map.station("P-1")->dock);  // robot 0 is done: the line moves up
   EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{1, 2}));
-  EXPECT_EQ(tc.planner().goal(1), d1->dock);
-  EXPECT_EQ(tc.planner().goal(2), d1->queue[0]);
+  EXPECT_EQ(tc.target(1), d1->dock);
+  EXPECT_EQ(tc.target(2), d1->queue[0]);
 }
 
 /// The line's order is where robots stand, not when they joined: robot 0 joined first but is far
@@ -376,7 +391,7 @@ TEST(TrafficControl, RobotsStandingInTheQueueGoBeforeRobotsOnTheirWay) {
   EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{0, 1}));
   tc.update();
   EXPECT_EQ(tc.line(d1->dock), (std::vector<std::size_t>{1, 0}));
-  EXPECT_EQ(tc.planner().goal(1), d1->dock);
+  EXPECT_EQ(tc.target(1), d1->dock);
 }
 
 /// While the robot that was at the dock drives off it, the next in line waits where it leaves the
@@ -402,7 +417,7 @@ TEST(TrafficControl, TheNextInLineWaitsClearOfTheLeavingRobotsWayOut) {
   tc.setGoal(1, d3->dock);
   tc.setGoal(0, map.station("P-1")->dock);  // robot 0 is done and drives off
   EXPECT_EQ(tc.line(d3->dock), (std::vector<std::size_t>{1}));
-  const NodeId wait = tc.planner().goal(1);
+  const NodeId wait = tc.target(1);
   EXPECT_NE(std::find(d3->queue.begin(), d3->queue.end(), wait), d3->queue.end());
   EXPECT_FALSE(shuts(wait));
 }
@@ -459,7 +474,7 @@ TEST(TrafficControl, TheDockIsFreeOnlyOnceTheLeavingRobotReportsItOff) {
     if (base.size() > 1 && map.graph.conflicting(base[1], d3->dock))
       tc.reached(0, base[1]);
     ASSERT_TRUE(map.graph.conflicting(tc.execution().at(0), d3->dock));
-    ASSERT_NE(tc.planner().goal(1), d3->dock) << "update " << k << ": the dock was given away";
+    ASSERT_NE(tc.target(1), d3->dock) << "update " << k << ": the dock was given away";
   }
   // Robot 0 drives what it is released until it reports a node clear of the dock.
   for (int k = 0; k < 200 && map.graph.conflicting(tc.execution().at(0), d3->dock); ++k) {
@@ -470,7 +485,7 @@ TEST(TrafficControl, TheDockIsFreeOnlyOnceTheLeavingRobotReportsItOff) {
   }
   ASSERT_FALSE(map.graph.conflicting(tc.execution().at(0), d3->dock)) << "robot 0 never left the dock";
   tc.update();
-  EXPECT_EQ(tc.planner().goal(1), d3->dock);
+  EXPECT_EQ(tc.target(1), d3->dock);
 }
 
 /// The stall of the CI check of 2cc34ae (2026-12-03, `FleetScenario.TwentyRobotsOneHundredTasks…`,
@@ -492,16 +507,20 @@ TEST(TrafficControl, ARobotOnTheLaneAboveAFullParkingRowGoesOn) {
   std::vector<NodeId> starts;
   for (const auto& n : fleet.names)
     starts.push_back(n == "r2" ? lane : home(n));
-  TrafficOptions options;
-  options.pibt.seed = 1;
-  TrafficControl tc(map.graph, starts, options);
-  tc.setStations(stationLines(map));
-  for (const auto& n : fleet.names)
-    tc.setGoal(index(n), n == "r2" ? p2 : home(n));
-  const std::size_t r2 = index("r2");
-  for (int t = 0; t < 600 && !tc.arrived(r2); ++t)
-    stepOnTime(tc);
-  EXPECT_TRUE(tc.arrived(r2)) << "r2 " << tc.explain(r2);
+  for (const PlannerCore core : {PlannerCore::Sipp, PlannerCore::Pibt}) {
+    SCOPED_TRACE(toString(core));
+    TrafficOptions options;
+    options.core = core;
+    options.pibt.seed = 1;
+    TrafficControl tc(map.graph, starts, options);
+    tc.setStations(stationLines(map));
+    for (const auto& n : fleet.names)
+      tc.setGoal(index(n), n == "r2" ? p2 : home(n));
+    const std::size_t r2 = index("r2");
+    for (int t = 0; t < 600 && !tc.arrived(r2); ++t)
+      stepOnTime(tc);
+    EXPECT_TRUE(tc.arrived(r2)) << "r2 " << tc.explain(r2);
+  }
 }
 }  // namespace
 }  // namespace fleet::traffic

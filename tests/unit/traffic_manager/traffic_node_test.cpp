@@ -104,7 +104,7 @@ TEST(TrafficNode, TheRiskMapSetsEachNodesCostAtMostEveryPeriod) {
   EXPECT_FALSE(node.onRiskMap(*risk, 2 * kS)) << "1 s after the last: too soon";
   EXPECT_TRUE(node.onRiskMap(*risk, 3 * kS));
   EXPECT_EQ(node.counters().riskUpdates, 2U);
-  EXPECT_EQ(node.control()->planner().distances().nodeCost().size(), g.size()) << "the planner has them";
+  EXPECT_EQ(node.control()->nodeCost().size(), g.size()) << "the planner has them";
 
   s.riskCostS = 0.0;
   TrafficNode off(smallWarehouse(), s, 7);

@@ -130,6 +130,8 @@ class DistanceTable {
   /// Takes in what setBlocked()/setNodeCost() changed since the last query: repairs the tables
   /// that read a changed node (drops everything when a change is too wide to be worth sorting out).
   void applyChanges();
+  /// Lists node `v` as changed (or marks the whole table dirty once half the nodes are listed).
+  void noteChange(NodeId v);
   /// distance_repair.cpp: the table after raised_'s nodes cost more to enter (the new cost already
   /// in baseEnter_), then after lowered_'s cost less. true when it changed.
   bool repairRaised(PartialTable& t);

@@ -95,8 +95,10 @@ class PrioritizedPlanner {
     previous_.clear();
   }
   /// A standing cost (s) of driving into each node (Sipp::setNodeCost); a plan kept through a node
-  /// that became dearer is searched again.
+  /// whose cost changed is searched again, and every kept plan once a node anywhere is a second or
+  /// more cheaper (a yield's end: a way round it may no longer be the earliest).
   void setNodeCost(std::vector<float> cost);
+  [[nodiscard]] const std::vector<float>& nodeCost() const { return sipp_.nodeCost(); }
 
  private:
   void reserveFixed(std::span<const PlanRequest> robots, bool starts);

@@ -73,6 +73,8 @@ class Sipp {
   /// collision-probability costs and a yield's come this way. The goals' tables leave costs out
   /// (driving time alone: still never above the time to the goal, so the search stays exact), so
   /// costs renewed every few seconds do not recompute them. Returns whether it changed anything.
+  /// Throws std::invalid_argument for a vector of another size than the graph's or a cost that is
+  /// negative or not finite (a negative one would make the tables overestimate).
   bool setNodeCost(std::vector<float> cost);
   [[nodiscard]] const std::vector<float>& nodeCost() const { return cost_; }
   [[nodiscard]] const SippStats& stats() const { return stats_; }

@@ -15,10 +15,10 @@
 // fleet does not keep planning around where the late robot was supposed to be. Held robots (docking,
 // faulted, paused, a vendor's vehicle that does not follow) are obstacles the plan goes around.
 //
-// The planner is one of two cores (TrafficOptions::core): PIBT as above (the default), or the timed
-// core — every robot's timed path by windowed prioritized planning over safe intervals
+// The planner is one of two cores (TrafficOptions::core): the timed core (the default since
+// 2026-12-06) — every robot's timed path by windowed prioritized planning over safe intervals
 // (prioritized_planner.hpp), planned again from where the releases end and appended to the same
-// execution (traffic_control_timed.cpp).
+// execution (traffic_control_timed.cpp) — or PIBT as above.
 
 #include <cstdint>
 #include <functional>
@@ -220,6 +220,8 @@ class TrafficControl {
   /// plan, and a yield's. The PIBT core routes by it (Pibt::setNodeCost); the timed core plans it
   /// as time (Sipp::setNodeCost). Plans already released stand; new steps route by it.
   void setNodeCost(std::vector<float> cost);
+  /// The running core's node costs (empty: none).
+  [[nodiscard]] std::span<const float> nodeCost() const;
 
   [[nodiscard]] const TrafficStats& stats() const { return stats_; }
   /// s of plan time of the newest planned step.
