@@ -39,6 +39,8 @@ Sipp::Sipp(const Graph& graph, TurnTime turn, std::size_t maxExpansions)
 void Sipp::index() {
   if (edgeStart_.size() == graph_.size() + 1)
     return;
+  if (!cost_.empty() && cost_.size() != graph_.size())
+    cost_.clear();  // the graph grew: costs per node are given again for its new size
   edgeStart_.assign(graph_.size() + 1, 0);
   for (std::size_t v = 0; v < graph_.size(); ++v)
     edgeStart_[v + 1] = edgeStart_[v] + graph_.edges(static_cast<NodeId>(v)).size();
