@@ -58,7 +58,8 @@ void PrioritizedPlanner::setNodeCost(std::vector<float> cost) {
     return;
   const auto& now = sipp_.nodeCost();
   const auto at = [](const std::vector<float>& c, NodeId v) {
-    return c.empty() ? 0.0F : c[static_cast<std::size_t>(v)];
+    // (costs given before the graph grew are shorter than it)
+    return static_cast<std::size_t>(v) < c.size() ? c[static_cast<std::size_t>(v)] : 0.0F;
   };
   // A node on a kept plan dearer or cheaper: it may go round now, or its timing is off. A node a
   // second or more cheaper anywhere (a yield's end): a way round it may no longer be the earliest,
